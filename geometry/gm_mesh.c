@@ -1,0 +1,331 @@
+/* gm_mesh: simplex meshes of a box or rectangle made with the gmsh C API,
+ * meshes built from caller arrays, and their mean edge length. */
+#include "gm_dual.h"
+
+#include <gmshc.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Relative size below which a simplex counts as flat. */
+#define GM_FLAT_TOL 1e-12
+
+/* Signed measure of cell c: volume (3D) or area (2D), and the largest edge
+ * length, so flatness is judged relative to the cell's own size. */
+static double cell_measure(int dim, const double *x, const long *cell,
+                           double *max_edge) {
+  const int npc = dim + 1;
+  double l2 = 0.0;
+  for (int a = 0; a < npc; a++)
+    for (int b = a + 1; b < npc; b++) {
+      double s = 0.0;
+      for (int k = 0; k < 3; k++) {
+        double d = x[3 * cell[b] + k] - x[3 * cell[a] + k];
+        s += d * d;
+      }
+      if (s > l2) l2 = s;
+    }
+  *max_edge = sqrt(l2);
+  const double *p0 = x + 3 * cell[0];
+  double e[3][3];
+  for (int a = 1; a < npc; a++)
+    for (int k = 0; k < 3; k++) e[a - 1][k] = x[3 * cell[a] + k] - p0[k];
+  if (dim == 2) return 0.5 * (e[0][0] * e[1][1] - e[0][1] * e[1][0]);
+  return (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+          e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+          e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
+         6.0;
+}
+
+/* Flip negatively oriented cells (swap their last two nodes) and reject
+ * flat ones: the dual construction relies on positive orientation. */
+static pm_err orient_cells(gm_mesh *m) {
+  const int npc = m->nodes_per_cell;
+  for (long c = 0; c < m->n_cells; c++) {
+    long *cell = m->cells + (size_t)npc * c;
+    double h;
+    double v = cell_measure(m->dim, m->x, cell, &h);
+    double scale = m->dim == 3 ? h * h * h : h * h;
+    PM_CHECK(fabs(v) > GM_FLAT_TOL * scale, PM_ERR_GEOMETRY,
+             "cell %ld has zero %s (%g)", c, m->dim == 3 ? "volume" : "area",
+             v);
+    if (v < 0.0) {
+      long t = cell[npc - 1];
+      cell[npc - 1] = cell[npc - 2];
+      cell[npc - 2] = t;
+    }
+  }
+  return PM_SUCCESS;
+}
+
+/* Frees the mesh and its arrays; NULL is a no-op. */
+void gm_mesh_destroy(gm_mesh *m) {
+  if (!m) return;
+  free(m->x);
+  free(m->cells);
+  free(m);
+}
+
+/* Copies the caller's arrays; checks indices, then orients the cells. */
+pm_err gm_mesh_from_arrays(int dim, long n_nodes, const double *x, long n_cells,
+                           const long *cells, const double box_min[3],
+                           const double box_max[3], gm_mesh **out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_mesh_from_arrays: out is NULL");
+  *out = NULL;
+  PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG, "mesh dimension %d is not 2 or 3",
+           dim);
+  PM_CHECK(n_nodes > 0 && n_cells > 0, PM_ERR_ARG,
+           "mesh needs nodes and cells (got %ld nodes, %ld cells)", n_nodes,
+           n_cells);
+  PM_CHECK(x && cells, PM_ERR_ARG, "mesh arrays are NULL");
+  PM_CHECK(box_min && box_max, PM_ERR_ARG, "mesh box is NULL");
+  for (int k = 0; k < dim; k++)
+    PM_CHECK(box_max[k] > box_min[k], PM_ERR_ARG,
+             "empty box along axis %d: [%g, %g]", k, box_min[k], box_max[k]);
+  const int npc = dim + 1;
+  for (long i = 0; i < (long)npc * n_cells; i++)
+    PM_CHECK(cells[i] >= 0 && cells[i] < n_nodes, PM_ERR_ARG,
+             "cell %ld refers to node %ld of %ld", i / npc, cells[i], n_nodes);
+  for (long i = 0; i < 3 * n_nodes; i++)
+    PM_CHECK(isfinite(x[i]), PM_ERR_ARG, "node %ld has a non-finite coordinate",
+             i / 3);
+
+  pm_err ret = PM_SUCCESS;
+  gm_mesh *m = NULL;
+  PM_TRY(PM_ALLOC(m, 1, "mesh"));
+  PM_TRY(PM_ALLOC(m->x, 3 * n_nodes, "mesh coordinates"));
+  PM_TRY(PM_ALLOC(m->cells, (size_t)npc * n_cells, "mesh cells"));
+  m->dim = dim;
+  m->n_nodes = n_nodes;
+  m->n_cells = n_cells;
+  m->nodes_per_cell = npc;
+  memcpy(m->x, x, sizeof(double) * 3 * (size_t)n_nodes);
+  memcpy(m->cells, cells, sizeof(long) * (size_t)npc * n_cells);
+  for (int k = 0; k < 3; k++) {
+    m->box_min[k] = box_min[k];
+    m->box_max[k] = box_max[k];
+  }
+  /* 2D meshes live in the z = 0 plane whatever the caller passed. */
+  if (dim == 2) {
+    for (long i = 0; i < n_nodes; i++) m->x[3 * i + 2] = 0.0;
+    m->box_min[2] = m->box_max[2] = 0.0;
+  }
+  PM_TRY(orient_cells(m));
+  *out = m;
+  m = NULL;
+done:
+  gm_mesh_destroy(m);
+  return ret;
+}
+
+/* The last gmsh error as a PM_ERR_MESH failure naming what we were doing. */
+static pm_err gmsh_fail(const char *what) {
+  char *msg = NULL;
+  int ierr = 0;
+  gmshLoggerGetLastError(&msg, &ierr);
+  pm_err e = PM_ERROR(PM_ERR_MESH, "gmsh: %s failed: %s", what,
+                      (ierr == 0 && msg && msg[0]) ? msg : "(no message)");
+  if (msg) gmshFree(msg);
+  return e;
+}
+
+/* After a gmsh call: on failure record gmsh's message and leave. */
+#define GM_GMSH_CHECK(what)                                                    \
+  do {                                                                         \
+    if (ierr) {                                                                \
+      ret = gmsh_fail(what);                                                   \
+      goto done;                                                               \
+    }                                                                          \
+  } while (0)
+
+/* Options that make gmsh quiet, single-threaded and repeatable, with element
+ * size h everywhere. */
+static pm_err gmsh_options(double h) {
+  static const struct {
+    const char *name;
+    double value;
+  } opts[] = {
+      {"General.Terminal", 0},
+      {"General.NumThreads", 1},
+      {"Mesh.RandomSeed", 1},
+      {"Mesh.MeshSizeFromPoints", 0},
+      {"Mesh.MeshSizeFromCurvature", 0},
+      {"Mesh.MeshSizeExtendFromBoundary", 1},
+  };
+  int ierr = 0;
+  for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
+    gmshOptionSetNumber(opts[i].name, opts[i].value, &ierr);
+    if (ierr) return gmsh_fail(opts[i].name);
+  }
+  gmshOptionSetNumber("Mesh.MeshSizeMin", h, &ierr);
+  if (ierr) return gmsh_fail("Mesh.MeshSizeMin");
+  gmshOptionSetNumber("Mesh.MeshSizeMax", h, &ierr);
+  if (ierr) return gmsh_fail("Mesh.MeshSizeMax");
+  return PM_SUCCESS;
+}
+
+/* Copy gmsh's nodes and elements into a fresh mesh, keeping only the nodes
+ * that cells use, numbered 0.. in gmsh's node order. */
+static pm_err gmsh_extract(int dim, gm_mesh *m) {
+  pm_err ret = PM_SUCCESS;
+  size_t *tags = NULL, n_tags = 0, *etags = NULL, n_etags = 0;
+  size_t *enodes = NULL, n_enodes = 0;
+  double *coord = NULL, *param = NULL;
+  size_t n_coord = 0, n_param = 0;
+  long *map = NULL;
+  int ierr = 0;
+  const int npc = dim + 1;
+
+  gmshModelMeshGetNodes(&tags, &n_tags, &coord, &n_coord, &param, &n_param, -1,
+                        -1, 0, 0, &ierr);
+  GM_GMSH_CHECK("getNodes");
+  gmshModelMeshGetElementsByType(dim == 3 ? 4 : 2, &etags, &n_etags, &enodes,
+                                 &n_enodes, -1, 0, 1, &ierr);
+  GM_GMSH_CHECK("getElementsByType");
+  PM_ENSURE(n_coord == 3 * n_tags && n_enodes == (size_t)npc * n_etags,
+            PM_ERR_MESH, "gmsh returned inconsistent array sizes");
+  PM_ENSURE(n_etags > 0, PM_ERR_MESH, "gmsh produced no %s",
+            dim == 3 ? "tetrahedra" : "triangles");
+
+  size_t max_tag = 0;
+  for (size_t i = 0; i < n_tags; i++)
+    if (tags[i] > max_tag) max_tag = tags[i];
+  PM_TRY(PM_ALLOC(map, max_tag + 1, "node tag map"));
+  /* map[tag]: -1 unused, -2 used by a cell, then the compact index. */
+  for (size_t t = 0; t <= max_tag; t++) map[t] = -1;
+  for (size_t i = 0; i < n_enodes; i++) {
+    PM_ENSURE(enodes[i] <= max_tag, PM_ERR_MESH,
+              "gmsh element refers to unknown node %zu", enodes[i]);
+    map[enodes[i]] = -2;
+  }
+  long n = 0;
+  for (size_t i = 0; i < n_tags; i++)
+    if (map[tags[i]] == -2) map[tags[i]] = n++;
+  PM_ENSURE(n > 0, PM_ERR_MESH, "gmsh mesh has no nodes");
+  for (size_t i = 0; i < n_enodes; i++)
+    PM_ENSURE(map[enodes[i]] >= 0, PM_ERR_MESH,
+              "gmsh element refers to node %zu without coordinates", enodes[i]);
+
+  PM_TRY(PM_ALLOC(m->x, 3 * n, "mesh coordinates"));
+  PM_TRY(PM_ALLOC(m->cells, n_enodes, "mesh cells"));
+  for (size_t i = 0; i < n_tags; i++) {
+    long k = map[tags[i]];
+    if (k < 0) continue;
+    for (int d = 0; d < 3; d++) m->x[3 * k + d] = coord[3 * i + d];
+  }
+  for (size_t i = 0; i < n_enodes; i++) m->cells[i] = map[enodes[i]];
+  m->n_nodes = n;
+  m->n_cells = (long)n_etags;
+done:
+  free(map);
+  if (tags) gmshFree(tags);
+  if (coord) gmshFree(coord);
+  if (param) gmshFree(param);
+  if (etags) gmshFree(etags);
+  if (enodes) gmshFree(enodes);
+  return ret;
+}
+
+/* Not thread-safe: gmsh keeps global state, initialized and finalized here. */
+pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
+                   gm_mesh **out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_mesh_box: out is NULL");
+  *out = NULL;
+  PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG, "mesh dimension %d is not 2 or 3",
+           dim);
+  PM_CHECK(min && max, PM_ERR_ARG, "gm_mesh_box: box is NULL");
+  PM_CHECK(isfinite(h) && h > 0.0, PM_ERR_ARG,
+           "mesh size h must be positive (got %g)", h);
+  for (int k = 0; k < dim; k++)
+    PM_CHECK(isfinite(min[k]) && isfinite(max[k]) && max[k] > min[k],
+             PM_ERR_ARG, "empty box along axis %d: [%g, %g]", k, min[k],
+             max[k]);
+
+  pm_err ret = PM_SUCCESS;
+  gm_mesh *m = NULL;
+  int ierr = 0, initialized = 0;
+  PM_TRY(PM_ALLOC(m, 1, "mesh"));
+  m->dim = dim;
+  m->nodes_per_cell = dim + 1;
+  for (int k = 0; k < 3; k++) {
+    m->box_min[k] = k < dim ? min[k] : 0.0;
+    m->box_max[k] = k < dim ? max[k] : 0.0;
+  }
+
+  gmshInitialize(0, NULL, 0, &ierr);
+  GM_GMSH_CHECK("initialize");
+  initialized = 1;
+  PM_TRY(gmsh_options(h));
+  gmshModelAdd("pointmech_box", &ierr);
+  GM_GMSH_CHECK("model add");
+  if (dim == 3)
+    gmshModelOccAddBox(min[0], min[1], min[2], max[0] - min[0],
+                       max[1] - min[1], max[2] - min[2], -1, &ierr);
+  else
+    gmshModelOccAddRectangle(min[0], min[1], 0.0, max[0] - min[0],
+                             max[1] - min[1], -1, 0.0, &ierr);
+  GM_GMSH_CHECK("adding the box");
+  gmshModelOccSynchronize(&ierr);
+  GM_GMSH_CHECK("synchronize");
+  gmshModelMeshGenerate(dim, &ierr);
+  GM_GMSH_CHECK("mesh generation");
+  PM_TRY(gmsh_extract(dim, m));
+  if (dim == 2)
+    for (long i = 0; i < m->n_nodes; i++) m->x[3 * i + 2] = 0.0;
+  PM_TRY(orient_cells(m));
+  *out = m;
+  m = NULL;
+done:
+  if (initialized) gmshFinalize(&ierr);
+  gm_mesh_destroy(m);
+  return ret;
+}
+
+static int cmp_u64(const void *a, const void *b) {
+  unsigned long long x = *(const unsigned long long *)a;
+  unsigned long long y = *(const unsigned long long *)b;
+  return (x > y) - (x < y);
+}
+
+/* Each edge counted once however many cells share it; NAN when memory for
+ * the edge list cannot be had (a reporting figure, not worth an error). */
+double gm_mesh_mean_edge(const gm_mesh *m) {
+  if (!m || m->n_cells <= 0) return NAN;
+  const int npc = m->nodes_per_cell;
+  const size_t per = (size_t)npc * (npc - 1) / 2;
+  size_t n = per * (size_t)m->n_cells;
+  unsigned long long *key = malloc(n * sizeof *key);
+  if (!key) return NAN;
+  size_t k = 0;
+  for (long c = 0; c < m->n_cells; c++) {
+    const long *cell = m->cells + (size_t)npc * c;
+    for (int a = 0; a < npc; a++)
+      for (int b = a + 1; b < npc; b++) {
+        unsigned long long i = (unsigned long long)cell[a];
+        unsigned long long j = (unsigned long long)cell[b];
+        if (i > j) {
+          unsigned long long t = i;
+          i = j;
+          j = t;
+        }
+        key[k++] = i * (unsigned long long)m->n_nodes + j;
+      }
+  }
+  qsort(key, n, sizeof *key, cmp_u64);
+  double sum = 0.0;
+  size_t n_edges = 0;
+  for (size_t e = 0; e < n; e++) {
+    if (e > 0 && key[e] == key[e - 1]) continue;
+    long i = (long)(key[e] / (unsigned long long)m->n_nodes);
+    long j = (long)(key[e] % (unsigned long long)m->n_nodes);
+    double s = 0.0;
+    for (int d = 0; d < 3; d++) {
+      double dx = m->x[3 * j + d] - m->x[3 * i + d];
+      s += dx * dx;
+    }
+    sum += sqrt(s);
+    n_edges++;
+  }
+  free(key);
+  return sum / (double)n_edges;
+}

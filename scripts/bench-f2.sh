@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Table 1 of the FPM paper reproduced: case F2 at the paper's four
+# resolutions (or those given as arguments), each run from rest to its
+# quasi-static state; prints points, NRMSE of u_z, steps, wall time, time
+# per point-step and point-steps per second per core.
+#   scripts/bench-f2.sh [BUILD_DIR] [h ...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build}
+shift || true
+sizes=("$@")
+[ ${#sizes[@]} -gt 0 ] || sizes=(1.09e-2 8.02e-3 5.19e-3 3.73e-3)
+bin=$build/pointmech
+scene=cases/fpm/f2-unconstrained-compression.yaml
+out=${BENCH_OUT:-out/bench-f2}
+mkdir -p "$out"
+
+get() { # key file: a number or string value from our summary.json
+  sed -n "s/^  \"$1\": \"\{0,1\}\([^\",]*\)\"\{0,1\},\{0,1\}$/\1/p" "$2" | head -1
+}
+nrmse_z() { sed -n 's/^    "u_z": \([^,]*\),\{0,1\}$/\1/p' "$1" | head -1; }
+
+printf '%-9s %7s %8s %12s %7s %9s %10s %14s %8s\n' h points threads NRMSE_u_z \
+  steps wall_s setup_s "s/point-step" "Mps/s/c"
+for h in "${sizes[@]}"; do
+  dir=$out/h$h
+  "$bin" run "$scene" --set discretization.mesh_size="$h" --out "$dir" --quiet \
+    2>"$dir.log" || { echo "h=$h failed: see $dir.log"; continue; }
+  s=$dir/summary.json
+  printf '%-9s %7s %8s %12s %7s %9.2f %10.2f %14.3e %8.2f\n' "$h" \
+    "$(get points "$s")" "$(get threads "$s")" "$(nrmse_z "$s")" \
+    "$(get steps "$s")" "$(get wall_seconds "$s")" "$(get setup_seconds "$s")" \
+    "$(get seconds_per_point_step "$s")" \
+    "$(awk -v v="$(get point_steps_per_second_per_core "$s")" 'BEGIN{print v/1e6}')"
+done

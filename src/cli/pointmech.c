@@ -1,0 +1,183 @@
+/* pointmech: the command-line program.  The only layer that knows every
+ * backend: it loads the scene and hands it to the backend of its method. */
+#include <errno.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_driver.h"
+#include "pm_error.h"
+#include "pm_probe.h"
+#include "pm_scene.h"
+
+enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_NUMERIC = 2, EXIT_NOT_CONVERGED = 3 };
+
+#define MAX_SETS 64
+
+static void usage(FILE *out) {
+  fprintf(out,
+          "usage: pointmech run SCENE [--out DIR] [--set KEY=VALUE]... "
+          "[--quiet]\n"
+          "       pointmech plan SCENE [--set KEY=VALUE]...\n"
+          "       pointmech probe OUT --points FILE.csv [--frame N]\n"
+          "       pointmech --help | --version\n"
+          "\n"
+          "  run    simulate SCENE (YAML); writes OUT/results.h5 + "
+          "results.xdmf,\n"
+          "         history.csv and summary.json (default OUT: out/NAME)\n"
+          "  plan   print the pipeline, counts, time step, steps, memory and "
+          "an\n"
+          "         estimated run time without running\n"
+          "  probe  print the displacement of a run's last (or N-th) frame "
+          "at the\n"
+          "         reference coordinates of FILE.csv (x,y,z per line), by "
+          "moving\n"
+          "         least squares, as CSV\n"
+          "  --set  override any scene value by its dotted key, e.g.\n"
+          "         --set discretization.mesh_size=8.02e-3 --set "
+          "boundary.3.displacement.z=-0.06\n"
+          "\n"
+          "exit status: 0 success, 1 bad input, 2 numerical failure, 3 "
+          "quasi-static run not converged\n");
+}
+
+static int report(pm_err e) {
+  fprintf(stderr, "pointmech: error: %s\n", pm_error_message());
+  if (getenv("POINTMECH_TRACE"))
+    fprintf(stderr, "trace:\n%s", pm_error_traceback());
+  switch (e) {
+  case PM_ERR_UNSTABLE:
+  case PM_ERR_LINALG:
+    return EXIT_NUMERIC;
+  case PM_ERR_NOT_CONVERGED: return EXIT_NOT_CONVERGED;
+  default: return EXIT_INPUT;
+  }
+}
+
+typedef struct {
+  const char *scene;
+  const char *out;
+  const char *points;
+  long frame;
+  bool quiet;
+  int n_sets;
+  const char *sets[MAX_SETS];
+} cli_args;
+
+static int parse_args(int argc, char **argv, int first, cli_args *a) {
+  memset(a, 0, sizeof *a);
+  a->frame = -1;
+  for (int k = first; k < argc; k++) {
+    const char *arg = argv[k];
+    bool has_next = k + 1 < argc;
+    if (strcmp(arg, "--out") == 0 && has_next) a->out = argv[++k];
+    else if (strcmp(arg, "--points") == 0 && has_next) a->points = argv[++k];
+    else if (strcmp(arg, "--frame") == 0 && has_next) {
+      char *end;
+      a->frame = strtol(argv[++k], &end, 10);
+      if (*end || a->frame < 0) {
+        fprintf(stderr, "pointmech: --frame expects an integer >= 0, got %s\n",
+                argv[k]);
+        return -1;
+      }
+    } else if (strcmp(arg, "--set") == 0 && has_next) {
+      if (a->n_sets == MAX_SETS) {
+        fprintf(stderr, "pointmech: at most %d --set options\n", MAX_SETS);
+        return -1;
+      }
+      a->sets[a->n_sets++] = argv[++k];
+    } else if (strncmp(arg, "--set=", 6) == 0 && a->n_sets < MAX_SETS)
+      a->sets[a->n_sets++] = arg + 6;
+    else if (strcmp(arg, "--quiet") == 0) a->quiet = true;
+    else if (arg[0] == '-' ) {
+      fprintf(stderr, "pointmech: unknown option %s%s\n", arg,
+              has_next ? "" : " (or missing value)");
+      return -1;
+    } else if (!a->scene) a->scene = arg;
+    else {
+      fprintf(stderr, "pointmech: unexpected argument %s\n", arg);
+      return -1;
+    }
+  }
+  return 0;
+}
+
+static int cmd_run_or_plan(const cli_args *a, bool plan) {
+  pm_scene *s = NULL;
+  fpm_sim *sim = NULL;
+  int status = EXIT_OK;
+  pm_err e = pm_scene_load(a->scene, a->n_sets, a->sets, &s);
+  if (e) return report(e);
+  if (s->method != PM_METHOD_FPM) {
+    fprintf(stderr,
+            "pointmech: error: %s: method %s is not available in this build "
+            "(available: fpm)\n",
+            a->scene, pm_method_name(s->method));
+    pm_scene_destroy(s);
+    return EXIT_INPUT;
+  }
+  e = fpm_sim_create(s, &sim);
+  if (e) {
+    status = report(e);
+    goto done;
+  }
+  if (plan) {
+    e = fpm_sim_plan(sim, stdout);
+    if (e) status = report(e);
+    goto done;
+  }
+  char out_default[1024];
+  const char *out = a->out;
+  if (!out) {
+    snprintf(out_default, sizeof out_default, "out/%s", s->name);
+    out = out_default;
+  }
+  e = fpm_sim_run(sim, out, a->quiet);
+  if (e) status = report(e);
+  fprintf(stderr, "results in %s\n", out);
+done:
+  fpm_sim_destroy(sim);
+  pm_scene_destroy(s);
+  return status;
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    usage(stderr);
+    return EXIT_INPUT;
+  }
+  const char *cmd = argv[1];
+  if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 ||
+      strcmp(cmd, "help") == 0) {
+    usage(stdout);
+    return EXIT_OK;
+  }
+  if (strcmp(cmd, "--version") == 0) {
+    printf("pointmech %s\n", PM_VERSION);
+    return EXIT_OK;
+  }
+  cli_args a;
+  if (parse_args(argc, argv, 2, &a) != 0) {
+    usage(stderr);
+    return EXIT_INPUT;
+  }
+  if (strcmp(cmd, "run") == 0 || strcmp(cmd, "plan") == 0) {
+    if (!a.scene) {
+      fprintf(stderr, "pointmech: %s needs a SCENE file\n", cmd);
+      return EXIT_INPUT;
+    }
+    return cmd_run_or_plan(&a, strcmp(cmd, "plan") == 0);
+  }
+  if (strcmp(cmd, "probe") == 0) {
+    if (!a.scene || !a.points) {
+      fprintf(stderr, "pointmech: probe needs OUT and --points FILE.csv\n");
+      return EXIT_INPUT;
+    }
+    pm_err e = pm_probe(a.scene, a.points, a.frame, stdout);
+    return e ? report(e) : EXIT_OK;
+  }
+  fprintf(stderr, "pointmech: unknown command %s\n", cmd);
+  usage(stderr);
+  return EXIT_INPUT;
+}

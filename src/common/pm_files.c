@@ -1,0 +1,458 @@
+/* pm_files: atomic output files (temporary name + rename), mkdir -p, the
+ * history CSV and a small streaming JSON writer. */
+#include "pm_files.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+/* ---- Paths ------------------------------------------------------------- */
+
+pm_err pm_path_join(char *buf, size_t size, const char *dir, const char *name) {
+  int n;
+  PM_CHECK(buf && size > 0 && name, PM_ERR_ARG, "pm_path_join: NULL argument");
+  if (!dir || !dir[0])
+    n = snprintf(buf, size, "%s", name);
+  else if (dir[strlen(dir) - 1] == '/')
+    n = snprintf(buf, size, "%s%s", dir, name);
+  else
+    n = snprintf(buf, size, "%s/%s", dir, name);
+  PM_CHECK(n >= 0 && (size_t)n < size, PM_ERR_ARG,
+           "path '%s/%s' is too long (%zu bytes at most)", dir ? dir : "", name,
+           size - 1);
+  return PM_SUCCESS;
+}
+
+/* mkdir one component; an existing directory is fine. */
+static pm_err mkdir_one(const char *path) {
+  struct stat st;
+  int e;
+  if (mkdir(path, 0777) == 0) return PM_SUCCESS;
+  e = errno;
+  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) return PM_SUCCESS;
+  PM_CHECK(e != EEXIST, PM_ERR_IO,
+           "cannot create directory '%s': exists and is not a directory", path);
+  return PM_ERROR(PM_ERR_IO, "cannot create directory '%s': %s", path,
+                  strerror(e));
+}
+
+pm_err pm_mkdir_p(const char *dir) {
+  char buf[PM_PATH_MAX + 1];
+  size_t len;
+  PM_CHECK(dir && dir[0], PM_ERR_ARG, "pm_mkdir_p: empty directory name");
+  len = strlen(dir);
+  PM_CHECK(len <= PM_PATH_MAX, PM_ERR_ARG,
+           "directory name too long: '%.64s...'", dir);
+  memcpy(buf, dir, len + 1);
+  /* Create every prefix ending before a '/', then the whole path. */
+  for (size_t i = 1; i < len; i++) {
+    if (buf[i] != '/' || buf[i - 1] == '/') continue;
+    buf[i] = '\0';
+    PM_CALL(mkdir_one(buf));
+    buf[i] = '/';
+  }
+  PM_CALL(mkdir_one(buf));
+  return PM_SUCCESS;
+}
+
+/* fsync the directory holding path (best effort: errors are ignored, some
+ * file systems refuse to sync directories). */
+static void sync_parent_dir(const char *path) {
+  char dir[PM_PATH_MAX + 1];
+  const char *slash = strrchr(path, '/');
+  size_t len;
+  int fd;
+  if (!slash) {
+    strcpy(dir, ".");
+  } else {
+    len = (size_t)(slash - path);
+    if (len == 0) len = 1; /* "/file" */
+    if (len > PM_PATH_MAX) return;
+    memcpy(dir, path, len);
+    dir[len] = '\0';
+  }
+  fd = open(dir, O_RDONLY);
+  if (fd < 0) return;
+  (void)fsync(fd);
+  (void)close(fd);
+}
+
+pm_err pm_rename(const char *from, const char *to) {
+  PM_CHECK(from && to, PM_ERR_ARG, "pm_rename: NULL path");
+  PM_CHECK(rename(from, to) == 0, PM_ERR_IO, "cannot rename '%s' to '%s': %s",
+           from, to, strerror(errno));
+  sync_parent_dir(to);
+  return PM_SUCCESS;
+}
+
+/* ---- Atomic files ------------------------------------------------------ */
+
+struct pm_afile {
+  FILE *fp;
+  char *final_path; /* both point into one allocation: paths[] */
+  char *tmp_path;
+  char paths[];
+};
+
+pm_err pm_afile_open(const char *final_path, pm_afile **out) {
+  pm_err ret = PM_SUCCESS;
+  pm_afile *f = NULL;
+  size_t len, tmp_size;
+  int n;
+  PM_CHECK(out, PM_ERR_ARG, "pm_afile_open: NULL out");
+  *out = NULL;
+  PM_CHECK(final_path && final_path[0], PM_ERR_ARG,
+           "pm_afile_open: empty path");
+  len = strlen(final_path);
+  PM_CHECK(len + 32 <= PM_PATH_MAX, PM_ERR_ARG, "path too long: '%.64s...'",
+           final_path);
+  tmp_size = len + 32;
+  f = malloc(sizeof *f + len + 1 + tmp_size);
+  PM_ENSURE(f, PM_ERR_MEMORY, "cannot allocate the handle for '%s'",
+            final_path);
+  f->fp = NULL;
+  f->final_path = f->paths;
+  f->tmp_path = f->paths + len + 1;
+  memcpy(f->final_path, final_path, len + 1);
+  n = snprintf(f->tmp_path, tmp_size, "%s.tmp.%ld", final_path, (long)getpid());
+  PM_ENSURE(n > 0 && (size_t)n < tmp_size, PM_ERR_INTERNAL,
+            "temporary name of '%s' truncated", final_path);
+  f->fp = fopen(f->tmp_path, "w");
+  PM_ENSURE(f->fp, PM_ERR_IO, "cannot open '%s' for writing: %s", f->tmp_path,
+            strerror(errno));
+  *out = f;
+  f = NULL;
+done:
+  free(f);
+  return ret;
+}
+
+FILE *pm_afile_stream(pm_afile *f) { return f ? f->fp : NULL; }
+
+const char *pm_afile_path(const pm_afile *f) {
+  return f ? f->final_path : NULL;
+}
+
+pm_err pm_afile_commit(pm_afile *f) {
+  pm_err ret = PM_SUCCESS;
+  FILE *fp;
+  if (!f) return PM_SUCCESS;
+  fp = f->fp;
+  PM_ENSURE(!ferror(fp), PM_ERR_IO, "write error on '%s'", f->tmp_path);
+  PM_ENSURE(fflush(fp) == 0, PM_ERR_IO, "cannot write '%s': %s", f->tmp_path,
+            strerror(errno));
+  PM_ENSURE(fsync(fileno(fp)) == 0, PM_ERR_IO, "cannot sync '%s': %s",
+            f->tmp_path, strerror(errno));
+  f->fp = NULL; /* closed by fclose even when it fails */
+  PM_ENSURE(fclose(fp) == 0, PM_ERR_IO, "cannot close '%s': %s", f->tmp_path,
+            strerror(errno));
+  PM_TRY(pm_rename(f->tmp_path, f->final_path));
+done:
+  if (ret != PM_SUCCESS) {
+    if (f->fp) fclose(f->fp);
+    unlink(f->tmp_path);
+  }
+  free(f);
+  return ret;
+}
+
+void pm_afile_abort(pm_afile *f) {
+  if (!f) return;
+  if (f->fp) fclose(f->fp);
+  unlink(f->tmp_path);
+  free(f);
+}
+
+/* ---- History CSV ------------------------------------------------------- */
+
+struct pm_history {
+  pm_afile *file;
+  FILE *fp;
+  int ncols;
+};
+
+/* Write a CSV field, quoting it when it holds a separator. */
+static void csv_field(FILE *fp, const char *s) {
+  if (!strpbrk(s, ",\"\r\n")) {
+    fputs(s, fp);
+    return;
+  }
+  putc('"', fp);
+  for (; *s; s++) {
+    if (*s == '"') putc('"', fp);
+    putc(*s, fp);
+  }
+  putc('"', fp);
+}
+
+pm_err pm_history_open(const char *dir, int ncols, const char *const *names,
+                       pm_history **out) {
+  pm_err ret = PM_SUCCESS;
+  pm_history *h = NULL;
+  char path[PM_PATH_MAX + 1];
+  PM_CHECK(out, PM_ERR_ARG, "pm_history_open: NULL out");
+  *out = NULL;
+  PM_CHECK(ncols >= 1 && names, PM_ERR_ARG,
+           "history needs at least one column name (got %d)", ncols);
+  for (int i = 0; i < ncols; i++)
+    PM_CHECK(names[i], PM_ERR_ARG, "history column %d has no name", i);
+  PM_CALL(pm_path_join(path, sizeof path, dir, "history.csv"));
+  PM_TRY(PM_ALLOC(h, 1, "history writer"));
+  h->ncols = ncols;
+  PM_TRY(pm_afile_open(path, &h->file));
+  h->fp = pm_afile_stream(h->file);
+  for (int i = 0; i < ncols; i++) {
+    if (i) putc(',', h->fp);
+    csv_field(h->fp, names[i]);
+  }
+  putc('\n', h->fp);
+  PM_ENSURE(!ferror(h->fp), PM_ERR_IO, "cannot write the header of '%s'", path);
+  *out = h;
+  h = NULL;
+done:
+  if (h) pm_afile_abort(h->file);
+  free(h);
+  return ret;
+}
+
+pm_err pm_history_row(pm_history *h, const double *values) {
+  PM_CHECK(h && values, PM_ERR_ARG, "pm_history_row: NULL argument");
+  for (int i = 0; i < h->ncols; i++)
+    if (fprintf(h->fp, i ? ",%.10g" : "%.10g", values[i]) < 0) break;
+  PM_CHECK(putc('\n', h->fp) != EOF && !ferror(h->fp), PM_ERR_IO,
+           "cannot write a row of '%s'", pm_afile_path(h->file));
+  return PM_SUCCESS;
+}
+
+int pm_history_ncols(const pm_history *h) { return h ? h->ncols : 0; }
+
+pm_err pm_history_close(pm_history *h, bool keep) {
+  pm_err ret = PM_SUCCESS;
+  if (!h) return PM_SUCCESS;
+  if (keep)
+    ret = pm_afile_commit(h->file);
+  else
+    pm_afile_abort(h->file);
+  free(h);
+  if (ret != PM_SUCCESS)
+    pm_error_trace(ret, __FILE__, __LINE__, __func__, "pm_afile_commit");
+  return ret;
+}
+
+/* ---- JSON writer ------------------------------------------------------- */
+
+struct pm_json {
+  pm_afile *file;
+  FILE *fp;
+  int depth;
+  bool complete; /* the top-level value has been written */
+  bool misused;  /* a call failed: refuse to commit */
+  struct {
+    char close; /* '}' or ']' */
+    long count; /* values written so far in the container */
+  } stack[PM_JSON_MAX_DEPTH];
+};
+
+static void json_escaped(FILE *fp, const char *s) {
+  putc('"', fp);
+  for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+    switch (*p) {
+    case '"': fputs("\\\"", fp); break;
+    case '\\': fputs("\\\\", fp); break;
+    case '\b': fputs("\\b", fp); break;
+    case '\f': fputs("\\f", fp); break;
+    case '\n': fputs("\\n", fp); break;
+    case '\r': fputs("\\r", fp); break;
+    case '\t': fputs("\\t", fp); break;
+    default:
+      if (*p < 0x20)
+        fprintf(fp, "\\u%04x", (unsigned)*p);
+      else
+        putc(*p, fp);
+    }
+  }
+  putc('"', fp);
+}
+
+static void json_newline(pm_json *j, int depth) {
+  putc('\n', j->fp);
+  for (int i = 0; i < depth; i++) fputs("  ", j->fp);
+}
+
+/* Check key against the context, then write separator, indent and key. */
+static pm_err json_begin_value(pm_json *j, const char *key) {
+  PM_CHECK(j, PM_ERR_ARG, "JSON writer is NULL");
+  PM_CHECK(!j->misused, PM_ERR_ARG, "JSON writer for '%s' already failed",
+           pm_afile_path(j->file));
+  if (j->depth == 0) {
+    if (j->complete || key) j->misused = true;
+    PM_CHECK(!j->complete, PM_ERR_ARG, "JSON '%s': a second top-level value",
+             pm_afile_path(j->file));
+    PM_CHECK(!key, PM_ERR_ARG, "JSON '%s': key \"%s\" at the top level",
+             pm_afile_path(j->file), key);
+    return PM_SUCCESS;
+  }
+  bool in_object = j->stack[j->depth - 1].close == '}';
+  if (in_object != (key != NULL)) {
+    j->misused = true;
+    return PM_ERROR(PM_ERR_ARG,
+                    in_object ? "JSON '%s': object member without a key"
+                              : "JSON '%s': key \"%s\" inside an array",
+                    pm_afile_path(j->file), key ? key : "");
+  }
+  if (j->stack[j->depth - 1].count++ > 0) putc(',', j->fp);
+  json_newline(j, j->depth);
+  if (key) {
+    json_escaped(j->fp, key);
+    fputs(": ", j->fp);
+  }
+  return PM_SUCCESS;
+}
+
+/* After a value: mark a top-level value complete, check the stream. */
+static pm_err json_end_value(pm_json *j) {
+  if (j->depth == 0) j->complete = true;
+  PM_CHECK(!ferror(j->fp), PM_ERR_IO, "write error on '%s'",
+           pm_afile_path(j->file));
+  return PM_SUCCESS;
+}
+
+static pm_err json_begin(pm_json *j, const char *key, char open, char close) {
+  PM_CALL(json_begin_value(j, key));
+  if (j->depth >= PM_JSON_MAX_DEPTH) {
+    j->misused = true;
+    return PM_ERROR(PM_ERR_ARG, "JSON '%s': nesting deeper than %d",
+                    pm_afile_path(j->file), PM_JSON_MAX_DEPTH);
+  }
+  putc(open, j->fp);
+  j->stack[j->depth].close = close;
+  j->stack[j->depth].count = 0;
+  j->depth++;
+  PM_CHECK(!ferror(j->fp), PM_ERR_IO, "write error on '%s'",
+           pm_afile_path(j->file));
+  return PM_SUCCESS;
+}
+
+static pm_err json_end(pm_json *j, char close) {
+  PM_CHECK(j, PM_ERR_ARG, "JSON writer is NULL");
+  PM_CHECK(!j->misused, PM_ERR_ARG, "JSON writer for '%s' already failed",
+           pm_afile_path(j->file));
+  if (j->depth == 0 || j->stack[j->depth - 1].close != close) {
+    j->misused = true;
+    return PM_ERROR(PM_ERR_ARG, "JSON '%s': '%c' does not match an open %s",
+                    pm_afile_path(j->file), close,
+                    close == '}' ? "object" : "array");
+  }
+  j->depth--;
+  if (j->stack[j->depth].count > 0) json_newline(j, j->depth);
+  putc(close, j->fp);
+  PM_CALL(json_end_value(j));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_open(const char *path, pm_json **out) {
+  pm_err ret = PM_SUCCESS;
+  pm_json *j = NULL;
+  PM_CHECK(out, PM_ERR_ARG, "pm_json_open: NULL out");
+  *out = NULL;
+  PM_TRY(PM_ALLOC(j, 1, "JSON writer"));
+  PM_TRY(pm_afile_open(path, &j->file));
+  j->fp = pm_afile_stream(j->file);
+  *out = j;
+  j = NULL;
+done:
+  free(j);
+  return ret;
+}
+
+pm_err pm_json_begin_object(pm_json *j, const char *key) {
+  PM_CALL(json_begin(j, key, '{', '}'));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_end_object(pm_json *j) {
+  PM_CALL(json_end(j, '}'));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_begin_array(pm_json *j, const char *key) {
+  PM_CALL(json_begin(j, key, '[', ']'));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_end_array(pm_json *j) {
+  PM_CALL(json_end(j, ']'));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_number(pm_json *j, const char *key, double value) {
+  PM_CALL(json_begin_value(j, key));
+  if (isfinite(value)) {
+    char buf[40]; /* shortest of 15 / 17 digits that reads back exactly */
+    snprintf(buf, sizeof buf, "%.15g", value);
+    if (strtod(buf, NULL) != value) snprintf(buf, sizeof buf, "%.17g", value);
+    fputs(buf, j->fp);
+  } else
+    fputs("null", j->fp);
+  PM_CALL(json_end_value(j));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_integer(pm_json *j, const char *key, long long value) {
+  PM_CALL(json_begin_value(j, key));
+  fprintf(j->fp, "%lld", value);
+  PM_CALL(json_end_value(j));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_string(pm_json *j, const char *key, const char *value) {
+  PM_CALL(json_begin_value(j, key));
+  if (value)
+    json_escaped(j->fp, value);
+  else
+    fputs("null", j->fp);
+  PM_CALL(json_end_value(j));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_bool(pm_json *j, const char *key, bool value) {
+  PM_CALL(json_begin_value(j, key));
+  fputs(value ? "true" : "false", j->fp);
+  PM_CALL(json_end_value(j));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_null(pm_json *j, const char *key) {
+  PM_CALL(json_begin_value(j, key));
+  fputs("null", j->fp);
+  PM_CALL(json_end_value(j));
+  return PM_SUCCESS;
+}
+
+pm_err pm_json_close(pm_json *j, bool commit) {
+  pm_err ret = PM_SUCCESS;
+  if (!j) return PM_SUCCESS;
+  if (!commit) {
+    pm_afile_abort(j->file);
+    goto done;
+  }
+  if (j->misused || j->depth != 0 || !j->complete) {
+    ret = PM_ERROR(PM_ERR_ARG, "JSON '%s' is incomplete (%s): not written",
+                   pm_afile_path(j->file),
+                   j->misused ? "an earlier call failed"
+                   : j->depth ? "unclosed object or array"
+                              : "no value");
+    pm_afile_abort(j->file);
+    goto done;
+  }
+  putc('\n', j->fp);
+  PM_TRY(pm_afile_commit(j->file));
+done:
+  free(j);
+  return ret;
+}

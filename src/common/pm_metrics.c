@@ -1,0 +1,33 @@
+/* pm_metrics: NRMSE (FPM paper eq. 28) and observed convergence rates. */
+#include "pm_metrics.h"
+
+#include <math.h>
+
+double pm_nrmse(long n, int stride, const double *u, const double *ref) {
+  double sum = 0, lo = INFINITY, hi = -INFINITY;
+  for (long j = 0; j < n; j++) {
+    double d = u[j * stride] - ref[j * stride];
+    sum += d * d;
+    if (ref[j * stride] < lo) lo = ref[j * stride];
+    if (ref[j * stride] > hi) hi = ref[j * stride];
+  }
+  if (!(hi > lo)) return NAN;
+  return sqrt(sum) / (hi - lo);
+}
+
+double pm_convergence_rate(int n, const double *h, const double *err) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int m = 0;
+  for (int k = 0; k < n; k++) {
+    if (!(h[k] > 0 && err[k] > 0)) continue;
+    double x = log(h[k]), y = log(err[k]);
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+    m++;
+  }
+  if (m < 2) return NAN;
+  double den = m * sxx - sx * sx;
+  return den > 0 ? (m * sxy - sx * sy) / den : NAN;
+}

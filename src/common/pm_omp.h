@@ -1,0 +1,16 @@
+/* pm_omp: OpenMP pragmas behind a macro, so a build without OpenMP compiles
+ * warning-free, and the thread-count query both builds need. */
+#ifndef PM_OMP_H
+#define PM_OMP_H
+
+#ifdef _OPENMP
+#include <omp.h>
+#define PM_PRAGMA_(x) _Pragma(#x)
+#define PM_OMP(...) PM_PRAGMA_(omp __VA_ARGS__)
+static inline int pm_omp_threads(void) { return omp_get_max_threads(); }
+#else
+#define PM_OMP(...)
+static inline int pm_omp_threads(void) { return 1; }
+#endif
+
+#endif

@@ -1,0 +1,20 @@
+/* pm_probe: map a results frame's displacement to arbitrary reference
+ * coordinates by moving least squares, as used to compare resolutions. */
+#ifndef PM_PROBE_H
+#define PM_PROBE_H
+
+#include <stdio.h>
+
+#include "pm_error.h"
+
+/* Read OUT/results.h5 (frame index `frame`, or the last frame when < 0),
+ * read reference coordinates from points_csv (one "x,y,z" per line; a
+ * header line and '#' comments are skipped; 2 columns allowed in 2D) and
+ * write "x,y,z,u_x,u_y,u_z" rows to out.  The displacement at each query
+ * point is the linear moving-least-squares fit over the nearest result
+ * points (cubic-spline weight over a radius adapted to the point spacing),
+ * which reproduces linear fields exactly.  Errors name the file and line. */
+pm_err pm_probe(const char *out_dir, const char *points_csv, long frame,
+                FILE *out);
+
+#endif

@@ -1,0 +1,113 @@
+/* pm_scene: a simulation scene loaded from YAML against a schema, with
+ * command-line overrides.  One vocabulary for every method. */
+#ifndef PM_SCENE_H
+#define PM_SCENE_H
+
+#include <stdbool.h>
+
+#include "pm_error.h"
+#include "pm_expr.h"
+#include "pm_face.h"
+#include "pm_material.h"
+
+typedef enum { PM_METHOD_FPM = 0, PM_METHOD_MPM, PM_METHOD_MPM_IMPLICIT } pm_method;
+typedef enum { PM_RAMP_SMOOTH = 0, PM_RAMP_LINEAR, PM_RAMP_NONE } pm_ramp;
+typedef enum {
+  PM_QS_NONE = 0,               /* plain dynamics */
+  PM_QS_DYNAMIC_RELAXATION,     /* adaptive (Rayleigh-quotient) damping */
+  PM_QS_DAMPING                 /* fixed mass-proportional damping */
+} pm_qs_method;
+
+/* Output fields (bit mask). */
+enum {
+  PM_FIELD_DISPLACEMENT = 1u << 0,
+  PM_FIELD_VELOCITY = 1u << 1,
+  PM_FIELD_STRESS = 1u << 2, /* Cauchy stress */
+  PM_FIELD_STRAIN_ENERGY_DENSITY = 1u << 3,
+  PM_FIELD_JACOBIAN = 1u << 4,
+  PM_FIELD_FORCE = 1u << 5 /* residual (out-of-balance) force */
+};
+
+/* A position in the scene file (1-based; 0 when not from the file). */
+typedef struct {
+  int line, col;
+} pm_scene_mark;
+
+typedef struct {
+  char *name;
+  pm_material mat;
+  pm_scene_mark mark;
+} pm_scene_material;
+
+typedef struct {
+  int material;    /* index into materials */
+  pm_expr *region; /* NULL: the whole domain; else inside where expr > 0 */
+} pm_scene_body;
+
+/* A boundary condition on one named face.  Displacement components are
+ * prescribed values at full load (expressions in x, y, z and t, in m);
+ * traction components are nominal tractions at full load (Pa).  The value
+ * applied at time t is ramp(t) * value(x, y, z, t). */
+typedef struct {
+  pm_face face;
+  unsigned disp_mask;  /* bit c: component c prescribed */
+  pm_expr *disp[3];    /* NULL where not prescribed */
+  unsigned traction_mask;
+  pm_expr *traction[3];
+  pm_ramp ramp;
+  double ramp_time;    /* s; scene time.ramp when not given */
+  pm_scene_mark mark;
+} pm_scene_bc;
+
+typedef struct pm_scene {
+  char *path;          /* scene file as given */
+  char *text;          /* full source text (stored with the results) */
+  char *name;
+  pm_method method;
+  int dimension;       /* 2 (plane strain) or 3 */
+  double box_min[3], box_max[3]; /* domain.box; z ignored in 2D */
+  double mesh_size;    /* discretization.mesh_size, m, > 0 */
+  pm_scene_material *materials;
+  int n_materials;
+  pm_scene_body *bodies;
+  int n_bodies;
+  pm_scene_bc *bcs;
+  int n_bcs;
+  struct {
+    double penalty;     /* fpm.penalty p >= 0 (beta = p E / h) */
+  } fpm;
+  struct {
+    double end;         /* time.end, s, > 0 */
+    double dt;          /* time.dt, s; 0: stable dt from eqs. 24-26 */
+    double dt_safety;   /* time.dt_safety in (0, 1] */
+    double ramp;        /* time.ramp, s: default ramp duration */
+    pm_qs_method qs;    /* time.quasi_static.method */
+    double qs_tolerance;/* time.quasi_static.tolerance: relative residual */
+    double qs_damping;  /* time.quasi_static.damping: 1/s for PM_QS_DAMPING */
+    long max_steps;     /* time.max_steps; 0: no limit */
+  } time;
+  struct {
+    long every;         /* output.every: frame every N steps (> 0) */
+    unsigned fields;    /* PM_FIELD_* mask */
+  } output;
+  unsigned reference_mask;   /* reference.displacement components given */
+  pm_expr *reference[3];     /* analytic u_c(x, y, z, t) or NULL */
+} pm_scene;
+
+/* Load a scene file, apply overrides ("key.path=value", e.g.
+ * "discretization.mesh_size=8.02e-3", "boundary.3.displacement.z=-0.06",
+ * "time.quasi_static.tolerance=1e-9"), validate, and return a new scene.
+ * Errors (PM_ERR_IO for a missing file, PM_ERR_SCENE otherwise) carry
+ * "FILE:LINE:COL: KEY: expected ..., got ..." or, for an override,
+ * "--set KEY=VALUE: ...".  *out is NULL on failure. */
+pm_err pm_scene_load(const char *path, int n_overrides,
+                     const char *const *overrides, pm_scene **out);
+void pm_scene_destroy(pm_scene *s);
+
+const char *pm_method_name(pm_method m);
+
+/* Ramp factor in [0, 1] at time t for ramp kind and duration T:
+ * smooth is C2 (10 s^3 - 15 s^4 + 6 s^5), linear is s, none is 1. */
+double pm_ramp_factor(pm_ramp kind, double T, double t);
+
+#endif

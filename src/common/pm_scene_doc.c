@@ -1,0 +1,765 @@
+/* pm_scene_doc: the scene's libyaml node tree, which keeps file marks for
+ * messages, takes --set overrides and is checked against the cyaml schema. */
+#include "pm_scene_doc.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Deeper trees can only come from aliases that refer to themselves. */
+#define PM_SDOC_DEPTH 32
+/* Scalars longer than this are shortened in "got ..." messages. */
+#define PM_SDOC_GOT 60
+
+static yaml_node_t *node_get(const pm_sdoc *d, int id) {
+  /* libyaml takes a non-const document only to find the node. */
+  return id > 0 ? yaml_document_get_node((yaml_document_t *)&d->doc, id)
+                : NULL;
+}
+
+static int node_count(const pm_sdoc *d) {
+  return (int)(d->doc.nodes.top - d->doc.nodes.start);
+}
+
+static int root_id(const pm_sdoc *d) {
+  return d->loaded && node_count(d) > 0 ? 1 : 0;
+}
+
+/* Which override made node id: -1 for the file (or no node). */
+static int node_origin(const pm_sdoc *d, int id) {
+  if (id <= d->n_file_nodes) return -1;
+  for (int k = 0; k < d->n_overrides; k++)
+    if (id <= d->override_end[k]) return k;
+  return d->n_overrides; /* the override being applied */
+}
+
+static void path_join(char *buf, size_t size, const char *path,
+                      const char *seg) {
+  snprintf(buf, size, "%s%s%s", path, path[0] ? "." : "", seg);
+}
+
+/* Value (or key) node of the mapping pair with key name in mapping id. */
+static int map_lookup(const pm_sdoc *d, int id, const char *name, bool key) {
+  yaml_node_t *n = node_get(d, id);
+  if (!n || n->type != YAML_MAPPING_NODE) return 0;
+  for (yaml_node_pair_t *p = n->data.mapping.pairs.start;
+       p < n->data.mapping.pairs.top; p++) {
+    yaml_node_t *k = node_get(d, p->key);
+    if (k && k->type == YAML_SCALAR_NODE &&
+        strcmp((const char *)k->data.scalar.value, name) == 0)
+      return key ? p->key : p->value;
+  }
+  return 0;
+}
+
+/* Parse a list index segment; -1 when seg is not a plain decimal. */
+static long parse_index(const char *seg) {
+  if (!seg[0] || strspn(seg, "0123456789") != strlen(seg) || strlen(seg) > 9)
+    return -1;
+  return strtol(seg, NULL, 10);
+}
+
+int pm_sdoc_find(const pm_sdoc *d, const char *path, bool key) {
+  char buf[PM_SDOC_PATH];
+  int id = root_id(d), key_id = 0;
+  if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return 0;
+  for (char *seg = buf, *next; id && seg && *seg; seg = next) {
+    next = strchr(seg, '.');
+    if (next) *next++ = '\0';
+    yaml_node_t *n = node_get(d, id);
+    if (n->type == YAML_MAPPING_NODE) {
+      key_id = map_lookup(d, id, seg, true);
+      id = map_lookup(d, id, seg, false);
+    } else if (n->type == YAML_SEQUENCE_NODE) {
+      long i = parse_index(seg);
+      long count = n->data.sequence.items.top - n->data.sequence.items.start;
+      key_id = 0;
+      id = (i >= 0 && i < count) ? n->data.sequence.items.start[i] : 0;
+    } else {
+      id = 0;
+    }
+  }
+  return key ? (id ? key_id : 0) : id;
+}
+
+const char *pm_sdoc_scalar(const pm_sdoc *d, int id) {
+  yaml_node_t *n = node_get(d, id);
+  return n && n->type == YAML_SCALAR_NODE ? (const char *)n->data.scalar.value
+                                          : NULL;
+}
+
+pm_scene_mark pm_sdoc_mark(const pm_sdoc *d, int id) {
+  pm_scene_mark m = {0, 0};
+  yaml_node_t *n = node_get(d, id);
+  if (n && node_origin(d, id) < 0) {
+    m.line = (int)n->start_mark.line + 1;
+    m.col = (int)n->start_mark.column + 1;
+  }
+  return m;
+}
+
+void pm_sdoc_where(const pm_sdoc *d, int id, const char *path, char *buf,
+                   size_t size) {
+  int k = id ? node_origin(d, id) : -1;
+  if (k >= 0 && d->overrides) {
+    const char *kv = d->overrides[k];
+    size_t klen = strcspn(kv, "=");
+    bool same = strlen(path) == klen && strncmp(path, kv, klen) == 0;
+    snprintf(buf, size, "--set %s%s%s", kv, same || !path[0] ? "" : ": ",
+             same ? "" : path);
+    return;
+  }
+  pm_scene_mark m = pm_sdoc_mark(d, id);
+  if (m.line > 0)
+    snprintf(buf, size, "%s:%d:%d%s%s", d->path, m.line, m.col,
+             path[0] ? ": " : "", path);
+  else
+    snprintf(buf, size, "%s%s%s", d->path, path[0] ? ": " : "", path);
+}
+
+void pm_sdoc_got(const pm_sdoc *d, int id, char *buf, size_t size) {
+  yaml_node_t *n = node_get(d, id);
+  if (!n) {
+    snprintf(buf, size, "nothing");
+  } else if (n->type == YAML_MAPPING_NODE) {
+    snprintf(buf, size, "a mapping");
+  } else if (n->type == YAML_SEQUENCE_NODE) {
+    snprintf(buf, size, "a list");
+  } else if (n->data.scalar.length == 0) {
+    snprintf(buf, size, "an empty value");
+  } else if (n->data.scalar.length > PM_SDOC_GOT) {
+    snprintf(buf, size, "%.*s...", PM_SDOC_GOT, n->data.scalar.value);
+  } else {
+    snprintf(buf, size, "%s", n->data.scalar.value);
+  }
+}
+
+/* Node for a message about path: the node itself, or for an absent key the
+ * nearest ancestor that exists, so the location points at its parent. */
+static int where_node(const pm_sdoc *d, const char *path, bool key) {
+  char buf[PM_SDOC_PATH];
+  int id = pm_sdoc_find(d, path, key);
+  snprintf(buf, sizeof buf, "%s", path);
+  while (!id) {
+    char *dot = strrchr(buf, '.');
+    if (!dot) return root_id(d);
+    *dot = '\0';
+    id = pm_sdoc_find(d, buf, false);
+  }
+  return id;
+}
+
+pm_err pm_sdoc_fail(const pm_sdoc *d, const char *path, bool key,
+                    const char *fmt, ...) {
+  char where[PM_SDOC_WHERE], what[PM_SDOC_WHERE];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(what, sizeof what, fmt, ap);
+  va_end(ap);
+  pm_sdoc_where(d, where_node(d, path, key), path, where, sizeof where);
+  return PM_ERROR(PM_ERR_SCENE, "%s: %s", where, what);
+}
+
+pm_err pm_sdoc_expected(const pm_sdoc *d, const char *path, const char *what) {
+  char where[PM_SDOC_WHERE], got[PM_SDOC_GOT + 8];
+  int id = pm_sdoc_find(d, path, false);
+  pm_sdoc_got(d, id, got, sizeof got);
+  pm_sdoc_where(d, where_node(d, path, false), path, where, sizeof where);
+  return PM_ERROR(PM_ERR_SCENE, "%s: expected %s, got %s", where, what, got);
+}
+
+/* ---- parsing ---------------------------------------------------------- */
+
+static pm_err syntax_error(const char *path, const yaml_parser_t *p) {
+  const char *problem = p->problem ? p->problem : "unreadable YAML";
+  if (p->context)
+    return PM_ERROR(PM_ERR_SCENE, "%s:%zu:%zu: YAML syntax error: %s %s",
+                    path, p->problem_mark.line + 1,
+                    p->problem_mark.column + 1, problem, p->context);
+  return PM_ERROR(PM_ERR_SCENE, "%s:%zu:%zu: YAML syntax error: %s", path,
+                  p->problem_mark.line + 1, p->problem_mark.column + 1,
+                  problem);
+}
+
+pm_err pm_sdoc_parse(pm_sdoc *d, const char *path, const char *text,
+                     size_t len) {
+  pm_err ret = PM_SUCCESS;
+  yaml_parser_t parser;
+  yaml_document_t extra;
+  bool parser_ok = false, extra_ok = false;
+  d->path = path;
+  PM_ENSURE(yaml_parser_initialize(&parser), PM_ERR_MEMORY,
+            "cannot initialise the YAML parser for %s", path);
+  parser_ok = true;
+  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
+  if (!yaml_parser_load(&parser, &d->doc)) {
+    ret = syntax_error(path, &parser);
+    goto done;
+  }
+  d->loaded = true;
+  d->n_file_nodes = node_count(d);
+  PM_ENSURE(d->n_file_nodes > 0, PM_ERR_SCENE, "%s: empty scene", path);
+  /* A second document would be silently ignored by the loader. */
+  if (!yaml_parser_load(&parser, &extra)) {
+    ret = syntax_error(path, &parser);
+    goto done;
+  }
+  extra_ok = true;
+  yaml_node_t *extra_root = yaml_document_get_root_node(&extra);
+  PM_ENSURE(!extra_root, PM_ERR_SCENE,
+            "%s:%zu:%zu: expected one YAML document, got a second one", path,
+            extra_root ? extra_root->start_mark.line + 1 : 0,
+            extra_root ? extra_root->start_mark.column + 1 : 0);
+done:
+  if (extra_ok) yaml_document_delete(&extra);
+  if (parser_ok) yaml_parser_delete(&parser);
+  return ret;
+}
+
+void pm_sdoc_free(pm_sdoc *d) {
+  if (!d) return;
+  if (d->loaded) yaml_document_delete(&d->doc);
+  free(d->override_end);
+  memset(d, 0, sizeof *d);
+}
+
+/* ---- schema checks ---------------------------------------------------- */
+
+static bool name_in(const cyaml_strval_t *strings, uint32_t count,
+                    const char *s) {
+  for (uint32_t i = 0; i < count; i++)
+    if (strcmp(strings[i].str, s) == 0) return true;
+  return false;
+}
+
+static void list_names(char *buf, size_t size, const cyaml_strval_t *strings,
+                       uint32_t count) {
+  size_t used = 0;
+  buf[0] = '\0';
+  for (uint32_t i = 0; i < count && used < size; i++)
+    used += (size_t)snprintf(buf + used, size - used, "%s%s", i ? ", " : "",
+                             strings[i].str);
+}
+
+static void list_keys(char *buf, size_t size,
+                      const cyaml_schema_field_t *fields) {
+  size_t used = 0;
+  buf[0] = '\0';
+  for (int i = 0; fields[i].key && used < size; i++)
+    used += (size_t)snprintf(buf + used, size - used, "%s%s", i ? ", " : "",
+                             fields[i].key);
+}
+
+/* What a value of schema s looks like, for "expected ...". */
+static void describe(char *buf, size_t size, const cyaml_schema_value_t *s) {
+  char names[PM_SDOC_WHERE];
+  switch (s->type) {
+  case CYAML_INT:
+  case CYAML_UINT:
+    snprintf(buf, size, "an integer");
+    break;
+  case CYAML_FLOAT:
+    snprintf(buf, size, "a number");
+    break;
+  case CYAML_BOOL:
+    snprintf(buf, size, "true or false");
+    break;
+  case CYAML_STRING:
+    snprintf(buf, size, s->string.min > 0 ? "a non-empty string" : "a string");
+    break;
+  case CYAML_ENUM:
+    list_names(names, sizeof names, s->enumeration.strings,
+               s->enumeration.count);
+    snprintf(buf, size, "one of %s", names);
+    break;
+  case CYAML_FLAGS:
+    list_names(names, sizeof names, s->enumeration.strings,
+               s->enumeration.count);
+    snprintf(buf, size, "a list of names from %s", names);
+    break;
+  case CYAML_MAPPING:
+    snprintf(buf, size, "a mapping");
+    break;
+  default:
+    snprintf(buf, size, "a list");
+    break;
+  }
+}
+
+static pm_err expected_at(const pm_sdoc *d, int id, const char *path,
+                          const cyaml_schema_value_t *s) {
+  char what[PM_SDOC_WHERE], where[PM_SDOC_WHERE], got[PM_SDOC_GOT + 8];
+  describe(what, sizeof what, s);
+  pm_sdoc_got(d, id, got, sizeof got);
+  pm_sdoc_where(d, id, path, where, sizeof where);
+  return PM_ERROR(PM_ERR_SCENE, "%s: expected %s, got %s", where, what, got);
+}
+
+/* Whether text is a whole decimal integer that fits in data_size bytes.
+ * Leading zeros are refused: libcyaml would read them as octal. */
+static bool scalar_is_int(const char *text, uint32_t data_size, bool sign) {
+  char *end;
+  errno = 0;
+  long long v = strtoll(text, &end, 10);
+  const char *digits = text + (text[0] == '-' || text[0] == '+');
+  if (end == text || *end || errno == ERANGE || (!sign && v < 0)) return false;
+  if (digits[0] == '0' && digits[1] != '\0') return false;
+  if (data_size < 8) {
+    long long lim = 1LL << (8 * data_size - (sign ? 1 : 0));
+    if (v >= lim || v < -lim) return false;
+  }
+  return true;
+}
+
+static bool scalar_is_number(const char *text) {
+  char *end;
+  double v = strtod(text, &end);
+  return end != text && *end == '\0' && isfinite(v);
+}
+
+static pm_err check_value(const pm_sdoc *d, const cyaml_schema_value_t *s,
+                          int id, const char *path, int depth);
+
+static pm_err check_mapping(const pm_sdoc *d, const cyaml_schema_value_t *s,
+                            int id, const char *path, int depth) {
+  yaml_node_t *n = node_get(d, id);
+  char sub[PM_SDOC_PATH], where[PM_SDOC_WHERE], keys[PM_SDOC_WHERE];
+  const cyaml_schema_field_t *fields = s->mapping.fields;
+  if (n->type != YAML_MAPPING_NODE) return expected_at(d, id, path, s);
+  int n_pairs = (int)(n->data.mapping.pairs.top - n->data.mapping.pairs.start);
+  for (int i = 0; i < n_pairs; i++) {
+    /* Re-fetch: the node array is stable here, but keep one access path. */
+    yaml_node_pair_t pair = node_get(d, id)->data.mapping.pairs.start[i];
+    const char *key = pm_sdoc_scalar(d, pair.key);
+    if (!key) {
+      pm_sdoc_where(d, pair.key, path, where, sizeof where);
+      return PM_ERROR(PM_ERR_SCENE, "%s: expected a key name, got %s", where,
+                      node_get(d, pair.key)->type == YAML_MAPPING_NODE
+                          ? "a mapping"
+                          : "a list");
+    }
+    path_join(sub, sizeof sub, path, key);
+    const cyaml_schema_field_t *f = fields;
+    while (f->key && strcmp(f->key, key) != 0) f++;
+    if (!f->key) {
+      list_keys(keys, sizeof keys, fields);
+      pm_sdoc_where(d, pair.key, sub, where, sizeof where);
+      return PM_ERROR(PM_ERR_SCENE, "%s: unknown key (expected one of %s)",
+                      where, keys);
+    }
+    for (int j = 0; j < i; j++) {
+      const char *prev = pm_sdoc_scalar(
+          d, node_get(d, id)->data.mapping.pairs.start[j].key);
+      if (prev && strcmp(prev, key) == 0) {
+        pm_sdoc_where(d, pair.key, sub, where, sizeof where);
+        return PM_ERROR(PM_ERR_SCENE, "%s: duplicate key", where);
+      }
+    }
+    PM_CALL(check_value(d, &f->value, pair.value, sub, depth + 1));
+  }
+  for (const cyaml_schema_field_t *f = fields; f->key; f++) {
+    if ((f->value.flags & CYAML_FLAG_OPTIONAL) || map_lookup(d, id, f->key, 0))
+      continue;
+    path_join(sub, sizeof sub, path, f->key);
+    pm_sdoc_where(d, id, sub, where, sizeof where);
+    return PM_ERROR(PM_ERR_SCENE, "%s: missing required key", where);
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err check_sequence(const pm_sdoc *d, const cyaml_schema_value_t *s,
+                             int id, const char *path, int depth) {
+  yaml_node_t *n = node_get(d, id);
+  char sub[PM_SDOC_PATH], where[PM_SDOC_WHERE], idx[16];
+  if (n->type != YAML_SEQUENCE_NODE) return expected_at(d, id, path, s);
+  long count = n->data.sequence.items.top - n->data.sequence.items.start;
+  uint32_t lo = s->sequence.min, hi = s->sequence.max;
+  if ((uint32_t)count < lo || (hi != CYAML_UNLIMITED && (uint32_t)count > hi)) {
+    pm_sdoc_where(d, id, path, where, sizeof where);
+    if (lo == hi)
+      return PM_ERROR(PM_ERR_SCENE, "%s: expected %u entries, got %ld", where,
+                      lo, count);
+    if (hi == CYAML_UNLIMITED)
+      return PM_ERROR(PM_ERR_SCENE, "%s: expected at least %u entr%s, got %ld",
+                      where, lo, lo == 1 ? "y" : "ies", count);
+    return PM_ERROR(PM_ERR_SCENE, "%s: expected %u to %u entries, got %ld",
+                    where, lo, hi, count);
+  }
+  for (long i = 0; i < count; i++) {
+    snprintf(idx, sizeof idx, "%ld", i);
+    path_join(sub, sizeof sub, path, idx);
+    int item = node_get(d, id)->data.sequence.items.start[i];
+    PM_CALL(check_value(d, s->sequence.entry, item, sub, depth + 1));
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err check_flags(const pm_sdoc *d, const cyaml_schema_value_t *s,
+                          int id, const char *path) {
+  yaml_node_t *n = node_get(d, id);
+  char sub[PM_SDOC_PATH], idx[16], names[PM_SDOC_WHERE], what[PM_SDOC_WHERE];
+  if (n->type != YAML_SEQUENCE_NODE) return expected_at(d, id, path, s);
+  long count = n->data.sequence.items.top - n->data.sequence.items.start;
+  list_names(names, sizeof names, s->enumeration.strings,
+             s->enumeration.count);
+  snprintf(what, sizeof what, "one of %s", names);
+  for (long i = 0; i < count; i++) {
+    int item = node_get(d, id)->data.sequence.items.start[i];
+    const char *v = pm_sdoc_scalar(d, item);
+    if (v && name_in(s->enumeration.strings, s->enumeration.count, v))
+      continue;
+    snprintf(idx, sizeof idx, "%ld", i);
+    path_join(sub, sizeof sub, path, idx);
+    return pm_sdoc_expected(d, sub, what);
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err check_value(const pm_sdoc *d, const cyaml_schema_value_t *s,
+                          int id, const char *path, int depth) {
+  char where[PM_SDOC_WHERE];
+  if (depth > PM_SDOC_DEPTH) {
+    pm_sdoc_where(d, id, path, where, sizeof where);
+    return PM_ERROR(PM_ERR_SCENE, "%s: nested too deeply (recursive alias?)",
+                    where);
+  }
+  switch (s->type) {
+  case CYAML_MAPPING:
+    return check_mapping(d, s, id, path, depth);
+  case CYAML_SEQUENCE:
+  case CYAML_SEQUENCE_FIXED:
+    return check_sequence(d, s, id, path, depth);
+  case CYAML_FLAGS:
+    return check_flags(d, s, id, path);
+  case CYAML_IGNORE:
+    return PM_SUCCESS;
+  default:
+    break;
+  }
+  const char *v = pm_sdoc_scalar(d, id);
+  bool ok = v != NULL;
+  if (ok) {
+    switch (s->type) {
+    case CYAML_INT:
+      ok = scalar_is_int(v, s->data_size, true);
+      break;
+    case CYAML_UINT:
+      ok = scalar_is_int(v, s->data_size, false);
+      break;
+    case CYAML_FLOAT:
+      ok = scalar_is_number(v);
+      break;
+    case CYAML_BOOL:
+      ok = strcmp(v, "true") == 0 || strcmp(v, "false") == 0;
+      break;
+    case CYAML_ENUM:
+      ok = name_in(s->enumeration.strings, s->enumeration.count, v);
+      break;
+    case CYAML_STRING:
+      ok = strlen(v) >= s->string.min && strlen(v) <= s->string.max;
+      break;
+    default:
+      ok = false;
+      break;
+    }
+  }
+  return ok ? PM_SUCCESS : expected_at(d, id, path, s);
+}
+
+pm_err pm_sdoc_validate(const pm_sdoc *d, const cyaml_schema_value_t *schema) {
+  return check_value(d, schema, root_id(d), "", 0);
+}
+
+/* ---- overrides -------------------------------------------------------- */
+
+/* Copy node id of document src into d's document; returns the new id or 0
+ * when out of memory. */
+static int copy_node(pm_sdoc *d, yaml_document_t *src, int id, int depth) {
+  yaml_node_t *n = yaml_document_get_node(src, id);
+  int out = 0;
+  if (!n || depth > PM_SDOC_DEPTH) return 0;
+  switch (n->type) {
+  case YAML_SCALAR_NODE:
+    return yaml_document_add_scalar(&d->doc, NULL, n->data.scalar.value,
+                                    (int)n->data.scalar.length,
+                                    n->data.scalar.style);
+  case YAML_SEQUENCE_NODE:
+    out = yaml_document_add_sequence(&d->doc, NULL, YAML_FLOW_SEQUENCE_STYLE);
+    for (yaml_node_item_t *it = n->data.sequence.items.start;
+         out && it < n->data.sequence.items.top; it++) {
+      int item = copy_node(d, src, *it, depth + 1);
+      if (!item || !yaml_document_append_sequence_item(&d->doc, out, item))
+        return 0;
+    }
+    return out;
+  case YAML_MAPPING_NODE:
+    out = yaml_document_add_mapping(&d->doc, NULL, YAML_FLOW_MAPPING_STYLE);
+    for (yaml_node_pair_t *p = n->data.mapping.pairs.start;
+         out && p < n->data.mapping.pairs.top; p++) {
+      int key = copy_node(d, src, p->key, depth + 1);
+      int value = key ? copy_node(d, src, p->value, depth + 1) : 0;
+      if (!value || !yaml_document_append_mapping_pair(&d->doc, out, key,
+                                                       value))
+        return 0;
+    }
+    return out;
+  default:
+    return 0;
+  }
+}
+
+/* Make the node for an override's VALUE text; *id is its node id. */
+static pm_err override_value(pm_sdoc *d, const char *kv, const char *value,
+                             int *id) {
+  pm_err ret = PM_SUCCESS;
+  yaml_parser_t parser;
+  yaml_document_t snip;
+  bool parser_ok = false, snip_ok = false;
+  *id = 0;
+  if (!value[0] || !strchr("[{\"'", value[0])) {
+    *id = yaml_document_add_scalar(&d->doc, NULL, (yaml_char_t *)value,
+                                   (int)strlen(value), YAML_ANY_SCALAR_STYLE);
+    PM_ENSURE(*id, PM_ERR_MEMORY, "--set %s: out of memory", kv);
+    goto done;
+  }
+  PM_ENSURE(yaml_parser_initialize(&parser), PM_ERR_MEMORY,
+            "--set %s: cannot initialise the YAML parser", kv);
+  parser_ok = true;
+  yaml_parser_set_input_string(&parser, (const unsigned char *)value,
+                               strlen(value));
+  PM_ENSURE(yaml_parser_load(&parser, &snip), PM_ERR_SCENE,
+            "--set %s: invalid YAML value: %s", kv,
+            parser.problem ? parser.problem : "unreadable");
+  snip_ok = true;
+  PM_ENSURE(yaml_document_get_root_node(&snip), PM_ERR_SCENE,
+            "--set %s: empty value", kv);
+  *id = copy_node(d, &snip, 1, 0);
+  PM_ENSURE(*id, PM_ERR_MEMORY, "--set %s: out of memory", kv);
+done:
+  if (snip_ok) yaml_document_delete(&snip);
+  if (parser_ok) yaml_parser_delete(&parser);
+  return ret;
+}
+
+/* New empty mapping for an absent parent key, or the value node. */
+static pm_err override_node(pm_sdoc *d, const char *kv, const char *value,
+                            bool last, int *id) {
+  if (last) return override_value(d, kv, value, id);
+  *id = yaml_document_add_mapping(&d->doc, NULL, YAML_BLOCK_MAPPING_STYLE);
+  return *id ? PM_SUCCESS : PM_ERROR(PM_ERR_MEMORY, "--set %s: no memory", kv);
+}
+
+static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
+                             const char *kv) {
+  char key[PM_SDOC_PATH], sofar[PM_SDOC_PATH] = "", names[PM_SDOC_WHERE];
+  const char *eq = strchr(kv, '=');
+  size_t klen = eq ? (size_t)(eq - kv) : 0;
+  PM_CHECK(eq && klen > 0 && klen < sizeof key, PM_ERR_SCENE,
+           "--set %s: expected KEY=VALUE", kv);
+  memcpy(key, kv, klen);
+  key[klen] = '\0';
+  const char *value = eq + 1;
+  const cyaml_schema_value_t *s = schema;
+  int id = root_id(d);
+  for (char *seg = key, *next; seg; seg = next) {
+    next = strchr(seg, '.');
+    if (next) *next++ = '\0';
+    bool last = next == NULL;
+    char parent[PM_SDOC_PATH];
+    snprintf(parent, sizeof parent, "%s", sofar);
+    path_join(sofar, sizeof sofar, parent, seg);
+    yaml_node_t *n = node_get(d, id);
+    int child = 0;
+    if (s->type == CYAML_MAPPING) {
+      const cyaml_schema_field_t *f = s->mapping.fields;
+      while (f->key && strcmp(f->key, seg) != 0) f++;
+      if (!f->key) {
+        list_keys(names, sizeof names, s->mapping.fields);
+        return PM_ERROR(PM_ERR_SCENE,
+                        "--set %s: unknown key %s (expected one of %s)", kv,
+                        sofar, names);
+      }
+      if (n->type != YAML_MAPPING_NODE)
+        return expected_at(d, id, parent, s);
+      yaml_node_pair_t *pair = n->data.mapping.pairs.start;
+      while (pair < n->data.mapping.pairs.top &&
+             strcmp(pm_sdoc_scalar(d, pair->key) ? pm_sdoc_scalar(d, pair->key)
+                                                 : "",
+                    seg) != 0)
+        pair++;
+      if (pair < n->data.mapping.pairs.top && !last) {
+        child = pair->value;
+      } else if (pair < n->data.mapping.pairs.top) {
+        long at = pair - n->data.mapping.pairs.start;
+        PM_CALL(override_value(d, kv, value, &child));
+        /* Adding nodes may move the node array: look the pair up again. */
+        node_get(d, id)->data.mapping.pairs.start[at].value = child;
+      } else {
+        if (!last && f->value.type != CYAML_MAPPING)
+          return PM_ERROR(PM_ERR_SCENE,
+                          "--set %s: %s is not in the scene, so it has no "
+                          "entries to set",
+                          kv, sofar);
+        int k = yaml_document_add_scalar(&d->doc, NULL, (yaml_char_t *)seg,
+                                         (int)strlen(seg),
+                                         YAML_PLAIN_SCALAR_STYLE);
+        PM_CHECK(k, PM_ERR_MEMORY, "--set %s: out of memory", kv);
+        PM_CALL(override_node(d, kv, value, last, &child));
+        PM_CHECK(yaml_document_append_mapping_pair(&d->doc, id, k, child),
+                 PM_ERR_MEMORY, "--set %s: out of memory", kv);
+      }
+      s = &f->value;
+    } else if (s->type == CYAML_SEQUENCE || s->type == CYAML_SEQUENCE_FIXED ||
+               s->type == CYAML_FLAGS) {
+      long i = parse_index(seg);
+      if (i < 0)
+        return PM_ERROR(PM_ERR_SCENE,
+                        "--set %s: %s: expected a list index (0, 1, ...), "
+                        "got %s",
+                        kv, sofar, seg);
+      if (n->type != YAML_SEQUENCE_NODE)
+        return expected_at(d, id, parent, s);
+      long count = n->data.sequence.items.top - n->data.sequence.items.start;
+      const cyaml_schema_value_t *entry =
+          s->type == CYAML_FLAGS ? NULL : s->sequence.entry;
+      if (!last && !entry)
+        return PM_ERROR(PM_ERR_SCENE,
+                        "--set %s: unknown key %s (%s holds names)", kv,
+                        sofar, parent);
+      if (i > count ||
+          (i == count && !last && entry->type != CYAML_MAPPING))
+        return PM_ERROR(PM_ERR_SCENE,
+                        "--set %s: index %ld out of range (%s has %ld "
+                        "entries)",
+                        kv, i, parent, count);
+      if (i < count && !last) {
+        child = n->data.sequence.items.start[i];
+      } else if (i < count) {
+        PM_CALL(override_value(d, kv, value, &child));
+        node_get(d, id)->data.sequence.items.start[i] = child;
+      } else {
+        PM_CALL(override_node(d, kv, value, last, &child));
+        PM_CHECK(yaml_document_append_sequence_item(&d->doc, id, child),
+                 PM_ERR_MEMORY, "--set %s: out of memory", kv);
+      }
+      s = entry;
+    } else {
+      return PM_ERROR(PM_ERR_SCENE,
+                      "--set %s: unknown key %s (%s takes a single value)", kv,
+                      sofar, parent);
+    }
+    id = child;
+  }
+  return PM_SUCCESS;
+}
+
+pm_err pm_sdoc_apply_overrides(pm_sdoc *d, const cyaml_schema_value_t *schema,
+                               int n, const char *const *overrides) {
+  if (n <= 0) return PM_SUCCESS;
+  PM_CALL(PM_ALLOC(d->override_end, n, "override marks"));
+  d->overrides = overrides;
+  for (int k = 0; k < n; k++) {
+    PM_CALL(apply_override(d, schema, overrides[k]));
+    d->override_end[k] = node_count(d);
+    d->n_overrides = k + 1;
+  }
+  return PM_SUCCESS;
+}
+
+/* ---- emitting --------------------------------------------------------- */
+
+typedef struct {
+  char *data;
+  size_t len, cap;
+} emit_buf;
+
+static int emit_write(void *ctx, unsigned char *bytes, size_t size) {
+  emit_buf *b = ctx;
+  if (b->len + size + 1 > b->cap) {
+    size_t cap = 2 * (b->len + size + 1);
+    char *grown = realloc(b->data, cap);
+    if (!grown) return 0;
+    b->data = grown;
+    b->cap = cap;
+  }
+  memcpy(b->data + b->len, bytes, size);
+  b->len += size;
+  b->data[b->len] = '\0';
+  return 1;
+}
+
+static bool emit_node(yaml_emitter_t *em, pm_sdoc *d, int id, int depth) {
+  yaml_node_t *n = node_get(d, id);
+  yaml_event_t ev;
+  if (!n || depth > PM_SDOC_DEPTH) return false;
+  switch (n->type) {
+  case YAML_SCALAR_NODE:
+    return yaml_scalar_event_initialize(&ev, NULL, NULL, n->data.scalar.value,
+                                        (int)n->data.scalar.length, 1, 1,
+                                        n->data.scalar.style) &&
+           yaml_emitter_emit(em, &ev);
+  case YAML_SEQUENCE_NODE:
+    if (!yaml_sequence_start_event_initialize(&ev, NULL, NULL, 1,
+                                              YAML_ANY_SEQUENCE_STYLE) ||
+        !yaml_emitter_emit(em, &ev))
+      return false;
+    for (int i = 0; i < n->data.sequence.items.top - n->data.sequence.items.start;
+         i++)
+      if (!emit_node(em, d, node_get(d, id)->data.sequence.items.start[i],
+                     depth + 1))
+        return false;
+    return yaml_sequence_end_event_initialize(&ev) &&
+           yaml_emitter_emit(em, &ev);
+  case YAML_MAPPING_NODE:
+    if (!yaml_mapping_start_event_initialize(&ev, NULL, NULL, 1,
+                                             YAML_ANY_MAPPING_STYLE) ||
+        !yaml_emitter_emit(em, &ev))
+      return false;
+    for (int i = 0; i < n->data.mapping.pairs.top - n->data.mapping.pairs.start;
+         i++) {
+      yaml_node_pair_t p = node_get(d, id)->data.mapping.pairs.start[i];
+      if (!emit_node(em, d, p.key, depth + 1) ||
+          !emit_node(em, d, p.value, depth + 1))
+        return false;
+    }
+    return yaml_mapping_end_event_initialize(&ev) &&
+           yaml_emitter_emit(em, &ev);
+  default:
+    return false;
+  }
+}
+
+pm_err pm_sdoc_emit(pm_sdoc *d, char **text, size_t *len) {
+  pm_err ret = PM_SUCCESS;
+  yaml_emitter_t em;
+  yaml_event_t ev;
+  emit_buf b = {NULL, 0, 0};
+  bool em_ok = false;
+  *text = NULL;
+  *len = 0;
+  PM_ENSURE(yaml_emitter_initialize(&em), PM_ERR_MEMORY,
+            "cannot initialise the YAML emitter");
+  em_ok = true;
+  yaml_emitter_set_output(&em, emit_write, &b);
+  yaml_emitter_set_unicode(&em, 1);
+  bool ok = yaml_stream_start_event_initialize(&ev, YAML_UTF8_ENCODING) &&
+            yaml_emitter_emit(&em, &ev) &&
+            yaml_document_start_event_initialize(&ev, NULL, NULL, NULL, 1) &&
+            yaml_emitter_emit(&em, &ev) && emit_node(&em, d, root_id(d), 0) &&
+            yaml_document_end_event_initialize(&ev, 1) &&
+            yaml_emitter_emit(&em, &ev) && yaml_stream_end_event_initialize(&ev) &&
+            yaml_emitter_emit(&em, &ev) && yaml_emitter_flush(&em);
+  PM_ENSURE(ok && b.data, PM_ERR_INTERNAL, "%s: cannot re-emit the scene: %s",
+            d->path, em.problem ? em.problem : "out of memory");
+  *text = b.data;
+  *len = b.len;
+  b.data = NULL;
+done:
+  free(b.data);
+  if (em_ok) yaml_emitter_delete(&em);
+  return ret;
+}

@@ -1,0 +1,65 @@
+/* fpm_driver: a whole FPM simulation of a scene: meshing, subdomains,
+ * operators, the time loop, results, history, summary, and the plan. */
+#ifndef FPM_DRIVER_H
+#define FPM_DRIVER_H
+
+#include <stdio.h>
+
+#include "fpm_model.h"
+#include "fpm_solver.h"
+#include "gm_dual.h"
+#include "pm_progress.h"
+#include "pm_scene.h"
+
+typedef enum {
+  FPM_STATUS_NOT_RUN = 0,
+  FPM_STATUS_COMPLETED,     /* reached time.end / max_steps (dynamics) */
+  FPM_STATUS_CONVERGED,     /* quasi-static residual below tolerance */
+  FPM_STATUS_NOT_CONVERGED, /* quasi-static, ran out of time or steps */
+  FPM_STATUS_UNSTABLE,      /* stopped on a numerical failure */
+  FPM_STATUS_FAILED         /* other failure (I/O, ...) */
+} fpm_status;
+
+/* A prepared simulation.  Fields are read-only for callers. */
+typedef struct {
+  const pm_scene *scene;    /* borrowed */
+  gm_mesh *mesh;
+  gm_dual *dual;
+  fpm_model *model;
+  fpm_state *state;
+  double dt, dt_stable;     /* s */
+  long dt_point;            /* point that sets the stable step */
+  double mean_edge;         /* mean mesh edge length, m */
+  pm_timers timers;
+  int tm_mesh, tm_dual, tm_operators, tm_force, tm_update, tm_output;
+  /* after a run */
+  fpm_status status;
+  fpm_step_info last;
+  double wall;              /* run wall time (time loop + output), s */
+  double setup_wall;        /* mesh + dual + operators, s */
+  int n_ref;                /* reference components compared */
+  double nrmse[3];          /* eq. 28 per component, NaN if no reference */
+  double *scratch;          /* 9 n: output and metrics buffer */
+  char message[1024];       /* failure message, if any */
+} fpm_sim;
+
+/* Mesh the scene's domain, build subdomains, operators and state, and pick
+ * dt (time.dt if set, else dt_safety times the stable step). */
+pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out);
+void fpm_sim_destroy(fpm_sim *sim);
+
+/* Run to the end (or to the quasi-static state).  With out_dir non-NULL,
+ * writes results.h5 + results.xdmf, history.csv and summary.json there
+ * (each atomically); with quiet false, shows a progress line on a terminal
+ * and prints the stage timing table to stderr.  Returns PM_ERR_UNSTABLE on a
+ * numerical failure (outputs keep the frames up to it and summary.json says
+ * so) and PM_ERR_NOT_CONVERGED if a quasi-static run did not converge. */
+pm_err fpm_sim_run(fpm_sim *sim, const char *out_dir, bool quiet);
+
+/* Print the plan: pipeline, counts, dt, steps, memory and an estimated run
+ * time from timing a few force evaluations. */
+pm_err fpm_sim_plan(fpm_sim *sim, FILE *out);
+
+const char *fpm_status_name(fpm_status s);
+
+#endif

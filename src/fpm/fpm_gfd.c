@@ -1,0 +1,87 @@
+/* fpm_gfd: weighted least-squares gradient weights per point; the symmetric
+ * moment matrix is diagonalized by LAPACKE so its conditioning is known. */
+#include "fpm_gfd.h"
+
+#include <lapacke.h>
+#include <math.h>
+
+#include "pm_omp.h"
+
+pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
+                       const long *nbr, double cond_max, double *g,
+                       double *cond) {
+  PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG, "dimension must be 2 or 3");
+  long worst = -1;
+  double worst_cond = 0;
+  int lapack_info = 0;
+  long lapack_point = -1;
+  PM_OMP(parallel for schedule(dynamic, 256) default(none)
+         shared(n, x, nbr_ptr, nbr, g, cond, dim, cond_max, worst, worst_cond,
+                lapack_info, lapack_point))
+  for (long i = 0; i < n; i++) {
+    double A[9] = {0}, wsum = 0;
+    const double *xi = x + 3 * i;
+    for (long e = nbr_ptr[i]; e < nbr_ptr[i + 1]; e++) {
+      const double *xk = x + 3 * nbr[e];
+      double d[3] = {xk[0] - xi[0], xk[1] - xi[1], xk[2] - xi[2]};
+      double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      wsum += w;
+      for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++) A[dim * a + b] += w * d[a] * d[b];
+    }
+    /* Scale to a dimensionless matrix (eigenvalues sum to 1). */
+    for (int k = 0; k < dim * dim; k++) A[k] /= wsum;
+    double lam[3];
+    int info = LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', dim, A, dim, lam);
+    double c = (info == 0 && lam[0] > 0) ? lam[dim - 1] / lam[0] : INFINITY;
+    if (cond) cond[i] = c;
+    if (info != 0) {
+      PM_OMP(critical(fpm_gfd_fail)) {
+        lapack_info = info;
+        lapack_point = i;
+      }
+      continue;
+    }
+    if (!(c <= cond_max)) {
+      PM_OMP(critical(fpm_gfd_fail))
+      if (worst < 0 || !(c <= worst_cond)) {
+        worst = i;
+        worst_cond = c;
+      }
+      continue;
+    }
+    /* A^-1 = V diag(1/lam) V^T (columns of V are eigenvectors). */
+    double Ainv[9] = {0};
+    for (int a = 0; a < dim; a++)
+      for (int b = 0; b < dim; b++)
+        for (int m = 0; m < dim; m++)
+          Ainv[dim * a + b] += A[dim * a + m] * A[dim * b + m] / lam[m];
+    for (long e = nbr_ptr[i]; e < nbr_ptr[i + 1]; e++) {
+      const double *xk = x + 3 * nbr[e];
+      double d[3] = {xk[0] - xi[0], xk[1] - xi[1], xk[2] - xi[2]};
+      double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / wsum;
+      for (int a = 0; a < 3; a++) g[3 * e + a] = 0;
+      for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++) g[3 * e + a] += Ainv[dim * a + b] * w * d[b];
+    }
+  }
+  if (lapack_info < 0)
+    return PM_ERROR(PM_ERR_LINALG,
+                    "LAPACKE_dsyev: argument %d is invalid (point %ld)",
+                    -lapack_info, lapack_point);
+  if (lapack_info > 0)
+    return PM_ERROR(PM_ERR_LINALG,
+                    "LAPACKE_dsyev did not converge at point %ld "
+                    "(%g, %g, %g)",
+                    lapack_point, x[3 * lapack_point], x[3 * lapack_point + 1],
+                    x[3 * lapack_point + 2]);
+  if (worst >= 0)
+    return PM_ERROR(PM_ERR_GEOMETRY,
+                    "ill-conditioned support at point %ld (%g, %g, %g): "
+                    "%ld neighbours, condition number %.3g > %.3g; the "
+                    "support does not span %dD",
+                    worst, x[3 * worst], x[3 * worst + 1], x[3 * worst + 2],
+                    nbr_ptr[worst + 1] - nbr_ptr[worst], worst_cond, cond_max,
+                    dim);
+  return PM_SUCCESS;
+}

@@ -1,0 +1,25 @@
+/* fpm_gfd: generalized finite-difference gradient operator of the Fragile
+ * Points Method, by weighted least squares over each point's support. */
+#ifndef FPM_GFD_H
+#define FPM_GFD_H
+
+#include "pm_error.h"
+
+/* Weights g_ik such that grad u_i = sum_k (u_k - u_i) (x) g_ik for the
+ * support k in nbr[nbr_ptr[i] .. nbr_ptr[i+1]).  They minimize
+ *   sum_k w_ik |u_k - u_i - G (X_k - X_i)|^2,  w_ik = 1 / |X_k - X_i|^2,
+ * so a linear field is reproduced exactly; the inverse-square weight makes
+ * the fit scale-free and favours the nearest points.  In 2D (dim = 2) the
+ * z components of g are zero.
+ *   x      3 * n reference positions
+ *   g      out, 3 * nbr_ptr[n] weights, one triple per support entry
+ *   cond   out (may be NULL), n condition numbers of the scaled moment
+ *          matrix sum_k w_ik d_k d_k^T / (sum_k w_ik)
+ * Fails with PM_ERR_GEOMETRY naming the worst point (id and position) if a
+ * support does not span the space (condition number above cond_max), and
+ * with PM_ERR_LINALG when LAPACKE reports a failure. */
+pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
+                       const long *nbr, double cond_max, double *g,
+                       double *cond);
+
+#endif

@@ -1,0 +1,397 @@
+/* fpm_model: everything the FPM time loop reads but never changes, computed
+ * once from the scene and the median-dual subdomains. */
+#include "fpm_model.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_gfd.h"
+#include "pm_omp.h"
+
+/* Supports whose scaled moment matrix is worse than this cannot give a
+ * usable gradient. */
+#define FPM_COND_MAX 1e8
+
+void fpm_model_destroy(fpm_model *m) {
+  if (!m) return;
+  free(m->g);
+  free(m->gsum);
+  free(m->mirror);
+  free(m->cond);
+  free(m->e_area);
+  free(m->e_mrel);
+  free(m->e_di);
+  free(m->e_dk);
+  free(m->e_beta);
+  free(m->p_area);
+  free(m->p_mrel);
+  free(m->mat);
+  free(m->mass);
+  free(m->dpt_point);
+  free(m->dpt_area);
+  free(m->dpt_mrel);
+  free(m->tf_point);
+  free(m->tf_bc);
+  free(m->tf_area);
+  free(m->tf_rel);
+  free(m->tf_centroid);
+  free(m->tf_base);
+  free(m->cd_point);
+  free(m->cd_comp);
+  free(m->cd_bc);
+  free(m->cd_base);
+  free(m->fixed);
+  free(m);
+}
+
+size_t fpm_model_bytes(const fpm_model *m) {
+  size_t d = sizeof(double);
+  return m->nnz * (3 + 3 + 9 + 3 + 3 + 1) * d + m->nnz * sizeof(long) +
+         m->n * (3 + 1 + 3 + 9 + 1) * d + m->n * (sizeof(int) + 3) +
+         m->n_dpts * (36 * d + sizeof(long)) +
+         m->n_tfacets * (7 * d + sizeof(long) + sizeof(int)) +
+         m->n_cdofs * (d + sizeof(long) + 2 * sizeof(int));
+}
+
+/* Entry (k, i) for every entry (i, k): supports are symmetric (mesh
+ * edges), and the sorted CSR rows make it a binary search. */
+static pm_err build_mirror(fpm_model *m) {
+  for (long i = 0; i < m->n; i++)
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+      long k = m->nbr[e], lo = m->nbr_ptr[k], hi = m->nbr_ptr[k + 1] - 1;
+      long found = -1;
+      while (lo <= hi) {
+        long mid = (lo + hi) / 2;
+        if (m->nbr[mid] == i) {
+          found = mid;
+          break;
+        }
+        if (m->nbr[mid] < i) lo = mid + 1;
+        else hi = mid - 1;
+      }
+      PM_CHECK(found >= 0, PM_ERR_GEOMETRY,
+               "support of point %ld holds %ld but not the reverse", i, k);
+      m->mirror[e] = found;
+    }
+  return PM_SUCCESS;
+}
+
+static pm_err assign_materials(fpm_model *m, const pm_scene *s) {
+  PM_CHECK(s->n_materials >= 1 && s->n_materials <= FPM_MAX_MATERIALS,
+           PM_ERR_SCENE, "%s: between 1 and %d materials are supported (got %d)",
+           s->path, FPM_MAX_MATERIALS, s->n_materials);
+  m->n_mats = s->n_materials;
+  for (int k = 0; k < s->n_materials; k++) m->mats[k] = s->materials[k].mat;
+  for (long i = 0; i < m->n; i++) m->mat[i] = -1;
+  if (s->n_bodies == 0)
+    for (long i = 0; i < m->n; i++) m->mat[i] = 0;
+  for (int b = 0; b < s->n_bodies; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    for (long i = 0; i < m->n; i++) {
+      const double *xi = m->x + 3 * i;
+      if (!body->region || pm_expr_eval(body->region, xi[0], xi[1], xi[2], 0) > 0)
+        m->mat[i] = body->material;
+    }
+  }
+  for (long i = 0; i < m->n; i++)
+    PM_CHECK(m->mat[i] >= 0, PM_ERR_SCENE,
+             "%s: point %ld at (%g, %g, %g) lies in no body's region", s->path,
+             i, m->x[3 * i], m->x[3 * i + 1], m->x[3 * i + 2]);
+  for (long i = 0; i < m->n; i++)
+    m->mass[i] = m->mats[m->mat[i]].density * m->dual->volume[i];
+  return PM_SUCCESS;
+}
+
+/* Interface data per support entry, oriented outward from the entry's
+ * point, and the per-point sums of the consistency geometry. */
+static void build_interfaces(fpm_model *m) {
+  const gm_dual *d = m->dual;
+  for (long i = 0; i < m->n; i++) {
+    const double *xi = m->x + 3 * i;
+    double *pa = m->p_area + 3 * i, *pm = m->p_mrel + 9 * i;
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+      long k = m->nbr[e], f = d->nbr_iface[e];
+      const double *xk = m->x + 3 * k, *xe = d->if_centroid + 3 * f;
+      double sign = d->if_pair[2 * f] == i ? 1.0 : -1.0;
+      for (int a = 0; a < 3; a++) {
+        m->e_area[3 * e + a] = sign * d->if_area_vec[3 * f + a];
+        m->e_di[3 * e + a] = xe[a] - xi[a];
+        m->e_dk[3 * e + a] = xe[a] - xk[a];
+        pa[a] += m->e_area[3 * e + a];
+      }
+      for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+          double v = sign * d->if_moment[9 * f + 3 * a + b] -
+                     m->e_area[3 * e + a] * xi[b];
+          m->e_mrel[9 * e + 3 * a + b] = v;
+          pm[3 * a + b] += v;
+        }
+      double h = sqrt((xk[0] - xi[0]) * (xk[0] - xi[0]) +
+                      (xk[1] - xi[1]) * (xk[1] - xi[1]) +
+                      (xk[2] - xi[2]) * (xk[2] - xi[2]));
+      double E = 0.5 * (m->mats[m->mat[i]].youngs + m->mats[m->mat[k]].youngs);
+      m->e_beta[e] = m->penalty * E / h * d->if_area[f];
+    }
+  }
+}
+
+/* Boundary conditions: prescribed dofs from facets on faces with
+ * displacement conditions, the consistency flux of those facets, and the
+ * traction facets. */
+static pm_err build_boundary(fpm_model *m, const pm_scene *s) {
+  pm_err ret = PM_SUCCESS;
+  const gm_dual *d = m->dual;
+  int *bc_of = NULL;  /* 3 n: condition prescribing each dof, or -1 */
+  long *dpt_of = NULL; /* n: index into the dpt arrays, or -1 */
+  PM_TRY(PM_ALLOC(bc_of, 3 * m->n, "boundary dof map"));
+  PM_TRY(PM_ALLOC(dpt_of, m->n, "boundary point map"));
+  for (long k = 0; k < 3 * m->n; k++) bc_of[k] = -1;
+  for (long i = 0; i < m->n; i++) dpt_of[i] = -1;
+  m->n_dpts = 0;
+  m->n_tfacets = 0;
+  for (int b = 0; b < s->n_bcs; b++) {
+    const pm_scene_bc *bc = &s->bcs[b];
+    long on_face = 0;
+    for (long f = 0; f < d->n_facets; f++) {
+      if (d->facet_face[f] != (int)bc->face) continue;
+      on_face++;
+      long i = d->facet_point[f];
+      for (int c = 0; c < 3; c++)
+        if (bc->disp_mask & (1u << c)) bc_of[3 * i + c] = b;
+      if (bc->disp_mask && dpt_of[i] < 0) dpt_of[i] = m->n_dpts++;
+      if (bc->traction_mask) m->n_tfacets++;
+    }
+    PM_ENSURE(on_face > 0, PM_ERR_SCENE,
+              "%s:%d:%d: boundary condition on %s: no boundary facet lies on "
+              "that face",
+              s->path, bc->mark.line, bc->mark.col, pm_face_name(bc->face));
+  }
+  /* In 2D (plane strain) the out-of-plane component is fixed at zero. */
+  if (m->dim == 2)
+    for (long i = 0; i < m->n; i++) m->fixed[3 * i + 2] = 1;
+  m->n_cdofs = 0;
+  for (long k = 0; k < 3 * m->n; k++)
+    if (bc_of[k] >= 0) m->n_cdofs++;
+  PM_TRY(PM_ALLOC(m->cd_point, m->n_cdofs, "constrained dofs"));
+  PM_TRY(PM_ALLOC(m->cd_comp, m->n_cdofs, "constrained dofs"));
+  PM_TRY(PM_ALLOC(m->cd_bc, m->n_cdofs, "constrained dofs"));
+  PM_TRY(PM_ALLOC(m->cd_base, m->n_cdofs, "constrained dofs"));
+  long nc = 0;
+  for (long k = 0; k < 3 * m->n; k++) {
+    if (bc_of[k] < 0) continue;
+    long i = k / 3;
+    int c = (int)(k % 3);
+    const pm_scene_bc *bc = &s->bcs[bc_of[k]];
+    const double *xi = m->x + 3 * i;
+    m->cd_point[nc] = i;
+    m->cd_comp[nc] = c;
+    m->cd_bc[nc] = bc_of[k];
+    m->cd_base[nc] = pm_expr_eval(bc->disp[c], xi[0], xi[1], xi[2], 0);
+    if (pm_expr_uses(bc->disp[c], 't')) m->cd_time_dependent = true;
+    m->fixed[k] = 1;
+    nc++;
+  }
+  PM_TRY(PM_ALLOC(m->dpt_point, m->n_dpts, "boundary flux points"));
+  PM_TRY(PM_ALLOC(m->dpt_area, 9 * m->n_dpts, "boundary flux areas"));
+  PM_TRY(PM_ALLOC(m->dpt_mrel, 27 * m->n_dpts, "boundary flux moments"));
+  PM_TRY(PM_ALLOC(m->tf_point, m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_bc, m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_area, m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_rel, 3 * m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_centroid, 3 * m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_base, 3 * m->n_tfacets, "traction facets"));
+  long nt = 0;
+  for (int b = 0; b < s->n_bcs; b++) {
+    const pm_scene_bc *bc = &s->bcs[b];
+    for (long f = 0; f < d->n_facets; f++) {
+      if (d->facet_face[f] != (int)bc->face) continue;
+      long i = d->facet_point[f];
+      const double *xi = m->x + 3 * i, *af = d->facet_area_vec + 3 * f;
+      const double *Mf = d->facet_moment + 9 * f, *cf = d->facet_centroid + 3 * f;
+      if (bc->disp_mask) {
+        long p = dpt_of[i];
+        m->dpt_point[p] = i;
+        for (int c = 0; c < 3; c++) {
+          if (!(bc->disp_mask & (1u << c))) continue;
+          for (int a = 0; a < 3; a++) {
+            m->dpt_area[9 * p + 3 * c + a] += af[a];
+            for (int q = 0; q < 3; q++)
+              m->dpt_mrel[27 * p + 9 * c + 3 * a + q] +=
+                  Mf[3 * a + q] - af[a] * xi[q];
+          }
+        }
+      }
+      if (bc->traction_mask) {
+        m->tf_point[nt] = i;
+        m->tf_bc[nt] = b;
+        m->tf_area[nt] = d->facet_area[f];
+        for (int a = 0; a < 3; a++) {
+          m->tf_rel[3 * nt + a] = d->facet_area[f] * (cf[a] - xi[a]);
+          m->tf_centroid[3 * nt + a] = cf[a];
+        }
+        for (int c = 0; c < 3; c++) {
+          if (!(bc->traction_mask & (1u << c))) continue;
+          m->tf_base[3 * nt + c] =
+              pm_expr_eval(bc->traction[c], cf[0], cf[1], cf[2], 0);
+          if (pm_expr_uses(bc->traction[c], 't')) m->tf_time_dependent = true;
+        }
+        nt++;
+      }
+    }
+  }
+done:
+  free(bc_of);
+  free(dpt_of);
+  return ret;
+}
+
+pm_err fpm_model_create(const pm_scene *s, const gm_dual *d, fpm_model **out) {
+  pm_err ret = PM_SUCCESS;
+  fpm_model *m = NULL;
+  *out = NULL;
+  PM_TRY(PM_ALLOC(m, 1, "FPM model"));
+  m->dim = d->dim;
+  m->n = d->n_points;
+  m->dual = d;
+  m->x = d->x;
+  m->nbr_ptr = d->nbr_ptr;
+  m->nbr = d->nbr;
+  m->nnz = d->nbr_ptr[d->n_points];
+  m->scene = s;
+  m->penalty = s->fpm.penalty;
+  long n = m->n, nnz = m->nnz;
+  PM_TRY(PM_ALLOC(m->g, 3 * nnz, "GFD weights"));
+  PM_TRY(PM_ALLOC(m->gsum, 3 * n, "GFD weight sums"));
+  PM_TRY(PM_ALLOC(m->mirror, nnz, "support mirror"));
+  PM_TRY(PM_ALLOC(m->cond, n, "support condition numbers"));
+  PM_TRY(PM_ALLOC(m->e_area, 3 * nnz, "interface areas"));
+  PM_TRY(PM_ALLOC(m->e_mrel, 9 * nnz, "interface moments"));
+  PM_TRY(PM_ALLOC(m->e_di, 3 * nnz, "interface offsets"));
+  PM_TRY(PM_ALLOC(m->e_dk, 3 * nnz, "interface offsets"));
+  PM_TRY(PM_ALLOC(m->e_beta, nnz, "interface penalties"));
+  PM_TRY(PM_ALLOC(m->p_area, 3 * n, "point area sums"));
+  PM_TRY(PM_ALLOC(m->p_mrel, 9 * n, "point moment sums"));
+  PM_TRY(PM_ALLOC(m->mat, n, "point materials"));
+  PM_TRY(PM_ALLOC(m->mass, n, "point masses"));
+  PM_TRY(PM_ALLOC(m->fixed, 3 * n, "constraint mask"));
+  PM_TRY(fpm_gfd_weights(m->dim, n, m->x, m->nbr_ptr, m->nbr, FPM_COND_MAX,
+                         m->g, m->cond));
+  for (long i = 0; i < n; i++)
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
+      for (int a = 0; a < 3; a++) m->gsum[3 * i + a] += m->g[3 * e + a];
+  PM_TRY(build_mirror(m));
+  PM_TRY(assign_materials(m, s));
+  build_interfaces(m);
+  PM_TRY(build_boundary(m, s));
+  *out = m;
+  m = NULL;
+done:
+  fpm_model_destroy(m);
+  return ret;
+}
+
+pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
+  pm_err ret = PM_SUCCESS;
+  fpm_state *st = NULL;
+  *out = NULL;
+  PM_TRY(PM_ALLOC(st, 1, "FPM state"));
+  long n = m->n;
+  PM_TRY(PM_ALLOC(st->u, 3 * n, "displacement"));
+  PM_TRY(PM_ALLOC(st->v, 3 * n, "velocity"));
+  PM_TRY(PM_ALLOC(st->f, 3 * n, "force"));
+  PM_TRY(PM_ALLOC(st->H, 9 * n, "displacement gradient"));
+  PM_TRY(PM_ALLOC(st->P, 9 * n, "stress"));
+  PM_TRY(PM_ALLOC(st->T, 9 * n, "flux tensor"));
+  PM_TRY(PM_ALLOC(st->r, 3 * n, "interface force"));
+  PM_TRY(PM_ALLOC(st->W, n, "strain energy density"));
+  PM_TRY(PM_ALLOC(st->J, n, "volume ratio"));
+  PM_TRY(PM_ALLOC(st->tf_value, 3 * m->n_tfacets, "tractions"));
+  *out = st;
+  st = NULL;
+done:
+  fpm_state_destroy(st);
+  return ret;
+}
+
+void fpm_state_destroy(fpm_state *st) {
+  if (!st) return;
+  free(st->u);
+  free(st->v);
+  free(st->f);
+  free(st->H);
+  free(st->P);
+  free(st->T);
+  free(st->r);
+  free(st->W);
+  free(st->J);
+  free(st->tf_value);
+  free(st);
+}
+
+size_t fpm_state_bytes(const fpm_model *m) {
+  return (size_t)m->n * (3 * 4 + 9 * 3 + 2) * sizeof(double) +
+         (size_t)m->n_tfacets * 3 * sizeof(double);
+}
+
+double fpm_prescribed(const fpm_model *m, long k, double t) {
+  const pm_scene_bc *bc = &m->scene->bcs[m->cd_bc[k]];
+  double T = bc->ramp_time > 0 ? bc->ramp_time : m->scene->time.ramp;
+  double r = pm_ramp_factor(bc->ramp, T, t);
+  if (!m->cd_time_dependent) return r * m->cd_base[k];
+  const double *xi = m->x + 3 * m->cd_point[k];
+  return r * pm_expr_eval(bc->disp[m->cd_comp[k]], xi[0], xi[1], xi[2], t);
+}
+
+void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t) {
+  double norm2 = 0;
+  for (long k = 0; k < m->n_tfacets; k++) {
+    const pm_scene_bc *bc = &m->scene->bcs[m->tf_bc[k]];
+    double T = bc->ramp_time > 0 ? bc->ramp_time : m->scene->time.ramp;
+    double r = pm_ramp_factor(bc->ramp, T, t);
+    const double *c = m->tf_centroid + 3 * k;
+    for (int a = 0; a < 3; a++) {
+      double v = 0;
+      if (!(bc->traction_mask & (1u << a))) v = 0;
+      else if (m->tf_time_dependent)
+        v = r * pm_expr_eval(bc->traction[a], c[0], c[1], c[2], t);
+      else v = r * m->tf_base[3 * k + a];
+      st->tf_value[3 * k + a] = v;
+      norm2 += v * v * m->tf_area[k] * m->tf_area[k];
+    }
+  }
+  st->fext_norm = sqrt(norm2);
+}
+
+double fpm_load_end(const fpm_model *m) {
+  double end = 0;
+  for (int b = 0; b < m->scene->n_bcs; b++) {
+    const pm_scene_bc *bc = &m->scene->bcs[b];
+    if (bc->ramp == PM_RAMP_NONE) continue;
+    double T = bc->ramp_time > 0 ? bc->ramp_time : m->scene->time.ramp;
+    if (T > end) end = T;
+  }
+  return end;
+}
+
+double fpm_stable_dt(const fpm_model *m, long *critical_point) {
+  double lam_max = 0;
+  long crit = 0;
+  for (long j = 0; j < m->n; j++) {
+    double c2 = m->mats[m->mat[j]].wave_speed;
+    c2 *= c2;
+    double C2 = 0;
+    for (long e = m->nbr_ptr[j]; e < m->nbr_ptr[j + 1]; e++)
+      for (int a = 0; a < 3; a++) C2 += m->g[3 * e + a] * m->g[3 * e + a];
+    for (int a = 0; a < 3; a++) C2 += m->gsum[3 * j + a] * m->gsum[3 * j + a];
+    double mj = (double)(m->nbr_ptr[j + 1] - m->nbr_ptr[j]);
+    double lam = mj * c2 * C2;
+    if (lam > lam_max) {
+      lam_max = lam;
+      crit = j;
+    }
+  }
+  if (critical_point) *critical_point = crit;
+  double p = m->penalty > 1 ? m->penalty : 1;
+  return 2.0 / sqrt(lam_max) / sqrt(p);
+}

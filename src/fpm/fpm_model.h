@@ -1,0 +1,121 @@
+/* fpm_model: the Fragile Points Method discretization of a scene: points,
+ * supports, GFD operators, interface and boundary geometry, masses, boundary
+ * conditions, all computed once before the time loop; and the state. */
+#ifndef FPM_MODEL_H
+#define FPM_MODEL_H
+
+#include <stdbool.h>
+
+#include "gm_dual.h"
+#include "pm_error.h"
+#include "pm_material.h"
+#include "pm_scene.h"
+
+#define FPM_MAX_MATERIALS 16
+
+/* Everything that does not change during a run.  Arrays are per point
+ * (n), per support entry (nnz, in the CSR order of the dual's adjacency) or
+ * per boundary item.  Vectors are 3 per item, tensors 9 (row-major). */
+typedef struct {
+  int dim;
+  long n;                  /* points */
+  const gm_dual *dual;     /* borrowed: positions, volumes, adjacency */
+  const double *x;         /* dual->x */
+  const long *nbr_ptr;     /* dual->nbr_ptr */
+  const long *nbr;         /* dual->nbr */
+  long nnz;                /* support entries */
+  double *g;               /* 3 nnz: GFD weight g_ik of entry (i, k) */
+  double *gsum;            /* 3 n: sum_k g_ik */
+  long *mirror;            /* nnz: entry (k, i) of entry (i, k) */
+  double *cond;            /* n: support condition numbers */
+  /* Interface geometry per entry, oriented outward from the entry's point. */
+  double *e_area;          /* 3 nnz: a_e */
+  double *e_mrel;          /* 9 nnz: M_e - a_e (x) X_i */
+  double *e_di;            /* 3 nnz: x_e - X_i */
+  double *e_dk;            /* 3 nnz: x_e - X_k */
+  double *e_beta;          /* nnz: beta_e |e| = p E / h_e * area */
+  double *p_area;          /* 3 n: sum of the entries' a_e */
+  double *p_mrel;          /* 9 n: sum of the entries' M_e - a_e (x) X_i */
+  /* Materials. */
+  int n_mats;
+  pm_material mats[FPM_MAX_MATERIALS];
+  int *mat;                /* n: material of each point */
+  double *mass;            /* n: lumped mass rho V */
+  double penalty;          /* p */
+  /* Consistency flux on faces with displacement conditions, per point that
+   * has such facets: row c of the projected flux uses area A^c and moment
+   * B^c summed over the facets that prescribe component c. */
+  long n_dpts;
+  long *dpt_point;         /* n_dpts */
+  double *dpt_area;        /* 9 n_dpts: A^c for c = 0..2, 3 each */
+  double *dpt_mrel;        /* 27 n_dpts: B^c for c = 0..2, 9 each */
+  /* Traction facets (one row per facet and traction condition). */
+  long n_tfacets;
+  long *tf_point;          /* n_tfacets */
+  int *tf_bc;              /* n_tfacets: scene boundary condition */
+  double *tf_area;         /* n_tfacets: |f| */
+  double *tf_rel;          /* 3 n_tfacets: |f| (c_f - X_i) */
+  double *tf_centroid;     /* 3 n_tfacets */
+  double *tf_base;         /* 3 n_tfacets: traction at full load (t = 0) */
+  bool tf_time_dependent;  /* some traction expression uses t */
+  /* Prescribed displacement components. */
+  long n_cdofs;
+  long *cd_point;
+  int *cd_comp;
+  int *cd_bc;              /* scene boundary condition */
+  double *cd_base;         /* value at full load (t-independent part) */
+  bool cd_time_dependent;  /* some displacement expression uses t */
+  unsigned char *fixed;    /* 3 n: 1 where the component is prescribed */
+  const pm_scene *scene;   /* borrowed: boundary expressions and ramps */
+} fpm_model;
+
+/* Fields that change every step.  All allocated by fpm_state_create. */
+typedef struct {
+  double *u, *v;           /* 3 n displacement, velocity (half step) */
+  double *f;               /* 3 n net force f_int - f_ext */
+  double *H;               /* 9 n: F - I per point */
+  double *P;               /* 9 n: first Piola-Kirchhoff stress */
+  double *T;               /* 9 n: V P - Q, the gathered flux tensor */
+  double *r;               /* 3 n: interface and boundary force terms */
+  double *W;               /* n: strain energy density */
+  double *J;               /* n: det F */
+  double *tf_value;        /* 3 n_tfacets: traction at the current time */
+  double fext_norm;        /* |f_ext| of the current tractions */
+  double bflux_norm;       /* |consistency flux on prescribed faces| */
+} fpm_state;
+
+/* Build the model of scene s on dual d (both borrowed and kept alive by the
+ * caller until fpm_model_destroy).  Computes the GFD weights (failing with
+ * the point id and position of an ill-conditioned support), interface
+ * geometry, masses and boundary conditions. */
+pm_err fpm_model_create(const pm_scene *s, const gm_dual *d, fpm_model **out);
+void fpm_model_destroy(fpm_model *m);
+/* Bytes held by the model (not counting the dual). */
+size_t fpm_model_bytes(const fpm_model *m);
+
+pm_err fpm_state_create(const fpm_model *m, fpm_state **out);
+void fpm_state_destroy(fpm_state *st);
+size_t fpm_state_bytes(const fpm_model *m);
+
+/* Prescribed value of constrained dof k at time t. */
+double fpm_prescribed(const fpm_model *m, long k, double t);
+/* Evaluate the traction of every traction facet at time t into
+ * st->tf_value (serial: expressions are not thread-safe). */
+void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t);
+
+/* Time at which every ramped load has reached its full value. */
+double fpm_load_end(const fpm_model *m);
+
+/* The net nodal force f = f_int(u) - f_ext(t) into st->f (also F, P, W, J,
+ * T, r).  Returns -1, or the smallest point id whose deformation gradient
+ * is inadmissible (J <= 0 or not finite). */
+long fpm_force(const fpm_model *m, fpm_state *st);
+
+/* Stable time step of eqs. 24-26 of the FPM paper: for each point j,
+ * lambda_j <= m_j c_j^2 |C_j|_F^2 (m_j support size, c_j the dilatational
+ * wave speed, C_j the GFD derivative matrix including the centre column),
+ * dt = 2 / sqrt(max lambda_j) / sqrt(max(p, 1)).  Also returns the point
+ * that sets it. */
+double fpm_stable_dt(const fpm_model *m, long *critical_point);
+
+#endif

@@ -1,0 +1,168 @@
+/* fpm_solver: the explicit time loop.  Velocities live at half steps;
+ * dynamic relaxation damps with the lowest-mode frequency estimated from
+ * the Rayleigh quotient of the last increment. */
+#include "fpm_solver.h"
+
+#include <math.h>
+
+#include "pm_omp.h"
+#include "pm_progress.h"
+
+void fpm_reaction(const fpm_model *m, const fpm_state *st, int b,
+                  double R[3]) {
+  /* The force of the support on the body: the consistency flux P_i a_f of the face's
+   * facets on the prescribed components (part of the operator), plus any
+   * out-of-balance force left on the prescribed dofs. */
+  const gm_dual *d = m->dual;
+  const pm_scene_bc *bc = &m->scene->bcs[b];
+  R[0] = R[1] = R[2] = 0;
+  for (long f = 0; f < d->n_facets; f++) {
+    if (d->facet_face[f] != (int)bc->face) continue;
+    const double *P = st->P + 9 * d->facet_point[f], *a = d->facet_area_vec + 3 * f;
+    for (int c = 0; c < 3; c++)
+      if (bc->disp_mask & (1u << c))
+        R[c] += P[3 * c] * a[0] + P[3 * c + 1] * a[1] + P[3 * c + 2] * a[2];
+  }
+  for (long k = 0; k < m->n_cdofs; k++)
+    if (m->cd_bc[k] == b)
+      R[m->cd_comp[k]] += st->f[3 * m->cd_point[k] + m->cd_comp[k]];
+}
+
+static void apply_prescribed(const fpm_model *m, fpm_state *st, double t,
+                             double dt) {
+  for (long k = 0; k < m->n_cdofs; k++) {
+    long dof = 3 * m->cd_point[k] + m->cd_comp[k];
+    double ub = fpm_prescribed(m, k, t);
+    st->v[dof] = dt > 0 ? (ub - st->u[dof]) / dt : 0;
+    st->u[dof] = ub;
+  }
+}
+
+static pm_err unstable(const fpm_model *m, const fpm_state *st, long step,
+                       double t, double dt, long p) {
+  const double *x = m->x + 3 * p;
+  double J = st->J[p];
+  const char *cause = !isfinite(J) ? "deformation gradient is not finite"
+                      : J <= 0     ? "volume ratio J <= 0 (inverted subdomain)"
+                                   : "stress is not finite";
+  return PM_ERROR(PM_ERR_UNSTABLE,
+                  "step %ld, t = %.6g s: point %ld at (%g, %g, %g): %s "
+                  "(J = %g); dt = %.4g s",
+                  step, t, p, x[0], x[1], x[2], cause, J, dt);
+}
+
+pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
+               fpm_observer observer, void *ctx, fpm_step_info *info,
+               double stage_seconds[2]) {
+  const long n = m->n;
+  const double dt = opt->dt;
+  const double load_end = fpm_load_end(m);
+  double t = 0, c = opt->qs == PM_QS_DAMPING ? opt->damping : 0;
+  double ext_work = 0, t_force = 0, t_update = 0;
+  PM_CHECK(dt > 0 && isfinite(dt), PM_ERR_ARG, "time step must be > 0 (got %g)",
+           dt);
+  apply_prescribed(m, st, 0, 0);
+  fpm_update_tractions(m, st, 0);
+  long bad = fpm_force(m, st);
+  if (bad >= 0) return unstable(m, st, 0, 0, dt, bad);
+
+  fpm_step_info si = {0};
+  const double *restrict mass = m->mass;
+  const unsigned char *restrict fixed = m->fixed;
+  for (long step = 1;; step++) {
+    double w0 = pm_wtime();
+    double s1 = 0, s2 = 0;
+    const double cd2 = 0.5 * c * dt;
+    const double damp_old = (1 - cd2) / (1 + cd2), damp_new = dt / (1 + cd2);
+    double *restrict u = st->u, *restrict v = st->v;
+    const double *restrict f = st->f;
+    PM_OMP(parallel for schedule(static) default(none) reduction(+ : s1, s2)
+           shared(n, mass, fixed, u, v, f, damp_old, damp_new, dt))
+    for (long i = 0; i < n; i++) {
+      const double im = 1.0 / mass[i];
+      for (int a = 0; a < 3; a++) {
+        const long dof = 3 * i + a;
+        if (fixed[dof]) continue;
+        v[dof] = damp_old * v[dof] - damp_new * f[dof] * im;
+        const double du = dt * v[dof];
+        u[dof] += du;
+        s1 += du * f[dof];
+        s2 += mass[i] * du * du;
+      }
+    }
+    t += dt;
+    apply_prescribed(m, st, t, dt);
+    if (m->n_tfacets > 0) fpm_update_tractions(m, st, t);
+    double w1 = pm_wtime();
+    bad = fpm_force(m, st);
+    double w2 = pm_wtime();
+    t_force += w2 - w1;
+    if (bad >= 0) {
+      if (stage_seconds) {
+        stage_seconds[0] = t_force;
+        stage_seconds[1] = t_update;
+      }
+      return unstable(m, st, step, t, dt, bad);
+    }
+    double s3 = 0, rf = 0, kin = 0, se = 0;
+    const double *restrict W = st->W, *restrict vol = m->dual->volume;
+    PM_OMP(parallel for schedule(static) default(none)
+           reduction(+ : s3, rf, kin, se)
+           shared(n, mass, fixed, v, f, W, vol, dt))
+    for (long i = 0; i < n; i++) {
+      se += vol[i] * W[i];
+      for (int a = 0; a < 3; a++) {
+        const long dof = 3 * i + a;
+        kin += 0.5 * mass[i] * v[dof] * v[dof];
+        if (fixed[dof]) continue;
+        s3 += dt * v[dof] * f[dof];
+        rf += f[dof] * f[dof];
+      }
+    }
+    /* Reactions R = f on prescribed dofs; their power R . v and that of
+     * the tractions give the external work. */
+    double rr = 0;
+    for (long k = 0; k < m->n_cdofs; k++) {
+      long dof = 3 * m->cd_point[k] + m->cd_comp[k];
+      rr += st->f[dof] * st->f[dof];
+      ext_work += st->f[dof] * st->v[dof] * dt;
+    }
+    for (long k = 0; k < m->n_tfacets; k++)
+      for (int a = 0; a < 3; a++)
+        ext_work += st->tf_value[3 * k + a] * m->tf_area[k] *
+                    st->v[3 * m->tf_point[k] + a] * dt;
+    if (opt->qs == PM_QS_DYNAMIC_RELAXATION && s2 > 0) {
+      double w2r = (s3 - s1) / s2;
+      if (w2r > 0 && isfinite(w2r)) c = 2 * sqrt(w2r);
+      if (c * dt > 1.9) c = 1.9 / dt;
+    }
+    double ref = sqrt(rr) + st->bflux_norm + st->fext_norm;
+    si.step = step;
+    si.t = t;
+    si.kinetic = kin;
+    si.strain = se;
+    si.external_work = ext_work;
+    si.residual = ref > 0 ? sqrt(rf) / ref : sqrt(rf);
+    si.damping = c;
+    si.converged = opt->qs != PM_QS_NONE && t >= load_end &&
+                   si.residual < opt->qs_tolerance;
+    bool last = si.converged || t >= opt->t_end * (1 - 1e-12) ||
+                (opt->max_steps > 0 && step >= opt->max_steps);
+    bool frame = last || (opt->frame_every > 0 && step % opt->frame_every == 0);
+    t_update += (w1 - w0) + (pm_wtime() - w2);
+    if (observer) {
+      pm_err e = observer(ctx, m, st, &si, frame);
+      if (e != PM_SUCCESS) {
+        if (info) *info = si;
+        return pm_error_trace(e, __FILE__, __LINE__, __func__, "observer");
+      }
+    }
+    if (last) break;
+  }
+  if (info) *info = si;
+  if (stage_seconds) {
+    stage_seconds[0] = t_force;
+    stage_seconds[1] = t_update;
+  }
+  return PM_SUCCESS;
+}

@@ -1,0 +1,51 @@
+/* fpm_solver: central-difference time stepping of an FPM model, with
+ * optional damping or dynamic relaxation to a quasi-static state. */
+#ifndef FPM_SOLVER_H
+#define FPM_SOLVER_H
+
+#include <stdbool.h>
+
+#include "fpm_model.h"
+
+typedef struct {
+  double dt;           /* time step, s */
+  double t_end;        /* stop at this time */
+  long max_steps;      /* 0: no limit */
+  pm_qs_method qs;     /* quasi-static method */
+  double qs_tolerance; /* relative residual to stop at (quasi-static) */
+  double damping;      /* fixed damping (1/s) for PM_QS_DAMPING */
+  long frame_every;    /* call on_step with frame = true every N steps */
+} fpm_run_options;
+
+/* What a step reports to the observer. */
+typedef struct {
+  long step;
+  double t;
+  double kinetic;      /* 1/2 sum m v^2 */
+  double strain;       /* sum V W */
+  double external_work;/* work of reactions and tractions so far */
+  double residual;     /* |f| on free dofs / (|reactions| + |f_ext|) */
+  double damping;      /* current damping coefficient, 1/s */
+  bool converged;
+} fpm_step_info;
+
+/* Called after every step (frame = false) and on frame steps and at the
+ * last step (frame = true).  A non-success return stops the run. */
+typedef pm_err (*fpm_observer)(void *ctx, const fpm_model *m,
+                               const fpm_state *st, const fpm_step_info *info,
+                               bool frame);
+
+/* Run from the state's current u and v (normally zero) at t = 0.  On a
+ * numerical failure returns PM_ERR_UNSTABLE with the step, time, point id,
+ * position and cause; the observer has already seen every good frame.
+ * info receives the last step's figures.  Allocates nothing. */
+pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
+               fpm_observer observer, void *ctx, fpm_step_info *info,
+               double stage_seconds[2]);
+
+/* Reaction force: sum of f over the prescribed dofs of boundary condition
+ * b, per component (3). */
+void fpm_reaction(const fpm_model *m, const fpm_state *st, int b,
+                  double R[3]);
+
+#endif

@@ -1,0 +1,428 @@
+/* test_files: mkdir -p, atomic files, history CSV, the JSON writer, stage
+ * timers and the progress line. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+/* cmocka needs the three headers above first. */
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "pm_files.h"
+#include "pm_progress.h"
+
+/* ---- Helpers ----------------------------------------------------------- */
+
+static void remove_tree(const char *path) {
+  struct stat st;
+  if (lstat(path, &st) != 0) return;
+  if (S_ISDIR(st.st_mode)) {
+    DIR *d = opendir(path);
+    struct dirent *e;
+    char sub[1024];
+    while (d && (e = readdir(d))) {
+      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+      snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
+      remove_tree(sub);
+    }
+    if (d) closedir(d);
+    rmdir(path);
+  } else {
+    unlink(path);
+  }
+}
+
+static int make_dir(void **state) {
+  char *dir = malloc(64);
+  strcpy(dir, "/tmp/pm_test_files_XXXXXX");
+  assert_non_null(mkdtemp(dir));
+  *state = dir;
+  return 0;
+}
+
+static int drop_dir(void **state) {
+  remove_tree(*state);
+  free(*state);
+  return 0;
+}
+
+/* Number of directory entries (not . and ..). */
+static int count_entries(const char *dir) {
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  int n = 0;
+  assert_non_null(d);
+  while ((e = readdir(d)))
+    if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) n++;
+  closedir(d);
+  return n;
+}
+
+/* Whole file into a static buffer. */
+static const char *slurp(const char *path) {
+  static char buf[8192];
+  FILE *fp = fopen(path, "r");
+  size_t n;
+  assert_non_null(fp);
+  n = fread(buf, 1, sizeof buf - 1, fp);
+  buf[n] = '\0';
+  fclose(fp);
+  return buf;
+}
+
+static bool exists(const char *path) {
+  struct stat st;
+  return stat(path, &st) == 0;
+}
+
+/* ---- mkdir -p and atomic files ----------------------------------------- */
+
+static void test_mkdir_p(void **state) {
+  const char *dir = *state;
+  char path[512], file[512];
+  snprintf(path, sizeof path, "%s/a/b//c/", dir);
+  assert_int_equal(pm_mkdir_p(path), PM_SUCCESS);
+  assert_int_equal(pm_mkdir_p(path), PM_SUCCESS); /* idempotent */
+  snprintf(path, sizeof path, "%s/a/b/c", dir);
+  assert_true(exists(path));
+
+  /* A component that is a file. */
+  snprintf(file, sizeof file, "%s/plain", dir);
+  fclose(fopen(file, "w"));
+  snprintf(path, sizeof path, "%s/plain/sub", dir);
+  assert_int_equal(pm_mkdir_p(path), PM_ERR_IO);
+  assert_non_null(strstr(pm_error_message(), "plain"));
+  assert_int_equal(pm_mkdir_p(""), PM_ERR_ARG);
+  pm_error_clear();
+}
+
+static void test_afile_commit_abort(void **state) {
+  const char *dir = *state;
+  char path[512];
+  pm_afile *f = NULL;
+  snprintf(path, sizeof path, "%s/out.txt", dir);
+
+  assert_int_equal(pm_afile_open(path, &f), PM_SUCCESS);
+  fprintf(pm_afile_stream(f), "hello\n");
+  assert_false(exists(path)); /* not visible before commit */
+  assert_int_equal(count_entries(dir), 1);
+  assert_string_equal(pm_afile_path(f), path);
+  assert_int_equal(pm_afile_commit(f), PM_SUCCESS);
+  assert_string_equal(slurp(path), "hello\n");
+  assert_int_equal(count_entries(dir), 1);
+
+  /* Abort: the old file stays, no temporary file remains. */
+  assert_int_equal(pm_afile_open(path, &f), PM_SUCCESS);
+  fprintf(pm_afile_stream(f), "partial");
+  pm_afile_abort(f);
+  assert_string_equal(slurp(path), "hello\n");
+  assert_int_equal(count_entries(dir), 1);
+
+  /* Abort of a new file leaves nothing at all. */
+  snprintf(path, sizeof path, "%s/new.txt", dir);
+  assert_int_equal(pm_afile_open(path, &f), PM_SUCCESS);
+  pm_afile_abort(f);
+  assert_false(exists(path));
+  assert_int_equal(count_entries(dir), 1);
+  pm_afile_abort(NULL);
+  assert_int_equal(pm_afile_commit(NULL), PM_SUCCESS);
+}
+
+static void test_bad_directory(void **state) {
+  const char *dir = *state;
+  char missing[400], path[512];
+  pm_afile *f = (pm_afile *)1;
+  pm_history *h = (pm_history *)1;
+  pm_json *j = (pm_json *)1;
+  const char *names[] = {"t"};
+  snprintf(missing, sizeof missing, "%s/no/such/dir", dir);
+  snprintf(path, sizeof path, "%s/x.txt", missing);
+
+  assert_int_equal(pm_afile_open(path, &f), PM_ERR_IO);
+  assert_null(f);
+  assert_non_null(strstr(pm_error_message(), missing));
+  assert_int_equal(pm_history_open(missing, 1, names, &h), PM_ERR_IO);
+  assert_null(h);
+  assert_non_null(strstr(pm_error_message(), missing));
+  snprintf(path, sizeof path, "%s/summary.json", missing);
+  assert_int_equal(pm_json_open(path, &j), PM_ERR_IO);
+  assert_null(j);
+  assert_non_null(strstr(pm_error_message(), missing));
+
+  /* Unwritable directory (root ignores permissions: skip then). */
+  if (geteuid() != 0) {
+    char ro[400];
+    snprintf(ro, sizeof ro, "%s/readonly", dir);
+    assert_int_equal(mkdir(ro, 0500), 0);
+    snprintf(path, sizeof path, "%s/x.txt", ro);
+    assert_int_equal(pm_afile_open(path, &f), PM_ERR_IO);
+    assert_non_null(strstr(pm_error_message(), ro));
+    chmod(ro, 0700);
+  }
+  pm_error_clear();
+}
+
+/* ---- History ----------------------------------------------------------- */
+
+static void test_history(void **state) {
+  const char *dir = *state;
+  const char *names[] = {"time", "kinetic", "reaction, x"};
+  char path[512];
+  pm_history *h = NULL;
+  snprintf(path, sizeof path, "%s/history.csv", dir);
+
+  assert_int_equal(pm_history_open(dir, 3, names, &h), PM_SUCCESS);
+  assert_int_equal(pm_history_ncols(h), 3);
+  for (int i = 0; i < 3; i++) {
+    double row[3] = {0.5 * i, 1.0 / 3.0, -2e-12 * i};
+    assert_int_equal(pm_history_row(h, row), PM_SUCCESS);
+  }
+  double bad[3] = {NAN, INFINITY, 1e300};
+  assert_int_equal(pm_history_row(h, bad), PM_SUCCESS);
+  assert_false(exists(path));
+  assert_int_equal(pm_history_close(h, true), PM_SUCCESS);
+  assert_string_equal(slurp(path), "time,kinetic,\"reaction, x\"\n"
+                                   "0,0.3333333333,-0\n"
+                                   "0.5,0.3333333333,-2e-12\n"
+                                   "1,0.3333333333,-4e-12\n"
+                                   "nan,inf,1e+300\n");
+  assert_int_equal(count_entries(dir), 1);
+
+  /* keep = false discards and leaves the committed file alone. */
+  assert_int_equal(pm_history_open(dir, 1, names, &h), PM_SUCCESS);
+  double one = 1.0;
+  assert_int_equal(pm_history_row(h, &one), PM_SUCCESS);
+  assert_int_equal(pm_history_close(h, false), PM_SUCCESS);
+  assert_int_equal(count_entries(dir), 1);
+  assert_non_null(strstr(slurp(path), "reaction"));
+
+  assert_int_equal(pm_history_open(dir, 0, names, &h), PM_ERR_ARG);
+  assert_int_equal(pm_history_close(NULL, true), PM_SUCCESS);
+  pm_error_clear();
+}
+
+/* ---- JSON -------------------------------------------------------------- */
+
+/* Validate with Python's json module when it is installed. */
+static void python_json_check(const char *path) {
+  char cmd[1024];
+  if (access("/usr/bin/python3", X_OK) != 0) return;
+  snprintf(
+      cmd, sizeof cmd,
+      "/usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1]));"
+      " assert d[\"name\"] == \"a \\\"q\\\" \\\\ b\\n\\t\\u0001 \\u00e9\"; "
+      "assert d[\"nested\"][2][0][\"deep\"] == []; "
+      "assert d[\"nan\"] is None' %s",
+      path);
+  assert_int_equal(system(cmd), 0);
+}
+
+static void test_json(void **state) {
+  const char *dir = *state;
+  char path[512];
+  pm_json *j = NULL;
+  snprintf(path, sizeof path, "%s/summary.json", dir);
+
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_object(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_string(j, "name", "a \"q\" \\ b\n\t\x01 \xc3\xa9"),
+                   PM_SUCCESS);
+  assert_int_equal(pm_json_integer(j, "steps", 123456789012LL), PM_SUCCESS);
+  assert_int_equal(pm_json_number(j, "dt", 0.25), PM_SUCCESS);
+  assert_int_equal(pm_json_number(j, "nan", NAN), PM_SUCCESS);
+  assert_int_equal(pm_json_bool(j, "ok", true), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_array(j, "nested"), PM_SUCCESS);
+  assert_int_equal(pm_json_number(j, NULL, -1.5e-300), PM_SUCCESS);
+  assert_int_equal(pm_json_null(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_array(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_object(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_array(j, "deep"), PM_SUCCESS);
+  assert_int_equal(pm_json_end_array(j), PM_SUCCESS);
+  assert_int_equal(pm_json_end_object(j), PM_SUCCESS);
+  assert_int_equal(pm_json_end_array(j), PM_SUCCESS);
+  assert_int_equal(pm_json_end_array(j), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_object(j, "empty"), PM_SUCCESS);
+  assert_int_equal(pm_json_end_object(j), PM_SUCCESS);
+  assert_int_equal(pm_json_string(j, "null", NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_end_object(j), PM_SUCCESS);
+  assert_false(exists(path));
+  assert_int_equal(pm_json_close(j, true), PM_SUCCESS);
+  assert_string_equal(
+      slurp(path), "{\n"
+                   "  \"name\": \"a \\\"q\\\" \\\\ b\\n\\t\\u0001 \xc3\xa9\",\n"
+                   "  \"steps\": 123456789012,\n"
+                   "  \"dt\": 0.25,\n"
+                   "  \"nan\": null,\n"
+                   "  \"ok\": true,\n"
+                   "  \"nested\": [\n"
+                   "    -1.5e-300,\n"
+                   "    null,\n"
+                   "    [\n"
+                   "      {\n"
+                   "        \"deep\": []\n"
+                   "      }\n"
+                   "    ]\n"
+                   "  ],\n"
+                   "  \"empty\": {},\n"
+                   "  \"null\": null\n"
+                   "}\n");
+  assert_int_equal(count_entries(dir), 1);
+  python_json_check(path);
+}
+
+static void test_json_misuse(void **state) {
+  const char *dir = *state;
+  char path[512];
+  pm_json *j = NULL;
+  snprintf(path, sizeof path, "%s/bad.json", dir);
+
+  /* Key inside an array, then the writer refuses to commit. */
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_array(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_number(j, "x", 1.0), PM_ERR_ARG);
+  assert_int_equal(pm_json_end_array(j), PM_ERR_ARG);
+  assert_int_equal(pm_json_close(j, true), PM_ERR_ARG);
+  assert_false(exists(path));
+
+  /* Missing key in an object; mismatched end. */
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_object(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_bool(j, NULL, false), PM_ERR_ARG);
+  assert_int_equal(pm_json_close(j, true), PM_ERR_ARG);
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_object(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_end_array(j), PM_ERR_ARG);
+  assert_int_equal(pm_json_close(j, true), PM_ERR_ARG);
+
+  /* Depth limit: 16 levels fine, the 17th fails. */
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  for (int i = 0; i < PM_JSON_MAX_DEPTH; i++)
+    assert_int_equal(pm_json_begin_array(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_array(j, NULL), PM_ERR_ARG);
+  assert_int_equal(pm_json_close(j, true), PM_ERR_ARG);
+
+  /* Unclosed and empty documents are not committed; two top values fail. */
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  assert_int_equal(pm_json_begin_object(j, NULL), PM_SUCCESS);
+  assert_int_equal(pm_json_close(j, true), PM_ERR_ARG);
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  assert_int_equal(pm_json_close(j, true), PM_ERR_ARG);
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  assert_int_equal(pm_json_integer(j, NULL, 1), PM_SUCCESS);
+  assert_int_equal(pm_json_integer(j, NULL, 2), PM_ERR_ARG);
+  assert_int_equal(pm_json_close(j, false), PM_SUCCESS);
+  assert_false(exists(path));
+  assert_int_equal(count_entries(dir), 0);
+
+  /* A bare top-level scalar is a valid document. */
+  assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
+  assert_int_equal(pm_json_number(j, NULL, 2.5), PM_SUCCESS);
+  assert_int_equal(pm_json_close(j, true), PM_SUCCESS);
+  assert_string_equal(slurp(path), "2.5\n");
+  pm_error_clear();
+}
+
+/* ---- Timers and progress ----------------------------------------------- */
+
+static void test_timers(void **state) {
+  (void)state;
+  pm_timers t = {0};
+  char buf[2048];
+  FILE *fp;
+  size_t n;
+  double t0 = pm_wtime();
+  int a = pm_timers_add(&t, "assemble");
+  int b = pm_timers_add(&t, "solve");
+  assert_int_equal(a, 0);
+  assert_int_equal(b, 1);
+  assert_int_equal(pm_timers_add(&t, "assemble"), 0);
+  for (int i = 0; i < 3; i++) {
+    pm_timers_start(&t, a);
+    struct timespec ts = {0, 2000000};
+    nanosleep(&ts, NULL);
+    pm_timers_stop(&t, a);
+  }
+  pm_timers_stop(&t, b); /* stop without start: ignored */
+  pm_timers_start(&t, -1);
+  pm_timers_stop(&t, -1);
+  assert_int_equal(t.stage[a].calls, 3);
+  assert_int_equal(t.stage[b].calls, 0);
+  assert_true(pm_timers_seconds(&t, a) >= 0.006);
+  assert_true(pm_wtime() - t0 >= pm_timers_seconds(&t, a));
+
+  static const char *names[PM_TIMERS_MAX + 1] = {0};
+  static char storage[PM_TIMERS_MAX + 1][16];
+  for (int i = 0; i <= PM_TIMERS_MAX; i++) {
+    snprintf(storage[i], sizeof storage[i], "s%d", i);
+    names[i] = storage[i];
+  }
+  for (int i = 2; i < PM_TIMERS_MAX; i++)
+    assert_int_equal(pm_timers_add(&t, names[i]), i);
+  assert_int_equal(pm_timers_add(&t, names[PM_TIMERS_MAX]), -1);
+
+  fp = tmpfile();
+  assert_non_null(fp);
+  pm_timers_print(&t, fp, 1.0);
+  rewind(fp);
+  n = fread(buf, 1, sizeof buf - 1, fp);
+  buf[n] = '\0';
+  fclose(fp);
+  assert_non_null(strstr(buf, "stage"));
+  assert_non_null(strstr(buf, "assemble"));
+  assert_non_null(strstr(buf, "total"));
+}
+
+static void test_progress(void **state) {
+  (void)state;
+  pm_progress p;
+  char buf[1024];
+  size_t n;
+  FILE *fp = tmpfile();
+  assert_non_null(fp);
+
+  /* Not a terminal: nothing at all. */
+  pm_progress_init(&p, fp, "run");
+  assert_false(p.tty);
+  pm_progress_update(&p, 0.5, "status");
+  pm_progress_finish(&p);
+  assert_int_equal(ftell(fp), 0);
+
+  /* Forced terminal: first update draws, the next is rate limited,
+   * completion draws, finish ends the line. */
+  p.tty = true;
+  pm_progress_update(&p, 0.42, "t=0.51 s step 1234");
+  pm_progress_update(&p, 0.43, "skipped");
+  pm_progress_update(&p, 1.0, "done");
+  pm_progress_finish(&p);
+  rewind(fp);
+  n = fread(buf, 1, sizeof buf - 1, fp);
+  buf[n] = '\0';
+  fclose(fp);
+  assert_non_null(strstr(buf, "\r[run]   42.0%  ETA "));
+  assert_non_null(strstr(buf, "t=0.51 s step 1234"));
+  assert_null(strstr(buf, "skipped"));
+  assert_non_null(strstr(buf, "\r[run]  100.0%  ETA 0:00  done"));
+  assert_int_equal(buf[n - 1], '\n');
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test_setup_teardown(test_mkdir_p, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_afile_commit_abort, make_dir,
+                                      drop_dir),
+      cmocka_unit_test_setup_teardown(test_bad_directory, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_history, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_json, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_json_misuse, make_dir, drop_dir),
+      cmocka_unit_test(test_timers),
+      cmocka_unit_test(test_progress),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

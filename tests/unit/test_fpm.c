@@ -1,0 +1,197 @@
+/* Unit tests of the FPM operators: GFD weights reproduce linear fields,
+ * homogeneous deformations are in discrete equilibrium (patch tests), and
+ * the stable time step bounds the operator's spectrum. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_model.h"
+#include "fpm_solver.h"
+#include "gm_dual.h"
+
+typedef struct {
+  gm_mesh *mesh;
+  gm_dual *dual;
+  pm_scene scene;
+  pm_scene_material mat;
+  pm_scene_bc bcs[4];
+} fixture;
+
+static fixture *fixture_new(int dim, double h, double penalty, bool f2_bcs) {
+  fixture *fx = calloc(1, sizeof *fx);
+  double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
+  assert_int_equal(gm_mesh_box(dim, lo, hi, h, &fx->mesh), PM_SUCCESS);
+  assert_int_equal(gm_dual_build(fx->mesh, &fx->dual), PM_SUCCESS);
+  assert_int_equal(pm_material_init(&fx->mat.mat, PM_MODEL_NEO_HOOKEAN, 1000,
+                                    3000, 0.495),
+                   PM_SUCCESS);
+  fx->mat.name = "gel";
+  pm_scene *s = &fx->scene;
+  s->path = "test";
+  s->dimension = dim;
+  s->materials = &fx->mat;
+  s->n_materials = 1;
+  s->fpm.penalty = penalty;
+  s->time.ramp = 1;
+  if (f2_bcs) {
+    const char *val[4] = {"0", "0", "0", "-0.04"};
+    pm_face face[4] = {PM_FACE_XMIN, PM_FACE_YMIN, PM_FACE_ZMIN, PM_FACE_ZMAX};
+    int comp[4] = {0, 1, 2, 2};
+    for (int b = 0; b < 4; b++) {
+      fx->bcs[b].face = face[b];
+      fx->bcs[b].disp_mask = 1u << comp[b];
+      assert_int_equal(pm_expr_create(val[b], &fx->bcs[b].disp[comp[b]]),
+                       PM_SUCCESS);
+      fx->bcs[b].ramp = PM_RAMP_NONE;
+    }
+    s->bcs = fx->bcs;
+    s->n_bcs = 4;
+  }
+  return fx;
+}
+
+static void fixture_free(fixture *fx) {
+  for (int b = 0; b < 4; b++)
+    for (int c = 0; c < 3; c++) pm_expr_destroy(fx->bcs[b].disp[c]);
+  gm_dual_destroy(fx->dual);
+  gm_mesh_destroy(fx->mesh);
+  free(fx);
+}
+
+/* u = H X + c for a fixed H: the GFD gradient equals H at every point. */
+static void test_gfd_linear(void **state) {
+  (void)state;
+  for (int dim = 2; dim <= 3; dim++) {
+    fixture *fx = fixture_new(dim, dim == 3 ? 0.025 : 0.01, 0, false);
+    fpm_model *m;
+    fpm_state *st;
+    assert_int_equal(fpm_model_create(&fx->scene, fx->dual, &m), PM_SUCCESS);
+    assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+    double H[9] = {0.3, -0.2, 0.1, 0.05, -0.4, 0.2, -0.1, 0.15, 0.25};
+    if (dim == 2) H[2] = H[5] = H[6] = H[7] = H[8] = 0;
+    for (long i = 0; i < m->n; i++)
+      for (int a = 0; a < 3; a++)
+        st->u[3 * i + a] = 0.01 * (a + 1) + H[3 * a] * m->x[3 * i] +
+                           H[3 * a + 1] * m->x[3 * i + 1] +
+                           H[3 * a + 2] * m->x[3 * i + 2];
+    assert_int_equal(fpm_force(m, st), -1);
+    double err = 0;
+    for (long i = 0; i < m->n; i++)
+      for (int a = 0; a < 9; a++)
+        err = fmax(err, fabs(st->H[9 * i + a] - H[a]));
+    print_message("dim %d: %ld points, max |grad u - H| = %.3g\n", dim, m->n,
+                  err);
+    assert_true(err < 1e-12);
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+}
+
+/* A homogeneous deformation leaves zero force at every interior point.
+ * Points on the boundary and their neighbours carry the traction P n of
+ * the free faces (the test functions of the neighbours reach the boundary
+ * facets), so "interior" means neither. */
+static void check_homogeneous(double penalty) {
+  const double h = 0.0125;
+  fixture *fx = fixture_new(3, h, penalty, false);
+  fpm_model *m;
+  fpm_state *st;
+  assert_int_equal(fpm_model_create(&fx->scene, fx->dual, &m), PM_SUCCESS);
+  assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+  double H[9] = {0.3, -0.2, 0.1, 0.05, -0.4, 0.2, -0.1, 0.15, 0.25};
+  for (long i = 0; i < m->n; i++)
+    for (int a = 0; a < 3; a++)
+      st->u[3 * i + a] = H[3 * a] * m->x[3 * i] + H[3 * a + 1] * m->x[3 * i + 1] +
+                         H[3 * a + 2] * m->x[3 * i + 2];
+  assert_int_equal(fpm_force(m, st), -1);
+  /* boundary points: those with a facet */
+  unsigned char *on_boundary = calloc(m->n, 1);
+  for (long f = 0; f < fx->dual->n_facets; f++)
+    on_boundary[fx->dual->facet_point[f]] = 1;
+  for (long i = 0; i < m->n; i++)
+    if (on_boundary[i] == 1)
+      for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
+        if (!on_boundary[m->nbr[e]]) on_boundary[m->nbr[e]] = 2;
+  double scale = pm_t_norm(st->P) * h * h, worst = 0;
+  long interior = 0;
+  for (long i = 0; i < m->n; i++) {
+    if (on_boundary[i]) continue;
+    interior++;
+    for (int a = 0; a < 3; a++) worst = fmax(worst, fabs(st->f[3 * i + a]));
+  }
+  print_message("p = %g: %ld interior points, max |f| / (|P| h^2) = %.3g\n",
+                penalty, interior, worst / scale);
+  assert_true(interior > 0);
+  assert_true(worst <= 1e-11 * scale);
+  free(on_boundary);
+  fpm_state_destroy(st);
+  fpm_model_destroy(m);
+  fixture_free(fx);
+}
+
+static void test_homogeneous_p0(void **state) {
+  (void)state;
+  check_homogeneous(0);
+}
+static void test_homogeneous_p20(void **state) {
+  (void)state;
+  check_homogeneous(20);
+}
+
+/* The finite-strain patch test of case F2: the exact uniaxial-stress state
+ * (u_z = -0.4 z, lateral stretch from P_xx = 0) on every point, roller
+ * conditions on three faces and the top displacement: zero force on every
+ * free dof, boundary points included. */
+static void test_patch_f2(void **state) {
+  (void)state;
+  for (int k = 0; k < 2; k++) {
+    double penalty = k == 0 ? 0 : 20;
+    fixture *fx = fixture_new(3, 0.02, penalty, true);
+    fpm_model *m;
+    fpm_state *st;
+    assert_int_equal(fpm_model_create(&fx->scene, fx->dual, &m), PM_SUCCESS);
+    assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+    double s;
+    assert_int_equal(
+        pm_material_uniaxial_lateral_stretch(&m->mats[0], 0.6, &s), PM_SUCCESS);
+    for (long i = 0; i < m->n; i++) {
+      st->u[3 * i] = (s - 1) * m->x[3 * i];
+      st->u[3 * i + 1] = (s - 1) * m->x[3 * i + 1];
+      st->u[3 * i + 2] = -0.4 * m->x[3 * i + 2];
+    }
+    assert_int_equal(fpm_force(m, st), -1);
+    double scale = fabs(st->P[8]) * 0.02 * 0.02, worst = 0;
+    for (long i = 0; i < 3 * m->n; i++)
+      if (!m->fixed[i]) worst = fmax(worst, fabs(st->f[i]));
+    /* The support's force on the top face is the uniaxial force P_zz L^2;
+     * the lateral roller faces carry none. */
+    double R[3], Pzz = st->P[8];
+    fpm_reaction(m, st, 3, R);
+    print_message("F2 patch, p = %g: %ld points, max free |f| / (|P| h^2) = "
+                  "%.3g, top reaction %.6g N (exact %.6g N)\n",
+                  penalty, m->n, worst / scale, R[2], Pzz * 0.01);
+    assert_true(worst <= 1e-11 * scale);
+    assert_true(fabs(R[2] - Pzz * 0.01) <= 1e-10 * fabs(Pzz * 0.01));
+    fpm_reaction(m, st, 0, R);
+    assert_true(fabs(R[0]) <= 1e-10 * fabs(Pzz * 0.01));
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_gfd_linear),
+      cmocka_unit_test(test_homogeneous_p0),
+      cmocka_unit_test(test_homogeneous_p20),
+      cmocka_unit_test(test_patch_f2),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,328 @@
+/* test_output: results.h5 + results.xdmf written, read back with the HDF5
+ * API, aborted results and bad arguments or directories. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+/* cmocka needs the three headers above first. */
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <hdf5.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "pm_output.h"
+
+/* ---- Helpers ----------------------------------------------------------- */
+
+/* Expect success; on failure show the recorded message. */
+#define assert_ok(expr)                                                        \
+  do {                                                                         \
+    pm_err e_ = (expr);                                                        \
+    if (e_ != PM_SUCCESS)                                                      \
+      fail_msg("%s: %s\n%s", pm_err_name(e_), pm_error_message(),              \
+               pm_error_traceback());                                          \
+  } while (0)
+
+static void remove_tree(const char *path) {
+  struct stat st;
+  if (lstat(path, &st) != 0) return;
+  if (S_ISDIR(st.st_mode)) {
+    DIR *d = opendir(path);
+    struct dirent *e;
+    char sub[1024];
+    while (d && (e = readdir(d))) {
+      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+      snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
+      remove_tree(sub);
+    }
+    if (d) closedir(d);
+    rmdir(path);
+  } else {
+    unlink(path);
+  }
+}
+
+static int make_dir(void **state) {
+  char *dir = malloc(64);
+  strcpy(dir, "/tmp/pm_test_output_XXXXXX");
+  assert_non_null(mkdtemp(dir));
+  *state = dir;
+  return 0;
+}
+
+static int drop_dir(void **state) {
+  remove_tree(*state);
+  free(*state);
+  return 0;
+}
+
+/* Number of directory entries; *tmp counts names containing ".tmp.". */
+static int count_entries(const char *dir, int *tmp) {
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  int n = 0;
+  assert_non_null(d);
+  if (tmp) *tmp = 0;
+  while ((e = readdir(d))) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+    n++;
+    if (tmp && strstr(e->d_name, ".tmp.")) (*tmp)++;
+  }
+  closedir(d);
+  return n;
+}
+
+static char *slurp(const char *path) {
+  FILE *fp = fopen(path, "r");
+  char *buf;
+  long n;
+  assert_non_null(fp);
+  fseek(fp, 0, SEEK_END);
+  n = ftell(fp);
+  rewind(fp);
+  buf = calloc((size_t)n + 1, 1);
+  assert_int_equal(fread(buf, 1, (size_t)n, fp), (size_t)n);
+  fclose(fp);
+  return buf;
+}
+
+/* Two tetrahedra sharing a face. */
+#define NP 5
+#define NC 2
+static const double coords[3 * NP] = {0, 0, 0, 1, 0, 0, 0, 1,
+                                      0, 0, 0, 1, 1, 1, 1};
+static const long tets[4 * NC] = {0, 1, 2, 3, 1, 2, 3, 4};
+static const char *scene = "name: \"two tets\"\nmaterial: {E: 1e9}\n";
+
+static void fill_frame(int frame, double *u, double *damage, double *stress) {
+  for (int i = 0; i < NP; i++) {
+    for (int k = 0; k < 3; k++) u[3 * i + k] = 100 * frame + 10 * i + k;
+    damage[i] = 0.1 * i + frame;
+    for (int k = 0; k < 9; k++) stress[9 * i + k] = 1000 * frame + 9 * i + k;
+  }
+}
+
+/* Read /path of the file as doubles into out (count values). */
+static void read_doubles(hid_t file, const char *path, double *out,
+                         size_t count, int rank, const hsize_t *dims) {
+  hid_t d = H5Dopen2(file, path, H5P_DEFAULT);
+  hsize_t got[3] = {0, 0, 0};
+  assert_true(d >= 0);
+  hid_t s = H5Dget_space(d);
+  assert_int_equal(H5Sget_simple_extent_ndims(s), rank);
+  H5Sget_simple_extent_dims(s, got, NULL);
+  for (int k = 0; k < rank; k++) assert_int_equal(got[k], dims[k]);
+  assert_int_equal(H5Sget_simple_extent_npoints(s), (hssize_t)count);
+  assert_true(
+      H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) >= 0);
+  H5Sclose(s);
+  H5Dclose(d);
+}
+
+/* ---- Tests ------------------------------------------------------------- */
+
+static void test_write_read(void **state) {
+  const char *dir = *state;
+  pm_results *r = NULL;
+  double u[3 * NP], damage[NP], stress[9 * NP], buf[9 * NP];
+  char path[512];
+  int tmp;
+  pm_field fields[3] = {
+      {"displacement", 3, u}, {"damage", 1, damage}, {"stress", 9, stress}};
+
+  assert_ok(
+      pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "0.1.0", &r));
+  for (int f = 0; f < 2; f++) {
+    fill_frame(f, u, damage, stress);
+    assert_ok(pm_results_write_frame(r, 100 * f, 0.5 * f, 3, fields));
+  }
+  assert_int_equal(pm_results_frames(r), 2);
+  /* While open: only the temporary file. */
+  assert_int_equal(count_entries(dir, &tmp), 1);
+  assert_int_equal(tmp, 1);
+  assert_ok(pm_results_close(r, true));
+  assert_int_equal(count_entries(dir, &tmp), 2);
+  assert_int_equal(tmp, 0);
+
+  /* Read back with the HDF5 API. */
+  snprintf(path, sizeof path, "%s/results.h5", dir);
+  hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+  assert_true(file >= 0);
+  hsize_t cdims[2] = {NP, 3};
+  read_doubles(file, "/mesh/coordinates", buf, 3 * NP, 2, cdims);
+  assert_memory_equal(buf, coords, sizeof coords);
+
+  long cells[4 * NC];
+  hid_t d = H5Dopen2(file, "/mesh/cells", H5P_DEFAULT);
+  assert_true(d >= 0);
+  assert_true(
+      H5Dread(d, H5T_NATIVE_LONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, cells) >= 0);
+  H5Dclose(d);
+  assert_memory_equal(cells, tets, sizeof tets);
+
+  fill_frame(1, u, damage, stress);
+  read_doubles(file, "/frames/000001/displacement", buf, 3 * NP, 2, cdims);
+  assert_memory_equal(buf, u, sizeof u);
+  hsize_t tdims[3] = {NP, 3, 3};
+  read_doubles(file, "/frames/000001/stress", buf, 9 * NP, 3, tdims);
+  assert_memory_equal(buf, stress, sizeof stress);
+  hsize_t sdims[1] = {NP};
+  read_doubles(file, "/frames/000001/damage", buf, NP, 1, sdims);
+  assert_memory_equal(buf, damage, sizeof damage);
+
+  /* Frame attributes. */
+  double time = -1;
+  long step = -1;
+  hid_t g = H5Gopen2(file, "/frames/000001", H5P_DEFAULT);
+  assert_true(g >= 0);
+  hid_t a = H5Aopen(g, "time", H5P_DEFAULT);
+  assert_true(H5Aread(a, H5T_NATIVE_DOUBLE, &time) >= 0);
+  H5Aclose(a);
+  a = H5Aopen(g, "step", H5P_DEFAULT);
+  assert_true(H5Aread(a, H5T_NATIVE_LONG, &step) >= 0);
+  H5Aclose(a);
+  H5Gclose(g);
+  assert_true(time == 0.5);
+  assert_int_equal(step, 100);
+
+  /* Root attribute: the scene text, as a variable-length string. */
+  char *text = NULL;
+  a = H5Aopen(file, "scene", H5P_DEFAULT);
+  assert_true(a >= 0);
+  hid_t t = H5Aget_type(a);
+  assert_true(H5Aread(a, t, &text) >= 0);
+  assert_string_equal(text, scene);
+  H5free_memory(text);
+  H5Tclose(t);
+  H5Aclose(a);
+  assert_true(H5Aexists(file, "version") > 0);
+  assert_true(H5Fclose(file) >= 0);
+
+  /* XDMF: both frames, their times and datasets. */
+  snprintf(path, sizeof path, "%s/results.xdmf", dir);
+  char *x = slurp(path);
+  assert_non_null(strstr(x, "<Xdmf Version=\"3.0\">"));
+  assert_non_null(strstr(x, "CollectionType=\"Temporal\""));
+  assert_non_null(strstr(x, "<Time Value=\"0\"/>"));
+  assert_non_null(strstr(x, "<Time Value=\"0.5\"/>"));
+  assert_non_null(strstr(x, "TopologyType=\"Tetrahedron\" "
+                            "NumberOfElements=\"2\""));
+  assert_non_null(strstr(x, "results.h5:/mesh/cells"));
+  assert_non_null(strstr(x, "results.h5:/mesh/coordinates"));
+  assert_non_null(strstr(x, "results.h5:/frames/000000/displacement"));
+  assert_non_null(strstr(x, "results.h5:/frames/000001/damage"));
+  assert_non_null(strstr(x, "AttributeType=\"Tensor\""));
+  assert_non_null(strstr(x, "Dimensions=\"5 3 3\""));
+  assert_non_null(strstr(x, "</Xdmf>"));
+  free(x);
+
+  /* Well-formed XML and an h5py read, when Python is installed. */
+  if (access("/usr/bin/python3", X_OK) == 0) {
+    char cmd[1536];
+    snprintf(cmd, sizeof cmd,
+             "/usr/bin/python3 -c 'import sys, xml.etree.ElementTree as E; "
+             "g = E.parse(sys.argv[1]).getroot().findall(\".//Grid/Grid\"); "
+             "assert len(g) == 2' %s/results.xdmf",
+             dir);
+    assert_int_equal(system(cmd), 0);
+  }
+}
+
+static void test_abort_and_point_cloud(void **state) {
+  const char *dir = *state;
+  pm_results *r = NULL;
+  double damage[NP] = {0};
+  pm_field f = {"damage", 1, damage};
+  char path[512];
+
+  /* keep = false leaves nothing. */
+  assert_ok(
+      pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "0.1.0", &r));
+  assert_ok(pm_results_write_frame(r, 0, 0.0, 1, &f));
+  assert_ok(pm_results_close(r, false));
+  assert_int_equal(count_entries(dir, NULL), 0);
+
+  /* Point cloud without cells and without frames: bare mesh XDMF. */
+  assert_ok(pm_results_create(dir, 2, NP, coords, 0, 1, NULL, NULL, NULL, &r));
+  assert_ok(pm_results_close(r, true));
+  snprintf(path, sizeof path, "%s/results.xdmf", dir);
+  char *x = slurp(path);
+  assert_non_null(strstr(x, "TopologyType=\"Polyvertex\" "
+                            "NumberOfElements=\"5\" NodesPerElement=\"1\""));
+  assert_null(strstr(x, "Temporal"));
+  free(x);
+  assert_int_equal(count_entries(dir, NULL), 2);
+  assert_ok(pm_results_close(NULL, true));
+}
+
+static void test_bad_arguments(void **state) {
+  const char *dir = *state;
+  pm_results *r = NULL;
+  double v[3 * NP] = {0};
+  long bad_tets[4 * NC] = {0, 1, 2, 3, 1, 2, 3, 5};
+
+  assert_int_equal(
+      pm_results_create(dir, 3, NP, coords, NC, 4, bad_tets, scene, "v", &r),
+      PM_ERR_ARG);
+  assert_null(r);
+  assert_int_equal(
+      pm_results_create(dir, 3, NP, coords, NC, 5, tets, scene, "v", &r),
+      PM_ERR_ARG);
+  assert_int_equal(
+      pm_results_create(dir, 1, NP, coords, NC, 4, tets, scene, "v", &r),
+      PM_ERR_ARG);
+  assert_int_equal(count_entries(dir, NULL), 0);
+
+  assert_ok(pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "v", &r));
+  pm_field two = {"u", 2, v};
+  assert_int_equal(pm_results_write_frame(r, 0, 0.0, 1, &two), PM_ERR_ARG);
+  pm_field slash = {"a/b", 3, v};
+  assert_int_equal(pm_results_write_frame(r, 0, 0.0, 1, &slash), PM_ERR_ARG);
+  pm_field dup[2] = {{"u", 3, v}, {"u", 1, v}};
+  assert_int_equal(pm_results_write_frame(r, 0, 0.0, 2, dup), PM_ERR_ARG);
+  pm_field nodata = {"u", 3, NULL};
+  assert_int_equal(pm_results_write_frame(r, 0, 0.0, 1, &nodata), PM_ERR_ARG);
+  assert_int_equal(pm_results_frames(r), 0);
+  assert_ok(pm_results_close(r, false));
+  assert_int_equal(count_entries(dir, NULL), 0);
+  pm_error_clear();
+}
+
+static void test_bad_directory(void **state) {
+  const char *dir = *state;
+  pm_results *r = (pm_results *)1;
+  char missing[512];
+  snprintf(missing, sizeof missing, "%s/missing", dir);
+  assert_int_equal(
+      pm_results_create(missing, 3, NP, coords, NC, 4, tets, scene, "v", &r),
+      PM_ERR_IO);
+  assert_null(r);
+  assert_non_null(strstr(pm_error_message(), missing));
+
+  if (geteuid() != 0) { /* root ignores permissions */
+    char ro[512];
+    snprintf(ro, sizeof ro, "%s/readonly", dir);
+    assert_int_equal(mkdir(ro, 0500), 0);
+    assert_int_equal(
+        pm_results_create(ro, 3, NP, coords, NC, 4, tets, scene, "v", &r),
+        PM_ERR_IO);
+    assert_non_null(strstr(pm_error_message(), ro));
+    chmod(ro, 0700);
+  }
+  pm_error_clear();
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test_setup_teardown(test_write_read, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_abort_and_point_cloud, make_dir,
+                                      drop_dir),
+      cmocka_unit_test_setup_teardown(test_bad_arguments, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_bad_directory, make_dir, drop_dir),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

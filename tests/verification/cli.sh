@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# The pointmech program end to end: bad scenes and overrides are refused with
+# file:line:col and no output; a run that goes unstable stops with its
+# diagnosis; plan, run, outputs and probe work on a coarse case F2.
+set -u
+bin=$1
+src=$2
+scene=$src/cases/fpm/f2-unconstrained-compression.yaml
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+passes=0
+
+check() { # name, condition-command...
+  local name=$1
+  shift
+  if "$@"; then
+    passes=$((passes + 1))
+  else
+    failures=$((failures + 1))
+    echo "FAIL: $name"
+    [ -f "$work/err" ] && sed 's/^/    stderr: /' "$work/err" | head -5
+  fi
+}
+
+# A bad scene: exit 1, message "FILE:LINE:COL: ... KEY ...", no output dir.
+bad_scene() { # name, sed expression, expected line, key word
+  local name=$1 expr=$2 line=$3 word=$4 f="$work/$1.yaml"
+  sed "$expr" "$scene" >"$f"
+  "$bin" run "$f" --out "$work/out-$name" --quiet >/dev/null 2>"$work/err"
+  local rc=$?
+  check "$name: exit status 1 (got $rc)" test $rc -eq 1
+  check "$name: names $f:$line:<col>" grep -Eq "$f:$line:[0-9]+" "$work/err"
+  check "$name: names $word" grep -q -- "$word" "$work/err"
+  check "$name: no output created" test ! -e "$work/out-$name"
+}
+
+line_of() { grep -n -- "$1" "$scene" | head -1 | cut -d: -f1; }
+
+bad_scene unknown-key 's/fpm: {penalty: 20}/fpm: {penalty: 20, penalti: 3}/' \
+  "$(line_of 'fpm: {penalty')" penalti
+bad_scene wrong-type 's/mesh_size: 1.09e-2/mesh_size: fine/' \
+  "$(line_of 'mesh_size:')" mesh_size
+bad_scene negative-size 's/mesh_size: 1.09e-2/mesh_size: -0.01/' \
+  "$(line_of 'mesh_size:')" mesh_size
+bad_scene bad-poisson 's/poisson_ratio: 0.495/poisson_ratio: 0.5/' \
+  "$(line_of 'poisson_ratio')" poisson_ratio
+
+"$bin" run "$work/missing.yaml" --out "$work/out-missing" >/dev/null 2>"$work/err"
+rc=$?
+check "missing file: exit 1 (got $rc)" test $rc -eq 1
+check "missing file: named" grep -q "missing.yaml" "$work/err"
+check "missing file: no output" test ! -e "$work/out-missing"
+
+"$bin" run "$scene" --set fpm.penalty=strong --out "$work/out-set" >/dev/null 2>"$work/err"
+rc=$?
+check "bad override: exit 1 (got $rc)" test $rc -eq 1
+check "bad override: named" grep -q -- "fpm.penalty=strong" "$work/err"
+check "bad override: no output" test ! -e "$work/out-set"
+
+# Far above the stable step: stops with step, time, point and cause.
+"$bin" run "$scene" --set time.dt=2e-3 --set time.max_steps=5000 \
+  --out "$work/out-unstable" --quiet >/dev/null 2>"$work/err"
+rc=$?
+check "unstable: exit 2 (got $rc)" test $rc -eq 2
+check "unstable: diagnosis" grep -Eq "step [0-9]+, t = .*point [0-9]+ at \(" "$work/err"
+check "unstable: summary says so" grep -q '"status": "unstable"' "$work/out-unstable/summary.json"
+check "unstable: results kept" test -f "$work/out-unstable/results.h5"
+
+"$bin" plan "$scene" >"$work/plan" 2>"$work/err"
+rc=$?
+check "plan: exit 0 (got $rc)" test $rc -eq 0
+check "plan: reports points, dt, steps, memory, estimate" \
+  grep -q "estimate" "$work/plan"
+for w in points pipeline dt steps memory; do
+  check "plan: $w" grep -q "^$w" "$work/plan"
+done
+
+"$bin" --version >"$work/v" && check "version" grep -q "pointmech" "$work/v"
+"$bin" --help >"$work/h" && check "help" grep -q "usage" "$work/h"
+
+# A coarse F2 run, its outputs, and the probe at a few reference points.
+out=$work/out-f2
+"$bin" run "$scene" --set discretization.mesh_size=0.02 \
+  --set time.quasi_static.tolerance=1e-8 --out "$out" --quiet 2>"$work/err"
+rc=$?
+check "coarse F2: exit 0 (got $rc)" test $rc -eq 0
+for f in results.h5 results.xdmf history.csv summary.json; do
+  check "coarse F2: $f written" test -s "$out/$f"
+done
+check "coarse F2: no temporary files" test -z "$(ls "$out" | grep tmp)"
+check "coarse F2: converged" grep -q '"status": "converged"' "$out/summary.json"
+printf 'x,y,z\n0.05,0.05,0.05\n0.02,0.07,0.09\n0.08,0.01,0.03\n' >"$work/pts.csv"
+"$bin" probe "$out" --points "$work/pts.csv" >"$work/probe" 2>"$work/err"
+rc=$?
+check "probe: exit 0 (got $rc)" test $rc -eq 0
+# u_z = -0.4 z exactly (linear field: MLS reproduces it)
+check "probe: u_z = -0.4 z at every point" awk -F, '
+  NR > 1 { n++; if ((($6 + 0.4 * $3) ^ 2) ^ 0.5 > 1e-6) bad++ }
+  END { exit !(n == 3 && bad == 0) }' "$work/probe"
+
+echo "$passes passed, $failures failed"
+[ $failures -eq 0 ]

@@ -1,0 +1,16 @@
+# Verification tests: whole runs against analytic solutions, and the
+# command line's handling of bad input and numerical failure.
+set(PM_VERIFY_DIR ${CMAKE_CURRENT_LIST_DIR})
+file(GLOB PM_VERIFY_TESTS CONFIGURE_DEPENDS ${PM_VERIFY_DIR}/verify_*.c)
+foreach(src ${PM_VERIFY_TESTS})
+  get_filename_component(name ${src} NAME_WE)
+  add_executable(${name} ${src})
+  target_link_libraries(${name} PRIVATE pm_fpm pm_geometry pm_common PkgConfig::CMOCKA)
+  target_compile_definitions(${name} PRIVATE PM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  add_test(NAME verification.${name} COMMAND ${name})
+  set_tests_properties(verification.${name} PROPERTIES LABELS verification TIMEOUT 900)
+endforeach()
+
+add_test(NAME verification.cli
+  COMMAND bash ${PM_VERIFY_DIR}/cli.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.cli PROPERTIES LABELS verification TIMEOUT 600)

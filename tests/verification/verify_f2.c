@@ -1,0 +1,76 @@
+/* Verification of case F2 (FPM paper section 3.2): the 40% unconstrained
+ * compression of the neo-Hookean cube run from rest to its quasi-static
+ * state must reproduce the exact homogeneous solution. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "fpm_driver.h"
+#include "pm_metrics.h"
+#include "pm_scene.h"
+
+#define SCENE PM_SOURCE_DIR "/cases/fpm/f2-unconstrained-compression.yaml"
+
+/* NRMSE (eq. 28) of u_z against -0.4 z must be <= 1e-5, and so must the
+ * lateral components against (s - 1) x, (s - 1) y with s the exact lateral
+ * stretch of uniaxial stress at axial stretch 0.6. */
+static void run_f2(const char *mesh_size) {
+  char set[64];
+  snprintf(set, sizeof set, "discretization.mesh_size=%s", mesh_size);
+  const char *sets[] = {set};
+  pm_scene *s = NULL;
+  fpm_sim *sim = NULL;
+  if (pm_scene_load(SCENE, 1, sets, &s) != PM_SUCCESS)
+    fail_msg("%s", pm_error_message());
+  if (fpm_sim_create(s, &sim) != PM_SUCCESS) fail_msg("%s", pm_error_message());
+  if (fpm_sim_run(sim, NULL, true) != PM_SUCCESS)
+    fail_msg("%s", pm_error_message());
+  assert_int_equal(sim->status, FPM_STATUS_CONVERGED);
+  const fpm_model *m = sim->model;
+  double lat;
+  assert_int_equal(pm_material_uniaxial_lateral_stretch(&m->mats[0], 0.6, &lat),
+                   PM_SUCCESS);
+  double *ref = malloc(3 * m->n * sizeof *ref);
+  for (long i = 0; i < m->n; i++) {
+    ref[3 * i] = (lat - 1) * m->x[3 * i];
+    ref[3 * i + 1] = (lat - 1) * m->x[3 * i + 1];
+    ref[3 * i + 2] = -0.4 * m->x[3 * i + 2];
+  }
+  double ex = pm_nrmse(m->n, 3, sim->state->u, ref);
+  double ey = pm_nrmse(m->n, 3, sim->state->u + 1, ref + 1);
+  double ez = pm_nrmse(m->n, 3, sim->state->u + 2, ref + 2);
+  print_message("F2 h = %s m: %ld points, %ld steps, dt %.3g s, NRMSE u_z "
+                "%.3e (scene reference %.3e), u_x %.3e, u_y %.3e, wall %.2f s\n",
+                mesh_size, m->n, sim->last.step, sim->dt, ez, sim->nrmse[2], ex,
+                ey, sim->wall);
+  assert_true(ez <= 1e-5);
+  assert_true(fabs(sim->nrmse[2] - ez) <= 1e-12);
+  assert_true(ex <= 1e-5);
+  assert_true(ey <= 1e-5);
+  free(ref);
+  fpm_sim_destroy(sim);
+  pm_scene_destroy(s);
+}
+
+static void test_f2_h1(void **state) {
+  (void)state;
+  run_f2("1.09e-2");
+}
+
+static void test_f2_h2(void **state) {
+  (void)state;
+  run_f2("8.02e-3");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_f2_h1),
+      cmocka_unit_test(test_f2_h2),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
