@@ -1,6 +1,7 @@
 /* gm_mesh: simplex meshes of a box or rectangle made with the gmsh C API,
  * meshes built from caller arrays, and their mean edge length. */
 #include "gm_dual.h"
+#include "pm_omp.h"
 
 #include <gmshc.h>
 #include <math.h>
@@ -243,7 +244,7 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
 
   pm_err ret = PM_SUCCESS;
   gm_mesh *m = NULL;
-  int ierr = 0, initialized = 0;
+  int ierr = 0, initialized = 0, threads = 0;
   PM_TRY(PM_ALLOC(m, 1, "mesh"));
   m->dim = dim;
   m->nodes_per_cell = dim + 1;
@@ -252,6 +253,9 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
     m->box_max[k] = k < dim ? max[k] : 0.0;
   }
 
+  /* gmsh sets the process-wide OpenMP thread count from its own option:
+   * put ours back afterwards. */
+  threads = pm_omp_threads();
   gmshInitialize(0, NULL, 0, &ierr);
   GM_GMSH_CHECK("initialize");
   initialized = 1;
@@ -277,6 +281,7 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
   m = NULL;
 done:
   if (initialized) gmshFinalize(&ierr);
+  if (threads > 0) pm_omp_set_threads(threads);
   gm_mesh_destroy(m);
   return ret;
 }

@@ -3,7 +3,7 @@
 # resolutions (or those given as arguments), each run from rest to its
 # quasi-static state; prints points, NRMSE of u_z, steps, wall time, time
 # per point-step and point-steps per second per core.
-#   scripts/bench-f2.sh [BUILD_DIR] [h ...]
+#   scripts/bench-f2.sh [BUILD_DIR] [h ...]   (h among the case files')
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -11,7 +11,10 @@ shift || true
 sizes=("$@")
 [ ${#sizes[@]} -gt 0 ] || sizes=(1.09e-2 8.02e-3 5.19e-3 3.73e-3)
 bin=$build/pointmech
-scene=cases/fpm/f2-unconstrained-compression.yaml
+scene_of() { # the case file of resolution h
+  if [ "$1" = 1.09e-2 ]; then echo cases/fpm/f2-unconstrained-compression.yaml
+  else echo "cases/fpm/f2-unconstrained-compression-h$1.yaml"; fi
+}
 out=${BENCH_OUT:-out/bench-f2}
 mkdir -p "$out"
 
@@ -20,15 +23,15 @@ get() { # key file: a number or string value from our summary.json
 }
 nrmse_z() { sed -n 's/^    "u_z": \([^,]*\),\{0,1\}$/\1/p' "$1" | head -1; }
 
-printf '%-9s %7s %8s %12s %7s %9s %10s %14s %8s\n' h points threads NRMSE_u_z \
-  steps wall_s setup_s "s/point-step" "Mps/s/c"
+printf '%-9s %10s %7s %8s %12s %7s %9s %10s %14s %8s\n' h mean_edge points \
+  threads NRMSE_u_z steps wall_s setup_s "s/point-step" "Mps/s/c"
 for h in "${sizes[@]}"; do
   dir=$out/h$h
-  "$bin" run "$scene" --set discretization.mesh_size="$h" --out "$dir" --quiet \
+  "$bin" run "$(scene_of "$h")" --out "$dir" --quiet \
     2>"$dir.log" || { echo "h=$h failed: see $dir.log"; continue; }
   s=$dir/summary.json
-  printf '%-9s %7s %8s %12s %7s %9.2f %10.2f %14.3e %8.2f\n' "$h" \
-    "$(get points "$s")" "$(get threads "$s")" "$(nrmse_z "$s")" \
+  printf '%-9s %10.4g %7s %8s %12s %7s %9.2f %10.2f %14.3e %8.2f\n' "$h" \
+    "$(get mean_edge_length "$s")" "$(get points "$s")" "$(get threads "$s")" "$(nrmse_z "$s")" \
     "$(get steps "$s")" "$(get wall_seconds "$s")" "$(get setup_seconds "$s")" \
     "$(get seconds_per_point_step "$s")" \
     "$(awk -v v="$(get point_steps_per_second_per_core "$s")" 'BEGIN{print v/1e6}')"

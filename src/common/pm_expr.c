@@ -7,18 +7,153 @@
 #include <string.h>
 
 struct pm_expr {
-  char *text;       /* as given */
-  void *evaluator;  /* libmatheval handle */
-  unsigned uses;    /* bit i: variable "xyzt"[i] appears */
+  char *text;      /* as given */
+  void *evaluator; /* libmatheval handle */
+  unsigned uses;   /* bit i: variable "xyzt"[i] appears */
 };
 
 static const char pm_expr_vars[] = "xyzt";
 
-/* Characters libmatheval's grammar can use.  Anything else would reach the
- * flex scanner's default rule, which echoes it to stdout before failing. */
-static bool expr_char_ok(char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-         (c >= '0' && c <= '9') || strchr("_.+-*/^() \t", c) != NULL;
+/* libmatheval leaks a node on every syntax error and echoes stray
+ * characters to stdout, so a small recursive-descent check of its grammar
+ * runs first and only well-formed text reaches it. */
+typedef struct {
+  const char *text, *p;
+  const char *error; /* first problem found, NULL if none */
+} expr_syntax;
+
+static const char *const expr_functions[] = {
+    "exp",   "log",   "sqrt",     "sin",   "cos",   "tan",   "cot",
+    "sec",   "csc",   "asin",     "acos",  "atan",  "acot",  "asec",
+    "acsc",  "sinh",  "cosh",     "tanh",  "coth",  "sech",  "csch",
+    "asinh", "acosh", "atanh",    "acoth", "asech", "acsch", "abs",
+    "step",  "delta", "nandelta", "erf",   NULL};
+/* matheval's constants whose names start with a digit. */
+static const char *const expr_digit_constants[] = {"1_pi", "2_pi", "2_sqrtpi",
+                                                   NULL};
+
+static bool is_alpha(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+}
+static bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+static void syn_skip(expr_syntax *x) {
+  while (*x->p == ' ' || *x->p == '\t') x->p++;
+}
+
+static bool syn_fail(expr_syntax *x, const char *what) {
+  if (!x->error) x->error = what;
+  return false;
+}
+
+/* Length of the word (letters, digits, _) at p that is in names, or 0. */
+static size_t word_in(const char *p, const char *const *names) {
+  size_t n = 0;
+  while (is_alpha(p[n]) || is_digit(p[n])) n++;
+  for (int i = 0; names[i]; i++)
+    if (strlen(names[i]) == n && strncmp(p, names[i], n) == 0) return n;
+  return 0;
+}
+
+static bool syn_sum(expr_syntax *x);
+
+static bool syn_number(expr_syntax *x) {
+  const char *p = x->p;
+  size_t digits = 0;
+  while (is_digit(*p)) p++, digits++;
+  if (*p == '.') {
+    p++;
+    while (is_digit(*p)) p++, digits++;
+  }
+  if (!digits) return syn_fail(x, "malformed number");
+  if (*p == 'e' || *p == 'E') {
+    const char *q = p + 1;
+    if (*q == '+' || *q == '-') q++;
+    /* "2e" is 2 times the constant e to nobody; matheval rejects it. */
+    if (!is_digit(*q)) return syn_fail(x, "malformed number");
+    while (is_digit(*q)) q++;
+    p = q;
+  }
+  x->p = p;
+  return true;
+}
+
+/* primary: number | name | function '(' sum ')' | '(' sum ')' */
+static bool syn_primary(expr_syntax *x) {
+  syn_skip(x);
+  size_t n;
+  if (*x->p == '(') {
+    x->p++;
+    if (!syn_sum(x)) return false;
+    syn_skip(x);
+    if (*x->p != ')') return syn_fail(x, "expected ')'");
+    x->p++;
+    return true;
+  }
+  if ((n = word_in(x->p, expr_digit_constants)) > 0) {
+    x->p += n;
+    return true;
+  }
+  if (is_digit(*x->p) || *x->p == '.') return syn_number(x);
+  if (!is_alpha(*x->p))
+    return syn_fail(x, *x->p ? "expected a number, name or '('"
+                             : "unexpected end");
+  bool function = word_in(x->p, expr_functions) > 0;
+  while (is_alpha(*x->p) || is_digit(*x->p)) x->p++;
+  if (!function) return true;
+  syn_skip(x);
+  if (*x->p != '(') return syn_fail(x, "expected '(' after a function name");
+  return syn_primary(x);
+}
+
+/* factor: '-' factor | primary ['^' factor] */
+static bool syn_factor(expr_syntax *x) {
+  syn_skip(x);
+  if (*x->p == '-') {
+    x->p++;
+    return syn_factor(x);
+  }
+  if (!syn_primary(x)) return false;
+  syn_skip(x);
+  if (*x->p != '^') return true;
+  x->p++;
+  return syn_factor(x);
+}
+
+/* product: factor (('*' | '/') factor)* */
+static bool syn_product(expr_syntax *x) {
+  if (!syn_factor(x)) return false;
+  for (syn_skip(x); *x->p == '*' || *x->p == '/'; syn_skip(x)) {
+    x->p++;
+    if (!syn_factor(x)) return false;
+  }
+  return true;
+}
+
+/* sum: product (('+' | '-') product)* */
+static bool syn_sum(expr_syntax *x) {
+  if (!syn_product(x)) return false;
+  for (syn_skip(x); *x->p == '+' || *x->p == '-'; syn_skip(x)) {
+    x->p++;
+    if (!syn_product(x)) return false;
+  }
+  return true;
+}
+
+/* NULL when text is well formed; else what is wrong, *at its offset. */
+static const char *expr_syntax_error(const char *text, size_t *at) {
+  expr_syntax x = {text, text, NULL};
+  syn_skip(&x);
+  if (!*x.p) {
+    *at = 0;
+    return "empty";
+  }
+  if (syn_sum(&x)) {
+    syn_skip(&x);
+    if (*x.p) syn_fail(&x, "unexpected text");
+  }
+  *at = (size_t)(x.p - text);
+  return x.error;
 }
 
 pm_err pm_expr_create(const char *text, pm_expr **out) {
@@ -29,16 +164,15 @@ pm_err pm_expr_create(const char *text, pm_expr **out) {
   PM_TRY(PM_ALLOC(e, 1, "expression"));
   e->text = strdup(text);
   PM_ENSURE(e->text, PM_ERR_MEMORY, "cannot copy expression \"%s\"", text);
-  for (const char *c = text; *c; c++)
-    PM_ENSURE(expr_char_ok(*c), PM_ERR_EXPR,
-              "invalid expression \"%s\": unexpected character '%c'", text,
-              *c);
-  PM_ENSURE(strspn(text, " \t") < strlen(text), PM_ERR_EXPR,
-            "invalid expression \"%s\": empty", text);
+  size_t at = 0;
+  const char *problem = expr_syntax_error(text, &at);
+  PM_ENSURE(!problem, PM_ERR_EXPR,
+            "invalid expression \"%s\": syntax error at character %zu: %s",
+            text, at + 1, problem);
   /* matheval takes a non-const string; give it the private copy. */
   e->evaluator = evaluator_create(e->text);
-  PM_ENSURE(e->evaluator, PM_ERR_EXPR, "invalid expression \"%s\": syntax error",
-            text);
+  PM_ENSURE(e->evaluator, PM_ERR_EXPR,
+            "invalid expression \"%s\": syntax error", text);
   char **names = NULL;
   int count = 0;
   evaluator_get_variables(e->evaluator, &names, &count);

@@ -5,12 +5,16 @@
 
 #ifdef _OPENMP
 #include <omp.h>
+#define PM_OMP_AVAILABLE 1
 #define PM_PRAGMA_(x) _Pragma(#x)
 #define PM_OMP(...) PM_PRAGMA_(omp __VA_ARGS__)
 static inline int pm_omp_threads(void) { return omp_get_max_threads(); }
+static inline void pm_omp_set_threads(int n) { omp_set_num_threads(n); }
 #else
+#define PM_OMP_AVAILABLE 0
 #define PM_OMP(...)
 static inline int pm_omp_threads(void) { return 1; }
+static inline void pm_omp_set_threads(int n) { (void)n; }
 #endif
 
 #endif

@@ -17,8 +17,7 @@
 
 static yaml_node_t *node_get(const pm_sdoc *d, int id) {
   /* libyaml takes a non-const document only to find the node. */
-  return id > 0 ? yaml_document_get_node((yaml_document_t *)&d->doc, id)
-                : NULL;
+  return id > 0 ? yaml_document_get_node((yaml_document_t *)&d->doc, id) : NULL;
 }
 
 static int node_count(const pm_sdoc *d) {
@@ -37,9 +36,14 @@ static int node_origin(const pm_sdoc *d, int id) {
   return d->n_overrides; /* the override being applied */
 }
 
+/* buf = path.seg, cut to size (paths are for messages only). */
 static void path_join(char *buf, size_t size, const char *path,
                       const char *seg) {
-  snprintf(buf, size, "%s%s%s", path, path[0] ? "." : "", seg);
+  size_t n = 0;
+  for (const char *p = path; *p && n + 1 < size; p++) buf[n++] = *p;
+  if (path[0] && n + 1 < size) buf[n++] = '.';
+  for (const char *p = seg; *p && n + 1 < size; p++) buf[n++] = *p;
+  buf[n] = '\0';
 }
 
 /* Value (or key) node of the mapping pair with key name in mapping id. */
@@ -177,9 +181,9 @@ pm_err pm_sdoc_expected(const pm_sdoc *d, const char *path, const char *what) {
 static pm_err syntax_error(const char *path, const yaml_parser_t *p) {
   const char *problem = p->problem ? p->problem : "unreadable YAML";
   if (p->context)
-    return PM_ERROR(PM_ERR_SCENE, "%s:%zu:%zu: YAML syntax error: %s %s",
-                    path, p->problem_mark.line + 1,
-                    p->problem_mark.column + 1, problem, p->context);
+    return PM_ERROR(PM_ERR_SCENE, "%s:%zu:%zu: YAML syntax error: %s %s", path,
+                    p->problem_mark.line + 1, p->problem_mark.column + 1,
+                    problem, p->context);
   return PM_ERROR(PM_ERR_SCENE, "%s:%zu:%zu: YAML syntax error: %s", path,
                   p->problem_mark.line + 1, p->problem_mark.column + 1,
                   problem);
@@ -259,15 +263,9 @@ static void describe(char *buf, size_t size, const cyaml_schema_value_t *s) {
   char names[PM_SDOC_WHERE];
   switch (s->type) {
   case CYAML_INT:
-  case CYAML_UINT:
-    snprintf(buf, size, "an integer");
-    break;
-  case CYAML_FLOAT:
-    snprintf(buf, size, "a number");
-    break;
-  case CYAML_BOOL:
-    snprintf(buf, size, "true or false");
-    break;
+  case CYAML_UINT: snprintf(buf, size, "an integer"); break;
+  case CYAML_FLOAT: snprintf(buf, size, "a number"); break;
+  case CYAML_BOOL: snprintf(buf, size, "true or false"); break;
   case CYAML_STRING:
     snprintf(buf, size, s->string.min > 0 ? "a non-empty string" : "a string");
     break;
@@ -281,12 +279,8 @@ static void describe(char *buf, size_t size, const cyaml_schema_value_t *s) {
                s->enumeration.count);
     snprintf(buf, size, "a list of names from %s", names);
     break;
-  case CYAML_MAPPING:
-    snprintf(buf, size, "a mapping");
-    break;
-  default:
-    snprintf(buf, size, "a list");
-    break;
+  case CYAML_MAPPING: snprintf(buf, size, "a mapping"); break;
+  default: snprintf(buf, size, "a list"); break;
   }
 }
 
@@ -332,7 +326,6 @@ static pm_err check_mapping(const pm_sdoc *d, const cyaml_schema_value_t *s,
   if (n->type != YAML_MAPPING_NODE) return expected_at(d, id, path, s);
   int n_pairs = (int)(n->data.mapping.pairs.top - n->data.mapping.pairs.start);
   for (int i = 0; i < n_pairs; i++) {
-    /* Re-fetch: the node array is stable here, but keep one access path. */
     yaml_node_pair_t pair = node_get(d, id)->data.mapping.pairs.start[i];
     const char *key = pm_sdoc_scalar(d, pair.key);
     if (!key) {
@@ -352,8 +345,8 @@ static pm_err check_mapping(const pm_sdoc *d, const cyaml_schema_value_t *s,
                       where, keys);
     }
     for (int j = 0; j < i; j++) {
-      const char *prev = pm_sdoc_scalar(
-          d, node_get(d, id)->data.mapping.pairs.start[j].key);
+      const char *prev =
+          pm_sdoc_scalar(d, node_get(d, id)->data.mapping.pairs.start[j].key);
       if (prev && strcmp(prev, key) == 0) {
         pm_sdoc_where(d, pair.key, sub, where, sizeof where);
         return PM_ERROR(PM_ERR_SCENE, "%s: duplicate key", where);
@@ -374,7 +367,7 @@ static pm_err check_mapping(const pm_sdoc *d, const cyaml_schema_value_t *s,
 static pm_err check_sequence(const pm_sdoc *d, const cyaml_schema_value_t *s,
                              int id, const char *path, int depth) {
   yaml_node_t *n = node_get(d, id);
-  char sub[PM_SDOC_PATH], where[PM_SDOC_WHERE], idx[16];
+  char sub[PM_SDOC_PATH], where[PM_SDOC_WHERE], idx[24];
   if (n->type != YAML_SEQUENCE_NODE) return expected_at(d, id, path, s);
   long count = n->data.sequence.items.top - n->data.sequence.items.start;
   uint32_t lo = s->sequence.min, hi = s->sequence.max;
@@ -401,17 +394,16 @@ static pm_err check_sequence(const pm_sdoc *d, const cyaml_schema_value_t *s,
 static pm_err check_flags(const pm_sdoc *d, const cyaml_schema_value_t *s,
                           int id, const char *path) {
   yaml_node_t *n = node_get(d, id);
-  char sub[PM_SDOC_PATH], idx[16], names[PM_SDOC_WHERE], what[PM_SDOC_WHERE];
+  char sub[PM_SDOC_PATH], idx[24], names[PM_SDOC_WHERE];
+  char what[PM_SDOC_WHERE + 16];
   if (n->type != YAML_SEQUENCE_NODE) return expected_at(d, id, path, s);
   long count = n->data.sequence.items.top - n->data.sequence.items.start;
-  list_names(names, sizeof names, s->enumeration.strings,
-             s->enumeration.count);
+  list_names(names, sizeof names, s->enumeration.strings, s->enumeration.count);
   snprintf(what, sizeof what, "one of %s", names);
   for (long i = 0; i < count; i++) {
     int item = node_get(d, id)->data.sequence.items.start[i];
     const char *v = pm_sdoc_scalar(d, item);
-    if (v && name_in(s->enumeration.strings, s->enumeration.count, v))
-      continue;
+    if (v && name_in(s->enumeration.strings, s->enumeration.count, v)) continue;
     snprintf(idx, sizeof idx, "%ld", i);
     path_join(sub, sizeof sub, path, idx);
     return pm_sdoc_expected(d, sub, what);
@@ -428,31 +420,20 @@ static pm_err check_value(const pm_sdoc *d, const cyaml_schema_value_t *s,
                     where);
   }
   switch (s->type) {
-  case CYAML_MAPPING:
-    return check_mapping(d, s, id, path, depth);
+  case CYAML_MAPPING: return check_mapping(d, s, id, path, depth);
   case CYAML_SEQUENCE:
-  case CYAML_SEQUENCE_FIXED:
-    return check_sequence(d, s, id, path, depth);
-  case CYAML_FLAGS:
-    return check_flags(d, s, id, path);
-  case CYAML_IGNORE:
-    return PM_SUCCESS;
-  default:
-    break;
+  case CYAML_SEQUENCE_FIXED: return check_sequence(d, s, id, path, depth);
+  case CYAML_FLAGS: return check_flags(d, s, id, path);
+  case CYAML_IGNORE: return PM_SUCCESS;
+  default: break;
   }
   const char *v = pm_sdoc_scalar(d, id);
   bool ok = v != NULL;
   if (ok) {
     switch (s->type) {
-    case CYAML_INT:
-      ok = scalar_is_int(v, s->data_size, true);
-      break;
-    case CYAML_UINT:
-      ok = scalar_is_int(v, s->data_size, false);
-      break;
-    case CYAML_FLOAT:
-      ok = scalar_is_number(v);
-      break;
+    case CYAML_INT: ok = scalar_is_int(v, s->data_size, true); break;
+    case CYAML_UINT: ok = scalar_is_int(v, s->data_size, false); break;
+    case CYAML_FLOAT: ok = scalar_is_number(v); break;
     case CYAML_BOOL:
       ok = strcmp(v, "true") == 0 || strcmp(v, "false") == 0;
       break;
@@ -462,9 +443,7 @@ static pm_err check_value(const pm_sdoc *d, const cyaml_schema_value_t *s,
     case CYAML_STRING:
       ok = strlen(v) >= s->string.min && strlen(v) <= s->string.max;
       break;
-    default:
-      ok = false;
-      break;
+    default: ok = false; break;
     }
   }
   return ok ? PM_SUCCESS : expected_at(d, id, path, s);
@@ -502,13 +481,12 @@ static int copy_node(pm_sdoc *d, yaml_document_t *src, int id, int depth) {
          out && p < n->data.mapping.pairs.top; p++) {
       int key = copy_node(d, src, p->key, depth + 1);
       int value = key ? copy_node(d, src, p->value, depth + 1) : 0;
-      if (!value || !yaml_document_append_mapping_pair(&d->doc, out, key,
-                                                       value))
+      if (!value ||
+          !yaml_document_append_mapping_pair(&d->doc, out, key, value))
         return 0;
     }
     return out;
-  default:
-    return 0;
+  default: return 0;
   }
 }
 
@@ -583,8 +561,7 @@ static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
                         "--set %s: unknown key %s (expected one of %s)", kv,
                         sofar, names);
       }
-      if (n->type != YAML_MAPPING_NODE)
-        return expected_at(d, id, parent, s);
+      if (n->type != YAML_MAPPING_NODE) return expected_at(d, id, parent, s);
       yaml_node_pair_t *pair = n->data.mapping.pairs.start;
       while (pair < n->data.mapping.pairs.top &&
              strcmp(pm_sdoc_scalar(d, pair->key) ? pm_sdoc_scalar(d, pair->key)
@@ -604,9 +581,9 @@ static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
                           "--set %s: %s is not in the scene, so it has no "
                           "entries to set",
                           kv, sofar);
-        int k = yaml_document_add_scalar(&d->doc, NULL, (yaml_char_t *)seg,
-                                         (int)strlen(seg),
-                                         YAML_PLAIN_SCALAR_STYLE);
+        int k =
+            yaml_document_add_scalar(&d->doc, NULL, (yaml_char_t *)seg,
+                                     (int)strlen(seg), YAML_PLAIN_SCALAR_STYLE);
         PM_CHECK(k, PM_ERR_MEMORY, "--set %s: out of memory", kv);
         PM_CALL(override_node(d, kv, value, last, &child));
         PM_CHECK(yaml_document_append_mapping_pair(&d->doc, id, k, child),
@@ -621,17 +598,15 @@ static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
                         "--set %s: %s: expected a list index (0, 1, ...), "
                         "got %s",
                         kv, sofar, seg);
-      if (n->type != YAML_SEQUENCE_NODE)
-        return expected_at(d, id, parent, s);
+      if (n->type != YAML_SEQUENCE_NODE) return expected_at(d, id, parent, s);
       long count = n->data.sequence.items.top - n->data.sequence.items.start;
       const cyaml_schema_value_t *entry =
           s->type == CYAML_FLAGS ? NULL : s->sequence.entry;
       if (!last && !entry)
         return PM_ERROR(PM_ERR_SCENE,
-                        "--set %s: unknown key %s (%s holds names)", kv,
-                        sofar, parent);
-      if (i > count ||
-          (i == count && !last && entry->type != CYAML_MAPPING))
+                        "--set %s: unknown key %s (%s holds names)", kv, sofar,
+                        parent);
+      if (i > count || (i == count && !last && entry->type != CYAML_MAPPING))
         return PM_ERROR(PM_ERR_SCENE,
                         "--set %s: index %ld out of range (%s has %ld "
                         "entries)",
@@ -707,8 +682,8 @@ static bool emit_node(yaml_emitter_t *em, pm_sdoc *d, int id, int depth) {
                                               YAML_ANY_SEQUENCE_STYLE) ||
         !yaml_emitter_emit(em, &ev))
       return false;
-    for (int i = 0; i < n->data.sequence.items.top - n->data.sequence.items.start;
-         i++)
+    for (int i = 0;
+         i < n->data.sequence.items.top - n->data.sequence.items.start; i++)
       if (!emit_node(em, d, node_get(d, id)->data.sequence.items.start[i],
                      depth + 1))
         return false;
@@ -726,10 +701,8 @@ static bool emit_node(yaml_emitter_t *em, pm_sdoc *d, int id, int depth) {
           !emit_node(em, d, p.value, depth + 1))
         return false;
     }
-    return yaml_mapping_end_event_initialize(&ev) &&
-           yaml_emitter_emit(em, &ev);
-  default:
-    return false;
+    return yaml_mapping_end_event_initialize(&ev) && yaml_emitter_emit(em, &ev);
+  default: return false;
   }
 }
 
@@ -751,7 +724,8 @@ pm_err pm_sdoc_emit(pm_sdoc *d, char **text, size_t *len) {
             yaml_document_start_event_initialize(&ev, NULL, NULL, NULL, 1) &&
             yaml_emitter_emit(&em, &ev) && emit_node(&em, d, root_id(d), 0) &&
             yaml_document_end_event_initialize(&ev, 1) &&
-            yaml_emitter_emit(&em, &ev) && yaml_stream_end_event_initialize(&ev) &&
+            yaml_emitter_emit(&em, &ev) &&
+            yaml_stream_end_event_initialize(&ev) &&
             yaml_emitter_emit(&em, &ev) && yaml_emitter_flush(&em);
   PM_ENSURE(ok && b.data, PM_ERR_INTERNAL, "%s: cannot re-emit the scene: %s",
             d->path, em.problem ? em.problem : "out of memory");

@@ -17,7 +17,7 @@
 #define PM_SDOC_WHERE 512
 
 typedef struct {
-  const char *path;             /* scene file, for messages */
+  const char *path; /* scene file, for messages */
   yaml_document_t doc;
   bool loaded;                  /* doc holds a document to delete */
   int n_file_nodes;             /* node ids 1..n_file_nodes come from path */
@@ -71,7 +71,6 @@ pm_err pm_sdoc_expected(const pm_sdoc *d, const char *path, const char *what);
 /* Fail with PM_ERR_SCENE: "WHERE: " + printf-formatted text, for the node
  * at path (its key node when key is set). */
 pm_err pm_sdoc_fail(const pm_sdoc *d, const char *path, bool key,
-                    const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
+                    const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 
 #endif

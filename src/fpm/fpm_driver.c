@@ -25,6 +25,8 @@ const char *fpm_status_name(fpm_status s) {
   }
 }
 
+static void fill_reference(fpm_sim *sim, double t);
+
 void fpm_sim_destroy(fpm_sim *sim) {
   if (!sim) return;
   fpm_state_destroy(sim->state);
@@ -32,6 +34,7 @@ void fpm_sim_destroy(fpm_sim *sim) {
   gm_dual_destroy(sim->dual);
   gm_mesh_destroy(sim->mesh);
   free(sim->scratch);
+  free(sim->ref);
   free(sim);
 }
 
@@ -65,6 +68,14 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   PM_TRY(fpm_model_create(s, sim->dual, &sim->model));
   PM_TRY(fpm_state_create(sim->model, &sim->state));
   PM_TRY(PM_ALLOC(sim->scratch, 9 * sim->model->n, "output buffer"));
+  if (s->reference_mask) {
+    PM_TRY(PM_ALLOC(sim->ref, 3 * sim->model->n, "reference field"));
+    for (int c = 0; c < 3; c++)
+      if ((s->reference_mask & (1u << c)) &&
+          pm_expr_uses(s->reference[c], 't'))
+        sim->ref_time_dependent = true;
+    fill_reference(sim, 0);
+  }
   sim->dt_stable = fpm_stable_dt(sim->model, &sim->dt_point);
   sim->dt = s->time.dt > 0 ? s->time.dt : s->time.dt_safety * sim->dt_stable;
   pm_timers_stop(&sim->timers, sim->tm_operators);
@@ -78,6 +89,33 @@ done:
 
 /* ---- run ---------------------------------------------------------------- */
 
+/* Reference displacement at time t (serial: expressions are not
+ * thread-safe). */
+static void fill_reference(fpm_sim *sim, double t) {
+  const pm_scene *s = sim->scene;
+  const fpm_model *m = sim->model;
+  for (int c = 0; c < 3; c++) {
+    if (!(s->reference_mask & (1u << c))) continue;
+    for (long i = 0; i < m->n; i++)
+      sim->ref[3 * i + c] = pm_expr_eval(s->reference[c], m->x[3 * i],
+                                         m->x[3 * i + 1], m->x[3 * i + 2], t);
+  }
+}
+
+/* NRMSE (eq. 28) of each reference component at time t into sim->nrmse. */
+static void compute_errors(fpm_sim *sim, double t) {
+  const pm_scene *s = sim->scene;
+  sim->n_ref = 0;
+  for (int c = 0; c < 3; c++) sim->nrmse[c] = NAN;
+  if (!sim->ref) return;
+  if (sim->ref_time_dependent) fill_reference(sim, t);
+  for (int c = 0; c < 3; c++) {
+    if (!(s->reference_mask & (1u << c))) continue;
+    sim->nrmse[c] = pm_nrmse(sim->model->n, 3, sim->state->u + c, sim->ref + c);
+    sim->n_ref++;
+  }
+}
+
 typedef struct {
   fpm_sim *sim;
   pm_results *results;
@@ -87,6 +125,8 @@ typedef struct {
   int n_hist;
   double row[FPM_HIST_MAX];
   int reaction_bc[FPM_HIST_MAX]; /* per history column: bc, or -1 */
+  int first_error;               /* column of the first NRMSE, or -1 */
+  double t_start;                /* wall clock at the start of the run */
   int reaction_comp[FPM_HIST_MAX];
   char names_buf[FPM_HIST_MAX][40];
   const char *names[FPM_HIST_MAX];
@@ -95,12 +135,13 @@ typedef struct {
 } run_ctx;
 
 static void setup_history_columns(run_ctx *c) {
-  static const char *base[] = {"time",     "step",          "kinetic_energy",
-                               "strain_energy", "external_work", "residual",
-                               "damping"};
+  static const char *base[] = {"time",          "step",
+                               "wall_seconds",  "kinetic_energy",
+                               "strain_energy", "external_work",
+                               "residual",      "damping"};
   const pm_scene *s = c->sim->scene;
   int n = 0;
-  for (int k = 0; k < 7; k++) {
+  for (int k = 0; k < 8; k++) {
     snprintf(c->names_buf[n], sizeof c->names_buf[n], "%s", base[k]);
     c->reaction_bc[n] = -1;
     n++;
@@ -114,6 +155,16 @@ static void setup_history_columns(run_ctx *c) {
       c->reaction_comp[n] = comp;
       n++;
     }
+  /* Accuracy beside time: the error against the reference at each frame. */
+  c->first_error = -1;
+  for (int comp = 0; comp < 3 && n < FPM_HIST_MAX; comp++) {
+    if (!(s->reference_mask & (1u << comp))) continue;
+    if (c->first_error < 0) c->first_error = n;
+    snprintf(c->names_buf[n], sizeof c->names_buf[n], "nrmse_u_%c",
+             "xyz"[comp]);
+    c->reaction_bc[n] = -1;
+    n++;
+  }
   for (int k = 0; k < n; k++) c->names[k] = c->names_buf[k];
   c->n_hist = n;
 }
@@ -180,36 +231,27 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
     double *row = c->row;
     row[0] = info->t;
     row[1] = (double)info->step;
-    row[2] = info->kinetic;
-    row[3] = info->strain;
-    row[4] = info->external_work;
-    row[5] = info->residual;
-    row[6] = info->damping;
-    for (int k = 7; k < c->n_hist; k++) {
+    row[2] = pm_wtime() - c->t_start;
+    row[3] = info->kinetic;
+    row[4] = info->strain;
+    row[5] = info->external_work;
+    row[6] = info->residual;
+    row[7] = info->damping;
+    int k = 8;
+    for (; k < c->n_hist && c->reaction_bc[k] >= 0; k++) {
       double R[3];
       fpm_reaction(m, st, c->reaction_bc[k], R);
       row[k] = R[c->reaction_comp[k]];
+    }
+    if (c->first_error >= 0) {
+      compute_errors(sim, info->t);
+      for (int comp = 0; comp < 3; comp++)
+        if (isfinite(sim->nrmse[comp])) row[k++] = sim->nrmse[comp];
     }
     ret = pm_history_row(c->history, row);
   }
   pm_timers_stop(&sim->timers, sim->tm_output);
   return ret;
-}
-
-static void compute_errors(fpm_sim *sim) {
-  const pm_scene *s = sim->scene;
-  const fpm_model *m = sim->model;
-  sim->n_ref = 0;
-  for (int c = 0; c < 3; c++) {
-    sim->nrmse[c] = NAN;
-    if (!(s->reference_mask & (1u << c)) || !s->reference[c]) continue;
-    for (long i = 0; i < m->n; i++)
-      sim->scratch[i] = pm_expr_eval(s->reference[c], m->x[3 * i],
-                                     m->x[3 * i + 1], m->x[3 * i + 2],
-                                     sim->last.t);
-    sim->nrmse[c] = pm_nrmse(m->n, 1, sim->state->u + c, sim->scratch) ;
-    sim->n_ref++;
-  }
 }
 
 static pm_err write_summary(fpm_sim *sim, const char *out_dir) {
@@ -319,6 +361,7 @@ pm_err fpm_sim_run(fpm_sim *sim, const char *out_dir, bool quiet) {
   memset(sim->state->u, 0, 3 * m->n * sizeof(double));
   memset(sim->state->v, 0, 3 * m->n * sizeof(double));
   double t0 = pm_wtime(), stage[2] = {0, 0};
+  c->t_start = t0;
   run_err = fpm_run(m, sim->state, &opt, observe, c, &sim->last, stage);
   sim->wall = pm_wtime() - t0;
   if (!quiet) pm_progress_finish(&c->progress);
@@ -345,7 +388,7 @@ pm_err fpm_sim_run(fpm_sim *sim, const char *out_dir, bool quiet) {
              sim->last.step);
   }
   if (sim->status != FPM_STATUS_UNSTABLE && sim->status != FPM_STATUS_FAILED)
-    compute_errors(sim);
+    compute_errors(sim, sim->last.t);
   if (out_dir) {
     /* Frames written before a failure are good: keep them. */
     pm_results *r = c->results;

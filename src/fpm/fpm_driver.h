@@ -40,6 +40,8 @@ typedef struct {
   int n_ref;                /* reference components compared */
   double nrmse[3];          /* eq. 28 per component, NaN if no reference */
   double *scratch;          /* 9 n: output and metrics buffer */
+  double *ref;              /* 3 n: reference displacement, or NULL */
+  bool ref_time_dependent;  /* some reference component uses t */
   char message[1024];       /* failure message, if any */
 } fpm_sim;
 

@@ -4,6 +4,7 @@
 #include "fpm_solver.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "pm_omp.h"
 #include "pm_progress.h"
@@ -26,6 +27,47 @@ void fpm_reaction(const fpm_model *m, const fpm_state *st, int b,
   for (long k = 0; k < m->n_cdofs; k++)
     if (m->cd_bc[k] == b)
       R[m->cd_comp[k]] += st->f[3 * m->cd_point[k] + m->cd_comp[k]];
+}
+
+double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
+                       double *base, double *lambda) {
+  const long nd = 3 * m->n;
+  double *v = st->v, lam = 0;
+  memset(st->u, 0, nd * sizeof(double));
+  fpm_update_tractions(m, st, 0);
+  fpm_force(m, st);
+  memcpy(base, st->f, nd * sizeof(double));
+  unsigned long long seed = 88172645463325252ull;
+  double scale = 0;
+  for (long k = 0; k < 3 * m->n; k++) scale = fmax(scale, fabs(m->x[k]));
+  for (long k = 0; k < nd; k++) {
+    seed ^= seed << 13;
+    seed ^= seed >> 7;
+    seed ^= seed << 17;
+    v[k] = m->fixed[k] ? 0 : (double)(seed >> 11) / 9007199254740992.0 - 0.5;
+  }
+  for (int it = 0; it < iterations; it++) {
+    double vmax = 0, num = 0, den = 0;
+    for (long k = 0; k < nd; k++) vmax = fmax(vmax, fabs(v[k]));
+    if (!(vmax > 0 && isfinite(vmax))) break;
+    for (long k = 0; k < nd; k++) v[k] /= vmax;
+    double eps = 1e-7 * (scale > 0 ? scale : 1);
+    for (long k = 0; k < nd; k++) st->u[k] = eps * v[k];
+    if (fpm_force(m, st) >= 0) break;
+    for (long k = 0; k < nd; k++) {
+      if (m->fixed[k]) continue;
+      double Kv = (st->f[k] - base[k]) / eps, mk = m->mass[k / 3];
+      num += v[k] * Kv;
+      den += mk * v[k] * v[k];
+      v[k] = Kv / mk;
+    }
+    lam = den > 0 ? num / den : 0;
+  }
+  memset(st->u, 0, nd * sizeof(double));
+  memset(st->v, 0, nd * sizeof(double));
+  fpm_force(m, st);
+  if (lambda) *lambda = lam;
+  return lam > 0 ? 2 / sqrt(lam) : INFINITY;
 }
 
 static void apply_prescribed(const fpm_model *m, fpm_state *st, double t,

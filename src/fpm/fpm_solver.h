@@ -43,6 +43,14 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
                fpm_observer observer, void *ctx, fpm_step_info *info,
                double stage_seconds[2]);
 
+/* Largest eigenvalue of M^-1 K (K the tangent stiffness at u = 0, free
+ * dofs) by power iteration on finite differences of the force, and the
+ * step 2 / sqrt(lambda) it allows.  Uses st and work (3 n doubles) as work
+ * space and leaves u = v = 0.  A measured figure to compare with the bound
+ * of eqs. 24-26. */
+double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
+                       double *work, double *lambda);
+
 /* Reaction force: sum of f over the prescribed dofs of boundary condition
  * b, per component (3). */
 void fpm_reaction(const fpm_model *m, const fpm_state *st, int b,

@@ -13,6 +13,7 @@
 #include "fpm_model.h"
 #include "fpm_solver.h"
 #include "gm_dual.h"
+#include "pm_omp.h"
 
 typedef struct {
   gm_mesh *mesh;
@@ -186,8 +187,19 @@ static void test_patch_f2(void **state) {
   }
 }
 
+/* gmsh sets the OpenMP thread count process-wide; meshing must leave the
+ * caller's setting as it was (it once silently serialized every run). */
+static void test_meshing_keeps_threads(void **state) {
+  (void)state;
+  pm_omp_set_threads(2);
+  fixture *fx = fixture_new(3, 0.05, 0, false);
+  assert_int_equal(pm_omp_threads(), PM_OMP_AVAILABLE ? 2 : 1);
+  fixture_free(fx);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_meshing_keeps_threads),
       cmocka_unit_test(test_gfd_linear),
       cmocka_unit_test(test_homogeneous_p0),
       cmocka_unit_test(test_homogeneous_p20),

@@ -39,9 +39,9 @@ line_of() { grep -n -- "$1" "$scene" | head -1 | cut -d: -f1; }
 
 bad_scene unknown-key 's/fpm: {penalty: 20}/fpm: {penalty: 20, penalti: 3}/' \
   "$(line_of 'fpm: {penalty')" penalti
-bad_scene wrong-type 's/mesh_size: 1.09e-2/mesh_size: fine/' \
+bad_scene wrong-type 's/mesh_size: 8.72e-3/mesh_size: fine/' \
   "$(line_of 'mesh_size:')" mesh_size
-bad_scene negative-size 's/mesh_size: 1.09e-2/mesh_size: -0.01/' \
+bad_scene negative-size 's/mesh_size: 8.72e-3/mesh_size: -0.01/' \
   "$(line_of 'mesh_size:')" mesh_size
 bad_scene bad-poisson 's/poisson_ratio: 0.495/poisson_ratio: 0.5/' \
   "$(line_of 'poisson_ratio')" poisson_ratio

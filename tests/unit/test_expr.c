@@ -1,0 +1,94 @@
+/* test_expr: compiled expressions in x, y, z, t (values, constants, the
+ * variable whitelist and syntax errors). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+#include <math.h>
+#include <string.h>
+
+#include "pm_expr.h"
+
+/* |a - b| <= tol with both values in the message (NaN fails). */
+#define assert_near(a, b, tol) check_near((a), (b), (tol), #a, __LINE__)
+static void check_near(double a, double b, double tol, const char *what,
+                       int line) {
+  if (!(fabs(a - b) <= tol))
+    fail_msg("line %d: %s = %.17g, expected %.17g (tol %g)", line, what, a, b,
+             tol);
+}
+
+static double eval_text(const char *text, double x, double y, double z,
+                        double t) {
+  pm_expr *e = NULL;
+  assert_int_equal(pm_expr_create(text, &e), PM_SUCCESS);
+  double v = pm_expr_eval(e, x, y, z, t);
+  pm_expr_destroy(e);
+  return v;
+}
+
+static void test_values(void **state) {
+  (void)state;
+  assert_near(eval_text("0", 1, 2, 3, 4), 0.0, 0.0);
+  assert_near(eval_text("-0.04", 1, 2, 3, 4), -0.04, 1e-15);
+  assert_near(eval_text("1.5e-3", 0, 0, 0, 0), 1.5e-3, 1e-18);
+  assert_near(eval_text("-0.4*z", 0, 0, 0.05, 0), -0.02, 1e-15);
+  assert_near(eval_text("x + 2*y - z^2 + t", 1, 2, 3, 4), 0.0, 1e-12);
+  assert_near(eval_text("0.01*sin(2*pi*t)", 0, 0, 0, 0.25), 0.01, 1e-15);
+  assert_near(eval_text("e", 0, 0, 0, 0), exp(1.0), 1e-15);
+  assert_near(eval_text("100*t", 0, 0, 0, 0.5), 50.0, 1e-12);
+}
+
+static void test_text_and_uses(void **state) {
+  (void)state;
+  pm_expr *e = NULL;
+  assert_int_equal(pm_expr_create("x*t + 3", &e), PM_SUCCESS);
+  assert_string_equal(pm_expr_text(e), "x*t + 3");
+  assert_true(pm_expr_uses(e, 'x'));
+  assert_false(pm_expr_uses(e, 'y'));
+  assert_false(pm_expr_uses(e, 'z'));
+  assert_true(pm_expr_uses(e, 't'));
+  assert_false(pm_expr_uses(e, 'q'));
+  assert_false(pm_expr_uses(e, '\0'));
+  pm_expr_destroy(e);
+
+  assert_int_equal(pm_expr_create("2*pi", &e), PM_SUCCESS);
+  for (const char *v = "xyzt"; *v; v++) assert_false(pm_expr_uses(e, *v));
+  pm_expr_destroy(e);
+  pm_expr_destroy(NULL);
+}
+
+static void expect_error(const char *text, const char *fragment) {
+  pm_expr *e = (pm_expr *)&e; /* must be reset to NULL on failure */
+  pm_error_clear();
+  assert_int_equal(pm_expr_create(text, &e), PM_ERR_EXPR);
+  assert_null(e);
+  const char *msg = pm_error_message();
+  if (!strstr(msg, fragment))
+    fail_msg("message \"%s\" lacks \"%s\"", msg, fragment);
+}
+
+static void test_errors(void **state) {
+  (void)state;
+  expect_error("-0.4*q", "invalid expression \"-0.4*q\": unknown variable q "
+                         "(allowed: x, y, z, t)");
+  expect_error("xx + 1", "unknown variable xx");
+  expect_error("x +", "invalid expression \"x +\": syntax error");
+  expect_error("", "empty");
+  expect_error("x > 1", "syntax error at character 3");
+  expect_error("2*(x + 1", "expected ')'");
+  expect_error("sin x", "expected '(' after a function name");
+  expect_error("3 4", "unexpected text");
+  expect_error("foo(x)", "syntax error");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_values),
+      cmocka_unit_test(test_text_and_uses),
+      cmocka_unit_test(test_errors),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

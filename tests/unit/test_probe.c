@@ -1,0 +1,288 @@
+/* test_probe: moving-least-squares probing of results.h5 reproduces linear
+ * fields in 3-D and 2-D, picks frames, and reports bad files and lines. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+/* cmocka needs the three headers above first. */
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "pm_output.h"
+#include "pm_probe.h"
+
+#define N_SIDE 8    /* lattice points per axis */
+#define SPACING 0.1 /* lattice spacing */
+#define MAX_ROWS 16
+
+/* ---- Helpers ----------------------------------------------------------- */
+
+/* Expect success; on failure show the recorded message. */
+#define assert_ok(expr)                                                        \
+  do {                                                                         \
+    pm_err e_ = (expr);                                                        \
+    if (e_ != PM_SUCCESS)                                                      \
+      fail_msg("%s: %s\n%s", pm_err_name(e_), pm_error_message(),              \
+               pm_error_traceback());                                          \
+  } while (0)
+
+/* Expect code and a message containing text. */
+#define assert_fails(expr, code, text)                                         \
+  do {                                                                         \
+    pm_err e_ = (expr);                                                        \
+    if (e_ != (code) || !strstr(pm_error_message(), (text)))                   \
+      fail_msg("expected %s with '%s', got %s: %s", pm_err_name(code), (text), \
+               pm_err_name(e_), pm_error_message());                           \
+  } while (0)
+
+/* A linear field u = c + G x. */
+typedef struct {
+  double c[3], g[3][3];
+} linear;
+
+static const linear FIELD0 = {
+    {0.01, -0.02, 0.03},
+    {{0.1, -0.05, 0.02}, {0.03, 0.2, -0.1}, {-0.07, 0.04, 0.15}}};
+static const linear FIELD1 = {
+    {-0.05, 0.04, 0.02},
+    {{0.25, 0.1, -0.2}, {-0.15, 0.3, 0.05}, {0.12, -0.08, -0.25}}};
+
+static void eval(const linear *f, const double *x, double *u) {
+  for (int i = 0; i < 3; i++) {
+    u[i] = f->c[i];
+    for (int j = 0; j < 3; j++) u[i] += f->g[i][j] * x[j];
+  }
+}
+
+static void remove_tree(const char *path) {
+  struct stat st;
+  if (lstat(path, &st) != 0) return;
+  if (S_ISDIR(st.st_mode)) {
+    DIR *d = opendir(path);
+    struct dirent *e;
+    char sub[1024];
+    while (d && (e = readdir(d))) {
+      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+      snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
+      remove_tree(sub);
+    }
+    if (d) closedir(d);
+    rmdir(path);
+  } else {
+    unlink(path);
+  }
+}
+
+static int make_dir(void **state) {
+  char *dir = malloc(64);
+  strcpy(dir, "/tmp/pm_test_probe_XXXXXX");
+  assert_non_null(mkdtemp(dir));
+  *state = dir;
+  return 0;
+}
+
+static int drop_dir(void **state) {
+  remove_tree(*state);
+  free(*state);
+  return 0;
+}
+
+/* Jitter in [-0.3, 0.3) spacings from a fixed LCG: reproducible, and
+ * irregular enough that no neighbourhood is a symmetric lattice. */
+static double jitter(unsigned *seed) {
+  *seed = *seed * 1103515245u + 12345u;
+  return SPACING * (0.6 * ((*seed >> 8) & 0xffff) / 65536.0 - 0.3);
+}
+
+/* dir/results.h5 for a jittered lattice (dim 3: N^3 points; dim 2: N^2
+ * points at z = 0) with FIELD0 in frame 0 and FIELD1 in frame 1. */
+static void write_results(const char *dir, int dim) {
+  long n = dim == 3 ? N_SIDE * N_SIDE * N_SIDE : N_SIDE * N_SIDE;
+  double *x = calloc(3 * n, sizeof *x), *u0 = calloc(3 * n, sizeof *u0);
+  double *u1 = calloc(3 * n, sizeof *u1);
+  unsigned seed = 12345u;
+  pm_results *r = NULL;
+  assert_true(x && u0 && u1);
+  for (long p = 0; p < n; p++) {
+    long idx[3] = {p % N_SIDE, (p / N_SIDE) % N_SIDE, p / (N_SIDE * N_SIDE)};
+    for (int k = 0; k < dim; k++)
+      x[3 * p + k] = SPACING * idx[k] + jitter(&seed);
+    eval(&FIELD0, &x[3 * p], &u0[3 * p]);
+    eval(&FIELD1, &x[3 * p], &u1[3 * p]);
+  }
+  assert_ok(
+      pm_results_create(dir, dim, n, x, 0, 1, NULL, "scene: test", "t", &r));
+  pm_field f0 = {"displacement", 3, u0}, f1 = {"displacement", 3, u1};
+  assert_ok(pm_results_write_frame(r, 0, 0.0, 1, &f0));
+  assert_ok(pm_results_write_frame(r, 10, 1.0, 1, &f1));
+  assert_ok(pm_results_close(r, true));
+  free(x);
+  free(u0);
+  free(u1);
+}
+
+static void write_text(const char *path, const char *text) {
+  FILE *fp = fopen(path, "w");
+  assert_non_null(fp);
+  fputs(text, fp);
+  assert_int_equal(fclose(fp), 0);
+}
+
+/* Run pm_probe into memory; rows receives up to MAX_ROWS rows of six
+ * values.  Returns the error code and the row count in *nrows. */
+static pm_err probe(const char *dir, const char *csv, long frame,
+                    double rows[][6], int *nrows) {
+  char *buf = NULL;
+  size_t size = 0;
+  FILE *out = open_memstream(&buf, &size);
+  assert_non_null(out);
+  pm_err e = pm_probe(dir, csv, frame, out);
+  assert_int_equal(fclose(out), 0);
+  *nrows = 0;
+  if (e == PM_SUCCESS) {
+    const char *header = "x,y,z,u_x,u_y,u_z\n";
+    assert_memory_equal(buf, header, strlen(header));
+    for (char *s = strchr(buf, '\n') + 1; *s; s = strchr(s, '\n') + 1) {
+      assert_true(*nrows < MAX_ROWS);
+      double *v = rows[(*nrows)++];
+      assert_int_equal(sscanf(s, "%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2],
+                              &v[3], &v[4], &v[5]),
+                       6);
+    }
+  } else {
+    assert_int_equal(size, 0); /* no partial table */
+  }
+  free(buf);
+  return e;
+}
+
+/* Each row's displacement is f at its coordinates, to 1e-10. */
+static void check_rows(const linear *f, double rows[][6], int nrows) {
+  for (int i = 0; i < nrows; i++) {
+    double u[3];
+    eval(f, rows[i], u);
+    for (int k = 0; k < 3; k++)
+      if (fabs(rows[i][3 + k] - u[k]) > 1e-10)
+        fail_msg("row %d (%g, %g, %g): u_%c = %.12g, expected %.12g", i,
+                 rows[i][0], rows[i][1], rows[i][2], "xyz"[k], rows[i][3 + k],
+                 u[k]);
+  }
+}
+
+static void csv_path(char *buf, size_t size, const char *dir) {
+  snprintf(buf, size, "%s/points.csv", dir);
+}
+
+/* ---- Tests ------------------------------------------------------------- */
+
+static void test_linear_3d(void **state) {
+  const char *dir = *state;
+  char csv[256];
+  double rows[MAX_ROWS][6];
+  int n;
+  write_results(dir, 3);
+  csv_path(csv, sizeof csv, dir);
+  write_text(csv, "x,y,z\n"
+                  "# interior points\n"
+                  "0.35,0.35,0.35\n"
+                  "\n"
+                  "0.123, 0.456 ,0.611\n"
+                  "  # indented comment\n"
+                  "0.5,0.2,0.1\r\n"
+                  "0.05,0.65,0.3\n"
+                  "0.3,0.3\n");
+  assert_ok(probe(dir, csv, -1, rows, &n)); /* last frame */
+  assert_int_equal(n, 5);
+  assert_true(rows[1][0] == 0.123 && rows[1][2] == 0.611);
+  assert_true(rows[4][2] == 0.0); /* "x,y" means z = 0 */
+  check_rows(&FIELD1, rows, n);
+  assert_ok(probe(dir, csv, 1, rows, &n));
+  assert_int_equal(n, 5);
+  check_rows(&FIELD1, rows, n);
+  assert_ok(probe(dir, csv, 0, rows, &n));
+  assert_int_equal(n, 5);
+  check_rows(&FIELD0, rows, n);
+}
+
+/* All z equal: the fit is 2-D (a 3-D fit would be singular). */
+static void test_linear_2d(void **state) {
+  const char *dir = *state;
+  char csv[256];
+  double rows[MAX_ROWS][6];
+  int n;
+  write_results(dir, 2);
+  csv_path(csv, sizeof csv, dir);
+  write_text(csv, "0.35,0.35\n0.61,0.07\n0.2,0.5,0\n");
+  assert_ok(probe(dir, csv, -1, rows, &n));
+  assert_int_equal(n, 3);
+  check_rows(&FIELD1, rows, n);
+  assert_ok(probe(dir, csv, 0, rows, &n));
+  check_rows(&FIELD0, rows, n);
+}
+
+static void test_missing_results(void **state) {
+  const char *dir = *state;
+  char csv[256], missing[256];
+  double rows[MAX_ROWS][6];
+  int n;
+  csv_path(csv, sizeof csv, dir);
+  write_text(csv, "0.1,0.1,0.1\n");
+  snprintf(missing, sizeof missing, "%s/no_such_run", dir);
+  assert_fails(probe(missing, csv, -1, rows, &n), PM_ERR_IO, "no_such_run");
+}
+
+static void test_bad_points(void **state) {
+  const char *dir = *state;
+  char csv[256], where[300];
+  double rows[MAX_ROWS][6];
+  int n;
+  write_results(dir, 3);
+  csv_path(csv, sizeof csv, dir);
+  const char *bad[] = {"0.1,abc,0.3\n", "0.1,0.2,0.3,0.4\n", "0.1\n",
+                       "0.1,0.2,\n",    "0.1;0.2;0.3\n",     "0.1,0.2,0.3 x\n",
+                       "0.1,nan,0.3\n"};
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+    char text[128];
+    snprintf(text, sizeof text, "x,y,z\n0.3,0.3,0.3\n%s", bad[i]);
+    write_text(csv, text);
+    snprintf(where, sizeof where, "%s:3: expected x,y,z numbers", csv);
+    assert_fails(probe(dir, csv, -1, rows, &n), PM_ERR_ARG, where);
+  }
+  /* Only the first line may be a header. */
+  write_text(csv, "0.3,0.3,0.3\nx,y,z\n");
+  snprintf(where, sizeof where, "%s:2:", csv);
+  assert_fails(probe(dir, csv, -1, rows, &n), PM_ERR_ARG, where);
+  write_text(csv, "x,y,z\n# nothing\n");
+  assert_fails(probe(dir, csv, -1, rows, &n), PM_ERR_ARG, "no points");
+  snprintf(where, sizeof where, "%s/absent.csv", dir);
+  assert_fails(probe(dir, where, -1, rows, &n), PM_ERR_IO, "absent.csv");
+}
+
+static void test_frame_range(void **state) {
+  const char *dir = *state;
+  char csv[256];
+  double rows[MAX_ROWS][6];
+  int n;
+  write_results(dir, 3);
+  csv_path(csv, sizeof csv, dir);
+  write_text(csv, "0.3,0.3,0.3\n");
+  assert_fails(probe(dir, csv, 2, rows, &n), PM_ERR_ARG, "0 to 1");
+  assert_fails(probe(dir, csv, 1000000, rows, &n), PM_ERR_ARG, "0 to 1");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test_setup_teardown(test_linear_3d, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_linear_2d, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_missing_results, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_bad_points, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_frame_range, make_dir, drop_dir),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,308 @@
+/* test_scene: scene loading against the schema, located error messages for
+ * malformed scenes, --set overrides, ramps and method names. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "pm_scene.h"
+
+/* |a - b| <= tol with both values in the message (NaN fails). */
+#define assert_near(a, b, tol) check_near((a), (b), (tol), #a, __LINE__)
+static void check_near(double a, double b, double tol, const char *what,
+                       int line) {
+  if (!(fabs(a - b) <= tol))
+    fail_msg("line %d: %s = %.17g, expected %.17g (tol %g)", line, what, a, b,
+             tol);
+}
+
+#define SCENES PM_TEST_DATA "/scenes/"
+#define F2 SCENES "f2-unconstrained-compression.yaml"
+#define MINIMAL SCENES "minimal-2d.yaml"
+
+static pm_scene *load_ok(const char *path, int n, const char *const *set) {
+  pm_scene *s = NULL;
+  pm_err err = pm_scene_load(path, n, set, &s);
+  if (err != PM_SUCCESS)
+    fail_msg("loading %s failed: %s", path, pm_error_message());
+  assert_non_null(s);
+  return s;
+}
+
+/* Loading fails with code and a message containing every fragment. */
+static void load_fails(const char *path, int n, const char *const *set,
+                       pm_err code, const char *frag1, const char *frag2) {
+  pm_scene *s = (pm_scene *)&s; /* must be reset to NULL */
+  pm_error_clear();
+  assert_int_equal(pm_scene_load(path, n, set, &s), code);
+  assert_null(s);
+  const char *msg = pm_error_message();
+  if (frag1 && !strstr(msg, frag1))
+    fail_msg("message \"%s\" lacks \"%s\"", msg, frag1);
+  if (frag2 && !strstr(msg, frag2))
+    fail_msg("message \"%s\" lacks \"%s\"", msg, frag2);
+}
+
+static double eval(const pm_expr *e, double x, double y, double z, double t) {
+  assert_non_null(e);
+  return pm_expr_eval(e, x, y, z, t);
+}
+
+static void test_f2_values(void **state) {
+  (void)state;
+  pm_scene *s = load_ok(F2, 0, NULL);
+  assert_string_equal(s->path, F2);
+  assert_non_null(strstr(s->text, "name: f2-unconstrained-compression\n"));
+  assert_non_null(strstr(s->text, "# F2: unconstrained"));
+  assert_string_equal(s->name, "f2-unconstrained-compression");
+  assert_int_equal(s->method, PM_METHOD_FPM);
+  assert_int_equal(s->dimension, 3);
+  for (int c = 0; c < 3; c++) {
+    assert_near(s->box_min[c], 0.0, 0.0);
+    assert_near(s->box_max[c], 0.1, 1e-15);
+  }
+  assert_near(s->mesh_size, 1.09e-2, 1e-15);
+
+  assert_int_equal(s->n_materials, 1);
+  assert_string_equal(s->materials[0].name, "gel");
+  assert_int_equal(s->materials[0].mat.model, PM_MODEL_NEO_HOOKEAN);
+  assert_near(s->materials[0].mat.density, 1000, 0);
+  assert_near(s->materials[0].mat.youngs, 3000, 0);
+  assert_near(s->materials[0].mat.poisson, 0.495, 1e-15);
+  assert_int_equal(s->materials[0].mark.line, 8);
+  assert_int_equal(s->materials[0].mark.col, 5);
+
+  assert_int_equal(s->n_bodies, 1);
+  assert_int_equal(s->bodies[0].material, 0);
+  assert_null(s->bodies[0].region);
+
+  assert_int_equal(s->n_bcs, 5);
+  const pm_face faces[] = {PM_FACE_XMIN, PM_FACE_YMIN, PM_FACE_ZMIN,
+                           PM_FACE_ZMAX, PM_FACE_XMAX};
+  for (int i = 0; i < 5; i++) {
+    assert_int_equal(s->bcs[i].face, faces[i]);
+    assert_int_equal(s->bcs[i].mark.line, 11 + i);
+    assert_int_equal(s->bcs[i].mark.col, 5);
+  }
+  for (int i = 0; i < 3; i++) {
+    assert_int_equal(s->bcs[i].disp_mask, 1u << i);
+    assert_int_equal(s->bcs[i].traction_mask, 0);
+    assert_near(eval(s->bcs[i].disp[i], 1, 2, 3, 4), 0.0, 0.0);
+    assert_int_equal(s->bcs[i].ramp, PM_RAMP_SMOOTH);
+    assert_near(s->bcs[i].ramp_time, 1.0, 0); /* time.ramp = end/2 */
+  }
+  assert_int_equal(s->bcs[3].disp_mask, 4u);
+  assert_null(s->bcs[3].disp[0]);
+  assert_near(eval(s->bcs[3].disp[2], 0, 0, 0.1, 0), -0.04, 1e-15);
+  assert_int_equal(s->bcs[3].ramp, PM_RAMP_SMOOTH);
+  assert_near(s->bcs[3].ramp_time, 0.5, 0);
+  assert_int_equal(s->bcs[4].disp_mask, 0);
+  assert_int_equal(s->bcs[4].traction_mask, 1u);
+  assert_near(eval(s->bcs[4].traction[0], 0, 0, 0, 0.5), 50, 1e-12);
+  assert_int_equal(s->bcs[4].ramp, PM_RAMP_NONE);
+
+  assert_near(s->fpm.penalty, 20, 0);
+  assert_near(s->time.end, 2.0, 0);
+  assert_near(s->time.dt, 0, 0);
+  assert_near(s->time.dt_safety, 0.9, 0);
+  assert_near(s->time.ramp, 1.0, 0);
+  assert_int_equal(s->time.max_steps, 0);
+  assert_int_equal(s->time.qs, PM_QS_DYNAMIC_RELAXATION);
+  assert_near(s->time.qs_tolerance, 1e-8, 0);
+  assert_near(s->time.qs_damping, 0, 0);
+  assert_int_equal(s->output.every, 50);
+  assert_int_equal(s->output.fields, PM_FIELD_DISPLACEMENT | PM_FIELD_VELOCITY |
+                                         PM_FIELD_STRESS |
+                                         PM_FIELD_STRAIN_ENERGY_DENSITY |
+                                         PM_FIELD_JACOBIAN | PM_FIELD_FORCE);
+  assert_int_equal(s->reference_mask, 4u);
+  assert_null(s->reference[0]);
+  assert_near(eval(s->reference[2], 0, 0, 0.1, 0), -0.04, 1e-15);
+  assert_true(pm_expr_uses(s->reference[2], 'z'));
+  pm_scene_destroy(s);
+}
+
+static void test_defaults(void **state) {
+  (void)state;
+  pm_scene *s = load_ok(MINIMAL, 0, NULL);
+  assert_int_equal(s->method, PM_METHOD_MPM);
+  assert_int_equal(s->dimension, 2);
+  assert_near(s->box_max[0], 1.0, 0);
+  assert_near(s->box_max[1], 0.5, 0);
+  assert_int_equal(s->materials[0].mat.model, PM_MODEL_LINEAR_ELASTIC);
+  assert_int_equal(s->n_bodies, 1);
+  assert_int_equal(s->bodies[0].material, 0);
+  assert_null(s->bodies[0].region);
+  assert_int_equal(s->n_bcs, 0);
+  assert_near(s->fpm.penalty, 20, 0);
+  assert_near(s->time.dt, 0, 0);
+  assert_near(s->time.dt_safety, 0.9, 0);
+  assert_near(s->time.ramp, 0.5, 0);
+  assert_int_equal(s->time.max_steps, 0);
+  assert_int_equal(s->time.qs, PM_QS_NONE);
+  assert_near(s->time.qs_tolerance, 1e-8, 0);
+  assert_int_equal(s->output.every, 100);
+  assert_int_equal(s->output.fields, PM_FIELD_DISPLACEMENT | PM_FIELD_STRESS |
+                                         PM_FIELD_STRAIN_ENERGY_DENSITY);
+  assert_int_equal(s->reference_mask, 0);
+  pm_scene_destroy(s);
+}
+
+static void test_malformed(void **state) {
+  (void)state;
+  static const struct {
+    const char *file, *where, *what;
+  } cases[] = {
+      {"bad-unknown-key.yaml", "bad-unknown-key.yaml:9:3: time.end_time: ",
+       "unknown key (expected one of end, dt, dt_safety, ramp, max_steps, "
+       "quasi_static)"},
+      {"bad-wrong-type.yaml", "bad-wrong-type.yaml:9:14: materials.0.density: ",
+       "expected a number, got heavy"},
+      {"bad-mesh-size.yaml",
+       "bad-mesh-size.yaml:6:14: discretization.mesh_size: ",
+       "expected a number > 0, got -0.01"},
+      {"bad-poisson.yaml", "bad-poisson.yaml:7:89: materials.0.poisson_ratio",
+       "expected a number in (-1, 0.5), got 0.5"},
+      {"bad-material-name.yaml",
+       "bad-material-name.yaml:9:16: bodies.0.material: ",
+       "expected a material name (gel), got rubber"},
+      {"bad-face-2d.yaml",
+       "bad-face-2d.yaml:10:10: boundary.1.on: ", "got zmax"},
+      {"bad-missing-key.yaml",
+       "bad-missing-key.yaml:9:3: time.end: ", "missing required key"},
+      {"bad-expression.yaml",
+       "bad-expression.yaml:11:8: reference.displacement.z: ",
+       "invalid expression \"-0.4*q\": unknown variable q (allowed: x, y, z, "
+       "t)"},
+      {"bad-syntax.yaml", "bad-syntax.yaml:3:", "YAML syntax error"},
+  };
+  char path[512];
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    snprintf(path, sizeof path, SCENES "%s", cases[i].file);
+    load_fails(path, 0, NULL, PM_ERR_SCENE, cases[i].where, cases[i].what);
+  }
+}
+
+static void test_missing_file(void **state) {
+  (void)state;
+  load_fails(
+      SCENES "no-such-scene.yaml", 0, NULL, PM_ERR_IO,
+      "cannot open scene " SCENES "no-such-scene.yaml: ", "No such file");
+}
+
+static void test_overrides(void **state) {
+  (void)state;
+  const char *set[] = {
+      "discretization.mesh_size=8.02e-3", /* replace */
+      "time.dt=1e-3",                     /* add an absent key */
+      "boundary.3.displacement.z=-0.06",  /* index a list */
+      "time.quasi_static.tolerance=1e-9", /* nested */
+      "boundary.4.traction.x=2e3",        /* number for an expression */
+      "output.fields=[force, jacobian]",  /* YAML flow value */
+      "materials.0.poisson_ratio=0.3",    /* inside a flow mapping */
+  };
+  pm_scene *s = load_ok(F2, 7, set);
+  assert_near(s->mesh_size, 8.02e-3, 1e-18);
+  assert_near(s->time.dt, 1e-3, 0);
+  assert_near(eval(s->bcs[3].disp[2], 0, 0, 0.1, 0), -0.06, 1e-15);
+  assert_near(s->time.qs_tolerance, 1e-9, 0);
+  assert_near(eval(s->bcs[4].traction[0], 0, 0, 0, 1), 2e3, 0);
+  assert_int_equal(s->output.fields, PM_FIELD_FORCE | PM_FIELD_JACOBIAN);
+  assert_near(s->materials[0].mat.poisson, 0.3, 0);
+  /* The stored text is the file's. */
+  assert_non_null(strstr(s->text, "mesh_size: 1.09e-2"));
+  pm_scene_destroy(s);
+
+  /* Absent parents are created; a list grows by one at index n. */
+  const char *grow[] = {
+      "time.quasi_static.method=damping",
+      "time.quasi_static.damping=3",
+      "fpm.penalty=50",
+      "bodies=[{material: rubber, region: \"x - 0.5\"}]",
+      "boundary=[]",
+      "boundary.0.on=xmax",
+      "boundary.0.traction.x=100*t",
+      "reference.displacement.x=0.1*x",
+  };
+  s = load_ok(MINIMAL, 8, grow);
+  assert_int_equal(s->time.qs, PM_QS_DAMPING);
+  assert_near(s->time.qs_damping, 3, 0);
+  assert_near(s->fpm.penalty, 50, 0);
+  assert_near(eval(s->bodies[0].region, 0.75, 0, 0, 0), 0.25, 1e-15);
+  assert_int_equal(s->n_bcs, 1);
+  assert_int_equal(s->bcs[0].face, PM_FACE_XMAX);
+  assert_int_equal(s->bcs[0].mark.line, 0); /* not from the file */
+  assert_near(eval(s->bcs[0].traction[0], 0, 0, 0, 2), 200, 1e-12);
+  assert_int_equal(s->reference_mask, 1u);
+  pm_scene_destroy(s);
+}
+
+static void bad_override(const char *path, const char *set, const char *frag1,
+                         const char *frag2) {
+  load_fails(path, 1, &set, PM_ERR_SCENE, frag1, frag2);
+}
+
+static void test_bad_overrides(void **state) {
+  (void)state;
+  bad_override(F2, "time.end_tim=3",
+               "--set time.end_tim=3: unknown key "
+               "time.end_tim (expected one of end,",
+               NULL);
+  bad_override(
+      F2, "discretization.mesh_size=-1",
+      "--set discretization.mesh_size=-1: ", "expected a number > 0, got -1");
+  bad_override(F2, "time.dt=soon",
+               "--set time.dt=soon: ", "expected a number, got soon");
+  bad_override(F2, "boundary.9.on=xmin", "--set boundary.9.on=xmin: ",
+               "index 9 out of range (boundary has 5 entries)");
+  bad_override(F2, "materials.first.name=a",
+               "--set materials.first.name=a: ", "expected a list index");
+  bad_override(F2, "name.first=a", "--set name.first=a: unknown key", NULL);
+  bad_override(F2, "mesh_size", "--set mesh_size: expected KEY=VALUE", NULL);
+  bad_override(F2, "boundary.4.traction.x=2*w", "--set boundary.4.traction.x",
+               "unknown variable w");
+  bad_override(F2, "method=sph", "--set method=sph: ",
+               "expected one of fpm, mpm, mpm-implicit, got sph");
+  bad_override(MINIMAL, "boundary.0.on=xmin",
+               "--set boundary.0.on=xmin: ", "boundary is not in the scene");
+  /* A file value that an override makes invalid is reported at the file. */
+  bad_override(F2, "dimension=2",
+               "f2-unconstrained-compression.yaml:5:21: domain.box.min: ",
+               "expected 2 numbers (dimension 2), got 3");
+}
+
+static void test_ramp_and_names(void **state) {
+  (void)state;
+  assert_near(pm_ramp_factor(PM_RAMP_NONE, 1, 0), 1, 0);
+  assert_near(pm_ramp_factor(PM_RAMP_LINEAR, 2, 0.5), 0.25, 1e-15);
+  assert_near(pm_ramp_factor(PM_RAMP_LINEAR, 2, 3), 1, 0);
+  assert_near(pm_ramp_factor(PM_RAMP_SMOOTH, 2, 0), 0, 0);
+  assert_near(pm_ramp_factor(PM_RAMP_SMOOTH, 2, 1), 0.5, 1e-15);
+  assert_near(pm_ramp_factor(PM_RAMP_SMOOTH, 2, 2), 1, 0);
+  assert_near(pm_ramp_factor(PM_RAMP_SMOOTH, 2, -1), 0, 0);
+  /* C2: the slope is zero at both ends. */
+  double h = 1e-6;
+  assert_true(pm_ramp_factor(PM_RAMP_SMOOTH, 1, h) < 1e-15);
+  assert_true(1 - pm_ramp_factor(PM_RAMP_SMOOTH, 1, 1 - h) < 1e-15);
+  assert_string_equal(pm_method_name(PM_METHOD_FPM), "fpm");
+  assert_string_equal(pm_method_name(PM_METHOD_MPM), "mpm");
+  assert_string_equal(pm_method_name(PM_METHOD_MPM_IMPLICIT), "mpm-implicit");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_f2_values),
+      cmocka_unit_test(test_defaults),
+      cmocka_unit_test(test_malformed),
+      cmocka_unit_test(test_missing_file),
+      cmocka_unit_test(test_overrides),
+      cmocka_unit_test(test_bad_overrides),
+      cmocka_unit_test(test_ramp_and_names),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
