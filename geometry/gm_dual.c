@@ -13,8 +13,7 @@ static const int tet_edge[6][4] = {{0, 1, 2, 3}, {0, 2, 3, 1}, {0, 3, 1, 2},
                                    {1, 2, 0, 3}, {1, 3, 2, 0}, {2, 3, 0, 1}};
 /* Faces of a positively oriented tetrahedron, indexed by the opposite
  * vertex, ordered so that (q - p) x (r - p) points outward. */
-static const int tet_face[4][3] = {
-    {1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+static const int tet_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 /* Triangle edges (a, b) with the third vertex c, counter-clockwise. */
 static const int tri_edge[3][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}};
 /* Edges of a counter-clockwise triangle, indexed by the opposite vertex and

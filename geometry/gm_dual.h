@@ -9,12 +9,12 @@
 
 /* A simplex mesh.  Coordinates are 3 per node (z = 0 in 2D). */
 typedef struct {
-  int dim;              /* 2 or 3 */
+  int dim; /* 2 or 3 */
   long n_nodes;
-  double *x;            /* 3 * n_nodes */
+  double *x; /* 3 * n_nodes */
   long n_cells;
-  int nodes_per_cell;   /* 3 (triangles) or 4 (tetrahedra) */
-  long *cells;          /* nodes_per_cell * n_cells, 0-based, positive volume */
+  int nodes_per_cell; /* 3 (triangles) or 4 (tetrahedra) */
+  long *cells;        /* nodes_per_cell * n_cells, 0-based, positive volume */
   double box_min[3], box_max[3];
 } gm_mesh;
 
@@ -40,22 +40,22 @@ typedef struct {
 typedef struct {
   int dim;
   long n_points;
-  double *x;            /* 3 * n_points: reference positions (mesh nodes) */
-  double *volume;       /* n_points */
+  double *x;      /* 3 * n_points: reference positions (mesh nodes) */
+  double *volume; /* n_points */
   /* adjacency (CSR): neighbours of point i are nbr[nbr_ptr[i] .. nbr_ptr[i+1]),
    * sorted ascending; nbr_iface[k] is the interface shared with nbr[k]. */
-  long *nbr_ptr;        /* n_points + 1 */
+  long *nbr_ptr; /* n_points + 1 */
   long *nbr;
   long *nbr_iface;
   long n_ifaces;
-  long *if_pair;        /* 2 * n_ifaces: (i, j), i < j */
-  double *if_area_vec;  /* 3 * n_ifaces */
-  double *if_moment;    /* 9 * n_ifaces */
-  double *if_centroid;  /* 3 * n_ifaces */
-  double *if_area;      /* n_ifaces */
+  long *if_pair;       /* 2 * n_ifaces: (i, j), i < j */
+  double *if_area_vec; /* 3 * n_ifaces */
+  double *if_moment;   /* 9 * n_ifaces */
+  double *if_centroid; /* 3 * n_ifaces */
+  double *if_area;     /* n_ifaces */
   long n_facets;
-  long *facet_point;    /* n_facets */
-  int *facet_face;      /* n_facets: pm_face, or PM_FACE_NONE */
+  long *facet_point;      /* n_facets */
+  int *facet_face;        /* n_facets: pm_face, or PM_FACE_NONE */
   double *facet_area_vec; /* 3 * n_facets, outward */
   double *facet_moment;   /* 9 * n_facets */
   double *facet_centroid; /* 3 * n_facets */

@@ -40,6 +40,8 @@ static double cell_measure(int dim, const double *x, const long *cell,
 
 /* Flip negatively oriented cells (swap their last two nodes) and reject
  * flat ones: the dual construction relies on positive orientation. */
+static pm_err morton_order(gm_mesh *m);
+
 static pm_err orient_cells(gm_mesh *m) {
   const int npc = m->nodes_per_cell;
   for (long c = 0; c < m->n_cells; c++) {
@@ -263,8 +265,8 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
   gmshModelAdd("pointmech_box", &ierr);
   GM_GMSH_CHECK("model add");
   if (dim == 3)
-    gmshModelOccAddBox(min[0], min[1], min[2], max[0] - min[0],
-                       max[1] - min[1], max[2] - min[2], -1, &ierr);
+    gmshModelOccAddBox(min[0], min[1], min[2], max[0] - min[0], max[1] - min[1],
+                       max[2] - min[2], -1, &ierr);
   else
     gmshModelOccAddRectangle(min[0], min[1], 0.0, max[0] - min[0],
                              max[1] - min[1], -1, 0.0, &ierr);
@@ -276,6 +278,7 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
   PM_TRY(gmsh_extract(dim, m));
   if (dim == 2)
     for (long i = 0; i < m->n_nodes; i++) m->x[3 * i + 2] = 0.0;
+  PM_TRY(morton_order(m));
   PM_TRY(orient_cells(m));
   *out = m;
   m = NULL;
@@ -283,6 +286,68 @@ done:
   if (initialized) gmshFinalize(&ierr);
   if (threads > 0) pm_omp_set_threads(threads);
   gm_mesh_destroy(m);
+  return ret;
+}
+
+/* Spread the low 21 bits of v so that two zero bits follow each. */
+static unsigned long long spread3(unsigned long long v) {
+  v &= 0x1fffffull;
+  v = (v | v << 32) & 0x1f00000000ffffull;
+  v = (v | v << 16) & 0x1f0000ff0000ffull;
+  v = (v | v << 8) & 0x100f00f00f00f00full;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+  v = (v | v << 2) & 0x1249249249249249ull;
+  return v;
+}
+
+typedef struct {
+  unsigned long long key;
+  long node;
+} morton_entry;
+
+static int cmp_morton(const void *a, const void *b) {
+  const morton_entry *x = a, *y = b;
+  if (x->key != y->key) return (x->key > y->key) - (x->key < y->key);
+  return (x->node > y->node) - (x->node < y->node);
+}
+
+/* Renumber nodes along a Morton (Z-order) curve of the box so that mesh
+ * neighbours sit close in memory: the solvers gather neighbour data every
+ * step, and gmsh's own numbering scatters it. */
+static pm_err morton_order(gm_mesh *m) {
+  pm_err ret = PM_SUCCESS;
+  morton_entry *e = NULL;
+  long *new_of = NULL;
+  double *x = NULL;
+  const long n = m->n_nodes;
+  PM_TRY(PM_ALLOC(e, n, "node ordering"));
+  PM_TRY(PM_ALLOC(new_of, n, "node ordering"));
+  PM_TRY(PM_ALLOC(x, 3 * n, "node ordering"));
+  for (long i = 0; i < n; i++) {
+    unsigned long long key = 0;
+    for (int a = 0; a < m->dim; a++) {
+      double span = m->box_max[a] - m->box_min[a];
+      double s = span > 0 ? (m->x[3 * i + a] - m->box_min[a]) / span : 0;
+      s = s < 0 ? 0 : (s > 1 ? 1 : s);
+      key |= spread3((unsigned long long)(s * 2097151.0)) << a;
+    }
+    e[i].key = key;
+    e[i].node = i;
+  }
+  qsort(e, n, sizeof *e, cmp_morton);
+  for (long k = 0; k < n; k++) {
+    new_of[e[k].node] = k;
+    for (int a = 0; a < 3; a++) x[3 * k + a] = m->x[3 * e[k].node + a];
+  }
+  for (long c = 0; c < m->n_cells * m->nodes_per_cell; c++)
+    m->cells[c] = new_of[m->cells[c]];
+  free(m->x);
+  m->x = x;
+  x = NULL;
+done:
+  free(e);
+  free(new_of);
+  free(x);
   return ret;
 }
 

@@ -11,6 +11,7 @@ packages=(
   libcyaml-dev libyaml-dev
   libmatheval-dev
   libcmocka-dev
+  clang-format
 )
 
 missing=()

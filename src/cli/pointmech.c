@@ -48,8 +48,7 @@ static int report(pm_err e) {
     fprintf(stderr, "trace:\n%s", pm_error_traceback());
   switch (e) {
   case PM_ERR_UNSTABLE:
-  case PM_ERR_LINALG:
-    return EXIT_NUMERIC;
+  case PM_ERR_LINALG: return EXIT_NUMERIC;
   case PM_ERR_NOT_CONVERGED: return EXIT_NOT_CONVERGED;
   default: return EXIT_INPUT;
   }
@@ -71,8 +70,10 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
   for (int k = first; k < argc; k++) {
     const char *arg = argv[k];
     bool has_next = k + 1 < argc;
-    if (strcmp(arg, "--out") == 0 && has_next) a->out = argv[++k];
-    else if (strcmp(arg, "--points") == 0 && has_next) a->points = argv[++k];
+    if (strcmp(arg, "--out") == 0 && has_next)
+      a->out = argv[++k];
+    else if (strcmp(arg, "--points") == 0 && has_next)
+      a->points = argv[++k];
     else if (strcmp(arg, "--frame") == 0 && has_next) {
       char *end;
       a->frame = strtol(argv[++k], &end, 10);
@@ -89,12 +90,14 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
       a->sets[a->n_sets++] = argv[++k];
     } else if (strncmp(arg, "--set=", 6) == 0 && a->n_sets < MAX_SETS)
       a->sets[a->n_sets++] = arg + 6;
-    else if (strcmp(arg, "--quiet") == 0) a->quiet = true;
-    else if (arg[0] == '-' ) {
+    else if (strcmp(arg, "--quiet") == 0)
+      a->quiet = true;
+    else if (arg[0] == '-') {
       fprintf(stderr, "pointmech: unknown option %s%s\n", arg,
               has_next ? "" : " (or missing value)");
       return -1;
-    } else if (!a->scene) a->scene = arg;
+    } else if (!a->scene)
+      a->scene = arg;
     else {
       fprintf(stderr, "pointmech: unexpected argument %s\n", arg);
       return -1;

@@ -44,8 +44,8 @@ pm_err pm_error_set(pm_err code, const char *file, int line, const char *func,
   return code;
 }
 
-pm_err pm_error_trace(pm_err code, const char *file, int line,
-                      const char *func, const char *what) {
+pm_err pm_error_trace(pm_err code, const char *file, int line, const char *func,
+                      const char *what) {
   size_t used = strlen(last_trace);
   if (last_code == PM_SUCCESS) {
     /* A failure that recorded no message (should not happen): name it. */
@@ -53,8 +53,8 @@ pm_err pm_error_trace(pm_err code, const char *file, int line,
     snprintf(last_msg, sizeof last_msg, "%s", pm_err_string(code));
   }
   if (used + 1 < sizeof last_trace)
-    snprintf(last_trace + used, sizeof last_trace - used,
-             "  %s (%s:%d): %s\n", func, file, line, what);
+    snprintf(last_trace + used, sizeof last_trace - used, "  %s (%s:%d): %s\n",
+             func, file, line, what);
   return code;
 }
 

@@ -28,7 +28,7 @@ typedef enum {
 #define PM_X_ENUM(code, msg) code,
   PM_ERROR_LIST(PM_X_ENUM)
 #undef PM_X_ENUM
-  PM_ERR_COUNT
+      PM_ERR_COUNT
 } pm_err;
 
 /* Short fixed message for a code ("out of memory"). */
@@ -39,11 +39,10 @@ const char *pm_err_name(pm_err code);
 /* Record a failure: formats the message (printf-style) into the calling
  * thread's error state, replacing any earlier one, and returns code. */
 pm_err pm_error_set(pm_err code, const char *file, int line, const char *func,
-                    const char *fmt, ...)
-    __attribute__((format(printf, 5, 6)));
+                    const char *fmt, ...) __attribute__((format(printf, 5, 6)));
 /* Append a trace frame (where an error passed through).  Returns code. */
-pm_err pm_error_trace(pm_err code, const char *file, int line,
-                      const char *func, const char *what);
+pm_err pm_error_trace(pm_err code, const char *file, int line, const char *func,
+                      const char *what);
 /* The message of the last recorded failure ("" if none). */
 const char *pm_error_message(void);
 /* The trace frames of the last failure, one per line ("" if none). */
@@ -66,7 +65,8 @@ void pm_error_clear(void);
   do {                                                                         \
     pm_err pm_call_err_ = (expr);                                              \
     if (pm_call_err_ != PM_SUCCESS)                                            \
-      return pm_error_trace(pm_call_err_, __FILE__, __LINE__, __func__, #expr); \
+      return pm_error_trace(pm_call_err_, __FILE__, __LINE__, __func__,        \
+                            #expr);                                            \
   } while (0)
 
 /* Variants for functions with one exit that release resources: they need a

@@ -69,8 +69,8 @@ static bool neo_hookean(const pm_material *m, const double F[9], double P[9],
   return true;
 }
 
-static bool linear_elastic(const pm_material *m, const double F[9],
-                           double P[9], double *W, double *Jout) {
+static bool linear_elastic(const pm_material *m, const double F[9], double P[9],
+                           double *W, double *Jout) {
   double e[9];
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)

@@ -20,11 +20,11 @@ typedef enum {
  * pm_material_init and must not be set by hand. */
 typedef struct {
   pm_model model;
-  double density;       /* rho_0, kg/m^3 */
-  double youngs;        /* E, Pa */
-  double poisson;       /* nu, in (-1, 0.5) */
+  double density;           /* rho_0, kg/m^3 */
+  double youngs;            /* E, Pa */
+  double poisson;           /* nu, in (-1, 0.5) */
   double mu, kappa, lambda; /* shear, bulk and Lame moduli, Pa (derived) */
-  double wave_speed;    /* dilatational wave speed sqrt((lambda+2mu)/rho) */
+  double wave_speed;        /* dilatational wave speed sqrt((lambda+2mu)/rho) */
 } pm_material;
 
 /* "neo-hookean", "linear-elastic". */

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "pm_files.h"
+#include "pm_h5.h"
 
 #define FIELD_NAME_MAX 63
 #define OBJ_NAME_MAX 128
@@ -24,36 +25,6 @@ struct pm_results {
   char final_path[PM_PATH_MAX + 1];
   char xdmf_path[PM_PATH_MAX + 1];
 };
-
-/* The most specific message on HDF5's error stack (the stack is not
- * cleared by H5E calls, so this works right after a failed call). */
-static herr_t h5_walk(unsigned n, const H5E_error2_t *err, void *data) {
-  char *buf = data;
-  if (n == 0 && err->desc)
-    snprintf(buf, 512, "%s (in %s)", err->desc,
-             err->func_name ? err->func_name : "?");
-  return 0;
-}
-
-static const char *h5_message(void) {
-  static _Thread_local char buf[512];
-  buf[0] = '\0';
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, h5_walk, buf);
-  if (!buf[0]) snprintf(buf, sizeof buf, "no HDF5 error message");
-  return buf;
-}
-
-/* Check an herr_t / hid_t result: a negative value fails with PM_ERR_HDF5
- * naming the call, the object and the file (needs `ret` and `done`). */
-#define H5_OK(expr, call, obj, path)                                           \
-  do {                                                                         \
-    if ((expr) < 0) {                                                          \
-      ret = pm_error_set(PM_ERR_HDF5, __FILE__, __LINE__, __func__,            \
-                         "%s(%s) failed on '%s': %s", (call), (obj), (path),   \
-                         h5_message());                                        \
-      goto done;                                                               \
-    }                                                                          \
-  } while (0)
 
 /* Close an identifier if open, ignoring errors (cleanup paths only). */
 static void h5_close_quiet(hid_t *id) {

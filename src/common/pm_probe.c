@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "pm_files.h"
+#include "pm_h5.h"
 
 #define OBJ_NAME_MAX 64
 #define NB_MAX 4          /* unknowns of the linear fit: 1 + d */
@@ -40,35 +41,6 @@ typedef struct {
 } queries;
 
 /* ---- HDF5 input -------------------------------------------------------- */
-
-/* The most specific message on HDF5's error stack. */
-static herr_t h5_walk(unsigned n, const H5E_error2_t *err, void *data) {
-  char *buf = data;
-  if (n == 0 && err->desc)
-    snprintf(buf, 256, "%s (in %s)", err->desc,
-             err->func_name ? err->func_name : "?");
-  return 0;
-}
-
-static const char *h5_message(void) {
-  static _Thread_local char buf[256];
-  buf[0] = '\0';
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, h5_walk, buf);
-  if (!buf[0]) snprintf(buf, sizeof buf, "no HDF5 error message");
-  return buf;
-}
-
-/* A negative HDF5 result fails with PM_ERR_HDF5 naming the call, the object
- * and the file (needs `ret` and `done`). */
-#define H5_OK(expr, call, obj, path)                                           \
-  do {                                                                         \
-    if ((expr) < 0) {                                                          \
-      ret = pm_error_set(PM_ERR_HDF5, __FILE__, __LINE__, __func__,            \
-                         "%s(%s) failed on '%s': %s", (call), (obj), (path),   \
-                         h5_message());                                        \
-      goto done;                                                               \
-    }                                                                          \
-  } while (0)
 
 /* Read dataset loc/name (shown as obj), float64 [rows][3], into a new
  * array.  *rows < 0 learns the row count, otherwise it must match. */

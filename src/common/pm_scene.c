@@ -57,6 +57,7 @@ typedef struct {
 
 typedef struct {
   double end, dt, dt_safety, ramp;
+  int dt_rule;
   long max_steps;
   raw_quasi_static quasi_static;
 } raw_time;
@@ -115,6 +116,10 @@ static const cyaml_strval_t qs_names[] = {
     {"none", PM_QS_NONE},
     {"dynamic-relaxation", PM_QS_DYNAMIC_RELAXATION},
     {"damping", PM_QS_DAMPING},
+};
+static const cyaml_strval_t dt_rule_names[] = {
+    {"paper", PM_DT_PAPER},
+    {"spectral", PM_DT_SPECTRAL},
 };
 static const cyaml_strval_t field_names[] = {
     {"displacement", PM_FIELD_DISPLACEMENT},
@@ -213,6 +218,8 @@ static const cyaml_schema_field_t time_fields[] = {
     CYAML_FIELD_FLOAT("end", CYAML_FLAG_DEFAULT, raw_time, end),
     CYAML_FIELD_FLOAT("dt", OPT, raw_time, dt),
     CYAML_FIELD_FLOAT("dt_safety", OPT, raw_time, dt_safety),
+    CYAML_FIELD_ENUM("dt_rule", OPT | ENUM_FLAGS, raw_time, dt_rule,
+                     dt_rule_names, CYAML_ARRAY_LEN(dt_rule_names)),
     CYAML_FIELD_FLOAT("ramp", OPT, raw_time, ramp),
     CYAML_FIELD_INT("max_steps", OPT, raw_time, max_steps),
     CYAML_FIELD_MAPPING("quasi_static", OPT, raw_time, quasi_static,
@@ -514,6 +521,8 @@ static pm_err build_time(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   s->time.dt_safety = has(d, "time.dt_safety") ? t->dt_safety : 0.9;
   if (!(s->time.dt_safety > 0 && s->time.dt_safety <= 1))
     return pm_sdoc_expected(d, "time.dt_safety", "a number in (0, 1]");
+  s->time.dt_rule =
+      has(d, "time.dt_rule") ? (pm_dt_rule)t->dt_rule : PM_DT_PAPER;
   s->time.ramp = has(d, "time.ramp") ? t->ramp : t->end / 2;
   PM_CALL(check_positive(d, "time.ramp", t->ramp));
   s->time.max_steps = t->max_steps;

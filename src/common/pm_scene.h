@@ -10,13 +10,23 @@
 #include "pm_face.h"
 #include "pm_material.h"
 
-typedef enum { PM_METHOD_FPM = 0, PM_METHOD_MPM, PM_METHOD_MPM_IMPLICIT } pm_method;
+typedef enum {
+  PM_METHOD_FPM = 0,
+  PM_METHOD_MPM,
+  PM_METHOD_MPM_IMPLICIT
+} pm_method;
 typedef enum { PM_RAMP_SMOOTH = 0, PM_RAMP_LINEAR, PM_RAMP_NONE } pm_ramp;
 typedef enum {
-  PM_QS_NONE = 0,               /* plain dynamics */
-  PM_QS_DYNAMIC_RELAXATION,     /* adaptive (Rayleigh-quotient) damping */
-  PM_QS_DAMPING                 /* fixed mass-proportional damping */
+  PM_QS_NONE = 0,           /* plain dynamics */
+  PM_QS_DYNAMIC_RELAXATION, /* adaptive (Rayleigh-quotient) damping */
+  PM_QS_DAMPING             /* fixed mass-proportional damping */
 } pm_qs_method;
+
+/* How the stable time step is found. */
+typedef enum {
+  PM_DT_PAPER = 0, /* the bound of eqs. 24-26 of the FPM paper */
+  PM_DT_SPECTRAL   /* the measured largest eigenvalue of M^-1 K */
+} pm_dt_rule;
 
 /* Output fields (bit mask). */
 enum {
@@ -50,23 +60,23 @@ typedef struct {
  * applied at time t is ramp(t) * value(x, y, z, t). */
 typedef struct {
   pm_face face;
-  unsigned disp_mask;  /* bit c: component c prescribed */
-  pm_expr *disp[3];    /* NULL where not prescribed */
+  unsigned disp_mask; /* bit c: component c prescribed */
+  pm_expr *disp[3];   /* NULL where not prescribed */
   unsigned traction_mask;
   pm_expr *traction[3];
   pm_ramp ramp;
-  double ramp_time;    /* s; scene time.ramp when not given */
+  double ramp_time; /* s; scene time.ramp when not given */
   pm_scene_mark mark;
 } pm_scene_bc;
 
 typedef struct pm_scene {
-  char *path;          /* scene file as given */
-  char *text;          /* full source text (stored with the results) */
+  char *path; /* scene file as given */
+  char *text; /* full source text (stored with the results) */
   char *name;
   pm_method method;
-  int dimension;       /* 2 (plane strain) or 3 */
+  int dimension;                 /* 2 (plane strain) or 3 */
   double box_min[3], box_max[3]; /* domain.box; z ignored in 2D */
-  double mesh_size;    /* discretization.mesh_size, m, > 0 */
+  double mesh_size;              /* discretization.mesh_size, m, > 0 */
   pm_scene_material *materials;
   int n_materials;
   pm_scene_body *bodies;
@@ -74,24 +84,25 @@ typedef struct pm_scene {
   pm_scene_bc *bcs;
   int n_bcs;
   struct {
-    double penalty;     /* fpm.penalty p >= 0 (beta = p E / h) */
+    double penalty; /* fpm.penalty p >= 0 (beta = p E / h) */
   } fpm;
   struct {
-    double end;         /* time.end, s, > 0 */
-    double dt;          /* time.dt, s; 0: stable dt from eqs. 24-26 */
-    double dt_safety;   /* time.dt_safety in (0, 1] */
-    double ramp;        /* time.ramp, s: default ramp duration */
-    pm_qs_method qs;    /* time.quasi_static.method */
-    double qs_tolerance;/* time.quasi_static.tolerance: relative residual */
-    double qs_damping;  /* time.quasi_static.damping: 1/s for PM_QS_DAMPING */
-    long max_steps;     /* time.max_steps; 0: no limit */
+    double end;          /* time.end, s, > 0 */
+    double dt;           /* time.dt, s; 0: stable dt from eqs. 24-26 */
+    double dt_safety;    /* time.dt_safety in (0, 1] */
+    pm_dt_rule dt_rule;  /* time.dt_rule: paper (default) | spectral */
+    double ramp;         /* time.ramp, s: default ramp duration */
+    pm_qs_method qs;     /* time.quasi_static.method */
+    double qs_tolerance; /* time.quasi_static.tolerance: relative residual */
+    double qs_damping;   /* time.quasi_static.damping: 1/s for PM_QS_DAMPING */
+    long max_steps;      /* time.max_steps; 0: no limit */
   } time;
   struct {
-    long every;         /* output.every: frame every N steps (> 0) */
-    unsigned fields;    /* PM_FIELD_* mask */
+    long every;      /* output.every: frame every N steps (> 0) */
+    unsigned fields; /* PM_FIELD_* mask */
   } output;
-  unsigned reference_mask;   /* reference.displacement components given */
-  pm_expr *reference[3];     /* analytic u_c(x, y, z, t) or NULL */
+  unsigned reference_mask; /* reference.displacement components given */
+  pm_expr *reference[3];   /* analytic u_c(x, y, z, t) or NULL */
 } pm_scene;
 
 /* Load a scene file, apply overrides ("key.path=value", e.g.

@@ -14,14 +14,17 @@ static inline void pm_t_zero(double A[9]) { memset(A, 0, 9 * sizeof(double)); }
 static inline void pm_t_copy(const double A[9], double B[9]) {
   memcpy(B, A, 9 * sizeof(double));
 }
-static inline double pm_t_trace(const double A[9]) { return A[0] + A[4] + A[8]; }
+static inline double pm_t_trace(const double A[9]) {
+  return A[0] + A[4] + A[8];
+}
 static inline double pm_t_ddot(const double A[9], const double B[9]) {
   double s = 0;
   for (int i = 0; i < 9; i++) s += A[i] * B[i];
   return s;
 }
 static inline double pm_t_det(const double A[9]) {
-  return A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+  return A[0] * (A[4] * A[8] - A[5] * A[7]) -
+         A[1] * (A[3] * A[8] - A[5] * A[6]) +
          A[2] * (A[3] * A[7] - A[4] * A[6]);
 }
 /* det(I + H) - 1 without cancellation for small H. */
@@ -62,18 +65,19 @@ static inline void pm_t_transpose(const double A[9], double B[9]) {
 static inline void pm_t_mul(const double A[9], const double B[9], double C[9]) {
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
-      C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] +
-                     A[3 * i + 2] * B[6 + j];
+      C[3 * i + j] =
+          A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
 }
 /* C = A^T B */
-static inline void pm_t_tmul(const double A[9], const double B[9], double C[9]) {
+static inline void pm_t_tmul(const double A[9], const double B[9],
+                             double C[9]) {
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
-      C[3 * i + j] =
-          A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
+      C[3 * i + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
 }
 /* y = A x */
-static inline void pm_t_mulv(const double A[9], const double x[3], double y[3]) {
+static inline void pm_t_mulv(const double A[9], const double x[3],
+                             double y[3]) {
   for (int i = 0; i < 3; i++)
     y[i] = A[3 * i] * x[0] + A[3 * i + 1] * x[1] + A[3 * i + 2] * x[2];
 }
@@ -89,8 +93,11 @@ static inline double pm_t_norm(const double A[9]) {
 static inline double pm_v_dot(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
-static inline double pm_v_norm(const double a[3]) { return sqrt(pm_v_dot(a, a)); }
-static inline void pm_v_cross(const double a[3], const double b[3], double c[3]) {
+static inline double pm_v_norm(const double a[3]) {
+  return sqrt(pm_v_dot(a, a));
+}
+static inline void pm_v_cross(const double a[3], const double b[3],
+                              double c[3]) {
   c[0] = a[1] * b[2] - a[2] * b[1];
   c[1] = a[2] * b[0] - a[0] * b[2];
   c[2] = a[0] * b[1] - a[1] * b[0];
@@ -100,9 +107,15 @@ static inline void pm_t_rotation(const double axis[3], double angle,
                                  double R[9]) {
   double c = cos(angle), s = sin(angle), t = 1 - c;
   double x = axis[0], y = axis[1], z = axis[2];
-  R[0] = t * x * x + c;     R[1] = t * x * y - s * z; R[2] = t * x * z + s * y;
-  R[3] = t * x * y + s * z; R[4] = t * y * y + c;     R[5] = t * y * z - s * x;
-  R[6] = t * x * z - s * y; R[7] = t * y * z + s * x; R[8] = t * z * z + c;
+  R[0] = t * x * x + c;
+  R[1] = t * x * y - s * z;
+  R[2] = t * x * z + s * y;
+  R[3] = t * x * y + s * z;
+  R[4] = t * y * y + c;
+  R[5] = t * y * z - s * x;
+  R[6] = t * x * z - s * y;
+  R[7] = t * y * z + s * x;
+  R[8] = t * z * z + c;
 }
 
 #endif

@@ -22,31 +22,36 @@ typedef enum {
 
 /* A prepared simulation.  Fields are read-only for callers. */
 typedef struct {
-  const pm_scene *scene;    /* borrowed */
+  const pm_scene *scene; /* borrowed */
   gm_mesh *mesh;
   gm_dual *dual;
   fpm_model *model;
   fpm_state *state;
-  double dt, dt_stable;     /* s */
-  long dt_point;            /* point that sets the stable step */
-  double mean_edge;         /* mean mesh edge length, m */
+  double dt;          /* the step used, s */
+  double dt_stable;   /* stable step of the scene's rule, s */
+  double dt_paper;    /* bound of eqs. 24-26, s */
+  double dt_spectral; /* 2 / sqrt(lambda_max(M^-1 K)), s; 0 if not
+                         measured */
+  long dt_point;      /* point that sets the paper's bound */
+  double mean_edge;   /* mean mesh edge length, m */
   pm_timers timers;
   int tm_mesh, tm_dual, tm_operators, tm_force, tm_update, tm_output;
   /* after a run */
   fpm_status status;
   fpm_step_info last;
-  double wall;              /* run wall time (time loop + output), s */
-  double setup_wall;        /* mesh + dual + operators, s */
-  int n_ref;                /* reference components compared */
-  double nrmse[3];          /* eq. 28 per component, NaN if no reference */
-  double *scratch;          /* 9 n: output and metrics buffer */
-  double *ref;              /* 3 n: reference displacement, or NULL */
-  bool ref_time_dependent;  /* some reference component uses t */
-  char message[1024];       /* failure message, if any */
+  double wall;             /* run wall time (time loop + output), s */
+  double setup_wall;       /* mesh + dual + operators, s */
+  int n_ref;               /* reference components compared */
+  double nrmse[3];         /* eq. 28 per component, NaN if no reference */
+  double *scratch;         /* 9 n: output and metrics buffer */
+  double *ref;             /* 3 n: reference displacement, or NULL */
+  bool ref_time_dependent; /* some reference component uses t */
+  char message[1024];      /* failure message, if any */
 } fpm_sim;
 
 /* Mesh the scene's domain, build subdomains, operators and state, and pick
- * dt (time.dt if set, else dt_safety times the stable step). */
+ * dt: time.dt if set, else dt_safety times the stable step of
+ * time.dt_rule (the paper's bound, or the measured spectral radius). */
 pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out);
 void fpm_sim_destroy(fpm_sim *sim);
 
@@ -61,6 +66,9 @@ pm_err fpm_sim_run(fpm_sim *sim, const char *out_dir, bool quiet);
 /* Print the plan: pipeline, counts, dt, steps, memory and an estimated run
  * time from timing a few force evaluations. */
 pm_err fpm_sim_plan(fpm_sim *sim, FILE *out);
+
+/* Measure dt_spectral (power iteration) if not done yet. */
+void fpm_sim_measure_spectrum(fpm_sim *sim);
 
 const char *fpm_status_name(fpm_status s);
 

@@ -11,7 +11,8 @@
  * Returns the smallest inadmissible point id or -1. */
 static long stress_pass(const fpm_model *m, fpm_state *st) {
   const long n = m->n;
-  const long *restrict ptr = m->nbr_ptr, *restrict nbr = m->nbr;
+  const long *restrict ptr = m->nbr_ptr;
+  const int *restrict nbr = m->nbr;
   const double *restrict g = m->g, *restrict u = st->u;
   double *restrict H = st->H, *restrict P = st->P, *restrict W = st->W,
                    *restrict J = st->J;
@@ -28,9 +29,15 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
       const double d0 = u[3 * k] - u0, d1 = u[3 * k + 1] - u1,
                    d2 = u[3 * k + 2] - u2;
       const double g0 = g[3 * e], g1 = g[3 * e + 1], g2 = g[3 * e + 2];
-      h[0] += d0 * g0; h[1] += d0 * g1; h[2] += d0 * g2;
-      h[3] += d1 * g0; h[4] += d1 * g1; h[5] += d1 * g2;
-      h[6] += d2 * g0; h[7] += d2 * g1; h[8] += d2 * g2;
+      h[0] += d0 * g0;
+      h[1] += d0 * g1;
+      h[2] += d0 * g2;
+      h[3] += d1 * g0;
+      h[4] += d1 * g1;
+      h[5] += d1 * g2;
+      h[6] += d2 * g0;
+      h[7] += d2 * g1;
+      h[8] += d2 * g2;
     }
     double F[9];
     for (int a = 0; a < 9; a++) {
@@ -47,48 +54,51 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
   return bad < n ? bad : -1;
 }
 
-/* Pass 2: per point i, over its interfaces e (normal outward from i):
+/* Pass 2: per point i, over its interfaces e with outward area vector a,
+ * d_i = x_e - X_i, d_k = x_e - X_k:
  *   [[u]] = u_i + H_i d_i - u_k - H_k d_k,  b = beta |e| [[u]],
- *   r_i = sum_e (b - P_e a_e),  Q_i = sum_e (P_e (M_e - a_e (x) X_i) - b (x) d_i)
- * with P_e = (P_i + P_k) / 2, and T_i = V_i P_i - Q_i.  The P_i halves use
- * the precomputed sums of a_e and M_e - a_e (x) X_i. */
+ *   r_i = sum_e (b - P_e a),  Q_i = sum_e (P_e (M_e - a (x) X_i) - b (x) d_i)
+ * with P_e = (P_i + P_k) / 2, and T_i = V_i P_i - Q_i.  With the moment
+ * about the centroid, M_e - a (x) X_i = Mc + a (x) d_i, the neighbour's half
+ * is  1/2 P_k Mc + w (x) d_i  with  w = 1/2 P_k a - b;  the P_i half uses
+ * the precomputed sums of a and M_e - a (x) X_i.  Entry records stream in
+ * order; only the neighbours' u, H, P are gathered. */
 static void flux_pass(const fpm_model *m, fpm_state *st) {
   const long n = m->n;
-  const long *restrict ptr = m->nbr_ptr, *restrict nbr = m->nbr;
-  const double *restrict ea = m->e_area, *restrict em = m->e_mrel,
-                         *restrict edi = m->e_di, *restrict edk = m->e_dk,
-                         *restrict eb = m->e_beta, *restrict pa = m->p_area,
-                         *restrict pm = m->p_mrel, *restrict vol = m->dual->volume;
+  const long *restrict ptr = m->nbr_ptr;
+  const int *restrict nbr = m->nbr;
+  const double *restrict erec = m->erec, *restrict pa = m->p_area,
+                         *restrict pm = m->p_mrel,
+                         *restrict vol = m->dual->volume;
   const double *restrict u = st->u, *restrict H = st->H, *restrict P = st->P;
   double *restrict T = st->T, *restrict r = st->r;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(n, ptr, nbr, ea, em, edi, edk, eb, pa, pm, vol, u, H, P, T, r))
+         shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r))
   for (long i = 0; i < n; i++) {
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
     double Q[9] = {0}, ri[3] = {0};
-    /* sum over e of P_k a_e and P_k (M_e - a_e X_i); the P_i half after. */
     for (long e = ptr[i]; e < ptr[i + 1]; e++) {
       const long k = nbr[e];
+      const double *rec = erec + FPM_EREC * e;
+      const double *a = rec, *Mc = rec + 3, *di = rec + 12, *dk = rec + 15;
+      const double be = rec[18];
       const double *Pk = P + 9 * k, *Hk = H + 9 * k, *uk = u + 3 * k;
-      const double *a = ea + 3 * e, *M = em + 9 * e, *di = edi + 3 * e,
-                   *dk = edk + 3 * e;
-      double jump[3];
-      for (int c = 0; c < 3; c++)
-        jump[c] = ui[c] - uk[c] +
-                  Hi[3 * c] * di[0] + Hi[3 * c + 1] * di[1] +
-                  Hi[3 * c + 2] * di[2] -
-                  Hk[3 * c] * dk[0] - Hk[3 * c + 1] * dk[1] -
-                  Hk[3 * c + 2] * dk[2];
-      const double be = eb[e];
+      double w[3];
       for (int c = 0; c < 3; c++) {
-        const double b = be * jump[c];
-        ri[c] += b - 0.5 * (Pk[3 * c] * a[0] + Pk[3 * c + 1] * a[1] +
-                            Pk[3 * c + 2] * a[2]);
-        for (int q = 0; q < 3; q++)
-          Q[3 * c + q] += 0.5 * (Pk[3 * c] * M[q] + Pk[3 * c + 1] * M[3 + q] +
-                                 Pk[3 * c + 2] * M[6 + q]) -
-                          b * di[q];
+        const double jump = ui[c] - uk[c] + Hi[3 * c] * di[0] +
+                            Hi[3 * c + 1] * di[1] + Hi[3 * c + 2] * di[2] -
+                            Hk[3 * c] * dk[0] - Hk[3 * c + 1] * dk[1] -
+                            Hk[3 * c + 2] * dk[2];
+        w[c] = 0.5 * (Pk[3 * c] * a[0] + Pk[3 * c + 1] * a[1] +
+                      Pk[3 * c + 2] * a[2]) -
+               be * jump;
+        ri[c] -= w[c];
       }
+      for (int c = 0; c < 3; c++)
+        for (int q = 0; q < 3; q++)
+          Q[3 * c + q] += 0.5 * (Pk[3 * c] * Mc[q] + Pk[3 * c + 1] * Mc[3 + q] +
+                                 Pk[3 * c + 2] * Mc[6 + q]) +
+                          w[c] * di[q];
     }
     const double *A = pa + 3 * i, *B = pm + 9 * i;
     for (int c = 0; c < 3; c++) {
@@ -121,8 +131,8 @@ static void boundary_pass(const fpm_model *m, fpm_state *st) {
     const double *Pi = P + 9 * i;
     for (int c = 0; c < 3; c++) {
       const double *A = da + 9 * p + 3 * c, *B = dm + 27 * p + 9 * c;
-      const double flux = Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] +
-                          Pi[3 * c + 2] * A[2];
+      const double flux =
+          Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] + Pi[3 * c + 2] * A[2];
       r[3 * i + c] -= flux;
       norm2 += flux * flux;
       for (int q = 0; q < 3; q++)
@@ -145,8 +155,8 @@ static void boundary_pass(const fpm_model *m, fpm_state *st) {
 /* Pass 3: f_k = sum_{i in S(k)} T_i g_ik - T_k sum_j g_kj + r_k. */
 static void gather_pass(const fpm_model *m, fpm_state *st) {
   const long n = m->n;
-  const long *restrict ptr = m->nbr_ptr, *restrict nbr = m->nbr,
-                       *restrict mir = m->mirror;
+  const long *restrict ptr = m->nbr_ptr;
+  const int *restrict nbr = m->nbr, *restrict mir = m->mirror;
   const double *restrict g = m->g, *restrict gs = m->gsum, *restrict T = st->T,
                          *restrict r = st->r;
   double *restrict f = st->f;

@@ -62,7 +62,8 @@ pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
       double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / wsum;
       for (int a = 0; a < 3; a++) g[3 * e + a] = 0;
       for (int a = 0; a < dim; a++)
-        for (int b = 0; b < dim; b++) g[3 * e + a] += Ainv[dim * a + b] * w * d[b];
+        for (int b = 0; b < dim; b++)
+          g[3 * e + a] += Ainv[dim * a + b] * w * d[b];
     }
   }
   if (lapack_info < 0)

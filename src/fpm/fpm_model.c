@@ -19,11 +19,8 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->gsum);
   free(m->mirror);
   free(m->cond);
-  free(m->e_area);
-  free(m->e_mrel);
-  free(m->e_di);
-  free(m->e_dk);
-  free(m->e_beta);
+  free(m->nbr);
+  free(m->erec);
   free(m->p_area);
   free(m->p_mrel);
   free(m->mat);
@@ -47,7 +44,7 @@ void fpm_model_destroy(fpm_model *m) {
 
 size_t fpm_model_bytes(const fpm_model *m) {
   size_t d = sizeof(double);
-  return m->nnz * (3 + 3 + 9 + 3 + 3 + 1) * d + m->nnz * sizeof(long) +
+  return m->nnz * (3 + FPM_EREC) * d + m->nnz * 2 * sizeof(int) +
          m->n * (3 + 1 + 3 + 9 + 1) * d + m->n * (sizeof(int) + 3) +
          m->n_dpts * (36 * d + sizeof(long)) +
          m->n_tfacets * (7 * d + sizeof(long) + sizeof(int)) +
@@ -67,20 +64,23 @@ static pm_err build_mirror(fpm_model *m) {
           found = mid;
           break;
         }
-        if (m->nbr[mid] < i) lo = mid + 1;
-        else hi = mid - 1;
+        if (m->nbr[mid] < i)
+          lo = mid + 1;
+        else
+          hi = mid - 1;
       }
       PM_CHECK(found >= 0, PM_ERR_GEOMETRY,
                "support of point %ld holds %ld but not the reverse", i, k);
-      m->mirror[e] = found;
+      m->mirror[e] = (int)found;
     }
   return PM_SUCCESS;
 }
 
 static pm_err assign_materials(fpm_model *m, const pm_scene *s) {
   PM_CHECK(s->n_materials >= 1 && s->n_materials <= FPM_MAX_MATERIALS,
-           PM_ERR_SCENE, "%s: between 1 and %d materials are supported (got %d)",
-           s->path, FPM_MAX_MATERIALS, s->n_materials);
+           PM_ERR_SCENE,
+           "%s: between 1 and %d materials are supported (got %d)", s->path,
+           FPM_MAX_MATERIALS, s->n_materials);
   m->n_mats = s->n_materials;
   for (int k = 0; k < s->n_materials; k++) m->mats[k] = s->materials[k].mat;
   for (long i = 0; i < m->n; i++) m->mat[i] = -1;
@@ -90,7 +90,8 @@ static pm_err assign_materials(fpm_model *m, const pm_scene *s) {
     const pm_scene_body *body = &s->bodies[b];
     for (long i = 0; i < m->n; i++) {
       const double *xi = m->x + 3 * i;
-      if (!body->region || pm_expr_eval(body->region, xi[0], xi[1], xi[2], 0) > 0)
+      if (!body->region ||
+          pm_expr_eval(body->region, xi[0], xi[1], xi[2], 0) > 0)
         m->mat[i] = body->material;
     }
   }
@@ -103,8 +104,8 @@ static pm_err assign_materials(fpm_model *m, const pm_scene *s) {
   return PM_SUCCESS;
 }
 
-/* Interface data per support entry, oriented outward from the entry's
- * point, and the per-point sums of the consistency geometry. */
+/* Interface records per support entry and the per-point sums of the
+ * consistency geometry (oriented outward from each point). */
 static void build_interfaces(fpm_model *m) {
   const gm_dual *d = m->dual;
   for (long i = 0; i < m->n; i++) {
@@ -113,25 +114,27 @@ static void build_interfaces(fpm_model *m) {
     for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
       long k = m->nbr[e], f = d->nbr_iface[e];
       const double *xk = m->x + 3 * k, *xe = d->if_centroid + 3 * f;
+      const double *af = d->if_area_vec + 3 * f, *Mf = d->if_moment + 9 * f;
       double sign = d->if_pair[2 * f] == i ? 1.0 : -1.0;
-      for (int a = 0; a < 3; a++) {
-        m->e_area[3 * e + a] = sign * d->if_area_vec[3 * f + a];
-        m->e_di[3 * e + a] = xe[a] - xi[a];
-        m->e_dk[3 * e + a] = xe[a] - xk[a];
-        pa[a] += m->e_area[3 * e + a];
+      double *r = m->erec + FPM_EREC * e;
+      for (int p = 0; p < 3; p++) {
+        r[p] = sign * af[p];
+        r[12 + p] = xe[p] - xi[p];
+        r[15 + p] = xe[p] - xk[p];
+        for (int q = 0; q < 3; q++)
+          r[3 + 3 * p + q] = sign * (Mf[3 * p + q] - af[p] * xe[q]);
       }
-      for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++) {
-          double v = sign * d->if_moment[9 * f + 3 * a + b] -
-                     m->e_area[3 * e + a] * xi[b];
-          m->e_mrel[9 * e + 3 * a + b] = v;
-          pm[3 * a + b] += v;
-        }
+      for (int p = 0; p < 3; p++) {
+        pa[p] += r[p];
+        for (int q = 0; q < 3; q++)
+          pm[3 * p + q] += r[3 + 3 * p + q] + r[p] * r[12 + q];
+      }
       double h = sqrt((xk[0] - xi[0]) * (xk[0] - xi[0]) +
                       (xk[1] - xi[1]) * (xk[1] - xi[1]) +
                       (xk[2] - xi[2]) * (xk[2] - xi[2]));
       double E = 0.5 * (m->mats[m->mat[i]].youngs + m->mats[m->mat[k]].youngs);
-      m->e_beta[e] = m->penalty * E / h * d->if_area[f];
+      r[18] = m->penalty * E / h * d->if_area[f];
+      r[19] = 0;
     }
   }
 }
@@ -142,7 +145,7 @@ static void build_interfaces(fpm_model *m) {
 static pm_err build_boundary(fpm_model *m, const pm_scene *s) {
   pm_err ret = PM_SUCCESS;
   const gm_dual *d = m->dual;
-  int *bc_of = NULL;  /* 3 n: condition prescribing each dof, or -1 */
+  int *bc_of = NULL;   /* 3 n: condition prescribing each dof, or -1 */
   long *dpt_of = NULL; /* n: index into the dpt arrays, or -1 */
   PM_TRY(PM_ALLOC(bc_of, 3 * m->n, "boundary dof map"));
   PM_TRY(PM_ALLOC(dpt_of, m->n, "boundary point map"));
@@ -208,7 +211,8 @@ static pm_err build_boundary(fpm_model *m, const pm_scene *s) {
       if (d->facet_face[f] != (int)bc->face) continue;
       long i = d->facet_point[f];
       const double *xi = m->x + 3 * i, *af = d->facet_area_vec + 3 * f;
-      const double *Mf = d->facet_moment + 9 * f, *cf = d->facet_centroid + 3 * f;
+      const double *Mf = d->facet_moment + 9 * f,
+                   *cf = d->facet_centroid + 3 * f;
       if (bc->disp_mask) {
         long p = dpt_of[i];
         m->dpt_point[p] = i;
@@ -256,26 +260,25 @@ pm_err fpm_model_create(const pm_scene *s, const gm_dual *d, fpm_model **out) {
   m->dual = d;
   m->x = d->x;
   m->nbr_ptr = d->nbr_ptr;
-  m->nbr = d->nbr;
   m->nnz = d->nbr_ptr[d->n_points];
   m->scene = s;
   m->penalty = s->fpm.penalty;
   long n = m->n, nnz = m->nnz;
   PM_TRY(PM_ALLOC(m->g, 3 * nnz, "GFD weights"));
   PM_TRY(PM_ALLOC(m->gsum, 3 * n, "GFD weight sums"));
+  PM_ENSURE(nnz < 2147483647L, PM_ERR_ARG,
+            "%ld support entries exceed the 32-bit index range", nnz);
+  PM_TRY(PM_ALLOC(m->nbr, nnz, "support"));
+  for (long e = 0; e < nnz; e++) m->nbr[e] = (int)d->nbr[e];
   PM_TRY(PM_ALLOC(m->mirror, nnz, "support mirror"));
   PM_TRY(PM_ALLOC(m->cond, n, "support condition numbers"));
-  PM_TRY(PM_ALLOC(m->e_area, 3 * nnz, "interface areas"));
-  PM_TRY(PM_ALLOC(m->e_mrel, 9 * nnz, "interface moments"));
-  PM_TRY(PM_ALLOC(m->e_di, 3 * nnz, "interface offsets"));
-  PM_TRY(PM_ALLOC(m->e_dk, 3 * nnz, "interface offsets"));
-  PM_TRY(PM_ALLOC(m->e_beta, nnz, "interface penalties"));
+  PM_TRY(PM_ALLOC(m->erec, FPM_EREC * nnz, "interface records"));
   PM_TRY(PM_ALLOC(m->p_area, 3 * n, "point area sums"));
   PM_TRY(PM_ALLOC(m->p_mrel, 9 * n, "point moment sums"));
   PM_TRY(PM_ALLOC(m->mat, n, "point materials"));
   PM_TRY(PM_ALLOC(m->mass, n, "point masses"));
   PM_TRY(PM_ALLOC(m->fixed, 3 * n, "constraint mask"));
-  PM_TRY(fpm_gfd_weights(m->dim, n, m->x, m->nbr_ptr, m->nbr, FPM_COND_MAX,
+  PM_TRY(fpm_gfd_weights(m->dim, n, m->x, m->nbr_ptr, d->nbr, FPM_COND_MAX,
                          m->g, m->cond));
   for (long i = 0; i < n; i++)
     for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
@@ -352,10 +355,12 @@ void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t) {
     const double *c = m->tf_centroid + 3 * k;
     for (int a = 0; a < 3; a++) {
       double v = 0;
-      if (!(bc->traction_mask & (1u << a))) v = 0;
+      if (!(bc->traction_mask & (1u << a)))
+        v = 0;
       else if (m->tf_time_dependent)
         v = r * pm_expr_eval(bc->traction[a], c[0], c[1], c[2], t);
-      else v = r * m->tf_base[3 * k + a];
+      else
+        v = r * m->tf_base[3 * k + a];
       st->tf_value[3 * k + a] = v;
       norm2 += v * v * m->tf_area[k] * m->tf_area[k];
     }

@@ -12,76 +12,79 @@
 #include "pm_scene.h"
 
 #define FPM_MAX_MATERIALS 16
+#define FPM_EREC 20 /* doubles per support-entry record (19 used) */
 
 /* Everything that does not change during a run.  Arrays are per point
  * (n), per support entry (nnz, in the CSR order of the dual's adjacency) or
  * per boundary item.  Vectors are 3 per item, tensors 9 (row-major). */
 typedef struct {
   int dim;
-  long n;                  /* points */
-  const gm_dual *dual;     /* borrowed: positions, volumes, adjacency */
-  const double *x;         /* dual->x */
-  const long *nbr_ptr;     /* dual->nbr_ptr */
-  const long *nbr;         /* dual->nbr */
-  long nnz;                /* support entries */
-  double *g;               /* 3 nnz: GFD weight g_ik of entry (i, k) */
-  double *gsum;            /* 3 n: sum_k g_ik */
-  long *mirror;            /* nnz: entry (k, i) of entry (i, k) */
-  double *cond;            /* n: support condition numbers */
-  /* Interface geometry per entry, oriented outward from the entry's point. */
-  double *e_area;          /* 3 nnz: a_e */
-  double *e_mrel;          /* 9 nnz: M_e - a_e (x) X_i */
-  double *e_di;            /* 3 nnz: x_e - X_i */
-  double *e_dk;            /* 3 nnz: x_e - X_k */
-  double *e_beta;          /* nnz: beta_e |e| = p E / h_e * area */
-  double *p_area;          /* 3 n: sum of the entries' a_e */
-  double *p_mrel;          /* 9 n: sum of the entries' M_e - a_e (x) X_i */
+  long n;              /* points */
+  const gm_dual *dual; /* borrowed: positions, volumes, adjacency */
+  const double *x;     /* dual->x */
+  const long *nbr_ptr; /* dual->nbr_ptr: support of i is entries
+                          nbr_ptr[i] .. nbr_ptr[i+1] */
+  long nnz;            /* support entries */
+  int *nbr;            /* nnz: neighbour of each entry (32-bit copy) */
+  double *g;           /* 3 nnz: GFD weight g_ik of entry (i, k) */
+  double *gsum;        /* 3 n: sum_k g_ik */
+  int *mirror;         /* nnz: entry (k, i) of entry (i, k) */
+  double *cond;        /* n: support condition numbers */
+  /* Interface geometry, one record of FPM_EREC doubles per support entry,
+   * oriented outward from the entry's point i (neighbour k): area vector a
+   * (3), first moment about the interface centroid Mc = M - a (x) x_e (9),
+   * d_i = x_e - X_i (3), d_k = x_e - X_k (3), beta |e| = p E / h_e |e| (1).
+   * Entries stream in order in the flux pass; moments about the centroid
+   * keep M - a (x) X_i = Mc + a (x) d_i free of cancellation. */
+  double *erec;   /* FPM_EREC nnz */
+  double *p_area; /* 3 n: sum of a_e (outward from i) */
+  double *p_mrel; /* 9 n: sum of M_e - a_e (x) X_i (outward) */
   /* Materials. */
   int n_mats;
   pm_material mats[FPM_MAX_MATERIALS];
-  int *mat;                /* n: material of each point */
-  double *mass;            /* n: lumped mass rho V */
-  double penalty;          /* p */
+  int *mat;       /* n: material of each point */
+  double *mass;   /* n: lumped mass rho V */
+  double penalty; /* p */
   /* Consistency flux on faces with displacement conditions, per point that
    * has such facets: row c of the projected flux uses area A^c and moment
    * B^c summed over the facets that prescribe component c. */
   long n_dpts;
-  long *dpt_point;         /* n_dpts */
-  double *dpt_area;        /* 9 n_dpts: A^c for c = 0..2, 3 each */
-  double *dpt_mrel;        /* 27 n_dpts: B^c for c = 0..2, 9 each */
+  long *dpt_point;  /* n_dpts */
+  double *dpt_area; /* 9 n_dpts: A^c for c = 0..2, 3 each */
+  double *dpt_mrel; /* 27 n_dpts: B^c for c = 0..2, 9 each */
   /* Traction facets (one row per facet and traction condition). */
   long n_tfacets;
-  long *tf_point;          /* n_tfacets */
-  int *tf_bc;              /* n_tfacets: scene boundary condition */
-  double *tf_area;         /* n_tfacets: |f| */
-  double *tf_rel;          /* 3 n_tfacets: |f| (c_f - X_i) */
-  double *tf_centroid;     /* 3 n_tfacets */
-  double *tf_base;         /* 3 n_tfacets: traction at full load (t = 0) */
-  bool tf_time_dependent;  /* some traction expression uses t */
+  long *tf_point;         /* n_tfacets */
+  int *tf_bc;             /* n_tfacets: scene boundary condition */
+  double *tf_area;        /* n_tfacets: |f| */
+  double *tf_rel;         /* 3 n_tfacets: |f| (c_f - X_i) */
+  double *tf_centroid;    /* 3 n_tfacets */
+  double *tf_base;        /* 3 n_tfacets: traction at full load (t = 0) */
+  bool tf_time_dependent; /* some traction expression uses t */
   /* Prescribed displacement components. */
   long n_cdofs;
   long *cd_point;
   int *cd_comp;
-  int *cd_bc;              /* scene boundary condition */
-  double *cd_base;         /* value at full load (t-independent part) */
-  bool cd_time_dependent;  /* some displacement expression uses t */
-  unsigned char *fixed;    /* 3 n: 1 where the component is prescribed */
-  const pm_scene *scene;   /* borrowed: boundary expressions and ramps */
+  int *cd_bc;             /* scene boundary condition */
+  double *cd_base;        /* value at full load (t-independent part) */
+  bool cd_time_dependent; /* some displacement expression uses t */
+  unsigned char *fixed;   /* 3 n: 1 where the component is prescribed */
+  const pm_scene *scene;  /* borrowed: boundary expressions and ramps */
 } fpm_model;
 
 /* Fields that change every step.  All allocated by fpm_state_create. */
 typedef struct {
-  double *u, *v;           /* 3 n displacement, velocity (half step) */
-  double *f;               /* 3 n net force f_int - f_ext */
-  double *H;               /* 9 n: F - I per point */
-  double *P;               /* 9 n: first Piola-Kirchhoff stress */
-  double *T;               /* 9 n: V P - Q, the gathered flux tensor */
-  double *r;               /* 3 n: interface and boundary force terms */
-  double *W;               /* n: strain energy density */
-  double *J;               /* n: det F */
-  double *tf_value;        /* 3 n_tfacets: traction at the current time */
-  double fext_norm;        /* |f_ext| of the current tractions */
-  double bflux_norm;       /* |consistency flux on prescribed faces| */
+  double *u, *v;     /* 3 n displacement, velocity (half step) */
+  double *f;         /* 3 n net force f_int - f_ext */
+  double *H;         /* 9 n: F - I per point */
+  double *P;         /* 9 n: first Piola-Kirchhoff stress */
+  double *T;         /* 9 n: V P - Q, the gathered flux tensor */
+  double *r;         /* 3 n: interface and boundary force terms */
+  double *W;         /* n: strain energy density */
+  double *J;         /* n: det F */
+  double *tf_value;  /* 3 n_tfacets: traction at the current time */
+  double fext_norm;  /* |f_ext| of the current tractions */
+  double bflux_norm; /* |consistency flux on prescribed faces| */
 } fpm_state;
 
 /* Build the model of scene s on dual d (both borrowed and kept alive by the

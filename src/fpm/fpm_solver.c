@@ -9,17 +9,17 @@
 #include "pm_omp.h"
 #include "pm_progress.h"
 
-void fpm_reaction(const fpm_model *m, const fpm_state *st, int b,
-                  double R[3]) {
-  /* The force of the support on the body: the consistency flux P_i a_f of the face's
-   * facets on the prescribed components (part of the operator), plus any
+void fpm_reaction(const fpm_model *m, const fpm_state *st, int b, double R[3]) {
+  /* The force of the support on the body: the consistency flux P_i a_f of the
+   * face's facets on the prescribed components (part of the operator), plus any
    * out-of-balance force left on the prescribed dofs. */
   const gm_dual *d = m->dual;
   const pm_scene_bc *bc = &m->scene->bcs[b];
   R[0] = R[1] = R[2] = 0;
   for (long f = 0; f < d->n_facets; f++) {
     if (d->facet_face[f] != (int)bc->face) continue;
-    const double *P = st->P + 9 * d->facet_point[f], *a = d->facet_area_vec + 3 * f;
+    const double *P = st->P + 9 * d->facet_point[f],
+                 *a = d->facet_area_vec + 3 * f;
     for (int c = 0; c < 3; c++)
       if (bc->disp_mask & (1u << c))
         R[c] += P[3 * c] * a[0] + P[3 * c + 1] * a[1] + P[3 * c + 2] * a[2];
@@ -144,6 +144,10 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
         stage_seconds[0] = t_force;
         stage_seconds[1] = t_update;
       }
+      si.step = step;
+      si.t = t;
+      si.converged = false;
+      if (info) *info = si;
       return unstable(m, st, step, t, dt, bad);
     }
     double s3 = 0, rf = 0, kin = 0, se = 0;

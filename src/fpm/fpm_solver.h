@@ -21,11 +21,11 @@ typedef struct {
 typedef struct {
   long step;
   double t;
-  double kinetic;      /* 1/2 sum m v^2 */
-  double strain;       /* sum V W */
-  double external_work;/* work of reactions and tractions so far */
-  double residual;     /* |f| on free dofs / (|reactions| + |f_ext|) */
-  double damping;      /* current damping coefficient, 1/s */
+  double kinetic;       /* 1/2 sum m v^2 */
+  double strain;        /* sum V W */
+  double external_work; /* work of reactions and tractions so far */
+  double residual;      /* |f| on free dofs / (|reactions| + |f_ext|) */
+  double damping;       /* current damping coefficient, 1/s */
   bool converged;
 } fpm_step_info;
 
@@ -53,7 +53,6 @@ double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
 
 /* Reaction force: sum of f over the prescribed dofs of boundary condition
  * b, per component (3). */
-void fpm_reaction(const fpm_model *m, const fpm_state *st, int b,
-                  double R[3]);
+void fpm_reaction(const fpm_model *m, const fpm_state *st, int b, double R[3]);
 
 #endif

@@ -6,6 +6,8 @@
 /* cmocka needs the three headers above first. */
 #include <cmocka.h>
 
+#include "pm_testing.h"
+
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -19,39 +21,6 @@
 #include "pm_progress.h"
 
 /* ---- Helpers ----------------------------------------------------------- */
-
-static void remove_tree(const char *path) {
-  struct stat st;
-  if (lstat(path, &st) != 0) return;
-  if (S_ISDIR(st.st_mode)) {
-    DIR *d = opendir(path);
-    struct dirent *e;
-    char sub[1024];
-    while (d && (e = readdir(d))) {
-      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-      snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
-      remove_tree(sub);
-    }
-    if (d) closedir(d);
-    rmdir(path);
-  } else {
-    unlink(path);
-  }
-}
-
-static int make_dir(void **state) {
-  char *dir = malloc(64);
-  strcpy(dir, "/tmp/pm_test_files_XXXXXX");
-  assert_non_null(mkdtemp(dir));
-  *state = dir;
-  return 0;
-}
-
-static int drop_dir(void **state) {
-  remove_tree(*state);
-  free(*state);
-  return 0;
-}
 
 /* Number of directory entries (not . and ..). */
 static int count_entries(const char *dir) {
@@ -414,13 +383,18 @@ static void test_progress(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test_setup_teardown(test_mkdir_p, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_afile_commit_abort, make_dir,
-                                      drop_dir),
-      cmocka_unit_test_setup_teardown(test_bad_directory, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_history, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_json, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_json_misuse, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_mkdir_p, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_afile_commit_abort, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_bad_directory, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_history, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_json, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_json_misuse, pm_test_make_dir,
+                                      pm_test_drop_dir),
       cmocka_unit_test(test_timers),
       cmocka_unit_test(test_progress),
   };

@@ -28,9 +28,9 @@ static fixture *fixture_new(int dim, double h, double penalty, bool f2_bcs) {
   double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
   assert_int_equal(gm_mesh_box(dim, lo, hi, h, &fx->mesh), PM_SUCCESS);
   assert_int_equal(gm_dual_build(fx->mesh, &fx->dual), PM_SUCCESS);
-  assert_int_equal(pm_material_init(&fx->mat.mat, PM_MODEL_NEO_HOOKEAN, 1000,
-                                    3000, 0.495),
-                   PM_SUCCESS);
+  assert_int_equal(
+      pm_material_init(&fx->mat.mat, PM_MODEL_NEO_HOOKEAN, 1000, 3000, 0.495),
+      PM_SUCCESS);
   fx->mat.name = "gel";
   pm_scene *s = &fx->scene;
   s->path = "test";
@@ -108,7 +108,8 @@ static void check_homogeneous(double penalty) {
   double H[9] = {0.3, -0.2, 0.1, 0.05, -0.4, 0.2, -0.1, 0.15, 0.25};
   for (long i = 0; i < m->n; i++)
     for (int a = 0; a < 3; a++)
-      st->u[3 * i + a] = H[3 * a] * m->x[3 * i] + H[3 * a + 1] * m->x[3 * i + 1] +
+      st->u[3 * i + a] = H[3 * a] * m->x[3 * i] +
+                         H[3 * a + 1] * m->x[3 * i + 1] +
                          H[3 * a + 2] * m->x[3 * i + 2];
   assert_int_equal(fpm_force(m, st), -1);
   /* boundary points: those with a facet */
@@ -159,8 +160,8 @@ static void test_patch_f2(void **state) {
     assert_int_equal(fpm_model_create(&fx->scene, fx->dual, &m), PM_SUCCESS);
     assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
     double s;
-    assert_int_equal(
-        pm_material_uniaxial_lateral_stretch(&m->mats[0], 0.6, &s), PM_SUCCESS);
+    assert_int_equal(pm_material_uniaxial_lateral_stretch(&m->mats[0], 0.6, &s),
+                     PM_SUCCESS);
     for (long i = 0; i < m->n; i++) {
       st->u[3 * i] = (s - 1) * m->x[3 * i];
       st->u[3 * i + 1] = (s - 1) * m->x[3 * i + 1];

@@ -61,9 +61,9 @@ static gm_mesh *kuhn_mesh(int dim, const int n[3], const double lo[3],
       }
 #undef NODE
   gm_mesh *m = NULL;
-  assert_int_equal(gm_mesh_from_arrays(dim, n_nodes, x, n_cells, cells, lo,
-                                       hi, &m),
-                   PM_SUCCESS);
+  assert_int_equal(
+      gm_mesh_from_arrays(dim, n_nodes, x, n_cells, cells, lo, hi, &m),
+      PM_SUCCESS);
   free(x);
   free(cells);
   return m;
@@ -166,8 +166,8 @@ static void check_dual(const gm_mesh *m, const gm_dual *d) {
     for (int a = 0; a < 3; a++)
       for (int b = 0; b < 3; b++) {
         double expect = (a == b && a < dim) ? d->volume[i] : 0.0;
-        worst_m = fmax(worst_m,
-                       fabs(sm[9 * i + 3 * a + b] - expect) / d->volume[i]);
+        worst_m =
+            fmax(worst_m, fabs(sm[9 * i + 3 * a + b] - expect) / d->volume[i]);
       }
   }
   print_message("  %ld points, %ld interfaces, %ld facets: closure %.2e, "
@@ -297,8 +297,8 @@ static void check_gmsh_box(int dim, const double lo[3], const double hi[3],
   assert_int_equal(gm_dual_build(m, &d), PM_SUCCESS);
   check_dual(m, d);
   double me = gm_mesh_mean_edge(m);
-  print_message("  gmsh %dD h=%g: %ld nodes, %ld cells, mean edge %g\n", dim,
-                h, m->n_nodes, m->n_cells, me);
+  print_message("  gmsh %dD h=%g: %ld nodes, %ld cells, mean edge %g\n", dim, h,
+                m->n_nodes, m->n_cells, me);
   assert_true(me > 0.5 * h && me < 1.5 * h);
   assert_int_equal(gm_mesh_box(dim, lo, hi, h, &m2), PM_SUCCESS);
   assert_int_equal(m2->n_nodes, m->n_nodes);

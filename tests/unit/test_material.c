@@ -17,8 +17,8 @@ static pm_material gel(pm_model model) {
 }
 
 /* A deterministic, well-conditioned finite deformation. */
-static const double F0[9] = {1.21, 0.13, -0.07, 0.05, 0.83, 0.11,
-                             -0.09, 0.04, 0.64};
+static const double F0[9] = {1.21, 0.13,  -0.07, 0.05, 0.83,
+                             0.11, -0.09, 0.04,  0.64};
 
 /* dW along dF equals S : sym(F^T dF) and P : dF (central differences,
  * step 1e-6, relative tolerance 1e-6 of |S| |dF|). */
@@ -36,8 +36,8 @@ static void check_derivative(pm_model model, bool check_pk2) {
       Fp[k] = F0[k] + eps * dF[k];
       Fm[k] = F0[k] - eps * dF[k];
     }
-    double dW = (pm_material_energy(&m, Fp) - pm_material_energy(&m, Fm)) /
-                (2 * eps);
+    double dW =
+        (pm_material_energy(&m, Fp) - pm_material_energy(&m, Fm)) / (2 * eps);
     double FtdF[9], dE[9];
     pm_t_tmul(F0, dF, FtdF);
     for (int i = 0; i < 3; i++)

@@ -6,6 +6,8 @@
 /* cmocka needs the three headers above first. */
 #include <cmocka.h>
 
+#include "pm_testing.h"
+
 #include <dirent.h>
 #include <hdf5.h>
 #include <stdio.h>
@@ -26,39 +28,6 @@
       fail_msg("%s: %s\n%s", pm_err_name(e_), pm_error_message(),              \
                pm_error_traceback());                                          \
   } while (0)
-
-static void remove_tree(const char *path) {
-  struct stat st;
-  if (lstat(path, &st) != 0) return;
-  if (S_ISDIR(st.st_mode)) {
-    DIR *d = opendir(path);
-    struct dirent *e;
-    char sub[1024];
-    while (d && (e = readdir(d))) {
-      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-      snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
-      remove_tree(sub);
-    }
-    if (d) closedir(d);
-    rmdir(path);
-  } else {
-    unlink(path);
-  }
-}
-
-static int make_dir(void **state) {
-  char *dir = malloc(64);
-  strcpy(dir, "/tmp/pm_test_output_XXXXXX");
-  assert_non_null(mkdtemp(dir));
-  *state = dir;
-  return 0;
-}
-
-static int drop_dir(void **state) {
-  remove_tree(*state);
-  free(*state);
-  return 0;
-}
 
 /* Number of directory entries; *tmp counts names containing ".tmp.". */
 static int count_entries(const char *dir, int *tmp) {
@@ -318,11 +287,14 @@ static void test_bad_directory(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test_setup_teardown(test_write_read, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_abort_and_point_cloud, make_dir,
-                                      drop_dir),
-      cmocka_unit_test_setup_teardown(test_bad_arguments, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_bad_directory, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_write_read, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_abort_and_point_cloud,
+                                      pm_test_make_dir, pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_bad_arguments, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_bad_directory, pm_test_make_dir,
+                                      pm_test_drop_dir),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -6,6 +6,8 @@
 /* cmocka needs the three headers above first. */
 #include <cmocka.h>
 
+#include "pm_testing.h"
+
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -58,39 +60,6 @@ static void eval(const linear *f, const double *x, double *u) {
     u[i] = f->c[i];
     for (int j = 0; j < 3; j++) u[i] += f->g[i][j] * x[j];
   }
-}
-
-static void remove_tree(const char *path) {
-  struct stat st;
-  if (lstat(path, &st) != 0) return;
-  if (S_ISDIR(st.st_mode)) {
-    DIR *d = opendir(path);
-    struct dirent *e;
-    char sub[1024];
-    while (d && (e = readdir(d))) {
-      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-      snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
-      remove_tree(sub);
-    }
-    if (d) closedir(d);
-    rmdir(path);
-  } else {
-    unlink(path);
-  }
-}
-
-static int make_dir(void **state) {
-  char *dir = malloc(64);
-  strcpy(dir, "/tmp/pm_test_probe_XXXXXX");
-  assert_non_null(mkdtemp(dir));
-  *state = dir;
-  return 0;
-}
-
-static int drop_dir(void **state) {
-  remove_tree(*state);
-  free(*state);
-  return 0;
 }
 
 /* Jitter in [-0.3, 0.3) spacings from a fixed LCG: reproducible, and
@@ -278,11 +247,16 @@ static void test_frame_range(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test_setup_teardown(test_linear_3d, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_linear_2d, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_missing_results, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_bad_points, make_dir, drop_dir),
-      cmocka_unit_test_setup_teardown(test_frame_range, make_dir, drop_dir),
+      cmocka_unit_test_setup_teardown(test_linear_3d, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_linear_2d, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_missing_results, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_bad_points, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_frame_range, pm_test_make_dir,
+                                      pm_test_drop_dir),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

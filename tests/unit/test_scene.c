@@ -159,7 +159,8 @@ static void test_malformed(void **state) {
     const char *file, *where, *what;
   } cases[] = {
       {"bad-unknown-key.yaml", "bad-unknown-key.yaml:9:3: time.end_time: ",
-       "unknown key (expected one of end, dt, dt_safety, ramp, max_steps, "
+       "unknown key (expected one of end, dt, dt_safety, dt_rule, ramp, "
+       "max_steps, "
        "quasi_static)"},
       {"bad-wrong-type.yaml", "bad-wrong-type.yaml:9:14: materials.0.density: ",
        "expected a number, got heavy"},

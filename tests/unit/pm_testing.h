@@ -1,0 +1,51 @@
+/* pm_testing: helpers shared by the unit tests: a temporary directory per
+ * test (cmocka setup/teardown) removed with everything in it. */
+#ifndef PM_TESTING_H
+#define PM_TESTING_H
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static inline void pm_test_remove_tree(const char *path) {
+  struct stat st;
+  if (lstat(path, &st) != 0) return;
+  if (S_ISDIR(st.st_mode)) {
+    DIR *d = opendir(path);
+    struct dirent *e;
+    char sub[1024];
+    while (d && (e = readdir(d))) {
+      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+      int len = snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
+      if (len > 0 && (size_t)len < sizeof sub) pm_test_remove_tree(sub);
+    }
+    if (d) closedir(d);
+    rmdir(path);
+  } else {
+    unlink(path);
+  }
+}
+
+/* cmocka setup: *state = a new empty directory under /tmp. */
+static inline int pm_test_make_dir(void **state) {
+  char *dir = malloc(64);
+  strcpy(dir, "/tmp/pm_test_XXXXXX");
+  if (!mkdtemp(dir)) {
+    free(dir);
+    return -1;
+  }
+  *state = dir;
+  return 0;
+}
+
+/* cmocka teardown: remove the directory of pm_test_make_dir. */
+static inline int pm_test_drop_dir(void **state) {
+  pm_test_remove_tree(*state);
+  free(*state);
+  return 0;
+}
+
+#endif
