@@ -612,6 +612,32 @@ done:
   return ret;
 }
 
+/* Keep the overrides in the scene, and as comment lines at the end of its
+ * text, so that the text stored with the results reproduces the run. */
+static pm_err keep_overrides(pm_scene *s, int n, const char *const *kv) {
+  if (n == 0) return PM_SUCCESS;
+  PM_CALL(PM_ALLOC(s->overrides, n, "scene overrides"));
+  s->n_overrides = n;
+  size_t extra = 64;
+  for (int k = 0; k < n; k++) {
+    s->overrides[k] = strdup(kv[k]);
+    PM_CHECK(s->overrides[k], PM_ERR_MEMORY, "cannot copy override %s", kv[k]);
+    extra += strlen(kv[k]) + 16;
+  }
+  size_t len = strlen(s->text);
+  char *text = realloc(s->text, len + extra);
+  PM_CHECK(text, PM_ERR_MEMORY, "cannot extend the scene text");
+  s->text = text;
+  size_t at = len;
+  if (at > 0 && text[at - 1] != '\n') text[at++] = '\n';
+  at += (size_t)snprintf(text + at, len + extra - at,
+                         "# command-line overrides:\n");
+  for (int k = 0; k < n; k++)
+    at +=
+        (size_t)snprintf(text + at, len + extra - at, "#   --set %s\n", kv[k]);
+  return PM_SUCCESS;
+}
+
 pm_err pm_scene_load(const char *path, int n_overrides,
                      const char *const *overrides, pm_scene **out) {
   pm_err ret = PM_SUCCESS;
@@ -643,6 +669,7 @@ pm_err pm_scene_load(const char *path, int n_overrides,
   PM_ENSURE(cerr == CYAML_OK, PM_ERR_SCENE, "%s: %s: %s", path,
             cyaml_strerror(cerr), log.text);
   PM_TRY(build_scene(s, &doc, raw));
+  PM_TRY(keep_overrides(s, n_overrides, overrides));
   *out = s;
   s = NULL;
 done:
@@ -666,6 +693,8 @@ void pm_scene_destroy(pm_scene *s) {
   free(s->materials);
   free(s->bodies);
   free(s->bcs);
+  for (int k = 0; k < s->n_overrides; k++) free(s->overrides[k]);
+  free(s->overrides);
   free(s->name);
   free(s->text);
   free(s->path);

@@ -70,8 +70,11 @@ typedef struct {
 } pm_scene_bc;
 
 typedef struct pm_scene {
-  char *path; /* scene file as given */
-  char *text; /* full source text (stored with the results) */
+  char *path;       /* scene file as given */
+  char *text;       /* full source text (stored with the results),
+                       then the overrides as comment lines */
+  char **overrides; /* the "key=value" overrides applied */
+  int n_overrides;
   char *name;
   pm_method method;
   int dimension;                 /* 2 (plane strain) or 3 */

@@ -151,11 +151,12 @@ typedef struct {
 
 static void setup_history_columns(run_ctx *c) {
   static const char *base[] = {
-      "time",          "step",          "wall_seconds", "kinetic_energy",
-      "strain_energy", "external_work", "residual",     "damping"};
+      "time",           "step",          "wall_seconds",
+      "kinetic_energy", "strain_energy", "external_work",
+      "dissipated",     "residual",      "damping"};
   const pm_scene *s = c->sim->scene;
   int n = 0;
-  for (int k = 0; k < 8; k++) {
+  for (int k = 0; k < (int)(sizeof base / sizeof *base); k++) {
     snprintf(c->names_buf[n], sizeof c->names_buf[n], "%s", base[k]);
     c->reaction_bc[n] = -1;
     n++;
@@ -250,9 +251,10 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
     row[3] = info->kinetic;
     row[4] = info->strain;
     row[5] = info->external_work;
-    row[6] = info->residual;
-    row[7] = info->damping;
-    int k = 8;
+    row[6] = info->dissipated;
+    row[7] = info->residual;
+    row[8] = info->damping;
+    int k = 9;
     for (; k < c->n_hist && c->reaction_bc[k] >= 0; k++) {
       double R[3];
       fpm_reaction(m, st, c->reaction_bc[k], R);
@@ -283,6 +285,10 @@ static pm_err write_summary(fpm_sim *sim, const char *out_dir) {
   PM_TRY(pm_json_string(j, "scene", s->path));
   PM_TRY(pm_json_string(j, "name", s->name));
   PM_TRY(pm_json_string(j, "method", "fpm"));
+  PM_TRY(pm_json_begin_array(j, "overrides"));
+  for (int k = 0; k < s->n_overrides; k++)
+    PM_TRY(pm_json_string(j, NULL, s->overrides[k]));
+  PM_TRY(pm_json_end_array(j));
   PM_TRY(pm_json_string(j, "status", fpm_status_name(sim->status)));
   if (sim->message[0]) PM_TRY(pm_json_string(j, "message", sim->message));
   PM_TRY(pm_json_integer(j, "dimension", m->dim));
@@ -311,6 +317,13 @@ static pm_err write_summary(fpm_sim *sim, const char *out_dir) {
   PM_TRY(pm_json_number(j, "kinetic_energy", sim->last.kinetic));
   PM_TRY(pm_json_number(j, "strain_energy", sim->last.strain));
   PM_TRY(pm_json_number(j, "external_work", sim->last.external_work));
+  PM_TRY(pm_json_number(j, "dissipated", sim->last.dissipated));
+  double balance = sim->last.kinetic + sim->last.strain + sim->last.dissipated -
+                   sim->last.external_work;
+  PM_TRY(pm_json_number(j, "energy_balance_error",
+                        sim->last.external_work != 0
+                            ? balance / fabs(sim->last.external_work)
+                            : balance));
   PM_TRY(pm_json_number(j, "wall_seconds", sim->wall));
   PM_TRY(pm_json_number(j, "setup_seconds", sim->setup_wall));
   int threads = pm_omp_threads();

@@ -122,10 +122,10 @@ static void boundary_pass(const fpm_model *m, fpm_state *st) {
   const long *restrict dp = m->dpt_point;
   const double *restrict da = m->dpt_area, *restrict dm = m->dpt_mrel;
   const double *restrict P = st->P;
-  double *restrict T = st->T, *restrict r = st->r;
+  double *restrict T = st->T, *restrict r = st->r, *restrict bf = st->bflux;
   double norm2 = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : norm2)
-         shared(nd, dp, da, dm, P, T, r))
+         shared(nd, dp, da, dm, P, T, r, bf))
   for (long p = 0; p < nd; p++) {
     const long i = dp[p];
     const double *Pi = P + 9 * i;
@@ -134,6 +134,7 @@ static void boundary_pass(const fpm_model *m, fpm_state *st) {
       const double flux =
           Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] + Pi[3 * c + 2] * A[2];
       r[3 * i + c] -= flux;
+      bf[3 * p + c] = flux;
       norm2 += flux * flux;
       for (int q = 0; q < 3; q++)
         T[9 * i + 3 * c + q] -= Pi[3 * c] * B[q] + Pi[3 * c + 1] * B[3 + q] +

@@ -85,6 +85,8 @@ typedef struct {
   double *tf_value;  /* 3 n_tfacets: traction at the current time */
   double fext_norm;  /* |f_ext| of the current tractions */
   double bflux_norm; /* |consistency flux on prescribed faces| */
+  double *bflux;     /* 3 n_dpts: that flux per point: the supports' force on
+                        the body, with f on the prescribed dofs */
 } fpm_state;
 
 /* Build the model of scene s on dual d (both borrowed and kept alive by the

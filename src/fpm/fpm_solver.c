@@ -100,7 +100,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   const double dt = opt->dt;
   const double load_end = fpm_load_end(m);
   double t = 0, c = opt->qs == PM_QS_DAMPING ? opt->damping : 0;
-  double ext_work = 0, t_force = 0, t_update = 0;
+  double ext_work = 0, dissipated = 0, t_force = 0, t_update = 0;
   PM_CHECK(dt > 0 && isfinite(dt), PM_ERR_ARG, "time step must be > 0 (got %g)",
            dt);
   apply_prescribed(m, st, 0, 0);
@@ -150,29 +150,37 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
       if (info) *info = si;
       return unstable(m, st, step, t, dt, bad);
     }
-    double s3 = 0, rf = 0, kin = 0, se = 0;
+    double s3 = 0, rf = 0, kin = 0, se = 0, kin_free = 0;
     const double *restrict W = st->W, *restrict vol = m->dual->volume;
     PM_OMP(parallel for schedule(static) default(none)
-           reduction(+ : s3, rf, kin, se)
+           reduction(+ : s3, rf, kin, se, kin_free)
            shared(n, mass, fixed, v, f, W, vol, dt))
     for (long i = 0; i < n; i++) {
       se += vol[i] * W[i];
       for (int a = 0; a < 3; a++) {
         const long dof = 3 * i + a;
-        kin += 0.5 * mass[i] * v[dof] * v[dof];
+        const double k = 0.5 * mass[i] * v[dof] * v[dof];
+        kin += k;
         if (fixed[dof]) continue;
+        kin_free += k;
         s3 += dt * v[dof] * f[dof];
         rf += f[dof] * f[dof];
       }
     }
-    /* Reactions R = f on prescribed dofs; their power R . v and that of
-     * the tractions give the external work. */
+    /* The supports' force on the body is the boundary consistency flux
+     * plus the force left on prescribed dofs; its power, and that of the
+     * tractions, give the external work. */
     double rr = 0;
     for (long k = 0; k < m->n_cdofs; k++) {
       long dof = 3 * m->cd_point[k] + m->cd_comp[k];
       rr += st->f[dof] * st->f[dof];
       ext_work += st->f[dof] * st->v[dof] * dt;
     }
+    for (long p = 0; p < m->n_dpts; p++)
+      for (int a = 0; a < 3; a++)
+        ext_work += st->bflux[3 * p + a] * st->v[3 * m->dpt_point[p] + a] * dt;
+    /* Damping force c m v at the half step does work c m v^2 dt. */
+    dissipated += c * 2 * kin_free * dt;
     for (long k = 0; k < m->n_tfacets; k++)
       for (int a = 0; a < 3; a++)
         ext_work += st->tf_value[3 * k + a] * m->tf_area[k] *
@@ -188,6 +196,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     si.kinetic = kin;
     si.strain = se;
     si.external_work = ext_work;
+    si.dissipated = dissipated;
     si.residual = ref > 0 ? sqrt(rf) / ref : sqrt(rf);
     si.damping = c;
     si.converged = opt->qs != PM_QS_NONE && t >= load_end &&

@@ -24,6 +24,7 @@ typedef struct {
   double kinetic;       /* 1/2 sum m v^2 */
   double strain;        /* sum V W */
   double external_work; /* work of reactions and tractions so far */
+  double dissipated;    /* energy taken by damping so far */
   double residual;      /* |f| on free dofs / (|reactions| + |f_ext|) */
   double damping;       /* current damping coefficient, 1/s */
   bool converged;

@@ -208,6 +208,11 @@ static void test_overrides(void **state) {
       "materials.0.poisson_ratio=0.3",    /* inside a flow mapping */
   };
   pm_scene *s = load_ok(F2, 7, set);
+  /* The overrides are kept, and written into the text stored with the
+   * results, so the run can be reproduced from its output. */
+  assert_int_equal(s->n_overrides, 7);
+  assert_string_equal(s->overrides[2], "boundary.3.displacement.z=-0.06");
+  assert_non_null(strstr(s->text, "#   --set time.dt=1e-3\n"));
   assert_near(s->mesh_size, 8.02e-3, 1e-18);
   assert_near(s->time.dt, 1e-3, 0);
   assert_near(eval(s->bcs[3].disp[2], 0, 0, 0.1, 0), -0.06, 1e-15);
