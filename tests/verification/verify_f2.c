@@ -49,6 +49,14 @@ static void run_f2(const char *h, const char *file, const char *dt_rule) {
                 "u_x %.3e, u_y %.3e, wall %.2f s\n",
                 h, sim->mean_edge, dt_rule, m->n, sim->last.step, sim->dt, ez,
                 sim->nrmse[2], ex, ey, sim->wall);
+  /* Energy: kinetic + strain + dissipated = work of the supports. */
+  const fpm_step_info *e = &sim->last;
+  double balance = (e->kinetic + e->strain + e->dissipated - e->external_work) /
+                   e->external_work;
+  print_message("  energy: strain %.6g J, dissipated %.6g J, external %.6g J, "
+                "balance error %.2e\n",
+                e->strain, e->dissipated, e->external_work, balance);
+  assert_true(fabs(balance) <= 0.01);
   assert_true(ez <= 1e-5);
   assert_true(fabs(sim->nrmse[2] - ez) <= 1e-12);
   assert_true(ex <= 1e-5);
