@@ -78,7 +78,7 @@ pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
                     x[3 * lapack_point + 2]);
   if (worst >= 0)
     return PM_ERROR(PM_ERR_GEOMETRY,
-                    "ill-conditioned support at point %ld (%g, %g, %g): "
+                    "point %ld at (%g, %g, %g): ill-conditioned support: "
                     "%ld neighbours, condition number %.3g > %.3g; the "
                     "support does not span %dD",
                     worst, x[3 * worst], x[3 * worst + 1], x[3 * worst + 2],

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_gfd.h"
 #include "fpm_model.h"
 #include "fpm_solver.h"
 #include "gm_dual.h"
@@ -188,6 +189,22 @@ static void test_patch_f2(void **state) {
   }
 }
 
+/* A support that does not span 3D (all neighbours in one plane) is
+ * reported with the point's id and position. */
+static void test_gfd_ill_conditioned(void **state) {
+  (void)state;
+  const double x[] = {0.5, 0.5, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  const long ptr[] = {0, 4, 5, 6, 7, 8};
+  const long nbr[] = {1, 2, 3, 4, 0, 0, 0, 0};
+  double g[3 * 8], cond[5];
+  pm_error_clear();
+  assert_int_equal(fpm_gfd_weights(3, 5, x, ptr, nbr, 1e8, g, cond),
+                   PM_ERR_GEOMETRY);
+  print_message("%s\n", pm_error_message());
+  assert_non_null(strstr(pm_error_message(), "point 0 at (0.5, 0.5, 0)"));
+  assert_non_null(strstr(pm_error_message(), "condition number"));
+}
+
 /* gmsh sets the OpenMP thread count process-wide; meshing must leave the
  * caller's setting as it was (it once silently serialized every run). */
 static void test_meshing_keeps_threads(void **state) {
@@ -202,6 +219,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_meshing_keeps_threads),
       cmocka_unit_test(test_gfd_linear),
+      cmocka_unit_test(test_gfd_ill_conditioned),
       cmocka_unit_test(test_homogeneous_p0),
       cmocka_unit_test(test_homogeneous_p20),
       cmocka_unit_test(test_patch_f2),
