@@ -65,7 +65,7 @@ typedef struct {
   unsigned traction_mask;
   pm_expr *traction[3];
   pm_ramp ramp;
-  double ramp_time; /* s; scene time.ramp when not given */
+  double ramp_time; /* s; the loader puts time.ramp when not given */
   pm_scene_mark mark;
 } pm_scene_bc;
 

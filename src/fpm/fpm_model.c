@@ -341,8 +341,7 @@ size_t fpm_state_bytes(const fpm_model *m) {
 
 double fpm_prescribed(const fpm_model *m, long k, double t) {
   const pm_scene_bc *bc = &m->scene->bcs[m->cd_bc[k]];
-  double T = bc->ramp_time > 0 ? bc->ramp_time : m->scene->time.ramp;
-  double r = pm_ramp_factor(bc->ramp, T, t);
+  double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
   if (!m->cd_time_dependent) return r * m->cd_base[k];
   const double *xi = m->x + 3 * m->cd_point[k];
   return r * pm_expr_eval(bc->disp[m->cd_comp[k]], xi[0], xi[1], xi[2], t);
@@ -352,8 +351,7 @@ void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t) {
   double norm2 = 0;
   for (long k = 0; k < m->n_tfacets; k++) {
     const pm_scene_bc *bc = &m->scene->bcs[m->tf_bc[k]];
-    double T = bc->ramp_time > 0 ? bc->ramp_time : m->scene->time.ramp;
-    double r = pm_ramp_factor(bc->ramp, T, t);
+    double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
     const double *c = m->tf_centroid + 3 * k;
     for (int a = 0; a < 3; a++) {
       double v = 0;
@@ -375,8 +373,7 @@ double fpm_load_end(const fpm_model *m) {
   for (int b = 0; b < m->scene->n_bcs; b++) {
     const pm_scene_bc *bc = &m->scene->bcs[b];
     if (bc->ramp == PM_RAMP_NONE) continue;
-    double T = bc->ramp_time > 0 ? bc->ramp_time : m->scene->time.ramp;
-    if (T > end) end = T;
+    if (bc->ramp_time > end) end = bc->ramp_time;
   }
   return end;
 }

@@ -1,5 +1,6 @@
-/* pm_testing: helpers shared by the unit tests: a temporary directory per
- * test (cmocka setup/teardown) removed with everything in it. */
+/* pm_testing: helpers shared by the unit tests (include after cmocka.h):
+ * a success check that prints the error message, and a temporary directory
+ * per test (cmocka setup/teardown) removed with everything in it. */
 #ifndef PM_TESTING_H
 #define PM_TESTING_H
 
@@ -9,6 +10,17 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include "pm_error.h"
+
+/* Expect success; on failure show the recorded message. */
+#define assert_ok(expr)                                                        \
+  do {                                                                         \
+    pm_err e_ = (expr);                                                        \
+    if (e_ != PM_SUCCESS)                                                      \
+      fail_msg("%s: %s\n%s", pm_err_name(e_), pm_error_message(),              \
+               pm_error_traceback());                                          \
+  } while (0)
 
 static inline void pm_test_remove_tree(const char *path) {
   struct stat st;

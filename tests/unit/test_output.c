@@ -20,15 +20,6 @@
 
 /* ---- Helpers ----------------------------------------------------------- */
 
-/* Expect success; on failure show the recorded message. */
-#define assert_ok(expr)                                                        \
-  do {                                                                         \
-    pm_err e_ = (expr);                                                        \
-    if (e_ != PM_SUCCESS)                                                      \
-      fail_msg("%s: %s\n%s", pm_err_name(e_), pm_error_message(),              \
-               pm_error_traceback());                                          \
-  } while (0)
-
 /* Number of directory entries; *tmp counts names containing ".tmp.". */
 static int count_entries(const char *dir, int *tmp) {
   DIR *d = opendir(dir);

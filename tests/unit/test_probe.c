@@ -25,15 +25,6 @@
 
 /* ---- Helpers ----------------------------------------------------------- */
 
-/* Expect success; on failure show the recorded message. */
-#define assert_ok(expr)                                                        \
-  do {                                                                         \
-    pm_err e_ = (expr);                                                        \
-    if (e_ != PM_SUCCESS)                                                      \
-      fail_msg("%s: %s\n%s", pm_err_name(e_), pm_error_message(),              \
-               pm_error_traceback());                                          \
-  } while (0)
-
 /* Expect code and a message containing text. */
 #define assert_fails(expr, code, text)                                         \
   do {                                                                         \
