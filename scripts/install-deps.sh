@@ -11,7 +11,7 @@ packages=(
   libcyaml-dev libyaml-dev
   libmatheval-dev
   libcmocka-dev
-  clang-format
+  clang-format python3-matplotlib python3-numpy python3-h5py
 )
 
 missing=()

@@ -1,6 +1,7 @@
 /* pointmech: the command-line program.  The only layer that knows every
  * backend: it loads the scene and hands it to the backend of its method. */
 #include <errno.h>
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,6 +11,7 @@
 #include "pm_error.h"
 #include "pm_probe.h"
 #include "pm_scene.h"
+#include "pm_study.h"
 
 enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_NUMERIC = 2, EXIT_NOT_CONVERGED = 3 };
 
@@ -21,6 +23,10 @@ static void usage(FILE *out) {
           "[--quiet]\n"
           "       pointmech plan SCENE [--set KEY=VALUE]...\n"
           "       pointmech probe OUT --points FILE.csv [--frame N]\n"
+          "       pointmech convergence SCENE --set-ladder KEY=V1,V2,... "
+          "[--set-ladder ...]\n"
+          "                 [--reference analytic|last|DIR] [--out DIR] "
+          "[--set KEY=VALUE]...\n"
           "       pointmech --help | --version\n"
           "\n"
           "  run    simulate SCENE (YAML); writes OUT/results.h5 + "
@@ -34,6 +40,15 @@ static void usage(FILE *out) {
           "         reference coordinates of FILE.csv (x,y,z per line), by "
           "moving\n"
           "         least squares, as CSV\n"
+          "  convergence  run SCENE once per ladder value (several ladders "
+          "go in\n"
+          "         step) and tabulate h, points, steps, NRMSE against the "
+          "analytic\n"
+          "         field or a reference run (default: the last value), the "
+          "rate q\n"
+          "         and wall time in OUT/convergence.{md,csv} (default OUT:\n"
+          "         out/NAME-convergence); plot with "
+          "tools/plot-convergence.py\n"
           "  --set  override any scene value by its dotted key, e.g.\n"
           "         --set discretization.mesh_size=8.02e-3 --set "
           "boundary.3.displacement.z=-0.06\n"
@@ -58,6 +73,9 @@ typedef struct {
   const char *scene;
   const char *out;
   const char *points;
+  const char *reference;
+  int n_ladders;
+  const char *ladders[PM_STUDY_MAX_KEYS];
   long frame;
   bool quiet;
   int n_sets;
@@ -74,7 +92,16 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
       a->out = argv[++k];
     else if (strcmp(arg, "--points") == 0 && has_next)
       a->points = argv[++k];
-    else if (strcmp(arg, "--frame") == 0 && has_next) {
+    else if (strcmp(arg, "--reference") == 0 && has_next)
+      a->reference = argv[++k];
+    else if (strcmp(arg, "--set-ladder") == 0 && has_next) {
+      if (a->n_ladders == PM_STUDY_MAX_KEYS) {
+        fprintf(stderr, "pointmech: at most %d --set-ladder options\n",
+                PM_STUDY_MAX_KEYS);
+        return -1;
+      }
+      a->ladders[a->n_ladders++] = argv[++k];
+    } else if (strcmp(arg, "--frame") == 0 && has_next) {
       char *end;
       a->frame = strtol(argv[++k], &end, 10);
       if (*end || a->frame < 0) {
@@ -145,6 +172,80 @@ done:
   return status;
 }
 
+/* The boundary condition with the largest prescribed displacement at the
+ * end (evaluated at its face's centre) and that component: the loaded face. */
+static void loaded_face(const pm_scene *s, int *bc, int *comp) {
+  double best = -1;
+  *bc = -1;
+  *comp = 0;
+  for (int b = 0; b < s->n_bcs; b++) {
+    const pm_scene_bc *B = &s->bcs[b];
+    double c[3];
+    for (int a = 0; a < 3; a++) c[a] = 0.5 * (s->box_min[a] + s->box_max[a]);
+    int axis = (int)B->face / 2;
+    c[axis] = (int)B->face % 2 ? s->box_max[axis] : s->box_min[axis];
+    for (int k = 0; k < 3; k++) {
+      if (!(B->disp_mask & (1u << k))) continue;
+      double v = fabs(pm_expr_eval(B->disp[k], c[0], c[1], c[2], s->time.end));
+      if (v > best) {
+        best = v;
+        *bc = b;
+        *comp = k;
+      }
+    }
+  }
+}
+
+static pm_err run_fpm_level(void *ctx, const pm_scene *s, const char *out,
+                            bool quiet, pm_run_figures *fig) {
+  (void)ctx;
+  fpm_sim *sim = NULL;
+  *fig = (pm_run_figures){.status = "failed", .nrmse = NAN};
+  pm_err e = fpm_sim_create(s, &sim);
+  if (e) return e;
+  e = fpm_sim_run(sim, out, quiet);
+  fpm_field_figures ff;
+  fpm_sim_field_figures(sim, &ff);
+  const fpm_model *m = sim->model;
+  fig->status = fpm_status_name(sim->status);
+  fig->dim = m->dim;
+  fig->points = m->n;
+  fig->steps = sim->last.step;
+  fig->h = sim->mean_edge;
+  fig->wall = sim->wall;
+  fig->setup = sim->setup_wall;
+  fig->nrmse = sim->nrmse_vector;
+  fig->mean_sed = ff.mean_strain_energy_density;
+  fig->max_von_mises = ff.max_von_mises;
+  fig->min_jacobian = sim->run_min_jacobian;
+  fig->energy_error = fpm_sim_energy_error(sim);
+  int bc, comp;
+  loaded_face(s, &bc, &comp);
+  fig->reaction = NAN;
+  if (bc >= 0) {
+    double R[3];
+    fpm_reaction(m, sim->state, bc, R);
+    fig->reaction = R[comp];
+  }
+  fpm_sim_destroy(sim);
+  return e;
+}
+
+static int cmd_convergence(const cli_args *a) {
+  pm_study_options o = {
+      .scene = a->scene,
+      .n_sets = a->n_sets,
+      .sets = a->sets,
+      .n_keys = a->n_ladders,
+      .reference = a->reference,
+      .out_dir = a->out,
+      .quiet = a->quiet,
+  };
+  for (int k = 0; k < a->n_ladders; k++) o.ladder[k] = a->ladders[k];
+  pm_err e = pm_study_run(&o, run_fpm_level, NULL, stdout);
+  return e ? report(e) : EXIT_OK;
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
     usage(stderr);
@@ -171,6 +272,13 @@ int main(int argc, char **argv) {
       return EXIT_INPUT;
     }
     return cmd_run_or_plan(&a, strcmp(cmd, "plan") == 0);
+  }
+  if (strcmp(cmd, "convergence") == 0) {
+    if (!a.scene) {
+      fprintf(stderr, "pointmech: convergence needs a SCENE file\n");
+      return EXIT_INPUT;
+    }
+    return cmd_convergence(&a);
   }
   if (strcmp(cmd, "probe") == 0) {
     if (!a.scene || !a.points) {

@@ -96,6 +96,45 @@ bool pm_material_stress(const pm_material *m, const double F[9], double P[9],
   }
 }
 
+/* d(a F + b cof F) with dJ = cof : dF, dI1 = 2 F : dF,
+ * d cof = (dJ cof - cof dF^T cof) / J. */
+static bool neo_hookean_derivative(const pm_material *m, const double F[9],
+                                   const double dF[9], double dP[9]) {
+  double cof[9], t1[9], t2[9], dFT[9];
+  double J = pm_t_det(F);
+  if (!(J > 0)) return false;
+  pm_t_cofactor(F, cof);
+  double a = m->mu * exp(-2.0 / 3.0 * log(J));
+  double I1 = pm_t_ddot(F, F);
+  double b = -a * I1 / (3 * J) + m->kappa * (J - 1);
+  double dJ = pm_t_ddot(cof, dF), dI1 = 2 * pm_t_ddot(F, dF);
+  double da = -2.0 / 3.0 * a * dJ / J;
+  double db = -da * I1 / (3 * J) - a * dI1 / (3 * J) +
+              a * I1 * dJ / (3 * J * J) + m->kappa * dJ;
+  pm_t_transpose(dF, dFT);
+  pm_t_mul(cof, dFT, t1);
+  pm_t_mul(t1, cof, t2);
+  for (int k = 0; k < 9; k++)
+    dP[k] = da * F[k] + a * dF[k] + db * cof[k] + b * (dJ * cof[k] - t2[k]) / J;
+  return true;
+}
+
+bool pm_material_stress_derivative(const pm_material *m, const double F[9],
+                                   const double dF[9], double dP[9]) {
+  switch (m->model) {
+  case PM_MODEL_NEO_HOOKEAN: return neo_hookean_derivative(m, F, dF, dP);
+  case PM_MODEL_LINEAR_ELASTIC: {
+    double tr = dF[0] + dF[4] + dF[8];
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        dP[3 * i + j] = m->mu * (dF[3 * i + j] + dF[3 * j + i]) +
+                        (i == j ? m->lambda * tr : 0);
+    return true;
+  }
+  default: return false;
+  }
+}
+
 bool pm_material_pk2(const pm_material *m, const double F[9], double S[9]) {
   double P[9], Finv[9];
   if (!pm_material_stress(m, F, P, NULL, NULL)) return false;

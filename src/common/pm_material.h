@@ -42,6 +42,11 @@ pm_err pm_material_init(pm_material *m, pm_model model, double density,
  * not finite (P is then unspecified). */
 bool pm_material_stress(const pm_material *m, const double F[9], double P[9],
                         double *W, double *J);
+/* Directional derivative of P at F along dF: dP = A : dF with the
+ * tangent modulus A = d2W/dF dF (which has major symmetry, so also
+ * B : A = dP for B = dF).  False when J <= 0. */
+bool pm_material_stress_derivative(const pm_material *m, const double F[9],
+                                   const double dF[9], double dP[9]);
 /* Second Piola-Kirchhoff stress S = F^-1 P (9); false when J <= 0. */
 bool pm_material_pk2(const pm_material *m, const double F[9], double S[9]);
 /* Strain energy density W(F) alone; NaN when J <= 0. */

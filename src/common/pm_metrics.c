@@ -11,8 +11,27 @@ double pm_nrmse(long n, int stride, const double *u, const double *ref) {
     if (ref[j * stride] < lo) lo = ref[j * stride];
     if (ref[j * stride] > hi) hi = ref[j * stride];
   }
-  if (!(hi > lo)) return NAN;
-  return sqrt(sum) / (hi - lo);
+  if (!(hi > lo) || n <= 0) return NAN;
+  return sqrt(sum / (double)n) / (hi - lo);
+}
+
+double pm_nrmse_vector(long n, unsigned mask, const double *u,
+                       const double *ref) {
+  double sum = 0, lo = INFINITY, hi = -INFINITY;
+  for (long j = 0; j < n; j++) {
+    double r2 = 0;
+    for (int c = 0; c < 3; c++) {
+      if (!(mask & (1u << c))) continue;
+      double d = u[3 * j + c] - ref[3 * j + c];
+      sum += d * d;
+      r2 += ref[3 * j + c] * ref[3 * j + c];
+    }
+    double r = sqrt(r2);
+    lo = fmin(lo, r);
+    hi = fmax(hi, r);
+  }
+  if (!(hi > lo) || n <= 0) return NAN;
+  return sqrt(sum / (double)n) / (hi - lo);
 }
 
 double pm_convergence_rate(int n, const double *h, const double *err) {

@@ -3,11 +3,18 @@
 #ifndef PM_METRICS_H
 #define PM_METRICS_H
 
-/* NRMSE of the FPM paper (eq. 28) for one component:
- *   sqrt(sum_j (u_j - r_j)^2) / (max_j r_j - min_j r_j)
- * over n values taken every stride doubles from u and ref.  Returns NaN if
- * the reference has no range. */
+/* NRMSE of the FPM paper (eq. 28) for one component: the root of the MEAN
+ * square error over the range of the reference,
+ *   sqrt(sum_j (u_j - r_j)^2 / n) / (max_j r_j - min_j r_j)
+ * over n values taken every stride doubles from u and ref.  (Eq. 28 as
+ * printed omits the 1/n; its name and the paper's tables are those of the
+ * mean.)  Returns NaN if the reference has no range. */
 double pm_nrmse(long n, int stride, const double *u, const double *ref);
+
+/* The same for a vector field of n points ([n][3]; components not in mask
+ * are ignored): sqrt(sum_j |u_j - r_j|^2 / n) / (max_j |r_j| - min_j |r_j|). */
+double pm_nrmse_vector(long n, unsigned mask, const double *u,
+                       const double *ref);
 
 /* Least-squares slope of log(err) against log(h) over n >= 2 pairs: the
  * observed convergence rate q.  NaN if fewer than two positive pairs. */

@@ -397,6 +397,49 @@ static bool probe_at(cloud *c, const double *q, double u[3]) {
   }
 }
 
+static void cloud_free(cloud *c) {
+  free(c->x);
+  free(c->u);
+  free(c->start);
+  free(c->pts);
+  free(c->near);
+}
+
+pm_err pm_results_read(const char *out_dir, long frame, long *n, double **x,
+                       double **u) {
+  pm_err ret = PM_SUCCESS;
+  cloud c = {.n = 0};
+  char path[PM_PATH_MAX + 1];
+  *x = *u = NULL;
+  PM_CALL(pm_path_join(path, sizeof path, out_dir, "results.h5"));
+  PM_TRY(read_results(path, frame, &c));
+  *n = c.n;
+  *x = c.x;
+  *u = c.u;
+  c.x = c.u = NULL;
+done:
+  cloud_free(&c);
+  return ret;
+}
+
+pm_err pm_probe_map(const char *out_dir, long frame, long m, const double *q,
+                    double *u) {
+  pm_err ret = PM_SUCCESS;
+  cloud c = {.n = 0};
+  char path[PM_PATH_MAX + 1];
+  PM_CALL(pm_path_join(path, sizeof path, out_dir, "results.h5"));
+  PM_TRY(read_results(path, frame, &c));
+  PM_TRY(build_grid(&c, path));
+  for (long i = 0; i < m; i++)
+    PM_ENSURE(probe_at(&c, q + 3 * i, u + 3 * i), PM_ERR_GEOMETRY,
+              "no regular moving-least-squares fit at (%g, %g, %g) from the "
+              "%ld points of '%s'",
+              q[3 * i], q[3 * i + 1], q[3 * i + 2], c.n, path);
+done:
+  cloud_free(&c);
+  return ret;
+}
+
 /* ---- Entry point ------------------------------------------------------- */
 
 pm_err pm_probe(const char *out_dir, const char *points_csv, long frame,
@@ -433,10 +476,6 @@ done:
   free(val);
   free(qs.p);
   free(qs.line);
-  free(c.x);
-  free(c.u);
-  free(c.start);
-  free(c.pts);
-  free(c.near);
+  cloud_free(&c);
   return ret;
 }

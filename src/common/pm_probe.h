@@ -17,4 +17,14 @@
 pm_err pm_probe(const char *out_dir, const char *points_csv, long frame,
                 FILE *out);
 
+/* Read the reference coordinates and the displacement of frame `frame`
+ * (last when < 0) of OUT/results.h5 into new [n][3] arrays. */
+pm_err pm_results_read(const char *out_dir, long frame, long *n, double **x,
+                       double **u);
+
+/* The displacement of OUT/results.h5 (frame as above) at the m reference
+ * points q ([m][3]) by the same moving least squares, into u ([m][3]). */
+pm_err pm_probe_map(const char *out_dir, long frame, long m, const double *q,
+                    double *u);
+
 #endif

@@ -48,6 +48,7 @@ typedef struct {
 
 typedef struct {
   double penalty;
+  int flux;
 } raw_fpm;
 
 typedef struct {
@@ -68,6 +69,10 @@ typedef struct {
 } raw_output;
 
 typedef struct {
+  double min_jacobian, max_energy_error;
+} raw_stability;
+
+typedef struct {
   raw_vec displacement;
 } raw_reference;
 
@@ -86,6 +91,7 @@ typedef struct {
   raw_fpm fpm;
   raw_time time;
   raw_output output;
+  raw_stability stability;
   raw_reference reference;
 } raw_scene;
 
@@ -201,8 +207,15 @@ static const cyaml_schema_value_t bc_entry = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, raw_bc, bc_fields),
 };
 
+static const cyaml_strval_t flux_names[] = {
+    {"iipg", PM_FLUX_IIPG},
+    {"sipg", PM_FLUX_SIPG},
+};
+
 static const cyaml_schema_field_t fpm_fields[] = {
     CYAML_FIELD_FLOAT("penalty", OPT, raw_fpm, penalty),
+    CYAML_FIELD_ENUM("flux", OPT | ENUM_FLAGS, raw_fpm, flux, flux_names,
+                     CYAML_ARRAY_LEN(flux_names)),
     CYAML_FIELD_END,
 };
 
@@ -234,6 +247,12 @@ static const cyaml_schema_field_t output_fields[] = {
     CYAML_FIELD_END,
 };
 
+static const cyaml_schema_field_t stability_fields[] = {
+    CYAML_FIELD_FLOAT("min_jacobian", OPT, raw_stability, min_jacobian),
+    CYAML_FIELD_FLOAT("max_energy_error", OPT, raw_stability, max_energy_error),
+    CYAML_FIELD_END,
+};
+
 static const cyaml_schema_field_t reference_fields[] = {
     CYAML_FIELD_MAPPING("displacement", OPT, raw_reference, displacement,
                         vec_fields),
@@ -260,6 +279,8 @@ static const cyaml_schema_field_t scene_fields[] = {
     CYAML_FIELD_MAPPING("time", CYAML_FLAG_DEFAULT, raw_scene, time,
                         time_fields),
     CYAML_FIELD_MAPPING("output", OPT, raw_scene, output, output_fields),
+    CYAML_FIELD_MAPPING("stability", OPT, raw_scene, stability,
+                        stability_fields),
     CYAML_FIELD_MAPPING("reference", OPT, raw_scene, reference,
                         reference_fields),
     CYAML_FIELD_END,
@@ -513,6 +534,7 @@ static pm_err build_time(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   const raw_quasi_static *qs = &t->quasi_static;
   s->fpm.penalty = has(d, "fpm.penalty") ? r->fpm.penalty : 20.0;
   PM_CALL(check_nonneg(d, "fpm.penalty", s->fpm.penalty));
+  s->fpm.flux = has(d, "fpm.flux") ? (pm_flux)r->fpm.flux : PM_FLUX_IIPG;
 
   s->time.end = t->end;
   PM_CALL(check_positive(d, "time.end", t->end));
@@ -536,6 +558,15 @@ static pm_err build_time(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   PM_CALL(check_positive(d, "time.quasi_static.tolerance", qs->tolerance));
   s->time.qs_damping = qs->damping;
   PM_CALL(check_nonneg(d, "time.quasi_static.damping", qs->damping));
+  const raw_stability *st = &r->stability;
+  s->stability.min_jacobian =
+      has(d, "stability.min_jacobian") ? st->min_jacobian : 0.0;
+  if (!(s->stability.min_jacobian >= 0 && s->stability.min_jacobian < 1))
+    return pm_sdoc_expected(d, "stability.min_jacobian", "a number in [0, 1)");
+  s->stability.max_energy_error =
+      has(d, "stability.max_energy_error") ? st->max_energy_error : 0.1;
+  PM_CALL(
+      check_positive(d, "stability.max_energy_error", st->max_energy_error));
   if (s->time.qs == PM_QS_DAMPING && !(qs->damping > 0)) {
     if (has(d, "time.quasi_static.damping"))
       return pm_sdoc_expected(d, "time.quasi_static.damping",

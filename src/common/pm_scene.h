@@ -22,6 +22,12 @@ typedef enum {
   PM_QS_DAMPING             /* fixed mass-proportional damping */
 } pm_qs_method;
 
+/* Interior-penalty flux of FPM. */
+typedef enum {
+  PM_FLUX_IIPG = 0, /* incomplete (the FPM paper's eq. 16) */
+  PM_FLUX_SIPG      /* symmetric: the force is the gradient of an energy */
+} pm_flux;
+
 /* How the stable time step is found. */
 typedef enum {
   PM_DT_PAPER = 0, /* the bound of eqs. 24-26 of the FPM paper */
@@ -88,6 +94,7 @@ typedef struct pm_scene {
   int n_bcs;
   struct {
     double penalty; /* fpm.penalty p >= 0 (beta = p E / h) */
+    pm_flux flux;   /* fpm.flux: iipg (default) | sipg */
   } fpm;
   struct {
     double end;          /* time.end, s, > 0 */
@@ -100,6 +107,15 @@ typedef struct pm_scene {
     double qs_damping;   /* time.quasi_static.damping: 1/s for PM_QS_DAMPING */
     long max_steps;      /* time.max_steps; 0: no limit */
   } time;
+  struct {
+    /* stability.min_jacobian: stop when some J falls to or below it
+     * (default 0: an inverted subdomain) */
+    double min_jacobian;
+    /* stability.max_energy_error: stop when |kinetic + strain + dissipated
+     * - external work| exceeds this fraction of the energy in play
+     * (default 0.1) */
+    double max_energy_error;
+  } stability;
   struct {
     long every;      /* output.every: frame every N steps (> 0) */
     unsigned fields; /* PM_FIELD_* mask */

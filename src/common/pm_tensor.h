@@ -118,4 +118,13 @@ static inline void pm_t_rotation(const double axis[3], double angle,
   R[8] = t * z * z + c;
 }
 
+/* Von Mises equivalent of a symmetric stress: sqrt(3/2 s:s), s the
+ * deviator. */
+static inline double pm_t_von_mises(const double S[9]) {
+  double p = (S[0] + S[4] + S[8]) / 3;
+  double a = S[0] - p, b = S[4] - p, c = S[8] - p;
+  double sh = S[1] * S[1] + S[2] * S[2] + S[5] * S[5];
+  return sqrt(1.5 * (a * a + b * b + c * c + 2 * sh));
+}
+
 #endif

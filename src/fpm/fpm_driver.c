@@ -10,6 +10,7 @@
 #include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_output.h"
+#include "fpm_gfd.h"
 #include "pm_tensor.h"
 
 #define FPM_HIST_MAX 64
@@ -48,6 +49,7 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   PM_TRY(PM_ALLOC(sim, 1, "FPM simulation"));
   sim->scene = s;
   for (int c = 0; c < 3; c++) sim->nrmse[c] = NAN;
+  sim->nrmse_vector = NAN;
   pm_timers_init(&sim->timers);
   sim->tm_mesh = pm_timers_add(&sim->timers, "mesh (gmsh)");
   sim->tm_dual = pm_timers_add(&sim->timers, "median-dual subdomains");
@@ -121,14 +123,19 @@ static void fill_reference(fpm_sim *sim, double t) {
 static void compute_errors(fpm_sim *sim, double t) {
   const pm_scene *s = sim->scene;
   sim->n_ref = 0;
+  sim->nrmse_vector = NAN;
   for (int c = 0; c < 3; c++) sim->nrmse[c] = NAN;
   if (!sim->ref) return;
   if (sim->ref_time_dependent) fill_reference(sim, t);
   for (int c = 0; c < 3; c++) {
     if (!(s->reference_mask & (1u << c))) continue;
     sim->nrmse[c] = pm_nrmse(sim->model->n, 3, sim->state->u + c, sim->ref + c);
+    sim->nrmse_vector = sim->nrmse[c];
     sim->n_ref++;
   }
+  if (sim->n_ref > 1)
+    sim->nrmse_vector = pm_nrmse_vector(sim->model->n, s->reference_mask,
+                                        sim->state->u, sim->ref);
 }
 
 typedef struct {
@@ -151,9 +158,10 @@ typedef struct {
 
 static void setup_history_columns(run_ctx *c) {
   static const char *base[] = {
-      "time",           "step",          "wall_seconds",
-      "kinetic_energy", "strain_energy", "external_work",
-      "dissipated",     "residual",      "damping"};
+      "time",           "step",          "wall_seconds",   "kinetic_energy",
+      "strain_energy",  "external_work", "penalty_energy", "dissipated",
+      "residual",       "damping",       "energy_error",   "min_jacobian",
+      "ill_conditioned"};
   const pm_scene *s = c->sim->scene;
   int n = 0;
   for (int k = 0; k < (int)(sizeof base / sizeof *base); k++) {
@@ -225,6 +233,12 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
                       const fpm_step_info *info, bool frame) {
   run_ctx *c = ctx;
   fpm_sim *sim = c->sim;
+  if (info->min_jacobian < sim->run_min_jacobian) {
+    sim->run_min_jacobian = info->min_jacobian;
+    sim->run_min_jacobian_step = info->step;
+  }
+  if (info->step >= 100 && info->energy_error > sim->run_max_energy_error)
+    sim->run_max_energy_error = info->energy_error;
   if (c->show_progress) {
     double frac = info->t / sim->scene->time.end;
     if (sim->scene->time.qs != PM_QS_NONE && info->t >= c->load_end &&
@@ -251,10 +265,14 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
     row[3] = info->kinetic;
     row[4] = info->strain;
     row[5] = info->external_work;
-    row[6] = info->dissipated;
-    row[7] = info->residual;
-    row[8] = info->damping;
-    int k = 9;
+    row[6] = info->penalty;
+    row[7] = info->dissipated;
+    row[8] = info->residual;
+    row[9] = info->damping;
+    row[10] = info->energy_error;
+    row[11] = info->min_jacobian;
+    row[12] = (double)fpm_sim_conditioning(sim, NULL, NULL);
+    int k = 13;
     for (; k < c->n_hist && c->reaction_bc[k] >= 0; k++) {
       double R[3];
       fpm_reaction(m, st, c->reaction_bc[k], R);
@@ -269,6 +287,75 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
   }
   pm_timers_stop(&sim->timers, sim->tm_output);
   return ret;
+}
+
+double fpm_sim_energy_error(const fpm_sim *sim) {
+  const fpm_step_info *l = &sim->last;
+  double balance =
+      l->kinetic + l->strain + l->penalty + l->dissipated - l->external_work;
+  return l->external_work != 0 ? balance / fabs(l->external_work) : balance;
+}
+
+long fpm_sim_conditioning(const fpm_sim *sim, double *worst,
+                          long *worst_point) {
+  const fpm_model *m = sim->model;
+  return fpm_gfd_deformed_condition(m->dim, m->n, m->x, sim->state->u,
+                                    m->nbr_ptr, sim->dual->nbr, FPM_COND_MAX,
+                                    worst, worst_point);
+}
+
+void fpm_sim_field_figures(fpm_sim *sim, fpm_field_figures *ff) {
+  const fpm_model *m = sim->model;
+  const fpm_state *st = sim->state;
+  const double *vol = sim->dual->volume;
+  double *sig = sim->scratch;
+  cauchy_stress(m, st, sig);
+  double vsum = 0, wsum = 0;
+  *ff = (fpm_field_figures){.min_jacobian = INFINITY, .max_von_mises = -1};
+  for (long i = 0; i < m->n; i++) {
+    vsum += vol[i];
+    wsum += vol[i] * st->W[i];
+    double vm = pm_t_von_mises(sig + 9 * i);
+    if (vm > ff->max_von_mises) {
+      ff->max_von_mises = vm;
+      ff->max_von_mises_point = i;
+    }
+    if (st->J[i] < ff->min_jacobian) {
+      ff->min_jacobian = st->J[i];
+      ff->min_jacobian_point = i;
+    }
+  }
+  ff->mean_strain_energy_density = vsum > 0 ? wsum / vsum : 0;
+  ff->ill_conditioned =
+      fpm_sim_conditioning(sim, &ff->max_condition, &ff->max_condition_point);
+}
+
+static pm_err json_point(pm_json *j, const char *key, const fpm_model *m,
+                         long p) {
+  PM_CALL(pm_json_begin_array(j, key));
+  for (int a = 0; a < m->dim; a++)
+    PM_CALL(pm_json_number(j, NULL, m->x[3 * p + a]));
+  return pm_json_end_array(j);
+}
+
+/* Figures of the final fields: energy density, stress, J, conditioning. */
+static pm_err write_field_figures(fpm_sim *sim, pm_json *j) {
+  const fpm_model *m = sim->model;
+  fpm_field_figures ff;
+  fpm_sim_field_figures(sim, &ff);
+  PM_CALL(pm_json_number(j, "mean_strain_energy_density",
+                         ff.mean_strain_energy_density));
+  PM_CALL(pm_json_number(j, "max_von_mises", ff.max_von_mises));
+  PM_CALL(json_point(j, "max_von_mises_at", m, ff.max_von_mises_point));
+  PM_CALL(pm_json_number(j, "min_jacobian", ff.min_jacobian));
+  PM_CALL(json_point(j, "min_jacobian_at", m, ff.min_jacobian_point));
+  PM_CALL(pm_json_number(j, "run_min_jacobian", sim->run_min_jacobian));
+  PM_CALL(
+      pm_json_integer(j, "run_min_jacobian_step", sim->run_min_jacobian_step));
+  PM_CALL(pm_json_number(j, "run_max_energy_error", sim->run_max_energy_error));
+  PM_CALL(pm_json_integer(j, "ill_conditioned_points", ff.ill_conditioned));
+  PM_CALL(pm_json_number(j, "max_support_condition", ff.max_condition));
+  return PM_SUCCESS;
 }
 
 static pm_err write_summary(fpm_sim *sim, const char *out_dir) {
@@ -318,12 +405,9 @@ static pm_err write_summary(fpm_sim *sim, const char *out_dir) {
   PM_TRY(pm_json_number(j, "strain_energy", sim->last.strain));
   PM_TRY(pm_json_number(j, "external_work", sim->last.external_work));
   PM_TRY(pm_json_number(j, "dissipated", sim->last.dissipated));
-  double balance = sim->last.kinetic + sim->last.strain + sim->last.dissipated -
-                   sim->last.external_work;
-  PM_TRY(pm_json_number(j, "energy_balance_error",
-                        sim->last.external_work != 0
-                            ? balance / fabs(sim->last.external_work)
-                            : balance));
+  PM_TRY(pm_json_number(j, "penalty_energy", sim->last.penalty));
+  PM_TRY(pm_json_number(j, "energy_balance_error", fpm_sim_energy_error(sim)));
+  PM_TRY(write_field_figures(sim, j));
   PM_TRY(pm_json_number(j, "wall_seconds", sim->wall));
   PM_TRY(pm_json_number(j, "setup_seconds", sim->setup_wall));
   int threads = pm_omp_threads();
@@ -341,6 +425,9 @@ static pm_err write_summary(fpm_sim *sim, const char *out_dir) {
     PM_TRY(pm_json_number(j, sim->timers.stage[k].name,
                           sim->timers.stage[k].seconds));
   PM_TRY(pm_json_end_object(j));
+  if (isfinite(sim->nrmse_vector))
+    PM_TRY(pm_json_number(j, "nrmse_displacement", sim->nrmse_vector));
+  PM_TRY(pm_json_string(j, "flux", m->flux == PM_FLUX_SIPG ? "sipg" : "iipg"));
   PM_TRY(pm_json_begin_object(j, "nrmse"));
   for (int c = 0; c < 3; c++) {
     char key[8] = {'u', '_', "xyz"[c], 0};
@@ -391,9 +478,14 @@ pm_err fpm_sim_run(fpm_sim *sim, const char *out_dir, bool quiet) {
       .qs_tolerance = s->time.qs_tolerance,
       .damping = s->time.qs_damping,
       .frame_every = s->output.every,
+      .min_jacobian = s->stability.min_jacobian,
+      .max_energy_error = s->stability.max_energy_error,
   };
   memset(sim->state->u, 0, 3 * m->n * sizeof(double));
   memset(sim->state->v, 0, 3 * m->n * sizeof(double));
+  sim->run_min_jacobian = INFINITY;
+  sim->run_min_jacobian_step = 0;
+  sim->run_max_energy_error = 0;
   double t0 = pm_wtime(), stage[2] = {0, 0};
   c->t_start = t0;
   run_err = fpm_run(m, sim->state, &opt, observe, c, &sim->last, stage);

@@ -43,11 +43,28 @@ typedef struct {
   double setup_wall;       /* mesh + dual + operators, s */
   int n_ref;               /* reference components compared */
   double nrmse[3];         /* eq. 28 per component, NaN if no reference */
+  double nrmse_vector;     /* of the whole reference field (one component:
+                              that component's) */
   double *scratch;         /* 9 n: output and metrics buffer */
   double *ref;             /* 3 n: reference displacement, or NULL */
   bool ref_time_dependent; /* some reference component uses t */
   char message[1024];      /* failure message, if any */
+  double run_min_jacobian; /* smallest J seen at any step of the run */
+  long run_min_jacobian_step;
+  double run_max_energy_error; /* largest energy-balance error of the run */
 } fpm_sim;
+
+/* Figures of the current fields. */
+typedef struct {
+  double mean_strain_energy_density; /* sum V W / sum V, J/m^3 */
+  double max_von_mises;              /* of the Cauchy stress, Pa */
+  long max_von_mises_point;
+  double min_jacobian;
+  long min_jacobian_point;
+  long ill_conditioned; /* supports above the condition bound, deformed */
+  double max_condition;
+  long max_condition_point;
+} fpm_field_figures;
 
 /* Mesh the scene's domain, build subdomains, operators and state, and pick
  * dt: time.dt if set, else dt_safety times the stable step of
@@ -71,5 +88,16 @@ pm_err fpm_sim_plan(fpm_sim *sim, FILE *out);
 void fpm_sim_measure_spectrum(fpm_sim *sim);
 
 const char *fpm_status_name(fpm_status s);
+
+/* (kinetic + strain + interface + dissipated - external work) / |external
+ * work| at the last step. */
+double fpm_sim_energy_error(const fpm_sim *sim);
+
+/* Field figures of the current state (uses sim->scratch). */
+void fpm_sim_field_figures(fpm_sim *sim, fpm_field_figures *ff);
+
+/* Number of points whose support, in the current configuration, has a
+ * moment matrix with condition number above FPM_COND_MAX. */
+long fpm_sim_conditioning(const fpm_sim *sim, double *worst, long *worst_point);
 
 #endif

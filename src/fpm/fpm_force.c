@@ -4,6 +4,7 @@
 #include <math.h>
 
 #include "fpm_model.h"
+#include "pm_material.h"
 #include "pm_omp.h"
 #include "pm_tensor.h"
 
@@ -57,12 +58,13 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
 /* Pass 2: per point i, over its interfaces e with outward area vector a,
  * d_i = x_e - X_i, d_k = x_e - X_k:
  *   [[u]] = u_i + H_i d_i - u_k - H_k d_k,  b = beta |e| [[u]],
- *   r_i = sum_e (b - P_e a),  Q_i = sum_e (P_e (M_e - a (x) X_i) - b (x) d_i)
- * with P_e = (P_i + P_k) / 2, and T_i = V_i P_i - Q_i.  With the moment
- * about the centroid, M_e - a (x) X_i = Mc + a (x) d_i, the neighbour's half
- * is  1/2 P_k Mc + w (x) d_i  with  w = 1/2 P_k a - b;  the P_i half uses
- * the precomputed sums of a and M_e - a (x) X_i.  Entry records stream in
- * order; only the neighbours' u, H, P are gathered. */
+ *   r_i = sum_e (b - P_e a),  (penalty energy 1/2 sum_e beta |e| [[u]]^2)  Q_i
+ * = sum_e (P_e (M_e - a (x) X_i) - b (x) d_i) with P_e = (P_i + P_k) / 2, and
+ * T_i = V_i P_i - Q_i.  With the moment about the centroid, M_e - a (x) X_i =
+ * Mc + a (x) d_i, the neighbour's half is  1/2 P_k Mc + w (x) d_i  with  w =
+ * 1/2 P_k a - b;  the P_i half uses the precomputed sums of a and M_e - a (x)
+ * X_i.  Entry records stream in order; only the neighbours' u, H, P are
+ * gathered. */
 static void flux_pass(const fpm_model *m, fpm_state *st) {
   const long n = m->n;
   const long *restrict ptr = m->nbr_ptr;
@@ -72,11 +74,15 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
                          *restrict vol = m->dual->volume;
   const double *restrict u = st->u, *restrict H = st->H, *restrict P = st->P;
   double *restrict T = st->T, *restrict r = st->r;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r))
+  const int *restrict mat = m->mat;
+  const pm_material *mats = m->mats;
+  const bool sym = m->flux == PM_FLUX_SIPG;
+  double epen = 0;
+  PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
+         shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat, mats, sym))
   for (long i = 0; i < n; i++) {
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
-    double Q[9] = {0}, ri[3] = {0};
+    double Q[9] = {0}, ri[3] = {0}, B[9] = {0};
     for (long e = ptr[i]; e < ptr[i + 1]; e++) {
       const long k = nbr[e];
       const double *rec = erec + FPM_EREC * e;
@@ -93,6 +99,20 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
                       Pk[3 * c + 2] * a[2]) -
                be * jump;
         ri[c] -= w[c];
+        epen += 0.25 * be * jump * jump; /* each interface is seen twice */
+        if (sym) {
+          /* K_e = int_e [[u]] (x) n = [[u]](c_e) (x) a + (H_i - H_k) Mc^T */
+          const double h0 = Hi[3 * c] - Hk[3 * c],
+                       h1 = Hi[3 * c + 1] - Hk[3 * c + 1],
+                       h2 = Hi[3 * c + 2] - Hk[3 * c + 2];
+          for (int q = 0; q < 3; q++) {
+            const double K = jump * a[q] + h0 * Mc[3 * q] + h1 * Mc[3 * q + 1] +
+                             h2 * Mc[3 * q + 2];
+            B[3 * c + q] += K;
+            /* -{P} : K_e, each interface seen twice */
+            epen -= 0.25 * (Pi[3 * c + q] + Pk[3 * c + q]) * K;
+          }
+        }
       }
       for (int c = 0; c < 3; c++)
         for (int q = 0; q < 3; q++)
@@ -100,17 +120,29 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
                                  Pk[3 * c + 2] * Mc[6 + q]) +
                           w[c] * di[q];
     }
-    const double *A = pa + 3 * i, *B = pm + 9 * i;
+    if (sym) {
+      /* The adjoint term: -1/2 A_i : sum_e K_e, the derivative of
+       * -sum_e {P} : K_e through P_i (A_i = dP/dF at F_i). */
+      double F[9], dP[9];
+      for (int k = 0; k < 9; k++) F[k] = Hi[k];
+      F[0] += 1;
+      F[4] += 1;
+      F[8] += 1;
+      pm_material_stress_derivative(&mats[mat[i]], F, B, dP);
+      for (int k = 0; k < 9; k++) Q[k] += 0.5 * dP[k];
+    }
+    const double *A = pa + 3 * i, *Bm = pm + 9 * i;
     for (int c = 0; c < 3; c++) {
       r[3 * i + c] = ri[c] - 0.5 * (Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] +
                                     Pi[3 * c + 2] * A[2]);
       for (int q = 0; q < 3; q++)
         T[9 * i + 3 * c + q] =
             vol[i] * Pi[3 * c + q] - Q[3 * c + q] -
-            0.5 * (Pi[3 * c] * B[q] + Pi[3 * c + 1] * B[3 + q] +
-                   Pi[3 * c + 2] * B[6 + q]);
+            0.5 * (Pi[3 * c] * Bm[q] + Pi[3 * c + 1] * Bm[3 + q] +
+                   Pi[3 * c + 2] * Bm[6 + q]);
     }
   }
+  st->penalty_energy = epen;
 }
 
 /* Boundary terms: the consistency flux on facets with displacement

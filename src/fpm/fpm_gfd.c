@@ -86,3 +86,57 @@ pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
                     dim);
   return PM_SUCCESS;
 }
+
+/* Condition number of one support's moment matrix at positions x + u,
+ * weighted by the reference distances. */
+static double deformed_condition(int dim, long i, const double *x,
+                                 const double *u, const long *nbr_ptr,
+                                 const long *nbr) {
+  double A[9] = {0}, wsum = 0, lam[3];
+  const double *xi = x + 3 * i, *ui = u + 3 * i;
+  for (long e = nbr_ptr[i]; e < nbr_ptr[i + 1]; e++) {
+    const double *xk = x + 3 * nbr[e], *uk = u + 3 * nbr[e];
+    double D[3], d[3];
+    for (int a = 0; a < 3; a++) {
+      D[a] = xk[a] - xi[a];
+      d[a] = D[a] + uk[a] - ui[a];
+    }
+    double w = 1.0 / (D[0] * D[0] + D[1] * D[1] + D[2] * D[2]);
+    wsum += w;
+    for (int a = 0; a < dim; a++)
+      for (int b = 0; b < dim; b++) A[dim * a + b] += w * d[a] * d[b];
+  }
+  for (int k = 0; k < dim * dim; k++) A[k] /= wsum;
+  int info = LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', dim, A, dim, lam);
+  return (info == 0 && lam[0] > 0) ? lam[dim - 1] / lam[0] : INFINITY;
+}
+
+long fpm_gfd_deformed_condition(int dim, long n, const double *x,
+                                const double *u, const long *nbr_ptr,
+                                const long *nbr, double cond_max, double *worst,
+                                long *worst_point) {
+  long count = 0, wp = -1;
+  double wc = 0;
+  PM_OMP(parallel default(none) reduction(+ : count)
+         shared(n, x, u, nbr_ptr, nbr, dim, cond_max, wc, wp)) {
+    long my_p = -1;
+    double my_c = 0;
+    PM_OMP(for schedule(dynamic, 256) nowait)
+    for (long i = 0; i < n; i++) {
+      double c = deformed_condition(dim, i, x, u, nbr_ptr, nbr);
+      if (!(c <= cond_max)) count++;
+      if (my_p < 0 || !(c <= my_c)) {
+        my_c = c;
+        my_p = i;
+      }
+    }
+    PM_OMP(critical(fpm_gfd_worst))
+    if (my_p >= 0 && (wp < 0 || !(my_c <= wc) || (my_c == wc && my_p < wp))) {
+      wc = my_c;
+      wp = my_p;
+    }
+  }
+  if (worst) *worst = wc;
+  if (worst_point) *worst_point = wp;
+  return count;
+}

@@ -5,6 +5,9 @@
 
 #include "pm_error.h"
 
+/* Largest condition number of a support's scaled moment matrix. */
+#define FPM_COND_MAX 1e8
+
 /* Weights g_ik such that grad u_i = sum_k (u_k - u_i) (x) g_ik for the
  * support k in nbr[nbr_ptr[i] .. nbr_ptr[i+1]).  They minimize
  *   sum_k w_ik |u_k - u_i - G (X_k - X_i)|^2,  w_ik = 1 / |X_k - X_i|^2,
@@ -21,5 +24,15 @@
 pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
                        const long *nbr, double cond_max, double *g,
                        double *cond);
+
+/* Condition of the supports in the current configuration: the moment
+ * matrix of each support built from the deformed positions x + u (with the
+ * reference weights).  Returns the number of points whose condition number
+ * exceeds cond_max; *worst receives the largest condition number and
+ * *worst_point its point.  Allocates nothing. */
+long fpm_gfd_deformed_condition(int dim, long n, const double *x,
+                                const double *u, const long *nbr_ptr,
+                                const long *nbr, double cond_max, double *worst,
+                                long *worst_point);
 
 #endif

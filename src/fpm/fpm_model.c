@@ -11,7 +11,6 @@
 
 /* Supports whose scaled moment matrix is worse than this cannot give a
  * usable gradient. */
-#define FPM_COND_MAX 1e8
 
 void fpm_model_destroy(fpm_model *m) {
   if (!m) return;
@@ -263,6 +262,7 @@ pm_err fpm_model_create(const pm_scene *s, const gm_dual *d, fpm_model **out) {
   m->nnz = d->nbr_ptr[d->n_points];
   m->scene = s;
   m->penalty = s->fpm.penalty;
+  m->flux = s->fpm.flux;
   long n = m->n, nnz = m->nnz;
   PM_TRY(PM_ALLOC(m->g, 3 * nnz, "GFD weights"));
   PM_TRY(PM_ALLOC(m->gsum, 3 * n, "GFD weight sums"));

@@ -45,6 +45,7 @@ typedef struct {
   int *mat;       /* n: material of each point */
   double *mass;   /* n: lumped mass rho V */
   double penalty; /* p */
+  pm_flux flux;   /* IIPG or SIPG */
   /* Consistency flux on faces with displacement conditions, per point that
    * has such facets: row c of the projected flux uses area A^c and moment
    * B^c summed over the facets that prescribe component c. */
@@ -74,19 +75,21 @@ typedef struct {
 
 /* Fields that change every step.  All allocated by fpm_state_create. */
 typedef struct {
-  double *u, *v;     /* 3 n displacement, velocity (half step) */
-  double *f;         /* 3 n net force f_int - f_ext */
-  double *H;         /* 9 n: F - I per point */
-  double *P;         /* 9 n: first Piola-Kirchhoff stress */
-  double *T;         /* 9 n: V P - Q, the gathered flux tensor */
-  double *r;         /* 3 n: interface and boundary force terms */
-  double *W;         /* n: strain energy density */
-  double *J;         /* n: det F */
-  double *tf_value;  /* 3 n_tfacets: traction at the current time */
-  double fext_norm;  /* |f_ext| of the current tractions */
-  double bflux_norm; /* |consistency flux on prescribed faces| */
-  double *bflux;     /* 3 n_dpts: that flux per point: the supports' force on
-                        the body, with f on the prescribed dofs */
+  double *u, *v;         /* 3 n displacement, velocity (half step) */
+  double *f;             /* 3 n net force f_int - f_ext */
+  double *H;             /* 9 n: F - I per point */
+  double *P;             /* 9 n: first Piola-Kirchhoff stress */
+  double *T;             /* 9 n: V P - Q, the gathered flux tensor */
+  double *r;             /* 3 n: interface and boundary force terms */
+  double *W;             /* n: strain energy density */
+  double *J;             /* n: det F */
+  double *tf_value;      /* 3 n_tfacets: traction at the current time */
+  double fext_norm;      /* |f_ext| of the current tractions */
+  double bflux_norm;     /* |consistency flux on prescribed faces| */
+  double penalty_energy; /* interface energy, J: 1/2 sum_e beta |e| [[u]]^2,
+                            and with SIPG also - sum_e {P} : K_e */
+  double *bflux; /* 3 n_dpts: that flux per point: the supports' force on
+                    the body, with f on the prescribed dofs */
 } fpm_state;
 
 /* Build the model of scene s on dual d (both borrowed and kept alive by the

@@ -70,6 +70,9 @@ double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
   return lam > 0 ? 2 / sqrt(lam) : INFINITY;
 }
 
+/* Steps before the energy balance is checked against its bound. */
+#define FPM_ENERGY_CHECK_AFTER 100
+
 static void apply_prescribed(const fpm_model *m, fpm_state *st, double t,
                              double dt) {
   for (long k = 0; k < m->n_cdofs; k++) {
@@ -81,16 +84,32 @@ static void apply_prescribed(const fpm_model *m, fpm_state *st, double t,
 }
 
 static pm_err unstable(const fpm_model *m, const fpm_state *st, long step,
-                       double t, double dt, long p) {
+                       double t, double dt, long p, double min_jacobian) {
   const double *x = m->x + 3 * p;
   double J = st->J[p];
-  const char *cause = !isfinite(J) ? "deformation gradient is not finite"
-                      : J <= 0     ? "volume ratio J <= 0 (inverted subdomain)"
-                                   : "stress is not finite";
+  char why[96];
+  const char *cause = why;
+  if (!isfinite(J))
+    cause = "deformation gradient is not finite";
+  else if (J <= 0)
+    cause = "volume ratio J <= 0 (inverted subdomain)";
+  else if (J <= min_jacobian)
+    snprintf(why, sizeof why, "volume ratio J <= stability.min_jacobian = %g",
+             min_jacobian);
+  else
+    cause = "stress is not finite";
   return PM_ERROR(PM_ERR_UNSTABLE,
                   "step %ld, t = %.6g s: point %ld at (%g, %g, %g): %s "
                   "(J = %g); dt = %.4g s",
                   step, t, p, x[0], x[1], x[2], cause, J, dt);
+}
+
+/* The point of smallest J (serial; only on the way out). */
+static long argmin_jacobian(const fpm_model *m, const fpm_state *st) {
+  long best = 0;
+  for (long i = 1; i < m->n; i++)
+    if (st->J[i] < st->J[best]) best = i;
+  return best;
 }
 
 pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
@@ -106,26 +125,30 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   apply_prescribed(m, st, 0, 0);
   fpm_update_tractions(m, st, 0);
   long bad = fpm_force(m, st);
-  if (bad >= 0) return unstable(m, st, 0, 0, dt, bad);
+  if (bad >= 0) return unstable(m, st, 0, 0, dt, bad, 0);
 
   fpm_step_info si = {0};
   const double *restrict mass = m->mass;
   const unsigned char *restrict fixed = m->fixed;
   for (long step = 1;; step++) {
     double w0 = pm_wtime();
-    double s1 = 0, s2 = 0;
+    double s1 = 0, s2 = 0, sd = 0;
     const double cd2 = 0.5 * c * dt;
     const double damp_old = (1 - cd2) / (1 + cd2), damp_new = dt / (1 + cd2);
     double *restrict u = st->u, *restrict v = st->v;
     const double *restrict f = st->f;
-    PM_OMP(parallel for schedule(static) default(none) reduction(+ : s1, s2)
+    PM_OMP(parallel for schedule(static) default(none)
+           reduction(+ : s1, s2, sd)
            shared(n, mass, fixed, u, v, f, damp_old, damp_new, dt))
     for (long i = 0; i < n; i++) {
       const double im = 1.0 / mass[i];
       for (int a = 0; a < 3; a++) {
         const long dof = 3 * i + a;
         if (fixed[dof]) continue;
-        v[dof] = damp_old * v[dof] - damp_new * f[dof] * im;
+        const double v_old = v[dof];
+        v[dof] = damp_old * v_old - damp_new * f[dof] * im;
+        const double v_mid = 0.5 * (v_old + v[dof]);
+        sd += mass[i] * v_mid * v_mid;
         const double du = dt * v[dof];
         u[dof] += du;
         s1 += du * f[dof];
@@ -148,21 +171,23 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
       si.t = t;
       si.converged = false;
       if (info) *info = si;
-      return unstable(m, st, step, t, dt, bad);
+      return unstable(m, st, step, t, dt, bad, 0);
     }
-    double s3 = 0, rf = 0, kin = 0, se = 0, kin_free = 0;
-    const double *restrict W = st->W, *restrict vol = m->dual->volume;
+    double s3 = 0, rf = 0, kin = 0, se = 0, jmin = INFINITY;
+    const double *restrict W = st->W, *restrict vol = m->dual->volume,
+                           *restrict Jp = st->J;
     PM_OMP(parallel for schedule(static) default(none)
-           reduction(+ : s3, rf, kin, se, kin_free)
-           shared(n, mass, fixed, v, f, W, vol, dt))
+           reduction(+ : s3, rf, kin, se) reduction(min : jmin)
+           shared(n, mass, fixed, v, f, W, vol, Jp, dt))
     for (long i = 0; i < n; i++) {
       se += vol[i] * W[i];
+      jmin = Jp[i] < jmin ? Jp[i] : jmin;
       for (int a = 0; a < 3; a++) {
         const long dof = 3 * i + a;
-        const double k = 0.5 * mass[i] * v[dof] * v[dof];
-        kin += k;
+        /* Prescribed dofs move as the supports dictate: their kinetic
+         * energy comes from outside the balance, like their inertia. */
         if (fixed[dof]) continue;
-        kin_free += k;
+        kin += 0.5 * mass[i] * v[dof] * v[dof];
         s3 += dt * v[dof] * f[dof];
         rf += f[dof] * f[dof];
       }
@@ -179,8 +204,9 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     for (long p = 0; p < m->n_dpts; p++)
       for (int a = 0; a < 3; a++)
         ext_work += st->bflux[3 * p + a] * st->v[3 * m->dpt_point[p] + a] * dt;
-    /* Damping force c m v at the half step does work c m v^2 dt. */
-    dissipated += c * 2 * kin_free * dt;
+    /* The damping force c m (v_old + v_new) / 2 does work c m v_mid^2 dt
+     * (exactly what the update takes from the kinetic energy). */
+    dissipated += c * sd * dt;
     for (long k = 0; k < m->n_tfacets; k++)
       for (int a = 0; a < 3; a++)
         ext_work += st->tf_value[3 * k + a] * m->tf_area[k] *
@@ -195,10 +221,39 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     si.t = t;
     si.kinetic = kin;
     si.strain = se;
+    si.penalty = st->penalty_energy;
     si.external_work = ext_work;
     si.dissipated = dissipated;
     si.residual = ref > 0 ? sqrt(rf) / ref : sqrt(rf);
     si.damping = c;
+    si.min_jacobian = jmin;
+    si.min_jacobian_point = -1;
+    {
+      double held = kin + se + st->penalty_energy + dissipated;
+      double scale = fmax(fabs(ext_work), held);
+      si.energy_error = scale > 0 ? fabs(held - ext_work) / scale : 0;
+    }
+    /* The balance is checked once the loading has done work; the first
+     * steps' figures are at round-off level. */
+    if (opt->max_energy_error > 0 && step >= FPM_ENERGY_CHECK_AFTER &&
+        ext_work > 0 && si.energy_error > opt->max_energy_error) {
+      si.converged = false;
+      if (info) *info = si;
+      return PM_ERROR(
+          PM_ERR_UNSTABLE,
+          "step %ld, t = %.6g s: energy balance error %.3g exceeds "
+          "stability.max_energy_error = %g (kinetic %.4g + strain %.4g + "
+          "interface %.4g + dissipated %.4g J against external work %.4g J): "
+          "the discretization is creating energy; dt = %.4g s",
+          step, t, si.energy_error, opt->max_energy_error, kin, se,
+          st->penalty_energy, dissipated, ext_work, dt);
+    }
+    if (jmin <= opt->min_jacobian) {
+      si.converged = false;
+      if (info) *info = si;
+      return unstable(m, st, step, t, dt, argmin_jacobian(m, st),
+                      opt->min_jacobian);
+    }
     si.converged = opt->qs != PM_QS_NONE && t >= load_end &&
                    si.residual < opt->qs_tolerance;
     bool last = si.converged || t >= opt->t_end * (1 - 1e-12) ||

@@ -8,13 +8,15 @@
 #include "fpm_model.h"
 
 typedef struct {
-  double dt;           /* time step, s */
-  double t_end;        /* stop at this time */
-  long max_steps;      /* 0: no limit */
-  pm_qs_method qs;     /* quasi-static method */
-  double qs_tolerance; /* relative residual to stop at (quasi-static) */
-  double damping;      /* fixed damping (1/s) for PM_QS_DAMPING */
-  long frame_every;    /* call on_step with frame = true every N steps */
+  double dt;               /* time step, s */
+  double t_end;            /* stop at this time */
+  long max_steps;          /* 0: no limit */
+  pm_qs_method qs;         /* quasi-static method */
+  double qs_tolerance;     /* relative residual to stop at (quasi-static) */
+  double damping;          /* fixed damping (1/s) for PM_QS_DAMPING */
+  long frame_every;        /* call on_step with frame = true every N steps */
+  double min_jacobian;     /* stop when some J <= this (>= 0) */
+  double max_energy_error; /* stop when energy_error exceeds this */
 } fpm_run_options;
 
 /* What a step reports to the observer. */
@@ -23,10 +25,16 @@ typedef struct {
   double t;
   double kinetic;       /* 1/2 sum m v^2 */
   double strain;        /* sum V W */
+  double penalty;       /* interface penalty energy */
   double external_work; /* work of reactions and tractions so far */
   double dissipated;    /* energy taken by damping so far */
   double residual;      /* |f| on free dofs / (|reactions| + |f_ext|) */
   double damping;       /* current damping coefficient, 1/s */
+  double min_jacobian;  /* smallest volume ratio J over the points */
+  long min_jacobian_point;
+  double energy_error; /* |kinetic + strain + penalty + dissipated
+                          - external| over
+                          the larger of |external| and the energy held */
   bool converged;
 } fpm_step_info;
 

@@ -61,6 +61,45 @@ static void test_linear_derivative(void **state) {
   check_derivative(PM_MODEL_LINEAR_ELASTIC, false);
 }
 
+/* The tangent: dP along dF matches central differences of P (relative
+ * 1e-7 of |A| |dF|), and B : A : dF = dF : A : B (major symmetry). */
+static void check_tangent(pm_model model) {
+  pm_material m = gel(model);
+  double dF[9] = {0.3, -0.2, 0.1, 0.05, 0.7, -0.4, 0.2, 0.1, -0.6};
+  double B[9] = {-0.1, 0.4, 0.2, 0.3, -0.2, 0.1, 0.5, -0.3, 0.25};
+  double dP[9], dPB[9], Pp[9], Pm[9], Fp[9], Fm[9], eps = 1e-6;
+  assert_true(pm_material_stress_derivative(&m, F0, dF, dP));
+  assert_true(pm_material_stress_derivative(&m, F0, B, dPB));
+  for (int k = 0; k < 9; k++) {
+    Fp[k] = F0[k] + eps * dF[k];
+    Fm[k] = F0[k] - eps * dF[k];
+  }
+  assert_true(pm_material_stress(&m, Fp, Pp, NULL, NULL));
+  assert_true(pm_material_stress(&m, Fm, Pm, NULL, NULL));
+  double scale = (m.lambda + 2 * m.mu) * pm_t_norm(dF);
+  for (int k = 0; k < 9; k++)
+    assert_true(fabs((Pp[k] - Pm[k]) / (2 * eps) - dP[k]) <= 1e-7 * scale);
+  assert_true(fabs(pm_t_ddot(B, dP) - pm_t_ddot(dF, dPB)) <=
+              1e-12 * scale * pm_t_norm(B));
+}
+
+static void test_tangent(void **state) {
+  (void)state;
+  check_tangent(PM_MODEL_NEO_HOOKEAN);
+  check_tangent(PM_MODEL_LINEAR_ELASTIC);
+}
+
+/* Von Mises of a uniaxial stress is its magnitude; of a pressure, zero. */
+static void test_von_mises(void **state) {
+  (void)state;
+  double uni[9] = {0, 0, 0, 0, 0, 0, 0, 0, -7.5};
+  double pres[9] = {3, 0, 0, 0, 3, 0, 0, 0, 3};
+  double shear[9] = {0, 2, 0, 2, 0, 0, 0, 0, 0};
+  assert_true(fabs(pm_t_von_mises(uni) - 7.5) < 1e-14);
+  assert_true(fabs(pm_t_von_mises(pres)) < 1e-14);
+  assert_true(fabs(pm_t_von_mises(shear) - 2 * sqrt(3.0)) < 1e-14);
+}
+
 static void test_zero_at_rest(void **state) {
   (void)state;
   for (int model = 0; model < PM_MODEL_COUNT; model++) {
@@ -149,6 +188,8 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_neo_hookean_derivative),
       cmocka_unit_test(test_linear_derivative),
+      cmocka_unit_test(test_tangent),
+      cmocka_unit_test(test_von_mises),
       cmocka_unit_test(test_zero_at_rest),
       cmocka_unit_test(test_small_strain_limit),
       cmocka_unit_test(test_objectivity),

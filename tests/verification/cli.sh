@@ -6,22 +6,8 @@ set -u
 bin=$1
 src=$2
 scene=$src/cases/fpm/f2-unconstrained-compression.yaml
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-passes=0
-
-check() { # name, condition-command...
-  local name=$1
-  shift
-  if "$@"; then
-    passes=$((passes + 1))
-  else
-    failures=$((failures + 1))
-    echo "FAIL: $name"
-    [ -f "$work/err" ] && sed 's/^/    stderr: /' "$work/err" | head -5
-  fi
-}
+# shellcheck source=lib.sh
+. "$(dirname "$0")/lib.sh"
 
 # A bad scene: exit 1, message "FILE:LINE:COL: ... KEY ...", no output dir.
 bad_scene() { # name, sed expression, expected line, key word

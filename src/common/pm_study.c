@@ -1,0 +1,319 @@
+/* pm_study: ladders of runs, errors against an analytic field or a
+ * reference run (mapped by moving least squares), rates and wall times. */
+#include "pm_study.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_files.h"
+#include "pm_metrics.h"
+#include "pm_probe.h"
+
+#define VALUE_MAX 128
+
+typedef struct {
+  char key[VALUE_MAX];
+  int n;
+  char value[PM_STUDY_MAX_LEVELS][VALUE_MAX];
+} ladder_key;
+
+typedef struct {
+  pm_run_figures fig;
+  pm_err err;
+  double error; /* NRMSE against the reference; NaN when none */
+  double rate;  /* against the previous level; NaN when none */
+  char dir[PM_PATH_MAX + 1];
+} level;
+
+/* Split "key=v1,v2,..." into k. */
+static pm_err parse_ladder(const char *spec, ladder_key *k) {
+  const char *eq = strchr(spec, '=');
+  PM_CHECK(eq && eq > spec && (size_t)(eq - spec) < VALUE_MAX, PM_ERR_SCENE,
+           "--set-ladder %s: expected KEY=V1,V2,...", spec);
+  memcpy(k->key, spec, (size_t)(eq - spec));
+  k->key[eq - spec] = 0;
+  k->n = 0;
+  for (const char *p = eq + 1;;) {
+    const char *end = strchr(p, ',');
+    size_t len = end ? (size_t)(end - p) : strlen(p);
+    PM_CHECK(len > 0 && len < VALUE_MAX, PM_ERR_SCENE,
+             "--set-ladder %s: expected non-empty values of at most %d "
+             "characters separated by commas",
+             spec, VALUE_MAX - 1);
+    PM_CHECK(k->n < PM_STUDY_MAX_LEVELS, PM_ERR_SCENE,
+             "--set-ladder %s: at most %d values", spec, PM_STUDY_MAX_LEVELS);
+    memcpy(k->value[k->n], p, len);
+    k->value[k->n][len] = 0;
+    k->n++;
+    if (!end) break;
+    p = end + 1;
+  }
+  return PM_SUCCESS;
+}
+
+/* Load the scene of level lv (every --set, then the ladder values). */
+static pm_err load_level(const pm_study_options *o, const ladder_key *keys,
+                         int lv, pm_scene **s) {
+  const char *sets[64 + PM_STUDY_MAX_KEYS];
+  char buf[PM_STUDY_MAX_KEYS][2 * VALUE_MAX + 2];
+  int n = 0;
+  PM_CHECK(o->n_sets <= 64, PM_ERR_ARG, "at most 64 --set options");
+  for (int k = 0; k < o->n_sets; k++) sets[n++] = o->sets[k];
+  for (int k = 0; k < o->n_keys; k++) {
+    snprintf(buf[k], sizeof buf[k], "%s=%s", keys[k].key, keys[k].value[lv]);
+    sets[n++] = buf[k];
+  }
+  return pm_scene_load(o->scene, n, sets, s);
+}
+
+/* Error of run dir (points x, n) against the reference (rx, ru, rn). */
+static pm_err error_against(const char *dir, int dim, long rn, const double *rx,
+                            const double *ru, double *work, double *err) {
+  long n;
+  double *x = NULL, *u = NULL;
+  pm_err ret = PM_SUCCESS;
+  unsigned mask = dim == 2 ? 3u : 7u;
+  PM_TRY(pm_results_read(dir, -1, &n, &x, &u));
+  bool same = n == rn;
+  for (long i = 0; same && i < 3 * n; i++)
+    same = fabs(x[i] - rx[i]) <= 1e-12 * (1 + fabs(rx[i]));
+  if (same) {
+    *err = pm_nrmse_vector(rn, mask, u, ru);
+  } else {
+    PM_TRY(pm_probe_map(dir, -1, rn, rx, work));
+    *err = pm_nrmse_vector(rn, mask, work, ru);
+  }
+done:
+  free(x);
+  free(u);
+  return ret;
+}
+
+static void fmt_num(char *b, size_t size, double v) {
+  if (isfinite(v))
+    snprintf(b, size, "%.4g", v);
+  else
+    b[0] = 0;
+}
+
+static pm_err write_tables(const char *out_dir, const ladder_key *keys,
+                           int n_keys, const level *lv, int n_levels,
+                           const level *ref, const char *ref_label,
+                           double q_fit, FILE *out) {
+  pm_err ret = PM_SUCCESS;
+  pm_afile *csv = NULL, *md = NULL;
+  char path[PM_PATH_MAX + 1];
+  PM_TRY(pm_path_join(path, sizeof path, out_dir, "convergence.csv"));
+  PM_TRY(pm_afile_open(path, &csv));
+  PM_TRY(pm_path_join(path, sizeof path, out_dir, "convergence.md"));
+  PM_TRY(pm_afile_open(path, &md));
+  FILE *c = pm_afile_stream(csv), *m = pm_afile_stream(md);
+  fprintf(c, "level");
+  fprintf(m, "| level |");
+  for (int k = 0; k < n_keys; k++) {
+    fprintf(c, ",%s", keys[k].key);
+    fprintf(m, " %s |", keys[k].key);
+  }
+  fprintf(c, ",h,points,steps,status,error,rate,wall_seconds,setup_seconds,"
+             "mean_strain_energy_density,max_von_mises,reaction,min_jacobian,"
+             "energy_balance_error\n");
+  fprintf(m, " h (m) | points | steps | NRMSE | q | wall (s) | mean SED "
+             "(J/m^3) | max von Mises (Pa) | reaction (N) | min J | energy "
+             "error | status |\n|");
+  for (int k = 0; k < n_keys + 13; k++) fprintf(m, "---|");
+  fprintf(m, "\n");
+  int total = n_levels + (ref ? 1 : 0);
+  for (int r = 0; r < total; r++) {
+    const level *L = r < n_levels ? &lv[r] : ref;
+    const pm_run_figures *f = &L->fig;
+    char e[32], q[32], w[32], sed[32], vm[32], re[32], mj[32], ee[32];
+    fmt_num(e, sizeof e, L->error);
+    fmt_num(q, sizeof q, L->rate);
+    snprintf(w, sizeof w, "%.3f", f->wall);
+    fmt_num(sed, sizeof sed, f->mean_sed);
+    fmt_num(vm, sizeof vm, f->max_von_mises);
+    fmt_num(re, sizeof re, f->reaction);
+    fmt_num(mj, sizeof mj, f->min_jacobian);
+    fmt_num(ee, sizeof ee, f->energy_error);
+    const char *status = r < n_levels ? f->status : "reference";
+    if (r < n_levels) {
+      fprintf(c, "%d", r + 1);
+      fprintf(m, "| %d |", r + 1);
+    } else {
+      fprintf(c, "ref");
+      fprintf(m, "| ref |");
+    }
+    for (int k = 0; k < n_keys; k++) {
+      int idx = r < n_levels ? r : keys[k].n - 1;
+      fprintf(c, ",%s", keys[k].value[idx]);
+      fprintf(m, " %s |", keys[k].value[idx]);
+    }
+    fprintf(c, ",%.6g,%ld,%ld,%s,%s,%s,%s,%.4g,%s,%s,%s,%s,%s\n", f->h,
+            f->points, f->steps, status, e, q, w, f->setup, sed, vm, re, mj,
+            ee);
+    fprintf(
+        m, " %.4g | %ld | %ld | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n",
+        f->h, f->points, f->steps, e, q, w, sed, vm, re, mj, ee,
+        r < n_levels ? f->status : "reference");
+  }
+  fprintf(m,
+          "\nError: NRMSE (FPM paper eq. 28, root mean square) of the "
+          "displacement against %s.\n",
+          ref_label);
+  if (isfinite(q_fit))
+    fprintf(m,
+            "Observed rate (least-squares slope of log error against log "
+            "h over the levels): q = %.3f.\n",
+            q_fit);
+  PM_TRY(pm_afile_commit(csv));
+  csv = NULL;
+  PM_TRY(pm_afile_commit(md));
+  md = NULL;
+  if (out) {
+    PM_TRY(pm_path_join(path, sizeof path, out_dir, "convergence.md"));
+    FILE *in = fopen(path, "r");
+    if (in) {
+      char line[1024];
+      while (fgets(line, sizeof line, in)) fputs(line, out);
+      fclose(in);
+    }
+  }
+done:
+  if (csv) pm_afile_abort(csv);
+  if (md) pm_afile_abort(md);
+  return ret;
+}
+
+pm_err pm_study_run(const pm_study_options *o, pm_study_runner run, void *ctx,
+                    FILE *out) {
+  pm_err ret = PM_SUCCESS, first_fail = PM_SUCCESS;
+  ladder_key *keys = NULL;
+  level *lv = NULL, ref = {.err = PM_SUCCESS};
+  pm_scene *s = NULL;
+  double *rx = NULL, *ru = NULL, *work = NULL;
+  long rn = 0;
+  char out_dir[PM_PATH_MAX + 1], ref_label[PM_PATH_MAX + 64];
+  PM_ENSURE(o->n_keys >= 1, PM_ERR_SCENE,
+            "convergence needs at least one --set-ladder KEY=V1,V2,...");
+  PM_TRY(PM_ALLOC(keys, o->n_keys, "ladder"));
+  for (int k = 0; k < o->n_keys; k++) {
+    PM_TRY(parse_ladder(o->ladder[k], &keys[k]));
+    PM_ENSURE(keys[k].n == keys[0].n, PM_ERR_SCENE,
+              "--set-ladder %s has %d values but %s has %d: every ladder "
+              "needs the same number",
+              keys[k].key, keys[k].n, keys[0].key, keys[0].n);
+  }
+  int n_all = keys[0].n;
+  /* Validate every level's scene before running anything. */
+  bool analytic = false;
+  for (int l = 0; l < n_all; l++) {
+    PM_TRY(load_level(o, keys, l, &s));
+    if (l == 0) {
+      analytic = s->reference_mask != 0;
+      if (o->out_dir)
+        snprintf(out_dir, sizeof out_dir, "%s", o->out_dir);
+      else
+        snprintf(out_dir, sizeof out_dir, "out/%s-convergence", s->name);
+    }
+    pm_scene_destroy(s);
+    s = NULL;
+  }
+  const char *mode = o->reference ? o->reference
+                     : analytic   ? "analytic"
+                                  : "last";
+  bool use_analytic = strcmp(mode, "analytic") == 0;
+  bool use_last = strcmp(mode, "last") == 0;
+  PM_ENSURE(!use_analytic || analytic, PM_ERR_SCENE,
+            "%s: --reference analytic: the scene has no reference field",
+            o->scene);
+  int n_levels = use_last ? n_all - 1 : n_all;
+  PM_ENSURE(n_levels >= 1, PM_ERR_SCENE,
+            "--reference last needs at least two ladder values (the last "
+            "one is the reference run)");
+  PM_TRY(pm_mkdir_p(out_dir));
+  PM_TRY(PM_ALLOC(lv, n_levels, "ladder levels"));
+
+  /* The reference run comes first so each level's error is known at once. */
+  if (use_last) {
+    PM_TRY(pm_path_join(ref.dir, sizeof ref.dir, out_dir, "reference"));
+    PM_TRY(load_level(o, keys, n_all - 1, &s));
+    if (out) fprintf(out, "reference run -> %s\n", ref.dir);
+    ref.err = run(ctx, s, ref.dir, o->quiet, &ref.fig);
+    ref.error = ref.rate = NAN;
+    pm_scene_destroy(s);
+    s = NULL;
+    if (ref.err != PM_SUCCESS) {
+      char why[1024];
+      snprintf(why, sizeof why, "%s", pm_error_message());
+      PM_FAIL(ref.err, "the reference run (%s) failed: %s", ref.dir, why);
+    }
+    snprintf(ref_label, sizeof ref_label, "the reference run %s", ref.dir);
+  } else if (!use_analytic) {
+    snprintf(ref.dir, sizeof ref.dir, "%s", mode);
+    snprintf(ref_label, sizeof ref_label, "the reference run %s", mode);
+  } else {
+    snprintf(ref_label, sizeof ref_label, "the scene's analytic field");
+  }
+  if (!use_analytic) {
+    PM_TRY(pm_results_read(ref.dir, -1, &rn, &rx, &ru));
+    PM_TRY(PM_ALLOC(work, 3 * rn, "mapped displacement"));
+  }
+  for (int l = 0; l < n_levels; l++) {
+    level *L = &lv[l];
+    char name[32];
+    snprintf(name, sizeof name, "level-%d", l + 1);
+    PM_TRY(pm_path_join(L->dir, sizeof L->dir, out_dir, name));
+    PM_TRY(load_level(o, keys, l, &s));
+    if (out) {
+      fprintf(out, "level %d/%d:", l + 1, n_levels);
+      for (int k = 0; k < o->n_keys; k++)
+        fprintf(out, " %s=%s", keys[k].key, keys[k].value[l]);
+      fprintf(out, " -> %s\n", L->dir);
+    }
+    L->err = run(ctx, s, L->dir, o->quiet, &L->fig);
+    pm_scene_destroy(s);
+    s = NULL;
+    L->error = L->rate = NAN;
+    if (L->err != PM_SUCCESS) {
+      if (out) fprintf(out, "  %s\n", pm_error_message());
+      if (first_fail == PM_SUCCESS) first_fail = L->err;
+      continue;
+    }
+    if (use_analytic)
+      L->error = L->fig.nrmse;
+    else
+      PM_TRY(error_against(L->dir, L->fig.dim, rn, rx, ru, work, &L->error));
+  }
+  /* Rates: in h for a resolution ladder, else in the first key's value. */
+  bool by_h = false;
+  for (int l = 1; l < n_levels; l++)
+    if (fabs(lv[l].fig.h - lv[0].fig.h) > 1e-9 * lv[0].fig.h) by_h = true;
+  double xs[PM_STUDY_MAX_LEVELS], es[PM_STUDY_MAX_LEVELS];
+  for (int l = 0; l < n_levels; l++) {
+    xs[l] = by_h ? lv[l].fig.h : strtod(keys[0].value[l], NULL);
+    es[l] = lv[l].error;
+    if (l > 0 && xs[l] > 0 && xs[l - 1] > 0 && es[l] > 0 && es[l - 1] > 0 &&
+        xs[l] != xs[l - 1])
+      lv[l].rate = log(es[l] / es[l - 1]) / log(xs[l] / xs[l - 1]);
+  }
+  double q_fit = n_levels >= 2 ? pm_convergence_rate(n_levels, xs, es) : NAN;
+  PM_TRY(write_tables(out_dir, keys, o->n_keys, lv, n_levels,
+                      use_last ? &ref : NULL, ref_label, by_h ? q_fit : NAN,
+                      out));
+  if (out && !by_h && isfinite(q_fit))
+    fprintf(out, "slope of log error against log %s: %.3f\n", keys[0].key,
+            q_fit);
+  if (out) fprintf(out, "tables in %s/convergence.{md,csv}\n", out_dir);
+  if (first_fail != PM_SUCCESS)
+    ret = PM_ERROR(first_fail, "%s: some levels failed (see the table)",
+                   o->scene);
+done:
+  pm_scene_destroy(s);
+  free(keys);
+  free(lv);
+  free(rx);
+  free(ru);
+  free(work);
+  return ret;
+}

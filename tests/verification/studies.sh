@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# The block studies of the FPM paper through `pointmech convergence`, with
+# figures printed beside wall times:
+#  - F1 penalty study (2D, 157 points): p = 0 is inconsistent, p >= 20 close
+#    to p = 100 (paper's upper figures: extension 1.54e-2, compression
+#    7.01e-2);
+#  - observed rates of F3 60% extension and F4 20% compression on coarse
+#    ladders against a finer run: q >= 1.6 (paper 2.02 and 1.91);
+#  - F3 200% and F4 60% at the coarsest paper resolution: converged, J > 0
+#    throughout, energy balance within 1% of the external work.
+# The rate and extreme checks use the symmetric flux (fpm.flux: sipg,
+# p = 100), the one whose force derives from an energy.
+set -u
+bin=$1
+src=$2
+VERBOSE_CHECKS=1
+# shellcheck source=lib.sh
+. "$(dirname "$0")/lib.sh"
+le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 <= b + 0) }'; }
+ge() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 >= b + 0) }'; }
+# column NAME of the row whose first field is LEVEL in a convergence.csv
+col() { # csv, level, name
+  awk -F, -v lv="$2" -v name="$3" '
+    NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i; next }
+    $1 == lv { print $c }' "$1"
+}
+json() { # file, key: a number from summary.json
+  sed -n "s/^ *\"$2\": \\([-+0-9.eE]*\\),\\{0,1\\}\$/\\1/p" "$1" | head -1
+}
+rate() { sed -n 's/.*q = \([-0-9.]*\)\..*/\1/p' "$1"; }
+
+# ---- F1 penalty study ------------------------------------------------------
+for kind in extension compression-guided; do
+  out=$work/f1-$kind
+  "$bin" convergence "$src/cases/fpm/f1-$kind.yaml" --quiet \
+    --set-ladder fpm.penalty=0,10,20,50,100 --out "$out" >"$out.log" 2>&1
+  check "F1 $kind: the ladder ran (exit $?)" test -f "$out/convergence.csv"
+  sed -n '/^|/p' "$out.log"
+  e0=$(col "$out/convergence.csv" 1 error)
+  e20=$(col "$out/convergence.csv" 3 error)
+  e50=$(col "$out/convergence.csv" 4 error)
+  check "F1 $kind: p = 0 ($e0) is at least twice p = 20 ($e20)" \
+    ge "$e0" "$(awk -v x="$e20" 'BEGIN { print 2 * x }')"
+  if [ "$kind" = extension ]; then bound=1.54e-2; else bound=7.01e-2; fi
+  check "F1 $kind: p = 50 NRMSE $e50 <= $bound" le "$e50" "$bound"
+  if [ "$kind" != extension ]; then
+    check "F1 $kind: p = 20 NRMSE $e20 <= $bound" le "$e20" "$bound"
+  fi
+done
+
+# ---- rates on coarse ladders -----------------------------------------------
+ladder=discretization.mesh_size=0.025,0.02,0.016,0.0125,0.00872
+common="--set fpm.flux=sipg --set fpm.penalty=100 --set time.dt_rule=spectral
+  --set time.dt_safety=0.5 --set output.every=100000"
+for c in f3-extension-60 f4-compression-20; do
+  out=$work/$c
+  # shellcheck disable=SC2086
+  "$bin" convergence "$src/cases/fpm/$c-h1.09e-2.yaml" --quiet $common \
+    --set-ladder "$ladder" --out "$out" >"$out.log" 2>&1
+  check "$c: the ladder ran (exit $?)" test -f "$out/convergence.md"
+  sed -n '/^|/p' "$out.log"
+  q=$(rate "$out/convergence.md")
+  check "$c: observed rate q = $q >= 1.6" ge "$q" 1.6
+done
+
+# ---- extreme deformation ---------------------------------------------------
+for c in f3-extension-200 f4-compression-60; do
+  out=$work/x-$c
+  # shellcheck disable=SC2086
+  "$bin" run "$src/cases/fpm/$c-h1.09e-2.yaml" --quiet $common \
+    --out "$out" >"$out.log" 2>&1
+  rc=$?
+  s=$out/summary.json
+  check "$c: converged (exit $rc)" grep -q '"status": "converged"' "$s"
+  jmin=$(json "$s" run_min_jacobian)
+  ee=$(json "$s" energy_balance_error)
+  echo "  $c: steps $(json "$s" steps), wall $(json "$s" wall_seconds) s," \
+    "min J $jmin, energy error $ee, max von Mises $(json "$s" max_von_mises) Pa"
+  check "$c: J > 0 at every point and step (min $jmin)" ge "$jmin" 1e-6
+  ae=$(awk -v x="$ee" 'BEGIN { print (x < 0 ? -x : x) }')
+  check "$c: energy balance error |$ee| < 1%" le "$ae" 0.01
+  check "$c: no NaN in the summary" sh -c "! grep -qi nan '$s'"
+done
+
+echo "studies: $passes passed, $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,141 @@
+#!/usr/bin/python3
+"""Plot a convergence table written by `pointmech convergence`.
+
+Reads CSV (columns: level, one column per ladder key such as
+discretization.mesh_size, then h, points, steps, status, error, rate,
+wall_seconds, ...) and writes two PNGs:
+
+  PREFIX-error-h.png     log-log error against h, with a least-squares line
+                         and its slope q.  When every level has the same h
+                         (a parameter ladder), error is plotted against the
+                         first ladder key instead (linear x axis if a value
+                         is <= 0; the fit is then log10(error) against x).
+  PREFIX-error-time.png  log-log error against wall_seconds (accuracy/cost
+                         front), each point labelled with its level.
+
+The reference row (status "reference") and rows without a positive error
+are left out.  PREFIX defaults to the CSV path without ".csv".
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+FIXED = ("level h points steps status error rate wall_seconds setup_seconds "
+         "mean_strain_energy_density max_von_mises reaction min_jacobian "
+         "energy_balance_error").split()
+REQUIRED = ("level", "h", "status", "error", "wall_seconds")
+
+
+def fail(msg):
+    sys.exit(f"plot-convergence: {msg}")
+
+
+def num(text):
+    """Float value of a cell; nan for an empty, "nan" or non-numeric cell."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def read_table(path):
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+            header = rows[0].keys() if rows else None
+    except OSError as e:
+        fail(f"{path}: cannot read: {e.strerror}")
+    except csv.Error as e:
+        fail(f"{path}: malformed CSV: {e}")
+    if not header:
+        fail(f"{path}: no data rows")
+    missing = [c for c in REQUIRED if c not in header]
+    if missing:
+        fail(f"{path}: missing column(s): {', '.join(missing)}")
+    keys = [c for c in header if c and "." in c and c not in FIXED]
+    rows = [r for r in rows if (r["status"] or "").strip() != "reference"]
+    rows = [r for r in rows if num(r["error"]) > 0]
+    if not rows:
+        fail(f"{path}: no level with a positive error to plot")
+    return keys, rows
+
+
+def plot_error_h(rows, keys, title, out):
+    err = np.array([num(r["error"]) for r in rows])
+    h = np.array([num(r["h"]) for r in rows])
+    xlabel, x = "h (m)", h
+    if keys and np.nanmax(h) == np.nanmin(h):  # parameter ladder
+        xlabel, x = keys[0], np.array([num(r[keys[0]]) for r in rows])
+    ok = np.isfinite(x)
+    if not ok.any():
+        fail(f"column {xlabel!r} has no numeric value to plot against")
+    x, err = x[ok], err[ok]
+    logx = bool((x > 0).all())
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(x, err, "o", label="levels")
+    if len(np.unique(x)) >= 2:
+        fx = np.log10(x) if logx else x
+        q, c = np.polyfit(fx, np.log10(err), 1)
+        xs = np.linspace(fx.min(), fx.max(), 50)
+        ax.plot(10 ** xs if logx else xs, 10 ** (c + q * xs), "--",
+                label=f"fit q = {q:.2f}")
+    ax.set_xscale("log" if logx else "linear")
+    ax.set_yscale("log")
+    ax.set(xlabel=xlabel, ylabel="error (NRMSE)", title=title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
+def plot_error_time(rows, title, out):
+    pts = [(num(r["wall_seconds"]), num(r["error"]), r["level"]) for r in rows]
+    dropped = [p[2] for p in pts if not p[0] > 0]
+    if dropped:
+        print(f"plot-convergence: level(s) {', '.join(dropped)} left out of "
+              f"{out}: wall_seconds not positive", file=sys.stderr)
+    pts = [p for p in pts if p[0] > 0]
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    if pts:
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-")
+        for w, e, lv in pts:
+            ax.annotate(lv, (w, e), textcoords="offset points", xytext=(5, 5))
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    ax.set(xlabel="wall time (s)", ylabel="error (NRMSE)", title=title)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("csv", metavar="CSV", help="convergence.csv to plot")
+    ap.add_argument("--out-prefix", metavar="PREFIX",
+                    help="output prefix (default: CSV path without .csv)")
+    a = ap.parse_args()
+    keys, rows = read_table(a.csv)
+    prefix = a.out_prefix or (a.csv[:-4] if a.csv.endswith(".csv") else a.csv)
+    title = os.path.basename(os.path.dirname(os.path.abspath(a.csv)))
+    outs = (f"{prefix}-error-h.png", f"{prefix}-error-time.png")
+    try:
+        plot_error_h(rows, keys, title, outs[0])
+        plot_error_time(rows, title, outs[1])
+    except OSError as e:
+        fail(f"{e.filename or prefix}: cannot write: {e.strerror or e}")
+    for o in outs:
+        print(o)
+
+
+if __name__ == "__main__":
+    main()
