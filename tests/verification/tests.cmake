@@ -1,5 +1,8 @@
 # Verification tests: whole runs against analytic solutions, and the
 # command line's handling of bad input and numerical failure.
+# Each verification test runs its own OpenMP threads on every core, so
+# ctest gives it the machine (PROCESSORS 2): oversubscribed OpenMP threads
+# spin against each other and run several times slower.
 set(PM_VERIFY_DIR ${CMAKE_CURRENT_LIST_DIR})
 file(GLOB PM_VERIFY_TESTS CONFIGURE_DEPENDS ${PM_VERIFY_DIR}/verify_*.c)
 foreach(src ${PM_VERIFY_TESTS})
@@ -8,13 +11,13 @@ foreach(src ${PM_VERIFY_TESTS})
   target_link_libraries(${name} PRIVATE pm_fpm pm_geometry pm_common PkgConfig::CMOCKA)
   target_compile_definitions(${name} PRIVATE PM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   add_test(NAME verification.${name} COMMAND ${name})
-  set_tests_properties(verification.${name} PROPERTIES LABELS verification TIMEOUT 900)
+  set_tests_properties(verification.${name} PROPERTIES LABELS verification TIMEOUT 900 PROCESSORS 2)
 endforeach()
 
 add_test(NAME verification.cli
   COMMAND bash ${PM_VERIFY_DIR}/cli.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
-set_tests_properties(verification.cli PROPERTIES LABELS verification TIMEOUT 600)
+set_tests_properties(verification.cli PROPERTIES LABELS verification TIMEOUT 600 PROCESSORS 2)
 
 add_test(NAME verification.studies
   COMMAND bash ${PM_VERIFY_DIR}/studies.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
-set_tests_properties(verification.studies PROPERTIES LABELS verification TIMEOUT 900)
+set_tests_properties(verification.studies PROPERTIES LABELS verification TIMEOUT 900 PROCESSORS 2)
