@@ -5,18 +5,26 @@
 # with which the quasi-static run stays stable (no inverted subdomain, no
 # energy created beyond stability.max_energy_error) and prints its ratio
 # to the bound and to the measured spectral step.
-#   scripts/bench-dt.sh [BUILD_DIR]      FLUX=iipg|sipg  PENALTY=p
+# QS=none runs plain dynamics (no damping) to END seconds (default 2)
+# instead of dynamic relaxation; only the symmetric flux conserves energy
+# there.
+#   scripts/bench-dt.sh [BUILD_DIR]   FLUX=iipg|sipg  PENALTY=p  QS=...  END=s
 bench_name=dt
 # shellcheck source=bench-lib.sh
 . "$(dirname "$0")/bench-lib.sh"
 num() { sed -n "s/.*$1 *\([0-9.eE+-]*\) s.*/\1/p" | head -1; }
-echo "largest stable step, flux $flux, penalty $penalty"
+echo "largest stable step, flux $flux, penalty $penalty, ${QS:-dynamic-relaxation}"
 printf '%-22s %11s %11s %11s %9s %9s %7s\n' case dt_paper dt_spectral \
   dt_max "/paper" "/spectral" trials
 for c in f2-unconstrained-compression f3-extension-60-h1.09e-2; do
   scene=cases/fpm/$c.yaml
   sets=(--set fpm.flux="$flux" --set fpm.penalty="$penalty"
-    --set output.every=1000000 --set time.end=10)
+    --set output.every=1000000)
+  if [ "${QS:-dynamic-relaxation}" = none ]; then
+    sets+=(--set time.quasi_static.method=none --set time.end="${END:-2}")
+  else
+    sets+=(--set time.end="${END:-10}")
+  fi
   plan=$("$bin" plan "$scene" "${sets[@]}")
   paper=$(echo "$plan" | num "bound of eqs. 24-26:")
   spectral=$(echo "$plan" | num "spectral (power iteration):")

@@ -237,7 +237,8 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
     sim->run_min_jacobian = info->min_jacobian;
     sim->run_min_jacobian_step = info->step;
   }
-  if (info->step >= 100 && info->energy_error > sim->run_max_energy_error)
+  if (info->step >= 100 && info->t >= 0.1 * c->load_end &&
+      info->energy_error > sim->run_max_energy_error)
     sim->run_max_energy_error = info->energy_error;
   if (c->show_progress) {
     double frac = info->t / sim->scene->time.end;

@@ -311,6 +311,8 @@ pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
   PM_TRY(PM_ALLOC(st->J, n, "volume ratio"));
   PM_TRY(PM_ALLOC(st->tf_value, 3 * m->n_tfacets, "tractions"));
   PM_TRY(PM_ALLOC(st->bflux, 3 * m->n_dpts, "boundary flux"));
+  PM_TRY(
+      PM_ALLOC(st->support_prev, m->n_cdofs + 3 * m->n_dpts, "support forces"));
   *out = st;
   st = NULL;
 done:
@@ -331,12 +333,14 @@ void fpm_state_destroy(fpm_state *st) {
   free(st->J);
   free(st->tf_value);
   free(st->bflux);
+  free(st->support_prev);
   free(st);
 }
 
 size_t fpm_state_bytes(const fpm_model *m) {
   return (size_t)m->n * (3 * 4 + 9 * 3 + 2) * sizeof(double) +
-         (size_t)(m->n_tfacets + m->n_dpts) * 3 * sizeof(double);
+         (size_t)(m->n_tfacets + 2 * m->n_dpts) * 3 * sizeof(double) +
+         (size_t)m->n_cdofs * sizeof(double);
 }
 
 double fpm_prescribed(const fpm_model *m, long k, double t) {

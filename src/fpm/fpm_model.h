@@ -88,8 +88,10 @@ typedef struct {
   double bflux_norm;     /* |consistency flux on prescribed faces| */
   double penalty_energy; /* interface energy, J: 1/2 sum_e beta |e| [[u]]^2,
                             and with SIPG also - sum_e {P} : K_e */
-  double *bflux; /* 3 n_dpts: that flux per point: the supports' force on
-                    the body, with f on the prescribed dofs */
+  double *bflux;        /* 3 n_dpts: that flux per point: the supports' force on
+                           the body, with f on the prescribed dofs */
+  double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous
+                           step (trapezoidal work of the supports) */
 } fpm_state;
 
 /* Build the model of scene s on dual d (both borrowed and kept alive by the

@@ -53,6 +53,46 @@ check "unstable: diagnosis" grep -Eq "step [0-9]+, t = .*point [0-9]+ at \(" "$w
 check "unstable: summary says so" grep -q '"status": "unstable"' "$work/out-unstable/summary.json"
 check "unstable: results kept" test -f "$work/out-unstable/results.h5"
 
+# The stability bounds: J falling to stability.min_jacobian, and energy
+# created by the non-symmetric flux in undamped dynamics, each stop the run
+# with the step, time and cause.
+coarse_run() { # out-name, --set ...: a coarse F2 run; sets rc
+  local name=$1
+  shift
+  "$bin" run "$scene" --set discretization.mesh_size=0.02 "$@" \
+    --out "$work/$name" --quiet >/dev/null 2>"$work/err"
+  rc=$?
+}
+undamped=(--set time.quasi_static.method=none --set time.end=2)
+coarse_run out-jmin --set stability.min_jacobian=0.999
+check "min J bound: exit 2 (got $rc)" test $rc -eq 2
+check "min J bound: diagnosis" grep -Eq \
+  "step [0-9]+, t = .*point [0-9]+ at \(.*J <= stability.min_jacobian = 0.999" \
+  "$work/err"
+coarse_run out-energy "${undamped[@]}" --set fpm.flux=iipg
+check "energy bound: exit 2 (got $rc)" test $rc -eq 2
+check "energy bound: diagnosis" grep -Eq \
+  "step [0-9]+, t = .*energy balance error .* exceeds stability.max_energy_error" \
+  "$work/err"
+# The same undamped run with the symmetric flux keeps its energy.
+coarse_run out-sipg "${undamped[@]}" --set fpm.flux=sipg \
+  --set fpm.penalty=100 --set stability.max_energy_error=0.01
+check "symmetric flux, undamped: exit 0, energy within 1% (got $rc)" \
+  test $rc -eq 0
+"$bin" run "$scene" --set stability.min_jacobian=1.5 --out "$work/out-bad-j" \
+  --quiet >/dev/null 2>"$work/err"
+rc=$?
+check "bad stability.min_jacobian: exit 1 (got $rc)" test $rc -eq 1
+check "bad stability.min_jacobian: names the key" \
+  grep -q "stability.min_jacobian.*\[0, 1)" "$work/err"
+"$bin" convergence "$scene" --set-ladder discretization.mesh_size=0.02,0.015 \
+  --set-ladder fpm.penalty=20 --out "$work/out-bad-ladder" >/dev/null \
+  2>"$work/err"
+rc=$?
+check "unequal ladders: exit 1 (got $rc)" test $rc -eq 1
+check "unequal ladders: message" grep -q "same number" "$work/err"
+check "unequal ladders: nothing written" test ! -e "$work/out-bad-ladder"
+
 "$bin" plan "$scene" >"$work/plan" 2>"$work/err"
 rc=$?
 check "plan: exit 0 (got $rc)" test $rc -eq 0
