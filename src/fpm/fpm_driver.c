@@ -588,8 +588,11 @@ pm_err fpm_sim_plan(fpm_sim *sim, FILE *out) {
   for (int k = 0; k < m->n_mats; k++)
     fprintf(out, "%s%s", k ? ", " : "", pm_model_name(m->mats[k].model));
   fprintf(out,
-          ")\n             2. interface flux (IIPG, penalty %g), %ld "
+          ")\n             2. interface flux (%s, penalty %g), %ld "
           "support entries\n",
+          m->flux == PM_FLUX_SIPG ? "SIPG: with the adjoint term, tangent "
+                                    "per point"
+                                  : "IIPG",
           m->penalty, m->nnz);
   int stage = 3;
   if (m->n_dpts > 0)
