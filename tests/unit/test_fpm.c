@@ -153,9 +153,10 @@ static void test_homogeneous_p20(void **state) {
  * free dof, boundary points included. */
 static void test_patch_f2(void **state) {
   (void)state;
-  for (int k = 0; k < 2; k++) {
-    double penalty = k == 0 ? 0 : 20;
+  for (int k = 0; k < 3; k++) {
+    double penalty = k == 0 ? 0 : k == 1 ? 20 : 100;
     fixture *fx = fixture_new(3, 0.02, penalty, true);
+    if (k == 2) fx->scene.fpm.flux = PM_FLUX_SIPG;
     fpm_model *m;
     fpm_state *st;
     assert_int_equal(fpm_model_create(&fx->scene, fx->dual, &m), PM_SUCCESS);
@@ -187,6 +188,84 @@ static void test_patch_f2(void **state) {
     fpm_model_destroy(m);
     fixture_free(fx);
   }
+}
+
+/* Stored energy: strain energy plus the interface energy. */
+static double stored_energy(const fpm_model *m, fpm_state *st) {
+  assert_int_equal(fpm_force(m, st), -1);
+  double e = st->penalty_energy;
+  for (long i = 0; i < m->n; i++) e += m->dual->volume[i] * st->W[i];
+  return e;
+}
+
+/* With the symmetric flux the force is the gradient of the stored energy
+ * sum V W - sum_e {P} : K_e + 1/2 sum_e beta |e| [[u]]^2: its derivative
+ * along a random direction, by central differences, equals f . d (relative
+ * 1e-6).  The incomplete flux is not a gradient: its mismatch is printed. */
+static void test_sipg_is_gradient(void **state) {
+  (void)state;
+  for (int k = 0; k < 2; k++) {
+    fixture *fx = fixture_new(3, 0.03, 100, false);
+    fx->scene.fpm.flux = k == 0 ? PM_FLUX_SIPG : PM_FLUX_IIPG;
+    fpm_model *m;
+    fpm_state *st;
+    assert_int_equal(fpm_model_create(&fx->scene, fx->dual, &m), PM_SUCCESS);
+    assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+    long nd = 3 * m->n;
+    double *u0 = calloc(nd, sizeof *u0), *d = calloc(nd, sizeof *d);
+    unsigned long long seed = 12345;
+    for (long i = 0; i < nd; i++) {
+      seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+      double r = (double)(seed >> 11) / 9007199254740992.0 - 0.5;
+      const double *x = m->x + 3 * (i / 3);
+      /* a smooth finite deformation plus a rough perturbation */
+      u0[i] = 0.1 * x[(i + 1) % 3] * x[i % 3] / 0.1 + 2e-4 * r;
+      d[i] = r;
+    }
+    memcpy(st->u, u0, nd * sizeof *u0);
+    stored_energy(m, st);
+    double fd = 0;
+    for (long i = 0; i < nd; i++) fd += st->f[i] * d[i];
+    double eps = 1e-7, ep, em;
+    for (long i = 0; i < nd; i++) st->u[i] = u0[i] + eps * d[i];
+    ep = stored_energy(m, st);
+    for (long i = 0; i < nd; i++) st->u[i] = u0[i] - eps * d[i];
+    em = stored_energy(m, st);
+    double dE = (ep - em) / (2 * eps);
+    double rel = fabs(dE - fd) / fabs(fd);
+    print_message("%s: dE/de = %.10g, f . d = %.10g, relative mismatch %.3g\n",
+                  k == 0 ? "SIPG" : "IIPG", dE, fd, rel);
+    if (k == 0) assert_true(rel <= 1e-6);
+    free(u0);
+    free(d);
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+}
+
+/* Supports in the deformed configuration: none is ill-conditioned at rest;
+ * a flattening to 1e-6 of the height makes every support so. */
+static void test_deformed_condition(void **state) {
+  (void)state;
+  fixture *fx = fixture_new(3, 0.04, 20, false);
+  fpm_model *m;
+  assert_int_equal(fpm_model_create(&fx->scene, fx->dual, &m), PM_SUCCESS);
+  double *u = calloc(3 * m->n, sizeof *u), worst;
+  long wp;
+  assert_int_equal(fpm_gfd_deformed_condition(m->dim, m->n, m->x, u, m->nbr_ptr,
+                                              fx->dual->nbr, FPM_COND_MAX,
+                                              &worst, &wp),
+                   0);
+  assert_true(worst < 1e3 && wp >= 0);
+  for (long i = 0; i < m->n; i++) u[3 * i + 2] = (1e-6 - 1) * m->x[3 * i + 2];
+  assert_int_equal(fpm_gfd_deformed_condition(m->dim, m->n, m->x, u, m->nbr_ptr,
+                                              fx->dual->nbr, FPM_COND_MAX,
+                                              &worst, &wp),
+                   m->n);
+  free(u);
+  fpm_model_destroy(m);
+  fixture_free(fx);
 }
 
 /* A support that does not span 3D (all neighbours in one plane) is
@@ -223,6 +302,8 @@ int main(void) {
       cmocka_unit_test(test_homogeneous_p0),
       cmocka_unit_test(test_homogeneous_p20),
       cmocka_unit_test(test_patch_f2),
+      cmocka_unit_test(test_sipg_is_gradient),
+      cmocka_unit_test(test_deformed_condition),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
