@@ -313,8 +313,8 @@ static int face_shared(long c, const long *fn, int nf, const gm_mesh *m,
 /* Box face holding every node of a boundary face, or PM_FACE_NONE. */
 static int face_tag(const gm_mesh *m, const long *fn, int nf, double tol) {
   for (int f = 0; f < 2 * m->dim; f++) {
-    int axis = f / 2;
-    double plane = (f % 2) ? m->box_max[axis] : m->box_min[axis];
+    int axis = pm_face_axis(f);
+    double plane = pm_face_plane(f, m->box_min, m->box_max);
     int on = 1;
     for (int a = 0; a < nf && on; a++)
       on = fabs(m->x[3 * fn[a] + axis] - plane) <= tol;

@@ -182,8 +182,7 @@ static void loaded_face(const pm_scene *s, int *bc, int *comp) {
     const pm_scene_bc *B = &s->bcs[b];
     double c[3];
     for (int a = 0; a < 3; a++) c[a] = 0.5 * (s->box_min[a] + s->box_max[a]);
-    int axis = (int)B->face / 2;
-    c[axis] = (int)B->face % 2 ? s->box_max[axis] : s->box_min[axis];
+    c[pm_face_axis(B->face)] = pm_face_plane(B->face, s->box_min, s->box_max);
     for (int k = 0; k < 3; k++) {
       if (!(B->disp_mask & (1u << k))) continue;
       double v = fabs(pm_expr_eval(B->disp[k], c[0], c[1], c[2], s->time.end));
@@ -218,7 +217,7 @@ static pm_err run_fpm_level(void *ctx, const pm_scene *s, const char *out,
   fig->mean_sed = ff.mean_strain_energy_density;
   fig->max_von_mises = ff.max_von_mises;
   fig->min_jacobian = sim->run_min_jacobian;
-  fig->energy_error = fpm_sim_energy_error(sim);
+  fig->energy_error = fpm_energy_error(&sim->last);
   int bc, comp;
   loaded_face(s, &bc, &comp);
   fig->reaction = NAN;

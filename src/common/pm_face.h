@@ -21,4 +21,12 @@ static inline const char *pm_face_name(int face) {
   return (face >= 0 && face < PM_FACE_COUNT) ? names[face] : "none";
 }
 
+/* The axis a face is normal to (0, 1, 2) and the coordinate of its plane
+ * for the box [lo, hi]. */
+static inline int pm_face_axis(int face) { return face / 2; }
+static inline double pm_face_plane(int face, const double lo[3],
+                                   const double hi[3]) {
+  return (face % 2) ? hi[face / 2] : lo[face / 2];
+}
+
 #endif

@@ -237,9 +237,9 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
     sim->run_min_jacobian = info->min_jacobian;
     sim->run_min_jacobian_step = info->step;
   }
-  if (info->step >= 100 && info->t >= 0.1 * c->load_end &&
-      info->energy_error > sim->run_max_energy_error)
-    sim->run_max_energy_error = info->energy_error;
+  if (info->energy_checked &&
+      fabs(info->energy_error) > sim->run_max_energy_error)
+    sim->run_max_energy_error = fabs(info->energy_error);
   if (c->show_progress) {
     double frac = info->t / sim->scene->time.end;
     if (sim->scene->time.qs != PM_QS_NONE && info->t >= c->load_end &&
@@ -288,13 +288,6 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
   }
   pm_timers_stop(&sim->timers, sim->tm_output);
   return ret;
-}
-
-double fpm_sim_energy_error(const fpm_sim *sim) {
-  const fpm_step_info *l = &sim->last;
-  double balance =
-      l->kinetic + l->strain + l->penalty + l->dissipated - l->external_work;
-  return l->external_work != 0 ? balance / fabs(l->external_work) : balance;
 }
 
 long fpm_sim_conditioning(const fpm_sim *sim, double *worst,
@@ -407,7 +400,8 @@ static pm_err write_summary(fpm_sim *sim, const char *out_dir) {
   PM_TRY(pm_json_number(j, "external_work", sim->last.external_work));
   PM_TRY(pm_json_number(j, "dissipated", sim->last.dissipated));
   PM_TRY(pm_json_number(j, "penalty_energy", sim->last.penalty));
-  PM_TRY(pm_json_number(j, "energy_balance_error", fpm_sim_energy_error(sim)));
+  PM_TRY(
+      pm_json_number(j, "energy_balance_error", fpm_energy_error(&sim->last)));
   PM_TRY(write_field_figures(sim, j));
   PM_TRY(pm_json_number(j, "wall_seconds", sim->wall));
   PM_TRY(pm_json_number(j, "setup_seconds", sim->setup_wall));

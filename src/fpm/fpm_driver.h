@@ -51,7 +51,8 @@ typedef struct {
   char message[1024];      /* failure message, if any */
   double run_min_jacobian; /* smallest J seen at any step of the run */
   long run_min_jacobian_step;
-  double run_max_energy_error; /* largest energy-balance error of the run */
+  double run_max_energy_error; /* largest |energy-balance error| over the
+                                  steps where it is checked */
 } fpm_sim;
 
 /* Figures of the current fields. */
@@ -88,10 +89,6 @@ pm_err fpm_sim_plan(fpm_sim *sim, FILE *out);
 void fpm_sim_measure_spectrum(fpm_sim *sim);
 
 const char *fpm_status_name(fpm_status s);
-
-/* (kinetic + strain + interface + dissipated - external work) / |external
- * work| at the last step. */
-double fpm_sim_energy_error(const fpm_sim *sim);
 
 /* Field figures of the current state (uses sim->scratch). */
 void fpm_sim_field_figures(fpm_sim *sim, fpm_field_figures *ff);

@@ -58,13 +58,13 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
 /* Pass 2: per point i, over its interfaces e with outward area vector a,
  * d_i = x_e - X_i, d_k = x_e - X_k:
  *   [[u]] = u_i + H_i d_i - u_k - H_k d_k,  b = beta |e| [[u]],
- *   r_i = sum_e (b - P_e a),  (penalty energy 1/2 sum_e beta |e| [[u]]^2)  Q_i
- * = sum_e (P_e (M_e - a (x) X_i) - b (x) d_i) with P_e = (P_i + P_k) / 2, and
- * T_i = V_i P_i - Q_i.  With the moment about the centroid, M_e - a (x) X_i =
- * Mc + a (x) d_i, the neighbour's half is  1/2 P_k Mc + w (x) d_i  with  w =
- * 1/2 P_k a - b;  the P_i half uses the precomputed sums of a and M_e - a (x)
- * X_i.  Entry records stream in order; only the neighbours' u, H, P are
- * gathered. */
+ *   r_i = sum_e (b - P_e a),  Q_i = sum_e (P_e (M_e - a (x) X_i) - b (x) d_i)
+ * with P_e = (P_i + P_k) / 2, and T_i = V_i P_i - Q_i.  With the moment
+ * about the centroid, M_e - a (x) X_i = Mc + a (x) d_i, the neighbour's half
+ * is  1/2 P_k Mc + w (x) d_i  with  w = 1/2 P_k a - b;  the P_i half uses
+ * the precomputed sums of a and M_e - a (x) X_i.  Entry records stream in
+ * order; only the neighbours' u, H, P are gathered.  Also the interface
+ * energy 1/2 sum_e beta |e| [[u]]^2 (and, for SIPG, - sum_e {P} : K_e). */
 static void flux_pass(const fpm_model *m, fpm_state *st) {
   const long n = m->n;
   const long *restrict ptr = m->nbr_ptr;

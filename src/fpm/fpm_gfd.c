@@ -7,6 +7,31 @@
 
 #include "pm_omp.h"
 
+/* The scaled moment matrix of point i's support (dim x dim, row-major,
+ * eigenvalues summing to 1): sum_k w_ik d_k d_k^T / sum_k w_ik with
+ * w_ik = 1/|X_k - X_i|^2 and d_k = X_k - X_i, or, with u, the deformed
+ * d_k = X_k + u_k - X_i - u_i.  Returns sum_k w_ik. */
+static double moments(int dim, long i, const double *x, const double *u,
+                      const long *nbr_ptr, const long *nbr, double A[9]) {
+  double wsum = 0;
+  const double *xi = x + 3 * i;
+  for (int k = 0; k < 9; k++) A[k] = 0;
+  for (long e = nbr_ptr[i]; e < nbr_ptr[i + 1]; e++) {
+    const double *xk = x + 3 * nbr[e];
+    double D[3], d[3];
+    for (int a = 0; a < 3; a++) {
+      D[a] = xk[a] - xi[a];
+      d[a] = u ? D[a] + u[3 * nbr[e] + a] - u[3 * i + a] : D[a];
+    }
+    double w = 1.0 / (D[0] * D[0] + D[1] * D[1] + D[2] * D[2]);
+    wsum += w;
+    for (int a = 0; a < dim; a++)
+      for (int b = 0; b < dim; b++) A[dim * a + b] += w * d[a] * d[b];
+  }
+  for (int k = 0; k < dim * dim; k++) A[k] /= wsum;
+  return wsum;
+}
+
 pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
                        const long *nbr, double cond_max, double *g,
                        double *cond) {
@@ -19,19 +44,9 @@ pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
          shared(n, x, nbr_ptr, nbr, g, cond, dim, cond_max, worst, worst_cond,
                 lapack_info, lapack_point))
   for (long i = 0; i < n; i++) {
-    double A[9] = {0}, wsum = 0;
+    double A[9], lam[3];
     const double *xi = x + 3 * i;
-    for (long e = nbr_ptr[i]; e < nbr_ptr[i + 1]; e++) {
-      const double *xk = x + 3 * nbr[e];
-      double d[3] = {xk[0] - xi[0], xk[1] - xi[1], xk[2] - xi[2]};
-      double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      wsum += w;
-      for (int a = 0; a < dim; a++)
-        for (int b = 0; b < dim; b++) A[dim * a + b] += w * d[a] * d[b];
-    }
-    /* Scale to a dimensionless matrix (eigenvalues sum to 1). */
-    for (int k = 0; k < dim * dim; k++) A[k] /= wsum;
-    double lam[3];
+    const double wsum = moments(dim, i, x, NULL, nbr_ptr, nbr, A);
     int info = LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', dim, A, dim, lam);
     double c = (info == 0 && lam[0] > 0) ? lam[dim - 1] / lam[0] : INFINITY;
     if (cond) cond[i] = c;
@@ -92,21 +107,8 @@ pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
 static double deformed_condition(int dim, long i, const double *x,
                                  const double *u, const long *nbr_ptr,
                                  const long *nbr) {
-  double A[9] = {0}, wsum = 0, lam[3];
-  const double *xi = x + 3 * i, *ui = u + 3 * i;
-  for (long e = nbr_ptr[i]; e < nbr_ptr[i + 1]; e++) {
-    const double *xk = x + 3 * nbr[e], *uk = u + 3 * nbr[e];
-    double D[3], d[3];
-    for (int a = 0; a < 3; a++) {
-      D[a] = xk[a] - xi[a];
-      d[a] = D[a] + uk[a] - ui[a];
-    }
-    double w = 1.0 / (D[0] * D[0] + D[1] * D[1] + D[2] * D[2]);
-    wsum += w;
-    for (int a = 0; a < dim; a++)
-      for (int b = 0; b < dim; b++) A[dim * a + b] += w * d[a] * d[b];
-  }
-  for (int k = 0; k < dim * dim; k++) A[k] /= wsum;
+  double A[9], lam[3];
+  moments(dim, i, x, u, nbr_ptr, nbr, A);
   int info = LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', dim, A, dim, lam);
   return (info == 0 && lam[0] > 0) ? lam[dim - 1] / lam[0] : INFINITY;
 }

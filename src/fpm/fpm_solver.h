@@ -25,16 +25,14 @@ typedef struct {
   double t;
   double kinetic;       /* 1/2 sum m v^2 */
   double strain;        /* sum V W */
-  double penalty;       /* interface penalty energy */
+  double penalty;       /* interface energy (penalty; SIPG: and flux) */
   double external_work; /* work of reactions and tractions so far */
   double dissipated;    /* energy taken by damping so far */
   double residual;      /* |f| on free dofs / (|reactions| + |f_ext|) */
   double damping;       /* current damping coefficient, 1/s */
   double min_jacobian;  /* smallest volume ratio J over the points */
-  long min_jacobian_point;
-  double energy_error; /* |kinetic + strain + penalty + dissipated
-                          - external| over
-                          the larger of |external| and the energy held */
+  double energy_error;  /* fpm_energy_error of these figures */
+  bool energy_checked;  /* the balance is held to its bound at this step */
   bool converged;
 } fpm_step_info;
 
@@ -59,6 +57,11 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
  * of eqs. 24-26. */
 double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
                        double *work, double *lambda);
+
+/* Energy-balance error of a step's figures: (kinetic + strain + interface
+ * + dissipated - external work) over |external work| (over the energy held
+ * while no work has been done yet); signed, 0 when nothing moves. */
+double fpm_energy_error(const fpm_step_info *s);
 
 /* Reaction force: sum of f over the prescribed dofs of boundary condition
  * b, per component (3). */
