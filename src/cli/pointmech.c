@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fpm_driver.h"
+#include "mpm_driver.h"
 #include "pm_error.h"
 #include "pm_probe.h"
 #include "pm_scene.h"
@@ -133,16 +134,45 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
   return 0;
 }
 
+static const char *out_dir(const cli_args *a, const pm_scene *s, char *buf,
+                           size_t size) {
+  if (a->out) return a->out;
+  snprintf(buf, size, "out/%s", s->name);
+  return buf;
+}
+
+static int cmd_run_or_plan_mpm(const cli_args *a, pm_scene *s, bool plan) {
+  mpm_run *r = NULL;
+  int status = EXIT_OK;
+  pm_err e = mpm_run_create(s, &r);
+  if (e) {
+    status = report(e);
+  } else if (plan) {
+    e = mpm_run_plan(r, stdout);
+    if (e) status = report(e);
+  } else {
+    char buf[1024];
+    const char *out = out_dir(a, s, buf, sizeof buf);
+    e = mpm_run_go(r, out, a->quiet);
+    if (e) status = report(e);
+    fprintf(stderr, "results in %s\n", out);
+  }
+  mpm_run_destroy(r);
+  pm_scene_destroy(s);
+  return status;
+}
+
 static int cmd_run_or_plan(const cli_args *a, bool plan) {
   pm_scene *s = NULL;
   fpm_sim *sim = NULL;
   int status = EXIT_OK;
   pm_err e = pm_scene_load(a->scene, a->n_sets, a->sets, &s);
   if (e) return report(e);
+  if (s->method == PM_METHOD_MPM) return cmd_run_or_plan_mpm(a, s, plan);
   if (s->method != PM_METHOD_FPM) {
     fprintf(stderr,
             "pointmech: error: %s: method %s is not available in this build "
-            "(available: fpm)\n",
+            "(available: fpm, mpm)\n",
             a->scene, pm_method_name(s->method));
     pm_scene_destroy(s);
     return EXIT_INPUT;
@@ -158,11 +188,7 @@ static int cmd_run_or_plan(const cli_args *a, bool plan) {
     goto done;
   }
   char out_default[1024];
-  const char *out = a->out;
-  if (!out) {
-    snprintf(out_default, sizeof out_default, "out/%s", s->name);
-    out = out_default;
-  }
+  const char *out = out_dir(a, s, out_default, sizeof out_default);
   e = fpm_sim_run(sim, out, a->quiet);
   if (e) status = report(e);
   fprintf(stderr, "results in %s\n", out);
@@ -195,11 +221,38 @@ static void loaded_face(const pm_scene *s, int *bc, int *comp) {
   }
 }
 
-static pm_err run_fpm_level(void *ctx, const pm_scene *s, const char *out,
-                            bool quiet, pm_run_figures *fig) {
+static pm_err run_mpm_level(const pm_scene *s, const char *out, bool quiet,
+                            pm_run_figures *fig) {
+  mpm_run *r = NULL;
+  pm_err e = mpm_run_create(s, &r);
+  if (e) return e;
+  e = mpm_run_go(r, out, quiet);
+  const mpm_sim *sim = r->sim;
+  fig->status = mpm_status_name(r->status);
+  fig->dim = sim->dim;
+  fig->points = sim->n;
+  fig->steps = sim->step;
+  fig->h = sim->grid.h;
+  fig->wall = r->wall;
+  fig->setup = r->setup_wall;
+  fig->nrmse = r->nrmse_vector;
+  fig->mean_sed = NAN;
+  fig->max_von_mises = NAN;
+  fig->min_jacobian = NAN;
+  fig->energy_error = r->energy_error;
+  int bc, comp;
+  loaded_face(s, &bc, &comp);
+  fig->reaction = bc >= 0 ? sim->bcs[bc].reaction[comp] : NAN;
+  mpm_run_destroy(r);
+  return e;
+}
+
+static pm_err run_level(void *ctx, const pm_scene *s, const char *out,
+                        bool quiet, pm_run_figures *fig) {
   (void)ctx;
-  fpm_sim *sim = NULL;
   *fig = (pm_run_figures){.status = "failed", .nrmse = NAN};
+  if (s->method == PM_METHOD_MPM) return run_mpm_level(s, out, quiet, fig);
+  fpm_sim *sim = NULL;
   pm_err e = fpm_sim_create(s, &sim);
   if (e) return e;
   e = fpm_sim_run(sim, out, quiet);
@@ -241,7 +294,7 @@ static int cmd_convergence(const cli_args *a) {
       .quiet = a->quiet,
   };
   for (int k = 0; k < a->n_ladders; k++) o.ladder[k] = a->ladders[k];
-  pm_err e = pm_study_run(&o, run_fpm_level, NULL, stdout);
+  pm_err e = pm_study_run(&o, run_level, NULL, stdout);
   return e ? report(e) : EXIT_OK;
 }
 

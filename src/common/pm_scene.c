@@ -18,25 +18,56 @@ typedef struct {
 } raw_vec;
 
 typedef struct {
+  int type;
+  double gamma, p_inf;
+} raw_eos;
+
+typedef struct {
+  double c0, c1;
+} raw_av;
+
+typedef struct {
   char *name;
   int model;
   double density, youngs_modulus, poisson_ratio;
+  double viscosity, bulk_viscosity;
+  raw_eos eos;
+  raw_av artificial_viscosity;
 } raw_material;
-
-typedef struct {
-  char *material, *region;
-} raw_body;
-
-typedef struct {
-  int on, ramp;
-  raw_vec displacement, traction;
-  double ramp_time;
-} raw_bc;
 
 typedef struct {
   double *min, *max;
   unsigned min_count, max_count;
 } raw_box;
+
+typedef struct {
+  double *center;
+  unsigned center_count;
+  double radius;
+} raw_sphere;
+
+typedef struct {
+  double *base, *axis;
+  unsigned base_count, axis_count;
+  double radius;
+} raw_cylinder;
+
+typedef struct {
+  char *material, *region, *mesh;
+  raw_box box;
+  raw_sphere sphere;
+  raw_cylinder cylinder;
+  double *velocity;
+  unsigned velocity_count;
+  double density, pressure;
+} raw_body;
+
+typedef struct {
+  int on, ramp;
+  raw_vec displacement, traction, velocity;
+  bool absorbing;
+  double ramp_time;
+} raw_bc;
 
 typedef struct {
   raw_box box;
@@ -50,6 +81,21 @@ typedef struct {
   double penalty;
   int flux;
 } raw_fpm;
+
+typedef struct {
+  int energy_update;
+  double tolerance;
+  long max_iterations;
+} raw_mpm_fluid;
+
+typedef struct {
+  int shape, update;
+  double flip;
+  long *ppc;
+  unsigned ppc_count;
+  unsigned null_velocity;
+  raw_mpm_fluid fluid;
+} raw_mpm;
 
 typedef struct {
   int method;
@@ -89,6 +135,9 @@ typedef struct {
   raw_bc *boundary;
   unsigned boundary_count;
   raw_fpm fpm;
+  raw_mpm mpm;
+  double *gravity;
+  unsigned gravity_count;
   raw_time time;
   raw_output output;
   raw_stability stability;
@@ -105,9 +154,33 @@ static const cyaml_strval_t method_names[] = {
     {"mpm", PM_METHOD_MPM},
     {"mpm-implicit", PM_METHOD_MPM_IMPLICIT},
 };
+/* "fluid" is not a pm_model: it maps to PM_MODEL_COUNT. */
 static const cyaml_strval_t model_names[] = {
     {"neo-hookean", PM_MODEL_NEO_HOOKEAN},
     {"linear-elastic", PM_MODEL_LINEAR_ELASTIC},
+    {"fluid", PM_MODEL_COUNT},
+};
+static const cyaml_strval_t eos_names[] = {
+    {"ideal-gas", PM_EOS_IDEAL_GAS},
+    {"stiffened-gas", PM_EOS_STIFFENED_GAS},
+};
+static const cyaml_strval_t shape_names[] = {
+    {"linear", PM_SHAPE_LINEAR},
+    {"quadratic", PM_SHAPE_QUADRATIC},
+};
+static const cyaml_strval_t update_names[] = {
+    {"usf", PM_UPDATE_USF},
+    {"usl", PM_UPDATE_USL},
+    {"musl", PM_UPDATE_MUSL},
+};
+static const cyaml_strval_t energy_update_names[] = {
+    {"iterative", PM_ENERGY_ITERATIVE},
+    {"non-iterative", PM_ENERGY_NON_ITERATIVE},
+};
+static const cyaml_strval_t axis_names[] = {
+    {"x", 1u << 0},
+    {"y", 1u << 1},
+    {"z", 1u << 2},
 };
 static const cyaml_strval_t face_names[] = {
     {"xmin", PM_FACE_XMIN}, {"xmax", PM_FACE_XMAX}, {"ymin", PM_FACE_YMIN},
@@ -167,26 +240,67 @@ static const cyaml_schema_field_t discretization_fields[] = {
     CYAML_FIELD_END,
 };
 
+static const cyaml_schema_field_t eos_fields[] = {
+    CYAML_FIELD_ENUM("type", ENUM_FLAGS, raw_eos, type, eos_names,
+                     CYAML_ARRAY_LEN(eos_names)),
+    CYAML_FIELD_FLOAT("gamma", CYAML_FLAG_DEFAULT, raw_eos, gamma),
+    CYAML_FIELD_FLOAT("p_inf", OPT, raw_eos, p_inf),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t av_fields[] = {
+    CYAML_FIELD_FLOAT("c0", OPT, raw_av, c0),
+    CYAML_FIELD_FLOAT("c1", OPT, raw_av, c1),
+    CYAML_FIELD_END,
+};
+
 static const cyaml_schema_field_t material_fields[] = {
     CYAML_FIELD_STRING_PTR("name", CYAML_FLAG_DEFAULT, raw_material, name, 1,
                            CYAML_UNLIMITED),
     CYAML_FIELD_ENUM("model", ENUM_FLAGS, raw_material, model, model_names,
                      CYAML_ARRAY_LEN(model_names)),
     CYAML_FIELD_FLOAT("density", CYAML_FLAG_DEFAULT, raw_material, density),
-    CYAML_FIELD_FLOAT("youngs_modulus", CYAML_FLAG_DEFAULT, raw_material,
-                      youngs_modulus),
-    CYAML_FIELD_FLOAT("poisson_ratio", CYAML_FLAG_DEFAULT, raw_material,
-                      poisson_ratio),
+    CYAML_FIELD_FLOAT("youngs_modulus", OPT, raw_material, youngs_modulus),
+    CYAML_FIELD_FLOAT("poisson_ratio", OPT, raw_material, poisson_ratio),
+    CYAML_FIELD_FLOAT("viscosity", OPT, raw_material, viscosity),
+    CYAML_FIELD_FLOAT("bulk_viscosity", OPT, raw_material, bulk_viscosity),
+    CYAML_FIELD_MAPPING("eos", OPT, raw_material, eos, eos_fields),
+    CYAML_FIELD_MAPPING("artificial_viscosity", OPT, raw_material,
+                        artificial_viscosity, av_fields),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t material_entry = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, raw_material, material_fields),
 };
 
+static const cyaml_schema_field_t sphere_fields[] = {
+    CYAML_FIELD_SEQUENCE("center", CYAML_FLAG_POINTER, raw_sphere, center,
+                         &number_entry, 2, 3),
+    CYAML_FIELD_FLOAT("radius", CYAML_FLAG_DEFAULT, raw_sphere, radius),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t cylinder_fields[] = {
+    CYAML_FIELD_SEQUENCE("base", CYAML_FLAG_POINTER, raw_cylinder, base,
+                         &number_entry, 3, 3),
+    CYAML_FIELD_SEQUENCE("axis", CYAML_FLAG_POINTER, raw_cylinder, axis,
+                         &number_entry, 3, 3),
+    CYAML_FIELD_FLOAT("radius", CYAML_FLAG_DEFAULT, raw_cylinder, radius),
+    CYAML_FIELD_END,
+};
+
 static const cyaml_schema_field_t body_fields[] = {
     CYAML_FIELD_STRING_PTR("material", CYAML_FLAG_DEFAULT, raw_body, material,
                            1, CYAML_UNLIMITED),
     CYAML_FIELD_STRING_PTR("region", OPT, raw_body, region, 1, CYAML_UNLIMITED),
+    CYAML_FIELD_MAPPING("box", OPT, raw_body, box, box_fields),
+    CYAML_FIELD_MAPPING("sphere", OPT, raw_body, sphere, sphere_fields),
+    CYAML_FIELD_MAPPING("cylinder", OPT, raw_body, cylinder, cylinder_fields),
+    CYAML_FIELD_STRING_PTR("mesh", OPT, raw_body, mesh, 1, CYAML_UNLIMITED),
+    CYAML_FIELD_SEQUENCE("velocity", CYAML_FLAG_POINTER | OPT, raw_body,
+                         velocity, &number_entry, 2, 3),
+    CYAML_FIELD_FLOAT("density", OPT, raw_body, density),
+    CYAML_FIELD_FLOAT("pressure", OPT, raw_body, pressure),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t body_entry = {
@@ -198,6 +312,8 @@ static const cyaml_schema_field_t bc_fields[] = {
                      CYAML_ARRAY_LEN(face_names)),
     CYAML_FIELD_MAPPING("displacement", OPT, raw_bc, displacement, vec_fields),
     CYAML_FIELD_MAPPING("traction", OPT, raw_bc, traction, vec_fields),
+    CYAML_FIELD_MAPPING("velocity", OPT, raw_bc, velocity, vec_fields),
+    CYAML_FIELD_BOOL("absorbing", OPT, raw_bc, absorbing),
     CYAML_FIELD_ENUM("ramp", OPT | ENUM_FLAGS, raw_bc, ramp, ramp_names,
                      CYAML_ARRAY_LEN(ramp_names)),
     CYAML_FIELD_FLOAT("ramp_time", OPT, raw_bc, ramp_time),
@@ -216,6 +332,33 @@ static const cyaml_schema_field_t fpm_fields[] = {
     CYAML_FIELD_FLOAT("penalty", OPT, raw_fpm, penalty),
     CYAML_FIELD_ENUM("flux", OPT | ENUM_FLAGS, raw_fpm, flux, flux_names,
                      CYAML_ARRAY_LEN(flux_names)),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_value_t integer_entry = {
+    CYAML_VALUE_INT(CYAML_FLAG_DEFAULT, long),
+};
+
+static const cyaml_schema_field_t mpm_fluid_fields[] = {
+    CYAML_FIELD_ENUM("energy_update", OPT | ENUM_FLAGS, raw_mpm_fluid,
+                     energy_update, energy_update_names,
+                     CYAML_ARRAY_LEN(energy_update_names)),
+    CYAML_FIELD_FLOAT("tolerance", OPT, raw_mpm_fluid, tolerance),
+    CYAML_FIELD_INT("max_iterations", OPT, raw_mpm_fluid, max_iterations),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t mpm_fields[] = {
+    CYAML_FIELD_ENUM("shape", OPT | ENUM_FLAGS, raw_mpm, shape, shape_names,
+                     CYAML_ARRAY_LEN(shape_names)),
+    CYAML_FIELD_ENUM("update", OPT | ENUM_FLAGS, raw_mpm, update, update_names,
+                     CYAML_ARRAY_LEN(update_names)),
+    CYAML_FIELD_FLOAT("flip", OPT, raw_mpm, flip),
+    CYAML_FIELD_SEQUENCE("particles_per_cell", CYAML_FLAG_POINTER | OPT,
+                         raw_mpm, ppc, &integer_entry, 1, 3),
+    CYAML_FIELD_FLAGS("null_velocity", OPT | ENUM_FLAGS, raw_mpm, null_velocity,
+                      axis_names, CYAML_ARRAY_LEN(axis_names)),
+    CYAML_FIELD_MAPPING("fluid", OPT, raw_mpm, fluid, mpm_fluid_fields),
     CYAML_FIELD_END,
 };
 
@@ -276,6 +419,9 @@ static const cyaml_schema_field_t scene_fields[] = {
     CYAML_FIELD_SEQUENCE("boundary", CYAML_FLAG_POINTER | OPT, raw_scene,
                          boundary, &bc_entry, 0, CYAML_UNLIMITED),
     CYAML_FIELD_MAPPING("fpm", OPT, raw_scene, fpm, fpm_fields),
+    CYAML_FIELD_MAPPING("mpm", OPT, raw_scene, mpm, mpm_fields),
+    CYAML_FIELD_SEQUENCE("gravity", CYAML_FLAG_POINTER | OPT, raw_scene,
+                         gravity, &number_entry, 2, 3),
     CYAML_FIELD_MAPPING("time", CYAML_FLAG_DEFAULT, raw_scene, time,
                         time_fields),
     CYAML_FIELD_MAPPING("output", OPT, raw_scene, output, output_fields),
@@ -430,6 +576,50 @@ static pm_err build_domain(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   return PM_SUCCESS;
 }
 
+/* A material of model fluid: an equation of state and viscosities. */
+static pm_err build_fluid(const pm_scene *s, const pm_sdoc *d, int i,
+                          const raw_material *m, pm_scene_material *out) {
+  char p[PM_SDOC_PATH];
+  if (s->method == PM_METHOD_FPM)
+    return pm_sdoc_expected(d, path_fmt(p, "materials.%d.model", i),
+                            "a solid model (neo-hookean, linear-elastic) for "
+                            "method fpm");
+  static const char *const solid_keys[] = {"youngs_modulus", "poisson_ratio"};
+  for (int k = 0; k < 2; k++)
+    if (has(d, path_fmt(p, "materials.%d.%s", i, solid_keys[k])))
+      return pm_sdoc_fail(d, p, true,
+                          "expected a key of model fluid (density, viscosity, "
+                          "bulk_viscosity, eos, artificial_viscosity), got %s",
+                          solid_keys[k]);
+  if (!has(d, path_fmt(p, "materials.%d.eos", i)))
+    return pm_sdoc_fail(d, path_fmt(p, "materials.%d", i), false,
+                        "missing required key eos (model fluid needs an "
+                        "equation of state: {type: ideal-gas | "
+                        "stiffened-gas, gamma: > 1, p_inf: Pa})");
+  out->fluid = true;
+  pm_fluid *f = &out->fluid_props;
+  f->eos = (pm_eos)m->eos.type;
+  f->gamma = m->eos.gamma;
+  f->p_inf = m->eos.p_inf;
+  f->density = m->density;
+  f->viscosity = m->viscosity;
+  f->bulk_viscosity = m->bulk_viscosity;
+  if (!(f->gamma > 1))
+    return pm_sdoc_expected(d, path_fmt(p, "materials.%d.eos.gamma", i),
+                            "a number > 1");
+  path_fmt(p, "materials.%d.eos.p_inf", i);
+  if (f->eos == PM_EOS_IDEAL_GAS && has(d, p))
+    return pm_sdoc_fail(d, p, true,
+                        "expected no p_inf for type ideal-gas (use "
+                        "stiffened-gas), got p_inf");
+  PM_CALL(check_nonneg(d, p, f->p_inf));
+  PM_CALL(
+      check_nonneg(d, path_fmt(p, "materials.%d.viscosity", i), f->viscosity));
+  PM_CALL(check_nonneg(d, path_fmt(p, "materials.%d.bulk_viscosity", i),
+                       f->bulk_viscosity));
+  return PM_SUCCESS;
+}
+
 static pm_err build_materials(pm_scene *s, const pm_sdoc *d,
                               const raw_scene *r) {
   char p[PM_SDOC_PATH];
@@ -448,6 +638,32 @@ static pm_err build_materials(pm_scene *s, const pm_sdoc *d,
         pm_sdoc_mark(d, pm_sdoc_find(d, path_fmt(p, "materials.%d", i), false));
     PM_CALL(
         check_positive(d, path_fmt(p, "materials.%d.density", i), m->density));
+    PM_CALL(check_nonneg(d,
+                         path_fmt(p, "materials.%d.artificial_viscosity.c0", i),
+                         m->artificial_viscosity.c0));
+    PM_CALL(check_nonneg(d,
+                         path_fmt(p, "materials.%d.artificial_viscosity.c1", i),
+                         m->artificial_viscosity.c1));
+    out->av_c0 = m->artificial_viscosity.c0;
+    out->av_c1 = m->artificial_viscosity.c1;
+    if (m->model == PM_MODEL_COUNT) {
+      PM_CALL(build_fluid(s, d, i, m, out));
+      continue;
+    }
+    static const char *const fluid_keys[] = {"viscosity", "bulk_viscosity",
+                                             "eos"};
+    for (int k = 0; k < 3; k++)
+      if (has(d, path_fmt(p, "materials.%d.%s", i, fluid_keys[k])))
+        return pm_sdoc_fail(d, p, true,
+                            "expected a key of a solid model (%s), got %s "
+                            "(a key of model fluid)",
+                            pm_model_name((pm_model)m->model), fluid_keys[k]);
+    static const char *const solid_keys[] = {"youngs_modulus", "poisson_ratio"};
+    for (int k = 0; k < 2; k++)
+      if (!has(d, path_fmt(p, "materials.%d.%s", i, solid_keys[k])))
+        return pm_sdoc_fail(d, path_fmt(p, "materials.%d", i), false,
+                            "missing required key %s (model %s)", solid_keys[k],
+                            pm_model_name((pm_model)m->model));
     PM_CALL(check_positive(d, path_fmt(p, "materials.%d.youngs_modulus", i),
                            m->youngs_modulus));
     if (!(m->poisson_ratio > -1 && m->poisson_ratio < 0.5))
@@ -463,12 +679,111 @@ static pm_err build_materials(pm_scene *s, const pm_sdoc *d,
   return PM_SUCCESS;
 }
 
+/* Read a coordinate list of the scene's dimension at path. */
+static pm_err read_point(const pm_sdoc *d, const char *path, int dim,
+                         const double *v, unsigned count, double out[3]) {
+  if (count != (unsigned)dim)
+    return pm_sdoc_fail(d, path, false,
+                        "expected %d numbers (dimension %d), got %u", dim, dim,
+                        count);
+  for (int c = 0; c < dim; c++) out[c] = v[c];
+  return PM_SUCCESS;
+}
+
+/* The body's shape: exactly one of region, box, sphere, cylinder, mesh
+ * (none: the whole domain). */
+static pm_err build_body_shape(pm_scene *s, const pm_sdoc *d, int i,
+                               const raw_body *b, pm_scene_body *body) {
+  char p[PM_SDOC_PATH];
+  static const char *const keys[] = {"region", "box", "sphere", "cylinder",
+                                     "mesh"};
+  int given = -1;
+  for (int k = 0; k < 5; k++) {
+    if (!has(d, path_fmt(p, "bodies.%d.%s", i, keys[k]))) continue;
+    if (given >= 0)
+      return pm_sdoc_fail(d, p, true,
+                          "expected one shape (region, box, sphere, cylinder "
+                          "or mesh), got %s and %s",
+                          keys[given], keys[k]);
+    given = k;
+  }
+  body->shape = PM_BODY_DOMAIN;
+  if (given < 0) return PM_SUCCESS;
+  if (given > 0 && s->method == PM_METHOD_FPM)
+    return pm_sdoc_fail(d, path_fmt(p, "bodies.%d.%s", i, keys[given]), true,
+                        "expected region (method fpm meshes the domain box), "
+                        "got %s",
+                        keys[given]);
+  switch (given) {
+  case 0:
+    if (strcmp(b->region, "domain") == 0) return PM_SUCCESS;
+    body->shape = PM_BODY_REGION;
+    return compile_at(d, path_fmt(p, "bodies.%d.region", i), b->region, "xyz",
+                      &body->region);
+  case 1:
+    body->shape = PM_BODY_BOX;
+    PM_CALL(read_point(d, path_fmt(p, "bodies.%d.box.min", i), s->dimension,
+                       b->box.min, b->box.min_count, body->a));
+    PM_CALL(read_point(d, path_fmt(p, "bodies.%d.box.max", i), s->dimension,
+                       b->box.max, b->box.max_count, body->b));
+    for (int c = 0; c < s->dimension; c++)
+      if (!(body->b[c] > body->a[c]))
+        return pm_sdoc_expected(d, path_fmt(p, "bodies.%d.box.max.%d", i, c),
+                                "a number > the box's min");
+    return PM_SUCCESS;
+  case 2:
+    body->shape = PM_BODY_SPHERE;
+    PM_CALL(read_point(d, path_fmt(p, "bodies.%d.sphere.center", i),
+                       s->dimension, b->sphere.center, b->sphere.center_count,
+                       body->a));
+    body->radius = b->sphere.radius;
+    return check_positive(d, path_fmt(p, "bodies.%d.sphere.radius", i),
+                          b->sphere.radius);
+  case 3:
+    body->shape = PM_BODY_CYLINDER;
+    if (s->dimension != 3)
+      return pm_sdoc_fail(d, path_fmt(p, "bodies.%d.cylinder", i), true,
+                          "expected box, sphere, region or mesh (dimension "
+                          "2), got cylinder");
+    for (int c = 0; c < 3; c++) {
+      body->a[c] = b->cylinder.base[c];
+      body->b[c] = b->cylinder.axis[c];
+    }
+    if (!(pm_v_norm(body->b) > 0))
+      return pm_sdoc_expected(d, path_fmt(p, "bodies.%d.cylinder.axis", i),
+                              "a non-zero vector (base to top face)");
+    body->radius = b->cylinder.radius;
+    return check_positive(d, path_fmt(p, "bodies.%d.cylinder.radius", i),
+                          b->cylinder.radius);
+  default: {
+    body->shape = PM_BODY_MESH;
+    /* Relative to the scene's folder. */
+    const char *slash = strrchr(s->path, '/');
+    size_t dir = (b->mesh[0] != '/' && slash) ? (size_t)(slash - s->path) : 0;
+    size_t len = dir + 1 + strlen(b->mesh) + 1;
+    body->mesh = malloc(len);
+    PM_CHECK(body->mesh, PM_ERR_MEMORY, "cannot copy a mesh path");
+    if (dir)
+      snprintf(body->mesh, len, "%.*s/%s", (int)dir, s->path, b->mesh);
+    else
+      snprintf(body->mesh, len, "%s", b->mesh);
+    return PM_SUCCESS;
+  }
+  }
+}
+
 static pm_err build_bodies(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   char p[PM_SDOC_PATH], what[PM_SDOC_WHERE];
   int n = r->bodies_count > 0 ? (int)r->bodies_count : 1;
   PM_CALL(PM_ALLOC(s->bodies, n, "scene bodies"));
   s->n_bodies = n;
-  if (r->bodies_count == 0) return PM_SUCCESS; /* materials[0], domain */
+  if (r->bodies_count == 0) {
+    /* materials[0] over the whole domain. */
+    const pm_scene_material *mat = &s->materials[0];
+    s->bodies[0].density =
+        mat->fluid ? mat->fluid_props.density : mat->mat.density;
+    return PM_SUCCESS;
+  }
   for (int i = 0; i < n; i++) {
     const raw_body *b = &r->bodies[i];
     int m = 0;
@@ -481,10 +796,45 @@ static pm_err build_bodies(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
       if (used < sizeof what) snprintf(what + used, sizeof what - used, ")");
       return pm_sdoc_expected(d, path_fmt(p, "bodies.%d.material", i), what);
     }
-    s->bodies[i].material = m;
-    if (b->region && strcmp(b->region, "domain") != 0)
-      PM_CALL(compile_at(d, path_fmt(p, "bodies.%d.region", i), b->region,
-                         "xyz", &s->bodies[i].region));
+    pm_scene_body *body = &s->bodies[i];
+    body->material = m;
+    body->mark =
+        pm_sdoc_mark(d, pm_sdoc_find(d, path_fmt(p, "bodies.%d", i), false));
+    PM_CALL(build_body_shape(s, d, i, b, body));
+    const pm_scene_material *mat = &s->materials[m];
+    body->density = mat->fluid ? mat->fluid_props.density : mat->mat.density;
+    if (has(d, path_fmt(p, "bodies.%d.density", i))) {
+      if (s->method == PM_METHOD_FPM)
+        return pm_sdoc_fail(d, p, true,
+                            "expected no body density for method fpm (set "
+                            "the material's), got density");
+      PM_CALL(check_positive(d, p, b->density));
+      body->density = b->density;
+    }
+    if (has(d, path_fmt(p, "bodies.%d.pressure", i))) {
+      if (!mat->fluid)
+        return pm_sdoc_fail(d, p, true,
+                            "expected a key of a solid body (material, shape, "
+                            "velocity, density), got pressure (material %s "
+                            "is not a fluid)",
+                            mat->name);
+      body->pressure = b->pressure;
+      if (!(b->pressure + mat->fluid_props.p_inf > 0))
+        return pm_sdoc_expected(d, p, "a pressure > -p_inf of the material");
+    }
+    if (b->velocity) {
+      path_fmt(p, "bodies.%d.velocity", i);
+      if (s->method == PM_METHOD_FPM)
+        return pm_sdoc_fail(d, p, true,
+                            "expected no initial velocity for "
+                            "method fpm, got velocity");
+      if (b->velocity_count != (unsigned)s->dimension)
+        return pm_sdoc_fail(d, p, false,
+                            "expected %d numbers (dimension %d), got %u",
+                            s->dimension, s->dimension, b->velocity_count);
+      for (unsigned c = 0; c < b->velocity_count; c++)
+        body->velocity[c] = b->velocity[c];
+    }
   }
   return PM_SUCCESS;
 }
@@ -508,10 +858,35 @@ static pm_err build_bcs(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
     PM_CALL(compile_vec(d, path_fmt(p, "boundary.%d.traction", i), &b->traction,
                         s->dimension, "xyzt", bc->traction,
                         &bc->traction_mask));
-    if (!bc->disp_mask && !bc->traction_mask)
+    PM_CALL(compile_vec(d, path_fmt(p, "boundary.%d.velocity", i), &b->velocity,
+                        s->dimension, "xyzt", bc->velocity,
+                        &bc->velocity_mask));
+    bc->absorbing = b->absorbing;
+    const char *grid_only = bc->velocity_mask ? "velocity"
+                            : bc->absorbing   ? "absorbing"
+                                              : NULL;
+    if (grid_only && s->method == PM_METHOD_FPM)
+      return pm_sdoc_fail(d, path_fmt(p, "boundary.%d.%s", i, grid_only), true,
+                          "expected displacement or traction (method fpm), "
+                          "got %s",
+                          grid_only);
+    if (bc->traction_mask && s->method == PM_METHOD_MPM)
+      return pm_sdoc_fail(d, path_fmt(p, "boundary.%d.traction", i), true,
+                          "expected displacement, velocity or absorbing "
+                          "(method mpm), got traction");
+    if (!bc->disp_mask && !bc->traction_mask && !bc->velocity_mask &&
+        !bc->absorbing)
       return pm_sdoc_fail(d, path_fmt(p, "boundary.%d", i), false,
-                          "expected a displacement or traction component, "
-                          "got none");
+                          "expected a displacement, traction or velocity "
+                          "component, or absorbing: true, got none");
+    unsigned dv = bc->disp_mask & bc->velocity_mask;
+    for (int c = 0; c < 3; c++)
+      if (dv & (1u << c))
+        return pm_sdoc_fail(
+            d, path_fmt(q, "boundary.%d.velocity.%c", i, "xyz"[c]), true,
+            "expected a component not prescribed as displacement, got %c "
+            "(also in boundary.%d.displacement)",
+            "xyz"[c], i);
     unsigned both = bc->disp_mask & bc->traction_mask;
     for (int c = 0; c < 3; c++)
       if (both & (1u << c))
@@ -529,18 +904,74 @@ static pm_err build_bcs(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   return PM_SUCCESS;
 }
 
+static pm_err build_mpm(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
+  char p[PM_SDOC_PATH];
+  const raw_mpm *m = &r->mpm;
+  /* Both sections may be present: one scene runs with either method, and
+   * each method reads its own. */
+  s->mpm.shape = has(d, "mpm.shape") ? (pm_shape)m->shape : PM_SHAPE_QUADRATIC;
+  s->mpm.update = has(d, "mpm.update") ? (pm_update)m->update : PM_UPDATE_MUSL;
+  s->mpm.flip = has(d, "mpm.flip") ? m->flip : 1.0;
+  if (!(s->mpm.flip >= 0 && s->mpm.flip <= 1))
+    return pm_sdoc_expected(d, "mpm.flip", "a number in [0, 1]");
+  for (int c = 0; c < 3; c++) s->mpm.ppc[c] = c < s->dimension ? 2 : 1;
+  if (m->ppc) {
+    if (m->ppc_count != 1 && m->ppc_count != (unsigned)s->dimension)
+      return pm_sdoc_fail(d, "mpm.particles_per_cell", false,
+                          "expected 1 or %d integers (dimension %d), got %u",
+                          s->dimension, s->dimension, m->ppc_count);
+    for (int c = 0; c < s->dimension; c++) {
+      long n = m->ppc[m->ppc_count == 1 ? 0 : c];
+      if (n < 1 || n > 64)
+        return pm_sdoc_expected(
+            d,
+            path_fmt(p, "mpm.particles_per_cell.%d", m->ppc_count == 1 ? 0 : c),
+            "an integer in [1, 64]");
+      s->mpm.ppc[c] = (int)n;
+    }
+  }
+  s->mpm.null_velocity = m->null_velocity;
+  if (s->dimension == 2 && (m->null_velocity & 4u))
+    return pm_sdoc_expected(d, "mpm.null_velocity",
+                            "a list of x, y "
+                            "(dimension 2)");
+  s->mpm.energy_update = has(d, "mpm.fluid.energy_update")
+                             ? (pm_energy_update)m->fluid.energy_update
+                             : PM_ENERGY_ITERATIVE;
+  s->mpm.energy_tolerance =
+      has(d, "mpm.fluid.tolerance") ? m->fluid.tolerance : 1e-10;
+  PM_CALL(check_positive(d, "mpm.fluid.tolerance", m->fluid.tolerance));
+  s->mpm.max_iterations =
+      has(d, "mpm.fluid.max_iterations") ? (int)m->fluid.max_iterations : 50;
+  if (!(s->mpm.max_iterations >= 1 && s->mpm.max_iterations <= 10000))
+    return pm_sdoc_expected(d, "mpm.fluid.max_iterations",
+                            "an integer in [1, 10000]");
+  if (r->gravity) {
+    if (s->method == PM_METHOD_FPM)
+      return pm_sdoc_fail(d, "gravity", true,
+                          "expected no gravity for method fpm, got gravity");
+    PM_CALL(read_point(d, "gravity", s->dimension, r->gravity, r->gravity_count,
+                       s->gravity));
+    s->has_gravity = pm_v_norm(s->gravity) > 0;
+  }
+  return PM_SUCCESS;
+}
+
 static pm_err build_time(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   const raw_time *t = &r->time;
   const raw_quasi_static *qs = &t->quasi_static;
   s->fpm.penalty = has(d, "fpm.penalty") ? r->fpm.penalty : 20.0;
   PM_CALL(check_nonneg(d, "fpm.penalty", s->fpm.penalty));
   s->fpm.flux = has(d, "fpm.flux") ? (pm_flux)r->fpm.flux : PM_FLUX_IIPG;
+  PM_CALL(build_mpm(s, d, r));
 
   s->time.end = t->end;
   PM_CALL(check_positive(d, "time.end", t->end));
   s->time.dt = t->dt;
   PM_CALL(check_nonneg(d, "time.dt", t->dt));
-  s->time.dt_safety = has(d, "time.dt_safety") ? t->dt_safety : 0.9;
+  s->time.dt_safety = has(d, "time.dt_safety")     ? t->dt_safety
+                      : s->method == PM_METHOD_FPM ? 0.9
+                                                   : 0.5;
   if (!(s->time.dt_safety > 0 && s->time.dt_safety <= 1))
     return pm_sdoc_expected(d, "time.dt_safety", "a number in (0, 1]");
   s->time.dt_rule =
@@ -714,11 +1145,15 @@ done:
 void pm_scene_destroy(pm_scene *s) {
   if (!s) return;
   for (int i = 0; i < s->n_materials; i++) free(s->materials[i].name);
-  for (int i = 0; i < s->n_bodies; i++) pm_expr_destroy(s->bodies[i].region);
+  for (int i = 0; i < s->n_bodies; i++) {
+    pm_expr_destroy(s->bodies[i].region);
+    free(s->bodies[i].mesh);
+  }
   for (int i = 0; i < s->n_bcs; i++)
     for (int c = 0; c < 3; c++) {
       pm_expr_destroy(s->bcs[i].disp[c]);
       pm_expr_destroy(s->bcs[i].traction[c]);
+      pm_expr_destroy(s->bcs[i].velocity[c]);
     }
   for (int c = 0; c < 3; c++) pm_expr_destroy(s->reference[c]);
   free(s->materials);
@@ -739,6 +1174,32 @@ const char *pm_method_name(pm_method m) {
   case PM_METHOD_MPM_IMPLICIT: return "mpm-implicit";
   }
   return "unknown";
+}
+
+bool pm_body_contains(const pm_scene_body *b, int dim, const double x[3]) {
+  switch (b->shape) {
+  case PM_BODY_DOMAIN: return true;
+  case PM_BODY_REGION:
+    return pm_expr_eval(b->region, x[0], x[1], dim == 3 ? x[2] : 0, 0) > 0;
+  case PM_BODY_BOX:
+    for (int c = 0; c < dim; c++)
+      if (x[c] < b->a[c] || x[c] > b->b[c]) return false;
+    return true;
+  case PM_BODY_SPHERE: {
+    double r2 = 0;
+    for (int c = 0; c < dim; c++) r2 += (x[c] - b->a[c]) * (x[c] - b->a[c]);
+    return r2 <= b->radius * b->radius;
+  }
+  case PM_BODY_CYLINDER: {
+    double d[3] = {x[0] - b->a[0], x[1] - b->a[1], x[2] - b->a[2]};
+    double len2 = pm_v_dot(b->b, b->b), s = pm_v_dot(d, b->b) / len2;
+    if (s < 0 || s > 1) return false;
+    double r2 = pm_v_dot(d, d) - s * s * len2;
+    return r2 <= b->radius * b->radius;
+  }
+  case PM_BODY_MESH: return false;
+  }
+  return false;
 }
 
 double pm_ramp_factor(pm_ramp kind, double T, double t) {

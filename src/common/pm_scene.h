@@ -8,6 +8,7 @@
 #include "pm_error.h"
 #include "pm_expr.h"
 #include "pm_face.h"
+#include "pm_fluid.h"
 #include "pm_material.h"
 
 typedef enum {
@@ -49,15 +50,46 @@ typedef struct {
   int line, col;
 } pm_scene_mark;
 
+/* MPM grid shape functions, update variants and fluid energy update. */
+typedef enum { PM_SHAPE_LINEAR = 0, PM_SHAPE_QUADRATIC } pm_shape;
+typedef enum { PM_UPDATE_USF = 0, PM_UPDATE_USL, PM_UPDATE_MUSL } pm_update;
+typedef enum {
+  PM_ENERGY_ITERATIVE = 0, /* steps (1)-(6) of the fluid paper, eqs. 27-31 */
+  PM_ENERGY_NON_ITERATIVE  /* energy from the previous stress (eq. 27 only) */
+} pm_energy_update;
+
 typedef struct {
   char *name;
+  bool fluid; /* model: fluid (then `fluid` holds it, `mat` is unused) */
   pm_material mat;
+  pm_fluid fluid_props;
+  double av_c0, av_c1; /* artificial viscosity (eq. 32); 0: none */
   pm_scene_mark mark;
 } pm_scene_material;
 
+/* Shape of a body (MPM seeding; FPM uses region only). */
+typedef enum {
+  PM_BODY_DOMAIN = 0, /* the whole domain box */
+  PM_BODY_REGION,     /* region expression > 0 */
+  PM_BODY_BOX,        /* box: {min, max} */
+  PM_BODY_SPHERE,     /* sphere: {center, radius} (a disk in 2D) */
+  PM_BODY_CYLINDER,   /* cylinder: {base, axis, radius}; axis from the base
+                          to the top face */
+  PM_BODY_MESH        /* mesh: a gmsh-readable volume (surface in 2D) */
+} pm_body_shape;
+
 typedef struct {
-  int material;    /* index into materials */
-  pm_expr *region; /* NULL: the whole domain; else inside where expr > 0 */
+  int material; /* index into materials */
+  pm_body_shape shape;
+  pm_expr *region;   /* PM_BODY_REGION: inside where expr > 0 */
+  double a[3], b[3]; /* box: min, max; sphere: center; cylinder: base, axis */
+  double radius;
+  char *mesh;         /* PM_BODY_MESH: file path, relative paths resolved
+                         against the scene's folder */
+  double velocity[3]; /* initial velocity, m/s */
+  double density;     /* initial density, kg/m^3 (default: the material's) */
+  double pressure;    /* fluids: initial pressure, Pa */
+  pm_scene_mark mark;
 } pm_scene_body;
 
 /* A boundary condition on one named face.  Displacement components are
@@ -70,6 +102,9 @@ typedef struct {
   pm_expr *disp[3];   /* NULL where not prescribed */
   unsigned traction_mask;
   pm_expr *traction[3];
+  unsigned velocity_mask; /* MPM: prescribed velocity components, m/s */
+  pm_expr *velocity[3];
+  bool absorbing; /* MPM: viscous (absorbing) boundary on this face */
   pm_ramp ramp;
   double ramp_time; /* s; the loader puts time.ramp when not given */
   pm_scene_mark mark;
@@ -96,6 +131,20 @@ typedef struct pm_scene {
     double penalty; /* fpm.penalty p >= 0 (beta = p E / h) */
     pm_flux flux;   /* fpm.flux: iipg (default) | sipg */
   } fpm;
+  struct {
+    pm_shape shape;   /* mpm.shape: quadratic (default) | linear */
+    pm_update update; /* mpm.update: musl (default) | usl | usf */
+    double flip;      /* mpm.flip: FLIP fraction of the particle velocity
+                         update in [0, 1] (1 FLIP, 0 PIC; default 1) */
+    int ppc[3];       /* mpm.particles_per_cell: per direction (default 2) */
+    pm_energy_update energy_update; /* mpm.fluid.energy_update */
+    double energy_tolerance;        /* mpm.fluid.tolerance (relative) */
+    int max_iterations;             /* mpm.fluid.max_iterations */
+    unsigned null_velocity;         /* mpm.null_velocity: grid velocity
+                                       components held at zero (mask) */
+  } mpm;
+  double gravity[3]; /* gravity: m/s^2 */
+  bool has_gravity;
   struct {
     double end;          /* time.end, s, > 0 */
     double dt;           /* time.dt, s; 0: stable dt from eqs. 24-26 */
@@ -135,6 +184,11 @@ pm_err pm_scene_load(const char *path, int n_overrides,
 void pm_scene_destroy(pm_scene *s);
 
 const char *pm_method_name(pm_method m);
+
+/* True when x (3 components; z unused in 2D) lies in the body's shape:
+ * domain, region (expr > 0), box, sphere or cylinder (boundary included).
+ * A mesh shape needs the geometry layer: this returns false for it. */
+bool pm_body_contains(const pm_scene_body *b, int dim, const double x[3]);
 
 /* Ramp factor in [0, 1] at time t for ramp kind and duration T:
  * smooth is C2 (10 s^3 - 15 s^4 + 6 s^5), linear is s, none is 1. */

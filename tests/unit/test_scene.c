@@ -141,7 +141,7 @@ static void test_defaults(void **state) {
   assert_int_equal(s->n_bcs, 0);
   assert_near(s->fpm.penalty, 20, 0);
   assert_near(s->time.dt, 0, 0);
-  assert_near(s->time.dt_safety, 0.9, 0);
+  assert_near(s->time.dt_safety, 0.5, 0); /* the default of method mpm */
   assert_near(s->time.ramp, 0.5, 0);
   assert_int_equal(s->time.max_steps, 0);
   assert_int_equal(s->time.qs, PM_QS_NONE);

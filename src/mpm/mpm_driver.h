@@ -1,0 +1,52 @@
+/* mpm_driver: a whole explicit MPM simulation of a scene: setup, the time
+ * loop with output (results.h5/xdmf, history.csv, summary.json), progress,
+ * stage timings, and the plan. */
+#ifndef MPM_DRIVER_H
+#define MPM_DRIVER_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "mpm_model.h"
+#include "pm_scene.h"
+
+typedef enum {
+  MPM_STATUS_NOT_RUN = 0,
+  MPM_STATUS_COMPLETED,     /* reached time.end / max_steps */
+  MPM_STATUS_CONVERGED,     /* quasi-static residual below tolerance */
+  MPM_STATUS_NOT_CONVERGED, /* quasi-static, ran out of time or steps */
+  MPM_STATUS_UNSTABLE,      /* stopped on a numerical failure */
+  MPM_STATUS_FAILED         /* other failure (I/O, ...) */
+} mpm_status;
+
+typedef struct {
+  mpm_sim *sim;
+  const pm_scene *scene;
+  mpm_status status;
+  double setup_wall, wall;
+  double energy0; /* kinetic + strain + internal at t = 0 */
+  double kinetic, strain, internal;
+  double energy_error; /* (E - E0 + dissipated - external work) / E0 */
+  double nrmse[3], nrmse_vector;
+  char message[1024];
+} mpm_run;
+
+pm_err mpm_run_create(const pm_scene *s, mpm_run **out);
+void mpm_run_destroy(mpm_run *r);
+
+/* Run to time.end (or the quasi-static state), writing to out_dir when
+ * non-NULL.  Returns PM_ERR_UNSTABLE on a numerical failure (the frames
+ * before it are kept, summary.json says so), PM_ERR_NOT_CONVERGED when a
+ * quasi-static run did not converge. */
+pm_err mpm_run_go(mpm_run *r, const char *out_dir, bool quiet);
+
+/* Print the pipeline, counts, per-particle memory, dt, steps and an
+ * estimated run time (from timing a few steps on a copy of the state). */
+pm_err mpm_run_plan(mpm_run *r, FILE *out);
+
+const char *mpm_status_name(mpm_status s);
+
+/* Reaction force on boundary condition b (last step), N. */
+void mpm_reaction(const mpm_run *r, int b, double R[3]);
+
+#endif
