@@ -90,8 +90,8 @@ static pm_err grid_create(mpm_grid *g, const pm_scene *s) {
   PM_CALL(PM_ALLOC(g->vel0, 3 * n, "grid velocities"));
   if (s->mpm.update != PM_UPDATE_USL)
     PM_CALL(PM_ALLOC(g->vel, 3 * n, "grid velocities"));
-  g->vel_stress = g->vel ? g->vel : g->vel_new;
   PM_CALL(PM_ALLOC(g->vel_new, 3 * n, "grid velocities"));
+  g->vel_stress = g->vel ? g->vel : g->vel_new;
   return PM_SUCCESS;
 }
 

@@ -232,7 +232,7 @@ static void test_overrides(void **state) {
       "bodies=[{material: rubber, region: \"x - 0.5\"}]",
       "boundary=[]",
       "boundary.0.on=xmax",
-      "boundary.0.traction.x=100*t",
+      "boundary.0.velocity.x=100*t",
       "reference.displacement.x=0.1*x",
   };
   s = load_ok(MINIMAL, 8, grow);
@@ -243,7 +243,7 @@ static void test_overrides(void **state) {
   assert_int_equal(s->n_bcs, 1);
   assert_int_equal(s->bcs[0].face, PM_FACE_XMAX);
   assert_int_equal(s->bcs[0].mark.line, 0); /* not from the file */
-  assert_near(eval(s->bcs[0].traction[0], 0, 0, 0, 2), 200, 1e-12);
+  assert_near(eval(s->bcs[0].velocity[0], 0, 0, 0, 2), 200, 1e-12);
   assert_int_equal(s->reference_mask, 1u);
   pm_scene_destroy(s);
 }
