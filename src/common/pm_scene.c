@@ -780,6 +780,12 @@ static pm_err build_bodies(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   if (r->bodies_count == 0) {
     /* materials[0] over the whole domain. */
     const pm_scene_material *mat = &s->materials[0];
+    if (mat->fluid)
+      return pm_sdoc_fail(d, "materials.0", false,
+                          "expected bodies: a fluid needs a body with its "
+                          "initial pressure (bodies: [{material: %s, "
+                          "pressure: ...}])",
+                          mat->name);
     s->bodies[0].density =
         mat->fluid ? mat->fluid_props.density : mat->mat.density;
     return PM_SUCCESS;
@@ -821,7 +827,11 @@ static pm_err build_bodies(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
       body->pressure = b->pressure;
       if (!(b->pressure + mat->fluid_props.p_inf > 0))
         return pm_sdoc_expected(d, p, "a pressure > -p_inf of the material");
-    }
+    } else if (mat->fluid)
+      return pm_sdoc_fail(d, path_fmt(p, "bodies.%d", i), false,
+                          "missing required key pressure (a body of fluid "
+                          "%s needs its initial pressure, Pa)",
+                          mat->name);
     if (b->velocity) {
       path_fmt(p, "bodies.%d.velocity", i);
       if (s->method == PM_METHOD_FPM)

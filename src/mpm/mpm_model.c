@@ -36,7 +36,9 @@ size_t mpm_grid_bytes(const mpm_grid *g) {
   if (g->impedance) per_node += 2;
   if (g->force_prev) per_node += 3;
   per_node += (size_t)g->threads * g->acc_stride;
-  return per_node * sizeof(double) * (size_t)g->n_nodes;
+  size_t bytes = per_node * sizeof(double) * (size_t)g->n_nodes;
+  if (g->fixed) bytes += 3 * (size_t)g->n_nodes;
+  return bytes;
 }
 
 /* ---- grid --------------------------------------------------------------- */
@@ -244,9 +246,18 @@ static void place_seed(void *ctx, const double x[3], int body) {
     sim->x[3 * p + d] = x[d];
     sim->v[3 * p + d] = b->velocity[d];
   }
-  sim->vol0[p] = c->vol;
-  sim->vol[p] = c->vol;
-  sim->mass[p] = b->density * c->vol;
+  /* The particle's share of its cell, clipped to the domain box where the
+   * box is not a whole number of sub-cells. */
+  double vol = c->vol;
+  for (int d = 0; d < c->s->dimension; d++) {
+    double hs = sim->grid.h / c->s->mpm.ppc[d];
+    double top = x[d] + 0.5 * hs, end = c->s->box_max[d];
+    if (top > end + 1e-12 * hs)
+      vol *= (end - (x[d] - 0.5 * hs)) / hs;
+  }
+  sim->vol0[p] = vol;
+  sim->vol[p] = vol;
+  sim->mass[p] = b->density * vol;
   double *sig = sim->sigma + 9 * p;
   if (g->F) pm_t_identity(g->F + 9 * k);
   if (g->fluid) {
@@ -395,12 +406,18 @@ pm_err mpm_model_create(const pm_scene *s, mpm_sim **out) {
                   "per-thread grid accumulators"));
   if (sim->has_absorbing)
     PM_TRY(PM_ALLOC(g->impedance, 2 * g->n_nodes, "grid impedances"));
+  if (s->time.qs != PM_QS_NONE)
+    PM_TRY(PM_ALLOC(g->fixed, 3 * g->n_nodes, "constrained dof flags"));
   if (s->time.qs == PM_QS_DYNAMIC_RELAXATION)
     PM_TRY(PM_ALLOC(g->force_prev, 3 * g->n_nodes, "previous grid forces"));
   sim->dt_fixed = s->time.dt;
   sim->damping = s->time.qs == PM_QS_DAMPING ? s->time.qs_damping : 0;
   mpm_build_pipeline(sim);
   sim->dt_stable = mpm_stable_dt(sim);
+  PM_ENSURE(sim->dt_fixed > 0 || isfinite(sim->dt_stable), PM_ERR_SCENE,
+            "%s: no stable time step: no particle has a wave speed or a "
+            "velocity (set time.dt)",
+            s->path);
   sim->dt = sim->dt_fixed > 0 ? sim->dt_fixed : sim->dt_stable;
   *out = sim;
   sim = NULL;
@@ -421,6 +438,7 @@ void mpm_model_destroy(mpm_sim *sim) {
   free(g->acc);
   free(g->impedance);
   free(g->force_prev);
+  free(g->fixed);
   for (int k = 0; k < sim->n_groups; k++) {
     mpm_group *gr = &sim->group[k];
     free(gr->F);

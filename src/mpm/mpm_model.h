@@ -61,9 +61,11 @@ typedef struct {
   int acc_stride; /* 7, or 9 with the impedance sums */
   int threads;
   /* optional */
-  double *impedance;  /* 2 per node: sum w m c_p, sum w m c_s (absorbing) */
-  double *force_prev; /* 3 per node: internal force of the previous step
-                         (dynamic relaxation) */
+  double *impedance;    /* 2 per node: sum w m c_p, sum w m c_s (absorbing) */
+  double *force_prev;   /* 3 per node: internal force of the previous step
+                           (dynamic relaxation) */
+  unsigned char *fixed; /* 3 per node: dof set by a boundary condition this
+                           step (quasi-static residual) */
 } mpm_grid;
 
 /* A boundary condition on a face, as grid columns normal to the face. */
@@ -128,8 +130,9 @@ struct mpm_sim {
   /* time */
   double t, dt, dt_stable;
   long step;
-  double dt_fixed; /* time.dt, or 0: the stable step each step */
-  double max_div;  /* largest |tr D| of the last stress update, 1/s */
+  double dt_fixed;     /* time.dt, or 0: the stable step each step */
+  double max_div;      /* largest |tr D| of this step's stress update, 1/s */
+  double max_div_prev; /* the same for the previous step (for dt) */
   /* quasi-static */
   double damping; /* current rate, 1/s */
   double residual;

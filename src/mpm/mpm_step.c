@@ -58,7 +58,8 @@ static void p2g_mode(mpm_sim *sim, int mode) {
   const int S = g->acc_stride;
   const bool imp = (mode & P2G_FORCE) && g->impedance;
   const long nn = g->n_nodes;
-  PM_OMP(parallel) {
+  /* The accumulators were sized for g->threads: run exactly that many. */
+  PM_OMP(parallel num_threads(g->threads)) {
     double *acc = g->acc + (size_t)thread_id() * nn * S;
     memset(acc, 0, sizeof(double) * nn * S);
     for (int gi = 0; gi < sim->n_groups; gi++) {
@@ -166,9 +167,9 @@ static double bc_wall(const mpm_sim *sim, const mpm_bc *bc,
 
 /* Set the prescribed components of vel on every node at or beyond each
  * face's current wall.  With reactions, also accumulate the force the
- * constraint applies, the work it does, and remove the constrained dofs from
- * the residual sum *r2. */
-static void apply_bcs(mpm_sim *sim, double *vel, bool reactions, double *r2) {
+ * constraint applies and the work it does, and mark the constrained dofs
+ * (g->fixed, when the residual is wanted). */
+static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
   const pm_scene *s = sim->scene;
   mpm_grid *g = &sim->grid;
   for (int b = 0; b < sim->n_bcs; b++) {
@@ -185,7 +186,7 @@ static void apply_bcs(mpm_sim *sim, double *vel, bool reactions, double *r2) {
       if ((mask >> c & 1u) && bc->constant[c])
         vconst[c] = bc_velocity(sim, sb, c, xc);
     if (bc->constant[a]) wall_const = bc_wall(sim, bc, sb, xc);
-    double R[3] = {0, 0, 0}, rr = 0, work = 0;
+    double R[3] = {0, 0, 0}, work = 0;
     long step_a = g->stride[a];
     for (long k = 0; k < bc->n_cols; k++) {
       long col = bc->col[k];
@@ -203,32 +204,64 @@ static void apply_bcs(mpm_sim *sim, double *vel, bool reactions, double *r2) {
         if (mask >> c & 1u)
           v[c] = bc->constant[c] ? vconst[c] : bc_velocity(sim, sb, c, x);
       double wall = bc->constant[a] ? wall_const : bc_wall(sim, bc, sb, x);
-      /* Walk the column from the outer edge of the grid inwards. */
+      /* The nodes at or beyond the wall, and the first two inside it. */
       long ia_face = (long)llround((bc->plane - g->origin[a]) * g->inv_h);
       long i_start = bc->outward > 0 ? g->nn[a] - 1 : 0;
       long di = bc->outward > 0 ? -1 : 1;
-      for (long i = i_start; i >= 0 && i < g->nn[a]; i += di) {
-        double xa = g->origin[a] + i * g->h;
-        if ((xa - wall) * bc->outward < -1e-9 * g->h) break;
+      long i_in = i_start;
+      while (i_in >= 0 && i_in < g->nn[a] &&
+             (g->origin[a] + i_in * g->h - wall) * bc->outward >= -1e-9 * g->h)
+        i_in += di;
+      /* The inside nodes count only where material is (a node without
+       * mass has no velocity to extend). */
+      long n_in = col + (i_in - ia_face) * step_a;
+      long n_in2 = col + (i_in + di - ia_face) * step_a;
+      bool has_in = i_in >= 0 && i_in < g->nn[a] && g->mass[n_in] > 0;
+      bool has_in2 = has_in && i_in + di >= 0 && i_in + di < g->nn[a] &&
+                     g->mass[n_in2] > 0;
+      double p_in = (g->origin[a] + i_in * g->h) * bc->outward;
+      for (long i = i_start; i != i_in; i += di) {
         long node = col + (i - ia_face) * step_a;
+        /* Distance beyond the wall, and the velocity at the mirror point
+         * (the inside field extended linearly through the last two inside
+         * nodes): prescribed components are reflected oddly about the
+         * prescribed value, so a linear field stays linear through the
+         * wall; free components of a wall (normal prescribed) evenly, as
+         * at a plane of symmetry. */
+        double d = (g->origin[a] + i * g->h - wall) * bc->outward;
+        double p_mirror = wall * bc->outward - d;
         double m = g->mass[node];
         for (int c = 0; c < 3; c++) {
-          if (!(mask >> c & 1u)) continue;
+          bool fixed = mask >> c & 1u;
+          if (!fixed && !(mask >> a & 1u)) continue;
+          if (!fixed && !has_in) continue;
+          double vm = fixed ? v[c] : 0;
+          if (has_in) {
+            double v_in = vel[3 * n_in + c];
+            double slope = has_in2 ? (v_in - vel[3 * n_in2 + c]) * g->inv_h : 0;
+            vm = v_in + slope * (p_mirror - p_in);
+          }
+          double vset;
+          if (fixed)
+            vset = d > 1e-9 * g->h ? 2 * v[c] - vm : v[c];
+          else if (d > 1e-9 * g->h)
+            vset = vm;
+          else
+            continue;
           if (reactions && m > 0) {
             double f = g->force[3 * node + c];
-            double Rc = m * (v[c] - g->vel0[3 * node + c]) / sim->dt - f;
+            double Rc = m * (vset - g->vel0[3 * node + c]) / sim->dt - f;
             R[c] += Rc;
-            work += Rc * v[c] * sim->dt;
-            rr += f * f;
+            work += Rc * vset * sim->dt;
           }
-          vel[3 * node + c] = v[c];
+          if (reactions && g->fixed) g->fixed[3 * node + c] = 1;
+          vel[3 * node + c] = vset;
         }
       }
     }
     if (reactions) {
       for (int c = 0; c < 3; c++) bc->reaction[c] = R[c];
       sim->external_work += work;
-      if (r2) *r2 -= rr;
     }
   }
 }
@@ -295,6 +328,8 @@ static void stage_damping(mpm_sim *sim, int arg) {
   if (g->force_prev) {
     /* Dynamic relaxation: c = 2 sqrt(v.K v / v.M v), with K v estimated by
      * the change of the internal force over the step. */
+    /* Free dofs only (those the conditions set in the previous step are
+     * left out: their forces change by what the conditions impose). */
     double num = 0, den = 0;
     PM_OMP(parallel for schedule(static) reduction(+ : num, den))
     for (long i = 0; i < g->n_nodes; i++) {
@@ -302,16 +337,18 @@ static void stage_damping(mpm_sim *sim, int arg) {
       if (m <= 0) continue;
       for (int c = 0; c < 3; c++) {
         double v = g->mom[3 * i + c] / m;
-        num += v * (g->force_prev[3 * i + c] - g->force[3 * i + c]);
-        den += m * v * v;
+        if (!g->fixed[3 * i + c]) {
+          num += v * (g->force_prev[3 * i + c] - g->force[3 * i + c]);
+          den += m * v * v;
+        }
         g->force_prev[3 * i + c] = g->force[3 * i + c];
       }
     }
     if (den > 0 && sim->step > 0) {
       double lambda = num / (sim->dt * den);
       double c = lambda > 0 ? 2.0 * sqrt(lambda) : 0.0;
-      /* Keep the rate within what the step can resolve. */
-      double cmax = 1.0 / sim->dt;
+      /* Keep the rate well within what the step resolves. */
+      double cmax = 0.2 / sim->dt;
       sim->damping = fmin(c, cmax);
     }
   }
@@ -335,9 +372,8 @@ static void stage_grid_update(mpm_sim *sim, int arg) {
   (void)arg;
   mpm_grid *g = &sim->grid;
   const unsigned nul = sim->scene->mpm.null_velocity;
-  const double dt = sim->dt, c = sim->damping;
-  double r2 = 0, f2 = 0;
-  PM_OMP(parallel for schedule(static) reduction(+ : r2, f2))
+  const double dt = sim->dt;
+  PM_OMP(parallel for schedule(static))
   for (long i = 0; i < g->n_nodes; i++) {
     double m = g->mass[i];
     for (int k = 0; k < 3; k++) {
@@ -345,22 +381,36 @@ static void stage_grid_update(mpm_sim *sim, int arg) {
       if (m > 0 && !(nul >> k & 1u)) {
         v0 = g->mom[3 * i + k] / m;
         v1 = v0 + dt * g->force[3 * i + k] / m;
-        /* The residual leaves out the damping force. */
-        double f = g->force[3 * i + k] + c * m * v0;
-        r2 += f * f;
-        f2 += g->force[3 * i + k] * g->force[3 * i + k];
       }
       g->vel0[3 * i + k] = v0;
       g->vel_new[3 * i + k] = v1;
     }
   }
-  apply_bcs(sim, g->vel_new, true, &r2);
+  if (g->fixed) memset(g->fixed, 0, 3 * (size_t)g->n_nodes);
+  apply_bcs(sim, g->vel_new, true);
+  if (!g->fixed) return;
+  /* Quasi-static residual: the out-of-balance force (without the damping)
+   * on the free dofs, relative to the reactions (or, with none, to the
+   * forces on all dofs). */
+  const double c = sim->damping;
+  double r2 = 0, f2 = 0;
+  PM_OMP(parallel for schedule(static) reduction(+ : r2, f2))
+  for (long i = 0; i < g->n_nodes; i++) {
+    double m = g->mass[i];
+    if (m <= 0) continue;
+    for (int k = 0; k < 3; k++) {
+      if (nul >> k & 1u) continue;
+      double f = g->force[3 * i + k] + c * m * g->vel0[3 * i + k];
+      f2 += f * f;
+      if (!g->fixed[3 * i + k]) r2 += f * f;
+    }
+  }
   double scale = 0;
   for (int b = 0; b < sim->n_bcs; b++)
     for (int k = 0; k < 3; k++)
       scale += sim->bcs[b].reaction[k] * sim->bcs[b].reaction[k];
-  sim->residual = sqrt(fmax(r2, 0) / fmax(scale, 1e-300));
-  (void)f2;
+  if (!(scale > 0)) scale = f2;
+  sim->residual = scale > 0 ? sqrt(r2 / scale) : 0.0;
 }
 
 /* USF: the velocity before the update, with its conditions, for the
@@ -376,7 +426,7 @@ static void stage_grid_velocity(mpm_sim *sim, int arg) {
       g->vel[3 * i + k] =
           (m > 0 && !(nul >> k & 1u)) ? g->mom[3 * i + k] / m : 0.0;
   }
-  apply_bcs(sim, g->vel, false, NULL);
+  apply_bcs(sim, g->vel, false);
 }
 
 /* ---- grid to particle --------------------------------------------------- */
@@ -629,7 +679,7 @@ static void stage_stress_fluid(mpm_sim *sim, int gi) {
 
 double mpm_stable_dt(const mpm_sim *sim) {
   const mpm_grid *g = &sim->grid;
-  const double h = g->h, div = sim->max_div;
+  const double h = g->h, div = sim->max_div_prev;
   double worst = 0; /* largest effective speed */
   for (int gi = 0; gi < sim->n_groups; gi++) {
     const mpm_group *gr = &sim->group[gi];
@@ -822,6 +872,7 @@ pm_err mpm_step(mpm_sim *sim) {
   }
   sim->t += sim->dt;
   sim->step++;
+  sim->max_div_prev = sim->max_div;
   sim->iter_capped_total += sim->iter_capped_step;
   if (sim->iter_max_step > sim->iter_max_total)
     sim->iter_max_total = sim->iter_max_step;

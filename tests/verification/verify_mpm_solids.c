@@ -18,9 +18,20 @@
 
 #define CASES PM_SOURCE_DIR "/cases/mpm/"
 #define MAX_CROSSINGS 64
-#define FLIP_DIP_BOUND 1.0
-#define FLIP_GAIN_BOUND 1.0
-#define FLIP_END_BOUND 1.0
+
+/* Bounds on E(t) / E(0) = (kinetic + strain) / initial of the FLIP disks.
+ * The contact of the disks is the grid's single velocity field: no-slip,
+ * and it takes energy while the disks are in contact (Sulsky et al. show a
+ * dip of several percent).  Measured on this scene (h = 0.05 m, 2 x 2
+ * particles per cell, MUSL): a dip to 0.924 at t = 1.83 s, most 1.0012,
+ * 0.983 at t = 3 s; with dt_safety 0.1 instead of 0.5 the dip is 0.912 and
+ * the end 0.996, with 3 x 3 particles per cell 0.914 and 0.981, at h =
+ * 0.025 m 0.980 and 0.996.  The bounds are the worst of these plus a
+ * margin: they catch a change of the transfers or the contact, not the
+ * rounding of the step. */
+#define FLIP_DIP_BOUND 0.10  /* min E / E0 >= 0.90 */
+#define FLIP_GAIN_BOUND 0.01 /* max E / E0 <= 1.01: no energy created */
+#define FLIP_END_BOUND 0.03  /* |E(end) / E0 - 1| <= 0.03 */
 
 /* NaN-safe: false when either value is NaN. */
 static bool close_to(double a, double b, double rtol, double atol) {
@@ -124,7 +135,9 @@ static void bar_record(const mpm_sim *sim, void *ctx) {
 }
 
 /* Measured period within 1% of T = 4 L / c, c = sqrt(E / rho) (exact for
- * the plane strain bar with nu = 0, whose P-wave modulus is E). */
+ * the plane strain bar with nu = 0, whose P-wave modulus is E).  The error
+ * (+0.65% at h = 0.5 m) comes almost all from the fixed end and is first
+ * order in h: see scripts/make-mpm-scenes.sh. */
 static void test_bar_first_mode(void **state) {
   (void)state;
   pm_scene *s = load_scene(CASES "bar-first-mode.yaml", 0, NULL);
@@ -141,7 +154,7 @@ static void test_bar_first_mode(void **state) {
   double measured = 2 * (b.cross[b.n - 1] - b.cross[0]) / (b.n - 1);
   double err = (measured - T) / T;
   printf("\nMPM bar, first axial mode: L = %g m, c = %g m/s, cell %g m, "
-         "%ld particles, %ld steps (dt %.4g s), %.2f s (driver %.2f s)\n",
+         "%ld particles, %ld steps (mean dt %.4g s), %.2f s (driver %.2f s)\n",
          L, c, sim->grid.h, sim->n, sim->step, s->time.end / sim->step, wall,
          driver_wall);
   printf("  %-34s %12s\n", "quantity", "value");
@@ -237,7 +250,6 @@ static void test_disks_collision(void **state) {
   double err_flip = fabs(flip.e_end / flip.e0 - 1);
   double err_pic = fabs(pic.e_end / pic.e0 - 1);
   assert_true(err_flip < err_pic);
-  /* FLIP_DIP_BOUND: see the comment at its definition. */
   assert_true(flip.e_min / flip.e0 >= 1 - FLIP_DIP_BOUND);
   assert_true(flip.e_max / flip.e0 <= 1 + FLIP_GAIN_BOUND);
   assert_true(err_flip <= FLIP_END_BOUND);
