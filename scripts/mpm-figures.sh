@@ -1,0 +1,22 @@
+#!/bin/bash
+# The figures of the explicit MPM cases:
+#   OUT/m2-shock-tube/profiles.png  M2 at the paper's size (pressure ratio
+#                                   1000), iterative and non-iterative
+#                                   energy update against the exact solution
+#   OUT/m2-sod/profiles.png         the same tube at the Sod ratio
+#   OUT/disks-energy.png            the colliding disks' energy, FLIP and PIC
+# usage: scripts/mpm-figures.sh [BUILD_DIR] [OUT]  (defaults build, out/mpm-figures)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build}
+out=${2:-out/mpm-figures}
+mkdir -p "$out"
+scripts/shock-tube-figure.sh "$build" cases/mpm/m2-shock-tube.yaml "$out/m2-shock-tube"
+scripts/shock-tube-figure.sh "$build" cases/mpm/m2-sod.yaml "$out/m2-sod"
+for blend in 1 0; do
+  "$build/pointmech" run cases/mpm/disks-collision.yaml --quiet \
+    --out "$out/disks-flip$blend" --set mpm.flip=$blend --set output.every=2
+done
+/usr/bin/python3 tools/plot-history.py --sum total=kinetic_energy+strain_energy \
+  --title "two elastic disks colliding: energy (J per m)" \
+  --out "$out/disks-energy.png" FLIP="$out/disks-flip1" PIC="$out/disks-flip0"
