@@ -1004,6 +1004,12 @@ static pm_err build_time(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
       has(d, "stability.min_jacobian") ? st->min_jacobian : 0.0;
   if (!(s->stability.min_jacobian >= 0 && s->stability.min_jacobian < 1))
     return pm_sdoc_expected(d, "stability.min_jacobian", "a number in [0, 1)");
+  if (s->method != PM_METHOD_FPM && has(d, "stability.max_energy_error"))
+    return pm_sdoc_fail(d, "stability.max_energy_error", true,
+                        "expected min_jacobian only for method %s (its "
+                        "transfers dissipate energy by design: the balance "
+                        "is reported, not bounded), got max_energy_error",
+                        pm_method_name(s->method));
   s->stability.max_energy_error =
       has(d, "stability.max_energy_error") ? st->max_energy_error : 0.1;
   PM_CALL(

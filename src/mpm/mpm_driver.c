@@ -560,9 +560,9 @@ pm_err mpm_run_plan(mpm_run *r, FILE *out) {
     double per = (pm_wtime() - t0) / reps;
     fprintf(out,
             "estimate     %.3g s per step, %.3g s for %.0f steps on %d "
-            "threads (%.3g particle-steps/s; setup took %.3g s)\n",
-            per, per * steps, steps, pm_omp_threads(), sim->n / per,
-            r->setup_wall);
+            "thread%s (%.3g particle-steps/s; setup took %.3g s)\n",
+            per, per * steps, steps, pm_omp_threads(),
+            pm_omp_threads() == 1 ? "" : "s", sim->n / per, r->setup_wall);
   }
   return PM_SUCCESS;
 }

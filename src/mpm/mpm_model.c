@@ -252,8 +252,7 @@ static void place_seed(void *ctx, const double x[3], int body) {
   for (int d = 0; d < c->s->dimension; d++) {
     double hs = sim->grid.h / c->s->mpm.ppc[d];
     double top = x[d] + 0.5 * hs, end = c->s->box_max[d];
-    if (top > end + 1e-12 * hs)
-      vol *= (end - (x[d] - 0.5 * hs)) / hs;
+    if (top > end + 1e-12 * hs) vol *= (end - (x[d] - 0.5 * hs)) / hs;
   }
   sim->vol0[p] = vol;
   sim->vol[p] = vol;

@@ -204,7 +204,7 @@ static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
         if (mask >> c & 1u)
           v[c] = bc->constant[c] ? vconst[c] : bc_velocity(sim, sb, c, x);
       double wall = bc->constant[a] ? wall_const : bc_wall(sim, bc, sb, x);
-      /* The nodes at or beyond the wall, and the first two inside it. */
+      /* The nodes at or beyond the wall, and the first inside it. */
       long ia_face = (long)llround((bc->plane - g->origin[a]) * g->inv_h);
       long i_start = bc->outward > 0 ? g->nn[a] - 1 : 0;
       long di = bc->outward > 0 ? -1 : 1;
@@ -215,32 +215,24 @@ static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
       /* The inside nodes count only where material is (a node without
        * mass has no velocity to extend). */
       long n_in = col + (i_in - ia_face) * step_a;
-      long n_in2 = col + (i_in + di - ia_face) * step_a;
       bool has_in = i_in >= 0 && i_in < g->nn[a] && g->mass[n_in] > 0;
-      bool has_in2 = has_in && i_in + di >= 0 && i_in + di < g->nn[a] &&
-                     g->mass[n_in2] > 0;
-      double p_in = (g->origin[a] + i_in * g->h) * bc->outward;
       for (long i = i_start; i != i_in; i += di) {
         long node = col + (i - ia_face) * step_a;
-        /* Distance beyond the wall, and the velocity at the mirror point
-         * (the inside field extended linearly through the last two inside
-         * nodes): prescribed components are reflected oddly about the
-         * prescribed value, so a linear field stays linear through the
-         * wall; free components of a wall (normal prescribed) evenly, as
-         * at a plane of symmetry. */
+        /* Distance beyond the wall.  Prescribed components are reflected
+         * oddly about the prescribed value, v = 2 v_b - v_in, with v_in the
+         * first inside node's: on a wall at a node plane that node is the
+         * ghost's mirror, so a linear field stays linear through the wall.
+         * Free components of a wall (normal prescribed) are reflected
+         * evenly, as at a plane of symmetry.  (Extrapolating the inside
+         * field to the exact mirror point of a moving wall was tried: it
+         * is unstable where few particles reach the inside nodes.) */
         double d = (g->origin[a] + i * g->h - wall) * bc->outward;
-        double p_mirror = wall * bc->outward - d;
         double m = g->mass[node];
         for (int c = 0; c < 3; c++) {
           bool fixed = mask >> c & 1u;
           if (!fixed && !(mask >> a & 1u)) continue;
           if (!fixed && !has_in) continue;
-          double vm = fixed ? v[c] : 0;
-          if (has_in) {
-            double v_in = vel[3 * n_in + c];
-            double slope = has_in2 ? (v_in - vel[3 * n_in2 + c]) * g->inv_h : 0;
-            vm = v_in + slope * (p_mirror - p_in);
-          }
+          double vm = has_in ? vel[3 * n_in + c] : fixed ? v[c] : 0;
           double vset;
           if (fixed)
             vset = d > 1e-9 * g->h ? 2 * v[c] - vm : v[c];
@@ -460,7 +452,8 @@ void mpm_g2p(mpm_sim *sim, int arg) {
       sim->dx[3 * p + k] = dt * vn[k];
     }
     if (!isfinite(v[0] + v[1] + v[2]))
-      fail_at(sim, p, "velocity is not finite (%g, %g)", v[0], v[1]);
+      fail_at(sim, p, "velocity is not finite (|v|^2 = %g, v_x = %g)",
+              v[0] * v[0] + v[1] * v[1] + v[2] * v[2], v[0]);
   }
 }
 
@@ -529,6 +522,7 @@ static void stage_stress_solid(mpm_sim *sim, int gi) {
   const double dt = sim->dt, h = g->h;
   const pm_material *mat = &gr->solid;
   const bool rate = mat->model == PM_MODEL_LINEAR_ELASTIC;
+  const double jmin = sim->scene->stability.min_jacobian;
   const bool av = gr->q != NULL;
   double maxdiv = 0;
   PM_OMP(parallel for schedule(static) reduction(max : maxdiv))
@@ -544,8 +538,11 @@ static void stage_stress_solid(mpm_sim *sim, int gi) {
     pm_t_mul(A, F, Fn);
     memcpy(F, Fn, sizeof Fn);
     double J = pm_t_det(F);
-    if (!(J > 0) || !isfinite(J)) {
-      fail_at(sim, p, "volume ratio J = %g <= 0 (inverted; %g)", J, 0);
+    if (!(J > jmin) || !isfinite(J)) {
+      fail_at(sim, p,
+              J > 0 ? "volume ratio J = %g <= stability.min_jacobian = %g"
+                    : "volume ratio J = %g <= 0: inverted (bound %g)",
+              J, jmin);
       continue;
     }
     sim->vol[p] = sim->vol0[p] * J;
@@ -565,7 +562,8 @@ static void stage_stress_solid(mpm_sim *sim, int gi) {
     } else {
       double P[9];
       if (!pm_material_stress(mat, F, P, NULL, NULL)) {
-        fail_at(sim, p, "stress is not finite (J = %g)%g", J, 0);
+        fail_at(sim, p, "stress is not finite (J = %g, |F| = %g)", J,
+                pm_t_norm(F));
         continue;
       }
       /* sigma = P F^T / J */
