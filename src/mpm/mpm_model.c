@@ -37,7 +37,7 @@ size_t mpm_grid_bytes(const mpm_grid *g) {
   if (g->force_prev) per_node += 3;
   per_node += (size_t)g->threads * g->acc_stride;
   size_t bytes = per_node * sizeof(double) * (size_t)g->n_nodes;
-  if (g->fixed) bytes += 3 * (size_t)g->n_nodes;
+  if (g->owner) bytes += 3 * sizeof(short) * (size_t)g->n_nodes;
   return bytes;
 }
 
@@ -405,8 +405,8 @@ pm_err mpm_model_create(const pm_scene *s, mpm_sim **out) {
                   "per-thread grid accumulators"));
   if (sim->has_absorbing)
     PM_TRY(PM_ALLOC(g->impedance, 2 * g->n_nodes, "grid impedances"));
-  if (s->time.qs != PM_QS_NONE)
-    PM_TRY(PM_ALLOC(g->fixed, 3 * g->n_nodes, "constrained dof flags"));
+  if (sim->n_bcs > 0)
+    PM_TRY(PM_ALLOC(g->owner, 3 * g->n_nodes, "constrained dof owners"));
   if (s->time.qs == PM_QS_DYNAMIC_RELAXATION)
     PM_TRY(PM_ALLOC(g->force_prev, 3 * g->n_nodes, "previous grid forces"));
   sim->dt_fixed = s->time.dt;
@@ -437,7 +437,7 @@ void mpm_model_destroy(mpm_sim *sim) {
   free(g->acc);
   free(g->impedance);
   free(g->force_prev);
-  free(g->fixed);
+  free(g->owner);
   for (int k = 0; k < sim->n_groups; k++) {
     mpm_group *gr = &sim->group[k];
     free(gr->F);

@@ -61,11 +61,12 @@ typedef struct {
   int acc_stride; /* 7, or 9 with the impedance sums */
   int threads;
   /* optional */
-  double *impedance;    /* 2 per node: sum w m c_p, sum w m c_s (absorbing) */
-  double *force_prev;   /* 3 per node: internal force of the previous step
-                           (dynamic relaxation) */
-  unsigned char *fixed; /* 3 per node: dof set by a boundary condition this
-                           step (quasi-static residual) */
+  double *impedance;  /* 2 per node: sum w m c_p, sum w m c_s (absorbing) */
+  double *force_prev; /* 3 per node: internal force of the previous step
+                         (dynamic relaxation) */
+  short *owner;       /* 3 per node: the condition that set the dof this step,
+                         -(b + 1) prescribed, b + 1 reflected, 0 free (with
+                         boundary conditions) */
 } mpm_grid;
 
 /* A boundary condition on a face, as grid columns normal to the face. */

@@ -75,7 +75,13 @@ static void p2g_mode(mpm_sim *sim, int mode) {
           for (int k = 0; k < 9; k++)
             s[k] = -sim->vol[p] * sim->sigma[9 * p + k];
         double cp = 0, cs = 0;
-        if (imp) wave_speeds(sim, gr, p, &cp, &cs);
+        if (imp) {
+          /* Impedances rho c of the particle. */
+          wave_speeds(sim, gr, p, &cp, &cs);
+          double rho = m / sim->vol[p];
+          cp *= rho;
+          cs *= rho;
+        }
         for (int c = 0; c < st.n[2]; c++)
           for (int b = 0; b < st.n[1]; b++) {
             double wbc = st.w[1][b] * st.w[2][c];
@@ -166,10 +172,10 @@ static double bc_wall(const mpm_sim *sim, const mpm_bc *bc,
 }
 
 /* Set the prescribed components of vel on every node at or beyond each
- * face's current wall.  With reactions, also accumulate the force the
- * constraint applies and the work it does, and mark the constrained dofs
- * (g->fixed, when the residual is wanted). */
-static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
+ * face's current wall.  With mark, record in g->owner which condition set
+ * each dof (-(b + 1) prescribed, b + 1 reflected; a prescription wins over
+ * a reflection). */
+static void apply_bcs_once(mpm_sim *sim, double *vel, bool mark) {
   const pm_scene *s = sim->scene;
   mpm_grid *g = &sim->grid;
   for (int b = 0; b < sim->n_bcs; b++) {
@@ -186,7 +192,6 @@ static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
       if ((mask >> c & 1u) && bc->constant[c])
         vconst[c] = bc_velocity(sim, sb, c, xc);
     if (bc->constant[a]) wall_const = bc_wall(sim, bc, sb, xc);
-    double R[3] = {0, 0, 0}, work = 0;
     long step_a = g->stride[a];
     for (long k = 0; k < bc->n_cols; k++) {
       long col = bc->col[k];
@@ -240,22 +245,46 @@ static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
             vset = vm;
           else
             continue;
-          if (reactions && m > 0) {
-            double f = g->force[3 * node + c];
-            double Rc = m * (vset - g->vel0[3 * node + c]) / sim->dt - f;
-            R[c] += Rc;
-            work += Rc * vset * sim->dt;
+          if (mark && m > 0) {
+            short *o = &g->owner[3 * node + c];
+            if (fixed)
+              *o = (short)-(b + 1);
+            else if (*o >= 0)
+              *o = (short)(b + 1);
           }
-          if (reactions && g->fixed) g->fixed[3 * node + c] = 1;
           vel[3 * node + c] = vset;
         }
       }
     }
-    if (reactions) {
-      for (int c = 0; c < 3; c++) bc->reaction[c] = R[c];
-      sim->external_work += work;
-    }
   }
+}
+
+/* The conditions, twice: where two faces meet, one face's mirror reads
+ * nodes the other sets, so the second pass sees them set.  With
+ * reactions, then one pass over the constrained dofs: the force each
+ * condition applies, R = m (v - v0) / dt - f, counted once per dof (to the
+ * condition that prescribes it, else the one that reflects it), and its
+ * work R (v0 + v) / 2 dt. */
+static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
+  mpm_grid *g = &sim->grid;
+  if (sim->n_bcs == 0) return;
+  if (reactions) memset(g->owner, 0, 3 * sizeof(short) * (size_t)g->n_nodes);
+  apply_bcs_once(sim, vel, false);
+  apply_bcs_once(sim, vel, reactions);
+  if (!reactions) return;
+  for (int b = 0; b < sim->n_bcs; b++)
+    for (int c = 0; c < 3; c++) sim->bcs[b].reaction[c] = 0;
+  double work = 0;
+  const double dt = sim->dt;
+  for (long i = 0; i < 3 * g->n_nodes; i++) {
+    short o = g->owner[i];
+    if (!o) continue;
+    long node = i / 3;
+    double R = g->mass[node] * (vel[i] - g->vel0[i]) / dt - g->force[i];
+    sim->bcs[(o > 0 ? o : -o) - 1].reaction[i % 3] += R;
+    work += R * 0.5 * (g->vel0[i] + vel[i]) * dt;
+  }
+  sim->external_work += work;
 }
 
 /* ---- grid stages -------------------------------------------------------- */
@@ -264,22 +293,19 @@ static void stage_gravity(mpm_sim *sim, int arg) {
   (void)arg;
   mpm_grid *g = &sim->grid;
   const double *gv = sim->scene->gravity;
-  double work = 0;
-  PM_OMP(parallel for schedule(static) reduction(+ : work))
+  /* Its work is counted in the grid update, with the mean velocity. */
+  PM_OMP(parallel for schedule(static))
   for (long i = 0; i < g->n_nodes; i++) {
     double m = g->mass[i];
     if (m <= 0) continue;
-    for (int c = 0; c < 3; c++) {
-      g->force[3 * i + c] += m * gv[c];
-      work += gv[c] * g->mom[3 * i + c];
-    }
+    for (int c = 0; c < 3; c++) g->force[3 * i + c] += m * gv[c];
   }
-  sim->external_work += work * sim->dt;
 }
 
-/* Viscous boundary: traction -rho (c_p v_n n + c_s v_t) on the nodes at or
- * beyond the face, with rho c taken from the particles' mass-weighted wave
- * speeds (impedance sums over the node volume). */
+/* Viscous boundary: the traction t = -rho (c_p v_n n + c_s v_t) on the
+ * face, with rho c the mass-weighted mean of the particles' impedances at
+ * the node, spread as f_I = N_I(face) t A: the face node and (quadratic)
+ * the node inside it; the light node beyond is left out. */
 static void stage_absorbing(mpm_sim *sim, int arg) {
   (void)arg;
   mpm_grid *g = &sim->grid;
@@ -288,17 +314,17 @@ static void stage_absorbing(mpm_sim *sim, int arg) {
     const mpm_bc *bc = &sim->bcs[b];
     if (!bc->absorbing) continue;
     int a = bc->axis;
-    long ia_face = (long)llround((bc->plane - g->origin[a]) * g->inv_h);
-    long i_end = bc->outward > 0 ? g->nn[a] - 1 : 0;
-    long n_layers = labs(i_end - ia_face) + 1;
+    const bool quad = g->shape == PM_SHAPE_QUADRATIC;
+    const double share[2] = {quad ? 0.75 : 1.0, quad ? 0.125 : 0.0};
     PM_OMP(parallel for schedule(static) reduction(+ : lost))
     for (long k = 0; k < bc->n_cols; k++)
-      for (long l = 0; l < n_layers; l++) {
-        long node = bc->col[k] + (long)bc->outward * l * g->stride[a];
+      for (int l = 0; l < 2; l++) {
+        if (share[l] == 0) continue;
+        long node = bc->col[k] - (long)bc->outward * l * g->stride[a];
         double m = g->mass[node];
         if (m <= 0) continue;
-        double zp = g->impedance[2 * node] / g->node_volume;
-        double zs = g->impedance[2 * node + 1] / g->node_volume;
+        double zp = share[l] * g->impedance[2 * node] / m;
+        double zs = share[l] * g->impedance[2 * node + 1] / m;
         const double *p = g->mom + 3 * node;
         for (int c = 0; c < sim->dim; c++) {
           double v = p[c] / m, z = c == a ? zp : zs;
@@ -329,7 +355,7 @@ static void stage_damping(mpm_sim *sim, int arg) {
       if (m <= 0) continue;
       for (int c = 0; c < 3; c++) {
         double v = g->mom[3 * i + c] / m;
-        if (!g->fixed[3 * i + c]) {
+        if (!g->owner || !g->owner[3 * i + c]) {
           num += v * (g->force_prev[3 * i + c] - g->force[3 * i + c]);
           den += m * v * v;
         }
@@ -378,9 +404,21 @@ static void stage_grid_update(mpm_sim *sim, int arg) {
       g->vel_new[3 * i + k] = v1;
     }
   }
-  if (g->fixed) memset(g->fixed, 0, 3 * (size_t)g->n_nodes);
   apply_bcs(sim, g->vel_new, true);
-  if (!g->fixed) return;
+  if (sim->scene->has_gravity) {
+    /* The work of gravity over the step, with the mean velocity. */
+    const double *gv = sim->scene->gravity;
+    double work = 0;
+    PM_OMP(parallel for schedule(static) reduction(+ : work))
+    for (long i = 0; i < g->n_nodes; i++) {
+      double m = g->mass[i];
+      if (m <= 0) continue;
+      for (int k = 0; k < 3; k++)
+        work += m * gv[k] * 0.5 * (g->vel0[3 * i + k] + g->vel_new[3 * i + k]);
+    }
+    sim->external_work += work * dt;
+  }
+  if (sim->scene->time.qs == PM_QS_NONE) return;
   /* Quasi-static residual: the out-of-balance force (without the damping)
    * on the free dofs, relative to the reactions (or, with none, to the
    * forces on all dofs). */
@@ -394,7 +432,7 @@ static void stage_grid_update(mpm_sim *sim, int arg) {
       if (nul >> k & 1u) continue;
       double f = g->force[3 * i + k] + c * m * g->vel0[3 * i + k];
       f2 += f * f;
-      if (!g->fixed[3 * i + k]) r2 += f * f;
+      if (!g->owner || !g->owner[3 * i + k]) r2 += f * f;
     }
   }
   double scale = 0;

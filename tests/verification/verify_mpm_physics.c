@@ -41,18 +41,29 @@ static bool state_finite(const mpm_sim *sim) {
   return true;
 }
 
-/* A whole run through the driver, without output; the caller destroys it. */
-static mpm_run *run_driver(const pm_scene *s, mpm_status expected) {
+static mpm_run *create_run(const pm_scene *s) {
   mpm_run *r = NULL;
   if (mpm_run_create(s, &r) != PM_SUCCESS) fail_msg("%s", pm_error_message());
+  return r;
+}
+
+/* Run r through the driver, without output: it must end with status
+ * `expected` and a finite state. */
+static void go_run(mpm_run *r, mpm_status expected) {
+  const char *name = r->scene->name;
   pm_err err = mpm_run_go(r, NULL, true);
   if (err != PM_SUCCESS && r->status != expected)
-    fail_msg("%s: %s", s->name, pm_error_message());
+    fail_msg("%s: %s", name, pm_error_message());
   if (r->status != expected)
-    fail_msg("%s: status %s, expected %s (%s)", s->name,
-             mpm_status_name(r->status), mpm_status_name(expected),
-             r->message);
+    fail_msg("%s: status %s, expected %s (%s)", name,
+             mpm_status_name(r->status), mpm_status_name(expected), r->message);
   assert_true(state_finite(r->sim));
+}
+
+/* A whole run through the driver; the caller destroys it. */
+static mpm_run *run_driver(const pm_scene *s, mpm_status expected) {
+  mpm_run *r = create_run(s);
+  go_run(r, expected);
   return r;
 }
 
@@ -62,8 +73,8 @@ static mpm_run *run_driver(const pm_scene *s, mpm_status expected) {
 static bool row(const char *what, double measured, double expected,
                 double scale, double tol) {
   double ref = scale > 0 ? scale : fabs(expected);
-  double err = ref > 0 ? fabs(measured - expected) / ref
-                       : fabs(measured - expected);
+  double err =
+      ref > 0 ? fabs(measured - expected) / ref : fabs(measured - expected);
   bool ok = err <= tol;
   printf("  %-46s %13.6g %13.6g %10.2e %9.2e  %s\n", what, measured, expected,
          err, tol, ok ? "ok" : "FAIL");
@@ -106,10 +117,11 @@ static const char free_fall_scene[] =
  * mass gets v + g dt, the velocity field stays uniform, its gradient is
  * zero (the B-spline gradients sum to zero) and the block stays unstressed.
  * The positions move with the updated velocity (symplectic Euler), so after
- * N steps the drop is g dt^2 (1 + 2 + ... + N) = g T (T + dt) / 2 exactly,
- * g T dt / 2 (a relative dt / T) more than the continuous g T^2 / 2, and
- * the velocity is g T exactly.  Kinetic energy M (g T)^2 / 2 is then all
- * the work of gravity, so the energy balance has nothing to be off by but
+ * N steps the velocity is g T exactly and the drop is g dt^2 (1 + 2 + ...
+ * + N) = g T (T + dt) / 2 exactly: g T dt / 2, a relative dt / T, more than
+ * the continuous g T^2 / 2.  The kinetic energy M (g T)^2 / 2 is then all
+ * the work of gravity, which a force times the step's mean velocity
+ * accounts exactly, so the energy balance has nothing to be off by but
  * round-off. */
 static void test_free_fall(void **state) {
   (void)state;
@@ -120,25 +132,24 @@ static void test_free_fall(void **state) {
   if (!f) fail_msg("cannot write %s", path);
   fputs(free_fall_scene, f);
   fclose(f);
-  pm_scene *s = load_scene(path, 0, NULL);
+  pm_scene *s = NULL;
+  pm_err err = pm_scene_load(path, 0, NULL, &s);
   unlink(path);
   rmdir(dir);
+  if (err != PM_SUCCESS) fail_msg("%s", pm_error_message());
 
   const double g = -s->gravity[2], dt = s->time.dt, T = s->time.end;
   const long N = lround(T / dt);
-  double z0 = 0, M = 0;
-  mpm_run *r = NULL;
-  if (mpm_run_create(s, &r) != PM_SUCCESS) fail_msg("%s", pm_error_message());
+  mpm_run *r = create_run(s);
   const mpm_sim *sim = r->sim;
+  const double L = 0.04, rho = sim->group[0].solid.density;
+  double z0 = 0, M = 0;
   for (long p = 0; p < sim->n; p++) {
     M += sim->mass[p];
     z0 += sim->mass[p] * sim->x[3 * p + 2];
   }
   z0 /= M;
-  const double L = 0.04, rho = sim->group[0].solid.density;
-  mpm_run_destroy(r);
-  r = run_driver(s, MPM_STATUS_COMPLETED);
-  sim = r->sim;
+  go_run(r, MPM_STATUS_COMPLETED);
   assert_int_equal(sim->step, N);
 
   double z = 0, vz = 0, lateral = 0, smax = 0;
@@ -153,32 +164,30 @@ static void test_free_fall(void **state) {
   z /= M;
   vz /= M;
   const double drop = z0 - z, drop_scheme = 0.5 * g * dt * dt * N * (N + 1);
-  const double drop_exact = 0.5 * g * T * T;
+  const double ke = 0.5 * M * g * g * T * T;
 
   table_head("1. Free fall: 40 mm cube, 512 particles, g = 9.81 m/s^2");
   printf("  %ld steps of dt = %g s to T = %g s, %.2f s\n", N, dt, T, r->wall);
   bool ok = true;
   /* Round-off: N position increments of 1e-16 relative each on z ~ 0.16 m,
    * against a drop of 0.047 m: a few 1e-13. */
-  ok &= row("drop of the centre of mass, m (g T (T + dt)/2)", drop,
+  ok &= row("drop of the centre of mass, m (g T (T + dt) / 2)", drop,
             drop_scheme, 0, 1e-10);
-  /* The time integration's one error, exactly dt / T relative. */
-  ok &= row("drop, against continuous g T^2 / 2", drop, drop_exact, 0,
-            (1 + 1e-6) * dt / T);
-  ok &= row("velocity of the centre of mass, m/s (-g T)", vz, -g * T, 0,
-            1e-12);
+  info("  the continuous drop g T^2 / 2 (dt / T less), m", drop,
+       0.5 * g * T * T);
+  ok &= row("velocity of the centre of mass, m/s (-g T)", vz, -g * T, 0, 1e-12);
   /* Lateral motion and stress are round-off: sums of B-spline gradients
    * (1e-16 / h) times v; bounded at 1e-12 m and 1e-9 rho g L. */
   ok &= row("largest lateral displacement, m", lateral, 0, 1, 1e-12);
-  ok &= row("largest |sigma_ij| / (rho g L)", smax / (rho * g * L), 0, 1,
-            1e-9);
+  ok &= row("largest |sigma_ij| / (rho g L)", smax / (rho * g * L), 0, 1, 1e-9);
   /* All the work of gravity is kinetic energy (see above). */
   ok &= row("energy balance error (mpm_run)", r->energy_error, 0, 1, 1e-9);
-  info("  kinetic energy, J (M (g T)^2 / 2)", r->kinetic,
-       0.5 * M * g * g * T * T);
-  info("  work of gravity, J (kinetic energy)", sim->external_work,
-       0.5 * M * g * g * T * T);
-  info("  work with start-of-step momenta, J", sim->external_work,
+  info("  kinetic energy, J (M (g T)^2 / 2)", r->kinetic, ke);
+  info("  work of gravity as counted, J (kinetic energy)", sim->external_work,
+       ke);
+  /* What the count is when it takes each step's starting momentum: the
+   * balance is then off by exactly 1 / (N - 1). */
+  info("  the same with start-of-step momenta, J", sim->external_work,
        0.5 * M * g * g * dt * dt * N * (N - 1));
   fflush(stdout);
   mpm_run_destroy(r);
@@ -190,8 +199,8 @@ static void test_free_fall(void **state) {
 
 /* The column of cases/mpm/gravity-column.yaml settled by dynamic
  * relaxation: sigma_yy = -rho g (H - Y) at reference height Y, the floor
- * carries the weight, and (linear elasticity, laterally confined)
- * sigma_xx = nu / (1 - nu) sigma_yy. */
+ * carries the weight, the rollers carry none of it, and (linear
+ * elasticity, laterally confined) sigma_xx = nu / (1 - nu) sigma_yy. */
 static void test_gravity_column(void **state) {
   (void)state;
   pm_scene *s = load_scene(CASES "gravity-column.yaml", 0, NULL);
@@ -199,23 +208,42 @@ static void test_gravity_column(void **state) {
   const mpm_sim *sim = r->sim;
   const mpm_group *gr = &sim->group[0];
   const double g = -s->gravity[1], rho = gr->solid.density;
-  const double nu = gr->solid.poisson;
+  const double nu = gr->solid.poisson, h = sim->grid.h;
   const double H = s->box_max[1] - s->box_min[1];
   const double scale = rho * g * H;
-  double M = 0, err_max = 0, err_sum = 0, ratio_sum = 0;
+  /* Rows of particles (by reference height) in the middle half. */
+  const int rows = (int)lround(H / h) * s->mpm.ppc[1];
+  double *row_sum = calloc(rows, sizeof *row_sum);
+  double *row_exact = calloc(rows, sizeof *row_exact);
+  long *row_n = calloc(rows, sizeof *row_n);
+  assert_non_null(row_sum);
+  assert_non_null(row_exact);
+  assert_non_null(row_n);
+  double M = 0, err_max = 0, ratio_sum = 0, pe = 0;
   long n_mid = 0;
   for (long p = 0; p < sim->n; p++) {
     M += sim->mass[p];
+    pe += sim->mass[p] * g * (sim->x0[3 * p + 1] - sim->x[3 * p + 1]);
     double Y = sim->x0[3 * p + 1] - s->box_min[1];
     if (Y < 0.25 * H || Y > 0.75 * H) continue;
     const double *sg = sim->sigma + 9 * p;
     double exact = -rho * g * (H - Y);
-    double e = fabs(sg[4] - exact) / scale;
-    err_max = fmax(err_max, e);
-    err_sum += e;
+    err_max = fmax(err_max, fabs(sg[4] - exact) / scale);
+    int k = (int)floor(Y / H * rows);
+    row_sum[k] += sg[4];
+    row_exact[k] += exact;
+    row_n[k]++;
     ratio_sum += sg[0] / sg[4];
     n_mid++;
   }
+  double row_err = 0;
+  for (int k = 0; k < rows; k++)
+    if (row_n[k])
+      row_err =
+          fmax(row_err, fabs(row_sum[k] - row_exact[k]) / row_n[k] / scale);
+  free(row_sum);
+  free(row_exact);
+  free(row_n);
   double R_floor[3], R_left[3], R_right[3];
   mpm_reaction(r, 0, R_floor);
   mpm_reaction(r, 1, R_left);
@@ -226,25 +254,41 @@ static void test_gravity_column(void **state) {
          "residual %.2e, %.2f s\n",
          sim->n, sim->step, sim->t, sim->residual, r->wall);
   bool ok = true;
-  /* The brief's bound: the residual (1e-6) and the damping force at rest
-   * leave far less than this. */
+  /* In equilibrium the floor takes all the weight but what the residual
+   * (1e-6 of the reactions) and the ghost nodes beyond the rollers (light,
+   * and set by reflection rather than in equilibrium: 3e-4 of the weight
+   * here) leave; the bound is the brief's 1%. */
   ok &= row("floor reaction, N (weight M g)", R_floor[1], M * g, 0, 0.01);
-  /* TODO: measured */
+  /* A frictionless roller takes no weight.  Bound: 1e-3 of it, three
+   * times what the rollers' ghost nodes leave (3e-4). */
+  ok &= row("vertical reaction of the rollers / M g",
+            (R_left[1] + R_right[1]) / (M * g), 0, 1, 1e-3);
+  /* The mean over a row of particles is the equilibrium of the slab above
+   * it, exact whatever the discretization does across the row: measured
+   * 2.3e-4 of rho g H (the particle quadrature of the weight). */
+  ok &= row("max |row mean sigma_yy - exact| / rho g H, mid", row_err, 0, 1,
+            1e-3);
+  /* Particle by particle, the rollers leave a boundary layer two cells
+   * wide: the first interior node misses what the mirror images of the
+   * particles next to the wall would give it, and the particles in the
+   * first cell carry up to 2.1% of rho g H less compression (2.8% of the
+   * local stress), the next ones a little more.  It does not shrink with
+   * the cell (1.5% at h = H / 40, 2.1% at H / 80) nor with a wider column
+   * (2.1% at twice the width): a limitation of B-spline MPM at walls, not
+   * a convergence error.  Bound 2.5%. */
   ok &= row("max |sigma_yy + rho g (H - Y)| / rho g H, mid", err_max, 0, 1,
-            0.02);
-  ok &= row("mean |sigma_yy + rho g (H - Y)| / rho g H, mid",
-            err_sum / n_mid, 0, 1, 0.01);
-  ok &= row("mean sigma_xx / sigma_yy, mid (nu / (1 - nu))",
-            ratio_sum / n_mid, nu / (1 - nu), 0, 0.01);
-  info("  vertical reaction of the rollers, N", R_left[1] + R_right[1], 0);
-  info("  energy balance error (mpm_run)", r->energy_error, 0);
-  info("  strain energy, J", r->strain, 0);
-  info("  external work, J", sim->external_work, 0);
-  info("  dissipated, J", sim->dissipated, 0);
-  double pe = 0;
-  for (long p = 0; p < sim->n; p++)
-    pe += sim->mass[p] * g * (sim->x0[3 * p + 1] - sim->x[3 * p + 1]);
-  info("  potential energy released, J", pe, 0);
+            0.025);
+  /* The lateral stress, as a mean over the middle half: 0.12% off. */
+  ok &= row("mean sigma_xx / sigma_yy, mid (nu / (1 - nu))", ratio_sum / n_mid,
+            nu / (1 - nu), 0, 0.01);
+  /* Strain energy + damping losses = potential energy released (the
+   * floor and rollers do no work): -5e-4 with the reactions counted once
+   * per constrained dof.  Bound 1%. */
+  ok &= row("energy balance error (mpm_run)", r->energy_error, 0, 1, 0.01);
+  info("  external work as counted, J (potential energy)", sim->external_work,
+       pe);
+  info("  strain energy + dissipated, J (potential energy)",
+       r->strain + sim->dissipated, pe);
   fflush(stdout);
   mpm_run_destroy(r);
   pm_scene_destroy(s);
@@ -278,14 +322,13 @@ static void test_absorbing_bar(void **state) {
   run_bar(0, NULL, &ab);
   /* Free ends: a y-velocity condition, which null_velocity [y] imposes
    * anyway, so the ends carry no condition on x. */
-  const char *free_sets[] = {"boundary.0.absorbing=false",
-                             "boundary.0.velocity.y=0",
-                             "boundary.1.absorbing=false",
-                             "boundary.1.velocity.y=0"};
+  const char *free_sets[] = {
+      "boundary.0.absorbing=false", "boundary.0.velocity.y=0",
+      "boundary.1.absorbing=false", "boundary.1.velocity.y=0"};
   run_bar(4, free_sets, &fr);
   const char *fixed_sets[] = {
-      "boundary.0.absorbing=false", "boundary.0.displacement.x=0",
-      "boundary.0.ramp=none",       "boundary.1.absorbing=false",
+      "boundary.0.absorbing=false",  "boundary.0.displacement.x=0",
+      "boundary.0.ramp=none",        "boundary.1.absorbing=false",
       "boundary.1.displacement.x=0", "boundary.1.ramp=none"};
   run_bar(6, fixed_sets, &fx);
 
@@ -294,12 +337,22 @@ static void test_absorbing_bar(void **state) {
          "fixed\n",
          ab.n, ab.steps, ab.wall, fr.wall, fx.wall);
   bool ok = true;
-  /* TODO */
+  /* A viscous end of impedance rho c A is exact for a wave at normal
+   * incidence in a 1-D continuum: what is left at t = 0.8 s is what the
+   * discrete end reflects or holds.  Each 1% of energy left is a
+   * reflection coefficient of 0.1; a dashpot of half the impedance
+   * reflects 1/3, 11% of the energy.  Bound 5% (the brief's). */
   ok &= row("energy left, absorbing ends", ab.e_end / ab.e0, 0, 1, 0.05);
+  /* Free and fixed ends reflect everything; what FLIP loses or gains on
+   * the way is the time integration's: measured +0.18% and -0.44%.
+   * Bound 2%. */
   ok &= row("energy left, free ends", fr.e_end / fr.e0, 1, 0, 0.02);
   ok &= row("energy left, fixed ends", fx.e_end / fx.e0, 1, 0, 0.02);
-  ok &= row("energy balance error, absorbing ends", ab.energy_error, 0, 1,
-            0.01);
+  /* Kinetic + strain + absorbed = initial energy.  Measured -0.15%; an
+   * error of 0.14% is already there at t = 0.05 s, before the pulse
+   * reaches the ends.  Bound 1%. */
+  ok &=
+      row("energy balance error, absorbing ends", ab.energy_error, 0, 1, 0.01);
   info("  dissipated by the ends / E(0)", ab.dissipated / ab.e0,
        1 - ab.e_end / ab.e0);
   fflush(stdout);
@@ -351,14 +404,19 @@ static void test_water_pulse(void **state) {
   pr.level = pR + 0.5 * (ex.p_star - fl->p_inf - pR);
   for (int k = 0; k < N_PROBES; k++) pr.t_cross[k] = NAN;
   probe_pressures(sim, &pr, pr.p_prev);
+  double e0;
+  {
+    double ke, se, ie;
+    mpm_energies(sim, &ke, &se, &ie);
+    e0 = ke + se + ie;
+  }
   double t0 = pm_wtime();
   while (sim->t < s->time.end * (1 - 1e-12)) {
     if (mpm_step(sim) != PM_SUCCESS) fail_msg("%s", pm_error_message());
     double p[N_PROBES];
     probe_pressures(sim, &pr, p);
     for (int k = 0; k < N_PROBES; k++) {
-      if (isnan(pr.t_cross[k]) && pr.p_prev[k] < pr.level &&
-          p[k] >= pr.level)
+      if (isnan(pr.t_cross[k]) && pr.p_prev[k] < pr.level && p[k] >= pr.level)
         pr.t_cross[k] = pr.t_prev + (sim->t - pr.t_prev) *
                                         (pr.level - pr.p_prev[k]) /
                                         (p[k] - pr.p_prev[k]);
@@ -389,19 +447,44 @@ static void test_water_pulse(void **state) {
          sim->n, sim->step, sim->dt, wall, sim->iter_max_total,
          sim->iter_capped_total);
   bool ok = true;
-  /* TODO */
-  ok &= row("front speed, 0.7 m to 0.9 m, m/s (a)", speed, a, 0, 0.02);
-  ok &= row("front arrival at 0.9 m, ms ((0.9 - 0.5) / a)",
-            1e3 * pr.t_cross[1], 1e3 * (pr.x[1] - x0) / a, 0, 0.02);
-  info("  exact front (shock) speed, m/s", speed, ex.s_right_head);
+  /* The front's middle, timed between two probes 0.2 m apart, moves at
+   * the sound speed: the waves are acoustic (the jump is 1e-3 of p +
+   * P_inf, so the exact front, a weak shock, is 2.5e-4 faster than a), the
+   * artificial viscosity spreads the front symmetrically about its
+   * middle, and the crossing is interpolated within steps of 0.6 us
+   * against 114 us between the probes.  Measured 3.5e-4; bound 1%, which
+   * a wrong gamma (gamma = 4 gives a 11% slower sound), P_inf or density
+   * update would break. */
+  ok &= row("front speed, 0.7 m to 0.9 m, m/s (a)", speed, a, 0, 0.01);
+  /* The arrival time also holds the start, where the step is spread over
+   * a cell: measured 4.5e-3 late (1 us, 0.36 cell).  Bound 2%. */
+  ok &= row("front arrival at 0.9 m, ms ((0.9 - 0.5) / a)", 1e3 * pr.t_cross[1],
+            1e3 * (pr.x[1] - x0) / a, 0, 0.02);
+  info("  exact front (weak shock) speed, m/s", speed, ex.s_right_head);
+  /* Behind the front, at the first probe, the star state of the exact
+   * Riemann solution (a stiffened gas is an ideal gas in p + P_inf):
+   * measured within 6e-4 of the jump and of u*.  Bound 2%. */
   ok &= row("pressure behind the front, Pa (exact p*)", p_behind,
-            ex.p_star - fl->p_inf, jump, 0.05);
-  ok &= row("velocity behind the front, m/s (exact u*)", u_behind, ex.u_star,
-            0, 0.05);
-  ok &= row("overshoot of the probes / jump", (pr.p_max - pR) / jump, 1, 0,
-            0.1);
-  ok &= row("particle-steps at the iteration cap", sim->iter_capped_total, 0,
-            1, 0);
+            ex.p_star - fl->p_inf, jump, 0.02);
+  ok &= row("velocity behind the front, m/s (exact u*)", u_behind, ex.u_star, 0,
+            0.02);
+  /* The artificial viscosity keeps the front monotone: the largest
+   * pressure seen at the probes, over the jump it should reach, measured
+   * 0.9994 (no overshoot).  Bound 5%. */
+  ok &= row("largest probe pressure rise / jump", (pr.p_max - pR) / jump, 1, 0,
+            0.05);
+  ok &= row("particle-steps at the iteration cap", sim->iter_capped_total, 0, 1,
+            0);
+  /* Energy: the walls do no work, so kinetic + internal is constant.  The
+   * iteration converges to the end-of-step pressure (a backward Euler step
+   * of the energy), which misplaces an O(dt) share of the energy
+   * exchanged: +2.1% of the kinetic energy at dt_safety 0.5, +1.05% at
+   * 0.25, +0.52% at 0.125 (the non-iterative update, from the
+   * start-of-step stress: -2.3%).  A method property; bound 3%. */
+  double ke, se, ie;
+  mpm_energies(sim, &ke, &se, &ie);
+  double imbalance = ke + se + ie + sim->dissipated - sim->external_work - e0;
+  ok &= row("energy imbalance / kinetic energy", imbalance / ke, 0, 1, 0.03);
   fflush(stdout);
   mpm_model_destroy(sim);
   pm_scene_destroy(s);
