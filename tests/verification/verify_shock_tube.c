@@ -122,13 +122,14 @@ static void run_tube(const char *update, double h, tube_result *out, FILE *csv,
     if (csv)
       fprintf(csv, "%.8g,%.8g,%.8g,%.8g,%.8g\n", x, q[0], q[1], q[2], q[3]);
     /* Shock: the last downward crossing of the mid density; contact: the
-     * upward crossing of its mid density right of the rarefaction tail. */
+     * first crossing of its mid density right of the rarefaction tail. */
     if (isfinite(prev_rho)) {
       if (prev_rho >= rho_shock_mid && q[0] < rho_shock_mid)
         out->x_shock = prev_x + (x - prev_x) * (prev_rho - rho_shock_mid) /
                                     (prev_rho - q[0]);
-      if (x > tail && prev_rho < rho_contact_mid && q[0] >= rho_contact_mid &&
-          !isfinite(out->x_contact))
+      if (x > tail && !isfinite(out->x_contact) &&
+          (prev_rho - rho_contact_mid) * (q[0] - rho_contact_mid) <= 0 &&
+          prev_rho != q[0])
         out->x_contact = prev_x + (x - prev_x) * (rho_contact_mid - prev_rho) /
                                       (q[0] - prev_rho);
     }
