@@ -30,11 +30,9 @@ double pm_nrmse_vector(long n, unsigned mask, const double *u,
     lo = fmin(lo, r);
     hi = fmax(hi, r);
   }
+  (void)lo;
   if (!(hi > 0) || n <= 0) return NAN;
-  /* A field of nearly uniform magnitude (a rigid translation) has no
-   * range to speak of: use its largest magnitude instead. */
-  double scale = hi - lo > 1e-6 * hi ? hi - lo : hi;
-  return sqrt(sum / (double)n) / scale;
+  return sqrt(sum / (double)n) / hi;
 }
 
 double pm_convergence_rate(int n, const double *h, const double *err) {

@@ -12,9 +12,10 @@
 double pm_nrmse(long n, int stride, const double *u, const double *ref);
 
 /* The same for a vector field of n points ([n][3]; components not in mask
- * are ignored): sqrt(sum_j |u_j - r_j|^2 / n) / (max_j |r_j| - min_j |r_j|),
- * or over max_j |r_j| when the range is below 1e-6 of it (a field of
- * uniform magnitude such as a rigid translation).  NaN if r is zero. */
+ * are ignored), over the largest magnitude of the reference:
+ * sqrt(sum_j |u_j - r_j|^2 / n) / max_j |r_j|.  (That is the range of |r|
+ * whenever some point of the reference is at rest, as on a held face; and
+ * it stays meaningful for a rigid translation.)  NaN if r is zero. */
 double pm_nrmse_vector(long n, unsigned mask, const double *u,
                        const double *ref);
 

@@ -550,7 +550,7 @@ static pm_err check_nonneg(const pm_sdoc *d, const char *path, double v) {
 /* ---- conversion ------------------------------------------------------- */
 
 static pm_err build_domain(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
-  char p[PM_SDOC_PATH], what[64];
+  char p[PM_SDOC_PATH], what[128];
   if (r->dimension != 2 && r->dimension != 3)
     return pm_sdoc_expected(d, "dimension", "2 or 3");
   s->dimension = (int)r->dimension;
@@ -573,6 +573,18 @@ static pm_err build_domain(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   }
   s->mesh_size = r->discretization.mesh_size;
   PM_CALL(check_positive(d, "discretization.mesh_size", s->mesh_size));
+  if (s->method != PM_METHOD_FPM)
+    for (int c = 0; c < s->dimension; c++) {
+      /* MPM: the box faces are grid planes, where conditions act. */
+      double cells = (s->box_max[c] - s->box_min[c]) / s->mesh_size;
+      if (fabs(cells - round(cells)) > 1e-6 * cells) {
+        snprintf(what, sizeof what,
+                 "a cell size that divides domain.box (%g m along %c: %.4g "
+                 "cells)",
+                 s->box_max[c] - s->box_min[c], "xyz"[c], cells);
+        return pm_sdoc_expected(d, "discretization.mesh_size", what);
+      }
+    }
   return PM_SUCCESS;
 }
 
@@ -615,8 +627,12 @@ static pm_err build_fluid(const pm_scene *s, const pm_sdoc *d, int i,
   PM_CALL(check_nonneg(d, p, f->p_inf));
   PM_CALL(
       check_nonneg(d, path_fmt(p, "materials.%d.viscosity", i), f->viscosity));
-  PM_CALL(check_nonneg(d, path_fmt(p, "materials.%d.bulk_viscosity", i),
-                       f->bulk_viscosity));
+  /* lambda >= -2 mu / 3: a non-negative bulk viscosity lambda + 2 mu / 3
+   * (Stokes' condition is lambda = -2 mu / 3). */
+  if (!(f->bulk_viscosity >= -2.0 / 3.0 * f->viscosity * (1 + 1e-12)))
+    return pm_sdoc_expected(d, path_fmt(p, "materials.%d.bulk_viscosity", i),
+                            "a number >= -2/3 viscosity (Stokes: -2/3 "
+                            "viscosity)");
   return PM_SUCCESS;
 }
 

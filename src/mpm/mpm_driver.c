@@ -12,7 +12,7 @@
 #include "pm_output.h"
 #include "pm_tensor.h"
 
-#define MPM_HIST_MAX 64
+#define MPM_HIST_MAX 128
 
 const char *mpm_status_name(mpm_status s) {
   switch (s) {
@@ -65,13 +65,19 @@ typedef struct {
   int reaction_bc[MPM_HIST_MAX];
   int reaction_comp[MPM_HIST_MAX];
   int col_internal, col_iter, col_nrmse;
+  bool overflow;    /* more history columns than MPM_HIST_MAX */
+  int iter_max_row; /* energy iterations since the last row */
+  long iter_capped_prev;
   double *scratch; /* 9 n */
   double *ref;     /* 3 n or NULL */
   double t_start;
 } run_ctx;
 
 static void add_col(run_ctx *c, const char *name) {
-  if (c->n_hist >= MPM_HIST_MAX) return;
+  if (c->n_hist >= MPM_HIST_MAX) {
+    c->overflow = true;
+    return;
+  }
   snprintf(c->names_buf[c->n_hist], sizeof c->names_buf[0], "%s", name);
   c->names[c->n_hist] = c->names_buf[c->n_hist];
   c->reaction_bc[c->n_hist] = -1;
@@ -122,7 +128,7 @@ static void setup_history(run_ctx *c) {
 static void fill_reference(run_ctx *c, double t) {
   const mpm_sim *sim = c->run->sim;
   const pm_scene *s = c->run->scene;
-  PM_OMP(parallel for schedule(static))
+  /* Serial: an expression is not thread-safe. */
   for (long p = 0; p < sim->n; p++) {
     const double *X = sim->x0 + 3 * p;
     for (int k = 0; k < 3; k++)
@@ -176,8 +182,11 @@ static pm_err write_history_row(run_ctx *c) {
   row[k++] = r->energy_error;
   row[k++] = sim->residual;
   if (c->col_iter >= 0) {
-    row[k++] = sim->iter_max_step;
-    row[k++] = (double)sim->iter_capped_step;
+    /* Over the steps since the previous row. */
+    row[k++] = c->iter_max_row;
+    row[k++] = (double)(sim->iter_capped_total - c->iter_capped_prev);
+    c->iter_capped_prev = sim->iter_capped_total;
+    c->iter_max_row = 0;
   }
   for (; k < c->n_hist && c->reaction_bc[k] >= 0; k++)
     row[k] = sim->bcs[c->reaction_bc[k]].reaction[c->reaction_comp[k]];
@@ -372,6 +381,11 @@ pm_err mpm_run_go(mpm_run *r, const char *out_dir, bool quiet) {
   PM_TRY(PM_ALLOC(c->scratch, 9 * sim->n, "output buffer"));
   if (s->reference_mask) PM_TRY(PM_ALLOC(c->ref, 3 * sim->n, "reference"));
   setup_history(c);
+  PM_ENSURE(!c->overflow, PM_ERR_SCENE,
+            "%s: boundary: expected at most %d history columns (reactions "
+            "of every prescribed component), got more: merge boundary "
+            "entries",
+            s->path, MPM_HIST_MAX);
   if (out_dir) {
     PM_TRY(pm_mkdir_p(out_dir));
     PM_TRY(pm_results_create(out_dir, sim->dim, sim->n, sim->x0, 0, 1, NULL,
@@ -401,6 +415,8 @@ pm_err mpm_run_go(mpm_run *r, const char *out_dir, bool quiet) {
     }
     run_err = mpm_step(sim);
     if (run_err) break;
+    if (sim->iter_max_step > c->iter_max_row)
+      c->iter_max_row = sim->iter_max_step;
     if (s->time.qs != PM_QS_NONE && sim->t >= t_load && sim->step > 10 &&
         sim->residual < s->time.qs_tolerance) {
       converged = true;
@@ -511,7 +527,11 @@ pm_err mpm_run_plan(mpm_run *r, FILE *out) {
   fprintf(out, "particles    %ld (%d x %d x %d per cell)\n", sim->n,
           s->mpm.ppc[0], s->mpm.ppc[1], sim->dim == 3 ? s->mpm.ppc[2] : 1);
   size_t common = mpm_particle_bytes_common();
-  size_t bytes = mpm_grid_bytes(g) + common * (size_t)sim->n;
+  /* Particles, grid, and the run's output buffers (9 n, and 3 n for a
+   * reference field). */
+  size_t out_bytes =
+      sizeof(double) * (size_t)sim->n * (s->reference_mask ? 12 : 9);
+  size_t bytes = mpm_grid_bytes(g) + common * (size_t)sim->n + out_bytes;
   for (int gi = 0; gi < sim->n_groups; gi++) {
     const mpm_group *gr = &sim->group[gi];
     size_t own = mpm_group_bytes_per_particle(gr);
@@ -543,12 +563,15 @@ pm_err mpm_run_plan(mpm_run *r, FILE *out) {
   double steps = ceil(s->time.end / sim->dt);
   if (s->time.max_steps > 0 && steps > s->time.max_steps)
     steps = (double)s->time.max_steps;
-  fprintf(out, "steps        %.0f to t = %g s%s\n", steps, s->time.end,
-          s->time.qs != PM_QS_NONE ? " (at most: stops when converged)" : "");
+  fprintf(out, "steps        %.0f to t = %g s%s%s\n", steps, s->time.end,
+          s->time.qs != PM_QS_NONE ? " (at most: stops when converged)" : "",
+          sim->dt_fixed > 0 ? ""
+                            : " (at the first step's dt; the step adapts)");
   fprintf(out,
           "memory       %.1f MiB (grid %.1f MiB with %d thread "
-          "accumulators)\n",
-          bytes / 1048576.0, mpm_grid_bytes(g) / 1048576.0, g->threads);
+          "accumulators, output buffers %.1f MiB)\n",
+          bytes / 1048576.0, mpm_grid_bytes(g) / 1048576.0, g->threads,
+          out_bytes / 1048576.0);
   /* Time a few steps (the state is advanced: a plan is not run after). */
   double t0 = pm_wtime();
   int reps = 0;

@@ -93,8 +93,9 @@ typedef struct {
   char detail[160]; /* what it does, for the plan */
 } mpm_stage;
 
-#define MPM_MAX_STAGES 24
 #define MPM_MAX_GROUPS 16
+/* Fixed stages (at most 11) and one stress stage per group. */
+#define MPM_MAX_STAGES (12 + MPM_MAX_GROUPS)
 
 /* A numerical failure found inside a stage. */
 typedef struct {

@@ -43,11 +43,11 @@ static inline void wave_speeds(const mpm_sim *sim, const mpm_group *g, long p,
     *cp = pm_eos_sound_speed(&g->fluid_props, g->rho[k], g->pressure[k]);
     *cs = 0;
   } else {
-    /* Density follows the volume: rho = rho0 / J. */
-    double J = sim->vol[p] / sim->vol0[p];
-    double s = J > 0 ? sqrt(J) : 1.0;
-    *cp = g->solid.wave_speed * s;
-    *cs = sqrt(g->solid.mu / g->solid.density) * s;
+    /* The particle's own density (a body may set it), which follows its
+     * volume. */
+    double rho = sim->mass[p] / sim->vol[p];
+    *cp = sqrt((g->solid.lambda + 2 * g->solid.mu) / rho);
+    *cs = sqrt(g->solid.mu / rho);
   }
 }
 
@@ -116,7 +116,11 @@ static void p2g_mode(mpm_sim *sim, int mode) {
       }
     }
     PM_OMP(barrier)
-    const int T = g->threads;
+#ifdef _OPENMP
+    const int T = omp_get_num_threads();
+#else
+    const int T = 1;
+#endif
     PM_OMP(for schedule(static))
     for (long i = 0; i < nn; i++) {
       double sum[MPM_ACC_BASE + 2] = {0};
@@ -612,8 +616,9 @@ static void stage_stress_solid(mpm_sim *sim, int gi) {
                            J;
     }
     if (av) {
-      double q = pm_artificial_viscosity(gr->c0, gr->c1, mat->density / J, h,
-                                         mat->wave_speed, trD);
+      double rho = sim->mass[p] / sim->vol[p];
+      double q = pm_artificial_viscosity(
+          gr->c0, gr->c1, rho, h, sqrt((mat->lambda + 2 * mat->mu) / rho), trD);
       gr->q[k] = q;
       sig[0] -= q;
       sig[4] -= q;
@@ -687,15 +692,16 @@ static void stage_stress_fluid(mpm_sim *sim, int gi) {
     } else {
       itmax = itmax > 1 ? itmax : 1;
     }
-    if (!(e + fl->gamma * fl->p_inf / ((fl->gamma - 1) * rho) >= 0) ||
-        !isfinite(e)) {
+    if (!iterative) P = pm_eos_pressure(fl, rho, e);
+    if (!(P + fl->p_inf > 0) || !isfinite(e)) {
+      /* No real sound speed: the state has left the equation of state
+       * (cavitation, or an energy driven negative). */
       fail_at(sim, p,
-              "internal energy %g J/kg is below the EOS minimum (rho "
-              "= %g kg/m^3)",
-              e, rho);
+              "pressure %g Pa <= -p_inf: no sound speed (internal energy %g "
+              "J/kg)",
+              P, e);
       continue;
     }
-    if (!iterative) P = pm_eos_pressure(fl, rho, e);
     gr->rho[k] = rho;
     gr->energy[k] = e;
     gr->pressure[k] = P;
@@ -719,17 +725,17 @@ double mpm_stable_dt(const mpm_sim *sim) {
   double worst = 0; /* largest effective speed */
   for (int gi = 0; gi < sim->n_groups; gi++) {
     const mpm_group *gr = &sim->group[gi];
-    double nu = 0;
-    if (gr->fluid)
-      nu = (2 * gr->fluid_props.viscosity +
-            fabs(gr->fluid_props.bulk_viscosity)) /
-           gr->fluid_props.density;
+    /* Dynamic viscosity of the viscous term; over the particle's density. */
+    double mu_v = gr->fluid ? 2 * gr->fluid_props.viscosity +
+                                  fabs(gr->fluid_props.bulk_viscosity)
+                            : 0.0;
     double w = 0;
     PM_OMP(parallel for schedule(static) reduction(max : w))
     for (long p = gr->begin; p < gr->end; p++) {
       double cp, cs;
       wave_speeds(sim, gr, p, &cp, &cs);
       const double *v = sim->v + 3 * p;
+      double nu = mu_v * sim->vol[p] / sim->mass[p];
       double Q = gr->c1 * cp + gr->c0 * h * div + 2.0 * nu / h;
       double speed = Q + sqrt(Q * Q + cp * cp) +
                      sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
@@ -743,6 +749,13 @@ double mpm_stable_dt(const mpm_sim *sim) {
 static void stage_time_step(mpm_sim *sim, int arg) {
   (void)arg;
   sim->dt_stable = mpm_stable_dt(sim);
+  if (!isfinite(sim->dt_stable)) {
+    fail_at(sim, 0,
+            "no stable step: no particle has a wave speed or a velocity "
+            "(%g; %g)",
+            sim->dt_stable, sim->t);
+    return;
+  }
   sim->dt = sim->dt_stable;
   double left = sim->scene->time.end - sim->t;
   if (left > 0 && sim->dt > left) sim->dt = left;
@@ -781,6 +794,7 @@ void mpm_energies(const mpm_sim *sim, double *kinetic, double *strain,
 
 static mpm_stage *add(mpm_sim *sim, const char *name, mpm_stage_fn fn,
                       int arg) {
+  PM_ASSERT(sim->n_stages < MPM_MAX_STAGES);
   mpm_stage *st = &sim->stage[sim->n_stages++];
   st->fn = fn;
   st->arg = arg;
