@@ -38,6 +38,7 @@ size_t mpm_grid_bytes(const mpm_grid *g) {
   per_node += (size_t)g->threads * g->acc_stride;
   size_t bytes = per_node * sizeof(double) * (size_t)g->n_nodes;
   if (g->owner) bytes += 3 * sizeof(short) * (size_t)g->n_nodes;
+  if (g->fold) bytes += 6 * sizeof(double) * (size_t)g->n_nodes;
   return bytes;
 }
 
@@ -405,8 +406,11 @@ pm_err mpm_model_create(const pm_scene *s, mpm_sim **out) {
                   "per-thread grid accumulators"));
   if (sim->has_absorbing)
     PM_TRY(PM_ALLOC(g->impedance, 2 * g->n_nodes, "grid impedances"));
-  if (sim->n_bcs > 0)
+  if (sim->n_bcs > 0) {
     PM_TRY(PM_ALLOC(g->owner, 3 * g->n_nodes, "constrained dof owners"));
+    PM_TRY(PM_ALLOC(g->fold, 3 * g->n_nodes, "folded condition forces"));
+    PM_TRY(PM_ALLOC(g->fold_out, 3 * g->n_nodes, "folded condition forces"));
+  }
   if (s->time.qs == PM_QS_DYNAMIC_RELAXATION)
     PM_TRY(PM_ALLOC(g->force_prev, 3 * g->n_nodes, "previous grid forces"));
   sim->dt_fixed = s->time.dt;
@@ -438,6 +442,8 @@ void mpm_model_destroy(mpm_sim *sim) {
   free(g->impedance);
   free(g->force_prev);
   free(g->owner);
+  free(g->fold);
+  free(g->fold_out);
   for (int k = 0; k < sim->n_groups; k++) {
     mpm_group *gr = &sim->group[k];
     free(gr->F);

@@ -67,6 +67,9 @@ typedef struct {
   short *owner;       /* 3 per node: the condition that set the dof this step,
                          -(b + 1) prescribed, b + 1 reflected, 0 free (with
                          boundary conditions) */
+  double *fold;       /* 3 per node: forces of the conditions' dependent dofs
+                         moved onto the dofs they follow (their anchors) */
+  double *fold_out;   /* 3 per node: the force a dependent dof moved out */
 } mpm_grid;
 
 /* A boundary condition on a face, as grid columns normal to the face. */

@@ -175,14 +175,34 @@ static double bc_wall(const mpm_sim *sim, const mpm_bc *bc,
                          pm_expr_eval(sb->disp[a], x[0], x[1], x[2], sim->t);
 }
 
-/* Set the prescribed components of vel on every node at or beyond each
- * face's current wall.  With mark, record in g->owner which condition set
- * each dof (-(b + 1) prescribed, b + 1 reflected; a prescription wins over
- * a reflection). */
-static void apply_bcs_once(mpm_sim *sim, double *vel, bool mark) {
+/* The dependent dofs of the conditions.  On each column of a face, a node
+ * at or beyond the face's current wall is set from one free node of the
+ * column (its anchor), v = T v_anchor + (1 - T) v_b:
+ *  - prescribed components: the line through the anchor's velocity and the
+ *    prescribed value at the wall, so a linear field stays linear through
+ *    the wall wherever it is.  The anchor is the first inside node at least
+ *    h/2 from the wall (nearer, the line's slope would amplify the anchor's
+ *    noise); a node inside the wall but nearer than h/2 is then set too.
+ *    On a wall at a node plane this is the odd reflection v = 2 v_b - v_in.
+ *  - free components of a wall (normal prescribed): the first inside
+ *    node's, as at a plane of symmetry (T = 1), beyond the wall.
+ * With fold, instead of setting vel, the dependent dofs' forces are moved
+ * onto their anchors (f_anchor += T f): the free dofs then carry the
+ * shape functions of the constrained space, S_anchor + T S_ghost, and the
+ * internal force is its Galerkin force (without it, a free node whose
+ * support crosses the wall misses the ghost's share and feels the stress
+ * at the wall as a spurious load).  With mark, record in g->owner which
+ * condition set each dof (-(b + 1) prescribed, b + 1 reflected; a
+ * prescription wins over a reflection). */
+static void apply_bcs_once(mpm_sim *sim, double *vel, bool mark,
+                           const double *force, double *fold) {
   const pm_scene *s = sim->scene;
   mpm_grid *g = &sim->grid;
-  for (int b = 0; b < sim->n_bcs; b++) {
+  const double eps = 1e-9 * g->h;
+  /* Folding visits the faces in reverse: a dof set by two faces follows
+   * the last one's rule, as its velocity does. */
+  for (int bb = 0; bb < sim->n_bcs; bb++) {
+    int b = fold ? sim->n_bcs - 1 - bb : bb;
     mpm_bc *bc = &sim->bcs[b];
     const pm_scene_bc *sb = &s->bcs[bc->bc];
     unsigned mask = bc->disp_mask | bc->vel_mask;
@@ -209,46 +229,59 @@ static void apply_bcs_once(mpm_sim *sim, double *vel, bool mark) {
       }
       x[a] = bc->plane;
       double v[3] = {0, 0, 0};
-      for (int c = 0; c < 3; c++)
-        if (mask >> c & 1u)
-          v[c] = bc->constant[c] ? vconst[c] : bc_velocity(sim, sb, c, x);
+      if (!fold)
+        for (int c = 0; c < 3; c++)
+          if (mask >> c & 1u)
+            v[c] = bc->constant[c] ? vconst[c] : bc_velocity(sim, sb, c, x);
       double wall = bc->constant[a] ? wall_const : bc_wall(sim, bc, sb, x);
-      /* The nodes at or beyond the wall, and the first inside it. */
+      /* The first node inside the wall, and the anchor of the prescribed
+       * components. */
       long ia_face = (long)llround((bc->plane - g->origin[a]) * g->inv_h);
       long i_start = bc->outward > 0 ? g->nn[a] - 1 : 0;
       long di = bc->outward > 0 ? -1 : 1;
+#define DIST(i) ((g->origin[a] + (i)*g->h - wall) * bc->outward)
+#define INSIDE(i) ((i) >= 0 && (i) < g->nn[a])
+#define NODE(i) (col + ((i)-ia_face) * step_a)
       long i_in = i_start;
-      while (i_in >= 0 && i_in < g->nn[a] &&
-             (g->origin[a] + i_in * g->h - wall) * bc->outward >= -1e-9 * g->h)
-        i_in += di;
+      while (INSIDE(i_in) && DIST(i_in) >= -eps) i_in += di;
+      long i_an = i_in;
+      if (INSIDE(i_an) && DIST(i_an) > -0.5 * g->h) i_an += di;
       /* The inside nodes count only where material is (a node without
        * mass has no velocity to extend). */
-      long n_in = col + (i_in - ia_face) * step_a;
-      bool has_in = i_in >= 0 && i_in < g->nn[a] && g->mass[n_in] > 0;
-      for (long i = i_start; i != i_in; i += di) {
-        long node = col + (i - ia_face) * step_a;
-        /* Distance beyond the wall.  Prescribed components are reflected
-         * oddly about the prescribed value, v = 2 v_b - v_in, with v_in the
-         * first inside node's: on a wall at a node plane that node is the
-         * ghost's mirror, so a linear field stays linear through the wall.
-         * Free components of a wall (normal prescribed) are reflected
-         * evenly, as at a plane of symmetry.  (Extrapolating the inside
-         * field to the exact mirror point of a moving wall was tried: it
-         * is unstable where few particles reach the inside nodes.) */
-        double d = (g->origin[a] + i * g->h - wall) * bc->outward;
+      long n_in = NODE(i_in), n_an = NODE(i_an);
+      bool has_in = INSIDE(i_in) && g->mass[n_in] > 0;
+      bool has_an = INSIDE(i_an) && g->mass[n_an] > 0;
+      double d_an = INSIDE(i_an) ? DIST(i_an) : -g->h;
+      long i_end = INSIDE(i_an) ? i_an : i_in;
+      for (long i = i_start; i != i_end; i += di) {
+        long node = NODE(i);
+        double d = DIST(i);
         double m = g->mass[node];
         for (int c = 0; c < 3; c++) {
           bool fixed = mask >> c & 1u;
-          if (!fixed && !(mask >> a & 1u)) continue;
-          if (!fixed && !has_in) continue;
-          double vm = has_in ? vel[3 * n_in + c] : fixed ? v[c] : 0;
-          double vset;
-          if (fixed)
-            vset = d > 1e-9 * g->h ? 2 * v[c] - vm : v[c];
-          else if (d > 1e-9 * g->h)
-            vset = vm;
-          else
+          long anchor;
+          double T;
+          if (fixed) {
+            /* v = v_an + (d - d_an) / -d_an (v_b - v_an) */
+            anchor = has_an && fabs(d) > eps ? n_an : -1;
+            T = anchor >= 0 ? 1.0 - (d - d_an) / -d_an : 0.0;
+          } else {
+            if (!(mask >> a & 1u) || !has_in || d <= eps) continue;
+            anchor = n_in;
+            T = 1.0;
+          }
+          if (fold) {
+            short *o = &g->owner[3 * node + c];
+            if (*o) continue; /* folded by a later face */
+            *o = 1;
+            if (anchor < 0 || m <= 0) continue;
+            double f = T * (force[3 * node + c] + fold[3 * node + c]);
+            fold[3 * anchor + c] += f;
+            g->fold_out[3 * node + c] = f;
             continue;
+          }
+          double vset =
+              anchor >= 0 ? T * vel[3 * anchor + c] + (1.0 - T) * v[c] : v[c];
           if (mark && m > 0) {
             short *o = &g->owner[3 * node + c];
             if (fixed)
@@ -259,22 +292,40 @@ static void apply_bcs_once(mpm_sim *sim, double *vel, bool mark) {
           vel[3 * node + c] = vset;
         }
       }
+#undef DIST
+#undef INSIDE
+#undef NODE
     }
   }
+}
+
+/* The forces of the dependent dofs moved onto their anchors (see
+ * apply_bcs_once), into g->fold. */
+static void fold_bcs(mpm_sim *sim) {
+  mpm_grid *g = &sim->grid;
+  size_t n3 = 3 * (size_t)g->n_nodes;
+  memset(g->fold, 0, n3 * sizeof(double));
+  memset(g->fold_out, 0, n3 * sizeof(double));
+  if (sim->n_bcs == 0) return;
+  memset(g->owner, 0, n3 * sizeof(short));
+  apply_bcs_once(sim, NULL, false, g->force, g->fold);
 }
 
 /* The conditions, twice: where two faces meet, one face's mirror reads
  * nodes the other sets, so the second pass sees them set.  With
  * reactions, then one pass over the constrained dofs: the force each
- * condition applies, R = m (v - v0) / dt - f, counted once per dof (to the
- * condition that prescribes it, else the one that reflects it), and its
- * work R (v0 + v) / 2 dt. */
+ * condition applies, R = m (v - v0) / dt - f - f_in + f_out, with f_in the
+ * force folded onto the dof and f_out the force it folded onto its anchor
+ * (the anchors' share of the internal force, not a reaction), counted
+ * once per dof (to the condition that prescribes it, else the one that
+ * reflects it); and the work of the conditions, m (v - v0) / dt - f times
+ * (v0 + v) / 2 dt, over the constrained dofs and the anchors. */
 static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
   mpm_grid *g = &sim->grid;
   if (sim->n_bcs == 0) return;
   if (reactions) memset(g->owner, 0, 3 * sizeof(short) * (size_t)g->n_nodes);
-  apply_bcs_once(sim, vel, false);
-  apply_bcs_once(sim, vel, reactions);
+  apply_bcs_once(sim, vel, false, NULL, NULL);
+  apply_bcs_once(sim, vel, reactions, NULL, NULL);
   if (!reactions) return;
   for (int b = 0; b < sim->n_bcs; b++)
     for (int c = 0; c < 3; c++) sim->bcs[b].reaction[c] = 0;
@@ -282,10 +333,14 @@ static void apply_bcs(mpm_sim *sim, double *vel, bool reactions) {
   const double dt = sim->dt;
   for (long i = 0; i < 3 * g->n_nodes; i++) {
     short o = g->owner[i];
-    if (!o) continue;
+    double fold = g->fold ? g->fold[i] : 0.0;
+    if (!o && fold == 0) continue;
     long node = i / 3;
+    if (!(g->mass[node] > 0)) continue;
     double R = g->mass[node] * (vel[i] - g->vel0[i]) / dt - g->force[i];
-    sim->bcs[(o > 0 ? o : -o) - 1].reaction[i % 3] += R;
+    if (o)
+      sim->bcs[(o > 0 ? o : -o) - 1].reaction[i % 3] +=
+          R - fold + (g->fold_out ? g->fold_out[i] : 0.0);
     work += R * 0.5 * (g->vel0[i] + vel[i]) * dt;
   }
   sim->external_work += work;
@@ -395,6 +450,8 @@ static void stage_grid_update(mpm_sim *sim, int arg) {
   mpm_grid *g = &sim->grid;
   const unsigned nul = sim->scene->mpm.null_velocity;
   const double dt = sim->dt;
+  const double *fold = g->fold;
+  if (fold) fold_bcs(sim);
   PM_OMP(parallel for schedule(static))
   for (long i = 0; i < g->n_nodes; i++) {
     double m = g->mass[i];
@@ -402,7 +459,8 @@ static void stage_grid_update(mpm_sim *sim, int arg) {
       double v0 = 0, v1 = 0;
       if (m > 0 && !(nul >> k & 1u)) {
         v0 = g->mom[3 * i + k] / m;
-        v1 = v0 + dt * g->force[3 * i + k] / m;
+        double f = g->force[3 * i + k] + (fold ? fold[3 * i + k] : 0.0);
+        v1 = v0 + dt * f / m;
       }
       g->vel0[3 * i + k] = v0;
       g->vel_new[3 * i + k] = v1;
@@ -434,7 +492,8 @@ static void stage_grid_update(mpm_sim *sim, int arg) {
     if (m <= 0) continue;
     for (int k = 0; k < 3; k++) {
       if (nul >> k & 1u) continue;
-      double f = g->force[3 * i + k] + c * m * g->vel0[3 * i + k];
+      double f = g->force[3 * i + k] + c * m * g->vel0[3 * i + k] +
+                 (fold ? fold[3 * i + k] : 0.0);
       f2 += f * f;
       if (!g->owner || !g->owner[3 * i + k]) r2 += f * f;
     }

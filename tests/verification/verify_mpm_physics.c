@@ -255,29 +255,23 @@ static void test_gravity_column(void **state) {
          sim->n, sim->step, sim->t, sim->residual, r->wall);
   bool ok = true;
   /* In equilibrium the floor takes all the weight but what the residual
-   * (1e-6 of the reactions) and the ghost nodes beyond the rollers (light,
-   * and set by reflection rather than in equilibrium: 3e-4 of the weight
-   * here) leave; the bound is the brief's 1%. */
-  ok &= row("floor reaction, N (weight M g)", R_floor[1], M * g, 0, 0.01);
-  /* A frictionless roller takes no weight.  Bound: 1e-3 of it, three
-   * times what the rollers' ghost nodes leave (3e-4). */
+   * (1e-6 of the reactions) leaves: measured 3.6e-6 of it.  Bound 1e-4. */
+  ok &= row("floor reaction, N (weight M g)", R_floor[1], M * g, 0, 1e-4);
+  /* A frictionless roller takes no weight: measured 3e-10 of it, with the
+   * ghost nodes' forces moved onto their anchors (3e-4 without).  Bound
+   * 1e-6, the residual tolerance. */
   ok &= row("vertical reaction of the rollers / M g",
-            (R_left[1] + R_right[1]) / (M * g), 0, 1, 1e-3);
+            (R_left[1] + R_right[1]) / (M * g), 0, 1, 1e-6);
   /* The mean over a row of particles is the equilibrium of the slab above
-   * it, exact whatever the discretization does across the row: measured
-   * 2.3e-4 of rho g H (the particle quadrature of the weight). */
+   * it: measured 4.3e-6 of rho g H.  Bound 1e-4. */
   ok &= row("max |row mean sigma_yy - exact| / rho g H, mid", row_err, 0, 1,
-            1e-3);
-  /* Particle by particle, the rollers leave a boundary layer two cells
-   * wide: the first interior node misses what the mirror images of the
-   * particles next to the wall would give it, and the particles in the
-   * first cell carry up to 2.1% of rho g H less compression (2.8% of the
-   * local stress), the next ones a little more.  It does not shrink with
-   * the cell (1.5% at h = H / 40, 2.1% at H / 80) nor with a wider column
-   * (2.1% at twice the width): a limitation of B-spline MPM at walls, not
-   * a convergence error.  Bound 2.5%. */
-  ok &= row("max |sigma_yy + rho g (H - Y)| / rho g H, mid", err_max, 0, 1,
-            0.025);
+            1e-4);
+  /* Particle by particle: with the ghost nodes' forces moved onto their
+   * anchors (the constrained shape functions), the walls leave no
+   * boundary layer: measured 4.3e-6 of rho g H (2.1% when the ghost
+   * forces were dropped).  Bound 1e-4. */
+  ok &=
+      row("max |sigma_yy + rho g (H - Y)| / rho g H, mid", err_max, 0, 1, 1e-4);
   /* The lateral stress, as a mean over the middle half: 0.12% off. */
   ok &= row("mean sigma_xx / sigma_yy, mid (nu / (1 - nu))", ratio_sum / n_mid,
             nu / (1 - nu), 0, 0.01);
