@@ -236,9 +236,11 @@ static pm_err run_mpm_level(const pm_scene *s, const char *out, bool quiet,
   fig->wall = r->wall;
   fig->setup = r->setup_wall;
   fig->nrmse = r->nrmse_vector;
-  fig->mean_sed = NAN;
-  fig->max_von_mises = NAN;
-  fig->min_jacobian = NAN;
+  mpm_field_figures ff;
+  mpm_run_field_figures(r, &ff);
+  fig->mean_sed = ff.mean_strain_energy_density;
+  fig->max_von_mises = ff.max_von_mises;
+  fig->min_jacobian = ff.min_jacobian; /* at the end of the run */
   fig->energy_error = r->energy_error;
   int bc, comp;
   loaded_face(s, &bc, &comp);

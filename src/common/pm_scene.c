@@ -958,9 +958,8 @@ static pm_err build_mpm(pm_scene *s, const pm_sdoc *d, const raw_scene *r) {
   }
   s->mpm.null_velocity = m->null_velocity;
   if (s->dimension == 2 && (m->null_velocity & 4u))
-    return pm_sdoc_expected(d, "mpm.null_velocity",
-                            "a list of x, y "
-                            "(dimension 2)");
+    return pm_sdoc_fail(d, "mpm.null_velocity", false,
+                        "expected a list of x, y (dimension 2), got z");
   s->mpm.energy_update = has(d, "mpm.fluid.energy_update")
                              ? (pm_energy_update)m->fluid.energy_update
                              : PM_ENERGY_ITERATIVE;

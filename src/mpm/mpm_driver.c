@@ -49,6 +49,36 @@ void mpm_run_destroy(mpm_run *r) {
   free(r);
 }
 
+void mpm_run_field_figures(const mpm_run *r, mpm_field_figures *ff) {
+  const mpm_sim *sim = r->sim;
+  double w = 0, v0 = 0;
+  *ff = (mpm_field_figures){.max_von_mises = 0,
+                            .max_von_mises_particle = -1,
+                            .min_jacobian = INFINITY,
+                            .min_jacobian_particle = -1};
+  for (int gi = 0; gi < sim->n_groups; gi++) {
+    const mpm_group *g = &sim->group[gi];
+    for (long p = g->begin; p < g->end; p++) {
+      double vm = pm_t_von_mises(sim->sigma + 9 * p);
+      if (vm > ff->max_von_mises) {
+        ff->max_von_mises = vm;
+        ff->max_von_mises_particle = p;
+      }
+      double J = sim->vol[p] / sim->vol0[p];
+      if (J < ff->min_jacobian) {
+        ff->min_jacobian = J;
+        ff->min_jacobian_particle = p;
+      }
+      if (!g->fluid) {
+        w += sim->vol0[p] *
+             pm_material_energy(&g->solid, g->F + 9 * (p - g->begin));
+        v0 += sim->vol0[p];
+      }
+    }
+  }
+  ff->mean_strain_energy_density = v0 > 0 ? w / v0 : NAN;
+}
+
 void mpm_reaction(const mpm_run *r, int b, double R[3]) {
   for (int c = 0; c < 3; c++) R[c] = r->sim->bcs[b].reaction[c];
 }
@@ -310,6 +340,15 @@ static pm_err write_summary(mpm_run *r, const char *out_dir) {
   PM_TRY(pm_json_number(j, "external_work", sim->external_work));
   PM_TRY(pm_json_number(j, "dissipated", sim->dissipated));
   PM_TRY(pm_json_number(j, "energy_balance_error", r->energy_error));
+  mpm_field_figures ff;
+  mpm_run_field_figures(r, &ff);
+  PM_TRY(pm_json_number(j, "mean_strain_energy_density",
+                        ff.mean_strain_energy_density));
+  PM_TRY(pm_json_number(j, "max_von_mises", ff.max_von_mises));
+  PM_TRY(
+      pm_json_integer(j, "max_von_mises_particle", ff.max_von_mises_particle));
+  PM_TRY(pm_json_number(j, "min_jacobian", ff.min_jacobian));
+  PM_TRY(pm_json_integer(j, "min_jacobian_particle", ff.min_jacobian_particle));
   PM_TRY(pm_json_number(j, "wall_seconds", r->wall));
   PM_TRY(pm_json_number(j, "setup_seconds", r->setup_wall));
   int threads = pm_omp_threads();

@@ -46,6 +46,18 @@ pm_err mpm_run_plan(mpm_run *r, FILE *out);
 
 const char *mpm_status_name(mpm_status s);
 
+/* Figures of the current fields: mean strain energy density of the solids
+ * (sum V0 W / sum V0, J/m^3), largest von Mises stress (Pa) and the
+ * particle it is at, smallest volume ratio J and its particle. */
+typedef struct {
+  double mean_strain_energy_density;
+  double max_von_mises;
+  long max_von_mises_particle;
+  double min_jacobian;
+  long min_jacobian_particle;
+} mpm_field_figures;
+void mpm_run_field_figures(const mpm_run *r, mpm_field_figures *ff);
+
 /* Reaction force on boundary condition b (last step), N. */
 void mpm_reaction(const mpm_run *r, int b, double R[3]);
 
