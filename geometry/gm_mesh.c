@@ -1,12 +1,13 @@
 /* gm_mesh: simplex meshes of a box or rectangle made with the gmsh C API,
  * meshes built from caller arrays, and their mean edge length. */
 #include "gm_dual.h"
-#include "pm_omp.h"
 
 #include <gmshc.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "gm_gmsh.h"
 
 /* Relative size below which a simplex counts as flat. */
 #define GM_FLAT_TOL 1e-12
@@ -121,51 +122,14 @@ done:
   return ret;
 }
 
-/* The last gmsh error as a PM_ERR_MESH failure naming what we were doing. */
-static pm_err gmsh_fail(const char *what) {
-  char *msg = NULL;
-  int ierr = 0;
-  gmshLoggerGetLastError(&msg, &ierr);
-  pm_err e = PM_ERROR(PM_ERR_MESH, "gmsh: %s failed: %s", what,
-                      (ierr == 0 && msg && msg[0]) ? msg : "(no message)");
-  if (msg) gmshFree(msg);
-  return e;
-}
-
 /* After a gmsh call: on failure record gmsh's message and leave. */
 #define GM_GMSH_CHECK(what)                                                    \
   do {                                                                         \
     if (ierr) {                                                                \
-      ret = gmsh_fail(what);                                                   \
+      ret = gm_gmsh_fail(what, NULL);                                          \
       goto done;                                                               \
     }                                                                          \
   } while (0)
-
-/* Options that make gmsh quiet, single-threaded and repeatable, with element
- * size h everywhere. */
-static pm_err gmsh_options(double h) {
-  static const struct {
-    const char *name;
-    double value;
-  } opts[] = {
-      {"General.Terminal", 0},
-      {"General.NumThreads", 1},
-      {"Mesh.RandomSeed", 1},
-      {"Mesh.MeshSizeFromPoints", 0},
-      {"Mesh.MeshSizeFromCurvature", 0},
-      {"Mesh.MeshSizeExtendFromBoundary", 1},
-  };
-  int ierr = 0;
-  for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
-    gmshOptionSetNumber(opts[i].name, opts[i].value, &ierr);
-    if (ierr) return gmsh_fail(opts[i].name);
-  }
-  gmshOptionSetNumber("Mesh.MeshSizeMin", h, &ierr);
-  if (ierr) return gmsh_fail("Mesh.MeshSizeMin");
-  gmshOptionSetNumber("Mesh.MeshSizeMax", h, &ierr);
-  if (ierr) return gmsh_fail("Mesh.MeshSizeMax");
-  return PM_SUCCESS;
-}
 
 /* Copy gmsh's nodes and elements into a fresh mesh, keeping only the nodes
  * that cells use, numbered 0.. in gmsh's node order. */
@@ -246,7 +210,8 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
 
   pm_err ret = PM_SUCCESS;
   gm_mesh *m = NULL;
-  int ierr = 0, initialized = 0, threads = 0;
+  int ierr = 0;
+  gm_gmsh_session session = {.threads = 0, .open = false};
   PM_TRY(PM_ALLOC(m, 1, "mesh"));
   m->dim = dim;
   m->nodes_per_cell = dim + 1;
@@ -255,13 +220,8 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
     m->box_max[k] = k < dim ? max[k] : 0.0;
   }
 
-  /* gmsh sets the process-wide OpenMP thread count from its own option:
-   * put ours back afterwards. */
-  threads = pm_omp_threads();
-  gmshInitialize(0, NULL, 0, &ierr);
-  GM_GMSH_CHECK("initialize");
-  initialized = 1;
-  PM_TRY(gmsh_options(h));
+  PM_TRY(gm_gmsh_begin(&session, NULL));
+  PM_TRY(gm_gmsh_size(h, NULL));
   gmshModelAdd("pointmech_box", &ierr);
   GM_GMSH_CHECK("model add");
   if (dim == 3)
@@ -283,8 +243,7 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
   *out = m;
   m = NULL;
 done:
-  if (initialized) gmshFinalize(&ierr);
-  if (threads > 0) pm_omp_set_threads(threads);
+  gm_gmsh_end(&session);
   gm_mesh_destroy(m);
   return ret;
 }

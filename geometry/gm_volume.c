@@ -1,7 +1,6 @@
 /* gm_volume: read (and if needed mesh) a solid with the gmsh C API, keep its
  * simplices as affine maps, and locate points through a bucket grid. */
 #include "gm_volume.h"
-#include "pm_omp.h"
 
 #include <errno.h>
 #include <gmshc.h>
@@ -11,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+
+#include "gm_gmsh.h"
 
 /* Barycentric slack: a point counts as inside when its distance outside a
  * face is below this fraction of the element's height over that face, so
@@ -52,68 +53,14 @@ void gm_volume_destroy(gm_volume *v) {
 
 /* ---- reading with gmsh ------------------------------------------------ */
 
-/* The last gmsh error as a PM_ERR_MESH failure naming what we were doing. */
-static pm_err gmsh_fail(const char *what, const char *path) {
-  char *msg = NULL;
-  int ierr = 0;
-  gmshLoggerGetLastError(&msg, &ierr);
-  pm_err e =
-      PM_ERROR(PM_ERR_MESH, "gmsh: %s '%s' failed: %s", what, path,
-               (ierr == 0 && msg && msg[0]) ? msg : "(no message from gmsh)");
-  if (msg) gmshFree(msg);
-  return e;
-}
-
 /* After a gmsh call: on failure record gmsh's message and leave. */
 #define GM_VOL_GMSH_CHECK(what)                                                \
   do {                                                                         \
     if (ierr) {                                                                \
-      ret = gmsh_fail(what, path);                                             \
+      ret = gm_gmsh_fail(what, path);                                          \
       goto done;                                                               \
     }                                                                          \
   } while (0)
-
-/* Quiet, single-threaded, repeatable gmsh (the options gm_mesh uses; gmsh
- * resets every option at gmshInitialize, so nothing leaks between us). */
-static pm_err gmsh_quiet(const char *path) {
-  static const struct {
-    const char *name;
-    double value;
-  } opts[] = {
-      {"General.Terminal", 0},
-      {"General.NumThreads", 1},
-      {"Mesh.RandomSeed", 1},
-  };
-  int ierr = 0;
-  for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
-    gmshOptionSetNumber(opts[i].name, opts[i].value, &ierr);
-    if (ierr) return gmsh_fail(opts[i].name, path);
-  }
-  return PM_SUCCESS;
-}
-
-/* Element size h everywhere.  Set after reading the file, so that h
- * overrides sizes the file itself sets. */
-static pm_err gmsh_size(double h, const char *path) {
-  static const struct {
-    const char *name;
-    double value;
-  } opts[] = {
-      {"Mesh.MeshSizeFromPoints", 0},
-      {"Mesh.MeshSizeFromCurvature", 0},
-      {"Mesh.MeshSizeExtendFromBoundary", 1},
-  };
-  int ierr = 0;
-  for (size_t i = 0; i < sizeof opts / sizeof opts[0]; i++) {
-    gmshOptionSetNumber(opts[i].name, opts[i].value, &ierr);
-    if (ierr) return gmsh_fail(opts[i].name, path);
-  }
-  gmshOptionSetNumber("Mesh.MeshSizeMin", h, &ierr);
-  if (ierr) return gmsh_fail("Mesh.MeshSizeMin", path);
-  gmshOptionSetNumber("Mesh.MeshSizeMax", h, &ierr);
-  if (ierr) return gmsh_fail("Mesh.MeshSizeMax", path);
-  return PM_SUCCESS;
-}
 
 /* Copy the corner coordinates of every element of dimension dim out of
  * gmsh: *corners gets 3 * (dim + 1) doubles per element (malloc'd). */
@@ -224,23 +171,17 @@ done:
 static pm_err gmsh_read(const char *path, int dim, double h, double **corners,
                         long *n) {
   pm_err ret = PM_SUCCESS;
-  int ierr = 0, initialized = 0, threads = 0;
+  int ierr = 0;
   int *types = NULL;
   size_t n_types = 0;
-
-  /* gmsh sets the process-wide OpenMP thread count from its own option:
-   * put ours back afterwards. */
-  threads = pm_omp_threads();
-  gmshInitialize(0, NULL, 0, &ierr);
-  GM_VOL_GMSH_CHECK("initializing for");
-  initialized = 1;
-  PM_TRY(gmsh_quiet(path));
+  gm_gmsh_session session = {.threads = 0, .open = false};
+  PM_TRY(gm_gmsh_begin(&session, path));
   gmshOpen(path, &ierr);
   GM_VOL_GMSH_CHECK("reading");
   gmshModelMeshGetElementTypes(&types, &n_types, dim, -1, &ierr);
   GM_VOL_GMSH_CHECK("listing the element types of");
   if (n_types == 0) {
-    if (h > 0.0) PM_TRY(gmsh_size(h, path));
+    if (h > 0.0) PM_TRY(gm_gmsh_size(h, path));
     gmshModelMeshGenerate(dim, &ierr);
     GM_VOL_GMSH_CHECK("meshing");
   }
@@ -255,8 +196,7 @@ static pm_err gmsh_read(const char *path, int dim, double h, double **corners,
   }
 done:
   if (types) gmshFree(types);
-  if (initialized) gmshFinalize(&ierr);
-  if (threads > 0) pm_omp_set_threads(threads);
+  gm_gmsh_end(&session);
   return ret;
 }
 
