@@ -456,3 +456,17 @@ done:
   free(j);
   return ret;
 }
+
+pm_err pm_json_run_header(pm_json *j, const char *scene_path, const char *name,
+                          const char *method, int n_overrides,
+                          char *const *overrides) {
+  PM_CALL(pm_json_string(j, "program", "pointmech"));
+  PM_CALL(pm_json_string(j, "version", PM_VERSION));
+  PM_CALL(pm_json_string(j, "scene", scene_path));
+  PM_CALL(pm_json_string(j, "name", name));
+  PM_CALL(pm_json_string(j, "method", method));
+  PM_CALL(pm_json_begin_array(j, "overrides"));
+  for (int k = 0; k < n_overrides; k++)
+    PM_CALL(pm_json_string(j, NULL, overrides[k]));
+  return pm_json_end_array(j);
+}

@@ -116,4 +116,11 @@ pm_err pm_json_null(pm_json *j, const char *key);
  * document (file discarded) or PM_ERR_IO from the commit. */
 pm_err pm_json_close(pm_json *j, bool commit);
 
+/* The opening members of a run's summary.json, the same for every method:
+ * program, version, scene (path), name, method and the --set overrides
+ * (n_overrides strings). */
+pm_err pm_json_run_header(pm_json *j, const char *scene_path, const char *name,
+                          const char *method, int n_overrides,
+                          char *const *overrides);
+
 #endif

@@ -361,15 +361,8 @@ static pm_err write_summary(fpm_sim *sim, const char *out_dir) {
   PM_TRY(pm_path_join(path, sizeof path, out_dir, "summary.json"));
   PM_TRY(pm_json_open(path, &j));
   PM_TRY(pm_json_begin_object(j, NULL));
-  PM_TRY(pm_json_string(j, "program", "pointmech"));
-  PM_TRY(pm_json_string(j, "version", PM_VERSION));
-  PM_TRY(pm_json_string(j, "scene", s->path));
-  PM_TRY(pm_json_string(j, "name", s->name));
-  PM_TRY(pm_json_string(j, "method", "fpm"));
-  PM_TRY(pm_json_begin_array(j, "overrides"));
-  for (int k = 0; k < s->n_overrides; k++)
-    PM_TRY(pm_json_string(j, NULL, s->overrides[k]));
-  PM_TRY(pm_json_end_array(j));
+  PM_TRY(pm_json_run_header(j, s->path, s->name, "fpm", s->n_overrides,
+                            s->overrides));
   PM_TRY(pm_json_string(j, "status", fpm_status_name(sim->status)));
   if (sim->message[0]) PM_TRY(pm_json_string(j, "message", sim->message));
   PM_TRY(pm_json_integer(j, "dimension", m->dim));
