@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "mpm_driver.h"
+#include "mpm_verify.h"
 #include "mpm_model.h"
 #include "pm_fluid.h"
 #include "pm_progress.h"
@@ -24,22 +25,6 @@
 #define CASES PM_SOURCE_DIR "/cases/mpm/"
 
 /* ---- helpers ------------------------------------------------------------ */
-
-static pm_scene *load_scene(const char *file, int n_sets,
-                            const char *const *sets) {
-  pm_scene *s = NULL;
-  if (pm_scene_load(file, n_sets, sets, &s) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
-  return s;
-}
-
-static bool state_finite(const mpm_sim *sim) {
-  for (long i = 0; i < 3 * sim->n; i++)
-    if (!isfinite(sim->x[i]) || !isfinite(sim->v[i])) return false;
-  for (long i = 0; i < 9 * sim->n; i++)
-    if (!isfinite(sim->sigma[i])) return false;
-  return true;
-}
 
 static mpm_run *create_run(const pm_scene *s) {
   mpm_run *r = NULL;

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 
 #include "mpm_driver.h"
+#include "mpm_verify.h"
 #include "mpm_model.h"
 #include "pm_progress.h"
 #include "pm_scene.h"
@@ -36,22 +37,6 @@
 /* NaN-safe: false when either value is NaN. */
 static bool close_to(double a, double b, double rtol, double atol) {
   return fabs(a - b) <= atol + rtol * fabs(b);
-}
-
-static pm_scene *load_scene(const char *file, int n_sets,
-                            const char *const *sets) {
-  pm_scene *s = NULL;
-  if (pm_scene_load(file, n_sets, sets, &s) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
-  return s;
-}
-
-static bool state_finite(const mpm_sim *sim) {
-  for (long i = 0; i < 3 * sim->n; i++)
-    if (!isfinite(sim->x[i]) || !isfinite(sim->v[i])) return false;
-  for (long i = 0; i < 9 * sim->n; i++)
-    if (!isfinite(sim->sigma[i])) return false;
-  return true;
 }
 
 /* A whole run through the driver (no output): it must complete with a finite
