@@ -11,8 +11,6 @@
 #include "pm_omp.h"
 #include "pm_tensor.h"
 
-void mpm_build_pipeline(mpm_sim *sim);
-
 /* ---- sizes -------------------------------------------------------------- */
 
 size_t mpm_particle_bytes_common(void) {

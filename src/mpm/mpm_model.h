@@ -179,8 +179,11 @@ void mpm_energies(const mpm_sim *sim, double *kinetic, double *strain,
 /* The grid basis of a particle at x. */
 void mpm_stencil_at(const mpm_grid *g, const double x[3], mpm_stencil *st);
 
-/* Stage functions exported for the tests. */
+/* Assemble sim->stage from the scene (called by mpm_model_create). */
+void mpm_build_pipeline(mpm_sim *sim);
+
+/* Particle to grid of mass and momentum, and with with_force the internal
+ * force (the first stage of USL/MUSL; used by the tests). */
 void mpm_p2g(mpm_sim *sim, int with_force);
-void mpm_g2p(mpm_sim *sim, int unused);
 
 #endif

@@ -12,8 +12,6 @@
 #include "pm_omp.h"
 #include "pm_tensor.h"
 
-void mpm_build_pipeline(mpm_sim *sim);
-
 enum { P2G_MASS = 1, P2G_MOM = 2, P2G_FORCE = 4 };
 
 static inline int thread_id(void) {
@@ -145,8 +143,6 @@ static void p2g_mode(mpm_sim *sim, int mode) {
 void mpm_p2g(mpm_sim *sim, int with_force) {
   p2g_mode(sim, P2G_MASS | P2G_MOM | (with_force ? P2G_FORCE : 0));
 }
-
-static void stage_p2g(mpm_sim *sim, int mode) { p2g_mode(sim, mode); }
 
 /* ---- boundary conditions on the grid ------------------------------------ */
 
@@ -524,7 +520,7 @@ static void stage_grid_velocity(mpm_sim *sim, int arg) {
 
 /* ---- grid to particle --------------------------------------------------- */
 
-void mpm_g2p(mpm_sim *sim, int arg) {
+static void stage_g2p(mpm_sim *sim, int arg) {
   (void)arg;
   const mpm_grid *g = &sim->grid;
   const double flip = sim->scene->mpm.flip, dt = sim->dt;
@@ -557,8 +553,6 @@ void mpm_g2p(mpm_sim *sim, int arg) {
               v[0] * v[0] + v[1] * v[1] + v[2] * v[2], v[0]);
   }
 }
-
-static void stage_g2p(mpm_sim *sim, int arg) { mpm_g2p(sim, arg); }
 
 /* MUSL: momentum remapped from the updated particle velocities. */
 static void stage_remap(mpm_sim *sim, int arg) {
@@ -924,17 +918,17 @@ void mpm_build_pipeline(mpm_sim *sim) {
              s->time.dt_safety);
   }
   if (s->mpm.update == PM_UPDATE_USF) {
-    st = add(sim, "p2g", stage_p2g, P2G_MASS | P2G_MOM);
+    st = add(sim, "p2g", p2g_mode, P2G_MASS | P2G_MOM);
     snprintf(st->detail, sizeof st->detail, "mass and momentum to the grid");
     st = add(sim, "grid velocity", stage_grid_velocity, 0);
     snprintf(st->detail, sizeof st->detail,
              "USF: velocities with conditions for the stress");
     add_stress(sim);
-    st = add(sim, "p2g force", stage_p2g, P2G_FORCE);
+    st = add(sim, "p2g force", p2g_mode, P2G_FORCE);
     snprintf(st->detail, sizeof st->detail, "internal forces to the grid%s",
              sim->has_absorbing ? ", impedances" : "");
   } else {
-    st = add(sim, "p2g", stage_p2g, P2G_MASS | P2G_MOM | P2G_FORCE);
+    st = add(sim, "p2g", p2g_mode, P2G_MASS | P2G_MOM | P2G_FORCE);
     snprintf(st->detail, sizeof st->detail,
              "mass, momentum and internal force to the grid%s",
              sim->has_absorbing ? ", impedances" : "");
