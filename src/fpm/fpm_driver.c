@@ -573,7 +573,7 @@ pm_err fpm_sim_plan(fpm_sim *sim, FILE *out) {
           sim->mesh->n_cells, sim->dual->n_ifaces, sim->dual->n_facets);
   fprintf(out, "pipeline     1. stress per point (");
   for (int k = 0; k < m->n_mats; k++)
-    fprintf(out, "%s%s", k ? ", " : "", pm_model_name(m->mats[k].model));
+    fprintf(out, "%s%s", k ? ", " : "", m->mats[k].model->name);
   fprintf(out,
           ")\n             2. interface flux (%s, penalty %g), %ld "
           "support entries\n",

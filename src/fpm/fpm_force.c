@@ -19,9 +19,12 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
                    *restrict J = st->J;
   const int *restrict mat = m->mat;
   const pm_material *mats = m->mats;
+  const double *ms = m->mstate;
+  const long mss = m->mstate_stride;
   long bad = n;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(n, ptr, nbr, g, u, H, P, W, J, mat, mats) reduction(min : bad))
+         shared(n, ptr, nbr, g, u, H, P, W, J, mat, mats, ms, mss)
+         reduction(min : bad))
   for (long i = 0; i < n; i++) {
     double h[9] = {0};
     const double u0 = u[3 * i], u1 = u[3 * i + 1], u2 = u[3 * i + 2];
@@ -48,7 +51,8 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
     F[0] += 1;
     F[4] += 1;
     F[8] += 1;
-    if (!pm_material_stress(&mats[mat[i]], F, P + 9 * i, W + i, J + i) &&
+    if (!pm_material_stress(&mats[mat[i]], F, ms ? ms + mss * i : NULL,
+                            P + 9 * i, W + i, J + i) &&
         i < bad)
       bad = i;
   }
@@ -76,10 +80,13 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
   double *restrict T = st->T, *restrict r = st->r;
   const int *restrict mat = m->mat;
   const pm_material *mats = m->mats;
+  const double *ms = m->mstate;
+  const long mss = m->mstate_stride;
   const bool sym = m->flux == PM_FLUX_SIPG;
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
-         shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat, mats, sym))
+         shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat, mats, ms,
+                mss, sym))
   for (long i = 0; i < n; i++) {
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
     double Q[9] = {0}, ri[3] = {0}, B[9] = {0};
@@ -128,7 +135,7 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
       F[0] += 1;
       F[4] += 1;
       F[8] += 1;
-      pm_material_stress_derivative(&mats[mat[i]], F, B, dP);
+      pm_material_tangent(&mats[mat[i]], F, ms ? ms + mss * i : NULL, B, dP);
       for (int k = 0; k < 9; k++) Q[k] += 0.5 * dP[k];
     }
     const double *A = pa + 3 * i, *Bm = pm + 9 * i;

@@ -23,6 +23,7 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->p_area);
   free(m->p_mrel);
   free(m->mat);
+  free(m->mstate);
   free(m->mass);
   free(m->dpt_point);
   free(m->dpt_area);
@@ -100,6 +101,18 @@ static pm_err assign_materials(fpm_model *m, const pm_scene *s) {
              i, m->x[3 * i], m->x[3 * i + 1], m->x[3 * i + 2]);
   for (long i = 0; i < m->n; i++)
     m->mass[i] = m->mats[m->mat[i]].density * m->dual->volume[i];
+  for (int k = 0; k < m->n_mats; k++)
+    if (m->mats[k].state_size > m->mstate_stride)
+      m->mstate_stride = m->mats[k].state_size;
+  if (m->mstate_stride == 0) return PM_SUCCESS;
+  PM_CALL(PM_ALLOC(m->mstate, (size_t)m->mstate_stride * m->n,
+                   "per-point material state"));
+  for (long i = 0; i < m->n; i++) {
+    const pm_material *mat = &m->mats[m->mat[i]];
+    pm_material_point pt = {.n_fibres = 0};
+    if (mat->model->state_init)
+      mat->model->state_init(mat, &pt, m->mstate + m->mstate_stride * i);
+  }
   return PM_SUCCESS;
 }
 
@@ -131,7 +144,8 @@ static void build_interfaces(fpm_model *m) {
       double h = sqrt((xk[0] - xi[0]) * (xk[0] - xi[0]) +
                       (xk[1] - xi[1]) * (xk[1] - xi[1]) +
                       (xk[2] - xi[2]) * (xk[2] - xi[2]));
-      double E = 0.5 * (m->mats[m->mat[i]].youngs + m->mats[m->mat[k]].youngs);
+      double E = 0.5 * (m->mats[m->mat[i]].youngs_modulus +
+                        m->mats[m->mat[k]].youngs_modulus);
       r[18] = m->penalty * E / h * d->if_area[f];
       r[19] = 0;
     }

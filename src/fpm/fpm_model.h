@@ -43,6 +43,9 @@ typedef struct {
   int n_mats;
   pm_material mats[FPM_MAX_MATERIALS];
   int *mat;       /* n: material of each point */
+  double *mstate; /* mstate_stride n: per-point state of the models that
+                     have one (fibre directions), or NULL when none has */
+  int mstate_stride;
   double *mass;   /* n: lumped mass rho V */
   double penalty; /* p */
   pm_flux flux;   /* IIPG or SIPG */

@@ -71,7 +71,7 @@ void mpm_run_field_figures(const mpm_run *r, mpm_field_figures *ff) {
       }
       if (!g->fluid) {
         w += sim->vol0[p] *
-             pm_material_energy(&g->solid, g->F + 9 * (p - g->begin));
+             pm_material_energy(&g->solid, g->F + 9 * (p - g->begin), NULL);
         v0 += sim->vol0[p];
       }
     }
@@ -258,7 +258,7 @@ static pm_err write_frame(run_ctx *c) {
         pres[p] = g->pressure[k];
         ener[p] = g->energy[k];
       } else {
-        sed[p] = pm_material_energy(&g->solid, g->F + 9 * k);
+        sed[p] = pm_material_energy(&g->solid, g->F + 9 * k, NULL);
         pres[p] = -(sg[0] + sg[4] + sg[8]) / 3.0;
         ener[p] = 0;
       }

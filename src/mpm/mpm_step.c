@@ -44,8 +44,8 @@ static inline void wave_speeds(const mpm_sim *sim, const mpm_group *g, long p,
     /* The particle's own density (a body may set it), which follows its
      * volume. */
     double rho = sim->mass[p] / sim->vol[p];
-    *cp = sqrt((g->solid.lambda + 2 * g->solid.mu) / rho);
-    *cs = sqrt(g->solid.mu / rho);
+    *cp = sqrt(g->solid.wave_modulus / rho);
+    *cs = sqrt(g->solid.shear_modulus / rho);
   }
 }
 
@@ -616,7 +616,7 @@ static void stage_stress_solid(mpm_sim *sim, int gi) {
   const mpm_grid *g = &sim->grid;
   const double dt = sim->dt, h = g->h;
   const pm_material *mat = &gr->solid;
-  const bool rate = mat->model == PM_MODEL_LINEAR_ELASTIC;
+  const bool rate = mat->model->rate != NULL;
   const double jmin = sim->scene->stability.min_jacobian;
   const bool av = gr->q != NULL;
   double maxdiv = 0;
@@ -645,18 +645,11 @@ static void stage_stress_solid(mpm_sim *sim, int gi) {
     double trD = D[0] + D[4] + D[8];
     maxdiv = fmax(maxdiv, fabs(trD));
     if (rate) {
-      double WS[9], SW[9];
-      pm_t_mul(W, sig, WS);
-      pm_t_mul(sig, W, SW);
-      for (int i = 0; i < 9; i++)
-        sig[i] += dt * (2 * mat->mu * D[i] + WS[i] - SW[i]);
-      sig[0] += dt * mat->lambda * trD;
-      sig[4] += dt * mat->lambda * trD;
-      sig[8] += dt * mat->lambda * trD;
+      mat->model->rate(mat, D, W, dt, sig);
       if (av) sig[0] += gr->q[k], sig[4] += gr->q[k], sig[8] += gr->q[k];
     } else {
       double P[9];
-      if (!pm_material_stress(mat, F, P, NULL, NULL)) {
+      if (!pm_material_stress(mat, F, NULL, P, NULL, NULL)) {
         fail_at(sim, p, "stress is not finite (J = %g, |F| = %g)", J,
                 pm_t_norm(F));
         continue;
@@ -670,8 +663,8 @@ static void stage_stress_solid(mpm_sim *sim, int gi) {
     }
     if (av) {
       double rho = sim->mass[p] / sim->vol[p];
-      double q = pm_artificial_viscosity(
-          gr->c0, gr->c1, rho, h, sqrt((mat->lambda + 2 * mat->mu) / rho), trD);
+      double q = pm_artificial_viscosity(gr->c0, gr->c1, rho, h,
+                                         sqrt(mat->wave_modulus / rho), trD);
       gr->q[k] = q;
       sig[0] -= q;
       sig[4] -= q;
@@ -833,7 +826,8 @@ void mpm_energies(const mpm_sim *sim, double *kinetic, double *strain,
     } else {
       PM_OMP(parallel for schedule(static) reduction(+ : se))
       for (long p = gr->begin; p < gr->end; p++) {
-        double W = pm_material_energy(&gr->solid, gr->F + 9 * (p - gr->begin));
+        double W =
+            pm_material_energy(&gr->solid, gr->F + 9 * (p - gr->begin), NULL);
         se += sim->vol0[p] * W;
       }
     }
@@ -877,9 +871,8 @@ static void add_stress(mpm_sim *sim) {
     } else {
       st = add(sim, "stress: solid", stage_stress_solid, gi);
       snprintf(st->detail, sizeof st->detail, "%s: %s%s", gr->name,
-               gr->solid.model == PM_MODEL_LINEAR_ELASTIC
-                   ? "linear elastic, Jaumann rate form"
-                   : "neo-Hookean from F",
+               gr->solid.model->rate ? "linear elastic, Jaumann rate form"
+                                     : "neo-Hookean from F",
                gr->q ? ", artificial viscosity (eq. 32)" : "");
     }
   }

@@ -70,10 +70,10 @@ static void test_f2_values(void **state) {
 
   assert_int_equal(s->n_materials, 1);
   assert_string_equal(s->materials[0].name, "gel");
-  assert_int_equal(s->materials[0].mat.model, PM_MODEL_NEO_HOOKEAN);
+  assert_string_equal(s->materials[0].mat.model->name, "neo-hookean");
   assert_near(s->materials[0].mat.density, 1000, 0);
-  assert_near(s->materials[0].mat.youngs, 3000, 0);
-  assert_near(s->materials[0].mat.poisson, 0.495, 1e-15);
+  assert_near(s->materials[0].mat.youngs_modulus, 3000, 0);
+  assert_near(s->materials[0].mat.poisson_ratio, 0.495, 1e-15);
   assert_int_equal(s->materials[0].mark.line, 8);
   assert_int_equal(s->materials[0].mark.col, 5);
 
@@ -134,7 +134,7 @@ static void test_defaults(void **state) {
   assert_int_equal(s->dimension, 2);
   assert_near(s->box_max[0], 1.0, 0);
   assert_near(s->box_max[1], 0.5, 0);
-  assert_int_equal(s->materials[0].mat.model, PM_MODEL_LINEAR_ELASTIC);
+  assert_string_equal(s->materials[0].mat.model->name, "linear-elastic");
   assert_int_equal(s->n_bodies, 1);
   assert_int_equal(s->bodies[0].material, 0);
   assert_null(s->bodies[0].region);
@@ -219,7 +219,7 @@ static void test_overrides(void **state) {
   assert_near(s->time.qs_tolerance, 1e-9, 0);
   assert_near(eval(s->bcs[4].traction[0], 0, 0, 0, 1), 2e3, 0);
   assert_int_equal(s->output.fields, PM_FIELD_FORCE | PM_FIELD_JACOBIAN);
-  assert_near(s->materials[0].mat.poisson, 0.3, 0);
+  assert_near(s->materials[0].mat.poisson_ratio, 0.3, 0);
   /* The stored text is the file's. */
   assert_non_null(strstr(s->text, "mesh_size: 1.09e-2"));
   pm_scene_destroy(s);

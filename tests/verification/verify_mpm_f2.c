@@ -32,11 +32,11 @@ static void test_f2_mpm(void **state) {
    * F = diag(s, s, 0.6) with the traction-free lateral stretch s, times
    * the reference area 0.1 x 0.1. */
   const pm_material *mat = &s->materials[0].mat;
-  double lat, P[9];
-  assert_int_equal(pm_material_uniaxial_lateral_stretch(mat, 0.6, &lat),
-                   PM_SUCCESS);
+  double lateral[2], P[9];
+  assert_int_equal(pm_material_uniaxial(mat, NULL, 0.6, lateral), PM_SUCCESS);
+  const double lat = lateral[0];
   double F[9] = {lat, 0, 0, 0, lat, 0, 0, 0, 0.6};
-  assert_true(pm_material_stress(mat, F, P, NULL, NULL));
+  assert_true(pm_material_stress(mat, F, NULL, P, NULL, NULL));
   double exact = P[8] * 0.01;
   int top = 3; /* boundary.3: zmax */
   double R[3];

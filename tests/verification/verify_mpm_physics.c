@@ -193,7 +193,7 @@ static void test_gravity_column(void **state) {
   const mpm_sim *sim = r->sim;
   const mpm_group *gr = &sim->group[0];
   const double g = -s->gravity[1], rho = gr->solid.density;
-  const double nu = gr->solid.poisson, h = sim->grid.h;
+  const double nu = gr->solid.poisson_ratio, h = sim->grid.h;
   const double H = s->box_max[1] - s->box_min[1];
   const double scale = rho * g * H;
   /* Rows of particles (by reference height) in the middle half. */

@@ -127,9 +127,9 @@ static void test_bar_first_mode(void **state) {
   (void)state;
   pm_scene *s = load_scene(CASES "bar-first-mode.yaml", 0, NULL);
   const pm_material *m = &s->materials[0].mat;
-  assert_true(m->poisson == 0);
+  assert_true(m->poisson_ratio == 0);
   double L = s->box_max[0] - s->box_min[0];
-  double c = sqrt(m->youngs / m->density);
+  double c = sqrt(m->youngs_modulus / m->density);
   double T = 4 * L / c;
   bar_rec b = {0};
   double wall, driver_wall;

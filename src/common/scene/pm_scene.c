@@ -154,11 +154,11 @@ static const cyaml_strval_t method_names[] = {
     {"mpm", PM_METHOD_MPM},
     {"mpm-implicit", PM_METHOD_MPM_IMPLICIT},
 };
-/* "fluid" is not a pm_model: it maps to PM_MODEL_COUNT. */
+enum { MODEL_NEO_HOOKEAN, MODEL_LINEAR_ELASTIC, MODEL_FLUID };
 static const cyaml_strval_t model_names[] = {
-    {"neo-hookean", PM_MODEL_NEO_HOOKEAN},
-    {"linear-elastic", PM_MODEL_LINEAR_ELASTIC},
-    {"fluid", PM_MODEL_COUNT},
+    {"neo-hookean", MODEL_NEO_HOOKEAN},
+    {"linear-elastic", MODEL_LINEAR_ELASTIC},
+    {"fluid", MODEL_FLUID},
 };
 static const cyaml_strval_t eos_names[] = {
     {"ideal-gas", PM_EOS_IDEAL_GAS},
@@ -633,7 +633,12 @@ static pm_err build_fluid(const pm_scene *s, const pm_sdoc *d, int i,
     return pm_sdoc_expected(d, path_fmt(p, "materials.%d.bulk_viscosity", i),
                             "a number >= -2/3 viscosity (Stokes: -2/3 "
                             "viscosity)");
-  return PM_SUCCESS;
+  PM_CALL(pm_material_begin(&out->mat, "fluid", m->density));
+  out->mat.fluid = *f;
+  if (!has(d, path_fmt(p, "materials.%d.eos.p_inf", i)))
+    out->mat.fluid.p_inf = NAN;
+  const char *key;
+  return out->mat.model->init(&out->mat, &key);
 }
 
 static pm_err build_materials(pm_scene *s, const pm_sdoc *d,
@@ -662,7 +667,7 @@ static pm_err build_materials(pm_scene *s, const pm_sdoc *d,
                          m->artificial_viscosity.c1));
     out->av_c0 = m->artificial_viscosity.c0;
     out->av_c1 = m->artificial_viscosity.c1;
-    if (m->model == PM_MODEL_COUNT) {
+    if (m->model == MODEL_FLUID) {
       PM_CALL(build_fluid(s, d, i, m, out));
       continue;
     }
@@ -673,20 +678,21 @@ static pm_err build_materials(pm_scene *s, const pm_sdoc *d,
         return pm_sdoc_fail(d, p, true,
                             "expected a key of a solid model (%s), got %s "
                             "(a key of model fluid)",
-                            pm_model_name((pm_model)m->model), fluid_keys[k]);
+                            model_names[m->model].str, fluid_keys[k]);
     static const char *const solid_keys[] = {"youngs_modulus", "poisson_ratio"};
     for (int k = 0; k < 2; k++)
       if (!has(d, path_fmt(p, "materials.%d.%s", i, solid_keys[k])))
         return pm_sdoc_fail(d, path_fmt(p, "materials.%d", i), false,
                             "missing required key %s (model %s)", solid_keys[k],
-                            pm_model_name((pm_model)m->model));
+                            model_names[m->model].str);
     PM_CALL(check_positive(d, path_fmt(p, "materials.%d.youngs_modulus", i),
                            m->youngs_modulus));
     if (!(m->poisson_ratio > -1 && m->poisson_ratio < 0.5))
       return pm_sdoc_expected(d, path_fmt(p, "materials.%d.poisson_ratio", i),
                               "a number in (-1, 0.5)");
-    if (pm_material_init(&out->mat, (pm_model)m->model, m->density,
-                         m->youngs_modulus, m->poisson_ratio) != PM_SUCCESS) {
+    if (pm_material_elastic(&out->mat, model_names[m->model].str, m->density,
+                            m->youngs_modulus,
+                            m->poisson_ratio) != PM_SUCCESS) {
       char msg[PM_SDOC_WHERE];
       snprintf(msg, sizeof msg, "%s", pm_error_message());
       return pm_sdoc_fail(d, path_fmt(p, "materials.%d", i), false, "%s", msg);
