@@ -75,6 +75,19 @@ static inline void pm_t_tmul(const double A[9], const double B[9],
     for (int j = 0; j < 3; j++)
       C[3 * i + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
 }
+/* C = A B^T */
+static inline void pm_t_mult(const double A[9], const double B[9],
+                             double C[9]) {
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      C[3 * i + j] = A[3 * i] * B[3 * j] + A[3 * i + 1] * B[3 * j + 1] +
+                     A[3 * i + 2] * B[3 * j + 2];
+}
+/* D = A - tr(A)/3 I, the deviator */
+static inline void pm_t_dev(const double A[9], double D[9]) {
+  double p = pm_t_trace(A) / 3;
+  for (int i = 0; i < 9; i++) D[i] = A[i] - (i % 4 == 0 ? p : 0);
+}
 /* y = A x */
 static inline void pm_t_mulv(const double A[9], const double x[3],
                              double y[3]) {

@@ -11,6 +11,10 @@
 
 static const pm_model *const table[] = {
     &pm_model_neo_hookean,
+    &pm_model_neo_hookean_log,
+    &pm_model_mooney_rivlin,
+    &pm_model_ogden,
+    &pm_model_holzapfel_gasser_ogden,
     &pm_model_linear_elastic,
     &pm_model_fluid,
 };

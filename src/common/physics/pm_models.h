@@ -8,6 +8,10 @@
 #include "pm_material.h"
 
 extern const pm_model pm_model_neo_hookean;
+extern const pm_model pm_model_neo_hookean_log;
+extern const pm_model pm_model_mooney_rivlin;
+extern const pm_model pm_model_ogden;
+extern const pm_model pm_model_holzapfel_gasser_ogden;
 extern const pm_model pm_model_linear_elastic;
 extern const pm_model pm_model_fluid;
 
