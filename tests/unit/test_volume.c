@@ -23,23 +23,6 @@
 
 #define PI 3.14159265358979323846
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define PM_TEST_ASAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(PM_TEST_ASAN)
-/* gmsh 4.8 and OpenCASCADE leak a little on their own: meshing curved
- * surfaces (meshGFace), the .geo parser after a syntax error (its Malloc),
- * STEP reading and writing (OpenCASCADE's libTK*).  The sanitizer build runs
- * with detect_leaks=1: ignore exactly those, so that a leak of ours, or an
- * array from the gmsh API left without gmshFree, still fails. */
-const char *__lsan_default_suppressions(void);
-const char *__lsan_default_suppressions(void) {
-  return "leak:meshGFace\nleak:^Malloc(\nleak:libTK\n";
-}
-#endif
-
 /* Writes text to dir/name; path receives the full name. */
 static void write_file(const char *dir, const char *name, const char *text,
                        char path[512]) {
