@@ -25,6 +25,16 @@ pm_err gm_gmsh_size(double h, const char *path);
 /* The last gmsh error as PM_ERR_MESH: "gmsh: WHAT['PATH'] failed: MSG". */
 pm_err gm_gmsh_fail(const char *what, const char *path);
 
+/* After a gmsh call, in a function with `int ierr`, `pm_err ret` and a
+ * `done` label: on failure record gmsh's message and leave. */
+#define GM_GMSH_CHECK(what, path)                                              \
+  do {                                                                         \
+    if (ierr) {                                                                \
+      ret = gm_gmsh_fail(what, path);                                          \
+      goto done;                                                               \
+    }                                                                          \
+  } while (0)
+
 /* The linear simplices of dimension dim of a gmsh model, and optionally its
  * physical groups of dimension dim - 1 (boundary surfaces in 3D, curves in
  * 2D).  Arrays are malloc'd and owned by the struct (gm_gmsh_mesh_free). */

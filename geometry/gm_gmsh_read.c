@@ -11,15 +11,6 @@
 #include <string.h>
 #include <sys/stat.h>
 
-/* After a gmsh call: on failure record gmsh's message and leave. */
-#define GM_READ_CHECK(what)                                                    \
-  do {                                                                         \
-    if (ierr) {                                                                \
-      ret = gm_gmsh_fail(what, name);                                          \
-      goto done;                                                               \
-    }                                                                          \
-  } while (0)
-
 /* How messages name the model. */
 static const char *label(const char *name) {
   return name ? name : "(model in memory)";
@@ -53,7 +44,7 @@ static pm_err simplex_nodes(const char *name, int type, int dim,
   int edim = 0, order = 0, all = 0, corners = 0, ierr = 0;
   gmshModelMeshGetElementProperties(type, &tname, &edim, &order, &all, &local,
                                     &n_local, &corners, &ierr);
-  GM_READ_CHECK("reading element properties in");
+  GM_GMSH_CHECK("reading element properties in", name);
   PM_ENSURE(corners == dim + 1, PM_ERR_UNSUPPORTED,
             "'%s' has %s elements (gmsh type %d)%s%s%s: only %s are "
             "supported",
@@ -81,13 +72,13 @@ static pm_err append_corners(const char *name, int d, int entity,
   size_t n_enodes = 0;
   const size_t npc = (size_t)d + 1;
   gmshModelMeshGetElementTypes(&types, &n_types, d, entity, &ierr);
-  GM_READ_CHECK("listing the element types of");
+  GM_GMSH_CHECK("listing the element types of", name);
   for (size_t t = 0; t < n_types; t++) {
     size_t per = 0;
     PM_TRY(simplex_nodes(name, types[t], d, group, &per));
     gmshModelMeshGetElementsByType(types[t], &etags, &n_etags, &enodes,
                                    &n_enodes, entity, 0, 1, &ierr);
-    GM_READ_CHECK("reading the elements of");
+    GM_GMSH_CHECK("reading the elements of", name);
     PM_ENSURE(n_enodes == per * n_etags, PM_ERR_MESH,
               "gmsh returned %zu nodes for %zu elements of '%s'", n_enodes,
               n_etags, label(name));
@@ -140,7 +131,7 @@ static pm_err read_groups(const char *name, int dim, const long *map,
   long nf = 0;
   const int d = dim - 1;
   gmshModelGetPhysicalGroups(&dimtags, &n_dimtags, d, &ierr);
-  GM_READ_CHECK("listing the physical groups of");
+  GM_GMSH_CHECK("listing the physical groups of", name);
   const int ng = (int)(n_dimtags / 2);
   PM_TRY(PM_ALLOC(out->group_name, ng, "physical group names"));
   PM_TRY(PM_ALLOC(out->group_ptr, ng + 1, "physical groups"));
@@ -148,7 +139,7 @@ static pm_err read_groups(const char *name, int dim, const long *map,
   for (int g = 0; g < ng; g++) {
     const int tag = dimtags[2 * g + 1];
     gmshModelGetPhysicalName(d, tag, &pname, &ierr);
-    GM_READ_CHECK("reading the physical names of");
+    GM_GMSH_CHECK("reading the physical names of", name);
     char fallback[32];
     snprintf(fallback, sizeof fallback, "surface-%d", tag);
     out->group_name[g] = strdup(pname && pname[0] ? pname : fallback);
@@ -156,7 +147,7 @@ static pm_err read_groups(const char *name, int dim, const long *map,
     gmshFree(pname);
     pname = NULL;
     gmshModelGetEntitiesForPhysicalGroup(d, tag, &ents, &n_ents, &ierr);
-    GM_READ_CHECK("reading the physical groups of");
+    GM_GMSH_CHECK("reading the physical groups of", name);
     for (size_t e = 0; e < n_ents; e++)
       PM_TRY(append_corners(name, d, ents[e], out->group_name[g], &ftag, &nf));
     gmshFree(ents);
@@ -196,7 +187,7 @@ pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out) {
   }
   gmshModelMeshGetNodes(&tags, &n_tags, &coord, &n_coord, &param, &n_param, -1,
                         -1, 0, 0, &ierr);
-  GM_READ_CHECK("reading the nodes of");
+  GM_GMSH_CHECK("reading the nodes of", name);
   PM_ENSURE(n_coord == 3 * n_tags, PM_ERR_MESH,
             "gmsh returned %zu coordinates for %zu nodes of '%s'", n_coord,
             n_tags, label(name));
@@ -269,17 +260,16 @@ pm_err gm_gmsh_load(const char *path, int dim, double h, bool groups,
   pm_err ret = PM_SUCCESS;
   int ierr = 0, *types = NULL;
   size_t n_types = 0;
-  const char *name = path;
   gm_gmsh_session session = {.threads = 0, .open = false};
   PM_TRY(gm_gmsh_begin(&session, path));
   gmshOpen(path, &ierr);
-  GM_READ_CHECK("reading");
+  GM_GMSH_CHECK("reading", path);
   gmshModelMeshGetElementTypes(&types, &n_types, dim, -1, &ierr);
-  GM_READ_CHECK("listing the element types of");
+  GM_GMSH_CHECK("listing the element types of", path);
   if (n_types == 0) {
     if (h > 0.0) PM_TRY(gm_gmsh_size(h, path));
     gmshModelMeshGenerate(dim, &ierr);
-    GM_READ_CHECK("meshing");
+    GM_GMSH_CHECK("meshing", path);
   }
   PM_TRY(gm_gmsh_read(path, dim, groups, out));
 done:

@@ -136,15 +136,6 @@ done:
   return ret;
 }
 
-/* After a gmsh call: on failure record gmsh's message and leave. */
-#define GM_GMSH_CHECK(what)                                                    \
-  do {                                                                         \
-    if (ierr) {                                                                \
-      ret = gm_gmsh_fail(what, NULL);                                          \
-      goto done;                                                               \
-    }                                                                          \
-  } while (0)
-
 /* A new mesh taking over raw's nodes and elements (raw keeps its groups). */
 static pm_err mesh_from_raw(gm_gmsh_mesh *raw, gm_mesh **out) {
   gm_mesh *m = NULL;
@@ -184,18 +175,18 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
   PM_TRY(gm_gmsh_begin(&session, NULL));
   PM_TRY(gm_gmsh_size(h, NULL));
   gmshModelAdd("pointmech_box", &ierr);
-  GM_GMSH_CHECK("model add");
+  GM_GMSH_CHECK("model add", NULL);
   if (dim == 3)
     gmshModelOccAddBox(min[0], min[1], min[2], max[0] - min[0], max[1] - min[1],
                        max[2] - min[2], -1, &ierr);
   else
     gmshModelOccAddRectangle(min[0], min[1], 0.0, max[0] - min[0],
                              max[1] - min[1], -1, 0.0, &ierr);
-  GM_GMSH_CHECK("adding the box");
+  GM_GMSH_CHECK("adding the box", NULL);
   gmshModelOccSynchronize(&ierr);
-  GM_GMSH_CHECK("synchronize");
+  GM_GMSH_CHECK("synchronize", NULL);
   gmshModelMeshGenerate(dim, &ierr);
-  GM_GMSH_CHECK("mesh generation");
+  GM_GMSH_CHECK("mesh generation", NULL);
   PM_TRY(gm_gmsh_read(NULL, dim, false, &raw));
   PM_TRY(mesh_from_raw(&raw, &m));
   for (int k = 0; k < 3; k++) {

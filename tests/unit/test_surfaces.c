@@ -8,7 +8,6 @@
 #include <cmocka.h>
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,17 +17,6 @@
 
 #define PI 3.14159265358979323846
 #define DATA PM_TEST_DATA "/geometry/"
-
-/* Writes text to dir/name; path receives the full name. */
-static void write_file(const char *dir, const char *name, const char *text,
-                       char path[512]) {
-  int len = snprintf(path, 512, "%s/%s", dir, name);
-  assert_true(len > 0 && len < 512);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  assert_true(fputs(text, f) >= 0);
-  assert_int_equal(fclose(f), 0);
-}
 
 /* Per surface of d's mesh: the sum of its facets' area vectors and areas,
  * and how many facets it has (index n_surfaces: facets on none). */
@@ -202,18 +190,9 @@ static void check_same_as_box(int dim, const char *path, double h) {
 }
 
 static void test_same_as_box(void **state) {
-  char path[512];
+  (void)state;
   check_same_as_box(3, DATA "box-faces.geo", 0.02);
-  /* OpenCASCADE numbers a rectangle's edges ymin, xmax, ymax, xmin. */
-  write_file(*state, "square.geo",
-             "SetFactory(\"OpenCASCADE\");\n"
-             "Rectangle(1) = {0, 0, 0, 0.1, 0.1};\n"
-             "Physical Curve(\"xmin\") = {4};\n"
-             "Physical Curve(\"xmax\") = {2};\n"
-             "Physical Curve(\"ymin\") = {1};\n"
-             "Physical Curve(\"ymax\") = {3};\n",
-             path);
-  check_same_as_box(2, path, 0.01);
+  check_same_as_box(2, DATA "square-faces.geo", 0.01);
 }
 
 /* One tetrahedron given upside down (gm_mesh_file turns it over: the tags
@@ -221,27 +200,12 @@ static void test_same_as_box(void **state) {
  * group without a name called "surface-TAG", a face in two groups on the
  * later one's (so "a" keeps its name but no face), and a triangle that is
  * not a face of the mesh changing nothing. */
-static const char one_tet[] =
-    "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-    "$PhysicalNames\n4\n2 1 \"a\"\n2 2 \"c\"\n2 3 \"b\"\n2 5 \"lid\"\n"
-    "$EndPhysicalNames\n"
-    "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 5 5 5\n$EndNodes\n"
-    "$Elements\n7\n"
-    "1 4 2 9 1 1 3 2 4\n"
-    "2 2 2 1 1 1 2 3\n"
-    "3 2 2 2 2 4 1 2\n"
-    "4 2 2 3 3 3 4 1\n"
-    "5 2 2 4 4 2 3 4\n"
-    "6 2 2 3 5 1 2 5\n"
-    "7 2 2 5 6 3 2 1\n"
-    "$EndElements\n";
-
 static void test_msh_groups(void **state) {
-  char path[512], buf[64];
-  write_file(*state, "tet.msh", one_tet, path);
+  (void)state;
+  char buf[64];
   gm_mesh *m = NULL;
   gm_dual *d = NULL;
-  assert_ok(gm_mesh_file(path, 3, 0.0, &m));
+  assert_ok(gm_mesh_file(DATA "tet-groups.msh", 3, 0.0, &m));
   assert_int_equal(m->n_cells, 1);
   assert_int_equal(m->n_nodes, 4);
   assert_string_equal(gm_mesh_surface_list(m, buf, sizeof buf),
@@ -292,74 +256,34 @@ static void test_disk_2d(void **state) {
   gm_mesh_destroy(m);
 }
 
-/* Errors name the file and the cause. */
+/* The errors of gm_mesh_file of its own (those of reading the file, which
+ * it shares with gm_volume_load, are in test_volume). */
 static void test_errors(void **state) {
-  char path[512], missing[512];
+  (void)state;
   gm_mesh *m = (gm_mesh *)0x1;
-  snprintf(missing, sizeof missing, "%s/none.geo", (char *)*state);
-  assert_int_equal(gm_mesh_file(missing, 3, 0.1, &m), PM_ERR_IO);
-  assert_null(m);
-  assert_non_null(strstr(pm_error_message(), missing));
-  assert_int_equal(gm_mesh_file(*state, 3, 0.1, &m), PM_ERR_IO);
-  assert_non_null(strstr(pm_error_message(), "directory"));
-  /* No volume: a disk asked for in 3D. */
-  write_file(*state, "disk.geo",
-             "SetFactory(\"OpenCASCADE\");\nDisk(1) = {0, 0, 0, 0.5};\n", path);
-  assert_int_equal(gm_mesh_file(path, 3, 0.1, &m), PM_ERR_MESH);
-  print_message("  %s\n", pm_error_message());
-  assert_non_null(strstr(pm_error_message(), path));
-  assert_non_null(strstr(pm_error_message(), "no tetrahedra"));
-  /* Hexahedra. */
-  write_file(*state, "hex.msh",
-             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-             "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
-             "5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n"
-             "$Elements\n1\n1 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n",
-             path);
-  assert_int_equal(gm_mesh_file(path, 3, 0.1, &m), PM_ERR_UNSUPPORTED);
-  print_message("  %s\n", pm_error_message());
-  assert_non_null(strstr(pm_error_message(), path));
-  assert_non_null(strstr(pm_error_message(), "Hexahedron"));
   /* A quadrangle in a physical surface. */
-  write_file(*state, "quad.msh",
-             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-             "$PhysicalNames\n1\n2 1 \"lid\"\n$EndPhysicalNames\n"
-             "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 0\n"
-             "$EndNodes\n"
-             "$Elements\n2\n1 4 2 9 1 1 2 3 4\n2 3 2 1 1 1 2 5 3\n"
-             "$EndElements\n",
-             path);
-  assert_int_equal(gm_mesh_file(path, 3, 0.1, &m), PM_ERR_UNSUPPORTED);
+  assert_int_equal(gm_mesh_file(DATA "quad-in-group.msh", 3, 0.1, &m),
+                   PM_ERR_UNSUPPORTED);
+  assert_null(m);
   print_message("  %s\n", pm_error_message());
+  assert_non_null(strstr(pm_error_message(), "quad-in-group.msh"));
   assert_non_null(strstr(pm_error_message(), "physical group 'lid'"));
   /* A flat tetrahedron. */
-  write_file(*state, "flat.msh",
-             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-             "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n$EndNodes\n"
-             "$Elements\n1\n1 4 2 1 1 1 2 3 4\n$EndElements\n",
-             path);
-  assert_int_equal(gm_mesh_file(path, 3, 0.1, &m), PM_ERR_GEOMETRY);
+  assert_int_equal(gm_mesh_file(DATA "flat-tet.msh", 3, 0.1, &m),
+                   PM_ERR_GEOMETRY);
   print_message("  %s\n", pm_error_message());
-  assert_non_null(strstr(pm_error_message(), path));
-  assert_int_equal(gm_mesh_file(path, 4, 0.1, &m), PM_ERR_ARG);
-  assert_int_equal(gm_mesh_file(NULL, 3, 0.1, &m), PM_ERR_ARG);
-  assert_int_equal(gm_mesh_file(path, 3, 0.1, NULL), PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "flat-tet.msh"));
+  assert_int_equal(gm_mesh_file(DATA "flat-tet.msh", 3, 0.1, NULL), PM_ERR_ARG);
   assert_null(m);
   pm_error_clear();
 }
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_box_names),
-      cmocka_unit_test(test_block_file),
-      cmocka_unit_test(test_cylinder_file),
-      cmocka_unit_test_setup_teardown(test_same_as_box, pm_test_make_dir,
-                                      pm_test_drop_dir),
-      cmocka_unit_test_setup_teardown(test_msh_groups, pm_test_make_dir,
-                                      pm_test_drop_dir),
-      cmocka_unit_test(test_disk_2d),
-      cmocka_unit_test_setup_teardown(test_errors, pm_test_make_dir,
-                                      pm_test_drop_dir),
+      cmocka_unit_test(test_box_names),     cmocka_unit_test(test_block_file),
+      cmocka_unit_test(test_cylinder_file), cmocka_unit_test(test_same_as_box),
+      cmocka_unit_test(test_msh_groups),    cmocka_unit_test(test_disk_2d),
+      cmocka_unit_test(test_errors),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
