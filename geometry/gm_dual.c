@@ -1,5 +1,6 @@
 /* gm_dual: median-dual cells of a simplex mesh: volumes, interfaces between
- * edge neighbours (CSR adjacency) and boundary facets tagged by box face. */
+ * edge neighbours (CSR adjacency) and boundary facets tagged with the
+ * mesh's surfaces. */
 #include "gm_dual.h"
 
 #include <math.h>
@@ -34,7 +35,7 @@ void gm_dual_destroy(gm_dual *d) {
   free(d->if_centroid);
   free(d->if_area);
   free(d->facet_point);
-  free(d->facet_face);
+  free(d->facet_surface);
   free(d->facet_area_vec);
   free(d->facet_moment);
   free(d->facet_centroid);
@@ -310,19 +311,6 @@ static int face_shared(long c, const long *fn, int nf, const gm_mesh *m,
   return 0;
 }
 
-/* Box face holding every node of a boundary face, or PM_FACE_NONE. */
-static int face_tag(const gm_mesh *m, const long *fn, int nf, double tol) {
-  for (int f = 0; f < 2 * m->dim; f++) {
-    int axis = pm_face_axis(f);
-    double plane = pm_face_plane(f, m->box_min, m->box_max);
-    int on = 1;
-    for (int a = 0; a < nf && on; a++)
-      on = fabs(m->x[3 * fn[a] + axis] - plane) <= tol;
-    if (on) return f;
-  }
-  return PM_FACE_NONE;
-}
-
 /* Boundary facets: faces of one cell only, split among their nodes. */
 static pm_err build_facets(const gm_mesh *m, const long *inc_ptr,
                            const long *inc, gm_dual *d) {
@@ -346,16 +334,12 @@ static pm_err build_facets(const gm_mesh *m, const long *inc_ptr,
   const long nf = n_bnd * dim;
   d->n_facets = nf;
   PM_TRY(PM_ALLOC(d->facet_point, nf, "facet points"));
-  PM_TRY(PM_ALLOC(d->facet_face, nf, "facet faces"));
+  PM_TRY(PM_ALLOC(d->facet_surface, nf, "facet surfaces"));
   PM_TRY(PM_ALLOC(d->facet_area_vec, 3 * nf, "facet area vectors"));
   PM_TRY(PM_ALLOC(d->facet_moment, 9 * nf, "facet moments"));
   PM_TRY(PM_ALLOC(d->facet_centroid, 3 * nf, "facet centroids"));
   PM_TRY(PM_ALLOC(d->facet_area, nf, "facet areas"));
 
-  double size = 0.0;
-  for (int k = 0; k < dim; k++)
-    size = fmax(size, m->box_max[k] - m->box_min[k]);
-  const double tol = 1e-9 * size;
   long f = 0;
   for (long c = 0; c < m->n_cells; c++) {
     const long *cell = m->cells + (size_t)npc * c;
@@ -367,13 +351,14 @@ static pm_err build_facets(const gm_mesh *m, const long *inc_ptr,
         fn[a] = cell[dim == 3 ? tet_face[o][a] : tri_face[o][a]];
         q[a] = m->x + 3 * fn[a];
       }
-      int tag = face_tag(m, fn, dim, tol);
+      const int tag =
+          m->face_surface ? m->face_surface[(size_t)npc * c + o] : -1;
       double fc[3] = {0, 0, 0};
       for (int a = 0; a < dim; a++)
         for (int k = 0; k < 3; k++) fc[k] += q[a][k] / dim;
       for (int a = 0; a < dim; a++, f++) {
         d->facet_point[f] = fn[a];
-        d->facet_face[f] = tag;
+        d->facet_surface[f] = tag;
         double *av = d->facet_area_vec + 3 * f, *mom = d->facet_moment + 9 * f;
         double *cen = d->facet_centroid + 3 * f, *area = d->facet_area + f;
         double pa[3], ct[3];

@@ -1,6 +1,7 @@
 /* gm_gmsh: the gmsh session of the geometry modules (gm_mesh, gm_volume):
  * quiet, single-threaded and repeatable, leaving the process's OpenMP
- * thread count as it found it, and gmsh's errors as PM_ERR_MESH. */
+ * thread count as it found it, and gmsh's errors as PM_ERR_MESH; and the
+ * one reader of gmsh models and files they share. */
 #ifndef GM_GMSH_H
 #define GM_GMSH_H
 
@@ -23,5 +24,60 @@ void gm_gmsh_end(gm_gmsh_session *s);
 pm_err gm_gmsh_size(double h, const char *path);
 /* The last gmsh error as PM_ERR_MESH: "gmsh: WHAT['PATH'] failed: MSG". */
 pm_err gm_gmsh_fail(const char *what, const char *path);
+
+/* After a gmsh call, in a function with `int ierr`, `pm_err ret` and a
+ * `done` label: on failure record gmsh's message and leave. */
+#define GM_GMSH_CHECK(what, path)                                              \
+  do {                                                                         \
+    if (ierr) {                                                                \
+      ret = gm_gmsh_fail(what, path);                                          \
+      goto done;                                                               \
+    }                                                                          \
+  } while (0)
+
+/* The linear simplices of dimension dim of a gmsh model, and optionally its
+ * physical groups of dimension dim - 1 (boundary surfaces in 3D, curves in
+ * 2D).  Arrays are malloc'd and owned by the struct (gm_gmsh_mesh_free). */
+typedef struct {
+  int dim;
+  long n_nodes;
+  double *x; /* 3 * n_nodes: the nodes elements use as corners, in gmsh's
+                node order; z = 0 in 2D */
+  long n_elems;
+  long *elem; /* (dim + 1) * n_elems: corner nodes, 0-based, as gmsh lists
+                 them (not reoriented) */
+  int n_groups;
+  char **group_name; /* n_groups: the physical name, or "surface-TAG" for a
+                        group without one */
+  long *group_ptr;   /* n_groups + 1: faces of group g are
+                        group_face[dim * group_ptr[g] .. dim * group_ptr[g+1]) */
+  long *group_face;  /* dim corner nodes per face (0-based like elem); -1 for
+                        a node that is no element's corner */
+} gm_gmsh_mesh;
+
+/* Read the open session's model into out (zeroed first): every element of
+ * dimension dim counts through its corner nodes (higher-order nodes are
+ * ignored), and with groups true the physical groups of dimension dim - 1
+ * and their elements.  name labels the model in messages (the file path;
+ * NULL for a model built in memory).  Fails with PM_ERR_UNSUPPORTED for
+ * elements that are not simplices (hexahedra, prisms, quadrangles, in the
+ * volume or in a group), PM_ERR_MESH for no element of dimension dim (the
+ * message gives the model's dimension), 2D nodes off the z = 0 plane or
+ * inconsistent gmsh data, PM_ERR_MEMORY.  On failure out holds nothing. */
+pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out);
+
+/* Read a gmsh-readable file (.msh, .geo, .step/.stp, .brep) into out: checks
+ * the file is a readable regular file (PM_ERR_IO naming it: gmsh reports a
+ * missing file without failing), opens it in a session of its own, meshes
+ * it at element size h when it holds no element of dimension dim (h <= 0:
+ * the file's and gmsh's own sizes; a mesh in the file is used whatever h),
+ * reads it as gm_gmsh_read does and closes gmsh whatever happens.  Not
+ * thread-safe (gmsh keeps global state); must not run inside another
+ * session. */
+pm_err gm_gmsh_load(const char *path, int dim, double h, bool groups,
+                    gm_gmsh_mesh *out);
+
+/* Frees the arrays of m and zeroes it; NULL is a no-op. */
+void gm_gmsh_mesh_free(gm_gmsh_mesh *m);
 
 #endif

@@ -1,6 +1,7 @@
 /* gm_mesh: simplex meshes of a box or rectangle made with the gmsh C API,
- * meshes built from caller arrays, and their mean edge length. */
-#include "gm_dual.h"
+ * of a gmsh-readable file, or built from caller arrays; node ordering,
+ * orientation and mean edge length. */
+#include "gm_mesh.h"
 
 #include <gmshc.h>
 #include <math.h>
@@ -8,6 +9,7 @@
 #include <string.h>
 
 #include "gm_gmsh.h"
+#include "gm_surface.h"
 
 /* Relative size below which a simplex counts as flat. */
 #define GM_FLAT_TOL 1e-12
@@ -39,11 +41,13 @@ static double cell_measure(int dim, const double *x, const long *cell,
          6.0;
 }
 
-/* Flip negatively oriented cells (swap their last two nodes) and reject
- * flat ones: the dual construction relies on positive orientation. */
 static pm_err morton_order(gm_mesh *m);
 
-static pm_err orient_cells(gm_mesh *m) {
+/* Flip negatively oriented cells (swap their last two nodes) and reject
+ * flat ones (path, may be NULL, names the file in the message): the dual
+ * construction relies on positive orientation.  A face's surface tag
+ * follows the node it is opposite to. */
+static pm_err orient_cells(gm_mesh *m, const char *path) {
   const int npc = m->nodes_per_cell;
   for (long c = 0; c < m->n_cells; c++) {
     long *cell = m->cells + (size_t)npc * c;
@@ -51,12 +55,19 @@ static pm_err orient_cells(gm_mesh *m) {
     double v = cell_measure(m->dim, m->x, cell, &h);
     double scale = m->dim == 3 ? h * h * h : h * h;
     PM_CHECK(fabs(v) > GM_FLAT_TOL * scale, PM_ERR_GEOMETRY,
-             "cell %ld has zero %s (%g)", c, m->dim == 3 ? "volume" : "area",
+             "cell %ld%s%s%s has zero %s (%g)", c, path ? " of '" : "",
+             path ? path : "", path ? "'" : "", m->dim == 3 ? "volume" : "area",
              v);
     if (v < 0.0) {
       long t = cell[npc - 1];
       cell[npc - 1] = cell[npc - 2];
       cell[npc - 2] = t;
+      if (m->face_surface) {
+        int *fs = m->face_surface + (size_t)npc * c;
+        int u = fs[npc - 1];
+        fs[npc - 1] = fs[npc - 2];
+        fs[npc - 2] = u;
+      }
     }
   }
   return PM_SUCCESS;
@@ -67,10 +78,12 @@ void gm_mesh_destroy(gm_mesh *m) {
   if (!m) return;
   free(m->x);
   free(m->cells);
+  gm_surface_drop(m);
   free(m);
 }
 
-/* Copies the caller's arrays; checks indices, then orients the cells. */
+/* Copies the caller's arrays after checking them, orients the cells and
+ * names the box faces. */
 pm_err gm_mesh_from_arrays(int dim, long n_nodes, const double *x, long n_cells,
                            const long *cells, const double box_min[3],
                            const double box_max[3], gm_mesh **out) {
@@ -114,7 +127,8 @@ pm_err gm_mesh_from_arrays(int dim, long n_nodes, const double *x, long n_cells,
     for (long i = 0; i < n_nodes; i++) m->x[3 * i + 2] = 0.0;
     m->box_min[2] = m->box_max[2] = 0.0;
   }
-  PM_TRY(orient_cells(m));
+  PM_TRY(orient_cells(m, NULL));
+  PM_TRY(gm_surface_name_box(m));
   *out = m;
   m = NULL;
 done:
@@ -122,75 +136,20 @@ done:
   return ret;
 }
 
-/* After a gmsh call: on failure record gmsh's message and leave. */
-#define GM_GMSH_CHECK(what)                                                    \
-  do {                                                                         \
-    if (ierr) {                                                                \
-      ret = gm_gmsh_fail(what, NULL);                                          \
-      goto done;                                                               \
-    }                                                                          \
-  } while (0)
-
-/* Copy gmsh's nodes and elements into a fresh mesh, keeping only the nodes
- * that cells use, numbered 0.. in gmsh's node order. */
-static pm_err gmsh_extract(int dim, gm_mesh *m) {
-  pm_err ret = PM_SUCCESS;
-  size_t *tags = NULL, n_tags = 0, *etags = NULL, n_etags = 0;
-  size_t *enodes = NULL, n_enodes = 0;
-  double *coord = NULL, *param = NULL;
-  size_t n_coord = 0, n_param = 0;
-  long *map = NULL;
-  int ierr = 0;
-  const int npc = dim + 1;
-
-  gmshModelMeshGetNodes(&tags, &n_tags, &coord, &n_coord, &param, &n_param, -1,
-                        -1, 0, 0, &ierr);
-  GM_GMSH_CHECK("getNodes");
-  gmshModelMeshGetElementsByType(dim == 3 ? 4 : 2, &etags, &n_etags, &enodes,
-                                 &n_enodes, -1, 0, 1, &ierr);
-  GM_GMSH_CHECK("getElementsByType");
-  PM_ENSURE(n_coord == 3 * n_tags && n_enodes == (size_t)npc * n_etags,
-            PM_ERR_MESH, "gmsh returned inconsistent array sizes");
-  PM_ENSURE(n_etags > 0, PM_ERR_MESH, "gmsh produced no %s",
-            dim == 3 ? "tetrahedra" : "triangles");
-
-  size_t max_tag = 0;
-  for (size_t i = 0; i < n_tags; i++)
-    if (tags[i] > max_tag) max_tag = tags[i];
-  PM_TRY(PM_ALLOC(map, max_tag + 1, "node tag map"));
-  /* map[tag]: -1 unused, -2 used by a cell, then the compact index. */
-  for (size_t t = 0; t <= max_tag; t++) map[t] = -1;
-  for (size_t i = 0; i < n_enodes; i++) {
-    PM_ENSURE(enodes[i] <= max_tag, PM_ERR_MESH,
-              "gmsh element refers to unknown node %zu", enodes[i]);
-    map[enodes[i]] = -2;
-  }
-  long n = 0;
-  for (size_t i = 0; i < n_tags; i++)
-    if (map[tags[i]] == -2) map[tags[i]] = n++;
-  PM_ENSURE(n > 0, PM_ERR_MESH, "gmsh mesh has no nodes");
-  for (size_t i = 0; i < n_enodes; i++)
-    PM_ENSURE(map[enodes[i]] >= 0, PM_ERR_MESH,
-              "gmsh element refers to node %zu without coordinates", enodes[i]);
-
-  PM_TRY(PM_ALLOC(m->x, 3 * n, "mesh coordinates"));
-  PM_TRY(PM_ALLOC(m->cells, n_enodes, "mesh cells"));
-  for (size_t i = 0; i < n_tags; i++) {
-    long k = map[tags[i]];
-    if (k < 0) continue;
-    for (int d = 0; d < 3; d++) m->x[3 * k + d] = coord[3 * i + d];
-  }
-  for (size_t i = 0; i < n_enodes; i++) m->cells[i] = map[enodes[i]];
-  m->n_nodes = n;
-  m->n_cells = (long)n_etags;
-done:
-  free(map);
-  if (tags) gmshFree(tags);
-  if (coord) gmshFree(coord);
-  if (param) gmshFree(param);
-  if (etags) gmshFree(etags);
-  if (enodes) gmshFree(enodes);
-  return ret;
+/* A new mesh taking over raw's nodes and elements (raw keeps its groups). */
+static pm_err mesh_from_raw(gm_gmsh_mesh *raw, gm_mesh **out) {
+  gm_mesh *m = NULL;
+  PM_CALL(PM_ALLOC(m, 1, "mesh"));
+  m->dim = raw->dim;
+  m->nodes_per_cell = raw->dim + 1;
+  m->n_nodes = raw->n_nodes;
+  m->x = raw->x;
+  m->n_cells = raw->n_elems;
+  m->cells = raw->elem;
+  raw->x = NULL;
+  raw->elem = NULL;
+  *out = m;
+  return PM_SUCCESS;
 }
 
 /* Not thread-safe: gmsh keeps global state, initialized and finalized here. */
@@ -210,40 +169,67 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
 
   pm_err ret = PM_SUCCESS;
   gm_mesh *m = NULL;
+  gm_gmsh_mesh raw = {.dim = 0};
   int ierr = 0;
   gm_gmsh_session session = {.threads = 0, .open = false};
-  PM_TRY(PM_ALLOC(m, 1, "mesh"));
-  m->dim = dim;
-  m->nodes_per_cell = dim + 1;
-  for (int k = 0; k < 3; k++) {
-    m->box_min[k] = k < dim ? min[k] : 0.0;
-    m->box_max[k] = k < dim ? max[k] : 0.0;
-  }
-
   PM_TRY(gm_gmsh_begin(&session, NULL));
   PM_TRY(gm_gmsh_size(h, NULL));
   gmshModelAdd("pointmech_box", &ierr);
-  GM_GMSH_CHECK("model add");
+  GM_GMSH_CHECK("model add", NULL);
   if (dim == 3)
     gmshModelOccAddBox(min[0], min[1], min[2], max[0] - min[0], max[1] - min[1],
                        max[2] - min[2], -1, &ierr);
   else
     gmshModelOccAddRectangle(min[0], min[1], 0.0, max[0] - min[0],
                              max[1] - min[1], -1, 0.0, &ierr);
-  GM_GMSH_CHECK("adding the box");
+  GM_GMSH_CHECK("adding the box", NULL);
   gmshModelOccSynchronize(&ierr);
-  GM_GMSH_CHECK("synchronize");
+  GM_GMSH_CHECK("synchronize", NULL);
   gmshModelMeshGenerate(dim, &ierr);
-  GM_GMSH_CHECK("mesh generation");
-  PM_TRY(gmsh_extract(dim, m));
-  if (dim == 2)
-    for (long i = 0; i < m->n_nodes; i++) m->x[3 * i + 2] = 0.0;
+  GM_GMSH_CHECK("mesh generation", NULL);
+  PM_TRY(gm_gmsh_read(NULL, dim, false, &raw));
+  PM_TRY(mesh_from_raw(&raw, &m));
+  for (int k = 0; k < 3; k++) {
+    m->box_min[k] = k < dim ? min[k] : 0.0;
+    m->box_max[k] = k < dim ? max[k] : 0.0;
+  }
   PM_TRY(morton_order(m));
-  PM_TRY(orient_cells(m));
+  PM_TRY(orient_cells(m, NULL));
+  PM_TRY(gm_surface_name_box(m));
   *out = m;
   m = NULL;
 done:
   gm_gmsh_end(&session);
+  gm_gmsh_mesh_free(&raw);
+  gm_mesh_destroy(m);
+  return ret;
+}
+
+/* Not thread-safe: gm_gmsh_load runs a gmsh session of its own. */
+pm_err gm_mesh_file(const char *path, int dim, double h, gm_mesh **out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_mesh_file: out is NULL");
+  *out = NULL;
+  pm_err ret = PM_SUCCESS;
+  gm_mesh *m = NULL;
+  gm_gmsh_mesh raw = {.dim = 0};
+  PM_TRY(gm_gmsh_load(path, dim, h, true, &raw));
+  PM_TRY(mesh_from_raw(&raw, &m));
+  for (int k = 0; k < 3; k++) {
+    m->box_min[k] = m->box_max[k] = m->x[k];
+    for (long i = 1; i < m->n_nodes; i++) {
+      m->box_min[k] = fmin(m->box_min[k], m->x[3 * i + k]);
+      m->box_max[k] = fmax(m->box_max[k], m->x[3 * i + k]);
+    }
+  }
+  /* Tags first, in gmsh's numbering: they follow the cells' own nodes
+   * through the renumbering and the reorientation. */
+  PM_TRY(gm_surface_from_groups(m, &raw));
+  PM_TRY(morton_order(m));
+  PM_TRY(orient_cells(m, path));
+  *out = m;
+  m = NULL;
+done:
+  gm_gmsh_mesh_free(&raw);
   gm_mesh_destroy(m);
   return ret;
 }

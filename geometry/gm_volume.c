@@ -2,14 +2,10 @@
  * simplices as affine maps, and locate points through a bucket grid. */
 #include "gm_volume.h"
 
-#include <errno.h>
-#include <gmshc.h>
 #include <math.h>
 #include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "gm_gmsh.h"
 
@@ -49,155 +45,6 @@ void gm_volume_destroy(gm_volume *v) {
   free(v->start);
   free(v->elem);
   free(v);
-}
-
-/* ---- reading with gmsh ------------------------------------------------ */
-
-/* After a gmsh call: on failure record gmsh's message and leave. */
-#define GM_VOL_GMSH_CHECK(what)                                                \
-  do {                                                                         \
-    if (ierr) {                                                                \
-      ret = gm_gmsh_fail(what, path);                                          \
-      goto done;                                                               \
-    }                                                                          \
-  } while (0)
-
-/* Copy the corner coordinates of every element of dimension dim out of
- * gmsh: *corners gets 3 * (dim + 1) doubles per element (malloc'd). */
-static pm_err gmsh_copy_simplices(const char *path, int dim, double **corners,
-                                  long *n_out) {
-  pm_err ret = PM_SUCCESS;
-  int ierr = 0;
-  int *types = NULL;
-  size_t n_types = 0, *tags = NULL, n_tags = 0, *etags = NULL, n_etags = 0;
-  size_t *enodes = NULL, n_enodes = 0, n_coord = 0, n_param = 0;
-  double *coord = NULL, *param = NULL;
-  long *map = NULL;
-  double *c = NULL;
-  int corner_nodes[16] = {0}, all_nodes[16] = {0};
-  const int npc = dim + 1;
-  *corners = NULL;
-  *n_out = 0;
-
-  gmshModelMeshGetElementTypes(&types, &n_types, dim, -1, &ierr);
-  GM_VOL_GMSH_CHECK("listing the element types of");
-  PM_ENSURE(n_types <= 16, PM_ERR_MESH,
-            "'%s' mixes %zu element types of dimension %d", path, n_types, dim);
-  for (size_t t = 0; t < n_types; t++) {
-    char *name = NULL;
-    double *local = NULL;
-    size_t n_local = 0;
-    int edim = 0, order = 0;
-    gmshModelMeshGetElementProperties(types[t], &name, &edim, &order,
-                                      &all_nodes[t], &local, &n_local,
-                                      &corner_nodes[t], &ierr);
-    if (local) gmshFree(local);
-    if (ierr) {
-      if (name) gmshFree(name);
-      GM_VOL_GMSH_CHECK("reading element properties in");
-    }
-    if (corner_nodes[t] != npc) {
-      ret = PM_ERROR(PM_ERR_UNSUPPORTED,
-                     "'%s' has %s elements (gmsh type %d): only %s are "
-                     "supported",
-                     path, name ? name : "?", types[t],
-                     dim == 3 ? "tetrahedra" : "triangles");
-      if (name) gmshFree(name);
-      goto done;
-    }
-    if (name) gmshFree(name);
-  }
-
-  /* map[tag] = position of node tag in coord, -1 when absent. */
-  gmshModelMeshGetNodes(&tags, &n_tags, &coord, &n_coord, &param, &n_param, -1,
-                        -1, 0, 0, &ierr);
-  GM_VOL_GMSH_CHECK("reading the nodes of");
-  PM_ENSURE(n_coord == 3 * n_tags, PM_ERR_MESH,
-            "gmsh returned %zu coordinates for %zu nodes of '%s'", n_coord,
-            n_tags, path);
-  size_t max_tag = 0;
-  for (size_t i = 0; i < n_tags; i++)
-    if (tags[i] > max_tag) max_tag = tags[i];
-  PM_TRY(PM_ALLOC(map, max_tag + 1, "node tag map"));
-  for (size_t t = 0; t <= max_tag; t++) map[t] = -1;
-  for (size_t i = 0; i < n_tags; i++) map[tags[i]] = (long)i;
-
-  long n = 0;
-  for (size_t t = 0; t < n_types; t++) {
-    gmshModelMeshGetElementsByType(types[t], &etags, &n_etags, &enodes,
-                                   &n_enodes, -1, 0, 1, &ierr);
-    GM_VOL_GMSH_CHECK("reading the elements of");
-    const size_t per = (size_t)all_nodes[t];
-    PM_ENSURE(per > 0 && n_enodes == per * n_etags, PM_ERR_MESH,
-              "gmsh returned %zu nodes for %zu elements of '%s'", n_enodes,
-              n_etags, path);
-    if (n_etags > 0) {
-      double *grown = realloc(c, sizeof *c * 3 * npc * ((size_t)n + n_etags));
-      PM_ENSURE(grown, PM_ERR_MEMORY, "no memory for %zu elements of '%s'",
-                (size_t)n + n_etags, path);
-      c = grown;
-    }
-    for (size_t e = 0; e < n_etags; e++, n++)
-      for (int a = 0; a < npc; a++) {
-        /* gmsh lists an element's corner nodes first. */
-        size_t tag = enodes[per * e + (size_t)a];
-        PM_ENSURE(tag <= max_tag && map[tag] >= 0, PM_ERR_MESH,
-                  "element %zu of '%s' refers to node %zu without coordinates",
-                  etags[e], path, tag);
-        memcpy(c + 3 * ((size_t)npc * n + a), coord + 3 * map[tag],
-               3 * sizeof *c);
-      }
-    gmshFree(etags);
-    gmshFree(enodes);
-    etags = enodes = NULL;
-  }
-  *corners = c;
-  *n_out = n;
-  c = NULL;
-done:
-  free(c);
-  free(map);
-  if (types) gmshFree(types);
-  if (tags) gmshFree(tags);
-  if (coord) gmshFree(coord);
-  if (param) gmshFree(param);
-  if (etags) gmshFree(etags);
-  if (enodes) gmshFree(enodes);
-  return ret;
-}
-
-/* Read path with gmsh, mesh it when it has no elements of dimension dim,
- * and copy the corners out.  gmsh lives only inside this call. */
-static pm_err gmsh_read(const char *path, int dim, double h, double **corners,
-                        long *n) {
-  pm_err ret = PM_SUCCESS;
-  int ierr = 0;
-  int *types = NULL;
-  size_t n_types = 0;
-  gm_gmsh_session session = {.threads = 0, .open = false};
-  PM_TRY(gm_gmsh_begin(&session, path));
-  gmshOpen(path, &ierr);
-  GM_VOL_GMSH_CHECK("reading");
-  gmshModelMeshGetElementTypes(&types, &n_types, dim, -1, &ierr);
-  GM_VOL_GMSH_CHECK("listing the element types of");
-  if (n_types == 0) {
-    if (h > 0.0) PM_TRY(gm_gmsh_size(h, path));
-    gmshModelMeshGenerate(dim, &ierr);
-    GM_VOL_GMSH_CHECK("meshing");
-  }
-  PM_TRY(gmsh_copy_simplices(path, dim, corners, n));
-  if (*n == 0) {
-    int model_dim = gmshModelGetDimension(&ierr);
-    PM_FAIL(PM_ERR_MESH,
-            "'%s' gives no %s (the model's dimension is %d): is it a %dD "
-            "solid?",
-            path, dim == 3 ? "tetrahedra" : "triangles", ierr ? -1 : model_dim,
-            dim);
-  }
-done:
-  if (types) gmshFree(types);
-  gm_gmsh_end(&session);
-  return ret;
 }
 
 /* ---- affine maps and the bucket grid ----------------------------------- */
@@ -334,21 +181,6 @@ static pm_err volume_build(const char *path, int dim, double *corners, long n,
   const int npc = dim + 1, stride = dim + dim * dim;
   PM_ENSURE(n < INT32_MAX, PM_ERR_UNSUPPORTED,
             "'%s' has %ld elements, more than a volume can index", path, n);
-  if (dim == 2) {
-    /* Triangles must lie in z = 0: a surface mesh elsewhere projected onto
-     * the plane would give nonsense. */
-    double ext = 0.0, zmax = 0.0;
-    for (long i = 0; i < n * npc; i++) {
-      for (int k = 0; k < 2; k++)
-        ext = fmax(ext, fabs(corners[3 * i + k] - corners[k]));
-      zmax = fmax(zmax, fabs(corners[3 * i + 2]));
-    }
-    PM_ENSURE(zmax <= 1e-9 * ext, PM_ERR_MESH,
-              "'%s': 2D triangles must lie in the z = 0 plane (a node has "
-              "|z| = %g, the xy extent is %g)",
-              path, zmax, ext);
-    for (long i = 0; i < n * npc; i++) corners[3 * i + 2] = 0.0;
-  }
   PM_TRY(PM_ALLOC(v, 1, "volume"));
   PM_TRY(PM_ALLOC(v->affine, (size_t)stride * n, "element maps"));
   v->dim = dim;
@@ -382,36 +214,20 @@ done:
   return ret;
 }
 
-/* Regular readable file, checked before gmsh sees it: gmsh reports a
- * missing file without failing. */
-static pm_err check_readable(const char *path) {
-  struct stat st;
-  PM_CHECK(stat(path, &st) == 0, PM_ERR_IO, "cannot open volume file '%s': %s",
-           path, strerror(errno));
-  PM_CHECK(!S_ISDIR(st.st_mode), PM_ERR_IO, "volume file '%s' is a directory",
-           path);
-  FILE *f = fopen(path, "rb");
-  PM_CHECK(f, PM_ERR_IO, "cannot read volume file '%s': %s", path,
-           strerror(errno));
-  fclose(f);
-  return PM_SUCCESS;
-}
-
 pm_err gm_volume_load(const char *path, int dim, double h, gm_volume **out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_volume_load: out is NULL");
   *out = NULL;
-  PM_CHECK(path && path[0], PM_ERR_ARG, "gm_volume_load: no file name");
-  PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG,
-           "volume dimension must be 2 or 3 (got %d) for '%s'", dim, path);
-  PM_CHECK(isfinite(h), PM_ERR_ARG,
-           "mesh size h must be finite (got %g) for '%s'", h, path);
-  PM_CALL(check_readable(path));
   pm_err ret = PM_SUCCESS;
+  gm_gmsh_mesh raw = {.dim = 0};
   double *corners = NULL;
-  long n = 0;
-  PM_TRY(gmsh_read(path, dim, h, &corners, &n));
-  PM_TRY(volume_build(path, dim, corners, n, out));
+  PM_TRY(gm_gmsh_load(path, dim, h, false, &raw));
+  const size_t npc = (size_t)dim + 1;
+  PM_TRY(PM_ALLOC(corners, 3 * npc * (size_t)raw.n_elems, "element corners"));
+  for (size_t k = 0; k < npc * (size_t)raw.n_elems; k++)
+    memcpy(corners + 3 * k, raw.x + 3 * raw.elem[k], 3 * sizeof *corners);
+  PM_TRY(volume_build(path, dim, corners, raw.n_elems, out));
 done:
+  gm_gmsh_mesh_free(&raw);
   free(corners);
   return ret;
 }

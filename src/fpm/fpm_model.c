@@ -170,7 +170,7 @@ static pm_err build_boundary(fpm_model *m, const pm_scene *s) {
     const pm_scene_bc *bc = &s->bcs[b];
     long on_face = 0;
     for (long f = 0; f < d->n_facets; f++) {
-      if (d->facet_face[f] != (int)bc->face) continue;
+      if (d->facet_surface[f] != (int)bc->face) continue;
       on_face++;
       long i = d->facet_point[f];
       for (int c = 0; c < 3; c++)
@@ -221,7 +221,7 @@ static pm_err build_boundary(fpm_model *m, const pm_scene *s) {
   for (int b = 0; b < s->n_bcs; b++) {
     const pm_scene_bc *bc = &s->bcs[b];
     for (long f = 0; f < d->n_facets; f++) {
-      if (d->facet_face[f] != (int)bc->face) continue;
+      if (d->facet_surface[f] != (int)bc->face) continue;
       long i = d->facet_point[f];
       const double *xi = m->x + 3 * i, *af = d->facet_area_vec + 3 * f;
       const double *Mf = d->facet_moment + 9 * f,

@@ -17,7 +17,7 @@ void fpm_reaction(const fpm_model *m, const fpm_state *st, int b, double R[3]) {
   const pm_scene_bc *bc = &m->scene->bcs[b];
   R[0] = R[1] = R[2] = 0;
   for (long f = 0; f < d->n_facets; f++) {
-    if (d->facet_face[f] != (int)bc->face) continue;
+    if (d->facet_surface[f] != (int)bc->face) continue;
     const double *P = st->P + 9 * d->facet_point[f],
                  *a = d->facet_area_vec + 3 * f;
     for (int c = 0; c < 3; c++)

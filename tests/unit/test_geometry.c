@@ -1,5 +1,6 @@
-/* test_geometry: median-dual cells of hand-made and gmsh meshes: volumes,
- * closure, divergence theorem for moments, boundary facets, adjacency. */
+/* test_geometry: median-dual cells of hand-made, gmsh box and gmsh file
+ * meshes: volumes, closure, divergence theorem for moments, boundary
+ * facets, adjacency; the figures of box meshes; the cell-builder table. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -7,10 +8,16 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "pm_testing.h"
+
+#include "gm_cells.h"
 #include "gm_dual.h"
+
+#define DATA PM_TEST_DATA "/geometry/"
 
 /* Structured box of n[0] x n[1] (x n[2]) cubes (squares), each split into 6
  * Kuhn tetrahedra (2 triangles).  Some tetrahedra come out negatively
@@ -69,20 +76,38 @@ static gm_mesh *kuhn_mesh(int dim, const int n[3], const double lo[3],
   return m;
 }
 
-/* Checks every property the dual promises.  All boundary facets must lie
- * on box faces (true for box meshes). */
-static void check_dual(const gm_mesh *m, const gm_dual *d) {
+/* Sum of the cells' measures (volume in 3D, area in 2D). */
+static double mesh_measure(const gm_mesh *m) {
+  double sum = 0.0;
+  for (long c = 0; c < m->n_cells; c++) {
+    const long *cell = m->cells + (size_t)m->nodes_per_cell * c;
+    double e[3][3];
+    for (int a = 0; a < m->dim; a++)
+      for (int k = 0; k < 3; k++)
+        e[a][k] = m->x[3 * cell[a + 1] + k] - m->x[3 * cell[0] + k];
+    if (m->dim == 2) {
+      sum += 0.5 * (e[0][0] * e[1][1] - e[0][1] * e[1][0]);
+      continue;
+    }
+    sum += (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+            e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+            e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
+           6.0;
+  }
+  return sum;
+}
+
+/* Checks every property the dual of any mesh promises: volumes positive
+ * and summing to the mesh's measure, adjacency, interface orientation, and
+ * cell by cell closure (interfaces and facets sum to a zero area vector)
+ * and the divergence theorem (their moments sum to V I). */
+static void check_partition(const gm_mesh *m, const gm_dual *d) {
   const int dim = m->dim;
   assert_int_equal(d->dim, dim);
   assert_int_equal(d->n_points, m->n_nodes);
   const long n = d->n_points;
-  double ext[3] = {0, 0, 0}, domain = 1.0;
-  for (int k = 0; k < dim; k++) {
-    ext[k] = m->box_max[k] - m->box_min[k];
-    domain *= ext[k];
-  }
+  const double domain = mesh_measure(m);
 
-  /* Volumes: positive, summing to the domain's. */
   double vsum = 0.0;
   for (long i = 0; i < n; i++) {
     assert_true(d->volume[i] > 0.0);
@@ -116,8 +141,6 @@ static void check_dual(const gm_mesh *m, const gm_dual *d) {
     if (dim == 2) assert_true(a[2] == 0.0);
   }
 
-  /* Closure and divergence theorem, cell by cell: the sum of outward area
-   * vectors vanishes and the sum of outward moments is V I. */
   double *sa = calloc(3 * (size_t)n, sizeof *sa);
   double *sm = calloc(9 * (size_t)n, sizeof *sm);
   double *scale = calloc((size_t)n, sizeof *scale);
@@ -135,29 +158,12 @@ static void check_dual(const gm_mesh *m, const gm_dual *d) {
       scale[ij[s]] += d->if_area[f];
     }
   }
-  double face_area[PM_FACE_COUNT] = {0};
   for (long f = 0; f < d->n_facets; f++) {
     long i = d->facet_point[f];
-    int face = d->facet_face[f];
     assert_true(i >= 0 && i < n);
     for (int k = 0; k < 3; k++) sa[3 * i + k] += d->facet_area_vec[3 * f + k];
     for (int k = 0; k < 9; k++) sm[9 * i + k] += d->facet_moment[9 * f + k];
     scale[i] += d->facet_area[f];
-    /* Tagged to the face it lies on, pointing out of the box. */
-    assert_true(face >= 0 && face < 2 * dim);
-    int axis = face / 2;
-    double plane = (face % 2) ? m->box_max[axis] : m->box_min[axis];
-    double sign = (face % 2) ? 1.0 : -1.0;
-    assert_true(fabs(d->facet_centroid[3 * f + axis] - plane) <=
-                1e-12 * ext[axis]);
-    assert_true(fabs(d->x[3 * i + axis] - plane) <= 1e-12 * ext[axis]);
-    assert_true(fabs(sign * d->facet_area_vec[3 * f + axis] -
-                     d->facet_area[f]) <= 1e-12 * d->facet_area[f]);
-    face_area[face] += d->facet_area[f];
-  }
-  for (int face = 0; face < 2 * dim; face++) {
-    double expect = dim == 2 ? ext[1 - face / 2] : domain / ext[face / 2];
-    assert_true(fabs(face_area[face] - expect) <= 1e-12 * expect);
   }
   double worst_a = 0.0, worst_m = 0.0;
   for (long i = 0; i < n; i++) {
@@ -178,6 +184,39 @@ static void check_dual(const gm_mesh *m, const gm_dual *d) {
   free(sa);
   free(sm);
   free(scale);
+}
+
+/* Checks the dual of a mesh of its box: the partition properties, and
+ * every facet on the box face its surface names, pointing out of the box,
+ * the faces' areas adding up. */
+static void check_dual(const gm_mesh *m, const gm_dual *d) {
+  const int dim = m->dim;
+  double ext[3] = {0, 0, 0}, domain = 1.0;
+  for (int k = 0; k < dim; k++) {
+    ext[k] = m->box_max[k] - m->box_min[k];
+    domain *= ext[k];
+  }
+  assert_true(fabs(mesh_measure(m) - domain) <= 1e-12 * domain);
+  check_partition(m, d);
+  double face_area[PM_FACE_COUNT] = {0};
+  for (long f = 0; f < d->n_facets; f++) {
+    long i = d->facet_point[f];
+    int face = d->facet_surface[f];
+    assert_true(face >= 0 && face < 2 * dim);
+    int axis = face / 2;
+    double plane = (face % 2) ? m->box_max[axis] : m->box_min[axis];
+    double sign = (face % 2) ? 1.0 : -1.0;
+    assert_true(fabs(d->facet_centroid[3 * f + axis] - plane) <=
+                1e-12 * ext[axis]);
+    assert_true(fabs(d->x[3 * i + axis] - plane) <= 1e-12 * ext[axis]);
+    assert_true(fabs(sign * d->facet_area_vec[3 * f + axis] -
+                     d->facet_area[f]) <= 1e-12 * d->facet_area[f]);
+    face_area[face] += d->facet_area[f];
+  }
+  for (int face = 0; face < 2 * dim; face++) {
+    double expect = dim == 2 ? ext[1 - face / 2] : domain / ext[face / 2];
+    assert_true(fabs(face_area[face] - expect) <= 1e-12 * expect);
+  }
 }
 
 static void test_hand_made_3d(void **state) {
@@ -236,7 +275,7 @@ static void test_single_tet(void **state) {
   assert_int_equal(d->n_facets, 12);
   int count[PM_FACE_COUNT + 1] = {0};
   for (long f = 0; f < d->n_facets; f++) {
-    int face = d->facet_face[f];
+    int face = d->facet_surface[f];
     count[face == PM_FACE_NONE ? PM_FACE_COUNT : face]++;
   }
   assert_int_equal(count[PM_FACE_XMIN], 3);
@@ -247,7 +286,7 @@ static void test_single_tet(void **state) {
     assert_true(fabs(d->volume[i] - 1.0 / 24) < 1e-15);
   /* Node 0's facet on z = 0 is a third of that face (area 1/2). */
   for (long f = 0; f < d->n_facets; f++)
-    if (d->facet_point[f] == 0 && d->facet_face[f] == PM_FACE_ZMIN) {
+    if (d->facet_point[f] == 0 && d->facet_surface[f] == PM_FACE_ZMIN) {
       assert_true(fabs(d->facet_area[f] - 1.0 / 6) < 1e-15);
       assert_true(fabs(d->facet_area_vec[3 * f + 2] + 1.0 / 6) < 1e-15);
     }
@@ -323,11 +362,117 @@ static void test_gmsh_rect_2d(void **state) {
   check_gmsh_box(2, lo, hi, 1.0);
 }
 
+/* Meshes of files (a block, a cylinder, a disk in 2D): the partition
+ * properties hold whatever the boundary, and every facet of a closed
+ * boundary all in groups has a surface. */
+static void test_file_meshes(void **state) {
+  (void)state;
+  const struct {
+    const char *path;
+    int dim;
+    double h;
+    bool all_named;
+  } files[] = {{DATA "block.geo", 3, 0.02, true},
+               {DATA "cylinder.geo", 3, 0.01, false},
+               {DATA "disk.geo", 2, 0.05, true}};
+  for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
+    gm_mesh *m = NULL;
+    gm_dual *d = NULL;
+    assert_ok(gm_mesh_file(files[k].path, files[k].dim, files[k].h, &m));
+    assert_ok(gm_dual_build(m, &d));
+    print_message("  %s\n", files[k].path);
+    check_partition(m, d);
+    long none = 0;
+    for (long f = 0; f < d->n_facets; f++) {
+      assert_true(d->facet_surface[f] >= -1 &&
+                  d->facet_surface[f] < m->n_surfaces);
+      none += d->facet_surface[f] < 0;
+    }
+    if (files[k].all_named)
+      assert_int_equal(none, 0);
+    else
+      assert_true(none > 0);
+    gm_dual_destroy(d);
+    gm_mesh_destroy(m);
+  }
+}
+
+/* Box meshes and their duals as they were before meshes carried surfaces
+ * (figures of gmsh 4.8: another gmsh version may mesh differently): counts
+ * exactly, position-weighted sums to round-off, so that node order, cell
+ * orientation and facet order are all pinned. */
+static void test_box_figures(void **state) {
+  (void)state;
+  const struct {
+    int dim;
+    double h;
+    long nodes, cells, ifaces, facets;
+    double sum_x, sum_v, sum_a, sum_f;
+  } ref[] = {{3, 0.02, 237, 734, 1169, 1194, 35.599350903805131,
+              0.11930048398625899, 82.419554735275753, 124.98788923142524},
+             {2, 0.01, 142, 242, 383, 80, 14.130367474295316,
+              0.71672546600843778, 394.85955103002891, 41.239999999999988}};
+  const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
+  for (size_t k = 0; k < sizeof ref / sizeof ref[0]; k++) {
+    gm_mesh *m = NULL;
+    gm_dual *d = NULL;
+    assert_ok(gm_mesh_box(ref[k].dim, lo, hi, ref[k].h, &m));
+    assert_ok(gm_dual_build(m, &d));
+    assert_int_equal(m->n_nodes, ref[k].nodes);
+    assert_int_equal(m->n_cells, ref[k].cells);
+    assert_int_equal(d->n_ifaces, ref[k].ifaces);
+    assert_int_equal(d->n_facets, ref[k].facets);
+    double sx = 0, sv = 0, sa = 0, sf = 0;
+    for (long i = 0; i < 3 * m->n_nodes; i++) sx += m->x[i];
+    for (long i = 0; i < d->n_points; i++) sv += d->volume[i] * (i + 1);
+    for (long i = 0; i < d->n_ifaces; i++) sa += d->if_area[i] * (i + 1);
+    /* The facets' surfaces count too: they were their box faces then. */
+    for (long i = 0; i < d->n_facets; i++)
+      sf += d->facet_area[i] * (i + 1) * (1 + d->facet_surface[i]);
+    assert_true(fabs(sx - ref[k].sum_x) <= 1e-14 * ref[k].sum_x);
+    assert_true(fabs(sv - ref[k].sum_v) <= 1e-14 * ref[k].sum_v);
+    assert_true(fabs(sa - ref[k].sum_a) <= 1e-14 * ref[k].sum_a);
+    assert_true(fabs(sf - ref[k].sum_f) <= 1e-14 * ref[k].sum_f);
+    gm_dual_destroy(d);
+    gm_mesh_destroy(m);
+  }
+}
+
+/* The builder table: "median-dual" is gm_dual_build; unknown names give
+ * NULL. */
+static void test_cells_table(void **state) {
+  (void)state;
+  const gm_cells_builder *b = gm_cells_find("median-dual");
+  assert_non_null(b);
+  assert_string_equal(b->name, "median-dual");
+  assert_non_null(b->summary);
+  assert_true(b->build == gm_dual_build);
+  assert_null(gm_cells_find("voronoi"));
+  assert_null(gm_cells_find("Median-Dual"));
+  assert_null(gm_cells_find(""));
+  assert_null(gm_cells_find(NULL));
+  assert_true(gm_cells_count() >= 1);
+  assert_true(gm_cells_at(0) == b);
+  assert_null(gm_cells_at(gm_cells_count()));
+  assert_null(gm_cells_at(-1));
+  /* Through the table, a box mesh's cells as gm_dual_build makes them. */
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
+  gm_mesh *m = NULL;
+  gm_dual *d = NULL;
+  assert_ok(gm_mesh_box(2, lo, hi, 0.25, &m));
+  assert_ok(b->build(m, &d));
+  check_dual(m, d);
+  gm_dual_destroy(d);
+  gm_mesh_destroy(m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_hand_made_3d), cmocka_unit_test(test_hand_made_2d),
       cmocka_unit_test(test_single_tet),   cmocka_unit_test(test_bad_input),
       cmocka_unit_test(test_gmsh_box_3d),  cmocka_unit_test(test_gmsh_rect_2d),
+      cmocka_unit_test(test_file_meshes),  cmocka_unit_test(test_box_figures),
+      cmocka_unit_test(test_cells_table),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

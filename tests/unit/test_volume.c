@@ -1,5 +1,6 @@
 /* test_volume: point-in-solid queries on volumes read from small .geo and
- * .msh files written at test time: membership, measure, bounds, errors. */
+ * .msh files written at test time: membership, measure, bounds, and the
+ * errors of the gmsh file reader it shares with gm_mesh_file. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -22,23 +23,6 @@
 #include "pm_omp.h"
 
 #define PI 3.14159265358979323846
-
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define PM_TEST_ASAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(PM_TEST_ASAN)
-/* gmsh 4.8 and OpenCASCADE leak a little on their own: meshing curved
- * surfaces (meshGFace), the .geo parser after a syntax error (its Malloc),
- * STEP reading and writing (OpenCASCADE's libTK*).  The sanitizer build runs
- * with detect_leaks=1: ignore exactly those, so that a leak of ours, or an
- * array from the gmsh API left without gmshFree, still fails. */
-const char *__lsan_default_suppressions(void);
-const char *__lsan_default_suppressions(void) {
-  return "leak:meshGFace\nleak:^Malloc(\nleak:libTK\n";
-}
-#endif
 
 /* Writes text to dir/name; path receives the full name. */
 static void write_file(const char *dir, const char *name, const char *text,
@@ -349,32 +333,43 @@ static void test_cad_files(void **state) {
   }
 }
 
+/* Both readers of gmsh files, gm_volume_load and gm_mesh_file, fail on
+ * path (dimension dim, size h) with code, no result and a message that
+ * names the file and holds what. */
+static void expect_failure(const char *path, int dim, double h, pm_err code,
+                           const char *what) {
+  gm_volume *v = (gm_volume *)0x1;
+  gm_mesh *m = (gm_mesh *)0x1;
+  assert_int_equal(gm_volume_load(path, dim, h, &v), code);
+  assert_null(v);
+  print_message("  %s\n", pm_error_message());
+  assert_non_null(strstr(pm_error_message(), what));
+  if (path) assert_non_null(strstr(pm_error_message(), path));
+  assert_int_equal(gm_mesh_file(path, dim, h, &m), code);
+  assert_null(m);
+  assert_non_null(strstr(pm_error_message(), what));
+  if (path) assert_non_null(strstr(pm_error_message(), path));
+}
+
 /* The error paths. */
 static void test_errors(void **state) {
   char path[512], missing[512];
   gm_volume *v = (gm_volume *)0x1;
   snprintf(missing, sizeof missing, "%s/no_such_file.geo", (char *)*state);
-  assert_int_equal(gm_volume_load(missing, 3, 0.1, &v), PM_ERR_IO);
-  assert_null(v);
-  assert_non_null(strstr(pm_error_message(), missing));
-  assert_int_equal(gm_volume_load(*state, 3, 0.1, &v), PM_ERR_IO);
-  assert_non_null(strstr(pm_error_message(), "directory"));
+  expect_failure(missing, 3, 0.1, PM_ERR_IO, "No such file");
+  expect_failure(*state, 3, 0.1, PM_ERR_IO, "directory");
 
   /* A 2D disk asked for as a 3D solid: gmsh makes no tetrahedra. */
   write_file(*state, "disk.geo",
              "SetFactory(\"OpenCASCADE\");\nDisk(1) = {0, 0, 0, 0.5};\n", path);
-  assert_int_equal(gm_volume_load(path, 3, 0.1, &v), PM_ERR_MESH);
-  assert_null(v);
-  print_message("  disk as 3D: %s\n", pm_error_message());
-  assert_non_null(strstr(pm_error_message(), "no tetrahedra"));
+  expect_failure(path, 3, 0.1, PM_ERR_MESH, "no tetrahedra");
   /* A .msh holding only a triangle. */
   write_file(*state, "tri.msh",
              "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
              "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
              "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n",
              path);
-  assert_int_equal(gm_volume_load(path, 3, 0.1, &v), PM_ERR_MESH);
-  print_message("  triangle .msh as 3D: %s\n", pm_error_message());
+  expect_failure(path, 3, 0.1, PM_ERR_MESH, "no tetrahedra");
   /* ... which is fine in 2D. */
   assert_ok(gm_volume_load(path, 2, 0.1, &v));
   assert_true(fabs(gm_volume_measure(v) - 0.5) <= 1e-15);
@@ -383,13 +378,10 @@ static void test_errors(void **state) {
   write_file(*state, "bad.geo",
              "SetFactory(\"OpenCASCADE\");\nSphere(1) = {0, 0, 0, 0.5;\n",
              path);
-  assert_int_equal(gm_volume_load(path, 3, 0.1, &v), PM_ERR_MESH);
-  print_message("  bad .geo: %s\n", pm_error_message());
-  assert_non_null(strstr(pm_error_message(), "syntax error"));
+  expect_failure(path, 3, 0.1, PM_ERR_MESH, "syntax error");
   /* A 3D solid asked for in 2D: its surface triangles leave z = 0. */
   write_file(*state, "sphere.geo", sphere_geo, path);
-  assert_int_equal(gm_volume_load(path, 2, 0.2, &v), PM_ERR_MESH);
-  assert_non_null(strstr(pm_error_message(), "z = 0"));
+  expect_failure(path, 2, 0.2, PM_ERR_MESH, "z = 0");
   /* Hexahedra are not simplices. */
   write_file(*state, "hex.msh",
              "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
@@ -397,14 +389,12 @@ static void test_errors(void **state) {
              "5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n"
              "$Elements\n1\n1 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n",
              path);
-  assert_int_equal(gm_volume_load(path, 3, 0.1, &v), PM_ERR_UNSUPPORTED);
-  print_message("  hexahedron: %s\n", pm_error_message());
+  expect_failure(path, 3, 0.1, PM_ERR_UNSUPPORTED, "Hexahedron");
   /* Arguments. */
-  assert_int_equal(gm_volume_load(path, 4, 0.1, &v), PM_ERR_ARG);
-  assert_int_equal(gm_volume_load(path, 3, NAN, &v), PM_ERR_ARG);
-  assert_int_equal(gm_volume_load(NULL, 3, 0.1, &v), PM_ERR_ARG);
+  expect_failure(path, 4, 0.1, PM_ERR_ARG, "2 or 3");
+  expect_failure(path, 3, NAN, PM_ERR_ARG, "finite");
+  expect_failure(NULL, 3, 0.1, PM_ERR_ARG, "no volume file name");
   assert_int_equal(gm_volume_load(path, 3, 0.1, NULL), PM_ERR_ARG);
-  assert_null(v);
   gm_volume_destroy(NULL);
   pm_error_clear();
 }

@@ -1,0 +1,279 @@
+/* gm_gmsh_read: a gmsh model, built in memory or read from a file, as
+ * linear simplices and the named physical groups on their boundary.  The
+ * one reader of gmsh meshes for gm_mesh and gm_volume. */
+#include "gm_gmsh.h"
+
+#include <errno.h>
+#include <gmshc.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* How messages name the model. */
+static const char *label(const char *name) {
+  return name ? name : "(model in memory)";
+}
+
+static const char *simplices(int dim) {
+  return dim == 3 ? "tetrahedra" : dim == 2 ? "triangles" : "line segments";
+}
+
+void gm_gmsh_mesh_free(gm_gmsh_mesh *m) {
+  if (!m) return;
+  free(m->x);
+  free(m->elem);
+  if (m->group_name)
+    for (int g = 0; g < m->n_groups; g++) free(m->group_name[g]);
+  free(m->group_name);
+  free(m->group_ptr);
+  free(m->group_face);
+  memset(m, 0, sizeof *m);
+}
+
+/* Nodes per element of gmsh type `type` (corners and higher-order nodes),
+ * after checking that it is a simplex of dimension dim.  group names the
+ * physical group in the message (NULL: the volume itself). */
+static pm_err simplex_nodes(const char *name, int type, int dim,
+                            const char *group, size_t *per) {
+  pm_err ret = PM_SUCCESS;
+  char *tname = NULL;
+  double *local = NULL;
+  size_t n_local = 0;
+  int edim = 0, order = 0, all = 0, corners = 0, ierr = 0;
+  gmshModelMeshGetElementProperties(type, &tname, &edim, &order, &all, &local,
+                                    &n_local, &corners, &ierr);
+  GM_GMSH_CHECK("reading element properties in", name);
+  PM_ENSURE(corners == dim + 1, PM_ERR_UNSUPPORTED,
+            "'%s' has %s elements (gmsh type %d)%s%s%s: only %s are "
+            "supported",
+            label(name), tname ? tname : "?", type,
+            group ? " in physical group '" : "", group ? group : "",
+            group ? "'" : "", simplices(dim));
+  PM_ENSURE(all >= corners, PM_ERR_MESH,
+            "gmsh gives %d nodes to its element type %d of %d corners", all,
+            type, corners);
+  *per = (size_t)all;
+done:
+  if (tname) gmshFree(tname);
+  if (local) gmshFree(local);
+  return ret;
+}
+
+/* Appends the corner node tags of every element of dimension d on model
+ * entity `entity` (-1: all of them) to *tags, d + 1 per element (*tags
+ * grows with realloc; *n counts the elements). */
+static pm_err append_corners(const char *name, int d, int entity,
+                             const char *group, size_t **tags, long *n) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0, *types = NULL;
+  size_t n_types = 0, *etags = NULL, n_etags = 0, *enodes = NULL;
+  size_t n_enodes = 0;
+  const size_t npc = (size_t)d + 1;
+  gmshModelMeshGetElementTypes(&types, &n_types, d, entity, &ierr);
+  GM_GMSH_CHECK("listing the element types of", name);
+  for (size_t t = 0; t < n_types; t++) {
+    size_t per = 0;
+    PM_TRY(simplex_nodes(name, types[t], d, group, &per));
+    gmshModelMeshGetElementsByType(types[t], &etags, &n_etags, &enodes,
+                                   &n_enodes, entity, 0, 1, &ierr);
+    GM_GMSH_CHECK("reading the elements of", name);
+    PM_ENSURE(n_enodes == per * n_etags, PM_ERR_MESH,
+              "gmsh returned %zu nodes for %zu elements of '%s'", n_enodes,
+              n_etags, label(name));
+    if (n_etags > 0) {
+      size_t *grown =
+          realloc(*tags, sizeof **tags * npc * ((size_t)*n + n_etags));
+      PM_ENSURE(grown, PM_ERR_MEMORY, "no memory for %zu elements of '%s'",
+                (size_t)*n + n_etags, label(name));
+      *tags = grown;
+    }
+    /* gmsh lists an element's corner nodes first. */
+    for (size_t e = 0; e < n_etags; e++, (*n)++)
+      memcpy(*tags + npc * (size_t)*n, enodes + per * e, sizeof **tags * npc);
+    gmshFree(etags);
+    gmshFree(enodes);
+    etags = enodes = NULL;
+  }
+done:
+  if (types) gmshFree(types);
+  if (etags) gmshFree(etags);
+  if (enodes) gmshFree(enodes);
+  return ret;
+}
+
+/* Triangles must lie in z = 0: a surface mesh elsewhere projected onto the
+ * plane would give nonsense.  Then z is set to 0 exactly. */
+static pm_err check_plane(const char *name, gm_gmsh_mesh *m) {
+  double ext = 0.0, zmax = 0.0;
+  for (long i = 0; i < m->n_nodes; i++) {
+    for (int k = 0; k < 2; k++)
+      ext = fmax(ext, fabs(m->x[3 * i + k] - m->x[k]));
+    zmax = fmax(zmax, fabs(m->x[3 * i + 2]));
+  }
+  PM_CHECK(zmax <= 1e-9 * ext, PM_ERR_MESH,
+           "'%s': 2D triangles must lie in the z = 0 plane (a node has |z| = "
+           "%g, the xy extent is %g)",
+           label(name), zmax, ext);
+  for (long i = 0; i < m->n_nodes; i++) m->x[3 * i + 2] = 0.0;
+  return PM_SUCCESS;
+}
+
+/* Physical groups of dimension dim - 1, their faces numbered through map
+ * (node tag -> node number, -1 for a node no element uses). */
+static pm_err read_groups(const char *name, int dim, const long *map,
+                          size_t max_tag, gm_gmsh_mesh *out) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0, *dimtags = NULL, *ents = NULL;
+  size_t n_dimtags = 0, n_ents = 0, *ftag = NULL;
+  char *pname = NULL;
+  long nf = 0;
+  const int d = dim - 1;
+  gmshModelGetPhysicalGroups(&dimtags, &n_dimtags, d, &ierr);
+  GM_GMSH_CHECK("listing the physical groups of", name);
+  const int ng = (int)(n_dimtags / 2);
+  PM_TRY(PM_ALLOC(out->group_name, ng, "physical group names"));
+  PM_TRY(PM_ALLOC(out->group_ptr, ng + 1, "physical groups"));
+  out->n_groups = ng;
+  for (int g = 0; g < ng; g++) {
+    const int tag = dimtags[2 * g + 1];
+    gmshModelGetPhysicalName(d, tag, &pname, &ierr);
+    GM_GMSH_CHECK("reading the physical names of", name);
+    char fallback[32];
+    snprintf(fallback, sizeof fallback, "surface-%d", tag);
+    out->group_name[g] = strdup(pname && pname[0] ? pname : fallback);
+    PM_ENSURE(out->group_name[g], PM_ERR_MEMORY, "no memory for a name");
+    gmshFree(pname);
+    pname = NULL;
+    gmshModelGetEntitiesForPhysicalGroup(d, tag, &ents, &n_ents, &ierr);
+    GM_GMSH_CHECK("reading the physical groups of", name);
+    for (size_t e = 0; e < n_ents; e++)
+      PM_TRY(append_corners(name, d, ents[e], out->group_name[g], &ftag, &nf));
+    gmshFree(ents);
+    ents = NULL;
+    out->group_ptr[g + 1] = nf;
+  }
+  PM_TRY(PM_ALLOC(out->group_face, (size_t)dim * nf, "physical group faces"));
+  for (size_t k = 0; k < (size_t)dim * nf; k++)
+    out->group_face[k] = ftag[k] <= max_tag ? map[ftag[k]] : -1;
+done:
+  free(ftag);
+  if (dimtags) gmshFree(dimtags);
+  if (ents) gmshFree(ents);
+  if (pname) gmshFree(pname);
+  return ret;
+}
+
+pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_gmsh_read: out is NULL");
+  memset(out, 0, sizeof *out);
+  PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG,
+           "mesh dimension must be 2 or 3 (got %d) for '%s'", dim, label(name));
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0;
+  size_t *tags = NULL, n_tags = 0, n_coord = 0, n_param = 0, *ctag = NULL;
+  double *coord = NULL, *param = NULL;
+  long *map = NULL, n = 0;
+  const size_t npc = (size_t)dim + 1;
+  out->dim = dim;
+  PM_TRY(append_corners(name, dim, -1, NULL, &ctag, &n));
+  if (n == 0) {
+    int model_dim = gmshModelGetDimension(&ierr);
+    PM_FAIL(PM_ERR_MESH,
+            "'%s' gives no %s (the model's dimension is %d): is it a %dD "
+            "solid?",
+            label(name), simplices(dim), ierr ? -1 : model_dim, dim);
+  }
+  gmshModelMeshGetNodes(&tags, &n_tags, &coord, &n_coord, &param, &n_param, -1,
+                        -1, 0, 0, &ierr);
+  GM_GMSH_CHECK("reading the nodes of", name);
+  PM_ENSURE(n_coord == 3 * n_tags, PM_ERR_MESH,
+            "gmsh returned %zu coordinates for %zu nodes of '%s'", n_coord,
+            n_tags, label(name));
+  size_t max_tag = 0;
+  for (size_t i = 0; i < n_tags; i++)
+    if (tags[i] > max_tag) max_tag = tags[i];
+  /* map[tag]: -1 unused, -2 a corner, then the corner's number: the nodes
+   * elements use, numbered in gmsh's node order. */
+  PM_TRY(PM_ALLOC(map, max_tag + 1, "node tag map"));
+  for (size_t t = 0; t <= max_tag; t++) map[t] = -1;
+  for (size_t k = 0; k < npc * (size_t)n; k++) {
+    PM_ENSURE(ctag[k] <= max_tag, PM_ERR_MESH,
+              "an element of '%s' refers to node %zu without coordinates",
+              label(name), ctag[k]);
+    map[ctag[k]] = -2;
+  }
+  long nn = 0;
+  for (size_t i = 0; i < n_tags; i++)
+    if (map[tags[i]] == -2) map[tags[i]] = nn++;
+  for (size_t k = 0; k < npc * (size_t)n; k++)
+    PM_ENSURE(map[ctag[k]] >= 0, PM_ERR_MESH,
+              "an element of '%s' refers to node %zu without coordinates",
+              label(name), ctag[k]);
+  PM_TRY(PM_ALLOC(out->x, 3 * nn, "mesh coordinates"));
+  PM_TRY(PM_ALLOC(out->elem, npc * (size_t)n, "mesh elements"));
+  for (size_t i = 0; i < n_tags; i++) {
+    long k = map[tags[i]];
+    if (k >= 0) memcpy(out->x + 3 * k, coord + 3 * i, 3 * sizeof *coord);
+  }
+  for (size_t k = 0; k < npc * (size_t)n; k++) out->elem[k] = map[ctag[k]];
+  out->n_nodes = nn;
+  out->n_elems = n;
+  if (dim == 2) PM_TRY(check_plane(name, out));
+  if (groups) PM_TRY(read_groups(name, dim, map, max_tag, out));
+done:
+  if (ret) gm_gmsh_mesh_free(out);
+  free(ctag);
+  free(map);
+  if (tags) gmshFree(tags);
+  if (coord) gmshFree(coord);
+  if (param) gmshFree(param);
+  return ret;
+}
+
+/* Regular readable file, checked before gmsh sees it: gmsh reports a
+ * missing file without failing. */
+static pm_err check_readable(const char *path) {
+  struct stat st;
+  PM_CHECK(stat(path, &st) == 0, PM_ERR_IO, "cannot open volume file '%s': %s",
+           path, strerror(errno));
+  PM_CHECK(!S_ISDIR(st.st_mode), PM_ERR_IO, "volume file '%s' is a directory",
+           path);
+  FILE *f = fopen(path, "rb");
+  PM_CHECK(f, PM_ERR_IO, "cannot read volume file '%s': %s", path,
+           strerror(errno));
+  fclose(f);
+  return PM_SUCCESS;
+}
+
+pm_err gm_gmsh_load(const char *path, int dim, double h, bool groups,
+                    gm_gmsh_mesh *out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_gmsh_load: out is NULL");
+  memset(out, 0, sizeof *out);
+  PM_CHECK(path && path[0], PM_ERR_ARG, "no volume file name");
+  PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG,
+           "volume dimension must be 2 or 3 (got %d) for '%s'", dim, path);
+  PM_CHECK(isfinite(h), PM_ERR_ARG,
+           "mesh size h must be finite (got %g) for '%s'", h, path);
+  PM_CALL(check_readable(path));
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0, *types = NULL;
+  size_t n_types = 0;
+  gm_gmsh_session session = {.threads = 0, .open = false};
+  PM_TRY(gm_gmsh_begin(&session, path));
+  gmshOpen(path, &ierr);
+  GM_GMSH_CHECK("reading", path);
+  gmshModelMeshGetElementTypes(&types, &n_types, dim, -1, &ierr);
+  GM_GMSH_CHECK("listing the element types of", path);
+  if (n_types == 0) {
+    if (h > 0.0) PM_TRY(gm_gmsh_size(h, path));
+    gmshModelMeshGenerate(dim, &ierr);
+    GM_GMSH_CHECK("meshing", path);
+  }
+  PM_TRY(gm_gmsh_read(path, dim, groups, out));
+done:
+  if (types) gmshFree(types);
+  gm_gmsh_end(&session);
+  return ret;
+}
