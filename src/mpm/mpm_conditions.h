@@ -43,12 +43,15 @@ typedef struct {
  * mpm_conditions_destroy. */
 pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
                              int *n_bcs);
+/* Release conditions made by mpm_conditions_create (NULL accepted). */
 void mpm_conditions_destroy(mpm_bc *bcs, int n_bcs);
 
 /* Allocate the conditions' workspace for n_bcs conditions on grid g (none
  * when n_bcs is 0). */
 pm_err mpm_cond_work_create(mpm_cond_work *cw, const mpm_grid *g, int n_bcs);
+/* Release the conditions' workspace (and zero it). */
 void mpm_cond_work_destroy(mpm_cond_work *cw);
+/* Bytes the conditions' workspace takes. */
 size_t mpm_cond_work_bytes(const mpm_cond_work *cw, const mpm_grid *g);
 
 /* End of the loading: the longest ramp of a prescribed condition, s. */

@@ -38,6 +38,7 @@ typedef struct {
 /* Model, initial state, workspace and output buffer of scene s (which
  * must outlive the run).  Failures as mpm_model_create; *out NULL then. */
 pm_err mpm_run_create(const pm_scene *s, mpm_run **out);
+/* Release a run and all it holds (NULL accepted). */
 void mpm_run_destroy(mpm_run *r);
 
 /* Run to time.end (or the quasi-static state), writing to out_dir when
@@ -51,6 +52,7 @@ pm_err mpm_run_go(mpm_run *r, const char *out_dir, bool quiet);
  * a plan is not run after). */
 pm_err mpm_run_plan(mpm_run *r, FILE *out);
 
+/* "completed", "converged", ... (a static string). */
 const char *mpm_status_name(mpm_status s);
 
 /* Figures of the current fields: mean strain energy density of the
@@ -64,6 +66,7 @@ typedef struct {
   double min_jacobian;
   long min_jacobian_particle;
 } mpm_field_figures;
+/* The figures of r's current fields into ff (uses r->scratch). */
 void mpm_run_field_figures(const mpm_run *r, mpm_field_figures *ff);
 
 /* Reaction force on boundary condition b (last step), N. */

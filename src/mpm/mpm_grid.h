@@ -64,6 +64,7 @@ pm_err mpm_grid_init(mpm_grid *g, int dim, pm_shape shape, double h,
  * allocated stays for mpm_nodes_destroy. */
 pm_err mpm_nodes_create(mpm_nodes *n, const mpm_grid *g, bool with_vel,
                         bool with_impedance, int threads);
+/* Release the nodal arrays (and zero n). */
 void mpm_nodes_destroy(mpm_nodes *n);
 /* Bytes the nodal arrays take. */
 size_t mpm_nodes_bytes(const mpm_nodes *n, const mpm_grid *g);

@@ -212,7 +212,7 @@ static double residual(const mpm_ctx *ctx) {
   const mpm_model *m = ctx->model;
   const mpm_nodes *nd = &ctx->work->nodes;
   const mpm_cond_work *cw = &ctx->work->cond;
-  const unsigned nul = m->opt.null;
+  const unsigned nul = m->opt.null_velocity;
   const long nn = m->grid.n_nodes;
   const double c = ctx->state->damping;
   const double *fold = cw->fold;
@@ -244,7 +244,7 @@ static double residual(const mpm_ctx *ctx) {
 pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
   const mpm_model *m = ctx->model;
   mpm_nodes *nd = &ctx->work->nodes;
-  const unsigned nul = m->opt.null;
+  const unsigned nul = m->opt.null_velocity;
   const long nn = m->grid.n_nodes;
   const double dt = ctx->state->dt;
   const double *fold = ctx->work->cond.fold;
@@ -272,7 +272,7 @@ pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
 
 void mpm_grid_velocity(mpm_ctx *ctx) {
   mpm_nodes *nd = &ctx->work->nodes;
-  const unsigned nul = ctx->model->opt.null;
+  const unsigned nul = ctx->model->opt.null_velocity;
   const long nn = ctx->model->grid.n_nodes;
   const double *restrict mass = nd->mass, *restrict mom = nd->mom;
   double *restrict vel = nd->vel;

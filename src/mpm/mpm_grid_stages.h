@@ -21,20 +21,35 @@ void mpm_grid_velocity(mpm_ctx *ctx);
 double mpm_stable_dt(const struct mpm_model *m, const struct mpm_state *s,
                      double *cp);
 
-/* Stages.  time step: the stable step, cut to end at time.end.  gravity:
- * m g on the nodes (its work booked after the update, with the step's
- * mean velocity).  absorbing: viscous tractions on absorbing faces.
- * damping: mass-proportional, fixed or by dynamic relaxation.  grid
- * update: v^L = v + dt f / m with null directions and conditions, their
- * reactions and work, and the quasi-static residual.  grid velocity: see
- * mpm_grid_velocity. */
+/* Stage: the stable step into the state's dt, cut to end at time.end;
+ * PM_ERR_UNSTABLE when there is none. */
 pm_err mpm_stage_time_step(mpm_ctx *ctx, const mpm_stage *self);
+
+/* Stage: m g on the nodes with mass. */
 pm_err mpm_stage_gravity(mpm_ctx *ctx, const mpm_stage *self);
+/* Hook of the gravity stage after the grid update: books its work over the
+ * step, m g . (v0 + v^L) / 2 dt. */
 pm_err mpm_book_gravity(mpm_ctx *ctx, const mpm_stage *self);
+
+/* Stage: viscous tractions on the absorbing faces (implicit in v), their
+ * dissipation booked. */
 pm_err mpm_stage_absorbing(mpm_ctx *ctx, const mpm_stage *self);
+
+/* Stage: mass-proportional damping, fixed or by dynamic relaxation (the
+ * rate from the change of the force on the dofs left free in the last
+ * step), its dissipation booked. */
 pm_err mpm_stage_damping(mpm_ctx *ctx, const mpm_stage *self);
+/* Hook of the damping stage after the grid update (dynamic relaxation with
+ * conditions): the dofs the conditions set, into the state for the next
+ * step's rate. */
 pm_err mpm_remember_fixed(mpm_ctx *ctx, const mpm_stage *self);
+
+/* Stage: v^L = v + dt f / m with null directions, the conditions (their
+ * forces folded onto the anchors, their reactions, their work booked
+ * here) and the quasi-static residual. */
 pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self);
+
+/* Stage (USF): mpm_grid_velocity. */
 pm_err mpm_stage_grid_velocity(mpm_ctx *ctx, const mpm_stage *self);
 
 #endif

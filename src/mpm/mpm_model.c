@@ -13,7 +13,7 @@ void mpm_options_from_scene(const pm_scene *s, mpm_options *o) {
       .shape = s->mpm.shape,
       .update = s->mpm.update,
       .flip = s->mpm.flip,
-      .null = s->mpm.null_velocity,
+      .null_velocity = s->mpm.null_velocity,
       .energy_update = s->mpm.energy_update,
       .energy_tolerance = s->mpm.energy_tolerance,
       .max_iterations = s->mpm.max_iterations,

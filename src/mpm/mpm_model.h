@@ -20,9 +20,9 @@ struct mpm_state;
 typedef struct mpm_options {
   pm_shape shape;
   pm_update update;
-  double flip;   /* FLIP fraction of the particle velocity update */
-  int ppc[3];    /* particles per cell and direction */
-  unsigned null; /* grid velocity components held at zero (mask) */
+  double flip;            /* FLIP fraction of the particle velocity update */
+  int ppc[3];             /* particles per cell and direction */
+  unsigned null_velocity; /* grid velocity components held at zero (mask) */
   pm_energy_update energy_update; /* kinds with an energy equation */
   double energy_tolerance;
   int max_iterations;
@@ -70,6 +70,7 @@ void mpm_options_from_scene(const pm_scene *s, mpm_options *o);
  * failure *model and *state are NULL. */
 pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
                         struct mpm_state **state);
+/* Release a model (NULL accepted); its states and workspaces first. */
 void mpm_model_destroy(mpm_model *m);
 
 /* Bytes of the model's arrays (particle constants, condition columns). */

@@ -64,6 +64,7 @@ size_t mpm_group_bytes_per_particle(const mpm_group *g);
 /* Allocate the state arrays of group g into gs (zeroed).  PM_ERR_MEMORY on
  * failure (what was allocated stays for mpm_group_state_free). */
 pm_err mpm_group_state_alloc(const mpm_group *g, mpm_group_state *gs);
+/* Release a group's state arrays (and zero gs). */
 void mpm_group_state_free(mpm_group_state *gs);
 
 /* Kinetic, strain and internal energy of the particles, J. */

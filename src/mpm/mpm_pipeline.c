@@ -95,7 +95,8 @@ void mpm_pipeline_build(mpm_model *m) {
   pl->update = st->index;
   snprintf(st->detail, sizeof st->detail,
            "v^L = v + dt f / m, %d boundary condition%s%s", m->n_bcs,
-           m->n_bcs == 1 ? "" : "s", o->null ? ", null directions" : "");
+           m->n_bcs == 1 ? "" : "s",
+           o->null_velocity ? ", null directions" : "");
   st = add(pl, "g2p", mpm_stage_g2p);
   snprintf(st->detail, sizeof st->detail,
            "particle velocities (FLIP %g / PIC %g)", o->flip, 1 - o->flip);

@@ -35,7 +35,8 @@ pm_err mpm_solve(const mpm_model *m, mpm_state *s, mpm_work *w,
                      s->step > MPM_CONVERGE_AFTER &&
                      w->residual < m->opt.qs_tolerance,
     };
-    bool frame = s->step % opt->frame_every == 0 || info.converged;
+    bool frame = (opt->frame_every > 0 && s->step % opt->frame_every == 0) ||
+                 info.converged;
     if (observer) {
       ret = observer(ctx, m, s, w, &info, frame);
       if (ret) {

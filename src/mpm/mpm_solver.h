@@ -10,7 +10,7 @@
 typedef struct {
   double t_end;     /* stop at this time, s */
   long max_steps;   /* 0: no limit */
-  long frame_every; /* frame = true every N steps (> 0) */
+  long frame_every; /* frame = true every N steps (0: never) */
 } mpm_run_options;
 
 /* What a step reports to the observer. */

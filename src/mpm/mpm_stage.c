@@ -6,14 +6,6 @@
 #include "mpm_state.h"
 #include "pm_omp.h"
 
-int mpm_thread_id(void) {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
-
 void mpm_fail(mpm_work *w, long p, const char *fmt, double a, double b) {
   PM_OMP(critical(mpm_fail)) {
     if (!w->fail.failed) {

@@ -70,8 +70,4 @@ pm_err mpm_stage_status(const mpm_ctx *ctx, const mpm_stage *self);
 void mpm_book_work(mpm_ctx *ctx, const mpm_stage *self, double work);
 void mpm_book_dissipated(mpm_ctx *ctx, const mpm_stage *self, double energy);
 
-/* The calling thread's number inside a parallel region (0 without
- * OpenMP). */
-int mpm_thread_id(void);
-
 #endif

@@ -61,6 +61,7 @@ typedef struct mpm_work {
 /* A state of model m's shape, zeroed (t = 0 and no particle data): what a
  * checkpoint is read into.  PM_ERR_MEMORY on failure (*out NULL). */
 pm_err mpm_state_create(const mpm_model *m, mpm_state **out);
+/* Release a state (NULL accepted). */
 void mpm_state_destroy(mpm_state *s);
 
 /* Copy every value of src into dst (both of model m's shape). */
@@ -79,6 +80,7 @@ size_t mpm_state_bytes(const mpm_model *m, const mpm_state *s);
 
 /* The workspace of model m.  PM_ERR_MEMORY on failure (*out NULL). */
 pm_err mpm_work_create(const mpm_model *m, mpm_work **out);
+/* Release a workspace (NULL accepted). */
 void mpm_work_destroy(mpm_work *w);
 /* Bytes of the workspace's arrays (grid and particles). */
 size_t mpm_work_bytes(const mpm_model *m, const mpm_work *w);

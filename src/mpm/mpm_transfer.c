@@ -10,6 +10,14 @@
 #include "mpm_state.h"
 #include "pm_omp.h"
 
+static inline int thread_id(void) {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
 /* One thread's share of the particles of a group into its accumulators
  * acc.  Inline, so that each constant mode gets its own loop. */
 static inline __attribute__((always_inline)) void
@@ -18,9 +26,9 @@ p2g_group(const mpm_model *m, const mpm_state *s, const mpm_work *w,
           const bool imp) {
   const mpm_grid *g = &m->grid;
   const int S = w->nodes.acc_stride;
-  const int what =
-      (mode & (MPM_P2G_MASS | MPM_P2G_MOM) || imp ? MPM_STENCIL_W : 0) |
-      (mode & MPM_P2G_FORCE ? MPM_STENCIL_GRAD : 0);
+  const bool weights = (mode & (MPM_P2G_MASS | MPM_P2G_MOM)) || imp;
+  const int what = (weights ? MPM_STENCIL_W : 0) |
+                   (mode & MPM_P2G_FORCE ? MPM_STENCIL_GRAD : 0);
   const double *restrict x = s->x, *restrict v = s->v, *restrict vol = s->vol,
                          *restrict sigma = s->sigma, *restrict mass = m->mass;
   const double *restrict cp_p = w->cp, *restrict cs_p = w->cs;
@@ -112,7 +120,7 @@ void mpm_p2g(mpm_ctx *ctx, int mode) {
   /* The accumulators were sized for nd->threads: run exactly that many. */
   PM_OMP(parallel num_threads(nd->threads) default(none)
              shared(m, s, w, nd, nn, mode, imp)) {
-    double *acc = nd->acc + (size_t)mpm_thread_id() * nn * nd->acc_stride;
+    double *acc = nd->acc + (size_t)thread_id() * nn * nd->acc_stride;
     memset(acc, 0, sizeof(double) * nn * nd->acc_stride);
     const int all = MPM_P2G_MASS | MPM_P2G_MOM | MPM_P2G_FORCE;
     if (mode == all && imp)
