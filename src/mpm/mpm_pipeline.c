@@ -38,8 +38,8 @@ static void add_grid_forces(mpm_model *m) {
     st->after_update = mpm_book_gravity;
     st->books = MPM_BOOKS_WORK;
     snprintf(st->detail, sizeof st->detail,
-             "m g on the nodes, g = (%g, %g, %g)", o->gravity[0], o->gravity[1],
-             o->gravity[2]);
+             "m g on the nodes, g = (%g, %g, %g); its work after the update",
+             o->gravity[0], o->gravity[1], o->gravity[2]);
   }
   if (m->has_absorbing) {
     st = add(&m->pipeline, "absorbing boundaries", mpm_stage_absorbing);
