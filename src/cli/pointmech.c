@@ -227,12 +227,11 @@ static pm_err run_mpm_level(const pm_scene *s, const char *out, bool quiet,
   pm_err e = mpm_run_create(s, &r);
   if (e) return e;
   e = mpm_run_go(r, out, quiet);
-  const mpm_sim *sim = r->sim;
   fig->status = mpm_status_name(r->status);
-  fig->dim = sim->dim;
-  fig->points = sim->n;
-  fig->steps = sim->step;
-  fig->h = sim->grid.h;
+  fig->dim = r->model->dim;
+  fig->points = r->model->n;
+  fig->steps = r->state->step;
+  fig->h = r->model->grid.h;
   fig->wall = r->wall;
   fig->setup = r->setup_wall;
   fig->nrmse = r->nrmse_vector;
@@ -244,7 +243,9 @@ static pm_err run_mpm_level(const pm_scene *s, const char *out, bool quiet,
   fig->energy_error = r->energy_error;
   int bc, comp;
   loaded_face(s, &bc, &comp);
-  fig->reaction = bc >= 0 ? sim->bcs[bc].reaction[comp] : NAN;
+  double R[3] = {NAN, NAN, NAN};
+  if (bc >= 0) mpm_reaction(r, bc, R);
+  fig->reaction = R[comp];
   mpm_run_destroy(r);
   return e;
 }

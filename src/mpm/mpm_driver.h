@@ -1,13 +1,14 @@
 /* mpm_driver: a whole explicit MPM simulation of a scene: setup, the time
- * loop with output (results.h5/xdmf, history.csv, summary.json), progress,
- * stage timings, and the plan. */
+ * loop (mpm_solver) with output (results.h5/xdmf, history.csv,
+ * summary.json) and progress through its observer, stage timings, and the
+ * plan. */
 #ifndef MPM_DRIVER_H
 #define MPM_DRIVER_H
 
 #include <stdbool.h>
 #include <stdio.h>
 
-#include "mpm_model.h"
+#include "mpm_state.h"
 #include "pm_scene.h"
 
 typedef enum {
@@ -20,7 +21,9 @@ typedef enum {
 } mpm_status;
 
 typedef struct {
-  mpm_sim *sim;
+  mpm_model *model;
+  mpm_state *state;
+  mpm_work *work;
   const pm_scene *scene;
   mpm_status status;
   double setup_wall, wall;
@@ -29,9 +32,13 @@ typedef struct {
   double energy_error; /* (E - E0 + dissipated - external work) / E0 */
   double nrmse[3], nrmse_vector;
   char message[1024];
+  double *scratch; /* output buffer, 9 per particle */
 } mpm_run;
 
+/* Model, initial state, workspace and output buffer of scene s (which
+ * must outlive the run).  Failures as mpm_model_create; *out NULL then. */
 pm_err mpm_run_create(const pm_scene *s, mpm_run **out);
+/* Release a run and all it holds (NULL accepted). */
 void mpm_run_destroy(mpm_run *r);
 
 /* Run to time.end (or the quasi-static state), writing to out_dir when
@@ -41,14 +48,17 @@ void mpm_run_destroy(mpm_run *r);
 pm_err mpm_run_go(mpm_run *r, const char *out_dir, bool quiet);
 
 /* Print the pipeline, counts, per-particle memory, dt, steps and an
- * estimated run time (from timing a few steps on a copy of the state). */
+ * estimated run time (from timing a few steps: the state is advanced, so
+ * a plan is not run after). */
 pm_err mpm_run_plan(mpm_run *r, FILE *out);
 
+/* "completed", "converged", ... (a static string). */
 const char *mpm_status_name(mpm_status s);
 
-/* Figures of the current fields: mean strain energy density of the solids
- * (sum V0 W / sum V0, J/m^3), largest von Mises stress (Pa) and the
- * particle it is at, smallest volume ratio J and its particle. */
+/* Figures of the current fields: mean strain energy density of the
+ * particles that store strain energy (sum V0 W / sum V0, J/m^3), largest
+ * von Mises stress (Pa) and the particle it is at, smallest volume ratio J
+ * and its particle. */
 typedef struct {
   double mean_strain_energy_density;
   double max_von_mises;
@@ -56,6 +66,7 @@ typedef struct {
   double min_jacobian;
   long min_jacobian_particle;
 } mpm_field_figures;
+/* The figures of r's current fields into ff (uses r->scratch). */
 void mpm_run_field_figures(const mpm_run *r, mpm_field_figures *ff);
 
 /* Reaction force on boundary condition b (last step), N. */

@@ -1,189 +1,79 @@
-/* mpm_model: the MPM discretization of a scene: a Cartesian background
- * grid, particles as struct-of-arrays grouped by material (optional state
- * only where a material needs it), grid boundary conditions, and the step
- * as an array of stages built once from what the scene contains. */
+/* mpm_model: the explicit MPM discretization of a scene, everything that is
+ * fixed once it is set up: options, grid geometry, particle constants,
+ * groups and their kinds, boundary-condition descriptors and the step's
+ * pipeline.  What changes is in mpm_state (see mpm_state.h). */
 #ifndef MPM_MODEL_H
 #define MPM_MODEL_H
 
 #include <stdbool.h>
-#include <stddef.h>
 
-#include "mpm_shape.h"
-#include "pm_error.h"
-#include "pm_fluid.h"
-#include "pm_material.h"
-#include "pm_progress.h"
+#include "mpm_conditions.h"
+#include "mpm_grid.h"
+#include "mpm_particles.h"
+#include "mpm_pipeline.h"
 #include "pm_scene.h"
 
-/* Particles of one material, contiguous in [begin, end).  Optional state is
- * indexed p - begin and is NULL when the group does not need it. */
-typedef struct {
-  int material; /* scene material index */
-  const char *name;
-  bool fluid;
-  pm_material solid; /* solids */
-  pm_fluid fluid_props;
-  double c0, c1; /* artificial viscosity (eq. 32); both 0: none */
-  long begin, end;
-  double *F;        /* 9: deformation gradient (solids) */
-  double *rho;      /* density (fluids) */
-  double *energy;   /* specific internal energy (fluids) */
-  double *pressure; /* equation-of-state pressure, without q (fluids) */
-  double *q;        /* artificial viscosity pressure (c0 or c1 > 0) */
-} mpm_group;
+struct mpm_state;
 
-/* Node accumulator record in the per-thread buffers. */
-enum { MPM_ACC_M = 0, MPM_ACC_P = 1, MPM_ACC_F = 4, MPM_ACC_BASE = 7 };
-
-typedef struct {
-  int dim;
+/* What the model takes from the scene, copied at creation so that nothing
+ * after it reads the scene's mpm, time or stability sections. */
+typedef struct mpm_options {
   pm_shape shape;
-  int width; /* nodes per axis in a stencil */
-  int ghost; /* node layers outside the domain box */
-  double h, inv_h;
-  double origin[3]; /* node (0, 0, 0) */
-  long nn[3];       /* nodes per axis (1 on z in 2-D) */
-  long stride[3];   /* index step per axis */
-  long n_nodes;
-  double lo[3], hi[3]; /* where a particle's stencil lies inside the grid */
-  double node_volume;  /* h^dim */
-  double *mass;        /* per node */
-  double *mom;         /* 3 per node: momentum */
-  double *force;       /* 3 per node: internal + external force */
-  double *vel0;        /* 3 per node: velocity before the update */
-  double *vel_new;     /* 3 per node: updated (Lagrangian) velocity */
-  double *vel;         /* 3 per node: the velocity of USF (before the
-                          update) or MUSL (remapped), with the boundary
-                          conditions; NULL for USL */
-  const double *vel_stress; /* the velocity the stress update reads */
-  /* Per-thread accumulators [threads][n_nodes][acc_stride]. */
-  double *acc;
-  int acc_stride; /* 7, or 9 with the impedance sums */
-  int threads;
-  /* optional */
-  double *impedance;  /* 2 per node: sum w m c_p, sum w m c_s (absorbing) */
-  double *force_prev; /* 3 per node: internal force of the previous step
-                         (dynamic relaxation) */
-  short *owner;       /* 3 per node: the condition that set the dof this step,
-                         -(b + 1) prescribed, b + 1 reflected, 0 free (with
-                         boundary conditions) */
-  double *fold;       /* 3 per node: forces of the conditions' dependent dofs
-                         moved onto the dofs they follow (their anchors) */
-  double *fold_out;   /* 3 per node: the force a dependent dof moved out */
-} mpm_grid;
+  pm_update update;
+  double flip;            /* FLIP fraction of the particle velocity update */
+  int ppc[3];             /* particles per cell and direction */
+  unsigned null_velocity; /* grid velocity components held at zero (mask) */
+  pm_energy_update energy_update; /* kinds with an energy equation */
+  double energy_tolerance;
+  int max_iterations;
+  bool has_gravity;
+  double gravity[3]; /* m/s^2 */
+  double t_end;      /* s */
+  double dt_fixed;   /* time.dt, or 0: the stable step each step */
+  double dt_safety;
+  long max_steps; /* 0: no limit */
+  pm_qs_method qs;
+  double qs_tolerance;
+  double qs_damping;   /* 1/s, fixed damping */
+  double min_jacobian; /* stop when some J falls to or below it */
+} mpm_options;
 
-/* A boundary condition on a face, as grid columns normal to the face. */
-typedef struct {
-  int bc; /* scene index */
-  int axis;
-  double outward; /* -1 on a min face, +1 on a max face */
-  double plane;   /* face coordinate */
-  long n_cols;
-  long *col; /* node index of each column on the face plane */
-  unsigned disp_mask, vel_mask;
-  bool absorbing;
-  bool constant[3]; /* expression uses none of x, y, z */
-  double reaction[3];
-} mpm_bc;
-
-typedef struct mpm_sim mpm_sim;
-typedef void (*mpm_stage_fn)(mpm_sim *sim, int arg);
-typedef struct {
-  mpm_stage_fn fn;
-  int arg;
-  int timer;
-  const char *name; /* short name: the timer's */
-  char detail[160]; /* what it does, for the plan */
-} mpm_stage;
-
-#define MPM_MAX_GROUPS 16
-/* Fixed stages (at most 11) and one stress stage per group. */
-#define MPM_MAX_STAGES (12 + MPM_MAX_GROUPS)
-
-/* A numerical failure found inside a stage. */
-typedef struct {
-  bool failed;
-  long particle;
-  char cause[192];
-} mpm_failure;
-
-struct mpm_sim {
-  const pm_scene *scene; /* borrowed */
+typedef struct mpm_model {
+  mpm_options opt;
   int dim;
+  double box_min[3], box_max[3];
   mpm_grid grid;
-  /* particles */
+  /* particles: count and constants, 3 or 1 per particle */
   long n;
-  double *x0;    /* 3: reference position */
-  double *x;     /* 3: position */
-  double *v;     /* 3: velocity */
-  double *dx;    /* 3: position increment of the step */
-  double *mass;  /* per particle */
-  double *vol0;  /* initial volume */
-  double *vol;   /* current volume */
-  double *sigma; /* 9: Cauchy stress */
+  double *x0;   /* reference position */
+  double *mass; /* mass, kg */
+  double *vol0; /* initial volume */
   mpm_group group[MPM_MAX_GROUPS];
   int n_groups;
-  bool has_fluid;
+  unsigned kinds; /* the groups' kinds' flags, or-ed (MPM_KIND_*) */
   /* boundary conditions */
   mpm_bc *bcs;
   int n_bcs;
   bool has_absorbing;
-  /* the step */
-  mpm_stage stage[MPM_MAX_STAGES];
-  int n_stages;
-  pm_timers timers;
-  /* time */
-  double t, dt, dt_stable;
-  long step;
-  double dt_fixed;     /* time.dt, or 0: the stable step each step */
-  double max_div;      /* largest |tr D| of this step's stress update, 1/s */
-  double max_div_prev; /* the same for the previous step (for dt) */
-  /* quasi-static */
-  double damping; /* current rate, 1/s */
-  double residual;
-  /* energy bookkeeping, J (per unit thickness in 2-D) */
-  double external_work, dissipated;
-  /* fluid energy iteration: per step, max iterations and particles that hit
-   * the cap; over the run, totals */
-  int iter_max_step;
-  long iter_capped_step, iter_capped_total;
-  int iter_max_total;
-  mpm_failure fail;
-};
+  mpm_pipeline pipeline;
+} mpm_model;
 
-/* Build the grid, seed the particles, allocate the state the scene needs,
- * and assemble the step.  Bad scenes fail with PM_ERR_SCENE naming the
- * scene file position. */
-pm_err mpm_model_create(const pm_scene *s, mpm_sim **out);
-void mpm_model_destroy(mpm_sim *sim);
+/* Copy what the model needs from the scene into o (the one place that reads
+ * the scene's mpm section). */
+void mpm_options_from_scene(const pm_scene *s, mpm_options *o);
 
-/* Bytes of particle state, in total and per particle of each group (the
- * common arrays plus the group's own). */
-size_t mpm_particle_bytes_common(void);
-size_t mpm_group_bytes_per_particle(const mpm_group *g);
-size_t mpm_grid_bytes(const mpm_grid *g);
+/* Build the grid, seed the particles, set up the groups' kinds and the
+ * conditions, assemble the pipeline, and return the model with its initial
+ * state (t = 0, dt the first step's).  The scene must outlive the model (it
+ * borrows names and expressions).  Bad scenes fail with PM_ERR_SCENE naming
+ * the scene file position; a scene of another method with PM_ERR_ARG.  On
+ * failure *model and *state are NULL. */
+pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
+                        struct mpm_state **state);
+/* Release a model (NULL accepted); its states and workspaces first. */
+void mpm_model_destroy(mpm_model *m);
 
-/* Stable step: h over the largest of (wave speed + |v|) and the viscous and
- * artificial viscous terms (LS-DYNA form), over all particles. */
-double mpm_stable_dt(const mpm_sim *sim);
-
-/* One explicit step of size sim->dt: run every stage.  Returns
- * PM_ERR_UNSTABLE (message with step, time, particle, position, cause) on
- * a numerical failure. */
-pm_err mpm_step(mpm_sim *sim);
-
-/* Kinetic, strain and (fluid) internal energy of the particles. */
-void mpm_energies(const mpm_sim *sim, double *kinetic, double *strain,
-                  double *internal);
-
-/* The grid basis of a particle at x. */
-void mpm_stencil_at(const mpm_grid *g, const double x[3], mpm_stencil *st);
-
-/* Assemble sim->stage from the scene (called by mpm_model_create). */
-void mpm_build_pipeline(mpm_sim *sim);
-
-/* Particle to grid of mass and momentum, and with with_force the internal
- * force (the first stage of USL/MUSL; used by the tests). */
-void mpm_p2g(mpm_sim *sim, int with_force);
+/* Bytes of the model's arrays (particle constants, condition columns). */
+size_t mpm_model_bytes(const mpm_model *m);
 
 #endif

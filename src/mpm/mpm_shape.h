@@ -44,12 +44,4 @@ static inline void mpm_shape_1d(pm_shape s, double xi, double inv_h, long *i0,
   }
 }
 
-/* A particle's stencil: nodes base + a*s0 + b*s1 + c*s2 for a, b, c <
- * width (the third axis has one node, weight 1, in 2-D). */
-typedef struct {
-  long base; /* node index of the first node */
-  int n[3];  /* nodes per axis */
-  double w[3][3], dw[3][3];
-} mpm_stencil;
-
 #endif

@@ -6,7 +6,7 @@
 #include <math.h>
 #include <stdbool.h>
 
-#include "mpm_model.h"
+#include "mpm_state.h"
 #include "pm_scene.h"
 
 /* Load a scene with overrides, or fail the test with the message. */
@@ -19,12 +19,20 @@ static inline pm_scene *load_scene(const char *file, int n_sets,
 }
 
 /* Positions, velocities and stresses are all finite. */
-static inline bool state_finite(const mpm_sim *sim) {
-  for (long i = 0; i < 3 * sim->n; i++)
-    if (!isfinite(sim->x[i]) || !isfinite(sim->v[i])) return false;
-  for (long i = 0; i < 9 * sim->n; i++)
-    if (!isfinite(sim->sigma[i])) return false;
+static inline bool state_finite(const mpm_model *m, const mpm_state *s) {
+  for (long i = 0; i < 3 * m->n; i++)
+    if (!isfinite(s->x[i]) || !isfinite(s->v[i])) return false;
+  for (long i = 0; i < 9 * m->n; i++)
+    if (!isfinite(s->sigma[i])) return false;
   return true;
+}
+
+/* Group gi's state array called name, or fail the test. */
+static inline const double *group_array(const mpm_state *s, int gi,
+                                        const char *name) {
+  const mpm_array *a = mpm_group_state_find(&s->group[gi], name);
+  if (!a) fail_msg("group %d has no array %s", gi, name);
+  return a->data;
 }
 
 #endif

@@ -44,7 +44,7 @@ static void test_f2_mpm(void **state) {
   print_message("F2 by MPM, cell 0.02 m: %ld particles, %ld steps, %.2f s; "
                 "NRMSE u_z %.3e; reaction %.4f N (exact %.4f N, %.2e); "
                 "energy balance %.2e\n",
-                r->sim->n, r->sim->step, r->wall, r->nrmse_vector, -R[2],
+                r->model->n, r->state->step, r->wall, r->nrmse_vector, -R[2],
                 -exact, fabs(R[2] / exact - 1), r->energy_error);
   /* NRMSE: measured 1.75e-3, the level the relaxation's tolerance (1e-4)
    * leaves (7.3e-4 at 1e-5 for the 0.01 m cell); bound 5e-3.  Reaction:

@@ -42,7 +42,7 @@ static void go_run(mpm_run *r, mpm_status expected) {
   if (r->status != expected)
     fail_msg("%s: status %s, expected %s (%s)", name,
              mpm_status_name(r->status), mpm_status_name(expected), r->message);
-  assert_true(state_finite(r->sim));
+  assert_true(state_finite(r->model, r->state));
 }
 
 /* A whole run through the driver; the caller destroys it. */
@@ -126,25 +126,26 @@ static void test_free_fall(void **state) {
   const double g = -s->gravity[2], dt = s->time.dt, T = s->time.end;
   const long N = lround(T / dt);
   mpm_run *r = create_run(s);
-  const mpm_sim *sim = r->sim;
-  const double L = 0.04, rho = sim->group[0].solid.density;
+  const mpm_model *md = r->model;
+  const mpm_state *st = r->state;
+  const double L = 0.04, rho = s->materials[0].mat.density;
   double z0 = 0, M = 0;
-  for (long p = 0; p < sim->n; p++) {
-    M += sim->mass[p];
-    z0 += sim->mass[p] * sim->x[3 * p + 2];
+  for (long p = 0; p < md->n; p++) {
+    M += md->mass[p];
+    z0 += md->mass[p] * st->x[3 * p + 2];
   }
   z0 /= M;
   go_run(r, MPM_STATUS_COMPLETED);
-  assert_int_equal(sim->step, N);
+  assert_int_equal(st->step, N);
 
   double z = 0, vz = 0, lateral = 0, smax = 0;
-  for (long p = 0; p < sim->n; p++) {
-    const double m = sim->mass[p];
-    z += m * sim->x[3 * p + 2];
-    vz += m * sim->v[3 * p + 2];
+  for (long p = 0; p < md->n; p++) {
+    const double m = md->mass[p];
+    z += m * st->x[3 * p + 2];
+    vz += m * st->v[3 * p + 2];
     for (int c = 0; c < 2; c++)
-      lateral = fmax(lateral, fabs(sim->x[3 * p + c] - sim->x0[3 * p + c]));
-    for (int k = 0; k < 9; k++) smax = fmax(smax, fabs(sim->sigma[9 * p + k]));
+      lateral = fmax(lateral, fabs(st->x[3 * p + c] - md->x0[3 * p + c]));
+    for (int k = 0; k < 9; k++) smax = fmax(smax, fabs(st->sigma[9 * p + k]));
   }
   z /= M;
   vz /= M;
@@ -168,11 +169,11 @@ static void test_free_fall(void **state) {
   /* All the work of gravity is kinetic energy (see above). */
   ok &= row("energy balance error (mpm_run)", r->energy_error, 0, 1, 1e-9);
   info("  kinetic energy, J (M (g T)^2 / 2)", r->kinetic, ke);
-  info("  work of gravity as counted, J (kinetic energy)", sim->external_work,
+  info("  work of gravity as counted, J (kinetic energy)", st->external_work,
        ke);
   /* What the count is when it takes each step's starting momentum: the
    * balance is then off by exactly 1 / (N - 1). */
-  info("  the same with start-of-step momenta, J", sim->external_work,
+  info("  the same with start-of-step momenta, J", st->external_work,
        0.5 * M * g * g * dt * dt * N * (N - 1));
   fflush(stdout);
   mpm_run_destroy(r);
@@ -190,10 +191,11 @@ static void test_gravity_column(void **state) {
   (void)state;
   pm_scene *s = load_scene(CASES "gravity-column.yaml", 0, NULL);
   mpm_run *r = run_driver(s, MPM_STATUS_CONVERGED);
-  const mpm_sim *sim = r->sim;
-  const mpm_group *gr = &sim->group[0];
-  const double g = -s->gravity[1], rho = gr->solid.density;
-  const double nu = gr->solid.poisson_ratio, h = sim->grid.h;
+  const mpm_model *md = r->model;
+  const mpm_state *st = r->state;
+  const pm_material *mat = &s->materials[md->group[0].material].mat;
+  const double g = -s->gravity[1], rho = mat->density;
+  const double nu = mat->poisson_ratio, h = md->grid.h;
   const double H = s->box_max[1] - s->box_min[1];
   const double scale = rho * g * H;
   /* Rows of particles (by reference height) in the middle half. */
@@ -206,12 +208,12 @@ static void test_gravity_column(void **state) {
   assert_non_null(row_n);
   double M = 0, err_max = 0, ratio_sum = 0, pe = 0;
   long n_mid = 0;
-  for (long p = 0; p < sim->n; p++) {
-    M += sim->mass[p];
-    pe += sim->mass[p] * g * (sim->x0[3 * p + 1] - sim->x[3 * p + 1]);
-    double Y = sim->x0[3 * p + 1] - s->box_min[1];
+  for (long p = 0; p < md->n; p++) {
+    M += md->mass[p];
+    pe += md->mass[p] * g * (md->x0[3 * p + 1] - st->x[3 * p + 1]);
+    double Y = md->x0[3 * p + 1] - s->box_min[1];
     if (Y < 0.25 * H || Y > 0.75 * H) continue;
-    const double *sg = sim->sigma + 9 * p;
+    const double *sg = st->sigma + 9 * p;
     double exact = -rho * g * (H - Y);
     err_max = fmax(err_max, fabs(sg[4] - exact) / scale);
     int k = (int)floor(Y / H * rows);
@@ -237,7 +239,7 @@ static void test_gravity_column(void **state) {
   table_head("2. Column on a floor: H = 1 m, 40 x 4 cells, dynamic relaxation");
   printf("  %ld particles, converged after %ld steps (t = %.4g s), "
          "residual %.2e, %.2f s\n",
-         sim->n, sim->step, sim->t, sim->residual, r->wall);
+         md->n, st->step, st->t, r->work->residual, r->wall);
   bool ok = true;
   /* In equilibrium the floor takes all the weight but what the residual
    * (1e-6 of the reactions) leaves: measured 3.6e-6 of it.  Bound 1e-4. */
@@ -264,10 +266,10 @@ static void test_gravity_column(void **state) {
    * floor and rollers do no work): -5e-4 with the reactions counted once
    * per constrained dof.  Bound 1%. */
   ok &= row("energy balance error (mpm_run)", r->energy_error, 0, 1, 0.01);
-  info("  external work as counted, J (potential energy)", sim->external_work,
+  info("  external work as counted, J (potential energy)", st->external_work,
        pe);
   info("  strain energy + dissipated, J (potential energy)",
-       r->strain + sim->dissipated, pe);
+       r->strain + st->dissipated, pe);
   fflush(stdout);
   mpm_run_destroy(r);
   pm_scene_destroy(s);
@@ -286,11 +288,11 @@ static void run_bar(int n_sets, const char *const *sets, bar_result *out) {
   mpm_run *r = run_driver(s, MPM_STATUS_COMPLETED);
   out->e0 = r->energy0;
   out->e_end = r->kinetic + r->strain;
-  out->dissipated = r->sim->dissipated;
+  out->dissipated = r->state->dissipated;
   out->energy_error = r->energy_error;
   out->wall = r->wall;
-  out->steps = r->sim->step;
-  out->n = r->sim->n;
+  out->steps = r->state->step;
+  out->n = r->model->n;
   mpm_run_destroy(r);
   pm_scene_destroy(s);
 }
@@ -344,19 +346,20 @@ static void test_absorbing_bar(void **state) {
 
 typedef struct {
   const mpm_group *g;
+  const double *pressure;   /* the group's */
   double x[N_PROBES], half; /* probe positions, half bin width */
   double level;             /* pressure of the front's middle */
   double t_prev, p_prev[N_PROBES], t_cross[N_PROBES], p_max;
 } probe_rec;
 
-static void probe_pressures(const mpm_sim *sim, const probe_rec *pr,
+static void probe_pressures(const mpm_state *st, const probe_rec *pr,
                             double p[N_PROBES]) {
   for (int k = 0; k < N_PROBES; k++) {
     double sum = 0;
     long n = 0;
     for (long q = pr->g->begin; q < pr->g->end; q++)
-      if (fabs(sim->x[3 * q] - pr->x[k]) < pr->half) {
-        sum += pr->g->pressure[q - pr->g->begin];
+      if (fabs(st->x[3 * q] - pr->x[k]) < pr->half) {
+        sum += pr->pressure[q - pr->g->begin];
         n++;
       }
     p[k] = n ? sum / n : NAN;
@@ -366,11 +369,15 @@ static void probe_pressures(const mpm_sim *sim, const probe_rec *pr,
 static void test_water_pulse(void **state) {
   (void)state;
   pm_scene *s = load_scene(CASES "water-pulse.yaml", 0, NULL);
-  mpm_sim *sim = NULL;
-  if (mpm_model_create(s, &sim) != PM_SUCCESS)
+  mpm_model *md = NULL;
+  mpm_state *st = NULL;
+  mpm_work *w = NULL;
+  if (mpm_model_create(s, &md, &st) != PM_SUCCESS ||
+      mpm_work_create(md, &w) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
-  const mpm_group *g = &sim->group[0];
-  const pm_fluid *fl = &g->fluid_props;
+  const mpm_group *g = &md->group[0];
+  const double *pressure = group_array(st, 0, "pressure");
+  const pm_fluid *fl = &s->materials[g->material].fluid_props;
   const double x0 = s->bodies[0].b[0], rho0 = s->bodies[1].density;
   const double pL = s->bodies[0].pressure, pR = s->bodies[1].pressure;
   const double a = pm_eos_sound_speed(fl, rho0, pR);
@@ -379,40 +386,41 @@ static void test_water_pulse(void **state) {
   pm_riemann_state left = {s->bodies[0].density, 0, pL + fl->p_inf};
   pm_riemann_state right = {rho0, 0, pR + fl->p_inf};
   assert_int_equal(pm_riemann_solve(fl->gamma, left, right, &ex), PM_SUCCESS);
-  probe_rec pr = {.g = g, .x = {0.7, 0.9}, .half = 0.5 * sim->grid.h};
+  probe_rec pr = {
+      .g = g, .pressure = pressure, .x = {0.7, 0.9}, .half = 0.5 * md->grid.h};
   pr.level = pR + 0.5 * (ex.p_star - fl->p_inf - pR);
   for (int k = 0; k < N_PROBES; k++) pr.t_cross[k] = NAN;
-  probe_pressures(sim, &pr, pr.p_prev);
+  probe_pressures(st, &pr, pr.p_prev);
   double e0;
   {
     double ke, se, ie;
-    mpm_energies(sim, &ke, &se, &ie);
+    mpm_energies(md, st, &ke, &se, &ie);
     e0 = ke + se + ie;
   }
   double t0 = pm_wtime();
-  while (sim->t < s->time.end * (1 - 1e-12)) {
-    if (mpm_step(sim) != PM_SUCCESS) fail_msg("%s", pm_error_message());
+  while (st->t < s->time.end * (1 - 1e-12)) {
+    if (mpm_step(md, st, w) != PM_SUCCESS) fail_msg("%s", pm_error_message());
     double p[N_PROBES];
-    probe_pressures(sim, &pr, p);
+    probe_pressures(st, &pr, p);
     for (int k = 0; k < N_PROBES; k++) {
       if (isnan(pr.t_cross[k]) && pr.p_prev[k] < pr.level && p[k] >= pr.level)
-        pr.t_cross[k] = pr.t_prev + (sim->t - pr.t_prev) *
+        pr.t_cross[k] = pr.t_prev + (st->t - pr.t_prev) *
                                         (pr.level - pr.p_prev[k]) /
                                         (p[k] - pr.p_prev[k]);
       pr.p_prev[k] = p[k];
       pr.p_max = fmax(pr.p_max, p[k]);
     }
-    pr.t_prev = sim->t;
+    pr.t_prev = st->t;
   }
   double wall = pm_wtime() - t0;
-  assert_true(state_finite(sim));
+  assert_true(state_finite(md, st));
   /* The state behind the front, at the first probe. */
   double p_behind = 0, u_behind = 0;
   long n_behind = 0;
   for (long q = g->begin; q < g->end; q++)
-    if (fabs(sim->x[3 * q] - pr.x[0]) < 2 * sim->grid.h) {
-      p_behind += g->pressure[q - g->begin];
-      u_behind += sim->v[3 * q];
+    if (fabs(st->x[3 * q] - pr.x[0]) < 2 * md->grid.h) {
+      p_behind += pressure[q - g->begin];
+      u_behind += st->v[3 * q];
       n_behind++;
     }
   p_behind /= n_behind;
@@ -423,8 +431,8 @@ static void test_water_pulse(void **state) {
   table_head("4. Sound in water: stiffened gas, 1 m tube, 200 cells");
   printf("  %ld particles, %ld steps (last dt %.3g s), %.2f s, energy "
          "iterations <= %d, capped %ld\n",
-         sim->n, sim->step, sim->dt, wall, sim->iter_max_total,
-         sim->iter_capped_total);
+         md->n, st->step, st->dt, wall, st->iter_max_total,
+         st->iter_capped_total);
   bool ok = true;
   /* The front's middle, timed between two probes 0.2 m apart, moves at
    * the sound speed: the waves are acoustic (the jump is 1e-3 of p +
@@ -452,7 +460,7 @@ static void test_water_pulse(void **state) {
    * 0.9994 (no overshoot).  Bound 5%. */
   ok &= row("largest probe pressure rise / jump", (pr.p_max - pR) / jump, 1, 0,
             0.05);
-  ok &= row("particle-steps at the iteration cap", sim->iter_capped_total, 0, 1,
+  ok &= row("particle-steps at the iteration cap", st->iter_capped_total, 0, 1,
             0);
   /* Energy: the walls do no work, so kinetic + internal is constant.  The
    * iteration converges to the end-of-step pressure (a backward Euler step
@@ -461,11 +469,13 @@ static void test_water_pulse(void **state) {
    * 0.25, +0.52% at 0.125 (the non-iterative update, from the
    * start-of-step stress: -2.3%).  A method property; bound 3%. */
   double ke, se, ie;
-  mpm_energies(sim, &ke, &se, &ie);
-  double imbalance = ke + se + ie + sim->dissipated - sim->external_work - e0;
+  mpm_energies(md, st, &ke, &se, &ie);
+  double imbalance = ke + se + ie + st->dissipated - st->external_work - e0;
   ok &= row("energy imbalance / kinetic energy", imbalance / ke, 0, 1, 0.03);
   fflush(stdout);
-  mpm_model_destroy(sim);
+  mpm_work_destroy(w);
+  mpm_state_destroy(st);
+  mpm_model_destroy(md);
   pm_scene_destroy(s);
   assert_true(ok);
 }

@@ -48,41 +48,55 @@ static void run_driver(const pm_scene *s, double *kinetic, double *strain,
   if (mpm_run_go(r, NULL, true) != PM_SUCCESS)
     fail_msg("%s: %s", s->name, pm_error_message());
   assert_int_equal(r->status, MPM_STATUS_COMPLETED);
-  assert_true(state_finite(r->sim));
-  assert_true(fabs(r->sim->t - s->time.end) <= 1e-9 * s->time.end);
+  assert_true(state_finite(r->model, r->state));
+  assert_true(fabs(r->state->t - s->time.end) <= 1e-9 * s->time.end);
   *kinetic = r->kinetic;
   *strain = r->strain;
   *wall = r->wall;
   mpm_run_destroy(r);
 }
 
+/* A model with its state and workspace. */
+typedef struct {
+  mpm_model *m;
+  mpm_state *s;
+  mpm_work *w;
+} sim_t;
+
+static void sim_destroy(sim_t *sim) {
+  mpm_work_destroy(sim->w);
+  mpm_state_destroy(sim->s);
+  mpm_model_destroy(sim->m);
+}
+
 /* The driver's time loop (stable step each step, the last one cut to end at
  * time.end), calling record after every step. */
-typedef void (*record_fn)(const mpm_sim *sim, void *ctx);
+typedef void (*record_fn)(const mpm_model *m, const mpm_state *st, void *ctx);
 
-static mpm_sim *step_to_end(const pm_scene *s, record_fn record, void *ctx,
-                            double *wall) {
-  mpm_sim *sim = NULL;
-  if (mpm_model_create(s, &sim) != PM_SUCCESS)
+static sim_t step_to_end(const pm_scene *s, record_fn record, void *ctx,
+                         double *wall) {
+  sim_t sim = {NULL, NULL, NULL};
+  if (mpm_model_create(s, &sim.m, &sim.s) != PM_SUCCESS ||
+      mpm_work_create(sim.m, &sim.w) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
-  assert_true(sim->dt_fixed == 0);
-  record(sim, ctx);
+  assert_true(sim.m->opt.dt_fixed == 0);
+  record(sim.m, sim.s, ctx);
   double t0 = pm_wtime();
-  while (sim->t < s->time.end * (1 - 1e-12)) {
-    if (mpm_step(sim) != PM_SUCCESS)
+  while (sim.s->t < s->time.end * (1 - 1e-12)) {
+    if (mpm_step(sim.m, sim.s, sim.w) != PM_SUCCESS)
       fail_msg("%s: %s", s->name, pm_error_message());
-    record(sim, ctx);
+    record(sim.m, sim.s, ctx);
   }
   *wall = pm_wtime() - t0;
-  assert_true(state_finite(sim));
+  assert_true(state_finite(sim.m, sim.s));
   return sim;
 }
 
 /* The manual loop must be the driver's: the same final energies. */
-static void check_same_as_driver(const pm_scene *s, const mpm_sim *sim,
-                                 double e0, double *driver_wall) {
+static void check_same_as_driver(const pm_scene *s, const sim_t *sim, double e0,
+                                 double *driver_wall) {
   double ke, se, ie, dke, dse;
-  mpm_energies(sim, &ke, &se, &ie);
+  mpm_energies(sim->m, sim->s, &ke, &se, &ie);
   run_driver(s, &dke, &dse, driver_wall);
   assert_true(close_to(ke, dke, 1e-9, 1e-12 * e0));
   assert_true(close_to(se, dse, 1e-9, 1e-12 * e0));
@@ -101,17 +115,17 @@ typedef struct {
   double e_min, e_max, e0;
 } bar_rec;
 
-static void bar_record(const mpm_sim *sim, void *ctx) {
+static void bar_record(const mpm_model *m, const mpm_state *st, void *ctx) {
   bar_rec *b = ctx;
   double p = 0;
-  for (long i = 0; i < sim->n; i++) p += sim->mass[i] * sim->v[3 * i];
+  for (long i = 0; i < m->n; i++) p += m->mass[i] * st->v[3 * i];
   if (b->started && (p > 0) != (b->p_prev > 0) && b->n < MAX_CROSSINGS)
     b->cross[b->n++] =
-        b->t_prev + (sim->t - b->t_prev) * b->p_prev / (b->p_prev - p);
-  b->t_prev = sim->t;
+        b->t_prev + (st->t - b->t_prev) * b->p_prev / (b->p_prev - p);
+  b->t_prev = st->t;
   b->p_prev = p;
   double ke, se, ie;
-  mpm_energies(sim, &ke, &se, &ie);
+  mpm_energies(m, st, &ke, &se, &ie);
   double e = ke + se;
   if (!b->started) b->e0 = b->e_min = b->e_max = e;
   b->e_min = fmin(b->e_min, e);
@@ -133,15 +147,15 @@ static void test_bar_first_mode(void **state) {
   double T = 4 * L / c;
   bar_rec b = {0};
   double wall, driver_wall;
-  mpm_sim *sim = step_to_end(s, bar_record, &b, &wall);
-  check_same_as_driver(s, sim, b.e0, &driver_wall);
+  sim_t sim = step_to_end(s, bar_record, &b, &wall);
+  check_same_as_driver(s, &sim, b.e0, &driver_wall);
   assert_true(b.n >= 3);
   double measured = 2 * (b.cross[b.n - 1] - b.cross[0]) / (b.n - 1);
   double err = (measured - T) / T;
   printf("\nMPM bar, first axial mode: L = %g m, c = %g m/s, cell %g m, "
          "%ld particles, %ld steps (mean dt %.4g s), %.2f s (driver %.2f s)\n",
-         L, c, sim->grid.h, sim->n, sim->step, s->time.end / sim->step, wall,
-         driver_wall);
+         L, c, sim.m->grid.h, sim.m->n, sim.s->step, s->time.end / sim.s->step,
+         wall, driver_wall);
   printf("  %-34s %12s\n", "quantity", "value");
   printf("  %-34s %12.6f\n", "period, analytic 4 L / c (s)", T);
   printf("  %-34s %12.6f\n", "period, measured (s)", measured);
@@ -151,7 +165,7 @@ static void test_bar_first_mode(void **state) {
   printf("  %-34s %12.6f\n", "E(t) / E(0), max", b.e_max / b.e0);
   fflush(stdout);
   assert_true(fabs(err) <= 0.01);
-  mpm_model_destroy(sim);
+  sim_destroy(&sim);
   pm_scene_destroy(s);
 }
 
@@ -162,26 +176,28 @@ typedef struct {
   bool started;
 } disk_rec;
 
-static void disk_record(const mpm_sim *sim, void *ctx) {
+static void disk_record(const mpm_model *m, const mpm_state *st, void *ctx) {
   disk_rec *d = ctx;
   double ke, se, ie;
-  mpm_energies(sim, &ke, &se, &ie);
+  mpm_energies(m, st, &ke, &se, &ie);
   double e = ke + se;
   if (!d->started) d->e0 = d->e_min = d->e_max = e;
   d->started = true;
-  if (e < d->e_min) d->e_min = e, d->t_min = sim->t;
+  if (e < d->e_min) d->e_min = e, d->t_min = st->t;
   d->e_max = fmax(d->e_max, e);
   d->e_end = e;
 }
 
 /* Centre-of-mass velocity of the disk that started at x < 0.5. */
-static void lower_disk_velocity(const mpm_sim *sim, double v[2]) {
+static void lower_disk_velocity(const sim_t *sim, double v[2]) {
+  const mpm_model *md = sim->m;
+  const mpm_state *st = sim->s;
   double m = 0, p[2] = {0, 0};
-  for (long i = 0; i < sim->n; i++) {
-    if (sim->x0[3 * i] >= 0.5) continue;
-    m += sim->mass[i];
-    p[0] += sim->mass[i] * sim->v[3 * i];
-    p[1] += sim->mass[i] * sim->v[3 * i + 1];
+  for (long i = 0; i < md->n; i++) {
+    if (md->x0[3 * i] >= 0.5) continue;
+    m += md->mass[i];
+    p[0] += md->mass[i] * st->v[3 * i];
+    p[1] += md->mass[i] * st->v[3 * i + 1];
   }
   v[0] = p[0] / m;
   v[1] = p[1] / m;
@@ -195,12 +211,12 @@ static void run_disks(const char *flip, disk_rec *d, double v_end[2],
   pm_scene *s = load_scene(CASES "disks-collision.yaml", 1, sets);
   double driver_wall;
   *d = (disk_rec){0};
-  mpm_sim *sim = step_to_end(s, disk_record, d, wall);
-  check_same_as_driver(s, sim, d->e0, &driver_wall);
-  lower_disk_velocity(sim, v_end);
+  sim_t sim = step_to_end(s, disk_record, d, wall);
+  check_same_as_driver(s, &sim, d->e0, &driver_wall);
+  lower_disk_velocity(&sim, v_end);
   printf("  flip = %s: %ld particles, %ld steps, %.2f s (driver %.2f s)\n",
-         flip, sim->n, sim->step, *wall, driver_wall);
-  mpm_model_destroy(sim);
+         flip, sim.m->n, sim.s->step, *wall, driver_wall);
+  sim_destroy(&sim);
   pm_scene_destroy(s);
 }
 

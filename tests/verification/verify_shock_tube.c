@@ -70,27 +70,32 @@ static void run_tube(const char *update, double h, tube_result *out, FILE *csv,
   if (mpm_run_go(r, NULL, true) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
   assert_int_equal(r->status, MPM_STATUS_COMPLETED);
-  const mpm_sim *sim = r->sim;
-  assert_int_equal(sim->n_groups, 1);
-  const mpm_group *g = &sim->group[0];
-  const double L = s->box_max[0] - s->box_min[0], t = sim->t;
-  const double bin = sim->grid.h;
+  const mpm_model *md = r->model;
+  const mpm_state *st = r->state;
+  assert_int_equal(md->n_groups, 1);
+  const mpm_group *g = &md->group[0];
+  const mpm_group_state *gs = &st->group[0];
+  const double *rho = mpm_group_state_find(gs, "density")->data,
+               *pressure = mpm_group_state_find(gs, "pressure")->data,
+               *energy = mpm_group_state_find(gs, "energy")->data;
+  const double L = s->box_max[0] - s->box_min[0], t = st->t;
+  const double bin = md->grid.h;
   const long nb = (long)llround(L / bin);
   double *acc = calloc(5 * nb, sizeof *acc);
   for (long p = g->begin; p < g->end; p++) {
-    long b = (long)floor((sim->x[3 * p] - s->box_min[0]) / bin);
+    long b = (long)floor((st->x[3 * p] - s->box_min[0]) / bin);
     if (b < 0) b = 0;
     if (b >= nb) b = nb - 1;
     long k = p - g->begin;
     acc[5 * b] += 1;
-    acc[5 * b + 1] += g->rho[k];
-    acc[5 * b + 2] += sim->v[3 * p];
-    acc[5 * b + 3] += g->pressure[k];
-    acc[5 * b + 4] += g->energy[k];
+    acc[5 * b + 1] += rho[k];
+    acc[5 * b + 2] += st->v[3 * p];
+    acc[5 * b + 3] += pressure[k];
+    acc[5 * b + 4] += energy[k];
   }
   /* The exact solution of the scene's two states (bodies 0 and 1). */
   pm_riemann ex;
-  double gamma = g->fluid_props.gamma;
+  double gamma = s->materials[g->material].fluid_props.gamma;
   pm_riemann_state left = {s->bodies[0].density, 0, s->bodies[0].pressure};
   pm_riemann_state right = {s->bodies[1].density, 0, s->bodies[1].pressure};
   assert_int_equal(pm_riemann_solve(gamma, left, right, &ex), PM_SUCCESS);
@@ -153,10 +158,10 @@ static void run_tube(const char *update, double h, tube_result *out, FILE *csv,
     }
   }
   out->wall = r->wall;
-  out->particles = sim->n;
-  out->steps = sim->step;
-  out->iterations = sim->iter_max_total;
-  out->capped = sim->iter_capped_total;
+  out->particles = md->n;
+  out->steps = st->step;
+  out->iterations = st->iter_max_total;
+  out->capped = st->iter_capped_total;
   free(acc);
   mpm_run_destroy(r);
   pm_scene_destroy(s);

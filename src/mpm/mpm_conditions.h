@@ -1,0 +1,70 @@
+/* mpm_conditions: boundary conditions on the grid.  A face condition sets
+ * the nodes at and beyond its (moving) wall from an anchor inside it, moves
+ * their forces onto the anchors, and counts its reaction and work; null
+ * directions zero components everywhere (in the grid update). */
+#ifndef MPM_CONDITIONS_H
+#define MPM_CONDITIONS_H
+
+#include <stdbool.h>
+
+#include "mpm_grid.h"
+#include "mpm_stage.h"
+#include "pm_scene.h"
+
+/* A condition on a face, as grid columns normal to it: fixed after setup.
+ * The expressions are the scene's (borrowed). */
+typedef struct {
+  pm_face face;
+  int axis;
+  double outward; /* -1 on a min face, +1 on a max face */
+  double plane;   /* face coordinate */
+  long n_cols;
+  long *col; /* node index of each column on the face plane (owned) */
+  unsigned disp_mask, vel_mask;
+  const pm_expr *disp[3], *velocity[3]; /* NULL where not prescribed */
+  pm_ramp ramp;
+  double ramp_time;
+  bool absorbing;
+  bool constant[3]; /* expression uses none of x, y, z */
+} mpm_bc;
+
+/* What the conditions keep during a step: workspace. */
+typedef struct {
+  short *owner;     /* 3 per node: the condition that set the dof this step,
+                       -(b + 1) prescribed, b + 1 reflected, 0 free */
+  double *fold;     /* 3 per node: forces of the conditions' dependent dofs
+                       moved onto the dofs they follow (their anchors) */
+  double *fold_out; /* 3 per node: the force a dependent dof moved out */
+  double *reaction; /* 3 per condition: its force on the body, N */
+} mpm_cond_work;
+
+/* Build the conditions of scene s on grid g into *bcs (n_bcs of them).
+ * PM_ERR_MEMORY on failure; the caller releases with
+ * mpm_conditions_destroy. */
+pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
+                             int *n_bcs);
+/* Release conditions made by mpm_conditions_create (NULL accepted). */
+void mpm_conditions_destroy(mpm_bc *bcs, int n_bcs);
+
+/* Allocate the conditions' workspace for n_bcs conditions on grid g (none
+ * when n_bcs is 0). */
+pm_err mpm_cond_work_create(mpm_cond_work *cw, const mpm_grid *g, int n_bcs);
+/* Release the conditions' workspace (and zero it). */
+void mpm_cond_work_destroy(mpm_cond_work *cw);
+/* Bytes the conditions' workspace takes. */
+size_t mpm_cond_work_bytes(const mpm_cond_work *cw, const mpm_grid *g);
+
+/* End of the loading: the longest ramp of a prescribed condition, s. */
+double mpm_load_end(const mpm_bc *bcs, int n_bcs);
+
+/* Move the forces of the dependent dofs onto their anchors (into the
+ * work's fold), from the nodal forces of this step. */
+void mpm_conditions_fold(const mpm_ctx *ctx);
+
+/* Apply the conditions to the nodal velocities vel (3 per node) for the
+ * step from the state's t to t + dt.  With reactions: record which
+ * condition set each dof, the reactions (in the work), and return the
+ * conditions' work over the step (J); else return 0. */
+double mpm_conditions_apply(const mpm_ctx *ctx, double *vel, bool reactions);
+
+#endif

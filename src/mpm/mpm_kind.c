@@ -1,0 +1,6 @@
+/* mpm_kind: the table of particle kinds. */
+#include "mpm_kind.h"
+
+const mpm_kind *mpm_kind_of(const pm_scene_material *sm) {
+  return sm->fluid ? &mpm_kind_fluid : &mpm_kind_solid;
+}

@@ -1,0 +1,85 @@
+/* mpm_kind: particle kinds (solid, fluid; membranes next).  A kind brings
+ * its constants, its per-particle state arrays, its constitutive stage and
+ * what the rest of the step needs to know of it (wave speeds, energies,
+ * output fields), so that nothing outside a kind's file branches on what a
+ * particle is.  Per-particle work is a loop inside the kind. */
+#ifndef MPM_KIND_H
+#define MPM_KIND_H
+
+#include <stddef.h>
+
+#include "mpm_particles.h"
+#include "mpm_stage.h"
+#include "pm_scene.h"
+
+struct mpm_options;
+
+/* What a kind has (mpm_kind.flags). */
+enum {
+  MPM_KIND_STRAIN_ENERGY = 1u,   /* stores elastic strain energy */
+  MPM_KIND_INTERNAL_ENERGY = 2u, /* carries a specific internal energy;
+                                    outputs density, pressure and energy */
+  MPM_KIND_ITERATES = 4u         /* its update iterates: it reports the
+                                    iterations of a step */
+};
+
+typedef struct mpm_kind {
+  const char *name;       /* "solid", "fluid" */
+  const char *stage_name; /* its constitutive stage's ("stress: solid") */
+  unsigned flags;         /* MPM_KIND_* */
+
+  /* Fill group g (material, c0, c1 and the particle range already set) from
+   * its scene material: the kind's constants into g->params (owned by g,
+   * released with free), g->viscosity, and the layout of its state arrays.
+   * PM_ERR_MEMORY on failure. */
+  pm_err (*setup)(mpm_group *g, const pm_scene_material *sm,
+                  const struct mpm_options *opt);
+
+  /* Initial state of particle k (from the group's start) of a body of
+   * density rho0 (kg/m^3) and pressure p0 (Pa): its entries of the
+   * group's arrays and its Cauchy stress sigma (9, zero on entry). */
+  void (*seed)(const mpm_group *g, mpm_group_state *gs, long k, double rho0,
+               double p0, double sigma[9]);
+
+  /* The constitutive stage: velocity gradient to stress, volume and the
+   * kind's state, for the particles of group self->group. */
+  mpm_stage_fn stress;
+
+  /* The constitutive stage in a line for the plan (without the group's
+   * name), into buf. */
+  void (*describe)(const mpm_group *g, char *buf, size_t size);
+
+  /* Dilatational wave speed cp[p] and, when cs is not NULL, shear wave
+   * speed cs[p] (m/s) of the group's particles p in [begin, end). */
+  void (*wave_speeds)(const struct mpm_model *m, const struct mpm_state *s,
+                      const mpm_group *g, double *cp, double *cs);
+
+  /* Add the group's strain energy (sum V0 W) to *strain and internal energy
+   * (sum m e) to *internal, J. */
+  void (*energies)(const struct mpm_model *m, const struct mpm_state *s,
+                   const mpm_group *g, double *strain, double *internal);
+
+  /* Output fields of the group's particles p in [begin, end): strain energy
+   * density W (J/m^3 of reference volume), pressure (Pa) and specific
+   * internal energy (J/kg), each an array indexed by p. */
+  void (*fields)(const struct mpm_model *m, const struct mpm_state *s,
+                 const mpm_group *g, double *sed, double *pressure,
+                 double *energy);
+} mpm_kind;
+
+extern const mpm_kind mpm_kind_solid;
+extern const mpm_kind mpm_kind_fluid;
+
+/* The kind of a scene material's particles. */
+const mpm_kind *mpm_kind_of(const pm_scene_material *sm);
+
+/* D and W, the symmetric and skew parts of L (all row-major 3x3). */
+static inline void mpm_sym_skew(const double L[9], double D[9], double W[9]) {
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      D[3 * i + j] = 0.5 * (L[3 * i + j] + L[3 * j + i]);
+      W[3 * i + j] = 0.5 * (L[3 * i + j] - L[3 * j + i]);
+    }
+}
+
+#endif

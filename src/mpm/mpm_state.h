@@ -1,0 +1,88 @@
+/* mpm_state: what an MPM run changes, in two parts.  mpm_state is exactly
+ * what a checkpoint writes to resume bit for bit; mpm_work is what a step
+ * rebuilds or only reports, so a checkpoint leaves it out. */
+#ifndef MPM_STATE_H
+#define MPM_STATE_H
+
+#include "mpm_model.h"
+#include "pm_progress.h"
+
+/* The state of a run.  Everything a later step reads that an earlier one
+ * wrote: time and step size, the particles, every kind's arrays, the
+ * stages' energy accounts, the damping rate and what dynamic relaxation
+ * remembers of the last step, and the counters the history reports over
+ * the whole run. */
+typedef struct mpm_state {
+  double t;            /* time, s */
+  long step;           /* steps taken */
+  double dt;           /* the step size (of the last step, or the next) */
+  double dt_stable;    /* the stable step as last estimated, s */
+  double max_div_prev; /* largest |tr D| of the last stress update, 1/s (the
+                          stable step's artificial viscosity term) */
+  /* particles */
+  double *x;                             /* 3: position */
+  double *v;                             /* 3: velocity */
+  double *vol;                           /* volume */
+  double *sigma;                         /* 9: Cauchy stress */
+  mpm_group_state group[MPM_MAX_GROUPS]; /* each kind's arrays */
+  /* energy, J: each stage's accounts, and the totals of the same bookings */
+  mpm_energy_account energy[MPM_MAX_STAGES];
+  double external_work, dissipated;
+  /* quasi-static */
+  double damping;       /* current rate, 1/s */
+  double *force_prev;   /* 3 per node: the last step's grid force before
+                           damping (dynamic relaxation) */
+  unsigned char *fixed; /* 3 per node: dofs the conditions set in the last
+                           step, which dynamic relaxation leaves out */
+  /* iterations of the constitutive updates over the run */
+  int iter_max_total;
+  long iter_capped_total;
+} mpm_state;
+
+/* The workspace of a step: nodal arrays, the conditions' bookkeeping,
+ * particle increments and wave speeds, and the figures of the last step.
+ * A step overwrites all of it before reading it. */
+typedef struct mpm_work {
+  mpm_nodes nodes;
+  mpm_cond_work cond;
+  double *dx; /* 3 per particle: position increment of the step */
+  double *cp; /* per particle: dilatational wave speed */
+  double *cs; /* per particle: shear wave speed (absorbing faces only) */
+  /* figures of the last step */
+  double max_div;   /* largest |tr D| of the stress update, 1/s */
+  double residual;  /* quasi-static residual */
+  int iter_max;     /* most iterations a particle took */
+  long iter_capped; /* particles whose iteration hit the cap */
+  mpm_failure fail;
+  pm_timers timers;
+  int timer[MPM_MAX_STAGES]; /* each stage's timer */
+} mpm_work;
+
+/* A state of model m's shape, zeroed (t = 0 and no particle data): what a
+ * checkpoint is read into.  PM_ERR_MEMORY on failure (*out NULL). */
+pm_err mpm_state_create(const mpm_model *m, mpm_state **out);
+/* Release a state (NULL accepted). */
+void mpm_state_destroy(mpm_state *s);
+
+/* Copy every value of src into dst (both of model m's shape). */
+void mpm_state_copy(const mpm_model *m, mpm_state *dst, const mpm_state *src);
+
+/* The state's per-particle arrays, named: position, velocity, volume,
+ * stress, then each group's own.  Writes at most max into out (the
+ * arrays stay the state's); returns how many there are (at most
+ * MPM_STATE_MAX_ARRAYS). */
+#define MPM_STATE_MAX_ARRAYS (4 + MPM_MAX_GROUPS * MPM_MAX_ARRAYS)
+int mpm_state_arrays(const mpm_model *m, const mpm_state *s, mpm_array *out,
+                     int max);
+
+/* Bytes of the state's arrays (particles and grid). */
+size_t mpm_state_bytes(const mpm_model *m, const mpm_state *s);
+
+/* The workspace of model m.  PM_ERR_MEMORY on failure (*out NULL). */
+pm_err mpm_work_create(const mpm_model *m, mpm_work **out);
+/* Release a workspace (NULL accepted). */
+void mpm_work_destroy(mpm_work *w);
+/* Bytes of the workspace's arrays (grid and particles). */
+size_t mpm_work_bytes(const mpm_model *m, const mpm_work *w);
+
+#endif

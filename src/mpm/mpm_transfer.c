@@ -1,0 +1,208 @@
+/* mpm_transfer: the transfers between particles and grid, each a flat
+ * loop over a particle's expanded stencil. */
+#include "mpm_transfer.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "mpm_grid_stages.h"
+#include "mpm_kind.h"
+#include "mpm_state.h"
+#include "pm_omp.h"
+
+static inline int thread_id(void) {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
+/* One thread's share of the particles of a group into its accumulators
+ * acc.  Inline, so that each constant mode gets its own loop. */
+static inline __attribute__((always_inline)) void
+p2g_group(const mpm_model *m, const mpm_state *s, const mpm_work *w,
+          const mpm_group *gr, double *restrict acc, const int mode,
+          const bool imp) {
+  const mpm_grid *g = &m->grid;
+  const int S = w->nodes.acc_stride;
+  const bool weights = (mode & (MPM_P2G_MASS | MPM_P2G_MOM)) || imp;
+  const int what = (weights ? MPM_STENCIL_W : 0) |
+                   (mode & MPM_P2G_FORCE ? MPM_STENCIL_GRAD : 0);
+  const double *restrict x = s->x, *restrict v = s->v, *restrict vol = s->vol,
+                         *restrict sigma = s->sigma, *restrict mass = m->mass;
+  const double *restrict cp_p = w->cp, *restrict cs_p = w->cs;
+  PM_OMP(for schedule(static) nowait)
+  for (long p = gr->begin; p < gr->end; p++) {
+    mpm_stencil st;
+    mpm_stencil_at(g, x + 3 * p, what, &st);
+    const double mp = mass[p];
+    const double *vp = v + 3 * p;
+    double sg[9] = {0};
+    if (mode & MPM_P2G_FORCE)
+      for (int k = 0; k < 9; k++) sg[k] = -vol[p] * sigma[9 * p + k];
+    double cp = 0, cs = 0;
+    if (imp) {
+      /* Impedances rho c of the particle. */
+      double rho = mp / vol[p];
+      cp = cp_p[p] * rho;
+      cs = cs_p[p] * rho;
+    }
+    for (int k = 0; k < st.n; k++) {
+      double *r = acc + st.node[k] * S;
+      if (mode & MPM_P2G_MASS) r[MPM_ACC_M] += st.w[k] * mp;
+      if (mode & MPM_P2G_MOM) {
+        r[MPM_ACC_P + 0] += st.w[k] * mp * vp[0];
+        r[MPM_ACC_P + 1] += st.w[k] * mp * vp[1];
+        r[MPM_ACC_P + 2] += st.w[k] * mp * vp[2];
+      }
+      if (mode & MPM_P2G_FORCE) {
+        const double *gr3 = st.grad[k];
+        r[MPM_ACC_F + 0] += sg[0] * gr3[0] + sg[1] * gr3[1] + sg[2] * gr3[2];
+        r[MPM_ACC_F + 1] += sg[3] * gr3[0] + sg[4] * gr3[1] + sg[5] * gr3[2];
+        r[MPM_ACC_F + 2] += sg[6] * gr3[0] + sg[7] * gr3[1] + sg[8] * gr3[2];
+        if (imp) {
+          r[MPM_ACC_BASE + 0] += st.w[k] * mp * cp;
+          r[MPM_ACC_BASE + 1] += st.w[k] * mp * cs;
+        }
+      }
+    }
+  }
+}
+
+/* Every group into acc, with a constant mode. */
+static inline __attribute__((always_inline)) void
+p2g_groups(const mpm_model *m, const mpm_state *s, const mpm_work *w,
+           double *acc, const int mode, const bool imp) {
+  for (int gi = 0; gi < m->n_groups; gi++)
+    p2g_group(m, s, w, &m->group[gi], acc, mode, imp);
+}
+
+/* The threads' accumulators summed in thread order into the nodal arrays
+ * (inside the parallel region). */
+static void reduce_nodes(mpm_nodes *nd, long nn, int mode, bool imp) {
+  const int S = nd->acc_stride;
+#ifdef _OPENMP
+  const int T = omp_get_num_threads();
+#else
+  const int T = 1;
+#endif
+  PM_OMP(for schedule(static))
+  for (long i = 0; i < nn; i++) {
+    double sum[MPM_ACC_BASE + 2] = {0};
+    for (int t = 0; t < T; t++) {
+      const double *r = nd->acc + ((size_t)t * nn + i) * S;
+      for (int k = 0; k < S; k++) sum[k] += r[k];
+    }
+    if (mode & MPM_P2G_MASS) nd->mass[i] = sum[MPM_ACC_M];
+    if (mode & MPM_P2G_MOM)
+      for (int c = 0; c < 3; c++) nd->mom[3 * i + c] = sum[MPM_ACC_P + c];
+    if (mode & MPM_P2G_FORCE) {
+      for (int c = 0; c < 3; c++) nd->force[3 * i + c] = sum[MPM_ACC_F + c];
+      if (imp) {
+        nd->impedance[2 * i] = sum[MPM_ACC_BASE];
+        nd->impedance[2 * i + 1] = sum[MPM_ACC_BASE + 1];
+      }
+    }
+  }
+}
+
+void mpm_p2g(mpm_ctx *ctx, int mode) {
+  const mpm_model *m = ctx->model;
+  const mpm_state *s = ctx->state;
+  mpm_work *w = ctx->work;
+  mpm_nodes *nd = &w->nodes;
+  const bool imp = (mode & MPM_P2G_FORCE) && nd->impedance;
+  const long nn = m->grid.n_nodes;
+  if (imp)
+    for (int gi = 0; gi < m->n_groups; gi++)
+      m->group[gi].kind->wave_speeds(m, s, &m->group[gi], w->cp, w->cs);
+  /* The accumulators were sized for nd->threads: run exactly that many. */
+  PM_OMP(parallel num_threads(nd->threads) default(none)
+             shared(m, s, w, nd, nn, mode, imp)) {
+    double *acc = nd->acc + (size_t)thread_id() * nn * nd->acc_stride;
+    memset(acc, 0, sizeof(double) * nn * nd->acc_stride);
+    const int all = MPM_P2G_MASS | MPM_P2G_MOM | MPM_P2G_FORCE;
+    if (mode == all && imp)
+      p2g_groups(m, s, w, acc, all, true);
+    else if (mode == all)
+      p2g_groups(m, s, w, acc, all, false);
+    else if (mode == MPM_P2G_MOM)
+      p2g_groups(m, s, w, acc, MPM_P2G_MOM, false);
+    else if (mode == (MPM_P2G_MASS | MPM_P2G_MOM))
+      p2g_groups(m, s, w, acc, MPM_P2G_MASS | MPM_P2G_MOM, false);
+    else
+      p2g_groups(m, s, w, acc, mode, imp);
+    PM_OMP(barrier)
+    reduce_nodes(nd, nn, mode, imp);
+  }
+}
+
+pm_err mpm_stage_p2g(mpm_ctx *ctx, const mpm_stage *self) {
+  mpm_p2g(ctx, self->mode);
+  return PM_SUCCESS;
+}
+
+pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
+  const mpm_model *m = ctx->model;
+  mpm_state *s = ctx->state;
+  mpm_work *w = ctx->work;
+  const mpm_grid *g = &m->grid;
+  const long n = m->n;
+  const double flip = m->opt.flip, dt = s->dt;
+  const double *restrict vel_new = w->nodes.vel_new, *restrict vel0 =
+                                                         w->nodes.vel0;
+  const double *restrict x = s->x;
+  double *restrict v = s->v, *restrict dx = w->dx;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(g, n, flip, dt, vel_new, vel0, x, v, dx, w))
+  for (long p = 0; p < n; p++) {
+    mpm_stencil st;
+    mpm_stencil_at(g, x + 3 * p, MPM_STENCIL_W, &st);
+    double vn[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+    for (int k = 0; k < st.n; k++) {
+      const double *v1 = vel_new + 3 * st.node[k];
+      const double *v0 = vel0 + 3 * st.node[k];
+      for (int c = 0; c < 3; c++) {
+        vn[c] += st.w[k] * v1[c];
+        dv[c] += st.w[k] * (v1[c] - v0[c]);
+      }
+    }
+    double *vp = v + 3 * p;
+    for (int c = 0; c < 3; c++) {
+      vp[c] = flip * (vp[c] + dv[c]) + (1.0 - flip) * vn[c];
+      dx[3 * p + c] = dt * vn[c];
+    }
+    if (!isfinite(vp[0] + vp[1] + vp[2]))
+      mpm_fail(w, p, "velocity is not finite (|v|^2 = %g, v_x = %g)",
+               vp[0] * vp[0] + vp[1] * vp[1] + vp[2] * vp[2], vp[0]);
+  }
+  return mpm_stage_status(ctx, self);
+}
+
+pm_err mpm_stage_remap(mpm_ctx *ctx, const mpm_stage *self) {
+  (void)self;
+  mpm_p2g(ctx, MPM_P2G_MOM);
+  mpm_grid_velocity(ctx);
+  return PM_SUCCESS;
+}
+
+pm_err mpm_stage_move(mpm_ctx *ctx, const mpm_stage *self) {
+  const mpm_grid *g = &ctx->model->grid;
+  mpm_work *w = ctx->work;
+  const long n = ctx->model->n;
+  double *restrict x = ctx->state->x;
+  const double *restrict dx = w->dx;
+  PM_OMP(parallel for schedule(static) default(none) shared(g, w, n, x, dx))
+  for (long p = 0; p < n; p++) {
+    double *xp = x + 3 * p;
+    for (int c = 0; c < 3; c++) xp[c] += dx[3 * p + c];
+    for (int c = 0; c < g->dim; c++)
+      if (!(xp[c] >= g->lo[c] && xp[c] < g->hi[c]))
+        mpm_fail(w, p,
+                 "left the grid (%g is outside the grid's reach along this "
+                 "axis, which ends at %g): enlarge domain.box",
+                 xp[c], xp[c] < g->lo[c] ? g->lo[c] : g->hi[c]);
+  }
+  return mpm_stage_status(ctx, self);
+}
