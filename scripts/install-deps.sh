@@ -8,7 +8,7 @@ packages=(
   liblapacke-dev libopenblas-dev
   libgmsh-dev
   libhdf5-dev
-  libcyaml-dev libyaml-dev
+  libyaml-dev
   libmatheval-dev
   libcmocka-dev
   clang-format python3-matplotlib python3-numpy python3-h5py

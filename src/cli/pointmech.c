@@ -1,5 +1,6 @@
-/* pointmech: the command-line program.  The only layer that knows every
- * backend: it loads the scene and hands it to the backend of its method. */
+/* pointmech: the command-line program.  It knows the methods only through
+ * the backend table (pm_app registers them): it loads the scene, whose
+ * method names its backend, and runs it through the one run driver. */
 #include <errno.h>
 #include <math.h>
 #include <stdbool.h>
@@ -7,10 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fpm_driver.h"
-#include "mpm_driver.h"
+#include "pm_app.h"
 #include "pm_error.h"
 #include "pm_probe.h"
+#include "pm_run.h"
 #include "pm_scene.h"
 #include "pm_study.h"
 
@@ -28,6 +29,7 @@ static void usage(FILE *out) {
           "[--set-ladder ...]\n"
           "                 [--reference analytic|last|DIR] [--out DIR] "
           "[--set KEY=VALUE]...\n"
+          "       pointmech keys\n"
           "       pointmech --help | --version\n"
           "\n"
           "  run    simulate SCENE (YAML); writes OUT/results.h5 + "
@@ -50,6 +52,8 @@ static void usage(FILE *out) {
           "         and wall time in OUT/convergence.{md,csv} (default OUT:\n"
           "         out/NAME-convergence); plot with "
           "tools/plot-convergence.py\n"
+          "  keys   print every scene key: meaning, type, range, unit, "
+          "default\n"
           "  --set  override any scene value by its dotted key, e.g.\n"
           "         --set discretization.mesh_size=8.02e-3 --set "
           "boundary.3.displacement.z=-0.06\n"
@@ -141,149 +145,24 @@ static const char *out_dir(const cli_args *a, const pm_scene *s, char *buf,
   return buf;
 }
 
-static int cmd_run_or_plan_mpm(const cli_args *a, pm_scene *s, bool plan) {
-  mpm_run *r = NULL;
+static int cmd_run_or_plan(const cli_args *a, bool plan) {
+  pm_scene *s = NULL;
   int status = EXIT_OK;
-  pm_err e = mpm_run_create(s, &r);
-  if (e) {
-    status = report(e);
-  } else if (plan) {
-    e = mpm_run_plan(r, stdout);
+  pm_err e = pm_scene_load(a->scene, a->n_sets, a->sets, &s);
+  if (e) return report(e);
+  if (plan) {
+    e = pm_plan_scene(s, stdout);
     if (e) status = report(e);
   } else {
     char buf[1024];
     const char *out = out_dir(a, s, buf, sizeof buf);
-    e = mpm_run_go(r, out, a->quiet);
+    pm_outcome o;
+    e = pm_run_scene(s, out, a->quiet, &o);
     if (e) status = report(e);
     fprintf(stderr, "results in %s\n", out);
   }
-  mpm_run_destroy(r);
   pm_scene_destroy(s);
   return status;
-}
-
-static int cmd_run_or_plan(const cli_args *a, bool plan) {
-  pm_scene *s = NULL;
-  fpm_sim *sim = NULL;
-  int status = EXIT_OK;
-  pm_err e = pm_scene_load(a->scene, a->n_sets, a->sets, &s);
-  if (e) return report(e);
-  if (s->method == PM_METHOD_MPM) return cmd_run_or_plan_mpm(a, s, plan);
-  if (s->method != PM_METHOD_FPM) {
-    fprintf(stderr,
-            "pointmech: error: %s: method %s is not available in this build "
-            "(available: fpm, mpm)\n",
-            a->scene, pm_method_name(s->method));
-    pm_scene_destroy(s);
-    return EXIT_INPUT;
-  }
-  e = fpm_sim_create(s, &sim);
-  if (e) {
-    status = report(e);
-    goto done;
-  }
-  if (plan) {
-    e = fpm_sim_plan(sim, stdout);
-    if (e) status = report(e);
-    goto done;
-  }
-  char out_default[1024];
-  const char *out = out_dir(a, s, out_default, sizeof out_default);
-  e = fpm_sim_run(sim, out, a->quiet);
-  if (e) status = report(e);
-  fprintf(stderr, "results in %s\n", out);
-done:
-  fpm_sim_destroy(sim);
-  pm_scene_destroy(s);
-  return status;
-}
-
-/* The boundary condition with the largest prescribed displacement at the
- * end (evaluated at its face's centre) and that component: the loaded face. */
-static void loaded_face(const pm_scene *s, int *bc, int *comp) {
-  double best = -1;
-  *bc = -1;
-  *comp = 0;
-  for (int b = 0; b < s->n_bcs; b++) {
-    const pm_scene_bc *B = &s->bcs[b];
-    double c[3];
-    for (int a = 0; a < 3; a++) c[a] = 0.5 * (s->box_min[a] + s->box_max[a]);
-    c[pm_face_axis(B->face)] = pm_face_plane(B->face, s->box_min, s->box_max);
-    for (int k = 0; k < 3; k++) {
-      if (!(B->disp_mask & (1u << k))) continue;
-      double v = fabs(pm_expr_eval(B->disp[k], c[0], c[1], c[2], s->time.end));
-      if (v > best) {
-        best = v;
-        *bc = b;
-        *comp = k;
-      }
-    }
-  }
-}
-
-static pm_err run_mpm_level(const pm_scene *s, const char *out, bool quiet,
-                            pm_run_figures *fig) {
-  mpm_run *r = NULL;
-  pm_err e = mpm_run_create(s, &r);
-  if (e) return e;
-  e = mpm_run_go(r, out, quiet);
-  fig->status = mpm_status_name(r->status);
-  fig->dim = r->model->dim;
-  fig->points = r->model->n;
-  fig->steps = r->state->step;
-  fig->h = r->model->grid.h;
-  fig->wall = r->wall;
-  fig->setup = r->setup_wall;
-  fig->nrmse = r->nrmse_vector;
-  mpm_field_figures ff;
-  mpm_run_field_figures(r, &ff);
-  fig->mean_sed = ff.mean_strain_energy_density;
-  fig->max_von_mises = ff.max_von_mises;
-  fig->min_jacobian = ff.min_jacobian; /* at the end of the run */
-  fig->energy_error = r->energy_error;
-  int bc, comp;
-  loaded_face(s, &bc, &comp);
-  double R[3] = {NAN, NAN, NAN};
-  if (bc >= 0) mpm_reaction(r, bc, R);
-  fig->reaction = R[comp];
-  mpm_run_destroy(r);
-  return e;
-}
-
-static pm_err run_level(void *ctx, const pm_scene *s, const char *out,
-                        bool quiet, pm_run_figures *fig) {
-  (void)ctx;
-  *fig = (pm_run_figures){.status = "failed", .nrmse = NAN};
-  if (s->method == PM_METHOD_MPM) return run_mpm_level(s, out, quiet, fig);
-  fpm_sim *sim = NULL;
-  pm_err e = fpm_sim_create(s, &sim);
-  if (e) return e;
-  e = fpm_sim_run(sim, out, quiet);
-  fpm_field_figures ff;
-  fpm_sim_field_figures(sim, &ff);
-  const fpm_model *m = sim->model;
-  fig->status = fpm_status_name(sim->status);
-  fig->dim = m->dim;
-  fig->points = m->n;
-  fig->steps = sim->last.step;
-  fig->h = sim->mean_edge;
-  fig->wall = sim->wall;
-  fig->setup = sim->setup_wall;
-  fig->nrmse = sim->nrmse_vector;
-  fig->mean_sed = ff.mean_strain_energy_density;
-  fig->max_von_mises = ff.max_von_mises;
-  fig->min_jacobian = sim->run_min_jacobian;
-  fig->energy_error = fpm_energy_error(&sim->last);
-  int bc, comp;
-  loaded_face(s, &bc, &comp);
-  fig->reaction = NAN;
-  if (bc >= 0) {
-    double R[3];
-    fpm_reaction(m, sim->state, bc, R);
-    fig->reaction = R[comp];
-  }
-  fpm_sim_destroy(sim);
-  return e;
 }
 
 static int cmd_convergence(const cli_args *a) {
@@ -297,7 +176,7 @@ static int cmd_convergence(const cli_args *a) {
       .quiet = a->quiet,
   };
   for (int k = 0; k < a->n_ladders; k++) o.ladder[k] = a->ladders[k];
-  pm_err e = pm_study_run(&o, run_level, NULL, stdout);
+  pm_err e = pm_study_run(&o, stdout);
   return e ? report(e) : EXIT_OK;
 }
 
@@ -316,6 +195,8 @@ int main(int argc, char **argv) {
     printf("pointmech %s\n", PM_VERSION);
     return EXIT_OK;
   }
+  pm_err init = pm_app_init();
+  if (init) return report(init);
   cli_args a;
   if (parse_args(argc, argv, 2, &a) != 0) {
     usage(stderr);
@@ -327,6 +208,10 @@ int main(int argc, char **argv) {
       return EXIT_INPUT;
     }
     return cmd_run_or_plan(&a, strcmp(cmd, "plan") == 0);
+  }
+  if (strcmp(cmd, "keys") == 0) {
+    pm_scene_print_keys(stdout);
+    return EXIT_OK;
   }
   if (strcmp(cmd, "convergence") == 0) {
     if (!a.scene) {

@@ -82,7 +82,7 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
   const pm_material *mats = m->mats;
   const double *ms = m->mstate;
   const long mss = m->mstate_stride;
-  const bool sym = m->flux == PM_FLUX_SIPG;
+  const bool sym = m->flux == FPM_FLUX_SIPG;
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
          shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat, mats, ms,

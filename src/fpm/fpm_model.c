@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fpm_gfd.h"
+#include "gm_shape.h"
 #include "pm_omp.h"
 
 /* Supports whose scaled moment matrix is worse than this cannot give a
@@ -39,6 +40,8 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->cd_bc);
   free(m->cd_base);
   free(m->fixed);
+  free(m->bcf_ptr);
+  free(m->bcf_facet);
   free(m);
 }
 
@@ -76,44 +79,58 @@ static pm_err build_mirror(fpm_model *m) {
   return PM_SUCCESS;
 }
 
-static pm_err assign_materials(fpm_model *m, const pm_scene *s) {
-  PM_CHECK(s->n_materials >= 1 && s->n_materials <= FPM_MAX_MATERIALS,
-           PM_ERR_SCENE,
-           "%s: between 1 and %d materials are supported (got %d)", s->path,
-           FPM_MAX_MATERIALS, s->n_materials);
+/* Each point takes the material of the last body that holds it (a body
+ * meshed as the domain holds every point), and the per-point state its
+ * model derives from that body (fibre directions). */
+static pm_err assign_materials(fpm_model *m, const pm_scene *s,
+                               int domain_body) {
+  pm_err ret = PM_SUCCESS;
+  int *body_of = NULL;
+  gm_shape *shape = NULL;
+  PM_ENSURE(s->n_materials >= 1 && s->n_materials <= FPM_MAX_MATERIALS,
+            PM_ERR_SCENE,
+            "%s: between 1 and %d materials are supported (got %d)", s->path,
+            FPM_MAX_MATERIALS, s->n_materials);
   m->n_mats = s->n_materials;
   for (int k = 0; k < s->n_materials; k++) m->mats[k] = s->materials[k].mat;
-  for (long i = 0; i < m->n; i++) m->mat[i] = -1;
-  if (s->n_bodies == 0)
-    for (long i = 0; i < m->n; i++) m->mat[i] = 0;
+  PM_TRY(PM_ALLOC(body_of, m->n, "point bodies"));
+  for (long i = 0; i < m->n; i++) body_of[i] = -1;
   for (int b = 0; b < s->n_bodies; b++) {
-    const pm_scene_body *body = &s->bodies[b];
-    for (long i = 0; i < m->n; i++) {
-      const double *xi = m->x + 3 * i;
-      if (!body->region ||
-          pm_expr_eval(body->region, xi[0], xi[1], xi[2], 0) > 0)
-        m->mat[i] = body->material;
+    if (b == domain_body) {
+      for (long i = 0; i < m->n; i++) body_of[i] = b;
+      continue;
     }
+    PM_TRY(gm_shape_create(&s->bodies[b], s->dimension, s->box_min, s->box_max,
+                           s->mesh_size, &shape));
+    for (long i = 0; i < m->n; i++)
+      if (gm_shape_contains(shape, m->x + 3 * i)) body_of[i] = b;
+    gm_shape_destroy(shape);
+    shape = NULL;
   }
-  for (long i = 0; i < m->n; i++)
-    PM_CHECK(m->mat[i] >= 0, PM_ERR_SCENE,
-             "%s: point %ld at (%g, %g, %g) lies in no body's region", s->path,
-             i, m->x[3 * i], m->x[3 * i + 1], m->x[3 * i + 2]);
-  for (long i = 0; i < m->n; i++)
+  for (long i = 0; i < m->n; i++) {
+    PM_ENSURE(body_of[i] >= 0, PM_ERR_SCENE,
+              "%s: point %ld at (%g, %g, %g) lies in no body", s->path, i,
+              m->x[3 * i], m->x[3 * i + 1], m->x[3 * i + 2]);
+    m->mat[i] = s->bodies[body_of[i]].material;
     m->mass[i] = m->mats[m->mat[i]].density * m->dual->volume[i];
+  }
   for (int k = 0; k < m->n_mats; k++)
     if (m->mats[k].state_size > m->mstate_stride)
       m->mstate_stride = m->mats[k].state_size;
-  if (m->mstate_stride == 0) return PM_SUCCESS;
-  PM_CALL(PM_ALLOC(m->mstate, (size_t)m->mstate_stride * m->n,
-                   "per-point material state"));
-  for (long i = 0; i < m->n; i++) {
-    const pm_material *mat = &m->mats[m->mat[i]];
-    pm_material_point pt = {.n_fibres = 0};
-    if (mat->model->state_init)
-      mat->model->state_init(mat, &pt, m->mstate + m->mstate_stride * i);
+  if (m->mstate_stride > 0) {
+    PM_TRY(PM_ALLOC(m->mstate, (size_t)m->mstate_stride * m->n,
+                    "per-point material state"));
+    for (long i = 0; i < m->n; i++) {
+      const pm_material *mat = &m->mats[m->mat[i]];
+      if (mat->model->state_init)
+        mat->model->state_init(mat, &s->bodies[body_of[i]].point,
+                               m->mstate + m->mstate_stride * i);
+    }
   }
-  return PM_SUCCESS;
+done:
+  gm_shape_destroy(shape);
+  free(body_of);
+  return ret;
 }
 
 /* Interface records per support entry and the per-point sums of the
@@ -152,118 +169,13 @@ static void build_interfaces(fpm_model *m) {
   }
 }
 
-/* Boundary conditions: prescribed dofs from facets on faces with
- * displacement conditions, the consistency flux of those facets, and the
- * traction facets. */
-static pm_err build_boundary(fpm_model *m, const pm_scene *s) {
-  pm_err ret = PM_SUCCESS;
-  const gm_dual *d = m->dual;
-  int *bc_of = NULL;   /* 3 n: condition prescribing each dof, or -1 */
-  long *dpt_of = NULL; /* n: index into the dpt arrays, or -1 */
-  PM_TRY(PM_ALLOC(bc_of, 3 * m->n, "boundary dof map"));
-  PM_TRY(PM_ALLOC(dpt_of, m->n, "boundary point map"));
-  for (long k = 0; k < 3 * m->n; k++) bc_of[k] = -1;
-  for (long i = 0; i < m->n; i++) dpt_of[i] = -1;
-  m->n_dpts = 0;
-  m->n_tfacets = 0;
-  for (int b = 0; b < s->n_bcs; b++) {
-    const pm_scene_bc *bc = &s->bcs[b];
-    long on_face = 0;
-    for (long f = 0; f < d->n_facets; f++) {
-      if (d->facet_surface[f] != (int)bc->face) continue;
-      on_face++;
-      long i = d->facet_point[f];
-      for (int c = 0; c < 3; c++)
-        if (bc->disp_mask & (1u << c)) bc_of[3 * i + c] = b;
-      if (bc->disp_mask && dpt_of[i] < 0) dpt_of[i] = m->n_dpts++;
-      if (bc->traction_mask) m->n_tfacets++;
-    }
-    PM_ENSURE(on_face > 0, PM_ERR_SCENE,
-              "%s:%d:%d: boundary condition on %s: no boundary facet lies on "
-              "that face",
-              s->path, bc->mark.line, bc->mark.col, pm_face_name(bc->face));
-  }
-  /* In 2D (plane strain) the out-of-plane component is fixed at zero. */
-  if (m->dim == 2)
-    for (long i = 0; i < m->n; i++) m->fixed[3 * i + 2] = 1;
-  m->n_cdofs = 0;
-  for (long k = 0; k < 3 * m->n; k++)
-    if (bc_of[k] >= 0) m->n_cdofs++;
-  PM_TRY(PM_ALLOC(m->cd_point, m->n_cdofs, "constrained dofs"));
-  PM_TRY(PM_ALLOC(m->cd_comp, m->n_cdofs, "constrained dofs"));
-  PM_TRY(PM_ALLOC(m->cd_bc, m->n_cdofs, "constrained dofs"));
-  PM_TRY(PM_ALLOC(m->cd_base, m->n_cdofs, "constrained dofs"));
-  long nc = 0;
-  for (long k = 0; k < 3 * m->n; k++) {
-    if (bc_of[k] < 0) continue;
-    long i = k / 3;
-    int c = (int)(k % 3);
-    const pm_scene_bc *bc = &s->bcs[bc_of[k]];
-    const double *xi = m->x + 3 * i;
-    m->cd_point[nc] = i;
-    m->cd_comp[nc] = c;
-    m->cd_bc[nc] = bc_of[k];
-    m->cd_base[nc] = pm_expr_eval(bc->disp[c], xi[0], xi[1], xi[2], 0);
-    if (pm_expr_uses(bc->disp[c], 't')) m->cd_time_dependent = true;
-    m->fixed[k] = 1;
-    nc++;
-  }
-  PM_TRY(PM_ALLOC(m->dpt_point, m->n_dpts, "boundary flux points"));
-  PM_TRY(PM_ALLOC(m->dpt_area, 9 * m->n_dpts, "boundary flux areas"));
-  PM_TRY(PM_ALLOC(m->dpt_mrel, 27 * m->n_dpts, "boundary flux moments"));
-  PM_TRY(PM_ALLOC(m->tf_point, m->n_tfacets, "traction facets"));
-  PM_TRY(PM_ALLOC(m->tf_bc, m->n_tfacets, "traction facets"));
-  PM_TRY(PM_ALLOC(m->tf_area, m->n_tfacets, "traction facets"));
-  PM_TRY(PM_ALLOC(m->tf_rel, 3 * m->n_tfacets, "traction facets"));
-  PM_TRY(PM_ALLOC(m->tf_centroid, 3 * m->n_tfacets, "traction facets"));
-  PM_TRY(PM_ALLOC(m->tf_base, 3 * m->n_tfacets, "traction facets"));
-  long nt = 0;
-  for (int b = 0; b < s->n_bcs; b++) {
-    const pm_scene_bc *bc = &s->bcs[b];
-    for (long f = 0; f < d->n_facets; f++) {
-      if (d->facet_surface[f] != (int)bc->face) continue;
-      long i = d->facet_point[f];
-      const double *xi = m->x + 3 * i, *af = d->facet_area_vec + 3 * f;
-      const double *Mf = d->facet_moment + 9 * f,
-                   *cf = d->facet_centroid + 3 * f;
-      if (bc->disp_mask) {
-        long p = dpt_of[i];
-        m->dpt_point[p] = i;
-        for (int c = 0; c < 3; c++) {
-          if (!(bc->disp_mask & (1u << c))) continue;
-          for (int a = 0; a < 3; a++) {
-            m->dpt_area[9 * p + 3 * c + a] += af[a];
-            for (int q = 0; q < 3; q++)
-              m->dpt_mrel[27 * p + 9 * c + 3 * a + q] +=
-                  Mf[3 * a + q] - af[a] * xi[q];
-          }
-        }
-      }
-      if (bc->traction_mask) {
-        m->tf_point[nt] = i;
-        m->tf_bc[nt] = b;
-        m->tf_area[nt] = d->facet_area[f];
-        for (int a = 0; a < 3; a++) {
-          m->tf_rel[3 * nt + a] = d->facet_area[f] * (cf[a] - xi[a]);
-          m->tf_centroid[3 * nt + a] = cf[a];
-        }
-        for (int c = 0; c < 3; c++) {
-          if (!(bc->traction_mask & (1u << c))) continue;
-          m->tf_base[3 * nt + c] =
-              pm_expr_eval(bc->traction[c], cf[0], cf[1], cf[2], 0);
-          if (pm_expr_uses(bc->traction[c], 't')) m->tf_time_dependent = true;
-        }
-        nt++;
-      }
-    }
-  }
-done:
-  free(bc_of);
-  free(dpt_of);
-  return ret;
+int fpm_domain_body(const pm_scene *s) {
+  return s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH ? 0 : -1;
 }
 
-pm_err fpm_model_create(const pm_scene *s, const gm_dual *d, fpm_model **out) {
+pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
+                        const gm_mesh *mesh, const gm_dual *d,
+                        fpm_model **out) {
   pm_err ret = PM_SUCCESS;
   fpm_model *m = NULL;
   *out = NULL;
@@ -275,8 +187,8 @@ pm_err fpm_model_create(const pm_scene *s, const gm_dual *d, fpm_model **out) {
   m->nbr_ptr = d->nbr_ptr;
   m->nnz = d->nbr_ptr[d->n_points];
   m->scene = s;
-  m->penalty = s->fpm.penalty;
-  m->flux = s->fpm.flux;
+  m->penalty = o->penalty;
+  m->flux = (fpm_flux)o->flux;
   long n = m->n, nnz = m->nnz;
   PM_TRY(PM_ALLOC(m->g, 3 * nnz, "GFD weights"));
   PM_TRY(PM_ALLOC(m->gsum, 3 * n, "GFD weight sums"));
@@ -298,9 +210,9 @@ pm_err fpm_model_create(const pm_scene *s, const gm_dual *d, fpm_model **out) {
     for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
       for (int a = 0; a < 3; a++) m->gsum[3 * i + a] += m->g[3 * e + a];
   PM_TRY(build_mirror(m));
-  PM_TRY(assign_materials(m, s));
+  PM_TRY(assign_materials(m, s, fpm_domain_body(s)));
   build_interfaces(m);
-  PM_TRY(build_boundary(m, s));
+  PM_TRY(fpm_build_boundary(m, s, mesh));
   *out = m;
   m = NULL;
 done:
@@ -355,45 +267,6 @@ size_t fpm_state_bytes(const fpm_model *m) {
   return (size_t)m->n * (3 * 4 + 9 * 3 + 2) * sizeof(double) +
          (size_t)(m->n_tfacets + 2 * m->n_dpts) * 3 * sizeof(double) +
          (size_t)m->n_cdofs * sizeof(double);
-}
-
-double fpm_prescribed(const fpm_model *m, long k, double t) {
-  const pm_scene_bc *bc = &m->scene->bcs[m->cd_bc[k]];
-  double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
-  if (!m->cd_time_dependent) return r * m->cd_base[k];
-  const double *xi = m->x + 3 * m->cd_point[k];
-  return r * pm_expr_eval(bc->disp[m->cd_comp[k]], xi[0], xi[1], xi[2], t);
-}
-
-void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t) {
-  double norm2 = 0;
-  for (long k = 0; k < m->n_tfacets; k++) {
-    const pm_scene_bc *bc = &m->scene->bcs[m->tf_bc[k]];
-    double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
-    const double *c = m->tf_centroid + 3 * k;
-    for (int a = 0; a < 3; a++) {
-      double v = 0;
-      if (!(bc->traction_mask & (1u << a)))
-        v = 0;
-      else if (m->tf_time_dependent)
-        v = r * pm_expr_eval(bc->traction[a], c[0], c[1], c[2], t);
-      else
-        v = r * m->tf_base[3 * k + a];
-      st->tf_value[3 * k + a] = v;
-      norm2 += v * v * m->tf_area[k] * m->tf_area[k];
-    }
-  }
-  st->fext_norm = sqrt(norm2);
-}
-
-double fpm_load_end(const fpm_model *m) {
-  double end = 0;
-  for (int b = 0; b < m->scene->n_bcs; b++) {
-    const pm_scene_bc *bc = &m->scene->bcs[b];
-    if (bc->ramp == PM_RAMP_NONE) continue;
-    if (bc->ramp_time > end) end = bc->ramp_time;
-  }
-  return end;
 }
 
 double fpm_stable_dt(const fpm_model *m, long *critical_point) {

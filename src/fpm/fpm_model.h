@@ -9,6 +9,7 @@
 #include "gm_dual.h"
 #include "pm_error.h"
 #include "pm_material.h"
+#include "fpm_scene.h"
 #include "pm_scene.h"
 
 #define FPM_MAX_MATERIALS 16
@@ -48,7 +49,7 @@ typedef struct {
   int mstate_stride;
   double *mass;   /* n: lumped mass rho V */
   double penalty; /* p */
-  pm_flux flux;   /* IIPG or SIPG */
+  fpm_flux flux;  /* IIPG or SIPG */
   /* Consistency flux on faces with displacement conditions, per point that
    * has such facets: row c of the projected flux uses area A^c and moment
    * B^c summed over the facets that prescribe component c. */
@@ -73,6 +74,8 @@ typedef struct {
   double *cd_base;        /* value at full load (t-independent part) */
   bool cd_time_dependent; /* some displacement expression uses t */
   unsigned char *fixed;   /* 3 n: 1 where the component is prescribed */
+  long *bcf_ptr;          /* n_bcs + 1: the facets of condition b are */
+  long *bcf_facet;        /* bcf_facet[bcf_ptr[b] .. bcf_ptr[b + 1]) */
   const pm_scene *scene;  /* borrowed: boundary expressions and ramps */
 } fpm_model;
 
@@ -97,11 +100,24 @@ typedef struct {
                            step (trapezoidal work of the supports) */
 } fpm_state;
 
-/* Build the model of scene s on dual d (both borrowed and kept alive by the
- * caller until fpm_model_destroy).  Computes the GFD weights (failing with
+/* Build the model of scene s with the fpm options o on the cells d of
+ * mesh (s, mesh and d borrowed and kept alive by the caller until
+ * fpm_model_destroy).  Computes the GFD weights (failing with
  * the point id and position of an ill-conditioned support), interface
  * geometry, masses and boundary conditions. */
-pm_err fpm_model_create(const pm_scene *s, const gm_dual *d, fpm_model **out);
+pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
+                        const gm_mesh *mesh, const gm_dual *d, fpm_model **out);
+
+/* The body FPM meshes as its domain: the scene's only body when it is a
+ * gmsh volume (bodies: [{mesh: FILE}]), whose physical surfaces then name
+ * boundary conditions; -1 when FPM meshes domain.box. */
+int fpm_domain_body(const pm_scene *s);
+
+/* The boundary conditions of s on the model (called by fpm_model_create):
+ * the facets each condition selects on mesh's surfaces or in its region
+ * (none is an error at the condition's key), prescribed dofs, the
+ * consistency flux on prescribed facets and the traction facets. */
+pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s, const gm_mesh *mesh);
 void fpm_model_destroy(fpm_model *m);
 /* Bytes held by the model (not counting the dual). */
 size_t fpm_model_bytes(const fpm_model *m);
@@ -115,9 +131,6 @@ double fpm_prescribed(const fpm_model *m, long k, double t);
 /* Evaluate the traction of every traction facet at time t into
  * st->tf_value (serial: expressions are not thread-safe). */
 void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t);
-
-/* Time at which every ramped load has reached its full value. */
-double fpm_load_end(const fpm_model *m);
 
 /* The net nodal force f = f_int(u) - f_ext(t) into st->f (also F, P, W, J,
  * T, r).  Returns -1, or the smallest point id whose deformation gradient

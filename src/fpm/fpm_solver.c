@@ -16,8 +16,8 @@ void fpm_reaction(const fpm_model *m, const fpm_state *st, int b, double R[3]) {
   const gm_dual *d = m->dual;
   const pm_scene_bc *bc = &m->scene->bcs[b];
   R[0] = R[1] = R[2] = 0;
-  for (long f = 0; f < d->n_facets; f++) {
-    if (d->facet_surface[f] != (int)bc->face) continue;
+  for (long e = m->bcf_ptr[b]; e < m->bcf_ptr[b + 1]; e++) {
+    const long f = m->bcf_facet[e];
     const double *P = st->P + 9 * d->facet_point[f],
                  *a = d->facet_area_vec + 3 * f;
     for (int c = 0; c < 3; c++)
@@ -123,7 +123,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
                double stage_seconds[2]) {
   const long n = m->n;
   const double dt = opt->dt;
-  const double load_end = fpm_load_end(m);
+  const double load_end = pm_scene_load_end(m->scene);
   double t = 0, c = opt->qs == PM_QS_DAMPING ? opt->damping : 0;
   double ext_work = 0, dissipated = 0, t_force = 0, t_update = 0;
   PM_CHECK(dt > 0 && isfinite(dt), PM_ERR_ARG, "time step must be > 0 (got %g)",
@@ -138,6 +138,17 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     st->support_prev[m->n_cdofs + k] = st->bflux[k];
 
   fpm_step_info si = {0};
+  /* The initial state, as a frame. */
+  si.min_jacobian = INFINITY;
+  for (long i = 0; i < n; i++)
+    si.min_jacobian = fmin(si.min_jacobian, st->J[i]);
+  if (observer) {
+    pm_err e = observer(ctx, m, st, &si, true);
+    if (e != PM_SUCCESS) {
+      if (info) *info = si;
+      return pm_error_trace(e, __FILE__, __LINE__, __func__, "observer");
+    }
+  }
   const double *restrict mass = m->mass;
   const unsigned char *restrict fixed = m->fixed;
   for (long step = 1;; step++) {

@@ -36,8 +36,9 @@ typedef struct {
   bool converged;
 } fpm_step_info;
 
-/* Called after every step (frame = false) and on frame steps and at the
- * last step (frame = true).  A non-success return stops the run. */
+/* Called with the initial state (step 0) and after every step: frame is
+ * true at step 0, every frame_every steps and at the last step.  A
+ * non-success return stops the run. */
 typedef pm_err (*fpm_observer)(void *ctx, const fpm_model *m,
                                const fpm_state *st, const fpm_step_info *info,
                                bool frame);

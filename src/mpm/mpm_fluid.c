@@ -24,8 +24,8 @@ static pm_err fluid_setup(mpm_group *g, const pm_scene_material *sm,
                           const mpm_options *opt) {
   fluid_params *fp = NULL;
   PM_CALL(PM_ALLOC(fp, 1, "fluid constants"));
-  fp->fl = sm->fluid_props;
-  fp->iterative = opt->energy_update == PM_ENERGY_ITERATIVE;
+  fp->fl = sm->mat.fluid;
+  fp->iterative = opt->energy_update == MPM_ENERGY_ITERATIVE;
   fp->tolerance = opt->energy_tolerance;
   fp->cap = opt->max_iterations;
   g->params = fp;
@@ -39,8 +39,9 @@ static pm_err fluid_setup(mpm_group *g, const pm_scene_material *sm,
 }
 
 static void fluid_seed(const mpm_group *g, mpm_group_state *gs, long k,
-                       double rho0, double p0, double sigma[9]) {
+                       const pm_scene_body *b, double sigma[9]) {
   const fluid_params *fp = g->params;
+  const double rho0 = b->density, p0 = b->pressure;
   gs->array[FLUID_RHO].data[k] = rho0;
   gs->array[FLUID_P].data[k] = p0;
   gs->array[FLUID_E].data[k] = pm_eos_energy(&fp->fl, rho0, p0);
@@ -107,18 +108,20 @@ static pm_err fluid_stress(mpm_ctx *ctx, const mpm_stage *self) {
   const pm_fluid *fl = &fp->fl;
   const double dt = s->dt, h = g->h, c0 = gr->c0, c1 = gr->c1;
   const long begin = gr->begin, end = gr->end;
-  const double *vel = w->nodes.vel_stress, *x = s->x, *mass = m->mass;
+  const double *vel = w->nodes.vel_stress, *x = s->x, *mass = m->mass,
+               *vol0 = m->vol0;
   mpm_array *arr = s->group[self->group].array;
   double *rho_a = arr[FLUID_RHO].data, *e_a = arr[FLUID_E].data,
          *p_a = arr[FLUID_P].data, *vol = s->vol, *sigma = s->sigma;
   double *qa = gr->n_arrays > FLUID_Q ? arr[FLUID_Q].data : NULL;
-  double maxdiv = 0;
+  double maxdiv = 0, Jlow = INFINITY;
   int itmax = 0;
   long capped = 0;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(g, fp, fl, w, dt, h, c0, c1, begin, end, vel, x, mass, rho_a,
-                e_a, p_a, vol, sigma, qa)
-         reduction(max : maxdiv, itmax) reduction(+ : capped))
+         shared(g, fp, fl, w, dt, h, c0, c1, begin, end, vel, x, mass, vol0,
+                rho_a, e_a, p_a, vol, sigma, qa)
+         reduction(max : maxdiv, itmax) reduction(+ : capped)
+         reduction(min : Jlow))
   for (long p = begin; p < end; p++) {
     long k = p - begin;
     double L[9], D[9], W[9], tau[9];
@@ -164,12 +167,14 @@ static pm_err fluid_stress(mpm_ctx *ctx, const mpm_stage *self) {
     p_a[k] = P;
     if (qa) qa[k] = q;
     vol[p] = mass[p] / rho;
+    Jlow = fmin(Jlow, vol[p] / vol0[p]);
     for (int i = 0; i < 9; i++) sig[i] = tau[i];
     sig[0] -= P + q;
     sig[4] -= P + q;
     sig[8] -= P + q;
   }
   if (maxdiv > w->max_div) w->max_div = maxdiv;
+  if (Jlow < w->min_jacobian) w->min_jacobian = Jlow;
   if (itmax > w->iter_max) w->iter_max = itmax;
   w->iter_capped += capped;
   return mpm_stage_status(ctx, self);

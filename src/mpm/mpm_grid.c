@@ -4,13 +4,13 @@
 #include <math.h>
 #include <stdlib.h>
 
-pm_err mpm_grid_init(mpm_grid *g, int dim, pm_shape shape, double h,
+pm_err mpm_grid_init(mpm_grid *g, int dim, mpm_basis shape, double h,
                      const double box_min[3], const double box_max[3],
                      const char *path) {
   g->dim = dim;
   g->shape = shape;
   g->width = mpm_shape_width(shape);
-  g->ghost = shape == PM_SHAPE_QUADRATIC ? 1 : 0;
+  g->ghost = shape == MPM_BASIS_QUADRATIC ? 1 : 0;
   g->h = h;
   g->inv_h = 1.0 / h;
   g->node_volume = 1;

@@ -16,7 +16,7 @@
  * node layers outside it.  Part of the model: nothing here changes. */
 typedef struct {
   int dim;
-  pm_shape shape;
+  mpm_basis shape;
   int width; /* nodes per axis in a stencil */
   int ghost; /* node layers outside the domain box */
   double h, inv_h;
@@ -54,7 +54,7 @@ typedef struct {
 /* Lay the grid over the box [box_min, box_max] in cells of h (dim 2 or 3).
  * Fails with PM_ERR_SCENE, naming the scene file `path` and
  * discretization.mesh_size, when the grid would be too large. */
-pm_err mpm_grid_init(mpm_grid *g, int dim, pm_shape shape, double h,
+pm_err mpm_grid_init(mpm_grid *g, int dim, mpm_basis shape, double h,
                      const double box_min[3], const double box_max[3],
                      const char *path);
 
@@ -90,7 +90,7 @@ typedef struct {
 static inline __attribute__((always_inline)) void
 mpm_stencil_expand(const mpm_grid *g, const double x[3], int what,
                    mpm_stencil *st, const int dim, const int width) {
-  const pm_shape shape = width == 3 ? PM_SHAPE_QUADRATIC : PM_SHAPE_LINEAR;
+  const mpm_basis shape = width == 3 ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;
   const int nz = dim == 3 ? width : 1;
   long base = 0;
   double w[3][3], dw[3][3];

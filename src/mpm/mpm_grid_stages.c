@@ -109,7 +109,7 @@ pm_err mpm_stage_absorbing(mpm_ctx *ctx, const mpm_stage *self) {
     const mpm_bc *bc = &m->bcs[b];
     if (!bc->absorbing) continue;
     const int a = bc->axis;
-    const bool quad = g->shape == PM_SHAPE_QUADRATIC;
+    const bool quad = g->shape == MPM_BASIS_QUADRATIC;
     const double share[2] = {quad ? 0.75 : 1.0, quad ? 0.125 : 0.0};
     PM_OMP(parallel for schedule(static) default(none)
            shared(bc, g, nd, a, share, dt, dim, area) reduction(+ : lost))

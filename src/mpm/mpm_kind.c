@@ -2,5 +2,5 @@
 #include "mpm_kind.h"
 
 const mpm_kind *mpm_kind_of(const pm_scene_material *sm) {
-  return sm->fluid ? &mpm_kind_fluid : &mpm_kind_solid;
+  return pm_material_is_fluid(&sm->mat) ? &mpm_kind_fluid : &mpm_kind_solid;
 }

@@ -35,11 +35,12 @@ typedef struct mpm_kind {
   pm_err (*setup)(mpm_group *g, const pm_scene_material *sm,
                   const struct mpm_options *opt);
 
-  /* Initial state of particle k (from the group's start) of a body of
-   * density rho0 (kg/m^3) and pressure p0 (Pa): its entries of the
-   * group's arrays and its Cauchy stress sigma (9, zero on entry). */
-  void (*seed)(const mpm_group *g, mpm_group_state *gs, long k, double rho0,
-               double p0, double sigma[9]);
+  /* Initial state of particle k (from the group's start) of body b (its
+   * density, kg/m^3, pressure, Pa, and what its material's points take
+   * from it): its entries of the group's arrays and its Cauchy stress
+   * sigma (9, zero on entry). */
+  void (*seed)(const mpm_group *g, mpm_group_state *gs, long k,
+               const pm_scene_body *b, double sigma[9]);
 
   /* The constitutive stage: velocity gradient to stress, volume and the
    * kind's state, for the particles of group self->group. */

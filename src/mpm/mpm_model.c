@@ -3,20 +3,22 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "mpm_grid_stages.h"
 #include "mpm_seed.h"
 #include "mpm_state.h"
 
 void mpm_options_from_scene(const pm_scene *s, mpm_options *o) {
+  const mpm_settings *set = mpm_scene_settings(s);
   *o = (mpm_options){
-      .shape = s->mpm.shape,
-      .update = s->mpm.update,
-      .flip = s->mpm.flip,
-      .null_velocity = s->mpm.null_velocity,
-      .energy_update = s->mpm.energy_update,
-      .energy_tolerance = s->mpm.energy_tolerance,
-      .max_iterations = s->mpm.max_iterations,
+      .shape = (mpm_basis)set->shape,
+      .update = (mpm_update)set->update,
+      .flip = set->flip,
+      .null_velocity = set->null_velocity,
+      .energy_update = (mpm_energy_update)set->fluid.energy_update,
+      .energy_tolerance = set->fluid.tolerance,
+      .max_iterations = (int)set->fluid.max_iterations,
       .has_gravity = s->has_gravity,
       .t_end = s->time.end,
       .dt_fixed = s->time.dt,
@@ -28,7 +30,7 @@ void mpm_options_from_scene(const pm_scene *s, mpm_options *o) {
       .min_jacobian = s->stability.min_jacobian,
   };
   for (int c = 0; c < 3; c++) {
-    o->ppc[c] = s->mpm.ppc[c];
+    o->ppc[c] = set->ppc[c];
     o->gravity[c] = s->gravity[c];
   }
 }
@@ -56,9 +58,9 @@ pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
   mpm_state *st = NULL;
   *model = NULL;
   *state = NULL;
-  PM_ENSURE(s->method == PM_METHOD_MPM, PM_ERR_ARG,
+  PM_ENSURE(s->method && strcmp(s->method, "mpm") == 0, PM_ERR_ARG,
             "mpm_model_create: scene %s has method %s", s->path,
-            pm_method_name(s->method));
+            s->method ? s->method : "(none)");
   PM_TRY(PM_ALLOC(m, 1, "MPM model"));
   mpm_options_from_scene(s, &m->opt);
   m->dim = s->dimension;

@@ -11,6 +11,7 @@
 #include "mpm_grid.h"
 #include "mpm_particles.h"
 #include "mpm_pipeline.h"
+#include "mpm_scene.h"
 #include "pm_scene.h"
 
 struct mpm_state;
@@ -18,12 +19,12 @@ struct mpm_state;
 /* What the model takes from the scene, copied at creation so that nothing
  * after it reads the scene's mpm, time or stability sections. */
 typedef struct mpm_options {
-  pm_shape shape;
-  pm_update update;
+  mpm_basis shape;
+  mpm_update update;
   double flip;            /* FLIP fraction of the particle velocity update */
   int ppc[3];             /* particles per cell and direction */
   unsigned null_velocity; /* grid velocity components held at zero (mask) */
-  pm_energy_update energy_update; /* kinds with an energy equation */
+  mpm_energy_update energy_update; /* kinds with an energy equation */
   double energy_tolerance;
   int max_iterations;
   bool has_gravity;

@@ -70,7 +70,7 @@ void mpm_pipeline_build(mpm_model *m) {
              "dt = %g h / max(wave speed + |v|, with viscous terms)",
              o->dt_safety);
   }
-  if (o->update == PM_UPDATE_USF) {
+  if (o->update == MPM_USF) {
     st = add(pl, "p2g", mpm_stage_p2g);
     st->mode = MPM_P2G_MASS | MPM_P2G_MOM;
     snprintf(st->detail, sizeof st->detail, "mass and momentum to the grid");
@@ -100,12 +100,12 @@ void mpm_pipeline_build(mpm_model *m) {
   st = add(pl, "g2p", mpm_stage_g2p);
   snprintf(st->detail, sizeof st->detail,
            "particle velocities (FLIP %g / PIC %g)", o->flip, 1 - o->flip);
-  if (o->update == PM_UPDATE_MUSL) {
+  if (o->update == MPM_MUSL) {
     st = add(pl, "remap", mpm_stage_remap);
     snprintf(st->detail, sizeof st->detail,
              "MUSL: momentum from the updated particles");
   }
-  if (o->update != PM_UPDATE_USF) add_stress(m);
+  if (o->update != MPM_USF) add_stress(m);
   st = add(pl, "move", mpm_stage_move);
   snprintf(st->detail, sizeof st->detail, "positions x += dt v^L");
 }
@@ -116,6 +116,7 @@ pm_err mpm_step(const mpm_model *m, mpm_state *s, mpm_work *w) {
   w->iter_max = 0;
   w->iter_capped = 0;
   w->max_div = 0;
+  w->min_jacobian = INFINITY;
   w->fail.failed = false;
   for (int k = 0; k < pl->n; k++) {
     const mpm_stage *st = &pl->stage[k];

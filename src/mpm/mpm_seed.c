@@ -6,73 +6,41 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gm_volume.h"
+#include "gm_shape.h"
 #include "mpm_kind.h"
 #include "pm_tensor.h"
 
 typedef struct {
   const pm_scene *s;
-  gm_volume **vol; /* per body, for mesh shapes */
+  gm_shape **shape; /* per body */
 } seeder;
 
 /* The last body containing x (later bodies take precedence), or -1. */
 static int body_at(const seeder *sd, const double x[3]) {
-  const pm_scene *s = sd->s;
-  for (int b = s->n_bodies - 1; b >= 0; b--) {
-    const pm_scene_body *body = &s->bodies[b];
-    bool in = body->shape == PM_BODY_MESH
-                  ? gm_volume_contains(sd->vol[b], x)
-                  : pm_body_contains(body, s->dimension, x);
-    if (in) return b;
-  }
-  return -1;
+  return gm_shape_last_containing((const gm_shape *const *)sd->shape,
+                                  sd->s->n_bodies, x);
 }
 
-/* Bounding box of a body's shape; false when it has none (region, domain). */
-static bool body_bounds(const seeder *sd, int b, double lo[3], double hi[3]) {
-  const pm_scene_body *body = &sd->s->bodies[b];
-  switch (body->shape) {
-  case PM_BODY_BOX:
-    for (int c = 0; c < 3; c++) lo[c] = body->a[c], hi[c] = body->b[c];
-    return true;
-  case PM_BODY_SPHERE:
-    for (int c = 0; c < 3; c++)
-      lo[c] = body->a[c] - body->radius, hi[c] = body->a[c] + body->radius;
-    return true;
-  case PM_BODY_CYLINDER: {
-    /* End discs of radius r about the axis. */
-    double len = pm_v_norm(body->b);
-    for (int c = 0; c < 3; c++) {
-      double e = body->radius * sqrt(fmax(0, 1 - pow(body->b[c] / len, 2)));
-      double a = body->a[c], t = body->a[c] + body->b[c];
-      lo[c] = fmin(a, t) - e;
-      hi[c] = fmax(a, t) + e;
-    }
-    return true;
-  }
-  case PM_BODY_MESH: gm_volume_bounds(sd->vol[b], lo, hi); return true;
-  default: return false;
-  }
-}
-
-static pm_err check_inside(const seeder *sd) {
+/* Every body's shape, each inside the grid (domain.box): a particle
+ * outside it would have no nodes.  Failures name the body's position. */
+static pm_err make_shapes(seeder *sd) {
   const pm_scene *s = sd->s;
-  static const char *const key[] = {"",       "region",   "box",
-                                    "sphere", "cylinder", "mesh"};
+  PM_CALL(PM_ALLOC(sd->shape, s->n_bodies, "body shapes"));
   for (int b = 0; b < s->n_bodies; b++) {
-    double lo[3], hi[3];
-    if (!body_bounds(sd, b, lo, hi)) continue;
-    for (int c = 0; c < s->dimension; c++) {
-      double tol = 1e-9 * (s->box_max[c] - s->box_min[c]);
-      if (lo[c] < s->box_min[c] - tol || hi[c] > s->box_max[c] + tol)
-        return PM_ERROR(
-            PM_ERR_SCENE,
-            "%s:%d:%d: bodies.%d.%s: expected a shape inside the grid "
-            "(domain.box, %c in [%g, %g]), got one reaching %c = %g: its "
-            "particles would be outside the grid",
-            s->path, s->bodies[b].mark.line, s->bodies[b].mark.col, b,
-            key[s->bodies[b].shape], "xyz"[c], s -> box_min[c], s -> box_max[c],
-            "xyz"[c], lo[c] < s -> box_min[c] - tol ? lo[c] : hi[c]);
+    const pm_scene_body *body = &s->bodies[b];
+    char msg[1024];
+    if (gm_shape_create(body, s->dimension, s->box_min, s->box_max,
+                        0.5 * s->mesh_size, &sd->shape[b]) != PM_SUCCESS) {
+      snprintf(msg, sizeof msg, "%s", pm_error_message());
+      return PM_ERROR(PM_ERR_SCENE, "%s:%d:%d: bodies.%d: %s", s->path,
+                      body->mark.line, body->mark.col, b, msg);
+    }
+    if (gm_shape_check_inside(sd->shape[b], b, s->box_min, s->box_max) !=
+        PM_SUCCESS) {
+      snprintf(msg, sizeof msg, "%s", pm_error_message());
+      return PM_ERROR(PM_ERR_SCENE,
+                      "%s:%d:%d: %s: its particles would be outside the grid",
+                      s->path, body->mark.line, body->mark.col, msg);
     }
   }
   return PM_SUCCESS;
@@ -154,8 +122,7 @@ static void place_seed(void *ctx, const double x[3], int body) {
   m->vol0[p] = vol;
   st->vol[p] = vol;
   m->mass[p] = b->density * vol;
-  g->kind->seed(g, &st->group[gi], p - g->begin, b->density, b->pressure,
-                st->sigma + 9 * p);
+  g->kind->seed(g, &st->group[gi], p - g->begin, b, st->sigma + 9 * p);
 }
 
 /* One group per material that has particles, in material order, each set
@@ -188,25 +155,13 @@ static pm_err make_groups(seed_ctx *c, long *total) {
 
 pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   pm_err ret = PM_SUCCESS;
-  seeder sd = {.s = s, .vol = NULL};
+  seeder sd = {.s = s, .shape = NULL};
   seed_ctx c;
   memset(&c, 0, sizeof c);
   c.s = s;
   c.m = m;
   *state = NULL;
-  PM_TRY(PM_ALLOC(sd.vol, s->n_bodies, "body volumes"));
-  for (int b = 0; b < s->n_bodies; b++)
-    if (s->bodies[b].shape == PM_BODY_MESH) {
-      ret = gm_volume_load(s->bodies[b].mesh, s->dimension, 0.5 * s->mesh_size,
-                           &sd.vol[b]);
-      if (ret) {
-        char msg[1024];
-        snprintf(msg, sizeof msg, "%s", pm_error_message());
-        PM_FAIL(PM_ERR_SCENE, "%s:%d:%d: bodies.%d.mesh: %s", s->path,
-                s->bodies[b].mark.line, s->bodies[b].mark.col, b, msg);
-      }
-    }
-  PM_TRY(check_inside(&sd));
+  PM_TRY(make_shapes(&sd));
   PM_ENSURE(s->n_materials <= MPM_MAX_GROUPS, PM_ERR_SCENE,
             "%s: at most %d materials are supported by method mpm, got %d",
             s->path, MPM_MAX_GROUPS, s->n_materials);
@@ -229,8 +184,8 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   c.st = NULL;
 done:
   mpm_state_destroy(c.st);
-  if (sd.vol)
-    for (int b = 0; b < s->n_bodies; b++) gm_volume_destroy(sd.vol[b]);
-  free(sd.vol);
+  if (sd.shape)
+    for (int b = 0; b < s->n_bodies; b++) gm_shape_destroy(sd.shape[b]);
+  free(sd.shape);
   return ret;
 }

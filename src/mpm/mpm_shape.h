@@ -6,19 +6,19 @@
 
 #include <math.h>
 
-#include "pm_scene.h"
+#include "mpm_scene.h"
 
 /* Nodes per axis in a particle's stencil. */
-static inline int mpm_shape_width(pm_shape s) {
-  return s == PM_SHAPE_QUADRATIC ? 3 : 2;
+static inline int mpm_shape_width(mpm_basis s) {
+  return s == MPM_BASIS_QUADRATIC ? 3 : 2;
 }
 
 /* One axis: xi = (x - origin) / h in cell units.  Writes the first node
  * index *i0 and the weights w[k] and derivatives dw[k] (per unit length,
  * inv_h = 1 / h) of nodes i0 + k, k < width. */
-static inline void mpm_shape_1d(pm_shape s, double xi, double inv_h, long *i0,
+static inline void mpm_shape_1d(mpm_basis s, double xi, double inv_h, long *i0,
                                 double w[3], double dw[3]) {
-  if (s == PM_SHAPE_QUADRATIC) {
+  if (s == MPM_BASIS_QUADRATIC) {
     /* Quadratic B-spline, support 3 h, centred on the node. */
     double b = floor(xi - 0.5);
     double d = xi - b; /* in [0.5, 1.5) */

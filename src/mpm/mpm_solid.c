@@ -11,10 +11,12 @@
 #include "pm_material.h"
 #include "pm_omp.h"
 
-enum { SOLID_F = 0, SOLID_Q = 1 }; /* state array slots */
+enum { SOLID_F = 0 }; /* state array slots: F, then q and the model's */
 
 typedef struct {
   pm_material mat;
+  int q;      /* slot of the artificial viscosity pressure, or -1 */
+  int mstate; /* slot of the model's per-particle state, or -1 */
 } solid_params;
 
 static pm_err solid_setup(mpm_group *g, const pm_scene_material *sm,
@@ -23,25 +25,50 @@ static pm_err solid_setup(mpm_group *g, const pm_scene_material *sm,
   solid_params *sp = NULL;
   PM_CALL(PM_ALLOC(sp, 1, "solid constants"));
   sp->mat = sm->mat;
+  sp->q = sp->mstate = -1;
   g->params = sp;
   g->viscosity = 0;
   mpm_group_add_array(g, "F", 9);
-  if (g->c0 > 0 || g->c1 > 0) mpm_group_add_array(g, "q", 1);
+  if (g->c0 > 0 || g->c1 > 0) {
+    sp->q = g->n_arrays;
+    mpm_group_add_array(g, "q", 1);
+  }
+  /* What the model keeps per point (fibre directions): constant, but it
+   * travels with the particle. */
+  if (sp->mat.state_size > 0) {
+    sp->mstate = g->n_arrays;
+    mpm_group_add_array(g, "material_state", sp->mat.state_size);
+  }
   return PM_SUCCESS;
 }
 
 static void solid_seed(const mpm_group *g, mpm_group_state *gs, long k,
-                       double rho0, double p0, double sigma[9]) {
-  (void)g, (void)rho0, (void)p0, (void)sigma;
+                       const pm_scene_body *b, double sigma[9]) {
+  (void)sigma;
+  const solid_params *sp = g->params;
   pm_t_identity(gs->array[SOLID_F].data + 9 * k);
+  if (sp->mstate >= 0)
+    sp->mat.model->state_init(&sp->mat, &b->point,
+                              gs->array[sp->mstate].data +
+                                  (size_t)sp->mat.state_size * k);
+}
+
+/* The model's state of the group's particles, and its stride (0: none). */
+static const double *model_state(const mpm_group *g, const mpm_state *s,
+                                 long *stride) {
+  const solid_params *sp = g->params;
+  *stride = sp->mat.state_size;
+  return sp->mstate >= 0 ? s->group[g->index].array[sp->mstate].data : NULL;
 }
 
 static void solid_describe(const mpm_group *g, char *buf, size_t size) {
   const solid_params *sp = g->params;
-  snprintf(buf, size, "%s%s",
-           sp->mat.model->rate ? "linear elastic, Jaumann rate form"
-                               : "neo-Hookean from F",
-           g->n_arrays > SOLID_Q ? ", artificial viscosity (eq. 32)" : "");
+  if (sp->mat.model->rate)
+    snprintf(buf, size, "%s, Jaumann rate form%s", sp->mat.model->name,
+             sp->q >= 0 ? ", artificial viscosity (eq. 32)" : "");
+  else
+    snprintf(buf, size, "%s from F%s", sp->mat.model->name,
+             sp->q >= 0 ? ", artificial viscosity (eq. 32)" : "");
 }
 
 /* Dilatational wave speed at density rho. */
@@ -55,7 +82,10 @@ static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
   mpm_work *w = ctx->work;
   const mpm_group *gr = &m->group[self->group];
   const mpm_grid *g = &m->grid;
-  const pm_material *mat = &((const solid_params *)gr->params)->mat;
+  const solid_params *sp = gr->params;
+  const pm_material *mat = &sp->mat;
+  long mss;
+  const double *ms = model_state(gr, s, &mss);
   const double dt = s->dt, h = g->h, c0 = gr->c0, c1 = gr->c1;
   const bool rate = mat->model->rate != NULL;
   const double jmin = m->opt.min_jacobian;
@@ -64,12 +94,12 @@ static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
                *vol0 = m->vol0;
   double *Fa = s->group[self->group].array[SOLID_F].data, *vol = s->vol,
          *sigma = s->sigma;
-  double *qa =
-      gr->n_arrays > SOLID_Q ? s->group[self->group].array[SOLID_Q].data : NULL;
-  double maxdiv = 0;
+  double *qa = sp->q >= 0 ? s->group[self->group].array[sp->q].data : NULL;
+  double maxdiv = 0, Jlow = INFINITY;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(g, mat, w, dt, h, c0, c1, rate, jmin, begin, end, vel, x,
-                mass, vol0, Fa, vol, sigma, qa) reduction(max : maxdiv))
+         shared(g, mat, ms, mss, w, dt, h, c0, c1, rate, jmin, begin, end, vel,
+                x, mass, vol0, Fa, vol, sigma, qa)
+         reduction(max : maxdiv) reduction(min : Jlow))
   for (long p = begin; p < end; p++) {
     long k = p - begin;
     double L[9], D[9], W[9], A[9], Fn[9];
@@ -90,6 +120,7 @@ static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
       continue;
     }
     vol[p] = vol0[p] * J;
+    Jlow = fmin(Jlow, J);
     mpm_sym_skew(L, D, W);
     double trD = D[0] + D[4] + D[8];
     maxdiv = fmax(maxdiv, fabs(trD));
@@ -98,7 +129,8 @@ static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
       if (qa) sig[0] += qa[k], sig[4] += qa[k], sig[8] += qa[k];
     } else {
       double P[9];
-      if (!pm_material_stress(mat, F, NULL, P, NULL, NULL)) {
+      if (!pm_material_stress(mat, F, ms ? ms + mss * k : NULL, P, NULL,
+                              NULL)) {
         mpm_fail(w, p, "stress is not finite (J = %g, |F| = %g)", J,
                  pm_t_norm(F));
         continue;
@@ -121,6 +153,7 @@ static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
     }
   }
   if (maxdiv > w->max_div) w->max_div = maxdiv;
+  if (Jlow < w->min_jacobian) w->min_jacobian = Jlow;
   return mpm_stage_status(ctx, self);
 }
 
@@ -146,12 +179,17 @@ static void solid_energies(const mpm_model *m, const mpm_state *s,
   (void)internal;
   const pm_material *mat = &((const solid_params *)g->params)->mat;
   const long begin = g->begin, end = g->end;
+  long mss;
+  const double *ms = model_state(g, s, &mss);
   const double *F = s->group[g->index].array[SOLID_F].data, *vol0 = m->vol0;
   double se = *strain;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(mat, begin, end, F, vol0) reduction(+ : se))
-  for (long p = begin; p < end; p++)
-    se += vol0[p] * pm_material_energy(mat, F + 9 * (p - begin), NULL);
+         shared(mat, ms, mss, begin, end, F, vol0) reduction(+ : se))
+  for (long p = begin; p < end; p++) {
+    const long k = p - begin;
+    se +=
+        vol0[p] * pm_material_energy(mat, F + 9 * k, ms ? ms + mss * k : NULL);
+  }
   *strain = se;
 }
 
@@ -161,12 +199,15 @@ static void solid_fields(const mpm_model *m, const mpm_state *s,
   (void)m;
   const pm_material *mat = &((const solid_params *)g->params)->mat;
   const long begin = g->begin, end = g->end;
+  long mss;
+  const double *ms = model_state(g, s, &mss);
   const double *F = s->group[g->index].array[SOLID_F].data, *sigma = s->sigma;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(mat, begin, end, F, sigma, sed, pressure, energy))
+         shared(mat, ms, mss, begin, end, F, sigma, sed, pressure, energy))
   for (long p = begin; p < end; p++) {
     const double *sg = sigma + 9 * p;
-    sed[p] = pm_material_energy(mat, F + 9 * (p - begin), NULL);
+    const long k = p - begin;
+    sed[p] = pm_material_energy(mat, F + 9 * k, ms ? ms + mss * k : NULL);
     pressure[p] = -(sg[0] + sg[4] + sg[8]) / 3.0;
     energy[p] = 0;
   }

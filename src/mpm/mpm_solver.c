@@ -35,8 +35,10 @@ pm_err mpm_solve(const mpm_model *m, mpm_state *s, mpm_work *w,
                      s->step > MPM_CONVERGE_AFTER &&
                      w->residual < m->opt.qs_tolerance,
     };
-    bool frame = (opt->frame_every > 0 && s->step % opt->frame_every == 0) ||
-                 info.converged;
+    bool last = info.converged || s->t >= opt->t_end * (1 - 1e-12) ||
+                (opt->max_steps > 0 && s->step >= opt->max_steps);
+    bool frame =
+        (opt->frame_every > 0 && s->step % opt->frame_every == 0) || last;
     if (observer) {
       ret = observer(ctx, m, s, w, &info, frame);
       if (ret) {

@@ -25,7 +25,8 @@ typedef struct {
 } mpm_step_info;
 
 /* Called after every step; frame is true every frame_every steps and on
- * the converged step.  A non-success return stops the run with it. */
+ * the last step (converged, at t_end or at max_steps).  A non-success
+ * return stops the run with it. */
 typedef pm_err (*mpm_observer)(void *ctx, const mpm_model *m,
                                const mpm_state *s, const mpm_work *w,
                                const mpm_step_info *info, bool frame);

@@ -49,10 +49,11 @@ typedef struct mpm_work {
   double *cp; /* per particle: dilatational wave speed */
   double *cs; /* per particle: shear wave speed (absorbing faces only) */
   /* figures of the last step */
-  double max_div;   /* largest |tr D| of the stress update, 1/s */
-  double residual;  /* quasi-static residual */
-  int iter_max;     /* most iterations a particle took */
-  long iter_capped; /* particles whose iteration hit the cap */
+  double max_div;      /* largest |tr D| of the stress update, 1/s */
+  double min_jacobian; /* smallest volume ratio J of the stress update */
+  double residual;     /* quasi-static residual */
+  int iter_max;        /* most iterations a particle took */
+  long iter_capped;    /* particles whose iteration hit the cap */
   mpm_failure fail;
   pm_timers timers;
   int timer[MPM_MAX_STAGES]; /* each stage's timer */

@@ -16,13 +16,15 @@
 
 #include "pm_testing.h"
 
-#include "mpm_driver.h"
+#include "mpm_backend.h"
 #include "mpm_kind.h"
 #include "mpm_model.h"
 #include "mpm_shape.h"
 #include "mpm_solver.h"
 #include "mpm_state.h"
 #include "mpm_transfer.h"
+#include "pm_app.h"
+#include "pm_run.h"
 #include "pm_scene.h"
 
 #define PI 3.14159265358979323846
@@ -102,7 +104,7 @@ static void test_shape_1d(void **state) {
   (void)state;
   const double h = 0.37, inv_h = 1 / h;
   for (int s = 0; s < 2; s++) {
-    const pm_shape shape = s ? PM_SHAPE_QUADRATIC : PM_SHAPE_LINEAR;
+    const mpm_basis shape = s ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;
     const int width = mpm_shape_width(shape);
     assert_int_equal(width, s ? 3 : 2);
     for (int trial = 0; trial < 20000; trial++) {
@@ -134,7 +136,7 @@ static void test_shape_1d(void **state) {
 
 /* Weight and derivative (per cell) of node i at xi, 0 outside its
  * support: the global basis function, whichever stencil holds it. */
-static void node_weight(pm_shape s, long i, double xi, double *N, double *dN) {
+static void node_weight(mpm_basis s, long i, double xi, double *N, double *dN) {
   long i0;
   double w[3], dw[3];
   mpm_shape_1d(s, xi, 1.0, &i0, w, dw);
@@ -145,9 +147,9 @@ static void node_weight(pm_shape s, long i, double xi, double *N, double *dN) {
 
 /* Largest jumps of the basis functions and their derivatives across the
  * knots (half-integers for the quadratic, integers for the linear). */
-static void knot_jumps(pm_shape s, double delta, double *jump_w,
+static void knot_jumps(mpm_basis s, double delta, double *jump_w,
                        double *jump_dw) {
-  double knot_shift = s == PM_SHAPE_QUADRATIC ? 0.5 : 0.0;
+  double knot_shift = s == MPM_BASIS_QUADRATIC ? 0.5 : 0.0;
   *jump_w = *jump_dw = 0;
   for (long n = 2; n < 12; n++) {
     double knot = n + knot_shift;
@@ -173,12 +175,12 @@ static void test_shape_continuity(void **state) {
   /* Quadratic: C1.  Across 2 delta the weight changes by at most
    * 2 delta max|N'| = 2 delta and the derivative by 2 delta max|N''| =
    * 4 delta; the bounds leave room for rounding. */
-  knot_jumps(PM_SHAPE_QUADRATIC, delta, &jw, &jdw);
+  knot_jumps(MPM_BASIS_QUADRATIC, delta, &jw, &jdw);
   assert_true(jw <= 3 * delta);
   assert_true(jdw <= 5 * delta);
   /* Linear: C0 only: the same check sees the kink (slopes -1 | +1, or
    * +1 | -1 at the node: a jump of 2 per cell). */
-  knot_jumps(PM_SHAPE_LINEAR, delta, &jw, &jdw);
+  knot_jumps(MPM_BASIS_LINEAR, delta, &jw, &jdw);
   assert_true(jw <= 3 * delta);
   assert_near(jdw, 2.0, 1e-6);
 }
@@ -446,15 +448,12 @@ static bool has_stage(const model *m, const char *name) {
 
 /* The plan's text, for searching. */
 static char *plan_text(const pm_scene *s) {
-  mpm_run *r = NULL;
-  assert_ok(mpm_run_create(s, &r));
   char *text = NULL;
   size_t len = 0;
   FILE *f = open_memstream(&text, &len);
   assert_non_null(f);
-  assert_ok(mpm_run_plan(r, f));
+  assert_ok(pm_plan_scene(s, f));
   assert_int_equal(fclose(f), 0);
-  mpm_run_destroy(r);
   return text;
 }
 
@@ -680,7 +679,7 @@ static const struct {
               "bodies:\n"
               "  - {material: gas, pressure: 1.0}\n"
               "time: {end: 1}\n",
-     "{name: gas", ": materials.0: ", "missing required key eos", false},
+     "{name: gas", ": materials.0.eos: ", "missing required key", false},
     {"negative-mesh.yaml",
      BAD_HEAD "discretization: {mesh_size: -0.1}\n" BAD_GEL "time: {end: 1}\n",
      "-0.1", ": discretization.mesh_size: ", "expected a number > 0, got -0.1",
@@ -937,11 +936,10 @@ static void test_stage_energy(void **state) {
   const char *sets[] = {COLUMN[0], COLUMN[1], COLUMN[2], COLUMN[3],
                         "time.max_steps=5"};
   assert_ok(pm_scene_load(MINIMAL, 5, sets, &s));
-  mpm_run *r = NULL;
-  assert_ok(mpm_run_create(s, &r));
+  pm_outcome o;
   char out[600], path[700];
   snprintf(out, sizeof out, "%s/run", (const char *)*state);
-  pm_err e = mpm_run_go(r, out, true);
+  pm_err e = pm_run_scene(s, out, true, &o);
   assert_true(e == PM_SUCCESS || e == PM_ERR_NOT_CONVERGED);
   snprintf(path, sizeof path, "%s/summary.json", out);
   FILE *f = fopen(path, "r");
@@ -955,7 +953,6 @@ static void test_stage_energy(void **state) {
   assert_contains(text, "\"grid update\": {");
   assert_contains(text, "\"damping\": {");
   assert_contains(text, "\"dissipated\":");
-  mpm_run_destroy(r);
   pm_scene_destroy(s);
 }
 
@@ -991,10 +988,12 @@ static void test_solver_observer(void **state) {
   watch o = {0};
   mpm_step_info last;
   assert_ok(mpm_solve(m.model, m.state, m.work, &opt, observe, &o, &last));
+  /* Frames every 3 steps and at the last step. */
   assert_int_equal(o.calls, 7);
-  assert_int_equal(o.frames, 2);
+  assert_int_equal(o.frames, 3);
   assert_int_equal(o.frame_step[0], 3);
   assert_int_equal(o.frame_step[1], 6);
+  assert_int_equal(o.frame_step[2], 7);
   assert_int_equal(last.step, 7);
   assert_int_equal(m.state->step, 7);
   assert_false(last.converged);
@@ -1014,6 +1013,8 @@ static void test_solver_observer(void **state) {
   o = (watch){0};
   assert_ok(mpm_solve(m.model, m.state, m.work, &opt, observe, &o, &last));
   assert_int_equal(o.calls, 4);
+  assert_int_equal(o.frames, 1); /* the last step, at t_end */
+  assert_int_equal(o.frame_step[0], 4);
   assert_near(m.state->t, 1.0, 4 * EPS);
   assert_near(m.state->dt, 0.1, 1e-12);
   drop_model(&m);
@@ -1158,5 +1159,6 @@ int main(void) {
       cmocka_unit_test_setup_teardown(test_seed_sphere, pm_test_make_dir,
                                       pm_test_drop_dir),
   };
+  if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -10,6 +10,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "fpm_scene.h"
+#include "pm_app.h"
 #include "pm_scene.h"
 
 /* |a - b| <= tol with both values in the message (NaN fails). */
@@ -60,7 +62,8 @@ static void test_f2_values(void **state) {
   assert_non_null(strstr(s->text, "name: f2-unconstrained-compression\n"));
   assert_non_null(strstr(s->text, "# F2: unconstrained"));
   assert_string_equal(s->name, "f2-unconstrained-compression");
-  assert_int_equal(s->method, PM_METHOD_FPM);
+  assert_string_equal(s->method, "fpm");
+  assert_string_equal(s->backend->method, "fpm");
   assert_int_equal(s->dimension, 3);
   for (int c = 0; c < 3; c++) {
     assert_near(s->box_min[c], 0.0, 0.0);
@@ -106,7 +109,7 @@ static void test_f2_values(void **state) {
   assert_near(eval(s->bcs[4].traction[0], 0, 0, 0, 0.5), 50, 1e-12);
   assert_int_equal(s->bcs[4].ramp, PM_RAMP_NONE);
 
-  assert_near(s->fpm.penalty, 20, 0);
+  assert_near(fpm_scene_options(s)->penalty, 20, 0);
   assert_near(s->time.end, 2.0, 0);
   assert_near(s->time.dt, 0, 0);
   assert_near(s->time.dt_safety, 0.9, 0);
@@ -130,7 +133,7 @@ static void test_f2_values(void **state) {
 static void test_defaults(void **state) {
   (void)state;
   pm_scene *s = load_ok(MINIMAL, 0, NULL);
-  assert_int_equal(s->method, PM_METHOD_MPM);
+  assert_string_equal(s->method, "mpm");
   assert_int_equal(s->dimension, 2);
   assert_near(s->box_max[0], 1.0, 0);
   assert_near(s->box_max[1], 0.5, 0);
@@ -139,7 +142,7 @@ static void test_defaults(void **state) {
   assert_int_equal(s->bodies[0].material, 0);
   assert_null(s->bodies[0].region);
   assert_int_equal(s->n_bcs, 0);
-  assert_near(s->fpm.penalty, 20, 0);
+  assert_near(fpm_scene_options(s)->penalty, 20, 0);
   assert_near(s->time.dt, 0, 0);
   assert_near(s->time.dt_safety, 0.5, 0); /* the default of method mpm */
   assert_near(s->time.ramp, 0.5, 0);
@@ -163,7 +166,7 @@ static void test_malformed(void **state) {
        "max_steps, "
        "quasi_static)"},
       {"bad-wrong-type.yaml", "bad-wrong-type.yaml:9:14: materials.0.density: ",
-       "expected a number, got heavy"},
+       "expected a number > 0, got heavy"},
       {"bad-mesh-size.yaml",
        "bad-mesh-size.yaml:6:14: discretization.mesh_size: ",
        "expected a number > 0, got -0.01"},
@@ -238,7 +241,7 @@ static void test_overrides(void **state) {
   s = load_ok(MINIMAL, 8, grow);
   assert_int_equal(s->time.qs, PM_QS_DAMPING);
   assert_near(s->time.qs_damping, 3, 0);
-  assert_near(s->fpm.penalty, 50, 0);
+  assert_near(fpm_scene_options(s)->penalty, 50, 0);
   assert_near(eval(s->bodies[0].region, 0.75, 0, 0, 0), 0.25, 1e-15);
   assert_int_equal(s->n_bcs, 1);
   assert_int_equal(s->bcs[0].face, PM_FACE_XMAX);
@@ -256,14 +259,12 @@ static void bad_override(const char *path, const char *set, const char *frag1,
 static void test_bad_overrides(void **state) {
   (void)state;
   bad_override(F2, "time.end_tim=3",
-               "--set time.end_tim=3: unknown key "
-               "time.end_tim (expected one of end,",
-               NULL);
+               "--set time.end_tim=3: unknown key (expected one of end,", NULL);
   bad_override(
       F2, "discretization.mesh_size=-1",
       "--set discretization.mesh_size=-1: ", "expected a number > 0, got -1");
   bad_override(F2, "time.dt=soon",
-               "--set time.dt=soon: ", "expected a number, got soon");
+               "--set time.dt=soon: ", "expected a number >= 0, got soon");
   bad_override(F2, "boundary.9.on=xmin", "--set boundary.9.on=xmin: ",
                "index 9 out of range (boundary has 5 entries)");
   bad_override(F2, "materials.first.name=a",
@@ -272,14 +273,114 @@ static void test_bad_overrides(void **state) {
   bad_override(F2, "mesh_size", "--set mesh_size: expected KEY=VALUE", NULL);
   bad_override(F2, "boundary.4.traction.x=2*w", "--set boundary.4.traction.x",
                "unknown variable w");
-  bad_override(F2, "method=sph", "--set method=sph: ",
-               "expected one of fpm, mpm, mpm-implicit, got sph");
+  bad_override(F2, "method=sph",
+               "--set method=sph: ", "expected one of fpm, mpm, got sph");
   bad_override(MINIMAL, "boundary.0.on=xmin",
                "--set boundary.0.on=xmin: ", "boundary is not in the scene");
   /* A file value that an override makes invalid is reported at the file. */
   bad_override(F2, "dimension=2",
                "f2-unconstrained-compression.yaml:5:21: domain.box.min: ",
                "expected 2 numbers (dimension 2), got 3");
+}
+
+/* A parameter the model does not take, or one it needs and lacks, fails at
+ * file:line:col naming the keys it expects; so do sections' keys and what
+ * a method cannot honour. */
+static void test_model_keys_and_methods(void **state) {
+  (void)state;
+  static const struct {
+    const char *set, *frag1, *frag2;
+  } cases[] = {
+      {"materials.0={name: gel, model: mooney-rivlin, density: 1000, c10: 300, "
+       "c01: 100, youngs_modulus: 3}",
+       "materials.0.youngs_modulus: unknown key (expected one of name, model, "
+       "density, artificial_viscosity, and model mooney-rivlin's c10, c01, "
+       "bulk_modulus)",
+       NULL},
+      {"materials.0={name: gel, model: mooney-rivlin, density: 1000, c10: "
+       "300, c01: 100}",
+       "materials.0.bulk_modulus: missing required key", NULL},
+      {"materials.0={name: gel, model: neo-hookean, density: 1000, "
+       "youngs_modulus: 3000}",
+       "--set materials.0={name: gel, model: neo-hookean, density: 1000, "
+       "youngs_modulus: 3000}: missing required key poisson_ratio",
+       "takes youngs_modulus and poisson_ratio, or shear_modulus and "
+       "bulk_modulus"},
+      {"materials.0={name: gel, model: ogden, density: 1000, mu: [1, 2], "
+       "alpha: [2], bulk_modulus: 10}",
+       "materials.0.alpha: ", "expected as many alpha as mu"},
+      {"materials.0={name: gel, model: rubbery, density: 1000}",
+       "materials.0.model: expected one of neo-hookean, neo-hookean-log, "
+       "mooney-rivlin, ogden, holzapfel-gasser-ogden, linear-elastic, fluid, "
+       "got rubbery",
+       NULL},
+      {"materials.0={name: gel, model: holzapfel-gasser-ogden, density: "
+       "1000, shear_modulus: 1000, k1: 1000, k2: 2, bulk_modulus: 1e5}",
+       "bodies.0: missing required key fibres", "needs 1 to 2 fibre"},
+      {"bodies.0.fibres=[[1, 0, 0]]", "--set bodies.0.fibres=[[1, 0, 0]]: ",
+       "expected no fibres (model neo-hookean of material gel takes none)"},
+      {"fpm.cells=voronoi",
+       "--set fpm.cells=voronoi: ", "expected one of median-dual, got voronoi"},
+      {"fpm.flux=symmetric", "--set fpm.flux=symmetric: ",
+       "expected one of iipg, sipg, got symmetric"},
+      {"gravity=[0, 0, -9.81]",
+       "--set gravity=[0, 0, -9.81]: ", "expected no gravity for method fpm"},
+      {"boundary.0.velocity.y=1",
+       "--set boundary.0.velocity.y=1: boundary.0.velocity",
+       "expected displacement or traction (method fpm), got velocity"},
+      {"boundary.0.on=top", "--set boundary.0.on=top: ",
+       "expected a face of domain.box (xmin, xmax, ymin, ymax, zmin, zmax), a "
+       "region, or the name of a physical surface of a gmsh body, got top"},
+      {"boundary.0.region=x",
+       "--set boundary.0.region=x: ", "expected on or region, got both"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+    load_fails(F2, 1, &cases[i].set, PM_ERR_SCENE, cases[i].frag1,
+               cases[i].frag2);
+}
+
+/* The new vocabulary reads: a model's keys (both forms of the elastic
+ * pair, lists), fibres normalized, a region condition, a body region of
+ * the word domain, the sections' defaults and presence queries. */
+static void test_vocabulary(void **state) {
+  (void)state;
+  const char *set[] = {
+      "materials.0={name: t, model: holzapfel-gasser-ogden, density: 1000, "
+      "shear_modulus: 1000, k1: 500, k2: 2, bulk_modulus: 1e5}",
+      "materials.1={name: gel, model: neo-hookean-log, density: 900, "
+      "shear_modulus: 1000, bulk_modulus: 2000}",
+      "materials.2={name: rubber, model: ogden, density: 1100, mu: [1500, "
+      "-20], alpha: [1.3, -2], bulk_modulus: 1e5}",
+      "bodies=[{material: t, region: domain, fibres: [[3, 4, 0], [0, 0, 2]]}, "
+      "{material: rubber, sphere: {center: [0.05, 0.05, 0.05], radius: "
+      "0.01}}]",
+      "boundary.1={region: \"0.001 - y\", displacement: {y: 0}}",
+  };
+  pm_scene *s = load_ok(F2, 5, set);
+  const pm_material *t = &s->materials[0].mat, *g = &s->materials[1].mat;
+  assert_string_equal(t->model->name, "holzapfel-gasser-ogden");
+  assert_near(t->shear_modulus, 1000, 0);
+  /* mu and K given: E = 9 K mu / (3 K + mu), nu = (3K - 2mu)/(2(3K + mu)) */
+  assert_near(g->youngs_modulus, 9 * 2000 * 1000 / 7000.0, 1e-10);
+  assert_near(g->poisson_ratio, 4000 / 14000.0, 1e-15);
+  assert_near(s->materials[2].mat.shear_modulus, (1500 * 1.3 + 20 * 2) / 2,
+              1e-10);
+  assert_int_equal(s->bodies[0].shape, PM_BODY_DOMAIN);
+  assert_int_equal(s->bodies[0].point.n_fibres, 2);
+  assert_near(s->bodies[0].point.fibres[0][0], 0.6, 1e-15);
+  assert_near(s->bodies[0].point.fibres[0][1], 0.8, 1e-15);
+  assert_near(s->bodies[0].point.fibres[1][2], 1, 0);
+  assert_int_equal(s->bodies[1].shape, PM_BODY_SPHERE);
+  assert_int_equal(s->bcs[1].on, PM_ON_REGION);
+  assert_near(eval(s->bcs[1].region, 0, 0, 0, 0), 0.001, 1e-18);
+  assert_int_equal(s->bcs[0].on, PM_ON_FACE);
+  assert_int_equal(s->bcs[0].face, PM_FACE_XMIN);
+  assert_true(pm_scene_has(s, "fpm.penalty"));
+  assert_false(pm_scene_has(s, "fpm.flux"));
+  const fpm_options *o = fpm_scene_options(s);
+  assert_int_equal(o->flux, FPM_FLUX_IIPG);
+  assert_string_equal(o->cells, "median-dual");
+  pm_scene_destroy(s);
 }
 
 static void test_ramp_and_names(void **state) {
@@ -295,9 +396,6 @@ static void test_ramp_and_names(void **state) {
   double h = 1e-6;
   assert_true(pm_ramp_factor(PM_RAMP_SMOOTH, 1, h) < 1e-15);
   assert_true(1 - pm_ramp_factor(PM_RAMP_SMOOTH, 1, 1 - h) < 1e-15);
-  assert_string_equal(pm_method_name(PM_METHOD_FPM), "fpm");
-  assert_string_equal(pm_method_name(PM_METHOD_MPM), "mpm");
-  assert_string_equal(pm_method_name(PM_METHOD_MPM_IMPLICIT), "mpm-implicit");
 }
 
 int main(void) {
@@ -308,7 +406,10 @@ int main(void) {
       cmocka_unit_test(test_missing_file),
       cmocka_unit_test(test_overrides),
       cmocka_unit_test(test_bad_overrides),
+      cmocka_unit_test(test_model_keys_and_methods),
+      cmocka_unit_test(test_vocabulary),
       cmocka_unit_test(test_ramp_and_names),
   };
+  if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -42,17 +42,17 @@ bad_scene() { # name, scene, sed expression, line pattern, message
 }
 
 bad_scene fluid-without-eos "$tube" '/eos:/d' '- name: gas' \
-  'materials.0: missing required key eos'
+  'materials.0.eos: missing required key'
 bad_scene negative-cell "$tube" 's/mesh_size: 5.0e-3/mesh_size: -0.01/' \
   'mesh_size:' 'discretization.mesh_size: expected a number > 0, got -0.01'
 bad_scene box-outside-grid "$tube" \
   's/max: \[1.0, 5.0e-3, 5.0e-3\]}, density: 0.125/max: [1.2, 5.0e-3, 5.0e-3]}, density: 0.125/' \
-  'density: 0.125' 'bodies.1.box: expected a shape inside the grid'
+  'density: 0.125' 'bodies.1.box: expected a shape inside domain.box'
 check "box-outside-grid: says 'outside the grid'" \
   grep -qF 'outside the grid' "$work/err"
 bad_scene sphere-outside-grid "$disks" \
   's/center: \[0.8, 0.8\]/center: [0.9, 0.8]/' 'center: \[0.9, 0.8\]' \
-  'bodies.1.sphere: expected a shape inside the grid'
+  'bodies.1.sphere: expected a shape inside domain.box'
 check "sphere-outside-grid: says 'outside the grid'" \
   grep -qF 'outside the grid' "$work/err"
 bad_scene fluid-without-pressure "$tube" 's/, pressure: 0.001//' \

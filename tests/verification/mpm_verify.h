@@ -5,14 +5,20 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include <stdlib.h>
 
+#include "mpm_backend.h"
 #include "mpm_state.h"
+#include "pm_app.h"
+#include "pm_run.h"
 #include "pm_scene.h"
 
-/* Load a scene with overrides, or fail the test with the message. */
+/* Load a scene with overrides, or fail the test with the message (the
+ * backends are registered first). */
 static inline pm_scene *load_scene(const char *file, int n_sets,
                                    const char *const *sets) {
   pm_scene *s = NULL;
+  if (pm_app_init() != PM_SUCCESS) fail_msg("%s", pm_error_message());
   if (pm_scene_load(file, n_sets, sets, &s) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
   return s;
@@ -33,6 +39,40 @@ static inline const double *group_array(const mpm_state *s, int gi,
   const mpm_array *a = mpm_group_state_find(&s->group[gi], name);
   if (!a) fail_msg("group %d has no array %s", gi, name);
   return a->data;
+}
+
+/* A simulation and the outcome of its run through the run driver. */
+typedef struct {
+  mpm_sim *sim;
+  pm_outcome out;
+} verify_run;
+
+/* The simulation of s, or fail the test. */
+static inline verify_run *verify_create(const pm_scene *s) {
+  verify_run *r = calloc(1, sizeof *r);
+  if (!r || mpm_sim_create(s, &r->sim) != PM_SUCCESS)
+    fail_msg("%s", pm_error_message());
+  return r;
+}
+
+/* Run it without output: it must end with status expected and a finite
+ * state. */
+static inline void verify_go(verify_run *r, pm_status expected) {
+  const char *name = r->sim->scene->name;
+  pm_err err = pm_run_sim(r->sim->scene, r->sim, NULL, true, &r->out);
+  if (err != PM_SUCCESS && r->out.fig.status != expected)
+    fail_msg("%s: %s", name, pm_error_message());
+  if (r->out.fig.status != expected)
+    fail_msg("%s: status %s, expected %s (%s)", name,
+             pm_status_name(r->out.fig.status), pm_status_name(expected),
+             r->out.message);
+  assert_true(state_finite(r->sim->model, r->sim->state));
+}
+
+static inline void verify_destroy(verify_run *r) {
+  if (!r) return;
+  mpm_sim_destroy(r->sim);
+  free(r);
 }
 
 #endif

@@ -72,7 +72,7 @@ for c in f3-extension-200 f4-compression-60; do
   rc=$?
   s=$out/summary.json
   check "$c: converged (exit $rc)" grep -q '"status": "converged"' "$s"
-  jmin=$(json "$s" run_min_jacobian)
+  jmin=$(json "$s" min_jacobian)
   ee=$(json "$s" energy_balance_error)
   echo "  $c: steps $(json "$s" steps), wall $(json "$s" wall_seconds) s," \
     "min J $jmin, energy error $ee, max von Mises $(json "$s" max_von_mises) Pa"

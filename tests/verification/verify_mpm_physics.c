@@ -14,7 +14,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "mpm_driver.h"
 #include "mpm_verify.h"
 #include "mpm_model.h"
 #include "pm_fluid.h"
@@ -26,29 +25,12 @@
 
 /* ---- helpers ------------------------------------------------------------ */
 
-static mpm_run *create_run(const pm_scene *s) {
-  mpm_run *r = NULL;
-  if (mpm_run_create(s, &r) != PM_SUCCESS) fail_msg("%s", pm_error_message());
-  return r;
-}
+static verify_run *create_run(const pm_scene *s) { return verify_create(s); }
 
-/* Run r through the driver, without output: it must end with status
- * `expected` and a finite state. */
-static void go_run(mpm_run *r, mpm_status expected) {
-  const char *name = r->scene->name;
-  pm_err err = mpm_run_go(r, NULL, true);
-  if (err != PM_SUCCESS && r->status != expected)
-    fail_msg("%s: %s", name, pm_error_message());
-  if (r->status != expected)
-    fail_msg("%s: status %s, expected %s (%s)", name,
-             mpm_status_name(r->status), mpm_status_name(expected), r->message);
-  assert_true(state_finite(r->model, r->state));
-}
-
-/* A whole run through the driver; the caller destroys it. */
-static mpm_run *run_driver(const pm_scene *s, mpm_status expected) {
-  mpm_run *r = create_run(s);
-  go_run(r, expected);
+/* A whole run through the run driver; the caller destroys it. */
+static verify_run *run_driver(const pm_scene *s, pm_status expected) {
+  verify_run *r = create_run(s);
+  verify_go(r, expected);
   return r;
 }
 
@@ -125,9 +107,9 @@ static void test_free_fall(void **state) {
 
   const double g = -s->gravity[2], dt = s->time.dt, T = s->time.end;
   const long N = lround(T / dt);
-  mpm_run *r = create_run(s);
-  const mpm_model *md = r->model;
-  const mpm_state *st = r->state;
+  verify_run *r = create_run(s);
+  const mpm_model *md = r->sim->model;
+  const mpm_state *st = r->sim->state;
   const double L = 0.04, rho = s->materials[0].mat.density;
   double z0 = 0, M = 0;
   for (long p = 0; p < md->n; p++) {
@@ -135,7 +117,7 @@ static void test_free_fall(void **state) {
     z0 += md->mass[p] * st->x[3 * p + 2];
   }
   z0 /= M;
-  go_run(r, MPM_STATUS_COMPLETED);
+  verify_go(r, PM_STATUS_COMPLETED);
   assert_int_equal(st->step, N);
 
   double z = 0, vz = 0, lateral = 0, smax = 0;
@@ -153,7 +135,8 @@ static void test_free_fall(void **state) {
   const double ke = 0.5 * M * g * g * T * T;
 
   table_head("1. Free fall: 40 mm cube, 512 particles, g = 9.81 m/s^2");
-  printf("  %ld steps of dt = %g s to T = %g s, %.2f s\n", N, dt, T, r->wall);
+  printf("  %ld steps of dt = %g s to T = %g s, %.2f s\n", N, dt, T,
+         r->out.fig.wall_seconds);
   bool ok = true;
   /* Round-off: N position increments of 1e-16 relative each on z ~ 0.16 m,
    * against a drop of 0.047 m: a few 1e-13. */
@@ -167,8 +150,9 @@ static void test_free_fall(void **state) {
   ok &= row("largest lateral displacement, m", lateral, 0, 1, 1e-12);
   ok &= row("largest |sigma_ij| / (rho g L)", smax / (rho * g * L), 0, 1, 1e-9);
   /* All the work of gravity is kinetic energy (see above). */
-  ok &= row("energy balance error (mpm_run)", r->energy_error, 0, 1, 1e-9);
-  info("  kinetic energy, J (M (g T)^2 / 2)", r->kinetic, ke);
+  ok &= row("energy balance error (mpm_run)", r->out.fig.energy_error, 0, 1,
+            1e-9);
+  info("  kinetic energy, J (M (g T)^2 / 2)", r->out.fig.kinetic, ke);
   info("  work of gravity as counted, J (kinetic energy)", st->external_work,
        ke);
   /* What the count is when it takes each step's starting momentum: the
@@ -176,7 +160,7 @@ static void test_free_fall(void **state) {
   info("  the same with start-of-step momenta, J", st->external_work,
        0.5 * M * g * g * dt * dt * N * (N - 1));
   fflush(stdout);
-  mpm_run_destroy(r);
+  verify_destroy(r);
   pm_scene_destroy(s);
   assert_true(ok);
 }
@@ -190,16 +174,16 @@ static void test_free_fall(void **state) {
 static void test_gravity_column(void **state) {
   (void)state;
   pm_scene *s = load_scene(CASES "gravity-column.yaml", 0, NULL);
-  mpm_run *r = run_driver(s, MPM_STATUS_CONVERGED);
-  const mpm_model *md = r->model;
-  const mpm_state *st = r->state;
+  verify_run *r = run_driver(s, PM_STATUS_CONVERGED);
+  const mpm_model *md = r->sim->model;
+  const mpm_state *st = r->sim->state;
   const pm_material *mat = &s->materials[md->group[0].material].mat;
   const double g = -s->gravity[1], rho = mat->density;
   const double nu = mat->poisson_ratio, h = md->grid.h;
   const double H = s->box_max[1] - s->box_min[1];
   const double scale = rho * g * H;
   /* Rows of particles (by reference height) in the middle half. */
-  const int rows = (int)lround(H / h) * s->mpm.ppc[1];
+  const int rows = (int)lround(H / h) * md->opt.ppc[1];
   double *row_sum = calloc(rows, sizeof *row_sum);
   double *row_exact = calloc(rows, sizeof *row_exact);
   long *row_n = calloc(rows, sizeof *row_n);
@@ -232,14 +216,15 @@ static void test_gravity_column(void **state) {
   free(row_exact);
   free(row_n);
   double R_floor[3], R_left[3], R_right[3];
-  mpm_reaction(r, 0, R_floor);
-  mpm_reaction(r, 1, R_left);
-  mpm_reaction(r, 2, R_right);
+  memcpy(R_floor, r->out.fig.reaction[0], sizeof R_floor);
+  memcpy(R_left, r->out.fig.reaction[1], sizeof R_left);
+  memcpy(R_right, r->out.fig.reaction[2], sizeof R_right);
 
   table_head("2. Column on a floor: H = 1 m, 40 x 4 cells, dynamic relaxation");
   printf("  %ld particles, converged after %ld steps (t = %.4g s), "
          "residual %.2e, %.2f s\n",
-         md->n, st->step, st->t, r->work->residual, r->wall);
+         md->n, st->step, st->t, r->sim->work->residual,
+         r->out.fig.wall_seconds);
   bool ok = true;
   /* In equilibrium the floor takes all the weight but what the residual
    * (1e-6 of the reactions) leaves: measured 3.6e-6 of it.  Bound 1e-4. */
@@ -265,13 +250,14 @@ static void test_gravity_column(void **state) {
   /* Strain energy + damping losses = potential energy released (the
    * floor and rollers do no work): -5e-4 with the reactions counted once
    * per constrained dof.  Bound 1%. */
-  ok &= row("energy balance error (mpm_run)", r->energy_error, 0, 1, 0.01);
+  ok &= row("energy balance error (mpm_run)", r->out.fig.energy_error, 0, 1,
+            0.01);
   info("  external work as counted, J (potential energy)", st->external_work,
        pe);
   info("  strain energy + dissipated, J (potential energy)",
-       r->strain + st->dissipated, pe);
+       r->out.fig.strain + st->dissipated, pe);
   fflush(stdout);
-  mpm_run_destroy(r);
+  verify_destroy(r);
   pm_scene_destroy(s);
   assert_true(ok);
 }
@@ -285,15 +271,15 @@ typedef struct {
 
 static void run_bar(int n_sets, const char *const *sets, bar_result *out) {
   pm_scene *s = load_scene(CASES "absorbing-bar.yaml", n_sets, sets);
-  mpm_run *r = run_driver(s, MPM_STATUS_COMPLETED);
-  out->e0 = r->energy0;
-  out->e_end = r->kinetic + r->strain;
-  out->dissipated = r->state->dissipated;
-  out->energy_error = r->energy_error;
-  out->wall = r->wall;
-  out->steps = r->state->step;
-  out->n = r->model->n;
-  mpm_run_destroy(r);
+  verify_run *r = run_driver(s, PM_STATUS_COMPLETED);
+  out->e0 = r->out.fig.energy0;
+  out->e_end = r->out.fig.kinetic + r->out.fig.strain;
+  out->dissipated = r->sim->state->dissipated;
+  out->energy_error = r->out.fig.energy_error;
+  out->wall = r->out.fig.wall_seconds;
+  out->steps = r->sim->state->step;
+  out->n = r->sim->model->n;
+  verify_destroy(r);
   pm_scene_destroy(s);
 }
 
@@ -377,7 +363,7 @@ static void test_water_pulse(void **state) {
     fail_msg("%s", pm_error_message());
   const mpm_group *g = &md->group[0];
   const double *pressure = group_array(st, 0, "pressure");
-  const pm_fluid *fl = &s->materials[g->material].fluid_props;
+  const pm_fluid *fl = &s->materials[g->material].mat.fluid;
   const double x0 = s->bodies[0].b[0], rho0 = s->bodies[1].density;
   const double pL = s->bodies[0].pressure, pR = s->bodies[1].pressure;
   const double a = pm_eos_sound_speed(fl, rho0, pR);
@@ -487,5 +473,6 @@ int main(void) {
       cmocka_unit_test(test_absorbing_bar),
       cmocka_unit_test(test_water_pulse),
   };
+  if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "mpm_driver.h"
 #include "mpm_verify.h"
 #include "mpm_model.h"
 #include "pm_progress.h"
@@ -43,17 +42,17 @@ static bool close_to(double a, double b, double rtol, double atol) {
  * state.  Returns its final kinetic and strain energies. */
 static void run_driver(const pm_scene *s, double *kinetic, double *strain,
                        double *wall) {
-  mpm_run *r = NULL;
-  if (mpm_run_create(s, &r) != PM_SUCCESS) fail_msg("%s", pm_error_message());
-  if (mpm_run_go(r, NULL, true) != PM_SUCCESS)
+  verify_run *r = NULL;
+  r = verify_create(s);
+  if (pm_run_sim(s, r->sim, NULL, true, &r->out) != PM_SUCCESS)
     fail_msg("%s: %s", s->name, pm_error_message());
-  assert_int_equal(r->status, MPM_STATUS_COMPLETED);
-  assert_true(state_finite(r->model, r->state));
-  assert_true(fabs(r->state->t - s->time.end) <= 1e-9 * s->time.end);
-  *kinetic = r->kinetic;
-  *strain = r->strain;
-  *wall = r->wall;
-  mpm_run_destroy(r);
+  assert_int_equal(r->out.fig.status, PM_STATUS_COMPLETED);
+  assert_true(state_finite(r->sim->model, r->sim->state));
+  assert_true(fabs(r->sim->state->t - s->time.end) <= 1e-9 * s->time.end);
+  *kinetic = r->out.fig.kinetic;
+  *strain = r->out.fig.strain;
+  *wall = r->out.fig.wall_seconds;
+  verify_destroy(r);
 }
 
 /* A model with its state and workspace. */
@@ -261,5 +260,6 @@ int main(void) {
       cmocka_unit_test(test_bar_first_mode),
       cmocka_unit_test(test_disks_collision),
   };
+  if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

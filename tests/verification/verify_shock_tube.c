@@ -18,9 +18,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mpm_driver.h"
 #include "pm_metrics.h"
 #include "pm_riemann.h"
+#include "mpm_verify.h"
 #include "pm_scene.h"
 
 #define REDUCED PM_SOURCE_DIR "/cases/mpm/m2-shock-tube-reduced.yaml"
@@ -47,7 +47,7 @@ typedef struct {
 static void run_tube(const char *update, double h, tube_result *out, FILE *csv,
                      FILE *exact_csv) {
   pm_scene *s = NULL;
-  mpm_run *r = NULL;
+  verify_run *r = NULL;
   const char *sets[MAX_SETS + 8];
   char buf[8][64];
   int n = 0;
@@ -64,14 +64,13 @@ static void run_tube(const char *update, double h, tube_result *out, FILE *csv,
       sets[n++] = buf[k + 1];
     }
   }
-  if (pm_scene_load(g_scene, n, sets, &s) != PM_SUCCESS)
+  s = load_scene(g_scene, n, sets);
+  r = verify_create(s);
+  if (pm_run_sim(s, r->sim, NULL, true, &r->out) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
-  if (mpm_run_create(s, &r) != PM_SUCCESS) fail_msg("%s", pm_error_message());
-  if (mpm_run_go(r, NULL, true) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
-  assert_int_equal(r->status, MPM_STATUS_COMPLETED);
-  const mpm_model *md = r->model;
-  const mpm_state *st = r->state;
+  assert_int_equal(r->out.fig.status, PM_STATUS_COMPLETED);
+  const mpm_model *md = r->sim->model;
+  const mpm_state *st = r->sim->state;
   assert_int_equal(md->n_groups, 1);
   const mpm_group *g = &md->group[0];
   const mpm_group_state *gs = &st->group[0];
@@ -95,7 +94,7 @@ static void run_tube(const char *update, double h, tube_result *out, FILE *csv,
   }
   /* The exact solution of the scene's two states (bodies 0 and 1). */
   pm_riemann ex;
-  double gamma = s->materials[g->material].fluid_props.gamma;
+  double gamma = s->materials[g->material].mat.fluid.gamma;
   pm_riemann_state left = {s->bodies[0].density, 0, s->bodies[0].pressure};
   pm_riemann_state right = {s->bodies[1].density, 0, s->bodies[1].pressure};
   assert_int_equal(pm_riemann_solve(gamma, left, right, &ex), PM_SUCCESS);
@@ -157,13 +156,13 @@ static void run_tube(const char *update, double h, tube_result *out, FILE *csv,
               pm_riemann_energy(gamma, e[0], e[2]));
     }
   }
-  out->wall = r->wall;
+  out->wall = r->out.fig.wall_seconds;
   out->particles = md->n;
   out->steps = st->step;
   out->iterations = st->iter_max_total;
   out->capped = st->iter_capped_total;
   free(acc);
-  mpm_run_destroy(r);
+  verify_destroy(r);
   pm_scene_destroy(s);
 }
 
@@ -265,5 +264,6 @@ int main(int argc, char **argv) {
   }
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_shock_tube),
                                      cmocka_unit_test(test_shock_tube_ladder)};
+  if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -19,7 +19,7 @@ typedef struct {
 } ladder_key;
 
 typedef struct {
-  pm_run_figures fig;
+  pm_outcome out;
   pm_err err;
   double error; /* NRMSE against the reference; NaN when none */
   double rate;  /* against the previous level; NaN when none */
@@ -126,17 +126,17 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
   int total = n_levels + (ref ? 1 : 0);
   for (int r = 0; r < total; r++) {
     const level *L = r < n_levels ? &lv[r] : ref;
-    const pm_run_figures *f = &L->fig;
+    const pm_figures *f = &L->out.fig;
     char e[32], q[32], w[32], sed[32], vm[32], re[32], mj[32], ee[32];
     fmt_num(e, sizeof e, L->error);
     fmt_num(q, sizeof q, L->rate);
-    snprintf(w, sizeof w, "%.3f", f->wall);
+    snprintf(w, sizeof w, "%.3f", f->wall_seconds);
     fmt_num(sed, sizeof sed, f->mean_sed);
     fmt_num(vm, sizeof vm, f->max_von_mises);
-    fmt_num(re, sizeof re, f->reaction);
+    fmt_num(re, sizeof re, L->out.loaded_reaction);
     fmt_num(mj, sizeof mj, f->min_jacobian);
     fmt_num(ee, sizeof ee, f->energy_error);
-    const char *status = r < n_levels ? f->status : "reference";
+    const char *status = r < n_levels ? pm_status_name(f->status) : "reference";
     if (r < n_levels) {
       fprintf(c, "%d", r + 1);
       fprintf(m, "| %d |", r + 1);
@@ -150,12 +150,11 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
       fprintf(m, " %s |", keys[k].value[idx]);
     }
     fprintf(c, ",%.6g,%ld,%ld,%s,%s,%s,%s,%.4g,%s,%s,%s,%s,%s\n", f->h,
-            f->points, f->steps, status, e, q, w, f->setup, sed, vm, re, mj,
-            ee);
+            f->points, f->steps, status, e, q, w, f->setup_seconds, sed, vm, re,
+            mj, ee);
     fprintf(
         m, " %.4g | %ld | %ld | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n",
-        f->h, f->points, f->steps, e, q, w, sed, vm, re, mj, ee,
-        r < n_levels ? f->status : "reference");
+        f->h, f->points, f->steps, e, q, w, sed, vm, re, mj, ee, status);
   }
   fprintf(m,
           "\nError: NRMSE (FPM paper eq. 28, root mean square) of the "
@@ -185,8 +184,7 @@ done:
   return ret;
 }
 
-pm_err pm_study_run(const pm_study_options *o, pm_study_runner run, void *ctx,
-                    FILE *out) {
+pm_err pm_study_run(const pm_study_options *o, FILE *out) {
   pm_err ret = PM_SUCCESS, first_fail = PM_SUCCESS;
   ladder_key *keys = NULL;
   level *lv = NULL, ref = {.err = PM_SUCCESS};
@@ -239,7 +237,7 @@ pm_err pm_study_run(const pm_study_options *o, pm_study_runner run, void *ctx,
     PM_TRY(pm_path_join(ref.dir, sizeof ref.dir, out_dir, "reference"));
     PM_TRY(load_level(o, keys, n_all - 1, &s));
     if (out) fprintf(out, "reference run -> %s\n", ref.dir);
-    ref.err = run(ctx, s, ref.dir, o->quiet, &ref.fig);
+    ref.err = pm_run_scene(s, ref.dir, o->quiet, &ref.out);
     ref.error = ref.rate = NAN;
     pm_scene_destroy(s);
     s = NULL;
@@ -271,7 +269,7 @@ pm_err pm_study_run(const pm_study_options *o, pm_study_runner run, void *ctx,
         fprintf(out, " %s=%s", keys[k].key, keys[k].value[l]);
       fprintf(out, " -> %s\n", L->dir);
     }
-    L->err = run(ctx, s, L->dir, o->quiet, &L->fig);
+    L->err = pm_run_scene(s, L->dir, o->quiet, &L->out);
     pm_scene_destroy(s);
     s = NULL;
     L->error = L->rate = NAN;
@@ -281,17 +279,19 @@ pm_err pm_study_run(const pm_study_options *o, pm_study_runner run, void *ctx,
       continue;
     }
     if (use_analytic)
-      L->error = L->fig.nrmse;
+      L->error = L->out.nrmse_vector;
     else
-      PM_TRY(error_against(L->dir, L->fig.dim, rn, rx, ru, work, &L->error));
+      PM_TRY(
+          error_against(L->dir, L->out.fig.dim, rn, rx, ru, work, &L->error));
   }
   /* Rates: in h for a resolution ladder, else in the first key's value. */
   bool by_h = false;
   for (int l = 1; l < n_levels; l++)
-    if (fabs(lv[l].fig.h - lv[0].fig.h) > 1e-9 * lv[0].fig.h) by_h = true;
+    if (fabs(lv[l].out.fig.h - lv[0].out.fig.h) > 1e-9 * lv[0].out.fig.h)
+      by_h = true;
   double xs[PM_STUDY_MAX_LEVELS], es[PM_STUDY_MAX_LEVELS];
   for (int l = 0; l < n_levels; l++) {
-    xs[l] = by_h ? lv[l].fig.h : strtod(keys[0].value[l], NULL);
+    xs[l] = by_h ? lv[l].out.fig.h : strtod(keys[0].value[l], NULL);
     es[l] = lv[l].error;
     if (l > 0 && xs[l] > 0 && xs[l - 1] > 0 && es[l] > 0 && es[l - 1] > 0 &&
         xs[l] != xs[l - 1])

@@ -8,31 +8,11 @@
 #include <stdio.h>
 
 #include "pm_error.h"
+#include "pm_run.h"
 #include "pm_scene.h"
 
 #define PM_STUDY_MAX_KEYS 8
 #define PM_STUDY_MAX_LEVELS 32
-
-/* What a backend reports about one finished run. */
-typedef struct {
-  const char *status; /* "converged", "completed", "unstable", ... */
-  int dim;
-  long points, steps;
-  double h;           /* mean point spacing (mean edge), m */
-  double wall, setup; /* run and setup wall time, s */
-  double nrmse;       /* against the scene's analytic field; NaN if none */
-  double mean_sed;    /* mean strain energy density, J/m^3 */
-  double max_von_mises;
-  double reaction;     /* loaded face, along its largest prescribed value */
-  double min_jacobian; /* smallest J seen during the run */
-  double energy_error; /* final energy-balance error */
-} pm_run_figures;
-
-/* Run scene s, writing to out_dir; fill fig even when the run fails
- * (fig->status says how).  Returns the run's error code. */
-typedef pm_err (*pm_study_runner)(void *ctx, const pm_scene *s,
-                                  const char *out_dir, bool quiet,
-                                  pm_run_figures *fig);
 
 typedef struct {
   const char *scene; /* scene file */
@@ -53,7 +33,6 @@ typedef struct {
  * out (may be NULL). Bad ladders and scenes fail with PM_ERR_SCENE before
  * anything runs.  A level that fails numerically is tabulated with its status;
  * the return is then that level's error (the tables are still written). */
-pm_err pm_study_run(const pm_study_options *o, pm_study_runner run, void *ctx,
-                    FILE *out);
+pm_err pm_study_run(const pm_study_options *o, FILE *out);
 
 #endif

@@ -81,7 +81,8 @@ void pm_key_describe(const pm_key *k, char *buf, size_t size) {
   case PM_KEY_POINT: snprintf(buf, size, "a list of 2 or 3 numbers"); break;
   case PM_KEY_NUMBERS: {
     char each[128];
-    describe_range(k, "numbers", each, sizeof each);
+    describe_range(k, (k->flags & PM_KEY_WHOLE) ? "integers" : "numbers", each,
+                   sizeof each);
     if (k->min_count == k->max_count)
       snprintf(buf, size, "a list of %d %s", k->max_count, each);
     else
@@ -91,6 +92,37 @@ void pm_key_describe(const pm_key *k, char *buf, size_t size) {
   }
   case PM_KEY_MAPPING: snprintf(buf, size, "a mapping"); break;
   case PM_KEY_LIST: snprintf(buf, size, "a list of mappings"); break;
-  default: snprintf(buf, size, "a value"); break;
+  default: snprintf(buf, size, "%s", k->what ? k->what : "a value"); break;
+  }
+}
+
+void pm_key_print(FILE *out, const pm_key *keys, const char *prefix) {
+  char path[256], what[512], line[768];
+  for (const pm_key *k = keys; k && k->type != PM_KEY_END; k++) {
+    snprintf(path, sizeof path, "%s%s", prefix, k->name);
+    if (k->type == PM_KEY_MAPPING) {
+      fprintf(out, "%-38s %s\n", path, k->doc ? k->doc : "");
+      char sub[260];
+      snprintf(sub, sizeof sub, "%s.", path);
+      pm_key_print(out, k->keys, sub);
+      continue;
+    }
+    if (k->type == PM_KEY_LIST) snprintf(path + strlen(path), 8, ".N");
+    pm_key_describe(k, what, sizeof what);
+    snprintf(line, sizeof line, "%s%s%s%s%s", what,
+             k->unit && k->unit[0] ? ", " : "", k->unit ? k->unit : "",
+             (k->flags & PM_KEY_REQUIRED)        ? "; required"
+             : (k->def && strcmp(k->def, "nan")) ? "; default "
+                                                 : "",
+             (k->flags & PM_KEY_REQUIRED) || !k->def || !strcmp(k->def, "nan")
+                 ? ""
+                 : k->def);
+    fprintf(out, "%-38s %s\n%-38s   %s\n", path, k->doc ? k->doc : "", "",
+            line);
+    if (k->type == PM_KEY_LIST) {
+      char sub[264];
+      snprintf(sub, sizeof sub, "%s.", path);
+      pm_key_print(out, k->keys, sub);
+    }
   }
 }

@@ -11,6 +11,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "pm_error.h"
 
@@ -48,7 +49,8 @@ enum {
 enum {
   PM_KEY_REQUIRED = 1u << 0, /* must be present (def is then unused) */
   PM_KEY_NO_T = 1u << 1,     /* EXPR / COMPONENTS: x, y, z only (no t) */
-  PM_KEY_NO_XYZ = 1u << 2    /* EXPR / COMPONENTS: t only */
+  PM_KEY_NO_XYZ = 1u << 2,   /* EXPR / COMPONENTS: t only */
+  PM_KEY_WHOLE = 1u << 3     /* NUMBERS: whole numbers only */
 };
 
 /* A name of an ENUM or FLAGS key and its value; tables end with {NULL}. */
@@ -82,6 +84,7 @@ struct pm_key {
   size_t count_offset;      /* COMPONENTS (mask), NUMBERS, LIST (count) */
   int min_count, max_count; /* NUMBERS, LIST, FLAGS (0: no bound) */
   pm_key_read_fn read;      /* CUSTOM */
+  const char *what;         /* CUSTOM: what it takes ("2 or 3") */
   const char *unit;         /* SI unit ("Pa", "m", "1/s"; "" none) */
   const char *doc;          /* one line for `pointmech keys` */
 };
@@ -101,5 +104,10 @@ void pm_key_describe(const pm_key *k, char *buf, size_t size);
 
 /* Whether v is in k's range. */
 bool pm_key_in_range(const pm_key *k, double v);
+
+/* Print a table for readers: one entry per key (prefix.name, its meaning,
+ * then what it takes, its unit and default), nested tables after their
+ * key. */
+void pm_key_print(FILE *out, const pm_key *keys, const char *prefix);
 
 #endif

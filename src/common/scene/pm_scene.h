@@ -1,21 +1,22 @@
-/* pm_scene: a simulation scene loaded from YAML against a schema, with
- * command-line overrides.  One vocabulary for every method. */
+/* pm_scene: a simulation scene loaded from YAML, with command-line
+ * overrides.  The shared vocabulary (domain, materials, bodies, boundary,
+ * gravity, time, output, reference, stability) is read here; each method's
+ * own section ("fpm:", "mpm:") is declared and checked by its backend
+ * (pm_backend.h) and kept here as an options struct. */
 #ifndef PM_SCENE_H
 #define PM_SCENE_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "pm_error.h"
 #include "pm_expr.h"
 #include "pm_face.h"
-#include "pm_fluid.h"
 #include "pm_material.h"
+#include "pm_scene_doc.h"
 
-typedef enum {
-  PM_METHOD_FPM = 0,
-  PM_METHOD_MPM,
-  PM_METHOD_MPM_IMPLICIT
-} pm_method;
+struct pm_backend;
+
 typedef enum { PM_RAMP_SMOOTH = 0, PM_RAMP_LINEAR, PM_RAMP_NONE } pm_ramp;
 typedef enum {
   PM_QS_NONE = 0,           /* plain dynamics */
@@ -23,16 +24,10 @@ typedef enum {
   PM_QS_DAMPING             /* fixed mass-proportional damping */
 } pm_qs_method;
 
-/* Interior-penalty flux of FPM. */
-typedef enum {
-  PM_FLUX_IIPG = 0, /* incomplete (the FPM paper's eq. 16) */
-  PM_FLUX_SIPG      /* symmetric: the force is the gradient of an energy */
-} pm_flux;
-
 /* How the stable time step is found. */
 typedef enum {
-  PM_DT_PAPER = 0, /* the bound of eqs. 24-26 of the FPM paper */
-  PM_DT_SPECTRAL   /* the measured largest eigenvalue of M^-1 K */
+  PM_DT_PAPER = 0, /* the method's bound (FPM: eqs. 24-26 of its paper) */
+  PM_DT_SPECTRAL   /* the measured largest eigenvalue of M^-1 K (FPM) */
 } pm_dt_rule;
 
 /* Output fields (bit mask). */
@@ -45,29 +40,14 @@ enum {
   PM_FIELD_FORCE = 1u << 5 /* residual (out-of-balance) force */
 };
 
-/* A position in the scene file (1-based; 0 when not from the file). */
-typedef struct {
-  int line, col;
-} pm_scene_mark;
-
-/* MPM grid shape functions, update variants and fluid energy update. */
-typedef enum { PM_SHAPE_LINEAR = 0, PM_SHAPE_QUADRATIC } pm_shape;
-typedef enum { PM_UPDATE_USF = 0, PM_UPDATE_USL, PM_UPDATE_MUSL } pm_update;
-typedef enum {
-  PM_ENERGY_ITERATIVE = 0, /* steps (1)-(6) of the fluid paper, eqs. 27-31 */
-  PM_ENERGY_NON_ITERATIVE  /* energy from the previous stress (eq. 27 only) */
-} pm_energy_update;
-
 typedef struct {
   char *name;
-  bool fluid; /* model: fluid (then `fluid` holds it, `mat` is unused) */
-  pm_material mat;
-  pm_fluid fluid_props;
+  pm_material mat;     /* the model of the table and its constants */
   double av_c0, av_c1; /* artificial viscosity (eq. 32); 0: none */
   pm_scene_mark mark;
 } pm_scene_material;
 
-/* Shape of a body (MPM seeding; FPM uses region only). */
+/* Shape of a body. */
 typedef enum {
   PM_BODY_DOMAIN = 0, /* the whole domain box */
   PM_BODY_REGION,     /* region expression > 0 */
@@ -79,91 +59,88 @@ typedef enum {
 } pm_body_shape;
 
 typedef struct {
-  int material; /* index into materials */
+  int material;        /* index into materials */
+  char *material_name; /* as the scene gives it */
   pm_body_shape shape;
   pm_expr *region;   /* PM_BODY_REGION: inside where expr > 0 */
   double a[3], b[3]; /* box: min, max; sphere: center; cylinder: base, axis */
   double radius;
+  int n_cylinder;     /* numbers read for the cylinder's vectors */
   char *mesh;         /* PM_BODY_MESH: file path, relative paths resolved
                          against the scene's folder */
   double velocity[3]; /* initial velocity, m/s */
   double density;     /* initial density, kg/m^3 (default: the material's) */
   double pressure;    /* fluids: initial pressure, Pa */
+  pm_material_point point; /* what its material's points take from it
+                              (fibre directions, unit) */
   pm_scene_mark mark;
 } pm_scene_body;
 
-/* A boundary condition on one named face.  Displacement components are
- * prescribed values at full load (expressions in x, y, z and t, in m);
- * traction components are nominal tractions at full load (Pa).  The value
- * applied at time t is ramp(t) * value(x, y, z, t). */
+/* Where a boundary condition acts. */
+typedef enum {
+  PM_ON_FACE = 0, /* a face of domain.box (on: xmin ... zmax) */
+  PM_ON_SURFACE,  /* a named surface of the domain's mesh (on: NAME, a gmsh
+                     physical group) */
+  PM_ON_REGION    /* the boundary where region(x, y, z) > 0 */
+} pm_on;
+
+/* A boundary condition.  Displacement components are prescribed values at
+ * full load (expressions in x, y, z and t, in m); traction components are
+ * nominal tractions at full load (Pa); velocity components (m/s).  The
+ * value applied at time t is ramp(t) * value(x, y, z, t). */
 typedef struct {
-  pm_face face;
+  pm_on on;
+  pm_face face;       /* PM_ON_FACE */
+  char *surface;      /* PM_ON_SURFACE: the name; PM_ON_FACE: the face name */
+  pm_expr *region;    /* PM_ON_REGION */
   unsigned disp_mask; /* bit c: component c prescribed */
   pm_expr *disp[3];   /* NULL where not prescribed */
   unsigned traction_mask;
   pm_expr *traction[3];
-  unsigned velocity_mask; /* MPM: prescribed velocity components, m/s */
+  unsigned velocity_mask;
   pm_expr *velocity[3];
-  bool absorbing; /* MPM: viscous (absorbing) boundary on this face */
+  bool absorbing; /* viscous (absorbing) boundary */
   pm_ramp ramp;
-  double ramp_time; /* s; the loader puts time.ramp when not given */
+  double ramp_time; /* s; time.ramp when not given */
   pm_scene_mark mark;
 } pm_scene_bc;
 
 typedef struct pm_scene {
   char *path;       /* scene file as given */
-  char *text;       /* full source text (stored with the results),
-                       then the overrides as comment lines */
+  char *text;       /* full source text (stored with the results), then the
+                       overrides as comment lines */
   char **overrides; /* the "key=value" overrides applied */
   int n_overrides;
   char *name;
-  pm_method method;
-  int dimension;                 /* 2 (plane strain) or 3 */
-  double box_min[3], box_max[3]; /* domain.box; z ignored in 2D */
-  double mesh_size;              /* discretization.mesh_size, m, > 0 */
+  char *method;                     /* "fpm", "mpm", ... */
+  const struct pm_backend *backend; /* the registered backend of method */
+  int dimension;                    /* 2 (plane strain) or 3 */
+  double box_min[3], box_max[3];    /* domain.box; z 0 in 2D */
+  double mesh_size;                 /* discretization.mesh_size, m, > 0 */
   pm_scene_material *materials;
   int n_materials;
   pm_scene_body *bodies;
   int n_bodies;
   pm_scene_bc *bcs;
   int n_bcs;
-  struct {
-    double penalty; /* fpm.penalty p >= 0 (beta = p E / h) */
-    pm_flux flux;   /* fpm.flux: iipg (default) | sipg */
-  } fpm;
-  struct {
-    pm_shape shape;   /* mpm.shape: quadratic (default) | linear */
-    pm_update update; /* mpm.update: musl (default) | usl | usf */
-    double flip;      /* mpm.flip: FLIP fraction of the particle velocity
-                         update in [0, 1] (1 FLIP, 0 PIC; default 1) */
-    int ppc[3];       /* mpm.particles_per_cell: per direction (default 2) */
-    pm_energy_update energy_update; /* mpm.fluid.energy_update */
-    double energy_tolerance;        /* mpm.fluid.tolerance (relative) */
-    int max_iterations;             /* mpm.fluid.max_iterations */
-    unsigned null_velocity;         /* mpm.null_velocity: grid velocity
-                                       components held at zero (mask) */
-  } mpm;
   double gravity[3]; /* gravity: m/s^2 */
   bool has_gravity;
   struct {
     double end;          /* time.end, s, > 0 */
-    double dt;           /* time.dt, s; 0: stable dt from eqs. 24-26 */
-    double dt_safety;    /* time.dt_safety in (0, 1] */
+    double dt;           /* time.dt, s; 0: the stable step */
+    double dt_safety;    /* time.dt_safety in (0, 1]; the backend's default
+                            when not given */
     pm_dt_rule dt_rule;  /* time.dt_rule: paper (default) | spectral */
     double ramp;         /* time.ramp, s: default ramp duration */
     pm_qs_method qs;     /* time.quasi_static.method */
     double qs_tolerance; /* time.quasi_static.tolerance: relative residual */
-    double qs_damping;   /* time.quasi_static.damping: 1/s for PM_QS_DAMPING */
+    double qs_damping;   /* time.quasi_static.damping: 1/s for damping */
     long max_steps;      /* time.max_steps; 0: no limit */
   } time;
   struct {
-    /* stability.min_jacobian: stop when some J falls to or below it
-     * (default 0: an inverted subdomain) */
-    double min_jacobian;
-    /* stability.max_energy_error: stop when |kinetic + strain + dissipated
-     * - external work| exceeds this fraction of the energy in play
-     * (default 0.1) */
-    double max_energy_error;
+    double min_jacobian;     /* stop when some J falls to or below it */
+    double max_energy_error; /* stop when the energy-balance error exceeds
+                                this fraction (methods that bound it) */
   } stability;
   struct {
     long every;      /* output.every: frame every N steps (> 0) */
@@ -171,27 +148,54 @@ typedef struct pm_scene {
   } output;
   unsigned reference_mask; /* reference.displacement components given */
   pm_expr *reference[3];   /* analytic u_c(x, y, z, t) or NULL */
+  /* private: the options of every registered section, and the document
+   * (kept for located messages after loading) */
+  void *section_opts[8];
+  pm_sdoc doc;
 } pm_scene;
 
 /* Load a scene file, apply overrides ("key.path=value", e.g.
- * "discretization.mesh_size=8.02e-3", "boundary.3.displacement.z=-0.06",
- * "time.quasi_static.tolerance=1e-9"), validate, and return a new scene.
- * Errors (PM_ERR_IO for a missing file, PM_ERR_SCENE otherwise) carry
+ * "discretization.mesh_size=8.02e-3", "boundary.3.displacement.z=-0.06"),
+ * read it against the shared keys and every registered backend's section,
+ * and have the scene's backend check that it can honour it.  Errors
+ * (PM_ERR_IO for a missing file, PM_ERR_SCENE otherwise) carry
  * "FILE:LINE:COL: KEY: expected ..., got ..." or, for an override,
- * "--set KEY=VALUE: ...".  *out is NULL on failure. */
+ * "--set KEY=VALUE: ...".  Backends must be registered first
+ * (pm_backend_register).  *out is NULL on failure. */
 pm_err pm_scene_load(const char *path, int n_overrides,
                      const char *const *overrides, pm_scene **out);
 void pm_scene_destroy(pm_scene *s);
 
-const char *pm_method_name(pm_method m);
+/* The options of the registered section called name (the struct its
+ * backend declared), or NULL when no backend declares it. */
+const void *pm_scene_section(const pm_scene *s, const char *name);
+
+/* Whether the scene gives the key at a dotted path (file or override). */
+bool pm_scene_has(const pm_scene *s, const char *path);
+
+/* Located failures about the key at path (PM_ERR_SCENE): "WHERE: " + the
+ * formatted text (at the key's name with key set), and "WHERE: expected
+ * WHAT, got VALUE". */
+pm_err pm_scene_fail(const pm_scene *s, const char *path, bool key,
+                     const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+pm_err pm_scene_expected(const pm_scene *s, const char *path, const char *what);
 
 /* True when x (3 components; z unused in 2D) lies in the body's shape:
  * domain, region (expr > 0), box, sphere or cylinder (boundary included).
  * A mesh shape needs the geometry layer: this returns false for it. */
 bool pm_body_contains(const pm_scene_body *b, int dim, const double x[3]);
 
+/* The whole vocabulary, from the key tables: shared keys, every model's
+ * and every registered backend's section. */
+void pm_scene_print_keys(FILE *out);
+
 /* Ramp factor in [0, 1] at time t for ramp kind and duration T:
  * smooth is C2 (10 s^3 - 15 s^4 + 6 s^5), linear is s, none is 1. */
 double pm_ramp_factor(pm_ramp kind, double T, double t);
+
+/* Time at which every ramped condition of the scene (with a displacement
+ * or velocity) has reached its full value. */
+double pm_scene_load_end(const pm_scene *s);
 
 #endif

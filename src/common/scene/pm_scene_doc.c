@@ -1,5 +1,6 @@
 /* pm_scene_doc: the scene's libyaml node tree, which keeps file marks for
- * messages, takes --set overrides and is checked against the cyaml schema. */
+ * messages and takes --set overrides; the key reader (pm_reader) checks it
+ * against the key tables. */
 #include "pm_scene_doc.h"
 
 #include <errno.h>
@@ -88,6 +89,49 @@ int pm_sdoc_find(const pm_sdoc *d, const char *path, bool key) {
     }
   }
   return key ? (id ? key_id : 0) : id;
+}
+
+int pm_sdoc_root(const pm_sdoc *d) { return root_id(d); }
+
+pm_sdoc_kind pm_sdoc_kind_of(const pm_sdoc *d, int id) {
+  yaml_node_t *n = node_get(d, id);
+  if (!n) return PM_SDOC_NONE;
+  switch (n->type) {
+  case YAML_SCALAR_NODE: return PM_SDOC_SCALAR;
+  case YAML_MAPPING_NODE: return PM_SDOC_MAPPING;
+  case YAML_SEQUENCE_NODE: return PM_SDOC_LIST;
+  default: return PM_SDOC_NONE;
+  }
+}
+
+int pm_sdoc_count(const pm_sdoc *d, int id) {
+  yaml_node_t *n = node_get(d, id);
+  if (!n) return 0;
+  if (n->type == YAML_MAPPING_NODE)
+    return (int)(n->data.mapping.pairs.top - n->data.mapping.pairs.start);
+  if (n->type == YAML_SEQUENCE_NODE)
+    return (int)(n->data.sequence.items.top - n->data.sequence.items.start);
+  return 0;
+}
+
+int pm_sdoc_item(const pm_sdoc *d, int id, int i) {
+  yaml_node_t *n = node_get(d, id);
+  if (!n || n->type != YAML_SEQUENCE_NODE || i < 0 || i >= pm_sdoc_count(d, id))
+    return 0;
+  return n->data.sequence.items.start[i];
+}
+
+int pm_sdoc_pair(const pm_sdoc *d, int id, int i, int *value) {
+  yaml_node_t *n = node_get(d, id);
+  if (!n || n->type != YAML_MAPPING_NODE || i < 0 || i >= pm_sdoc_count(d, id))
+    return 0;
+  yaml_node_pair_t p = n->data.mapping.pairs.start[i];
+  if (value) *value = p.value;
+  return p.key;
+}
+
+int pm_sdoc_child(const pm_sdoc *d, int id, const char *key) {
+  return map_lookup(d, id, key, false);
 }
 
 const char *pm_sdoc_scalar(const pm_sdoc *d, int id) {
@@ -231,228 +275,6 @@ void pm_sdoc_free(pm_sdoc *d) {
   memset(d, 0, sizeof *d);
 }
 
-/* ---- schema checks ---------------------------------------------------- */
-
-static bool name_in(const cyaml_strval_t *strings, uint32_t count,
-                    const char *s) {
-  for (uint32_t i = 0; i < count; i++)
-    if (strcmp(strings[i].str, s) == 0) return true;
-  return false;
-}
-
-static void list_names(char *buf, size_t size, const cyaml_strval_t *strings,
-                       uint32_t count) {
-  size_t used = 0;
-  buf[0] = '\0';
-  for (uint32_t i = 0; i < count && used < size; i++)
-    used += (size_t)snprintf(buf + used, size - used, "%s%s", i ? ", " : "",
-                             strings[i].str);
-}
-
-static void list_keys(char *buf, size_t size,
-                      const cyaml_schema_field_t *fields) {
-  size_t used = 0;
-  buf[0] = '\0';
-  for (int i = 0; fields[i].key && used < size; i++)
-    used += (size_t)snprintf(buf + used, size - used, "%s%s", i ? ", " : "",
-                             fields[i].key);
-}
-
-/* What a value of schema s looks like, for "expected ...". */
-static void describe(char *buf, size_t size, const cyaml_schema_value_t *s) {
-  char names[PM_SDOC_WHERE];
-  switch (s->type) {
-  case CYAML_INT:
-  case CYAML_UINT: snprintf(buf, size, "an integer"); break;
-  case CYAML_FLOAT: snprintf(buf, size, "a number"); break;
-  case CYAML_BOOL: snprintf(buf, size, "true or false"); break;
-  case CYAML_STRING:
-    snprintf(buf, size, s->string.min > 0 ? "a non-empty string" : "a string");
-    break;
-  case CYAML_ENUM:
-    list_names(names, sizeof names, s->enumeration.strings,
-               s->enumeration.count);
-    snprintf(buf, size, "one of %s", names);
-    break;
-  case CYAML_FLAGS:
-    list_names(names, sizeof names, s->enumeration.strings,
-               s->enumeration.count);
-    snprintf(buf, size, "a list of names from %s", names);
-    break;
-  case CYAML_MAPPING: snprintf(buf, size, "a mapping"); break;
-  default: snprintf(buf, size, "a list"); break;
-  }
-}
-
-static pm_err expected_at(const pm_sdoc *d, int id, const char *path,
-                          const cyaml_schema_value_t *s) {
-  char what[PM_SDOC_WHERE], where[PM_SDOC_WHERE], got[PM_SDOC_GOT + 8];
-  describe(what, sizeof what, s);
-  pm_sdoc_got(d, id, got, sizeof got);
-  pm_sdoc_where(d, id, path, where, sizeof where);
-  return PM_ERROR(PM_ERR_SCENE, "%s: expected %s, got %s", where, what, got);
-}
-
-/* Whether text is a whole decimal integer that fits in data_size bytes.
- * Leading zeros are refused: libcyaml would read them as octal. */
-static bool scalar_is_int(const char *text, uint32_t data_size, bool sign) {
-  char *end;
-  errno = 0;
-  long long v = strtoll(text, &end, 10);
-  const char *digits = text + (text[0] == '-' || text[0] == '+');
-  if (end == text || *end || errno == ERANGE || (!sign && v < 0)) return false;
-  if (digits[0] == '0' && digits[1] != '\0') return false;
-  if (data_size < 8) {
-    long long lim = 1LL << (8 * data_size - (sign ? 1 : 0));
-    if (v >= lim || v < -lim) return false;
-  }
-  return true;
-}
-
-static bool scalar_is_number(const char *text) {
-  char *end;
-  double v = strtod(text, &end);
-  return end != text && *end == '\0' && isfinite(v);
-}
-
-static pm_err check_value(const pm_sdoc *d, const cyaml_schema_value_t *s,
-                          int id, const char *path, int depth);
-
-static pm_err check_mapping(const pm_sdoc *d, const cyaml_schema_value_t *s,
-                            int id, const char *path, int depth) {
-  yaml_node_t *n = node_get(d, id);
-  char sub[PM_SDOC_PATH], where[PM_SDOC_WHERE], keys[PM_SDOC_WHERE];
-  const cyaml_schema_field_t *fields = s->mapping.fields;
-  if (n->type != YAML_MAPPING_NODE) return expected_at(d, id, path, s);
-  int n_pairs = (int)(n->data.mapping.pairs.top - n->data.mapping.pairs.start);
-  for (int i = 0; i < n_pairs; i++) {
-    yaml_node_pair_t pair = node_get(d, id)->data.mapping.pairs.start[i];
-    const char *key = pm_sdoc_scalar(d, pair.key);
-    if (!key) {
-      pm_sdoc_where(d, pair.key, path, where, sizeof where);
-      return PM_ERROR(PM_ERR_SCENE, "%s: expected a key name, got %s", where,
-                      node_get(d, pair.key)->type == YAML_MAPPING_NODE
-                          ? "a mapping"
-                          : "a list");
-    }
-    path_join(sub, sizeof sub, path, key);
-    const cyaml_schema_field_t *f = fields;
-    while (f->key && strcmp(f->key, key) != 0) f++;
-    if (!f->key) {
-      list_keys(keys, sizeof keys, fields);
-      pm_sdoc_where(d, pair.key, sub, where, sizeof where);
-      return PM_ERROR(PM_ERR_SCENE, "%s: unknown key (expected one of %s)",
-                      where, keys);
-    }
-    for (int j = 0; j < i; j++) {
-      const char *prev =
-          pm_sdoc_scalar(d, node_get(d, id)->data.mapping.pairs.start[j].key);
-      if (prev && strcmp(prev, key) == 0) {
-        pm_sdoc_where(d, pair.key, sub, where, sizeof where);
-        return PM_ERROR(PM_ERR_SCENE, "%s: duplicate key", where);
-      }
-    }
-    PM_CALL(check_value(d, &f->value, pair.value, sub, depth + 1));
-  }
-  for (const cyaml_schema_field_t *f = fields; f->key; f++) {
-    if ((f->value.flags & CYAML_FLAG_OPTIONAL) || map_lookup(d, id, f->key, 0))
-      continue;
-    path_join(sub, sizeof sub, path, f->key);
-    pm_sdoc_where(d, id, sub, where, sizeof where);
-    return PM_ERROR(PM_ERR_SCENE, "%s: missing required key", where);
-  }
-  return PM_SUCCESS;
-}
-
-static pm_err check_sequence(const pm_sdoc *d, const cyaml_schema_value_t *s,
-                             int id, const char *path, int depth) {
-  yaml_node_t *n = node_get(d, id);
-  char sub[PM_SDOC_PATH], where[PM_SDOC_WHERE], idx[24];
-  if (n->type != YAML_SEQUENCE_NODE) return expected_at(d, id, path, s);
-  long count = n->data.sequence.items.top - n->data.sequence.items.start;
-  uint32_t lo = s->sequence.min, hi = s->sequence.max;
-  if ((uint32_t)count < lo || (hi != CYAML_UNLIMITED && (uint32_t)count > hi)) {
-    pm_sdoc_where(d, id, path, where, sizeof where);
-    if (lo == hi)
-      return PM_ERROR(PM_ERR_SCENE, "%s: expected %u entries, got %ld", where,
-                      lo, count);
-    if (hi == CYAML_UNLIMITED)
-      return PM_ERROR(PM_ERR_SCENE, "%s: expected at least %u entr%s, got %ld",
-                      where, lo, lo == 1 ? "y" : "ies", count);
-    return PM_ERROR(PM_ERR_SCENE, "%s: expected %u to %u entries, got %ld",
-                    where, lo, hi, count);
-  }
-  for (long i = 0; i < count; i++) {
-    snprintf(idx, sizeof idx, "%ld", i);
-    path_join(sub, sizeof sub, path, idx);
-    int item = node_get(d, id)->data.sequence.items.start[i];
-    PM_CALL(check_value(d, s->sequence.entry, item, sub, depth + 1));
-  }
-  return PM_SUCCESS;
-}
-
-static pm_err check_flags(const pm_sdoc *d, const cyaml_schema_value_t *s,
-                          int id, const char *path) {
-  yaml_node_t *n = node_get(d, id);
-  char sub[PM_SDOC_PATH], idx[24], names[PM_SDOC_WHERE];
-  char what[PM_SDOC_WHERE + 16];
-  if (n->type != YAML_SEQUENCE_NODE) return expected_at(d, id, path, s);
-  long count = n->data.sequence.items.top - n->data.sequence.items.start;
-  list_names(names, sizeof names, s->enumeration.strings, s->enumeration.count);
-  snprintf(what, sizeof what, "one of %s", names);
-  for (long i = 0; i < count; i++) {
-    int item = node_get(d, id)->data.sequence.items.start[i];
-    const char *v = pm_sdoc_scalar(d, item);
-    if (v && name_in(s->enumeration.strings, s->enumeration.count, v)) continue;
-    snprintf(idx, sizeof idx, "%ld", i);
-    path_join(sub, sizeof sub, path, idx);
-    return pm_sdoc_expected(d, sub, what);
-  }
-  return PM_SUCCESS;
-}
-
-static pm_err check_value(const pm_sdoc *d, const cyaml_schema_value_t *s,
-                          int id, const char *path, int depth) {
-  char where[PM_SDOC_WHERE];
-  if (depth > PM_SDOC_DEPTH) {
-    pm_sdoc_where(d, id, path, where, sizeof where);
-    return PM_ERROR(PM_ERR_SCENE, "%s: nested too deeply (recursive alias?)",
-                    where);
-  }
-  switch (s->type) {
-  case CYAML_MAPPING: return check_mapping(d, s, id, path, depth);
-  case CYAML_SEQUENCE:
-  case CYAML_SEQUENCE_FIXED: return check_sequence(d, s, id, path, depth);
-  case CYAML_FLAGS: return check_flags(d, s, id, path);
-  case CYAML_IGNORE: return PM_SUCCESS;
-  default: break;
-  }
-  const char *v = pm_sdoc_scalar(d, id);
-  bool ok = v != NULL;
-  if (ok) {
-    switch (s->type) {
-    case CYAML_INT: ok = scalar_is_int(v, s->data_size, true); break;
-    case CYAML_UINT: ok = scalar_is_int(v, s->data_size, false); break;
-    case CYAML_FLOAT: ok = scalar_is_number(v); break;
-    case CYAML_BOOL:
-      ok = strcmp(v, "true") == 0 || strcmp(v, "false") == 0;
-      break;
-    case CYAML_ENUM:
-      ok = name_in(s->enumeration.strings, s->enumeration.count, v);
-      break;
-    case CYAML_STRING:
-      ok = strlen(v) >= s->string.min && strlen(v) <= s->string.max;
-      break;
-    default: ok = false; break;
-    }
-  }
-  return ok ? PM_SUCCESS : expected_at(d, id, path, s);
-}
-
-pm_err pm_sdoc_validate(const pm_sdoc *d, const cyaml_schema_value_t *schema) {
-  return check_value(d, schema, root_id(d), "", 0);
-}
-
 /* ---- overrides -------------------------------------------------------- */
 
 /* Copy node id of document src into d's document; returns the new id or 0
@@ -531,9 +353,13 @@ static pm_err override_node(pm_sdoc *d, const char *kv, const char *value,
   return *id ? PM_SUCCESS : PM_ERROR(PM_ERR_MEMORY, "--set %s: no memory", kv);
 }
 
-static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
-                             const char *kv) {
-  char key[PM_SDOC_PATH], sofar[PM_SDOC_PATH] = "", names[PM_SDOC_WHERE];
+/* Walk KEY of "KEY=VALUE" down the tree, creating absent mapping keys
+ * (with their absent parent mappings) and appending at index n of an
+ * n-item list, and put VALUE there.  A numeric segment indexes a list, any
+ * other names a key (the vocabulary has no numeric keys); whether the key
+ * exists is the reader's to check, against the tables. */
+static pm_err apply_override(pm_sdoc *d, const char *kv) {
+  char key[PM_SDOC_PATH], sofar[PM_SDOC_PATH] = "";
   const char *eq = strchr(kv, '=');
   size_t klen = eq ? (size_t)(eq - kv) : 0;
   PM_CHECK(eq && klen > 0 && klen < sizeof key, PM_ERR_SCENE,
@@ -541,7 +367,6 @@ static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
   memcpy(key, kv, klen);
   key[klen] = '\0';
   const char *value = eq + 1;
-  const cyaml_schema_value_t *s = schema;
   int id = root_id(d);
   for (char *seg = key, *next; seg; seg = next) {
     next = strchr(seg, '.');
@@ -550,33 +375,27 @@ static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
     char parent[PM_SDOC_PATH];
     snprintf(parent, sizeof parent, "%s", sofar);
     path_join(sofar, sizeof sofar, parent, seg);
+    PM_CHECK(seg[0], PM_ERR_SCENE, "--set %s: empty key segment", kv);
     yaml_node_t *n = node_get(d, id);
     int child = 0;
-    if (s->type == CYAML_MAPPING) {
-      const cyaml_schema_field_t *f = s->mapping.fields;
-      while (f->key && strcmp(f->key, seg) != 0) f++;
-      if (!f->key) {
-        list_keys(names, sizeof names, s->mapping.fields);
-        return PM_ERROR(PM_ERR_SCENE,
-                        "--set %s: unknown key %s (expected one of %s)", kv,
-                        sofar, names);
+    if (n->type == YAML_MAPPING_NODE) {
+      long at = -1,
+           n_pairs = n->data.mapping.pairs.top - n->data.mapping.pairs.start;
+      for (long i = 0; i < n_pairs && at < 0; i++) {
+        const char *k = pm_sdoc_scalar(d, n->data.mapping.pairs.start[i].key);
+        if (k && strcmp(k, seg) == 0) at = i;
       }
-      if (n->type != YAML_MAPPING_NODE) return expected_at(d, id, parent, s);
-      yaml_node_pair_t *pair = n->data.mapping.pairs.start;
-      while (pair < n->data.mapping.pairs.top &&
-             strcmp(pm_sdoc_scalar(d, pair->key) ? pm_sdoc_scalar(d, pair->key)
-                                                 : "",
-                    seg) != 0)
-        pair++;
-      if (pair < n->data.mapping.pairs.top && !last) {
-        child = pair->value;
-      } else if (pair < n->data.mapping.pairs.top) {
-        long at = pair - n->data.mapping.pairs.start;
+      if (at >= 0 && !last) {
+        child = n->data.mapping.pairs.start[at].value;
+      } else if (at >= 0) {
         PM_CALL(override_value(d, kv, value, &child));
         /* Adding nodes may move the node array: look the pair up again. */
         node_get(d, id)->data.mapping.pairs.start[at].value = child;
       } else {
-        if (!last && f->value.type != CYAML_MAPPING)
+        char nseg[32] = "";
+        if (!last)
+          snprintf(nseg, sizeof nseg, "%.*s", (int)strcspn(next, "."), next);
+        if (!last && parse_index(nseg) >= 0)
           return PM_ERROR(PM_ERR_SCENE,
                           "--set %s: %s is not in the scene, so it has no "
                           "entries to set",
@@ -589,24 +408,18 @@ static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
         PM_CHECK(yaml_document_append_mapping_pair(&d->doc, id, k, child),
                  PM_ERR_MEMORY, "--set %s: out of memory", kv);
       }
-      s = &f->value;
-    } else if (s->type == CYAML_SEQUENCE || s->type == CYAML_SEQUENCE_FIXED ||
-               s->type == CYAML_FLAGS) {
+    } else if (n->type == YAML_SEQUENCE_NODE) {
       long i = parse_index(seg);
       if (i < 0)
         return PM_ERROR(PM_ERR_SCENE,
                         "--set %s: %s: expected a list index (0, 1, ...), "
                         "got %s",
                         kv, sofar, seg);
-      if (n->type != YAML_SEQUENCE_NODE) return expected_at(d, id, parent, s);
       long count = n->data.sequence.items.top - n->data.sequence.items.start;
-      const cyaml_schema_value_t *entry =
-          s->type == CYAML_FLAGS ? NULL : s->sequence.entry;
-      if (!last && !entry)
-        return PM_ERROR(PM_ERR_SCENE,
-                        "--set %s: unknown key %s (%s holds names)", kv, sofar,
-                        parent);
-      if (i > count || (i == count && !last && entry->type != CYAML_MAPPING))
+      char nseg[32] = "";
+      if (!last)
+        snprintf(nseg, sizeof nseg, "%.*s", (int)strcspn(next, "."), next);
+      if (i > count || (i == count && !last && parse_index(nseg) >= 0))
         return PM_ERROR(PM_ERR_SCENE,
                         "--set %s: index %ld out of range (%s has %ld "
                         "entries)",
@@ -621,7 +434,6 @@ static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
         PM_CHECK(yaml_document_append_sequence_item(&d->doc, id, child),
                  PM_ERR_MEMORY, "--set %s: out of memory", kv);
       }
-      s = entry;
     } else {
       return PM_ERROR(PM_ERR_SCENE,
                       "--set %s: unknown key %s (%s takes a single value)", kv,
@@ -632,108 +444,15 @@ static pm_err apply_override(pm_sdoc *d, const cyaml_schema_value_t *schema,
   return PM_SUCCESS;
 }
 
-pm_err pm_sdoc_apply_overrides(pm_sdoc *d, const cyaml_schema_value_t *schema,
-                               int n, const char *const *overrides) {
+pm_err pm_sdoc_apply_overrides(pm_sdoc *d, int n,
+                               const char *const *overrides) {
   if (n <= 0) return PM_SUCCESS;
   PM_CALL(PM_ALLOC(d->override_end, n, "override marks"));
   d->overrides = overrides;
   for (int k = 0; k < n; k++) {
-    PM_CALL(apply_override(d, schema, overrides[k]));
+    PM_CALL(apply_override(d, overrides[k]));
     d->override_end[k] = node_count(d);
     d->n_overrides = k + 1;
   }
   return PM_SUCCESS;
-}
-
-/* ---- emitting --------------------------------------------------------- */
-
-typedef struct {
-  char *data;
-  size_t len, cap;
-} emit_buf;
-
-static int emit_write(void *ctx, unsigned char *bytes, size_t size) {
-  emit_buf *b = ctx;
-  if (b->len + size + 1 > b->cap) {
-    size_t cap = 2 * (b->len + size + 1);
-    char *grown = realloc(b->data, cap);
-    if (!grown) return 0;
-    b->data = grown;
-    b->cap = cap;
-  }
-  memcpy(b->data + b->len, bytes, size);
-  b->len += size;
-  b->data[b->len] = '\0';
-  return 1;
-}
-
-static bool emit_node(yaml_emitter_t *em, pm_sdoc *d, int id, int depth) {
-  yaml_node_t *n = node_get(d, id);
-  yaml_event_t ev;
-  if (!n || depth > PM_SDOC_DEPTH) return false;
-  switch (n->type) {
-  case YAML_SCALAR_NODE:
-    return yaml_scalar_event_initialize(&ev, NULL, NULL, n->data.scalar.value,
-                                        (int)n->data.scalar.length, 1, 1,
-                                        n->data.scalar.style) &&
-           yaml_emitter_emit(em, &ev);
-  case YAML_SEQUENCE_NODE:
-    if (!yaml_sequence_start_event_initialize(&ev, NULL, NULL, 1,
-                                              YAML_ANY_SEQUENCE_STYLE) ||
-        !yaml_emitter_emit(em, &ev))
-      return false;
-    for (int i = 0;
-         i < n->data.sequence.items.top - n->data.sequence.items.start; i++)
-      if (!emit_node(em, d, node_get(d, id)->data.sequence.items.start[i],
-                     depth + 1))
-        return false;
-    return yaml_sequence_end_event_initialize(&ev) &&
-           yaml_emitter_emit(em, &ev);
-  case YAML_MAPPING_NODE:
-    if (!yaml_mapping_start_event_initialize(&ev, NULL, NULL, 1,
-                                             YAML_ANY_MAPPING_STYLE) ||
-        !yaml_emitter_emit(em, &ev))
-      return false;
-    for (int i = 0; i < n->data.mapping.pairs.top - n->data.mapping.pairs.start;
-         i++) {
-      yaml_node_pair_t p = node_get(d, id)->data.mapping.pairs.start[i];
-      if (!emit_node(em, d, p.key, depth + 1) ||
-          !emit_node(em, d, p.value, depth + 1))
-        return false;
-    }
-    return yaml_mapping_end_event_initialize(&ev) && yaml_emitter_emit(em, &ev);
-  default: return false;
-  }
-}
-
-pm_err pm_sdoc_emit(pm_sdoc *d, char **text, size_t *len) {
-  pm_err ret = PM_SUCCESS;
-  yaml_emitter_t em;
-  yaml_event_t ev;
-  emit_buf b = {NULL, 0, 0};
-  bool em_ok = false;
-  *text = NULL;
-  *len = 0;
-  PM_ENSURE(yaml_emitter_initialize(&em), PM_ERR_MEMORY,
-            "cannot initialise the YAML emitter");
-  em_ok = true;
-  yaml_emitter_set_output(&em, emit_write, &b);
-  yaml_emitter_set_unicode(&em, 1);
-  bool ok = yaml_stream_start_event_initialize(&ev, YAML_UTF8_ENCODING) &&
-            yaml_emitter_emit(&em, &ev) &&
-            yaml_document_start_event_initialize(&ev, NULL, NULL, NULL, 1) &&
-            yaml_emitter_emit(&em, &ev) && emit_node(&em, d, root_id(d), 0) &&
-            yaml_document_end_event_initialize(&ev, 1) &&
-            yaml_emitter_emit(&em, &ev) &&
-            yaml_stream_end_event_initialize(&ev) &&
-            yaml_emitter_emit(&em, &ev) && yaml_emitter_flush(&em);
-  PM_ENSURE(ok && b.data, PM_ERR_INTERNAL, "%s: cannot re-emit the scene: %s",
-            d->path, em.problem ? em.problem : "out of memory");
-  *text = b.data;
-  *len = b.len;
-  b.data = NULL;
-done:
-  free(b.data);
-  if (em_ok) yaml_emitter_delete(&em);
-  return ret;
 }

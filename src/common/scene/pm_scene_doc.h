@@ -1,16 +1,14 @@
-/* pm_scene_doc: a scene's YAML node tree (libyaml) with file marks, checked
- * against a libcyaml schema and edited by --set overrides.  Private to the
- * scene loader. */
+/* pm_scene_doc: a scene's YAML node tree (libyaml) with file marks, edited
+ * by --set overrides, and located messages about its nodes.  Private to the
+ * scene loader and the key reader. */
 #ifndef PM_SCENE_DOC_H
 #define PM_SCENE_DOC_H
 
-#include <cyaml/cyaml.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <yaml.h>
 
 #include "pm_error.h"
-#include "pm_scene.h"
 
 /* Longest key path and location prefix built for messages. */
 #define PM_SDOC_PATH 256
@@ -33,21 +31,38 @@ typedef struct {
 pm_err pm_sdoc_parse(pm_sdoc *d, const char *path, const char *text,
                      size_t len);
 /* Apply overrides[0..n) (each "KEY=VALUE", KEY a dotted path with 0-based
- * list indices) in order.  A key must exist in schema; absent mapping keys
- * are added (with any absent parent mappings) and index n of an n-item list
- * appends.  VALUE is a plain scalar unless it starts with [, {, " or ', in
- * which case it is parsed as YAML.  overrides must outlive d. */
-pm_err pm_sdoc_apply_overrides(pm_sdoc *d, const cyaml_schema_value_t *schema,
-                               int n, const char *const *overrides);
-/* Check the tree against schema: keys known and unique, required keys
- * present, scalar types, list lengths, enum and flag names.  The first
- * problem fails with PM_ERR_SCENE and a located message. */
-pm_err pm_sdoc_validate(const pm_sdoc *d, const cyaml_schema_value_t *schema);
-/* Write the (overridden) tree as YAML text for libcyaml; *text is
- * malloc'd, NUL-terminated, *len excludes the NUL. */
-pm_err pm_sdoc_emit(pm_sdoc *d, char **text, size_t *len);
+ * list indices) in order: absent mapping keys are added (with any absent
+ * parent mappings) and index n of an n-item list appends.  VALUE is a plain
+ * scalar unless it starts with [, {, " or ', in which case it is parsed as
+ * YAML.  Whether the keys exist is checked by the reader afterwards, which
+ * names the override.  overrides must outlive d. */
+pm_err pm_sdoc_apply_overrides(pm_sdoc *d, int n, const char *const *overrides);
 /* Release the tree; d may be zeroed or partly built. */
 void pm_sdoc_free(pm_sdoc *d);
+
+/* A position in the scene file (1-based; 0 when not from the file). */
+typedef struct {
+  int line, col;
+} pm_scene_mark;
+
+typedef enum {
+  PM_SDOC_NONE = 0,
+  PM_SDOC_SCALAR,
+  PM_SDOC_MAPPING,
+  PM_SDOC_LIST
+} pm_sdoc_kind;
+
+/* The root node (0 for an empty tree), what a node is, and its size:
+ * pairs of a mapping, items of a list (0 otherwise). */
+int pm_sdoc_root(const pm_sdoc *d);
+pm_sdoc_kind pm_sdoc_kind_of(const pm_sdoc *d, int id);
+int pm_sdoc_count(const pm_sdoc *d, int id);
+/* Item i of list id (0 when out of range). */
+int pm_sdoc_item(const pm_sdoc *d, int id, int i);
+/* Pair i of mapping id: returns its key node, *value its value node. */
+int pm_sdoc_pair(const pm_sdoc *d, int id, int i, int *value);
+/* Value node of key in mapping id, or 0. */
+int pm_sdoc_child(const pm_sdoc *d, int id, const char *key);
 
 /* Node id at a dotted path ("time.quasi_static.tolerance", "boundary.2"),
  * or 0 when absent.  With key, the id of the mapping key node instead (0

@@ -1,0 +1,12 @@
+/* pm_app: the backend table of this build. */
+#include "pm_app.h"
+
+#include "fpm_backend.h"
+#include "mpm_backend.h"
+#include "pm_backend.h"
+
+pm_err pm_app_init(void) {
+  PM_CALL(pm_backend_register(&fpm_backend));
+  PM_CALL(pm_backend_register(&mpm_backend));
+  return PM_SUCCESS;
+}

@@ -1,0 +1,50 @@
+/* pm_backend: the registry of methods, status names and the energy
+ * balance every method reports the same way. */
+#include "pm_backend.h"
+
+#include <math.h>
+#include <string.h>
+
+static const pm_backend *registry[PM_BACKENDS_MAX];
+static int n_registered;
+
+pm_err pm_backend_register(const pm_backend *b) {
+  PM_CHECK(b && b->method, PM_ERR_ARG, "pm_backend_register: no backend");
+  for (int k = 0; k < n_registered; k++)
+    if (registry[k] == b) return PM_SUCCESS;
+  PM_CHECK(!pm_backend_find(b->method), PM_ERR_ARG,
+           "method %s is registered twice", b->method);
+  PM_CHECK(n_registered < PM_BACKENDS_MAX, PM_ERR_ARG,
+           "at most %d methods can be registered", PM_BACKENDS_MAX);
+  registry[n_registered++] = b;
+  return PM_SUCCESS;
+}
+
+int pm_backend_count(void) { return n_registered; }
+
+const pm_backend *pm_backend_at(int k) {
+  return k >= 0 && k < n_registered ? registry[k] : NULL;
+}
+
+const pm_backend *pm_backend_find(const char *method) {
+  for (int k = 0; method && k < n_registered; k++)
+    if (strcmp(registry[k]->method, method) == 0) return registry[k];
+  return NULL;
+}
+
+const char *pm_status_name(pm_status s) {
+  switch (s) {
+  case PM_STATUS_COMPLETED: return "completed";
+  case PM_STATUS_CONVERGED: return "converged";
+  case PM_STATUS_NOT_CONVERGED: return "not-converged";
+  case PM_STATUS_UNSTABLE: return "unstable";
+  case PM_STATUS_FAILED: return "failed";
+  default: return "not-run";
+  }
+}
+
+double pm_energy_error(double E0, double E, double D, double W) {
+  double scale = fmax(fabs(E0), fabs(W));
+  if (!(scale > 0)) scale = fabs(E + D);
+  return scale > 0 ? (E - E0 + D - W) / scale : 0.0;
+}

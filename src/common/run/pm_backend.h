@@ -1,0 +1,182 @@
+/* pm_backend: the interface every method implements (FPM, MPM, and next the
+ * implicit MPM), its figures with one meaning for every method, and the
+ * registry the program fills.  The command line and the scene loader know a
+ * method only through its entry. */
+#ifndef PM_BACKEND_H
+#define PM_BACKEND_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "pm_error.h"
+#include "pm_files.h"
+#include "pm_keys.h"
+#include "pm_output.h"
+#include "pm_progress.h"
+
+struct pm_scene;
+
+typedef enum {
+  PM_STATUS_NOT_RUN = 0,
+  PM_STATUS_COMPLETED,     /* reached time.end or time.max_steps */
+  PM_STATUS_CONVERGED,     /* quasi-static: residual below the tolerance */
+  PM_STATUS_NOT_CONVERGED, /* quasi-static: ran out of time or steps */
+  PM_STATUS_UNSTABLE,      /* stopped on a numerical failure */
+  PM_STATUS_FAILED         /* any other failure (I/O, memory) */
+} pm_status;
+
+/* "completed", "converged", "not-converged", "unstable", "failed",
+ * "not-run". */
+const char *pm_status_name(pm_status s);
+
+/* A backend's own top-level scene section ("fpm:", "mpm:"): its keys, each
+ * with its default, into an options struct of `size` bytes that the loader
+ * allocates (zeroed), fills and keeps in the scene. */
+typedef struct {
+  const char *name;
+  const pm_key *keys;
+  size_t size;
+  /* Checks across the section's keys once the shared vocabulary is read
+   * (may be NULL); fails with pm_scene_fail naming the key. */
+  pm_err (*check)(const struct pm_scene *s, void *opts);
+} pm_section;
+
+/* Boundary conditions whose reactions a run reports. */
+#define PM_FIGURES_MAX_BCS 64
+
+/* What a run reports.  Every figure has one meaning for every method: in
+ * summary.json, in history.csv and in convergence tables. */
+typedef struct {
+  pm_status status;
+  int dim;
+  long points; /* FPM points, MPM particles */
+  long steps;
+  double time;      /* simulated time reached, s */
+  double h;         /* resolution: FPM mean edge length, MPM cell size, m */
+  double dt;        /* the last step taken, s */
+  double dt_stable; /* the method's stable step at setup, without
+                       time.dt_safety, s */
+  double residual;  /* quasi-static: out-of-balance force over the
+                       reactions (0 in dynamics) */
+  /* Energies, J (per unit thickness in 2D). */
+  double kinetic, strain, internal, interface;
+  double external_work, dissipated;
+  double energy0;          /* kinetic + strain + internal at t = 0 */
+  double energy_error;     /* pm_energy_error of these */
+  double max_energy_error; /* largest |energy_error| where it was checked */
+  /* Smallest volume ratio J over the whole run, and its step. */
+  double min_jacobian;
+  long min_jacobian_step;
+  /* Fields at the end. */
+  double mean_sed;      /* sum V0 W / sum V0 over the solids, J/m^3 */
+  double max_von_mises; /* of the Cauchy stress, Pa */
+  double max_von_mises_at[3];
+  double end_min_jacobian; /* smallest J at the end, and where */
+  double end_min_jacobian_at[3];
+  /* Reactions of each boundary condition (N; per unit thickness in 2D):
+   * the force the supports apply on the body. */
+  int n_bcs;
+  double reaction[PM_FIGURES_MAX_BCS][3];
+  /* Cost. */
+  double setup_seconds; /* discretization and operators */
+  double wall_seconds;  /* the time loop with output */
+  double step_seconds;  /* the step's stages alone (throughput) */
+  size_t memory_bytes;  /* state, operators and workspace */
+} pm_figures;
+
+/* Energy-balance error: (E - E0 + D - W) / max(|E0|, |W|), with E the
+ * energy held, D the energy dissipated and W the external work; over E + D
+ * when both E0 and W are 0 (energy from nothing); 0 when nothing moves. */
+double pm_energy_error(double E0, double E, double D, double W);
+
+/* What a backend reports after each step of its time loop. */
+typedef struct {
+  long step;
+  double t, dt;
+  double residual; /* quasi-static residual (0 in dynamics) */
+  double progress; /* fraction of the run done, in [0, 1] */
+} pm_step_report;
+
+/* The run's observer: called after every step (frame false) and on frame
+ * steps and the last step (frame true).  A non-success return stops the
+ * run with that error. */
+typedef struct {
+  void *ctx;
+  pm_err (*step)(void *ctx, const pm_step_report *r, bool frame);
+} pm_observer;
+
+/* The points a run writes and measures: n reference positions [n][3] and,
+ * for a mesh, its cells (nodes_per_cell indices each; NULL for a point
+ * cloud).  Borrowed from the backend. */
+typedef struct {
+  long n;
+  const double *x;
+  long n_cells;
+  int nodes_per_cell;
+  const long *cells;
+} pm_points;
+
+/* Columns of a backend's own history (beyond the shared ones). */
+#define PM_HISTORY_MAX 128
+
+typedef struct pm_backend {
+  const char *method;        /* scene name: "fpm" */
+  const char *description;   /* one line: "explicit total-Lagrangian
+                                Fragile Points Method" */
+  const pm_section *section; /* its scene section, or NULL */
+  double dt_safety;          /* its default time.dt_safety */
+  /* Refuse what this method cannot honour in a scene that names it
+   * (fluids in FPM, tractions in MPM, ...), naming the key through
+   * pm_scene_fail.  Called by the loader. */
+  pm_err (*check)(const struct pm_scene *s);
+  /* Set up the discretization, operators and state of a loaded scene
+   * (borrowed until destroy).  *sim is the backend's own. */
+  pm_err (*create)(const struct pm_scene *s, void **sim);
+  void (*destroy)(void *sim);
+  /* Print the pipeline, counts, time step, steps, memory and an estimated
+   * run time, without running. */
+  pm_err (*plan)(void *sim, FILE *out);
+  /* Run the time loop from the initial state to the end (or the
+   * quasi-static state), reporting the initial state (step 0) and every
+   * step to obs, as a frame at step 0, every output.every steps and at
+   * the last step.  Returns
+   * PM_ERR_UNSTABLE (message: step, time, point, position, cause) on a
+   * numerical failure and PM_SUCCESS otherwise (not converging is a
+   * status, see figures). */
+  pm_err (*run)(void *sim, const pm_observer *obs);
+  /* The points the results are written on. */
+  void (*points)(void *sim, pm_points *p);
+  /* The fields of the current state (PM_FIELD_* mask wanted; a backend may
+   * add its own, e.g. fluid pressure) into out[0..max); returns how many.
+   * The data stay valid until the next call. */
+  int (*fields)(void *sim, unsigned wanted, pm_field *out, int max);
+  /* The current displacement of every point, [n][3], borrowed. */
+  const double *(*displacement)(void *sim);
+  /* Figures of the current state and run.  With fields false, only what is
+   * cheap (energies, residual, reactions, J over the run, step counts):
+   * every frame's history row; with true, the field figures too. */
+  void (*figures)(void *sim, pm_figures *f, bool fields);
+  /* The backend's own history columns: names (borrowed) into names[0..max),
+   * returns how many; and their values now. */
+  int (*history_names)(void *sim, const char **names, int max);
+  void (*history_values)(void *sim, double *values);
+  /* Its own members of summary.json, after the shared ones (may be
+   * NULL). */
+  pm_err (*summary)(void *sim, pm_json *j);
+  /* Its stage timers (printed after a run, summed in summary.json). */
+  const pm_timers *(*timers)(void *sim);
+} pm_backend;
+
+/* ---- registry ------------------------------------------------------------ */
+
+/* Register b (idempotent; at most PM_BACKENDS_MAX).  The program registers
+ * its backends before loading a scene. */
+#define PM_BACKENDS_MAX 8
+pm_err pm_backend_register(const pm_backend *b);
+int pm_backend_count(void);
+const pm_backend *pm_backend_at(int k);
+/* The backend of a method name, or NULL. */
+const pm_backend *pm_backend_find(const char *method);
+
+#endif

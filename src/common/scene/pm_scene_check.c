@@ -1,0 +1,241 @@
+/* pm_scene_check: what the key tables cannot say alone: defaults that
+ * depend on other keys, names resolved to indices, and checks across keys,
+ * each failing at the key at fault. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_scene_vocab.h"
+
+#define PATH(buf, ...) (snprintf((buf), sizeof(buf), __VA_ARGS__), (buf))
+
+static pm_err finish_domain(pm_reader *r, pm_scene *s) {
+  char p[PM_SDOC_PATH], what[128];
+  for (int c = 0; c < s->dimension; c++)
+    if (!(s->box_max[c] > s->box_min[c])) {
+      snprintf(what, sizeof what, "a number > domain.box.min.%d (%g)", c,
+               s->box_min[c]);
+      return pm_reader_expected(r, PATH(p, "domain.box.max.%d", c), what);
+    }
+  return PM_SUCCESS;
+}
+
+/* Exactly one shape key; the shape's own checks. */
+static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
+  static const char *const keys[] = {"region", "box", "sphere", "cylinder",
+                                     "mesh"};
+  static const pm_body_shape shapes[] = {PM_BODY_REGION, PM_BODY_BOX,
+                                         PM_BODY_SPHERE, PM_BODY_CYLINDER,
+                                         PM_BODY_MESH};
+  char p[PM_SDOC_PATH];
+  int given = -1;
+  for (int k = 0; k < 5; k++) {
+    if (!pm_reader_has(r, PATH(p, "bodies.%d.%s", i, keys[k]))) continue;
+    if (given >= 0)
+      return pm_reader_fail(r, p, true,
+                            "expected one shape (region, box, sphere, "
+                            "cylinder or mesh), got %s and %s",
+                            keys[given], keys[k]);
+    given = k;
+  }
+  if (given < 0) {
+    b->shape = PM_BODY_DOMAIN;
+    return PM_SUCCESS;
+  }
+  if (given > 0) b->shape = shapes[given]; /* region: set by its reader */
+  switch (b->shape) {
+  case PM_BODY_BOX:
+    for (int c = 0; c < s->dimension; c++)
+      if (!(b->b[c] > b->a[c]))
+        return pm_reader_expected(r, PATH(p, "bodies.%d.box.max.%d", i, c),
+                                  "a number > the box's min");
+    return PM_SUCCESS;
+  case PM_BODY_CYLINDER:
+    if (s->dimension != 3)
+      return pm_reader_fail(r, PATH(p, "bodies.%d.cylinder", i), true,
+                            "expected box, sphere, region or mesh (dimension "
+                            "2), got cylinder");
+    if (!(pm_v_norm(b->b) > 0))
+      return pm_reader_expected(r, PATH(p, "bodies.%d.cylinder.axis", i),
+                                "a non-zero vector (base to top face)");
+    return PM_SUCCESS;
+  case PM_BODY_MESH: {
+    /* Relative to the scene's folder. */
+    const char *slash = strrchr(s->path, '/');
+    size_t dir = (b->mesh[0] != '/' && slash) ? (size_t)(slash - s->path) : 0;
+    size_t len = dir + 1 + strlen(b->mesh) + 1;
+    char *full = malloc(len);
+    PM_CHECK(full, PM_ERR_MEMORY, "cannot copy a mesh path");
+    if (dir)
+      snprintf(full, len, "%.*s/%s", (int)dir, s->path, b->mesh);
+    else
+      snprintf(full, len, "%s", b->mesh);
+    free(b->mesh);
+    b->mesh = full;
+    return PM_SUCCESS;
+  }
+  default: return PM_SUCCESS;
+  }
+}
+
+/* The initial state a body's material needs: density, pressure for
+ * fluids, fibres for anisotropic models. */
+static pm_err finish_body_state(pm_reader *r, int i, pm_scene_body *b,
+                                const pm_scene_material *mat) {
+  char p[PM_SDOC_PATH];
+  const pm_model *md = mat->mat.model;
+  bool fluid = pm_material_is_fluid(&mat->mat);
+  if (isnan(b->density)) b->density = mat->mat.density;
+  if (pm_reader_has(r, PATH(p, "bodies.%d.pressure", i))) {
+    if (!fluid)
+      return pm_reader_fail(r, p, true,
+                            "expected a key of a solid body (material, shape, "
+                            "velocity, density, fibres), got pressure "
+                            "(material %s is not a fluid)",
+                            mat->name);
+    if (!(b->pressure + mat->mat.fluid.p_inf > 0))
+      return pm_reader_expected(r, p, "a pressure > -p_inf of the material");
+  } else if (fluid) {
+    return pm_reader_fail(r, PATH(p, "bodies.%d", i), false,
+                          "missing required key pressure (a body of fluid "
+                          "%s needs its initial pressure, Pa)",
+                          mat->name);
+  }
+  int nf = b->point.n_fibres;
+  if (nf > md->fibres_max) {
+    if (md->fibres_max == 0)
+      return pm_reader_fail(r, PATH(p, "bodies.%d.fibres", i), true,
+                            "expected no fibres (model %s of material %s "
+                            "takes none), got %d",
+                            md->name, mat->name, nf);
+    return pm_reader_fail(r, PATH(p, "bodies.%d.fibres", i), false,
+                          "expected at most %d fibre directions (model %s), "
+                          "got %d",
+                          md->fibres_max, md->name, nf);
+  }
+  if (nf < md->fibres_min)
+    return pm_reader_fail(r, PATH(p, "bodies.%d", i), false,
+                          "missing required key fibres (model %s of material "
+                          "%s needs %d to %d fibre directions)",
+                          md->name, mat->name, md->fibres_min, md->fibres_max);
+  return PM_SUCCESS;
+}
+
+static pm_err finish_bodies(pm_reader *r, pm_scene *s) {
+  char p[PM_SDOC_PATH], what[PM_SDOC_WHERE];
+  if (s->n_bodies == 0) {
+    /* materials[0] over the whole domain. */
+    const pm_scene_material *mat = &s->materials[0];
+    if (pm_material_is_fluid(&mat->mat))
+      return pm_reader_fail(r, "materials.0", false,
+                            "expected bodies: a fluid needs a body with its "
+                            "initial pressure (bodies: [{material: %s, "
+                            "pressure: ...}])",
+                            mat->name);
+    PM_CALL(PM_ALLOC(s->bodies, 1, "scene bodies"));
+    s->n_bodies = 1;
+    s->bodies[0].density = NAN;
+    s->bodies[0].pressure = NAN;
+    return finish_body_state(r, 0, &s->bodies[0], mat);
+  }
+  for (int i = 0; i < s->n_bodies; i++) {
+    pm_scene_body *b = &s->bodies[i];
+    int m = 0;
+    while (m < s->n_materials && strcmp(s->materials[m].name, b->material_name))
+      m++;
+    if (m == s->n_materials) {
+      size_t used = (size_t)snprintf(what, sizeof what, "a material name (");
+      for (int j = 0; j < s->n_materials && used < sizeof what; j++)
+        used += (size_t)snprintf(what + used, sizeof what - used, "%s%s",
+                                 j ? ", " : "", s->materials[j].name);
+      if (used < sizeof what) snprintf(what + used, sizeof what - used, ")");
+      return pm_reader_expected(r, PATH(p, "bodies.%d.material", i), what);
+    }
+    b->material = m;
+    b->mark = pm_sdoc_mark(
+        r->doc, pm_sdoc_find(r->doc, PATH(p, "bodies.%d", i), false));
+    PM_CALL(finish_shape(r, s, i, b));
+    PM_CALL(finish_body_state(r, i, b, &s->materials[m]));
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err finish_time(pm_reader *r, pm_scene *s) {
+  if (isnan(s->time.ramp)) s->time.ramp = s->time.end / 2;
+  if (s->time.qs == PM_QS_DAMPING && !(s->time.qs_damping > 0)) {
+    if (pm_reader_has(r, "time.quasi_static.damping"))
+      return pm_reader_expected(r, "time.quasi_static.damping",
+                                "a number > 0 (method damping)");
+    return pm_reader_fail(r, "time.quasi_static.damping", false,
+                          "missing required key (method damping needs a "
+                          "damping rate > 0, 1/s)");
+  }
+  return PM_SUCCESS;
+}
+
+/* Where the condition acts: on a face or a named surface, or a region. */
+static pm_err finish_on(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc) {
+  char p[PM_SDOC_PATH];
+  bool has_on = bc->surface != NULL, has_region = bc->region != NULL;
+  if (has_on == has_region) {
+    if (has_on)
+      return pm_reader_fail(r, PATH(p, "boundary.%d.region", i), true,
+                            "expected on or region, got both");
+    return pm_reader_fail(r, PATH(p, "boundary.%d", i), false,
+                          "missing required key on (a face xmin ... zmax or "
+                          "a named surface) or region");
+  }
+  if (has_region) {
+    bc->on = PM_ON_REGION;
+    return PM_SUCCESS;
+  }
+  bc->on = PM_ON_SURFACE;
+  for (int f = 0; f < PM_FACE_COUNT; f++)
+    if (strcmp(bc->surface, pm_face_name(f)) == 0) {
+      if (f >= 2 * s->dimension)
+        return pm_reader_expected(r, PATH(p, "boundary.%d.on", i),
+                                  "one of xmin, xmax, ymin, ymax (dimension "
+                                  "2)");
+      bc->on = PM_ON_FACE;
+      bc->face = (pm_face)f;
+    }
+  return PM_SUCCESS;
+}
+
+static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
+  char p[PM_SDOC_PATH];
+  for (int i = 0; i < s->n_bcs; i++) {
+    pm_scene_bc *bc = &s->bcs[i];
+    bc->mark = pm_sdoc_mark(
+        r->doc, pm_sdoc_find(r->doc, PATH(p, "boundary.%d", i), false));
+    PM_CALL(finish_on(r, s, i, bc));
+    if (!bc->disp_mask && !bc->traction_mask && !bc->velocity_mask &&
+        !bc->absorbing)
+      return pm_reader_fail(r, PATH(p, "boundary.%d", i), false,
+                            "expected a displacement, traction or velocity "
+                            "component, or absorbing: true, got none");
+    static const char *const other[] = {"velocity", "traction"};
+    unsigned both[2] = {bc->disp_mask & bc->velocity_mask,
+                        bc->disp_mask & bc->traction_mask};
+    for (int k = 0; k < 2; k++)
+      for (int c = 0; c < 3; c++)
+        if (both[k] & (1u << c))
+          return pm_reader_fail(
+              r, PATH(p, "boundary.%d.%s.%c", i, other[k], "xyz"[c]), true,
+              "expected a component not prescribed as displacement, got %c "
+              "(also in boundary.%d.displacement)",
+              "xyz"[c], i);
+    if (isnan(bc->ramp_time)) bc->ramp_time = s->time.ramp;
+  }
+  return PM_SUCCESS;
+}
+
+pm_err pm_scene_finish(pm_reader *r, pm_scene *s) {
+  PM_CALL(finish_domain(r, s));
+  PM_CALL(finish_bodies(r, s));
+  PM_CALL(finish_time(r, s));
+  PM_CALL(finish_bcs(r, s));
+  s->has_gravity = pm_v_norm(s->gravity) > 0;
+  return PM_SUCCESS;
+}

@@ -1,0 +1,591 @@
+/* pm_scene_vocab: the shared scene vocabulary as key tables (each key once,
+ * with its default, range, unit and meaning), the readers of the keys a
+ * table cannot describe alone (materials, whose keys depend on their
+ * model; fibres), and the checks across keys. */
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_scene_vocab.h"
+
+/* ---- names -------------------------------------------------------------- */
+
+static const pm_name ramp_names[] = {{"smooth", PM_RAMP_SMOOTH},
+                                     {"linear", PM_RAMP_LINEAR},
+                                     {"none", PM_RAMP_NONE},
+                                     {NULL, 0}};
+static const pm_name qs_names[] = {
+    {"none", PM_QS_NONE},
+    {"dynamic-relaxation", PM_QS_DYNAMIC_RELAXATION},
+    {"damping", PM_QS_DAMPING},
+    {NULL, 0}};
+static const pm_name dt_rule_names[] = {
+    {"paper", PM_DT_PAPER}, {"spectral", PM_DT_SPECTRAL}, {NULL, 0}};
+static const pm_name field_names[] = {
+    {"displacement", PM_FIELD_DISPLACEMENT},
+    {"velocity", PM_FIELD_VELOCITY},
+    {"stress", PM_FIELD_STRESS},
+    {"strain_energy_density", PM_FIELD_STRAIN_ENERGY_DENSITY},
+    {"jacobian", PM_FIELD_JACOBIAN},
+    {"force", PM_FIELD_FORCE},
+    {NULL, 0}};
+
+#define S(field) offsetof(pm_scene, field)
+#define B(field) offsetof(pm_scene_body, field)
+#define C(field) offsetof(pm_scene_bc, field)
+#define M(field) offsetof(pm_scene_material, field)
+
+/* ---- custom readers ----------------------------------------------------- */
+
+static pm_err read_dimension(pm_reader *r, int id, const char *path,
+                             const pm_key *k, void *dst) {
+  (void)k;
+  const char *v = pm_sdoc_scalar(r->doc, id);
+  if (!v || (strcmp(v, "2") && strcmp(v, "3")))
+    return pm_reader_expected(r, path, "2 or 3");
+  *(int *)dst = v[0] - '0';
+  r->dimension = *(int *)dst;
+  return PM_SUCCESS;
+}
+
+/* fibres: [[ax, ay, az], ...]: 1 to PM_FIBRES_MAX non-zero directions,
+ * normalized. */
+static pm_err read_fibres(pm_reader *r, int id, const char *path,
+                          const pm_key *k, void *dst) {
+  (void)k;
+  typedef struct {
+    double v[3];
+    int n;
+  } dir3;
+  static const pm_key dir = {.name = "fibre",
+                             .type = PM_KEY_NUMBERS,
+                             .count_offset = offsetof(dir3, n),
+                             .min_count = 3,
+                             .max_count = 3};
+  pm_material_point *pt = dst;
+  char sub[PM_SDOC_PATH];
+  int n = pm_sdoc_count(r->doc, id);
+  if (pm_sdoc_kind_of(r->doc, id) != PM_SDOC_LIST || n < 1 || n > PM_FIBRES_MAX)
+    return pm_reader_expected(r, path,
+                              "a list of 1 or 2 directions [ax, ay, az]");
+  pt->n_fibres = n;
+  for (int f = 0; f < n; f++) {
+    dir3 d;
+    snprintf(sub, sizeof sub, "%s.%d", path, f);
+    PM_CALL(pm_reader_value(r, pm_sdoc_item(r->doc, id, f), sub, &dir, &d));
+    double len = pm_v_norm(d.v);
+    if (!(len > 0)) return pm_reader_expected(r, sub, "a non-zero direction");
+    for (int c = 0; c < 3; c++) pt->fibres[f][c] = d.v[c] / len;
+  }
+  return PM_SUCCESS;
+}
+
+/* region: an expression in x, y, z (inside where > 0), or the word
+ * domain. */
+static pm_err read_region(pm_reader *r, int id, const char *path,
+                          const pm_key *k, void *dst) {
+  (void)k;
+  pm_scene_body *b = (pm_scene_body *)((char *)dst - B(region));
+  const char *text = pm_sdoc_scalar(r->doc, id);
+  if (!text || !text[0])
+    return pm_reader_expected(r, path, "an expression in x, y, z, or domain");
+  if (strcmp(text, "domain") == 0) {
+    b->shape = PM_BODY_DOMAIN;
+    return PM_SUCCESS;
+  }
+  b->shape = PM_BODY_REGION;
+  return pm_reader_expr(r, id, path, text, "xyz", &b->region);
+}
+
+static const pm_key av_keys[] = {{.name = "c0",
+                                  .type = PM_KEY_NUMBER,
+                                  .offset = M(av_c0),
+                                  .def = "0",
+                                  .range = PM_RANGE_GE,
+                                  .unit = "",
+                                  .doc = "quadratic coefficient of eq. 32"},
+                                 {.name = "c1",
+                                  .type = PM_KEY_NUMBER,
+                                  .offset = M(av_c1),
+                                  .def = "0",
+                                  .range = PM_RANGE_GE,
+                                  .unit = "",
+                                  .doc = "linear coefficient of eq. 32"},
+                                 {0}};
+
+/* The keys every material has; the rest are its model's. */
+static const pm_key material_keys[] = {
+    {.name = "name",
+     .type = PM_KEY_STRING,
+     .offset = M(name),
+     .flags = PM_KEY_REQUIRED,
+     .doc = "what bodies call it"},
+    {.name = "model",
+     .type = PM_KEY_CUSTOM,
+     .flags = PM_KEY_REQUIRED,
+     .read = NULL, /* read first, by read_materials */
+     .doc = "an entry of the table of constitutive models"},
+    {.name = "density",
+     .type = PM_KEY_NUMBER,
+     .offset = M(mat) + offsetof(pm_material, density),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .unit = "kg/m^3",
+     .doc = "reference density"},
+    {.name = "artificial_viscosity",
+     .type = PM_KEY_MAPPING,
+     .keys = av_keys,
+     .doc = "shock viscosity of eq. 32 {c0, c1} (MPM)"},
+    {0}};
+
+static pm_err skip_value(pm_reader *r, int id, const char *path,
+                         const pm_key *k, void *dst) {
+  (void)r, (void)id, (void)path, (void)k, (void)dst;
+  return PM_SUCCESS;
+}
+
+/* One material: its model first (the keys it takes depend on it), then
+ * every key against the common and the model's tables, then the model's
+ * checks, located at the key they name. */
+static pm_err read_material(pm_reader *r, int id, const char *path,
+                            pm_scene_material *out) {
+  char sub[PM_SDOC_PATH], names[512], expected[1024];
+  if (pm_sdoc_kind_of(r->doc, id) != PM_SDOC_MAPPING)
+    return pm_reader_expected(r, path, "a mapping");
+  out->mark = pm_sdoc_mark(r->doc, id);
+  snprintf(sub, sizeof sub, "%s.model", path);
+  int mid = pm_sdoc_child(r->doc, id, "model");
+  if (!mid) return pm_reader_fail(r, sub, false, "missing required key");
+  const char *model = pm_sdoc_scalar(r->doc, mid);
+  pm_model_names(names, sizeof names);
+  if (!model || !pm_model_find(model)) {
+    snprintf(expected, sizeof expected, "one of %s", names);
+    return pm_reader_expected(r, sub, expected);
+  }
+  PM_CALL(pm_material_begin(&out->mat, model, NAN));
+  const pm_model *md = out->mat.model;
+  pm_key common[sizeof material_keys / sizeof *material_keys];
+  memcpy(common, material_keys, sizeof material_keys);
+  common[1].read = skip_value;
+  size_t used = (size_t)snprintf(expected, sizeof expected,
+                                 "name, model, density, "
+                                 "artificial_viscosity, and model %s's ",
+                                 md->name);
+  for (const pm_key *k = md->keys; k->type != PM_KEY_END; k++)
+    used += (size_t)snprintf(expected + used, sizeof expected - used, "%s%s",
+                             k == md->keys ? "" : ", ", k->name);
+  const pm_key *tables[2] = {common, md->keys};
+  void *bases[2] = {out, &out->mat};
+  PM_CALL(pm_reader_mapping(r, id, path, 2, tables, bases, expected));
+  const char *bad = NULL;
+  if (md->init(&out->mat, &bad) != PM_SUCCESS) {
+    char msg[PM_SDOC_WHERE];
+    snprintf(msg, sizeof msg, "%s", pm_error_message());
+    if (bad) {
+      snprintf(sub, sizeof sub, "%s.%s", path, bad);
+      return pm_reader_fail(r, sub, false, "%s", msg);
+    }
+    return pm_reader_fail(r, path, false, "%s (model %s takes %s)", msg,
+                          md->name, md->key_sets ? md->key_sets : "its keys");
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err read_materials(pm_reader *r, int id, const char *path,
+                             const pm_key *k, void *dst) {
+  (void)k;
+  pm_scene *s = (pm_scene *)((char *)dst - S(materials));
+  char sub[PM_SDOC_PATH];
+  if (pm_sdoc_kind_of(r->doc, id) != PM_SDOC_LIST ||
+      pm_sdoc_count(r->doc, id) < 1)
+    return pm_reader_expected(r, path, "a list of at least one material");
+  int n = pm_sdoc_count(r->doc, id);
+  PM_CALL(PM_ALLOC(s->materials, n, "scene materials"));
+  s->n_materials = n;
+  for (int i = 0; i < n; i++) {
+    snprintf(sub, sizeof sub, "%s.%d", path, i);
+    PM_CALL(
+        read_material(r, pm_sdoc_item(r->doc, id, i), sub, &s->materials[i]));
+    for (int j = 0; j < i; j++)
+      if (strcmp(s->materials[j].name, s->materials[i].name) == 0) {
+        snprintf(sub, sizeof sub, "%s.%d.name", path, i);
+        return pm_reader_expected(r, sub,
+                                  "a name not used by an earlier material");
+      }
+  }
+  return PM_SUCCESS;
+}
+
+/* ---- tables ------------------------------------------------------------- */
+
+static const pm_key box_keys[] = {{.name = "min",
+                                   .type = PM_KEY_POINT,
+                                   .offset = S(box_min),
+                                   .flags = PM_KEY_REQUIRED,
+                                   .unit = "m",
+                                   .doc = "lower corner"},
+                                  {.name = "max",
+                                   .type = PM_KEY_POINT,
+                                   .offset = S(box_max),
+                                   .flags = PM_KEY_REQUIRED,
+                                   .unit = "m",
+                                   .doc = "upper corner"},
+                                  {0}};
+
+static const pm_key domain_keys[] = {
+    {.name = "box",
+     .type = PM_KEY_MAPPING,
+     .flags = PM_KEY_REQUIRED,
+     .keys = box_keys,
+     .doc = "FPM: the block meshed; MPM: the grid (faces on grid planes)"},
+    {0}};
+
+static const pm_key discretization_keys[] = {
+    {.name = "mesh_size",
+     .type = PM_KEY_NUMBER,
+     .offset = S(mesh_size),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .unit = "m",
+     .doc = "FPM: gmsh element size; MPM: cell size"},
+    {0}};
+
+static const pm_key body_box_keys[] = {{.name = "min",
+                                        .type = PM_KEY_POINT,
+                                        .offset = B(a),
+                                        .flags = PM_KEY_REQUIRED,
+                                        .unit = "m"},
+                                       {.name = "max",
+                                        .type = PM_KEY_POINT,
+                                        .offset = B(b),
+                                        .flags = PM_KEY_REQUIRED,
+                                        .unit = "m"},
+                                       {0}};
+static const pm_key sphere_keys[] = {{.name = "center",
+                                      .type = PM_KEY_POINT,
+                                      .offset = B(a),
+                                      .flags = PM_KEY_REQUIRED,
+                                      .unit = "m"},
+                                     {.name = "radius",
+                                      .type = PM_KEY_NUMBER,
+                                      .offset = B(radius),
+                                      .flags = PM_KEY_REQUIRED,
+                                      .range = PM_RANGE_GT,
+                                      .unit = "m"},
+                                     {0}};
+static const pm_key cylinder_keys[] = {
+    {.name = "base",
+     .type = PM_KEY_NUMBERS,
+     .offset = B(a),
+     .flags = PM_KEY_REQUIRED,
+     .min_count = 3,
+     .max_count = 3,
+     .count_offset = B(n_cylinder),
+     .unit = "m",
+     .doc = "centre of the base face"},
+    {.name = "axis",
+     .type = PM_KEY_NUMBERS,
+     .offset = B(b),
+     .flags = PM_KEY_REQUIRED,
+     .min_count = 3,
+     .max_count = 3,
+     .count_offset = B(n_cylinder),
+     .unit = "m",
+     .doc = "from the base face's centre to the top face's"},
+    {.name = "radius",
+     .type = PM_KEY_NUMBER,
+     .offset = B(radius),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .unit = "m"},
+    {0}};
+
+static const pm_key body_keys[] = {
+    {.name = "material",
+     .type = PM_KEY_STRING,
+     .offset = B(material_name),
+     .flags = PM_KEY_REQUIRED,
+     .doc = "the name of a material"},
+    {.name = "region",
+     .type = PM_KEY_CUSTOM,
+     .offset = B(region),
+     .read = read_region,
+     .doc = "inside where f(x, y, z) > 0 (or: domain)"},
+    {.name = "box",
+     .type = PM_KEY_MAPPING,
+     .keys = body_box_keys,
+     .doc = "{min, max}"},
+    {.name = "sphere",
+     .type = PM_KEY_MAPPING,
+     .keys = sphere_keys,
+     .doc = "{center, radius} (a disk in 2D)"},
+    {.name = "cylinder",
+     .type = PM_KEY_MAPPING,
+     .keys = cylinder_keys,
+     .doc = "{base, axis, radius} (3D)"},
+    {.name = "mesh",
+     .type = PM_KEY_STRING,
+     .offset = B(mesh),
+     .doc = "a gmsh-readable volume (.msh .geo .step .brep), relative to the "
+            "scene"},
+    {.name = "velocity",
+     .type = PM_KEY_POINT,
+     .offset = B(velocity),
+     .unit = "m/s",
+     .doc = "initial velocity (MPM)"},
+    {.name = "density",
+     .type = PM_KEY_NUMBER,
+     .offset = B(density),
+     .def = "nan",
+     .range = PM_RANGE_GT,
+     .unit = "kg/m^3",
+     .doc = "initial density (MPM; default: the material's)"},
+    {.name = "pressure",
+     .type = PM_KEY_NUMBER,
+     .offset = B(pressure),
+     .def = "nan",
+     .unit = "Pa",
+     .doc = "initial pressure (fluids)"},
+    {.name = "fibres",
+     .type = PM_KEY_CUSTOM,
+     .offset = B(point),
+     .read = read_fibres,
+     .what = "a list of 1 or 2 directions [ax, ay, az]",
+     .doc = "fibre directions [[ax, ay, az], ...] (anisotropic models)"},
+    {0}};
+
+static const pm_key bc_keys[] = {
+    {.name = "on",
+     .type = PM_KEY_STRING,
+     .offset = C(surface),
+     .doc = "xmin, xmax, ymin, ymax, zmin, zmax, or a named surface"},
+    {.name = "region",
+     .type = PM_KEY_EXPR,
+     .offset = C(region),
+     .flags = PM_KEY_NO_T,
+     .doc = "the boundary where f(x, y, z) > 0 (instead of on)"},
+    {.name = "displacement",
+     .type = PM_KEY_COMPONENTS,
+     .offset = C(disp),
+     .count_offset = C(disp_mask),
+     .unit = "m",
+     .doc = "prescribed components at full load, f(x, y, z, t)"},
+    {.name = "traction",
+     .type = PM_KEY_COMPONENTS,
+     .offset = C(traction),
+     .count_offset = C(traction_mask),
+     .unit = "Pa",
+     .doc = "nominal traction at full load (FPM)"},
+    {.name = "velocity",
+     .type = PM_KEY_COMPONENTS,
+     .offset = C(velocity),
+     .count_offset = C(velocity_mask),
+     .unit = "m/s",
+     .doc = "prescribed velocity (MPM)"},
+    {.name = "absorbing",
+     .type = PM_KEY_BOOL,
+     .offset = C(absorbing),
+     .def = "false",
+     .doc = "viscous (absorbing) boundary (MPM)"},
+    {.name = "ramp",
+     .type = PM_KEY_ENUM,
+     .offset = C(ramp),
+     .def = "smooth",
+     .names = ramp_names,
+     .doc = "smooth: 10 s^3 - 15 s^4 + 6 s^5; linear: s; none: 1"},
+    {.name = "ramp_time",
+     .type = PM_KEY_NUMBER,
+     .offset = C(ramp_time),
+     .def = "nan",
+     .range = PM_RANGE_GT,
+     .unit = "s",
+     .doc = "ramp duration (default: time.ramp)"},
+    {0}};
+
+static const pm_key quasi_static_keys[] = {
+    {.name = "method",
+     .type = PM_KEY_ENUM,
+     .offset = S(time.qs),
+     .def = "none",
+     .names = qs_names,
+     .doc = "none, dynamic-relaxation (adaptive damping) or damping"},
+    {.name = "tolerance",
+     .type = PM_KEY_NUMBER,
+     .offset = S(time.qs_tolerance),
+     .def = "1e-8",
+     .range = PM_RANGE_GT,
+     .unit = "",
+     .doc = "stop when the residual over the reactions falls below it"},
+    {.name = "damping",
+     .type = PM_KEY_NUMBER,
+     .offset = S(time.qs_damping),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .unit = "1/s",
+     .doc = "mass-proportional damping rate (method damping)"},
+    {0}};
+
+static const pm_key time_keys[] = {
+    {.name = "end",
+     .type = PM_KEY_NUMBER,
+     .offset = S(time.end),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .unit = "s",
+     .doc = "the longest a run may go"},
+    {.name = "dt",
+     .type = PM_KEY_NUMBER,
+     .offset = S(time.dt),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .unit = "s",
+     .doc = "> 0 forces a step; 0: the stable step"},
+    {.name = "dt_safety",
+     .type = PM_KEY_NUMBER,
+     .offset = S(time.dt_safety),
+     .def = "nan",
+     .range = PM_RANGE_GT | PM_RANGE_LE,
+     .hi = 1,
+     .unit = "",
+     .doc = "dt = dt_safety x stable step (default: the method's)"},
+    {.name = "dt_rule",
+     .type = PM_KEY_ENUM,
+     .offset = S(time.dt_rule),
+     .def = "paper",
+     .names = dt_rule_names,
+     .doc = "paper: the method's bound; spectral: measured (FPM)"},
+    {.name = "ramp",
+     .type = PM_KEY_NUMBER,
+     .offset = S(time.ramp),
+     .def = "nan",
+     .range = PM_RANGE_GT,
+     .unit = "s",
+     .doc = "default ramp duration (default: end / 2)"},
+    {.name = "max_steps",
+     .type = PM_KEY_INTEGER,
+     .offset = S(time.max_steps),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .doc = "0: no limit"},
+    {.name = "quasi_static",
+     .type = PM_KEY_MAPPING,
+     .keys = quasi_static_keys,
+     .doc = "{method, tolerance, damping}"},
+    {0}};
+
+static const pm_key output_keys[] = {
+    {.name = "every",
+     .type = PM_KEY_INTEGER,
+     .offset = S(output.every),
+     .def = "100",
+     .range = PM_RANGE_GT,
+     .doc = "a frame every N steps"},
+    {.name = "fields",
+     .type = PM_KEY_FLAGS,
+     .offset = S(output.fields),
+     .def = "displacement, stress, strain_energy_density",
+     .min_count = 1,
+     .names = field_names,
+     .doc = "fields written in each frame"},
+    {0}};
+
+static const pm_key stability_keys[] = {
+    {.name = "min_jacobian",
+     .type = PM_KEY_NUMBER,
+     .offset = S(stability.min_jacobian),
+     .def = "0",
+     .range = PM_RANGE_GE | PM_RANGE_LT,
+     .hi = 1,
+     .unit = "",
+     .doc = "stop when some J falls to or below it"},
+    {.name = "max_energy_error",
+     .type = PM_KEY_NUMBER,
+     .offset = S(stability.max_energy_error),
+     .def = "0.1",
+     .range = PM_RANGE_GT,
+     .unit = "",
+     .doc = "stop when the energy-balance error exceeds it (FPM)"},
+    {0}};
+
+static const pm_key reference_keys[] = {
+    {.name = "displacement",
+     .type = PM_KEY_COMPONENTS,
+     .offset = S(reference),
+     .count_offset = S(reference_mask),
+     .unit = "m",
+     .doc = "analytic u(x, y, z, t): NRMSE in summary and history"},
+    {0}};
+
+const pm_key pm_scene_keys[] = {
+    {.name = "name",
+     .type = PM_KEY_STRING,
+     .offset = S(name),
+     .flags = PM_KEY_REQUIRED,
+     .doc = "the output folder's name"},
+    {.name = "method",
+     .type = PM_KEY_STRING,
+     .offset = S(method),
+     .flags = PM_KEY_REQUIRED,
+     .doc = "a registered method (fpm, mpm)"},
+    {.name = "dimension",
+     .type = PM_KEY_CUSTOM,
+     .offset = S(dimension),
+     .flags = PM_KEY_REQUIRED,
+     .read = read_dimension,
+     .doc = "3, or 2 for plane strain"},
+    {.name = "domain",
+     .type = PM_KEY_MAPPING,
+     .flags = PM_KEY_REQUIRED,
+     .keys = domain_keys,
+     .doc = "{box: {min, max}}"},
+    {.name = "discretization",
+     .type = PM_KEY_MAPPING,
+     .flags = PM_KEY_REQUIRED,
+     .keys = discretization_keys,
+     .doc = "{mesh_size}"},
+    {.name = "materials",
+     .type = PM_KEY_CUSTOM,
+     .offset = S(materials),
+     .flags = PM_KEY_REQUIRED,
+     .read = read_materials,
+     .doc = "[{name, model, density, ...the model's keys}]"},
+    {.name = "bodies",
+     .type = PM_KEY_LIST,
+     .offset = S(bodies),
+     .count_offset = S(n_bodies),
+     .elem_size = sizeof(pm_scene_body),
+     .min_count = 1,
+     .keys = body_keys,
+     .doc = "[{material, shape, ...}]; later bodies take precedence"},
+    {.name = "time",
+     .type = PM_KEY_MAPPING,
+     .flags = PM_KEY_REQUIRED,
+     .keys = time_keys,
+     .doc = "{end, dt, dt_safety, ...}"},
+    {.name = "boundary",
+     .type = PM_KEY_LIST,
+     .offset = S(bcs),
+     .count_offset = S(n_bcs),
+     .elem_size = sizeof(pm_scene_bc),
+     .keys = bc_keys,
+     .doc = "[{on, displacement | traction | ...}]"},
+    {.name = "gravity",
+     .type = PM_KEY_POINT,
+     .offset = S(gravity),
+     .unit = "m/s^2",
+     .doc = "body force per mass (MPM)"},
+    {.name = "output",
+     .type = PM_KEY_MAPPING,
+     .keys = output_keys,
+     .doc = "{every, fields}"},
+    {.name = "stability",
+     .type = PM_KEY_MAPPING,
+     .keys = stability_keys,
+     .doc = "{min_jacobian, max_energy_error}"},
+    {.name = "reference",
+     .type = PM_KEY_MAPPING,
+     .keys = reference_keys,
+     .doc = "{displacement: {x, y, z}}"},
+    {0}};

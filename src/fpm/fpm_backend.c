@@ -1,0 +1,445 @@
+/* fpm_backend: sets up an FPM simulation from a scene and runs it for the
+ * run driver (pm_run): observer, fields, figures, history, summary and the
+ * plan. */
+#include "fpm_backend.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_gfd.h"
+#include "fpm_scene.h"
+#include "gm_cells.h"
+#include "pm_files.h"
+#include "pm_omp.h"
+#include "pm_tensor.h"
+
+void fpm_sim_destroy(fpm_sim *sim) {
+  if (!sim) return;
+  fpm_state_destroy(sim->state);
+  fpm_model_destroy(sim->model);
+  gm_dual_destroy(sim->dual);
+  gm_mesh_destroy(sim->mesh);
+  free(sim->scratch);
+  free(sim);
+}
+
+pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
+  pm_err ret = PM_SUCCESS;
+  fpm_sim *sim = NULL;
+  *out = NULL;
+  PM_ENSURE(s->method && strcmp(s->method, "fpm") == 0, PM_ERR_ARG,
+            "fpm_sim_create: scene %s has method %s", s->path,
+            s->method ? s->method : "(none)");
+  PM_TRY(PM_ALLOC(sim, 1, "FPM simulation"));
+  sim->scene = s;
+  pm_timers_init(&sim->timers);
+  sim->tm_mesh = pm_timers_add(&sim->timers, "mesh (gmsh)");
+  sim->tm_dual = pm_timers_add(&sim->timers, "subdomains");
+  sim->tm_operators = pm_timers_add(&sim->timers, "GFD operators and BCs");
+  sim->tm_force = pm_timers_add(&sim->timers, "internal force");
+  sim->tm_update = pm_timers_add(&sim->timers, "time integration");
+  double t0 = pm_wtime();
+  pm_timers_start(&sim->timers, sim->tm_mesh);
+  /* The domain: the box, or the scene's one gmsh volume. */
+  int domain = fpm_domain_body(s);
+  if (domain >= 0)
+    PM_TRY(gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
+                        &sim->mesh));
+  else
+    PM_TRY(gm_mesh_box(s->dimension, s->box_min, s->box_max, s->mesh_size,
+                       &sim->mesh));
+  pm_timers_stop(&sim->timers, sim->tm_mesh);
+  sim->mean_edge = gm_mesh_mean_edge(sim->mesh);
+  pm_timers_start(&sim->timers, sim->tm_dual);
+  const fpm_options *o = fpm_scene_options(s);
+  sim->cells = gm_cells_find(o->cells);
+  PM_TRY(sim->cells->build(sim->mesh, &sim->dual));
+  pm_timers_stop(&sim->timers, sim->tm_dual);
+  pm_timers_start(&sim->timers, sim->tm_operators);
+  PM_TRY(fpm_model_create(s, o, sim->mesh, sim->dual, &sim->model));
+  PM_TRY(fpm_state_create(sim->model, &sim->state));
+  PM_TRY(PM_ALLOC(sim->scratch, 9 * sim->model->n, "output buffer"));
+  sim->dt_paper = fpm_stable_dt(sim->model, &sim->dt_point);
+  sim->dt_stable = sim->dt_paper;
+  if (s->time.dt_rule == PM_DT_SPECTRAL) {
+    fpm_sim_measure_spectrum(sim);
+    sim->dt_stable = sim->dt_spectral;
+  }
+  sim->dt = s->time.dt > 0 ? s->time.dt : s->time.dt_safety * sim->dt_stable;
+  pm_timers_stop(&sim->timers, sim->tm_operators);
+  sim->setup_wall = pm_wtime() - t0;
+  *out = sim;
+  sim = NULL;
+done:
+  fpm_sim_destroy(sim);
+  return ret;
+}
+
+/* Power iterations for the spectral radius: the Rayleigh quotient
+ * approaches it from below, to within a percent on the meshes tried. */
+#define FPM_SPECTRAL_ITERATIONS 100
+
+void fpm_sim_measure_spectrum(fpm_sim *sim) {
+  if (sim->dt_spectral > 0) return;
+  double lambda;
+  sim->dt_spectral = fpm_spectral_dt(
+      sim->model, sim->state, FPM_SPECTRAL_ITERATIONS, sim->scratch, &lambda);
+}
+
+/* Cauchy stress sigma = P F^T / J per point into scratch. */
+static void cauchy_stress(const fpm_model *m, const fpm_state *st,
+                          double *sig) {
+  const long n = m->n;
+  PM_OMP(parallel for schedule(static) default(none) shared(n, st, sig))
+  for (long i = 0; i < n; i++) {
+    double F[9], FT[9];
+    for (int a = 0; a < 9; a++) F[a] = st->H[9 * i + a];
+    F[0] += 1;
+    F[4] += 1;
+    F[8] += 1;
+    pm_t_transpose(F, FT);
+    pm_t_mul(st->P + 9 * i, FT, sig + 9 * i);
+    for (int a = 0; a < 9; a++) sig[9 * i + a] /= st->J[i];
+  }
+}
+
+long fpm_sim_conditioning(const fpm_sim *sim, double *worst,
+                          long *worst_point) {
+  const fpm_model *m = sim->model;
+  return fpm_gfd_deformed_condition(m->dim, m->n, m->x, sim->state->u,
+                                    m->nbr_ptr, sim->dual->nbr, FPM_COND_MAX,
+                                    worst, worst_point);
+}
+
+/* ---- run ---------------------------------------------------------------- */
+
+/* Each step of fpm_run: the run's figures, and the report to the run's
+ * observer with a progress fraction (time, or the residual's way to its
+ * tolerance once the loads are on). */
+static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
+                      const fpm_step_info *info, bool frame) {
+  fpm_sim *sim = ctx;
+  const pm_scene *s = sim->scene;
+  (void)m;
+  (void)st;
+  sim->last = *info;
+  if (info->min_jacobian < sim->run_min_jacobian) {
+    sim->run_min_jacobian = info->min_jacobian;
+    sim->run_min_jacobian_step = info->step;
+  }
+  if (info->energy_checked &&
+      fabs(info->energy_error) > sim->run_max_energy_error)
+    sim->run_max_energy_error = fabs(info->energy_error);
+  double frac = info->t / s->time.end, load_end = sim->load_end;
+  if (s->time.qs != PM_QS_NONE && info->t >= load_end && sim->res0 > 0 &&
+      info->residual > 0) {
+    double q =
+        log(sim->res0 / info->residual) / log(sim->res0 / s->time.qs_tolerance);
+    if (q > frac) frac = q;
+  } else if (info->step > 0 && info->t >= load_end && sim->res0 == 0) {
+    sim->res0 = info->residual;
+  }
+  pm_step_report r = {.step = info->step,
+                      .t = info->t,
+                      .dt = sim->dt,
+                      .residual = info->residual,
+                      .progress = frac};
+  return sim->obs ? sim->obs->step(sim->obs->ctx, &r, frame) : PM_SUCCESS;
+}
+
+static pm_err run(void *p, const pm_observer *obs) {
+  fpm_sim *sim = p;
+  const pm_scene *s = sim->scene;
+  fpm_model *m = sim->model;
+  fpm_run_options opt = {
+      .dt = sim->dt,
+      .t_end = s->time.end,
+      .max_steps = s->time.max_steps,
+      .qs = s->time.qs,
+      .qs_tolerance = s->time.qs_tolerance,
+      .damping = s->time.qs_damping,
+      .frame_every = s->output.every,
+      .min_jacobian = s->stability.min_jacobian,
+      .max_energy_error = s->stability.max_energy_error,
+  };
+  memset(sim->state->u, 0, 3 * m->n * sizeof(double));
+  memset(sim->state->v, 0, 3 * m->n * sizeof(double));
+  sim->run_min_jacobian = INFINITY;
+  sim->run_min_jacobian_step = 0;
+  sim->run_max_energy_error = 0;
+  sim->res0 = 0;
+  sim->load_end = pm_scene_load_end(s);
+  sim->obs = obs;
+  double stage[2] = {0, 0};
+  pm_err e = fpm_run(m, sim->state, &opt, observe, sim, &sim->last, stage);
+  sim->obs = NULL;
+  sim->timers.stage[sim->tm_force].seconds += stage[0];
+  sim->timers.stage[sim->tm_force].calls += sim->last.step + 1;
+  sim->timers.stage[sim->tm_update].seconds += stage[1];
+  sim->timers.stage[sim->tm_update].calls += sim->last.step;
+  if (e == PM_ERR_UNSTABLE)
+    sim->status = PM_STATUS_UNSTABLE;
+  else if (e != PM_SUCCESS)
+    sim->status = PM_STATUS_FAILED;
+  else if (s->time.qs == PM_QS_NONE)
+    sim->status = PM_STATUS_COMPLETED;
+  else
+    sim->status =
+        sim->last.converged ? PM_STATUS_CONVERGED : PM_STATUS_NOT_CONVERGED;
+  return e;
+}
+
+/* ---- what the run driver reads ------------------------------------------ */
+
+static void points(void *p, pm_points *pts) {
+  fpm_sim *sim = p;
+  pts->n = sim->model->n;
+  pts->x = sim->model->x;
+  pts->n_cells = sim->mesh->n_cells;
+  pts->nodes_per_cell = sim->mesh->nodes_per_cell;
+  pts->cells = sim->mesh->cells;
+}
+
+static const double *displacement(void *p) { return ((fpm_sim *)p)->state->u; }
+
+static int fields(void *p, unsigned want, pm_field *out, int max) {
+  fpm_sim *sim = p;
+  const fpm_state *st = sim->state;
+  int nf = 0;
+  if (max < 6) return 0;
+  if (want & PM_FIELD_DISPLACEMENT)
+    out[nf++] = (pm_field){"displacement", 3, st->u};
+  if (want & PM_FIELD_VELOCITY) out[nf++] = (pm_field){"velocity", 3, st->v};
+  if (want & PM_FIELD_STRESS) {
+    cauchy_stress(sim->model, st, sim->scratch);
+    out[nf++] = (pm_field){"stress", 9, sim->scratch};
+  }
+  if (want & PM_FIELD_STRAIN_ENERGY_DENSITY)
+    out[nf++] = (pm_field){"strain_energy_density", 1, st->W};
+  if (want & PM_FIELD_JACOBIAN) out[nf++] = (pm_field){"jacobian", 1, st->J};
+  if (want & PM_FIELD_FORCE) out[nf++] = (pm_field){"force", 3, st->f};
+  return nf;
+}
+
+/* Mean strain energy density, largest von Mises stress and smallest J of
+ * the current fields, with their points. */
+static void field_figures(fpm_sim *sim, pm_figures *f) {
+  const fpm_model *m = sim->model;
+  const fpm_state *st = sim->state;
+  const double *vol = sim->dual->volume, *sig = sim->scratch;
+  cauchy_stress(m, st, sim->scratch);
+  double vsum = 0, wsum = 0;
+  long vm_at = 0, j_at = 0;
+  f->max_von_mises = -1;
+  f->end_min_jacobian = INFINITY;
+  for (long i = 0; i < m->n; i++) {
+    vsum += vol[i];
+    wsum += vol[i] * st->W[i];
+    double vm = pm_t_von_mises(sig + 9 * i);
+    if (vm > f->max_von_mises) {
+      f->max_von_mises = vm;
+      vm_at = i;
+    }
+    if (st->J[i] < f->end_min_jacobian) {
+      f->end_min_jacobian = st->J[i];
+      j_at = i;
+    }
+  }
+  f->mean_sed = vsum > 0 ? wsum / vsum : 0;
+  for (int a = 0; a < 3; a++) {
+    f->max_von_mises_at[a] = m->x[3 * vm_at + a];
+    f->end_min_jacobian_at[a] = m->x[3 * j_at + a];
+  }
+}
+
+static void figures(void *p, pm_figures *f, bool with_fields) {
+  fpm_sim *sim = p;
+  const fpm_model *m = sim->model;
+  const pm_scene *s = sim->scene;
+  const fpm_step_info *l = &sim->last;
+  f->status = sim->status;
+  f->dim = m->dim;
+  f->points = m->n;
+  f->steps = l->step;
+  f->time = l->t;
+  f->h = sim->mean_edge;
+  f->dt = sim->dt;
+  f->dt_stable = sim->dt_stable;
+  f->residual = l->residual;
+  f->kinetic = l->kinetic;
+  f->strain = l->strain;
+  f->internal = 0;
+  f->interface = l->penalty;
+  f->external_work = l->external_work;
+  f->dissipated = l->dissipated;
+  f->energy0 = 0;
+  f->energy_error = fpm_energy_error(l);
+  f->max_energy_error = sim->run_max_energy_error;
+  f->min_jacobian = sim->run_min_jacobian;
+  f->min_jacobian_step = sim->run_min_jacobian_step;
+  f->n_bcs = s->n_bcs;
+  for (int b = 0; b < s->n_bcs && b < PM_FIGURES_MAX_BCS; b++)
+    fpm_reaction(m, sim->state, b, f->reaction[b]);
+  f->setup_seconds = sim->setup_wall;
+  f->step_seconds = pm_timers_seconds(&sim->timers, sim->tm_force) +
+                    pm_timers_seconds(&sim->timers, sim->tm_update);
+  f->memory_bytes = fpm_model_bytes(m) + fpm_state_bytes(m);
+  if (with_fields) field_figures(sim, f);
+}
+
+static const char *const own_cols[] = {"damping", "ill_conditioned"};
+
+static int history_names(void *p, const char **names, int max) {
+  (void)p;
+  int n = 0;
+  for (; n < 2 && n < max; n++) names[n] = own_cols[n];
+  return n;
+}
+
+static void history_values(void *p, double *v) {
+  fpm_sim *sim = p;
+  v[0] = sim->last.damping;
+  v[1] = (double)fpm_sim_conditioning(sim, NULL, NULL);
+}
+
+static pm_err summary(void *p, pm_json *j) {
+  fpm_sim *sim = p;
+  const fpm_model *m = sim->model;
+  const pm_scene *s = sim->scene;
+  double worst;
+  long worst_point;
+  long ill = fpm_sim_conditioning(sim, &worst, &worst_point);
+  PM_CALL(pm_json_integer(j, "cells", sim->mesh->n_cells));
+  PM_CALL(pm_json_integer(j, "interfaces", sim->dual->n_ifaces));
+  PM_CALL(pm_json_integer(j, "boundary_facets", sim->dual->n_facets));
+  PM_CALL(pm_json_integer(j, "prescribed_dofs", m->n_cdofs));
+  PM_CALL(pm_json_number(j, "mesh_size", s->mesh_size));
+  PM_CALL(pm_json_number(j, "mean_edge_length", sim->mean_edge));
+  PM_CALL(pm_json_number(j, "penalty", m->penalty));
+  PM_CALL(
+      pm_json_string(j, "flux", m->flux == FPM_FLUX_SIPG ? "sipg" : "iipg"));
+  PM_CALL(pm_json_string(j, "dt_rule",
+                         s->time.dt > 0                      ? "time.dt"
+                         : s->time.dt_rule == PM_DT_SPECTRAL ? "spectral"
+                                                             : "paper"));
+  PM_CALL(pm_json_number(j, "dt_paper", sim->dt_paper));
+  if (sim->dt_spectral > 0)
+    PM_CALL(pm_json_number(j, "dt_spectral", sim->dt_spectral));
+  PM_CALL(pm_json_integer(j, "dt_critical_point", sim->dt_point));
+  PM_CALL(pm_json_integer(j, "ill_conditioned_points", ill));
+  return pm_json_number(j, "max_support_condition", worst);
+}
+
+static const pm_timers *timers(void *p) { return &((fpm_sim *)p)->timers; }
+
+static pm_err create(const pm_scene *s, void **out) {
+  fpm_sim *sim = NULL;
+  PM_CALL(fpm_sim_create(s, &sim));
+  *out = sim;
+  return PM_SUCCESS;
+}
+
+static void destroy(void *sim) { fpm_sim_destroy(sim); }
+
+static pm_err plan(void *sim, FILE *out);
+
+const pm_backend fpm_backend = {
+    .method = "fpm",
+    .description = "explicit total-Lagrangian Fragile Points Method",
+    .section = &fpm_section,
+    .dt_safety = 0.9,
+    .check = fpm_check_scene,
+    .create = create,
+    .destroy = destroy,
+    .plan = plan,
+    .run = run,
+    .points = points,
+    .fields = fields,
+    .displacement = displacement,
+    .figures = figures,
+    .history_names = history_names,
+    .history_values = history_values,
+    .summary = summary,
+    .timers = timers,
+};
+
+/* ---- plan --------------------------------------------------------------- */
+
+static pm_err plan(void *p, FILE *out) {
+  fpm_sim *sim = p;
+  const pm_scene *s = sim->scene;
+  fpm_model *m = sim->model;
+  fpm_state *st = sim->state;
+  /* Time a few force evaluations at a small deformation. */
+  for (long i = 0; i < 3 * m->n; i++) st->u[i] = 1e-9 * m->x[i];
+  double t0 = pm_wtime();
+  int reps = 0;
+  do {
+    fpm_force(m, st);
+    reps++;
+  } while (pm_wtime() - t0 < 0.2 && reps < 1000);
+  double per_step = 1.1 * (pm_wtime() - t0) / reps;
+  memset(st->u, 0, 3 * m->n * sizeof(double));
+  double steps = ceil(s->time.end / sim->dt);
+  if (s->time.max_steps > 0 && steps > s->time.max_steps)
+    steps = (double)s->time.max_steps;
+  size_t bytes = fpm_model_bytes(m) + fpm_state_bytes(m);
+  const double *xc = m->x + 3 * sim->dt_point;
+  fprintf(out, "scene        %s (%s)\n", s->name, s->path);
+  fprintf(out, "method       fpm, %dD, %s\n", m->dim,
+          m->dim == 2 ? "plane strain" : "solid");
+  fprintf(out, "points       %ld (mesh size %g m, mean edge %.4g m)\n", m->n,
+          s->mesh_size, sim->mean_edge);
+  fprintf(out,
+          "cells        %ld simplices, %ld interfaces, %ld boundary facets\n",
+          sim->mesh->n_cells, sim->dual->n_ifaces, sim->dual->n_facets);
+  fprintf(out, "pipeline     1. stress per point (");
+  for (int k = 0; k < m->n_mats; k++)
+    fprintf(out, "%s%s", k ? ", " : "", m->mats[k].model->name);
+  fprintf(out,
+          ")\n             2. interface flux (%s, penalty %g), %ld "
+          "support entries\n",
+          m->flux == FPM_FLUX_SIPG ? "SIPG: with the adjoint term, tangent "
+                                     "per point"
+                                   : "IIPG",
+          m->penalty, m->nnz);
+  int stage = 3;
+  if (m->n_dpts > 0)
+    fprintf(out,
+            "             %d. consistency flux on prescribed faces, %ld "
+            "points\n",
+            stage++, m->n_dpts);
+  if (m->n_tfacets > 0)
+    fprintf(out, "             %d. tractions, %ld facets%s\n", stage++,
+            m->n_tfacets, m->tf_time_dependent ? " (time-dependent)" : "");
+  fprintf(out, "             %d. gather forces\n", stage++);
+  fprintf(out, "             %d. central difference%s, %ld prescribed dofs\n",
+          stage++,
+          s->time.qs == PM_QS_DYNAMIC_RELAXATION ? " with dynamic relaxation"
+          : s->time.qs == PM_QS_DAMPING          ? " with damping"
+                                                 : "",
+          m->n_cdofs);
+  fpm_sim_measure_spectrum(sim);
+  fprintf(out, "dt           %.4g s (%s)\n", sim->dt,
+          s->time.dt > 0                      ? "time.dt"
+          : s->time.dt_rule == PM_DT_SPECTRAL ? "dt_safety x spectral"
+                                              : "dt_safety x paper bound");
+  fprintf(out,
+          "             bound of eqs. 24-26: %.4g s, set by point %ld at "
+          "(%g, %g, %g)\n",
+          sim->dt_paper, sim->dt_point, xc[0], xc[1], xc[2]);
+  fprintf(out,
+          "             spectral (power iteration): %.4g s = %.2f x the "
+          "bound\n",
+          sim->dt_spectral, sim->dt_spectral / sim->dt_paper);
+  fprintf(out, "steps        %.0f to t = %g s%s\n", steps, s->time.end,
+          s->time.qs != PM_QS_NONE ? " (at most: stops when converged)" : "");
+  fprintf(out, "memory       %.1f MiB (operators and state)\n",
+          bytes / 1048576.0);
+  fprintf(out,
+          "estimate     %.3g s per step, %.3g s for %.0f steps on %d "
+          "threads (setup took %.3g s)\n",
+          per_step, per_step * steps, steps, pm_omp_threads(), sim->setup_wall);
+  return PM_SUCCESS;
+}

@@ -1,0 +1,63 @@
+/* fpm_backend: FPM as an entry of the backend table: the simulation of a
+ * scene (mesh, subdomains, operators, state, stable step), its time loop
+ * reporting to the run's observer, its fields, figures and plan. */
+#ifndef FPM_BACKEND_H
+#define FPM_BACKEND_H
+
+#include <stdio.h>
+
+#include "fpm_model.h"
+#include "fpm_solver.h"
+#include "gm_cells.h"
+#include "gm_dual.h"
+#include "pm_backend.h"
+#include "pm_progress.h"
+#include "pm_scene.h"
+
+extern const pm_backend fpm_backend;
+
+/* A prepared simulation.  Fields are read-only for callers. */
+typedef struct {
+  const pm_scene *scene; /* borrowed */
+  gm_mesh *mesh;
+  const gm_cells_builder *cells; /* the partition into subdomains */
+  gm_dual *dual;
+  fpm_model *model;
+  fpm_state *state;
+  double dt;          /* the step used, s */
+  double dt_stable;   /* stable step of the scene's rule, s */
+  double dt_paper;    /* bound of eqs. 24-26, s */
+  double dt_spectral; /* 2 / sqrt(lambda_max(M^-1 K)), s; 0 if not
+                         measured */
+  long dt_point;      /* point that sets the paper's bound */
+  double mean_edge;   /* mean mesh edge length, m */
+  pm_timers timers;
+  int tm_mesh, tm_dual, tm_operators, tm_force, tm_update;
+  double setup_wall; /* mesh + dual + operators, s */
+  double *scratch;   /* 9 n: output buffer */
+  /* the run */
+  pm_status status;
+  fpm_step_info last;      /* the last step's figures */
+  double run_min_jacobian; /* smallest J seen at any step of the run */
+  long run_min_jacobian_step;
+  double run_max_energy_error; /* largest |energy-balance error| over the
+                                  steps where it is checked */
+  const pm_observer *obs;      /* during a run */
+  double res0;                 /* first residual after the ramps */
+  double load_end;             /* when every ramp has ended, s */
+} fpm_sim;
+
+/* Mesh the scene's domain, build subdomains, operators and state, and pick
+ * dt: time.dt if set, else dt_safety times the stable step of
+ * time.dt_rule (the paper's bound, or the measured spectral radius). */
+pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out);
+void fpm_sim_destroy(fpm_sim *sim);
+
+/* Measure dt_spectral (power iteration) if not done yet. */
+void fpm_sim_measure_spectrum(fpm_sim *sim);
+
+/* Number of points whose support, in the current configuration, has a
+ * moment matrix with condition number above FPM_COND_MAX. */
+long fpm_sim_conditioning(const fpm_sim *sim, double *worst, long *worst_point);
+
+#endif

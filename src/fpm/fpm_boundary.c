@@ -1,0 +1,193 @@
+/* fpm_boundary: the boundary conditions of an FPM model: the facets each
+ * condition acts on (a face of the box, a named surface of the mesh, or
+ * the boundary inside a region), the prescribed dofs, the consistency flux
+ * of facets with displacement conditions, and the traction facets. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_model.h"
+
+/* The facets of each condition, as CSR lists bcf_ptr / bcf_facet: on a
+ * named surface of the mesh (the box's faces are its surfaces xmin ...
+ * zmax), or where the region expression is positive at the facet's
+ * centroid.  A condition that selects nothing is an error at its key. */
+static pm_err select_facets(fpm_model *m, const pm_scene *s,
+                            const gm_mesh *mesh) {
+  const gm_dual *d = m->dual;
+  char path[64], names[512];
+  PM_CALL(PM_ALLOC(m->bcf_ptr, s->n_bcs + 1, "boundary facet lists"));
+  for (int pass = 0; pass < 2; pass++) {
+    long n = 0;
+    for (int b = 0; b < s->n_bcs; b++) {
+      const pm_scene_bc *bc = &s->bcs[b];
+      int surf = -1;
+      if (bc->on != PM_ON_REGION) {
+        surf = gm_mesh_surface_find(mesh, bc->surface);
+        if (surf < 0) {
+          gm_mesh_surface_list(mesh, names, sizeof names);
+          snprintf(path, sizeof path, "boundary.%d.on", b);
+          return pm_scene_fail(s, path, false,
+                               "expected a surface of the mesh (%s), got %s",
+                               names, bc->surface);
+        }
+      }
+      m->bcf_ptr[b] = n;
+      for (long f = 0; f < d->n_facets; f++) {
+        const double *c = d->facet_centroid + 3 * f;
+        bool in = bc->on == PM_ON_REGION
+                      ? pm_expr_eval(bc->region, c[0], c[1], c[2], 0) > 0
+                      : d->facet_surface[f] == surf;
+        if (!in) continue;
+        if (pass) m->bcf_facet[n] = f;
+        n++;
+      }
+      if (n == m->bcf_ptr[b]) {
+        snprintf(path, sizeof path, "boundary.%d.%s", b,
+                 bc->on == PM_ON_REGION ? "region" : "on");
+        return pm_scene_fail(
+            s, path, false, "no boundary facet lies %s %s",
+            bc->on == PM_ON_REGION ? "in region" : "on surface",
+            bc->on == PM_ON_REGION ? pm_expr_text(bc->region) : bc->surface);
+      }
+    }
+    m->bcf_ptr[s->n_bcs] = n;
+    if (!pass) PM_CALL(PM_ALLOC(m->bcf_facet, n, "boundary facet lists"));
+  }
+  return PM_SUCCESS;
+}
+
+/* Boundary conditions: prescribed dofs from facets on faces with
+ * displacement conditions, the consistency flux of those facets, and the
+ * traction facets. */
+pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s,
+                          const gm_mesh *mesh) {
+  pm_err ret = PM_SUCCESS;
+  const gm_dual *d = m->dual;
+  int *bc_of = NULL;   /* 3 n: condition prescribing each dof, or -1 */
+  long *dpt_of = NULL; /* n: index into the dpt arrays, or -1 */
+  PM_TRY(PM_ALLOC(bc_of, 3 * m->n, "boundary dof map"));
+  PM_TRY(PM_ALLOC(dpt_of, m->n, "boundary point map"));
+  for (long k = 0; k < 3 * m->n; k++) bc_of[k] = -1;
+  for (long i = 0; i < m->n; i++) dpt_of[i] = -1;
+  m->n_dpts = 0;
+  m->n_tfacets = 0;
+  PM_TRY(select_facets(m, s, mesh));
+  for (int b = 0; b < s->n_bcs; b++) {
+    const pm_scene_bc *bc = &s->bcs[b];
+    for (long e = m->bcf_ptr[b]; e < m->bcf_ptr[b + 1]; e++) {
+      long i = d->facet_point[m->bcf_facet[e]];
+      for (int c = 0; c < 3; c++)
+        if (bc->disp_mask & (1u << c)) bc_of[3 * i + c] = b;
+      if (bc->disp_mask && dpt_of[i] < 0) dpt_of[i] = m->n_dpts++;
+      if (bc->traction_mask) m->n_tfacets++;
+    }
+  }
+  /* In 2D (plane strain) the out-of-plane component is fixed at zero. */
+  if (m->dim == 2)
+    for (long i = 0; i < m->n; i++) m->fixed[3 * i + 2] = 1;
+  m->n_cdofs = 0;
+  for (long k = 0; k < 3 * m->n; k++)
+    if (bc_of[k] >= 0) m->n_cdofs++;
+  PM_TRY(PM_ALLOC(m->cd_point, m->n_cdofs, "constrained dofs"));
+  PM_TRY(PM_ALLOC(m->cd_comp, m->n_cdofs, "constrained dofs"));
+  PM_TRY(PM_ALLOC(m->cd_bc, m->n_cdofs, "constrained dofs"));
+  PM_TRY(PM_ALLOC(m->cd_base, m->n_cdofs, "constrained dofs"));
+  long nc = 0;
+  for (long k = 0; k < 3 * m->n; k++) {
+    if (bc_of[k] < 0) continue;
+    long i = k / 3;
+    int c = (int)(k % 3);
+    const pm_scene_bc *bc = &s->bcs[bc_of[k]];
+    const double *xi = m->x + 3 * i;
+    m->cd_point[nc] = i;
+    m->cd_comp[nc] = c;
+    m->cd_bc[nc] = bc_of[k];
+    m->cd_base[nc] = pm_expr_eval(bc->disp[c], xi[0], xi[1], xi[2], 0);
+    if (pm_expr_uses(bc->disp[c], 't')) m->cd_time_dependent = true;
+    m->fixed[k] = 1;
+    nc++;
+  }
+  PM_TRY(PM_ALLOC(m->dpt_point, m->n_dpts, "boundary flux points"));
+  PM_TRY(PM_ALLOC(m->dpt_area, 9 * m->n_dpts, "boundary flux areas"));
+  PM_TRY(PM_ALLOC(m->dpt_mrel, 27 * m->n_dpts, "boundary flux moments"));
+  PM_TRY(PM_ALLOC(m->tf_point, m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_bc, m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_area, m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_rel, 3 * m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_centroid, 3 * m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_base, 3 * m->n_tfacets, "traction facets"));
+  long nt = 0;
+  for (int b = 0; b < s->n_bcs; b++) {
+    const pm_scene_bc *bc = &s->bcs[b];
+    for (long e = m->bcf_ptr[b]; e < m->bcf_ptr[b + 1]; e++) {
+      long f = m->bcf_facet[e], i = d->facet_point[f];
+      const double *xi = m->x + 3 * i, *af = d->facet_area_vec + 3 * f;
+      const double *Mf = d->facet_moment + 9 * f,
+                   *cf = d->facet_centroid + 3 * f;
+      if (bc->disp_mask) {
+        long p = dpt_of[i];
+        m->dpt_point[p] = i;
+        for (int c = 0; c < 3; c++) {
+          if (!(bc->disp_mask & (1u << c))) continue;
+          for (int a = 0; a < 3; a++) {
+            m->dpt_area[9 * p + 3 * c + a] += af[a];
+            for (int q = 0; q < 3; q++)
+              m->dpt_mrel[27 * p + 9 * c + 3 * a + q] +=
+                  Mf[3 * a + q] - af[a] * xi[q];
+          }
+        }
+      }
+      if (bc->traction_mask) {
+        m->tf_point[nt] = i;
+        m->tf_bc[nt] = b;
+        m->tf_area[nt] = d->facet_area[f];
+        for (int a = 0; a < 3; a++) {
+          m->tf_rel[3 * nt + a] = d->facet_area[f] * (cf[a] - xi[a]);
+          m->tf_centroid[3 * nt + a] = cf[a];
+        }
+        for (int c = 0; c < 3; c++) {
+          if (!(bc->traction_mask & (1u << c))) continue;
+          m->tf_base[3 * nt + c] =
+              pm_expr_eval(bc->traction[c], cf[0], cf[1], cf[2], 0);
+          if (pm_expr_uses(bc->traction[c], 't')) m->tf_time_dependent = true;
+        }
+        nt++;
+      }
+    }
+  }
+done:
+  free(bc_of);
+  free(dpt_of);
+  return ret;
+}
+
+double fpm_prescribed(const fpm_model *m, long k, double t) {
+  const pm_scene_bc *bc = &m->scene->bcs[m->cd_bc[k]];
+  double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
+  if (!m->cd_time_dependent) return r * m->cd_base[k];
+  const double *xi = m->x + 3 * m->cd_point[k];
+  return r * pm_expr_eval(bc->disp[m->cd_comp[k]], xi[0], xi[1], xi[2], t);
+}
+
+void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t) {
+  double norm2 = 0;
+  for (long k = 0; k < m->n_tfacets; k++) {
+    const pm_scene_bc *bc = &m->scene->bcs[m->tf_bc[k]];
+    double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
+    const double *c = m->tf_centroid + 3 * k;
+    for (int a = 0; a < 3; a++) {
+      double v = 0;
+      if (!(bc->traction_mask & (1u << a)))
+        v = 0;
+      else if (m->tf_time_dependent)
+        v = r * pm_expr_eval(bc->traction[a], c[0], c[1], c[2], t);
+      else
+        v = r * m->tf_base[3 * k + a];
+      st->tf_value[3 * k + a] = v;
+      norm2 += v * v * m->tf_area[k] * m->tf_area[k];
+    }
+  }
+  st->fext_norm = sqrt(norm2);
+}

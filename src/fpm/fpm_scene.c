@@ -1,0 +1,119 @@
+/* fpm_scene: the fpm section's keys and the checks of a scene run by FPM. */
+#include "fpm_scene.h"
+
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "gm_cells.h"
+
+static const pm_name flux_names[] = {
+    {"iipg", FPM_FLUX_IIPG}, {"sipg", FPM_FLUX_SIPG}, {NULL, 0}};
+
+static const pm_key fpm_keys[] = {
+    {.name = "penalty",
+     .type = PM_KEY_NUMBER,
+     .offset = offsetof(fpm_options, penalty),
+     .def = "20",
+     .range = PM_RANGE_GE,
+     .unit = "",
+     .doc = "interior penalty p: beta = p E / h per interface"},
+    {.name = "flux",
+     .type = PM_KEY_ENUM,
+     .offset = offsetof(fpm_options, flux),
+     .def = "iipg",
+     .names = flux_names,
+     .doc = "iipg (the paper's eq. 16) or sipg (symmetric, energy-"
+            "conserving)"},
+    {.name = "cells",
+     .type = PM_KEY_STRING,
+     .offset = offsetof(fpm_options, cells),
+     .def = "median-dual",
+     .doc = "the partition into subdomains (median-dual of the gmsh mesh)"},
+    {0}};
+
+static pm_err check_section(const pm_scene *s, void *opts) {
+  const fpm_options *o = opts;
+  char what[256];
+  if (gm_cells_find(o->cells)) return PM_SUCCESS;
+  size_t used = (size_t)snprintf(what, sizeof what, "one of");
+  for (int k = 0; k < gm_cells_count() && used < sizeof what; k++)
+    used += (size_t)snprintf(what + used, sizeof what - used, "%s %s",
+                             k ? "," : "", gm_cells_at(k)->name);
+  return pm_scene_expected(s, "fpm.cells", what);
+}
+
+const pm_section fpm_section = {
+    .name = "fpm",
+    .keys = fpm_keys,
+    .size = sizeof(fpm_options),
+    .check = check_section,
+};
+
+const fpm_options *fpm_scene_options(const pm_scene *s) {
+  return pm_scene_section(s, "fpm");
+}
+
+#define PATH(buf, ...) (snprintf((buf), sizeof(buf), __VA_ARGS__), (buf))
+
+static pm_err check_materials(const pm_scene *s) {
+  char p[64];
+  for (int i = 0; i < s->n_materials; i++) {
+    const pm_scene_material *m = &s->materials[i];
+    if (pm_material_is_fluid(&m->mat))
+      return pm_scene_expected(s, PATH(p, "materials.%d.model", i),
+                               "a solid model for method fpm");
+    if (pm_scene_has(s, PATH(p, "materials.%d.artificial_viscosity", i)))
+      return pm_scene_fail(s, p, true,
+                           "expected no artificial viscosity for method fpm "
+                           "(a shock viscosity of MPM), got "
+                           "artificial_viscosity");
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err check_bodies(const pm_scene *s) {
+  static const char *const mpm_only[] = {"velocity", "density", "pressure"};
+  char p[64];
+  for (int i = 0; i < s->n_bodies; i++) {
+    for (int k = 0; k < 3; k++)
+      if (pm_scene_has(s, PATH(p, "bodies.%d.%s", i, mpm_only[k])))
+        return pm_scene_fail(s, p, true,
+                             "expected no initial %s for method fpm (it "
+                             "starts at rest in the reference state), got %s",
+                             mpm_only[k], mpm_only[k]);
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err check_boundary(const pm_scene *s) {
+  char p[64];
+  for (int i = 0; i < s->n_bcs; i++) {
+    const pm_scene_bc *bc = &s->bcs[i];
+    if (bc->velocity_mask || bc->absorbing)
+      return pm_scene_fail(s,
+                           PATH(p, "boundary.%d.%s", i,
+                                bc->velocity_mask ? "velocity" : "absorbing"),
+                           true,
+                           "expected displacement or traction (method fpm), "
+                           "got %s",
+                           bc->velocity_mask ? "velocity" : "absorbing");
+    if (bc->on == PM_ON_SURFACE &&
+        !(s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH))
+      return pm_scene_expected(s, PATH(p, "boundary.%d.on", i),
+                               "a face of domain.box (xmin, xmax, ymin, ymax, "
+                               "zmin, zmax), a region, or the name of a "
+                               "physical surface of a gmsh body");
+  }
+  return PM_SUCCESS;
+}
+
+pm_err fpm_check_scene(const pm_scene *s) {
+  PM_CALL(check_materials(s));
+  PM_CALL(check_bodies(s));
+  PM_CALL(check_boundary(s));
+  if (pm_scene_has(s, "gravity"))
+    return pm_scene_fail(s, "gravity", true,
+                         "expected no gravity for method fpm, got gravity");
+  return PM_SUCCESS;
+}

@@ -1,0 +1,31 @@
+/* fpm_scene: the "fpm:" section of a scene (its keys, each with its
+ * default) and what method fpm refuses in a scene. */
+#ifndef FPM_SCENE_H
+#define FPM_SCENE_H
+
+#include "pm_backend.h"
+#include "pm_scene.h"
+
+/* Interior-penalty flux. */
+typedef enum {
+  FPM_FLUX_IIPG = 0, /* incomplete (the FPM paper's eq. 16) */
+  FPM_FLUX_SIPG      /* symmetric: the force is the gradient of an energy */
+} fpm_flux;
+
+/* Options of the fpm section. */
+typedef struct {
+  double penalty; /* fpm.penalty p >= 0 (beta = p E / h) */
+  int flux;       /* fpm_flux */
+  char *cells;    /* fpm.cells: the partition into subdomains */
+} fpm_options;
+
+extern const pm_section fpm_section;
+
+/* The fpm options of a scene (its defaults when the scene has none). */
+const fpm_options *fpm_scene_options(const pm_scene *s);
+
+/* What FPM cannot honour (fluids, initial velocities, gravity, grid
+ * conditions, ...), failing at the key with pm_scene_fail. */
+pm_err fpm_check_scene(const pm_scene *s);
+
+#endif

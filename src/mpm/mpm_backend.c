@@ -1,0 +1,426 @@
+/* mpm_backend: sets up an explicit MPM simulation from a scene and runs it
+ * for the run driver (pm_run): observer, fields, figures, history, summary
+ * and the plan. */
+#include "mpm_backend.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_kind.h"
+#include "mpm_pipeline.h"
+#include "pm_omp.h"
+#include "pm_tensor.h"
+
+pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
+  pm_err ret = PM_SUCCESS;
+  mpm_sim *r = NULL;
+  *out = NULL;
+  PM_TRY(PM_ALLOC(r, 1, "MPM simulation"));
+  r->scene = s;
+  double t0 = pm_wtime();
+  PM_TRY(mpm_model_create(s, &r->model, &r->state));
+  PM_TRY(mpm_work_create(r->model, &r->work));
+  r->setup_wall = pm_wtime() - t0;
+  PM_TRY(PM_ALLOC(r->scratch, 9 * r->model->n, "output buffer"));
+  *out = r;
+  r = NULL;
+done:
+  mpm_sim_destroy(r);
+  return ret;
+}
+
+void mpm_sim_destroy(mpm_sim *r) {
+  if (!r) return;
+  mpm_work_destroy(r->work);
+  mpm_state_destroy(r->state);
+  mpm_model_destroy(r->model);
+  free(r->scratch);
+  free(r);
+}
+
+/* Everything the simulation holds: model, state, workspace and buffer. */
+static size_t sim_bytes(const mpm_sim *r) {
+  return mpm_model_bytes(r->model) + mpm_state_bytes(r->model, r->state) +
+         mpm_work_bytes(r->model, r->work) +
+         9 * sizeof(double) * (size_t)r->model->n;
+}
+
+/* ---- run ---------------------------------------------------------------- */
+
+/* Report a step (the initial state as step 0) to the run's observer. */
+static pm_err report(mpm_sim *r, bool frame) {
+  const mpm_state *s = r->state;
+  pm_step_report rep = {.step = s->step,
+                        .t = s->t,
+                        .dt = s->dt,
+                        .residual = r->work->residual,
+                        .progress = s->t / r->model->opt.t_end};
+  return r->obs ? r->obs->step(r->obs->ctx, &rep, frame) : PM_SUCCESS;
+}
+
+static pm_err observe(void *ctx, const mpm_model *m, const mpm_state *s,
+                      const mpm_work *w, const mpm_step_info *info,
+                      bool frame) {
+  (void)m;
+  mpm_sim *r = ctx;
+  r->last = *info;
+  if (w->min_jacobian < r->run_min_jacobian) {
+    r->run_min_jacobian = w->min_jacobian;
+    r->run_min_jacobian_step = s->step;
+  }
+  if (info->iter_max > r->iter_max_row) r->iter_max_row = info->iter_max;
+  return report(r, frame);
+}
+
+static pm_err run(void *p, const pm_observer *obs) {
+  mpm_sim *r = p;
+  const mpm_model *m = r->model;
+  double kin, strain, internal;
+  mpm_energies(m, r->state, &kin, &strain, &internal);
+  r->energy0 = kin + strain + internal;
+  r->run_min_jacobian = INFINITY;
+  r->run_min_jacobian_step = 0;
+  for (long q = 0; q < m->n; q++)
+    r->run_min_jacobian =
+        fmin(r->run_min_jacobian, r->state->vol[q] / m->vol0[q]);
+  r->obs = obs;
+  pm_err e = report(r, true);
+  mpm_run_options opt = {.t_end = m->opt.t_end,
+                         .max_steps = m->opt.max_steps,
+                         .frame_every = r->scene->output.every};
+  if (!e) e = mpm_solve(m, r->state, r->work, &opt, observe, r, &r->last);
+  r->obs = NULL;
+  if (e == PM_ERR_UNSTABLE)
+    r->status = PM_STATUS_UNSTABLE;
+  else if (e != PM_SUCCESS)
+    r->status = PM_STATUS_FAILED;
+  else if (m->opt.qs == PM_QS_NONE)
+    r->status = PM_STATUS_COMPLETED;
+  else
+    r->status =
+        r->last.converged ? PM_STATUS_CONVERGED : PM_STATUS_NOT_CONVERGED;
+  return e;
+}
+
+/* ---- what the run driver reads ------------------------------------------ */
+
+static void points(void *p, pm_points *pts) {
+  const mpm_sim *r = p;
+  *pts = (pm_points){.n = r->model->n, .x = r->model->x0, .nodes_per_cell = 1};
+}
+
+/* u = x - x0 into the buffer's last 3 n. */
+static const double *displacement(void *p) {
+  mpm_sim *r = p;
+  const long n3 = 3 * r->model->n;
+  const double *x = r->state->x, *x0 = r->model->x0;
+  double *u = r->scratch + 6 * r->model->n;
+  PM_OMP(parallel for schedule(static) default(none) shared(n3, x, x0, u))
+  for (long i = 0; i < n3; i++) u[i] = x[i] - x0[i];
+  return u;
+}
+
+/* Per particle into the buffer: strain energy density, J, density,
+ * pressure, internal energy (n each, in that order). */
+static void particle_fields(mpm_sim *r) {
+  const mpm_model *m = r->model;
+  const mpm_state *s = r->state;
+  const long n = m->n;
+  double *sed = r->scratch, *jac = sed + n, *rho = sed + 2 * n,
+         *pres = sed + 3 * n, *ener = sed + 4 * n;
+  for (long p = 0; p < n; p++) {
+    jac[p] = s->vol[p] / m->vol0[p];
+    rho[p] = m->mass[p] / s->vol[p];
+  }
+  for (int gi = 0; gi < m->n_groups; gi++)
+    m->group[gi].kind->fields(m, s, &m->group[gi], sed, pres, ener);
+}
+
+static int fields(void *p, unsigned want, pm_field *f, int max) {
+  mpm_sim *r = p;
+  const mpm_state *s = r->state;
+  const long n = r->model->n;
+  int nf = 0;
+  if (max < 8) return 0;
+  double *sed = r->scratch, *jac = sed + n, *rho = sed + 2 * n,
+         *pres = sed + 3 * n, *ener = sed + 4 * n;
+  particle_fields(r);
+  if (want & PM_FIELD_DISPLACEMENT)
+    f[nf++] = (pm_field){"displacement", 3, displacement(r)};
+  if (want & PM_FIELD_VELOCITY) f[nf++] = (pm_field){"velocity", 3, s->v};
+  if (want & PM_FIELD_STRESS) f[nf++] = (pm_field){"stress", 9, s->sigma};
+  if (want & PM_FIELD_STRAIN_ENERGY_DENSITY)
+    f[nf++] = (pm_field){"strain_energy_density", 1, sed};
+  if (want & PM_FIELD_JACOBIAN) f[nf++] = (pm_field){"jacobian", 1, jac};
+  if (r->model->kinds & MPM_KIND_INTERNAL_ENERGY) {
+    f[nf++] = (pm_field){"density", 1, rho};
+    f[nf++] = (pm_field){"pressure", 1, pres};
+    f[nf++] = (pm_field){"internal_energy", 1, ener};
+  }
+  return nf;
+}
+
+/* Mean strain energy density of the particles that store it, largest von
+ * Mises stress and smallest J, with where they are now. */
+static void field_figures(mpm_sim *r, pm_figures *f) {
+  const mpm_model *m = r->model;
+  const mpm_state *s = r->state;
+  const double *sed = r->scratch;
+  double w = 0, v0 = 0;
+  long vm_at = 0, j_at = 0;
+  particle_fields(r);
+  f->max_von_mises = 0;
+  f->end_min_jacobian = INFINITY;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    const bool elastic = g->kind->flags & MPM_KIND_STRAIN_ENERGY;
+    for (long p = g->begin; p < g->end; p++) {
+      double vm = pm_t_von_mises(s->sigma + 9 * p);
+      if (vm > f->max_von_mises) {
+        f->max_von_mises = vm;
+        vm_at = p;
+      }
+      double J = s->vol[p] / m->vol0[p];
+      if (J < f->end_min_jacobian) {
+        f->end_min_jacobian = J;
+        j_at = p;
+      }
+      if (elastic) {
+        w += m->vol0[p] * sed[p];
+        v0 += m->vol0[p];
+      }
+    }
+  }
+  f->mean_sed = v0 > 0 ? w / v0 : NAN;
+  for (int a = 0; a < 3; a++) {
+    f->max_von_mises_at[a] = s->x[3 * vm_at + a];
+    f->end_min_jacobian_at[a] = s->x[3 * j_at + a];
+  }
+}
+
+static void figures(void *p, pm_figures *f, bool with_fields) {
+  mpm_sim *r = p;
+  const mpm_model *m = r->model;
+  const mpm_state *s = r->state;
+  const pm_timers *t = &r->work->timers;
+  f->status = r->status;
+  f->dim = m->dim;
+  f->points = m->n;
+  f->steps = s->step;
+  f->time = s->t;
+  f->h = m->grid.h;
+  f->dt = s->dt;
+  f->dt_stable = s->dt_stable / m->opt.dt_safety;
+  f->residual = r->work->residual;
+  mpm_energies(m, s, &f->kinetic, &f->strain, &f->internal);
+  f->interface = 0;
+  f->external_work = s->external_work;
+  f->dissipated = s->dissipated;
+  f->energy0 = r->energy0;
+  f->energy_error =
+      pm_energy_error(r->energy0, f->kinetic + f->strain + f->internal,
+                      s->dissipated, s->external_work);
+  f->max_energy_error = NAN; /* reported, not bounded */
+  f->min_jacobian = r->run_min_jacobian;
+  f->min_jacobian_step = r->run_min_jacobian_step;
+  f->n_bcs = m->n_bcs;
+  for (int b = 0; b < m->n_bcs && b < PM_FIGURES_MAX_BCS; b++)
+    for (int c = 0; c < 3; c++)
+      f->reaction[b][c] = r->work->cond.reaction[3 * b + c];
+  f->setup_seconds = r->setup_wall;
+  f->step_seconds = 0;
+  for (int k = 0; k < t->n; k++) f->step_seconds += t->stage[k].seconds;
+  f->memory_bytes = sim_bytes(r);
+  if (with_fields) field_figures(r, f);
+}
+
+static const char *const iter_cols[] = {"energy_iterations",
+                                        "energy_iterations_capped"};
+
+static int history_names(void *p, const char **names, int max) {
+  const mpm_sim *r = p;
+  if (!(r->model->kinds & MPM_KIND_ITERATES) || max < 2) return 0;
+  names[0] = iter_cols[0];
+  names[1] = iter_cols[1];
+  return 2;
+}
+
+/* The iterations over the steps since the previous row. */
+static void history_values(void *p, double *v) {
+  mpm_sim *r = p;
+  v[0] = r->iter_max_row;
+  v[1] = (double)(r->state->iter_capped_total - r->iter_capped_prev);
+  r->iter_capped_prev = r->state->iter_capped_total;
+  r->iter_max_row = 0;
+}
+
+static const char *basis_name(mpm_basis b) {
+  return b == MPM_BASIS_QUADRATIC ? "quadratic" : "linear";
+}
+
+/* "usf", "usl", "musl"; upper case with upper. */
+static const char *update_name(mpm_update u, bool upper) {
+  static const char *const lower_names[] = {"usf", "usl", "musl"};
+  static const char *const upper_names[] = {"USF", "USL", "MUSL"};
+  return (upper ? upper_names : lower_names)[u];
+}
+
+static pm_err summary_groups(pm_json *j, const mpm_model *m) {
+  PM_CALL(pm_json_begin_object(j, "groups"));
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    PM_CALL(pm_json_begin_object(j, g->name));
+    PM_CALL(pm_json_integer(j, "particles", g->end - g->begin));
+    PM_CALL(pm_json_string(j, "kind", g->kind->name));
+    PM_CALL(pm_json_integer(j, "bytes_per_particle",
+                            (long long)(mpm_particle_bytes_common() +
+                                        mpm_group_bytes_per_particle(g))));
+    PM_CALL(pm_json_end_object(j));
+  }
+  return pm_json_end_object(j);
+}
+
+/* Each stage's energy accounts (those it keeps). */
+static pm_err summary_stage_energy(pm_json *j, const mpm_model *m,
+                                   const mpm_state *s) {
+  PM_CALL(pm_json_begin_object(j, "energy_by_stage"));
+  for (int k = 0; k < m->pipeline.n; k++) {
+    const mpm_stage *st = &m->pipeline.stage[k];
+    if (!st->books) continue;
+    PM_CALL(pm_json_begin_object(j, st->name));
+    if (st->books & MPM_BOOKS_WORK)
+      PM_CALL(pm_json_number(j, "work", s->energy[k].work));
+    if (st->books & MPM_BOOKS_DISSIPATED)
+      PM_CALL(pm_json_number(j, "dissipated", s->energy[k].dissipated));
+    PM_CALL(pm_json_end_object(j));
+  }
+  return pm_json_end_object(j);
+}
+
+static pm_err summary(void *p, pm_json *j) {
+  const mpm_sim *r = p;
+  const mpm_model *m = r->model;
+  const mpm_state *s = r->state;
+  PM_CALL(pm_json_integer(j, "particles", m->n));
+  PM_CALL(summary_groups(j, m));
+  PM_CALL(pm_json_integer(j, "grid_nodes", m->grid.n_nodes));
+  PM_CALL(pm_json_number(j, "cell_size", m->grid.h));
+  PM_CALL(pm_json_string(j, "shape", basis_name(m->opt.shape)));
+  PM_CALL(pm_json_string(j, "update", update_name(m->opt.update, false)));
+  PM_CALL(pm_json_number(j, "flip", m->opt.flip));
+  if (m->kinds & MPM_KIND_ITERATES) {
+    PM_CALL(pm_json_integer(j, "energy_iterations_max", s->iter_max_total));
+    PM_CALL(
+        pm_json_integer(j, "energy_iterations_capped", s->iter_capped_total));
+  }
+  return summary_stage_energy(j, m, s);
+}
+
+static const pm_timers *timers(void *p) {
+  return &((const mpm_sim *)p)->work->timers;
+}
+
+/* ---- plan --------------------------------------------------------------- */
+
+static void plan_groups(const mpm_model *m, FILE *out) {
+  size_t common = mpm_particle_bytes_common();
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    size_t own = mpm_group_bytes_per_particle(g);
+    fprintf(out,
+            "  group %-8s %ld particles, %s, %zu bytes per particle (%zu "
+            "common + %zu:",
+            g->name, g->end - g->begin, g->kind->name, common + own, common,
+            own);
+    for (int k = 0; k < g->n_arrays; k++)
+      fprintf(out, " %s", g->layout[k].name);
+    fprintf(out, "%s)\n", own ? "" : " none");
+  }
+}
+
+static pm_err plan(void *p, FILE *out) {
+  mpm_sim *r = p;
+  const mpm_model *m = r->model;
+  mpm_state *st = r->state;
+  const pm_scene *s = r->scene;
+  const mpm_grid *g = &m->grid;
+  const mpm_options *o = &m->opt;
+  fprintf(out, "scene        %s (%s)\n", s->name, s->path);
+  fprintf(out, "method       mpm, %dD%s, %s B-splines, %s, FLIP %g\n", m->dim,
+          m->dim == 2 ? " plane strain" : "", basis_name(o->shape),
+          update_name(o->update, true), o->flip);
+  fprintf(out, "grid         %ld x %ld x %ld nodes, cell %g m\n", g->nn[0],
+          g->nn[1], g->nn[2], g->h);
+  fprintf(out, "particles    %ld (%d x %d x %d per cell)\n", m->n, o->ppc[0],
+          o->ppc[1], m->dim == 3 ? o->ppc[2] : 1);
+  plan_groups(m, out);
+  fprintf(out, "pipeline\n");
+  for (int k = 0; k < m->pipeline.n; k++)
+    fprintf(out, "  %2d. %-20s %s\n", k + 1, m->pipeline.stage[k].name,
+            m->pipeline.stage[k].detail);
+  fprintf(out, "dt           %.4g s (%s); stable estimate %.4g s\n", st->dt,
+          o->dt_fixed > 0 ? "time.dt" : "dt_safety x stable, each step",
+          st->dt_stable);
+  if (o->dt_fixed > st->dt_stable)
+    fprintf(out,
+            "             warning: time.dt is %.2f x the stable estimate\n",
+            o->dt_fixed / st->dt_stable);
+  double steps = ceil(o->t_end / st->dt);
+  if (o->max_steps > 0 && steps > o->max_steps) steps = (double)o->max_steps;
+  fprintf(out, "steps        %.0f to t = %g s%s%s\n", steps, o->t_end,
+          o->qs != PM_QS_NONE ? " (at most: stops when converged)" : "",
+          o->dt_fixed > 0 ? "" : " (at the first step's dt; the step adapts)");
+  fprintf(out,
+          "memory       %.1f MiB (model %.1f, state %.1f, workspace %.1f "
+          "with %d thread accumulators, output buffers %.1f)\n",
+          sim_bytes(r) / 1048576.0, mpm_model_bytes(m) / 1048576.0,
+          mpm_state_bytes(m, st) / 1048576.0,
+          mpm_work_bytes(m, r->work) / 1048576.0, r->work->nodes.threads,
+          9 * sizeof(double) * (size_t)m->n / 1048576.0);
+  /* Time a few steps (the state is advanced: a plan is not run after). */
+  double t0 = pm_wtime();
+  int reps = 0;
+  while (pm_wtime() - t0 < 0.3 && reps < 200) {
+    if (mpm_step(m, st, r->work) != PM_SUCCESS) break;
+    reps++;
+  }
+  if (reps > 0) {
+    double per = (pm_wtime() - t0) / reps;
+    fprintf(out,
+            "estimate     %.3g s per step, %.3g s for %.0f steps on %d "
+            "thread%s (%.3g particle-steps/s; setup took %.3g s)\n",
+            per, per * steps, steps, pm_omp_threads(),
+            pm_omp_threads() == 1 ? "" : "s", m->n / per, r->setup_wall);
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err create(const pm_scene *s, void **out) {
+  mpm_sim *r = NULL;
+  PM_CALL(mpm_sim_create(s, &r));
+  *out = r;
+  return PM_SUCCESS;
+}
+
+static void destroy(void *p) { mpm_sim_destroy(p); }
+
+const pm_backend mpm_backend = {
+    .method = "mpm",
+    .description = "explicit Material Point Method",
+    .section = &mpm_section,
+    .dt_safety = 0.5,
+    .check = mpm_check_scene,
+    .create = create,
+    .destroy = destroy,
+    .plan = plan,
+    .run = run,
+    .points = points,
+    .fields = fields,
+    .displacement = displacement,
+    .figures = figures,
+    .history_names = history_names,
+    .history_values = history_values,
+    .summary = summary,
+    .timers = timers,
+};

@@ -1,0 +1,39 @@
+/* mpm_backend: explicit MPM as an entry of the backend table: the
+ * simulation of a scene (model, state, workspace), its time loop reporting
+ * to the run's observer, its fields, figures and plan. */
+#ifndef MPM_BACKEND_H
+#define MPM_BACKEND_H
+
+#include "mpm_solver.h"
+#include "mpm_state.h"
+#include "pm_backend.h"
+#include "pm_scene.h"
+
+extern const pm_backend mpm_backend;
+
+/* A prepared simulation.  Fields are read-only for callers. */
+typedef struct {
+  const pm_scene *scene; /* borrowed: must outlive the simulation */
+  mpm_model *model;
+  mpm_state *state;
+  mpm_work *work;
+  double setup_wall; /* s */
+  double *scratch;   /* output buffer, 9 per particle */
+  /* the run */
+  pm_status status;
+  double energy0;          /* kinetic + strain + internal at t = 0 */
+  double run_min_jacobian; /* smallest J of any step's stress update */
+  long run_min_jacobian_step;
+  int iter_max_row; /* most iterations since the last history row */
+  long iter_capped_prev;
+  mpm_step_info last;     /* the last step's figures */
+  const pm_observer *obs; /* during a run */
+} mpm_sim;
+
+/* Model, initial state, workspace and output buffer of scene s.  Failures
+ * as mpm_model_create; *out NULL then. */
+pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out);
+/* Release a simulation and all it holds (NULL accepted). */
+void mpm_sim_destroy(mpm_sim *r);
+
+#endif

@@ -1,0 +1,159 @@
+/* mpm_scene: the mpm section's keys and the checks of a scene run by MPM. */
+#include "mpm_scene.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+
+static const pm_name shape_names[] = {
+    {"linear", MPM_BASIS_LINEAR}, {"quadratic", MPM_BASIS_QUADRATIC}, {0}};
+static const pm_name update_names[] = {
+    {"usf", MPM_USF}, {"usl", MPM_USL}, {"musl", MPM_MUSL}, {0}};
+static const pm_name energy_update_names[] = {
+    {"iterative", MPM_ENERGY_ITERATIVE},
+    {"non-iterative", MPM_ENERGY_NON_ITERATIVE},
+    {0}};
+static const pm_name axis_names[] = {
+    {"x", 1u << 0}, {"y", 1u << 1}, {"z", 1u << 2}, {0}};
+
+#define O(field) offsetof(mpm_settings, field)
+
+static const pm_key fluid_keys[] = {
+    {.name = "energy_update",
+     .type = PM_KEY_ENUM,
+     .offset = O(fluid.energy_update),
+     .def = "iterative",
+     .names = energy_update_names,
+     .doc = "iterative (steps 1-6 of the fluid paper) or non-iterative "
+            "(eq. 27)"},
+    {.name = "tolerance",
+     .type = PM_KEY_NUMBER,
+     .offset = O(fluid.tolerance),
+     .def = "1e-10",
+     .range = PM_RANGE_GT,
+     .unit = "",
+     .doc = "relative change of the energy that ends the iteration"},
+    {.name = "max_iterations",
+     .type = PM_KEY_INTEGER,
+     .offset = O(fluid.max_iterations),
+     .def = "50",
+     .range = PM_RANGE_GE | PM_RANGE_LE,
+     .lo = 1,
+     .hi = 10000,
+     .doc = "cap on the iterations of one particle-step"},
+    {0}};
+
+static const pm_key mpm_keys[] = {
+    {.name = "shape",
+     .type = PM_KEY_ENUM,
+     .offset = O(shape),
+     .def = "quadratic",
+     .names = shape_names,
+     .doc = "grid basis: linear or quadratic B-splines"},
+    {.name = "update",
+     .type = PM_KEY_ENUM,
+     .offset = O(update),
+     .def = "musl",
+     .names = update_names,
+     .doc = "usf, usl or musl"},
+    {.name = "flip",
+     .type = PM_KEY_NUMBER,
+     .offset = O(flip),
+     .def = "1",
+     .range = PM_RANGE_GE | PM_RANGE_LE,
+     .hi = 1,
+     .unit = "",
+     .doc = "FLIP fraction of the particle velocity update (1 FLIP, 0 PIC)"},
+    {.name = "particles_per_cell",
+     .type = PM_KEY_NUMBERS,
+     .offset = O(ppc_given),
+     .count_offset = O(n_ppc_given),
+     .def = "2",
+     .flags = PM_KEY_WHOLE,
+     .range = PM_RANGE_GE | PM_RANGE_LE,
+     .lo = 1,
+     .hi = 64,
+     .min_count = 1,
+     .max_count = 3,
+     .doc = "per direction: [n] or [nx, ny(, nz)]"},
+    {.name = "null_velocity",
+     .type = PM_KEY_FLAGS,
+     .offset = O(null_velocity),
+     .names = axis_names,
+     .doc = "grid velocity components held at zero (1-D runs in the 3-D "
+            "code)"},
+    {.name = "fluid",
+     .type = PM_KEY_MAPPING,
+     .keys = fluid_keys,
+     .doc = "{energy_update, tolerance, max_iterations}"},
+    {0}};
+
+static pm_err check_section(const pm_scene *s, void *opts) {
+  mpm_settings *o = opts;
+  if (o->n_ppc_given != 1 && o->n_ppc_given != s->dimension)
+    return pm_scene_fail(s, "mpm.particles_per_cell", false,
+                         "expected 1 or %d integers (dimension %d), got %d",
+                         s->dimension, s->dimension, o->n_ppc_given);
+  for (int c = 0; c < 3; c++)
+    o->ppc[c] = c >= s->dimension     ? 1
+                : o->n_ppc_given == 1 ? (int)o->ppc_given[0]
+                                      : (int)o->ppc_given[c];
+  if (s->dimension == 2 && (o->null_velocity & 4u))
+    return pm_scene_fail(s, "mpm.null_velocity", false,
+                         "expected a list of x, y (dimension 2), got z");
+  return PM_SUCCESS;
+}
+
+const pm_section mpm_section = {
+    .name = "mpm",
+    .keys = mpm_keys,
+    .size = sizeof(mpm_settings),
+    .check = check_section,
+};
+
+const mpm_settings *mpm_scene_settings(const pm_scene *s) {
+  return pm_scene_section(s, "mpm");
+}
+
+#define PATH(buf, ...) (snprintf((buf), sizeof(buf), __VA_ARGS__), (buf))
+
+pm_err mpm_check_scene(const pm_scene *s) {
+  char p[64], what[192];
+  /* The box faces are grid planes, where conditions act. */
+  for (int c = 0; c < s->dimension; c++) {
+    double cells = (s->box_max[c] - s->box_min[c]) / s->mesh_size;
+    if (fabs(cells - round(cells)) > 1e-6 * cells) {
+      snprintf(what, sizeof what,
+               "a cell size that divides domain.box (%g m along %c: %.4g "
+               "cells)",
+               s->box_max[c] - s->box_min[c], "xyz"[c], cells);
+      return pm_scene_expected(s, "discretization.mesh_size", what);
+    }
+  }
+  for (int i = 0; i < s->n_bcs; i++) {
+    const pm_scene_bc *bc = &s->bcs[i];
+    if (bc->traction_mask)
+      return pm_scene_fail(s, PATH(p, "boundary.%d.traction", i), true,
+                           "expected displacement, velocity or absorbing "
+                           "(method mpm), got traction");
+    if (bc->on != PM_ON_FACE)
+      return pm_scene_fail(
+          s,
+          PATH(p, "boundary.%d.%s", i,
+               bc->on == PM_ON_REGION ? "region" : "on"),
+          bc->on == PM_ON_REGION,
+          "expected on: a face of domain.box (xmin, xmax, ymin, ymax, zmin, "
+          "zmax) for method mpm (its conditions act on grid planes), got %s",
+          bc->on == PM_ON_REGION ? "region" : bc->surface);
+  }
+  if (pm_scene_has(s, "stability.max_energy_error"))
+    return pm_scene_fail(s, "stability.max_energy_error", true,
+                         "expected min_jacobian only for method mpm (its "
+                         "transfers dissipate energy by design: the balance "
+                         "is reported, not bounded), got max_energy_error");
+  if (s->time.dt_rule == PM_DT_SPECTRAL)
+    return pm_scene_expected(s, "time.dt_rule",
+                             "paper for method mpm (its stable step is the "
+                             "CFL bound of every step)");
+  return PM_SUCCESS;
+}

@@ -1,0 +1,46 @@
+/* mpm_scene: the "mpm:" section of a scene (its keys, each with its
+ * default) and what method mpm refuses in a scene. */
+#ifndef MPM_SCENE_H
+#define MPM_SCENE_H
+
+#include "pm_backend.h"
+#include "pm_scene.h"
+
+/* Grid basis functions, update variants and the fluid energy update. */
+typedef enum { MPM_BASIS_LINEAR = 0, MPM_BASIS_QUADRATIC } mpm_basis;
+typedef enum { MPM_USF = 0, MPM_USL, MPM_MUSL } mpm_update;
+typedef enum {
+  MPM_ENERGY_ITERATIVE = 0, /* steps (1)-(6) of the fluid paper, eqs. 27-31 */
+  MPM_ENERGY_NON_ITERATIVE  /* energy from the previous stress (eq. 27) */
+} mpm_energy_update;
+
+/* Settings of the mpm section (what the scene says; the model copies what it
+ * uses into mpm_options). */
+typedef struct {
+  int shape;   /* mpm_basis: mpm.shape */
+  int update;  /* mpm_update: mpm.update */
+  double flip; /* mpm.flip: FLIP fraction in [0, 1] (1 FLIP, 0 PIC) */
+  double ppc_given[3];
+  int n_ppc_given;
+  int ppc[3];             /* particles per cell per direction (1 on z in
+                             2D), from mpm.particles_per_cell */
+  unsigned null_velocity; /* mpm.null_velocity: grid velocity components
+                             held at zero (mask) */
+  struct {
+    int energy_update;   /* mpm_energy_update */
+    double tolerance;    /* relative change that ends the iteration */
+    long max_iterations; /* cap on the iterations per particle-step */
+  } fluid;
+} mpm_settings;
+
+extern const pm_section mpm_section;
+
+/* The mpm options of a scene (its defaults when the scene has none). */
+const mpm_settings *mpm_scene_settings(const pm_scene *s);
+
+/* What MPM cannot honour (tractions, a bound on the energy balance, a cell
+ * size that does not divide the box, named surfaces, ...), failing at the
+ * key with pm_scene_fail. */
+pm_err mpm_check_scene(const pm_scene *s);
+
+#endif
