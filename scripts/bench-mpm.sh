@@ -20,7 +20,7 @@ for scene in cases/mpm/bench-block.yaml cases/mpm/m2-shock-tube.yaml; do
       --set time.max_steps="$steps" --set output.every=1000000 2>/dev/null
     s="$dir/summary.json"
     printf '%-28s %8s %7s %8s %14.3e %14.3e\n' "$name" "$(get particles "$s")" \
-      "$threads" "$(get steps "$s")" "$(get particle_steps_per_second "$s")" \
-      "$(get particle_steps_per_second_per_core "$s")"
+      "$threads" "$(get steps "$s")" "$(get point_steps_per_second "$s")" \
+      "$(get point_steps_per_second_per_core "$s")"
   done
 done

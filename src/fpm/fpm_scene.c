@@ -54,16 +54,14 @@ const fpm_options *fpm_scene_options(const pm_scene *s) {
   return pm_scene_section(s, "fpm");
 }
 
-#define PATH(buf, ...) (snprintf((buf), sizeof(buf), __VA_ARGS__), (buf))
-
 static pm_err check_materials(const pm_scene *s) {
   char p[64];
   for (int i = 0; i < s->n_materials; i++) {
     const pm_scene_material *m = &s->materials[i];
     if (pm_material_is_fluid(&m->mat))
-      return pm_scene_expected(s, PATH(p, "materials.%d.model", i),
+      return pm_scene_expected(s, PM_PATH(p, "materials.%d.model", i),
                                "a solid model for method fpm");
-    if (pm_scene_has(s, PATH(p, "materials.%d.artificial_viscosity", i)))
+    if (pm_scene_has(s, PM_PATH(p, "materials.%d.artificial_viscosity", i)))
       return pm_scene_fail(s, p, true,
                            "expected no artificial viscosity for method fpm "
                            "(a shock viscosity of MPM), got "
@@ -77,7 +75,7 @@ static pm_err check_bodies(const pm_scene *s) {
   char p[64];
   for (int i = 0; i < s->n_bodies; i++) {
     for (int k = 0; k < 3; k++)
-      if (pm_scene_has(s, PATH(p, "bodies.%d.%s", i, mpm_only[k])))
+      if (pm_scene_has(s, PM_PATH(p, "bodies.%d.%s", i, mpm_only[k])))
         return pm_scene_fail(s, p, true,
                              "expected no initial %s for method fpm (it "
                              "starts at rest in the reference state), got %s",
@@ -91,16 +89,17 @@ static pm_err check_boundary(const pm_scene *s) {
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
     if (bc->velocity_mask || bc->absorbing)
-      return pm_scene_fail(s,
-                           PATH(p, "boundary.%d.%s", i,
-                                bc->velocity_mask ? "velocity" : "absorbing"),
-                           true,
-                           "expected displacement or traction (method fpm), "
-                           "got %s",
-                           bc->velocity_mask ? "velocity" : "absorbing");
+      return pm_scene_fail(
+          s,
+          PM_PATH(p, "boundary.%d.%s", i,
+                  bc->velocity_mask ? "velocity" : "absorbing"),
+          true,
+          "expected displacement or traction (method fpm), "
+          "got %s",
+          bc->velocity_mask ? "velocity" : "absorbing");
     if (bc->on == PM_ON_SURFACE &&
         !(s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH))
-      return pm_scene_expected(s, PATH(p, "boundary.%d.on", i),
+      return pm_scene_expected(s, PM_PATH(p, "boundary.%d.on", i),
                                "a face of domain.box (xmin, xmax, ymin, ymax, "
                                "zmin, zmax), a region, or the name of a "
                                "physical surface of a gmsh body");

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "pm_backend.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
 
@@ -71,9 +72,8 @@ double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
 }
 
 double fpm_energy_error(const fpm_step_info *s) {
-  double held = s->kinetic + s->strain + s->penalty + s->dissipated;
-  double scale = s->external_work != 0 ? fabs(s->external_work) : held;
-  return scale > 0 ? (held - s->external_work) / scale : 0;
+  return pm_energy_error(0, s->kinetic + s->strain + s->penalty, s->dissipated,
+                         s->external_work);
 }
 
 /* Steps before the energy balance is checked against its bound. */

@@ -59,9 +59,10 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
 double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
                        double *work, double *lambda);
 
-/* Energy-balance error of a step's figures: (kinetic + strain + interface
- * + dissipated - external work) over |external work| (over the energy held
- * while no work has been done yet); signed, 0 when nothing moves. */
+/* Energy-balance error of a step's figures (pm_energy_error from rest:
+ * (kinetic + strain + interface + dissipated - external work) over
+ * |external work|, over the energy held while no work has been done yet;
+ * signed, 0 when nothing moves). */
 double fpm_energy_error(const fpm_step_info *s);
 
 /* Reaction force: sum of f over the prescribed dofs of boundary condition

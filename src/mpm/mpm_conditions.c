@@ -76,14 +76,6 @@ size_t mpm_cond_work_bytes(const mpm_cond_work *cw, const mpm_grid *g) {
   return (3 * sizeof(short) + 6 * sizeof(double)) * (size_t)g->n_nodes;
 }
 
-double mpm_load_end(const mpm_bc *bcs, int n_bcs) {
-  double T = 0;
-  for (int b = 0; b < n_bcs; b++)
-    if ((bcs[b].disp_mask | bcs[b].vel_mask) && bcs[b].ramp != PM_RAMP_NONE)
-      T = fmax(T, bcs[b].ramp_time);
-  return T;
-}
-
 /* Velocity the condition prescribes on component c at face position x over
  * the step from t to t + dt. */
 static double bc_velocity(const mpm_bc *bc, int c, const double x[3], double t,

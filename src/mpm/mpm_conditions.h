@@ -54,9 +54,6 @@ void mpm_cond_work_destroy(mpm_cond_work *cw);
 /* Bytes the conditions' workspace takes. */
 size_t mpm_cond_work_bytes(const mpm_cond_work *cw, const mpm_grid *g);
 
-/* End of the loading: the longest ramp of a prescribed condition, s. */
-double mpm_load_end(const mpm_bc *bcs, int n_bcs);
-
 /* Move the forces of the dependent dofs onto their anchors (into the
  * work's fold), from the nodal forces of this step. */
 void mpm_conditions_fold(const mpm_ctx *ctx);

@@ -21,6 +21,7 @@ void mpm_options_from_scene(const pm_scene *s, mpm_options *o) {
       .max_iterations = (int)set->fluid.max_iterations,
       .has_gravity = s->has_gravity,
       .t_end = s->time.end,
+      .t_load = pm_scene_load_end(s),
       .dt_fixed = s->time.dt,
       .dt_safety = s->time.dt_safety,
       .max_steps = s->time.max_steps,

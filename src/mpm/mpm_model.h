@@ -30,6 +30,7 @@ typedef struct mpm_options {
   bool has_gravity;
   double gravity[3]; /* m/s^2 */
   double t_end;      /* s */
+  double t_load;     /* when every ramped condition is at full value, s */
   double dt_fixed;   /* time.dt, or 0: the stable step each step */
   double dt_safety;
   long max_steps; /* 0: no limit */

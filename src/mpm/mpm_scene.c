@@ -115,8 +115,6 @@ const mpm_settings *mpm_scene_settings(const pm_scene *s) {
   return pm_scene_section(s, "mpm");
 }
 
-#define PATH(buf, ...) (snprintf((buf), sizeof(buf), __VA_ARGS__), (buf))
-
 pm_err mpm_check_scene(const pm_scene *s) {
   char p[64], what[192];
   /* The box faces are grid planes, where conditions act. */
@@ -133,14 +131,14 @@ pm_err mpm_check_scene(const pm_scene *s) {
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
     if (bc->traction_mask)
-      return pm_scene_fail(s, PATH(p, "boundary.%d.traction", i), true,
+      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.traction", i), true,
                            "expected displacement, velocity or absorbing "
                            "(method mpm), got traction");
     if (bc->on != PM_ON_FACE)
       return pm_scene_fail(
           s,
-          PATH(p, "boundary.%d.%s", i,
-               bc->on == PM_ON_REGION ? "region" : "on"),
+          PM_PATH(p, "boundary.%d.%s", i,
+                  bc->on == PM_ON_REGION ? "region" : "on"),
           bc->on == PM_ON_REGION,
           "expected on: a face of domain.box (xmin, xmax, ymin, ymax, zmin, "
           "zmax) for method mpm (its conditions act on grid planes), got %s",

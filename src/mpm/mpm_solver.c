@@ -10,7 +10,7 @@
 pm_err mpm_solve(const mpm_model *m, mpm_state *s, mpm_work *w,
                  const mpm_run_options *opt, mpm_observer observer, void *ctx,
                  mpm_step_info *last) {
-  const double t_load = mpm_load_end(m->bcs, m->n_bcs);
+  const double t_load = m->opt.t_load;
   const double dt_fixed = m->opt.dt_fixed;
   mpm_step_info info = {.step = s->step, .t = s->t, .dt = s->dt};
   pm_err ret = PM_SUCCESS;

@@ -60,4 +60,15 @@ static inline int pm_test_drop_dir(void **state) {
   return 0;
 }
 
+/* Writes text to dir/name; path receives the full name. */
+static inline void pm_test_write_file(const char *dir, const char *name,
+                                      const char *text, char path[512]) {
+  int len = snprintf(path, 512, "%s/%s", dir, name);
+  assert_true(len > 0 && len < 512);
+  FILE *f = fopen(path, "w");
+  assert_non_null(f);
+  assert_true(fputs(text, f) >= 0);
+  assert_int_equal(fclose(f), 0);
+}
+
 #endif

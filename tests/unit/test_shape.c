@@ -264,41 +264,6 @@ static void test_meshed_sphere(void **state) {
   gm_shape_destroy(s);
 }
 
-/* The analytic kinds answer as pm_body_contains (the scene's own test,
- * which seeding used so far) does, on a lattice through the domain box
- * that meets the shapes' boundaries. */
-static void test_same_as_scene(void **state) {
-  (void)state;
-  pm_scene_body b[5] = {body_of(PM_BODY_DOMAIN), body_of(PM_BODY_REGION),
-                        body_of(PM_BODY_BOX), body_of(PM_BODY_SPHERE),
-                        body_of(PM_BODY_CYLINDER)};
-  assert_ok(pm_expr_create("x - y*z", &b[1].region));
-  memcpy(b[2].a, (const double[3]){0.5, 1, 1.25}, 3 * sizeof(double));
-  memcpy(b[2].b, (const double[3]){2, 3, 4.5}, 3 * sizeof(double));
-  memcpy(b[3].a, (const double[3]){1.5, 2, 2.5}, 3 * sizeof(double));
-  b[3].radius = 1.25;
-  memcpy(b[4].a, (const double[3]){0.25, 0.5, 1}, 3 * sizeof(double));
-  memcpy(b[4].b, (const double[3]){2, 3, 3}, 3 * sizeof(double));
-  b[4].radius = 0.75;
-  long in = 0;
-  for (int dim = 2; dim <= 3; dim++)
-    for (int k = 0; k < (dim == 3 ? 5 : 4); k++) {
-      gm_shape *s = make(&b[k], dim);
-      for (int i = 0; i <= 24; i++)
-        for (int j = 0; j <= 32; j++)
-          for (int l = 0; l <= (dim == 3 ? 40 : 0); l++) {
-            const double x[3] = {0.125 * i, 0.125 * j, 0.125 * l};
-            bool mine = gm_shape_contains(s, x);
-            assert_int_equal(mine, pm_body_contains(&b[k], dim, x));
-            in += mine;
-          }
-      gm_shape_destroy(s);
-    }
-  print_message("  %ld lattice points inside\n", in);
-  pm_expr_destroy(b[1].region);
-}
-
-/* Later shapes take precedence. */
 static void test_last_containing(void **state) {
   (void)state;
   pm_scene_body dom = body_of(PM_BODY_DOMAIN), box = body_of(PM_BODY_BOX);
@@ -415,7 +380,6 @@ int main(void) {
       cmocka_unit_test(test_sphere),
       cmocka_unit_test(test_tilted_cylinder),
       cmocka_unit_test(test_meshed_sphere),
-      cmocka_unit_test(test_same_as_scene),
       cmocka_unit_test(test_last_containing),
       cmocka_unit_test(test_check_inside),
       cmocka_unit_test(test_errors),

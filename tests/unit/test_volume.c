@@ -24,17 +24,6 @@
 
 #define PI 3.14159265358979323846
 
-/* Writes text to dir/name; path receives the full name. */
-static void write_file(const char *dir, const char *name, const char *text,
-                       char path[512]) {
-  int len = snprintf(path, 512, "%s/%s", dir, name);
-  assert_true(len > 0 && len < 512);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  assert_true(fputs(text, f) >= 0);
-  assert_int_equal(fclose(f), 0);
-}
-
 /* Deterministic uniform numbers in [0, 1) (xorshift64*). */
 static double uniform(uint64_t *s) {
   *s ^= *s >> 12;
@@ -88,7 +77,7 @@ static const char sphere_geo[] = "SetFactory(\"OpenCASCADE\");\n"
 static void test_sphere(void **state) {
   const double r = 0.5, h = 0.08;
   char path[512];
-  write_file(*state, "sphere.geo", sphere_geo, path);
+  pm_test_write_file(*state, "sphere.geo", sphere_geo, path);
   char cwd[1024], cwd2[1024];
   assert_non_null(getcwd(cwd, sizeof cwd));
   gm_volume *v = NULL;
@@ -161,10 +150,10 @@ static void test_sphere(void **state) {
  * through), while points 1e-7 outside a face are not. */
 static void test_box(void **state) {
   char path[512];
-  write_file(*state, "box.geo",
-             "SetFactory(\"OpenCASCADE\");\n"
-             "Box(1) = {-1, 0, 2, 2, 1, 0.5};\n",
-             path);
+  pm_test_write_file(*state, "box.geo",
+                     "SetFactory(\"OpenCASCADE\");\n"
+                     "Box(1) = {-1, 0, 2, 2, 1, 0.5};\n",
+                     path);
   const double lo[3] = {-1, 0, 2}, hi[3] = {1, 1, 2.5};
   gm_volume *v = NULL;
   assert_ok(gm_volume_load(path, 3, 0.2, &v));
@@ -209,10 +198,10 @@ static void test_box(void **state) {
 static void test_disk_2d(void **state) {
   const double r = 0.5, h = 0.05;
   char path[512];
-  write_file(*state, "disk.geo",
-             "SetFactory(\"OpenCASCADE\");\n"
-             "Disk(1) = {0, 0, 0, 0.5};\n",
-             path);
+  pm_test_write_file(*state, "disk.geo",
+                     "SetFactory(\"OpenCASCADE\");\n"
+                     "Disk(1) = {0, 0, 0, 0.5};\n",
+                     path);
   gm_volume *v = NULL;
   assert_ok(gm_volume_load(path, 2, h, &v));
   assert_int_equal(gm_volume_dim(v), 2);
@@ -245,19 +234,19 @@ static void test_disk_2d(void **state) {
  * moved off the edges: only the corners count), used as it is whatever h. */
 static void test_msh_tetrahedra(void **state) {
   char path[512];
-  write_file(*state, "tets.msh",
-             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-             "$Nodes\n14\n"
-             "1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n"
-             "11 10 0 0\n12 11 0 0\n13 10 1 0\n14 10 0 1\n"
-             "15 10.5 0 0.3\n16 10.6 0.6 0\n17 10 0.5 0\n"
-             "18 10 0 0.5\n19 10.5 0 0.5\n20 10 0.5 0.5\n"
-             "$EndNodes\n"
-             "$Elements\n2\n"
-             "1 4 2 1 1 1 3 2 4\n"
-             "2 11 2 2 2 11 12 13 14 15 16 17 18 19 20\n"
-             "$EndElements\n",
-             path);
+  pm_test_write_file(*state, "tets.msh",
+                     "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+                     "$Nodes\n14\n"
+                     "1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n"
+                     "11 10 0 0\n12 11 0 0\n13 10 1 0\n14 10 0 1\n"
+                     "15 10.5 0 0.3\n16 10.6 0.6 0\n17 10 0.5 0\n"
+                     "18 10 0 0.5\n19 10.5 0 0.5\n20 10 0.5 0.5\n"
+                     "$EndNodes\n"
+                     "$Elements\n2\n"
+                     "1 4 2 1 1 1 3 2 4\n"
+                     "2 11 2 2 2 11 12 13 14 15 16 17 18 19 20\n"
+                     "$EndElements\n",
+                     path);
   gm_volume *v = NULL;
   assert_ok(gm_volume_load(path, 3, 0.01, &v));
   assert_int_equal(gm_volume_elements(v), 2);
@@ -360,35 +349,36 @@ static void test_errors(void **state) {
   expect_failure(*state, 3, 0.1, PM_ERR_IO, "directory");
 
   /* A 2D disk asked for as a 3D solid: gmsh makes no tetrahedra. */
-  write_file(*state, "disk.geo",
-             "SetFactory(\"OpenCASCADE\");\nDisk(1) = {0, 0, 0, 0.5};\n", path);
+  pm_test_write_file(
+      *state, "disk.geo",
+      "SetFactory(\"OpenCASCADE\");\nDisk(1) = {0, 0, 0, 0.5};\n", path);
   expect_failure(path, 3, 0.1, PM_ERR_MESH, "no tetrahedra");
   /* A .msh holding only a triangle. */
-  write_file(*state, "tri.msh",
-             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-             "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
-             "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n",
-             path);
+  pm_test_write_file(*state, "tri.msh",
+                     "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+                     "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                     "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n",
+                     path);
   expect_failure(path, 3, 0.1, PM_ERR_MESH, "no tetrahedra");
   /* ... which is fine in 2D. */
   assert_ok(gm_volume_load(path, 2, 0.1, &v));
   assert_true(fabs(gm_volume_measure(v) - 0.5) <= 1e-15);
   gm_volume_destroy(v);
   /* A syntax error: gmsh's own message is quoted. */
-  write_file(*state, "bad.geo",
-             "SetFactory(\"OpenCASCADE\");\nSphere(1) = {0, 0, 0, 0.5;\n",
-             path);
+  pm_test_write_file(
+      *state, "bad.geo",
+      "SetFactory(\"OpenCASCADE\");\nSphere(1) = {0, 0, 0, 0.5;\n", path);
   expect_failure(path, 3, 0.1, PM_ERR_MESH, "syntax error");
   /* A 3D solid asked for in 2D: its surface triangles leave z = 0. */
-  write_file(*state, "sphere.geo", sphere_geo, path);
+  pm_test_write_file(*state, "sphere.geo", sphere_geo, path);
   expect_failure(path, 2, 0.2, PM_ERR_MESH, "z = 0");
   /* Hexahedra are not simplices. */
-  write_file(*state, "hex.msh",
-             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-             "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
-             "5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n"
-             "$Elements\n1\n1 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n",
-             path);
+  pm_test_write_file(*state, "hex.msh",
+                     "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+                     "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
+                     "5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n"
+                     "$Elements\n1\n1 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n",
+                     path);
   expect_failure(path, 3, 0.1, PM_ERR_UNSUPPORTED, "Hexahedron");
   /* Arguments. */
   expect_failure(path, 4, 0.1, PM_ERR_ARG, "2 or 3");
@@ -404,7 +394,7 @@ static void test_errors(void **state) {
  * and the OpenMP thread count must survive. */
 static void test_gmsh_state(void **state) {
   char path[512];
-  write_file(*state, "sphere.geo", sphere_geo, path);
+  pm_test_write_file(*state, "sphere.geo", sphere_geo, path);
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
   gm_mesh *m1 = NULL, *m2 = NULL;
   gm_volume *v1 = NULL, *v2 = NULL;

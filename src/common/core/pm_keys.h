@@ -71,22 +71,24 @@ typedef pm_err (*pm_key_read_fn)(pm_reader *r, int id, const char *path,
 struct pm_key {
   const char *name;
   pm_key_type type;
-  size_t offset;            /* of the value in the target struct */
-  const char *def;          /* default, as scene text ("20", "iipg", "[2]",
-                               "nan"); NULL: optional with no default (the
-                               target keeps its zero; presence can be asked) */
-  unsigned flags;           /* PM_KEY_* */
-  unsigned range;           /* PM_RANGE_* */
-  double lo, hi;            /* range bounds */
-  const pm_name *names;     /* ENUM, FLAGS */
-  const pm_key *keys;       /* MAPPING, LIST */
-  size_t elem_size;         /* LIST */
-  size_t count_offset;      /* COMPONENTS (mask), NUMBERS, LIST (count) */
-  int min_count, max_count; /* NUMBERS, LIST, FLAGS (0: no bound) */
-  pm_key_read_fn read;      /* CUSTOM */
-  const char *what;         /* CUSTOM: what it takes ("2 or 3") */
-  const char *unit;         /* SI unit ("Pa", "m", "1/s"; "" none) */
-  const char *doc;          /* one line for `pointmech keys` */
+  size_t offset;              /* of the value in the target struct */
+  const char *def;            /* default, as scene text ("20", "iipg", "[2]",
+                                 "nan"); NULL: optional with no default (the
+                                 target keeps its zero; presence can be asked) */
+  unsigned flags;             /* PM_KEY_* */
+  unsigned range;             /* PM_RANGE_* */
+  double lo, hi;              /* range bounds */
+  const pm_name *names;       /* ENUM, FLAGS */
+  const pm_key *keys;         /* MAPPING, LIST */
+  size_t elem_size;           /* LIST */
+  size_t count_offset;        /* COMPONENTS (mask), NUMBERS, LIST (count) */
+  int min_count, max_count;   /* NUMBERS, LIST, FLAGS (0: no bound) */
+  pm_key_read_fn read;        /* CUSTOM */
+  void (*release)(void *dst); /* CUSTOM: free what read allocated (may be
+                                 NULL) */
+  const char *what;           /* CUSTOM: what it takes ("2 or 3") */
+  const char *unit;           /* SI unit ("Pa", "m", "1/s"; "" none) */
+  const char *doc;            /* one line for `pointmech keys` */
 };
 
 /* The key of table keys named name, or NULL. */

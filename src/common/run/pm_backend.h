@@ -14,8 +14,7 @@
 #include "pm_keys.h"
 #include "pm_output.h"
 #include "pm_progress.h"
-
-struct pm_scene;
+#include "pm_scene.h"
 
 typedef enum {
   PM_STATUS_NOT_RUN = 0,
@@ -172,7 +171,7 @@ typedef struct pm_backend {
 
 /* Register b (idempotent; at most PM_BACKENDS_MAX).  The program registers
  * its backends before loading a scene. */
-#define PM_BACKENDS_MAX 8
+#define PM_BACKENDS_MAX PM_SCENE_SECTIONS
 pm_err pm_backend_register(const pm_backend *b);
 int pm_backend_count(void);
 const pm_backend *pm_backend_at(int k);

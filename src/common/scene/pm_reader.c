@@ -58,10 +58,9 @@ static int name_value(const pm_name *names, const char *s, int *v) {
   return 0;
 }
 
-pm_err pm_reader_expr(pm_reader *r, int id, const char *path, const char *text,
+pm_err pm_reader_expr(pm_reader *r, const char *path, const char *text,
                       const char *vars, pm_expr **out) {
   char msg[PM_SDOC_WHERE];
-  (void)id;
   if (pm_expr_create(text, out) != PM_SUCCESS) {
     /* Copy first: the new message is formatted into the same buffer. */
     snprintf(msg, sizeof msg, "%s", pm_error_message());
@@ -267,7 +266,7 @@ pm_err pm_reader_value(pm_reader *r, int id, const char *path, const pm_key *k,
     if (!s || !s[0]) return expected_key(r, path, k);
     pm_expr_destroy(*(pm_expr **)dst);
     *(pm_expr **)dst = NULL;
-    return pm_reader_expr(r, id, path, s, expr_vars(k), (pm_expr **)dst);
+    return pm_reader_expr(r, path, s, expr_vars(k), (pm_expr **)dst);
   case PM_KEY_COMPONENTS: return read_components(r, id, path, k, dst);
   case PM_KEY_POINT:
     return read_numbers(r, id, path, k, dst, r->dimension, r->dimension, NULL);
@@ -437,6 +436,9 @@ void pm_reader_release(const pm_key *keys, void *base) {
       }
       break;
     case PM_KEY_MAPPING: pm_reader_release(k->keys, dst); break;
+    case PM_KEY_CUSTOM:
+      if (k->release) k->release(dst);
+      break;
     case PM_KEY_LIST: {
       char *elems = *(char **)dst;
       int n = *(int *)((char *)base + k->count_offset);

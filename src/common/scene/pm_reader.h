@@ -41,7 +41,7 @@ bool pm_reader_has(const pm_reader *r, const char *path);
 
 /* Compile an expression in the variables vars ("xyzt", "xyz") found at
  * path; a variable outside vars fails naming it. */
-pm_err pm_reader_expr(pm_reader *r, int id, const char *path, const char *text,
+pm_err pm_reader_expr(pm_reader *r, const char *path, const char *text,
                       const char *vars, pm_expr **out);
 
 /* Release what reading keys into base allocated (strings, expressions,

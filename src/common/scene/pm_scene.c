@@ -253,32 +253,6 @@ double pm_scene_load_end(const pm_scene *s) {
   return end;
 }
 
-bool pm_body_contains(const pm_scene_body *b, int dim, const double x[3]) {
-  switch (b->shape) {
-  case PM_BODY_DOMAIN: return true;
-  case PM_BODY_REGION:
-    return pm_expr_eval(b->region, x[0], x[1], dim == 3 ? x[2] : 0, 0) > 0;
-  case PM_BODY_BOX:
-    for (int c = 0; c < dim; c++)
-      if (x[c] < b->a[c] || x[c] > b->b[c]) return false;
-    return true;
-  case PM_BODY_SPHERE: {
-    double r2 = 0;
-    for (int c = 0; c < dim; c++) r2 += (x[c] - b->a[c]) * (x[c] - b->a[c]);
-    return r2 <= b->radius * b->radius;
-  }
-  case PM_BODY_CYLINDER: {
-    double d[3] = {x[0] - b->a[0], x[1] - b->a[1], x[2] - b->a[2]};
-    double len2 = pm_v_dot(b->b, b->b), s = pm_v_dot(d, b->b) / len2;
-    if (s < 0 || s > 1) return false;
-    double r2 = pm_v_dot(d, d) - s * s * len2;
-    return r2 <= b->radius * b->radius;
-  }
-  case PM_BODY_MESH: return false;
-  }
-  return false;
-}
-
 double pm_ramp_factor(pm_ramp kind, double T, double t) {
   if (kind == PM_RAMP_NONE) return 1.0;
   if (t <= 0) return 0.0;

@@ -17,6 +17,9 @@
 
 struct pm_backend;
 
+/* Sections a scene can hold: one per registered backend. */
+#define PM_SCENE_SECTIONS 8
+
 typedef enum { PM_RAMP_SMOOTH = 0, PM_RAMP_LINEAR, PM_RAMP_NONE } pm_ramp;
 typedef enum {
   PM_QS_NONE = 0,           /* plain dynamics */
@@ -150,7 +153,7 @@ typedef struct pm_scene {
   pm_expr *reference[3];   /* analytic u_c(x, y, z, t) or NULL */
   /* private: the options of every registered section, and the document
    * (kept for located messages after loading) */
-  void *section_opts[8];
+  void *section_opts[PM_SCENE_SECTIONS];
   pm_sdoc doc;
 } pm_scene;
 
@@ -173,6 +176,10 @@ const void *pm_scene_section(const pm_scene *s, const char *name);
 /* Whether the scene gives the key at a dotted path (file or override). */
 bool pm_scene_has(const pm_scene *s, const char *path);
 
+/* Format a key path into the char array buf and give buf:
+ * PM_PATH(p, "boundary.%d.on", i). */
+#define PM_PATH(buf, ...) (snprintf((buf), sizeof(buf), __VA_ARGS__), (buf))
+
 /* Located failures about the key at path (PM_ERR_SCENE): "WHERE: " + the
  * formatted text (at the key's name with key set), and "WHERE: expected
  * WHAT, got VALUE". */
@@ -180,11 +187,6 @@ pm_err pm_scene_fail(const pm_scene *s, const char *path, bool key,
                      const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 pm_err pm_scene_expected(const pm_scene *s, const char *path, const char *what);
-
-/* True when x (3 components; z unused in 2D) lies in the body's shape:
- * domain, region (expr > 0), box, sphere or cylinder (boundary included).
- * A mesh shape needs the geometry layer: this returns false for it. */
-bool pm_body_contains(const pm_scene_body *b, int dim, const double x[3]);
 
 /* The whole vocabulary, from the key tables: shared keys, every model's
  * and every registered backend's section. */

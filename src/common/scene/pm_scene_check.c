@@ -8,15 +8,13 @@
 
 #include "pm_scene_vocab.h"
 
-#define PATH(buf, ...) (snprintf((buf), sizeof(buf), __VA_ARGS__), (buf))
-
 static pm_err finish_domain(pm_reader *r, pm_scene *s) {
   char p[PM_SDOC_PATH], what[128];
   for (int c = 0; c < s->dimension; c++)
     if (!(s->box_max[c] > s->box_min[c])) {
       snprintf(what, sizeof what, "a number > domain.box.min.%d (%g)", c,
                s->box_min[c]);
-      return pm_reader_expected(r, PATH(p, "domain.box.max.%d", c), what);
+      return pm_reader_expected(r, PM_PATH(p, "domain.box.max.%d", c), what);
     }
   return PM_SUCCESS;
 }
@@ -31,7 +29,7 @@ static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
   char p[PM_SDOC_PATH];
   int given = -1;
   for (int k = 0; k < 5; k++) {
-    if (!pm_reader_has(r, PATH(p, "bodies.%d.%s", i, keys[k]))) continue;
+    if (!pm_reader_has(r, PM_PATH(p, "bodies.%d.%s", i, keys[k]))) continue;
     if (given >= 0)
       return pm_reader_fail(r, p, true,
                             "expected one shape (region, box, sphere, "
@@ -48,16 +46,16 @@ static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
   case PM_BODY_BOX:
     for (int c = 0; c < s->dimension; c++)
       if (!(b->b[c] > b->a[c]))
-        return pm_reader_expected(r, PATH(p, "bodies.%d.box.max.%d", i, c),
+        return pm_reader_expected(r, PM_PATH(p, "bodies.%d.box.max.%d", i, c),
                                   "a number > the box's min");
     return PM_SUCCESS;
   case PM_BODY_CYLINDER:
     if (s->dimension != 3)
-      return pm_reader_fail(r, PATH(p, "bodies.%d.cylinder", i), true,
+      return pm_reader_fail(r, PM_PATH(p, "bodies.%d.cylinder", i), true,
                             "expected box, sphere, region or mesh (dimension "
                             "2), got cylinder");
     if (!(pm_v_norm(b->b) > 0))
-      return pm_reader_expected(r, PATH(p, "bodies.%d.cylinder.axis", i),
+      return pm_reader_expected(r, PM_PATH(p, "bodies.%d.cylinder.axis", i),
                                 "a non-zero vector (base to top face)");
     return PM_SUCCESS;
   case PM_BODY_MESH: {
@@ -87,7 +85,7 @@ static pm_err finish_body_state(pm_reader *r, int i, pm_scene_body *b,
   const pm_model *md = mat->mat.model;
   bool fluid = pm_material_is_fluid(&mat->mat);
   if (isnan(b->density)) b->density = mat->mat.density;
-  if (pm_reader_has(r, PATH(p, "bodies.%d.pressure", i))) {
+  if (pm_reader_has(r, PM_PATH(p, "bodies.%d.pressure", i))) {
     if (!fluid)
       return pm_reader_fail(r, p, true,
                             "expected a key of a solid body (material, shape, "
@@ -97,7 +95,7 @@ static pm_err finish_body_state(pm_reader *r, int i, pm_scene_body *b,
     if (!(b->pressure + mat->mat.fluid.p_inf > 0))
       return pm_reader_expected(r, p, "a pressure > -p_inf of the material");
   } else if (fluid) {
-    return pm_reader_fail(r, PATH(p, "bodies.%d", i), false,
+    return pm_reader_fail(r, PM_PATH(p, "bodies.%d", i), false,
                           "missing required key pressure (a body of fluid "
                           "%s needs its initial pressure, Pa)",
                           mat->name);
@@ -105,17 +103,17 @@ static pm_err finish_body_state(pm_reader *r, int i, pm_scene_body *b,
   int nf = b->point.n_fibres;
   if (nf > md->fibres_max) {
     if (md->fibres_max == 0)
-      return pm_reader_fail(r, PATH(p, "bodies.%d.fibres", i), true,
+      return pm_reader_fail(r, PM_PATH(p, "bodies.%d.fibres", i), true,
                             "expected no fibres (model %s of material %s "
                             "takes none), got %d",
                             md->name, mat->name, nf);
-    return pm_reader_fail(r, PATH(p, "bodies.%d.fibres", i), false,
+    return pm_reader_fail(r, PM_PATH(p, "bodies.%d.fibres", i), false,
                           "expected at most %d fibre directions (model %s), "
                           "got %d",
                           md->fibres_max, md->name, nf);
   }
   if (nf < md->fibres_min)
-    return pm_reader_fail(r, PATH(p, "bodies.%d", i), false,
+    return pm_reader_fail(r, PM_PATH(p, "bodies.%d", i), false,
                           "missing required key fibres (model %s of material "
                           "%s needs %d to %d fibre directions)",
                           md->name, mat->name, md->fibres_min, md->fibres_max);
@@ -150,11 +148,11 @@ static pm_err finish_bodies(pm_reader *r, pm_scene *s) {
         used += (size_t)snprintf(what + used, sizeof what - used, "%s%s",
                                  j ? ", " : "", s->materials[j].name);
       if (used < sizeof what) snprintf(what + used, sizeof what - used, ")");
-      return pm_reader_expected(r, PATH(p, "bodies.%d.material", i), what);
+      return pm_reader_expected(r, PM_PATH(p, "bodies.%d.material", i), what);
     }
     b->material = m;
     b->mark = pm_sdoc_mark(
-        r->doc, pm_sdoc_find(r->doc, PATH(p, "bodies.%d", i), false));
+        r->doc, pm_sdoc_find(r->doc, PM_PATH(p, "bodies.%d", i), false));
     PM_CALL(finish_shape(r, s, i, b));
     PM_CALL(finish_body_state(r, i, b, &s->materials[m]));
   }
@@ -180,9 +178,9 @@ static pm_err finish_on(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc) {
   bool has_on = bc->surface != NULL, has_region = bc->region != NULL;
   if (has_on == has_region) {
     if (has_on)
-      return pm_reader_fail(r, PATH(p, "boundary.%d.region", i), true,
+      return pm_reader_fail(r, PM_PATH(p, "boundary.%d.region", i), true,
                             "expected on or region, got both");
-    return pm_reader_fail(r, PATH(p, "boundary.%d", i), false,
+    return pm_reader_fail(r, PM_PATH(p, "boundary.%d", i), false,
                           "missing required key on (a face xmin ... zmax or "
                           "a named surface) or region");
   }
@@ -194,7 +192,7 @@ static pm_err finish_on(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc) {
   for (int f = 0; f < PM_FACE_COUNT; f++)
     if (strcmp(bc->surface, pm_face_name(f)) == 0) {
       if (f >= 2 * s->dimension)
-        return pm_reader_expected(r, PATH(p, "boundary.%d.on", i),
+        return pm_reader_expected(r, PM_PATH(p, "boundary.%d.on", i),
                                   "one of xmin, xmax, ymin, ymax (dimension "
                                   "2)");
       bc->on = PM_ON_FACE;
@@ -208,11 +206,11 @@ static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
   for (int i = 0; i < s->n_bcs; i++) {
     pm_scene_bc *bc = &s->bcs[i];
     bc->mark = pm_sdoc_mark(
-        r->doc, pm_sdoc_find(r->doc, PATH(p, "boundary.%d", i), false));
+        r->doc, pm_sdoc_find(r->doc, PM_PATH(p, "boundary.%d", i), false));
     PM_CALL(finish_on(r, s, i, bc));
     if (!bc->disp_mask && !bc->traction_mask && !bc->velocity_mask &&
         !bc->absorbing)
-      return pm_reader_fail(r, PATH(p, "boundary.%d", i), false,
+      return pm_reader_fail(r, PM_PATH(p, "boundary.%d", i), false,
                             "expected a displacement, traction or velocity "
                             "component, or absorbing: true, got none");
     static const char *const other[] = {"velocity", "traction"};
@@ -222,7 +220,7 @@ static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
       for (int c = 0; c < 3; c++)
         if (both[k] & (1u << c))
           return pm_reader_fail(
-              r, PATH(p, "boundary.%d.%s.%c", i, other[k], "xyz"[c]), true,
+              r, PM_PATH(p, "boundary.%d.%s.%c", i, other[k], "xyz"[c]), true,
               "expected a component not prescribed as displacement, got %c "
               "(also in boundary.%d.displacement)",
               "xyz"[c], i);

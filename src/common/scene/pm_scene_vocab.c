@@ -96,7 +96,12 @@ static pm_err read_region(pm_reader *r, int id, const char *path,
     return PM_SUCCESS;
   }
   b->shape = PM_BODY_REGION;
-  return pm_reader_expr(r, id, path, text, "xyz", &b->region);
+  return pm_reader_expr(r, path, text, "xyz", &b->region);
+}
+
+static void release_expr(void *dst) {
+  pm_expr_destroy(*(pm_expr **)dst);
+  *(pm_expr **)dst = NULL;
 }
 
 static const pm_key av_keys[] = {{.name = "c0",
@@ -312,6 +317,7 @@ static const pm_key body_keys[] = {
      .type = PM_KEY_CUSTOM,
      .offset = B(region),
      .read = read_region,
+     .release = release_expr,
      .doc = "inside where f(x, y, z) > 0 (or: domain)"},
     {.name = "box",
      .type = PM_KEY_MAPPING,
