@@ -213,12 +213,7 @@ void pm_scene_print_keys(FILE *out) {
   char names[512];
   fprintf(out, "Scene keys (SI units).  A list entry is written KEY.N.\n\n");
   pm_key_print(out, pm_scene_keys, "");
-  fprintf(out, "%-38s %s\n", "materials.N.name", "what bodies call it");
-  fprintf(out, "%-38s %s\n", "materials.N.model", "its constitutive model");
-  fprintf(out, "%-38s %s\n", "materials.N.density",
-          "reference density, kg/m^3");
-  fprintf(out, "%-38s %s\n", "materials.N.artificial_viscosity.c0, c1",
-          "shock viscosity of eq. 32 (MPM), >= 0");
+  pm_key_print(out, pm_scene_material_keys, "materials.N.");
   pm_model_names(names, sizeof names);
   fprintf(out, "\nModels (materials.N.model: %s) and their keys:\n", names);
   for (int k = 0; k < pm_model_count(); k++) {

@@ -35,7 +35,6 @@ static const pm_name field_names[] = {
 #define S(field) offsetof(pm_scene, field)
 #define B(field) offsetof(pm_scene_body, field)
 #define C(field) offsetof(pm_scene_bc, field)
-#define M(field) offsetof(pm_scene_material, field)
 
 /* ---- custom readers ----------------------------------------------------- */
 
@@ -102,125 +101,6 @@ static pm_err read_region(pm_reader *r, int id, const char *path,
 static void release_expr(void *dst) {
   pm_expr_destroy(*(pm_expr **)dst);
   *(pm_expr **)dst = NULL;
-}
-
-static const pm_key av_keys[] = {{.name = "c0",
-                                  .type = PM_KEY_NUMBER,
-                                  .offset = M(av_c0),
-                                  .def = "0",
-                                  .range = PM_RANGE_GE,
-                                  .unit = "",
-                                  .doc = "quadratic coefficient of eq. 32"},
-                                 {.name = "c1",
-                                  .type = PM_KEY_NUMBER,
-                                  .offset = M(av_c1),
-                                  .def = "0",
-                                  .range = PM_RANGE_GE,
-                                  .unit = "",
-                                  .doc = "linear coefficient of eq. 32"},
-                                 {0}};
-
-/* The keys every material has; the rest are its model's. */
-static const pm_key material_keys[] = {
-    {.name = "name",
-     .type = PM_KEY_STRING,
-     .offset = M(name),
-     .flags = PM_KEY_REQUIRED,
-     .doc = "what bodies call it"},
-    {.name = "model",
-     .type = PM_KEY_CUSTOM,
-     .flags = PM_KEY_REQUIRED,
-     .read = NULL, /* read first, by read_materials */
-     .doc = "an entry of the table of constitutive models"},
-    {.name = "density",
-     .type = PM_KEY_NUMBER,
-     .offset = M(mat) + offsetof(pm_material, density),
-     .flags = PM_KEY_REQUIRED,
-     .range = PM_RANGE_GT,
-     .unit = "kg/m^3",
-     .doc = "reference density"},
-    {.name = "artificial_viscosity",
-     .type = PM_KEY_MAPPING,
-     .keys = av_keys,
-     .doc = "shock viscosity of eq. 32 {c0, c1} (MPM)"},
-    {0}};
-
-static pm_err skip_value(pm_reader *r, int id, const char *path,
-                         const pm_key *k, void *dst) {
-  (void)r, (void)id, (void)path, (void)k, (void)dst;
-  return PM_SUCCESS;
-}
-
-/* One material: its model first (the keys it takes depend on it), then
- * every key against the common and the model's tables, then the model's
- * checks, located at the key they name. */
-static pm_err read_material(pm_reader *r, int id, const char *path,
-                            pm_scene_material *out) {
-  char sub[PM_SDOC_PATH], names[512], expected[1024];
-  if (pm_sdoc_kind_of(r->doc, id) != PM_SDOC_MAPPING)
-    return pm_reader_expected(r, path, "a mapping");
-  out->mark = pm_sdoc_mark(r->doc, id);
-  snprintf(sub, sizeof sub, "%s.model", path);
-  int mid = pm_sdoc_child(r->doc, id, "model");
-  if (!mid) return pm_reader_fail(r, sub, false, "missing required key");
-  const char *model = pm_sdoc_scalar(r->doc, mid);
-  pm_model_names(names, sizeof names);
-  if (!model || !pm_model_find(model)) {
-    snprintf(expected, sizeof expected, "one of %s", names);
-    return pm_reader_expected(r, sub, expected);
-  }
-  PM_CALL(pm_material_begin(&out->mat, model, NAN));
-  const pm_model *md = out->mat.model;
-  pm_key common[sizeof material_keys / sizeof *material_keys];
-  memcpy(common, material_keys, sizeof material_keys);
-  common[1].read = skip_value;
-  size_t used = (size_t)snprintf(expected, sizeof expected,
-                                 "name, model, density, "
-                                 "artificial_viscosity, and model %s's ",
-                                 md->name);
-  for (const pm_key *k = md->keys; k->type != PM_KEY_END; k++)
-    used += (size_t)snprintf(expected + used, sizeof expected - used, "%s%s",
-                             k == md->keys ? "" : ", ", k->name);
-  const pm_key *tables[2] = {common, md->keys};
-  void *bases[2] = {out, &out->mat};
-  PM_CALL(pm_reader_mapping(r, id, path, 2, tables, bases, expected));
-  const char *bad = NULL;
-  if (md->init(&out->mat, &bad) != PM_SUCCESS) {
-    char msg[PM_SDOC_WHERE];
-    snprintf(msg, sizeof msg, "%s", pm_error_message());
-    if (bad) {
-      snprintf(sub, sizeof sub, "%s.%s", path, bad);
-      return pm_reader_fail(r, sub, false, "%s", msg);
-    }
-    return pm_reader_fail(r, path, false, "%s (model %s takes %s)", msg,
-                          md->name, md->key_sets ? md->key_sets : "its keys");
-  }
-  return PM_SUCCESS;
-}
-
-static pm_err read_materials(pm_reader *r, int id, const char *path,
-                             const pm_key *k, void *dst) {
-  (void)k;
-  pm_scene *s = (pm_scene *)((char *)dst - S(materials));
-  char sub[PM_SDOC_PATH];
-  if (pm_sdoc_kind_of(r->doc, id) != PM_SDOC_LIST ||
-      pm_sdoc_count(r->doc, id) < 1)
-    return pm_reader_expected(r, path, "a list of at least one material");
-  int n = pm_sdoc_count(r->doc, id);
-  PM_CALL(PM_ALLOC(s->materials, n, "scene materials"));
-  s->n_materials = n;
-  for (int i = 0; i < n; i++) {
-    snprintf(sub, sizeof sub, "%s.%d", path, i);
-    PM_CALL(
-        read_material(r, pm_sdoc_item(r->doc, id, i), sub, &s->materials[i]));
-    for (int j = 0; j < i; j++)
-      if (strcmp(s->materials[j].name, s->materials[i].name) == 0) {
-        snprintf(sub, sizeof sub, "%s.%d.name", path, i);
-        return pm_reader_expected(r, sub,
-                                  "a name not used by an earlier material");
-      }
-  }
-  return PM_SUCCESS;
 }
 
 /* ---- tables ------------------------------------------------------------- */
@@ -317,6 +197,7 @@ static const pm_key body_keys[] = {
      .type = PM_KEY_CUSTOM,
      .offset = B(region),
      .read = read_region,
+     .what = "an expression in x, y, z, or domain",
      .release = release_expr,
      .doc = "inside where f(x, y, z) > 0 (or: domain)"},
     {.name = "box",
@@ -540,6 +421,7 @@ const pm_key pm_scene_keys[] = {
      .offset = S(dimension),
      .flags = PM_KEY_REQUIRED,
      .read = read_dimension,
+     .what = "2 or 3",
      .doc = "3, or 2 for plane strain"},
     {.name = "domain",
      .type = PM_KEY_MAPPING,
@@ -555,7 +437,8 @@ const pm_key pm_scene_keys[] = {
      .type = PM_KEY_CUSTOM,
      .offset = S(materials),
      .flags = PM_KEY_REQUIRED,
-     .read = read_materials,
+     .read = pm_scene_read_materials,
+     .what = "a list of materials (below)",
      .doc = "[{name, model, density, ...the model's keys}]"},
     {.name = "bodies",
      .type = PM_KEY_LIST,

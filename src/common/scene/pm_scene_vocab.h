@@ -9,6 +9,17 @@
 /* The top-level keys every method shares. */
 extern const pm_key pm_scene_keys[];
 
+/* The keys every material has (name, model, density, artificial
+ * viscosity); the rest are its model's.  PM_MATERIAL_KEYS entries with the
+ * end. */
+#define PM_MATERIAL_KEYS 5
+extern const pm_key pm_scene_material_keys[PM_MATERIAL_KEYS];
+
+/* The materials list (a CUSTOM key of pm_scene_keys): each entry against
+ * the common keys and its model's, then its model's checks. */
+pm_err pm_scene_read_materials(pm_reader *r, int id, const char *path,
+                               const pm_key *k, void *dst);
+
 /* After reading: defaults that depend on other keys, names resolved to
  * indices, and the checks across keys, each failing at the key at fault. */
 pm_err pm_scene_finish(pm_reader *r, pm_scene *s);
