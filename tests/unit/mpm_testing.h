@@ -43,17 +43,6 @@ static inline double uniform(void) {
   return (double)((rng * 0x2545F4914F6CDD1Dull) >> 11) * 0x1.0p-53;
 }
 
-/* Writes text to dir/name; path receives the full name. */
-static inline void write_file(const char *dir, const char *name,
-                              const char *text, char path[512]) {
-  int len = snprintf(path, 512, "%s/%s", dir, name);
-  assert_true(len > 0 && len < 512);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  assert_true(fputs(text, f) >= 0);
-  assert_int_equal(fclose(f), 0);
-}
-
 /* A scene's model, state and workspace. */
 typedef struct {
   pm_scene *scene;

@@ -3,6 +3,7 @@
  * updated-Lagrangian backends. */
 #include <math.h>
 
+#include "pm_hyper.h"
 #include "pm_models.h"
 
 static bool stress(const pm_material *m, const double F[9], const double *st,
@@ -20,9 +21,7 @@ static bool stress(const pm_material *m, const double F[9], const double *st,
   P[8] += lambda * tr;
   if (W) *W = 0.5 * lambda * tr * tr + mu * pm_t_ddot(e, e);
   if (Jout) *Jout = pm_t_det(F);
-  for (int k = 0; k < 9; k++)
-    if (!isfinite(P[k])) return false;
-  return true;
+  return pm_hyper_finite(P);
 }
 
 static bool tangent(const pm_material *m, const double F[9], const double *st,

@@ -3,6 +3,7 @@
  * to keep its relative accuracy as F -> I. */
 #include <math.h>
 
+#include "pm_hyper.h"
 #include "pm_models.h"
 
 /* P = mu J^-2/3 (F - I1/3 F^-T) + K (J - 1) J F^-T, with J F^-T = cof F.
@@ -31,9 +32,7 @@ static bool stress(const pm_material *m, const double F[9], const double *st,
   double a = mu * Jm23, b = -a * I1 / (3 * J) + kappa * Jm1;
   for (int k = 0; k < 9; k++) P[k] = a * F[k] + b * cof[k];
   if (W) *W = 0.5 * mu * (Jm23 * I1m3 + 3 * Jm23m1) + 0.5 * kappa * Jm1 * Jm1;
-  for (int k = 0; k < 9; k++)
-    if (!isfinite(P[k])) return false;
-  return true;
+  return pm_hyper_finite(P);
 }
 
 /* d(a F + b cof F) with dJ = cof : dF, dI1 = 2 F : dF,
