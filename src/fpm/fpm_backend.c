@@ -142,7 +142,6 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
   }
   pm_step_report r = {.step = info->step,
                       .t = info->t,
-                      .dt = sim->dt,
                       .residual = info->residual,
                       .progress = frac};
   return sim->obs ? sim->obs->step(sim->obs->ctx, &r, frame) : PM_SUCCESS;
@@ -278,7 +277,6 @@ static void figures(void *p, pm_figures *f, bool with_fields) {
   f->max_energy_error = sim->run_max_energy_error;
   f->min_jacobian = sim->run_min_jacobian;
   f->min_jacobian_step = sim->run_min_jacobian_step;
-  f->n_bcs = s->n_bcs;
   for (int b = 0; b < s->n_bcs && b < PM_FIGURES_MAX_BCS; b++)
     fpm_reaction(m, sim->state, b, f->reaction[b]);
   f->setup_seconds = sim->setup_wall;

@@ -53,7 +53,6 @@ static pm_err report(mpm_sim *r, bool frame) {
   const mpm_state *s = r->state;
   pm_step_report rep = {.step = s->step,
                         .t = s->t,
-                        .dt = s->dt,
                         .residual = r->work->residual,
                         .progress = s->t / r->model->opt.t_end};
   return r->obs ? r->obs->step(r->obs->ctx, &rep, frame) : PM_SUCCESS;
@@ -224,7 +223,6 @@ static void figures(void *p, pm_figures *f, bool with_fields) {
   f->max_energy_error = NAN; /* reported, not bounded */
   f->min_jacobian = r->run_min_jacobian;
   f->min_jacobian_step = r->run_min_jacobian_step;
-  f->n_bcs = m->n_bcs;
   for (int b = 0; b < m->n_bcs && b < PM_FIGURES_MAX_BCS; b++)
     for (int c = 0; c < 3; c++)
       f->reaction[b][c] = r->work->cond.reaction[3 * b + c];

@@ -75,7 +75,6 @@ typedef struct {
   double end_min_jacobian_at[3];
   /* Reactions of each boundary condition (N; per unit thickness in 2D):
    * the force the supports apply on the body. */
-  int n_bcs;
   double reaction[PM_FIGURES_MAX_BCS][3];
   /* Cost. */
   double setup_seconds; /* discretization and operators */
@@ -92,7 +91,7 @@ double pm_energy_error(double E0, double E, double D, double W);
 /* What a backend reports after each step of its time loop. */
 typedef struct {
   long step;
-  double t, dt;
+  double t;
   double residual; /* quasi-static residual (0 in dynamics) */
   double progress; /* fraction of the run done, in [0, 1] */
 } pm_step_report;

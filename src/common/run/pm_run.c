@@ -285,7 +285,10 @@ done:
 
 /* ---- the run ------------------------------------------------------------ */
 
-void pm_loaded_face(const pm_scene *s, int *bc, int *comp) {
+/* The loaded face of s: the condition with the largest prescribed
+ * displacement at time.end (at its face's centre) and that component; *bc
+ * is -1 when there is none. */
+static void loaded_face(const pm_scene *s, int *bc, int *comp) {
   double best = -1;
   *bc = -1;
   *comp = 0;
@@ -330,7 +333,7 @@ static void conclude(run_ctx *c, pm_err run_err) {
              f->residual, s->time.qs_tolerance, f->time, f->steps);
   }
   int bc, comp;
-  pm_loaded_face(s, &bc, &comp);
+  loaded_face(s, &bc, &comp);
   o->loaded_reaction = bc >= 0 ? f->reaction[bc][comp] : NAN;
 }
 

@@ -41,9 +41,4 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, bool quiet,
 /* Create the simulation and print its plan. */
 pm_err pm_plan_scene(const pm_scene *s, FILE *out);
 
-/* The loaded face of s: the condition with the largest prescribed
- * displacement at time.end (at its face's centre) and that component; *bc
- * is -1 when there is none. */
-void pm_loaded_face(const pm_scene *s, int *bc, int *comp);
-
 #endif
