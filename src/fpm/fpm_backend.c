@@ -395,14 +395,21 @@ static pm_err plan(void *p, FILE *out) {
   fprintf(out, "pipeline     1. stress per point (");
   for (int k = 0; k < m->n_mats; k++)
     fprintf(out, "%s%s", k ? ", " : "", m->mats[k].model->name);
+  fprintf(out, ")\n");
+  if (m->q)
+    fprintf(out,
+            "             2. quadratic fit per point, %ld entries (%ld "
+            "points over two rings, %ld linear)\n",
+            m->qs_ptr[m->n], m->n_qwide, m->n_qlinear);
   fprintf(out,
-          ")\n             2. interface flux (%s, penalty %g), %ld "
-          "support entries\n",
+          "             %d. interface flux (%s, penalty %g on the %s "
+          "jump), %ld support entries\n",
+          m->q ? 3 : 2,
           m->flux == FPM_FLUX_SIPG ? "SIPG: with the adjoint term, tangent "
                                      "per point"
                                    : "IIPG",
-          m->penalty, m->nnz);
-  int stage = 3;
+          m->penalty, m->q ? "quadratic" : "linear", m->nnz);
+  int stage = m->q ? 4 : 3;
   if (m->n_dpts > 0)
     fprintf(out,
             "             %d. consistency flux on prescribed faces, %ld "

@@ -1,12 +1,26 @@
 /* fpm_force: the net nodal force of the FPM discretization in three
  * gathers (stress per point, flux per point, force per point): no scatter,
- * no atomics, no allocation. */
+ * no atomics, no allocation.  The force is linear in (u, H, P, theta) but
+ * for P(F) and the SIPG adjoint term, so the same passes applied to
+ * (du, dH, dP, dtheta) give its exact linearisation (fpm_force_linear). */
 #include <math.h>
+#include <stdlib.h>
 
+#include "fpm_gfd.h"
 #include "fpm_model.h"
 #include "pm_material.h"
 #include "pm_omp.h"
 #include "pm_tensor.h"
+
+/* The arrays one evaluation of the passes reads and writes: the state's
+ * for the force, a fpm_linear's for its linearisation. */
+typedef struct {
+  const double *u, *H, *P, *theta; /* in */
+  double *T, *r, *zq, *Zq, *f;     /* out */
+  double *bflux;                   /* out, force only (else NULL) */
+  /* linearisation only: the state linearised about (NULL for the force) */
+  const fpm_state *base;
+} fields;
 
 /* Pass 1: F_i = I + sum_k (u_k - u_i) (x) g_ik, then P_i, W_i, J_i.
  * Returns the smallest inadmissible point id or -1. */
@@ -59,6 +73,38 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
   return bad < n ? bad : -1;
 }
 
+/* With fpm.jump: quadratic, the fit of each point:
+ * theta_i = sum_m (u_m - u_i) (x) q_im (3 x FPM_QFIT). */
+static void fit_pass(const fpm_model *m, const double *restrict u,
+                     double *restrict th) {
+  const long n = m->n;
+  const long *restrict ptr = m->qs_ptr;
+  const int *restrict nbr = m->qs_nbr;
+  const double *restrict q = m->q;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, ptr, nbr, q, u, th))
+  for (long i = 0; i < n; i++) {
+    double t[27] = {0};
+    const double *ui = u + 3 * i;
+    for (long e = ptr[i]; e < ptr[i + 1]; e++) {
+      const double *uk = u + 3 * nbr[e], *qe = q + FPM_QFIT * e;
+      for (int c = 0; c < 3; c++) {
+        const double d = uk[c] - ui[c];
+        for (int a = 0; a < FPM_QFIT; a++) t[FPM_QFIT * c + a] += d * qe[a];
+      }
+    }
+    for (int a = 0; a < 27; a++) th[27 * i + a] = t[a];
+  }
+}
+
+/* theta (3 x FPM_QFIT) applied to phi: the fit's increment at an offset. */
+static inline double fit_at(const double *theta, int c, const double *phi) {
+  const double *t = theta + FPM_QFIT * c;
+  double v = 0;
+  for (int a = 0; a < FPM_QFIT; a++) v += t[a] * phi[a];
+  return v;
+}
+
 /* Pass 2: per point i, over its interfaces e with outward area vector a,
  * d_i = x_e - X_i, d_k = x_e - X_k:
  *   [[u]] = u_i + H_i d_i - u_k - H_k d_k,  b = beta |e| [[u]],
@@ -68,45 +114,67 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
  * is  1/2 P_k Mc + w (x) d_i  with  w = 1/2 P_k a - b;  the P_i half uses
  * the precomputed sums of a and M_e - a (x) X_i.  Entry records stream in
  * order; only the neighbours' u, H, P are gathered.  Also the interface
- * energy 1/2 sum_e beta |e| [[u]]^2 (and, for SIPG, - sum_e {P} : K_e). */
-static void flux_pass(const fpm_model *m, fpm_state *st) {
+ * energy 1/2 sum_e beta |e| [[u]]^2 (and, for SIPG, - sum_e {P} : K_e).
+ * With fpm.jump: quadratic the penalty measures the jump of the fits,
+ * [[u]]_q = u_i + theta_i phi(d_i) - u_k - theta_k phi(d_k), and its force
+ * leaves through zq_i = sum_e b and Zq_i = sum_e b (x) phi(d_i) (gathered
+ * by the fit weights in pass 3) instead of r and Q. */
+static double flux_pass(const fpm_model *m, const fields *fl) {
   const long n = m->n;
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr;
   const double *restrict erec = m->erec, *restrict pa = m->p_area,
                          *restrict pm = m->p_mrel,
                          *restrict vol = m->dual->volume;
-  const double *restrict u = st->u, *restrict H = st->H, *restrict P = st->P;
-  double *restrict T = st->T, *restrict r = st->r;
+  const double *restrict u = fl->u, *restrict H = fl->H, *restrict P = fl->P;
+  double *restrict T = fl->T, *restrict r = fl->r;
+  const fpm_state *base = fl->base;
   const int *restrict mat = m->mat;
   const pm_material *mats = m->mats;
   const double *ms = m->mstate;
   const long mss = m->mstate_stride;
   const bool sym = m->flux == FPM_FLUX_SIPG;
+  const double *restrict th = fl->theta;
+  double *restrict zq = fl->zq, *restrict Zq = fl->Zq;
+  const bool quad = th != NULL;
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
          shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat, mats, ms,
-                mss, sym))
+                mss, sym, th, zq, Zq, quad, base))
   for (long i = 0; i < n; i++) {
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
-    double Q[9] = {0}, ri[3] = {0}, B[9] = {0};
+    double Q[9] = {0}, ri[3] = {0}, B[9] = {0}, z[3] = {0}, Z[27] = {0};
+    double B0[9] = {0}; /* linearisation, SIPG: sum_e K_e at the base */
     for (long e = ptr[i]; e < ptr[i + 1]; e++) {
       const long k = nbr[e];
       const double *rec = erec + FPM_EREC * e;
       const double *a = rec, *Mc = rec + 3, *di = rec + 12, *dk = rec + 15;
       const double be = rec[18];
       const double *Pk = P + 9 * k, *Hk = H + 9 * k, *uk = u + 3 * k;
-      double w[3];
+      double w[3], phi_i[FPM_QFIT], phi_k[FPM_QFIT];
+      if (quad) {
+        fpm_gfd_phi(di, phi_i);
+        fpm_gfd_phi(dk, phi_k);
+      }
       for (int c = 0; c < 3; c++) {
         const double jump = ui[c] - uk[c] + Hi[3 * c] * di[0] +
                             Hi[3 * c + 1] * di[1] + Hi[3 * c + 2] * di[2] -
                             Hk[3 * c] * dk[0] - Hk[3 * c + 1] * dk[1] -
                             Hk[3 * c + 2] * dk[2];
+        const double pjump =
+            quad ? ui[c] - uk[c] + fit_at(th + 27 * i, c, phi_i) -
+                       fit_at(th + 27 * k, c, phi_k)
+                 : jump;
+        const double b = be * pjump;
         w[c] = 0.5 * (Pk[3 * c] * a[0] + Pk[3 * c + 1] * a[1] +
                       Pk[3 * c + 2] * a[2]) -
-               be * jump;
+               (quad ? 0 : b);
         ri[c] -= w[c];
-        epen += 0.25 * be * jump * jump; /* each interface is seen twice */
+        if (quad) {
+          z[c] += b;
+          for (int q = 0; q < FPM_QFIT; q++) Z[FPM_QFIT * c + q] += b * phi_i[q];
+        }
+        epen += 0.25 * be * pjump * pjump; /* each interface is seen twice */
         if (sym) {
           /* K_e = int_e [[u]] (x) n = [[u]](c_e) (x) a + (H_i - H_k) Mc^T */
           const double h0 = Hi[3 * c] - Hk[3 * c],
@@ -119,6 +187,19 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
             /* -{P} : K_e, each interface seen twice */
             epen -= 0.25 * (Pi[3 * c + q] + Pk[3 * c + q]) * K;
           }
+          if (base) {
+            const double *bu = base->u, *bH = base->H;
+            const double *bHi = bH + 9 * i, *bHk = bH + 9 * k;
+            const double bj = bu[3 * i + c] - bu[3 * k + c] +
+                              bHi[3 * c] * di[0] + bHi[3 * c + 1] * di[1] +
+                              bHi[3 * c + 2] * di[2] - bHk[3 * c] * dk[0] -
+                              bHk[3 * c + 1] * dk[1] - bHk[3 * c + 2] * dk[2];
+            for (int q = 0; q < 3; q++)
+              B0[3 * c + q] += bj * a[q] +
+                               (bHi[3 * c] - bHk[3 * c]) * Mc[3 * q] +
+                               (bHi[3 * c + 1] - bHk[3 * c + 1]) * Mc[3 * q + 1] +
+                               (bHi[3 * c + 2] - bHk[3 * c + 2]) * Mc[3 * q + 2];
+          }
         }
       }
       for (int c = 0; c < 3; c++)
@@ -129,14 +210,41 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
     }
     if (sym) {
       /* The adjoint term: -1/2 A_i : sum_e K_e, the derivative of
-       * -sum_e {P} : K_e through P_i (A_i = dP/dF at F_i). */
+       * -sum_e {P} : K_e through P_i (A_i = dP/dF at F_i).  Linearised:
+       * 1/2 (A_i : dB + (dA_i[dF_i]) : B), the derivative of the tangent
+       * along dF_i = dH_i by central differences. */
+      const double *Hb = base ? base->H + 9 * i : Hi;
+      const double *msi = ms ? ms + mss * i : NULL;
       double F[9], dP[9];
-      for (int k = 0; k < 9; k++) F[k] = Hi[k];
+      for (int k = 0; k < 9; k++) F[k] = Hb[k];
       F[0] += 1;
       F[4] += 1;
       F[8] += 1;
-      pm_material_tangent(&mats[mat[i]], F, ms ? ms + mss * i : NULL, B, dP);
+      pm_material_tangent(&mats[mat[i]], F, msi, B, dP);
       for (int k = 0; k < 9; k++) Q[k] += 0.5 * dP[k];
+      if (base) {
+        double hn = 0, fn = 0;
+        for (int k = 0; k < 9; k++) {
+          hn += Hi[k] * Hi[k];
+          fn += F[k] * F[k];
+        }
+        if (hn > 0) {
+          const double eps = 1e-6 * sqrt(fn / hn);
+          double Fp[9], Fm[9], dPp[9], dPm[9];
+          for (int k = 0; k < 9; k++) {
+            Fp[k] = F[k] + eps * Hi[k];
+            Fm[k] = F[k] - eps * Hi[k];
+          }
+          pm_material_tangent(&mats[mat[i]], Fp, msi, B0, dPp);
+          pm_material_tangent(&mats[mat[i]], Fm, msi, B0, dPm);
+          for (int k = 0; k < 9; k++)
+            Q[k] += 0.5 * (dPp[k] - dPm[k]) / (2 * eps);
+        }
+      }
+    }
+    if (quad) {
+      for (int c = 0; c < 3; c++) zq[3 * i + c] = z[c];
+      for (int q = 0; q < 27; q++) Zq[27 * i + q] = Z[q];
     }
     const double *A = pa + 3 * i, *Bm = pm + 9 * i;
     for (int c = 0; c < 3; c++) {
@@ -149,19 +257,20 @@ static void flux_pass(const fpm_model *m, fpm_state *st) {
                    Pi[3 * c + 2] * Bm[6 + q]);
     }
   }
-  st->penalty_energy = epen;
+  return epen;
 }
 
 /* Boundary terms: the consistency flux on facets with displacement
  * conditions, projected on the prescribed components
  * (r_i -= Pi P_i a_f, T_i -= Pi P_i (M_f - a_f (x) X_i)), and prescribed
  * tractions (r_i -= t |f|, T_i -= t (x) |f| (c_f - X_i)). */
-static void boundary_pass(const fpm_model *m, fpm_state *st) {
+static void boundary_pass(const fpm_model *m, const fields *fl,
+                          fpm_state *st) {
   const long nd = m->n_dpts;
   const long *restrict dp = m->dpt_point;
   const double *restrict da = m->dpt_area, *restrict dm = m->dpt_mrel;
-  const double *restrict P = st->P;
-  double *restrict T = st->T, *restrict r = st->r, *restrict bf = st->bflux;
+  const double *restrict P = fl->P;
+  double *restrict T = fl->T, *restrict r = fl->r, *restrict bf = fl->bflux;
   double norm2 = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : norm2)
          shared(nd, dp, da, dm, P, T, r, bf))
@@ -173,13 +282,14 @@ static void boundary_pass(const fpm_model *m, fpm_state *st) {
       const double flux =
           Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] + Pi[3 * c + 2] * A[2];
       r[3 * i + c] -= flux;
-      bf[3 * p + c] = flux;
+      if (bf) bf[3 * p + c] = flux;
       norm2 += flux * flux;
       for (int q = 0; q < 3; q++)
         T[9 * i + 3 * c + q] -= Pi[3 * c] * B[q] + Pi[3 * c + 1] * B[3 + q] +
                                 Pi[3 * c + 2] * B[6 + q];
     }
   }
+  if (!st) return; /* the linearisation: tractions do not depend on u */
   st->bflux_norm = sqrt(norm2);
   /* Several facets share a point: serial (boundary only). */
   for (long k = 0; k < m->n_tfacets; k++) {
@@ -193,13 +303,13 @@ static void boundary_pass(const fpm_model *m, fpm_state *st) {
 }
 
 /* Pass 3: f_k = sum_{i in S(k)} T_i g_ik - T_k sum_j g_kj + r_k. */
-static void gather_pass(const fpm_model *m, fpm_state *st) {
+static void gather_pass(const fpm_model *m, const fields *fl) {
   const long n = m->n;
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr, *restrict mir = m->mirror;
-  const double *restrict g = m->g, *restrict gs = m->gsum, *restrict T = st->T,
-                         *restrict r = st->r;
-  double *restrict f = st->f;
+  const double *restrict g = m->g, *restrict gs = m->gsum, *restrict T = fl->T,
+                         *restrict r = fl->r;
+  double *restrict f = fl->f;
   PM_OMP(parallel for schedule(static) default(none)
          shared(n, ptr, nbr, mir, g, gs, T, r, f))
   for (long k = 0; k < n; k++) {
@@ -220,11 +330,150 @@ static void gather_pass(const fpm_model *m, fpm_state *st) {
   }
 }
 
+/* With fpm.jump: quadratic, the penalty force through the fits:
+ * f_k += zq_k - Zq_k qsum_k + sum over the fits holding k of Zq_i q_ik. */
+static void fit_gather_pass(const fpm_model *m, const fields *fl) {
+  const long n = m->n;
+  const long *restrict tp = m->qt_ptr;
+  const int *restrict te = m->qt_entry, *restrict own = m->qs_own;
+  const double *restrict q = m->q, *restrict qs = m->qsum,
+                         *restrict zq = fl->zq, *restrict Zq = fl->Zq;
+  double *restrict f = fl->f;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, tp, te, own, q, qs, zq, Zq, f))
+  for (long k = 0; k < n; k++) {
+    double fk[3];
+    for (int c = 0; c < 3; c++)
+      fk[c] = zq[3 * k + c] - fit_at(Zq + 27 * k, c, qs + FPM_QFIT * k);
+    for (long t = tp[k]; t < tp[k + 1]; t++) {
+      const long e = te[t];
+      const double *Zi = Zq + 27 * own[e], *qe = q + FPM_QFIT * e;
+      for (int c = 0; c < 3; c++) fk[c] += fit_at(Zi, c, qe);
+    }
+    for (int c = 0; c < 3; c++) f[3 * k + c] += fk[c];
+  }
+}
+
 long fpm_force(const fpm_model *m, fpm_state *st) {
   long bad = stress_pass(m, st);
   if (bad >= 0) return bad;
-  flux_pass(m, st);
-  boundary_pass(m, st);
-  gather_pass(m, st);
+  const fields fl = {.u = st->u, .H = st->H, .P = st->P, .theta = st->theta,
+                     .T = st->T, .r = st->r, .zq = st->zq, .Zq = st->Zq,
+                     .f = st->f, .bflux = st->bflux};
+  if (st->theta) fit_pass(m, st->u, st->theta);
+  st->penalty_energy = flux_pass(m, &fl);
+  boundary_pass(m, &fl, st);
+  gather_pass(m, &fl);
+  if (st->theta) fit_gather_pass(m, &fl);
   return -1;
+}
+
+struct fpm_linear {
+  double *D;               /* 81 n: dP/dF at each point, row-major (9 x 9) */
+  double *dH, *dP, *theta; /* 9 n, 9 n, 27 n (NULL with the linear jump) */
+  double *T, *r, *zq, *Zq; /* 9 n, 3 n, 3 n, 27 n */
+  const fpm_state *base;
+};
+
+pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
+  pm_err ret = PM_SUCCESS;
+  fpm_linear *l = NULL;
+  const long n = m->n;
+  *out = NULL;
+  PM_TRY(PM_ALLOC(l, 1, "FPM linearisation"));
+  PM_TRY(PM_ALLOC(l->D, 81 * n, "tangent moduli"));
+  PM_TRY(PM_ALLOC(l->dH, 9 * n, "gradient increments"));
+  PM_TRY(PM_ALLOC(l->dP, 9 * n, "stress increments"));
+  PM_TRY(PM_ALLOC(l->T, 9 * n, "flux tensor increments"));
+  PM_TRY(PM_ALLOC(l->r, 3 * n, "interface force increments"));
+  if (m->q) {
+    PM_TRY(PM_ALLOC(l->theta, 27 * n, "fit increments"));
+    PM_TRY(PM_ALLOC(l->zq, 3 * n, "penalty force increments"));
+    PM_TRY(PM_ALLOC(l->Zq, 27 * n, "penalty fit force increments"));
+  }
+  *out = l;
+  l = NULL;
+done:
+  fpm_linear_destroy(l);
+  return ret;
+}
+
+void fpm_linear_destroy(fpm_linear *l) {
+  if (!l) return;
+  free(l->D);
+  free(l->dH);
+  free(l->dP);
+  free(l->theta);
+  free(l->T);
+  free(l->r);
+  free(l->zq);
+  free(l->Zq);
+  free(l);
+}
+
+size_t fpm_linear_bytes(const fpm_model *m) {
+  return (size_t)m->n * (81 + 9 + 9 + 9 + 3 + (m->q ? 57 : 0)) *
+         sizeof(double);
+}
+
+void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
+                        fpm_linear *l) {
+  const long n = m->n;
+  const double *restrict H = st->H;
+  double *restrict D = l->D;
+  const int *restrict mat = m->mat;
+  const pm_material *mats = m->mats;
+  const double *ms = m->mstate;
+  const long mss = m->mstate_stride;
+  l->base = st;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, H, D, mat, mats, ms, mss))
+  for (long i = 0; i < n; i++) {
+    double F[9], E[9] = {0}, dP[9];
+    for (int k = 0; k < 9; k++) F[k] = H[9 * i + k];
+    F[0] += 1;
+    F[4] += 1;
+    F[8] += 1;
+    for (int b = 0; b < 9; b++) {
+      E[b] = 1;
+      pm_material_tangent(&mats[mat[i]], F, ms ? ms + mss * i : NULL, E, dP);
+      E[b] = 0;
+      for (int a = 0; a < 9; a++) D[81 * i + 9 * a + b] = dP[a];
+    }
+  }
+}
+
+void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
+                      double *df) {
+  const long n = m->n;
+  const long *restrict ptr = m->nbr_ptr;
+  const int *restrict nbr = m->nbr;
+  const double *restrict g = m->g, *restrict D = l->D;
+  double *restrict dH = l->dH, *restrict dP = l->dP;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, ptr, nbr, g, du, D, dH, dP))
+  for (long i = 0; i < n; i++) {
+    double h[9] = {0};
+    for (long e = ptr[i]; e < ptr[i + 1]; e++) {
+      const long k = nbr[e];
+      for (int c = 0; c < 3; c++) {
+        const double d = du[3 * k + c] - du[3 * i + c];
+        for (int a = 0; a < 3; a++) h[3 * c + a] += d * g[3 * e + a];
+      }
+    }
+    for (int a = 0; a < 9; a++) {
+      double s = 0;
+      for (int b = 0; b < 9; b++) s += D[81 * i + 9 * a + b] * h[b];
+      dH[9 * i + a] = h[a];
+      dP[9 * i + a] = s;
+    }
+  }
+  const fields fl = {.u = du, .H = dH, .P = dP, .theta = l->theta,
+                     .T = l->T, .r = l->r, .zq = l->zq, .Zq = l->Zq,
+                     .f = df, .base = l->base};
+  if (l->theta) fit_pass(m, du, l->theta);
+  flux_pass(m, &fl);
+  boundary_pass(m, &fl, NULL);
+  gather_pass(m, &fl);
+  if (l->theta) fit_gather_pass(m, &fl);
 }

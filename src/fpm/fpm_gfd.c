@@ -142,3 +142,66 @@ long fpm_gfd_deformed_condition(int dim, long n, const double *x,
   if (worst_point) *worst_point = wp;
   return count;
 }
+
+/* One point's quadratic fit: fills q for its support and returns the
+ * condition number (infinite when unusable, q then zero). */
+static double quadratic_fit(int dim, long i, const double *x,
+                            const long *nbr_ptr, const long *nbr, double *q) {
+  static const int slots2[] = {0, 1, 3, 4, 6}, slots3[] = {0, 1, 2, 3, 4,
+                                                            5, 6, 7, 8};
+  static const int order[FPM_QFIT] = {1, 1, 1, 2, 2, 2, 2, 2, 2};
+  const int *slot = dim == 2 ? slots2 : slots3;
+  const int m = dim == 2 ? 5 : 9;
+  const long b = nbr_ptr[i], e_end = nbr_ptr[i + 1];
+  const double *xi = x + 3 * i;
+  for (long e = b; e < e_end; e++)
+    for (int a = 0; a < FPM_QFIT; a++) q[FPM_QFIT * e + a] = 0;
+  if (e_end - b < m) return INFINITY;
+  double s = 0;
+  for (long e = b; e < e_end; e++) {
+    const double *xk = x + 3 * nbr[e];
+    s += sqrt((xk[0] - xi[0]) * (xk[0] - xi[0]) +
+              (xk[1] - xi[1]) * (xk[1] - xi[1]) +
+              (xk[2] - xi[2]) * (xk[2] - xi[2]));
+  }
+  s /= (double)(e_end - b);
+  double A[81] = {0}, lam[9], phi[FPM_QFIT];
+  for (long e = b; e < e_end; e++) {
+    const double *xk = x + 3 * nbr[e];
+    double d[3] = {(xk[0] - xi[0]) / s, (xk[1] - xi[1]) / s,
+                   (xk[2] - xi[2]) / s};
+    double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    fpm_gfd_phi(d, phi);
+    for (int r = 0; r < m; r++)
+      for (int c = 0; c < m; c++) A[m * r + c] += w * phi[slot[r]] * phi[slot[c]];
+  }
+  int info = LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', m, A, m, lam);
+  if (info != 0 || !(lam[0] > 0)) return INFINITY;
+  const double cond = lam[m - 1] / lam[0];
+  double Ainv[81] = {0};
+  for (int r = 0; r < m; r++)
+    for (int c = 0; c < m; c++)
+      for (int k = 0; k < m; k++)
+        Ainv[m * r + c] += A[m * r + k] * A[m * c + k] / lam[k];
+  for (long e = b; e < e_end; e++) {
+    const double *xk = x + 3 * nbr[e];
+    double d[3] = {(xk[0] - xi[0]) / s, (xk[1] - xi[1]) / s,
+                   (xk[2] - xi[2]) / s};
+    double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    fpm_gfd_phi(d, phi);
+    for (int r = 0; r < m; r++) {
+      double v = 0;
+      for (int c = 0; c < m; c++) v += Ainv[m * r + c] * w * phi[slot[c]];
+      q[FPM_QFIT * e + slot[r]] = v / (order[slot[r]] == 1 ? s : s * s);
+    }
+  }
+  return cond;
+}
+
+void fpm_gfd_quadratic(int dim, long n, const double *x, const long *nbr_ptr,
+                       const long *nbr, double *q, double *cond) {
+  PM_OMP(parallel for schedule(dynamic, 256) default(none)
+         shared(n, x, nbr_ptr, nbr, q, cond, dim))
+  for (long i = 0; i < n; i++)
+    cond[i] = quadratic_fit(dim, i, x, nbr_ptr, nbr, q);
+}

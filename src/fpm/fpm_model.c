@@ -42,6 +42,13 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->fixed);
   free(m->bcf_ptr);
   free(m->bcf_facet);
+  free(m->qs_ptr);
+  free(m->qt_ptr);
+  free(m->qs_nbr);
+  free(m->qs_own);
+  free(m->qt_entry);
+  free(m->q);
+  free(m->qsum);
   free(m);
 }
 
@@ -51,7 +58,10 @@ size_t fpm_model_bytes(const fpm_model *m) {
          m->n * (3 + 1 + 3 + 9 + 1) * d + m->n * (sizeof(int) + 3) +
          m->n_dpts * (36 * d + sizeof(long)) +
          m->n_tfacets * (7 * d + sizeof(long) + sizeof(int)) +
-         m->n_cdofs * (d + sizeof(long) + 2 * sizeof(int));
+         m->n_cdofs * (d + sizeof(long) + 2 * sizeof(int)) +
+         (m->q ? (size_t)m->qs_ptr[m->n] * (FPM_QFIT * d + 3 * sizeof(int)) +
+                     (size_t)m->n * (FPM_QFIT * d + 2 * sizeof(long))
+               : 0);
 }
 
 /* Entry (k, i) for every entry (i, k): supports are symmetric (mesh
@@ -169,6 +179,122 @@ static void build_interfaces(fpm_model *m) {
   }
 }
 
+/* A support with fewer points than this, or a fit worse conditioned than
+ * QFIT_COND_NARROW, takes its two rings; a two-ring fit worse than
+ * QFIT_COND_MAX falls back to the linear reconstruction. */
+#define QFIT_COND_NARROW 1e5
+#define QFIT_COND_MAX 1e8
+
+/* The two rings of point i (its support and theirs, without i), sorted,
+ * into out (capacity cap); returns the count. */
+static long two_rings(const fpm_model *m, long i, long *out, long cap) {
+  long c = 0;
+  for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+    long k = m->nbr[e];
+    if (c < cap) out[c++] = k;
+    for (long f = m->nbr_ptr[k]; f < m->nbr_ptr[k + 1]; f++)
+      if (m->nbr[f] != i && c < cap) out[c++] = m->nbr[f];
+  }
+  /* insertion sort and unique (short lists) */
+  for (long a = 1; a < c; a++)
+    for (long b = a; b > 0 && out[b - 1] > out[b]; b--) {
+      long t = out[b];
+      out[b] = out[b - 1];
+      out[b - 1] = t;
+    }
+  long u = 0;
+  for (long a = 0; a < c; a++)
+    if (u == 0 || out[a] != out[u - 1]) out[u++] = out[a];
+  return u;
+}
+
+/* The quadratic reconstruction of fpm.jump: quadratic: each point's fit
+ * over its support, or its two rings where the support cannot determine a
+ * quadratic, and the transpose lists of the fits. */
+static pm_err build_quadratic(fpm_model *m) {
+  pm_err ret = PM_SUCCESS;
+  const long n = m->n, nnz = m->nnz;
+  const int unknowns = m->dim == 2 ? 5 : 9;
+  double *q1 = NULL, *c1 = NULL;
+  long *nbr1 = NULL, *wide = NULL, *ring = NULL, *nbrq = NULL;
+  const long cap = 4096;
+  PM_TRY(PM_ALLOC(q1, FPM_QFIT * nnz, "quadratic fit weights"));
+  PM_TRY(PM_ALLOC(c1, n, "quadratic fit conditions"));
+  PM_TRY(PM_ALLOC(nbr1, nnz, "support"));
+  for (long e = 0; e < nnz; e++) nbr1[e] = m->nbr[e];
+  fpm_gfd_quadratic(m->dim, n, m->x, m->nbr_ptr, nbr1, q1, c1);
+  /* Which points need their two rings, and the fit supports' sizes. */
+  PM_TRY(PM_ALLOC(wide, n + 1, "quadratic fit rings"));
+  PM_TRY(PM_ALLOC(ring, cap, "two rings"));
+  PM_TRY(PM_ALLOC(m->qs_ptr, n + 1, "quadratic fit supports"));
+  m->n_qwide = 0;
+  for (long i = 0; i < n; i++) {
+    long cnt = m->nbr_ptr[i + 1] - m->nbr_ptr[i];
+    wide[i] = cnt < unknowns + 3 || !(c1[i] <= QFIT_COND_NARROW);
+    if (wide[i]) {
+      cnt = two_rings(m, i, ring, cap);
+      m->n_qwide++;
+    }
+    m->qs_ptr[i + 1] = m->qs_ptr[i] + cnt;
+  }
+  const long nq = m->qs_ptr[n];
+  PM_ENSURE(nq < 2147483647L, PM_ERR_ARG,
+            "%ld quadratic-fit entries exceed the 32-bit index range", nq);
+  PM_TRY(PM_ALLOC(nbrq, nq, "quadratic fit supports"));
+  PM_TRY(PM_ALLOC(m->qs_nbr, nq, "quadratic fit supports"));
+  PM_TRY(PM_ALLOC(m->qs_own, nq, "quadratic fit owners"));
+  PM_TRY(PM_ALLOC(m->q, FPM_QFIT * nq, "quadratic fit weights"));
+  PM_TRY(PM_ALLOC(m->qsum, FPM_QFIT * n, "quadratic fit sums"));
+  for (long i = 0; i < n; i++) {
+    long b = m->qs_ptr[i];
+    if (wide[i]) {
+      long c = two_rings(m, i, ring, cap);
+      for (long a = 0; a < c; a++) nbrq[b + a] = ring[a];
+    } else
+      for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
+        nbrq[b + e - m->nbr_ptr[i]] = m->nbr[e];
+  }
+  /* Refit every point over its final support (one pass; narrow points
+   * repeat their first fit). */
+  fpm_gfd_quadratic(m->dim, n, m->x, m->qs_ptr, nbrq, m->q, c1);
+  m->n_qlinear = 0;
+  for (long i = 0; i < n; i++) {
+    if (!(c1[i] <= QFIT_COND_MAX)) {
+      /* No usable quadratic: the point's linear GFD field, its support
+       * being part of the fit support (both sorted). */
+      m->n_qlinear++;
+      long f = m->qs_ptr[i];
+      for (long e = m->qs_ptr[i]; e < m->qs_ptr[i + 1]; e++)
+        for (int a = 0; a < FPM_QFIT; a++) m->q[FPM_QFIT * e + a] = 0;
+      for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+        while (nbrq[f] != m->nbr[e]) f++;
+        for (int a = 0; a < 3; a++) m->q[FPM_QFIT * f + a] = m->g[3 * e + a];
+      }
+    }
+    for (long e = m->qs_ptr[i]; e < m->qs_ptr[i + 1]; e++) {
+      m->qs_nbr[e] = (int)nbrq[e];
+      m->qs_own[e] = (int)i;
+      for (int a = 0; a < FPM_QFIT; a++)
+        m->qsum[FPM_QFIT * i + a] += m->q[FPM_QFIT * e + a];
+    }
+  }
+  /* Transpose: the entries whose neighbour is each point. */
+  PM_TRY(PM_ALLOC(m->qt_ptr, n + 1, "quadratic fit transpose"));
+  PM_TRY(PM_ALLOC(m->qt_entry, nq, "quadratic fit transpose"));
+  for (long e = 0; e < nq; e++) m->qt_ptr[m->qs_nbr[e] + 1]++;
+  for (long i = 0; i < n; i++) m->qt_ptr[i + 1] += m->qt_ptr[i];
+  for (long i = 0; i < n; i++) wide[i] = m->qt_ptr[i];
+  for (long e = 0; e < nq; e++) m->qt_entry[wide[m->qs_nbr[e]]++] = (int)e;
+done:
+  free(q1);
+  free(c1);
+  free(nbr1);
+  free(wide);
+  free(ring);
+  free(nbrq);
+  return ret;
+}
+
 int fpm_domain_body(const pm_scene *s) {
   return s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH ? 0 : -1;
 }
@@ -189,6 +315,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   m->scene = s;
   m->penalty = o->penalty;
   m->flux = (fpm_flux)o->flux;
+  m->jump = (fpm_jump)o->jump;
   long n = m->n, nnz = m->nnz;
   PM_TRY(PM_ALLOC(m->g, 3 * nnz, "GFD weights"));
   PM_TRY(PM_ALLOC(m->gsum, 3 * n, "GFD weight sums"));
@@ -212,6 +339,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   PM_TRY(build_mirror(m));
   PM_TRY(assign_materials(m, s, fpm_domain_body(s)));
   build_interfaces(m);
+  if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
   PM_TRY(fpm_build_boundary(m, s, mesh));
   *out = m;
   m = NULL;
@@ -235,6 +363,11 @@ pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
   PM_TRY(PM_ALLOC(st->r, 3 * n, "interface force"));
   PM_TRY(PM_ALLOC(st->W, n, "strain energy density"));
   PM_TRY(PM_ALLOC(st->J, n, "volume ratio"));
+  if (m->q) {
+    PM_TRY(PM_ALLOC(st->theta, 27 * n, "quadratic fits"));
+    PM_TRY(PM_ALLOC(st->zq, 3 * n, "penalty forces"));
+    PM_TRY(PM_ALLOC(st->Zq, 27 * n, "penalty fit forces"));
+  }
   PM_TRY(PM_ALLOC(st->tf_value, 3 * m->n_tfacets, "tractions"));
   PM_TRY(PM_ALLOC(st->bflux, 3 * m->n_dpts, "boundary flux"));
   PM_TRY(
@@ -257,6 +390,9 @@ void fpm_state_destroy(fpm_state *st) {
   free(st->r);
   free(st->W);
   free(st->J);
+  free(st->theta);
+  free(st->zq);
+  free(st->Zq);
   free(st->tf_value);
   free(st->bflux);
   free(st->support_prev);
@@ -266,7 +402,8 @@ void fpm_state_destroy(fpm_state *st) {
 size_t fpm_state_bytes(const fpm_model *m) {
   return (size_t)m->n * (3 * 4 + 9 * 3 + 2) * sizeof(double) +
          (size_t)(m->n_tfacets + 2 * m->n_dpts) * 3 * sizeof(double) +
-         (size_t)m->n_cdofs * sizeof(double);
+         (size_t)m->n_cdofs * sizeof(double) +
+         (m->q ? (size_t)m->n * 57 * sizeof(double) : 0);
 }
 
 double fpm_stable_dt(const fpm_model *m, long *critical_point) {

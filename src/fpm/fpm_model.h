@@ -50,6 +50,19 @@ typedef struct {
   double *mass;   /* n: lumped mass rho V */
   double penalty; /* p */
   fpm_flux flux;  /* IIPG or SIPG */
+  /* The quadratic reconstruction of fpm.jump: quadratic (all NULL with the
+   * linear jump).  Point i's fit uses the points qs_nbr[qs_ptr[i] ..
+   * qs_ptr[i+1]) (its support, or its two rings where the support cannot
+   * determine a quadratic); theta_i = sum (u_m - u_i) (x) q (3 x FPM_QFIT).
+   * qt_ptr/qt_entry list, per point m, the fit entries whose neighbour is
+   * m (the transpose, for the force gather); qs_own is each entry's point. */
+  fpm_jump jump;
+  long *qs_ptr, *qt_ptr;
+  int *qs_nbr, *qs_own, *qt_entry;
+  double *q;      /* FPM_QFIT per fit entry */
+  double *qsum;   /* FPM_QFIT n: sum of q over each fit */
+  long n_qwide;   /* points fitted over two rings */
+  long n_qlinear; /* points with no usable quadratic fit: linear there */
   /* Consistency flux on faces with displacement conditions, per point that
    * has such facets: row c of the projected flux uses area A^c and moment
    * B^c summed over the facets that prescribe component c. */
@@ -94,6 +107,9 @@ typedef struct {
   double bflux_norm;     /* |consistency flux on prescribed faces| */
   double penalty_energy; /* interface energy, J: 1/2 sum_e beta |e| [[u]]^2,
                             and with SIPG also - sum_e {P} : K_e */
+  double *theta; /* 27 n: the quadratic fit (fpm.jump: quadratic) */
+  double *zq;    /* 3 n: sum_e b_e, the penalty force through u_i */
+  double *Zq;    /* 27 n: sum_e b_e (x) phi(d_i), through theta_i */
   double *bflux;        /* 3 n_dpts: that flux per point: the supports' force on
                            the body, with f on the prescribed dofs */
   double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous
@@ -136,6 +152,22 @@ void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t);
  * T, r).  Returns -1, or the smallest point id whose deformation gradient
  * is inadmissible (J <= 0 or not finite). */
 long fpm_force(const fpm_model *m, fpm_state *st);
+
+/* The linearisation of fpm_force about a state: df = K du with K the
+ * consistent tangent (exact but for the SIPG adjoint term's derivative of
+ * the material tangent, taken by central differences).  Work space made
+ * once; nothing allocates per application. */
+typedef struct fpm_linear fpm_linear;
+pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out);
+void fpm_linear_destroy(fpm_linear *l);
+size_t fpm_linear_bytes(const fpm_model *m);
+/* Linearise about st, whose force fpm_force has just computed (st is
+ * borrowed until the next prepare: its u and H are read by each apply). */
+void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
+                        fpm_linear *l);
+/* df (3 n) = K du (3 n), every dof (prescribed ones included). */
+void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
+                      double *df);
 
 /* Stable time step of eqs. 24-26 of the FPM paper: for each point j,
  * lambda_j <= m_j c_j^2 |C_j|_F^2 (m_j support size, c_j the dilatational

@@ -10,6 +10,9 @@
 static const pm_name flux_names[] = {
     {"iipg", FPM_FLUX_IIPG}, {"sipg", FPM_FLUX_SIPG}, {NULL, 0}};
 
+static const pm_name jump_names[] = {
+    {"linear", FPM_JUMP_LINEAR}, {"quadratic", FPM_JUMP_QUADRATIC}, {NULL, 0}};
+
 static const pm_key fpm_keys[] = {
     {.name = "penalty",
      .type = PM_KEY_NUMBER,
@@ -25,6 +28,16 @@ static const pm_key fpm_keys[] = {
      .names = flux_names,
      .doc = "iipg (the paper's eq. 16) or sipg (symmetric, energy-"
             "conserving)"},
+    {.name = "jump",
+     .type = PM_KEY_ENUM,
+     .offset = offsetof(fpm_options, jump),
+     .def = "linear",
+     .names = jump_names,
+     .doc = "the reconstruction whose interface jump the penalty measures: "
+            "linear (each point's linear field, the paper) or quadratic (a "
+            "least-squares quadratic fit about each point: the penalty then "
+            "vanishes on quadratic fields and does not stiffen "
+            "near-incompressible solids)"},
     {.name = "cells",
      .type = PM_KEY_STRING,
      .offset = offsetof(fpm_options, cells),

@@ -12,10 +12,17 @@ typedef enum {
   FPM_FLUX_SIPG      /* symmetric: the force is the gradient of an energy */
 } fpm_flux;
 
+/* The reconstruction whose jump across an interface the penalty measures. */
+typedef enum {
+  FPM_JUMP_LINEAR = 0, /* each point's linear field (the FPM paper) */
+  FPM_JUMP_QUADRATIC   /* a least-squares quadratic fit about each point */
+} fpm_jump;
+
 /* Options of the fpm section. */
 typedef struct {
   double penalty; /* fpm.penalty p >= 0 (beta = p E / h) */
   int flux;       /* fpm_flux */
+  int jump;       /* fpm_jump */
   char *cells;    /* fpm.cells: the partition into subdomains */
 } fpm_options;
 

@@ -206,11 +206,13 @@ static void test_patch_f2(void **state) {
       "neo-hookean", "neo-hookean-log",        "mooney-rivlin",
       "ogden",       "holzapfel-gasser-ogden", "linear-elastic"};
   for (int mi = 0; mi < 6; mi++)
-    for (int k = 0; k < 3; k++) {
-      double penalty = k == 0 ? 0 : k == 1 ? 20 : 100;
+    for (int k = 0; k < 5; k++) {
+      /* p = 0; IIPG p = 20; SIPG p = 100; both with the quadratic jump */
+      double penalty = k == 0 ? 0 : k == 1 || k == 3 ? 20 : 100;
       fixture *fx = fixture_new(3, 0.02, penalty, true);
       gel_model(models[mi], &fx->mat, &fx->body);
-      if (k == 2) fx->opt.flux = FPM_FLUX_SIPG;
+      if (k == 2 || k == 4) fx->opt.flux = FPM_FLUX_SIPG;
+      if (k >= 3) fx->opt.jump = FPM_JUMP_QUADRATIC;
       fpm_model *m;
       fpm_state *st;
       assert_int_equal(
@@ -233,10 +235,12 @@ static void test_patch_f2(void **state) {
        * the lateral roller faces carry none. */
       double R[3], Pzz = st->P[8];
       fpm_reaction(m, st, 3, R);
-      print_message("F2 patch, %s, p = %g: %ld points, lateral stretches "
+      print_message("F2 patch, %s, %s %s jump, p = %g: %ld points, lateral stretches "
                     "%.6f %.6f, max free |f| / (|P| h^2) = %.3g, top "
                     "reaction %.6g N (exact %.6g N)\n",
-                    models[mi], penalty, m->n, lat[0], lat[1], worst / scale,
+                    models[mi], m->flux == FPM_FLUX_SIPG ? "SIPG" : "IIPG",
+                    m->jump == FPM_JUMP_QUADRATIC ? "quadratic" : "linear",
+                    penalty, m->n, lat[0], lat[1], worst / scale,
                     R[2], Pzz * 0.01);
       assert_true(worst <= 1e-11 * scale);
       assert_true(fabs(R[2] - Pzz * 0.01) <= 1e-10 * fabs(Pzz * 0.01));
@@ -261,9 +265,10 @@ static double stored_energy(const fpm_model *m, fpm_state *st) {
  * 1e-6).  The incomplete flux is not a gradient: its mismatch is printed. */
 static void test_sipg_is_gradient(void **state) {
   (void)state;
-  for (int k = 0; k < 2; k++) {
+  for (int k = 0; k < 3; k++) {
     fixture *fx = fixture_new(3, 0.03, 100, false);
-    fx->opt.flux = k == 0 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
+    fx->opt.flux = k == 1 ? FPM_FLUX_IIPG : FPM_FLUX_SIPG;
+    fx->opt.jump = k == 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
     fpm_model *m;
     fpm_state *st;
     assert_int_equal(
@@ -293,10 +298,72 @@ static void test_sipg_is_gradient(void **state) {
     double dE = (ep - em) / (2 * eps);
     double rel = fabs(dE - fd) / fabs(fd);
     print_message("%s: dE/de = %.10g, f . d = %.10g, relative mismatch %.3g\n",
-                  k == 0 ? "SIPG" : "IIPG", dE, fd, rel);
-    if (k == 0) assert_true(rel <= 1e-6);
+                  k == 0   ? "SIPG"
+                  : k == 1 ? "IIPG"
+                           : "SIPG, quadratic jump",
+                  dE, fd, rel);
+    if (k != 1) assert_true(rel <= 1e-6);
     free(u0);
     free(d);
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+}
+
+/* fpm_force_linear is the derivative of fpm_force: K d against central
+ * differences of f along a random d at a finite deformation, for both
+ * fluxes and both jumps (relative 1e-6 of |K d|). */
+static void test_force_linearisation(void **state) {
+  (void)state;
+  for (int k = 0; k < 4; k++) {
+    fixture *fx = fixture_new(3, 0.03, 20, true);
+    fx->opt.flux = k & 1 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
+    fx->opt.jump = k & 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
+    fpm_model *m;
+    fpm_state *st;
+    fpm_linear *lin;
+    assert_int_equal(
+        fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, &m),
+        PM_SUCCESS);
+    assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+    assert_int_equal(fpm_linear_create(m, &lin), PM_SUCCESS);
+    long nd = 3 * m->n;
+    double *u0 = calloc(nd, sizeof *u0), *d = calloc(nd, sizeof *d),
+           *kd = calloc(nd, sizeof *kd), *fp = calloc(nd, sizeof *fp);
+    unsigned long long seed = 777;
+    for (long i = 0; i < nd; i++) {
+      seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+      double r = (double)(seed >> 11) / 9007199254740992.0 - 0.5;
+      const double *x = m->x + 3 * (i / 3);
+      u0[i] = 0.2 * x[(i + 1) % 3] * x[i % 3] / 0.1 + 1e-3 * r;
+      d[i] = r;
+    }
+    memcpy(st->u, u0, nd * sizeof *u0);
+    assert_int_equal(fpm_force(m, st), -1);
+    fpm_linear_prepare(m, st, lin);
+    fpm_force_linear(m, lin, d, kd);
+    double eps = 1e-6;
+    for (long i = 0; i < nd; i++) st->u[i] = u0[i] + eps * d[i];
+    assert_int_equal(fpm_force(m, st), -1);
+    memcpy(fp, st->f, nd * sizeof *fp);
+    for (long i = 0; i < nd; i++) st->u[i] = u0[i] - eps * d[i];
+    assert_int_equal(fpm_force(m, st), -1);
+    double err = 0, norm = 0;
+    for (long i = 0; i < nd; i++) {
+      double fd = (fp[i] - st->f[i]) / (2 * eps);
+      err += (fd - kd[i]) * (fd - kd[i]);
+      norm += kd[i] * kd[i];
+    }
+    print_message("%s, %s jump: |K d - central difference| / |K d| = %.3g\n",
+                  k & 1 ? "SIPG" : "IIPG", k & 2 ? "quadratic" : "linear",
+                  sqrt(err / norm));
+    assert_true(sqrt(err / norm) <= 1e-6);
+    free(u0);
+    free(d);
+    free(kd);
+    free(fp);
+    fpm_linear_destroy(lin);
     fpm_state_destroy(st);
     fpm_model_destroy(m);
     fixture_free(fx);
@@ -364,6 +431,7 @@ int main(void) {
       cmocka_unit_test(test_homogeneous_p20),
       cmocka_unit_test(test_patch_f2),
       cmocka_unit_test(test_sipg_is_gradient),
+      cmocka_unit_test(test_force_linearisation),
       cmocka_unit_test(test_deformed_condition),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
