@@ -5,6 +5,7 @@
  * (du, dH, dP, dtheta) give its exact linearisation (fpm_force_linear). */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "fpm_gfd.h"
 #include "fpm_model.h"
@@ -18,8 +19,9 @@ typedef struct {
   const double *u, *H, *P, *theta; /* in */
   double *T, *r, *zq, *Zq, *f;     /* out */
   double *bflux;                   /* out, force only (else NULL) */
-  /* linearisation only: the state linearised about (NULL for the force) */
-  const fpm_state *base;
+  /* linearisation only: u and H of the state linearised about (NULL for
+   * the force) */
+  const double *bu, *bH;
 } fields;
 
 /* Pass 1: F_i = I + sum_k (u_k - u_i) (x) g_ik, then P_i, W_i, J_i.
@@ -128,7 +130,8 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
                          *restrict vol = m->dual->volume;
   const double *restrict u = fl->u, *restrict H = fl->H, *restrict P = fl->P;
   double *restrict T = fl->T, *restrict r = fl->r;
-  const fpm_state *base = fl->base;
+  const double *bu = fl->bu, *bH = fl->bH;
+  const bool base = bu != NULL;
   const int *restrict mat = m->mat;
   const pm_material *mats = m->mats;
   const double *ms = m->mstate;
@@ -140,7 +143,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
          shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat, mats, ms,
-                mss, sym, th, zq, Zq, quad, base))
+                mss, sym, th, zq, Zq, quad, base, bu, bH))
   for (long i = 0; i < n; i++) {
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
     double Q[9] = {0}, ri[3] = {0}, B[9] = {0}, z[3] = {0}, Z[27] = {0};
@@ -188,7 +191,6 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
             epen -= 0.25 * (Pi[3 * c + q] + Pk[3 * c + q]) * K;
           }
           if (base) {
-            const double *bu = base->u, *bH = base->H;
             const double *bHi = bH + 9 * i, *bHk = bH + 9 * k;
             const double bj = bu[3 * i + c] - bu[3 * k + c] +
                               bHi[3 * c] * di[0] + bHi[3 * c + 1] * di[1] +
@@ -213,7 +215,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
        * -sum_e {P} : K_e through P_i (A_i = dP/dF at F_i).  Linearised:
        * 1/2 (A_i : dB + (dA_i[dF_i]) : B), the derivative of the tangent
        * along dF_i = dH_i by central differences. */
-      const double *Hb = base ? base->H + 9 * i : Hi;
+      const double *Hb = base ? bH + 9 * i : Hi;
       const double *msi = ms ? ms + mss * i : NULL;
       double F[9], dP[9];
       for (int k = 0; k < 9; k++) F[k] = Hb[k];
@@ -372,7 +374,7 @@ struct fpm_linear {
   double *D;               /* 81 n: dP/dF at each point, row-major (9 x 9) */
   double *dH, *dP, *theta; /* 9 n, 9 n, 27 n (NULL with the linear jump) */
   double *T, *r, *zq, *Zq; /* 9 n, 3 n, 3 n, 27 n */
-  const fpm_state *base;
+  double *bu, *bH;         /* 3 n, 9 n: the state linearised about */
 };
 
 pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
@@ -386,6 +388,8 @@ pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
   PM_TRY(PM_ALLOC(l->dP, 9 * n, "stress increments"));
   PM_TRY(PM_ALLOC(l->T, 9 * n, "flux tensor increments"));
   PM_TRY(PM_ALLOC(l->r, 3 * n, "interface force increments"));
+  PM_TRY(PM_ALLOC(l->bu, 3 * n, "linearisation point"));
+  PM_TRY(PM_ALLOC(l->bH, 9 * n, "linearisation point"));
   if (m->q) {
     PM_TRY(PM_ALLOC(l->theta, 27 * n, "fit increments"));
     PM_TRY(PM_ALLOC(l->zq, 3 * n, "penalty force increments"));
@@ -408,11 +412,13 @@ void fpm_linear_destroy(fpm_linear *l) {
   free(l->r);
   free(l->zq);
   free(l->Zq);
+  free(l->bu);
+  free(l->bH);
   free(l);
 }
 
 size_t fpm_linear_bytes(const fpm_model *m) {
-  return (size_t)m->n * (81 + 9 + 9 + 9 + 3 + (m->q ? 57 : 0)) *
+  return (size_t)m->n * (81 + 9 + 9 + 9 + 3 + 12 + (m->q ? 57 : 0)) *
          sizeof(double);
 }
 
@@ -425,7 +431,8 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
   const pm_material *mats = m->mats;
   const double *ms = m->mstate;
   const long mss = m->mstate_stride;
-  l->base = st;
+  memcpy(l->bu, st->u, 3 * n * sizeof(double));
+  memcpy(l->bH, st->H, 9 * n * sizeof(double));
   PM_OMP(parallel for schedule(static) default(none)
          shared(n, H, D, mat, mats, ms, mss))
   for (long i = 0; i < n; i++) {
@@ -470,7 +477,7 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
   }
   const fields fl = {.u = du, .H = dH, .P = dP, .theta = l->theta,
                      .T = l->T, .r = l->r, .zq = l->zq, .Zq = l->Zq,
-                     .f = df, .base = l->base};
+                     .f = df, .bu = l->bu, .bH = l->bH};
   if (l->theta) fit_pass(m, du, l->theta);
   flux_pass(m, &fl);
   boundary_pass(m, &fl, NULL);

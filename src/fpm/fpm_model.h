@@ -161,8 +161,8 @@ typedef struct fpm_linear fpm_linear;
 pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out);
 void fpm_linear_destroy(fpm_linear *l);
 size_t fpm_linear_bytes(const fpm_model *m);
-/* Linearise about st, whose force fpm_force has just computed (st is
- * borrowed until the next prepare: its u and H are read by each apply). */
+/* Linearise about st, whose force fpm_force has just computed (its u and H
+ * are copied: st may change before the applications). */
 void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
                         fpm_linear *l);
 /* df (3 n) = K du (3 n), every dof (prescribed ones included). */

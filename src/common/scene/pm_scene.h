@@ -24,8 +24,17 @@ typedef enum { PM_RAMP_SMOOTH = 0, PM_RAMP_LINEAR, PM_RAMP_NONE } pm_ramp;
 typedef enum {
   PM_QS_NONE = 0,           /* plain dynamics */
   PM_QS_DYNAMIC_RELAXATION, /* adaptive (Rayleigh-quotient) damping */
-  PM_QS_DAMPING             /* fixed mass-proportional damping */
+  PM_QS_DAMPING,            /* fixed mass-proportional damping */
+  PM_QS_STATIC              /* Newton's method in load steps (no time) */
 } pm_qs_method;
+
+/* The linear solver of a static solve (time.quasi_static.linear_solver). */
+typedef enum {
+  PM_LINEAR_DIRECT = 0, /* LU (MUMPS) */
+  PM_LINEAR_GMRES_GAMG, /* GMRES + algebraic multigrid */
+  PM_LINEAR_CG_JACOBI,  /* CG + Jacobi (symmetric problems) */
+  PM_LINEAR_GMRES_ILU   /* GMRES + ILU(0) */
+} pm_linear_solver;
 
 /* How the stable time step is found. */
 typedef enum {
@@ -138,6 +147,10 @@ typedef struct pm_scene {
     pm_qs_method qs;     /* time.quasi_static.method */
     double qs_tolerance; /* time.quasi_static.tolerance: relative residual */
     double qs_damping;   /* time.quasi_static.damping: 1/s for damping */
+    long qs_load_steps;  /* time.quasi_static.load_steps (static) */
+    long qs_max_iterations;         /* ...max_iterations per load step */
+    pm_linear_solver qs_linear;     /* ...linear_solver */
+    char *qs_solver_options;        /* ...solver_options: PETSc options */
     long max_steps;      /* time.max_steps; 0: no limit */
   } time;
   struct {

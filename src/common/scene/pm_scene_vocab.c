@@ -20,7 +20,13 @@ static const pm_name qs_names[] = {
     {"none", PM_QS_NONE},
     {"dynamic-relaxation", PM_QS_DYNAMIC_RELAXATION},
     {"damping", PM_QS_DAMPING},
+    {"static", PM_QS_STATIC},
     {NULL, 0}};
+static const pm_name linear_names[] = {{"direct", PM_LINEAR_DIRECT},
+                                       {"gmres-gamg", PM_LINEAR_GMRES_GAMG},
+                                       {"cg-jacobi", PM_LINEAR_CG_JACOBI},
+                                       {"gmres-ilu", PM_LINEAR_GMRES_ILU},
+                                       {NULL, 0}};
 static const pm_name dt_rule_names[] = {
     {"paper", PM_DT_PAPER}, {"spectral", PM_DT_SPECTRAL}, {NULL, 0}};
 static const pm_name field_names[] = {
@@ -297,7 +303,8 @@ static const pm_key quasi_static_keys[] = {
      .offset = S(time.qs),
      .def = "none",
      .names = qs_names,
-     .doc = "none, dynamic-relaxation (adaptive damping) or damping"},
+     .doc = "none, dynamic-relaxation (adaptive damping), damping, or "
+            "static (equilibrium by Newton's method in load steps)"},
     {.name = "tolerance",
      .type = PM_KEY_NUMBER,
      .offset = S(time.qs_tolerance),
@@ -312,6 +319,35 @@ static const pm_key quasi_static_keys[] = {
      .range = PM_RANGE_GE,
      .unit = "1/s",
      .doc = "mass-proportional damping rate (method damping)"},
+    {.name = "load_steps",
+     .type = PM_KEY_INTEGER,
+     .offset = S(time.qs_load_steps),
+     .def = "10",
+     .range = PM_RANGE_GE,
+     .lo = 1,
+     .unit = "",
+     .doc = "method static: load steps along the scene's ramps (a step that "
+            "fails is halved and retried)"},
+    {.name = "max_iterations",
+     .type = PM_KEY_INTEGER,
+     .offset = S(time.qs_max_iterations),
+     .def = "25",
+     .range = PM_RANGE_GE,
+     .lo = 1,
+     .unit = "",
+     .doc = "method static: Newton iterations per load step"},
+    {.name = "linear_solver",
+     .type = PM_KEY_ENUM,
+     .offset = S(time.qs_linear),
+     .def = "direct",
+     .names = linear_names,
+     .doc = "method static: direct (LU), gmres-gamg, gmres-ilu or cg-jacobi"},
+    {.name = "solver_options",
+     .type = PM_KEY_STRING,
+     .offset = S(time.qs_solver_options),
+     .def = "nan",
+     .doc = "method static: PETSc options with prefix pm_ (e.g. "
+            "\"-pm_snes_monitor -pm_ksp_type bcgs\")"},
     {0}};
 
 static const pm_key time_keys[] = {
