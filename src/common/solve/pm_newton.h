@@ -52,6 +52,7 @@
 
 #include <stdbool.h>
 
+#include "pm_coloring.h"
 #include "pm_error.h"
 
 /* The most Newton iterations one solve may take (the length of the
@@ -110,12 +111,6 @@ typedef enum {
   PM_NEWTON_MATRIX_FREE_CHEAP_PC /* J applied by jacobian_apply; P assembled
                                     by colouring from precond_apply */
 } pm_newton_operator;
-
-/* Order in which the greedy colouring visits columns. */
-typedef enum {
-  PM_COLORING_LARGEST_FIRST = 0, /* columns with most neighbours first */
-  PM_COLORING_NATURAL            /* columns in index order */
-} pm_coloring_order;
 
 typedef enum {
   PM_LINE_SEARCH_BT = 0, /* backtracking (cubic), the default */
