@@ -11,6 +11,7 @@ packages=(
   libyaml-dev
   libmatheval-dev
   libcmocka-dev
+  libpetsc-real-dev
   clang-format python3-matplotlib python3-numpy python3-h5py
 )
 

@@ -5,6 +5,7 @@
 #define PM_TESTING_H
 
 #include <dirent.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,14 @@
 #include <unistd.h>
 
 #include "pm_error.h"
+
+/* |a - b| <= rel max(|a|, |b|) + abs_tol; NaN fails. */
+#define assert_close(a, b, rel, abs_tol)                                       \
+  do {                                                                         \
+    double a_ = (a), b_ = (b);                                                 \
+    if (!(fabs(a_ - b_) <= (rel)*fmax(fabs(a_), fabs(b_)) + (abs_tol)))        \
+      fail_msg("%s = %.17g, expected %.17g (%s)", #a, a_, b_, #b);             \
+  } while (0)
 
 /* Expect success; on failure show the recorded message. */
 #define assert_ok(expr)                                                        \

@@ -11,14 +11,6 @@
 #include "pm_riemann.h"
 #include "pm_testing.h"
 
-/* |a - b| <= rel max(|a|, |b|) + abs_tol; NaN fails. */
-#define assert_close(a, b, rel, abs_tol)                                       \
-  do {                                                                         \
-    double a_ = (a), b_ = (b);                                                 \
-    if (!(fabs(a_ - b_) <= (rel)*fmax(fabs(a_), fabs(b_)) + (abs_tol)))        \
-      fail_msg("%s = %.17g, expected %.17g (%s)", #a, a_, b_, #b);             \
-  } while (0)
-
 static const double G = 1.4;
 
 static pm_riemann solve(pm_riemann_state l, pm_riemann_state r) {

@@ -1,0 +1,128 @@
+/* pm_load_steps: the load factor from 0 to 1 in steps, each solved by
+ * Newton from the last converged state; a failed step is halved. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_newton.h"
+#include "pm_newton_impl.h"
+#include "pm_progress.h"
+
+/* Load factors this close to 1 are 1 (steps of 1/load_steps do not add up
+ * to 1 exactly). */
+#define PM_LOAD_END_SLACK 1e-12
+
+static void add_solve(pm_load_report *rep, const pm_newton_report *nr) {
+  rep->newton_iterations += nr->iterations;
+  rep->linear_iterations += nr->linear_iterations;
+  rep->time_residual += nr->time_residual;
+  rep->time_assembly += nr->time_assembly;
+  rep->time_linear += nr->time_linear;
+}
+
+static bool recoverable(pm_err e) {
+  return e == PM_ERR_NOT_CONVERGED || e == PM_ERR_UNSTABLE;
+}
+
+pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
+  pm_err ret = PM_SUCCESS;
+  pm_load_report local;
+  pm_load_report *rep = report ? report : &local;
+  double *xc = NULL, *xprev = NULL, *r = NULL;
+  double t0 = pm_wtime();
+  memset(rep, 0, sizeof *rep);
+  PM_CHECK(s && x, PM_ERR_ARG, "pm_load_steps: solver and x are required");
+  const pm_newton_problem *p = pm_newton_problem_of(s);
+  const pm_newton_options *o = pm_newton_options_of(s);
+  const long n = p->n;
+  PM_CHECK(p->set_load, PM_ERR_ARG,
+           "pm_load_steps: the problem has no set_load");
+  PM_TRY(PM_ALLOC(xc, n, "converged state"));
+  PM_TRY(PM_ALLOC(xprev, n, "previous converged state"));
+  if (o->predictor) PM_TRY(PM_ALLOC(r, n, "residual"));
+  memcpy(xc, x, (size_t)n * sizeof *xc);
+
+  const double nominal = 1.0 / o->load_steps;
+  double lambda = 0, lambda_prev = 0, dl = nominal;
+  bool have_prev = false;
+  int cuts = 0, good = 0;
+  rep->dlambda_min = nominal;
+  while (lambda < 1) {
+    double target = lambda + dl;
+    if (target > 1 - PM_LOAD_END_SLACK) target = 1;
+    PM_TRY(p->set_load(p->ctx, target));
+    memcpy(x, xc, (size_t)n * sizeof *x);
+    bool predicted = o->predictor && have_prev && lambda > lambda_prev;
+    double r_ref = 0;
+    if (predicted) {
+      /* rtol stays relative to the step's imbalance at the last state:
+       * a good prediction must not tighten it to roundoff. */
+      if (p->residual(p->ctx, xc, r) == PM_SUCCESS) {
+        for (long i = 0; i < n; i++) r_ref += r[i] * r[i];
+        r_ref = sqrt(r_ref);
+      } else {
+        pm_error_clear();
+      }
+      double f = (target - lambda) / (lambda - lambda_prev);
+      for (long i = 0; i < n; i++) x[i] = xc[i] + f * (xc[i] - xprev[i]);
+    }
+    pm_err e = pm_newton_solve_from(s, x, xc, r_ref, &rep->last);
+    add_solve(rep, &rep->last);
+    if (e != PM_SUCCESS && predicted && rep->last.iterations == 0 &&
+        rep->last.reason == PM_NEWTON_DIVERGED_DOMAIN) {
+      /* The extrapolated state is inadmissible: start from the last one. */
+      memcpy(x, xc, (size_t)n * sizeof *x);
+      e = pm_newton_solve_from(s, x, xc, r_ref, &rep->last);
+      add_solve(rep, &rep->last);
+    }
+    if (e == PM_SUCCESS) {
+      memcpy(xprev, xc, (size_t)n * sizeof *xc);
+      memcpy(xc, x, (size_t)n * sizeof *xc);
+      lambda_prev = lambda;
+      lambda = target;
+      have_prev = true;
+      rep->steps++;
+      rep->lambda = lambda;
+      if (target - lambda_prev < rep->dlambda_min)
+        rep->dlambda_min = target - lambda_prev;
+      cuts = 0;
+      if (p->on_step)
+        PM_TRY(p->on_step(p->ctx, rep->steps, lambda, xc, &rep->last));
+      if (dl < nominal && o->grow_after > 0 && ++good >= o->grow_after) {
+        dl = fmin(2 * dl, nominal);
+        good = 0;
+      }
+      continue;
+    }
+    if (!recoverable(e)) {
+      ret = pm_error_trace(e, __FILE__, __LINE__, __func__,
+                           "the Newton solve of a load step");
+      goto done;
+    }
+    pm_error_clear();
+    good = 0;
+    if (cuts >= o->max_cuts || dl / 2 < o->min_dlambda * (1 - 1e-12)) {
+      ret = PM_ERROR(e,
+                     "load step %d (lambda %.6g -> %.6g): %s; cut %d times to "
+                     "dlambda %.3g: giving up",
+                     rep->steps + 1, lambda, target, rep->last.message, cuts,
+                     target - lambda);
+      goto done;
+    }
+    cuts++;
+    rep->cuts++;
+    dl /= 2;
+  }
+done:
+  if (xc) {
+    memcpy(x, xc, (size_t)n * sizeof *x);
+    /* The load stays that of the state returned. */
+    if (ret != PM_SUCCESS) (void)p->set_load(p->ctx, rep->lambda);
+  }
+  rep->time_total = pm_wtime() - t0;
+  free(xc);
+  free(xprev);
+  free(r);
+  return ret;
+}

@@ -1,0 +1,283 @@
+/* pm_newton: Newton's method on PETSc (SNES) for a problem given by
+ * callbacks, with the consistent tangent assembled by column colouring (or
+ * applied matrix-free), and load stepping with step cutting.  It knows
+ * nothing of the methods that use it.
+ *
+ * The contract with a caller:
+ *
+ * - Unknowns are x[0..n-1] (n < 2^31).  The residual r(x) is zero at the
+ *   solution; the Jacobian is J = dr/dx.
+ * - residual(ctx, x, r) writes r(x).  Returning anything but PM_SUCCESS
+ *   says that x is inadmissible (J <= 0, a point inverted, a model outside
+ *   its range): the line search shortens the step, and load stepping cuts
+ *   the load step; the callback's message (PM_ERROR) is kept for the
+ *   report.  Only PM_ERR_MEMORY, PM_ERR_IO and PM_ERR_INTERNAL abort the
+ *   solve at once and are returned as they are.
+ * - jacobian_prepare(ctx, x), if given, is called once at each new
+ *   linearisation point x (an accepted Newton iterate, where residual
+ *   succeeded) before any jacobian_apply there; it may compute and cache
+ *   per-point tangents.  It is called with the same x as the residual call
+ *   that accepted it, but residual may also be called at other points (line
+ *   search trials, finite differences) between jacobian_prepare and the
+ *   last jacobian_apply at x: a residual call must not change what
+ *   jacobian_apply computes.
+ * - jacobian_apply(ctx, x, dx, dr) writes dr = J(x) dx exactly (the
+ *   consistent linearisation of residual, not an approximation: Newton's
+ *   quadratic convergence depends on it).  x is the point last passed to
+ *   jacobian_prepare (and the same pointer contents for every call until
+ *   the next jacobian_prepare).  Any failure aborts the solve.
+ * - The pattern (pat_ptr[n + 1], pat_idx[pat_ptr[n]], CSR over unknowns)
+ *   lists for each row i every column j with dr_i/dx_j possibly non-zero; a
+ *   superset is allowed (its zeros are stored), a missing entry is not:
+ *   colouring would add J_ij into another entry of row i.  The pattern is
+ *   copied by pm_newton_create; columns of a row need not be sorted and may
+ *   repeat.
+ * - The callbacks are called from the thread that called pm_newton_solve
+ *   or pm_load_steps, one at a time; they may use OpenMP inside.
+ * - x arrays given to callbacks are read-only and valid only during the
+ *   call; r and dr are written in full (n entries).
+ *
+ * Load stepping: set_load(ctx, lambda) sets the load factor, lambda in
+ * [0, 1]; residual and the Jacobian are those at the last lambda set.  The
+ * state passed to pm_load_steps is taken as converged at lambda = 0.
+ *
+ * PETSc is initialised on first use (without command-line arguments; a
+ * program started without mpirun runs as one MPI process) and finalised
+ * by pm_solve_finalize or at exit.  All objects are sequential (one
+ * process); PETSc's own options, prefixed "pm_" ("-pm_snes_monitor",
+ * "-pm_ksp_view", "-pm_pc_type ilu"), may be given per solver in
+ * pm_newton_options.petsc_options and override the options struct. */
+#ifndef PM_NEWTON_H
+#define PM_NEWTON_H
+
+#include <stdbool.h>
+
+#include "pm_coloring.h"
+#include "pm_error.h"
+
+/* The most Newton iterations one solve may take (the length of the
+ * per-iteration arrays of a report, less one). */
+#define PM_NEWTON_MAX_ITER 200
+
+struct pm_newton_report;
+
+typedef struct {
+  long n;    /* number of unknowns */
+  void *ctx; /* passed to every callback */
+
+  /* r(x); non-success: x inadmissible (see above).  Required. */
+  pm_err (*residual)(void *ctx, const double *x, double *r);
+  /* dr = J(x) dx.  Required. */
+  pm_err (*jacobian_apply)(void *ctx, const double *x, const double *dx,
+                           double *dr);
+  /* Called once at each new linearisation point.  Optional (NULL). */
+  pm_err (*jacobian_prepare)(void *ctx, const double *x);
+  /* Sparsity of J: row i's columns are pat_idx[pat_ptr[i] .. pat_ptr[i+1]).
+   * Required. */
+  const long *pat_ptr;
+  const long *pat_idx;
+
+  /* A cheaper operator P(x) dx ~ J(x) dx to build the preconditioner from
+   * (op PM_NEWTON_MATRIX_FREE_CHEAP_PC only), on its own pattern
+   * (pc_pat_ptr/pc_pat_idx, NULL: the Jacobian's).  Called after
+   * jacobian_prepare at the same x.  Optional. */
+  pm_err (*precond_apply)(void *ctx, const double *x, const double *dx,
+                          double *dr);
+  const long *pc_pat_ptr;
+  const long *pc_pat_idx;
+
+  /* Load stepping only (pm_load_steps); NULL otherwise. */
+  pm_err (*set_load)(void *ctx, double lambda);
+  /* After each converged load step (step counts from 1, lambda the load
+   * reached, x the converged state, report that step's last Newton solve).
+   * A failure stops the stepping and is returned.  Optional. */
+  pm_err (*on_step)(void *ctx, int step, double lambda, const double *x,
+                    const struct pm_newton_report *report);
+} pm_newton_problem;
+
+/* The linear solver of each Newton iteration. */
+typedef enum {
+  PM_NEWTON_DIRECT = 0, /* LU: MUMPS, else PETSc's own */
+  PM_NEWTON_GMRES_GAMG, /* GMRES + algebraic multigrid */
+  PM_NEWTON_CG_JACOBI,  /* CG + Jacobi: symmetric positive definite J only */
+  PM_NEWTON_GMRES_ILU   /* GMRES + ILU(0) */
+} pm_newton_linear;
+
+/* What the linear solver multiplies by, and what it preconditions with. */
+typedef enum {
+  PM_NEWTON_ASSEMBLED = 0,       /* J assembled by colouring, used for both */
+  PM_NEWTON_MATRIX_FREE,         /* J applied by jacobian_apply; J assembled
+                                    by colouring for the preconditioner */
+  PM_NEWTON_MATRIX_FREE_CHEAP_PC /* J applied by jacobian_apply; P assembled
+                                    by colouring from precond_apply */
+} pm_newton_operator;
+
+typedef enum {
+  PM_LINE_SEARCH_BT = 0, /* backtracking (cubic), the default */
+  PM_LINE_SEARCH_BASIC,  /* full Newton step; a domain error then fails */
+  PM_LINE_SEARCH_L2,     /* secant on the residual norm along the step */
+  PM_LINE_SEARCH_CP      /* critical point (for residuals that are gradients) */
+} pm_line_search;
+
+typedef struct {
+  /* Convergence: a criterion with tolerance > 0 is on.  A solve has
+   * converged after iteration k (x_{k+1} = x_k + alpha_k dx_k, J(x_k) dx_k
+   * = -r(x_k)) when every criterion that is on holds (all_criteria) or any
+   * one holds (!all_criteria); |r| <= atol always stops it.
+   *   residual:      |r(x_{k+1})| <= rtol |r(x_0)|
+   *   displacement:  |dx_k| <= dtol |x_{k+1} - x_start|  (x_start: the
+   *                  initial guess of pm_newton_solve; in pm_load_steps the
+   *                  last converged state, also with the predictor;
+   *                  alpha_k is not applied to dx_k)
+   *   energy:        |dx_k . r(x_k)| <= etol |dx_0 . r(x_0)|
+   * Norms are Euclidean over all unknowns. */
+  double rtol;       /* 1e-8 */
+  double atol;       /* 0: scale-dependent, the caller's to set */
+  double dtol;       /* 0 (off) */
+  double etol;       /* 0 (off) */
+  bool all_criteria; /* false */
+  int max_iter;      /* 25, at most PM_NEWTON_MAX_ITER */
+
+  pm_newton_linear linear; /* PM_NEWTON_DIRECT */
+  double linear_rtol;      /* iterative solvers: 1e-10 */
+  int linear_max_iter;     /* iterative solvers: 1000 */
+  pm_newton_operator op;   /* PM_NEWTON_ASSEMBLED */
+  /* Matrix-free operators: rebuild the preconditioner every pc_lag Newton
+   * iterations (1: every one). */
+  int pc_lag;                 /* 1 */
+  pm_coloring_order coloring; /* PM_COLORING_LARGEST_FIRST */
+  pm_line_search line_search; /* PM_LINE_SEARCH_BT */
+
+  /* Load stepping (pm_load_steps). */
+  int load_steps;     /* nominal steps from lambda 0 to 1: 10 */
+  int max_cuts;       /* halvings allowed in a row for one step: 10 */
+  double min_dlambda; /* smallest step (0: 1/load_steps/2^max_cuts) */
+  int grow_after;     /* after this many converged steps in a row at a cut
+                         step, double it (up to the nominal); 0 never: 2 */
+  bool predictor;     /* start each step from the linear extrapolation of
+                         the last two converged states: false */
+
+  /* PETSc options for this solver's SNES, KSP, PC and line search, with
+   * prefix "pm_" ("-pm_snes_monitor -pm_ksp_type bcgs"); NULL: none.
+   * Applied after the settings above, so they override them. */
+  const char *petsc_options;
+} pm_newton_options;
+
+/* The options above with their defaults. */
+pm_newton_options pm_newton_options_default(void);
+
+/* Why a solve stopped. */
+typedef enum {
+  PM_NEWTON_NOT_RUN = 0,
+  PM_NEWTON_CONVERGED_RESIDUAL,     /* rtol */
+  PM_NEWTON_CONVERGED_ABSOLUTE,     /* atol (also: r(x_0) = 0, no step) */
+  PM_NEWTON_CONVERGED_DISPLACEMENT, /* dtol */
+  PM_NEWTON_CONVERGED_ENERGY,       /* etol */
+  PM_NEWTON_CONVERGED_ALL,          /* every criterion on (all_criteria) */
+  PM_NEWTON_DIVERGED_MAX_ITER,      /* max_iter without converging */
+  PM_NEWTON_DIVERGED_LINE_SEARCH,   /* no step decreased the residual */
+  PM_NEWTON_DIVERGED_NAN,           /* residual not finite */
+  PM_NEWTON_DIVERGED_DOMAIN,        /* residual inadmissible at the start,
+                                       or no admissible step found */
+  PM_NEWTON_DIVERGED_LINEAR         /* the linear solver failed */
+} pm_newton_reason;
+
+/* "converged (residual)", "diverged (max iterations)", ... */
+const char *pm_newton_reason_name(pm_newton_reason r);
+
+/* What one Newton solve did.  Arrays are indexed by iteration: entry 0 is
+ * the initial state, entry k the state after iteration k (k <=
+ * iterations). */
+typedef struct pm_newton_report {
+  pm_newton_reason reason;
+  pm_err status;     /* PM_SUCCESS if converged, else the error returned */
+  char message[512]; /* one line: the reason with its figures (empty on
+                        success), e.g. "Newton did not converge in 25
+                        iterations (residual 3.2e-04 from 1.1e+00)" */
+  int iterations;
+  int linear_iterations;      /* summed over the iterations */
+  long residual_evaluations;  /* residual calls (line search included) */
+  long jacobian_applications; /* jacobian_apply and precond_apply calls */
+  double residual_norm[PM_NEWTON_MAX_ITER + 1];  /* |r(x_k)| */
+  double increment_norm[PM_NEWTON_MAX_ITER + 1]; /* |dx_{k-1}| (0: 0) */
+  double energy[PM_NEWTON_MAX_ITER + 1];         /* |dx_{k-1}.r(x_{k-1})| */
+  double step_length[PM_NEWTON_MAX_ITER + 1];    /* alpha_{k-1} (0: 0) */
+  /* Wall seconds: residual calls; Jacobian preparation and assembly
+   * (colouring applications and insertion); linear solves (factorisation,
+   * Krylov iterations, matrix-free applications); the whole solve. */
+  double time_residual, time_assembly, time_linear, time_total;
+} pm_newton_report;
+
+/* What load stepping did. */
+typedef struct {
+  int steps;          /* converged load steps */
+  int cuts;           /* step halvings, over all steps */
+  double lambda;      /* the load reached (1 on success) */
+  double dlambda_min; /* smallest step converged */
+  int newton_iterations;
+  int linear_iterations;
+  double time_residual, time_assembly, time_linear, time_total;
+  pm_newton_report last; /* the last Newton solve (the failing one on
+                            failure) */
+} pm_load_report;
+
+/* A solver for one problem: the colouring, PETSc's matrix, vectors, SNES
+ * and linear solver, created once and reused by every solve. */
+typedef struct pm_newton pm_newton;
+
+/* Checks the problem (n, callbacks, pattern indices in [0, n)) and the
+ * options (PM_ERR_ARG naming the bad value), colours the pattern, and
+ * creates the PETSc objects.  problem is copied (its pattern too); ctx
+ * must outlive the solver.  *out is NULL on failure. */
+pm_err pm_newton_create(const pm_newton_problem *problem,
+                        const pm_newton_options *options, pm_newton **out);
+/* Releases everything of *s and sets it to NULL; NULL is allowed. */
+void pm_newton_destroy(pm_newton **s);
+
+/* Colours of the Jacobian's pattern (the jacobian_apply calls one
+ * assembly takes), and of the cheap preconditioner's (0 if none). */
+int pm_newton_colors(const pm_newton *s);
+int pm_newton_pc_colors(const pm_newton *s);
+
+/* One Newton solve from x[0..n-1], the initial guess, which receives the
+ * last iterate (the solution on success; on failure the last accepted
+ * iterate).  report (may be NULL) is filled in either case.  Returns
+ * PM_SUCCESS when converged; PM_ERR_NOT_CONVERGED (max iterations, line
+ * search, linear solver) or PM_ERR_UNSTABLE (NaN, domain) with
+ * report->message as the error message; a callback's hard failure or a
+ * PETSc failure as it is. */
+pm_err pm_newton_solve(pm_newton *s, double *x, pm_newton_report *report);
+
+/* Loads from lambda = 0 (x converged there) to 1 in options.load_steps
+ * steps: each sets the load, solves by Newton from the last converged
+ * state (or the predictor), and calls on_step.  A step that fails (any
+ * reason of pm_newton_solve but a hard failure) is halved and retried from
+ * the last converged state, up to max_cuts halvings in a row and no
+ * smaller than min_dlambda.  x receives the last converged state, and the
+ * load is left set to its lambda.  report (may be NULL) is filled in
+ * either case.  On failure returns PM_ERR_NOT_CONVERGED or PM_ERR_UNSTABLE
+ * with a message naming the step, the loads and the cause, e.g. "load step
+ * 7 (lambda 0.4375 -> 0.46875): Newton did not converge in 25 iterations
+ * (residual 3.2e-04 from 1.1e+00); cut 6 times to dlambda 1e-04: giving
+ * up". */
+pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report);
+
+/* The assembled Jacobian at x (jacobian_prepare, then colouring) as values
+ * in the order of the problem's pattern: val[pat_ptr[i] + k] = J_ij for j
+ * = pat_idx[pat_ptr[i] + k] (a repeated column gets the value at each
+ * place).  For checks of a linearisation. */
+pm_err pm_newton_jacobian_values(pm_newton *s, const double *x, double *val);
+
+/* Compares the coloured Jacobian at x with central differences of
+ * residual in every column (2n residual calls: small problems), step h
+ * |x_j| + h in column j.  *max_error: the largest |J_fd - J| over all
+ * entries (also those outside the pattern) divided by the largest |J_fd|;
+ * *row, *col (may be NULL): where it is. */
+pm_err pm_newton_check_jacobian(pm_newton *s, const double *x, double h,
+                                double *max_error, long *row, long *col);
+
+/* Finalises PETSc if this module initialised it (also registered to run
+ * at exit).  No solver may be used afterwards, nor PETSc re-initialised. */
+void pm_solve_finalize(void);
+
+#endif

@@ -1,0 +1,17 @@
+/* pm_newton_impl: what load stepping uses of a Newton solver beyond the
+ * public interface. */
+#ifndef PM_NEWTON_IMPL_H
+#define PM_NEWTON_IMPL_H
+
+#include "pm_newton.h"
+
+const pm_newton_problem *pm_newton_problem_of(const pm_newton *s);
+const pm_newton_options *pm_newton_options_of(const pm_newton *s);
+
+/* pm_newton_solve with the displacement criterion measured from x_start
+ * (n values, copied) instead of the initial guess, and rtol relative to the
+ * larger of |r(x_0)| and r_ref; report is required. */
+pm_err pm_newton_solve_from(pm_newton *s, double *x, const double *x_start,
+                            double r_ref, pm_newton_report *report);
+
+#endif

@@ -1,0 +1,865 @@
+/* Unit tests of the shared Newton solver: colouring (validity, counts, the
+ * Jacobian against dense central differences), quadratic convergence, the
+ * stopping criteria, every linear solver and operator, domain errors, and
+ * load stepping with cuts (a run that completes and one that cannot). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_coloring.h"
+#include "pm_newton.h"
+#include "pm_testing.h"
+
+static const double PI = 3.14159265358979323846;
+
+/* ---- A chain of nonlinear springs --------------------------------------
+ * Nodes 0..n+1 at spacing h, the two ends fixed; node a is joined to a + d
+ * for d = 1..reach by a spring of rest length L = d h, stiffness k / d and
+ * tension T(s) = (k / d) (s + c s^3 / L^2) in its elongation s = u_b - u_a
+ * (inadmissible at s <= -L: the spring passes through itself).  The load
+ * is manufactured: at load factor lambda the external force is the
+ * internal force of u*(lambda) = lambda A sin(pi x / X), so u* is the
+ * solution. */
+typedef struct {
+  long n;
+  int reach;
+  double h, k, c, amp;
+  double lambda;
+  double *x;       /* a state */
+  double *force;   /* external force on the free nodes at lambda */
+  double *tangent; /* dT/ds per spring at the prepared point */
+  long *ptr, *idx; /* pattern */
+  long prepares;
+  /* Load stepping tests: a load jump above jump_limit from the last
+   * converged load is inadmissible (0: any). */
+  double jump_limit, lambda_done;
+  bool nan_residual; /* residual returns NaN */
+  bool hard_failure; /* residual fails with PM_ERR_MEMORY */
+} chain;
+
+static long springs_of(const chain *ch) {
+  long count = 0;
+  for (long a = 0; a <= ch->n + 1; a++)
+    for (int d = 1; d <= ch->reach && a + d <= ch->n + 1; d++) count++;
+  return count;
+}
+
+static double node_u(const chain *ch, const double *x, long g) {
+  return g == 0 || g == ch->n + 1 ? 0.0 : x[g - 1];
+}
+
+static double exact(const chain *ch, double lambda, long g) {
+  return lambda * ch->amp * sin(PI * (double)g / (double)(ch->n + 1));
+}
+
+/* Internal force of x into f (free nodes); false if a spring inverts. */
+static bool internal_force(const chain *ch, const double *x, double *f,
+                           long *bad) {
+  for (long i = 0; i < ch->n; i++) f[i] = 0;
+  for (long a = 0; a <= ch->n + 1; a++)
+    for (int d = 1; d <= ch->reach && a + d <= ch->n + 1; d++) {
+      long b = a + d;
+      double L = d * ch->h, s = node_u(ch, x, b) - node_u(ch, x, a);
+      if (!(s > -L)) {
+        *bad = a;
+        return false;
+      }
+      double t = ch->k / d * (s + ch->c * s * s * s / (L * L));
+      if (a >= 1 && a <= ch->n) f[a - 1] -= t;
+      if (b >= 1 && b <= ch->n) f[b - 1] += t;
+    }
+  return true;
+}
+
+static pm_err chain_set_load(void *ctx, double lambda) {
+  chain *ch = ctx;
+  double *u = calloc((size_t)ch->n, sizeof *u);
+  PM_CHECK(u, PM_ERR_MEMORY, "out of memory");
+  for (long i = 0; i < ch->n; i++) u[i] = exact(ch, lambda, i + 1);
+  long bad;
+  bool ok = internal_force(ch, u, ch->force, &bad);
+  free(u);
+  PM_CHECK(ok, PM_ERR_ARG, "manufactured state inverts spring %ld", bad);
+  ch->lambda = lambda;
+  return PM_SUCCESS;
+}
+
+static pm_err chain_residual(void *ctx, const double *x, double *r) {
+  chain *ch = ctx;
+  if (ch->hard_failure)
+    return PM_ERROR(PM_ERR_MEMORY, "out of memory (test residual)");
+  if (ch->jump_limit > 0 && ch->lambda - ch->lambda_done > ch->jump_limit)
+    return PM_ERROR(PM_ERR_UNSTABLE, "load jump %g above %g",
+                    ch->lambda - ch->lambda_done, ch->jump_limit);
+  long bad;
+  if (!internal_force(ch, x, r, &bad))
+    return PM_ERROR(PM_ERR_UNSTABLE, "spring from node %ld inverted", bad);
+  for (long i = 0; i < ch->n; i++)
+    r[i] = ch->nan_residual ? NAN : r[i] - ch->force[i];
+  return PM_SUCCESS;
+}
+
+static pm_err chain_prepare(void *ctx, const double *x) {
+  chain *ch = ctx;
+  long e = 0;
+  for (long a = 0; a <= ch->n + 1; a++)
+    for (int d = 1; d <= ch->reach && a + d <= ch->n + 1; d++) {
+      double L = d * ch->h, s = node_u(ch, x, a + d) - node_u(ch, x, a);
+      ch->tangent[e++] = ch->k / d * (1 + 3 * ch->c * s * s / (L * L));
+    }
+  ch->prepares++;
+  return PM_SUCCESS;
+}
+
+/* dr = J dx with the tangents of the springs up to distance `upto`. */
+static void apply_springs(const chain *ch, int upto, const double *dx,
+                          double *dr) {
+  long e = 0;
+  for (long i = 0; i < ch->n; i++) dr[i] = 0;
+  for (long a = 0; a <= ch->n + 1; a++)
+    for (int d = 1; d <= ch->reach && a + d <= ch->n + 1; d++, e++) {
+      if (d > upto) continue;
+      long b = a + d;
+      double ds = node_u(ch, dx, b) - node_u(ch, dx, a);
+      double t = ch->tangent[e] * ds;
+      if (a >= 1 && a <= ch->n) dr[a - 1] -= t;
+      if (b >= 1 && b <= ch->n) dr[b - 1] += t;
+    }
+}
+
+static pm_err chain_apply(void *ctx, const double *x, const double *dx,
+                          double *dr) {
+  (void)x;
+  apply_springs(ctx, ((chain *)ctx)->reach, dx, dr);
+  return PM_SUCCESS;
+}
+
+/* The nearest-neighbour springs only: a cheaper, tridiagonal operator. */
+static pm_err chain_apply_nearest(void *ctx, const double *x, const double *dx,
+                                  double *dr) {
+  (void)x;
+  apply_springs(ctx, 1, dx, dr);
+  return PM_SUCCESS;
+}
+
+static pm_err chain_on_step(void *ctx, int step, double lambda, const double *x,
+                            const pm_newton_report *report) {
+  chain *ch = ctx;
+  (void)step;
+  (void)x;
+  (void)report;
+  ch->lambda_done = lambda;
+  return PM_SUCCESS;
+}
+
+/* The pattern of a band of half-width `band` over n unknowns (freed by the
+ * caller). */
+static void band_pattern(long n, int band, long **ptr, long **idx) {
+  *ptr = calloc((size_t)n + 1, sizeof **ptr);
+  *idx = calloc((size_t)n * (size_t)(2 * band + 1), sizeof **idx);
+  assert_true(*ptr && *idx);
+  for (long i = 0; i < n; i++) {
+    (*ptr)[i + 1] = (*ptr)[i];
+    for (long j = i - band; j <= i + band; j++)
+      if (j >= 0 && j < n) (*idx)[(*ptr)[i + 1]++] = j;
+  }
+}
+
+/* A chain of n free nodes; its pattern (band of half-width `band`). */
+static void chain_init(chain *ch, long n, int reach, int band) {
+  memset(ch, 0, sizeof *ch);
+  ch->n = n;
+  ch->reach = reach;
+  ch->h = 1.0 / (double)(n + 1);
+  ch->k = 1.0e3;
+  ch->c = 4.0;
+  ch->amp = 0.25 / PI;
+  ch->x = calloc((size_t)n, sizeof *ch->x);
+  ch->force = calloc((size_t)n, sizeof *ch->force);
+  ch->tangent = calloc((size_t)springs_of(ch), sizeof *ch->tangent);
+  assert_true(ch->x && ch->force && ch->tangent);
+  band_pattern(n, band, &ch->ptr, &ch->idx);
+  assert_ok(chain_set_load(ch, 1.0));
+}
+
+static void chain_free(chain *ch) {
+  free(ch->x);
+  free(ch->force);
+  free(ch->tangent);
+  free(ch->ptr);
+  free(ch->idx);
+}
+
+static pm_newton_problem chain_problem(chain *ch) {
+  return (pm_newton_problem){.n = ch->n,
+                             .ctx = ch,
+                             .residual = chain_residual,
+                             .jacobian_apply = chain_apply,
+                             .jacobian_prepare = chain_prepare,
+                             .pat_ptr = ch->ptr,
+                             .pat_idx = ch->idx,
+                             .set_load = chain_set_load,
+                             .on_step = chain_on_step};
+}
+
+/* Solves the problem from rest (the state in ch->x) with a solver of
+ * these options, created and destroyed here; returns the solve's code. */
+static pm_err chain_solve(chain *ch, const pm_newton_problem *prob,
+                          const pm_newton_options *opt, pm_newton_report *rep) {
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(prob, opt, &s));
+  memset(ch->x, 0, (size_t)ch->n * sizeof *ch->x);
+  pm_err e = pm_newton_solve(s, ch->x, rep);
+  pm_newton_destroy(&s);
+  return e;
+}
+
+/* Loads the chain from rest in steps (the state in ch->x) with a solver
+ * of these options, created and destroyed here; returns the code. */
+static pm_err chain_load_steps(chain *ch, const pm_newton_problem *prob,
+                               const pm_newton_options *opt,
+                               pm_load_report *rep) {
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(prob, opt, &s));
+  memset(ch->x, 0, (size_t)ch->n * sizeof *ch->x);
+  ch->lambda_done = 0;
+  assert_ok(chain_set_load(ch, 0));
+  pm_err e = pm_load_steps(s, ch->x, rep);
+  pm_newton_destroy(&s);
+  return e;
+}
+
+/* Largest |x - u*(lambda)| over the largest |u*|. */
+static double chain_error(const chain *ch, const double *x, double lambda) {
+  double e = 0, m = 0;
+  for (long i = 0; i < ch->n; i++) {
+    e = fmax(e, fabs(x[i] - exact(ch, lambda, i + 1)));
+    m = fmax(m, fabs(exact(ch, lambda, i + 1)));
+  }
+  return e / m;
+}
+
+/* ---- Colouring --------------------------------------------------------- */
+
+/* No two columns of a colour share a row; the colour lists cover every
+ * column once. */
+static void assert_valid_coloring(const pm_pattern *p, const pm_coloring *c) {
+  long n = p->n;
+  int *seen = calloc((size_t)c->ncolors, sizeof *seen);
+  assert_non_null(seen);
+  for (long i = 0; i < n; i++) {
+    for (int k = 0; k < c->ncolors; k++) seen[k] = 0;
+    for (long q = p->ptr[i]; q < p->ptr[i + 1]; q++) {
+      int col = c->color[p->idx[q]];
+      assert_true(col >= 0 && col < c->ncolors);
+      assert_int_equal(seen[col], 0);
+      seen[col] = 1;
+    }
+  }
+  free(seen);
+  assert_int_equal(c->color_ptr[c->ncolors], n);
+  for (int k = 0; k < c->ncolors; k++)
+    for (long q = c->color_ptr[k]; q < c->color_ptr[k + 1]; q++)
+      assert_int_equal(c->color[c->color_col[q]], k);
+}
+
+/* A banded pattern takes exactly its longest row of colours (columns
+ * within 2 band share a row); an unsorted, repeated, random pattern gets a
+ * valid colouring by either order. */
+static void test_coloring(void **state) {
+  (void)state;
+  for (int band = 1; band <= 3; band++) {
+    chain ch;
+    chain_init(&ch, 40, band, band);
+    pm_pattern p;
+    assert_ok(pm_pattern_build(ch.n, ch.ptr, ch.idx, true, &p));
+    assert_int_equal(pm_pattern_max_row(&p), 2 * band + 1);
+    for (int order = 0; order < 2; order++) {
+      pm_coloring c;
+      assert_ok(pm_coloring_build(&p, (pm_coloring_order)order, &c));
+      assert_valid_coloring(&p, &c);
+      print_message("band %d, %s: %d colours (longest row %ld)\n", band,
+                    order ? "natural" : "largest-first", c.ncolors,
+                    pm_pattern_max_row(&p));
+      if (order == PM_COLORING_NATURAL)
+        assert_int_equal(c.ncolors, 2 * band + 1);
+      else
+        assert_true(c.ncolors >= 2 * band + 1 && c.ncolors <= 4 * band + 1);
+      pm_coloring_free(&c);
+    }
+    pm_pattern_free(&p);
+    chain_free(&ch);
+  }
+
+  /* Random: 200 columns, rows of up to 8 random columns, some repeated. */
+  enum { N = 200 };
+  long ptr[N + 1], idx[N * 8];
+  unsigned seed = 12345u;
+  ptr[0] = 0;
+  for (long i = 0; i < N; i++) {
+    seed = seed * 1103515245u + 12345u;
+    long len = 1 + (long)((seed >> 16) % 8);
+    ptr[i + 1] = ptr[i] + len;
+    for (long q = ptr[i]; q < ptr[i + 1]; q++) {
+      seed = seed * 1103515245u + 12345u;
+      idx[q] = (long)((seed >> 16) % N);
+    }
+    idx[ptr[i + 1] - 1] = idx[ptr[i]]; /* a repeat */
+  }
+  pm_pattern p;
+  assert_ok(pm_pattern_build(N, ptr, idx, false, &p));
+  for (long k = 0; k < ptr[N]; k++) assert_int_equal(p.idx[p.src[k]], idx[k]);
+  for (int order = 0; order < 2; order++) {
+    pm_coloring c;
+    assert_ok(pm_coloring_build(&p, (pm_coloring_order)order, &c));
+    assert_valid_coloring(&p, &c);
+    assert_true(c.ncolors >= pm_pattern_max_row(&p));
+    print_message("random 200 x 200, %s: %d colours (longest row %ld)\n",
+                  order ? "natural" : "largest-first", c.ncolors,
+                  pm_pattern_max_row(&p));
+    pm_coloring_free(&c);
+  }
+  pm_pattern_free(&p);
+
+  /* Bad patterns are named. */
+  long bad_ptr[3] = {0, 2, 1}, bad_idx[2] = {0, 1};
+  assert_int_equal(pm_pattern_build(2, bad_ptr, bad_idx, true, &p), PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "row 1"));
+  long out_ptr[3] = {0, 1, 2}, out_idx[2] = {0, 2};
+  assert_int_equal(pm_pattern_build(2, out_ptr, out_idx, true, &p), PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "row 1 has column 2"));
+  pm_error_clear();
+}
+
+/* The coloured Jacobian equals dense central differences of the residual
+ * (all n^2 entries, so a pattern missing an entry would show) to 1e-7,
+ * at a state away from the solution. */
+static void test_jacobian_against_differences(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 30, 2, 2);
+  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_options opt = pm_newton_options_default();
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  assert_int_equal(pm_newton_colors(s), 5);
+
+  long n = ch.n;
+  double *x = calloc((size_t)n, sizeof *x);
+  double *val = calloc((size_t)ch.ptr[n], sizeof *val);
+  double *dense = calloc((size_t)(n * n), sizeof *dense);
+  double *rp = calloc((size_t)n, sizeof *rp), *rm = calloc((size_t)n, 8);
+  assert_true(x && val && dense && rp && rm);
+  for (long i = 0; i < n; i++)
+    x[i] = 0.7 * exact(&ch, 1, i + 1) + 0.01 * sin(3.0 * (double)i);
+  long prepares = ch.prepares;
+  assert_ok(pm_newton_jacobian_values(s, x, val));
+  assert_int_equal(ch.prepares, prepares + 1);
+  for (long i = 0; i < n; i++)
+    for (long q = ch.ptr[i]; q < ch.ptr[i + 1]; q++)
+      dense[i * n + ch.idx[q]] = val[q];
+
+  double worst = 0, largest = 0;
+  for (long j = 0; j < n; j++) {
+    double xj = x[j], step = 1e-6 * (fabs(xj) + 1e-2);
+    x[j] = xj + step;
+    assert_ok(chain_residual(&ch, x, rp));
+    x[j] = xj - step;
+    assert_ok(chain_residual(&ch, x, rm));
+    x[j] = xj;
+    for (long i = 0; i < n; i++) {
+      double fd = (rp[i] - rm[i]) / (2 * step);
+      worst = fmax(worst, fabs(fd - dense[i * n + j]));
+      largest = fmax(largest, fabs(fd));
+    }
+  }
+  print_message("coloured vs dense differences: %.2e relative (5 colours, "
+                "n = %ld)\n",
+                worst / largest, n);
+  assert_true(worst / largest < 1e-7);
+
+  double err;
+  long row, col;
+  assert_ok(pm_newton_check_jacobian(s, x, 1e-6, &err, &row, &col));
+  assert_true(err < 1e-7);
+
+  free(x);
+  free(val);
+  free(dense);
+  free(rp);
+  free(rm);
+  pm_newton_destroy(&s);
+  assert_null(s);
+  chain_free(&ch);
+}
+
+/* A pattern that misses an entry of J is caught by the dense check. */
+static void test_missing_pattern_entry(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 12, 2, 1); /* reach 2 needs band 2 */
+  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_options opt = pm_newton_options_default();
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  double x[12] = {0}, err;
+  long row, col;
+  assert_ok(pm_newton_check_jacobian(s, x, 1e-6, &err, &row, &col));
+  assert_true(err > 0.1);
+  assert_true(labs(row - col) == 2);
+  pm_newton_destroy(&s);
+  chain_free(&ch);
+}
+
+/* ---- Newton ------------------------------------------------------------ */
+
+/* From rest to the full load in one solve: the solution is u*, and the
+ * residual norms fall quadratically: r_{k+1} / r_k^2 stays bounded and the
+ * observed order log(r_{k+1}/r_k) / log(r_k/r_{k-1}) is near 2 over the
+ * last iterations. */
+static void test_quadratic_convergence(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 200, 2, 2);
+  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_options opt = pm_newton_options_default();
+  opt.rtol = 1e-13;
+  pm_newton_report rep;
+  assert_ok(chain_solve(&ch, &prob, &opt, &rep));
+  double *x = ch.x;
+  assert_int_equal(rep.reason, PM_NEWTON_CONVERGED_RESIDUAL);
+  assert_int_equal(rep.status, PM_SUCCESS);
+  assert_true(rep.iterations >= 4 && rep.iterations <= 12);
+  assert_true(chain_error(&ch, x, 1.0) < 1e-12);
+  assert_int_equal(ch.prepares, rep.iterations);
+  assert_int_equal(rep.jacobian_applications, 5L * rep.iterations);
+
+  const double *r = rep.residual_norm;
+  int last = rep.iterations, pairs = 0;
+  double order_min = 1e300;
+  for (int k = 1; k < last; k++) {
+    /* Asymptotic range: well below the start, above roundoff. */
+    if (!(r[k] < 0.05 * r[0] && r[k + 1] > 1e-11 * r[0])) continue;
+    double c = r[k + 1] / (r[k] * r[k]);
+    double order = log(r[k + 1] / r[k]) / log(r[k] / r[k - 1]);
+    print_message("iteration %d: |r| %.3e, r_k+1/r_k^2 %.3e, order %.2f\n",
+                  k + 1, r[k + 1], c, order);
+    assert_true(c * r[0] < 50);
+    order_min = fmin(order_min, order);
+    pairs++;
+  }
+  assert_true(pairs >= 2);
+  assert_true(order_min > 1.8);
+
+  print_message("n %ld, %d iterations, %d colours: residual %.3f ms, "
+                "assembly %.3f ms, linear %.3f ms, total %.3f ms\n",
+                ch.n, rep.iterations, 5, 1e3 * rep.time_residual,
+                1e3 * rep.time_assembly, 1e3 * rep.time_linear,
+                1e3 * rep.time_total);
+  assert_true(rep.time_total >= rep.time_residual + rep.time_assembly);
+  for (int k = 1; k <= last; k++) {
+    assert_true(rep.increment_norm[k] > 0);
+    assert_true(rep.step_length[k] > 0 && rep.step_length[k] <= 1);
+  }
+
+  /* The same for the error e_k = |x_k - u*| / |u*|, each x_k from a solve
+   * stopped after k iterations. */
+  double e[8];
+  int m = 0;
+  for (int k = 1; k <= 6; k++, m++) {
+    pm_newton_options stop = opt;
+    stop.max_iter = k;
+    stop.rtol = 1e-300;
+    assert_int_equal(chain_solve(&ch, &prob, &stop, &rep),
+                     PM_ERR_NOT_CONVERGED);
+    pm_error_clear();
+    e[m] = chain_error(&ch, x, 1.0);
+  }
+  pairs = 0;
+  for (int k = 1; k + 1 < m; k++) {
+    if (!(e[k] < 0.05 && e[k + 1] > 1e-13)) continue;
+    double c = e[k + 1] / (e[k] * e[k]);
+    double order = log(e[k + 1] / e[k]) / log(e[k] / e[k - 1]);
+    print_message("error after %d iterations %.3e: e_k+1/e_k^2 %.3e, order "
+                  "%.2f\n",
+                  k + 2, e[k + 1], c, order);
+    assert_true(c < 10);
+    assert_true(order > 1.8);
+    pairs++;
+  }
+  assert_true(pairs >= 2);
+
+  /* Solving again from the solution converges at once (absolute floor
+   * on, or r0 = 0 exactly). */
+  opt.atol = 1e-9;
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  for (long i = 0; i < ch.n; i++) x[i] = exact(&ch, 1, i + 1);
+  assert_ok(pm_newton_solve(s, x, &rep));
+  assert_int_equal(rep.iterations, 0);
+  assert_int_equal(rep.reason, PM_NEWTON_CONVERGED_ABSOLUTE);
+  pm_newton_destroy(&s);
+  chain_free(&ch);
+}
+
+/* Each criterion alone stops the solve by itself with the solution
+ * reached; all_criteria waits for both. */
+static void test_criteria(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 100, 2, 2);
+  pm_newton_problem prob = chain_problem(&ch);
+  struct {
+    double rtol, dtol, etol;
+    bool all;
+    pm_newton_reason want;
+  } cases[] = {
+      {1e-10, 0, 0, false, PM_NEWTON_CONVERGED_RESIDUAL},
+      {0, 1e-10, 0, false, PM_NEWTON_CONVERGED_DISPLACEMENT},
+      {0, 0, 1e-20, false, PM_NEWTON_CONVERGED_ENERGY},
+      {0, 1e-10, 1e-20, true, PM_NEWTON_CONVERGED_ALL},
+  };
+  int its[4];
+  for (int c = 0; c < 4; c++) {
+    pm_newton_options opt = pm_newton_options_default();
+    opt.rtol = cases[c].rtol;
+    opt.dtol = cases[c].dtol;
+    opt.etol = cases[c].etol;
+    opt.all_criteria = cases[c].all;
+    pm_newton_report rep;
+    assert_ok(chain_solve(&ch, &prob, &opt, &rep));
+    const double *x = ch.x;
+    assert_int_equal(rep.reason, cases[c].want);
+    its[c] = rep.iterations;
+    int k = rep.iterations;
+    print_message("%s: %d iterations, |dx| %.2e, |dx.r| %.2e (first %.2e), "
+                  "error %.2e\n",
+                  pm_newton_reason_name(rep.reason), k, rep.increment_norm[k],
+                  rep.energy[k], rep.energy[1], chain_error(&ch, x, 1));
+    assert_true(chain_error(&ch, x, 1.0) < 1e-9);
+    if (cases[c].etol > 0)
+      assert_true(rep.energy[k] <= cases[c].etol * rep.energy[1]);
+    assert_true(k >= 2);
+  }
+  assert_true(its[3] >= its[1] && its[3] >= its[2]);
+  chain_free(&ch);
+}
+
+/* Every linear solver with every operator solves the problem to the same
+ * solution; CG + Jacobi since the chain's J is symmetric positive
+ * definite. */
+static void test_linear_solvers(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 150, 2, 2);
+  pm_newton_problem prob = chain_problem(&ch);
+  prob.precond_apply = chain_apply_nearest;
+  long *tri_ptr, *tri_idx;
+  band_pattern(ch.n, 1, &tri_ptr, &tri_idx);
+  prob.pc_pat_ptr = tri_ptr;
+  prob.pc_pat_idx = tri_idx;
+  static const char *lin[] = {"direct", "gmres-gamg", "cg-jacobi", "gmres-ilu"};
+  static const char *ops[] = {"assembled", "matrix-free",
+                              "matrix-free, cheap pc"};
+  for (int l = 0; l < 4; l++)
+    for (int o = 0; o < 3; o++) {
+      pm_newton_options opt = pm_newton_options_default();
+      opt.rtol = 1e-10;
+      opt.linear = (pm_newton_linear)l;
+      opt.op = (pm_newton_operator)o;
+      pm_newton *s = NULL;
+      assert_ok(pm_newton_create(&prob, &opt, &s));
+      assert_int_equal(pm_newton_pc_colors(s), o == 2 ? 3 : 0);
+      pm_newton_destroy(&s);
+      pm_newton_report rep;
+      assert_ok(chain_solve(&ch, &prob, &opt, &rep));
+      print_message("%-10s %-22s: %2d Newton, %4d linear iterations, "
+                    "%.2f ms (linear %.2f ms), error %.1e\n",
+                    lin[l], ops[o], rep.iterations, rep.linear_iterations,
+                    1e3 * rep.time_total, 1e3 * rep.time_linear,
+                    chain_error(&ch, ch.x, 1));
+      assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+      assert_true(rep.iterations <= 12);
+    }
+  free(tri_ptr);
+  free(tri_idx);
+  chain_free(&ch);
+}
+
+/* PETSc options with the "pm_" prefix override the struct: Jacobi-
+ * preconditioned GMRES in place of LU takes many linear iterations. */
+static void test_petsc_options(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 80, 2, 2);
+  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_options opt = pm_newton_options_default();
+  opt.petsc_options = "-pm_ksp_type gmres -pm_pc_type jacobi "
+                      "-pm_ksp_rtol 1e-12";
+  pm_newton_report rep;
+  assert_ok(chain_solve(&ch, &prob, &opt, &rep));
+  assert_true(rep.linear_iterations > 5 * rep.iterations);
+  assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+
+  /* An option PETSc rejects inside the solve is an error with PETSc's
+   * message, not a failed step. */
+  opt.petsc_options = "-pm_pc_type lu -pm_pc_factor_mat_solver_type nonesuch";
+  assert_int_equal(chain_solve(&ch, &prob, &opt, &rep), PM_ERR_LINALG);
+  print_message("%s\n", pm_error_message());
+  assert_non_null(strstr(pm_error_message(), "nonesuch"));
+  pm_error_clear();
+  chain_free(&ch);
+}
+
+/* Failures: an inadmissible start, a NaN residual, too few iterations, a
+ * hard callback failure, and bad options, each with its reason and a
+ * message that says so. */
+static void test_failures(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 20, 1, 1);
+  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_options opt = pm_newton_options_default();
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  double x[20] = {0};
+  pm_newton_report rep;
+
+  x[5] = -1.0; /* node 6 behind node 5: spring 5 inverted */
+  assert_int_equal(pm_newton_solve(s, x, &rep), PM_ERR_UNSTABLE);
+  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_DOMAIN);
+  assert_non_null(strstr(rep.message, "initial state is inadmissible"));
+  assert_non_null(strstr(rep.message, "spring from node 5 inverted"));
+  assert_non_null(strstr(pm_error_message(), "spring from node 5"));
+  assert_true(x[5] == -1.0);
+
+  memset(x, 0, sizeof x);
+  ch.nan_residual = true;
+  assert_int_equal(pm_newton_solve(s, x, &rep), PM_ERR_UNSTABLE);
+  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_NAN);
+  ch.nan_residual = false;
+
+  ch.hard_failure = true;
+  assert_int_equal(pm_newton_solve(s, x, &rep), PM_ERR_MEMORY);
+  assert_non_null(strstr(pm_error_message(), "test residual"));
+  ch.hard_failure = false;
+  pm_newton_destroy(&s);
+
+  opt.max_iter = 2;
+  opt.rtol = 1e-12;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  memset(x, 0, sizeof x);
+  assert_int_equal(pm_newton_solve(s, x, &rep), PM_ERR_NOT_CONVERGED);
+  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_MAX_ITER);
+  assert_non_null(strstr(rep.message, "did not converge in 2 iterations"));
+  assert_true(x[3] != 0); /* the last iterate */
+  pm_newton_destroy(&s);
+
+  opt = pm_newton_options_default();
+  opt.rtol = 0;
+  assert_int_equal(pm_newton_create(&prob, &opt, &s), PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "convergence criterion"));
+  opt = pm_newton_options_default();
+  opt.op = PM_NEWTON_MATRIX_FREE_CHEAP_PC;
+  assert_int_equal(pm_newton_create(&prob, &opt, &s), PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "precond_apply"));
+  assert_null(s);
+  pm_error_clear();
+  chain_free(&ch);
+}
+
+/* ---- Load stepping ----------------------------------------------------- */
+
+/* Steps of 1/4 with an inadmissible jump above 0.1: each step is cut to
+ * 1/16 (two cuts), grows back, is cut again, and the run reaches lambda =
+ * 1 on u*; on_step sees each converged step. */
+static void test_load_steps_cut(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 60, 2, 2);
+  ch.jump_limit = 0.1;
+  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_options opt = pm_newton_options_default();
+  opt.load_steps = 4;
+  opt.rtol = 1e-10;
+  pm_load_report rep;
+  assert_ok(chain_load_steps(&ch, &prob, &opt, &rep));
+  print_message("jump limit 0.1, steps of 0.25: %d steps, %d cuts, smallest "
+                "dlambda %g, %d Newton iterations, %.1f ms\n",
+                rep.steps, rep.cuts, rep.dlambda_min, rep.newton_iterations,
+                1e3 * rep.time_total);
+  assert_true(rep.cuts >= 2);
+  assert_true(rep.lambda == 1.0);
+  assert_true(ch.lambda_done == 1.0);
+  assert_close(rep.dlambda_min, 0.0625, 1e-12, 0);
+  assert_true(rep.steps >= 10 && rep.steps <= 16);
+  assert_true(chain_error(&ch, ch.x, 1.0) < 1e-9);
+
+  /* Without cutting room the same run fails at the first step. */
+  opt.max_cuts = 1;
+  assert_int_equal(chain_load_steps(&ch, &prob, &opt, &rep), PM_ERR_UNSTABLE);
+  const char *msg = pm_error_message();
+  print_message("%s\n", msg);
+  assert_non_null(strstr(msg, "load step 1 (lambda 0 -> 0.125)"));
+  assert_non_null(strstr(msg, "load jump 0.125 above 0.1"));
+  assert_non_null(strstr(msg, "cut 1 times to dlambda 0.125: giving up"));
+  assert_int_equal(rep.steps, 0);
+  assert_true(ch.lambda == 0.0); /* the load of the state returned */
+  pm_error_clear();
+  chain_free(&ch);
+}
+
+/* Too few Newton iterations for the whole load at once: the step is cut
+ * until it converges, and the predictor saves iterations. */
+static void test_load_steps_iterations(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 60, 2, 2);
+  ch.amp *= 2;
+  pm_newton_problem prob = chain_problem(&ch);
+  int iterations[2];
+  for (int predictor = 0; predictor < 2; predictor++) {
+    pm_newton_options opt = pm_newton_options_default();
+    opt.load_steps = 1;
+    opt.max_iter = 4;
+    opt.rtol = 1e-9;
+    opt.predictor = predictor;
+    pm_load_report rep;
+    assert_ok(chain_load_steps(&ch, &prob, &opt, &rep));
+    print_message("max_iter 4, %s: %d steps, %d cuts, %d Newton iterations\n",
+                  predictor ? "predictor" : "no predictor", rep.steps, rep.cuts,
+                  rep.newton_iterations);
+    assert_true(rep.cuts >= 1);
+    assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+    iterations[predictor] = rep.newton_iterations;
+  }
+  assert_true(iterations[1] <= iterations[0]);
+  chain_free(&ch);
+}
+
+/* A bar of saturating springs, T(s) = Tmax tanh(s / s0), fixed at one end
+ * and pulled by lambda P = lambda 2.2 Tmax at the other, has no state beyond
+ * lambda = 1/2.2: the stepping creeps up to it and gives up with a message
+ * naming the step and the loads. */
+typedef struct {
+  long n;
+  double tmax, s0, load;
+  double ratio; /* P / Tmax */
+} bar;
+
+static pm_err bar_set_load(void *ctx, double lambda) {
+  bar *b = ctx;
+  b->load = lambda * b->ratio * b->tmax;
+  return PM_SUCCESS;
+}
+
+static pm_err bar_residual(void *ctx, const double *x, double *r) {
+  const bar *b = ctx;
+  for (long i = 0; i < b->n; i++) {
+    double left = b->tmax * tanh((x[i] - (i ? x[i - 1] : 0)) / b->s0);
+    double right =
+        i + 1 < b->n ? b->tmax * tanh((x[i + 1] - x[i]) / b->s0) : b->load;
+    r[i] = left - right;
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err bar_apply(void *ctx, const double *x, const double *dx,
+                        double *dr) {
+  const bar *b = ctx;
+  for (long i = 0; i < b->n; i++) {
+    double sl = x[i] - (i ? x[i - 1] : 0), dsl = dx[i] - (i ? dx[i - 1] : 0);
+    double tl = tanh(sl / b->s0);
+    dr[i] = b->tmax / b->s0 * (1 - tl * tl) * dsl;
+    if (i + 1 < b->n) {
+      double tr = tanh((x[i + 1] - x[i]) / b->s0);
+      dr[i] -= b->tmax / b->s0 * (1 - tr * tr) * (dx[i + 1] - dx[i]);
+    }
+  }
+  return PM_SUCCESS;
+}
+
+static void test_load_steps_impossible(void **state) {
+  (void)state;
+  enum { N = 10 };
+  bar b = {N, 1.0, 0.01, 0, 2.2};
+  long *ptr, *idx;
+  band_pattern(N, 1, &ptr, &idx);
+  pm_newton_problem prob = {.n = N,
+                            .ctx = &b,
+                            .residual = bar_residual,
+                            .jacobian_apply = bar_apply,
+                            .pat_ptr = ptr,
+                            .pat_idx = idx,
+                            .set_load = bar_set_load};
+  pm_newton_options opt = pm_newton_options_default();
+  opt.load_steps = 4;
+  opt.max_cuts = 6;
+  opt.atol = 1e-12;
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  double x[N] = {0};
+  pm_load_report rep;
+  pm_err e = pm_load_steps(s, x, &rep);
+  assert_true(e == PM_ERR_NOT_CONVERGED || e == PM_ERR_UNSTABLE);
+  const char *msg = pm_error_message();
+  print_message("%s\n", msg);
+  char want[96];
+  snprintf(want, sizeof want, "load step %d (lambda %.6g -> ", rep.steps + 1,
+           rep.lambda);
+  assert_non_null(strstr(msg, want));
+  assert_non_null(strstr(msg, "Newton"));
+  assert_non_null(strstr(msg, "times to dlambda 0.00391: giving up"));
+  assert_true(rep.lambda < 1 / 2.2 && rep.lambda > 0.4);
+  /* The state returned is the converged one at rep.lambda: each spring
+   * carries the load. */
+  double s_exact = b.s0 * atanh(rep.lambda * 2.2);
+  for (long i = 0; i < N; i++)
+    assert_close(x[i], s_exact * (double)(i + 1), 1e-8, 1e-14);
+  assert_close(b.load, rep.lambda * 2.2, 1e-15, 0);
+  pm_error_clear();
+  pm_newton_destroy(&s);
+
+  /* P = 2 Tmax: at lambda = 1/2 tanh saturates in floating point and J is
+   * singular; MUMPS told to stop at a singular matrix fails inside the
+   * linear solver with an error: a linear solver failure, after which a
+   * new linear solver carries on. */
+  b.ratio = 2;
+  for (int icntl = 0; icntl < 2; icntl++) {
+    opt.petsc_options =
+        icntl ? "-pm_mat_mumps_icntl_24 1" : "-pm_mat_mumps_icntl_24 0";
+    assert_ok(pm_newton_create(&prob, &opt, &s));
+    memset(x, 0, sizeof x);
+    e = pm_load_steps(s, x, &rep);
+    print_message("%s: %s\n", pm_err_name(e), pm_error_message());
+    assert_true(e == PM_ERR_NOT_CONVERGED || e == PM_ERR_UNSTABLE);
+    pm_error_clear();
+    pm_newton_destroy(&s);
+  }
+  free(ptr);
+  free(idx);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_coloring),
+      cmocka_unit_test(test_jacobian_against_differences),
+      cmocka_unit_test(test_missing_pattern_entry),
+      cmocka_unit_test(test_quadratic_convergence),
+      cmocka_unit_test(test_criteria),
+      cmocka_unit_test(test_linear_solvers),
+      cmocka_unit_test(test_petsc_options),
+      cmocka_unit_test(test_failures),
+      cmocka_unit_test(test_load_steps_cut),
+      cmocka_unit_test(test_load_steps_iterations),
+      cmocka_unit_test(test_load_steps_impossible),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
