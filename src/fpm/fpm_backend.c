@@ -38,7 +38,14 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   sim->tm_dual = pm_timers_add(&sim->timers, "subdomains");
   sim->tm_operators = pm_timers_add(&sim->timers, "GFD operators and BCs");
   sim->tm_force = pm_timers_add(&sim->timers, "internal force");
-  sim->tm_update = pm_timers_add(&sim->timers, "time integration");
+  sim->tm_assembly = sim->tm_linear = -1;
+  if (s->time.qs == PM_QS_STATIC) {
+    sim->tm_update = pm_timers_add(&sim->timers, "load steps and output");
+    sim->tm_assembly = pm_timers_add(&sim->timers, "tangent (colouring)");
+    sim->tm_linear = pm_timers_add(&sim->timers, "linear solves");
+  } else {
+    sim->tm_update = pm_timers_add(&sim->timers, "time integration");
+  }
   double t0 = pm_wtime();
   pm_timers_start(&sim->timers, sim->tm_mesh);
   /* The domain: the box, or the scene's one gmsh volume. */
@@ -132,8 +139,10 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
       fabs(info->energy_error) > sim->run_max_energy_error)
     sim->run_max_energy_error = fabs(info->energy_error);
   double frac = info->t / s->time.end, load_end = sim->load_end;
-  if (s->time.qs != PM_QS_NONE && info->t >= load_end && sim->res0 > 0 &&
-      info->residual > 0) {
+  if (s->time.qs == PM_QS_STATIC) {
+    frac = load_end > 0 ? info->t / load_end : 1;
+  } else if (s->time.qs != PM_QS_NONE && info->t >= load_end && sim->res0 > 0 &&
+             info->residual > 0) {
     double q =
         log(sim->res0 / info->residual) / log(sim->res0 / s->time.qs_tolerance);
     if (q > frac) frac = q;
@@ -171,7 +180,42 @@ static pm_err run(void *p, const pm_observer *obs) {
   sim->load_end = pm_scene_load_end(s);
   sim->obs = obs;
   double stage[2] = {0, 0};
-  pm_err e = fpm_run(m, sim->state, &opt, observe, sim, &sim->last, stage);
+  pm_err e;
+  if (s->time.qs == PM_QS_STATIC) {
+    fpm_static_options so = {
+        .tolerance = s->time.qs_tolerance,
+        .load_steps = (int)s->time.qs_load_steps,
+        .max_iterations = (int)s->time.qs_max_iterations,
+        .linear = (pm_newton_linear)s->time.qs_linear,
+        .petsc_options = s->time.qs_solver_options,
+        .min_jacobian = s->stability.min_jacobian,
+    };
+    fpm_static_report *r = &sim->static_report;
+    double w0 = pm_wtime();
+    e = fpm_static_run(m, sim->state, &so, observe, sim, &sim->last, r);
+    double wall = pm_wtime() - w0;
+    sim->obs = NULL;
+    pm_stage *tm = sim->timers.stage;
+    tm[sim->tm_force].seconds += r->load.time_residual;
+    tm[sim->tm_force].calls += r->load.newton_iterations;
+    tm[sim->tm_assembly].seconds += r->load.time_assembly;
+    tm[sim->tm_assembly].calls += r->load.newton_iterations;
+    tm[sim->tm_linear].seconds += r->load.time_linear;
+    tm[sim->tm_linear].calls += r->load.newton_iterations;
+    tm[sim->tm_update].seconds += wall - r->load.time_residual -
+                                  r->load.time_assembly - r->load.time_linear;
+    tm[sim->tm_update].calls += r->load.steps;
+    if (e == PM_ERR_UNSTABLE)
+      sim->status = PM_STATUS_UNSTABLE;
+    else if (e == PM_ERR_NOT_CONVERGED)
+      sim->status = PM_STATUS_NOT_CONVERGED;
+    else if (e != PM_SUCCESS)
+      sim->status = PM_STATUS_FAILED;
+    else
+      sim->status = PM_STATUS_CONVERGED;
+    return e;
+  }
+  e = fpm_run(m, sim->state, &opt, observe, sim, &sim->last, stage);
   sim->obs = NULL;
   sim->timers.stage[sim->tm_force].seconds += stage[0];
   sim->timers.stage[sim->tm_force].calls += sim->last.step + 1;
@@ -326,6 +370,24 @@ static pm_err summary(void *p, pm_json *j) {
     PM_CALL(pm_json_number(j, "dt_spectral", sim->dt_spectral));
   PM_CALL(pm_json_integer(j, "dt_critical_point", sim->dt_point));
   PM_CALL(pm_json_integer(j, "ill_conditioned_points", ill));
+  PM_CALL(pm_json_string(j, "jump", m->q ? "quadratic" : "linear"));
+  if (m->q) {
+    PM_CALL(pm_json_integer(j, "fit_points_two_rings", m->n_qwide));
+    PM_CALL(pm_json_integer(j, "fit_points_linear", m->n_qlinear));
+  }
+  if (s->time.qs == PM_QS_STATIC) {
+    const fpm_static_report *r = &sim->static_report;
+    PM_CALL(pm_json_integer(j, "static_unknowns", r->unknowns));
+    PM_CALL(pm_json_integer(j, "static_jacobian_entries", r->pattern_entries));
+    PM_CALL(pm_json_integer(j, "static_colors", r->colors));
+    PM_CALL(pm_json_integer(j, "static_load_steps", r->load.steps));
+    PM_CALL(pm_json_integer(j, "static_cuts", r->load.cuts));
+    PM_CALL(pm_json_integer(j, "static_newton_iterations",
+                            r->load.newton_iterations));
+    PM_CALL(pm_json_integer(j, "static_linear_iterations",
+                            r->load.linear_iterations));
+    PM_CALL(pm_json_number(j, "static_setup_seconds", r->setup_seconds));
+  }
   return pm_json_number(j, "max_support_condition", worst);
 }
 

@@ -8,6 +8,7 @@
 
 #include "fpm_model.h"
 #include "fpm_solver.h"
+#include "fpm_static.h"
 #include "gm_cells.h"
 #include "gm_dual.h"
 #include "pm_backend.h"
@@ -33,18 +34,20 @@ typedef struct {
   double mean_edge;   /* mean mesh edge length, m */
   pm_timers timers;
   int tm_mesh, tm_dual, tm_operators, tm_force, tm_update;
-  double setup_wall; /* mesh + dual + operators, s */
-  double *scratch;   /* 9 n: output buffer */
+  int tm_assembly, tm_linear; /* static solves only (else -1) */
+  double setup_wall;          /* mesh + dual + operators, s */
+  double *scratch;            /* 9 n: output buffer */
   /* the run */
   pm_status status;
   fpm_step_info last;      /* the last step's figures */
   double run_min_jacobian; /* smallest J seen at any step of the run */
   long run_min_jacobian_step;
-  double run_max_energy_error; /* largest |energy-balance error| over the
-                                  steps where it is checked */
-  const pm_observer *obs;      /* during a run */
-  double res0;                 /* first residual after the ramps */
-  double load_end;             /* when every ramp has ended, s */
+  double run_max_energy_error;     /* largest |energy-balance error| over the
+                                      steps where it is checked */
+  const pm_observer *obs;          /* during a run */
+  double res0;                     /* first residual after the ramps */
+  double load_end;                 /* when every ramp has ended, s */
+  fpm_static_report static_report; /* time.quasi_static.method: static */
 } fpm_sim;
 
 /* Mesh the scene's domain, build subdomains, operators and state, and pick

@@ -164,10 +164,10 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
                             Hi[3 * c + 1] * di[1] + Hi[3 * c + 2] * di[2] -
                             Hk[3 * c] * dk[0] - Hk[3 * c + 1] * dk[1] -
                             Hk[3 * c + 2] * dk[2];
-        const double pjump =
-            quad ? ui[c] - uk[c] + fit_at(th + 27 * i, c, phi_i) -
-                       fit_at(th + 27 * k, c, phi_k)
-                 : jump;
+        const double pjump = quad ? ui[c] - uk[c] +
+                                        fit_at(th + 27 * i, c, phi_i) -
+                                        fit_at(th + 27 * k, c, phi_k)
+                                  : jump;
         const double b = be * pjump;
         w[c] = 0.5 * (Pk[3 * c] * a[0] + Pk[3 * c + 1] * a[1] +
                       Pk[3 * c + 2] * a[2]) -
@@ -175,7 +175,8 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
         ri[c] -= w[c];
         if (quad) {
           z[c] += b;
-          for (int q = 0; q < FPM_QFIT; q++) Z[FPM_QFIT * c + q] += b * phi_i[q];
+          for (int q = 0; q < FPM_QFIT; q++)
+            Z[FPM_QFIT * c + q] += b * phi_i[q];
         }
         epen += 0.25 * be * pjump * pjump; /* each interface is seen twice */
         if (sym) {
@@ -197,10 +198,10 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
                               bHi[3 * c + 2] * di[2] - bHk[3 * c] * dk[0] -
                               bHk[3 * c + 1] * dk[1] - bHk[3 * c + 2] * dk[2];
             for (int q = 0; q < 3; q++)
-              B0[3 * c + q] += bj * a[q] +
-                               (bHi[3 * c] - bHk[3 * c]) * Mc[3 * q] +
-                               (bHi[3 * c + 1] - bHk[3 * c + 1]) * Mc[3 * q + 1] +
-                               (bHi[3 * c + 2] - bHk[3 * c + 2]) * Mc[3 * q + 2];
+              B0[3 * c + q] +=
+                  bj * a[q] + (bHi[3 * c] - bHk[3 * c]) * Mc[3 * q] +
+                  (bHi[3 * c + 1] - bHk[3 * c + 1]) * Mc[3 * q + 1] +
+                  (bHi[3 * c + 2] - bHk[3 * c + 2]) * Mc[3 * q + 2];
           }
         }
       }
@@ -266,8 +267,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
  * conditions, projected on the prescribed components
  * (r_i -= Pi P_i a_f, T_i -= Pi P_i (M_f - a_f (x) X_i)), and prescribed
  * tractions (r_i -= t |f|, T_i -= t (x) |f| (c_f - X_i)). */
-static void boundary_pass(const fpm_model *m, const fields *fl,
-                          fpm_state *st) {
+static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
   const long nd = m->n_dpts;
   const long *restrict dp = m->dpt_point;
   const double *restrict da = m->dpt_area, *restrict dm = m->dpt_mrel;
@@ -359,9 +359,16 @@ static void fit_gather_pass(const fpm_model *m, const fields *fl) {
 long fpm_force(const fpm_model *m, fpm_state *st) {
   long bad = stress_pass(m, st);
   if (bad >= 0) return bad;
-  const fields fl = {.u = st->u, .H = st->H, .P = st->P, .theta = st->theta,
-                     .T = st->T, .r = st->r, .zq = st->zq, .Zq = st->Zq,
-                     .f = st->f, .bflux = st->bflux};
+  const fields fl = {.u = st->u,
+                     .H = st->H,
+                     .P = st->P,
+                     .theta = st->theta,
+                     .T = st->T,
+                     .r = st->r,
+                     .zq = st->zq,
+                     .Zq = st->Zq,
+                     .f = st->f,
+                     .bflux = st->bflux};
   if (st->theta) fit_pass(m, st->u, st->theta);
   st->penalty_energy = flux_pass(m, &fl);
   boundary_pass(m, &fl, st);
@@ -475,12 +482,22 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
       dP[9 * i + a] = s;
     }
   }
-  const fields fl = {.u = du, .H = dH, .P = dP, .theta = l->theta,
-                     .T = l->T, .r = l->r, .zq = l->zq, .Zq = l->Zq,
-                     .f = df, .bu = l->bu, .bH = l->bH};
+  const fields fl = {.u = du,
+                     .H = dH,
+                     .P = dP,
+                     .theta = l->theta,
+                     .T = l->T,
+                     .r = l->r,
+                     .zq = l->zq,
+                     .Zq = l->Zq,
+                     .f = df,
+                     .bu = l->bu,
+                     .bH = l->bH};
   if (l->theta) fit_pass(m, du, l->theta);
   flux_pass(m, &fl);
   boundary_pass(m, &fl, NULL);
   gather_pass(m, &fl);
   if (l->theta) fit_gather_pass(m, &fl);
 }
+
+const double *fpm_linear_tangent(const fpm_linear *l) { return l->D; }

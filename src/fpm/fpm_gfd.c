@@ -147,8 +147,8 @@ long fpm_gfd_deformed_condition(int dim, long n, const double *x,
  * condition number (infinite when unusable, q then zero). */
 static double quadratic_fit(int dim, long i, const double *x,
                             const long *nbr_ptr, const long *nbr, double *q) {
-  static const int slots2[] = {0, 1, 3, 4, 6}, slots3[] = {0, 1, 2, 3, 4,
-                                                            5, 6, 7, 8};
+  static const int slots2[] = {0, 1, 3, 4, 6},
+                   slots3[] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
   static const int order[FPM_QFIT] = {1, 1, 1, 2, 2, 2, 2, 2, 2};
   const int *slot = dim == 2 ? slots2 : slots3;
   const int m = dim == 2 ? 5 : 9;
@@ -173,7 +173,8 @@ static double quadratic_fit(int dim, long i, const double *x,
     double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     fpm_gfd_phi(d, phi);
     for (int r = 0; r < m; r++)
-      for (int c = 0; c < m; c++) A[m * r + c] += w * phi[slot[r]] * phi[slot[c]];
+      for (int c = 0; c < m; c++)
+        A[m * r + c] += w * phi[slot[r]] * phi[slot[c]];
   }
   int info = LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', m, A, m, lam);
   if (info != 0 || !(lam[0] > 0)) return INFINITY;

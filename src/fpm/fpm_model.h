@@ -107,9 +107,9 @@ typedef struct {
   double bflux_norm;     /* |consistency flux on prescribed faces| */
   double penalty_energy; /* interface energy, J: 1/2 sum_e beta |e| [[u]]^2,
                             and with SIPG also - sum_e {P} : K_e */
-  double *theta; /* 27 n: the quadratic fit (fpm.jump: quadratic) */
-  double *zq;    /* 3 n: sum_e b_e, the penalty force through u_i */
-  double *Zq;    /* 27 n: sum_e b_e (x) phi(d_i), through theta_i */
+  double *theta;         /* 27 n: the quadratic fit (fpm.jump: quadratic) */
+  double *zq;            /* 3 n: sum_e b_e, the penalty force through u_i */
+  double *Zq;            /* 27 n: sum_e b_e (x) phi(d_i), through theta_i */
   double *bflux;        /* 3 n_dpts: that flux per point: the supports' force on
                            the body, with f on the prescribed dofs */
   double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous
@@ -163,8 +163,10 @@ void fpm_linear_destroy(fpm_linear *l);
 size_t fpm_linear_bytes(const fpm_model *m);
 /* Linearise about st, whose force fpm_force has just computed (its u and H
  * are copied: st may change before the applications). */
-void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
-                        fpm_linear *l);
+void fpm_linear_prepare(const fpm_model *m, const fpm_state *st, fpm_linear *l);
+/* The tangent moduli dP/dF of the last prepare: 81 per point, row-major
+ * (row a = 3 i + j of P, column b of F). */
+const double *fpm_linear_tangent(const fpm_linear *l);
 /* df (3 n) = K du (3 n), every dof (prescribed ones included). */
 void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
                       double *df);

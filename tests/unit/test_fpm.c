@@ -13,6 +13,7 @@
 #include "fpm_gfd.h"
 #include "fpm_model.h"
 #include "fpm_solver.h"
+#include "fpm_static.h"
 #include "gm_dual.h"
 #include "pm_omp.h"
 
@@ -235,13 +236,13 @@ static void test_patch_f2(void **state) {
        * the lateral roller faces carry none. */
       double R[3], Pzz = st->P[8];
       fpm_reaction(m, st, 3, R);
-      print_message("F2 patch, %s, %s %s jump, p = %g: %ld points, lateral stretches "
-                    "%.6f %.6f, max free |f| / (|P| h^2) = %.3g, top "
-                    "reaction %.6g N (exact %.6g N)\n",
-                    models[mi], m->flux == FPM_FLUX_SIPG ? "SIPG" : "IIPG",
-                    m->jump == FPM_JUMP_QUADRATIC ? "quadratic" : "linear",
-                    penalty, m->n, lat[0], lat[1], worst / scale,
-                    R[2], Pzz * 0.01);
+      print_message(
+          "F2 patch, %s, %s %s jump, p = %g: %ld points, lateral stretches "
+          "%.6f %.6f, max free |f| / (|P| h^2) = %.3g, top "
+          "reaction %.6g N (exact %.6g N)\n",
+          models[mi], m->flux == FPM_FLUX_SIPG ? "SIPG" : "IIPG",
+          m->jump == FPM_JUMP_QUADRATIC ? "quadratic" : "linear", penalty, m->n,
+          lat[0], lat[1], worst / scale, R[2], Pzz * 0.01);
       assert_true(worst <= 1e-11 * scale);
       assert_true(fabs(R[2] - Pzz * 0.01) <= 1e-10 * fabs(Pzz * 0.01));
       fpm_reaction(m, st, 0, R);
@@ -250,6 +251,21 @@ static void test_patch_f2(void **state) {
       fpm_model_destroy(m);
       fixture_free(fx);
     }
+}
+
+/* A smooth finite deformation u_a = smooth x_(a+1) x_a / 0.1 plus a rough
+ * perturbation rough r (r uniform in [-1/2, 1/2], a fixed sequence from
+ * seed), into u; d (may be NULL) receives r. */
+static void smooth_plus_rough(const fpm_model *m, unsigned long long seed,
+                              double smooth, double rough, double *u,
+                              double *d) {
+  for (long i = 0; i < 3 * m->n; i++) {
+    seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+    double r = (double)(seed >> 11) / 9007199254740992.0 - 0.5;
+    const double *x = m->x + 3 * (i / 3);
+    u[i] = smooth * x[(i + 1) % 3] * x[i % 3] / 0.1 + rough * r;
+    if (d) d[i] = r;
+  }
 }
 
 static double stored_energy(const fpm_model *m, fpm_state *st) {
@@ -277,15 +293,7 @@ static void test_sipg_is_gradient(void **state) {
     assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
     long nd = 3 * m->n;
     double *u0 = calloc(nd, sizeof *u0), *d = calloc(nd, sizeof *d);
-    unsigned long long seed = 12345;
-    for (long i = 0; i < nd; i++) {
-      seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-      double r = (double)(seed >> 11) / 9007199254740992.0 - 0.5;
-      const double *x = m->x + 3 * (i / 3);
-      /* a smooth finite deformation plus a rough perturbation */
-      u0[i] = 0.1 * x[(i + 1) % 3] * x[i % 3] / 0.1 + 2e-4 * r;
-      d[i] = r;
-    }
+    smooth_plus_rough(m, 12345, 0.1, 2e-4, u0, d);
     memcpy(st->u, u0, nd * sizeof *u0);
     stored_energy(m, st);
     double fd = 0;
@@ -311,34 +319,34 @@ static void test_sipg_is_gradient(void **state) {
   }
 }
 
+/* The F2 cube at mesh size h, p = 20, with the flux and jump of variant k
+ * (bit 0: SIPG, bit 1: quadratic jump): its model and state. */
+static fixture *variant(double h, int k, fpm_model **m, fpm_state **st) {
+  fixture *fx = fixture_new(3, h, 20, true);
+  fx->opt.flux = k & 1 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
+  fx->opt.jump = k & 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
+  assert_int_equal(
+      fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, m),
+      PM_SUCCESS);
+  assert_int_equal(fpm_state_create(*m, st), PM_SUCCESS);
+  return fx;
+}
+
 /* fpm_force_linear is the derivative of fpm_force: K d against central
  * differences of f along a random d at a finite deformation, for both
  * fluxes and both jumps (relative 1e-6 of |K d|). */
 static void test_force_linearisation(void **state) {
   (void)state;
   for (int k = 0; k < 4; k++) {
-    fixture *fx = fixture_new(3, 0.03, 20, true);
-    fx->opt.flux = k & 1 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
-    fx->opt.jump = k & 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
     fpm_model *m;
     fpm_state *st;
     fpm_linear *lin;
-    assert_int_equal(
-        fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, &m),
-        PM_SUCCESS);
-    assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+    fixture *fx = variant(0.03, k, &m, &st);
     assert_int_equal(fpm_linear_create(m, &lin), PM_SUCCESS);
     long nd = 3 * m->n;
     double *u0 = calloc(nd, sizeof *u0), *d = calloc(nd, sizeof *d),
            *kd = calloc(nd, sizeof *kd), *fp = calloc(nd, sizeof *fp);
-    unsigned long long seed = 777;
-    for (long i = 0; i < nd; i++) {
-      seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-      double r = (double)(seed >> 11) / 9007199254740992.0 - 0.5;
-      const double *x = m->x + 3 * (i / 3);
-      u0[i] = 0.2 * x[(i + 1) % 3] * x[i % 3] / 0.1 + 1e-3 * r;
-      d[i] = r;
-    }
+    smooth_plus_rough(m, 777, 0.2, 1e-3, u0, d);
     memcpy(st->u, u0, nd * sizeof *u0);
     assert_int_equal(fpm_force(m, st), -1);
     fpm_linear_prepare(m, st, lin);
@@ -364,6 +372,36 @@ static void test_force_linearisation(void **state) {
     free(kd);
     free(fp);
     fpm_linear_destroy(lin);
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+}
+
+/* The tangent the static solver assembles directly equals the one coloured
+ * from fpm_force_linear and central differences of the force, for both
+ * jumps (IIPG: exact; SIPG: the adjoint term's derivative is left out of
+ * the assembled one, so only its distance is printed). */
+static void test_static_tangent(void **state) {
+  (void)state;
+  for (int k = 0; k < 4; k++) {
+    fpm_model *m;
+    fpm_state *st;
+    fixture *fx = variant(0.04, k, &m, &st);
+    long nd = 3 * m->n;
+    double *u = calloc(nd, sizeof *u);
+    smooth_plus_rough(m, 99, 0.2, 1e-3, u, NULL);
+    double ea, ed;
+    assert_int_equal(fpm_static_check_tangent(m, st, u, &ea, &ed), PM_SUCCESS);
+    print_message("%s, %s jump: assembled tangent against coloured %.3g, "
+                  "against differences %.3g\n",
+                  k & 1 ? "SIPG" : "IIPG", k & 2 ? "quadratic" : "linear", ea,
+                  ed);
+    if (!(k & 1)) {
+      assert_true(ea <= 1e-10);
+      assert_true(ed <= 1e-6);
+    }
+    free(u);
     fpm_state_destroy(st);
     fpm_model_destroy(m);
     fixture_free(fx);
@@ -432,6 +470,7 @@ int main(void) {
       cmocka_unit_test(test_patch_f2),
       cmocka_unit_test(test_sipg_is_gradient),
       cmocka_unit_test(test_force_linearisation),
+      cmocka_unit_test(test_static_tangent),
       cmocka_unit_test(test_deformed_condition),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -138,20 +138,20 @@ typedef struct pm_scene {
   double gravity[3]; /* gravity: m/s^2 */
   bool has_gravity;
   struct {
-    double end;          /* time.end, s, > 0 */
-    double dt;           /* time.dt, s; 0: the stable step */
-    double dt_safety;    /* time.dt_safety in (0, 1]; the backend's default
-                            when not given */
-    pm_dt_rule dt_rule;  /* time.dt_rule: paper (default) | spectral */
-    double ramp;         /* time.ramp, s: default ramp duration */
-    pm_qs_method qs;     /* time.quasi_static.method */
-    double qs_tolerance; /* time.quasi_static.tolerance: relative residual */
-    double qs_damping;   /* time.quasi_static.damping: 1/s for damping */
-    long qs_load_steps;  /* time.quasi_static.load_steps (static) */
-    long qs_max_iterations;         /* ...max_iterations per load step */
-    pm_linear_solver qs_linear;     /* ...linear_solver */
-    char *qs_solver_options;        /* ...solver_options: PETSc options */
-    long max_steps;      /* time.max_steps; 0: no limit */
+    double end;             /* time.end, s, > 0 */
+    double dt;              /* time.dt, s; 0: the stable step */
+    double dt_safety;       /* time.dt_safety in (0, 1]; the backend's default
+                               when not given */
+    pm_dt_rule dt_rule;     /* time.dt_rule: paper (default) | spectral */
+    double ramp;            /* time.ramp, s: default ramp duration */
+    pm_qs_method qs;        /* time.quasi_static.method */
+    double qs_tolerance;    /* time.quasi_static.tolerance: relative residual */
+    double qs_damping;      /* time.quasi_static.damping: 1/s for damping */
+    long qs_load_steps;     /* time.quasi_static.load_steps (static) */
+    long qs_max_iterations; /* ...max_iterations per load step */
+    pm_linear_solver qs_linear; /* ...linear_solver */
+    char *qs_solver_options;    /* ...solver_options: PETSc options */
+    long max_steps;             /* time.max_steps; 0: no limit */
   } time;
   struct {
     double min_jacobian;     /* stop when some J falls to or below it */

@@ -27,6 +27,7 @@ struct pm_newton {
   PetscInt *jcols, *pcols; /* pattern columns as PETSc indices */
   double *jvals, *pvals;   /* values in pattern order */
   double *seed, *dr;       /* colour seed and its image */
+  double *srcvals;         /* jacobian_values: values in the caller's order */
   Vec X, R, Xstart, Xlin, Xacc, Work;
   Mat J;     /* assembled Jacobian (not in the cheap mode) */
   Mat P;     /* assembled cheap operator (cheap mode only) */
@@ -117,6 +118,17 @@ static pm_err color_values(pm_newton *s, apply_fn f, const pm_coloring *col,
   return PM_SUCCESS;
 }
 
+/* The Jacobian's values at x in pattern order: the caller's assembly when
+ * it gives one, else colouring. */
+static pm_err jacobian_values(pm_newton *s, const double *x, double *vals) {
+  if (!s->p.jacobian_values)
+    return color_values(s, s->p.jacobian_apply, &s->jcol, x, vals);
+  PM_CALL(s->p.jacobian_values(s->p.ctx, x, s->srcvals));
+  memset(vals, 0, (size_t)s->jpat.ptr[s->jpat.n] * sizeof *vals);
+  for (long k = 0; k < s->jpat.nsrc; k++) vals[s->jpat.src[k]] += s->srcvals[k];
+  return PM_SUCCESS;
+}
+
 /* M = vals on the pattern (the matrix's preallocated structure). */
 static pm_err insert_values(Mat M, const pm_pattern *pat, const PetscInt *cols,
                             const double *vals) {
@@ -202,7 +214,7 @@ static PetscErrorCode snes_jacobian(SNES snes, Vec X, Mat A, Mat B, void *ctx) {
       e = color_values(s, s->p.precond_apply, &s->pcol, x, s->pvals);
       if (e == PM_SUCCESS) e = insert_values(B, &s->ppat, s->pcols, s->pvals);
     } else {
-      e = color_values(s, s->p.jacobian_apply, &s->jcol, x, s->jvals);
+      e = jacobian_values(s, x, s->jvals);
       if (e == PM_SUCCESS) e = insert_values(B, &s->jpat, s->jcols, s->jvals);
     }
   }
@@ -565,7 +577,11 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
   long n = problem->n;
   PM_TRY(
       pm_pattern_build(n, problem->pat_ptr, problem->pat_idx, true, &s->jpat));
-  PM_TRY(pm_coloring_build(&s->jpat, options->coloring, &s->jcol));
+  if (problem->jacobian_values)
+    PM_TRY(PM_ALLOC(s->srcvals, s->jpat.nsrc > 0 ? s->jpat.nsrc : 1,
+                    "Jacobian values"));
+  else
+    PM_TRY(pm_coloring_build(&s->jpat, options->coloring, &s->jcol));
   PM_TRY(PM_ALLOC(s->jvals, s->jpat.ptr[n], "Jacobian values"));
   if (options->op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
     const long *ptr =
@@ -608,6 +624,7 @@ void pm_newton_destroy(pm_newton **sp) {
   free(s->jcols);
   free(s->pcols);
   free(s->jvals);
+  free(s->srcvals);
   free(s->pvals);
   free(s->seed);
   free(s->dr);
@@ -786,7 +803,7 @@ pm_err pm_newton_jacobian_values(pm_newton *s, const double *x, double *val) {
   PM_CHECK(s && x && val, PM_ERR_ARG,
            "pm_newton_jacobian_values: solver, x and val are required");
   if (s->p.jacobian_prepare) PM_CALL(s->p.jacobian_prepare(s->p.ctx, x));
-  PM_CALL(color_values(s, s->p.jacobian_apply, &s->jcol, x, s->jvals));
+  PM_CALL(jacobian_values(s, x, s->jvals));
   for (long k = 0; k < s->jpat.nsrc; k++) val[k] = s->jvals[s->jpat.src[k]];
   return PM_SUCCESS;
 }
@@ -800,9 +817,13 @@ pm_err pm_newton_check_jacobian(pm_newton *s, const double *x, double h,
            "required (h %g)",
            h);
   long n = s->p.n;
+  /* The pattern by columns (a caller-assembled Jacobian has no colouring
+   * yet). */
+  if (!s->jcol.col_ptr)
+    PM_CALL(pm_coloring_build(&s->jpat, s->o.coloring, &s->jcol));
   const pm_coloring *c = &s->jcol;
   if (s->p.jacobian_prepare) PM_CALL(s->p.jacobian_prepare(s->p.ctx, x));
-  PM_CALL(color_values(s, s->p.jacobian_apply, c, x, s->jvals));
+  PM_CALL(jacobian_values(s, x, s->jvals));
   PM_TRY(PM_ALLOC(xp, n, "perturbed state"));
   PM_TRY(PM_ALLOC(rp, n, "perturbed residual"));
   PM_TRY(PM_ALLOC(rm, n, "perturbed residual"));

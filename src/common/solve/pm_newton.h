@@ -72,6 +72,11 @@ typedef struct {
                            double *dr);
   /* Called once at each new linearisation point.  Optional (NULL). */
   pm_err (*jacobian_prepare)(void *ctx, const double *x);
+  /* The Jacobian at x (after jacobian_prepare there) as values in the
+   * order of the problem's pattern (val[k] for pat_idx[k]; repeated
+   * entries are summed): the caller assembles it, and no colouring is
+   * made.  Optional (NULL: colouring of jacobian_apply). */
+  pm_err (*jacobian_values)(void *ctx, const double *x, double *val);
   /* Sparsity of J: row i's columns are pat_idx[pat_ptr[i] .. pat_ptr[i+1]).
    * Required. */
   const long *pat_ptr;

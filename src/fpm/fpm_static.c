@@ -1,0 +1,823 @@
+/* fpm_static: Newton's method in load steps on the free dofs of an FPM
+ * model.  Unknowns are the free displacement components; the prescribed
+ * ones follow the load factor.  The Jacobian's pattern couples each point
+ * with the points within reach of its force: the supports of the supports
+ * of its supports (and, with the quadratic jump, the fits of those). */
+#include "fpm_static.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_gfd.h"
+#include "pm_omp.h"
+#include "pm_progress.h"
+
+/* The tangent assembled directly: K = E D Gamma + S, where
+ *   H_j = sum_m u_m (x) gamma_jm        (gamma: GFD weights, self -gsum)
+ *   f_k[c] = sum_j sum_s P_j[c][s] E^c_kj[s] + (penalty, linear in u)
+ * E (constant: the interface and boundary geometry gathered by the GFD
+ * weights) is built once per run, and so is the penalty's scalar matrix S
+ * (the same for every component).  Per Newton iteration only the products
+ * with the tangent moduli D are formed.  Exact for IIPG; with SIPG the
+ * adjoint term's derivative is left out (the solve then multiplies by the
+ * exact tangent matrix-free and preconditions with this one). */
+typedef struct {
+  long *R_ptr, *R_list; /* per point k: the points its force reaches */
+  long *E_ptr, *E_j;    /* per point k: the points j whose stress reaches */
+  double *E;            /* 9 per (k, j): E^c_kj[s] at 3 c + s */
+  long *S_ptr, *S_m;    /* per point k: the penalty matrix's columns */
+  double *S;
+  double *Dg;   /* 27 per (j, m in S(j) and j): D_j gamma_jm */
+  long *Dg_ptr; /* n + 1: point j's records start at Dg_ptr[j] */
+  long max_reach;
+  int threads;
+  long *mark;   /* threads x n: a row's points */
+  double *work; /* threads x 9 max_reach: a row's blocks */
+} tangent;
+
+typedef struct {
+  const fpm_model *m;
+  fpm_state *st;
+  tangent tg;
+  const long *pat_ptr;
+  const long *free_of;
+  fpm_linear *lin;
+  const fpm_static_options *opt;
+  long nf;       /* free dofs */
+  long *dof;     /* nf: their dof index */
+  double *du;    /* 3 n work */
+  double *df;    /* 3 n work */
+  double *u_old; /* 3 n: the last converged displacement */
+  double load_end, t;
+  fpm_observer observer;
+  void *octx;
+  fpm_step_info si;
+  double ext_work;
+} static_ctx;
+
+/* The state at the free values x (prescribed dofs as set by set_load). */
+static long evaluate(static_ctx *c, const double *x) {
+  for (long j = 0; j < c->nf; j++) c->st->u[c->dof[j]] = x[j];
+  return fpm_force(c->m, c->st);
+}
+
+static pm_err inadmissible(const static_ctx *c, long p) {
+  const double *x = c->m->x + 3 * p;
+  return PM_ERROR(PM_ERR_UNSTABLE,
+                  "point %ld at (%g, %g, %g): volume ratio J = %g%s", p, x[0],
+                  x[1], x[2], c->st->J[p],
+                  isfinite(c->st->J[p]) ? " (inverted subdomain)"
+                                        : " (deformation not finite)");
+}
+
+static pm_err residual(void *ctx, const double *x, double *r) {
+  static_ctx *c = ctx;
+  long bad = evaluate(c, x);
+  if (bad >= 0) return inadmissible(c, bad);
+  const double *f = c->st->f;
+  for (long j = 0; j < c->nf; j++) r[j] = f[c->dof[j]];
+  return PM_SUCCESS;
+}
+
+static pm_err prepare(void *ctx, const double *x) {
+  static_ctx *c = ctx;
+  long bad = evaluate(c, x);
+  if (bad >= 0) return inadmissible(c, bad);
+  fpm_linear_prepare(c->m, c->st, c->lin);
+  return PM_SUCCESS;
+}
+
+static pm_err apply(void *ctx, const double *x, const double *dx, double *dr) {
+  static_ctx *c = ctx;
+  (void)x;
+  memset(c->du, 0, 3 * c->m->n * sizeof(double));
+  for (long j = 0; j < c->nf; j++) c->du[c->dof[j]] = dx[j];
+  fpm_force_linear(c->m, c->lin, c->du, c->df);
+  for (long j = 0; j < c->nf; j++) dr[j] = c->df[c->dof[j]];
+  return PM_SUCCESS;
+}
+
+static pm_err set_load(void *ctx, double lambda) {
+  static_ctx *c = ctx;
+  const fpm_model *m = c->m;
+  c->t = lambda * c->load_end;
+  /* Proportional loading: the loads at the end of the ramps times lambda
+   * (the path of a rate-independent solid does not depend on the ramps'
+   * shape, and a proportional path is what the predictor extrapolates). */
+  for (long k = 0; k < m->n_cdofs; k++)
+    c->st->u[3 * m->cd_point[k] + m->cd_comp[k]] =
+        lambda * fpm_prescribed(m, k, c->load_end);
+  if (m->n_tfacets > 0) {
+    fpm_update_tractions(m, c->st, c->load_end);
+    for (long k = 0; k < 3 * m->n_tfacets; k++) c->st->tf_value[k] *= lambda;
+    c->st->fext_norm *= lambda;
+  }
+  return PM_SUCCESS;
+}
+
+/* The figures of the state in c->st (its force just computed): energies,
+ * the residual over the supports' forces, smallest J; the external work
+ * by the trapezoidal rule from the last converged state. */
+static void figures(static_ctx *c, long step) {
+  const fpm_model *m = c->m;
+  const fpm_state *st = c->st;
+  const long n = m->n;
+  double se = 0, rf = 0, jmin = INFINITY;
+  for (long i = 0; i < n; i++) {
+    se += m->dual->volume[i] * st->W[i];
+    jmin = fmin(jmin, st->J[i]);
+    for (int a = 0; a < 3; a++)
+      if (!m->fixed[3 * i + a]) rf += st->f[3 * i + a] * st->f[3 * i + a];
+  }
+  double rr = 0, *prev = st->support_prev, *prev_b = prev + m->n_cdofs;
+  for (long k = 0; k < m->n_cdofs; k++) {
+    long dof = 3 * m->cd_point[k] + m->cd_comp[k];
+    rr += st->f[dof] * st->f[dof];
+    c->ext_work += 0.5 * (prev[k] + st->f[dof]) * (st->u[dof] - c->u_old[dof]);
+    prev[k] = st->f[dof];
+  }
+  for (long p = 0; p < m->n_dpts; p++)
+    for (int a = 0; a < 3; a++) {
+      const long dof = 3 * m->dpt_point[p] + a;
+      const double fb = st->bflux[3 * p + a];
+      c->ext_work +=
+          0.5 * (prev_b[3 * p + a] + fb) * (st->u[dof] - c->u_old[dof]);
+      prev_b[3 * p + a] = fb;
+    }
+  for (long k = 0; k < m->n_tfacets; k++)
+    for (int a = 0; a < 3; a++) {
+      const long dof = 3 * m->tf_point[k] + a;
+      c->ext_work += st->tf_value[3 * k + a] * m->tf_area[k] *
+                     (st->u[dof] - c->u_old[dof]);
+    }
+  memcpy(c->u_old, st->u, 3 * n * sizeof(double));
+  double ref = sqrt(rr) + st->bflux_norm + st->fext_norm;
+  fpm_step_info *si = &c->si;
+  si->step = step;
+  si->t = c->t;
+  si->kinetic = 0;
+  si->strain = se;
+  si->penalty = st->penalty_energy;
+  si->external_work = c->ext_work;
+  si->dissipated = 0;
+  si->residual = ref > 0 ? sqrt(rf) / ref : sqrt(rf);
+  si->damping = 0;
+  si->min_jacobian = jmin;
+  si->energy_error = fpm_energy_error(si);
+  si->energy_checked = false; /* the load path's quadrature, not a check */
+  si->converged = false;
+}
+
+static pm_err on_step(void *ctx, int step, double lambda, const double *x,
+                      const pm_newton_report *report) {
+  static_ctx *c = ctx;
+  (void)report;
+  c->t = lambda * c->load_end;
+  long bad = evaluate(c, x);
+  if (bad >= 0) return inadmissible(c, bad);
+  figures(c, step);
+  c->si.converged = lambda >= 1;
+  if (c->si.min_jacobian <= c->opt->min_jacobian)
+    return PM_ERROR(PM_ERR_UNSTABLE,
+                    "load step %d (lambda %.6g): smallest volume ratio J = "
+                    "%g <= stability.min_jacobian = %g",
+                    step, lambda, c->si.min_jacobian, c->opt->min_jacobian);
+  return c->observer ? c->observer(c->octx, c->m, c->st, &c->si, true)
+                     : PM_SUCCESS;
+}
+
+/* ---- The tangent, assembled directly ------------------------------------ */
+
+/* The weight of u_m in H_j for the r-th member of j's closed support
+ * (r = 0: j itself, -gsum_j; else its (r-1)-th neighbour), and that point. */
+static inline long closed_member(const fpm_model *m, long j, long r,
+                                 const double **w) {
+  if (r == 0) {
+    *w = m->gsum + 3 * j;
+    return j;
+  }
+  long e = m->nbr_ptr[j] + r - 1;
+  *w = m->g + 3 * e;
+  return m->nbr[e];
+}
+
+static inline long closed_size(const fpm_model *m, long j) {
+  return m->nbr_ptr[j + 1] - m->nbr_ptr[j] + 1;
+}
+
+static void tangent_free(tangent *t) {
+  free(t->R_ptr);
+  free(t->R_list);
+  free(t->E_ptr);
+  free(t->E_j);
+  free(t->E);
+  free(t->S_ptr);
+  free(t->S_m);
+  free(t->S);
+  free(t->Dg);
+  free(t->Dg_ptr);
+  free(t->work);
+  free(t->mark);
+}
+
+/* Adds the 3 x 3 geometry C^c_ij (rows s, columns q) of T_i = sum_j P_j C_ij
+ * for component row c: member r of i's closed support. */
+static void flux_geometry(const fpm_model *m, const long *dpt_of, long i,
+                          long r, int c, double C[9], double cv[3]) {
+  if (r == 0) {
+    const double *Bm = m->p_mrel + 9 * i, *A = m->p_area + 3 * i;
+    for (int a = 0; a < 9; a++) C[a] = -0.5 * Bm[a];
+    for (int a = 0; a < 3; a++) {
+      C[4 * a] += m->dual->volume[i];
+      cv[a] = -0.5 * A[a];
+    }
+    long p = dpt_of[i];
+    if (p >= 0) {
+      const double *Ac = m->dpt_area + 9 * p + 3 * c,
+                   *Bc = m->dpt_mrel + 27 * p + 9 * c;
+      for (int a = 0; a < 9; a++) C[a] -= Bc[a];
+      for (int a = 0; a < 3; a++) cv[a] -= Ac[a];
+    }
+    return;
+  }
+  const double *rec = m->erec + FPM_EREC * (m->nbr_ptr[i] + r - 1);
+  const double *a = rec, *Mc = rec + 3, *di = rec + 12;
+  for (int s = 0; s < 3; s++) {
+    cv[s] = -0.5 * a[s];
+    for (int q = 0; q < 3; q++)
+      C[3 * s + q] = -0.5 * (Mc[3 * s + q] + a[s] * di[q]);
+  }
+}
+
+/* E: per point k, the points j whose stress reaches f_k, with
+ * E^c_kj[s] = sum_i C^c_ij[s] . gamma_ik + c^c_kj[s]. */
+static pm_err build_E(const fpm_model *m, tangent *t) {
+  pm_err ret = PM_SUCCESS;
+  const long n = m->n;
+  long *mark = NULL, *list = NULL, *dpt_of = NULL;
+  PM_TRY(PM_ALLOC(mark, n, "tangent marks"));
+  PM_TRY(PM_ALLOC(list, n, "tangent lists"));
+  PM_TRY(PM_ALLOC(dpt_of, n, "prescribed-face points"));
+  PM_TRY(PM_ALLOC(t->E_ptr, n + 1, "tangent geometry"));
+  for (long i = 0; i < n; i++) mark[i] = dpt_of[i] = -1;
+  for (long p = 0; p < m->n_dpts; p++) dpt_of[m->dpt_point[p]] = p;
+  for (int pass = 0; pass < 2; pass++) {
+    for (long k = 0; k < n; k++) {
+      long cnt = 0;
+      /* i over k's closed support: gamma_ik is the weight of u_k in H_i */
+      for (long ri = 0; ri < closed_size(m, k); ri++) {
+        const double *dummy;
+        long i = closed_member(m, k, ri, &dummy);
+        for (long rj = 0; rj < closed_size(m, i); rj++) {
+          long j = closed_member(m, i, rj, &dummy);
+          if (mark[j] < 0) {
+            mark[j] = cnt;
+            list[cnt++] = j;
+          }
+        }
+      }
+      if (pass == 1) {
+        double *E = t->E + 9 * t->E_ptr[k];
+        for (long a = 0; a < cnt; a++) t->E_j[t->E_ptr[k] + a] = list[a];
+        for (long ri = 0; ri < closed_size(m, k); ri++) {
+          const double *w;
+          long i = closed_member(m, k, ri, &w);
+          double gik[3];
+          if (ri == 0)
+            for (int a = 0; a < 3; a++) gik[a] = -w[a];
+          else {
+            const double *g = m->g + 3 * m->mirror[m->nbr_ptr[k] + ri - 1];
+            for (int a = 0; a < 3; a++) gik[a] = g[a];
+          }
+          for (long rj = 0; rj < closed_size(m, i); rj++) {
+            const double *dummy;
+            long j = closed_member(m, i, rj, &dummy);
+            double *Ekj = E + 9 * mark[j];
+            for (int c = 0; c < 3; c++) {
+              double C[9], cv[3];
+              flux_geometry(m, dpt_of, i, rj, c, C, cv);
+              for (int s2 = 0; s2 < 3; s2++)
+                Ekj[3 * c + s2] += C[3 * s2] * gik[0] + C[3 * s2 + 1] * gik[1] +
+                                   C[3 * s2 + 2] * gik[2];
+            }
+          }
+        }
+        /* r_k = sum_j P_j c_kj over k's closed support */
+        for (long rj = 0; rj < closed_size(m, k); rj++) {
+          const double *dummy;
+          long j = closed_member(m, k, rj, &dummy);
+          for (int c = 0; c < 3; c++) {
+            double C[9], cv[3];
+            flux_geometry(m, dpt_of, k, rj, c, C, cv);
+            for (int s2 = 0; s2 < 3; s2++)
+              E[9 * mark[j] + 3 * c + s2] += cv[s2];
+          }
+        }
+      } else {
+        t->E_ptr[k + 1] = cnt;
+      }
+      for (long a = 0; a < cnt; a++) mark[list[a]] = -1;
+    }
+    if (pass == 0) {
+      for (long k = 0; k < n; k++) t->E_ptr[k + 1] += t->E_ptr[k];
+      PM_TRY(PM_ALLOC(t->E_j, t->E_ptr[n], "tangent geometry"));
+      PM_TRY(PM_ALLOC(t->E, 9 * t->E_ptr[n], "tangent geometry"));
+    }
+  }
+done:
+  free(mark);
+  free(list);
+  free(dpt_of);
+  return ret;
+}
+
+/* The penalty's reconstruction weight of u_x in point i's field at offset
+ * d (linear: H_i d; quadratic: theta_i phi(d)), for the r-th member of
+ * i's reconstruction support; returns the member's point. */
+static long recon_member(const fpm_model *m, long i, long r, const double d[3],
+                         double *w) {
+  if (m->q) {
+    double phi[FPM_QFIT];
+    fpm_gfd_phi(d, phi);
+    const double *q;
+    long x;
+    if (r == 0) {
+      q = m->qsum + FPM_QFIT * i;
+      x = i;
+    } else {
+      q = m->q + FPM_QFIT * (m->qs_ptr[i] + r - 1);
+      x = m->qs_nbr[m->qs_ptr[i] + r - 1];
+    }
+    double v = 0;
+    for (int a = 0; a < FPM_QFIT; a++) v += q[a] * phi[a];
+    *w = r == 0 ? -v : v;
+    return x;
+  }
+  const double *g;
+  long x = closed_member(m, i, r, &g);
+  double v = g[0] * d[0] + g[1] * d[1] + g[2] * d[2];
+  *w = r == 0 ? -v : v;
+  return x;
+}
+
+static long recon_size(const fpm_model *m, long i) {
+  return m->q ? m->qs_ptr[i + 1] - m->qs_ptr[i] + 1 : closed_size(m, i);
+}
+
+/* S: the penalty's scalar matrix, S_km = sum_i sum_(e of i) beta_e
+ * t_ek J_em with [[u]]_e = sum_m J_em u_m and t_ek = d[[u]]_e / d u_k
+ * through point i's side only (the force of the side's own field). */
+static pm_err build_S(const fpm_model *m, tangent *t) {
+  pm_err ret = PM_SUCCESS;
+  const long n = m->n;
+  long *mark = NULL, *list = NULL;
+  double *acc = NULL;
+  PM_TRY(PM_ALLOC(mark, n, "penalty marks"));
+  PM_TRY(PM_ALLOC(list, n, "penalty lists"));
+  PM_TRY(PM_ALLOC(acc, n, "penalty row"));
+  PM_TRY(PM_ALLOC(t->S_ptr, n + 1, "penalty matrix"));
+  for (long i = 0; i < n; i++) mark[i] = -1;
+  for (int pass = 0; pass < 2; pass++) {
+    for (long k = 0; k < n; k++) {
+      long cnt = 0;
+      /* the points i whose own field at their interfaces moves with u_k:
+       * k itself and those whose reconstruction holds k */
+      long ni = m->q ? 1 + m->qt_ptr[k + 1] - m->qt_ptr[k] : closed_size(m, k);
+      for (long ii = 0; ii < ni; ii++) {
+        long i;
+        if (ii == 0)
+          i = k;
+        else if (m->q)
+          i = m->qs_own[m->qt_entry[m->qt_ptr[k] + ii - 1]];
+        else
+          i = m->nbr[m->nbr_ptr[k] + ii - 1];
+        for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+          const double *rec = m->erec + FPM_EREC * e;
+          const double *di = rec + 12, *dk = rec + 15, be = rec[18];
+          const long kk = m->nbr[e];
+          /* t_ek: k's weight in u_i + recon_i(d_i) */
+          double tk = 0;
+          for (long r = 0; r < recon_size(m, i); r++) {
+            double w;
+            if (recon_member(m, i, r, di, &w) == k) tk += w;
+          }
+          if (k == i) tk += 1;
+          if (tk == 0 || be == 0) continue;
+          /* J_em over both sides */
+          for (int side = 0; side < 2; side++) {
+            long p = side ? kk : i;
+            double sign = side ? -1 : 1;
+            const double *d = side ? dk : di;
+            for (long r = 0; r < recon_size(m, p); r++) {
+              double w;
+              long x = recon_member(m, p, r, d, &w);
+              if (r == 0) w += 1;
+              if (mark[x] < 0) {
+                mark[x] = cnt;
+                list[cnt++] = x;
+                acc[mark[x]] = 0;
+              }
+              acc[mark[x]] += be * tk * sign * w;
+            }
+          }
+        }
+      }
+      if (pass == 0)
+        t->S_ptr[k + 1] = cnt;
+      else
+        for (long a = 0; a < cnt; a++) {
+          t->S_m[t->S_ptr[k] + a] = list[a];
+          t->S[t->S_ptr[k] + a] = acc[a];
+        }
+      for (long a = 0; a < cnt; a++) mark[list[a]] = -1;
+    }
+    if (pass == 0) {
+      for (long k = 0; k < n; k++) t->S_ptr[k + 1] += t->S_ptr[k];
+      PM_TRY(PM_ALLOC(t->S_m, t->S_ptr[n] > 0 ? t->S_ptr[n] : 1,
+                      "penalty matrix"));
+      PM_TRY(
+          PM_ALLOC(t->S, t->S_ptr[n] > 0 ? t->S_ptr[n] : 1, "penalty matrix"));
+    }
+  }
+done:
+  free(mark);
+  free(list);
+  free(acc);
+  return ret;
+}
+
+static pm_err tangent_build(const fpm_model *m, tangent *t) {
+  const long n = m->n;
+  PM_CALL(build_E(m, t));
+  PM_CALL(build_S(m, t));
+  PM_CALL(PM_ALLOC(t->Dg_ptr, n + 1, "tangent products"));
+  for (long j = 0; j < n; j++)
+    t->Dg_ptr[j + 1] = t->Dg_ptr[j] + closed_size(m, j);
+  PM_CALL(PM_ALLOC(t->Dg, 27 * t->Dg_ptr[n], "tangent products"));
+  t->max_reach = 0;
+  for (long k = 0; k < n; k++)
+    if (t->R_ptr[k + 1] - t->R_ptr[k] > t->max_reach)
+      t->max_reach = t->R_ptr[k + 1] - t->R_ptr[k];
+  t->threads = pm_omp_threads();
+  PM_CALL(PM_ALLOC(t->mark, (size_t)t->threads * n, "tangent marks"));
+  for (long a = 0; a < (long)t->threads * n; a++) t->mark[a] = -1;
+  PM_CALL(PM_ALLOC(t->work, (size_t)t->threads * 9 * t->max_reach,
+                   "tangent blocks"));
+  return PM_SUCCESS;
+}
+
+static pm_err tangent_values(void *ctx, const double *x, double *val) {
+  static_ctx *c = ctx;
+  (void)x;
+  const fpm_model *m = c->m;
+  tangent *t = &c->tg;
+  const long n = m->n;
+  const double *D = fpm_linear_tangent(c->lin);
+  /* D_j gamma_jm for every j and member m of its closed support */
+  PM_OMP(parallel for schedule(static) default(none) shared(n, m, t, D))
+  for (long j = 0; j < n; j++) {
+    const double *Dj = D + 81 * j;
+    for (long r = 0; r < closed_size(m, j); r++) {
+      const double *w;
+      closed_member(m, j, r, &w);
+      double g[3] = {w[0], w[1], w[2]};
+      if (r == 0) g[0] = -g[0], g[1] = -g[1], g[2] = -g[2];
+      double *out = t->Dg + 27 * (t->Dg_ptr[j] + r);
+      for (int row = 0; row < 9; row++)
+        for (int a = 0; a < 3; a++)
+          out[3 * row + a] = Dj[9 * row + 3 * a] * g[0] +
+                             Dj[9 * row + 3 * a + 1] * g[1] +
+                             Dj[9 * row + 3 * a + 2] * g[2];
+    }
+  }
+  const long *free_of = c->free_of, *pat = c->pat_ptr;
+  PM_OMP(parallel default(none) shared(n, m, t, free_of, pat, val)) {
+    int th = 0;
+#ifdef _OPENMP
+    th = omp_get_thread_num();
+#endif
+    long *mark = t->mark + (size_t)th * n;
+    double *blk = t->work + (size_t)th * 9 * t->max_reach;
+    PM_OMP(for schedule(dynamic, 16))
+    for (long k = 0; k < n; k++) {
+      const long r0 = t->R_ptr[k], nr = t->R_ptr[k + 1] - r0;
+      for (long a = 0; a < nr; a++) mark[t->R_list[r0 + a]] = a;
+      for (long a = 0; a < 9 * nr; a++) blk[a] = 0;
+      for (long q = t->E_ptr[k]; q < t->E_ptr[k + 1]; q++) {
+        const long j = t->E_j[q];
+        const double *E = t->E + 9 * q;
+        for (long r = 0; r < closed_size(m, j); r++) {
+          const double *w;
+          long mm = closed_member(m, j, r, &w);
+          const double *Dg = t->Dg + 27 * (t->Dg_ptr[j] + r);
+          double *b = blk + 9 * mark[mm];
+          for (int cc = 0; cc < 3; cc++)
+            for (int a = 0; a < 3; a++)
+              b[3 * cc + a] += E[3 * cc] * Dg[3 * (3 * cc) + a] +
+                               E[3 * cc + 1] * Dg[3 * (3 * cc + 1) + a] +
+                               E[3 * cc + 2] * Dg[3 * (3 * cc + 2) + a];
+        }
+      }
+      for (long q = t->S_ptr[k]; q < t->S_ptr[k + 1]; q++) {
+        double *b = blk + 9 * mark[t->S_m[q]];
+        for (int cc = 0; cc < 3; cc++) b[4 * cc] += t->S[q];
+      }
+      for (int cc = 0; cc < 3; cc++) {
+        long row = free_of[3 * k + cc];
+        if (row < 0) continue;
+        long w = pat[row];
+        for (long a = 0; a < nr; a++)
+          for (int b = 0; b < 3; b++)
+            if (free_of[3 * t->R_list[r0 + a] + b] >= 0)
+              val[w++] = blk[9 * a + 3 * cc + b];
+      }
+      for (long a = 0; a < nr; a++) mark[t->R_list[r0 + a]] = -1;
+    }
+  }
+  return PM_SUCCESS;
+}
+
+/* Marks the points of S(i) and i into list (marker: stamp). */
+static long add_support(const fpm_model *m, long i, long *list, long cnt,
+                        long *mark, long stamp) {
+  if (mark[i] != stamp) {
+    mark[i] = stamp;
+    list[cnt++] = i;
+  }
+  for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+    long k = m->nbr[e];
+    if (mark[k] != stamp) {
+      mark[k] = stamp;
+      list[cnt++] = k;
+    }
+  }
+  return cnt;
+}
+
+static long add_fit(const fpm_model *m, long j, long *list, long cnt,
+                    long *mark, long stamp) {
+  if (!m->q) return cnt;
+  for (long e = m->qs_ptr[j]; e < m->qs_ptr[j + 1]; e++) {
+    long k = m->qs_nbr[e];
+    if (mark[k] != stamp) {
+      mark[k] = stamp;
+      list[cnt++] = k;
+    }
+  }
+  return cnt;
+}
+
+/* The points whose displacement reaches the force on point k, into reach
+ * (returns the count). */
+static long reach(const fpm_model *m, long k, long *reach_list, long *a_list,
+                  long *mark_a, long *mark_r, long stamp) {
+  long na = add_support(m, k, a_list, 0, mark_a, stamp);
+  if (m->q)
+    for (long t = m->qt_ptr[k]; t < m->qt_ptr[k + 1]; t++) {
+      long i = m->qs_own[m->qt_entry[t]];
+      if (mark_a[i] != stamp) {
+        mark_a[i] = stamp;
+        a_list[na++] = i;
+      }
+    }
+  long nr = 0;
+  for (long ia = 0; ia < na; ia++) {
+    long i = a_list[ia];
+    for (long e = m->nbr_ptr[i] - 1; e < m->nbr_ptr[i + 1]; e++) {
+      long j = e < m->nbr_ptr[i] ? i : m->nbr[e];
+      nr = add_support(m, j, reach_list, nr, mark_r, stamp);
+      nr = add_fit(m, j, reach_list, nr, mark_r, stamp);
+    }
+  }
+  return nr;
+}
+
+/* The Jacobian's pattern over the free dofs (free_of: dof -> unknown). */
+static pm_err build_pattern(const fpm_model *m, const long *free_of, long nf,
+                            tangent *tg, long **ptr_out, long **idx_out) {
+  pm_err ret = PM_SUCCESS;
+  const long n = m->n;
+  long *mark_a = NULL, *mark_r = NULL, *a_list = NULL, *r_list = NULL,
+       *ptr = NULL, *idx = NULL;
+  PM_TRY(PM_ALLOC(mark_a, n, "pattern marks"));
+  PM_TRY(PM_ALLOC(mark_r, n, "pattern marks"));
+  PM_TRY(PM_ALLOC(a_list, n, "pattern lists"));
+  PM_TRY(PM_ALLOC(r_list, n, "pattern lists"));
+  PM_TRY(PM_ALLOC(ptr, nf + 1, "Jacobian pattern"));
+  PM_TRY(PM_ALLOC(tg->R_ptr, n + 1, "Jacobian reach"));
+  for (long i = 0; i < n; i++) mark_a[i] = mark_r[i] = -1;
+  /* Count, then fill. */
+  for (int pass = 0; pass < 2; pass++) {
+    for (long k = 0; k < n; k++) {
+      long nr = reach(m, k, r_list, a_list, mark_a, mark_r, pass * n + k);
+      if (pass == 0)
+        tg->R_ptr[k + 1] = nr;
+      else
+        for (long t = 0; t < nr; t++) tg->R_list[tg->R_ptr[k] + t] = r_list[t];
+      long cols = 0;
+      for (long t = 0; t < nr; t++)
+        for (int a = 0; a < 3; a++) cols += free_of[3 * r_list[t] + a] >= 0;
+      for (int c = 0; c < 3; c++) {
+        long row = free_of[3 * k + c];
+        if (row < 0) continue;
+        if (pass == 0) {
+          ptr[row + 1] = cols;
+          continue;
+        }
+        long w = ptr[row];
+        for (long t = 0; t < nr; t++)
+          for (int a = 0; a < 3; a++) {
+            long col = free_of[3 * r_list[t] + a];
+            if (col >= 0) idx[w++] = col;
+          }
+      }
+    }
+    if (pass == 0) {
+      for (long k = 0; k < n; k++) tg->R_ptr[k + 1] += tg->R_ptr[k];
+      PM_TRY(PM_ALLOC(tg->R_list, tg->R_ptr[n], "Jacobian reach"));
+      for (long r = 0; r < nf; r++) ptr[r + 1] += ptr[r];
+      PM_TRY(PM_ALLOC(idx, ptr[nf] > 0 ? ptr[nf] : 1, "Jacobian pattern"));
+    }
+  }
+  *ptr_out = ptr;
+  *idx_out = idx;
+  ptr = idx = NULL;
+done:
+  free(mark_a);
+  free(mark_r);
+  free(a_list);
+  free(r_list);
+  free(ptr);
+  free(idx);
+  return ret;
+}
+
+/* Everything a solve needs of the model: the free dofs, the Jacobian's
+ * pattern, the directly assembled tangent's constant parts, the
+ * linearisation's work space, and the problem for pm_newton.  Released by
+ * solve_free (also after a failure here). */
+typedef struct {
+  static_ctx c;
+  long *free_of, *ptr, *idx;
+  double *x;
+  pm_newton_problem prob;
+} solve_t;
+
+static void solve_free(solve_t *v) {
+  fpm_linear_destroy(v->c.lin);
+  tangent_free(&v->c.tg);
+  free(v->c.dof);
+  free(v->c.du);
+  free(v->c.df);
+  free(v->c.u_old);
+  free(v->free_of);
+  free(v->ptr);
+  free(v->idx);
+  free(v->x);
+}
+
+static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
+  const long n = m->n;
+  static_ctx *c = &v->c;
+  c->m = m;
+  c->st = st;
+  c->load_end = pm_scene_load_end(m->scene);
+  PM_CALL(fpm_linear_create(m, &c->lin));
+  PM_CALL(PM_ALLOC(v->free_of, 3 * n, "free dofs"));
+  PM_CALL(PM_ALLOC(c->dof, 3 * n, "free dofs"));
+  PM_CALL(PM_ALLOC(c->du, 3 * n, "displacement increment"));
+  PM_CALL(PM_ALLOC(c->df, 3 * n, "force increment"));
+  PM_CALL(PM_ALLOC(c->u_old, 3 * n, "converged displacement"));
+  for (long d = 0; d < 3 * n; d++) {
+    v->free_of[d] = -1;
+    if (!m->fixed[d]) {
+      v->free_of[d] = c->nf;
+      c->dof[c->nf++] = d;
+    }
+  }
+  PM_CHECK(c->nf > 0, PM_ERR_SCENE, "%s: every displacement is prescribed",
+           m->scene->path);
+  PM_CALL(PM_ALLOC(v->x, c->nf, "free displacements"));
+  PM_CALL(build_pattern(m, v->free_of, c->nf, &c->tg, &v->ptr, &v->idx));
+  c->pat_ptr = v->ptr;
+  c->free_of = v->free_of;
+  PM_CALL(tangent_build(m, &c->tg));
+  v->prob = (pm_newton_problem){.n = c->nf,
+                                .ctx = c,
+                                .residual = residual,
+                                .jacobian_apply = apply,
+                                .jacobian_prepare = prepare,
+                                .jacobian_values = tangent_values,
+                                .pat_ptr = v->ptr,
+                                .pat_idx = v->idx,
+                                .set_load = set_load,
+                                .on_step = on_step};
+  return PM_SUCCESS;
+}
+
+/* A force floor far below any load but above the force's round-off: the
+ * stiffest modulus times the squared size of the body, times 1e-12. */
+static double force_floor(const fpm_model *m) {
+  double emax = 0, lo[3] = {INFINITY, INFINITY, INFINITY},
+         hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int k = 0; k < m->n_mats; k++)
+    emax = fmax(emax, m->mats[k].youngs_modulus);
+  for (long i = 0; i < m->n; i++)
+    for (int a = 0; a < 3; a++) {
+      lo[a] = fmin(lo[a], m->x[3 * i + a]);
+      hi[a] = fmax(hi[a], m->x[3 * i + a]);
+    }
+  double diag2 = 0;
+  for (int a = 0; a < 3; a++) diag2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+  return 1e-12 * emax * diag2;
+}
+
+pm_err fpm_static_run(const fpm_model *m, fpm_state *st,
+                      const fpm_static_options *opt, fpm_observer observer,
+                      void *ctx, fpm_step_info *info, fpm_static_report *rep) {
+  pm_err ret = PM_SUCCESS;
+  solve_t v = {.c = {.opt = opt, .observer = observer, .octx = ctx}};
+  static_ctx *c = &v.c;
+  pm_newton *solver = NULL;
+  memset(rep, 0, sizeof *rep);
+  double w0 = pm_wtime();
+  PM_TRY(solve_setup(m, st, &v));
+  rep->unknowns = c->nf;
+  rep->pattern_entries = v.ptr[c->nf];
+
+  /* The initial state, as a frame. */
+  memset(st->u, 0, 3 * m->n * sizeof(double));
+  set_load(c, 0);
+  long bad = fpm_force(m, st);
+  if (bad >= 0) {
+    ret = inadmissible(c, bad);
+    goto done;
+  }
+  for (long k = 0; k < m->n_cdofs; k++)
+    st->support_prev[k] = st->f[3 * m->cd_point[k] + m->cd_comp[k]];
+  for (long k = 0; k < 3 * m->n_dpts; k++)
+    st->support_prev[m->n_cdofs + k] = st->bflux[k];
+  figures(c, 0);
+  if (observer) PM_TRY(observer(ctx, m, st, &c->si, true));
+
+  pm_newton_options no = pm_newton_options_default();
+  no.rtol = opt->tolerance;
+  no.atol = force_floor(m);
+  no.max_iter = opt->max_iterations;
+  no.linear = opt->linear;
+  no.load_steps = opt->load_steps;
+  no.predictor = true;
+  no.petsc_options = opt->petsc_options;
+  /* SIPG: the assembled tangent lacks the adjoint term's derivative; it
+   * preconditions the exact tangent applied matrix-free. */
+  if (m->flux == FPM_FLUX_SIPG) no.op = PM_NEWTON_MATRIX_FREE;
+  PM_TRY(pm_newton_create(&v.prob, &no, &solver));
+  rep->colors = pm_newton_colors(solver);
+  rep->setup_seconds = pm_wtime() - w0;
+  ret = pm_load_steps(solver, v.x, &rep->load);
+done:
+  if (info) *info = c->si;
+  pm_newton_destroy(&solver);
+  solve_free(&v);
+  return ret;
+}
+
+pm_err fpm_static_check_tangent(const fpm_model *m, fpm_state *st,
+                                const double *u, double *assembled_error,
+                                double *difference_error) {
+  pm_err ret = PM_SUCCESS;
+  solve_t v = {0};
+  double *v1 = NULL, *v2 = NULL;
+  pm_newton *direct = NULL, *colored = NULL;
+  PM_TRY(solve_setup(m, st, &v));
+  memcpy(st->u, u, 3 * m->n * sizeof(double));
+  for (long j = 0; j < v.c.nf; j++) v.x[j] = u[v.c.dof[j]];
+  pm_newton_options no = pm_newton_options_default();
+  PM_TRY(pm_newton_create(&v.prob, &no, &direct));
+  v.prob.jacobian_values = NULL;
+  PM_TRY(pm_newton_create(&v.prob, &no, &colored));
+  const long nv = v.ptr[v.c.nf];
+  PM_TRY(PM_ALLOC(v1, nv, "tangent values"));
+  PM_TRY(PM_ALLOC(v2, nv, "tangent values"));
+  PM_TRY(pm_newton_jacobian_values(direct, v.x, v1));
+  PM_TRY(pm_newton_jacobian_values(colored, v.x, v2));
+  double dmax = 0, big = 0;
+  for (long k = 0; k < nv; k++) {
+    dmax = fmax(dmax, fabs(v1[k] - v2[k]));
+    big = fmax(big, fabs(v2[k]));
+  }
+  *assembled_error = big > 0 ? dmax / big : dmax;
+  if (difference_error) {
+    long row, col;
+    PM_TRY(pm_newton_check_jacobian(direct, v.x, 1e-7, difference_error, &row,
+                                    &col));
+  }
+done:
+  pm_newton_destroy(&direct);
+  pm_newton_destroy(&colored);
+  solve_free(&v);
+  free(v1);
+  free(v2);
+  return ret;
+}

@@ -1,0 +1,108 @@
+/* Verification of the static solve (time.quasi_static.method: static):
+ * Newton's method in load steps reaches the exact state of case F2, with
+ * quadratic convergence near the solution, and the state of case F3 60%
+ * that dynamic relaxation reaches, to the relaxation's tolerance. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "fpm_backend.h"
+#include "pm_app.h"
+#include "pm_metrics.h"
+#include "pm_run.h"
+#include "pm_scene.h"
+
+#define CASES PM_SOURCE_DIR "/cases/fpm/"
+
+typedef struct {
+  pm_scene *scene;
+  fpm_sim *sim;
+  pm_outcome out;
+} run_t;
+
+static void run(const char *file, int n_sets, const char **sets, run_t *r) {
+  if (pm_scene_load(file, n_sets, sets, &r->scene) != PM_SUCCESS)
+    fail_msg("%s", pm_error_message());
+  if (fpm_sim_create(r->scene, &r->sim) != PM_SUCCESS)
+    fail_msg("%s", pm_error_message());
+  if (pm_run_sim(r->scene, r->sim, NULL, true, &r->out) != PM_SUCCESS)
+    fail_msg("%s", pm_error_message());
+  assert_int_equal(r->sim->status, PM_STATUS_CONVERGED);
+}
+
+static void done(run_t *r) {
+  fpm_sim_destroy(r->sim);
+  pm_scene_destroy(r->scene);
+}
+
+/* F2 (mesh size 0.02 m): NRMSE of u_z against -0.4 z below 1e-9; in the
+ * last load step the observed order of the residual's decrease,
+ * log(r_k+1 / r_k) / log(r_k / r_k-1), reaches 1.8 before round-off. */
+static void test_f2_static(void **state) {
+  (void)state;
+  const char *sets[] = {"time.quasi_static.method=static",
+                        "discretization.mesh_size=0.02"};
+  run_t r = {0};
+  run(CASES "f2-unconstrained-compression.yaml", 2, sets, &r);
+  const fpm_static_report *rep = &r.sim->static_report;
+  const pm_newton_report *last = &rep->load.last;
+  double order = 0;
+  for (int k = 1; k + 1 <= last->iterations; k++) {
+    double r0 = last->residual_norm[k - 1], r1 = last->residual_norm[k],
+           r2 = last->residual_norm[k + 1];
+    /* residuals far above round-off (1e-12 of the first) */
+    if (r2 > 1e-12 * last->residual_norm[0] && r1 < r0 && r2 < r1)
+      order = fmax(order, log(r2 / r1) / log(r1 / r0));
+  }
+  print_message("F2 static: %ld points, %ld unknowns, %d load steps (%d cuts), "
+                "%d Newton iterations, NRMSE u_z %.3e, last step's residuals",
+                r.sim->model->n, rep->unknowns, rep->load.steps, rep->load.cuts,
+                rep->load.newton_iterations, r.out.nrmse[2]);
+  for (int k = 0; k <= last->iterations; k++)
+    print_message(" %.2e", last->residual_norm[k]);
+  print_message(", observed order %.2f, wall %.2f s\n", order,
+                r.out.fig.wall_seconds);
+  assert_true(r.out.nrmse[2] < 1e-9);
+  assert_true(order >= 1.8);
+  done(&r);
+}
+
+/* F3 60% (mesh size 0.0145 m): the static solve and dynamic relaxation
+ * (tolerance 1e-8 on the residual over the reactions) give the same top
+ * reaction and stored energy to 1e-6. */
+static void test_f3_static_against_relaxation(void **state) {
+  (void)state;
+  const char *dr_sets[] = {"discretization.mesh_size=0.0145"};
+  const char *st_sets[] = {"discretization.mesh_size=0.0145",
+                           "time.quasi_static.method=static"};
+  run_t dr = {0}, st = {0};
+  run(CASES "f3-extension-60-h1.09e-2.yaml", 1, dr_sets, &dr);
+  run(CASES "f3-extension-60-h1.09e-2.yaml", 2, st_sets, &st);
+  double Rd = dr.out.loaded_reaction, Rs = st.out.loaded_reaction;
+  double Ed = dr.out.fig.mean_sed, Es = st.out.fig.mean_sed;
+  print_message("F3 60%%, %ld points: top reaction %.10g N by relaxation "
+                "(%ld steps, %.2f s), %.10g N static (%d Newton iterations, "
+                "%.2f s): difference %.2e; mean SED %.8g / %.8g J/m^3\n",
+                dr.sim->model->n, Rd, dr.sim->last.step,
+                dr.out.fig.wall_seconds, Rs,
+                st.sim->static_report.load.newton_iterations,
+                st.out.fig.wall_seconds, fabs(Rs - Rd) / fabs(Rd), Ed, Es);
+  assert_true(fabs(Rs - Rd) <= 1e-6 * fabs(Rd));
+  assert_true(fabs(Es - Ed) <= 1e-6 * fabs(Ed));
+  done(&dr);
+  done(&st);
+}
+
+int main(void) {
+  pm_app_init();
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_f2_static),
+      cmocka_unit_test(test_f3_static_against_relaxation),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
