@@ -37,10 +37,6 @@ pm_err pm_petsc_init(void) {
            "PETSc was finalised (pm_solve_finalize) and cannot start again");
   PM_PETSC_CALL(PetscInitialized(&ready));
   if (ready) return PM_SUCCESS;
-  /* Open MPI binds a process to one core when MPI starts, which would put
-   * every OpenMP thread of the time loops on that core.  Keep the binding
-   * the process had (a user's own setting wins: overwrite = 0). */
-  setenv("OMPI_MCA_hwloc_base_binding_policy", "none", 0);
   PetscErrorCode code = PetscInitializeNoArguments();
   PM_CHECK(code == 0, PM_ERR_LINALG, "PetscInitializeNoArguments failed (%d)",
            (int)code);
