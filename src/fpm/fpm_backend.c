@@ -481,6 +481,26 @@ static pm_err plan(void *p, FILE *out) {
     fprintf(out, "             %d. tractions, %ld facets%s\n", stage++,
             m->n_tfacets, m->tf_time_dependent ? " (time-dependent)" : "");
   fprintf(out, "             %d. gather forces\n", stage++);
+  if (s->time.qs == PM_QS_STATIC) {
+    static const char *const linear[] = {"direct (LU)", "GMRES + GAMG",
+                                         "CG + Jacobi", "GMRES + ILU(0)"};
+    fprintf(out,
+            "             %d. Newton's method in %ld proportional load steps "
+            "(at most %ld iterations each), %ld prescribed dofs\n"
+            "             tangent assembled directly (%s), linear solver "
+            "%s\n",
+            stage++, s->time.qs_load_steps, s->time.qs_max_iterations,
+            m->n_cdofs,
+            m->flux == FPM_FLUX_SIPG
+                ? "preconditioning the exact tangent applied matrix-free"
+                : "exact",
+            linear[s->time.qs_linear]);
+    fprintf(out,
+            "memory       %.1f MiB (operators and state; the tangent "
+            "and its factors come on top)\n",
+            (bytes + fpm_linear_bytes(m)) / 1048576.0);
+    return PM_SUCCESS;
+  }
   fprintf(out, "             %d. central difference%s, %ld prescribed dofs\n",
           stage++,
           s->time.qs == PM_QS_DYNAMIC_RELAXATION ? " with dynamic relaxation"
