@@ -328,6 +328,35 @@ static void test_coloring(void **state) {
   }
   pm_pattern_free(&p);
 
+  /* The same pattern with 3 unknowns per entry (identical rows and
+   * columns in threes, grouped by the colouring): valid, and no more than
+   * three times the colours. */
+  long *bptr = calloc(3 * N + 1, sizeof *bptr);
+  long *bidx = calloc(9 * (size_t)ptr[N], sizeof *bidx);
+  assert_true(bptr && bidx);
+  for (long i = 0; i < 3 * N; i++) {
+    long pi = i / 3;
+    bptr[i + 1] = bptr[i];
+    for (long q = ptr[pi]; q < ptr[pi + 1]; q++)
+      for (long a = 0; a < 3; a++) bidx[bptr[i + 1]++] = 3 * idx[q] + a;
+  }
+  assert_ok(pm_pattern_build(3 * N, bptr, bidx, true, &p));
+  for (int order = 0; order < 2; order++) {
+    pm_coloring c, single;
+    pm_pattern sp;
+    assert_ok(pm_pattern_build(N, ptr, idx, true, &sp));
+    assert_ok(pm_coloring_build(&sp, (pm_coloring_order)order, &single));
+    assert_ok(pm_coloring_build(&p, (pm_coloring_order)order, &c));
+    assert_valid_coloring(&p, &c);
+    assert_int_equal(c.ncolors, 3 * single.ncolors);
+    pm_coloring_free(&c);
+    pm_coloring_free(&single);
+    pm_pattern_free(&sp);
+  }
+  pm_pattern_free(&p);
+  free(bptr);
+  free(bidx);
+
   /* Bad patterns are named. */
   long bad_ptr[3] = {0, 2, 1}, bad_idx[2] = {0, 1};
   assert_int_equal(pm_pattern_build(2, bad_ptr, bad_idx, true, &p), PM_ERR_ARG);
