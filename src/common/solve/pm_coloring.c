@@ -194,6 +194,28 @@ done:
   return ret;
 }
 
+/* The pattern between groups: column group G's row groups
+ * row_of[col_ptr[G] ..], row group R's column groups col_of[row_ptr[R] ..]. */
+typedef struct {
+  long *col_ptr, *row_of, *row_ptr, *col_of;
+} linked;
+
+/* The column groups sharing a row with G (G among them) into out; seen[H]
+ * = G marks them.  Returns their number. */
+static long neighbour_groups(const linked *l, long G, long *seen, long *out) {
+  long count = 0;
+  for (long q = l->col_ptr[G]; q < l->col_ptr[G + 1]; q++) {
+    long R = l->row_of[q];
+    for (long u = l->row_ptr[R]; u < l->row_ptr[R + 1]; u++) {
+      long H = l->col_of[u];
+      if (seen[H] == G) continue;
+      seen[H] = G;
+      out[count++] = H;
+    }
+  }
+  return count;
+}
+
 typedef struct {
   long degree, group;
 } ranked;
@@ -216,8 +238,9 @@ pm_err pm_coloring_build(const pm_pattern *p, pm_coloring_order order,
   pm_err ret = PM_SUCCESS;
   long n = p->n, nnz = p->ptr[n];
   grouping cols = {0}, rows = {0};
-  long *cg_ptr = NULL, *cg_rows = NULL, *rg_ptr = NULL, *rg_cols = NULL;
-  long *start = NULL, *seen = NULL, *taken = NULL, *fill = NULL;
+  linked l = {0};
+  long *start = NULL, *seen = NULL, *near = NULL, *taken = NULL;
+  long *fill = NULL;
   ranked *rank = NULL;
   memset(c, 0, sizeof *c);
   PM_TRY(PM_ALLOC(c->color, n, "colours"));
@@ -239,33 +262,26 @@ pm_err pm_coloring_build(const pm_pattern *p, pm_coloring_order order,
 
   PM_TRY(group_lists(n, c->col_ptr, c->col_row, &cols));
   PM_TRY(group_lists(n, p->ptr, p->idx, &rows));
-  PM_TRY(
-      group_links(&cols, c->col_ptr, c->col_row, &rows, n, &cg_ptr, &cg_rows));
-  PM_TRY(group_links(&rows, p->ptr, p->idx, &cols, n, &rg_ptr, &rg_cols));
+  PM_TRY(group_links(&cols, c->col_ptr, c->col_row, &rows, n, &l.col_ptr,
+                     &l.row_of));
+  PM_TRY(group_links(&rows, p->ptr, p->idx, &cols, n, &l.row_ptr, &l.col_of));
 
   long ng = cols.count;
   PM_TRY(PM_ALLOC(rank, ng, "colouring order"));
   PM_TRY(PM_ALLOC(seen, ng, "colouring"));
+  PM_TRY(PM_ALLOC(near, ng, "colouring"));
   for (long G = 0; G < ng; G++) seen[G] = -1;
   for (long G = 0; G < ng; G++) {
     rank[G].group = G;
     if (order != PM_COLORING_LARGEST_FIRST) continue;
     /* Largest first: the columns that share a row with G's. */
-    for (long q = cg_ptr[G]; q < cg_ptr[G + 1]; q++) {
-      long R = cg_rows[q];
-      for (long u = rg_ptr[R]; u < rg_ptr[R + 1]; u++) {
-        long H = rg_cols[u];
-        if (seen[H] == G) continue;
-        seen[H] = G;
-        rank[G].degree += cols.size[H];
-      }
-    }
+    long count = neighbour_groups(&l, G, seen, near);
+    for (long k = 0; k < count; k++) rank[G].degree += cols.size[near[k]];
   }
   if (order == PM_COLORING_LARGEST_FIRST)
     qsort(rank, (size_t)ng, sizeof *rank, compare_ranked);
 
-  /* Greedy: seen[H] = G marks the groups met from G, taken[colour] = G
-   * the colours they hold. */
+  /* Greedy: taken[colour] = G marks the colours G's neighbours hold. */
   PM_TRY(PM_ALLOC(start, ng, "colouring"));
   PM_TRY(PM_ALLOC(taken, 2 * n + 1, "colouring"));
   for (long G = 0; G < ng; G++) start[G] = seen[G] = -1;
@@ -273,15 +289,11 @@ pm_err pm_coloring_build(const pm_pattern *p, pm_coloring_order order,
   long ncolors = 0;
   for (long v = 0; v < ng; v++) {
     long G = rank[v].group, m = cols.size[G];
-    for (long q = cg_ptr[G]; q < cg_ptr[G + 1]; q++) {
-      long R = cg_rows[q];
-      for (long u = rg_ptr[R]; u < rg_ptr[R + 1]; u++) {
-        long H = rg_cols[u];
-        if (seen[H] == G) continue;
-        seen[H] = G;
-        if (start[H] < 0) continue;
-        for (long t = 0; t < cols.size[H]; t++) taken[start[H] + t] = G;
-      }
+    long count = neighbour_groups(&l, G, seen, near);
+    for (long k = 0; k < count; k++) {
+      long H = near[k];
+      if (start[H] < 0) continue;
+      for (long t = 0; t < cols.size[H]; t++) taken[start[H] + t] = G;
     }
     long first = 0;
     for (long run = 0; run < m; first++) run = taken[first] == G ? 0 : run + 1;
@@ -289,9 +301,7 @@ pm_err pm_coloring_build(const pm_pattern *p, pm_coloring_order order,
     if (first > ncolors) ncolors = first;
   }
   PM_ENSURE(ncolors <= n, PM_ERR_INTERNAL,
-            "colouring took %ld colours for %ld "
-            "columns",
-            ncolors, n);
+            "colouring took %ld colours for %ld columns", ncolors, n);
   c->ncolors = (int)ncolors;
   memset(fill, 0, (size_t)n * sizeof *fill);
   for (long j = 0; j < n; j++) {
@@ -311,10 +321,11 @@ pm_err pm_coloring_build(const pm_pattern *p, pm_coloring_order order,
 done:
   grouping_free(&cols);
   grouping_free(&rows);
-  free(cg_ptr);
-  free(cg_rows);
-  free(rg_ptr);
-  free(rg_cols);
+  free(l.col_ptr);
+  free(l.row_of);
+  free(l.row_ptr);
+  free(l.col_of);
+  free(near);
   free(start);
   free(seen);
   free(taken);
