@@ -704,6 +704,50 @@ static void test_failures(void **state) {
   chain_free(&ch);
 }
 
+/* r(x) = x - 2 with every x >= 1 inadmissible: each step is shortened to
+ * stay below 1 until no admissible step is left; the state returned is
+ * admissible and the message names the cause. */
+static pm_err wall_residual(void *ctx, const double *x, double *r) {
+  (void)ctx;
+  if (x[0] >= 1)
+    return PM_ERROR(PM_ERR_UNSTABLE, "x = %g beyond the wall", x[0]);
+  r[0] = x[0] - 2;
+  return PM_SUCCESS;
+}
+
+static pm_err wall_apply(void *ctx, const double *x, const double *dx,
+                         double *dr) {
+  (void)ctx;
+  (void)x;
+  dr[0] = dx[0];
+  return PM_SUCCESS;
+}
+
+static void test_no_admissible_step(void **state) {
+  (void)state;
+  long ptr[2] = {0, 1}, idx[1] = {0};
+  pm_newton_problem prob = {.n = 1,
+                            .residual = wall_residual,
+                            .jacobian_apply = wall_apply,
+                            .pat_ptr = ptr,
+                            .pat_idx = idx};
+  pm_newton_options opt = pm_newton_options_default();
+  opt.max_iter = PM_NEWTON_MAX_ITER;
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  double x = 0;
+  pm_newton_report rep;
+  assert_int_equal(pm_newton_solve(s, &x, &rep), PM_ERR_UNSTABLE);
+  print_message("%s (x = %.17g)\n", rep.message, x);
+  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_DOMAIN);
+  assert_non_null(strstr(rep.message, "no admissible step in iteration"));
+  assert_non_null(strstr(rep.message, "beyond the wall"));
+  assert_true(x < 1 && x > 0.999);
+  assert_true(rep.step_length[1] < 1);
+  pm_error_clear();
+  pm_newton_destroy(&s);
+}
+
 /* ---- Load stepping ----------------------------------------------------- */
 
 /* Steps of 1/4 with an inadmissible jump above 0.1: each step is cut to
@@ -886,6 +930,7 @@ int main(void) {
       cmocka_unit_test(test_linear_solvers),
       cmocka_unit_test(test_petsc_options),
       cmocka_unit_test(test_failures),
+      cmocka_unit_test(test_no_admissible_step),
       cmocka_unit_test(test_load_steps_cut),
       cmocka_unit_test(test_load_steps_iterations),
       cmocka_unit_test(test_load_steps_impossible),
