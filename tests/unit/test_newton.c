@@ -328,6 +328,35 @@ static void test_coloring(void **state) {
   }
   pm_pattern_free(&p);
 
+  /* The same pattern with 3 unknowns per entry (identical rows and
+   * columns in threes, grouped by the colouring): valid, and no more than
+   * three times the colours. */
+  long *bptr = calloc(3 * N + 1, sizeof *bptr);
+  long *bidx = calloc(9 * (size_t)ptr[N], sizeof *bidx);
+  assert_true(bptr && bidx);
+  for (long i = 0; i < 3 * N; i++) {
+    long pi = i / 3;
+    bptr[i + 1] = bptr[i];
+    for (long q = ptr[pi]; q < ptr[pi + 1]; q++)
+      for (long a = 0; a < 3; a++) bidx[bptr[i + 1]++] = 3 * idx[q] + a;
+  }
+  assert_ok(pm_pattern_build(3 * N, bptr, bidx, true, &p));
+  for (int order = 0; order < 2; order++) {
+    pm_coloring c, single;
+    pm_pattern sp;
+    assert_ok(pm_pattern_build(N, ptr, idx, true, &sp));
+    assert_ok(pm_coloring_build(&sp, (pm_coloring_order)order, &single));
+    assert_ok(pm_coloring_build(&p, (pm_coloring_order)order, &c));
+    assert_valid_coloring(&p, &c);
+    assert_int_equal(c.ncolors, 3 * single.ncolors);
+    pm_coloring_free(&c);
+    pm_coloring_free(&single);
+    pm_pattern_free(&sp);
+  }
+  pm_pattern_free(&p);
+  free(bptr);
+  free(bidx);
+
   /* Bad patterns are named. */
   long bad_ptr[3] = {0, 2, 1}, bad_idx[2] = {0, 1};
   assert_int_equal(pm_pattern_build(2, bad_ptr, bad_idx, true, &p), PM_ERR_ARG);
@@ -675,6 +704,50 @@ static void test_failures(void **state) {
   chain_free(&ch);
 }
 
+/* r(x) = x - 2 with every x >= 1 inadmissible: each step is shortened to
+ * stay below 1 until no admissible step is left; the state returned is
+ * admissible and the message names the cause. */
+static pm_err wall_residual(void *ctx, const double *x, double *r) {
+  (void)ctx;
+  if (x[0] >= 1)
+    return PM_ERROR(PM_ERR_UNSTABLE, "x = %g beyond the wall", x[0]);
+  r[0] = x[0] - 2;
+  return PM_SUCCESS;
+}
+
+static pm_err wall_apply(void *ctx, const double *x, const double *dx,
+                         double *dr) {
+  (void)ctx;
+  (void)x;
+  dr[0] = dx[0];
+  return PM_SUCCESS;
+}
+
+static void test_no_admissible_step(void **state) {
+  (void)state;
+  long ptr[2] = {0, 1}, idx[1] = {0};
+  pm_newton_problem prob = {.n = 1,
+                            .residual = wall_residual,
+                            .jacobian_apply = wall_apply,
+                            .pat_ptr = ptr,
+                            .pat_idx = idx};
+  pm_newton_options opt = pm_newton_options_default();
+  opt.max_iter = PM_NEWTON_MAX_ITER;
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  double x = 0;
+  pm_newton_report rep;
+  assert_int_equal(pm_newton_solve(s, &x, &rep), PM_ERR_UNSTABLE);
+  print_message("%s (x = %.17g)\n", rep.message, x);
+  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_DOMAIN);
+  assert_non_null(strstr(rep.message, "no admissible step in iteration"));
+  assert_non_null(strstr(rep.message, "beyond the wall"));
+  assert_true(x < 1 && x > 0.999);
+  assert_true(rep.step_length[1] < 1);
+  pm_error_clear();
+  pm_newton_destroy(&s);
+}
+
 /* ---- Load stepping ----------------------------------------------------- */
 
 /* Steps of 1/4 with an inadmissible jump above 0.1: each step is cut to
@@ -857,6 +930,7 @@ int main(void) {
       cmocka_unit_test(test_linear_solvers),
       cmocka_unit_test(test_petsc_options),
       cmocka_unit_test(test_failures),
+      cmocka_unit_test(test_no_admissible_step),
       cmocka_unit_test(test_load_steps_cut),
       cmocka_unit_test(test_load_steps_iterations),
       cmocka_unit_test(test_load_steps_impossible),

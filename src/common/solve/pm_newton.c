@@ -49,6 +49,7 @@ struct pm_newton {
   long jacobians;      /* Jacobian callbacks in this solve (for pc_lag) */
   double linear_started;
   bool in_linear; /* between the linear solver's pre- and postsolve */
+  bool started;   /* the initial state was admissible */
 };
 
 static bool hard_failure(pm_err e) {
@@ -310,6 +311,7 @@ static PetscErrorCode converged_test(SNES snes, PetscInt it, PetscReal xnorm,
   PetscCall(SNESGetSolution(snes, &X));
   PetscCall(VecCopy(X, s->Xacc));
   if (it == 0) {
+    s->started = true;
     s->r0 = fmax(fnorm, s->r_ref);
     if (fnorm <= o->atol || fnorm == 0) {
       s->reason = PM_NEWTON_CONVERGED_ABSOLUTE;
@@ -683,8 +685,13 @@ static pm_err classify(pm_newton *s, pm_newton_report *rep) {
   case SNES_DIVERGED_FUNCTION_DOMAIN:
     rep->reason = PM_NEWTON_DIVERGED_DOMAIN;
     rep->status = PM_ERR_UNSTABLE;
-    snprintf(rep->message, cap, "Newton: the initial state is inadmissible: %s",
-             s->domain_msg);
+    if (!s->started)
+      snprintf(rep->message, cap,
+               "Newton: the initial state is inadmissible: %s", s->domain_msg);
+    else
+      snprintf(rep->message, cap,
+               "Newton: no admissible step in iteration %d (%s): %s", it + 1,
+               figures, s->domain_msg);
     break;
   case SNES_DIVERGED_LINEAR_SOLVE: {
     KSPConvergedReason kr;
@@ -734,6 +741,7 @@ pm_err pm_newton_solve_from(pm_newton *s, double *x, const double *x_start,
   s->r_ref = r_ref;
   s->jacobians = 0;
   s->in_linear = false;
+  s->started = false;
   PM_TRY(copy_in(s->X, x, n));
   PM_TRY(copy_in(s->Xstart, x_start, n));
   PM_PETSC(VecCopy(s->X, s->Xacc));

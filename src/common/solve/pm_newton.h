@@ -6,7 +6,8 @@
  * The contract with a caller:
  *
  * - Unknowns are x[0..n-1] (n < 2^31).  The residual r(x) is zero at the
- *   solution; the Jacobian is J = dr/dx.
+ *   solution; the Jacobian is J = dr/dx.  r must be a deterministic
+ *   function of x (and of the load): the line search compares values.
  * - residual(ctx, x, r) writes r(x).  Returning anything but PM_SUCCESS
  *   says that x is inadmissible (J <= 0, a point inverted, a model outside
  *   its range): the line search shortens the step, and load stepping cuts
@@ -23,9 +24,11 @@
  *   jacobian_apply computes.
  * - jacobian_apply(ctx, x, dx, dr) writes dr = J(x) dx exactly (the
  *   consistent linearisation of residual, not an approximation: Newton's
- *   quadratic convergence depends on it).  x is the point last passed to
- *   jacobian_prepare (and the same pointer contents for every call until
- *   the next jacobian_prepare).  Any failure aborts the solve.
+ *   quadratic convergence depends on it).  x holds the values last passed
+ *   to jacobian_prepare (the pointer may differ).  Without
+ *   jacobian_prepare, jacobian_apply works from x alone.  Any failure
+ *   aborts the solve.  One assembly takes pm_newton_colors() calls, each
+ *   with dx = 1 on the columns of one colour and 0 elsewhere.
  * - The pattern (pat_ptr[n + 1], pat_idx[pat_ptr[n]], CSR over unknowns)
  *   lists for each row i every column j with dr_i/dx_j possibly non-zero; a
  *   superset is allowed (its zeros are stored), a missing entry is not:
@@ -100,9 +103,12 @@ typedef struct {
                     const struct pm_newton_report *report);
 } pm_newton_problem;
 
-/* The linear solver of each Newton iteration. */
+/* The linear solver of each Newton iteration.  With a matrix-free operator
+ * the factorisation or preconditioner is built from the assembled matrix
+ * and preconditions GMRES (CG for cg-jacobi). */
 typedef enum {
-  PM_NEWTON_DIRECT = 0, /* LU: MUMPS, else PETSc's own */
+  PM_NEWTON_DIRECT = 0, /* LU: MUMPS (null pivots of a singular J set aside,
+                           ICNTL(24) = 1), else PETSc's own */
   PM_NEWTON_GMRES_GAMG, /* GMRES + algebraic multigrid */
   PM_NEWTON_CG_JACOBI,  /* CG + Jacobi: symmetric positive definite J only */
   PM_NEWTON_GMRES_ILU   /* GMRES + ILU(0) */
@@ -129,15 +135,22 @@ typedef struct {
    * converged after iteration k (x_{k+1} = x_k + alpha_k dx_k, J(x_k) dx_k
    * = -r(x_k)) when every criterion that is on holds (all_criteria) or any
    * one holds (!all_criteria); |r| <= atol always stops it.
-   *   residual:      |r(x_{k+1})| <= rtol |r(x_0)|
+   *   residual:      |r(x_{k+1})| <= rtol |r(x_0)|  (in pm_load_steps
+   *                  with the predictor, rtol is relative to the larger of
+   *                  |r(x_0)| and |r| of the last converged state under
+   *                  the new load, so a good prediction does not tighten
+   *                  it down to roundoff)
    *   displacement:  |dx_k| <= dtol |x_{k+1} - x_start|  (x_start: the
    *                  initial guess of pm_newton_solve; in pm_load_steps the
    *                  last converged state, also with the predictor;
    *                  alpha_k is not applied to dx_k)
    *   energy:        |dx_k . r(x_k)| <= etol |dx_0 . r(x_0)|
-   * Norms are Euclidean over all unknowns. */
+   * Norms are Euclidean over all unknowns.  A tolerance below the
+   * residual's roundoff (about 1e-16 times the largest internal force
+   * entry, times sqrt(n)) cannot be met: the solve then ends in a line
+   * search failure at that level. */
   double rtol;       /* 1e-8 */
-  double atol;       /* 0: scale-dependent, the caller's to set */
+  double atol;       /* 0; scale-dependent: the caller's to set (a force) */
   double dtol;       /* 0 (off) */
   double etol;       /* 0 (off) */
   bool all_criteria; /* false */
@@ -162,16 +175,19 @@ typedef struct {
   bool predictor;     /* start each step from the linear extrapolation of
                          the last two converged states: false */
 
-  /* PETSc options for this solver's SNES, KSP, PC and line search, with
-   * prefix "pm_" ("-pm_snes_monitor -pm_ksp_type bcgs"); NULL: none.
-   * Applied after the settings above, so they override them. */
+  /* PETSc options for this solver's SNES, KSP, PC, line search and the
+   * objects PETSc makes inside them (factor matrices, multigrid levels),
+   * with prefix "pm_" ("-pm_snes_monitor -pm_ksp_type bcgs
+   * -pm_mat_mumps_icntl_14 50"); NULL: none.  Applied after the settings
+   * above, so they override them; they are this solver's alone. */
   const char *petsc_options;
 } pm_newton_options;
 
 /* The options above with their defaults. */
 pm_newton_options pm_newton_options_default(void);
 
-/* Why a solve stopped. */
+/* Why a solve stopped.  Every DIVERGED reason is a failure load stepping
+ * answers by cutting the step. */
 typedef enum {
   PM_NEWTON_NOT_RUN = 0,
   PM_NEWTON_CONVERGED_RESIDUAL,     /* rtol */
@@ -184,7 +200,8 @@ typedef enum {
   PM_NEWTON_DIVERGED_NAN,           /* residual not finite */
   PM_NEWTON_DIVERGED_DOMAIN,        /* residual inadmissible at the start,
                                        or no admissible step found */
-  PM_NEWTON_DIVERGED_LINEAR         /* the linear solver failed */
+  PM_NEWTON_DIVERGED_LINEAR         /* the linear solver failed (no
+                                       convergence, a singular matrix) */
 } pm_newton_reason;
 
 /* "converged (residual)", "diverged (max iterations)", ... */
@@ -209,7 +226,8 @@ typedef struct pm_newton_report {
   double step_length[PM_NEWTON_MAX_ITER + 1];    /* alpha_{k-1} (0: 0) */
   /* Wall seconds: residual calls; Jacobian preparation and assembly
    * (colouring applications and insertion); linear solves (factorisation,
-   * Krylov iterations, matrix-free applications); the whole solve. */
+   * Krylov iterations, matrix-free applications); the whole solve (the
+   * rest is vector work and the line search's own Jacobian product). */
   double time_residual, time_assembly, time_linear, time_total;
 } pm_newton_report;
 
@@ -227,7 +245,10 @@ typedef struct {
 } pm_load_report;
 
 /* A solver for one problem: the colouring, PETSc's matrix, vectors, SNES
- * and linear solver, created once and reused by every solve. */
+ * and linear solver, created once and reused by every solve (nothing is
+ * allocated per iteration but what PETSc allocates itself).  Several may
+ * exist at once; one solve runs at a time in a process (PETSc is not
+ * thread-safe). */
 typedef struct pm_newton pm_newton;
 
 /* Checks the problem (n, callbacks, pattern indices in [0, n)) and the
@@ -245,12 +266,12 @@ int pm_newton_colors(const pm_newton *s);
 int pm_newton_pc_colors(const pm_newton *s);
 
 /* One Newton solve from x[0..n-1], the initial guess, which receives the
- * last iterate (the solution on success; on failure the last accepted
- * iterate).  report (may be NULL) is filled in either case.  Returns
- * PM_SUCCESS when converged; PM_ERR_NOT_CONVERGED (max iterations, line
- * search, linear solver) or PM_ERR_UNSTABLE (NaN, domain) with
- * report->message as the error message; a callback's hard failure or a
- * PETSc failure as it is. */
+ * last iterate (the solution on success; on failure the last iterate
+ * accepted by the line search, never an inadmissible trial).  report (may be
+ * NULL) is filled in either case.  Returns PM_SUCCESS when converged;
+ * PM_ERR_NOT_CONVERGED (max iterations, line search, linear solver) or
+ * PM_ERR_UNSTABLE (NaN, domain) with report->message as the error message; a
+ * callback's hard failure or a PETSc failure as it is. */
 pm_err pm_newton_solve(pm_newton *s, double *x, pm_newton_report *report);
 
 /* Loads from lambda = 0 (x converged there) to 1 in options.load_steps
