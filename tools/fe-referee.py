@@ -854,29 +854,27 @@ def main():
                     name, n, row["element"])), ignore_errors=True)
         done = [r for r in rows if r["status"] == "converged"]
         for old in os.listdir(folder):
-            if old.startswith("lattice"):
+            if old.startswith("lattice") or old == "tolerance.csv":
                 os.remove(os.path.join(folder, old))
-        if not done:
-            print("%s: no mesh reached the full load" % name)
+        # A referee needs two meshes at the full load to say how far it is
+        # converged; otherwise the ladder alone records what was reached.
+        if len(done) < 2:
+            print("%s: %d mesh(es) reached the full load: no referee, the "
+                  "ladder only" % (name, len(done)))
             status = 1
             continue
-        fine = done[-1]
-        write_lattice(os.path.join(folder, "lattice.csv"),
-                      header + "# lattice of the mesh N = %d (%s)\n"
-                      % (fine["N"], fine["element"]), lattices[fine["N"]])
-        if len(done) >= 2:
-            prev = done[-2]
-            write_lattice(os.path.join(folder, "lattice-N%d.csv" % prev["N"]),
+        fine, prev = done[-1], done[-2]
+        for row, path in ((fine, "lattice.csv"),
+                          (prev, "lattice-N%d.csv" % prev["N"])):
+            write_lattice(os.path.join(folder, path),
                           header + "# lattice of the mesh N = %d (%s)\n"
-                          % (prev["N"], prev["element"]),
-                          lattices[prev["N"]])
-            result = write_tolerance(
-                os.path.join(folder, "tolerance.csv"), header, spec, rows,
-                lattices)
-            for q, nf, np_, c, p, e, t in result:
-                print("%-30s %-18s change N %d -> %d: %.3e, order %s, "
-                      "estimated error %.3e (tolerance %g)"
-                      % (name, q, np_, nf, c, "%.2f" % p if p else "-", e, t))
+                          % (row["N"], row["element"]), lattices[row["N"]])
+        result = write_tolerance(os.path.join(folder, "tolerance.csv"), header,
+                                 spec, rows, lattices)
+        for q, nf, np_, c, p, e, t in result:
+            print("%-30s %-18s change N %d -> %d: %.3e, order %s, estimated "
+                  "error %.3e (tolerance %g)"
+                  % (name, q, np_, nf, c, "%.2f" % p if p else "-", e, t))
     return status
 
 
