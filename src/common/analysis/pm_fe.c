@@ -377,7 +377,7 @@ pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
   int axis = o->loaded_axis;
   if (axis >= 0 && axis < 3)
     e->reaction_error =
-        (o->loaded_reaction - r->reaction[axis]) / fabs(r->reaction[axis]);
+        (o->loaded_reaction - r->reaction[axis]) / r->reaction[axis];
   e->sed_error = (o->fig.mean_sed - r->mean_sed) / r->mean_sed;
 done:
   free(mapped);

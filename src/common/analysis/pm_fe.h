@@ -70,8 +70,9 @@ bool pm_fe_names_reference(const char *spec, char *buf, size_t size);
 /* A run against the reference. */
 typedef struct {
   double nrmse;          /* displacement at the lattice (pm_nrmse_vector) */
-  double reaction_error; /* (R - R_fe) / |R_fe| on the loaded face, along
-                            the loaded component */
+  double reaction_error; /* (R - R_fe) / R_fe on the loaded face, along
+                            the loaded component: > 0 when the run's
+                            reaction is the larger (the run is stiffer) */
   double sed_error;      /* (mean SED - FE) / FE */
 } pm_fe_errors;
 
