@@ -2,7 +2,10 @@
 # Tables 2 and 3 of the FPM paper: for each case given (default: all six),
 # the convergence study of the constrained block at the paper's four
 # resolutions against the dense run at h = 2.79e-3 m (about 80000 points),
-# mapped by moving least squares.  Writes out/study-CASE/convergence.{md,csv}.
+# mapped by moving least squares.  REFERENCE=fe compares the four
+# resolutions with the case's finite-element referee (cases/fe/CASE)
+# instead, without the dense run, and adds the reaction and strain energy
+# errors.  Writes out/study-CASE-FLUX/convergence.{md,csv}.
 #   scripts/study-blocks.sh [BUILD_DIR] [CASE ...]
 #   CASE: f3-extension-60 f3-extension-100 f3-extension-200
 #         f4-compression-20 f4-compression-40 f4-compression-60
@@ -19,10 +22,17 @@ cases=("$@")
 flux=${FLUX:-sipg}
 if [ "$flux" = sipg ]; then penalty=${PENALTY:-100}; else penalty=${PENALTY:-20}; fi
 for c in "${cases[@]}"; do
+  if [ "${REFERENCE:-last}" = fe ]; then
+    ref=(--reference "fe:cases/fe/$c")
+    sizes=8.72e-3,6.42e-3,4.15e-3,2.98e-3
+  else
+    ref=(--reference last)
+    sizes=8.72e-3,6.42e-3,4.15e-3,2.98e-3,2.15e-3
+  fi
   "$build/pointmech" convergence "cases/fpm/$c-h1.09e-2.yaml" --quiet \
     --set fpm.flux="$flux" --set fpm.penalty="$penalty" \
     --set time.dt_rule="${RULE:-spectral}" --set time.dt_safety="${SAFETY:-0.5}" \
-    --set output.every=1000000 \
-    --set-ladder discretization.mesh_size=8.72e-3,6.42e-3,4.15e-3,2.98e-3,2.15e-3 \
+    --set output.every=1000000 "${ref[@]}" \
+    --set-ladder discretization.mesh_size=$sizes \
     --out "${STUDY_OUT:-out}/study-$c-$flux"
 done

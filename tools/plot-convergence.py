@@ -13,6 +13,14 @@ wall_seconds, ...) and writes two PNGs:
   PREFIX-error-time.png  log-log error against wall_seconds (accuracy/cost
                          front), each point labelled with its level.
 
+and, for a table made against a finite-element referee (column
+reaction_error), a third:
+
+  PREFIX-reaction-time.png  log-log |reaction error| against wall_seconds;
+                         with --fe DIR (the referee's cases/fe folder) the
+                         referee's own meshes beside it: each mesh's
+                         reaction against the finest's, at its wall time.
+
 The reference row (status "reference") and rows without a positive error
 are left out.  PREFIX defaults to the CSV path without ".csv".
 """
@@ -30,7 +38,7 @@ import numpy as np  # noqa: E402
 
 FIXED = ("level h points steps status error rate wall_seconds setup_seconds "
          "mean_strain_energy_density max_von_mises reaction min_jacobian "
-         "energy_balance_error").split()
+         "energy_balance_error reaction_error reaction_rate sed_error").split()
 REQUIRED = ("level", "h", "status", "error", "wall_seconds")
 
 
@@ -118,19 +126,73 @@ def plot_error_time(rows, title, out):
     plt.close(fig)
 
 
+def fe_points(folder):
+    """(wall seconds, |reaction change| against the finest, N) of the
+    referee's meshes that reached the load, the finest left out."""
+    path = os.path.join(folder, "ladder.csv")
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(ln for ln in f if not ln.startswith("#")))
+    except OSError as e:
+        fail(f"{path}: cannot read: {e.strerror}")
+    rows = [r for r in rows if r.get("status", "converged") == "converged"]
+    if len(rows) < 2:
+        fail(f"{path}: fewer than two meshes reached the load")
+    comps = ("reaction_x", "reaction_y", "reaction_z")
+    fine = rows[-1]
+    c = max(comps, key=lambda k: abs(num(fine[k])))
+    ref = num(fine[c])
+    return [(num(r["wall_seconds"]), abs(num(r[c]) - ref) / abs(ref),
+             r["N"]) for r in rows[:-1]]
+
+
+def plot_reaction_time(rows, fe, title, out):
+    pts = [(num(r["wall_seconds"]), abs(num(r["reaction_error"])), r["level"])
+           for r in rows]
+    pts = [p for p in pts if p[0] > 0 and p[1] > 0]
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for data, style, label, tag in ((pts, "o-", "FPM levels", ""),
+                                    (fe, "s--", "FE meshes", "N = ")):
+        data = [p for p in data if p[0] > 0 and p[1] > 0]
+        if not data:
+            continue
+        ax.plot([p[0] for p in data], [p[1] for p in data], style, label=label)
+        for w, e, lv in data:
+            ax.annotate(tag + lv, (w, e), textcoords="offset points",
+                        xytext=(5, 5))
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set(xlabel="wall time (s)", ylabel="relative reaction error",
+           title=title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("csv", metavar="CSV", help="convergence.csv to plot")
     ap.add_argument("--out-prefix", metavar="PREFIX",
                     help="output prefix (default: CSV path without .csv)")
+    ap.add_argument("--fe", metavar="DIR",
+                    help="the finite-element referee's folder (cases/fe/CASE)"
+                    " for its own points on the reaction plot")
     a = ap.parse_args()
     keys, rows = read_table(a.csv)
+    fe = fe_points(a.fe) if a.fe else []
     prefix = a.out_prefix or (a.csv[:-4] if a.csv.endswith(".csv") else a.csv)
     title = os.path.basename(os.path.dirname(os.path.abspath(a.csv)))
-    outs = (f"{prefix}-error-h.png", f"{prefix}-error-time.png")
+    outs = [f"{prefix}-error-h.png", f"{prefix}-error-time.png"]
+    reaction = any(math.isfinite(num(r.get("reaction_error"))) for r in rows)
+    if reaction:
+        outs.append(f"{prefix}-reaction-time.png")
     try:
         plot_error_h(rows, keys, title, outs[0])
         plot_error_time(rows, title, outs[1])
+        if reaction:
+            plot_reaction_time(rows, fe, title, outs[2])
     except OSError as e:
         fail(f"{e.filename or prefix}: cannot write: {e.strerror or e}")
     for o in outs:

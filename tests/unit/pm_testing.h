@@ -1,6 +1,7 @@
 /* pm_testing: helpers shared by the unit tests (include after cmocka.h):
- * a success check that prints the error message, and a temporary directory
- * per test (cmocka setup/teardown) removed with everything in it. */
+ * a success check that prints the error message, a failure check on the
+ * code and the message, and a temporary directory per test (cmocka
+ * setup/teardown) removed with everything in it. */
 #ifndef PM_TESTING_H
 #define PM_TESTING_H
 
@@ -29,6 +30,15 @@
     if (e_ != PM_SUCCESS)                                                      \
       fail_msg("%s: %s\n%s", pm_err_name(e_), pm_error_message(),              \
                pm_error_traceback());                                          \
+  } while (0)
+
+/* Expect code and a message containing text. */
+#define assert_fails(expr, code, text)                                         \
+  do {                                                                         \
+    pm_err e_ = (expr);                                                        \
+    if (e_ != (code) || !strstr(pm_error_message(), (text)))                   \
+      fail_msg("expected %s with '%s', got %s: %s", pm_err_name(code), (text), \
+               pm_err_name(e_), pm_error_message());                           \
   } while (0)
 
 static inline void pm_test_remove_tree(const char *path) {

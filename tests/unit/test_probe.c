@@ -25,15 +25,6 @@
 
 /* ---- Helpers ----------------------------------------------------------- */
 
-/* Expect code and a message containing text. */
-#define assert_fails(expr, code, text)                                         \
-  do {                                                                         \
-    pm_err e_ = (expr);                                                        \
-    if (e_ != (code) || !strstr(pm_error_message(), (text)))                   \
-      fail_msg("expected %s with '%s', got %s: %s", pm_err_name(code), (text), \
-               pm_err_name(e_), pm_error_message());                           \
-  } while (0)
-
 /* A linear field u = c + G x. */
 typedef struct {
   double c[3], g[3][3];

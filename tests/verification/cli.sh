@@ -85,13 +85,9 @@ rc=$?
 check "bad stability.min_jacobian: exit 1 (got $rc)" test $rc -eq 1
 check "bad stability.min_jacobian: names the key" \
   grep -q "stability.min_jacobian.*\[0, 1)" "$work/err"
-"$bin" convergence "$scene" --set-ladder discretization.mesh_size=0.02,0.015 \
-  --set-ladder fpm.penalty=20 --out "$work/out-bad-ladder" >/dev/null \
-  2>"$work/err"
-rc=$?
-check "unequal ladders: exit 1 (got $rc)" test $rc -eq 1
-check "unequal ladders: message" grep -q "same number" "$work/err"
-check "unequal ladders: nothing written" test ! -e "$work/out-bad-ladder"
+refused "unequal ladders" "same number" "$work/out-bad-ladder" \
+  "$bin" convergence "$scene" --set-ladder discretization.mesh_size=0.02,0.015 \
+  --set-ladder fpm.penalty=20 --out "$work/out-bad-ladder"
 
 "$bin" plan "$scene" >"$work/plan" 2>"$work/err"
 rc=$?
@@ -124,6 +120,34 @@ check "probe: exit 0 (got $rc)" test $rc -eq 0
 check "probe: u_z = -0.4 z at every point" awk -F, '
   NR > 1 { n++; if ((($6 + 0.4 * $3) ^ 2) ^ 0.5 > 1e-6) bad++ }
   END { exit !(n == 3 && bad == 0) }' "$work/probe"
+
+# Convergence against the finite-element referee the scene names
+# (reference.fe): the displacement at the FE lattice, the reaction and the
+# mean strain energy density; F2's referee is the exact state.
+small() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && (a < 0 ? -a : a) <= b) }'; }
+out=$work/out-fe
+"$bin" convergence "$scene" --set-ladder discretization.mesh_size=0.025,0.02 \
+  --set time.quasi_static.tolerance=1e-8 --out "$out" --quiet \
+  >"$work/conv" 2>"$work/err"
+rc=$?
+check "convergence, FE referee by default: exit 0 (got $rc)" test $rc -eq 0
+check "convergence, FE referee: named under the table" \
+  grep -q "finite-element lattice of .*f2-unconstrained-compression" \
+  "$out/convergence.md"
+for lv in 1 2; do
+  e=$(col "$out/convergence.csv" $lv error)
+  re=$(col "$out/convergence.csv" $lv reaction_error)
+  se=$(col "$out/convergence.csv" $lv sed_error)
+  check "convergence, FE referee: level $lv NRMSE $e <= 1e-5" small "$e" 1e-5
+  check "convergence, FE referee: level $lv reaction error $re <= 1e-4" \
+    small "$re" 1e-4
+  check "convergence, FE referee: level $lv SED error $se <= 1e-4" \
+    small "$se" 1e-4
+done
+refused "convergence, missing FE referee" "no-such-fe/ladder.csv" \
+  "$work/out-fe-bad" "$bin" convergence "$scene" \
+  --set-ladder discretization.mesh_size=0.025 \
+  --reference fe:"$work/no-such-fe" --out "$work/out-fe-bad" --quiet
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

@@ -20,3 +20,22 @@ check() { # name, condition-command...
     return 0
   fi
 }
+
+# Column NAME of the row whose first field is LEVEL in a convergence.csv.
+col() { # csv, level, name
+  awk -F, -v lv="$2" -v name="$3" '
+    NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i; next }
+    $1 == lv { print $c }' "$1"
+}
+
+# A command that must refuse its input: exit status 1, TEXT in its error
+# output, and nothing written at OUT.
+refused() { # label, text, out, command...
+  local label=$1 text=$2 out=$3
+  shift 3
+  "$@" >/dev/null 2>"$work/err"
+  local rc=$?
+  check "$label: exit 1 (got $rc)" test $rc -eq 1
+  check "$label: message" grep -qF -- "$text" "$work/err"
+  check "$label: nothing written" test ! -e "$out"
+}

@@ -177,36 +177,28 @@ static pm_err add_query(queries *qs, const double p[3], long line) {
 /* Every point of the CSV file, skipping blanks, comments and a header. */
 static pm_err read_points(const char *csv, queries *qs) {
   pm_err ret = PM_SUCCESS;
-  FILE *fp = NULL;
-  char *buf = NULL;
-  size_t size = 0;
-  ssize_t len;
-  long line = 0;
+  pm_lines in = {0};
+  char *s;
   bool first = true;
   double p[3];
-  fp = fopen(csv, "r");
-  PM_ENSURE(fp, PM_ERR_IO, "cannot open points file '%s': %s", csv,
-            strerror(errno));
-  while ((len = getline(&buf, &size, fp)) >= 0) {
-    line++;
-    while (len > 0 && strchr(" \t\r\n", buf[len - 1])) buf[--len] = '\0';
-    const char *s = skip_blanks(buf);
-    if (*s == '\0' || *s == '#') continue;
+  PM_TRY(pm_lines_open(&in, csv, "points file"));
+  for (;;) {
+    PM_TRY(pm_lines_next(&in, &s));
+    if (!s) break;
     bool header = first && is_header(s);
     first = false;
     if (header) continue;
     if (!parse_point(s, p)) {
-      int shown = len > SHOW_MAX ? SHOW_MAX : (int)len;
+      int len = (int)strlen(s);
       PM_FAIL(PM_ERR_ARG, "%s:%ld: expected x,y,z numbers, got '%.*s%s'", csv,
-              line, shown, buf, len > SHOW_MAX ? "..." : "");
+              in.line, len > SHOW_MAX ? SHOW_MAX : len, s,
+              len > SHOW_MAX ? "..." : "");
     }
-    PM_TRY(add_query(qs, p, line));
+    PM_TRY(add_query(qs, p, in.line));
   }
-  PM_ENSURE(!ferror(fp), PM_ERR_IO, "read error on points file '%s'", csv);
   PM_ENSURE(qs->m > 0, PM_ERR_ARG, "points file '%s' holds no points", csv);
 done:
-  free(buf);
-  if (fp) fclose(fp);
+  pm_lines_close(&in);
   return ret;
 }
 

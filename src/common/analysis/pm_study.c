@@ -1,11 +1,13 @@
-/* pm_study: ladders of runs, errors against an analytic field or a
- * reference run (mapped by moving least squares), rates and wall times. */
+/* pm_study: ladders of runs, errors against an analytic field, a
+ * reference run or a finite-element reference (mapped by moving least
+ * squares), rates and wall times. */
 #include "pm_study.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "pm_fe.h"
 #include "pm_files.h"
 #include "pm_metrics.h"
 #include "pm_probe.h"
@@ -23,6 +25,10 @@ typedef struct {
   pm_err err;
   double error; /* NRMSE against the reference; NaN when none */
   double rate;  /* against the previous level; NaN when none */
+  /* Against a finite-element reference (NaN otherwise): the relative
+   * errors of the reaction on the loaded face and of the mean strain
+   * energy density, and the reaction error's rate. */
+  double reaction_error, reaction_rate, sed_error;
   char dir[PM_PATH_MAX + 1];
 } level;
 
@@ -97,13 +103,20 @@ static void fmt_num(char *b, size_t size, double v) {
     b[0] = 0;
 }
 
+/* What the levels are compared with, for the tables. */
+typedef struct {
+  const char *label;         /* "the scene's analytic field", ... */
+  const pm_fe_reference *fe; /* NULL unless a finite-element reference */
+  double q_fit, q_reaction;  /* least-squares rates (NaN when none) */
+} comparison;
+
 static pm_err write_tables(const char *out_dir, const ladder_key *keys,
                            int n_keys, const level *lv, int n_levels,
-                           const level *ref, const char *ref_label,
-                           double q_fit, FILE *out) {
+                           const level *ref, const comparison *cmp, FILE *out) {
   pm_err ret = PM_SUCCESS;
   pm_afile *csv = NULL, *md = NULL;
   char path[PM_PATH_MAX + 1];
+  bool fe = cmp->fe != NULL;
   PM_TRY(pm_path_join(path, sizeof path, out_dir, "convergence.csv"));
   PM_TRY(pm_afile_open(path, &csv));
   PM_TRY(pm_path_join(path, sizeof path, out_dir, "convergence.md"));
@@ -117,17 +130,20 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
   }
   fprintf(c, ",h,points,steps,status,error,rate,wall_seconds,setup_seconds,"
              "mean_strain_energy_density,max_von_mises,reaction,min_jacobian,"
-             "energy_balance_error\n");
-  fprintf(m, " h (m) | points | steps | NRMSE | q | wall (s) | mean SED "
-             "(J/m^3) | max von Mises (Pa) | reaction (N) | min J | energy "
-             "error | status |\n|");
-  for (int k = 0; k < n_keys + 13; k++) fprintf(m, "---|");
+             "energy_balance_error,reaction_error,reaction_rate,sed_error\n");
+  fprintf(m,
+          " h (m) | points | steps | NRMSE | q |%s wall (s) | mean SED "
+          "(J/m^3) | max von Mises (Pa) | reaction (N) | min J | energy "
+          "error | status |\n|",
+          fe ? " reaction error | q (reaction) | SED error |" : "");
+  for (int k = 0; k < n_keys + 13 + (fe ? 3 : 0); k++) fprintf(m, "---|");
   fprintf(m, "\n");
   int total = n_levels + (ref ? 1 : 0);
   for (int r = 0; r < total; r++) {
     const level *L = r < n_levels ? &lv[r] : ref;
     const pm_figures *f = &L->out.fig;
     char e[32], q[32], w[32], sed[32], vm[32], re[32], mj[32], ee[32];
+    char rerr[32], rq[32], serr[32];
     fmt_num(e, sizeof e, L->error);
     fmt_num(q, sizeof q, L->rate);
     snprintf(w, sizeof w, "%.3f", f->wall_seconds);
@@ -136,6 +152,9 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
     fmt_num(re, sizeof re, L->out.loaded_reaction);
     fmt_num(mj, sizeof mj, f->min_jacobian);
     fmt_num(ee, sizeof ee, f->energy_error);
+    fmt_num(rerr, sizeof rerr, L->reaction_error);
+    fmt_num(rq, sizeof rq, L->reaction_rate);
+    fmt_num(serr, sizeof serr, L->sed_error);
     const char *status = r < n_levels ? pm_status_name(f->status) : "reference";
     if (r < n_levels) {
       fprintf(c, "%d", r + 1);
@@ -149,22 +168,43 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
       fprintf(c, ",%s", keys[k].value[idx]);
       fprintf(m, " %s |", keys[k].value[idx]);
     }
-    fprintf(c, ",%.6g,%ld,%ld,%s,%s,%s,%s,%.4g,%s,%s,%s,%s,%s\n", f->h,
+    fprintf(c, ",%.6g,%ld,%ld,%s,%s,%s,%s,%.4g,%s,%s,%s,%s,%s,%s,%s,%s\n", f->h,
             f->points, f->steps, status, e, q, w, f->setup_seconds, sed, vm, re,
-            mj, ee);
-    fprintf(
-        m, " %.4g | %ld | %ld | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n",
-        f->h, f->points, f->steps, e, q, w, sed, vm, re, mj, ee, status);
+            mj, ee, rerr, rq, serr);
+    fprintf(m, " %.4g | %ld | %ld | %s | %s |", f->h, f->points, f->steps, e,
+            q);
+    if (fe) fprintf(m, " %s | %s | %s |", rerr, rq, serr);
+    fprintf(m, " %s | %s | %s | %s | %s | %s | %s |\n", w, sed, vm, re, mj, ee,
+            status);
   }
   fprintf(m,
           "\nError: NRMSE (FPM paper eq. 28, root mean square) of the "
           "displacement against %s.\n",
-          ref_label);
-  if (isfinite(q_fit))
+          cmp->label);
+  if (isfinite(cmp->q_fit))
     fprintf(m,
             "Observed rate (least-squares slope of log error against log "
             "h over the levels): q = %.3f.\n",
-            q_fit);
+            cmp->q_fit);
+  if (fe) {
+    const pm_fe_reference *r = cmp->fe;
+    fprintf(m,
+            "FE reference: reaction (%.7g, %.7g, %.7g) N, mean SED %.7g "
+            "J/m^3, von Mises at (%g, %g, %g) %.6g Pa.  Reaction and SED "
+            "errors: (run - FE) / FE, the reaction on the loaded face "
+            "along its prescribed component (> 0: the run is stiffer).\n",
+            r->reaction[0], r->reaction[1], r->reaction[2], r->mean_sed,
+            r->centre[0], r->centre[1], r->centre[2], r->von_mises_centre);
+    const pm_fe_tolerance *t = &r->tolerance;
+    fprintf(m,
+            "The referee claims (relative, between its two finest meshes and "
+            "their trend): reaction %g, mean SED %g, von Mises %g, lattice "
+            "NRMSE %g; differences below these are not resolved.\n",
+            t->reaction, t->mean_sed, t->von_mises_centre, t->lattice_nrmse);
+    if (isfinite(cmp->q_reaction))
+      fprintf(m, "Observed rate of the reaction error: q = %.3f.\n",
+              cmp->q_reaction);
+  }
   PM_TRY(pm_afile_commit(csv));
   csv = NULL;
   PM_TRY(pm_afile_commit(md));
@@ -184,14 +224,33 @@ done:
   return ret;
 }
 
+/* Rate of |err| between consecutive levels against x (NaN where either
+ * value is missing), and the least-squares rate over all levels. */
+static double rates(int n, const double *x, const double *err, double *rate) {
+  double a[PM_STUDY_MAX_LEVELS];
+  for (int l = 0; l < n; l++) {
+    a[l] = fabs(err[l]);
+    rate[l] = NAN;
+    if (l > 0 && x[l] > 0 && x[l - 1] > 0 && a[l] > 0 && a[l - 1] > 0 &&
+        x[l] != x[l - 1])
+      rate[l] = log(a[l] / a[l - 1]) / log(x[l] / x[l - 1]);
+  }
+  return n >= 2 ? pm_convergence_rate(n, x, a) : NAN;
+}
+
+/* The reference a study is against: "analytic", "last", "fe" or "run". */
+typedef enum { REF_ANALYTIC, REF_LAST, REF_FE, REF_RUN } ref_mode;
+
 pm_err pm_study_run(const pm_study_options *o, FILE *out) {
   pm_err ret = PM_SUCCESS, first_fail = PM_SUCCESS;
   ladder_key *keys = NULL;
   level *lv = NULL, ref = {.err = PM_SUCCESS};
   pm_scene *s = NULL;
+  pm_fe_reference *fe = NULL;
   double *rx = NULL, *ru = NULL, *work = NULL;
   long rn = 0;
-  char out_dir[PM_PATH_MAX + 1], ref_label[PM_PATH_MAX + 64];
+  char out_dir[PM_PATH_MAX + 1], ref_label[PM_PATH_MAX + 128];
+  char fe_dir[PM_PATH_MAX + 1] = "";
   PM_ENSURE(o->n_keys >= 1, PM_ERR_SCENE,
             "convergence needs at least one --set-ladder KEY=V1,V2,...");
   PM_TRY(PM_ALLOC(keys, o->n_keys, "ladder"));
@@ -209,6 +268,8 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
     PM_TRY(load_level(o, keys, l, &s));
     if (l == 0) {
       analytic = s->reference_mask != 0;
+      if (s->reference_fe)
+        snprintf(fe_dir, sizeof fe_dir, "%s", s->reference_fe);
       if (o->out_dir)
         snprintf(out_dir, sizeof out_dir, "%s", o->out_dir);
       else
@@ -217,28 +278,41 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
     pm_scene_destroy(s);
     s = NULL;
   }
-  const char *mode = o->reference ? o->reference
-                     : analytic   ? "analytic"
-                                  : "last";
-  bool use_analytic = strcmp(mode, "analytic") == 0;
-  bool use_last = strcmp(mode, "last") == 0;
-  PM_ENSURE(!use_analytic || analytic, PM_ERR_SCENE,
+  /* Without --reference: the scene's FE referee, else its analytic field,
+   * else the last ladder value. */
+  ref_mode mode;
+  if (!o->reference)
+    mode = fe_dir[0] ? REF_FE : analytic ? REF_ANALYTIC : REF_LAST;
+  else if (strcmp(o->reference, "analytic") == 0)
+    mode = REF_ANALYTIC;
+  else if (strcmp(o->reference, "last") == 0)
+    mode = REF_LAST;
+  else if (pm_fe_names_reference(o->reference, fe_dir, sizeof fe_dir))
+    mode = REF_FE;
+  else
+    mode = REF_RUN;
+  PM_ENSURE(mode != REF_ANALYTIC || analytic, PM_ERR_SCENE,
             "%s: --reference analytic: the scene has no reference field",
             o->scene);
-  int n_levels = use_last ? n_all - 1 : n_all;
+  PM_ENSURE(strncmp(o->reference ? o->reference : "", "fe:", 3) != 0 ||
+                mode == REF_FE,
+            PM_ERR_SCENE, "--reference %s: expected fe:DIR", o->reference);
+  int n_levels = mode == REF_LAST ? n_all - 1 : n_all;
   PM_ENSURE(n_levels >= 1, PM_ERR_SCENE,
             "--reference last needs at least two ladder values (the last "
             "one is the reference run)");
+  if (mode == REF_FE) PM_TRY(pm_fe_load(fe_dir, &fe));
   PM_TRY(pm_mkdir_p(out_dir));
   PM_TRY(PM_ALLOC(lv, n_levels, "ladder levels"));
 
   /* The reference run comes first so each level's error is known at once. */
-  if (use_last) {
+  if (mode == REF_LAST) {
     PM_TRY(pm_path_join(ref.dir, sizeof ref.dir, out_dir, "reference"));
     PM_TRY(load_level(o, keys, n_all - 1, &s));
     if (out) fprintf(out, "reference run -> %s\n", ref.dir);
     ref.err = pm_run_scene(s, ref.dir, o->quiet, &ref.out);
     ref.error = ref.rate = NAN;
+    ref.reaction_error = ref.reaction_rate = ref.sed_error = NAN;
     pm_scene_destroy(s);
     s = NULL;
     if (ref.err != PM_SUCCESS) {
@@ -247,13 +321,19 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
       PM_FAIL(ref.err, "the reference run (%s) failed: %s", ref.dir, why);
     }
     snprintf(ref_label, sizeof ref_label, "the reference run %s", ref.dir);
-  } else if (!use_analytic) {
-    snprintf(ref.dir, sizeof ref.dir, "%s", mode);
-    snprintf(ref_label, sizeof ref_label, "the reference run %s", mode);
+  } else if (mode == REF_RUN) {
+    snprintf(ref.dir, sizeof ref.dir, "%s", o->reference);
+    snprintf(ref_label, sizeof ref_label, "the reference run %s", o->reference);
+  } else if (mode == REF_FE) {
+    const pm_fe_row *f = &fe->rows[fe->finest];
+    snprintf(ref_label, sizeof ref_label,
+             "the finite-element lattice of %s (%ld points; N = %d, %s, "
+             "CalculiX %s)",
+             fe->dir, fe->n, f->n, f->element, f->ccx_version);
   } else {
     snprintf(ref_label, sizeof ref_label, "the scene's analytic field");
   }
-  if (!use_analytic) {
+  if (mode == REF_LAST || mode == REF_RUN) {
     PM_TRY(pm_results_read(ref.dir, -1, &rn, &rx, &ru));
     PM_TRY(PM_ALLOC(work, 3 * rn, "mapped displacement"));
   }
@@ -273,16 +353,24 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
     pm_scene_destroy(s);
     s = NULL;
     L->error = L->rate = NAN;
+    L->reaction_error = L->reaction_rate = L->sed_error = NAN;
     if (L->err != PM_SUCCESS) {
       if (out) fprintf(out, "  %s\n", pm_error_message());
       if (first_fail == PM_SUCCESS) first_fail = L->err;
       continue;
     }
-    if (use_analytic)
+    if (mode == REF_ANALYTIC) {
       L->error = L->out.nrmse_vector;
-    else
+    } else if (mode == REF_FE) {
+      pm_fe_errors e;
+      PM_TRY(pm_fe_compare(fe, L->dir, &L->out, &e));
+      L->error = e.nrmse;
+      L->reaction_error = e.reaction_error;
+      L->sed_error = e.sed_error;
+    } else {
       PM_TRY(
           error_against(L->dir, L->out.fig.dim, rn, rx, ru, work, &L->error));
+    }
   }
   /* Rates: in h for a resolution ladder, else in the first key's value. */
   bool by_h = false;
@@ -290,17 +378,22 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
     if (fabs(lv[l].out.fig.h - lv[0].out.fig.h) > 1e-9 * lv[0].out.fig.h)
       by_h = true;
   double xs[PM_STUDY_MAX_LEVELS], es[PM_STUDY_MAX_LEVELS];
+  double rs[PM_STUDY_MAX_LEVELS], rate[PM_STUDY_MAX_LEVELS];
   for (int l = 0; l < n_levels; l++) {
     xs[l] = by_h ? lv[l].out.fig.h : strtod(keys[0].value[l], NULL);
     es[l] = lv[l].error;
-    if (l > 0 && xs[l] > 0 && xs[l - 1] > 0 && es[l] > 0 && es[l - 1] > 0 &&
-        xs[l] != xs[l - 1])
-      lv[l].rate = log(es[l] / es[l - 1]) / log(xs[l] / xs[l - 1]);
+    rs[l] = lv[l].reaction_error;
   }
-  double q_fit = n_levels >= 2 ? pm_convergence_rate(n_levels, xs, es) : NAN;
+  double q_fit = rates(n_levels, xs, es, rate);
+  for (int l = 0; l < n_levels; l++) lv[l].rate = rate[l];
+  double q_reaction = rates(n_levels, xs, rs, rate);
+  for (int l = 0; l < n_levels; l++) lv[l].reaction_rate = rate[l];
+  comparison cmp = {.label = ref_label,
+                    .fe = fe,
+                    .q_fit = by_h ? q_fit : NAN,
+                    .q_reaction = by_h ? q_reaction : NAN};
   PM_TRY(write_tables(out_dir, keys, o->n_keys, lv, n_levels,
-                      use_last ? &ref : NULL, ref_label, by_h ? q_fit : NAN,
-                      out));
+                      mode == REF_LAST ? &ref : NULL, &cmp, out));
   if (out && !by_h && isfinite(q_fit))
     fprintf(out, "slope of log error against log %s: %.3f\n", keys[0].key,
             q_fit);
@@ -310,6 +403,7 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
                    o->scene);
 done:
   pm_scene_destroy(s);
+  pm_fe_free(fe);
   free(keys);
   free(lv);
   free(rx);

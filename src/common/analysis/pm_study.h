@@ -1,6 +1,7 @@
 /* pm_study: a ladder of runs of one scene (a resolution or a parameter
- * ladder), each compared with the scene's analytic field or with a
- * reference run, tabulated with its wall time and the observed rate. */
+ * ladder), each compared with the scene's analytic field, a reference run
+ * or a finite-element reference, tabulated with its wall time and the
+ * observed rate. */
 #ifndef PM_STUDY_H
 #define PM_STUDY_H
 
@@ -20,9 +21,13 @@ typedef struct {
   const char *const *sets;
   int n_keys; /* ladder keys and their comma-separated values */
   const char *ladder[PM_STUDY_MAX_KEYS]; /* "key=v1,v2,..." */
-  /* NULL: "analytic" if the scene has a reference field, else "last".
-   * "analytic", "last" (the last level is the reference run), or the
-   * directory of an earlier run. */
+  /* NULL: the scene's reference.fe if it names one, else "analytic" if
+   * the scene has a reference field, else "last".  "analytic", "last"
+   * (the last level is the reference run), "fe:DIR" or a directory holding
+   * ladder.csv (a finite-element reference, pm_fe: each level's error is
+   * the NRMSE at its lattice, with the reaction and mean strain energy
+   * density errors and the reaction error's rate beside), or the directory
+   * of an earlier run. */
   const char *reference;
   const char *out_dir; /* NULL: out/NAME-convergence */
   bool quiet;

@@ -1,5 +1,6 @@
 /* pm_files: atomic output files (temporary name + rename), mkdir -p, the
- * history CSV and a small streaming JSON writer. */
+ * history CSV, a small streaming JSON writer, and a reader of text tables'
+ * data lines. */
 #include "pm_files.h"
 
 #include <errno.h>
@@ -27,6 +28,70 @@ pm_err pm_path_join(char *buf, size_t size, const char *dir, const char *name) {
            size - 1);
   return PM_SUCCESS;
 }
+
+/* ---- Reading text tables ------------------------------------------------ */
+
+pm_err pm_lines_open(pm_lines *r, const char *path, const char *what) {
+  memset(r, 0, sizeof *r);
+  r->path = path;
+  r->fp = fopen(path, "r");
+  PM_CHECK(r->fp, PM_ERR_IO, "cannot open %s '%s': %s", what, path,
+           strerror(errno));
+  return PM_SUCCESS;
+}
+
+pm_err pm_lines_next(pm_lines *r, char **text) {
+  ssize_t len;
+  *text = NULL;
+  while ((len = getline(&r->buf, &r->size, r->fp)) >= 0) {
+    r->line++;
+    while (len > 0 && strchr(" \t\r\n", r->buf[len - 1])) r->buf[--len] = '\0';
+    char *s = r->buf + strspn(r->buf, " \t");
+    if (*s == '\0' || *s == '#') continue;
+    *text = s;
+    return PM_SUCCESS;
+  }
+  PM_CHECK(!ferror(r->fp), PM_ERR_IO, "read error on '%s' after line %ld",
+           r->path, r->line);
+  return PM_SUCCESS;
+}
+
+void pm_lines_close(pm_lines *r) {
+  if (r->fp) fclose(r->fp);
+  free(r->buf);
+  r->fp = NULL;
+  r->buf = NULL;
+}
+
+static char *trim(char *s) {
+  s += strspn(s, " \t");
+  size_t len = strlen(s);
+  while (len > 0 && (s[len - 1] == ' ' || s[len - 1] == '\t')) s[--len] = '\0';
+  return s;
+}
+
+int pm_split_fields(char *s, char **fields, int max) {
+  int n = 0;
+  for (;;) {
+    char *comma = strchr(s, ',');
+    if (comma) *comma = '\0';
+    if (n == max) return max + 1;
+    fields[n++] = trim(s);
+    if (!comma) return n;
+    s = comma + 1;
+  }
+}
+
+bool pm_parse_number(const char *s, double *v) {
+  char *end;
+  s += strspn(s, " \t");
+  *v = strtod(s, &end);
+  if (end == s) return false;
+  end += strspn(end, " \t");
+  return *end == '\0';
+}
+
+/* ---- Directories -------------------------------------------------------- */
 
 /* mkdir one component; an existing directory is fine. */
 static pm_err mkdir_one(const char *path) {

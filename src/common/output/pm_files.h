@@ -1,5 +1,6 @@
 /* pm_files: output files that appear whole or not at all (write to a
- * temporary name, rename when complete), mkdir -p, history CSV, JSON writer. */
+ * temporary name, rename when complete), mkdir -p, history CSV, JSON writer,
+ * and the data lines of text tables read back with their line numbers. */
 #ifndef PM_FILES_H
 #define PM_FILES_H
 
@@ -20,6 +21,41 @@ pm_err pm_mkdir_p(const char *dir);
 /* Join dir and name as "dir/name" into buf (size bytes).  dir NULL or ""
  * gives name alone.  Fails with PM_ERR_ARG when the result does not fit. */
 pm_err pm_path_join(char *buf, size_t size, const char *dir, const char *name);
+
+/* ---- Reading text tables ---------------------------------------------- */
+
+/* The data lines of a text file, one at a time: blank lines and lines whose
+ * first non-blank character is '#' are skipped, leading blanks and trailing
+ * blanks and line ends removed.  `line` is the 1-based number of the line
+ * last returned, for messages ("FILE:LINE: ..."). */
+typedef struct {
+  FILE *fp;
+  const char *path; /* borrowed: must outlive the reader */
+  char *buf;
+  size_t size;
+  long line;
+} pm_lines;
+
+/* Open path for reading.  Fails with PM_ERR_IO naming what ("points
+ * file") and the path. */
+pm_err pm_lines_open(pm_lines *r, const char *path, const char *what);
+
+/* The next data line in *text (owned by r, valid until the next call), or
+ * NULL at the end of the file.  Fails with PM_ERR_IO on a read error. */
+pm_err pm_lines_next(pm_lines *r, char **text);
+
+/* Close the file and free the buffer (a reader never opened, zeroed, is
+ * accepted). */
+void pm_lines_close(pm_lines *r);
+
+/* Split s at commas in place into at most max fields (blanks around each
+ * trimmed).  Returns the number of fields, or max + 1 when there are
+ * more. */
+int pm_split_fields(char *s, char **fields, int max);
+
+/* A whole field as a number (surrounding blanks allowed; "nan" and "inf"
+ * are numbers).  False when the field holds anything else. */
+bool pm_parse_number(const char *s, double *v);
 
 /* ---- Atomic files ------------------------------------------------------ */
 

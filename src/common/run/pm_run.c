@@ -335,6 +335,7 @@ static void conclude(run_ctx *c, pm_err run_err) {
   int bc, comp;
   loaded_face(s, &bc, &comp);
   o->loaded_reaction = bc >= 0 ? f->reaction[bc][comp] : NAN;
+  o->loaded_axis = bc >= 0 ? comp : -1;
 }
 
 static void report(run_ctx *c) {
@@ -369,6 +370,7 @@ pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir, bool quiet,
   memset(o, 0, sizeof *o);
   for (int k = 0; k < 3; k++) o->nrmse[k] = NAN;
   o->nrmse_vector = o->loaded_reaction = NAN;
+  o->loaded_axis = -1;
   PM_TRY(PM_ALLOC(c, 1, "run context"));
   c->s = s;
   c->be = s->backend;

@@ -21,6 +21,7 @@ typedef struct {
   double loaded_reaction; /* on the loaded face: the condition with the
                              largest prescribed displacement at the end,
                              along that component (NaN if none) */
+  int loaded_axis;        /* that component (0, 1, 2; -1 if none) */
   char message[1024];     /* why it stopped, when not a success */
 } pm_outcome;
 

@@ -164,6 +164,9 @@ typedef struct pm_scene {
   } output;
   unsigned reference_mask; /* reference.displacement components given */
   pm_expr *reference[3];   /* analytic u_c(x, y, z, t) or NULL */
+  char *reference_fe;      /* reference.fe: a folder of FE reference data
+                              (cases/fe/CASE), relative to the scene's
+                              folder when given relative; NULL if none */
   /* private: the options of every registered section, and the document
    * (kept for located messages after loading) */
   void *section_opts[PM_SCENE_SECTIONS];

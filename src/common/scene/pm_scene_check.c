@@ -19,6 +19,21 @@ static pm_err finish_domain(pm_reader *r, pm_scene *s) {
   return PM_SUCCESS;
 }
 
+/* A path given relative to the scene file's folder, made usable from the
+ * working directory (an absolute path is kept). */
+static pm_err relative_to_scene(const pm_scene *s, char **path) {
+  const char *slash = strrchr(s->path, '/');
+  size_t dir = ((*path)[0] != '/' && slash) ? (size_t)(slash - s->path) : 0;
+  if (!dir) return PM_SUCCESS;
+  size_t len = dir + 1 + strlen(*path) + 1;
+  char *full = malloc(len);
+  PM_CHECK(full, PM_ERR_MEMORY, "cannot copy the path '%s'", *path);
+  snprintf(full, len, "%.*s/%s", (int)dir, s->path, *path);
+  free(*path);
+  *path = full;
+  return PM_SUCCESS;
+}
+
 /* Exactly one shape key; the shape's own checks. */
 static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
   static const char *const keys[] = {"region", "box", "sphere", "cylinder",
@@ -58,21 +73,7 @@ static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
       return pm_reader_expected(r, PM_PATH(p, "bodies.%d.cylinder.axis", i),
                                 "a non-zero vector (base to top face)");
     return PM_SUCCESS;
-  case PM_BODY_MESH: {
-    /* Relative to the scene's folder. */
-    const char *slash = strrchr(s->path, '/');
-    size_t dir = (b->mesh[0] != '/' && slash) ? (size_t)(slash - s->path) : 0;
-    size_t len = dir + 1 + strlen(b->mesh) + 1;
-    char *full = malloc(len);
-    PM_CHECK(full, PM_ERR_MEMORY, "cannot copy a mesh path");
-    if (dir)
-      snprintf(full, len, "%.*s/%s", (int)dir, s->path, b->mesh);
-    else
-      snprintf(full, len, "%s", b->mesh);
-    free(b->mesh);
-    b->mesh = full;
-    return PM_SUCCESS;
-  }
+  case PM_BODY_MESH: return relative_to_scene(s, &b->mesh);
   default: return PM_SUCCESS;
   }
 }
@@ -234,6 +235,7 @@ pm_err pm_scene_finish(pm_reader *r, pm_scene *s) {
   PM_CALL(finish_bodies(r, s));
   PM_CALL(finish_time(r, s));
   PM_CALL(finish_bcs(r, s));
+  if (s->reference_fe) PM_CALL(relative_to_scene(s, &s->reference_fe));
   s->has_gravity = pm_v_norm(s->gravity) > 0;
   return PM_SUCCESS;
 }

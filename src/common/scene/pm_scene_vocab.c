@@ -439,6 +439,11 @@ static const pm_key reference_keys[] = {
      .count_offset = S(reference_mask),
      .unit = "m",
      .doc = "analytic u(x, y, z, t): NRMSE in summary and history"},
+    {.name = "fe",
+     .type = PM_KEY_STRING,
+     .offset = S(reference_fe),
+     .doc = "a folder of finite-element reference data (cases/fe/CASE), "
+            "relative to the scene: the default referee of convergence"},
     {0}};
 
 const pm_key pm_scene_keys[] = {
@@ -512,5 +517,5 @@ const pm_key pm_scene_keys[] = {
     {.name = "reference",
      .type = PM_KEY_MAPPING,
      .keys = reference_keys,
-     .doc = "{displacement: {x, y, z}}"},
+     .doc = "{displacement: {x, y, z}, fe: DIR}"},
     {0}};

@@ -1,0 +1,85 @@
+/* pm_fe: finite-element reference solutions of the block cases, stored as
+ * text under cases/fe/CASE/ (written by tools/fe-referee.py from CalculiX
+ * runs), and the comparison of a run against one. */
+#ifndef PM_FE_H
+#define PM_FE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "pm_error.h"
+#include "pm_files.h"
+#include "pm_run.h"
+
+#define PM_FE_TEXT_MAX 32
+
+/* One mesh of the ladder (a row of ladder.csv). */
+typedef struct {
+  int n; /* N: elements per edge (2-D: per m) */
+  long nodes, dofs;
+  char element[PM_FE_TEXT_MAX]; /* CalculiX element type */
+  double h;                     /* element edge, m */
+  double reaction[3];           /* on the loaded face, N (2-D: N/m) */
+  double mean_sed;              /* strain energy / volume, J/m^3 */
+  double von_mises_centre;      /* Cauchy von Mises at the centre, Pa */
+  long increments;              /* converged load increments */
+  double wall_seconds;
+  char ccx_version[PM_FE_TEXT_MAX];
+  double load_fraction; /* share of the prescribed displacement reached */
+  bool converged;       /* reached the full load */
+} pm_fe_row;
+
+/* The relative tolerances the case is claimed converged to (tolerance.csv:
+ * the change between the two finest converged meshes, rounded up). */
+typedef struct {
+  double reaction, mean_sed, von_mises_centre, lattice_nrmse;
+} pm_fe_tolerance;
+
+typedef struct {
+  char name[PM_FE_TEXT_MAX * 2]; /* the case: the folder's name */
+  char dir[PM_PATH_MAX + 1];
+  int n_rows;
+  pm_fe_row *rows;  /* the ladder, coarsest first */
+  int finest;       /* index of the finest converged row */
+  int previous;     /* the converged row before it, -1 when none */
+  long n;           /* lattice points */
+  double *x, *u;    /* [n][3]: reference points and their displacement on
+                       the finest converged mesh (lattice.csv) */
+  int dim;          /* 2 when the lattice lies in z = 0, else 3 */
+  double centre[3]; /* the lattice's centre: where von_mises_centre is */
+  /* The finest converged row's figures. */
+  double reaction[3], mean_sed, von_mises_centre;
+  pm_fe_tolerance tolerance; /* NaN where tolerance.csv gives none */
+} pm_fe_reference;
+
+/* Read DIR/ladder.csv, DIR/lattice.csv and (when present)
+ * DIR/tolerance.csv.  Malformed files fail with PM_ERR_ARG naming the file,
+ * the line and what was expected; missing files with PM_ERR_IO.  *out is
+ * released by pm_fe_free. */
+pm_err pm_fe_load(const char *dir, pm_fe_reference **out);
+void pm_fe_free(pm_fe_reference *r);
+
+/* A lattice file (x,y,z,u_x,u_y,u_z rows under that header) into new
+ * [n][3] arrays. */
+pm_err pm_fe_read_lattice(const char *path, long *n, double **x, double **u);
+
+/* The FE folder a study reference names: "fe:DIR", or a directory holding
+ * ladder.csv.  Copies DIR into buf; false for anything else. */
+bool pm_fe_names_reference(const char *spec, char *buf, size_t size);
+
+/* A run against the reference. */
+typedef struct {
+  double nrmse;          /* displacement at the lattice (pm_nrmse_vector) */
+  double reaction_error; /* (R - R_fe) / R_fe on the loaded face, along
+                            the loaded component: > 0 when the run's
+                            reaction is the larger (the run is stiffer) */
+  double sed_error;      /* (mean SED - FE) / FE */
+} pm_fe_errors;
+
+/* Compare the run written to out_dir (its last frame, mapped onto the
+ * lattice by moving least squares) and its outcome o with r.  The
+ * reaction error is NaN when o has no loaded face. */
+pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
+                     const pm_outcome *o, pm_fe_errors *e);
+
+#endif

@@ -1,0 +1,882 @@
+#!/usr/bin/env python3
+"""Finite-element referee for the FPM block cases (F1-F4) by CalculiX.
+
+For each case and each mesh of its ladder this writes a CalculiX deck
+(structured mesh of quadratic serendipity elements, the standard
+neo-Hookean material, a nonlinear static step with automatic
+incrementation), runs ccx when asked, and reads back the reaction on the
+loaded face, the total strain energy, the Cauchy stress at the block's
+centre and the displacement at a fixed lattice of reference points.  The
+results go to cases/fe/CASE/ladder.csv (one row per mesh) and
+lattice.csv / lattice-N<k>.csv (the lattice of the finest and the
+second-finest converged mesh).
+
+    tools/fe-referee.py --all --run          # every case, every mesh
+    tools/fe-referee.py f3-extension-60 --run --ladder 2,4,8
+    tools/fe-referee.py f3-extension-60 --ladder 8   # write the deck only
+    tools/fe-referee.py --list                   # the cases
+    tools/fe-referee.py --summary                # tables of cases/fe
+
+Needs CalculiX (Debian: apt-get install calculix-ccx) and numpy.
+"""
+
+import argparse
+import datetime
+import math
+import os
+import re
+import resource
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+OUT_ROOT = os.path.join(ROOT, "cases", "fe")
+
+# ---- material and cases -----------------------------------------------------
+
+YOUNG = 3000.0  # Pa
+
+
+def moduli(nu):
+    """Shear and bulk moduli of the gel for Poisson's ratio nu."""
+    mu = YOUNG / (2.0 * (1.0 + nu))
+    kappa = YOUNG / (3.0 * (1.0 - 2.0 * nu))
+    return mu, kappa
+
+
+def case(dim, faces, load, ladder, nu=0.495, about="", increment=(0.05, 0.1),
+         mirrors=()):
+    """A case: dimension, the prescribed components per face of the part
+    solved (face -> {component: value}), the loaded face and component, the
+    mesh ladder, Poisson's ratio, a description, the first and largest load
+    increments of the static step, and the planes of symmetry (axis, plane)
+    the part solved is mirrored about to give the whole block: the part is
+    the block's side of each plane at higher coordinates."""
+    return dict(dim=dim, faces=faces, load=load, ladder=ladder, nu=nu,
+                about=about, increment=increment, mirrors=mirrors)
+
+
+LADDER_3D = [2, 4, 8, 12, 16, 20]
+LADDER_2D = [1, 2, 4, 8, 16]  # k: 10k x 4k elements
+# F2's exact state is homogeneous, which every mesh reproduces: a short
+# ladder of the whole cube checks the deck.
+LADDER_F2 = [2, 4, 8]
+
+
+# F3 and F4 are symmetric about x = 0.05 and y = 0.05: the quarter
+# x, y >= 0.05 is solved, with u_x = 0 and u_y = 0 on those planes.
+QUARTER = ((0, 0.05), (1, 0.05))
+
+
+def constrained(uz, about, **options):
+    """F3/F4: the cube with its bottom fixed and its top held laterally and
+    moved by uz (m), solved on the quarter."""
+    faces = {"zmin": {0: 0.0, 1: 0.0, 2: 0.0},
+             "zmax": {0: 0.0, 1: 0.0, 2: uz},
+             "xmin": {0: 0.0}, "ymin": {1: 0.0}}
+    return case(3, faces, ("zmax", 2), LADDER_3D, about=about,
+                mirrors=QUARTER, **options)
+
+
+SLOW = dict(increment=(0.02, 0.05))  # smaller load steps for large strains
+
+CASES = {
+    "f1-extension": case(
+        2, {"xmin": {0: 0.0, 1: 0.0}, "xmax": {0: 2.0}}, ("xmax", 0),
+        LADDER_2D, about="F1: 10 x 4 m plane-strain block, u = 0 on x = 0, "
+        "u_x = +2 m on x = 10 (20% extension)"),
+    "f1-compression": case(
+        2, {"xmin": {0: 0.0, 1: 0.0}, "xmax": {0: -2.0}}, ("xmax", 0),
+        LADDER_2D, about="F1: 10 x 4 m plane-strain block, u = 0 on x = 0, "
+        "u_x = -2 m on x = 10 (20% compression), u_y free there"),
+    "f1-compression-guided": case(
+        2, {"xmin": {0: 0.0, 1: 0.0}, "xmax": {0: -2.0, 1: 0.0}}, ("xmax", 0),
+        LADDER_2D, about="F1: 10 x 4 m plane-strain block, u = 0 on x = 0, "
+        "u_x = -2 m and u_y = 0 on x = 10 (20% compression, guided end)"),
+    "f2-unconstrained-compression": case(
+        3, {"xmin": {0: 0.0}, "ymin": {1: 0.0}, "zmin": {2: 0.0},
+            "zmax": {2: -0.04}}, ("zmax", 2), LADDER_F2,
+        about="F2: 0.1 m cube on rollers (x = 0, y = 0, z = 0), "
+        "u_z = -0.04 m on z = 0.1 (exact: homogeneous, u_z = -0.4 z)"),
+    "f3-extension-60": constrained(
+        0.06, "F3: 0.1 m cube, bottom fixed, top held laterally, "
+        "u_z = +0.06 m"),
+    "f3-extension-100": constrained(
+        0.10, "F3: as f3-extension-60 with u_z = +0.10 m"),
+    "f3-extension-200": constrained(
+        0.20, "F3: as f3-extension-60 with u_z = +0.20 m", **SLOW),
+    "f4-compression-20": constrained(
+        -0.02, "F4: as F3 with u_z = -0.02 m"),
+    "f4-compression-40": constrained(
+        -0.04, "F4: as F3 with u_z = -0.04 m", **SLOW),
+    "f4-compression-60": constrained(
+        -0.06, "F4: as F3 with u_z = -0.06 m", **SLOW),
+    "f3-extension-60-nu0.3": constrained(
+        0.06, "F3 60% with nu = 0.3", nu=0.3),
+    "f3-extension-60-nu0.45": constrained(
+        0.06, "F3 60% with nu = 0.45", nu=0.45),
+}
+
+# Block sizes: the 3-D cube and the 2-D plane-strain block.
+BOX = {3: (0.1, 0.1, 0.1), 2: (10.0, 4.0)}
+# Elements along each edge for ladder value n: the cube n x n x n, the
+# 2-D block 10n x 4n (square elements of 1/n m).
+SHAPE = {3: lambda n: (n, n, n), 2: lambda n: (10 * n, 4 * n)}
+# The lattice of reference points where displacements are reported.
+LATTICE = {3: ((0.0125,) * 3, (9, 9, 9)), 2: ((0.5, 0.5), (21, 9))}
+CENTRE = {3: (0.05, 0.05, 0.05), 2: (5.0, 2.0)}
+
+AXIS = {"x": 0, "y": 1, "z": 2}
+
+# ---- structured mesh of quadratic serendipity elements -------------------------
+
+# Local nodes as offsets (-1, 0, 1) per axis, in CalculiX's order.
+# C3D20: corners of the bottom then the top face counter-clockwise, then
+# the mid-edge nodes of the bottom face, of the top face, of the verticals.
+C3D20_LOCAL = [
+    (-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1),
+    (-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1),
+    (0, -1, -1), (1, 0, -1), (0, 1, -1), (-1, 0, -1),
+    (0, -1, 1), (1, 0, 1), (0, 1, 1), (-1, 0, 1),
+    (-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0),
+]
+# CPE8: corners counter-clockwise, then the mid-edge nodes 1-2, 2-3, 3-4,
+# 4-1.
+CPE8_LOCAL = [(-1, -1), (1, -1), (1, 1), (-1, 1),
+              (0, -1), (1, 0), (0, 1), (-1, 0)]
+
+
+class Mesh:
+    """A structured mesh of the part solved: the block, or the block's side
+    of each plane of symmetry.  Nodes lie on the half-element grid where at
+    most one index is odd (corners and mid-edge nodes)."""
+
+    def __init__(self, dim, n, mirrors=()):
+        self.dim = dim
+        self.lo = [0.0] * dim
+        self.hi = list(BOX[dim])
+        ne = list(SHAPE[dim](n))
+        self.h = self.hi[0] / ne[0]
+        for axis, plane in mirrors:
+            self.lo[axis] = plane
+            ne[axis] = int(round((self.hi[axis] - plane) / self.h))
+        self.ne = tuple(ne)
+        self.mirrors = mirrors
+        self.local = C3D20_LOCAL if dim == 3 else CPE8_LOCAL
+        grid = [2 * e + 1 for e in self.ne]
+        self.id = -np.ones(grid, dtype=np.int64)
+        idx = np.indices(grid).reshape(dim, -1).T
+        keep = (idx % 2).sum(axis=1) <= 1
+        idx = idx[keep]
+        self.id[tuple(idx.T)] = np.arange(1, len(idx) + 1)
+        self.index = idx  # grid index of node id - 1
+        self.x = np.array(self.lo) + idx * (self.h / 2.0)
+        elems = np.indices(self.ne).reshape(dim, -1).T
+        centre = 2 * elems + 1  # grid index of each element's centre
+        self.conn = np.stack(
+            [self.id[tuple((centre + np.array(o)).T)] for o in self.local],
+            axis=1)
+
+    @property
+    def n_nodes(self):
+        return len(self.x)
+
+    @property
+    def share(self):
+        """The part's share of the block's volume."""
+        return 0.5 ** len(self.mirrors)
+
+    def face(self, name):
+        """Node ids on a face of the part (xmin, ..., zmax)."""
+        k = AXIS[name[0]]
+        at = 0 if name.endswith("min") else 2 * self.ne[k]
+        return np.nonzero(self.index[:, k] == at)[0] + 1
+
+    def node_at(self, p):
+        """Id of the node at point p, or None when p is not a node."""
+        g = [(p[k] - self.lo[k]) / (self.h / 2.0) for k in range(self.dim)]
+        gi = [int(round(v)) for v in g]
+        if any(abs(v - r) > 1e-9 for v, r in zip(g, gi)):
+            return None
+        if any(r < 0 or r > 2 * e for r, e in zip(gi, self.ne)):
+            return None
+        nid = int(self.id[tuple(gi)])
+        return nid if nid > 0 else None
+
+    def displacement(self, p, u):
+        """Displacement at a reference point p of the block: p mirrored into
+        the part, interpolated there by the element's shape functions, and
+        mirrored back."""
+        q, sign = list(p), np.ones(3)
+        for axis, plane in self.mirrors:
+            if q[axis] < plane:
+                q[axis] = 2.0 * plane - q[axis]
+                sign[axis] = -1.0
+        return sign * self.interpolate(q, u)
+
+    def interpolate(self, p, u):
+        """Value at reference point p of the part of the nodal field u
+        ([nodes][c]) by the shape functions of the element holding p."""
+        e, xi = [], []
+        for k in range(self.dim):
+            t = (p[k] - self.lo[k]) / self.h
+            ek = min(max(int(math.floor(t)), 0), self.ne[k] - 1)
+            e.append(ek)
+            xi.append(2.0 * (t - ek) - 1.0)
+        centre = np.array([2 * v + 1 for v in e])
+        value = 0.0
+        for off in self.local:
+            nid = self.id[tuple(centre + np.array(off))]
+            value = value + serendipity(off, xi) * u[nid - 1]
+        return value
+
+
+def serendipity(off, xi):
+    """Shape function of the quadratic serendipity node at local offset off
+    (entries -1, 0, 1) at natural coordinates xi (2-D or 3-D)."""
+    zero = [k for k, a in enumerate(off) if a == 0]
+    if not zero:  # corner
+        prod, s = 1.0, -(len(off) - 1.0)
+        for a, x in zip(off, xi):
+            prod *= 1.0 + a * x
+            s += a * x
+        return prod * s / 2 ** len(off)
+    k = zero[0]  # mid-edge node: quadratic along axis k, linear elsewhere
+    prod = 1.0 - xi[k] ** 2
+    for j, (a, x) in enumerate(zip(off, xi)):
+        if j != k:
+            prod *= 1.0 + a * x
+    return prod / 2 ** (len(off) - 1)
+
+
+# ---- deck ----------------------------------------------------------------------
+
+
+def number(v):
+    """A real for a CalculiX field: at most 20 characters, as many digits as
+    fit (%.12e gives 19 characters for a positive exponent below 100)."""
+    for digits in (12, 11, 10):
+        s = "%.*e" % (digits, v)
+        if len(s) <= 20:
+            return s
+    raise ValueError("%r does not fit a CalculiX field" % v)
+
+
+def id_lines(ids, per_line=8):
+    """Integers as comma-separated lines of per_line entries (CalculiX
+    reads at most 16 entries a line)."""
+    ids = list(ids)
+    return "".join(",".join(str(i) for i in ids[k:k + per_line]) + ",\n"
+                   for k in range(0, len(ids), per_line))
+
+
+def model_name(mesh):
+    return {0: "whole", 1: "half", 2: "quarter"}[len(mesh.mirrors)]
+
+
+def element_type(dim, reduced):
+    if dim == 3:
+        return "C3D20R" if reduced else "C3D20"
+    return "CPE8R" if reduced else "CPE8"
+
+
+def write_deck(path, name, spec, n, mesh, reduced):
+    """Write the CalculiX input of case name on the mesh of ladder value
+    n."""
+    dim = spec["dim"]
+    mu, kappa = moduli(spec["nu"])
+    out = ["*HEADING", "%s, N = %d, %s, %s elements (%s model)" % (
+        name, n, element_type(dim, reduced), " x ".join(map(str, mesh.ne)),
+        model_name(mesh)), "*NODE"]
+    for i, p in enumerate(mesh.x):
+        c = list(p) + [0.0] * (3 - dim)
+        out.append("%d,%s,%s,%s" % (i + 1, number(c[0]), number(c[1]),
+                                    number(c[2])))
+    out.append("*ELEMENT,TYPE=%s,ELSET=EALL" % element_type(dim, reduced))
+    for e, row in enumerate(mesh.conn):
+        ids = [e + 1] + [int(v) for v in row]
+        # At most 16 entries a line: the element and 15 nodes, then the rest.
+        out.append(",".join(str(v) for v in ids[:16])
+                   + ("," if len(ids) > 16 else ""))
+        if len(ids) > 16:
+            out.append(",".join(str(v) for v in ids[16:]))
+    lines = "\n".join(out) + "\n"
+    sets = {}
+    for face in spec["faces"]:
+        sets["N" + face.upper()] = mesh.face(face)
+    sets["NALL"] = np.arange(1, mesh.n_nodes + 1)
+    sets["NCENTRE"] = [mesh.node_at(CENTRE[dim])]
+    for sname, ids in sets.items():
+        lines += "*NSET,NSET=%s\n" % sname + id_lines(ids)
+    lines += "*MATERIAL,NAME=GEL\n*HYPERELASTIC,NEO HOOKE\n"
+    # CalculiX: U = C10 (Ibar1 - 3) + (J - 1)^2 / D1.
+    lines += "%s,%s\n" % (number(mu / 2.0), number(2.0 / kappa))
+    lines += "*SOLID SECTION,ELSET=EALL,MATERIAL=GEL\n"
+    if dim == 2:
+        lines += "1.\n"  # thickness, m: results per metre of depth
+    first, largest = spec["increment"]
+    lines += "*STEP,NLGEOM,INC=10000\n*STATIC\n"
+    lines += "%g,1.,1e-7,%g\n" % (first, largest)
+    # Equilibrium to a residual of 1e-7 of the mean force and a correction
+    # of 1e-6 of the largest increment (defaults 5e-3 and 1e-2); up to 40
+    # iterations and 10 cutbacks an increment (defaults 16 and 5).
+    lines += "*CONTROLS,PARAMETERS=FIELD\n1e-7,1e-6\n"
+    lines += "*CONTROLS,PARAMETERS=TIME INCREMENTATION\n4,8,9,40,10,4,0,10\n"
+    lines += "*BOUNDARY\n"
+    for face, comps in spec["faces"].items():
+        for c, v in sorted(comps.items()):
+            lines += "N%s,%d,%d,%s\n" % (face.upper(), c + 1, c + 1, number(v))
+    load = "N" + spec["load"][0].upper()
+    # CalculiX uses one output frequency for every request of a step; the
+    # default (every increment) keeps the last converged increment of a
+    # run that stops early.  The stress goes to the .frd for the centre
+    # node only; displacements and totals to the .dat (7 digits).
+    lines += "*EL FILE,NSET=NCENTRE\nS\n"
+    lines += "*NODE PRINT,NSET=NALL\nU\n"
+    lines += "*NODE PRINT,NSET=%s,TOTALS=ONLY\nRF\n" % load
+    lines += "*END STEP\n"
+    with open(path, "w") as f:
+        f.write(lines)
+
+
+# ---- strain energy of the FE displacement field ----------------------------
+
+
+def serendipity_gradient(off, xi):
+    """Derivatives along each natural coordinate of the shape function of
+    the node at local offset off, at xi."""
+    d = len(off)
+    grad = []
+    zero = [k for k, a in enumerate(off) if a == 0]
+    for k in range(d):
+        if not zero:  # corner: prod(1 + a x) (sum(a x) - (d - 1)) / 2^d
+            prod = 1.0
+            for j in range(d):
+                prod *= 1.0 + off[j] * xi[j]
+            others = 1.0
+            for j in range(d):
+                if j != k:
+                    others *= 1.0 + off[j] * xi[j]
+            s = sum(a * x for a, x in zip(off, xi)) - (d - 1.0)
+            grad.append((off[k] * others * s + prod * off[k]) / 2 ** d)
+        else:  # mid-edge along m: (1 - x_m^2) prod_{j != m}(1 + a x) / 2^(d-1)
+            m = zero[0]
+            v = -2.0 * xi[m] if k == m else 1.0 - xi[m] ** 2
+            for j in range(d):
+                if j == m:
+                    continue
+                v *= off[j] if j == k else 1.0 + off[j] * xi[j]
+            grad.append(v / 2 ** (d - 1))
+    return grad
+
+
+def gauss_rule(points):
+    """Tensor-product Gauss rule on [-1, 1]: abscissae and weights."""
+    if points == 2:
+        a = 1.0 / math.sqrt(3.0)
+        return [-a, a], [1.0, 1.0]
+    if points == 3:
+        a = math.sqrt(0.6)
+        return [-a, 0.0, a], [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]
+    raise ValueError(points)
+
+
+def strain_energy(mesh, u, nu, reduced):
+    """Total strain energy (J; per metre of depth in 2-D) of the nodal
+    displacement u ([nodes][3]) with the element's own quadrature: 2 points
+    per direction for the reduced-integration elements, 3 for the full."""
+    mu, kappa = moduli(nu)
+    dim = mesh.dim
+    xs, ws = gauss_rule(2 if reduced else 3)
+    points = np.array(np.meshgrid(*[xs] * dim, indexing="ij")).reshape(dim, -1).T
+    weights = np.prod(np.array(np.meshgrid(*[ws] * dim, indexing="ij"))
+                      .reshape(dim, -1), axis=0)
+    ue = u[mesh.conn - 1][:, :, :dim]  # [elements][local nodes][dim]
+    jac = (mesh.h / 2.0) ** dim  # reference volume per unit natural volume
+    total = 0.0
+    for xi, w in zip(points, weights):
+        # dN/dX = dN/dxi * 2 / h on the undistorted structured mesh.
+        g = np.array([serendipity_gradient(o, xi) for o in mesh.local])
+        g *= 2.0 / mesh.h
+        F = np.tile(np.eye(3), (len(ue), 1, 1))
+        F[:, :dim, :dim] += np.einsum("eai,aj->eij", ue, g)
+        J = np.linalg.det(F)
+        I1 = np.einsum("eij,eij->e", F, F)
+        W = 0.5 * mu * (J ** (-2.0 / 3.0) * I1 - 3.0) \
+            + 0.5 * kappa * (J - 1.0) ** 2
+        total += w * jac * W.sum()
+    return total
+
+
+# ---- CalculiX output --------------------------------------------------------
+
+
+def read_dat(path):
+    """The blocks of a .dat file: a list of (title, set, time, rows), rows
+    being lists of numbers."""
+    blocks = []
+    head = re.compile(r"^\s*(.+?) for set (\S+) and time\s+(\S+)\s*$")
+    with open(path) as f:
+        for line in f:
+            m = head.match(line)
+            if m:
+                blocks.append((m.group(1), m.group(2), float(m.group(3)), []))
+            elif blocks and line.strip():
+                blocks[-1][3].append([float(v) for v in line.split()])
+    return blocks
+
+
+def last_block(blocks, title, nset):
+    found = [b for b in blocks if b[0].startswith(title) and b[1] == nset]
+    return found[-1] if found else None
+
+
+def read_frd_stress(path, node):
+    """The six Cauchy stress components (xx, yy, zz, xy, yz, zx) of the last
+    STRESS block of a .frd file at node."""
+    value, in_stress = None, False
+    with open(path) as f:
+        for line in f:
+            if line.startswith(" -4"):
+                in_stress = line.split()[1] == "STRESS"
+            elif in_stress and line.startswith(" -1"):
+                if int(line[3:13]) == node:
+                    value = [float(line[13 + 12 * k:25 + 12 * k])
+                             for k in range(6)]
+    return value
+
+
+def von_mises(s):
+    xx, yy, zz, xy, yz, zx = s
+    return math.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2)
+                     + 3.0 * (xy ** 2 + yz ** 2 + zx ** 2))
+
+
+def read_sta(path):
+    """Converged increments, total iterations and the load fraction reached
+    (the step time of the last converged increment)."""
+    increments, iterations, reached = 0, 0, 0.0
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                v = line.split()
+                if len(v) == 7 and v[0].isdigit():
+                    increments += 1
+                    iterations += int(v[3])
+                    reached = float(v[4])
+    return increments, iterations, reached
+
+
+def ccx_version():
+    try:
+        r = subprocess.run(["ccx", "-v"], capture_output=True, text=True,
+                           timeout=30)
+        m = re.search(r"Version\s+(\S+)", r.stdout + r.stderr)
+        return m.group(1) if m else "unknown"
+    except OSError:
+        return "unknown"
+
+
+# ---- one run ----------------------------------------------------------------
+
+
+def lattice_points(dim):
+    step, count = LATTICE[dim]
+    axes = [np.arange(c) * s for s, c in zip(step, count)]
+    grid = np.array(np.meshgrid(*axes, indexing="ij")).reshape(dim, -1).T
+    return grid
+
+
+def run_case(name, spec, n, reduced, work, threads):
+    """Write and run the deck of case name on mesh n; return the row of the
+    ladder and the lattice displacements (None when the run reached no
+    load)."""
+    dim = spec["dim"]
+    if dim == 3 and n % 2:
+        raise SystemExit("%s: N = %d: the centre is a node only for even N"
+                         % (name, n))
+    mesh = Mesh(dim, n, spec["mirrors"])
+    job = "%s-N%d-%s" % (name, n, element_type(dim, reduced))
+    rundir = os.path.join(work, job)
+    shutil.rmtree(rundir, ignore_errors=True)
+    os.makedirs(rundir)
+    write_deck(os.path.join(rundir, job + ".inp"), name, spec, n, mesh,
+               reduced)
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads),
+               CCX_NPROC_EQUATION_SOLVER=str(threads),
+               CCX_NPROC_RESULTS=str(threads),
+               CCX_NPROC_STIFFNESS=str(threads))
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    with open(os.path.join(rundir, "ccx.log"), "w") as log:
+        subprocess.run(["ccx", "-i", job], cwd=rundir, stdout=log,
+                       stderr=subprocess.STDOUT, env=env)
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime
+    increments, iterations, reached = read_sta(os.path.join(rundir,
+                                                            job + ".sta"))
+    converged = abs(reached - 1.0) < 1e-9
+    row = dict(N=n, nodes=mesh.n_nodes, dofs=dim * mesh.n_nodes,
+               element=element_type(dim, reduced), h=mesh.h,
+               model=model_name(mesh),
+               reaction_x=math.nan, reaction_y=math.nan, reaction_z=math.nan,
+               mean_sed=math.nan, von_mises_centre=math.nan,
+               increments=increments, iterations=iterations, wall_seconds=wall,
+               cpu_seconds=cpu, work_density=math.nan,
+               load_fraction=reached,
+               status="converged" if converged else "stopped")
+    lattice = None
+    blocks = read_dat(os.path.join(rundir, job + ".dat"))
+    disp = last_block(blocks, "displacements", "NALL")
+    load_set = "N" + spec["load"][0].upper()
+    force = last_block(blocks, "total force", load_set)
+    # The part's reactions and energy stand for the whole block's: forces
+    # scale with the block's cross-section over the part's, and components
+    # normal to a plane of symmetry cancel with their mirror images.
+    volume = np.prod(BOX[dim]) * mesh.share
+    scale = np.array([0.0 if any(a == c for a, _ in mesh.mirrors)
+                      else 1.0 / mesh.share for c in range(3)])
+    face, axis = spec["load"]
+    history = [b for b in blocks
+               if b[0].startswith("total force") and b[1] == load_set]
+    if history:
+        t = np.array([0.0] + [b[2] for b in history])
+        f = np.array([0.0] + [b[3][0][axis] for b in history])
+        row["work_density"] = (np.trapz(f, t) * spec["faces"][face][axis]
+                               / volume)
+    if disp and force and disp[2] == force[2] and disp[2] > 0:
+        row["load_fraction"] = disp[2]
+        u = np.zeros((mesh.n_nodes, 3))
+        for r in disp[3]:
+            u[int(r[0]) - 1] = r[1:4]
+        reaction = np.array(force[3][0][:3]) * scale
+        if dim == 2:
+            reaction[2] = 0.0
+        row["reaction_x"], row["reaction_y"], row["reaction_z"] = reaction
+        row["mean_sed"] = strain_energy(mesh, u, spec["nu"], reduced) / volume
+        s = read_frd_stress(os.path.join(rundir, job + ".frd"),
+                            mesh.node_at(CENTRE[dim]))
+        if s:
+            # The whole block's nodal average at the centre takes the part's
+            # with its mirror images: shear components on a plane of
+            # symmetry average to zero.
+            for k, (i, j) in enumerate(((0, 1), (1, 2), (2, 0))):
+                if any(a in (i, j) for a, _ in mesh.mirrors):
+                    s[3 + k] = 0.0
+            row["von_mises_centre"] = von_mises(s)
+        pts = lattice_points(dim)
+        lattice = np.array([mesh.displacement(p, u) for p in pts])
+        lattice = np.hstack([np.pad(pts, ((0, 0), (0, 3 - dim))), lattice])
+    return row, lattice
+
+
+# ---- ladder files -------------------------------------------------------------
+
+COLUMNS = ["N", "nodes", "dofs", "element", "h", "reaction_x", "reaction_y",
+           "reaction_z", "mean_sed", "von_mises_centre", "increments",
+           "wall_seconds", "ccx_version", "model", "iterations",
+           "cpu_seconds", "work_density", "load_fraction", "status"]
+
+
+def cell(v):
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else "%.10g" % v
+    return str(v)
+
+
+def provenance(version):
+    return "# generated by tools/fe-referee.py, CalculiX %s, %s\n" % (
+        version, datetime.date.today().isoformat())
+
+
+def describe(name, spec):
+    mu, kappa = moduli(spec["nu"])
+    dim = spec["dim"]
+    text = "# %s: %s\n" % (name, spec["about"])
+    text += ("# neo-Hookean W = mu/2 (Ibar1 - 3) + K/2 (J - 1)^2, E = %g Pa, "
+             "nu = %g (mu = %.10g Pa, K = %.10g Pa)\n" % (YOUNG, spec["nu"],
+                                                           mu, kappa))
+    if spec["mirrors"]:
+        text += ("# solved on the part x, y >= 0.05 (the block is symmetric "
+                 "about x = 0.05 and y = 0.05) with u_x = 0 and u_y = 0 on "
+                 "those planes; figures are the whole block's\n")
+    if dim == 3:
+        text += "# N: elements per edge of the cube (N x N x N); "
+    else:
+        text += "# N: elements per metre (10N x 4N plane-strain elements, " \
+                "1 m deep); "
+    text += ("h: element edge (m); dofs: %d per node; reactions (N): sum over "
+             "the nodes of %s; mean_sed: strain energy / reference volume "
+             "(J/m^3); von_mises_centre: Cauchy von Mises stress at %s (Pa); "
+             "work_density: reaction integrated over the loaded face's "
+             "displacement (trapezoids over the increments) / volume; "
+             "load_fraction: share of the prescribed displacement reached\n"
+             % (dim, spec["load"][0], str(CENTRE[dim])))
+    return text
+
+
+def write_ladder(path, header, rows):
+    with open(path + ".tmp", "w") as f:
+        f.write(header)
+        f.write(",".join(COLUMNS) + "\n")
+        for r in rows:
+            f.write(",".join(cell(r[c]) for c in COLUMNS) + "\n")
+    os.replace(path + ".tmp", path)
+
+
+def write_lattice(path, header, lattice):
+    with open(path + ".tmp", "w") as f:
+        f.write(header)
+        f.write("x,y,z,u_x,u_y,u_z\n")
+        for p in lattice:
+            f.write(",".join("%.9e" % v for v in p) + "\n")
+    os.replace(path + ".tmp", path)
+
+
+def nrmse_vector(u, ref):
+    """The root-mean-square of |u - ref| over the largest |ref| (as
+    pm_nrmse_vector in src/common/analysis/pm_metrics.c)."""
+    err = np.sqrt(np.mean(np.sum((u - ref) ** 2, axis=1)))
+    return err / np.max(np.sqrt(np.sum(ref ** 2, axis=1)))
+
+
+def claim(change):
+    """The tolerance claimed for a measured change: the next value of the
+    1-2-5 series at or above it (at least 1e-5)."""
+    change = max(abs(change), 1e-5)
+    exp = math.floor(math.log10(change))
+    for m in (1, 2, 5, 10):
+        t = m * 10.0 ** exp
+        if t >= change * (1 - 1e-12):
+            return float("%.0e" % t)
+    return 10.0 ** (exp + 1)
+
+
+def observed_order(n, d1, d2):
+    """The order p of e(N) = C N^-p for which the changes d1 (n[0] -> n[1])
+    and d2 (n[1] -> n[2]) are in the ratio observed, or None when they do
+    not shrink monotonically or are at round-off."""
+    if not (d1 * d2 > 0 and abs(d2) < abs(d1)) or abs(d2) < 1e-9:
+        return None  # not shrinking, or already at round-off
+    target = abs(d1 / d2)
+
+    def ratio(p):
+        return (n[0] ** -p - n[1] ** -p) / (n[1] ** -p - n[2] ** -p)
+
+    lo, hi = 0.05, 12.0
+    if not ratio(lo) <= target <= ratio(hi):
+        return None
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if ratio(mid) < target:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def write_tolerance(path, header, spec, rows, lattices):
+    """The change of each quantity between the two finest converged meshes,
+    the error of the finest estimated from the last three (Richardson: the
+    observed order p, then change / ((N3/N2)^p - 1)), and the tolerance
+    claimed: the next value of 1, 2, 5 x 10^k above both."""
+    comp = "reaction_" + "xyz"[spec["load"][1]]
+    done = [r for r in rows if r["status"] == "converged"][-3:]
+    n = [r["N"] for r in done]
+    fine = done[-1]
+    result = []
+    for q in ("reaction", "mean_sed", "von_mises_centre", "lattice_nrmse"):
+        if q == "lattice_nrmse":
+            lat = [lattices[k][:, 3:] for k in n]
+            # Signed changes are not defined for a field: the NRMSE of each
+            # mesh against the next stands for their size.
+            d = [nrmse_vector(lat[i], lat[i + 1]) for i in range(len(n) - 1)]
+        else:
+            key = comp if q == "reaction" else q
+            v = [r[key] for r in done]
+            d = [(v[i + 1] - v[i]) / abs(fine[key]) for i in range(len(n) - 1)]
+        change = abs(d[-1])
+        p = observed_order(n, d[0], d[1]) if len(d) == 2 else None
+        estimate = change / ((n[-1] / n[-2]) ** p - 1.0) if p else math.nan
+        worst = change if math.isnan(estimate) else max(change, estimate)
+        result.append((q, n[-1], n[-2], change, p, estimate, claim(worst)))
+    with open(path + ".tmp", "w") as f:
+        f.write(header)
+        f.write("# relative_change: between the meshes N = %d and N = %d "
+                "(lattice: NRMSE of the coarser against the finer); order: "
+                "observed over N = %s (empty when the changes do not shrink "
+                "monotonically); estimated_error: of the finest mesh, "
+                "change / ((N_finest / N_previous)^order - 1); tolerance: "
+                "the next value of 1, 2, 5 x 10^k above both\n"
+                % (n[-2], n[-1], ", ".join(str(k) for k in n)))
+        f.write("quantity,finest_N,previous_N,relative_change,order,"
+                "estimated_error,tolerance\n")
+        for q, nf, np_, c, p, e, t in result:
+            f.write("%s,%d,%d,%.4e,%s,%s,%g\n" % (
+                q, nf, np_, c, "%.3f" % p if p else "",
+                "%.4e" % e if not math.isnan(e) else "", t))
+    os.replace(path + ".tmp", path)
+    return result
+
+
+def read_csv(path):
+    """Header and rows (dicts) of a CSV file with '#' comment lines."""
+    with open(path) as f:
+        lines = [ln.rstrip("\n") for ln in f if not ln.startswith("#")]
+    head = lines[0].split(",")
+    return [dict(zip(head, ln.split(","))) for ln in lines[1:] if ln]
+
+
+def summary(folder, names):
+    """Markdown tables of the committed results: each case's ladder and the
+    change between its two finest converged meshes."""
+    out = []
+    for name in names:
+        path = os.path.join(folder, name, "ladder.csv")
+        if not os.path.exists(path):
+            continue
+        spec = CASES[name]
+        comp = "reaction_" + "xyz"[spec["load"][1]]
+        rows = read_csv(path)
+        out.append("**%s** (%s, %s model)\n" % (
+            name, rows[-1]["element"], rows[-1]["model"]))
+        out.append("| N | nodes | reaction (N%s) | mean SED (J/m^3) | von "
+                   "Mises at centre (Pa) | increments | wall (s) | CPU (s) "
+                   "| status |" % ("/m" if spec["dim"] == 2 else ""))
+        out.append("|---|---|---|---|---|---|---|---|---|")
+        for r in rows:
+            status = r["status"] if r["status"] == "converged" else \
+                "stopped at %.3g of the load" % float(r["load_fraction"])
+            out.append("| %s | %s | %.7g | %.7g | %.6g | %s | %.1f | %.1f | %s |"
+                       % (r["N"], r["nodes"], float(r[comp]),
+                          float(r["mean_sed"]), float(r["von_mises_centre"]),
+                          r["increments"], float(r["wall_seconds"]),
+                          float(r["cpu_seconds"]), status))
+        tol = os.path.join(folder, name, "tolerance.csv")
+        if os.path.exists(tol):
+            t = read_csv(tol)
+            out.append("\nChange N = %s -> %s (observed order, estimated "
+                       "error of the finest, tolerance claimed): " % (
+                           t[0]["previous_N"], t[0]["finest_N"])
+                       + ", ".join("%s %.2e (%s, %s, %s)" % (
+                           q["quantity"], float(q["relative_change"]),
+                           q["order"] or "-", q["estimated_error"] or "-",
+                           q["tolerance"]) for q in t) + ".")
+        out.append("")
+    return "\n".join(out)
+
+
+def main():
+    ap = argparse.ArgumentParser(
+        description="CalculiX referee for the FPM block cases",
+        formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+    ap.add_argument("cases", nargs="*", help="case names (see --list)")
+    ap.add_argument("--all", action="store_true", help="every case")
+    ap.add_argument("--list", action="store_true", help="list the cases")
+    ap.add_argument("--summary", action="store_true",
+                    help="print markdown tables of the results in --out")
+    ap.add_argument("--run", action="store_true",
+                    help="run ccx and write cases/fe/CASE/*.csv")
+    ap.add_argument("--ladder", help="mesh values, e.g. 2,4,8 (default: the "
+                    "case's ladder)")
+    ap.add_argument("--element", choices=["reduced", "full"],
+                    default="reduced", help="C3D20R/CPE8R (reduced, default) "
+                    "or C3D20/CPE8 (full integration)")
+    ap.add_argument("--out", default=OUT_ROOT,
+                    help="results folder (default cases/fe)")
+    ap.add_argument("--work", default=os.path.join("/tmp", "fe-referee"),
+                    help="where decks run (default /tmp/fe-referee)")
+    ap.add_argument("--threads", type=int, default=1,
+                    help="threads given to ccx (default 1)")
+    ap.add_argument("--keep", action="store_true",
+                    help="keep the run folders under --work")
+    a = ap.parse_args()
+    if a.list:
+        for name, spec in CASES.items():
+            print("%-30s %s" % (name, spec["about"]))
+        return 0
+    names = list(CASES) if a.all else a.cases
+    if a.summary:
+        print(summary(a.out, names or list(CASES)))
+        return 0
+    unknown = [n for n in names if n not in CASES]
+    if unknown or not names:
+        ap.error("name cases (or --all): %s" % ", ".join(CASES))
+    reduced = a.element == "reduced"
+    os.makedirs(a.work, exist_ok=True)
+    if not a.run:
+        for name in names:
+            spec = CASES[name]
+            ladder = [int(v) for v in a.ladder.split(",")] if a.ladder \
+                else spec["ladder"]
+            for n in ladder:
+                job = "%s-N%d-%s" % (name, n, element_type(spec["dim"],
+                                                           reduced))
+                path = os.path.join(a.work, job + ".inp")
+                write_deck(path, name, spec, n,
+                           Mesh(spec["dim"], n, spec["mirrors"]), reduced)
+                print(path)
+        return 0
+    if shutil.which("ccx") is None:
+        sys.exit("fe-referee: ccx not found (apt-get install calculix-ccx)")
+    version = ccx_version()
+    status = 0
+    for name in names:
+        spec = CASES[name]
+        ladder = [int(v) for v in a.ladder.split(",")] if a.ladder \
+            else spec["ladder"]
+        folder = os.path.join(a.out, name)
+        os.makedirs(folder, exist_ok=True)
+        header = provenance(version) + describe(name, spec)
+        rows, lattices = [], {}
+        for n in ladder:
+            row, lattice = run_case(name, spec, n, reduced, a.work, a.threads)
+            row["ccx_version"] = version
+            rows.append(row)
+            if row["status"] == "converged":
+                lattices[n] = lattice
+            print("%-30s N %3d %-7s nodes %6d  R %.7g  SED %.7g  VM %.6g  "
+                  "W %.6g  inc %3d  wall %7.1f s  %s %.4g" % (
+                      name, n, row["element"], row["nodes"],
+                      row["reaction_" + "xyz"[spec["load"][1]]],
+                      row["mean_sed"], row["von_mises_centre"],
+                      row["work_density"], row["increments"],
+                      row["wall_seconds"], row["status"],
+                      row["load_fraction"]), flush=True)
+            write_ladder(os.path.join(folder, "ladder.csv"), header, rows)
+            if not a.keep:
+                shutil.rmtree(os.path.join(a.work, "%s-N%d-%s" % (
+                    name, n, row["element"])), ignore_errors=True)
+        done = [r for r in rows if r["status"] == "converged"]
+        for old in os.listdir(folder):
+            if old.startswith("lattice") or old == "tolerance.csv":
+                os.remove(os.path.join(folder, old))
+        # A referee needs two meshes at the full load to say how far it is
+        # converged; otherwise the ladder alone records what was reached.
+        if len(done) < 2:
+            print("%s: %d mesh(es) reached the full load: no referee, the "
+                  "ladder only" % (name, len(done)))
+            status = 1
+            continue
+        fine, prev = done[-1], done[-2]
+        for row, path in ((fine, "lattice.csv"),
+                          (prev, "lattice-N%d.csv" % prev["N"])):
+            write_lattice(os.path.join(folder, path),
+                          header + "# lattice of the mesh N = %d (%s)\n"
+                          % (row["N"], row["element"]), lattices[row["N"]])
+        result = write_tolerance(os.path.join(folder, "tolerance.csv"), header,
+                                 spec, rows, lattices)
+        for q, nf, np_, c, p, e, t in result:
+            print("%-30s %-18s change N %d -> %d: %.3e, order %s, estimated "
+                  "error %.3e (tolerance %g)"
+                  % (name, q, np_, nf, c, "%.2f" % p if p else "-", e, t))
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
