@@ -182,17 +182,9 @@ static pm_err run(void *p, const pm_observer *obs) {
   double stage[2] = {0, 0};
   pm_err e;
   if (s->time.qs == PM_QS_STATIC) {
-    fpm_static_options so = {
-        .tolerance = s->time.qs_tolerance,
-        .load_steps = (int)s->time.qs_load_steps,
-        .max_iterations = (int)s->time.qs_max_iterations,
-        .linear = (pm_newton_linear)s->time.qs_linear,
-        .petsc_options = s->time.qs_solver_options,
-        .min_jacobian = s->stability.min_jacobian,
-    };
     fpm_static_report *r = &sim->static_report;
     double w0 = pm_wtime();
-    e = fpm_static_run(m, sim->state, &so, observe, sim, &sim->last, r);
+    e = fpm_static_run(m, sim->state, observe, sim, &sim->last, r);
     double wall = pm_wtime() - w0;
     sim->obs = NULL;
     pm_stage *tm = sim->timers.stage;
@@ -379,7 +371,6 @@ static pm_err summary(void *p, pm_json *j) {
     const fpm_static_report *r = &sim->static_report;
     PM_CALL(pm_json_integer(j, "static_unknowns", r->unknowns));
     PM_CALL(pm_json_integer(j, "static_jacobian_entries", r->pattern_entries));
-    PM_CALL(pm_json_integer(j, "static_colors", r->colors));
     PM_CALL(pm_json_integer(j, "static_load_steps", r->load.steps));
     PM_CALL(pm_json_integer(j, "static_cuts", r->load.cuts));
     PM_CALL(pm_json_integer(j, "static_newton_iterations",

@@ -7,6 +7,18 @@
 
 #include "pm_omp.h"
 
+/* Ainv (m x m) = V diag(1/lam) V^T from LAPACKE_dsyev's eigenvectors V
+ * (columns, row-major in A) and eigenvalues lam. */
+static void inverse_from_eigen(int m, const double *A, const double *lam,
+                               double *Ainv) {
+  for (int r = 0; r < m; r++)
+    for (int c = 0; c < m; c++) {
+      double v = 0;
+      for (int k = 0; k < m; k++) v += A[m * r + k] * A[m * c + k] / lam[k];
+      Ainv[m * r + c] = v;
+    }
+}
+
 /* The scaled moment matrix of point i's support (dim x dim, row-major,
  * eigenvalues summing to 1): sum_k w_ik d_k d_k^T / sum_k w_ik with
  * w_ik = 1/|X_k - X_i|^2 and d_k = X_k - X_i, or, with u, the deformed
@@ -65,12 +77,8 @@ pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
       }
       continue;
     }
-    /* A^-1 = V diag(1/lam) V^T (columns of V are eigenvectors). */
-    double Ainv[9] = {0};
-    for (int a = 0; a < dim; a++)
-      for (int b = 0; b < dim; b++)
-        for (int m = 0; m < dim; m++)
-          Ainv[dim * a + b] += A[dim * a + m] * A[dim * b + m] / lam[m];
+    double Ainv[9];
+    inverse_from_eigen(dim, A, lam, Ainv);
     for (long e = nbr_ptr[i]; e < nbr_ptr[i + 1]; e++) {
       const double *xk = x + 3 * nbr[e];
       double d[3] = {xk[0] - xi[0], xk[1] - xi[1], xk[2] - xi[2]};
@@ -143,6 +151,15 @@ long fpm_gfd_deformed_condition(int dim, long n, const double *x,
   return count;
 }
 
+/* The basis of the quadratic fit at the offset of xk from xi scaled by s,
+ * into phi; returns the offset's weight 1/|d|^2. */
+static double scaled_basis(const double *xi, const double *xk, double s,
+                           double phi[FPM_QFIT]) {
+  double d[3] = {(xk[0] - xi[0]) / s, (xk[1] - xi[1]) / s, (xk[2] - xi[2]) / s};
+  fpm_gfd_phi(d, phi);
+  return 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
 /* One point's quadratic fit: fills q for its support and returns the
  * condition number (infinite when unusable, q then zero). */
 static double quadratic_fit(int dim, long i, const double *x,
@@ -167,11 +184,7 @@ static double quadratic_fit(int dim, long i, const double *x,
   s /= (double)(e_end - b);
   double A[81] = {0}, lam[9], phi[FPM_QFIT];
   for (long e = b; e < e_end; e++) {
-    const double *xk = x + 3 * nbr[e];
-    double d[3] = {(xk[0] - xi[0]) / s, (xk[1] - xi[1]) / s,
-                   (xk[2] - xi[2]) / s};
-    double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    fpm_gfd_phi(d, phi);
+    const double w = scaled_basis(xi, x + 3 * nbr[e], s, phi);
     for (int r = 0; r < m; r++)
       for (int c = 0; c < m; c++)
         A[m * r + c] += w * phi[slot[r]] * phi[slot[c]];
@@ -179,17 +192,10 @@ static double quadratic_fit(int dim, long i, const double *x,
   int info = LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', m, A, m, lam);
   if (info != 0 || !(lam[0] > 0)) return INFINITY;
   const double cond = lam[m - 1] / lam[0];
-  double Ainv[81] = {0};
-  for (int r = 0; r < m; r++)
-    for (int c = 0; c < m; c++)
-      for (int k = 0; k < m; k++)
-        Ainv[m * r + c] += A[m * r + k] * A[m * c + k] / lam[k];
+  double Ainv[81];
+  inverse_from_eigen(m, A, lam, Ainv);
   for (long e = b; e < e_end; e++) {
-    const double *xk = x + 3 * nbr[e];
-    double d[3] = {(xk[0] - xi[0]) / s, (xk[1] - xi[1]) / s,
-                   (xk[2] - xi[2]) / s};
-    double w = 1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    fpm_gfd_phi(d, phi);
+    const double w = scaled_basis(xi, x + 3 * nbr[e], s, phi);
     for (int r = 0; r < m; r++) {
       double v = 0;
       for (int c = 0; c < m; c++) v += Ainv[m * r + c] * w * phi[slot[c]];
@@ -200,9 +206,11 @@ static double quadratic_fit(int dim, long i, const double *x,
 }
 
 void fpm_gfd_quadratic(int dim, long n, const double *x, const long *nbr_ptr,
-                       const long *nbr, double *q, double *cond) {
+                       const long *nbr, const unsigned char *select, double *q,
+                       double *cond) {
   PM_OMP(parallel for schedule(dynamic, 256) default(none)
-         shared(n, x, nbr_ptr, nbr, q, cond, dim))
+         shared(n, x, nbr_ptr, nbr, select, q, cond, dim))
   for (long i = 0; i < n; i++)
-    cond[i] = quadratic_fit(dim, i, x, nbr_ptr, nbr, q);
+    if (!select || select[i])
+      cond[i] = quadratic_fit(dim, i, x, nbr_ptr, nbr, q);
 }

@@ -64,8 +64,11 @@ static inline void fpm_gfd_phi(const double d[3], double phi[FPM_QFIT]) {
  * support's mean distance; cond[i] receives the condition number of its
  * scaled moment matrix (infinite when the support has fewer points than
  * unknowns or LAPACKE fails; the weights of such a point are zero).
- * nbr_ptr/nbr is any support (it need not be the interface adjacency). */
+ * nbr_ptr/nbr is any support (it need not be the interface adjacency).
+ * With select non-NULL only the points where select[i] is set are fitted
+ * (the others' q and cond are left as they are). */
 void fpm_gfd_quadratic(int dim, long n, const double *x, const long *nbr_ptr,
-                       const long *nbr, double *q, double *cond);
+                       const long *nbr, const unsigned char *select, double *q,
+                       double *cond);
 
 #endif

@@ -215,22 +215,22 @@ static pm_err build_quadratic(fpm_model *m) {
   pm_err ret = PM_SUCCESS;
   const long n = m->n, nnz = m->nnz;
   const int unknowns = m->dim == 2 ? 5 : 9;
-  double *q1 = NULL, *c1 = NULL;
-  long *nbr1 = NULL, *wide = NULL, *ring = NULL, *nbrq = NULL;
+  const long *nbr = m->dual->nbr;
+  double *q1 = NULL, *cond = NULL;
+  long *ring = NULL, *nbrq = NULL, *fill = NULL;
+  unsigned char *wide = NULL;
   const long cap = 4096;
   PM_TRY(PM_ALLOC(q1, FPM_QFIT * nnz, "quadratic fit weights"));
-  PM_TRY(PM_ALLOC(c1, n, "quadratic fit conditions"));
-  PM_TRY(PM_ALLOC(nbr1, nnz, "support"));
-  for (long e = 0; e < nnz; e++) nbr1[e] = m->nbr[e];
-  fpm_gfd_quadratic(m->dim, n, m->x, m->nbr_ptr, nbr1, q1, c1);
+  PM_TRY(PM_ALLOC(cond, n, "quadratic fit conditions"));
+  fpm_gfd_quadratic(m->dim, n, m->x, m->nbr_ptr, nbr, NULL, q1, cond);
   /* Which points need their two rings, and the fit supports' sizes. */
-  PM_TRY(PM_ALLOC(wide, n + 1, "quadratic fit rings"));
+  PM_TRY(PM_ALLOC(wide, n, "quadratic fit rings"));
   PM_TRY(PM_ALLOC(ring, cap, "two rings"));
   PM_TRY(PM_ALLOC(m->qs_ptr, n + 1, "quadratic fit supports"));
   m->n_qwide = 0;
   for (long i = 0; i < n; i++) {
     long cnt = m->nbr_ptr[i + 1] - m->nbr_ptr[i];
-    wide[i] = cnt < unknowns + 3 || !(c1[i] <= QFIT_COND_NARROW);
+    wide[i] = cnt < unknowns + 3 || !(cond[i] <= QFIT_COND_NARROW);
     if (wide[i]) {
       cnt = two_rings(m, i, ring, cap);
       m->n_qwide++;
@@ -245,21 +245,26 @@ static pm_err build_quadratic(fpm_model *m) {
   PM_TRY(PM_ALLOC(m->qs_own, nq, "quadratic fit owners"));
   PM_TRY(PM_ALLOC(m->q, FPM_QFIT * nq, "quadratic fit weights"));
   PM_TRY(PM_ALLOC(m->qsum, FPM_QFIT * n, "quadratic fit sums"));
+  /* A narrow point keeps its first fit; a wide one is fitted again over
+   * its two rings. */
   for (long i = 0; i < n; i++) {
     long b = m->qs_ptr[i];
     if (wide[i]) {
       long c = two_rings(m, i, ring, cap);
       for (long a = 0; a < c; a++) nbrq[b + a] = ring[a];
-    } else
-      for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
-        nbrq[b + e - m->nbr_ptr[i]] = m->nbr[e];
+      continue;
+    }
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+      long f = b + e - m->nbr_ptr[i];
+      nbrq[f] = nbr[e];
+      for (int a = 0; a < FPM_QFIT; a++)
+        m->q[FPM_QFIT * f + a] = q1[FPM_QFIT * e + a];
+    }
   }
-  /* Refit every point over its final support (one pass; narrow points
-   * repeat their first fit). */
-  fpm_gfd_quadratic(m->dim, n, m->x, m->qs_ptr, nbrq, m->q, c1);
+  fpm_gfd_quadratic(m->dim, n, m->x, m->qs_ptr, nbrq, wide, m->q, cond);
   m->n_qlinear = 0;
   for (long i = 0; i < n; i++) {
-    if (!(c1[i] <= QFIT_COND_MAX)) {
+    if (!(cond[i] <= QFIT_COND_MAX)) {
       /* No usable quadratic: the point's linear GFD field, its support
        * being part of the fit support (both sorted). */
       m->n_qlinear++;
@@ -267,7 +272,7 @@ static pm_err build_quadratic(fpm_model *m) {
       for (long e = m->qs_ptr[i]; e < m->qs_ptr[i + 1]; e++)
         for (int a = 0; a < FPM_QFIT; a++) m->q[FPM_QFIT * e + a] = 0;
       for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
-        while (nbrq[f] != m->nbr[e]) f++;
+        while (nbrq[f] != nbr[e]) f++;
         for (int a = 0; a < 3; a++) m->q[FPM_QFIT * f + a] = m->g[3 * e + a];
       }
     }
@@ -281,17 +286,18 @@ static pm_err build_quadratic(fpm_model *m) {
   /* Transpose: the entries whose neighbour is each point. */
   PM_TRY(PM_ALLOC(m->qt_ptr, n + 1, "quadratic fit transpose"));
   PM_TRY(PM_ALLOC(m->qt_entry, nq, "quadratic fit transpose"));
+  PM_TRY(PM_ALLOC(fill, n, "quadratic fit transpose"));
   for (long e = 0; e < nq; e++) m->qt_ptr[m->qs_nbr[e] + 1]++;
   for (long i = 0; i < n; i++) m->qt_ptr[i + 1] += m->qt_ptr[i];
-  for (long i = 0; i < n; i++) wide[i] = m->qt_ptr[i];
-  for (long e = 0; e < nq; e++) m->qt_entry[wide[m->qs_nbr[e]]++] = (int)e;
+  for (long i = 0; i < n; i++) fill[i] = m->qt_ptr[i];
+  for (long e = 0; e < nq; e++) m->qt_entry[fill[m->qs_nbr[e]]++] = (int)e;
 done:
   free(q1);
-  free(c1);
-  free(nbr1);
+  free(cond);
   free(wide);
   free(ring);
   free(nbrq);
+  free(fill);
   return ret;
 }
 

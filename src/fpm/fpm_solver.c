@@ -71,6 +71,38 @@ double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
   return lam > 0 ? 2 / sqrt(lam) : INFINITY;
 }
 
+void fpm_support_start(const fpm_model *m, fpm_state *st) {
+  for (long k = 0; k < m->n_cdofs; k++)
+    st->support_prev[k] = st->f[3 * m->cd_point[k] + m->cd_comp[k]];
+  for (long k = 0; k < 3 * m->n_dpts; k++)
+    st->support_prev[m->n_cdofs + k] = st->bflux[k];
+}
+
+double fpm_support_work(const fpm_model *m, fpm_state *st, const double *du,
+                        double scale, double *rr) {
+  double work = 0, r2 = 0;
+  double *prev = st->support_prev, *prev_b = prev + m->n_cdofs;
+  for (long k = 0; k < m->n_cdofs; k++) {
+    long dof = 3 * m->cd_point[k] + m->cd_comp[k];
+    r2 += st->f[dof] * st->f[dof];
+    work += 0.5 * (prev[k] + st->f[dof]) * du[dof] * scale;
+    prev[k] = st->f[dof];
+  }
+  for (long p = 0; p < m->n_dpts; p++)
+    for (int a = 0; a < 3; a++) {
+      const double fb = st->bflux[3 * p + a];
+      work +=
+          0.5 * (prev_b[3 * p + a] + fb) * du[3 * m->dpt_point[p] + a] * scale;
+      prev_b[3 * p + a] = fb;
+    }
+  for (long k = 0; k < m->n_tfacets; k++)
+    for (int a = 0; a < 3; a++)
+      work += st->tf_value[3 * k + a] * m->tf_area[k] *
+              du[3 * m->tf_point[k] + a] * scale;
+  if (rr) *rr = r2;
+  return work;
+}
+
 double fpm_energy_error(const fpm_step_info *s) {
   return pm_energy_error(0, s->kinetic + s->strain + s->penalty, s->dissipated,
                          s->external_work);
@@ -132,10 +164,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   fpm_update_tractions(m, st, 0);
   long bad = fpm_force(m, st);
   if (bad >= 0) return unstable(m, st, 0, 0, dt, bad, 0);
-  for (long k = 0; k < m->n_cdofs; k++)
-    st->support_prev[k] = st->f[3 * m->cd_point[k] + m->cd_comp[k]];
-  for (long k = 0; k < 3 * m->n_dpts; k++)
-    st->support_prev[m->n_cdofs + k] = st->bflux[k];
+  fpm_support_start(m, st);
 
   fpm_step_info si = {0};
   /* The initial state, as a frame. */
@@ -216,28 +245,11 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     /* The supports' force on the body is the boundary consistency flux
      * plus the force left on prescribed dofs; its work (trapezoidal rule
      * over the step), and that of the tractions, give the external work. */
-    double rr = 0;
-    double *prev = st->support_prev, *prev_b = prev + m->n_cdofs;
-    for (long k = 0; k < m->n_cdofs; k++) {
-      long dof = 3 * m->cd_point[k] + m->cd_comp[k];
-      rr += st->f[dof] * st->f[dof];
-      ext_work += 0.5 * (prev[k] + st->f[dof]) * st->v[dof] * dt;
-      prev[k] = st->f[dof];
-    }
-    for (long p = 0; p < m->n_dpts; p++)
-      for (int a = 0; a < 3; a++) {
-        const double fb = st->bflux[3 * p + a];
-        ext_work += 0.5 * (prev_b[3 * p + a] + fb) *
-                    st->v[3 * m->dpt_point[p] + a] * dt;
-        prev_b[3 * p + a] = fb;
-      }
+    double rr;
+    ext_work += fpm_support_work(m, st, st->v, dt, &rr);
     /* The damping force c m (v_old + v_new) / 2 does work c m v_mid^2 dt
      * (exactly what the update takes from the kinetic energy). */
     dissipated += c * sd * dt;
-    for (long k = 0; k < m->n_tfacets; k++)
-      for (int a = 0; a < 3; a++)
-        ext_work += st->tf_value[3 * k + a] * m->tf_area[k] *
-                    st->v[3 * m->tf_point[k] + a] * dt;
     if (opt->qs == PM_QS_DYNAMIC_RELAXATION && s2 > 0) {
       double w2r = (s3 - s1) / s2;
       if (w2r > 0 && isfinite(w2r)) c = 2 * sqrt(w2r);

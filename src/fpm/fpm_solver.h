@@ -65,6 +65,17 @@ double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
  * signed, 0 when nothing moves). */
 double fpm_energy_error(const fpm_step_info *s);
 
+/* The supports' forces (force on prescribed dofs, boundary consistency
+ * flux) of the state, remembered as the start of the next increment. */
+void fpm_support_start(const fpm_model *m, fpm_state *st);
+
+/* Work of the supports over an increment du * scale (trapezoidal rule
+ * between the remembered forces and the state's, which are remembered
+ * next) and of the current tractions; *rr (may be NULL) receives the sum of
+ * the squared forces on prescribed dofs. */
+double fpm_support_work(const fpm_model *m, fpm_state *st, const double *du,
+                        double scale, double *rr);
+
 /* Reaction force: sum of f over the prescribed dofs of boundary condition
  * b, per component (3). */
 void fpm_reaction(const fpm_model *m, const fpm_state *st, int b, double R[3]);

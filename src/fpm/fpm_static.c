@@ -43,7 +43,6 @@ typedef struct {
   const long *pat_ptr;
   const long *free_of;
   fpm_linear *lin;
-  const fpm_static_options *opt;
   long nf;       /* free dofs */
   long *dof;     /* nf: their dof index */
   double *du;    /* 3 n work */
@@ -121,7 +120,7 @@ static pm_err set_load(void *ctx, double lambda) {
  * by the trapezoidal rule from the last converged state. */
 static void figures(static_ctx *c, long step) {
   const fpm_model *m = c->m;
-  const fpm_state *st = c->st;
+  fpm_state *st = c->st;
   const long n = m->n;
   double se = 0, rf = 0, jmin = INFINITY;
   for (long i = 0; i < n; i++) {
@@ -130,27 +129,10 @@ static void figures(static_ctx *c, long step) {
     for (int a = 0; a < 3; a++)
       if (!m->fixed[3 * i + a]) rf += st->f[3 * i + a] * st->f[3 * i + a];
   }
-  double rr = 0, *prev = st->support_prev, *prev_b = prev + m->n_cdofs;
-  for (long k = 0; k < m->n_cdofs; k++) {
-    long dof = 3 * m->cd_point[k] + m->cd_comp[k];
-    rr += st->f[dof] * st->f[dof];
-    c->ext_work += 0.5 * (prev[k] + st->f[dof]) * (st->u[dof] - c->u_old[dof]);
-    prev[k] = st->f[dof];
-  }
-  for (long p = 0; p < m->n_dpts; p++)
-    for (int a = 0; a < 3; a++) {
-      const long dof = 3 * m->dpt_point[p] + a;
-      const double fb = st->bflux[3 * p + a];
-      c->ext_work +=
-          0.5 * (prev_b[3 * p + a] + fb) * (st->u[dof] - c->u_old[dof]);
-      prev_b[3 * p + a] = fb;
-    }
-  for (long k = 0; k < m->n_tfacets; k++)
-    for (int a = 0; a < 3; a++) {
-      const long dof = 3 * m->tf_point[k] + a;
-      c->ext_work += st->tf_value[3 * k + a] * m->tf_area[k] *
-                     (st->u[dof] - c->u_old[dof]);
-    }
+  /* c->u_old becomes the increment, then the new state */
+  for (long d = 0; d < 3 * n; d++) c->u_old[d] = st->u[d] - c->u_old[d];
+  double rr;
+  c->ext_work += fpm_support_work(m, st, c->u_old, 1, &rr);
   memcpy(c->u_old, st->u, 3 * n * sizeof(double));
   double ref = sqrt(rr) + st->bflux_norm + st->fext_norm;
   fpm_step_info *si = &c->si;
@@ -178,11 +160,12 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
   if (bad >= 0) return inadmissible(c, bad);
   figures(c, step);
   c->si.converged = lambda >= 1;
-  if (c->si.min_jacobian <= c->opt->min_jacobian)
+  const double jlim = c->m->scene->stability.min_jacobian;
+  if (c->si.min_jacobian <= jlim)
     return PM_ERROR(PM_ERR_UNSTABLE,
                     "load step %d (lambda %.6g): smallest volume ratio J = "
                     "%g <= stability.min_jacobian = %g",
-                    step, lambda, c->si.min_jacobian, c->opt->min_jacobian);
+                    step, lambda, c->si.min_jacobian, jlim);
   return c->observer ? c->observer(c->octx, c->m, c->st, &c->si, true)
                      : PM_SUCCESS;
 }
@@ -733,11 +716,22 @@ static double force_floor(const fpm_model *m) {
   return 1e-12 * emax * diag2;
 }
 
-pm_err fpm_static_run(const fpm_model *m, fpm_state *st,
-                      const fpm_static_options *opt, fpm_observer observer,
+/* The solver layer's name for the scene's linear solver. */
+static pm_newton_linear linear_solver(pm_linear_solver l) {
+  switch (l) {
+  case PM_LINEAR_GMRES_GAMG: return PM_NEWTON_GMRES_GAMG;
+  case PM_LINEAR_CG_JACOBI: return PM_NEWTON_CG_JACOBI;
+  case PM_LINEAR_GMRES_ILU: return PM_NEWTON_GMRES_ILU;
+  case PM_LINEAR_DIRECT: break;
+  }
+  return PM_NEWTON_DIRECT;
+}
+
+pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
                       void *ctx, fpm_step_info *info, fpm_static_report *rep) {
   pm_err ret = PM_SUCCESS;
-  solve_t v = {.c = {.opt = opt, .observer = observer, .octx = ctx}};
+  solve_t v = {.c = {.observer = observer, .octx = ctx}};
+  const pm_scene *s = m->scene;
   static_ctx *c = &v.c;
   pm_newton *solver = NULL;
   memset(rep, 0, sizeof *rep);
@@ -754,26 +748,22 @@ pm_err fpm_static_run(const fpm_model *m, fpm_state *st,
     ret = inadmissible(c, bad);
     goto done;
   }
-  for (long k = 0; k < m->n_cdofs; k++)
-    st->support_prev[k] = st->f[3 * m->cd_point[k] + m->cd_comp[k]];
-  for (long k = 0; k < 3 * m->n_dpts; k++)
-    st->support_prev[m->n_cdofs + k] = st->bflux[k];
+  fpm_support_start(m, st);
   figures(c, 0);
   if (observer) PM_TRY(observer(ctx, m, st, &c->si, true));
 
   pm_newton_options no = pm_newton_options_default();
-  no.rtol = opt->tolerance;
+  no.rtol = s->time.qs_tolerance;
   no.atol = force_floor(m);
-  no.max_iter = opt->max_iterations;
-  no.linear = opt->linear;
-  no.load_steps = opt->load_steps;
+  no.max_iter = (int)s->time.qs_max_iterations;
+  no.linear = linear_solver(s->time.qs_linear);
+  no.load_steps = (int)s->time.qs_load_steps;
   no.predictor = true;
-  no.petsc_options = opt->petsc_options;
+  no.petsc_options = s->time.qs_solver_options;
   /* SIPG: the assembled tangent lacks the adjoint term's derivative; it
    * preconditions the exact tangent applied matrix-free. */
   if (m->flux == FPM_FLUX_SIPG) no.op = PM_NEWTON_MATRIX_FREE;
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
-  rep->colors = pm_newton_colors(solver);
   rep->setup_seconds = pm_wtime() - w0;
   ret = pm_load_steps(solver, v.x, &rep->load);
 done:

@@ -11,31 +11,23 @@
 #include "fpm_solver.h"
 #include "pm_newton.h"
 
-typedef struct {
-  double tolerance;   /* the residual figure of fpm_step_info to reach */
-  int load_steps;     /* nominal load steps */
-  int max_iterations; /* Newton iterations per load step */
-  pm_newton_linear linear;
-  const char *petsc_options; /* may be NULL */
-  double min_jacobian;       /* stop when some J <= this */
-} fpm_static_options;
-
 /* What the static solve did, beside the step figures. */
 typedef struct {
   pm_load_report load;  /* steps, cuts, iterations, times */
-  int colors;           /* Jacobian colours (applications per assembly) */
   long unknowns;        /* free dofs */
   long pattern_entries; /* stored Jacobian entries */
-  double setup_seconds; /* pattern, colouring, PETSc objects */
+  double setup_seconds; /* pattern, tangent geometry, PETSc objects */
 } fpm_static_report;
 
-/* Solve from rest.  observer sees the initial state (step 0) and every
- * converged load step as a frame (step = load step, t = lambda t_load).
- * On failure returns the error of pm_load_steps (PM_ERR_NOT_CONVERGED,
- * PM_ERR_UNSTABLE) with a message naming the load step, the load factor
- * and the cause; info then holds the last converged step's figures. */
-pm_err fpm_static_run(const fpm_model *m, fpm_state *st,
-                      const fpm_static_options *opt, fpm_observer observer,
+/* Solve from rest with the settings of the model's scene
+ * (time.quasi_static: tolerance, load_steps, max_iterations, linear_solver,
+ * solver_options; stability.min_jacobian).  observer sees the initial state
+ * (step 0) and every converged load step as a frame (step = load step, t =
+ * lambda t_load). On failure returns the error of pm_load_steps
+ * (PM_ERR_NOT_CONVERGED, PM_ERR_UNSTABLE) with a message naming the load step,
+ * the load factor and the cause; info then holds the last converged step's
+ * figures. */
+pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
                       void *ctx, fpm_step_info *info, fpm_static_report *rep);
 
 /* Checks of the directly assembled tangent at the state u (3 n, prescribed

@@ -76,6 +76,14 @@ static void fixture_free(fixture *fx) {
   free(fx);
 }
 
+/* The model of the fixture's scene and a state for it. */
+static void fixture_model(fixture *fx, fpm_model **m, fpm_state **st) {
+  assert_int_equal(
+      fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, m),
+      PM_SUCCESS);
+  assert_int_equal(fpm_state_create(*m, st), PM_SUCCESS);
+}
+
 /* u = H X + c for a fixed H: the GFD gradient equals H at every point. */
 static void test_gfd_linear(void **state) {
   (void)state;
@@ -83,10 +91,7 @@ static void test_gfd_linear(void **state) {
     fixture *fx = fixture_new(dim, dim == 3 ? 0.025 : 0.01, 0, false);
     fpm_model *m;
     fpm_state *st;
-    assert_int_equal(
-        fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, &m),
-        PM_SUCCESS);
-    assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+    fixture_model(fx, &m, &st);
     double H[9] = {0.3, -0.2, 0.1, 0.05, -0.4, 0.2, -0.1, 0.15, 0.25};
     if (dim == 2) H[2] = H[5] = H[6] = H[7] = H[8] = 0;
     for (long i = 0; i < m->n; i++)
@@ -117,10 +122,7 @@ static void check_homogeneous(double penalty) {
   fixture *fx = fixture_new(3, h, penalty, false);
   fpm_model *m;
   fpm_state *st;
-  assert_int_equal(
-      fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, &m),
-      PM_SUCCESS);
-  assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+  fixture_model(fx, &m, &st);
   double H[9] = {0.3, -0.2, 0.1, 0.05, -0.4, 0.2, -0.1, 0.15, 0.25};
   for (long i = 0; i < m->n; i++)
     for (int a = 0; a < 3; a++)
@@ -216,10 +218,7 @@ static void test_patch_f2(void **state) {
       if (k >= 3) fx->opt.jump = FPM_JUMP_QUADRATIC;
       fpm_model *m;
       fpm_state *st;
-      assert_int_equal(
-          fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, &m),
-          PM_SUCCESS);
-      assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+      fixture_model(fx, &m, &st);
       double lat[2];
       assert_int_equal(pm_material_uniaxial(&m->mats[0], m->mstate, 0.6, lat),
                        PM_SUCCESS);
@@ -287,10 +286,7 @@ static void test_sipg_is_gradient(void **state) {
     fx->opt.jump = k == 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
     fpm_model *m;
     fpm_state *st;
-    assert_int_equal(
-        fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, &m),
-        PM_SUCCESS);
-    assert_int_equal(fpm_state_create(m, &st), PM_SUCCESS);
+    fixture_model(fx, &m, &st);
     long nd = 3 * m->n;
     double *u0 = calloc(nd, sizeof *u0), *d = calloc(nd, sizeof *d);
     smooth_plus_rough(m, 12345, 0.1, 2e-4, u0, d);
@@ -325,10 +321,7 @@ static fixture *variant(double h, int k, fpm_model **m, fpm_state **st) {
   fixture *fx = fixture_new(3, h, 20, true);
   fx->opt.flux = k & 1 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
   fx->opt.jump = k & 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
-  assert_int_equal(
-      fpm_model_create(&fx->scene, &fx->opt, fx->mesh, fx->dual, m),
-      PM_SUCCESS);
-  assert_int_equal(fpm_state_create(*m, st), PM_SUCCESS);
+  fixture_model(fx, m, st);
   return fx;
 }
 
