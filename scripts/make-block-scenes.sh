@@ -15,6 +15,17 @@ write() { # case percent displacement h size
   # The finite-element referee (cases/fe); F4 60% has none: the FE runs
   # stop between 28% and 35% compression, where the free surface folds
   # over the clamped edges.
+  # The penalty: small, on the quadratic jump.  F4 60% takes p = 1: at p
+  # = 0.05 and 0.2 the IIPG flux's relaxation creates energy and a point
+  # by the clamped edge inverts at about 57% compression (t = 0.88 s).
+  penalty=0.05
+  penalty_note=""
+  if [ "$case_id-$pct" = f4-60 ]; then
+    penalty=1
+    penalty_note="
+# At 60% compression p = 0.05 and 0.2 are too little: the relaxation gains
+# energy and a point by the clamped edge inverts near 57%; p = 1 holds."
+  fi
   if [ "$case_id-$pct" = f4-60 ]; then
     about="errors are measured against the dense
 # run at h = 2.79e-3 m mapped by moving least squares (see README)."
@@ -43,7 +54,12 @@ bodies: [{material: gel, region: domain}]
 boundary:
   - {on: zmin, displacement: {x: 0, y: 0, z: 0}}
   - {on: zmax, displacement: {x: 0, y: 0, z: $disp}, ramp: smooth}
-fpm: {penalty: 20}
+# The penalty measures the jump of each point's quadratic fit, and is
+# small: the paper's linear jump at p = 20 makes this near-incompressible
+# block 18-28% too stiff against FE (the jump penalty's consistency error,
+# amplified sixfold near incompressibility).  The paper's formulation:
+# --set fpm.jump=linear --set fpm.penalty=20.$penalty_note
+fpm: {jump: quadratic, penalty: $penalty}
 time:
   end: 40.0
   ramp: 1.0

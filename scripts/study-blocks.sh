@@ -5,13 +5,17 @@
 # mapped by moving least squares.  REFERENCE=fe compares the four
 # resolutions with the case's finite-element referee (cases/fe/CASE)
 # instead, without the dense run, and adds the reaction and strain energy
-# errors.  Writes out/study-CASE-FLUX/convergence.{md,csv}.
+# errors.  Writes out/study-CASE-TAG/convergence.{md,csv}.
 #   scripts/study-blocks.sh [BUILD_DIR] [CASE ...]
 #   CASE: f3-extension-60 f3-extension-100 f3-extension-200
 #         f4-compression-20 f4-compression-40 f4-compression-60
-# FLUX (default sipg), PENALTY (default 100 for sipg, 20 for iipg), RULE
-# (default spectral) and SAFETY (default 0.5) choose the formulation and
-# step; the paper's own is FLUX=iipg PENALTY=20 RULE=paper SAFETY=0.9.
+# FORMULATION chooses the flux, jump and penalty (TAG is its name):
+#   scene  the scenes' own (default): IIPG, quadratic jump, p = 0.05
+#   paper  the FPM paper's: IIPG, linear jump, p = 20
+#   sipg   symmetric: SIPG, linear jump, p = 100
+# QS=static solves each state by Newton's method instead of dynamic
+# relaxation (TAG gets -static).  SIZES overrides the ladder of gmsh
+# element sizes (comma-separated).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -19,20 +23,33 @@ shift || true
 cases=("$@")
 [ ${#cases[@]} -gt 0 ] || cases=(f3-extension-60 f3-extension-100
   f3-extension-200 f4-compression-20 f4-compression-40 f4-compression-60)
-flux=${FLUX:-sipg}
-if [ "$flux" = sipg ]; then penalty=${PENALTY:-100}; else penalty=${PENALTY:-20}; fi
+tag=${FORMULATION:-scene}
+case $tag in
+scene) form=() ;;
+paper) form=(--set fpm.jump=linear --set fpm.penalty=20) ;;
+sipg)
+  form=(--set fpm.flux=sipg --set fpm.jump=linear --set fpm.penalty=100
+    --set time.dt_rule=spectral --set time.dt_safety=0.5)
+  ;;
+*)
+  echo "FORMULATION: expected scene, paper or sipg, got $tag" >&2
+  exit 1
+  ;;
+esac
+if [ "${QS:-}" = static ]; then
+  form+=(--set time.quasi_static.method=static)
+  tag=$tag-static
+fi
 for c in "${cases[@]}"; do
   if [ "${REFERENCE:-last}" = fe ]; then
     ref=(--reference "fe:cases/fe/$c")
-    sizes=8.72e-3,6.42e-3,4.15e-3,2.98e-3
+    sizes=${SIZES:-8.72e-3,6.42e-3,4.15e-3,2.98e-3}
   else
     ref=(--reference last)
-    sizes=8.72e-3,6.42e-3,4.15e-3,2.98e-3,2.15e-3
+    sizes=${SIZES:-8.72e-3,6.42e-3,4.15e-3,2.98e-3,2.15e-3}
   fi
   "$build/pointmech" convergence "cases/fpm/$c-h1.09e-2.yaml" --quiet \
-    --set fpm.flux="$flux" --set fpm.penalty="$penalty" \
-    --set time.dt_rule="${RULE:-spectral}" --set time.dt_safety="${SAFETY:-0.5}" \
-    --set output.every=1000000 "${ref[@]}" \
+    "${form[@]}" --set output.every=1000000 "${ref[@]}" \
     --set-ladder discretization.mesh_size=$sizes \
-    --out "${STUDY_OUT:-out}/study-$c-$flux"
+    --out "${STUDY_OUT:-out}/study-$c-$tag"
 done

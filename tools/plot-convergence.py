@@ -21,8 +21,17 @@ reaction_error), a third:
                          referee's own meshes beside it: each mesh's
                          reaction against the finest's, at its wall time.
 
+Given several CSVs (the same case by several formulations or solvers),
+one picture of what accuracy costs instead:
+
+  PREFIX-cost.png        the displacement error and (when the tables have
+                         it) the |reaction error| against wall time, one
+                         line per CSV (--labels names them), with the
+                         referee's meshes (--fe) on the reaction panel.
+
 The reference row (status "reference") and rows without a positive error
-are left out.  PREFIX defaults to the CSV path without ".csv".
+are left out.  PREFIX defaults to the CSV path without ".csv" (with
+several CSVs: "accuracy-cost" in the current folder).
 """
 import argparse
 import csv
@@ -171,19 +180,73 @@ def plot_reaction_time(rows, fe, title, out):
     plt.close(fig)
 
 
+def plot_cost(tables, labels, fe, title, out):
+    reaction = any(math.isfinite(num(r.get("reaction_error")))
+                   for _, rows in tables for r in rows)
+    fig, axes = plt.subplots(1, 2 if reaction else 1,
+                             figsize=(11 if reaction else 6, 4.5),
+                             squeeze=False)
+    panels = [("error", "displacement error (NRMSE)")]
+    if reaction:
+        panels.append(("reaction_error", "relative reaction error"))
+    for ax, (col, ylabel) in zip(axes[0], panels):
+        for (_, rows), label in zip(tables, labels):
+            pts = [(num(r["wall_seconds"]), abs(num(r.get(col))))
+                   for r in rows]
+            pts = [p for p in pts if p[0] > 0 and p[1] > 0]
+            if pts:
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-",
+                        label=label)
+        if col == "reaction_error" and fe:
+            data = [p for p in fe if p[0] > 0 and p[1] > 0]
+            ax.plot([p[0] for p in data], [p[1] for p in data], "ks--",
+                    label="FE meshes (against the finest)")
+            for w, e, n in data:
+                ax.annotate(f"N = {n}", (w, e), textcoords="offset points",
+                            xytext=(5, 5), fontsize=8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set(xlabel="wall time (s)", ylabel=ylabel, title=title)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("csv", metavar="CSV", help="convergence.csv to plot")
+    ap.add_argument("csv", metavar="CSV", nargs="+",
+                    help="convergence.csv to plot (several: one cost picture)")
     ap.add_argument("--out-prefix", metavar="PREFIX",
                     help="output prefix (default: CSV path without .csv)")
     ap.add_argument("--fe", metavar="DIR",
                     help="the finite-element referee's folder (cases/fe/CASE)"
                     " for its own points on the reaction plot")
+    ap.add_argument("--labels", metavar="A,B,...",
+                    help="names of the CSVs' lines on the cost picture "
+                    "(default: their folders)")
+    ap.add_argument("--title", help="title (default: the CSV's folder)")
     a = ap.parse_args()
-    keys, rows = read_table(a.csv)
     fe = fe_points(a.fe) if a.fe else []
+    if len(a.csv) > 1:
+        labels = (a.labels.split(",") if a.labels else
+                  [os.path.basename(os.path.dirname(os.path.abspath(c)))
+                   for c in a.csv])
+        if len(labels) != len(a.csv):
+            fail(f"--labels names {len(labels)} lines for {len(a.csv)} CSVs")
+        tables = [read_table(c) for c in a.csv]
+        out = f"{a.out_prefix or 'accuracy-cost'}-cost.png"
+        try:
+            plot_cost(tables, labels, fe, a.title or "accuracy and cost", out)
+        except OSError as e:
+            fail(f"{e.filename or out}: cannot write: {e.strerror or e}")
+        print(out)
+        return
+    a.csv = a.csv[0]
+    keys, rows = read_table(a.csv)
     prefix = a.out_prefix or (a.csv[:-4] if a.csv.endswith(".csv") else a.csv)
-    title = os.path.basename(os.path.dirname(os.path.abspath(a.csv)))
+    title = a.title or os.path.basename(os.path.dirname(os.path.abspath(a.csv)))
     outs = [f"{prefix}-error-h.png", f"{prefix}-error-time.png"]
     reaction = any(math.isfinite(num(r.get("reaction_error"))) for r in rows)
     if reaction:

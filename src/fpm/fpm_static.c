@@ -644,6 +644,7 @@ typedef struct {
   static_ctx c;
   long *free_of, *ptr, *idx;
   double *x;
+  double *rigid; /* the rigid motions on the free dofs (for multigrid) */
   pm_newton_problem prob;
 } solve_t;
 
@@ -658,6 +659,36 @@ static void solve_free(solve_t *v) {
   free(v->ptr);
   free(v->idx);
   free(v->x);
+  free(v->rigid);
+}
+
+/* The rigid motions of the body restricted to the free dofs: translations
+ * along each axis and rotations about the centroid (3 and 3 in 3D; x, y
+ * and the rotation about z in 2D), into rigid (count x nf). */
+static int rigid_modes(const fpm_model *m, const long *dof, long nf,
+                       double *rigid) {
+  double c[3] = {0, 0, 0};
+  for (long i = 0; i < m->n; i++)
+    for (int a = 0; a < 3; a++) c[a] += m->x[3 * i + a] / (double)m->n;
+  /* rotation about axis r: u = e_r x (x - c) */
+  const int rots3[3] = {0, 1, 2}, rots2[1] = {2};
+  const int nt = m->dim, nr = m->dim == 3 ? 3 : 1;
+  const int *rots = m->dim == 3 ? rots3 : rots2;
+  for (long j = 0; j < nf; j++) {
+    const long i = dof[j] / 3;
+    const int comp = (int)(dof[j] % 3);
+    const double *x = m->x + 3 * i;
+    for (int t = 0; t < nt; t++) rigid[t * nf + j] = comp == t ? 1 : 0;
+    for (int q = 0; q < nr; q++) {
+      const int r = rots[q], a = (r + 1) % 3, b = (r + 2) % 3;
+      /* (e_r x d)_a = -d_b, (e_r x d)_b = d_a */
+      double val = 0;
+      if (comp == a) val = -(x[b] - c[b]);
+      if (comp == b) val = x[a] - c[a];
+      rigid[(nt + q) * nf + j] = val;
+    }
+  }
+  return nt + nr;
 }
 
 static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
@@ -686,6 +717,8 @@ static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
   c->pat_ptr = v->ptr;
   c->free_of = v->free_of;
   PM_CALL(tangent_build(m, &c->tg));
+  PM_CALL(PM_ALLOC(v->rigid, 6 * c->nf, "rigid motions"));
+  const int n_rigid = rigid_modes(m, c->dof, c->nf, v->rigid);
   v->prob = (pm_newton_problem){.n = c->nf,
                                 .ctx = c,
                                 .residual = residual,
@@ -694,6 +727,8 @@ static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
                                 .jacobian_values = tangent_values,
                                 .pat_ptr = v->ptr,
                                 .pat_idx = v->idx,
+                                .near_null_count = n_rigid,
+                                .near_null = v->rigid,
                                 .set_load = set_load,
                                 .on_step = on_step};
   return PM_SUCCESS;

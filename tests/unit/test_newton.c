@@ -617,6 +617,28 @@ static void test_linear_solvers(void **state) {
       assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
       assert_true(rep.iterations <= 12);
     }
+  /* Near-null vectors for multigrid (a constant, a dependent copy that is
+   * dropped, a ramp): the same solution. */
+  double *nn = malloc(3 * (size_t)ch.n * sizeof *nn);
+  assert_non_null(nn);
+  for (long i = 0; i < ch.n; i++) {
+    nn[i] = 1;
+    nn[ch.n + i] = 2;
+    nn[2 * ch.n + i] = (double)i;
+  }
+  prob.near_null_count = 3;
+  prob.near_null = nn;
+  pm_newton_options opt = pm_newton_options_default();
+  opt.rtol = 1e-10;
+  opt.linear = PM_NEWTON_GMRES_GAMG;
+  pm_newton_report rep;
+  assert_ok(chain_solve(&ch, &prob, &opt, &rep));
+  print_message("gmres-gamg with 3 near-null vectors: %d Newton, %d linear "
+                "iterations, error %.1e\n",
+                rep.iterations, rep.linear_iterations,
+                chain_error(&ch, ch.x, 1));
+  assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+  free(nn);
   free(tri_ptr);
   free(tri_idx);
   chain_free(&ch);
@@ -789,8 +811,11 @@ static void test_load_steps_cut(void **state) {
   chain_free(&ch);
 }
 
-/* Too few Newton iterations for the whole load at once: the step is cut
- * until it converges, and the predictor saves iterations. */
+/* Too few Newton iterations for the whole load at once: without the
+ * predictor the step is cut until it converges; with it, the first step
+ * starts from the tangent predictor (the linear response to the load
+ * increment), which leaves Newton only the nonlinear remainder: no cut
+ * and fewer iterations. */
 static void test_load_steps_iterations(void **state) {
   (void)state;
   chain ch;
@@ -809,11 +834,11 @@ static void test_load_steps_iterations(void **state) {
     print_message("max_iter 4, %s: %d steps, %d cuts, %d Newton iterations\n",
                   predictor ? "predictor" : "no predictor", rep.steps, rep.cuts,
                   rep.newton_iterations);
-    assert_true(rep.cuts >= 1);
+    assert_true(predictor ? rep.cuts == 0 : rep.cuts >= 1);
     assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
     iterations[predictor] = rep.newton_iterations;
   }
-  assert_true(iterations[1] <= iterations[0]);
+  assert_true(iterations[1] < iterations[0]);
   chain_free(&ch);
 }
 

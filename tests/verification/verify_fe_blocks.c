@@ -1,17 +1,22 @@
-/* Verification of the comparison with the finite-element referee: case F3
- * 60% (constrained extension) at the coarsest paper resolution is run as
- * the program runs it, and its reaction, mean strain energy density and
- * displacement are set against the CalculiX reference its scene names
- * (reference.fe: cases/fe/f3-extension-60).  The figures are printed; what
- * is asserted is that the comparison works (the FE figures are finite, the
- * run's displacement maps onto the FE lattice), not how close the run
- * comes. */
+/* Verification against the finite-element referee: cases F3 60/100/200%
+ * (constrained extension) and F4 20% (compression) at the paper's coarsest
+ * resolution, h = 1.09e-2 m (1851 points), run as the program runs their
+ * scenes (IIPG, quadratic jump, p = 0.05, dynamic relaxation), and set
+ * against the CalculiX references they name (cases/fe: 20-node hexahedra,
+ * N = 20).  Asserted:
+ *  - the top reaction within 2% of FE for F3 and 5% for F4 20% (whose FE
+ *    force is itself uncertain by about 4%: the free surface folds over
+ *    the clamped edges);
+ *  - the displacement NRMSE at the FE lattice at or below the FPM paper's
+ *    figures for this h (1.11e-2, 1.28e-2, 1.63e-2 against its dense run),
+ *    for F3.  F4 20%'s NRMSE is printed beside the paper's 8.59e-3. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,16 +41,22 @@ static void remove_run(const char *dir) {
   rmdir(dir);
 }
 
-static void test_f3_60(void **state) {
-  (void)state;
+typedef struct {
+  const char *scene;
+  double reaction_tol; /* |reaction error| bound */
+  double nrmse_paper;  /* the paper's NRMSE at this h */
+  bool nrmse_asserted;
+} fe_case;
+
+static void check_case(const fe_case *c) {
   pm_scene *s = NULL;
   pm_fe_reference *fe = NULL;
   pm_outcome o;
   pm_fe_errors e;
-  char dir[] = "/tmp/verify_fe_blocks.XXXXXX";
+  char dir[] = "/tmp/verify_fe_blocks.XXXXXX", path[512];
   if (!mkdtemp(dir)) fail_msg("cannot create a temporary folder");
-  if (pm_scene_load(CASES "f3-extension-60-h1.09e-2.yaml", 0, NULL, &s) !=
-      PM_SUCCESS)
+  snprintf(path, sizeof path, CASES "%s", c->scene);
+  if (pm_scene_load(path, 0, NULL, &s) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
   assert_non_null(s->reference_fe);
   if (pm_fe_load(s->reference_fe, &fe) != PM_SUCCESS)
@@ -57,32 +68,51 @@ static void test_f3_60(void **state) {
     fail_msg("%s", pm_error_message());
   const pm_fe_row *f = &fe->rows[fe->finest];
   assert_int_equal(o.loaded_axis, 2);
-  print_message("F3 60%%, h = 1.09e-2 m: %ld points, %ld steps, wall %.1f s\n",
-                o.fig.points, o.fig.steps, o.fig.wall_seconds);
-  print_message("  FE referee %s: N = %d, %s, %ld nodes, CalculiX %s\n",
-                fe->dir, f->n, f->element, f->nodes, f->ccx_version);
-  print_message("  reaction on the loaded face (z): FPM %.6g N, FE %.6g N, "
-                "error %+.2f%%\n",
-                o.loaded_reaction, fe->reaction[2], 100 * e.reaction_error);
-  print_message("  mean strain energy density: FPM %.6g J/m^3, FE %.6g J/m^3, "
+  print_message("%s: %ld points, %ld steps, wall %.1f s; FE N = %d %s\n",
+                c->scene, o.fig.points, o.fig.steps, o.fig.wall_seconds, f->n,
+                f->element);
+  print_message("  top reaction: FPM %.6g N, FE %.6g N, error %+.2f%% "
+                "(bound %.0f%%)\n",
+                o.loaded_reaction, fe->reaction[2], 100 * e.reaction_error,
+                100 * c->reaction_tol);
+  print_message("  mean strain energy density: FPM %.6g, FE %.6g J/m^3, "
                 "error %+.2f%%\n",
                 o.fig.mean_sed, fe->mean_sed, 100 * e.sed_error);
-  print_message("  displacement NRMSE at the %ld FE lattice points: %.4e\n",
-                fe->n, e.nrmse);
-  /* The machinery, not the formulation's accuracy. */
-  assert_true(isfinite(fe->reaction[2]) && fe->reaction[2] > 0);
-  assert_true(isfinite(fe->mean_sed) && fe->mean_sed > 0);
-  assert_true(isfinite(e.reaction_error));
-  assert_true(isfinite(e.sed_error));
-  assert_true(isfinite(e.nrmse) && e.nrmse > 0 && e.nrmse < 1);
+  print_message("  displacement NRMSE at the %ld FE lattice points: %.3e "
+                "(paper %.3e%s)\n",
+                fe->n, e.nrmse, c->nrmse_paper,
+                c->nrmse_asserted ? ", bound" : ", not asserted");
+  assert_true(isfinite(e.reaction_error) && isfinite(e.nrmse));
+  assert_true(fabs(e.reaction_error) <= c->reaction_tol);
+  if (c->nrmse_asserted) assert_true(e.nrmse <= c->nrmse_paper);
   pm_fe_free(fe);
   pm_scene_destroy(s);
   remove_run(dir);
 }
 
+static void test_f3_60(void **state) {
+  (void)state;
+  check_case(&(fe_case){"f3-extension-60-h1.09e-2.yaml", 0.02, 1.11e-2, 1});
+}
+static void test_f3_100(void **state) {
+  (void)state;
+  check_case(&(fe_case){"f3-extension-100-h1.09e-2.yaml", 0.02, 1.28e-2, 1});
+}
+static void test_f3_200(void **state) {
+  (void)state;
+  check_case(&(fe_case){"f3-extension-200-h1.09e-2.yaml", 0.02, 1.63e-2, 1});
+}
+static void test_f4_20(void **state) {
+  (void)state;
+  check_case(&(fe_case){"f4-compression-20-h1.09e-2.yaml", 0.05, 8.59e-3, 0});
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_f3_60),
+      cmocka_unit_test(test_f3_100),
+      cmocka_unit_test(test_f3_200),
+      cmocka_unit_test(test_f4_20),
   };
   if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);

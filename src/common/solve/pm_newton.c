@@ -97,6 +97,22 @@ const pm_newton_options *pm_newton_options_of(const pm_newton *s) {
 int pm_newton_colors(const pm_newton *s) { return s ? s->jcol.ncolors : 0; }
 int pm_newton_pc_colors(const pm_newton *s) { return s ? s->pcol.ncolors : 0; }
 
+static pm_err copy_in(Vec v, const double *x, long n) {
+  double *a;
+  PM_PETSC_CALL(VecGetArray(v, &a));
+  memcpy(a, x, (size_t)n * sizeof *a);
+  PM_PETSC_CALL(VecRestoreArray(v, &a));
+  return PM_SUCCESS;
+}
+
+static pm_err copy_out(Vec v, double *x, long n) {
+  const double *a;
+  PM_PETSC_CALL(VecGetArrayRead(v, &a));
+  memcpy(x, a, (size_t)n * sizeof *a);
+  PM_PETSC_CALL(VecRestoreArrayRead(v, &a));
+  return PM_SUCCESS;
+}
+
 /* ---- Colouring assembly ------------------------------------------------ */
 
 /* vals (pattern order) = J(x) by one application of f per colour. */
@@ -533,6 +549,49 @@ static pm_err configure_snes(pm_newton *s) {
   return PM_SUCCESS;
 }
 
+/* The problem's near-null vectors, orthonormalised (modified Gram-Schmidt;
+ * a vector dependent on the earlier ones is dropped), as M's near null
+ * space. */
+static pm_err set_near_null(pm_newton *s, Mat M) {
+  pm_err ret = PM_SUCCESS;
+  const long n = s->p.n;
+  const int k = s->p.near_null_count;
+  Vec v[16];
+  int m = 0;
+  MatNullSpace ns = NULL;
+  PM_CHECK(k <= 16, PM_ERR_ARG,
+           "Newton problem: %d near-null vectors (at "
+           "most 16)",
+           k);
+  for (int a = 0; a < k; a++) {
+    double *w;
+    PetscReal norm0, norm;
+    PM_PETSC(VecDuplicate(s->X, &v[m]));
+    PM_TRY(copy_in(v[m], s->p.near_null + (size_t)a * n, n));
+    PM_PETSC(VecNorm(v[m], NORM_2, &norm0));
+    for (int b = 0; b < m; b++) {
+      PetscScalar dot;
+      PM_PETSC(VecDot(v[m], v[b], &dot));
+      PM_PETSC(VecAXPY(v[m], -dot, v[b]));
+    }
+    PM_PETSC(VecNorm(v[m], NORM_2, &norm));
+    if (!(norm > 1e-10 * norm0)) {
+      VecDestroy(&v[m]);
+      continue;
+    }
+    PM_PETSC(VecGetArray(v[m], &w));
+    for (long i = 0; i < n; i++) w[i] /= norm;
+    PM_PETSC(VecRestoreArray(v[m], &w));
+    m++;
+  }
+  PM_PETSC(MatNullSpaceCreate(PETSC_COMM_SELF, PETSC_FALSE, m, v, &ns));
+  PM_PETSC(MatSetNearNullSpace(M, ns));
+done:
+  MatNullSpaceDestroy(&ns);
+  for (int b = 0; b < m; b++) VecDestroy(&v[b]);
+  return ret;
+}
+
 static pm_err create_petsc_objects(pm_newton *s) {
   PetscInt n = (PetscInt)s->p.n;
   PM_PETSC_CALL(VecCreateSeq(PETSC_COMM_SELF, n, &s->X));
@@ -546,6 +605,9 @@ static pm_err create_petsc_objects(pm_newton *s) {
   } else {
     PM_CALL(create_matrix(&s->jpat, &s->jcols, s->jvals, &s->J));
   }
+  if (s->p.near_null_count > 0)
+    PM_CALL(set_near_null(s, s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P
+                                                                       : s->J));
   if (s->o.op != PM_NEWTON_ASSEMBLED) {
     PM_PETSC_CALL(MatCreateShell(PETSC_COMM_SELF, n, n, n, n, s, &s->Shell));
     PM_PETSC_CALL(
@@ -597,6 +659,7 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
   PM_TRY(PM_ALLOC(s->seed, n, "colour seed"));
   PM_TRY(PM_ALLOC(s->dr, n, "colour image"));
   PM_TRY(create_petsc_objects(s));
+  s->p.near_null = NULL; /* the caller's: read once, above */
   *out = s;
   s = NULL;
 done:
@@ -636,22 +699,6 @@ void pm_newton_destroy(pm_newton **sp) {
 }
 
 /* ---- Solving ----------------------------------------------------------- */
-
-static pm_err copy_in(Vec v, const double *x, long n) {
-  double *a;
-  PM_PETSC_CALL(VecGetArray(v, &a));
-  memcpy(a, x, (size_t)n * sizeof *a);
-  PM_PETSC_CALL(VecRestoreArray(v, &a));
-  return PM_SUCCESS;
-}
-
-static pm_err copy_out(Vec v, double *x, long n) {
-  const double *a;
-  PM_PETSC_CALL(VecGetArrayRead(v, &a));
-  memcpy(x, a, (size_t)n * sizeof *a);
-  PM_PETSC_CALL(VecRestoreArrayRead(v, &a));
-  return PM_SUCCESS;
-}
 
 /* The reason, status and message of a finished SNESSolve. */
 static pm_err classify(pm_newton *s, pm_newton_report *rep) {
@@ -795,6 +842,54 @@ done:
   if (copy_out(s->Xacc, x, n) != PM_SUCCESS && ret == PM_SUCCESS)
     ret = pm_error_code();
   rep->time_total = pm_wtime() - t0;
+  s->rep = NULL;
+  return ret;
+}
+
+pm_err pm_newton_tangent_solve(pm_newton *s, const double *x, const double *b,
+                               double *dx, pm_newton_report *rep) {
+  pm_err ret = PM_SUCCESS;
+  long n = s->p.n;
+  Mat A = s->o.op == PM_NEWTON_ASSEMBLED ? s->J : s->Shell;
+  Mat B = s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P : s->J;
+  KSPConvergedReason kr;
+  s->rep = rep;
+  s->hard = PM_SUCCESS;
+  s->jacobians = 0;
+  PM_TRY(copy_in(s->X, x, n));
+  PM_TRY(copy_in(s->Work, b, n));
+  PM_PETSC(PetscOptionsPush(s->opts));
+  PetscErrorCode code = snes_jacobian(s->snes, s->X, A, B, s);
+  if (!code) code = KSPSetOperators(s->ksp, A, B);
+  if (!code) {
+    linear_presolve(s->ksp, s->Work, s->R, s);
+    code = KSPSolve(s->ksp, s->Work, s->R);
+    if (s->in_linear) linear_postsolve(s->ksp, s->Work, s->R, s);
+  }
+  PetscOptionsPop();
+  if (s->hard != PM_SUCCESS) {
+    ret = pm_error_trace(s->hard, __FILE__, __LINE__, __func__,
+                         "the tangent of a load step's predictor");
+    goto done;
+  }
+  if (code) {
+    /* A failed factorisation leaves the solver unusable: replace it. */
+    PetscErrorCode cause;
+    const char *what = pm_petsc_last_message(&cause);
+    ret = PM_ERROR(PM_ERR_NOT_CONVERGED, "the predictor's linear solve: %s",
+                   what);
+    (void)replace_linear(s);
+    goto done;
+  }
+  PM_PETSC(KSPGetConvergedReason(s->ksp, &kr));
+  if (kr < 0) {
+    ret = PM_ERROR(PM_ERR_NOT_CONVERGED, "the predictor's linear solve: %s",
+                   KSPConvergedReasons[kr]);
+    if (kr == KSP_DIVERGED_PC_FAILED) (void)replace_linear(s);
+    goto done;
+  }
+  PM_TRY(copy_out(s->R, dx, n));
+done:
   s->rep = NULL;
   return ret;
 }

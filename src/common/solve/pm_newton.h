@@ -94,6 +94,13 @@ typedef struct {
   const long *pc_pat_ptr;
   const long *pc_pat_idx;
 
+  /* Vectors (near_null_count of n values each, one after the other) the
+   * Jacobian nearly annihilates -- for a solid, its rigid motions -- given
+   * to algebraic multigrid (gmres-gamg) to build its coarse spaces from.
+   * Copied by pm_newton_create.  Optional (0, NULL). */
+  int near_null_count;
+  const double *near_null;
+
   /* Load stepping only (pm_load_steps); NULL otherwise. */
   pm_err (*set_load)(void *ctx, double lambda);
   /* After each converged load step (step counts from 1, lambda the load
@@ -173,7 +180,11 @@ typedef struct {
   int grow_after;     /* after this many converged steps in a row at a cut
                          step, double it (up to the nominal); 0 never: 2 */
   bool predictor;     /* start each step from the linear extrapolation of
-                         the last two converged states: false */
+                         the last two converged states, or where there are
+                         not two (the first step) from the tangent
+                         predictor: xc + dx with J(xc) dx = -(r(xc) + the
+                         change of r over the step linearised in the
+                         load), one extra linear solve: false */
 
   /* PETSc options for this solver's SNES, KSP, PC, line search and the
    * objects PETSc makes inside them (factor matrices, multigrid levels),

@@ -14,4 +14,11 @@ const pm_newton_options *pm_newton_options_of(const pm_newton *s);
 pm_err pm_newton_solve_from(pm_newton *s, double *x, const double *x_start,
                             double r_ref, pm_newton_report *report);
 
+/* dx solves J(x) dx = b, with J assembled at x (jacobian_prepare there
+ * first) and the solver's linear solver; for the tangent predictor of a
+ * load step.  Times go to rep (required).  A linear solver failure is
+ * PM_ERR_NOT_CONVERGED. */
+pm_err pm_newton_tangent_solve(pm_newton *s, const double *x, const double *b,
+                               double *dx, pm_newton_report *rep);
+
 #endif
