@@ -12,7 +12,6 @@
 #include "gm_cells.h"
 #include "pm_files.h"
 #include "pm_omp.h"
-#include "pm_petsc.h"
 #include "pm_tensor.h"
 
 void fpm_sim_destroy(fpm_sim *sim) {
@@ -76,10 +75,6 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   }
   sim->dt = s->time.dt > 0 ? s->time.dt : s->time.dt_safety * sim->dt_stable;
   pm_timers_stop(&sim->timers, sim->tm_operators);
-  /* PETSc starts MPI, which may start a helper process; it must not
-   * inherit the run's open files (results.h5's lock would outlive the
-   * run), so a static solve starts PETSc before the output is opened. */
-  if (s->time.qs == PM_QS_STATIC) PM_TRY(pm_petsc_init());
   sim->setup_wall = pm_wtime() - t0;
   *out = sim;
   sim = NULL;

@@ -129,10 +129,9 @@ static void figures(static_ctx *c, long step) {
     for (int a = 0; a < 3; a++)
       if (!m->fixed[3 * i + a]) rf += st->f[3 * i + a] * st->f[3 * i + a];
   }
-  /* c->u_old becomes the increment, then the new state */
-  for (long d = 0; d < 3 * n; d++) c->u_old[d] = st->u[d] - c->u_old[d];
+  for (long d = 0; d < 3 * n; d++) c->du[d] = st->u[d] - c->u_old[d];
   double rr;
-  c->ext_work += fpm_support_work(m, st, c->u_old, 1, &rr);
+  c->ext_work += fpm_support_work(m, st, c->du, 1, &rr);
   memcpy(c->u_old, st->u, 3 * n * sizeof(double));
   double ref = sqrt(rr) + st->bflux_norm + st->fext_norm;
   fpm_step_info *si = &c->si;

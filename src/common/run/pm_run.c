@@ -9,6 +9,7 @@
 #include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_output.h"
+#include "pm_petsc.h"
 
 #define RUN_COLS (32 + PM_HISTORY_MAX + 3 * PM_FIGURES_MAX_BCS)
 #define RUN_FIELDS 16
@@ -356,6 +357,10 @@ static void report(run_ctx *c) {
 }
 
 static pm_err open_outputs(run_ctx *c, const char *out_dir) {
+  /* PETSc starts MPI, which may start a helper process; it must not
+   * inherit the run's open files (results.h5's lock would outlive the
+   * run), so a scene solved by Newton's method starts PETSc first. */
+  if (c->s->time.qs == PM_QS_STATIC) PM_CALL(pm_petsc_init());
   PM_CALL(pm_mkdir_p(out_dir));
   PM_CALL(pm_results_create(out_dir, c->s->dimension, c->pts.n, c->pts.x,
                             c->pts.n_cells, c->pts.nodes_per_cell, c->pts.cells,

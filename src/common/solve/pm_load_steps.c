@@ -89,7 +89,22 @@ pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
     if (target > 1 - PM_LOAD_END_SLACK) target = 1;
     PM_TRY(p->set_load(p->ctx, target));
     memcpy(x, xc, (size_t)n * sizeof *x);
-    bool predicted = o->predictor && have_prev && lambda > lambda_prev;
+    bool predicted = false;
+    if (o->predictor && have_prev && lambda > lambda_prev) {
+      double f = (target - lambda) / (lambda - lambda_prev);
+      for (long i = 0; i < n; i++) x[i] = xc[i] + f * (xc[i] - xprev[i]);
+      predicted = true;
+    } else if (o->predictor) {
+      /* No two states to extrapolate from: the tangent predictor. */
+      pm_err e = tangent_predictor(s, lambda, target, xc, r, rh, x, rep);
+      if (e != PM_SUCCESS && !recoverable(e)) {
+        ret = e;
+        goto done;
+      }
+      predicted = e == PM_SUCCESS;
+      if (!predicted) memcpy(x, xc, (size_t)n * sizeof *x);
+      pm_error_clear();
+    }
     double r_ref = 0;
     if (predicted) {
       /* rtol stays relative to the step's imbalance at the last state:
@@ -100,24 +115,6 @@ pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
       } else {
         pm_error_clear();
       }
-      double f = (target - lambda) / (lambda - lambda_prev);
-      for (long i = 0; i < n; i++) x[i] = xc[i] + f * (xc[i] - xprev[i]);
-    } else if (o->predictor) {
-      /* No two states to extrapolate from: the tangent predictor. */
-      pm_err e = tangent_predictor(s, lambda, target, xc, r, rh, x, rep);
-      if (e == PM_SUCCESS) {
-        predicted = true;
-        if (p->residual(p->ctx, xc, r) == PM_SUCCESS) {
-          for (long i = 0; i < n; i++) r_ref += r[i] * r[i];
-          r_ref = sqrt(r_ref);
-        }
-      } else if (!recoverable(e)) {
-        ret = e;
-        goto done;
-      } else {
-        memcpy(x, xc, (size_t)n * sizeof *x);
-      }
-      pm_error_clear();
     }
     pm_err e = pm_newton_solve_from(s, x, xc, r_ref, &rep->last);
     add_solve(rep, &rep->last);

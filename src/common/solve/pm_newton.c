@@ -508,6 +508,13 @@ static pm_err replace_linear(pm_newton *s) {
   return PM_SUCCESS;
 }
 
+/* What the linear solver multiplies by (A) and builds its preconditioner
+ * from (B). */
+static void operators(const pm_newton *s, Mat *A, Mat *B) {
+  *A = s->o.op == PM_NEWTON_ASSEMBLED ? s->J : s->Shell;
+  *B = s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P : s->J;
+}
+
 static pm_err configure_snes(pm_newton *s) {
   const pm_newton_options *o = &s->o;
   static const SNESLineSearchType types[] = {
@@ -531,8 +538,8 @@ static pm_err configure_snes(pm_newton *s) {
 
   PM_PETSC_CALL(SNESSetType(s->snes, SNESNEWTONLS));
   PM_PETSC_CALL(SNESSetFunction(s->snes, s->R, snes_residual, s));
-  Mat A = s->o.op == PM_NEWTON_ASSEMBLED ? s->J : s->Shell;
-  Mat B = s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P : s->J;
+  Mat A, B;
+  operators(s, &A, &B);
   PM_PETSC_CALL(SNESSetJacobian(s->snes, A, B, snes_jacobian, s));
   PM_PETSC_CALL(SNESSetConvergenceTest(s->snes, converged_test, s, NULL));
   /* The step-size test (stol) is off: a short step is no convergence. */
@@ -605,9 +612,11 @@ static pm_err create_petsc_objects(pm_newton *s) {
   } else {
     PM_CALL(create_matrix(&s->jpat, &s->jcols, s->jvals, &s->J));
   }
-  if (s->p.near_null_count > 0)
-    PM_CALL(set_near_null(s, s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P
-                                                                       : s->J));
+  if (s->p.near_null_count > 0) {
+    Mat A, B;
+    operators(s, &A, &B);
+    PM_CALL(set_near_null(s, B));
+  }
   if (s->o.op != PM_NEWTON_ASSEMBLED) {
     PM_PETSC_CALL(MatCreateShell(PETSC_COMM_SELF, n, n, n, n, s, &s->Shell));
     PM_PETSC_CALL(
@@ -850,8 +859,8 @@ pm_err pm_newton_tangent_solve(pm_newton *s, const double *x, const double *b,
                                double *dx, pm_newton_report *rep) {
   pm_err ret = PM_SUCCESS;
   long n = s->p.n;
-  Mat A = s->o.op == PM_NEWTON_ASSEMBLED ? s->J : s->Shell;
-  Mat B = s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P : s->J;
+  Mat A, B;
+  operators(s, &A, &B);
   KSPConvergedReason kr;
   s->rep = rep;
   s->hard = PM_SUCCESS;

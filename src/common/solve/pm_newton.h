@@ -97,7 +97,7 @@ typedef struct {
   /* Vectors (near_null_count of n values each, one after the other) the
    * Jacobian nearly annihilates -- for a solid, its rigid motions -- given
    * to algebraic multigrid (gmres-gamg) to build its coarse spaces from.
-   * Copied by pm_newton_create.  Optional (0, NULL). */
+   * Read by pm_newton_create, not kept (at most 16).  Optional (0, NULL). */
   int near_null_count;
   const double *near_null;
 
