@@ -47,7 +47,8 @@ import numpy as np  # noqa: E402
 
 FIXED = ("level h points steps status error rate wall_seconds setup_seconds "
          "mean_strain_energy_density max_von_mises reaction min_jacobian "
-         "energy_balance_error reaction_error reaction_rate sed_error").split()
+         "energy_balance_error reaction_error reaction_rate sed_error "
+         "error_interior").split()
 REQUIRED = ("level", "h", "status", "error", "wall_seconds")
 
 

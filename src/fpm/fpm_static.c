@@ -790,6 +790,9 @@ pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
   no.rtol = s->time.qs_tolerance;
   no.atol = force_floor(m);
   no.max_iter = (int)s->time.qs_max_iterations;
+  /* A step Newton creeps through (short line-search steps from a state
+   * outside its basin) is cut sooner than at max_iter. */
+  no.stall_after = 6;
   no.linear = linear_solver(s->time.qs_linear);
   no.load_steps = (int)s->time.qs_load_steps;
   no.predictor = true;

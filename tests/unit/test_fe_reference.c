@@ -198,6 +198,34 @@ static void test_good(void **state) {
   pm_fe_free(r);
 }
 
+/* The interior NRMSE sees only the lattice points off the bounding faces
+ * and keeps the whole lattice's normaliser: on a 3 x 3 x 3 lattice an error
+ * at a face point leaves it zero, and one at the centre (the one interior
+ * point) gives |d| / max|u| there, sqrt(27) times the whole lattice's. */
+static void test_interior_nrmse(void **state) {
+  (void)state;
+  double x[81], u[81], mapped[81];
+  pm_fe_reference r = {.n = 27, .x = x, .u = u, .dim = 3};
+  for (int k = 0; k < 27; k++) {
+    x[3 * k] = 0.05 * (k % 3);
+    x[3 * k + 1] = 0.05 * (k / 3 % 3);
+    x[3 * k + 2] = 0.05 * (k / 9);
+    u[3 * k] = u[3 * k + 1] = 0;
+    u[3 * k + 2] = -0.4 * x[3 * k + 2]; /* largest |u|: 0.04 */
+  }
+  memcpy(mapped, u, sizeof u);
+  mapped[3 * 1 + 0] += 1e-3; /* a point on the face y = 0 */
+  assert_true(pm_fe_nrmse_interior(&r, mapped) == 0);
+  assert_true(pm_nrmse_vector(27, 7u, mapped, u) > 0);
+  memcpy(mapped, u, sizeof u);
+  mapped[3 * 13 + 2] += 2e-3; /* the centre */
+  assert_close(pm_fe_nrmse_interior(&r, mapped), 2e-3 / 0.04, 1e-14, 0);
+  assert_close(pm_fe_nrmse_interior(&r, mapped),
+               sqrt(27.0) * pm_nrmse_vector(27, 7u, mapped, u), 1e-14, 0);
+  r.n = 9; /* one layer z = 0: no point is inside */
+  assert_true(isnan(pm_fe_nrmse_interior(&r, mapped)));
+}
+
 /* A malformed file: its text (the others are good), the line at fault and
  * what the message says there. */
 typedef struct {
@@ -280,6 +308,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_committed_cases),
       cmocka_unit_test(test_f2_exact),
+      cmocka_unit_test(test_interior_nrmse),
       cmocka_unit_test_setup_teardown(test_good, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_malformed, pm_test_make_dir,

@@ -82,6 +82,7 @@ static void check_case(const fe_case *c) {
                 "(paper %.3e%s)\n",
                 fe->n, e.nrmse, c->nrmse_paper,
                 c->nrmse_asserted ? ", bound" : ", not asserted");
+  print_message("  the same off the lattice's faces: %.3e\n", e.nrmse_interior);
   assert_true(isfinite(e.reaction_error) && isfinite(e.nrmse));
   assert_true(fabs(e.reaction_error) <= c->reaction_tol);
   if (c->nrmse_asserted) assert_true(e.nrmse <= c->nrmse_paper);

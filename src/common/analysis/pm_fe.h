@@ -70,11 +70,22 @@ bool pm_fe_names_reference(const char *spec, char *buf, size_t size);
 /* A run against the reference. */
 typedef struct {
   double nrmse;          /* displacement at the lattice (pm_nrmse_vector) */
+  double nrmse_interior; /* the same over the lattice points off the
+                            lattice's bounding faces (away from the clamped
+                            edges and the free surface), with the whole
+                            lattice's normaliser */
   double reaction_error; /* (R - R_fe) / R_fe on the loaded face, along
                             the loaded component: > 0 when the run's
                             reaction is the larger (the run is stiffer) */
   double sed_error;      /* (mean SED - FE) / FE */
 } pm_fe_errors;
+
+/* The NRMSE of mapped (a run's displacement at the lattice, [n][3])
+ * against the reference over the lattice points off the lattice's
+ * bounding faces, divided by the whole lattice's largest |u_fe| (the
+ * normaliser of pm_nrmse_vector), so that it compares with the whole
+ * lattice's figure; NaN when no point is inside. */
+double pm_fe_nrmse_interior(const pm_fe_reference *r, const double *mapped);
 
 /* Compare the run written to out_dir (its last frame, mapped onto the
  * lattice by moving least squares) and its outcome o with r.  The

@@ -139,7 +139,7 @@ pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
       if (p->on_step)
         PM_TRY(p->on_step(p->ctx, rep->steps, lambda, xc, &rep->last));
       if (dl < nominal && o->grow_after > 0 && ++good >= o->grow_after) {
-        dl = fmin(2 * dl, nominal);
+        dl = fmin(1.5 * dl, nominal);
         good = 0;
       }
       continue;

@@ -80,6 +80,7 @@ const char *pm_newton_reason_name(pm_newton_reason r) {
   case PM_NEWTON_CONVERGED_ENERGY: return "converged (energy)";
   case PM_NEWTON_CONVERGED_ALL: return "converged (all criteria)";
   case PM_NEWTON_DIVERGED_MAX_ITER: return "diverged (max iterations)";
+  case PM_NEWTON_DIVERGED_STALLED: return "diverged (stalled)";
   case PM_NEWTON_DIVERGED_LINE_SEARCH: return "diverged (line search)";
   case PM_NEWTON_DIVERGED_NAN: return "diverged (not a number)";
   case PM_NEWTON_DIVERGED_DOMAIN: return "diverged (inadmissible state)";
@@ -373,6 +374,12 @@ static PetscErrorCode converged_test(SNES snes, PetscInt it, PetscReal xnorm,
     s->reason = PM_NEWTON_DIVERGED_MAX_ITER;
     *reason = SNES_DIVERGED_MAX_IT;
     PetscFunctionReturn(0);
+  } else if (o->stall_after > 0 && it >= o->stall_after &&
+             it <= PM_NEWTON_MAX_ITER &&
+             fnorm > 0.5 * rep->residual_norm[it - 2]) {
+    s->reason = PM_NEWTON_DIVERGED_STALLED;
+    *reason = SNES_DIVERGED_MAX_IT;
+    PetscFunctionReturn(0);
   } else {
     PetscFunctionReturn(0);
   }
@@ -410,6 +417,9 @@ static pm_err check_options(const pm_newton_options *o) {
            PM_ERR_ARG, "unknown line search %d", (int)o->line_search);
   PM_CHECK(o->linear_rtol > 0 && o->linear_rtol < 1, PM_ERR_ARG,
            "linear_rtol must be in (0, 1) (got %g)", o->linear_rtol);
+  PM_CHECK(o->stall_after == 0 || o->stall_after >= 2, PM_ERR_ARG,
+           "Newton stall_after must be 0 (off) or >= 2 (got %d)",
+           o->stall_after);
   PM_CHECK(o->linear_max_iter >= 1, PM_ERR_ARG,
            "linear_max_iter must be >= 1 (got %d)", o->linear_max_iter);
   PM_CHECK(o->pc_lag >= 1, PM_ERR_ARG, "pc_lag must be >= 1 (got %d)",
@@ -726,6 +736,14 @@ static pm_err classify(pm_newton *s, pm_newton_report *rep) {
   rep->status = PM_ERR_NOT_CONVERGED;
   switch (sr) {
   case SNES_DIVERGED_MAX_IT:
+    if (s->reason == PM_NEWTON_DIVERGED_STALLED) {
+      rep->reason = PM_NEWTON_DIVERGED_STALLED;
+      snprintf(rep->message, cap,
+               "Newton stalled: the residual was not halved over iterations "
+               "%d and %d (%s)",
+               it - 1, it, figures);
+      break;
+    }
     rep->reason = PM_NEWTON_DIVERGED_MAX_ITER;
     snprintf(rep->message, cap, "Newton did not converge in %d iterations (%s)",
              it, figures);

@@ -162,6 +162,11 @@ typedef struct {
   double etol;       /* 0 (off) */
   bool all_criteria; /* false */
   int max_iter;      /* 25, at most PM_NEWTON_MAX_ITER */
+  /* A solve that has not halved the residual over the last two
+   * iterations, at iteration stall_after or later, stops as stalled (a
+   * failure load stepping answers by cutting the step, instead of creeping
+   * on with short line-search steps up to max_iter); 0: never. */
+  int stall_after; /* 0 */
 
   pm_newton_linear linear; /* PM_NEWTON_DIRECT */
   double linear_rtol;      /* iterative solvers: 1e-10 */
@@ -178,7 +183,8 @@ typedef struct {
   int max_cuts;       /* halvings allowed in a row for one step: 10 */
   double min_dlambda; /* smallest step (0: 1/load_steps/2^max_cuts) */
   int grow_after;     /* after this many converged steps in a row at a cut
-                         step, double it (up to the nominal); 0 never: 2 */
+                         step, grow it by half (up to the nominal); 0
+                         never: 2 */
   bool predictor;     /* start each step from the linear extrapolation of
                          the last two converged states, or where there are
                          not two (the first step) from the tangent
@@ -207,6 +213,8 @@ typedef enum {
   PM_NEWTON_CONVERGED_ENERGY,       /* etol */
   PM_NEWTON_CONVERGED_ALL,          /* every criterion on (all_criteria) */
   PM_NEWTON_DIVERGED_MAX_ITER,      /* max_iter without converging */
+  PM_NEWTON_DIVERGED_STALLED,       /* stall_after: the residual not halved
+                                       over two iterations */
   PM_NEWTON_DIVERGED_LINE_SEARCH,   /* no step decreased the residual */
   PM_NEWTON_DIVERGED_NAN,           /* residual not finite */
   PM_NEWTON_DIVERGED_DOMAIN,        /* residual inadmissible at the start,
