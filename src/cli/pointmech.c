@@ -15,7 +15,13 @@
 #include "pm_scene.h"
 #include "pm_study.h"
 
-enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_NUMERIC = 2, EXIT_NOT_CONVERGED = 3 };
+enum {
+  EXIT_OK = 0,
+  EXIT_INPUT = 1,
+  EXIT_NUMERIC = 2,
+  EXIT_NOT_CONVERGED = 3,
+  EXIT_INTERRUPTED = 4
+};
 
 #define MAX_SETS 64
 
@@ -64,7 +70,8 @@ static void usage(FILE *out) {
           "boundary.3.displacement.z=-0.06\n"
           "\n"
           "exit status: 0 success, 1 bad input, 2 numerical failure, 3 "
-          "quasi-static run not converged\n");
+          "quasi-static run not converged, 4 interrupted (SIGINT or "
+          "SIGTERM; results up to the last step kept)\n");
 }
 
 static int report(pm_err e) {
@@ -75,6 +82,7 @@ static int report(pm_err e) {
   case PM_ERR_UNSTABLE:
   case PM_ERR_LINALG: return EXIT_NUMERIC;
   case PM_ERR_NOT_CONVERGED: return EXIT_NOT_CONVERGED;
+  case PM_ERR_INTERRUPTED: return EXIT_INTERRUPTED;
   default: return EXIT_INPUT;
   }
 }

@@ -21,6 +21,14 @@ bad_scene() { # name, sed expression, expected line, key word
   check "$name: no output created" test ! -e "$work/out-$name"
 }
 
+# The four result files written whole, and no temporary file left.
+outputs_complete() { # name, output folder
+  for f in results.h5 results.xdmf history.csv summary.json; do
+    check "$1: $f written" test -s "$2/$f"
+  done
+  check "$1: no temporary files" test -z "$(ls "$2" | grep tmp)"
+}
+
 line_of() { grep -n -- "$1" "$scene" | head -1 | cut -d: -f1; }
 
 bad_scene unknown-key 's/fpm: {penalty: 20}/fpm: {penalty: 20, penalti: 3}/' \
@@ -107,10 +115,7 @@ out=$work/out-f2
   --set time.quasi_static.tolerance=1e-8 --out "$out" --quiet 2>"$work/err"
 rc=$?
 check "coarse F2: exit 0 (got $rc)" test $rc -eq 0
-for f in results.h5 results.xdmf history.csv summary.json; do
-  check "coarse F2: $f written" test -s "$out/$f"
-done
-check "coarse F2: no temporary files" test -z "$(ls "$out" | grep tmp)"
+outputs_complete "coarse F2" "$out"
 check "coarse F2: converged" grep -q '"status": "converged"' "$out/summary.json"
 printf 'x,y,z\n0.05,0.05,0.05\n0.02,0.07,0.09\n0.08,0.01,0.03\n' >"$work/pts.csv"
 "$bin" probe "$out" --points "$work/pts.csv" >"$work/probe" 2>"$work/err"
@@ -162,6 +167,36 @@ refused "convergence, missing FE referee" "no-such-fe/ladder.csv" \
   "$work/out-fe-bad" "$bin" convergence "$scene" \
   --set-ladder discretization.mesh_size=0.025 \
   --reference fe:"$work/no-such-fe" --out "$work/out-fe-bad" --quiet
+
+# SIGTERM during a run: the step ends, a last frame is written, the four
+# files are complete with status "interrupted", and the exit status is 4.
+# (A tolerance no run meets and a far end keep it running until then.)
+out=$work/out-term
+"$bin" run "$scene" --set discretization.mesh_size=0.02 \
+  --set time.quasi_static.tolerance=1e-300 --set time.end=1e6 \
+  --out "$out" --quiet 2>"$work/err" &
+pid=$!
+for _ in $(seq 600); do # the run has started once its frames are open
+  ls "$out" 2>/dev/null | grep -q '^history.csv.tmp' && break
+  sleep 0.1
+done
+sleep 1
+kill -TERM $pid
+wait $pid
+rc=$?
+check "SIGTERM: exit 4 (got $rc)" test $rc -eq 4
+outputs_complete SIGTERM "$out"
+check "SIGTERM: status interrupted" \
+  grep -q '"status": "interrupted"' "$out/summary.json"
+check "SIGTERM: the message names the signal and step" \
+  grep -q 'interrupted by SIGTERM after step [0-9]*, t = ' "$work/err"
+last=$(tail -1 "$out/history.csv" | cut -d, -f2)
+check "SIGTERM: the last history row ($last) is the step named" \
+  grep -q "after step $last," "$work/err"
+rows=$(($(wc -l <"$out/history.csv") - 1))
+frames=$(grep -c '<Time ' "$out/results.xdmf")
+check "SIGTERM: results.xdmf indexes a frame per history row, the last step's too ($frames, $rows)" \
+  test "$frames" -eq "$rows"
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

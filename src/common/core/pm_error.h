@@ -22,6 +22,7 @@
   X(PM_ERR_UNSTABLE, "numerical instability")                                  \
   X(PM_ERR_NOT_CONVERGED, "not converged")                                     \
   X(PM_ERR_UNSUPPORTED, "not supported")                                       \
+  X(PM_ERR_INTERRUPTED, "interrupted by a signal")                             \
   X(PM_ERR_INTERNAL, "internal error")
 
 typedef enum {

@@ -39,6 +39,7 @@ const char *pm_status_name(pm_status s) {
   case PM_STATUS_NOT_CONVERGED: return "not-converged";
   case PM_STATUS_UNSTABLE: return "unstable";
   case PM_STATUS_FAILED: return "failed";
+  case PM_STATUS_INTERRUPTED: return "interrupted";
   default: return "not-run";
   }
 }

@@ -22,7 +22,8 @@ typedef enum {
   PM_STATUS_CONVERGED,     /* quasi-static: residual below the tolerance */
   PM_STATUS_NOT_CONVERGED, /* quasi-static: ran out of time or steps */
   PM_STATUS_UNSTABLE,      /* stopped on a numerical failure */
-  PM_STATUS_FAILED         /* any other failure (I/O, memory) */
+  PM_STATUS_FAILED,        /* any other failure (I/O, memory) */
+  PM_STATUS_INTERRUPTED    /* stopped by SIGINT or SIGTERM after a step */
 } pm_status;
 
 /* "completed", "converged", "not-converged", "unstable", "failed",

@@ -3,6 +3,7 @@
 #include "pm_run.h"
 
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -159,8 +160,45 @@ static pm_err write_frame(run_ctx *c, const pm_step_report *r) {
   return write_row(c);
 }
 
+/* SIGINT or SIGTERM received during a run (0: none).  Sticky for the
+ * process: a study interrupted in one level does not start the next. */
+static volatile sig_atomic_t interrupt_signal;
+
+static void on_interrupt(int sig) { interrupt_signal = sig; }
+
+/* Catch SIGINT and SIGTERM once each (a second one acts as usual, so a
+ * run that does not reach the end of its step can still be stopped). */
+static void catch_interrupts(struct sigaction old[2]) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &sa, &old[0]);
+  sigaction(SIGTERM, &sa, &old[1]);
+}
+
+static void release_interrupts(const struct sigaction old[2]) {
+  sigaction(SIGINT, &old[0], NULL);
+  sigaction(SIGTERM, &old[1], NULL);
+}
+
 static pm_err observe(void *ctx, const pm_step_report *r, bool frame) {
   run_ctx *c = ctx;
+  const int sig = interrupt_signal;
+  if (sig) {
+    /* The state after this step becomes the last frame. */
+    if (!frame && c->results) {
+      pm_timers_start(&c->out_timer, c->tm_output);
+      pm_err e = write_frame(c, r);
+      pm_timers_stop(&c->out_timer, c->tm_output);
+      PM_CALL(e);
+    }
+    return PM_ERROR(PM_ERR_INTERRUPTED,
+                    "interrupted by %s after step %ld, t = %.6g s (results "
+                    "up to this step kept)",
+                    sig == SIGINT ? "SIGINT" : "SIGTERM", r->step, r->t);
+  }
   if (c->show_progress) {
     char status[96];
     snprintf(status, sizeof status, "t=%.4g s  step %ld  residual %.2e", r->t,
@@ -316,7 +354,10 @@ static void conclude(run_ctx *c, pm_err run_err) {
   pm_outcome *o = c->o;
   const pm_scene *s = c->s;
   pm_figures *f = &o->fig;
-  if (run_err == PM_ERR_UNSTABLE) {
+  if (run_err == PM_ERR_INTERRUPTED) {
+    f->status = PM_STATUS_INTERRUPTED;
+    snprintf(o->message, sizeof o->message, "%s", pm_error_message());
+  } else if (run_err == PM_ERR_UNSTABLE) {
     f->status = PM_STATUS_UNSTABLE;
     snprintf(o->message, sizeof o->message,
              "%s; dt %.4g s (%s), stable step %.4g s: reduce "
@@ -396,7 +437,10 @@ pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir, bool quiet,
   if (out_dir) PM_TRY(open_outputs(c, out_dir));
   pm_observer obs = {.ctx = c, .step = observe};
   c->t_start = pm_wtime();
+  struct sigaction old_handlers[2];
+  catch_interrupts(old_handlers);
   run_err = c->be->run(sim, &obs);
+  release_interrupts(old_handlers);
   if (!quiet) pm_progress_finish(&c->progress);
   c->be->figures(sim, &o->fig, true);
   o->fig.wall_seconds = pm_wtime() - c->t_start;
