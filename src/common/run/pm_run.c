@@ -161,10 +161,15 @@ static pm_err write_frame(run_ctx *c, const pm_step_report *r) {
 }
 
 /* SIGINT or SIGTERM received during a run (0: none).  Sticky for the
- * process: a study interrupted in one level does not start the next. */
+ * process: once a run is interrupted, pm_run_scene starts no other (a
+ * study's remaining levels are refused without being set up). */
 static volatile sig_atomic_t interrupt_signal;
 
 static void on_interrupt(int sig) { interrupt_signal = sig; }
+
+static const char *signal_name(int sig) {
+  return sig == SIGINT ? "SIGINT" : "SIGTERM";
+}
 
 /* Catch SIGINT and SIGTERM once each (a second one acts as usual, so a
  * run that does not reach the end of its step can still be stopped). */
@@ -185,31 +190,25 @@ static void release_interrupts(const struct sigaction old[2]) {
 
 static pm_err observe(void *ctx, const pm_step_report *r, bool frame) {
   run_ctx *c = ctx;
+  /* After a signal, the state after this step becomes the last frame. */
   const int sig = interrupt_signal;
-  if (sig) {
-    /* The state after this step becomes the last frame. */
-    if (!frame && c->results) {
-      pm_timers_start(&c->out_timer, c->tm_output);
-      pm_err e = write_frame(c, r);
-      pm_timers_stop(&c->out_timer, c->tm_output);
-      PM_CALL(e);
-    }
-    return PM_ERROR(PM_ERR_INTERRUPTED,
-                    "interrupted by %s after step %ld, t = %.6g s (results "
-                    "up to this step kept)",
-                    sig == SIGINT ? "SIGINT" : "SIGTERM", r->step, r->t);
-  }
   if (c->show_progress) {
     char status[96];
     snprintf(status, sizeof status, "t=%.4g s  step %ld  residual %.2e", r->t,
              r->step, r->residual);
     pm_progress_update(&c->progress, r->progress, status);
   }
-  if (!frame || !c->results) return PM_SUCCESS;
-  pm_timers_start(&c->out_timer, c->tm_output);
-  pm_err e = write_frame(c, r);
-  pm_timers_stop(&c->out_timer, c->tm_output);
-  return e;
+  if ((frame || sig) && c->results) {
+    pm_timers_start(&c->out_timer, c->tm_output);
+    pm_err e = write_frame(c, r);
+    pm_timers_stop(&c->out_timer, c->tm_output);
+    PM_CALL(e);
+  }
+  if (!sig) return PM_SUCCESS;
+  return PM_ERROR(PM_ERR_INTERRUPTED,
+                  "interrupted by %s after step %ld, t = %.6g s (results up "
+                  "to this step kept)",
+                  signal_name(sig), r->step, r->t);
 }
 
 /* ---- summary ------------------------------------------------------------ */
@@ -477,6 +476,13 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, bool quiet,
   void *sim = NULL;
   memset(o, 0, sizeof *o);
   o->fig.status = PM_STATUS_FAILED;
+  const int sig = interrupt_signal;
+  if (sig) {
+    o->fig.status = PM_STATUS_INTERRUPTED;
+    return PM_ERROR(PM_ERR_INTERRUPTED,
+                    "not started: an earlier run was interrupted by %s",
+                    signal_name(sig));
+  }
   PM_CALL(s->backend->create(s, &sim));
   pm_err e = pm_run_sim(s, sim, out_dir, quiet, o);
   s->backend->destroy(sim);
