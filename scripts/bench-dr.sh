@@ -23,7 +23,7 @@ for c in f2-unconstrained-compression f3-extension-60-h1.09e-2; do
   run() { # label, extra --set ...
     local label=$1 dir=$out/$c-$1
     shift
-    "$bin" run "$scene" "${sets[@]}" "$@" --quiet --out "$dir" >/dev/null 2>&1 || true
+    "$bin" run --overwrite "$scene" "${sets[@]}" "$@" --quiet --out "$dir" >/dev/null 2>&1 || true
     printf '%-22s %-26s %8s %9.3f %10.3g %-14s\n' "${c%-h1.09e-2}" "$label" \
       "$(get steps "$dir/summary.json")" "$(get wall_seconds "$dir/summary.json")" \
       "$(get residual "$dir/summary.json")" "$(get status "$dir/summary.json")"

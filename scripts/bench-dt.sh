@@ -33,7 +33,7 @@ for c in f2-unconstrained-compression f3-extension-60-h1.09e-2; do
     mid=$(awk -v l="$lo" -v h="$hi" 'BEGIN { printf "%.6g", sqrt(l * h) }')
     dt=$(awk -v f="$mid" -v p="$paper" 'BEGIN { printf "%.6g", f * p }')
     trials=$((trials + 1))
-    if "$bin" run "$scene" "${sets[@]}" --set time.dt="$dt" --quiet \
+    if "$bin" run --overwrite "$scene" "${sets[@]}" --set time.dt="$dt" --quiet \
       --out "$out/$c" >/dev/null 2>&1; then lo=$mid; else
       rc=$?
       # exit 3 (not converged in time) is stable; 2 is a numerical failure

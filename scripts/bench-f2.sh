@@ -30,7 +30,7 @@ printf '%-9s %10s %7s %8s %12s %7s %9s %10s %14s %8s\n' h mean_edge points \
   threads NRMSE_u_z steps wall_s setup_s "s/point-step" "Mps/s/c"
 for h in "${sizes[@]}"; do
   dir=$out/h$h
-  "$bin" run "$(scene_of "$h")" --set time.dt_rule="$rule" --out "$dir" --quiet \
+  "$bin" run --overwrite "$(scene_of "$h")" --set time.dt_rule="$rule" --out "$dir" --quiet \
     2>"$dir.log" || { echo "h=$h failed: see $dir.log"; continue; }
   s=$dir/summary.json
   printf '%-9s %10.4g %7s %8s %12s %7s %9.2f %10.2f %14.3e %8.2f\n' "$h" \

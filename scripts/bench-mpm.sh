@@ -16,7 +16,7 @@ for scene in cases/mpm/bench-block.yaml cases/mpm/m2-shock-tube.yaml; do
   name=$(basename "$scene" .yaml)
   for threads in 1 "$cores"; do
     dir="$out/$name-t$threads"
-    OMP_NUM_THREADS=$threads "$bin" run "$scene" --out "$dir" --quiet \
+    OMP_NUM_THREADS=$threads "$bin" run --overwrite "$scene" --out "$dir" --quiet \
       --set time.max_steps="$steps" --set output.every=1000000 2>/dev/null
     s="$dir/summary.json"
     printf '%-28s %8s %7s %8s %14.3e %14.3e\n' "$name" "$(get particles "$s")" \

@@ -10,7 +10,7 @@ bin=${1:-build}/pointmech
 out=${FIGURE_OUT:-out/f1-figure}
 mkdir -p "$out"
 for p in 0 20; do
-  "$bin" run cases/fpm/f1-extension.yaml --set fpm.jump=linear \
+  "$bin" run --overwrite cases/fpm/f1-extension.yaml --set fpm.jump=linear \
     --set fpm.penalty=$p --quiet \
     --out "$out/p$p"
 done

@@ -14,7 +14,7 @@ mkdir -p "$out"
 scripts/shock-tube-figure.sh "$build" cases/mpm/m2-shock-tube.yaml "$out/m2-shock-tube"
 scripts/shock-tube-figure.sh "$build" cases/mpm/m2-sod.yaml "$out/m2-sod"
 for blend in 1 0; do
-  "$build/pointmech" run cases/mpm/disks-collision.yaml --quiet \
+  "$build/pointmech" run --overwrite cases/mpm/disks-collision.yaml --quiet \
     --out "$out/disks-flip$blend" --set mpm.flip=$blend --set output.every=2
 done
 /usr/bin/python3 tools/plot-history.py --sum total=kinetic_energy+strain_energy \

@@ -48,7 +48,7 @@ for c in "${cases[@]}"; do
     ref=(--reference last)
     sizes=${SIZES:-8.72e-3,6.42e-3,4.15e-3,2.98e-3,2.15e-3}
   fi
-  "$build/pointmech" convergence "cases/fpm/$c-h1.09e-2.yaml" --quiet \
+  "$build/pointmech" convergence --overwrite "cases/fpm/$c-h1.09e-2.yaml" --quiet \
     "${form[@]}" --set output.every=1000000 "${ref[@]}" \
     --set-ladder discretization.mesh_size=$sizes \
     --out "${STUDY_OUT:-out}/study-$c-$tag"

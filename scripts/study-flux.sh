@@ -50,7 +50,7 @@ for form in "${forms[@]}"; do
     fe=cases/fe/f3-extension-60
     [ "$nu" = 0.495 ] || fe=$fe-nu$nu
     dir=$out/$form-nu$nu
-    "$build/pointmech" convergence cases/fpm/f3-extension-60-h1.09e-2.yaml \
+    "$build/pointmech" convergence --overwrite cases/fpm/f3-extension-60-h1.09e-2.yaml \
       --quiet "${set_form[@]}" --set materials.0.poisson_ratio="$nu" \
       --set output.every=1000000 --reference "fe:$fe" \
       --set-ladder discretization.mesh_size="$sizes" --out "$dir" \

@@ -28,19 +28,32 @@ enum {
 static void usage(FILE *out) {
   fprintf(out,
           "usage: pointmech run SCENE [--out DIR] [--set KEY=VALUE]... "
-          "[--quiet]\n"
+          "[--overwrite] [--quiet]\n"
+          "       pointmech resume OUT [--quiet]\n"
           "       pointmech plan SCENE [--set KEY=VALUE]...\n"
           "       pointmech probe OUT --points FILE.csv [--frame N]\n"
           "       pointmech convergence SCENE --set-ladder KEY=V1,V2,... "
           "[--set-ladder ...]\n"
           "                 [--reference analytic|last|fe:DIR|DIR] [--out DIR] "
-          "[--set KEY=VALUE]...\n"
+          "[--set KEY=VALUE]... [--overwrite]\n"
           "       pointmech keys\n"
           "       pointmech --help | --version\n"
           "\n"
           "  run    simulate SCENE (YAML); writes OUT/results.h5 + "
           "results.xdmf,\n"
-          "         history.csv and summary.json (default OUT: out/NAME)\n"
+          "         history.csv and summary.json (default OUT: out/NAME); "
+          "every frame\n"
+          "         is on disk as it is written (open results.xdmf in "
+          "ParaView while\n"
+          "         the run goes on); an OUT holding another run's files is "
+          "refused\n"
+          "         unless --overwrite\n"
+          "  resume continue the run in OUT from its last checkpoint "
+          "(output.checkpoint,\n"
+          "         or the one SIGINT/SIGTERM writes), appending to its "
+          "results; on the\n"
+          "         same thread count it ends bit-identical to an "
+          "uninterrupted run\n"
           "  plan   print the pipeline, counts, time step, steps, memory and "
           "an\n"
           "         estimated run time without running\n"
@@ -71,7 +84,8 @@ static void usage(FILE *out) {
           "\n"
           "exit status: 0 success, 1 bad input, 2 numerical failure, 3 "
           "quasi-static run not converged, 4 interrupted (SIGINT or "
-          "SIGTERM; results up to the last step kept)\n");
+          "SIGTERM; results up to the last step kept, and a checkpoint to "
+          "resume from)\n");
 }
 
 static int report(pm_err e) {
@@ -96,6 +110,7 @@ typedef struct {
   const char *ladders[PM_STUDY_MAX_KEYS];
   long frame;
   bool quiet;
+  bool overwrite;
   int n_sets;
   const char *sets[MAX_SETS];
 } cli_args;
@@ -106,7 +121,7 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
   for (int k = first; k < argc; k++) {
     const char *arg = argv[k];
     bool has_next = k + 1 < argc;
-    if (strcmp(arg, "--out") == 0 && has_next)
+    if ((strcmp(arg, "--out") == 0 || strcmp(arg, "-o") == 0) && has_next)
       a->out = argv[++k];
     else if (strcmp(arg, "--points") == 0 && has_next)
       a->points = argv[++k];
@@ -137,6 +152,8 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
       a->sets[a->n_sets++] = arg + 6;
     else if (strcmp(arg, "--quiet") == 0)
       a->quiet = true;
+    else if (strcmp(arg, "--overwrite") == 0)
+      a->overwrite = true;
     else if (arg[0] == '-') {
       fprintf(stderr, "pointmech: unknown option %s%s\n", arg,
               has_next ? "" : " (or missing value)");
@@ -158,6 +175,11 @@ static const char *out_dir(const cli_args *a, const pm_scene *s, char *buf,
   return buf;
 }
 
+static unsigned run_flags(const cli_args *a) {
+  return (a->quiet ? PM_RUN_QUIET : 0u) |
+         (a->overwrite ? PM_RUN_OVERWRITE : 0u);
+}
+
 static int cmd_run_or_plan(const cli_args *a, bool plan) {
   pm_scene *s = NULL;
   int status = EXIT_OK;
@@ -170,7 +192,7 @@ static int cmd_run_or_plan(const cli_args *a, bool plan) {
     char buf[1024];
     const char *out = out_dir(a, s, buf, sizeof buf);
     pm_outcome o;
-    e = pm_run_scene(s, out, a->quiet, &o);
+    e = pm_run_scene(s, out, run_flags(a), &o);
     if (e) status = report(e);
     fprintf(stderr, "results in %s\n", out);
   }
@@ -187,6 +209,7 @@ static int cmd_convergence(const cli_args *a) {
       .reference = a->reference,
       .out_dir = a->out,
       .quiet = a->quiet,
+      .overwrite = a->overwrite,
   };
   for (int k = 0; k < a->n_ladders; k++) o.ladder[k] = a->ladders[k];
   pm_err e = pm_study_run(&o, stdout);
@@ -221,6 +244,17 @@ int main(int argc, char **argv) {
       return EXIT_INPUT;
     }
     return cmd_run_or_plan(&a, strcmp(cmd, "plan") == 0);
+  }
+  if (strcmp(cmd, "resume") == 0) {
+    if (!a.scene) {
+      fprintf(stderr, "pointmech: resume needs the OUT folder of a run\n");
+      return EXIT_INPUT;
+    }
+    pm_outcome o;
+    pm_err e = pm_resume(a.scene, run_flags(&a), &o);
+    int status = e ? report(e) : EXIT_OK;
+    fprintf(stderr, "results in %s\n", a.scene);
+    return status;
   }
   if (strcmp(cmd, "keys") == 0) {
     pm_scene_print_keys(stdout);

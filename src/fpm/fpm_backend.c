@@ -11,6 +11,7 @@
 #include "fpm_scene.h"
 #include "gm_cells.h"
 #include "pm_files.h"
+#include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_tensor.h"
 
@@ -66,7 +67,7 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   pm_timers_start(&sim->timers, sim->tm_operators);
   PM_TRY(fpm_model_create(s, o, sim->mesh, sim->dual, &sim->model));
   PM_TRY(fpm_state_create(sim->model, &sim->state));
-  PM_TRY(PM_ALLOC(sim->scratch, 9 * sim->model->n, "output buffer"));
+  PM_TRY(PM_ALLOC(sim->scratch, 11 * sim->model->n, "output buffer"));
   sim->dt_paper = fpm_stable_dt(sim->model, &sim->dt_point);
   sim->dt_stable = sim->dt_paper;
   if (s->time.dt_rule == PM_DT_SPECTRAL) {
@@ -171,12 +172,15 @@ static pm_err run(void *p, const pm_observer *obs) {
       .min_jacobian = s->stability.min_jacobian,
       .max_energy_error = s->stability.max_energy_error,
   };
-  memset(sim->state->u, 0, 3 * m->n * sizeof(double));
-  memset(sim->state->v, 0, 3 * m->n * sizeof(double));
-  sim->run_min_jacobian = INFINITY;
-  sim->run_min_jacobian_step = 0;
-  sim->run_max_energy_error = 0;
-  sim->res0 = 0;
+  if (!sim->resumed) { /* a resumed run has these from its checkpoint */
+    memset(sim->state->u, 0, 3 * m->n * sizeof(double));
+    memset(sim->state->v, 0, 3 * m->n * sizeof(double));
+    sim->state->step = 0;
+    sim->run_min_jacobian = INFINITY;
+    sim->run_min_jacobian_step = 0;
+    sim->run_max_energy_error = 0;
+    sim->res0 = 0;
+  }
   sim->load_end = pm_scene_load_end(s);
   sim->obs = obs;
   double stage[2] = {0, 0};
@@ -207,6 +211,7 @@ static pm_err run(void *p, const pm_observer *obs) {
       sim->status = PM_STATUS_CONVERGED;
     return e;
   }
+  sim->first_step = sim->state->step;
   e = fpm_run(m, sim->state, &opt, observe, sim, &sim->last, stage);
   sim->obs = NULL;
   sim->timers.stage[sim->tm_force].seconds += stage[0];
@@ -242,13 +247,18 @@ static int fields(void *p, unsigned want, pm_field *out, int max) {
   fpm_sim *sim = p;
   const fpm_state *st = sim->state;
   int nf = 0;
-  if (max < 6) return 0;
+  if (max < 8) return 0;
   if (want & PM_FIELD_DISPLACEMENT)
     out[nf++] = (pm_field){"displacement", 3, st->u};
   if (want & PM_FIELD_VELOCITY) out[nf++] = (pm_field){"velocity", 3, st->v};
   if (want & PM_FIELD_STRESS) {
+    const long n = sim->model->n;
+    double *vm = sim->scratch + 9 * n, *p_mean = vm + n;
     cauchy_stress(sim->model, st, sim->scratch);
+    pm_stress_invariants(n, sim->scratch, vm, p_mean);
     out[nf++] = (pm_field){"stress", 9, sim->scratch};
+    out[nf++] = (pm_field){"von_mises", 1, vm};
+    out[nf++] = (pm_field){"pressure", 1, p_mean};
   }
   if (want & PM_FIELD_STRAIN_ENERGY_DENSITY)
     out[nf++] = (pm_field){"strain_energy_density", 1, st->W};
@@ -384,6 +394,39 @@ static pm_err summary(void *p, pm_json *j) {
 
 static const pm_timers *timers(void *p) { return &((fpm_sim *)p)->timers; }
 
+/* The time loop's state (fpm_state: u, v and what the loop carries) and
+ * what the run reports over all its steps. */
+static pm_err checkpoint(void *p, pm_ckpt *ck) {
+  fpm_sim *sim = p;
+  fpm_state *st = sim->state;
+  const long n3 = 3 * sim->model->n;
+  PM_CHECK(sim->scene->time.qs != PM_QS_STATIC, PM_ERR_ARG,
+           "static solves (time.quasi_static.method: static) cannot be "
+           "checkpointed: their load stepping is not part of a checkpoint yet");
+  PM_CALL(pm_ckpt_doubles(ck, "fpm.u", n3, st->u));
+  PM_CALL(pm_ckpt_doubles(ck, "fpm.v", n3, st->v));
+  PM_CALL(pm_ckpt_long(ck, "fpm.step", &st->step));
+  PM_CALL(pm_ckpt_double(ck, "fpm.t", &st->t));
+  PM_CALL(pm_ckpt_double(ck, "fpm.damping", &st->damping));
+  PM_CALL(pm_ckpt_double(ck, "fpm.external_work", &st->external_work));
+  PM_CALL(pm_ckpt_double(ck, "fpm.dissipated", &st->dissipated));
+  PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &sim->run_min_jacobian));
+  PM_CALL(
+      pm_ckpt_long(ck, "run.min_jacobian_step", &sim->run_min_jacobian_step));
+  PM_CALL(
+      pm_ckpt_double(ck, "run.max_energy_error", &sim->run_max_energy_error));
+  PM_CALL(pm_ckpt_double(ck, "run.residual0", &sim->res0));
+  if (pm_ckpt_reading(ck)) {
+    sim->resumed = true;
+    sim->last.step = st->step;
+    sim->last.t = st->t;
+    sim->last.damping = st->damping;
+    sim->last.external_work = st->external_work;
+    sim->last.dissipated = st->dissipated;
+  }
+  return PM_SUCCESS;
+}
+
 static pm_err create(const pm_scene *s, void **out) {
   fpm_sim *sim = NULL;
   PM_CALL(fpm_sim_create(s, &sim));
@@ -413,6 +456,7 @@ const pm_backend fpm_backend = {
     .history_values = history_values,
     .summary = summary,
     .timers = timers,
+    .checkpoint = checkpoint,
 };
 
 /* ---- plan --------------------------------------------------------------- */

@@ -36,7 +36,7 @@ typedef struct {
   int tm_mesh, tm_dual, tm_operators, tm_force, tm_update;
   int tm_assembly, tm_linear; /* static solves only (else -1) */
   double setup_wall;          /* mesh + dual + operators, s */
-  double *scratch;            /* 9 n: output buffer */
+  double *scratch;            /* 11 n: output buffer */
   /* the run */
   pm_status status;
   fpm_step_info last;      /* the last step's figures */
@@ -48,6 +48,8 @@ typedef struct {
   double res0;                     /* first residual after the ramps */
   double load_end;                 /* when every ramp has ended, s */
   fpm_static_report static_report; /* time.quasi_static.method: static */
+  bool resumed;                    /* the state came from a checkpoint */
+  long first_step;                 /* the step this run started from */
 } fpm_sim;
 
 /* Mesh the scene's domain, build subdomains, operators and state, and pick

@@ -114,6 +114,13 @@ typedef struct {
                            the body, with f on the prescribed dofs */
   double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous
                            step (trapezoidal work of the supports) */
+  /* What the time loop carries from step to step (fpm_run continues from
+   * it: step 0 is the initial state). */
+  long step;
+  double t;
+  double damping;       /* current damping coefficient, 1/s */
+  double external_work; /* of the supports and tractions so far, J */
+  double dissipated;    /* by damping so far, J */
 } fpm_state;
 
 /* Build the model of scene s with the fpm options o on the cells d of

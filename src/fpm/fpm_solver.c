@@ -156,22 +156,32 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   const long n = m->n;
   const double dt = opt->dt;
   const double load_end = pm_scene_load_end(m->scene);
-  double t = 0, c = opt->qs == PM_QS_DAMPING ? opt->damping : 0;
-  double ext_work = 0, dissipated = 0, t_force = 0, t_update = 0;
+  const bool resumed = st->step > 0;
+  double t = resumed ? st->t : 0;
+  double c = resumed                    ? st->damping
+             : opt->qs == PM_QS_DAMPING ? opt->damping
+                                        : 0;
+  double ext_work = resumed ? st->external_work : 0;
+  double dissipated = resumed ? st->dissipated : 0;
+  double t_force = 0, t_update = 0;
   PM_CHECK(dt > 0 && isfinite(dt), PM_ERR_ARG, "time step must be > 0 (got %g)",
            dt);
-  apply_prescribed(m, st, 0, 0);
-  fpm_update_tractions(m, st, 0);
+  /* A resumed state has its supports in place: only the force (a function
+   * of u and t) is computed again. */
+  if (!resumed) apply_prescribed(m, st, 0, 0);
+  fpm_update_tractions(m, st, t);
   long bad = fpm_force(m, st);
-  if (bad >= 0) return unstable(m, st, 0, 0, dt, bad, 0);
+  if (bad >= 0) return unstable(m, st, st->step, t, dt, bad, 0);
   fpm_support_start(m, st);
 
   fpm_step_info si = {0};
-  /* The initial state, as a frame. */
+  si.step = st->step;
+  si.t = t;
   si.min_jacobian = INFINITY;
   for (long i = 0; i < n; i++)
     si.min_jacobian = fmin(si.min_jacobian, st->J[i]);
-  if (observer) {
+  /* The initial state, as a frame. */
+  if (observer && !resumed) {
     pm_err e = observer(ctx, m, st, &si, true);
     if (e != PM_SUCCESS) {
       if (info) *info = si;
@@ -180,7 +190,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   }
   const double *restrict mass = m->mass;
   const unsigned char *restrict fixed = m->fixed;
-  for (long step = 1;; step++) {
+  for (long step = st->step + 1;; step++) {
     double w0 = pm_wtime();
     double s1 = 0, s2 = 0, sd = 0;
     const double cd2 = 0.5 * c * dt;
@@ -296,6 +306,11 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     bool last = si.converged || t >= opt->t_end * (1 - 1e-12) ||
                 (opt->max_steps > 0 && step >= opt->max_steps);
     bool frame = last || (opt->frame_every > 0 && step % opt->frame_every == 0);
+    st->step = step;
+    st->t = t;
+    st->damping = c;
+    st->external_work = ext_work;
+    st->dissipated = dissipated;
     t_update += (w1 - w0) + (pm_wtime() - w2);
     if (observer) {
       pm_err e = observer(ctx, m, st, &si, frame);

@@ -43,7 +43,10 @@ typedef pm_err (*fpm_observer)(void *ctx, const fpm_model *m,
                                const fpm_state *st, const fpm_step_info *info,
                                bool frame);
 
-/* Run from the state's current u and v (normally zero) at t = 0.  On a
+/* Run from the state: with st->step 0, from its u and v (normally zero)
+ * at t = 0, reporting the initial state; otherwise from the step, time and
+ * loop figures it holds (a checkpoint's), without reporting them again:
+ * the steps that follow are those the first run would have taken.  On a
  * numerical failure returns PM_ERR_UNSTABLE with the step, time, point id,
  * position and cause; the observer has already seen every good frame.
  * info receives the last step's figures.  Allocates nothing. */

@@ -9,6 +9,7 @@
 
 #include "mpm_kind.h"
 #include "mpm_pipeline.h"
+#include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_tensor.h"
 
@@ -22,7 +23,7 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
   PM_TRY(mpm_model_create(s, &r->model, &r->state));
   PM_TRY(mpm_work_create(r->model, &r->work));
   r->setup_wall = pm_wtime() - t0;
-  PM_TRY(PM_ALLOC(r->scratch, 9 * r->model->n, "output buffer"));
+  PM_TRY(PM_ALLOC(r->scratch, 11 * r->model->n, "output buffer"));
   *out = r;
   r = NULL;
 done:
@@ -43,7 +44,7 @@ void mpm_sim_destroy(mpm_sim *r) {
 static size_t sim_bytes(const mpm_sim *r) {
   return mpm_model_bytes(r->model) + mpm_state_bytes(r->model, r->state) +
          mpm_work_bytes(r->model, r->work) +
-         9 * sizeof(double) * (size_t)r->model->n;
+         11 * sizeof(double) * (size_t)r->model->n;
 }
 
 /* ---- run ---------------------------------------------------------------- */
@@ -75,16 +76,19 @@ static pm_err observe(void *ctx, const mpm_model *m, const mpm_state *s,
 static pm_err run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
   const mpm_model *m = r->model;
-  double kin, strain, internal;
-  mpm_energies(m, r->state, &kin, &strain, &internal);
-  r->energy0 = kin + strain + internal;
-  r->run_min_jacobian = INFINITY;
-  r->run_min_jacobian_step = 0;
-  for (long q = 0; q < m->n; q++)
-    r->run_min_jacobian =
-        fmin(r->run_min_jacobian, r->state->vol[q] / m->vol0[q]);
+  pm_err e = PM_SUCCESS;
   r->obs = obs;
-  pm_err e = report(r, true);
+  if (!r->resumed) { /* a resumed run has these from its checkpoint */
+    double kin, strain, internal;
+    mpm_energies(m, r->state, &kin, &strain, &internal);
+    r->energy0 = kin + strain + internal;
+    r->run_min_jacobian = INFINITY;
+    r->run_min_jacobian_step = 0;
+    for (long q = 0; q < m->n; q++)
+      r->run_min_jacobian =
+          fmin(r->run_min_jacobian, r->state->vol[q] / m->vol0[q]);
+    e = report(r, true);
+  }
   mpm_run_options opt = {.t_end = m->opt.t_end,
                          .max_steps = m->opt.max_steps,
                          .frame_every = r->scene->output.every};
@@ -141,14 +145,23 @@ static int fields(void *p, unsigned want, pm_field *f, int max) {
   const mpm_state *s = r->state;
   const long n = r->model->n;
   int nf = 0;
-  if (max < 8) return 0;
+  if (max < 11) return 0;
   double *sed = r->scratch, *jac = sed + n, *rho = sed + 2 * n,
          *pres = sed + 3 * n, *ener = sed + 4 * n;
   particle_fields(r);
+  /* The particles' current positions are each frame's geometry. */
+  f[nf++] = (pm_field){"position", 3, s->x};
   if (want & PM_FIELD_DISPLACEMENT)
     f[nf++] = (pm_field){"displacement", 3, displacement(r)};
   if (want & PM_FIELD_VELOCITY) f[nf++] = (pm_field){"velocity", 3, s->v};
-  if (want & PM_FIELD_STRESS) f[nf++] = (pm_field){"stress", 9, s->sigma};
+  if (want & PM_FIELD_STRESS) {
+    const bool has_pressure = r->model->kinds & MPM_KIND_INTERNAL_ENERGY;
+    double *vm = sed + 9 * n, *mean = has_pressure ? NULL : sed + 10 * n;
+    pm_stress_invariants(n, s->sigma, vm, mean);
+    f[nf++] = (pm_field){"stress", 9, s->sigma};
+    f[nf++] = (pm_field){"von_mises", 1, vm};
+    if (mean) f[nf++] = (pm_field){"pressure", 1, mean};
+  }
   if (want & PM_FIELD_STRAIN_ENERGY_DENSITY)
     f[nf++] = (pm_field){"strain_energy_density", 1, sed};
   if (want & PM_FIELD_JACOBIAN) f[nf++] = (pm_field){"jacobian", 1, jac};
@@ -403,6 +416,26 @@ static pm_err create(const pm_scene *s, void **out) {
 
 static void destroy(void *p) { mpm_sim_destroy(p); }
 
+/* The state, and what the run reports over all its steps. */
+static pm_err checkpoint(void *p, pm_ckpt *ck) {
+  mpm_sim *r = p;
+  long iter_max_row = r->iter_max_row;
+  PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
+  PM_CALL(pm_ckpt_double(ck, "run.energy0", &r->energy0));
+  PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &r->run_min_jacobian));
+  PM_CALL(pm_ckpt_long(ck, "run.min_jacobian_step", &r->run_min_jacobian_step));
+  PM_CALL(pm_ckpt_long(ck, "run.iter_max_row", &iter_max_row));
+  r->iter_max_row = (int)iter_max_row;
+  PM_CALL(pm_ckpt_long(ck, "run.iter_capped_prev", &r->iter_capped_prev));
+  if (pm_ckpt_reading(ck)) {
+    r->resumed = true;
+    r->last.step = r->state->step;
+    r->last.t = r->state->t;
+    r->last.dt = r->state->dt;
+  }
+  return PM_SUCCESS;
+}
+
 const pm_backend mpm_backend = {
     .method = "mpm",
     .description = "explicit Material Point Method",
@@ -421,4 +454,5 @@ const pm_backend mpm_backend = {
     .history_values = history_values,
     .summary = summary,
     .timers = timers,
+    .checkpoint = checkpoint,
 };

@@ -18,7 +18,7 @@ typedef struct {
   mpm_state *state;
   mpm_work *work;
   double setup_wall; /* s */
-  double *scratch;   /* output buffer, 9 per particle */
+  double *scratch;   /* output buffer, 11 per particle */
   /* the run */
   pm_status status;
   double energy0;          /* kinetic + strain + internal at t = 0 */
@@ -27,6 +27,7 @@ typedef struct {
   int iter_max_row; /* most iterations since the last history row */
   long iter_capped_prev;
   mpm_step_info last;     /* the last step's figures */
+  bool resumed;           /* the state came from a checkpoint */
   const pm_observer *obs; /* during a run */
 } mpm_sim;
 

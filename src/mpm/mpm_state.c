@@ -131,3 +131,31 @@ size_t mpm_work_bytes(const mpm_model *m, const mpm_work *w) {
          mpm_cond_work_bytes(&w->cond, &m->grid) +
          per_particle * sizeof(double) * (size_t)m->n;
 }
+
+pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck) {
+  mpm_array a[MPM_STATE_MAX_ARRAYS];
+  const long n3 = 3 * m->grid.n_nodes;
+  const long n_acc = (long)(sizeof s->energy / (sizeof(double)));
+  long iter_max = s->iter_max_total;
+  PM_CALL(pm_ckpt_double(ck, "mpm.t", &s->t));
+  PM_CALL(pm_ckpt_long(ck, "mpm.step", &s->step));
+  PM_CALL(pm_ckpt_double(ck, "mpm.dt", &s->dt));
+  PM_CALL(pm_ckpt_double(ck, "mpm.dt_stable", &s->dt_stable));
+  PM_CALL(pm_ckpt_double(ck, "mpm.max_div_prev", &s->max_div_prev));
+  int na = mpm_state_arrays(m, s, a, MPM_STATE_MAX_ARRAYS);
+  for (int k = 0; k < na; k++) {
+    char name[96];
+    snprintf(name, sizeof name, "mpm.%02d.%s", k, a[k].name);
+    PM_CALL(pm_ckpt_doubles(ck, name, a[k].ncomp * a[k].count, a[k].data));
+  }
+  PM_CALL(pm_ckpt_doubles(ck, "mpm.energy", n_acc, (double *)s->energy));
+  PM_CALL(pm_ckpt_double(ck, "mpm.external_work", &s->external_work));
+  PM_CALL(pm_ckpt_double(ck, "mpm.dissipated", &s->dissipated));
+  PM_CALL(pm_ckpt_double(ck, "mpm.damping", &s->damping));
+  PM_CALL(pm_ckpt_doubles(ck, "mpm.force_prev", s->force_prev ? n3 : 0,
+                          s->force_prev));
+  PM_CALL(pm_ckpt_bytes(ck, "mpm.fixed", s->fixed ? n3 : 0, s->fixed));
+  PM_CALL(pm_ckpt_long(ck, "mpm.iter_max_total", &iter_max));
+  s->iter_max_total = (int)iter_max;
+  return pm_ckpt_long(ck, "mpm.iter_capped_total", &s->iter_capped_total);
+}

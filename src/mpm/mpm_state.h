@@ -5,6 +5,7 @@
 #define MPM_STATE_H
 
 #include "mpm_model.h"
+#include "pm_checkpoint.h"
 #include "pm_progress.h"
 
 /* The state of a run.  Everything a later step reads that an earlier one
@@ -75,6 +76,10 @@ void mpm_state_copy(const mpm_model *m, mpm_state *dst, const mpm_state *src);
 #define MPM_STATE_MAX_ARRAYS (4 + MPM_MAX_GROUPS * MPM_MAX_ARRAYS)
 int mpm_state_arrays(const mpm_model *m, const mpm_state *s, mpm_array *out,
                      int max);
+
+/* Write every value of the state to a checkpoint, or read it back (the
+ * same items both ways: pm_checkpoint.h). */
+pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck);
 
 /* Bytes of the state's arrays (particles and grid). */
 size_t mpm_state_bytes(const mpm_model *m, const mpm_state *s);

@@ -117,7 +117,7 @@ static void test_bad_directory(void **state) {
   assert_int_equal(pm_afile_open(path, &f), PM_ERR_IO);
   assert_null(f);
   assert_non_null(strstr(pm_error_message(), missing));
-  assert_int_equal(pm_history_open(missing, 1, names, &h), PM_ERR_IO);
+  assert_int_equal(pm_history_open(missing, 1, names, -1, &h), PM_ERR_IO);
   assert_null(h);
   assert_non_null(strstr(pm_error_message(), missing));
   snprintf(path, sizeof path, "%s/summary.json", missing);
@@ -147,16 +147,21 @@ static void test_history(void **state) {
   pm_history *h = NULL;
   snprintf(path, sizeof path, "%s/history.csv", dir);
 
-  assert_int_equal(pm_history_open(dir, 3, names, &h), PM_SUCCESS);
+  assert_int_equal(pm_history_open(dir, 3, names, -1, &h), PM_SUCCESS);
   assert_int_equal(pm_history_ncols(h), 3);
   for (int i = 0; i < 3; i++) {
     double row[3] = {0.5 * i, 1.0 / 3.0, -2e-12 * i};
     assert_int_equal(pm_history_row(h, row), PM_SUCCESS);
   }
+  /* Synced rows are on disk while the run goes on. */
+  assert_int_equal(pm_history_sync(h), PM_SUCCESS);
+  assert_string_equal(slurp(path), "time,kinetic,\"reaction, x\"\n"
+                                   "0,0.3333333333,-0\n"
+                                   "0.5,0.3333333333,-2e-12\n"
+                                   "1,0.3333333333,-4e-12\n");
   double bad[3] = {NAN, INFINITY, 1e300};
   assert_int_equal(pm_history_row(h, bad), PM_SUCCESS);
-  assert_false(exists(path));
-  assert_int_equal(pm_history_close(h, true), PM_SUCCESS);
+  assert_int_equal(pm_history_close(h), PM_SUCCESS);
   assert_string_equal(slurp(path), "time,kinetic,\"reaction, x\"\n"
                                    "0,0.3333333333,-0\n"
                                    "0.5,0.3333333333,-2e-12\n"
@@ -164,16 +169,71 @@ static void test_history(void **state) {
                                    "nan,inf,1e+300\n");
   assert_int_equal(count_entries(dir), 1);
 
-  /* keep = false discards and leaves the committed file alone. */
-  assert_int_equal(pm_history_open(dir, 1, names, &h), PM_SUCCESS);
-  double one = 1.0;
-  assert_int_equal(pm_history_row(h, &one), PM_SUCCESS);
-  assert_int_equal(pm_history_close(h, false), PM_SUCCESS);
+  /* Resuming keeps the first rows and appends after them. */
+  assert_int_equal(pm_history_open(dir, 3, names, 2, &h), PM_SUCCESS);
+  double next[3] = {2, 0, 0};
+  assert_int_equal(pm_history_row(h, next), PM_SUCCESS);
+  assert_int_equal(pm_history_close(h), PM_SUCCESS);
+  assert_string_equal(slurp(path), "time,kinetic,\"reaction, x\"\n"
+                                   "0,0.3333333333,-0\n"
+                                   "0.5,0.3333333333,-2e-12\n"
+                                   "2,0,0\n");
   assert_int_equal(count_entries(dir), 1);
-  assert_non_null(strstr(slurp(path), "reaction"));
+  /* ... but not another table's, nor more rows than it has. */
+  assert_int_equal(pm_history_open(dir, 1, names, 1, &h), PM_ERR_IO);
+  assert_non_null(strstr(pm_error_message(), "columns"));
+  assert_int_equal(pm_history_open(dir, 3, names, 9, &h), PM_ERR_IO);
+  assert_non_null(strstr(pm_error_message(), "holds 3 rows"));
+  assert_int_equal(count_entries(dir), 1);
 
-  assert_int_equal(pm_history_open(dir, 0, names, &h), PM_ERR_ARG);
-  assert_int_equal(pm_history_close(NULL, true), PM_SUCCESS);
+  assert_int_equal(pm_history_open(dir, 0, names, -1, &h), PM_ERR_ARG);
+  assert_int_equal(pm_history_close(NULL), PM_SUCCESS);
+  pm_error_clear();
+}
+
+/* ---- Output folders ----------------------------------------------------- */
+
+static void test_outdir(void **state) {
+  const char *dir = *state;
+  char out[512], path[600];
+  pm_outdir *d = NULL, *d2 = (pm_outdir *)1;
+  snprintf(out, sizeof out, "%s/run", dir);
+
+  /* A new folder is created and locked: a second claim names the pid. */
+  assert_int_equal(pm_outdir_claim(out, PM_OUTDIR_NEW, &d), PM_SUCCESS);
+  assert_int_equal(pm_outdir_claim(out, PM_OUTDIR_OVERWRITE, &d2), PM_ERR_IO);
+  assert_null(d2);
+  char pid[32];
+  snprintf(pid, sizeof pid, "pid %ld", (long)getpid());
+  assert_non_null(strstr(pm_error_message(), "in use"));
+  assert_non_null(strstr(pm_error_message(), pid));
+  /* A run's files and a killed run's temporary file. */
+  snprintf(path, sizeof path, "%s/summary.json", out);
+  FILE *fp = fopen(path, "w");
+  fputs("{\n  \"status\": \"completed\"\n}\n", fp);
+  fclose(fp);
+  snprintf(path, sizeof path, "%s/results.h5.tmp.1", out);
+  fclose(fopen(path, "w"));
+  pm_outdir_release(d);
+
+  /* Not overwritten unless asked. */
+  assert_int_equal(pm_outdir_claim(out, PM_OUTDIR_NEW, &d), PM_ERR_IO);
+  assert_non_null(strstr(pm_error_message(), "status \"completed\""));
+  assert_non_null(strstr(pm_error_message(), "--overwrite"));
+  snprintf(path, sizeof path, "%s/summary.json", out);
+  assert_true(exists(path));
+  assert_int_equal(pm_outdir_claim(out, PM_OUTDIR_RESUME, &d), PM_SUCCESS);
+  assert_true(exists(path));
+  pm_outdir_release(d);
+  assert_int_equal(pm_outdir_claim(out, PM_OUTDIR_OVERWRITE, &d), PM_SUCCESS);
+  assert_false(exists(path));
+  snprintf(path, sizeof path, "%s/results.h5.tmp.1", out);
+  assert_false(exists(path));
+  pm_outdir_release(d);
+  /* Resuming needs the folder. */
+  snprintf(path, sizeof path, "%s/none", dir);
+  assert_int_equal(pm_outdir_claim(path, PM_OUTDIR_RESUME, &d), PM_ERR_IO);
+  assert_null(d);
   pm_error_clear();
 }
 
@@ -388,6 +448,8 @@ int main(void) {
       cmocka_unit_test_setup_teardown(test_afile_commit_abort, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_bad_directory, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_outdir, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_history, pm_test_make_dir,
                                       pm_test_drop_dir),

@@ -101,12 +101,15 @@ static void test_write_read(void **state) {
     assert_ok(pm_results_write_frame(r, 100 * f, 0.5 * f, 3, fields));
   }
   assert_int_equal(pm_results_frames(r), 2);
-  /* While open: only the temporary file. */
-  assert_int_equal(count_entries(dir, &tmp), 1);
-  assert_int_equal(tmp, 1);
-  assert_ok(pm_results_close(r, true));
-  assert_int_equal(count_entries(dir, &tmp), 2);
+  /* While the run goes on, every frame is on disk under its final name:
+   * the index, the XDMF and the results folder, no temporary file. */
+  assert_int_equal(count_entries(dir, &tmp), 3);
   assert_int_equal(tmp, 0);
+  snprintf(path, sizeof path, "%s/results", dir);
+  assert_int_equal(count_entries(path, &tmp), 3); /* mesh and two frames */
+  assert_int_equal(tmp, 0);
+  pm_results_close(r, true);
+  assert_int_equal(count_entries(dir, &tmp), 3);
 
   /* Read back with the HDF5 API. */
   snprintf(path, sizeof path, "%s/results.h5", dir);
@@ -166,15 +169,16 @@ static void test_write_read(void **state) {
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
   char *x = slurp(path);
   assert_non_null(strstr(x, "<Xdmf Version=\"3.0\">"));
+  assert_null(strstr(x, "position"));
   assert_non_null(strstr(x, "CollectionType=\"Temporal\""));
   assert_non_null(strstr(x, "<Time Value=\"0\"/>"));
   assert_non_null(strstr(x, "<Time Value=\"0.5\"/>"));
   assert_non_null(strstr(x, "TopologyType=\"Tetrahedron\" "
                             "NumberOfElements=\"2\""));
-  assert_non_null(strstr(x, "results.h5:/mesh/cells"));
-  assert_non_null(strstr(x, "results.h5:/mesh/coordinates"));
-  assert_non_null(strstr(x, "results.h5:/frames/000000/displacement"));
-  assert_non_null(strstr(x, "results.h5:/frames/000001/damage"));
+  assert_non_null(strstr(x, "results/mesh.h5:/cells"));
+  assert_non_null(strstr(x, "results/mesh.h5:/coordinates"));
+  assert_non_null(strstr(x, "results/frame_000000.h5:/displacement"));
+  assert_non_null(strstr(x, "results/frame_000001.h5:/damage"));
   assert_non_null(strstr(x, "AttributeType=\"Tensor\""));
   assert_non_null(strstr(x, "Dimensions=\"5 3 3\""));
   assert_non_null(strstr(x, "</Xdmf>"));
@@ -199,24 +203,80 @@ static void test_abort_and_point_cloud(void **state) {
   pm_field f = {"damage", 1, damage};
   char path[512];
 
-  /* keep = false leaves nothing. */
+  /* keep = false before any frame leaves nothing ... */
+  assert_ok(
+      pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "0.1.0", &r));
+  pm_results_close(r, false);
+  assert_int_equal(count_entries(dir, NULL), 0);
+  /* ... but a frame written is never taken back. */
   assert_ok(
       pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "0.1.0", &r));
   assert_ok(pm_results_write_frame(r, 0, 0.0, 1, &f));
-  assert_ok(pm_results_close(r, false));
-  assert_int_equal(count_entries(dir, NULL), 0);
+  pm_results_close(r, false);
+  assert_int_equal(count_entries(dir, NULL), 3);
 
   /* Point cloud without cells and without frames: bare mesh XDMF. */
   assert_ok(pm_results_create(dir, 2, NP, coords, 0, 1, NULL, NULL, NULL, &r));
-  assert_ok(pm_results_close(r, true));
+  pm_results_close(r, true);
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
   char *x = slurp(path);
   assert_non_null(strstr(x, "TopologyType=\"Polyvertex\" "
                             "NumberOfElements=\"5\" NodesPerElement=\"1\""));
   assert_null(strstr(x, "Temporal"));
   free(x);
-  assert_int_equal(count_entries(dir, NULL), 2);
-  assert_ok(pm_results_close(NULL, true));
+  pm_results_close(NULL, true);
+}
+
+/* Moving points: a "position" field is the frame's geometry.  A resumed
+ * run keeps the first frames and continues their numbering. */
+static void test_moving_and_reopen(void **state) {
+  const char *dir = *state;
+  pm_results *r = NULL;
+  double pos[3 * NP], u[3 * NP] = {0};
+  char path[512];
+  int tmp;
+  pm_field f[2] = {{"position", 3, pos}, {"displacement", 3, u}};
+  memcpy(pos, coords, sizeof pos);
+  assert_ok(pm_results_create(dir, 3, NP, coords, 0, 1, NULL, scene, "v", &r));
+  for (int k = 0; k < 3; k++) {
+    pos[0] = k;
+    assert_ok(pm_results_write_frame(r, 10 * k, k, 2, f));
+  }
+  pm_results_close(r, true);
+  snprintf(path, sizeof path, "%s/results.xdmf", dir);
+  char *x = slurp(path);
+  assert_non_null(strstr(x, "results/frame_000002.h5:/position</DataItem>\n"
+                            "        </Geometry>"));
+  assert_null(strstr(x, "Attribute Name=\"position\""));
+  free(x);
+
+  /* Keep two frames: the third goes, the next one is frame 2 again. */
+  assert_int_equal(pm_results_reopen(dir, NP + 1, 2, &r), PM_ERR_ARG);
+  assert_ok(pm_results_reopen(dir, NP, 2, &r));
+  assert_int_equal(pm_results_frames(r), 2);
+  snprintf(path, sizeof path, "%s/results/frame_000002.h5", dir);
+  assert_int_equal(access(path, F_OK), -1);
+  pos[0] = 7;
+  assert_ok(pm_results_write_frame(r, 25, 2.5, 2, f));
+  pm_results_close(r, true);
+  snprintf(path, sizeof path, "%s/results", dir);
+  assert_int_equal(count_entries(path, &tmp), 4);
+  assert_int_equal(tmp, 0);
+  snprintf(path, sizeof path, "%s/results.xdmf", dir);
+  x = slurp(path);
+  assert_non_null(strstr(x, "<Time Value=\"1\"/>"));
+  assert_non_null(strstr(x, "<Time Value=\"2.5\"/>"));
+  assert_null(strstr(x, "<Time Value=\"2\"/>"));
+  free(x);
+  /* The index reads as one file through its links. */
+  snprintf(path, sizeof path, "%s/results.h5", dir);
+  hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+  assert_true(file >= 0);
+  double back[3 * NP];
+  hsize_t dims[2] = {NP, 3};
+  read_doubles(file, "/frames/000002/position", back, 3 * NP, 2, dims);
+  assert_true(back[0] == 7);
+  H5Fclose(file);
 }
 
 static void test_bad_arguments(void **state) {
@@ -247,7 +307,7 @@ static void test_bad_arguments(void **state) {
   pm_field nodata = {"u", 3, NULL};
   assert_int_equal(pm_results_write_frame(r, 0, 0.0, 1, &nodata), PM_ERR_ARG);
   assert_int_equal(pm_results_frames(r), 0);
-  assert_ok(pm_results_close(r, false));
+  pm_results_close(r, false);
   assert_int_equal(count_entries(dir, NULL), 0);
   pm_error_clear();
 }
@@ -282,6 +342,8 @@ int main(void) {
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_abort_and_point_cloud,
                                       pm_test_make_dir, pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_moving_and_reopen, pm_test_make_dir,
+                                      pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_bad_arguments, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_bad_directory, pm_test_make_dir,

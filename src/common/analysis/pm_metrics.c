@@ -3,6 +3,9 @@
 
 #include <math.h>
 
+#include "pm_omp.h"
+#include "pm_tensor.h"
+
 double pm_nrmse(long n, int stride, const double *u, const double *ref) {
   double sum = 0, lo = INFINITY, hi = -INFINITY;
   for (long j = 0; j < n; j++) {
@@ -50,4 +53,15 @@ double pm_convergence_rate(int n, const double *h, const double *err) {
   if (m < 2) return NAN;
   double den = m * sxx - sx * sx;
   return den > 0 ? (m * sxy - sx * sy) / den : NAN;
+}
+
+void pm_stress_invariants(long n, const double *sigma, double *von_mises,
+                          double *pressure) {
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, sigma, von_mises, pressure))
+  for (long i = 0; i < n; i++) {
+    const double *S = sigma + 9 * i;
+    if (von_mises) von_mises[i] = pm_t_von_mises(S);
+    if (pressure) pressure[i] = -(S[0] + S[4] + S[8]) / 3;
+  }
 }

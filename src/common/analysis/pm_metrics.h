@@ -23,4 +23,10 @@ double pm_nrmse_vector(long n, unsigned mask, const double *u,
  * observed convergence rate q.  NaN if fewer than two positive pairs. */
 double pm_convergence_rate(int n, const double *h, const double *err);
 
+/* The invariants of n Cauchy stresses (9 each, row-major) that a reader
+ * wants by name: von Mises stress sqrt(3/2 s:s) into von_mises and the
+ * pressure -tr(sigma)/3 into pressure (either may be NULL). */
+void pm_stress_invariants(long n, const double *sigma, double *von_mises,
+                          double *pressure);
+
 #endif

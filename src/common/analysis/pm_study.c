@@ -234,6 +234,12 @@ done:
 
 /* Rate of |err| between consecutive levels against x (NaN where either
  * value is missing), and the least-squares rate over all levels. */
+/* The run flags of the study's levels. */
+static unsigned run_flags(const pm_study_options *o) {
+  return (o->quiet ? PM_RUN_QUIET : 0u) |
+         (o->overwrite ? PM_RUN_OVERWRITE : 0u);
+}
+
 static double rates(int n, const double *x, const double *err, double *rate) {
   double a[PM_STUDY_MAX_LEVELS];
   for (int l = 0; l < n; l++) {
@@ -318,7 +324,7 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
     PM_TRY(pm_path_join(ref.dir, sizeof ref.dir, out_dir, "reference"));
     PM_TRY(load_level(o, keys, n_all - 1, &s));
     if (out) fprintf(out, "reference run -> %s\n", ref.dir);
-    ref.err = pm_run_scene(s, ref.dir, o->quiet, &ref.out);
+    ref.err = pm_run_scene(s, ref.dir, run_flags(o), &ref.out);
     ref.error = ref.rate = NAN;
     ref.reaction_error = ref.reaction_rate = ref.sed_error = NAN;
     ref.error_interior = NAN;
@@ -358,7 +364,7 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
         fprintf(out, " %s=%s", keys[k].key, keys[k].value[l]);
       fprintf(out, " -> %s\n", L->dir);
     }
-    L->err = pm_run_scene(s, L->dir, o->quiet, &L->out);
+    L->err = pm_run_scene(s, L->dir, run_flags(o), &L->out);
     pm_scene_destroy(s);
     s = NULL;
     L->error = L->rate = NAN;

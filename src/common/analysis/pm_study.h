@@ -31,6 +31,7 @@ typedef struct {
   const char *reference;
   const char *out_dir; /* NULL: out/NAME-convergence */
   bool quiet;
+  bool overwrite; /* replace the files of an earlier study's levels */
 } pm_study_options;
 
 /* Run the ladder; write OUT/convergence.csv and OUT/convergence.md and the

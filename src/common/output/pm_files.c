@@ -3,11 +3,13 @@
  * data lines. */
 #include "pm_files.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <unistd.h>
@@ -236,9 +238,9 @@ void pm_afile_abort(pm_afile *f) {
 /* ---- History CSV ------------------------------------------------------- */
 
 struct pm_history {
-  pm_afile *file;
   FILE *fp;
   int ncols;
+  char path[PM_PATH_MAX + 1];
 };
 
 /* Write a CSV field, quoting it when it holds a separator. */
@@ -255,32 +257,92 @@ static void csv_field(FILE *fp, const char *s) {
   putc('"', fp);
 }
 
+static void csv_header(FILE *fp, int ncols, const char *const *names) {
+  for (int i = 0; i < ncols; i++) {
+    if (i) putc(',', fp);
+    csv_field(fp, names[i]);
+  }
+  putc('\n', fp);
+}
+
+/* history.csv of a resumed run: the same header, and its first keep_rows
+ * rows, rewritten whole (rows after them came after the checkpoint). */
+static pm_err history_truncate(const char *path, int ncols,
+                               const char *const *names, long keep_rows) {
+  pm_err ret = PM_SUCCESS;
+  FILE *in = NULL;
+  pm_afile *out = NULL;
+  char *line = NULL, *header = NULL;
+  size_t cap = 0, hcap = 0;
+  long rows = 0;
+  in = fopen(path, "r");
+  PM_CHECK(in, PM_ERR_IO, "cannot open '%s' to resume it: %s", path,
+           strerror(errno));
+  PM_TRY(pm_afile_open(path, &out));
+  FILE *fp = pm_afile_stream(out);
+  /* The header must be the one this run writes. */
+  csv_header(fp, ncols, names);
+  PM_ENSURE(fflush(fp) == 0, PM_ERR_IO, "cannot write '%s'", path);
+  {
+    FILE *h = open_memstream(&header, &hcap);
+    PM_ENSURE(h, PM_ERR_MEMORY, "cannot build the header of '%s'", path);
+    csv_header(h, ncols, names);
+    fclose(h);
+  }
+  PM_ENSURE(getline(&line, &cap, in) >= 0 && strcmp(line, header) == 0,
+            PM_ERR_IO,
+            "'%s' does not start with the columns this run writes: it "
+            "belongs to another scene or program version",
+            path);
+  while (rows < keep_rows && getline(&line, &cap, in) >= 0) {
+    PM_ENSURE(strchr(line, '\n'), PM_ERR_IO,
+              "'%s' row %ld is cut short: the checkpoint names %ld rows", path,
+              rows + 1, keep_rows);
+    fputs(line, fp);
+    rows++;
+  }
+  PM_ENSURE(rows == keep_rows, PM_ERR_IO,
+            "'%s' holds %ld rows, the checkpoint names %ld", path, rows,
+            keep_rows);
+  pm_afile *f = out;
+  out = NULL;
+  PM_TRY(pm_afile_commit(f));
+done:
+  if (in) fclose(in);
+  pm_afile_abort(out);
+  free(line);
+  free(header);
+  return ret;
+}
+
 pm_err pm_history_open(const char *dir, int ncols, const char *const *names,
-                       pm_history **out) {
+                       long keep_rows, pm_history **out) {
   pm_err ret = PM_SUCCESS;
   pm_history *h = NULL;
-  char path[PM_PATH_MAX + 1];
   PM_CHECK(out, PM_ERR_ARG, "pm_history_open: NULL out");
   *out = NULL;
   PM_CHECK(ncols >= 1 && names, PM_ERR_ARG,
            "history needs at least one column name (got %d)", ncols);
   for (int i = 0; i < ncols; i++)
     PM_CHECK(names[i], PM_ERR_ARG, "history column %d has no name", i);
-  PM_CALL(pm_path_join(path, sizeof path, dir, "history.csv"));
   PM_TRY(PM_ALLOC(h, 1, "history writer"));
   h->ncols = ncols;
-  PM_TRY(pm_afile_open(path, &h->file));
-  h->fp = pm_afile_stream(h->file);
-  for (int i = 0; i < ncols; i++) {
-    if (i) putc(',', h->fp);
-    csv_field(h->fp, names[i]);
+  PM_TRY(pm_path_join(h->path, sizeof h->path, dir, "history.csv"));
+  if (keep_rows >= 0) {
+    PM_TRY(history_truncate(h->path, ncols, names, keep_rows));
+    h->fp = fopen(h->path, "a");
+  } else {
+    /* Written in place: every row synced is a whole result. */
+    h->fp = fopen(h->path, "w");
   }
-  putc('\n', h->fp);
-  PM_ENSURE(!ferror(h->fp), PM_ERR_IO, "cannot write the header of '%s'", path);
+  PM_ENSURE(h->fp, PM_ERR_IO, "cannot open '%s' for writing: %s", h->path,
+            strerror(errno));
+  if (keep_rows < 0) csv_header(h->fp, ncols, names);
+  PM_TRY(pm_history_sync(h));
   *out = h;
   h = NULL;
 done:
-  if (h) pm_afile_abort(h->file);
+  if (h && h->fp) fclose(h->fp);
   free(h);
   return ret;
 }
@@ -290,22 +352,29 @@ pm_err pm_history_row(pm_history *h, const double *values) {
   for (int i = 0; i < h->ncols; i++)
     if (fprintf(h->fp, i ? ",%.10g" : "%.10g", values[i]) < 0) break;
   PM_CHECK(putc('\n', h->fp) != EOF && !ferror(h->fp), PM_ERR_IO,
-           "cannot write a row of '%s'", pm_afile_path(h->file));
+           "cannot write a row of '%s': %s", h->path, strerror(errno));
+  return PM_SUCCESS;
+}
+
+pm_err pm_history_sync(pm_history *h) {
+  PM_CHECK(h, PM_ERR_ARG, "pm_history_sync: NULL history");
+  PM_CHECK(fflush(h->fp) == 0 && !ferror(h->fp), PM_ERR_IO,
+           "cannot write '%s': %s", h->path, strerror(errno));
+  PM_CHECK(fsync(fileno(h->fp)) == 0, PM_ERR_IO, "cannot sync '%s': %s",
+           h->path, strerror(errno));
   return PM_SUCCESS;
 }
 
 int pm_history_ncols(const pm_history *h) { return h ? h->ncols : 0; }
 
-pm_err pm_history_close(pm_history *h, bool keep) {
+pm_err pm_history_close(pm_history *h) {
   pm_err ret = PM_SUCCESS;
   if (!h) return PM_SUCCESS;
-  if (keep)
-    ret = pm_afile_commit(h->file);
-  else
-    pm_afile_abort(h->file);
+  ret = pm_history_sync(h);
+  if (fclose(h->fp) != 0 && ret == PM_SUCCESS)
+    ret =
+        PM_ERROR(PM_ERR_IO, "cannot close '%s': %s", h->path, strerror(errno));
   free(h);
-  if (ret != PM_SUCCESS)
-    pm_error_trace(ret, __FILE__, __LINE__, __func__, "pm_afile_commit");
   return ret;
 }
 
@@ -534,4 +603,192 @@ pm_err pm_json_run_header(pm_json *j, const char *scene_path, const char *name,
   for (int k = 0; k < n_overrides; k++)
     PM_CALL(pm_json_string(j, NULL, overrides[k]));
   return pm_json_end_array(j);
+}
+
+/* ---- Output folders ----------------------------------------------------- */
+
+struct pm_outdir {
+  int fd;       /* the lock file, flock'ed for the run's life */
+  bool created; /* the claim created the folder */
+  char dir[PM_PATH_MAX + 1];
+};
+
+/* The files a run writes in its folder (results/ holds the frames). */
+static const char *const run_files[] = {"summary.json", "history.csv",
+                                        "results.h5", "results.xdmf",
+                                        "checkpoint.h5"};
+#define N_RUN_FILES (sizeof run_files / sizeof *run_files)
+#define LOCK_NAME ".pointmech.lock"
+
+/* The status member of dir/summary.json ("" when there is none). */
+static void summary_status(const char *dir, char *buf, size_t size) {
+  char path[PM_PATH_MAX + 1], line[512];
+  buf[0] = '\0';
+  if (pm_path_join(path, sizeof path, dir, "summary.json")) return;
+  FILE *fp = fopen(path, "r");
+  if (!fp) return;
+  while (fgets(line, sizeof line, fp)) {
+    char *p = strstr(line, "\"status\": \"");
+    if (!p) continue;
+    p += 11;
+    size_t n = strcspn(p, "\"");
+    snprintf(buf, size, "%.*s", (int)(n < size ? n : size - 1), p);
+    break;
+  }
+  fclose(fp);
+}
+
+/* Remove dir/name when it exists; a folder (results/) with its files. */
+static pm_err remove_entry(const char *dir, const char *name) {
+  char path[PM_PATH_MAX + 1], child[PM_PATH_MAX + 1];
+  struct stat st;
+  PM_CALL(pm_path_join(path, sizeof path, dir, name));
+  if (lstat(path, &st) != 0) return PM_SUCCESS;
+  if (S_ISDIR(st.st_mode)) {
+    DIR *d = opendir(path);
+    PM_CHECK(d, PM_ERR_IO, "cannot read '%s': %s", path, strerror(errno));
+    struct dirent *e;
+    pm_err ret = PM_SUCCESS;
+    while ((e = readdir(d)) && ret == PM_SUCCESS) {
+      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+      ret = pm_path_join(child, sizeof child, path, e->d_name);
+      if (ret == PM_SUCCESS && unlink(child) != 0)
+        ret = PM_ERROR(PM_ERR_IO, "cannot remove '%s': %s", child,
+                       strerror(errno));
+    }
+    closedir(d);
+    PM_CALL(ret);
+    PM_CHECK(rmdir(path) == 0, PM_ERR_IO, "cannot remove '%s': %s", path,
+             strerror(errno));
+    return PM_SUCCESS;
+  }
+  PM_CHECK(unlink(path) == 0, PM_ERR_IO, "cannot remove '%s': %s", path,
+           strerror(errno));
+  return PM_SUCCESS;
+}
+
+/* Does dir hold an earlier run's files?  *which names the first. */
+static bool holds_run(const char *dir, const char **which) {
+  char path[PM_PATH_MAX + 1];
+  struct stat st;
+  for (size_t k = 0; k < N_RUN_FILES; k++)
+    if (!pm_path_join(path, sizeof path, dir, run_files[k]) &&
+        stat(path, &st) == 0) {
+      *which = run_files[k];
+      return true;
+    }
+  if (!pm_path_join(path, sizeof path, dir, "results") &&
+      stat(path, &st) == 0) {
+    *which = "results/";
+    return true;
+  }
+  return false;
+}
+
+/* Remove the temporary files (NAME.tmp.PID) a killed run left in dir. */
+static pm_err drop_tmp(const char *dir) {
+  DIR *d = opendir(dir);
+  PM_CHECK(d, PM_ERR_IO, "cannot read '%s': %s", dir, strerror(errno));
+  struct dirent *e;
+  pm_err ret = PM_SUCCESS;
+  while ((e = readdir(d)) && ret == PM_SUCCESS)
+    if (strstr(e->d_name, ".tmp.")) ret = remove_entry(dir, e->d_name);
+  closedir(d);
+  return ret;
+}
+
+static pm_err take_lock(const char *dir, int *fd_out) {
+  char path[PM_PATH_MAX + 1], pid[32];
+  *fd_out = -1;
+  PM_CALL(pm_path_join(path, sizeof path, dir, LOCK_NAME));
+  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  PM_CHECK(fd >= 0, PM_ERR_IO, "output folder '%s' is not writable: %s", dir,
+           strerror(errno));
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    ssize_t n = pread(fd, pid, sizeof pid - 1, 0);
+    pid[n > 0 ? n : 0] = '\0';
+    pid[strcspn(pid, "\n")] = '\0';
+    close(fd);
+    return PM_ERROR(PM_ERR_IO,
+                    "output folder '%s' is in use by a running pointmech (pid "
+                    "%s): wait for it, stop it, or choose another --out",
+                    dir, pid[0] ? pid : "unknown");
+  }
+  int n = snprintf(pid, sizeof pid, "%ld\n", (long)getpid());
+  if (ftruncate(fd, 0) != 0 || pwrite(fd, pid, (size_t)n, 0) != n) {
+    int e = errno;
+    close(fd);
+    return PM_ERROR(PM_ERR_IO, "cannot write the lock file '%s': %s", path,
+                    strerror(e));
+  }
+  *fd_out = fd;
+  return PM_SUCCESS;
+}
+
+pm_err pm_outdir_claim(const char *dir, pm_outdir_mode mode, pm_outdir **out) {
+  pm_err ret = PM_SUCCESS;
+  pm_outdir *d = NULL;
+  const char *which = NULL;
+  struct stat st;
+  PM_CHECK(out && dir && dir[0], PM_ERR_ARG, "pm_outdir_claim: no folder");
+  PM_CHECK(strlen(dir) < sizeof d->dir - 32, PM_ERR_ARG,
+           "output folder name too long: '%.64s...'", dir);
+  *out = NULL;
+  bool existed = stat(dir, &st) == 0;
+  if (mode == PM_OUTDIR_RESUME)
+    PM_CHECK(stat(dir, &st) == 0 && S_ISDIR(st.st_mode), PM_ERR_IO,
+             "cannot resume '%s': %s", dir,
+             errno ? strerror(errno) : "not a folder");
+  else
+    PM_CALL(pm_mkdir_p(dir));
+  PM_CHECK(access(dir, W_OK | X_OK) == 0, PM_ERR_IO,
+           "output folder '%s' is not writable: %s", dir, strerror(errno));
+  PM_TRY(PM_ALLOC(d, 1, "output folder"));
+  d->fd = -1;
+  d->created = !existed;
+  snprintf(d->dir, sizeof d->dir, "%s", dir);
+  PM_TRY(take_lock(dir, &d->fd));
+  if (mode == PM_OUTDIR_NEW && holds_run(dir, &which)) {
+    char status[64];
+    summary_status(dir, status, sizeof status);
+    PM_ENSURE(false, PM_ERR_IO,
+              "output folder '%s' already holds the results of another run "
+              "(%s%s%s%s): pass --overwrite to replace them, `pointmech "
+              "resume %s` to continue that run, or choose another --out",
+              dir, which, status[0] ? ", status \"" : "", status,
+              status[0] ? "\"" : "", dir);
+  }
+  PM_TRY(drop_tmp(dir));
+  if (mode == PM_OUTDIR_OVERWRITE) {
+    for (size_t k = 0; k < N_RUN_FILES; k++)
+      PM_TRY(remove_entry(dir, run_files[k]));
+    PM_TRY(remove_entry(dir, "results"));
+  }
+  *out = d;
+  d = NULL;
+done:
+  pm_outdir_release(d);
+  return ret;
+}
+
+void pm_outdir_release(pm_outdir *d) {
+  if (!d) return;
+  /* A folder this claim created and nothing was written to goes again. */
+  if (d->created && d->fd >= 0) {
+    char path[PM_PATH_MAX + 1];
+    DIR *dd = opendir(d->dir);
+    int others = 0;
+    struct dirent *e;
+    while (dd && (e = readdir(dd)))
+      if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..") &&
+          strcmp(e->d_name, LOCK_NAME))
+        others++;
+    if (dd) closedir(dd);
+    if (dd && others == 0 &&
+        pm_path_join(path, sizeof path, d->dir, LOCK_NAME) == PM_SUCCESS &&
+        unlink(path) == 0)
+      rmdir(d->dir);
+  }
+  if (d->fd >= 0) close(d->fd); /* releases the lock */
+  free(d);
 }

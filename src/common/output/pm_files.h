@@ -91,27 +91,62 @@ pm_err pm_rename(const char *from, const char *to);
 
 /* ---- History CSV ------------------------------------------------------- */
 
-/* DIR/history.csv written row by row (through pm_afile). */
+/* DIR/history.csv, written in place row by row: what pm_history_sync has
+ * made durable is a whole table up to that row. */
 typedef struct pm_history pm_history;
 
-/* Create DIR/history.csv.tmp.<pid> and write the header line of ncols
- * column names (names[i] borrowed for the call only; names with a comma,
- * quote or line break are quoted).  *out is owned by the caller and
- * released by pm_history_close.  Fails with PM_ERR_ARG (ncols < 1, NULL
- * name), PM_ERR_IO naming the path, PM_ERR_MEMORY. */
+/* keep_rows < 0: create DIR/history.csv (replacing an older one) with the
+ * header line of ncols column names (names[i] borrowed for the call only;
+ * names with a comma, quote or line break are quoted).  keep_rows >= 0
+ * (a resumed run): the file must start with the same header; it keeps its
+ * first keep_rows rows (replaced whole) and rows are appended after them.
+ * *out is owned by the caller and released by pm_history_close.  Fails with
+ * PM_ERR_ARG (ncols < 1, NULL name), PM_ERR_IO naming the path (and, on
+ * resume, a header that differs or fewer rows than keep_rows),
+ * PM_ERR_MEMORY. */
 pm_err pm_history_open(const char *dir, int ncols, const char *const *names,
-                       pm_history **out);
+                       long keep_rows, pm_history **out);
 
 /* Append one row of ncols values (printed %.10g; non-finite values appear as
  * nan/inf).  Allocation-free.  Fails with PM_ERR_IO on a write error. */
 pm_err pm_history_row(pm_history *h, const double *values);
 
+/* Flush the rows written so far to disk (fflush + fsync).  PM_ERR_IO with
+ * the system's reason (full disk, file size limit). */
+pm_err pm_history_sync(pm_history *h);
+
 /* Number of columns of h. */
 int pm_history_ncols(const pm_history *h);
 
-/* keep: commit (rename to DIR/history.csv); otherwise discard the temporary
- * file.  Always frees h (NULL accepted).  Fails with PM_ERR_IO on commit. */
-pm_err pm_history_close(pm_history *h, bool keep);
+/* Sync and close; always frees h (NULL accepted).  PM_ERR_IO on failure. */
+pm_err pm_history_close(pm_history *h);
+
+/* ---- Output folders ----------------------------------------------------- */
+
+/* How a run takes its output folder. */
+typedef enum {
+  PM_OUTDIR_NEW = 0,   /* refuse a folder holding another run's files */
+  PM_OUTDIR_OVERWRITE, /* remove another run's files first */
+  PM_OUTDIR_RESUME     /* continue the run whose files are there */
+} pm_outdir_mode;
+
+/* A folder held by this process for a run. */
+typedef struct pm_outdir pm_outdir;
+
+/* Claim dir for a run: create it (and its parents) unless resuming, check
+ * that it is writable, lock it (DIR/.pointmech.lock holds the pid; the
+ * lock dies with the process, so a killed run never blocks the next one),
+ * remove temporary files left by a killed run, and apply mode to the files
+ * a run writes (summary.json, history.csv, results.h5, results.xdmf,
+ * checkpoint.h5, results/).  Fails with PM_ERR_IO naming the folder and the
+ * reason: not writable, in use by a running pointmech (its pid), or, for
+ * PM_OUTDIR_NEW, holding another run's files (and its status).  Release
+ * with pm_outdir_release. */
+pm_err pm_outdir_claim(const char *dir, pm_outdir_mode mode, pm_outdir **out);
+
+/* Unlock and free (NULL accepted).  A folder the claim created and
+ * nothing was written to is removed. */
+void pm_outdir_release(pm_outdir *d);
 
 /* ---- JSON writer ------------------------------------------------------- */
 

@@ -1,13 +1,19 @@
-/* pm_output: results.h5 written frame by frame under a temporary name, and
- * results.xdmf generated from the file's own frames when it is closed. */
+/* pm_output: results as one synced file per frame, an index (results.h5)
+ * of external links and results.xdmf, both rewritten atomically after each
+ * frame. */
 #include "pm_output.h"
 
+#include <dirent.h>
+#include <stdarg.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <hdf5.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "pm_files.h"
@@ -15,15 +21,22 @@
 
 #define FIELD_NAME_MAX 63
 #define OBJ_NAME_MAX 128
+#define RESULTS_SUBDIR "results"
+#define FRAME_FMT "frame_%06ld.h5"
 
 struct pm_results {
-  hid_t file, frames, gcpl;
-  hid_t space[3]; /* dataspaces of scalar, vector and tensor fields */
   int dim, nodes_per_cell;
   long n_points, n_cells, n_frames;
-  char tmp_path[PM_PATH_MAX + 40]; /* final_path + ".tmp.<pid>" */
-  char final_path[PM_PATH_MAX + 1];
-  char xdmf_path[PM_PATH_MAX + 1];
+  bool created; /* by pm_results_create: removed by close(!keep, no frame) */
+  char *scene_text, *version;
+  /* The XDMF of the frames so far (one <Grid> each), rewritten whole. */
+  char *xdmf;
+  size_t xdmf_len, xdmf_cap;
+  char dir[PM_PATH_MAX + 1];
+  char sub[PM_PATH_MAX + 1];        /* dir/results */
+  char index_path[PM_PATH_MAX + 1]; /* dir/results.h5 */
+  char xdmf_path[PM_PATH_MAX + 1];  /* dir/results.xdmf */
+  char mesh_path[PM_PATH_MAX + 1];  /* dir/results/mesh.h5 */
 };
 
 /* Close an identifier if open, ignoring errors (cleanup paths only). */
@@ -54,7 +67,72 @@ static bool field_name_ok(const char *name) {
   return true;
 }
 
-/* ---- Attributes -------------------------------------------------------- */
+/* ---- Files written whole ------------------------------------------------ */
+
+/* path + ".tmp.<pid>" into buf. */
+static void tmp_name(char *buf, size_t size, const char *path) {
+  snprintf(buf, size, "%s.tmp.%ld", path, (long)getpid());
+}
+
+/* Make the HDF5 file tmp durable and give it its final name.  A write the
+ * system refused (full disk, file size limit) shows here at the latest. */
+static pm_err commit_file(const char *tmp, const char *path) {
+  int fd = open(tmp, O_RDONLY | O_CLOEXEC);
+  PM_CHECK(fd >= 0, PM_ERR_IO, "cannot reopen '%s' to sync it: %s", tmp,
+           strerror(errno));
+  int rc = fsync(fd), e = errno;
+  close(fd);
+  PM_CHECK(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", tmp, strerror(e));
+  return pm_rename(tmp, path);
+}
+
+/* Close the HDF5 file written under tmp and commit it to path. */
+static pm_err close_and_commit(hid_t *file, const char *tmp, const char *path) {
+  hid_t f = *file;
+  *file = -1;
+  PM_CHECK(H5Fclose(f) >= 0, PM_ERR_HDF5, "H5Fclose(/) failed on '%s': %s", tmp,
+           pm_h5_message());
+  return commit_file(tmp, path);
+}
+
+/* An HDF5 failure that the system caused (no space, file too large, no
+ * permission) is an I/O error, named with the system's reason. */
+static pm_err classify(pm_err e, int saved_errno, const char *path) {
+  if (e != PM_ERR_HDF5) return e;
+  if (saved_errno == ENOSPC || saved_errno == EFBIG || saved_errno == EDQUOT ||
+      saved_errno == EACCES || saved_errno == EROFS || saved_errno == EIO) {
+    pm_error_clear();
+    return PM_ERROR(PM_ERR_IO, "cannot write '%s': %s", path,
+                    strerror(saved_errno));
+  }
+  return e;
+}
+
+/* Refuse a file of about bytes that the file size limit or the free space
+ * on dir's disk cannot hold, before HDF5 meets it half-way (a file HDF5
+ * cannot flush cannot be closed either). */
+static pm_err check_room(const char *dir, const char *path, double bytes) {
+  struct rlimit rl;
+  struct statvfs vfs;
+  if (getrlimit(RLIMIT_FSIZE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+      bytes > (double)rl.rlim_cur)
+    return PM_ERROR(PM_ERR_IO,
+                    "cannot write '%s': File too large (about %.0f bytes; "
+                    "the file size limit, ulimit -f, is %.0f bytes)",
+                    path, bytes, (double)rl.rlim_cur);
+  if (statvfs(dir, &vfs) == 0 &&
+      bytes > (double)vfs.f_bavail * (double)vfs.f_frsize)
+    return PM_ERROR(PM_ERR_IO,
+                    "cannot write '%s': No space left on device (about %.0f "
+                    "bytes, %.0f free)",
+                    path, bytes, (double)vfs.f_bavail * (double)vfs.f_frsize);
+  return PM_SUCCESS;
+}
+
+/* HDF5's own overhead of a small file, bytes (headers, attributes). */
+#define H5_OVERHEAD 16384.0
+
+/* ---- Attributes and datasets -------------------------------------------- */
 
 /* Scalar attribute name of file type ftype on loc written from value. */
 static pm_err write_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
@@ -89,9 +167,68 @@ done:
   return ret;
 }
 
-/* ---- Create ------------------------------------------------------------ */
+/* Read scalar attribute name of loc into value (memory type mtype). */
+static pm_err read_attr(hid_t loc, const char *name, hid_t mtype, void *value,
+                        const char *obj, const char *path) {
+  pm_err ret = PM_SUCCESS;
+  hid_t attr = -1;
+  H5_OK(attr = H5Aopen(loc, name, H5P_DEFAULT), "H5Aopen", obj, path);
+  H5_OK(H5Aread(attr, mtype, value), "H5Aread", obj, path);
+  H5_OK(H5Aclose(attr), "H5Aclose", obj, path);
+  attr = -1;
+done:
+  h5_close_quiet(&attr);
+  return ret;
+}
 
-/* Check the arguments of pm_results_create. */
+/* A variable-length string attribute as a malloc'd copy (*out). */
+static pm_err read_string_attr(hid_t loc, const char *name, char **out,
+                               const char *path) {
+  pm_err ret = PM_SUCCESS;
+  hid_t type = -1;
+  char *value = NULL;
+  *out = NULL;
+  H5_OK(type = H5Tcopy(H5T_C_S1), "H5Tcopy", name, path);
+  H5_OK(H5Tset_size(type, H5T_VARIABLE), "H5Tset_size", name, path);
+  PM_TRY(read_attr(loc, name, type, &value, name, path));
+  *out = strdup(value ? value : "");
+  PM_ENSURE(*out, PM_ERR_MEMORY, "cannot copy attribute %s of '%s'", name,
+            path);
+done:
+  if (value) H5free_memory(value);
+  h5_close_quiet(&type);
+  return ret;
+}
+
+/* Write the dataset loc/name of rank dims (file type ftype, memory mtype). */
+static pm_err write_dataset(hid_t loc, const char *name, int rank,
+                            const hsize_t *dims, hid_t ftype, hid_t mtype,
+                            const void *data, const char *path,
+                            hid_t *keep_open) {
+  pm_err ret = PM_SUCCESS;
+  hid_t space = -1, dset = -1;
+  H5_OK(space = H5Screate_simple(rank, dims, NULL), "H5Screate_simple", name,
+        path);
+  H5_OK(dset = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT,
+                          H5P_DEFAULT),
+        "H5Dcreate2", name, path);
+  H5_OK(H5Dwrite(dset, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "H5Dwrite",
+        name, path);
+  if (keep_open) {
+    *keep_open = dset;
+    dset = -1;
+  } else {
+    H5_OK(H5Dclose(dset), "H5Dclose", name, path);
+    dset = -1;
+  }
+done:
+  h5_close_quiet(&dset);
+  h5_close_quiet(&space);
+  return ret;
+}
+
+/* ---- Checks ------------------------------------------------------------- */
+
 static pm_err check_mesh(int dim, long n_points, const double *x, long n_cells,
                          int npc, const long *cells) {
   PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG, "results: dim %d is not 2 or 3",
@@ -123,123 +260,6 @@ static pm_err check_dir(const char *dir) {
   return PM_SUCCESS;
 }
 
-/* Write a 2-D dataset loc/name of file type ftype from memory type mtype. */
-static pm_err write_2d(hid_t loc, const char *name, hsize_t rows, hsize_t cols,
-                       hid_t ftype, hid_t mtype, const void *data,
-                       const char *path, hid_t *keep_open) {
-  pm_err ret = PM_SUCCESS;
-  hid_t space = -1, dset = -1;
-  hsize_t dims[2] = {rows, cols};
-  H5_OK(space = H5Screate_simple(2, dims, NULL), "H5Screate_simple", name,
-        path);
-  H5_OK(dset = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT,
-                          H5P_DEFAULT),
-        "H5Dcreate2", name, path);
-  H5_OK(H5Dwrite(dset, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "H5Dwrite",
-        name, path);
-  if (keep_open) {
-    *keep_open = dset;
-    dset = -1;
-  } else {
-    H5_OK(H5Dclose(dset), "H5Dclose", name, path);
-    dset = -1;
-  }
-done:
-  h5_close_quiet(&dset);
-  h5_close_quiet(&space);
-  return ret;
-}
-
-static void results_free(pm_results *r, bool unlink_tmp) {
-  if (!r) return;
-  h5_close_quiet(&r->frames);
-  h5_close_quiet(&r->gcpl);
-  for (int i = 0; i < 3; i++) h5_close_quiet(&r->space[i]);
-  h5_close_quiet(&r->file);
-  if (unlink_tmp && r->tmp_path[0]) unlink(r->tmp_path);
-  free(r);
-}
-
-pm_err pm_results_create(const char *dir, int dim, long n_points,
-                         const double *x, long n_cells, int nodes_per_cell,
-                         const long *cells, const char *scene_text,
-                         const char *version, pm_results **out) {
-  pm_err ret = PM_SUCCESS;
-  pm_results *r = NULL;
-  long *ids = NULL;
-  hid_t mesh = -1, dset = -1;
-  const char *path = "";
-  int npc = nodes_per_cell;
-  PM_CHECK(out, PM_ERR_ARG, "pm_results_create: NULL out");
-  *out = NULL;
-  PM_CALL(check_mesh(dim, n_points, x, n_cells, npc, cells));
-  PM_CALL(check_dir(dir));
-  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-
-  if (npc == 1 && !cells) { /* point cloud: cell i is point i */
-    PM_TRY(PM_ALLOC(ids, n_points, "point cloud cells"));
-    for (long i = 0; i < n_points; i++) ids[i] = i;
-    cells = ids;
-    n_cells = n_points;
-  }
-  PM_TRY(PM_ALLOC(r, 1, "results writer"));
-  r->file = r->frames = r->gcpl = -1;
-  r->space[0] = r->space[1] = r->space[2] = -1;
-  r->dim = dim;
-  r->nodes_per_cell = npc;
-  r->n_points = n_points;
-  r->n_cells = n_cells;
-  PM_TRY(pm_path_join(r->final_path, sizeof r->final_path, dir, "results.h5"));
-  PM_TRY(pm_path_join(r->xdmf_path, sizeof r->xdmf_path, dir, "results.xdmf"));
-  snprintf(r->tmp_path, sizeof r->tmp_path, "%s.tmp.%ld", r->final_path,
-           (long)getpid());
-  path = r->tmp_path;
-
-  H5_OK(r->file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-        "H5Fcreate", "/", path);
-  PM_TRY(write_string_attr(r->file, "scene", scene_text, path));
-  PM_TRY(write_string_attr(r->file, "version", version, path));
-  PM_TRY(write_attr(r->file, "dim", H5T_STD_I32LE, H5T_NATIVE_INT, &dim, path));
-
-  H5_OK(mesh =
-            H5Gcreate2(r->file, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-        "H5Gcreate2", "/mesh", path);
-  PM_TRY(write_2d(mesh, "coordinates", (hsize_t)n_points, 3, H5T_IEEE_F64LE,
-                  H5T_NATIVE_DOUBLE, x, path, NULL));
-  PM_TRY(write_2d(mesh, "cells", (hsize_t)n_cells, (hsize_t)npc, H5T_STD_I64LE,
-                  H5T_NATIVE_LONG, cells, path, &dset));
-  PM_TRY(write_attr(dset, "nodes_per_cell", H5T_STD_I32LE, H5T_NATIVE_INT, &npc,
-                    path));
-  H5_OK(H5Dclose(dset), "H5Dclose", "/mesh/cells", path);
-  dset = -1;
-  H5_OK(H5Gclose(mesh), "H5Gclose", "/mesh", path);
-  mesh = -1;
-
-  /* Frames keep their creation order (frame names sort only to 999999). */
-  H5_OK(r->gcpl = H5Pcreate(H5P_GROUP_CREATE), "H5Pcreate", "gcpl", path);
-  H5_OK(H5Pset_link_creation_order(r->gcpl, H5P_CRT_ORDER_TRACKED |
-                                                H5P_CRT_ORDER_INDEXED),
-        "H5Pset_link_creation_order", "gcpl", path);
-  H5_OK(r->frames =
-            H5Gcreate2(r->file, "frames", H5P_DEFAULT, r->gcpl, H5P_DEFAULT),
-        "H5Gcreate2", "/frames", path);
-  hsize_t dims[3] = {(hsize_t)n_points, 3, 3};
-  for (int i = 0; i < 3; i++)
-    H5_OK(r->space[i] = H5Screate_simple(i + 1, dims, NULL), "H5Screate_simple",
-          "field space", path);
-  H5_OK(H5Fflush(r->file, H5F_SCOPE_LOCAL), "H5Fflush", "/", path);
-  *out = r;
-  r = NULL;
-done:
-  h5_close_quiet(&dset);
-  h5_close_quiet(&mesh);
-  results_free(r, true);
-  free(ids);
-  return ret;
-}
-
-/* ---- Frames ------------------------------------------------------------ */
-
 static pm_err check_fields(int n_fields, const pm_field *fields) {
   PM_CHECK(n_fields >= 0 && (n_fields == 0 || fields), PM_ERR_ARG,
            "results frame: %d fields", n_fields);
@@ -261,50 +281,51 @@ static pm_err check_fields(int n_fields, const pm_field *fields) {
   return PM_SUCCESS;
 }
 
-pm_err pm_results_write_frame(pm_results *r, long step, double time,
-                              int n_fields, const pm_field *fields) {
-  pm_err ret = PM_SUCCESS;
-  hid_t group = -1, dset = -1;
-  char gname[32], obj[OBJ_NAME_MAX];
-  const char *path;
-  PM_CHECK(r, PM_ERR_ARG, "pm_results_write_frame: NULL results");
-  PM_CALL(check_fields(n_fields, fields));
-  path = r->tmp_path;
-  snprintf(gname, sizeof gname, "%06ld", r->n_frames);
-  snprintf(obj, sizeof obj, "/frames/%s", gname);
-  H5_OK(group = H5Gcreate2(r->frames, gname, H5P_DEFAULT, r->gcpl, H5P_DEFAULT),
-        "H5Gcreate2", obj, path);
-  r->n_frames++; /* the name is taken even if the frame fails below */
-  PM_TRY(
-      write_attr(group, "step", H5T_STD_I64LE, H5T_NATIVE_LONG, &step, path));
-  PM_TRY(write_attr(group, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time,
-                    path));
-  for (int i = 0; i < n_fields; i++) {
-    const pm_field *f = &fields[i];
-    hid_t space = r->space[f->ncomp == 1 ? 0 : f->ncomp == 3 ? 1 : 2];
-    snprintf(obj, sizeof obj, "/frames/%s/%s", gname, f->name);
-    H5_OK(dset = H5Dcreate2(group, f->name, H5T_IEEE_F64LE, space, H5P_DEFAULT,
-                            H5P_DEFAULT, H5P_DEFAULT),
-          "H5Dcreate2", obj, path);
-    H5_OK(H5Dwrite(dset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                   f->data),
-          "H5Dwrite", obj, path);
-    H5_OK(H5Dclose(dset), "H5Dclose", obj, path);
-    dset = -1;
-  }
-  snprintf(obj, sizeof obj, "/frames/%s", gname);
-  H5_OK(H5Gclose(group), "H5Gclose", obj, path);
-  group = -1;
-  H5_OK(H5Fflush(r->file, H5F_SCOPE_LOCAL), "H5Fflush", "/", path);
-done:
-  h5_close_quiet(&dset);
-  h5_close_quiet(&group);
-  return ret;
+/* ---- Paths -------------------------------------------------------------- */
+
+static pm_err set_paths(pm_results *r, const char *dir) {
+  PM_CHECK(strlen(dir) + 40 < sizeof r->dir, PM_ERR_ARG,
+           "output directory name too long: '%.64s...'", dir);
+  snprintf(r->dir, sizeof r->dir, "%s", dir);
+  PM_CALL(pm_path_join(r->sub, sizeof r->sub, dir, RESULTS_SUBDIR));
+  PM_CALL(pm_path_join(r->index_path, sizeof r->index_path, dir, "results.h5"));
+  PM_CALL(pm_path_join(r->xdmf_path, sizeof r->xdmf_path, dir, "results.xdmf"));
+  return pm_path_join(r->mesh_path, sizeof r->mesh_path, r->sub, "mesh.h5");
 }
 
-long pm_results_frames(const pm_results *r) { return r ? r->n_frames : 0; }
+static void frame_path(const pm_results *r, long k, char *buf, size_t size) {
+  char name[32];
+  snprintf(name, sizeof name, FRAME_FMT, k);
+  /* r->sub leaves room for the name (set_paths checks the length). */
+  if (pm_path_join(buf, size, r->sub, name) != PM_SUCCESS) buf[0] = '\0';
+}
 
-/* ---- XDMF -------------------------------------------------------------- */
+/* ---- XDMF --------------------------------------------------------------- */
+
+/* Append printf-formatted text to the frames' XDMF. */
+static pm_err xdmf_add(pm_results *r, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static pm_err xdmf_add(pm_results *r, const char *fmt, ...) {
+  for (;;) {
+    va_list ap;
+    va_start(ap, fmt);
+    size_t room = r->xdmf_cap - r->xdmf_len;
+    int n = vsnprintf(r->xdmf ? r->xdmf + r->xdmf_len : NULL, room, fmt, ap);
+    va_end(ap);
+    PM_CHECK(n >= 0, PM_ERR_INTERNAL, "XDMF text formatting failed");
+    if ((size_t)n < room) {
+      r->xdmf_len += (size_t)n;
+      return PM_SUCCESS;
+    }
+    size_t cap = r->xdmf_cap ? 2 * r->xdmf_cap : 16384;
+    while (cap < r->xdmf_len + (size_t)n + 1) cap *= 2;
+    char *grown = realloc(r->xdmf, cap);
+    PM_CHECK(grown, PM_ERR_MEMORY, "cannot grow the XDMF text to %zu bytes",
+             cap);
+    r->xdmf = grown;
+    r->xdmf_cap = cap;
+  }
+}
 
 /* Shortest of %.15g / %.17g that reads back as v. */
 static void format_double(char *buf, size_t size, double v) {
@@ -312,161 +333,455 @@ static void format_double(char *buf, size_t size, double v) {
   if (strtod(buf, NULL) != v) snprintf(buf, size, "%.17g", v);
 }
 
-static void xdmf_mesh(const pm_results *r, FILE *fp, int ind) {
+/* The mesh's topology element, indented by ind. */
+static void topology_text(const pm_results *r, int ind, char *buf,
+                          size_t size) {
   const char *topo = r->nodes_per_cell == 1   ? "Polyvertex"
                      : r->nodes_per_cell == 3 ? "Triangle"
                      : r->dim == 3            ? "Tetrahedron"
                                               : "Quadrilateral";
-  fprintf(fp, "%*s<Topology TopologyType=\"%s\" NumberOfElements=\"%ld\"", ind,
-          "", topo, r->n_cells);
-  if (r->nodes_per_cell == 1) fprintf(fp, " NodesPerElement=\"1\"");
-  fprintf(fp,
-          ">\n%*s<DataItem Dimensions=\"%ld %d\" NumberType=\"Int\" "
-          "Precision=\"8\" Format=\"HDF\">results.h5:/mesh/cells</DataItem>\n"
-          "%*s</Topology>\n",
-          ind + 2, "", r->n_cells, r->nodes_per_cell, ind, "");
-  fprintf(fp,
-          "%*s<Geometry GeometryType=\"XYZ\">\n"
-          "%*s<DataItem Dimensions=\"%ld 3\" NumberType=\"Float\" "
-          "Precision=\"8\" Format=\"HDF\">results.h5:/mesh/coordinates"
-          "</DataItem>\n%*s</Geometry>\n",
-          ind, "", ind + 2, "", r->n_points, ind, "");
+  snprintf(buf, size,
+           "%*s<Topology TopologyType=\"%s\" NumberOfElements=\"%ld\"%s>\n"
+           "%*s<DataItem Dimensions=\"%ld %d\" NumberType=\"Int\" "
+           "Precision=\"8\" Format=\"HDF\">" RESULTS_SUBDIR
+           "/mesh.h5:/cells</DataItem>\n%*s</Topology>\n",
+           ind, "", topo, r->n_cells,
+           r->nodes_per_cell == 1 ? " NodesPerElement=\"1\"" : "", ind + 2, "",
+           r->n_cells, r->nodes_per_cell, ind, "");
 }
 
-/* Read scalar attribute name of loc into value (memory type mtype). */
-static pm_err read_attr(hid_t loc, const char *name, hid_t mtype, void *value,
-                        const char *obj, const char *path) {
-  pm_err ret = PM_SUCCESS;
-  hid_t attr = -1;
-  H5_OK(attr = H5Aopen(loc, name, H5P_DEFAULT), "H5Aopen", obj, path);
-  H5_OK(H5Aread(attr, mtype, value), "H5Aread", obj, path);
-  H5_OK(H5Aclose(attr), "H5Aclose", obj, path);
-  attr = -1;
-done:
-  h5_close_quiet(&attr);
-  return ret;
-}
+static const char *geometry_fmt =
+    "%*s<Geometry GeometryType=\"XYZ\">\n"
+    "%*s<DataItem Dimensions=\"%ld 3\" NumberType=\"Float\" Precision=\"8\" "
+    "Format=\"HDF\">" RESULTS_SUBDIR "/%s:/%s</DataItem>\n%*s</Geometry>\n";
 
-/* One frame's uniform grid, its fields listed from the file itself. */
-static pm_err xdmf_frame(const pm_results *r, long index, FILE *fp) {
-  pm_err ret = PM_SUCCESS;
-  hid_t group = -1, dset = -1, space = -1;
-  char gname[32], obj[OBJ_NAME_MAX], name[FIELD_NAME_MAX + 2], tbuf[40];
-  const char *path = r->tmp_path;
-  H5G_info_t info;
-  double time;
-  long step;
-  snprintf(gname, sizeof gname, "%06ld", index);
-  snprintf(obj, sizeof obj, "/frames/%s", gname);
-  H5_OK(group = H5Gopen2(r->frames, gname, H5P_DEFAULT), "H5Gopen2", obj, path);
-  PM_TRY(read_attr(group, "time", H5T_NATIVE_DOUBLE, &time, obj, path));
-  PM_TRY(read_attr(group, "step", H5T_NATIVE_LONG, &step, obj, path));
-  H5_OK(H5Gget_info(group, &info), "H5Gget_info", obj, path);
+/* One frame's uniform grid, from its field names and component counts. */
+static pm_err xdmf_frame(pm_results *r, long k, long step, double time, int nf,
+                         const char *const *names, const int *ncomp) {
+  char tbuf[40], file[32], topo[512];
+  const char *geometry = NULL;
   format_double(tbuf, sizeof tbuf, time);
-  fprintf(fp,
-          "      <Grid Name=\"frame_%s\" GridType=\"Uniform\">\n"
-          "        <Time Value=\"%s\"/>\n"
-          "        <Information Name=\"step\" Value=\"%ld\"/>\n",
-          gname, tbuf, step);
-  xdmf_mesh(r, fp, 8);
-  for (hsize_t k = 0; k < info.nlinks; k++) {
-    ssize_t len;
-    int rank;
-    H5_OK(len = H5Lget_name_by_idx(group, ".", H5_INDEX_CRT_ORDER, H5_ITER_INC,
-                                   k, name, sizeof name, H5P_DEFAULT),
-          "H5Lget_name_by_idx", obj, path);
-    PM_ENSURE((size_t)len < sizeof name, PM_ERR_HDF5,
-              "field name in %s too long in '%s'", obj, path);
-    snprintf(obj, sizeof obj, "/frames/%s/%s", gname, name);
-    H5_OK(dset = H5Dopen2(group, name, H5P_DEFAULT), "H5Dopen2", obj, path);
-    H5_OK(space = H5Dget_space(dset), "H5Dget_space", obj, path);
-    H5_OK(rank = H5Sget_simple_extent_ndims(space),
-          "H5Sget_simple_extent_ndims", obj, path);
-    PM_ENSURE(rank >= 1 && rank <= 3, PM_ERR_HDF5,
-              "dataset %s in '%s' has rank %d", obj, path, rank);
-    fprintf(fp,
-            "        <Attribute Name=\"%s\" AttributeType=\"%s\" "
-            "Center=\"Node\">\n"
-            "          <DataItem Dimensions=\"%ld%s\" NumberType=\"Float\" "
-            "Precision=\"8\" Format=\"HDF\">results.h5:%s</DataItem>\n"
-            "        </Attribute>\n",
-            name,
-            rank == 1   ? "Scalar"
-            : rank == 2 ? "Vector"
+  snprintf(file, sizeof file, FRAME_FMT, k);
+  for (int i = 0; i < nf; i++)
+    if (ncomp[i] == 3 && strcmp(names[i], "position") == 0) geometry = names[i];
+  PM_CALL(xdmf_add(r,
+                   "      <Grid Name=\"frame_%06ld\" GridType=\"Uniform\">\n"
+                   "        <Time Value=\"%s\"/>\n"
+                   "        <Information Name=\"step\" Value=\"%ld\"/>\n",
+                   k, tbuf, step));
+  topology_text(r, 8, topo, sizeof topo);
+  PM_CALL(xdmf_add(r, "%s", topo));
+  PM_CALL(xdmf_add(r, geometry_fmt, 8, "", 10, "", r->n_points,
+                   geometry ? file : "mesh.h5",
+                   geometry ? "position" : "coordinates", 8, ""));
+  for (int i = 0; i < nf; i++) {
+    if (names[i] == geometry) continue;
+    PM_CALL(xdmf_add(
+        r,
+        "        <Attribute Name=\"%s\" AttributeType=\"%s\" "
+        "Center=\"Node\">\n"
+        "          <DataItem Dimensions=\"%ld%s\" "
+        "NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" RESULTS_SUBDIR
+        "/%s:/%s</DataItem>\n"
+        "        </Attribute>\n",
+        names[i],
+        ncomp[i] == 1   ? "Scalar"
+        : ncomp[i] == 3 ? "Vector"
                         : "Tensor",
-            r->n_points,
-            rank == 1   ? ""
-            : rank == 2 ? " 3"
+        r->n_points,
+        ncomp[i] == 1   ? ""
+        : ncomp[i] == 3 ? " 3"
                         : " 3 3",
-            obj);
-    H5_OK(H5Sclose(space), "H5Sclose", obj, path);
-    space = -1;
-    H5_OK(H5Dclose(dset), "H5Dclose", obj, path);
-    dset = -1;
-    snprintf(obj, sizeof obj, "/frames/%s", gname);
+        file, names[i]));
   }
-  fprintf(fp, "      </Grid>\n");
-  H5_OK(H5Gclose(group), "H5Gclose", obj, path);
-  group = -1;
-done:
-  h5_close_quiet(&space);
-  h5_close_quiet(&dset);
-  h5_close_quiet(&group);
-  return ret;
+  return xdmf_add(r, "      </Grid>\n");
 }
 
-/* The whole XDMF document (written before the HDF5 file is closed). */
-static pm_err xdmf_write(const pm_results *r, FILE *fp) {
+/* results.xdmf: the topology once, then the frames (or the bare mesh). */
+static pm_err xdmf_commit(const pm_results *r) {
+  pm_afile *f = NULL;
+  PM_CALL(pm_afile_open(r->xdmf_path, &f));
+  FILE *fp = pm_afile_stream(f);
   fprintf(fp, "<?xml version=\"1.0\" ?>\n"
               "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
               "<Xdmf Version=\"3.0\">\n  <Domain>\n");
   if (r->n_frames == 0) {
-    fprintf(fp, "    <Grid Name=\"mesh\" GridType=\"Uniform\">\n");
-    xdmf_mesh(r, fp, 6);
+    char topo[512];
+    topology_text(r, 6, topo, sizeof topo);
+    fprintf(fp, "    <Grid Name=\"mesh\" GridType=\"Uniform\">\n%s", topo);
+    fprintf(fp, geometry_fmt, 6, "", 8, "", r->n_points, "mesh.h5",
+            "coordinates", 6, "");
     fprintf(fp, "    </Grid>\n");
   } else {
     fprintf(fp, "    <Grid Name=\"pointmech\" GridType=\"Collection\" "
                 "CollectionType=\"Temporal\">\n");
-    for (long i = 0; i < r->n_frames; i++) PM_CALL(xdmf_frame(r, i, fp));
+    fwrite(r->xdmf, 1, r->xdmf_len, fp);
     fprintf(fp, "    </Grid>\n");
   }
   fprintf(fp, "  </Domain>\n</Xdmf>\n");
-  PM_CHECK(!ferror(fp), PM_ERR_IO, "write error on '%s'", r->xdmf_path);
-  return PM_SUCCESS;
+  return pm_afile_commit(f);
 }
 
-/* ---- Close ------------------------------------------------------------- */
+/* ---- Index -------------------------------------------------------------- */
 
-pm_err pm_results_close(pm_results *r, bool keep) {
+/* results.h5: attributes and external links to the mesh and the frames. */
+static pm_err index_commit(const pm_results *r) {
   pm_err ret = PM_SUCCESS;
-  pm_afile *xdmf = NULL;
-  const char *path;
-  bool renamed = false;
-  if (!r) return PM_SUCCESS;
-  path = r->tmp_path;
-  if (keep) {
-    PM_TRY(pm_afile_open(r->xdmf_path, &xdmf));
-    PM_TRY(xdmf_write(r, pm_afile_stream(xdmf)));
+  hid_t file = -1, frames = -1, gcpl = -1;
+  char tmp[PM_PATH_MAX + 40], name[32], target[64];
+  const char *path = tmp;
+  long nf = r->n_frames;
+  tmp_name(tmp, sizeof tmp, r->index_path);
+  H5_OK(file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+        "H5Fcreate", "/", path);
+  PM_TRY(write_string_attr(file, "scene", r->scene_text, path));
+  PM_TRY(write_string_attr(file, "version", r->version, path));
+  PM_TRY(write_attr(file, "dim", H5T_STD_I32LE, H5T_NATIVE_INT, &r->dim, path));
+  PM_TRY(write_attr(file, "frames", H5T_STD_I64LE, H5T_NATIVE_LONG, &nf, path));
+  H5_OK(H5Lcreate_external(RESULTS_SUBDIR "/mesh.h5", "/", file, "mesh",
+                           H5P_DEFAULT, H5P_DEFAULT),
+        "H5Lcreate_external", "/mesh", path);
+  /* Frames keep their creation order (frame names sort only to 999999). */
+  H5_OK(gcpl = H5Pcreate(H5P_GROUP_CREATE), "H5Pcreate", "gcpl", path);
+  H5_OK(H5Pset_link_creation_order(gcpl, H5P_CRT_ORDER_TRACKED |
+                                             H5P_CRT_ORDER_INDEXED),
+        "H5Pset_link_creation_order", "gcpl", path);
+  H5_OK(frames = H5Gcreate2(file, "frames", H5P_DEFAULT, gcpl, H5P_DEFAULT),
+        "H5Gcreate2", "/frames", path);
+  for (long k = 0; k < nf; k++) {
+    snprintf(name, sizeof name, "%06ld", k);
+    snprintf(target, sizeof target, RESULTS_SUBDIR "/" FRAME_FMT, k);
+    H5_OK(
+        H5Lcreate_external(target, "/", frames, name, H5P_DEFAULT, H5P_DEFAULT),
+        "H5Lcreate_external", name, path);
   }
-  for (int i = 0; i < 3; i++) {
-    H5_OK(H5Sclose(r->space[i]), "H5Sclose", "field space", path);
-    r->space[i] = -1;
-  }
-  H5_OK(H5Pclose(r->gcpl), "H5Pclose", "gcpl", path);
-  r->gcpl = -1;
-  H5_OK(H5Gclose(r->frames), "H5Gclose", "/frames", path);
-  r->frames = -1;
-  H5_OK(H5Fclose(r->file), "H5Fclose", "/", path);
-  r->file = -1;
-  if (keep) {
-    PM_TRY(pm_rename(r->tmp_path, r->final_path));
-    renamed = true;
-    pm_afile *x = xdmf; /* commit frees it, even on failure */
-    xdmf = NULL;
-    PM_TRY(pm_afile_commit(x));
-  }
+  H5_OK(H5Gclose(frames), "H5Gclose", "/frames", path);
+  frames = -1;
+  PM_TRY(close_and_commit(&file, tmp, r->index_path));
 done:
-  pm_afile_abort(xdmf);
-  results_free(r, !renamed);
+  h5_close_quiet(&gcpl);
+  h5_close_quiet(&frames);
+  h5_close_quiet(&file);
+  if (ret != PM_SUCCESS) unlink(tmp);
   return ret;
 }
+
+/* Index, then XDMF: each replaced whole. */
+static pm_err publish(const pm_results *r) {
+  PM_CALL(index_commit(r));
+  return xdmf_commit(r);
+}
+
+/* ---- Create, reopen, close ---------------------------------------------- */
+
+static void results_free(pm_results *r) {
+  if (!r) return;
+  free(r->scene_text);
+  free(r->version);
+  free(r->xdmf);
+  free(r);
+}
+
+static pm_err write_mesh(const pm_results *r, const double *x,
+                         const long *cells) {
+  pm_err ret = PM_SUCCESS;
+  hid_t file = -1, dset = -1;
+  char tmp[PM_PATH_MAX + 40];
+  const char *path = tmp;
+  int npc = r->nodes_per_cell;
+  hsize_t xd[2] = {(hsize_t)r->n_points, 3};
+  hsize_t cd[2] = {(hsize_t)r->n_cells, (hsize_t)npc};
+  tmp_name(tmp, sizeof tmp, r->mesh_path);
+  PM_TRY(check_room(r->sub, r->mesh_path,
+                    H5_OVERHEAD + 8.0 * (3.0 * (double)r->n_points +
+                                         (double)r->n_cells * npc)));
+  H5_OK(file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+        "H5Fcreate", "/", path);
+  PM_TRY(write_dataset(file, "coordinates", 2, xd, H5T_IEEE_F64LE,
+                       H5T_NATIVE_DOUBLE, x, path, NULL));
+  PM_TRY(write_dataset(file, "cells", 2, cd, H5T_STD_I64LE, H5T_NATIVE_LONG,
+                       cells, path, &dset));
+  PM_TRY(write_attr(dset, "nodes_per_cell", H5T_STD_I32LE, H5T_NATIVE_INT, &npc,
+                    path));
+  H5_OK(H5Dclose(dset), "H5Dclose", "/cells", path);
+  dset = -1;
+  PM_TRY(close_and_commit(&file, tmp, r->mesh_path));
+done:
+  h5_close_quiet(&dset);
+  h5_close_quiet(&file);
+  if (ret != PM_SUCCESS) unlink(tmp);
+  return ret;
+}
+
+pm_err pm_results_create(const char *dir, int dim, long n_points,
+                         const double *x, long n_cells, int nodes_per_cell,
+                         const long *cells, const char *scene_text,
+                         const char *version, pm_results **out) {
+  pm_err ret = PM_SUCCESS;
+  pm_results *r = NULL;
+  long *ids = NULL;
+  int npc = nodes_per_cell;
+  PM_CHECK(out, PM_ERR_ARG, "pm_results_create: NULL out");
+  *out = NULL;
+  PM_CALL(check_mesh(dim, n_points, x, n_cells, npc, cells));
+  PM_CALL(check_dir(dir));
+  /* No clean-up at exit: after a write the system refused, HDF5's own
+   * would close a file it cannot flush again. */
+  H5dont_atexit();
+  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  if (npc == 1 && !cells) { /* point cloud: cell i is point i */
+    PM_TRY(PM_ALLOC(ids, n_points, "point cloud cells"));
+    for (long i = 0; i < n_points; i++) ids[i] = i;
+    cells = ids;
+    n_cells = n_points;
+  }
+  PM_TRY(PM_ALLOC(r, 1, "results writer"));
+  r->dim = dim;
+  r->nodes_per_cell = npc;
+  r->n_points = n_points;
+  r->n_cells = n_cells;
+  PM_TRY(set_paths(r, dir));
+  r->scene_text = strdup(scene_text ? scene_text : "");
+  r->version = strdup(version ? version : "");
+  PM_ENSURE(r->scene_text && r->version, PM_ERR_MEMORY,
+            "cannot copy the scene text");
+  PM_TRY(pm_mkdir_p(r->sub));
+  r->created = true;
+  int saved = 0;
+  ret = write_mesh(r, x, cells);
+  if (ret == PM_SUCCESS) ret = publish(r);
+  saved = errno;
+  PM_TRY(classify(ret, saved, r->mesh_path));
+  *out = r;
+  r = NULL;
+done:
+  if (r) {
+    pm_results_close(r, false);
+    r = NULL;
+  }
+  free(ids);
+  return ret;
+}
+
+/* Remove frame files of index >= n_keep and temporary files left in
+ * dir/results by a run that was killed. */
+static pm_err drop_later_frames(const pm_results *r, long n_keep) {
+  DIR *d = opendir(r->sub);
+  PM_CHECK(d, PM_ERR_IO, "cannot read '%s': %s", r->sub, strerror(errno));
+  struct dirent *e;
+  char path[PM_PATH_MAX + 1];
+  pm_err ret = PM_SUCCESS;
+  while ((e = readdir(d))) {
+    long k;
+    int used = 0;
+    bool tmp = strstr(e->d_name, ".tmp.") != NULL;
+    bool later = sscanf(e->d_name, "frame_%ld.h5%n", &k, &used) == 1 &&
+                 e->d_name[used] == '\0' && k >= n_keep;
+    if (!tmp && !later) continue;
+    if (pm_path_join(path, sizeof path, r->sub, e->d_name) != PM_SUCCESS)
+      continue;
+    if (unlink(path) != 0 && errno != ENOENT) {
+      ret =
+          PM_ERROR(PM_ERR_IO, "cannot remove '%s': %s", path, strerror(errno));
+      break;
+    }
+  }
+  closedir(d);
+  return ret;
+}
+
+/* Frame k's attributes and field list, read back into the XDMF. */
+static pm_err reread_frame(pm_results *r, long k) {
+  pm_err ret = PM_SUCCESS;
+  hid_t file = -1, dset = -1, space = -1;
+  char path[PM_PATH_MAX + 1], names_buf[16][FIELD_NAME_MAX + 2];
+  const char *names[16];
+  int ncomp[16], nf = 0;
+  H5G_info_t info;
+  double time;
+  long step;
+  frame_path(r, k, path, sizeof path);
+  H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
+        path);
+  PM_TRY(read_attr(file, "time", H5T_NATIVE_DOUBLE, &time, "/", path));
+  PM_TRY(read_attr(file, "step", H5T_NATIVE_LONG, &step, "/", path));
+  H5_OK(H5Gget_info(file, &info), "H5Gget_info", "/", path);
+  PM_ENSURE(info.nlinks <= 16, PM_ERR_HDF5,
+            "'%s' holds %llu fields (16 at most)", path,
+            (unsigned long long)info.nlinks);
+  for (hsize_t i = 0; i < info.nlinks; i++, nf++) {
+    ssize_t len;
+    hssize_t count;
+    H5_OK(len = H5Lget_name_by_idx(file, ".", H5_INDEX_CRT_ORDER, H5_ITER_INC,
+                                   i, names_buf[nf], sizeof names_buf[nf],
+                                   H5P_DEFAULT),
+          "H5Lget_name_by_idx", "/", path);
+    PM_ENSURE((size_t)len < sizeof names_buf[nf], PM_ERR_HDF5,
+              "field name too long in '%s'", path);
+    names[nf] = names_buf[nf];
+    H5_OK(dset = H5Dopen2(file, names[nf], H5P_DEFAULT), "H5Dopen2", names[nf],
+          path);
+    H5_OK(space = H5Dget_space(dset), "H5Dget_space", names[nf], path);
+    H5_OK(count = H5Sget_simple_extent_npoints(space),
+          "H5Sget_simple_extent_npoints", names[nf], path);
+    ncomp[nf] = (int)(count / r->n_points);
+    PM_ENSURE(count == (hssize_t)ncomp[nf] * r->n_points &&
+                  (ncomp[nf] == 1 || ncomp[nf] == 3 || ncomp[nf] == 9),
+              PM_ERR_HDF5, "field %s of '%s' has %lld values for %ld points",
+              names[nf], path, (long long)count, r->n_points);
+    h5_close_quiet(&space);
+    h5_close_quiet(&dset);
+  }
+  PM_TRY(xdmf_frame(r, k, step, time, nf, names, ncomp));
+done:
+  h5_close_quiet(&space);
+  h5_close_quiet(&dset);
+  h5_close_quiet(&file);
+  return ret;
+}
+
+pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
+                         pm_results **out) {
+  pm_err ret = PM_SUCCESS;
+  pm_results *r = NULL;
+  hid_t file = -1, dset = -1, space = -1;
+  hsize_t dims[2];
+  const char *path = "";
+  PM_CHECK(out && n_keep >= 0, PM_ERR_ARG, "pm_results_reopen: bad arguments");
+  *out = NULL;
+  PM_CALL(check_dir(dir));
+  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  PM_TRY(PM_ALLOC(r, 1, "results writer"));
+  PM_TRY(set_paths(r, dir));
+  path = r->index_path;
+  H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
+        path);
+  PM_TRY(read_string_attr(file, "scene", &r->scene_text, path));
+  PM_TRY(read_string_attr(file, "version", &r->version, path));
+  PM_TRY(read_attr(file, "dim", H5T_NATIVE_INT, &r->dim, "/", path));
+  h5_close_quiet(&file);
+  path = r->mesh_path;
+  H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
+        path);
+  H5_OK(dset = H5Dopen2(file, "cells", H5P_DEFAULT), "H5Dopen2", "/cells",
+        path);
+  H5_OK(space = H5Dget_space(dset), "H5Dget_space", "/cells", path);
+  H5_OK(H5Sget_simple_extent_dims(space, dims, NULL),
+        "H5Sget_simple_extent_dims", "/cells", path);
+  r->n_cells = (long)dims[0];
+  r->nodes_per_cell = (int)dims[1];
+  h5_close_quiet(&space);
+  h5_close_quiet(&dset);
+  H5_OK(dset = H5Dopen2(file, "coordinates", H5P_DEFAULT), "H5Dopen2",
+        "/coordinates", path);
+  H5_OK(space = H5Dget_space(dset), "H5Dget_space", "/coordinates", path);
+  H5_OK(H5Sget_simple_extent_dims(space, dims, NULL),
+        "H5Sget_simple_extent_dims", "/coordinates", path);
+  r->n_points = (long)dims[0];
+  PM_ENSURE(r->n_points == n_points, PM_ERR_ARG,
+            "'%s' holds %ld points, the run has %ld", path, r->n_points,
+            n_points);
+  h5_close_quiet(&space);
+  h5_close_quiet(&dset);
+  h5_close_quiet(&file);
+  PM_TRY(drop_later_frames(r, n_keep));
+  for (long k = 0; k < n_keep; k++) PM_TRY(reread_frame(r, k));
+  r->n_frames = n_keep;
+  PM_TRY(publish(r));
+  *out = r;
+  r = NULL;
+done:
+  h5_close_quiet(&space);
+  h5_close_quiet(&dset);
+  h5_close_quiet(&file);
+  results_free(r);
+  return ret;
+}
+
+void pm_results_close(pm_results *r, bool keep) {
+  if (!r) return;
+  if (!keep && r->created && r->n_frames == 0) {
+    unlink(r->index_path);
+    unlink(r->xdmf_path);
+    unlink(r->mesh_path);
+    rmdir(r->sub);
+  }
+  results_free(r);
+}
+
+/* ---- Frames ------------------------------------------------------------- */
+
+/* The frame's HDF5 file, under tmp. */
+static pm_err write_frame_file(const pm_results *r, const char *tmp, long step,
+                               double time, int n_fields,
+                               const pm_field *fields) {
+  pm_err ret = PM_SUCCESS;
+  hid_t file = -1, fcpl = -1;
+  const char *path = tmp;
+  /* The fields keep their order (read back when a run resumes). */
+  H5_OK(fcpl = H5Pcreate(H5P_FILE_CREATE), "H5Pcreate", "fcpl", path);
+  H5_OK(H5Pset_link_creation_order(fcpl, H5P_CRT_ORDER_TRACKED |
+                                             H5P_CRT_ORDER_INDEXED),
+        "H5Pset_link_creation_order", "fcpl", path);
+  H5_OK(file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT), "H5Fcreate",
+        "/", path);
+  PM_TRY(write_attr(file, "step", H5T_STD_I64LE, H5T_NATIVE_LONG, &step, path));
+  PM_TRY(
+      write_attr(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, path));
+  for (int i = 0; i < n_fields; i++) {
+    const pm_field *f = &fields[i];
+    hsize_t dims[3] = {(hsize_t)r->n_points, 3, 3};
+    int rank = f->ncomp == 1 ? 1 : f->ncomp == 3 ? 2 : 3;
+    PM_TRY(write_dataset(file, f->name, rank, dims, H5T_IEEE_F64LE,
+                         H5T_NATIVE_DOUBLE, f->data, path, NULL));
+  }
+  H5_OK(H5Fclose(file), "H5Fclose", "/", path);
+  file = -1;
+done:
+  h5_close_quiet(&fcpl);
+  h5_close_quiet(&file);
+  return ret;
+}
+
+pm_err pm_results_write_frame(pm_results *r, long step, double time,
+                              int n_fields, const pm_field *fields) {
+  pm_err ret = PM_SUCCESS;
+  char path[PM_PATH_MAX + 1], tmp[PM_PATH_MAX + 40];
+  const char *names[16];
+  int ncomp[16];
+  size_t xdmf_len;
+  PM_CHECK(r, PM_ERR_ARG, "pm_results_write_frame: NULL results");
+  PM_CALL(check_fields(n_fields, fields));
+  PM_CHECK(n_fields <= 16, PM_ERR_ARG, "results frame: %d fields (16 at most)",
+           n_fields);
+  frame_path(r, r->n_frames, path, sizeof path);
+  tmp_name(tmp, sizeof tmp, path);
+  double bytes = H5_OVERHEAD;
+  for (int i = 0; i < n_fields; i++)
+    bytes += 8.0 * fields[i].ncomp * (double)r->n_points;
+  PM_CALL(check_room(r->sub, path, bytes));
+  xdmf_len = r->xdmf_len;
+  ret = write_frame_file(r, tmp, step, time, n_fields, fields);
+  int saved = errno;
+  PM_TRY(classify(ret, saved, path));
+  PM_TRY(commit_file(tmp, path));
+  for (int i = 0; i < n_fields; i++) {
+    names[i] = fields[i].name;
+    ncomp[i] = fields[i].ncomp;
+  }
+  PM_TRY(xdmf_frame(r, r->n_frames, step, time, n_fields, names, ncomp));
+  r->n_frames++;
+  ret = publish(r);
+  saved = errno;
+  if (ret != PM_SUCCESS) { /* the index still lists the frames before */
+    r->n_frames--;
+    r->xdmf_len = xdmf_len;
+    unlink(path);
+    PM_TRY(classify(ret, saved, r->index_path));
+  }
+done:
+  unlink(tmp);
+  return ret;
+}
+
+long pm_results_frames(const pm_results *r) { return r ? r->n_frames : 0; }

@@ -1,18 +1,34 @@
-/* pm_output: simulation results as OUT/results.h5 (HDF5) plus OUT/results.xdmf
- * (XDMF 3 temporal collection) so ParaView opens them directly.
+/* pm_output: simulation results that survive interruption, as
+ * OUT/results.h5 (HDF5) plus OUT/results.xdmf (XDMF 3 temporal collection)
+ * so ParaView opens them directly, also while the run goes on.
  *
- * Layout of results.h5 (every name fixed; readers such as probe rely on it):
- *   /                       attributes: scene (string, full scene text),
- *                           version (string), dim (int: 2 or 3)
- *   /mesh/coordinates       float64 [n_points][3] reference coordinates
- *   /mesh/cells             int64 [n_cells][nodes_per_cell] point indices,
- *                           attribute nodes_per_cell (int)
- *   /frames/NNNNNN          one group per frame, NNNNNN = frame index from
- *                           000000 (links in creation order), attributes
- *                           step (int64) and time (float64)
- *   /frames/NNNNNN/<field>  float64 [n_points] (scalar), [n_points][3]
- *                           (vector) or [n_points][3][3] (tensor, row-major)
- * The file is written as results.h5.tmp.<pid> and renamed on close. */
+ * Every frame is a file of its own, written under a temporary name, synced
+ * and renamed; then the index (results.h5) and results.xdmf are rewritten
+ * the same way.  A process killed at any moment leaves every earlier frame
+ * whole and an index and XDMF that point only at frames that exist; no
+ * file is held open between frames, so readers never meet a lock.
+ *
+ * Layout (every name fixed; readers such as probe rely on it):
+ *   OUT/results/mesh.h5          /coordinates float64 [n_points][3]
+ *                                reference coordinates; /cells int64
+ *                                [n_cells][nodes_per_cell] point indices,
+ *                                attribute nodes_per_cell (int)
+ *   OUT/results/frame_NNNNNN.h5  one frame, NNNNNN = frame index from
+ *                                000000: root attributes step (int64) and
+ *                                time (float64); one dataset per field,
+ *                                float64 [n_points] (scalar), [n_points][3]
+ *                                (vector) or [n_points][3][3] (tensor,
+ *                                row-major).  A vector field named
+ *                                "position" is the frame's geometry
+ *                                (particles that move).
+ *   OUT/results.h5               the index: attributes scene (string, full
+ *                                scene text), version (string), dim (int: 2
+ *                                or 3), frames (int64); /mesh an external
+ *                                link to results/mesh.h5, /frames/NNNNNN
+ *                                external links to the frames (creation
+ *                                order tracked), so that results.h5 reads
+ *                                as one file (/frames/000003/displacement).
+ *   OUT/results.xdmf             one uniform grid per frame. */
 #ifndef PM_OUTPUT_H
 #define PM_OUTPUT_H
 
@@ -32,8 +48,9 @@ typedef struct {
 
 typedef struct pm_results pm_results;
 
-/* Create dir/results.h5.tmp.<pid> (dir must exist: see pm_mkdir_p) holding
- * the mesh and the root attributes.
+/* Start results in dir (which must exist: see pm_mkdir_p): writes
+ * results/mesh.h5, an index with no frame and results.xdmf with the bare
+ * mesh, replacing older ones.
  *   dim:            2 or 3 (stored; 2-D coordinates still carry z)
  *   n_points, x:    n_points >= 1 points, x[3*i + k] (borrowed)
  *   n_cells, nodes_per_cell, cells: cells[c*nodes_per_cell + k], indices in
@@ -41,37 +58,41 @@ typedef struct pm_results pm_results;
  *                   cloud (XDMF Polyvertex), 3 = triangles, 4 = tetrahedra
  *                   (dim 3) or quadrilaterals (dim 2).  For a point cloud
  *                   cells may be NULL: one cell per point, n_cells ignored.
- *   scene_text, version: stored as root attributes (NULL stored as "").
+ *   scene_text, version: stored in the index (NULL stored as "").
  * *out is owned by the caller and released by pm_results_close.  Silences
  * HDF5's automatic error printing for the process.  Fails with PM_ERR_ARG
  * (bad sizes, cell index out of range), PM_ERR_IO (dir missing or not
- * writable, naming it), PM_ERR_HDF5 (naming the call and object),
- * PM_ERR_MEMORY.  On failure nothing is left on disk. */
+ * writable, a write refused: naming the path and the system's reason),
+ * PM_ERR_HDF5 (naming the call and object), PM_ERR_MEMORY.  On failure
+ * nothing is left on disk. */
 pm_err pm_results_create(const char *dir, int dim, long n_points,
                          const double *x, long n_cells, int nodes_per_cell,
                          const long *cells, const char *scene_text,
                          const char *version, pm_results **out);
 
-/* Append frame /frames/NNNNNN with attributes step and time and one dataset
- * per field, then flush the file so that it stays readable if the run dies.
- * Allocates nothing itself (HDF5 does internally).  Fails with PM_ERR_ARG
- * (bad field: name, ncomp, NULL data, duplicate) before writing anything,
- * or PM_ERR_HDF5; after a PM_ERR_HDF5 the results should be closed with
- * keep = false. */
+/* Continue the results in dir with their first n_keep frames (a resumed
+ * run): later frames are deleted, the index and results.xdmf rewritten
+ * from the frames kept.  n_points must match the mesh.  Fails with
+ * PM_ERR_IO / PM_ERR_HDF5 naming what is missing or unreadable. */
+pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
+                         pm_results **out);
+
+/* Append frame NNNNNN (the next index) with attributes step and time and
+ * one dataset per field, synced to disk, then rewrite the index and the
+ * XDMF.  Fails with PM_ERR_ARG (bad field: name, ncomp, NULL data,
+ * duplicate) before writing anything, PM_ERR_IO (a write refused, e.g. the
+ * disk is full or the file size limit is reached: naming the file and the
+ * reason) or PM_ERR_HDF5; after a failure the frame's temporary file is
+ * gone and the earlier frames, index and XDMF are as they were. */
 pm_err pm_results_write_frame(pm_results *r, long step, double time,
                               int n_fields, const pm_field *fields);
 
-/* Number of frames written so far. */
+/* Number of frames written so far (with those kept by pm_results_reopen). */
 long pm_results_frames(const pm_results *r);
 
-/* keep: write dir/results.xdmf.tmp.<pid> from the frames in the file (one
- * uniform grid per frame, Time = the frame's time; the bare mesh when no
- * frame was written), close the HDF5 file, rename it to dir/results.h5 and
- * commit the XDMF (both replace older files).  !keep: close and delete the
- * temporary file, leaving older results alone.  Always frees r (NULL
- * accepted).  On failure (PM_ERR_HDF5 / PM_ERR_IO) the temporary files are
- * deleted; only a failure of the very last step (XDMF rename) can leave a
- * new results.h5 without its results.xdmf. */
-pm_err pm_results_close(pm_results *r, bool keep);
+/* Release r (NULL accepted).  keep false and no frame written: the files
+ * pm_results_create wrote are removed (a run that failed before its first
+ * frame leaves nothing).  Frames are never removed.  Cannot fail. */
+void pm_results_close(pm_results *r, bool keep);
 
 #endif

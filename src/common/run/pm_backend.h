@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "pm_checkpoint.h"
 #include "pm_error.h"
 #include "pm_files.h"
 #include "pm_keys.h"
@@ -27,7 +28,7 @@ typedef enum {
 } pm_status;
 
 /* "completed", "converged", "not-converged", "unstable", "failed",
- * "not-run". */
+ * "interrupted", "not-run". */
 const char *pm_status_name(pm_status s);
 
 /* A backend's own top-level scene section ("fpm:", "mpm:"): its keys, each
@@ -136,10 +137,12 @@ typedef struct pm_backend {
   /* Print the pipeline, counts, time step, steps, memory and an estimated
    * run time, without running. */
   pm_err (*plan)(void *sim, FILE *out);
-  /* Run the time loop from the initial state to the end (or the
-   * quasi-static state), reporting the initial state (step 0) and every
-   * step to obs, as a frame at step 0, every output.every steps and at
-   * the last step.  Returns
+  /* Run the time loop from the current state to the end (or the
+   * quasi-static state), reporting every step to obs, as a frame every
+   * output.every steps and at the last step.  The initial state is step 0,
+   * reported as a frame; a state read from a checkpoint is not reported
+   * again, and the steps that follow are those the first run would have
+   * taken, bit for bit on the same thread count.  Returns
    * PM_ERR_UNSTABLE (message: step, time, point, position, cause) on a
    * numerical failure and PM_SUCCESS otherwise (not converging is a
    * status, see figures). */
@@ -165,6 +168,12 @@ typedef struct pm_backend {
   pm_err (*summary)(void *sim, pm_json *j);
   /* Its stage timers (printed after a run, summed in summary.json). */
   const pm_timers *(*timers)(void *sim);
+  /* The state a resumed run needs and what the run reports over all its
+   * steps, as checkpoint items (pm_checkpoint.h): the same items in the
+   * same order for a writer (between steps) and a reader (after create,
+   * before run).  Fails with PM_ERR_ARG naming what cannot be
+   * checkpointed.  NULL: the method has no checkpoints. */
+  pm_err (*checkpoint)(void *sim, pm_ckpt *ck);
 } pm_backend;
 
 /* ---- registry ------------------------------------------------------------ */

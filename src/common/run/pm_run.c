@@ -6,6 +6,8 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "pm_metrics.h"
 #include "pm_omp.h"
@@ -40,9 +42,22 @@ typedef struct {
   double *ref; /* 3 n reference displacement, or NULL */
   bool ref_time;
   double t_start;
-  pm_timers out_timer; /* output: the one stage this driver times */
-  int tm_output;
+  pm_timers out_timer; /* the stages this driver times */
+  int tm_output, tm_checkpoint;
   pm_outcome *o;
+  /* output folder, checkpoints and resuming */
+  const char *out_dir;
+  pm_outdir *outdir;
+  long history_rows;
+  long ckpt_every;       /* steps (0: never) */
+  double ckpt_seconds;   /* wall time (0: never) */
+  double ckpt_last_wall; /* when the last one was written */
+  long ckpt_step;        /* the step of the last one (-1: none) */
+  long ckpt_count;       /* checkpoints written by this process */
+  long resumes;          /* how often this run was resumed */
+  long resumed_from;     /* the step it was last resumed from (0: none) */
+  char ckpt_note[512];   /* why no checkpoint was written, if one failed */
+  bool extra_frame;      /* the last frame is a signal's, off the schedule */
 } run_ctx;
 
 /* ---- errors against the scene's reference field ------------------------- */
@@ -150,7 +165,10 @@ static pm_err write_row(run_ctx *c) {
     for (int comp = 0; comp < 3; comp++)
       if (c->s->reference_mask >> comp & 1u) row[k++] = c->o->nrmse[comp];
   }
-  return pm_history_row(c->history, row);
+  PM_CALL(pm_history_row(c->history, row));
+  PM_CALL(pm_history_sync(c->history));
+  c->history_rows++;
+  return PM_SUCCESS;
 }
 
 static pm_err write_frame(run_ctx *c, const pm_step_report *r) {
@@ -188,9 +206,110 @@ static void release_interrupts(const struct sigaction old[2]) {
   sigaction(SIGTERM, &old[1], NULL);
 }
 
+/* ---- checkpoints -------------------------------------------------------- */
+
+/* The driver's items of a checkpoint, before the backend's: what the run
+ * is (program version, method, scene file, its text and the overrides) and
+ * how far its outputs go.  Reading fills h (strings malloc'd). */
+typedef struct {
+  char *version, *method, *scene_path, *scene_text, *overrides;
+  long frames, history_rows, threads, resumes, step;
+  double wall_seconds, output_seconds, checkpoint_seconds;
+} ckpt_header;
+
+static void header_free(ckpt_header *h) {
+  free(h->version);
+  free(h->method);
+  free(h->scene_path);
+  free(h->scene_text);
+  free(h->overrides);
+  memset(h, 0, sizeof *h);
+}
+
+static pm_err header_items(pm_ckpt *ck, ckpt_header *h) {
+  PM_CALL(pm_ckpt_string(ck, "run.version", &h->version));
+  PM_CALL(pm_ckpt_string(ck, "run.method", &h->method));
+  PM_CALL(pm_ckpt_string(ck, "run.scene_path", &h->scene_path));
+  PM_CALL(pm_ckpt_string(ck, "run.scene_text", &h->scene_text));
+  PM_CALL(pm_ckpt_string(ck, "run.overrides", &h->overrides));
+  PM_CALL(pm_ckpt_long(ck, "run.step", &h->step));
+  PM_CALL(pm_ckpt_long(ck, "run.frames", &h->frames));
+  PM_CALL(pm_ckpt_long(ck, "run.history_rows", &h->history_rows));
+  PM_CALL(pm_ckpt_long(ck, "run.threads", &h->threads));
+  PM_CALL(pm_ckpt_long(ck, "run.resumes", &h->resumes));
+  PM_CALL(pm_ckpt_double(ck, "run.wall_seconds", &h->wall_seconds));
+  PM_CALL(pm_ckpt_double(ck, "run.output_seconds", &h->output_seconds));
+  return pm_ckpt_double(ck, "run.checkpoint_seconds", &h->checkpoint_seconds);
+}
+
+/* The --set overrides as one string, one per line. */
+static char *join_overrides(const pm_scene *s) {
+  size_t len = 1;
+  for (int k = 0; k < s->n_overrides; k++) len += strlen(s->overrides[k]) + 1;
+  char *buf = malloc(len), *p = buf;
+  if (!buf) return NULL;
+  for (int k = 0; k < s->n_overrides; k++)
+    p += sprintf(p, "%s\n", s->overrides[k]);
+  *p = '\0';
+  return buf;
+}
+
+/* Write OUT/checkpoint.h5 of the state after step (replacing the older
+ * one).  PM_ERR_ARG when the method cannot checkpoint this scene. */
+static pm_err write_checkpoint(run_ctx *c, long step) {
+  pm_err ret = PM_SUCCESS;
+  pm_ckpt *ck = NULL;
+  const pm_scene *s = c->s;
+  ckpt_header h = {
+      .version = (char *)PM_VERSION,
+      .method = s->method,
+      .scene_path = s->path,
+      .scene_text = s->text,
+      .overrides = join_overrides(s),
+      .step = step,
+      /* A signal's frame is not one of the run's: a resumed run drops
+       * it, so that its results are those of an uninterrupted run. */
+      .frames = pm_results_frames(c->results) - c->extra_frame,
+      .history_rows = c->history_rows - c->extra_frame,
+      .threads = pm_omp_threads(),
+      .resumes = c->resumes,
+      .wall_seconds = pm_wtime() - c->t_start,
+      .output_seconds = pm_timers_seconds(&c->out_timer, c->tm_output),
+      .checkpoint_seconds = pm_timers_seconds(&c->out_timer, c->tm_checkpoint),
+  };
+  char *overrides = h.overrides;
+  PM_CHECK(overrides, PM_ERR_MEMORY, "cannot join the scene's overrides");
+  PM_CHECK(c->be->checkpoint, PM_ERR_ARG, "method %s cannot write checkpoints",
+           s->method);
+  pm_timers_start(&c->out_timer, c->tm_checkpoint);
+  PM_TRY(pm_ckpt_create(c->out_dir, &ck));
+  PM_TRY(header_items(ck, &h));
+  PM_TRY(c->be->checkpoint(c->sim, ck));
+  pm_ckpt *done_ck = ck;
+  ck = NULL;
+  PM_TRY(pm_ckpt_finish(done_ck));
+  c->ckpt_step = step;
+  c->ckpt_count++;
+  c->ckpt_last_wall = pm_wtime();
+done:
+  pm_timers_stop(&c->out_timer, c->tm_checkpoint);
+  pm_ckpt_abort(ck);
+  free(overrides);
+  return ret;
+}
+
+/* A checkpoint is due after step (not the initial state). */
+static bool checkpoint_due(const run_ctx *c, long step) {
+  if (step <= 0 || step == c->ckpt_step) return false;
+  if (c->ckpt_every > 0 && step % c->ckpt_every == 0) return true;
+  return c->ckpt_seconds > 0 &&
+         pm_wtime() - c->ckpt_last_wall >= c->ckpt_seconds;
+}
+
 static pm_err observe(void *ctx, const pm_step_report *r, bool frame) {
   run_ctx *c = ctx;
-  /* After a signal, the state after this step becomes the last frame. */
+  /* After a signal, the state after this step becomes the last frame and
+   * a checkpoint. */
   const int sig = interrupt_signal;
   if (c->show_progress) {
     char status[96];
@@ -203,12 +322,28 @@ static pm_err observe(void *ctx, const pm_step_report *r, bool frame) {
     pm_err e = write_frame(c, r);
     pm_timers_stop(&c->out_timer, c->tm_output);
     PM_CALL(e);
+    c->extra_frame = !frame;
+  }
+  if (c->results && (checkpoint_due(c, r->step) || (sig && r->step > 0))) {
+    pm_err e = write_checkpoint(c, r->step);
+    if (e == PM_ERR_ARG && sig) /* the method cannot: say so, go on */
+      snprintf(c->ckpt_note, sizeof c->ckpt_note, "no checkpoint: %s",
+               pm_error_message());
+    else
+      PM_CALL(e);
   }
   if (!sig) return PM_SUCCESS;
+  if (c->ckpt_step == r->step)
+    return PM_ERROR(PM_ERR_INTERRUPTED,
+                    "interrupted by %s after step %ld, t = %.6g s (results up "
+                    "to this step kept; `pointmech resume %s` continues from "
+                    "its checkpoint)",
+                    signal_name(sig), r->step, r->t, c->out_dir);
   return PM_ERROR(PM_ERR_INTERRUPTED,
                   "interrupted by %s after step %ld, t = %.6g s (results up "
-                  "to this step kept)",
-                  signal_name(sig), r->step, r->t);
+                  "to this step kept%s%s)",
+                  signal_name(sig), r->step, r->t, c->ckpt_note[0] ? "; " : "",
+                  c->ckpt_note);
 }
 
 /* ---- summary ------------------------------------------------------------ */
@@ -269,8 +404,15 @@ static pm_err summary_cost(run_ctx *c, pm_json *j) {
   PM_CALL(pm_json_begin_object(j, "stage_seconds"));
   for (int k = 0; k < t->n; k++)
     PM_CALL(pm_json_number(j, t->stage[k].name, t->stage[k].seconds));
-  PM_CALL(pm_json_number(j, "output", pm_timers_seconds(&c->out_timer, 0)));
-  return pm_json_end_object(j);
+  PM_CALL(pm_json_number(j, "output",
+                         pm_timers_seconds(&c->out_timer, c->tm_output)));
+  PM_CALL(pm_json_number(j, "checkpoint",
+                         pm_timers_seconds(&c->out_timer, c->tm_checkpoint)));
+  PM_CALL(pm_json_end_object(j));
+  PM_CALL(pm_json_integer(j, "checkpoints", c->ckpt_count));
+  PM_CALL(pm_json_integer(j, "checkpoint_step", c->ckpt_step));
+  PM_CALL(pm_json_integer(j, "resumes", c->resumes));
+  return pm_json_integer(j, "resumed_from_step", c->resumed_from);
 }
 
 static pm_err summary_accuracy(run_ctx *c, pm_json *j) {
@@ -309,10 +451,36 @@ static pm_err write_summary(run_ctx *c, const char *out_dir) {
                             s->overrides));
   PM_TRY(pm_json_string(j, "status", pm_status_name(c->o->fig.status)));
   if (c->o->message[0]) PM_TRY(pm_json_string(j, "message", c->o->message));
+  PM_TRY(pm_json_integer(j, "frames", pm_results_frames(c->results)));
   PM_TRY(summary_figures(c, j));
   PM_TRY(summary_cost(c, j));
   PM_TRY(summary_accuracy(c, j));
   if (c->be->summary) PM_TRY(c->be->summary(c->sim, j));
+  PM_TRY(pm_json_end_object(j));
+  ret = pm_json_close(j, true);
+  j = NULL;
+done:
+  if (j) pm_json_close(j, false);
+  return ret;
+}
+
+/* summary.json while the run goes on: status "running" and who runs it
+ * (a killed run leaves it so; its folder's lock is then free). */
+static pm_err write_running(run_ctx *c) {
+  pm_err ret = PM_SUCCESS;
+  pm_json *j = NULL;
+  char path[PM_PATH_MAX + 1];
+  const pm_scene *s = c->s;
+  PM_TRY(pm_path_join(path, sizeof path, c->out_dir, "summary.json"));
+  PM_TRY(pm_json_open(path, &j));
+  PM_TRY(pm_json_begin_object(j, NULL));
+  PM_TRY(pm_json_run_header(j, s->path, s->name, s->method, s->n_overrides,
+                            s->overrides));
+  PM_TRY(pm_json_string(j, "status", "running"));
+  PM_TRY(pm_json_integer(j, "pid", (long long)getpid()));
+  PM_TRY(pm_json_integer(j, "started", (long long)time(NULL)));
+  PM_TRY(pm_json_integer(j, "resumes", c->resumes));
+  PM_TRY(pm_json_integer(j, "resumed_from_step", c->resumed_from));
   PM_TRY(pm_json_end_object(j));
   ret = pm_json_close(j, true);
   j = NULL;
@@ -396,22 +564,75 @@ static void report(run_ctx *c) {
   pm_timers_print(&t, stderr, f->setup_seconds + f->wall_seconds);
 }
 
-static pm_err open_outputs(run_ctx *c, const char *out_dir) {
+/* What a resumed run starts from: the checkpoint being read (positioned
+ * after the driver's items) and its header. */
+typedef struct {
+  pm_ckpt *ck;
+  ckpt_header h;
+} resume_info;
+
+static pm_outdir_mode outdir_mode(unsigned flags) {
+  return flags & PM_RUN_OVERWRITE ? PM_OUTDIR_OVERWRITE : PM_OUTDIR_NEW;
+}
+
+/* outdir: the folder, claimed by the caller (taken over), or NULL. */
+static pm_err open_outputs(run_ctx *c, const char *out_dir, unsigned flags,
+                           pm_outdir **outdir, resume_info *rs) {
   /* PETSc starts MPI, which may start a helper process; it must not
    * inherit the run's open files (results.h5's lock would outlive the
    * run), so a scene solved by Newton's method starts PETSc first. */
   if (c->s->time.qs == PM_QS_STATIC) PM_CALL(pm_petsc_init());
-  PM_CALL(pm_mkdir_p(out_dir));
-  PM_CALL(pm_results_create(out_dir, c->s->dimension, c->pts.n, c->pts.x,
-                            c->pts.n_cells, c->pts.nodes_per_cell, c->pts.cells,
-                            c->s->text, PM_VERSION, &c->results));
-  return pm_history_open(out_dir, c->n_cols, c->names, &c->history);
+  c->out_dir = out_dir;
+  if (outdir && *outdir) {
+    c->outdir = *outdir;
+    *outdir = NULL;
+  } else {
+    PM_CALL(pm_outdir_claim(out_dir, outdir_mode(flags), &c->outdir));
+  }
+  if (rs) {
+    PM_CALL(pm_results_reopen(out_dir, c->pts.n, rs->h.frames, &c->results));
+    c->history_rows = rs->h.history_rows;
+    PM_CALL(pm_history_open(out_dir, c->n_cols, c->names, c->history_rows,
+                            &c->history));
+  } else {
+    PM_CALL(pm_results_create(out_dir, c->s->dimension, c->pts.n, c->pts.x,
+                              c->pts.n_cells, c->pts.nodes_per_cell,
+                              c->pts.cells, c->s->text, PM_VERSION,
+                              &c->results));
+    PM_CALL(pm_history_open(out_dir, c->n_cols, c->names, -1, &c->history));
+  }
+  return write_running(c);
 }
 
-pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir, bool quiet,
-                  pm_outcome *o) {
+/* Read the backend's items of a checkpoint and check it whole. */
+static pm_err restore(run_ctx *c, resume_info *rs) {
+  PM_CHECK(c->be->checkpoint, PM_ERR_ARG, "method %s cannot resume",
+           c->s->method);
+  PM_CALL(c->be->checkpoint(c->sim, rs->ck));
+  pm_ckpt *ck = rs->ck;
+  rs->ck = NULL;
+  PM_CALL(pm_ckpt_finish(ck));
+  c->resumes = rs->h.resumes + 1;
+  c->resumed_from = rs->h.step;
+  c->ckpt_step = rs->h.step;
+  c->out_timer.stage[c->tm_output].seconds = rs->h.output_seconds;
+  c->out_timer.stage[c->tm_checkpoint].seconds = rs->h.checkpoint_seconds;
+  if (rs->h.threads != pm_omp_threads())
+    fprintf(stderr,
+            "pointmech: warning: the checkpoint was written on %ld threads, "
+            "this run has %d: results differ from an uninterrupted run at "
+            "round-off (set OMP_NUM_THREADS=%ld to repeat it bit for bit)\n",
+            rs->h.threads, pm_omp_threads(), rs->h.threads);
+  return PM_SUCCESS;
+}
+
+static pm_err run_sim(const pm_scene *s, void *sim, const char *out_dir,
+                      unsigned flags, pm_outcome *o, pm_outdir **outdir,
+                      resume_info *rs) {
   pm_err ret = PM_SUCCESS, run_err = PM_SUCCESS;
   run_ctx *c = NULL;
+  const bool quiet = flags & PM_RUN_QUIET;
+  void (*old_xfsz)(int) = SIG_ERR;
   memset(o, 0, sizeof *o);
   for (int k = 0; k < 3; k++) o->nrmse[k] = NAN;
   o->nrmse_vector = o->loaded_reaction = NAN;
@@ -423,6 +644,10 @@ pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir, bool quiet,
   c->o = o;
   c->show_progress = !quiet;
   c->tm_output = pm_timers_add(&c->out_timer, "output");
+  c->tm_checkpoint = pm_timers_add(&c->out_timer, "checkpoint");
+  c->ckpt_step = -1;
+  c->ckpt_every = s->output.checkpoint.every;
+  c->ckpt_seconds = 60 * s->output.checkpoint.minutes;
   c->be->points(sim, &c->pts);
   PM_TRY(setup_columns(c));
   if (s->reference_mask) {
@@ -432,10 +657,15 @@ pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir, bool quiet,
         c->ref_time = true;
     fill_reference(c, 0);
   }
+  if (rs) PM_TRY(restore(c, rs));
   pm_progress_init(&c->progress, stderr, s->name);
-  if (out_dir) PM_TRY(open_outputs(c, out_dir));
+  /* A full disk or the file size limit fails a write (EFBIG) instead of
+   * killing the process, so that the run can say what happened. */
+  old_xfsz = signal(SIGXFSZ, SIG_IGN);
+  if (out_dir) PM_TRY(open_outputs(c, out_dir, flags, outdir, rs));
   pm_observer obs = {.ctx = c, .step = observe};
-  c->t_start = pm_wtime();
+  c->t_start = pm_wtime() - (rs ? rs->h.wall_seconds : 0);
+  c->ckpt_last_wall = pm_wtime();
   struct sigaction old_handlers[2];
   catch_interrupts(old_handlers);
   run_err = c->be->run(sim, &obs);
@@ -448,12 +678,9 @@ pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir, bool quiet,
     compute_errors(c, o->fig.time);
   if (out_dir) {
     /* Frames written before a failure are good: keep them. */
-    pm_results *r = c->results;
-    c->results = NULL;
-    PM_TRY(pm_results_close(r, true));
     pm_history *h = c->history;
     c->history = NULL;
-    PM_TRY(pm_history_close(h, true));
+    PM_TRY(pm_history_close(h));
     PM_TRY(write_summary(c, out_dir));
   }
   if (!quiet) report(c);
@@ -462,31 +689,98 @@ pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir, bool quiet,
   else if (o->fig.status == PM_STATUS_NOT_CONVERGED)
     ret = PM_ERROR(PM_ERR_NOT_CONVERGED, "%s", o->message);
 done:
+  if (old_xfsz != SIG_ERR) signal(SIGXFSZ, old_xfsz);
   if (c) {
-    if (c->results) pm_results_close(c->results, false);
-    if (c->history) pm_history_close(c->history, false);
+    pm_results_close(c->results, o->fig.status != PM_STATUS_NOT_RUN);
+    if (c->history) pm_history_close(c->history);
+    pm_outdir_release(c->outdir);
     free(c->ref);
     free(c);
   }
   return ret;
 }
 
-pm_err pm_run_scene(const pm_scene *s, const char *out_dir, bool quiet,
-                    pm_outcome *o) {
-  void *sim = NULL;
+pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir,
+                  unsigned flags, pm_outcome *o) {
+  return run_sim(s, sim, out_dir, flags, o, NULL, NULL);
+}
+
+/* Refuse to start once a run of this process was interrupted. */
+static pm_err check_not_interrupted(pm_outcome *o) {
   memset(o, 0, sizeof *o);
   o->fig.status = PM_STATUS_FAILED;
   const int sig = interrupt_signal;
-  if (sig) {
-    o->fig.status = PM_STATUS_INTERRUPTED;
-    return PM_ERROR(PM_ERR_INTERRUPTED,
-                    "not started: an earlier run was interrupted by %s",
-                    signal_name(sig));
+  if (!sig) return PM_SUCCESS;
+  o->fig.status = PM_STATUS_INTERRUPTED;
+  return PM_ERROR(PM_ERR_INTERRUPTED,
+                  "not started: an earlier run was interrupted by %s",
+                  signal_name(sig));
+}
+
+pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
+                    pm_outcome *o) {
+  pm_err ret = PM_SUCCESS;
+  void *sim = NULL;
+  pm_outdir *outdir = NULL;
+  PM_CALL(check_not_interrupted(o));
+  /* The folder first: a busy or taken one is refused before the setup. */
+  if (out_dir) PM_TRY(pm_outdir_claim(out_dir, outdir_mode(flags), &outdir));
+  PM_TRY(s->backend->create(s, &sim));
+  ret = run_sim(s, sim, out_dir, flags, o, &outdir, NULL);
+done:
+  if (sim) s->backend->destroy(sim);
+  pm_outdir_release(outdir);
+  return ret;
+}
+
+/* The overrides of a checkpoint (one per line) as an argument vector
+ * pointing into text (changed in place). */
+static int split_overrides(char *text, char **argv, int max) {
+  int n = 0;
+  for (char *p = text; *p && n < max;) {
+    char *nl = strchr(p, '\n');
+    if (nl) *nl = '\0';
+    argv[n++] = p;
+    if (!nl) break;
+    p = nl + 1;
   }
-  PM_CALL(s->backend->create(s, &sim));
-  pm_err e = pm_run_sim(s, sim, out_dir, quiet, o);
-  s->backend->destroy(sim);
-  return e;
+  return n;
+}
+
+pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o) {
+  pm_err ret = PM_SUCCESS;
+  resume_info rs = {0};
+  pm_outdir *outdir = NULL;
+  pm_scene *s = NULL;
+  void *sim = NULL;
+  char *argv[256];
+  PM_CALL(check_not_interrupted(o));
+  PM_TRY(pm_outdir_claim(out_dir, PM_OUTDIR_RESUME, &outdir));
+  PM_TRY(pm_ckpt_open(out_dir, &rs.ck));
+  PM_TRY(header_items(rs.ck, &rs.h));
+  PM_ENSURE(strcmp(rs.h.version, PM_VERSION) == 0, PM_ERR_ARG,
+            "cannot resume '%s': its checkpoint was written by pointmech %s, "
+            "this is pointmech %s",
+            out_dir, rs.h.version, PM_VERSION);
+  int n_sets = split_overrides(rs.h.overrides, argv, 256);
+  PM_TRY(pm_scene_load(rs.h.scene_path, n_sets, (const char *const *)argv, &s));
+  PM_ENSURE(strcmp(s->text, rs.h.scene_text) == 0, PM_ERR_ARG,
+            "cannot resume '%s': the scene %s has changed since its "
+            "checkpoint (step %ld); restore it, or start a new run",
+            out_dir, rs.h.scene_path, rs.h.step);
+  PM_ENSURE(strcmp(s->method, rs.h.method) == 0, PM_ERR_ARG,
+            "cannot resume '%s': the checkpoint is of method %s, the scene "
+            "now names %s",
+            out_dir, rs.h.method, s->method);
+  PM_TRY(s->backend->create(s, &sim));
+  ret = run_sim(s, sim, out_dir, flags, o, &outdir, &rs);
+done:
+  if (sim) s->backend->destroy(sim);
+  pm_scene_destroy(s);
+  pm_ckpt_abort(rs.ck);
+  pm_outdir_release(outdir);
+  header_free(&rs.h);
+  return ret;
 }
 
 pm_err pm_plan_scene(const pm_scene *s, FILE *out) {

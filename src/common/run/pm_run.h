@@ -25,19 +25,40 @@ typedef struct {
   char message[1024];     /* why it stopped, when not a success */
 } pm_outcome;
 
+/* How a run goes (a bit mask; true is PM_RUN_QUIET). */
+enum {
+  PM_RUN_QUIET = 1u << 0,    /* no progress line, no stage-time table */
+  PM_RUN_OVERWRITE = 1u << 1 /* replace another run's files in out_dir */
+};
+
 /* Run the simulation sim that s->backend created from s.  With out_dir
- * non-NULL, writes the files there (each committed atomically; the frames
- * before a numerical failure are kept); with quiet false, shows a progress
- * line on a terminal and prints the stage times to stderr.  Fills *o even
- * on failure.  Returns PM_ERR_UNSTABLE on a numerical failure,
+ * non-NULL: claims the folder (created if missing; refused when another
+ * pointmech runs there, or, without PM_RUN_OVERWRITE, when it holds another
+ * run's files), writes every frame as it comes (pm_output.h: crash-safe),
+ * history.csv rows synced with each frame, summary.json with status
+ * "running" and then the outcome, and checkpoints as output.checkpoint
+ * asks.  SIGINT and SIGTERM end the run after the current step with a last
+ * frame and a checkpoint.  Unless PM_RUN_QUIET, shows a progress line on a
+ * terminal and prints the stage times to stderr.  Fills *o even on
+ * failure.  Returns PM_ERR_UNSTABLE on a numerical failure,
  * PM_ERR_NOT_CONVERGED when a quasi-static run did not reach its
- * tolerance, and I/O errors as they come. */
-pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir, bool quiet,
-                  pm_outcome *o);
+ * tolerance, PM_ERR_INTERRUPTED after a signal, and I/O errors as they
+ * come. */
+pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir,
+                  unsigned flags, pm_outcome *o);
 
 /* Create the backend's simulation of s, run it as pm_run_sim, destroy it. */
-pm_err pm_run_scene(const pm_scene *s, const char *out_dir, bool quiet,
+pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
                     pm_outcome *o);
+
+/* Continue the run in out_dir from its checkpoint.h5: the scene is loaded
+ * again from the file and overrides the checkpoint names (refused when its
+ * text changed, when the checkpoint comes from another program version, or
+ * when it is damaged, with the reason), frames and history rows written
+ * after the checkpoint are dropped, and the run goes on appending to the
+ * same results, history and summary.  On the thread count of the first run
+ * it ends bit-identical to an uninterrupted run. */
+pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o);
 
 /* Create the simulation and print its plan. */
 pm_err pm_plan_scene(const pm_scene *s, FILE *out);

@@ -161,6 +161,10 @@ typedef struct pm_scene {
   struct {
     long every;      /* output.every: frame every N steps (> 0) */
     unsigned fields; /* PM_FIELD_* mask */
+    struct {
+      long every;     /* output.checkpoint.every: steps (0: never) */
+      double minutes; /* output.checkpoint.minutes: wall time (0: never) */
+    } checkpoint;
   } output;
   unsigned reference_mask; /* reference.displacement components given */
   pm_expr *reference[3];   /* analytic u_c(x, y, z, t) or NULL */

@@ -398,6 +398,23 @@ static const pm_key time_keys[] = {
      .doc = "{method, tolerance, damping}"},
     {0}};
 
+static const pm_key checkpoint_keys[] = {
+    {.name = "every",
+     .type = PM_KEY_INTEGER,
+     .offset = S(output.checkpoint.every),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .doc = "a checkpoint every N steps (0: none); `pointmech resume OUT` "
+            "continues from the last"},
+    {.name = "minutes",
+     .type = PM_KEY_NUMBER,
+     .offset = S(output.checkpoint.minutes),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .unit = "min",
+     .doc = "a checkpoint every M minutes of wall time (0: none)"},
+    {0}};
+
 static const pm_key output_keys[] = {
     {.name = "every",
      .type = PM_KEY_INTEGER,
@@ -412,6 +429,11 @@ static const pm_key output_keys[] = {
      .min_count = 1,
      .names = field_names,
      .doc = "fields written in each frame"},
+    {.name = "checkpoint",
+     .type = PM_KEY_MAPPING,
+     .keys = checkpoint_keys,
+     .doc = "{every, minutes}: the whole state, written atomically (SIGINT "
+            "and SIGTERM write one too)"},
     {0}};
 
 static const pm_key stability_keys[] = {

@@ -1,0 +1,191 @@
+#!/usr/bin/env bash
+# Nothing lost: a run killed with SIGKILL leaves readable results up to its
+# last frame; `resume` after SIGTERM and after SIGKILL ends bit-identical to
+# an uninterrupted run (FPM and MPM); resuming a changed scene, another
+# program version or a damaged checkpoint is refused; output folders that
+# are in use, hold another run, are read-only or hit the file size limit
+# fail cleanly.
+set -u
+bin=$1
+src=$2
+here=$(dirname "$0")
+py=/usr/bin/python3
+# shellcheck source=lib.sh
+. "$here/lib.sh"
+export OMP_NUM_THREADS=2
+
+# Rows in OUT/history.csv (0 while it does not exist).
+rows() { if [ -f "$1/history.csv" ]; then wc -l <"$1/history.csv"; else echo 0; fi; }
+
+# Start a run (arguments after the output folder), wait until its history
+# holds at least N lines, then send SIGNAL; sets rc to its exit status.
+run_until() { # signal, lines, out, scene, args...
+  local sig=$1 n=$2 out=$3 scene=$4
+  shift 4
+  "$bin" run "$scene" --out "$out" --quiet "$@" >/dev/null 2>"$work/err" &
+  local pid=$! waited=0
+  while [ "$(rows "$out")" -lt "$n" ] && kill -0 $pid 2>/dev/null &&
+    [ $waited -lt 6000 ]; do
+    sleep 0.01
+    waited=$((waited + 1))
+  done
+  kill -"$sig" $pid 2>/dev/null
+  wait $pid
+  rc=$?
+}
+
+# results.h5 opens with h5py and every frame it lists exists; results.xdmf
+# parses and points only at existing frame files; prints the frame count.
+readable() { # out
+  $py - "$1" <<'EOF'
+import os, sys, h5py, xml.etree.ElementTree as ET
+out = sys.argv[1]
+with h5py.File(os.path.join(out, "results.h5"), "r") as f:
+    n = len(f["frames"])
+    assert f.attrs["frames"] == n
+    for k in f["frames"]:
+        assert "displacement" in f["frames"][k] or "position" in f["frames"][k]
+grids = ET.parse(os.path.join(out, "results.xdmf")).getroot().findall(".//Grid/Grid")
+assert len(grids) == n, (len(grids), n)
+for item in ET.parse(os.path.join(out, "results.xdmf")).getroot().iter("DataItem"):
+    assert os.path.exists(os.path.join(out, item.text.split(":")[0])), item.text
+print(n)
+EOF
+}
+
+# A straight run, then the same stopped by SIGTERM and by SIGKILL and
+# resumed: the results and history must be those of the straight run.
+resume_case() { # label, scene, lines before the signals, args...
+  local label=$1 scene=$2 n=$3
+  shift 3
+  local straight=$work/$label-straight
+  "$bin" run "$scene" --out "$straight" --quiet "$@" >/dev/null 2>&1
+  local status
+  status=$(grep '"status"' "$straight/summary.json")
+  check "$label: straight run done ($status)" grep -q '"status": "[cn]' "$straight/summary.json"
+
+  local out=$work/$label-term
+  run_until TERM "$n" "$out" "$scene" "$@"
+  check "$label SIGTERM: exit 4 (got $rc)" test $rc -eq 4
+  check "$label SIGTERM: checkpoint written" test -s "$out/checkpoint.h5"
+  check "$label SIGTERM: message says resume" grep -q "pointmech resume" "$work/err"
+  "$bin" resume "$out" --quiet >/dev/null 2>"$work/err"
+  check "$label SIGTERM + resume: status as the straight run's" \
+    grep -qF "$status" "$out/summary.json"
+  check "$label SIGTERM: resumed once" grep -q '"resumes": 1' "$out/summary.json"
+  check "$label SIGTERM + resume: bit-identical to the straight run" \
+    $py "$here/same_results.py" "$straight" "$out"
+
+  out=$work/$label-kill
+  run_until KILL $((n + 3)) "$out" "$scene" "$@" --set output.checkpoint.every=$((${ckpt_every}))
+  check "$label SIGKILL: killed (got $rc)" test $rc -eq 137
+  local frames
+  frames=$(readable "$out" 2>"$work/err")
+  check "$label SIGKILL: results.h5 and results.xdmf readable, $frames frames" \
+    test -n "$frames"
+  check "$label SIGKILL: every frame the history lists is there" \
+    test "$frames" -ge $(($(rows "$out") - 1))
+  check "$label SIGKILL: summary says running" \
+    grep -q '"status": "running"' "$out/summary.json"
+  "$bin" resume "$out" --quiet >/dev/null 2>"$work/err"
+  check "$label SIGKILL + resume: bit-identical to the straight run" \
+    $py "$here/same_results.py" "$straight" "$out"
+}
+
+fpm=$src/cases/fpm/f2-unconstrained-compression.yaml
+ckpt_every=300
+resume_case fpm "$fpm" 5 --set discretization.mesh_size=0.02 \
+  --set time.max_steps=1200 --set time.end=1 --set output.every=100
+mpm=$src/cases/mpm/m2-shock-tube-reduced.yaml
+ckpt_every=100
+resume_case mpm "$mpm" 4 --set time.max_steps=400 --set output.every=50
+
+# Resuming what cannot be resumed.
+scene=$work/f2.yaml
+cp "$fpm" "$scene"
+coarse=(--set discretization.mesh_size=0.02 --set time.max_steps=1200 --set output.every=100)
+out=$work/changed
+run_until TERM 4 "$out" "$scene" "${coarse[@]}"
+sed -i 's/poisson_ratio: 0.495/poisson_ratio: 0.49/' "$scene"
+refused_resume() { # label, text, out
+  "$bin" resume "$3" --quiet >/dev/null 2>"$work/err"
+  local rc=$?
+  check "$1: exit 1 (got $rc)" test $rc -eq 1
+  check "$1: says why" grep -qF -- "$2" "$work/err"
+  check "$1: results left as they were" grep -q '"status": "interrupted"' "$3/summary.json"
+}
+refused_resume "changed scene" "has changed since its checkpoint" "$out"
+cp "$fpm" "$scene"
+$py - "$out/checkpoint.h5" <<'EOF'
+import sys, h5py, numpy as np
+with h5py.File(sys.argv[1], "r+") as f:
+    v = f["run.version"][()]
+    f["run.version"][...] = np.frombuffer(b"9" * len(v), dtype=np.uint8)
+EOF
+refused_resume "other version" "written by pointmech 999" "$out"
+out=$work/damaged
+run_until TERM 4 "$out" "$scene" "${coarse[@]}"
+$py - "$out/checkpoint.h5" <<'EOF'
+import sys, h5py
+with h5py.File(sys.argv[1], "r+") as f:
+    f["fpm.u"][7] += 1e-12
+EOF
+refused_resume "damaged checkpoint" "is damaged: checksum" "$out"
+head -c 3000 "$out/checkpoint.h5" >"$work/cut.h5" && mv "$work/cut.h5" "$out/checkpoint.h5"
+refused_resume "truncated checkpoint" "is damaged" "$out"
+"$bin" resume "$work/none" >/dev/null 2>"$work/err"
+check "resume of no folder: exit 1" test $? -eq 1
+
+# Output folders: one run at a time, no silent overwrite.
+out=$work/busy
+"$bin" run "$scene" --out "$out" --quiet "${coarse[@]}" --set time.max_steps=0 \
+  --set time.quasi_static.tolerance=1e-30 >/dev/null 2>&1 &
+pid=$!
+while [ "$(rows "$out")" -lt 2 ]; do sleep 0.01; done
+"$bin" run "$scene" --out "$out" --overwrite --quiet "${coarse[@]}" >/dev/null 2>"$work/err"
+check "folder in use: exit 1" test $? -eq 1
+check "folder in use: names the pid" grep -q "in use by a running pointmech (pid $pid)" "$work/err"
+kill -TERM $pid
+wait $pid
+check "folder in use: the first run's results intact" test "$(readable "$out")" -ge 1
+"$bin" run "$scene" --out "$out" --quiet "${coarse[@]}" >/dev/null 2>"$work/err"
+check "another run's folder: exit 1" test $? -eq 1
+check "another run's folder: says how to go on" grep -q -- "--overwrite" "$work/err"
+check "another run's folder: left alone" grep -q '"status": "interrupted"' "$out/summary.json"
+"$bin" run "$scene" --out "$out" --overwrite --quiet "${coarse[@]}" \
+  --set time.max_steps=200 >/dev/null 2>"$work/err"
+check "--overwrite: runs" grep -q '"steps": 200' "$out/summary.json"
+check "--overwrite: no checkpoint of the run before" test ! -e "$out/checkpoint.h5"
+
+# A read-only folder (as root, run as nobody: root writes anywhere).
+ro=$work/readonly
+mkdir -p "$ro"
+chmod 0555 "$ro"
+as_user=()
+if [ "$(id -u)" = 0 ] && command -v setpriv >/dev/null; then
+  chmod o+rx "$work"
+  as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
+fi
+if [ "$(id -u)" != 0 ] || [ ${#as_user[@]} -gt 0 ]; then
+  "${as_user[@]}" "$bin" run "$scene" --out "$ro/out" --quiet "${coarse[@]}" \
+    >/dev/null 2>"$work/err"
+  check "read-only folder: exit 1" test $? -eq 1
+  check "read-only folder: names it" grep -q "$ro/out.*Permission denied" "$work/err"
+  check "read-only folder: nothing written" test -z "$(ls -A "$ro")"
+fi
+
+# The file size limit (RLIMIT_FSIZE, 60 KiB): the particles' mesh fits, a
+# frame does not; a clean error and readable results.
+out=$work/fsize
+(ulimit -f 60 && "$bin" run "$mpm" --out "$out" --quiet \
+  --set time.max_steps=100 >/dev/null 2>"$work/err")
+rc=$?
+check "file size limit: exit 1 (got $rc)" test $rc -eq 1
+check "file size limit: says why" grep -q "File too large" "$work/err"
+check "file size limit: results readable" test -n "$(readable "$out")"
+check "file size limit: no temporary file" \
+  test -z "$(find "$out" -name '*.tmp.*')"
+check "file size limit: summary says failed" grep -q '"status": "failed"' "$out/summary.json"
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]
