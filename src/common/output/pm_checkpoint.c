@@ -234,8 +234,7 @@ pm_err pm_ckpt_finish(pm_ckpt *c) {
     int fd = open(c->tmp, O_RDONLY | O_CLOEXEC);
     int rc = fd >= 0 ? fsync(fd) : -1, e = errno;
     if (fd >= 0) close(fd);
-    PM_ENSURE(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", c->tmp,
-              strerror(e));
+    PM_ENSURE(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", c->tmp, strerror(e));
     PM_TRY(pm_rename(c->tmp, c->path));
     c->tmp[0] = '\0';
   }
