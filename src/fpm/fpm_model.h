@@ -152,8 +152,15 @@ size_t fpm_state_bytes(const fpm_model *m);
 /* Prescribed value of constrained dof k at time t. */
 double fpm_prescribed(const fpm_model *m, long k, double t);
 /* Evaluate the traction of every traction facet at time t into
- * st->tf_value (serial: expressions are not thread-safe). */
-void fpm_update_tractions(const fpm_model *m, fpm_state *st, double t);
+ * st->tf_value (serial: expressions are not thread-safe).  Returns -1, or
+ * the first entry 3 k + a of tf_value that is not finite. */
+long fpm_update_tractions(const fpm_model *m, fpm_state *st, double t);
+/* PM_ERR_UNSTABLE for a condition whose expression gave a value that is
+ * not finite at time t (step < 0: none): constrained dof k (traction
+ * false) or entry k = 3 f + a of the traction facets (traction true),
+ * naming the point, the scene key and the expression. */
+pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
+                             long step, double t);
 
 /* The net nodal force f = f_int(u) - f_ext(t) into st->f (also F, P, W, J,
  * T, r).  Returns -1, or the smallest point id whose deformation gradient

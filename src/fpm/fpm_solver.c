@@ -111,14 +111,30 @@ double fpm_energy_error(const fpm_step_info *s) {
 /* Steps before the energy balance is checked against its bound. */
 #define FPM_ENERGY_CHECK_AFTER 100
 
-static void apply_prescribed(const fpm_model *m, fpm_state *st, double t,
+/* Set the prescribed dofs at time t; returns -1, or the first constrained
+ * dof whose value is not finite. */
+static long apply_prescribed(const fpm_model *m, fpm_state *st, double t,
                              double dt) {
+  long bad = -1;
   for (long k = 0; k < m->n_cdofs; k++) {
     long dof = 3 * m->cd_point[k] + m->cd_comp[k];
     double ub = fpm_prescribed(m, k, t);
+    if (!isfinite(ub) && bad < 0) bad = k;
     st->v[dof] = dt > 0 ? (ub - st->u[dof]) / dt : 0;
     st->u[dof] = ub;
   }
+  return bad;
+}
+
+/* The prescribed dofs and tractions at time t; PM_ERR_UNSTABLE naming the
+ * condition when a value is not finite. */
+static pm_err apply_loads(const fpm_model *m, fpm_state *st, long step,
+                          double t, double dt) {
+  long bad = apply_prescribed(m, st, t, dt);
+  if (bad >= 0) return fpm_condition_failure(m, false, bad, step, t);
+  bad = fpm_update_tractions(m, st, t);
+  if (bad >= 0) return fpm_condition_failure(m, true, bad, step, t);
+  return PM_SUCCESS;
 }
 
 static pm_err unstable(const fpm_model *m, const fpm_state *st, long step,
@@ -166,10 +182,15 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   double t_force = 0, t_update = 0;
   PM_CHECK(dt > 0 && isfinite(dt), PM_ERR_ARG, "time step must be > 0 (got %g)",
            dt);
-  /* A resumed state has its supports in place: only the force (a function
-   * of u and t) is computed again. */
-  if (!resumed) apply_prescribed(m, st, 0, 0);
-  fpm_update_tractions(m, st, t);
+  /* A resumed state has its supports in place: only the tractions and the
+   * force (functions of u and t) are computed again. */
+  if (!resumed) {
+    PM_CALL(apply_loads(m, st, 0, 0, 0));
+  } else {
+    long bad_traction = fpm_update_tractions(m, st, t);
+    if (bad_traction >= 0)
+      return fpm_condition_failure(m, true, bad_traction, st->step, t);
+  }
   long bad = fpm_force(m, st);
   if (bad >= 0) return unstable(m, st, st->step, t, dt, bad, 0);
   fpm_support_start(m, st);
@@ -216,13 +237,13 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
       }
     }
     t += dt;
-    apply_prescribed(m, st, t, dt);
-    if (m->n_tfacets > 0) fpm_update_tractions(m, st, t);
+    pm_err stop = apply_loads(m, st, step, t, dt);
     double w1 = pm_wtime();
-    bad = fpm_force(m, st);
+    bad = stop == PM_SUCCESS ? fpm_force(m, st) : -1;
     double w2 = pm_wtime();
     t_force += w2 - w1;
-    if (bad >= 0) {
+    if (bad >= 0) stop = unstable(m, st, step, t, dt, bad, 0);
+    if (stop != PM_SUCCESS) {
       if (stage_seconds) {
         stage_seconds[0] = t_force;
         stage_seconds[1] = t_update;
@@ -231,7 +252,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
       si.t = t;
       si.converged = false;
       if (info) *info = si;
-      return unstable(m, st, step, t, dt, bad, 0);
+      return stop;
     }
     double s3 = 0, rf = 0, kin = 0, se = 0, jmin = INFINITY;
     const double *restrict W = st->W, *restrict vol = m->dual->volume,

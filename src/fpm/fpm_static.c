@@ -104,11 +104,15 @@ static pm_err set_load(void *ctx, double lambda) {
   /* Proportional loading: the loads at the end of the ramps times lambda
    * (the path of a rate-independent solid does not depend on the ramps'
    * shape, and a proportional path is what the predictor extrapolates). */
-  for (long k = 0; k < m->n_cdofs; k++)
-    c->st->u[3 * m->cd_point[k] + m->cd_comp[k]] =
-        lambda * fpm_prescribed(m, k, c->load_end);
+  for (long k = 0; k < m->n_cdofs; k++) {
+    double u = fpm_prescribed(m, k, c->load_end);
+    if (!isfinite(u))
+      return fpm_condition_failure(m, false, k, -1, c->load_end);
+    c->st->u[3 * m->cd_point[k] + m->cd_comp[k]] = lambda * u;
+  }
   if (m->n_tfacets > 0) {
-    fpm_update_tractions(m, c->st, c->load_end);
+    long bad = fpm_update_tractions(m, c->st, c->load_end);
+    if (bad >= 0) return fpm_condition_failure(m, true, bad, -1, c->load_end);
     for (long k = 0; k < 3 * m->n_tfacets; k++) c->st->tf_value[k] *= lambda;
     c->st->fext_norm *= lambda;
   }

@@ -101,6 +101,27 @@ static double bc_wall(const mpm_bc *bc, const double x[3], double t) {
                          pm_expr_eval(bc->disp[a], x[0], x[1], x[2], t);
 }
 
+/* Record the first value of the run that is not finite: expression e at
+ * face position x of the column of node, over the step from t to t + dt
+ * (the end whose value is not finite). */
+static void note_not_finite(mpm_cond_work *cw, const pm_expr *e, long node,
+                            const double x[3], double t, double dt) {
+  if (cw->bad_expr) return;
+  cw->bad_expr = e;
+  cw->bad_node = node;
+  for (int c = 0; c < 3; c++) cw->bad_x[c] = x[c];
+  cw->bad_t = isfinite(pm_expr_eval(e, x[0], x[1], x[2], t + dt)) ? t : t + dt;
+}
+
+pm_err mpm_conditions_status(const mpm_ctx *ctx) {
+  const mpm_cond_work *cw = &ctx->work->cond;
+  const double *x = cw->bad_x;
+  if (!cw->bad_expr) return PM_SUCCESS;
+  return pm_expr_fail_value(
+      cw->bad_expr, pm_expr_eval(cw->bad_expr, x[0], x[1], x[2], cw->bad_t),
+      ctx->state->step + 1, cw->bad_t, "node", cw->bad_node, x);
+}
+
 /* The dependent dofs of the conditions.  On each column of a face, a node
  * at or beyond the face's current wall is set from one free node of the
  * column (its anchor), v = T v_anchor + (1 - T) v_b:
@@ -125,8 +146,9 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
   const mpm_model *m = ctx->model;
   const mpm_grid *g = &m->grid;
   const double *mass = ctx->work->nodes.mass;
-  short *owner = ctx->work->cond.owner;
-  double *fold_out = ctx->work->cond.fold_out;
+  mpm_cond_work *cw = &ctx->work->cond;
+  short *owner = cw->owner;
+  double *fold_out = cw->fold_out;
   const double t = ctx->state->t, dt = ctx->state->dt;
   const double eps = 1e-9 * g->h;
   /* Folding visits the faces in reverse: a dof set by two faces follows
@@ -159,10 +181,15 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
       x[a] = bc->plane;
       double v[3] = {0, 0, 0};
       if (!fold)
-        for (int c = 0; c < 3; c++)
-          if (mask >> c & 1u)
-            v[c] = bc->constant[c] ? vconst[c] : bc_velocity(bc, c, x, t, dt);
+        for (int c = 0; c < 3; c++) {
+          if (!(mask >> c & 1u)) continue;
+          v[c] = bc->constant[c] ? vconst[c] : bc_velocity(bc, c, x, t, dt);
+          if (!isfinite(v[c]))
+            note_not_finite(cw, bc->disp[c] ? bc->disp[c] : bc->velocity[c],
+                            col, x, t, dt);
+        }
       double wall = bc->constant[a] ? wall_const : bc_wall(bc, x, t);
+      if (!isfinite(wall)) note_not_finite(cw, bc->disp[a], col, x, t, 0);
       /* The first node inside the wall, and the anchor of the prescribed
        * components. */
       long ia_face = (long)llround((bc->plane - g->origin[a]) * g->inv_h);

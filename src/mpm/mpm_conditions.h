@@ -36,6 +36,12 @@ typedef struct {
                        moved onto the dofs they follow (their anchors) */
   double *fold_out; /* 3 per node: the force a dependent dof moved out */
   double *reaction; /* 3 per condition: its force on the body, N */
+  /* The first prescribed value that was not finite: its expression (NULL
+   * while none), the node of its column, the face position and the time
+   * it was evaluated at. */
+  const pm_expr *bad_expr;
+  long bad_node;
+  double bad_x[3], bad_t;
 } mpm_cond_work;
 
 /* Build the conditions of scene s on grid g into *bcs (n_bcs of them).
@@ -63,5 +69,10 @@ void mpm_conditions_fold(const mpm_ctx *ctx);
  * condition set each dof, the reactions (in the work), and return the
  * conditions' work over the step (J); else return 0. */
 double mpm_conditions_apply(const mpm_ctx *ctx, double *vel, bool reactions);
+
+/* PM_SUCCESS, or PM_ERR_UNSTABLE when a condition's expression gave a
+ * value that is not finite in this step: "step N, t = T s: node I at (x):
+ * KEY: "TEXT" = nan, not a finite value" (pm_expr_fail_value). */
+pm_err mpm_conditions_status(const mpm_ctx *ctx);
 
 #endif

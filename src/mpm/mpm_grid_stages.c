@@ -267,7 +267,7 @@ pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
   double work = mpm_conditions_apply(ctx, nd->vel_new, true);
   if (m->n_bcs > 0) mpm_book_work(ctx, self, work);
   if (m->opt.qs != PM_QS_NONE) ctx->work->residual = residual(ctx);
-  return PM_SUCCESS;
+  return mpm_conditions_status(ctx);
 }
 
 void mpm_grid_velocity(mpm_ctx *ctx) {
@@ -289,5 +289,5 @@ void mpm_grid_velocity(mpm_ctx *ctx) {
 pm_err mpm_stage_grid_velocity(mpm_ctx *ctx, const mpm_stage *self) {
   (void)self;
   mpm_grid_velocity(ctx);
-  return PM_SUCCESS;
+  return mpm_conditions_status(ctx);
 }

@@ -184,7 +184,7 @@ pm_err mpm_stage_remap(mpm_ctx *ctx, const mpm_stage *self) {
   (void)self;
   mpm_p2g(ctx, MPM_P2G_MOM);
   mpm_grid_velocity(ctx);
-  return PM_SUCCESS;
+  return mpm_conditions_status(ctx);
 }
 
 pm_err mpm_stage_move(mpm_ctx *ctx, const mpm_stage *self) {

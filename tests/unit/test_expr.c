@@ -84,11 +84,59 @@ static void test_errors(void **state) {
   expect_error("foo(x)", "syntax error");
 }
 
+/* Numbers that are not finite, and constants whose value is not, are
+ * refused when compiled; a variable expression is not (its value depends
+ * on where and when), and its failure names where it comes from. */
+static void test_not_finite(void **state) {
+  (void)state;
+  expect_error("nan", "invalid expression \"nan\": not a number (expected a "
+                      "finite value)");
+  expect_error(".nan", "invalid expression \".nan\": not a number");
+  expect_error("-.inf", "invalid expression \"-.inf\": infinite");
+  expect_error("inf", "invalid expression \"inf\": infinite");
+  expect_error("1e999", "invalid expression \"1e999\": too large for a "
+                        "double");
+  expect_error("1/0", "invalid expression \"1/0\": its value is inf "
+                      "(expected a finite value)");
+  expect_error("sqrt(-1)", "invalid expression \"sqrt(-1)\": its value is "
+                           "nan");
+  expect_error("-log(0)*2", "its value is inf");
+  expect_error("log(0)", "its value is -inf");
+  expect_error("2*t + 1e999",
+               "syntax error at character 7: number too large for a double");
+
+  pm_expr *e = NULL;
+  assert_int_equal(pm_expr_create("sqrt(0.5 - t)", &e), PM_SUCCESS);
+  assert_null(pm_expr_origin(e));
+  assert_true(isnan(pm_expr_eval(e, 0, 0, 0, 1)));
+  assert_int_equal(pm_expr_set_origin(e, "a.yaml:3:7: boundary.1.velocity.x"),
+                   PM_SUCCESS);
+  assert_string_equal(pm_expr_origin(e), "a.yaml:3:7: boundary.1.velocity.x");
+  const double x[3] = {0.5, 0.25, 0};
+  pm_error_clear();
+  assert_int_equal(
+      pm_expr_fail_value(e, pm_expr_eval(e, 0, 0, 0, 1), 12, 1, "node", 40, x),
+      PM_ERR_UNSTABLE);
+  assert_string_equal(pm_error_message(),
+                      "step 12, t = 1 s: node 40 at (0.5, 0.25, 0): "
+                      "a.yaml:3:7: boundary.1.velocity.x: \"sqrt(0.5 - t)\" "
+                      "= nan, not a finite value");
+  pm_expr_destroy(e);
+
+  assert_null(pm_number_not_finite("1e308"));
+  assert_null(pm_number_not_finite("x"));
+  assert_null(pm_number_not_finite(""));
+  assert_string_equal(pm_number_not_finite("+.Inf"), "infinite");
+  assert_string_equal(pm_number_not_finite("NaN"), "not a number");
+  assert_string_equal(pm_number_not_finite("-1e400"), "too large for a double");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_values),
       cmocka_unit_test(test_text_and_uses),
       cmocka_unit_test(test_errors),
+      cmocka_unit_test(test_not_finite),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -277,6 +277,14 @@ static void test_bad_overrides(void **state) {
                "--set method=sph: ", "expected one of fpm, mpm, got sph");
   bad_override(MINIMAL, "boundary.0.on=xmin",
                "--set boundary.0.on=xmin: ", "boundary is not in the scene");
+  /* A value nested past any key's needs is refused as such, not as a
+   * failed allocation. */
+  char deep[128];
+  snprintf(deep, sizeof deep, "materials.0.name=%.40s%.40s",
+           "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[",
+           "]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]");
+  bad_override(F2, deep, "--set materials.0.name=[[[",
+               "]]]: expected a value nested at most 32 levels deep");
   /* A file value that an override makes invalid is reported at the file. */
   bad_override(F2, "dimension=2",
                "f2-unconstrained-compression.yaml:5:21: domain.box.min: ",
@@ -398,6 +406,125 @@ static void test_ramp_and_names(void **state) {
   assert_true(1 - pm_ramp_factor(PM_RAMP_SMOOTH, 1, 1 - h) < 1e-15);
 }
 
+/* A 2-D MPM scene as text, with line 9 "  end: END" and line 11 the
+ * condition on xmin ("  - {on: xmin, displacement: {x: DISP}}"). */
+static void scene_text(char *buf, size_t size, const char *end,
+                       const char *disp) {
+  snprintf(buf, size,
+           "name: t\n"
+           "method: mpm\n"
+           "dimension: 2\n"
+           "domain: {box: {min: [0, 0], max: [1, 0.5]}}\n"
+           "discretization: {mesh_size: 0.1}\n"
+           "materials:\n"
+           "  - {name: r, model: linear-elastic, density: 1100, "
+           "youngs_modulus: 1e6, poisson_ratio: 0.3}\n"
+           "time:\n"
+           "  end: %s\n"
+           "boundary:\n"
+           "  - {on: xmin, displacement: {x: %s}}\n",
+           end, disp);
+}
+
+/* Loading text fails with PM_ERR_SCENE and a message containing frag. */
+static void text_fails(const char *text, int n, const char *const *set,
+                       const char *frag) {
+  pm_scene *s = (pm_scene *)&s;
+  pm_error_clear();
+  assert_int_equal(
+      pm_scene_load_text(text, strlen(text), "mem/t.yaml", n, set, &s),
+      PM_ERR_SCENE);
+  assert_null(s);
+  if (!strstr(pm_error_message(), frag))
+    fail_msg("message \"%s\" lacks \"%s\"", pm_error_message(), frag);
+}
+
+/* NaN and Inf, however written, are refused at FILE:LINE:COL (or at the
+ * --set override) naming the key and what it takes, as are constant
+ * expressions whose value is not finite. */
+static void test_not_finite(void **state) {
+  (void)state;
+  char text[1024];
+  scene_text(text, sizeof text, "0.5", "0");
+  pm_scene *s = NULL;
+  assert_int_equal(
+      pm_scene_load_text(text, strlen(text), "mem/t.yaml", 0, NULL, &s),
+      PM_SUCCESS);
+  assert_string_equal(s->path, "mem/t.yaml");
+  assert_near(s->time.end, 0.5, 0);
+  assert_string_equal(pm_expr_origin(s->bcs[0].disp[0]),
+                      "mem/t.yaml:11:34: boundary.0.displacement.x");
+  pm_scene_destroy(s);
+
+  static const struct {
+    const char *end, *disp, *what;
+  } yaml[] = {
+      {".nan", "0",
+       "mem/t.yaml:9:8: time.end: expected a number > 0, got .nan (not a "
+       "number; numbers must be finite)"},
+      {"nan", "0",
+       "mem/t.yaml:9:8: time.end: expected a number > 0, got nan "
+       "(not a number; "},
+      {".inf", "0",
+       "mem/t.yaml:9:8: time.end: expected a number > 0, got "
+       ".inf (infinite; "},
+      {"-inf", "0",
+       "mem/t.yaml:9:8: time.end: expected a number > 0, got "
+       "-inf (infinite; "},
+      {"1e999", "0",
+       "mem/t.yaml:9:8: time.end: expected a number > 0, got "
+       "1e999 (too large for a double; numbers must be finite)"},
+      {"1", "1/0",
+       "mem/t.yaml:11:34: boundary.0.displacement.x: invalid expression "
+       "\"1/0\": its value is inf (expected a finite value)"},
+      {"1", "sqrt(-1)",
+       "mem/t.yaml:11:34: boundary.0.displacement.x: invalid expression "
+       "\"sqrt(-1)\": its value is nan"},
+      {"1", ".nan",
+       "mem/t.yaml:11:34: boundary.0.displacement.x: invalid "
+       "expression \".nan\": not a number"},
+      {"1", "-0.1*t*1e999",
+       "mem/t.yaml:11:34: boundary.0.displacement.x: "
+       "invalid expression \"-0.1*t*1e999\": syntax "
+       "error at character 8: number too large"},
+  };
+  for (size_t i = 0; i < sizeof yaml / sizeof yaml[0]; i++) {
+    scene_text(text, sizeof text, yaml[i].end, yaml[i].disp);
+    text_fails(text, 0, NULL, yaml[i].what);
+  }
+
+  /* Lists of numbers and integers, and expressions, by override. */
+  static const struct {
+    const char *set, *what;
+  } sets[] = {
+      {"domain.box.max=[1, .Inf]",
+       "--set domain.box.max=[1, .Inf]: domain.box.max.1: expected a number, "
+       "got .Inf (infinite; numbers must be finite)"},
+      {"output.every=.inf", "--set output.every=.inf: expected an integer > "
+                            "0, got .inf (infinite; "},
+      {"materials.0.density=-1e400",
+       "--set materials.0.density=-1e400: expected a number > 0, got -1e400 "
+       "(too large for a double; "},
+      {"gravity=[0, NaN]", "--set gravity=[0, NaN]: gravity.1: expected a "
+                           "number, got NaN (not a number; "},
+      {"boundary.0.displacement.x=log(0)",
+       "--set boundary.0.displacement.x=log(0): invalid expression "
+       "\"log(0)\": its value is -inf"},
+  };
+  scene_text(text, sizeof text, "1", "0");
+  for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++)
+    text_fails(text, 1, &sets[i].set, sets[i].what);
+  /* A variable expression is the run's to check. */
+  const char *var = "boundary.0.displacement.x=sqrt(0.5 - t)";
+  s = NULL;
+  assert_int_equal(
+      pm_scene_load_text(text, strlen(text), "mem/t.yaml", 1, &var, &s),
+      PM_SUCCESS);
+  assert_string_equal(pm_expr_origin(s->bcs[0].disp[0]),
+                      "--set boundary.0.displacement.x=sqrt(0.5 - t)");
+  pm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_f2_values),
@@ -409,6 +536,7 @@ int main(void) {
       cmocka_unit_test(test_model_keys_and_methods),
       cmocka_unit_test(test_vocabulary),
       cmocka_unit_test(test_ramp_and_names),
+      cmocka_unit_test(test_not_finite),
   };
   if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);

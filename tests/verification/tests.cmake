@@ -22,6 +22,10 @@ add_test(NAME verification.cli_mpm
   COMMAND bash ${PM_VERIFY_DIR}/cli-mpm.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.cli_mpm PROPERTIES LABELS verification TIMEOUT 600 PROCESSORS 2)
 
+add_test(NAME verification.cli_not_finite
+  COMMAND bash ${PM_VERIFY_DIR}/cli-not-finite.sh $<TARGET_FILE:pointmech>)
+set_tests_properties(verification.cli_not_finite PROPERTIES LABELS verification TIMEOUT 300)
+
 add_test(NAME verification.studies
   COMMAND bash ${PM_VERIFY_DIR}/studies.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.studies PROPERTIES LABELS verification TIMEOUT 900 PROCESSORS 2)

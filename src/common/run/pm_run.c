@@ -524,6 +524,11 @@ static void conclude(run_ctx *c, pm_err run_err) {
   if (run_err == PM_ERR_INTERRUPTED) {
     f->status = PM_STATUS_INTERRUPTED;
     snprintf(o->message, sizeof o->message, "%s", pm_error_message());
+  } else if (run_err == PM_ERR_UNSTABLE &&
+             strstr(pm_error_message(), PM_EXPR_NOT_FINITE)) {
+    /* A condition's expression, not the step: no advice on dt. */
+    f->status = PM_STATUS_UNSTABLE;
+    snprintf(o->message, sizeof o->message, "%s", pm_error_message());
   } else if (run_err == PM_ERR_UNSTABLE) {
     f->status = PM_STATUS_UNSTABLE;
     snprintf(o->message, sizeof o->message,

@@ -2,12 +2,15 @@
  * those four variables so a typo in a scene is an error, not a zero. */
 #include "pm_expr.h"
 
+#include <math.h>
 #include <matheval.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 struct pm_expr {
   char *text;      /* as given */
+  char *origin;    /* scene key and position, or NULL */
   void *evaluator; /* libmatheval handle */
   unsigned uses;   /* bit i: variable "xyzt"[i] appears */
 };
@@ -74,6 +77,8 @@ static bool syn_number(expr_syntax *x) {
     while (is_digit(*q)) q++;
     p = q;
   }
+  if (!isfinite(strtod(x->p, NULL)))
+    return syn_fail(x, "number too large for a double");
   x->p = p;
   return true;
 }
@@ -156,6 +161,12 @@ static const char *expr_syntax_error(const char *text, size_t *at) {
   return x.error;
 }
 
+/* A value that is not finite as text: "nan" (whatever its sign), "inf",
+ * "-inf". */
+static const char *value_text(double v) {
+  return isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
+}
+
 pm_err pm_expr_create(const char *text, pm_expr **out) {
   pm_err ret = PM_SUCCESS;
   pm_expr *e = NULL;
@@ -164,6 +175,12 @@ pm_err pm_expr_create(const char *text, pm_expr **out) {
   PM_TRY(PM_ALLOC(e, 1, "expression"));
   e->text = strdup(text);
   PM_ENSURE(e->text, PM_ERR_MEMORY, "cannot copy expression \"%s\"", text);
+  /* "nan" and "inf" would read as unknown variables, ".nan" as a syntax
+   * error: say what they are. */
+  const char *not_finite = pm_number_not_finite(text);
+  PM_ENSURE(!not_finite, PM_ERR_EXPR,
+            "invalid expression \"%s\": %s (expected a finite value)", text,
+            not_finite);
   size_t at = 0;
   const char *problem = expr_syntax_error(text, &at);
   PM_ENSURE(!problem, PM_ERR_EXPR,
@@ -183,6 +200,15 @@ pm_err pm_expr_create(const char *text, pm_expr **out) {
               "z, t)",
               text, names[i]);
     e->uses |= 1u << (v - pm_expr_vars);
+  }
+  /* A constant is known now: one that is not finite is an input error,
+   * not a failure at some step of the run. */
+  if (!e->uses) {
+    double value = pm_expr_eval(e, 0, 0, 0, 0);
+    PM_ENSURE(isfinite(value), PM_ERR_EXPR,
+              "invalid expression \"%s\": its value is %s (expected a finite "
+              "value)",
+              text, value_text(value));
   }
   *out = e;
   e = NULL;
@@ -204,9 +230,47 @@ bool pm_expr_uses(const pm_expr *e, char var) {
 
 const char *pm_expr_text(const pm_expr *e) { return e ? e->text : NULL; }
 
+pm_err pm_expr_set_origin(pm_expr *e, const char *where) {
+  char *copy = strdup(where);
+  PM_CHECK(copy, PM_ERR_MEMORY, "cannot copy the origin of \"%s\"", e->text);
+  free(e->origin);
+  e->origin = copy;
+  return PM_SUCCESS;
+}
+
+const char *pm_expr_origin(const pm_expr *e) { return e ? e->origin : NULL; }
+
+pm_err pm_expr_fail_value(const pm_expr *e, double v, long step, double t,
+                          const char *what, long index, const double x[3]) {
+  char when[64] = "";
+  if (step >= 0) snprintf(when, sizeof when, "step %ld, ", step);
+  return PM_ERROR(PM_ERR_UNSTABLE,
+                  "%st = %.6g s: %s %ld at (%g, %g, %g): %s%s\"%s\" = "
+                  "%s, " PM_EXPR_NOT_FINITE,
+                  when, t, what, index, x[0], x[1], x[2],
+                  e->origin ? e->origin : "", e->origin ? ": " : "", e->text,
+                  value_text(v));
+}
+
+const char *pm_number_not_finite(const char *text) {
+  const char *p = text + (text[0] == '+' || text[0] == '-');
+  /* YAML 1.2's spellings, which strtod does not read. */
+  if (!strcmp(p, ".inf") || !strcmp(p, ".Inf") || !strcmp(p, ".INF"))
+    return "infinite";
+  if (p == text &&
+      (!strcmp(p, ".nan") || !strcmp(p, ".NaN") || !strcmp(p, ".NAN")))
+    return "not a number";
+  char *end;
+  double v = strtod(text, &end);
+  if (end == text || *end || isfinite(v)) return NULL;
+  if (isnan(v)) return "not a number";
+  return strpbrk(text, "iI") ? "infinite" : "too large for a double";
+}
+
 void pm_expr_destroy(pm_expr *e) {
   if (!e) return;
   if (e->evaluator) evaluator_destroy(e->evaluator);
+  free(e->origin);
   free(e->text);
   free(e);
 }

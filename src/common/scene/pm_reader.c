@@ -42,10 +42,27 @@ static bool scalar_is_number(const char *text, double *out) {
   return true;
 }
 
+/* "WHERE: expected WHAT, got GOT" for a number at path, saying why when
+ * GOT is a number that is not finite (nan, .inf, 1e999). */
+static pm_err expected_number(pm_reader *r, const char *path,
+                              const char *what) {
+  char got[PM_SDOC_WHERE];
+  int id = pm_sdoc_find(r->doc, path, false);
+  const char *s = pm_sdoc_scalar(r->doc, id);
+  const char *why = s ? pm_number_not_finite(s) : NULL;
+  if (!why) return pm_reader_expected(r, path, what);
+  pm_sdoc_got(r->doc, id, got, sizeof got);
+  return pm_reader_fail(r, path, false,
+                        "expected %s, got %s (%s; numbers must be finite)",
+                        what, got, why);
+}
+
 /* "WHERE: expected <what k takes>, got GOT" at node id. */
 static pm_err expected_key(pm_reader *r, const char *path, const pm_key *k) {
   char what[512];
   pm_key_describe(k, what, sizeof what);
+  if (k->type == PM_KEY_NUMBER || k->type == PM_KEY_INTEGER)
+    return expected_number(r, path, what);
   return pm_reader_expected(r, path, what);
 }
 
@@ -65,6 +82,15 @@ pm_err pm_reader_expr(pm_reader *r, const char *path, const char *text,
     /* Copy first: the new message is formatted into the same buffer. */
     snprintf(msg, sizeof msg, "%s", pm_error_message());
     return pm_reader_fail(r, path, false, "%s", msg);
+  }
+  /* Kept for messages about the values it gives during a run. */
+  pm_sdoc_where(r->doc, pm_sdoc_find(r->doc, path, false), path, msg,
+                sizeof msg);
+  pm_err err = pm_expr_set_origin(*out, msg);
+  if (err != PM_SUCCESS) {
+    pm_expr_destroy(*out);
+    *out = NULL;
+    return err;
   }
   for (const char *v = "xyzt"; *v; v++) {
     if (strchr(vars, *v) || !pm_expr_uses(*out, *v)) continue;
@@ -131,7 +157,7 @@ static pm_err read_numbers(pm_reader *r, int id, const char *path,
         item.type = (k->flags & PM_KEY_WHOLE) ? PM_KEY_INTEGER : PM_KEY_NUMBER;
         pm_key_describe(&item, what, sizeof what);
       }
-      return pm_reader_expected(r, sub, what);
+      return expected_number(r, sub, what);
     }
     v[i] = x;
   }

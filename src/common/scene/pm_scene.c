@@ -134,11 +134,25 @@ static pm_err read_scene(pm_scene *s) {
   return PM_SUCCESS;
 }
 
-pm_err pm_scene_load(const char *path, int n_overrides,
-                     const char *const *overrides, pm_scene **out) {
+/* The steps after the text is in s: parse, override, read, check. */
+static pm_err load_scene(pm_scene *s, size_t len, int n_overrides,
+                         const char *const *overrides) {
+  PM_CALL(pm_sdoc_parse(&s->doc, s->path, s->text, len));
+  PM_CALL(pm_sdoc_apply_overrides(&s->doc, n_overrides, overrides));
+  PM_CALL(read_scene(s));
+  PM_CALL(keep_overrides(s, n_overrides, overrides));
+  /* Messages after loading name overrides from the scene's own copy. */
+  s->doc.overrides = (const char *const *)s->overrides;
+  return PM_SUCCESS;
+}
+
+/* A new scene named path (for messages and relative paths), its text from
+ * the file path (text NULL) or a copy of text[0..len). */
+static pm_err load(const char *path, const char *text, size_t len,
+                   int n_overrides, const char *const *overrides,
+                   pm_scene **out) {
   pm_err ret = PM_SUCCESS;
   pm_scene *s = NULL;
-  size_t len = 0;
   PM_ENSURE(out, PM_ERR_ARG, "pm_scene_load: out is NULL");
   *out = NULL;
   PM_ENSURE(path, PM_ERR_ARG, "pm_scene_load: no scene path");
@@ -147,18 +161,31 @@ pm_err pm_scene_load(const char *path, int n_overrides,
   PM_TRY(PM_ALLOC(s, 1, "scene"));
   s->path = strdup(path);
   PM_ENSURE(s->path, PM_ERR_MEMORY, "cannot copy scene path");
-  PM_TRY(read_text(path, &s->text, &len));
-  PM_TRY(pm_sdoc_parse(&s->doc, s->path, s->text, len));
-  PM_TRY(pm_sdoc_apply_overrides(&s->doc, n_overrides, overrides));
-  PM_TRY(read_scene(s));
-  PM_TRY(keep_overrides(s, n_overrides, overrides));
-  /* Messages after loading name overrides from the scene's own copy. */
-  s->doc.overrides = (const char *const *)s->overrides;
+  if (text) {
+    PM_TRY(PM_ALLOC(s->text, len + 1, "scene text"));
+    memcpy(s->text, text, len);
+  } else {
+    PM_TRY(read_text(path, &s->text, &len));
+  }
+  PM_TRY(load_scene(s, len, n_overrides, overrides));
   *out = s;
   s = NULL;
 done:
   pm_scene_destroy(s);
   return ret;
+}
+
+pm_err pm_scene_load(const char *path, int n_overrides,
+                     const char *const *overrides, pm_scene **out) {
+  return load(path, NULL, 0, n_overrides, overrides, out);
+}
+
+pm_err pm_scene_load_text(const char *text, size_t len, const char *name,
+                          int n_overrides, const char *const *overrides,
+                          pm_scene **out) {
+  if (!text && out) *out = NULL;
+  PM_CHECK(text, PM_ERR_ARG, "pm_scene_load_text: no text");
+  return load(name, text, len, n_overrides, overrides, out);
 }
 
 void pm_scene_destroy(pm_scene *s) {

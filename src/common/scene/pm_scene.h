@@ -187,6 +187,12 @@ typedef struct pm_scene {
  * (pm_backend_register).  *out is NULL on failure. */
 pm_err pm_scene_load(const char *path, int n_overrides,
                      const char *const *overrides, pm_scene **out);
+/* The same for a scene given as text (len bytes, which need not end in a
+ * NUL), named name in messages and resolving relative paths against
+ * name's folder, as if read from a file called name. */
+pm_err pm_scene_load_text(const char *text, size_t len, const char *name,
+                          int n_overrides, const char *const *overrides,
+                          pm_scene **out);
 void pm_scene_destroy(pm_scene *s);
 
 /* The options of the registered section called name (the struct its

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Deeper trees can only come from aliases that refer to themselves. */
+/* Deepest override value copied: the vocabulary nests far less. */
 #define PM_SDOC_DEPTH 32
 /* Scalars longer than this are shortened in "got ..." messages. */
 #define PM_SDOC_GOT 60
@@ -277,12 +277,17 @@ void pm_sdoc_free(pm_sdoc *d) {
 
 /* ---- overrides -------------------------------------------------------- */
 
-/* Copy node id of document src into d's document; returns the new id or 0
- * when out of memory. */
-static int copy_node(pm_sdoc *d, yaml_document_t *src, int id, int depth) {
+/* Copy node id of document src into d's document; returns the new id, or
+ * 0 when out of memory or (*deep set) nested deeper than PM_SDOC_DEPTH. */
+static int copy_node(pm_sdoc *d, yaml_document_t *src, int id, int depth,
+                     bool *deep) {
   yaml_node_t *n = yaml_document_get_node(src, id);
   int out = 0;
-  if (!n || depth > PM_SDOC_DEPTH) return 0;
+  if (!n) return 0;
+  if (depth > PM_SDOC_DEPTH) {
+    *deep = true;
+    return 0;
+  }
   switch (n->type) {
   case YAML_SCALAR_NODE:
     return yaml_document_add_scalar(&d->doc, NULL, n->data.scalar.value,
@@ -292,7 +297,7 @@ static int copy_node(pm_sdoc *d, yaml_document_t *src, int id, int depth) {
     out = yaml_document_add_sequence(&d->doc, NULL, YAML_FLOW_SEQUENCE_STYLE);
     for (yaml_node_item_t *it = n->data.sequence.items.start;
          out && it < n->data.sequence.items.top; it++) {
-      int item = copy_node(d, src, *it, depth + 1);
+      int item = copy_node(d, src, *it, depth + 1, deep);
       if (!item || !yaml_document_append_sequence_item(&d->doc, out, item))
         return 0;
     }
@@ -301,8 +306,8 @@ static int copy_node(pm_sdoc *d, yaml_document_t *src, int id, int depth) {
     out = yaml_document_add_mapping(&d->doc, NULL, YAML_FLOW_MAPPING_STYLE);
     for (yaml_node_pair_t *p = n->data.mapping.pairs.start;
          out && p < n->data.mapping.pairs.top; p++) {
-      int key = copy_node(d, src, p->key, depth + 1);
-      int value = key ? copy_node(d, src, p->value, depth + 1) : 0;
+      int key = copy_node(d, src, p->key, depth + 1, deep);
+      int value = key ? copy_node(d, src, p->value, depth + 1, deep) : 0;
       if (!value ||
           !yaml_document_append_mapping_pair(&d->doc, out, key, value))
         return 0;
@@ -337,7 +342,11 @@ static pm_err override_value(pm_sdoc *d, const char *kv, const char *value,
   snip_ok = true;
   PM_ENSURE(yaml_document_get_root_node(&snip), PM_ERR_SCENE,
             "--set %s: empty value", kv);
-  *id = copy_node(d, &snip, 1, 0);
+  bool deep = false;
+  *id = copy_node(d, &snip, 1, 0, &deep);
+  PM_ENSURE(!deep, PM_ERR_SCENE,
+            "--set %s: expected a value nested at most %d levels deep", kv,
+            PM_SDOC_DEPTH);
   PM_ENSURE(*id, PM_ERR_MEMORY, "--set %s: out of memory", kv);
 done:
   if (snip_ok) yaml_document_delete(&snip);
