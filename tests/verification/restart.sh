@@ -100,6 +100,15 @@ mpm=$src/cases/mpm/m2-shock-tube-reduced.yaml
 ckpt_every=100
 resume_case mpm "$mpm" 4 --set time.max_steps=400 --set output.every=50
 
+# Checkpoints by wall time: every 0.1 s of a run of about a second.
+out=$work/minutes
+"$bin" run "$fpm" --out "$out" --quiet --set discretization.mesh_size=0.02 \
+  --set time.max_steps=1200 --set output.checkpoint.minutes=0.0017 \
+  >/dev/null 2>&1
+n=$(sed -n 's/^  "checkpoints": \([0-9]*\),/\1/p' "$out/summary.json")
+check "checkpoints every 0.1 s of wall time: $n written" test "${n:-0}" -ge 2
+check "checkpoints every 0.1 s: the last one readable" test -s "$out/checkpoint.h5"
+
 # Resuming what cannot be resumed.
 scene=$work/f2.yaml
 cp "$fpm" "$scene"
