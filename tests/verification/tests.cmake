@@ -25,3 +25,7 @@ set_tests_properties(verification.cli_mpm PROPERTIES LABELS verification TIMEOUT
 add_test(NAME verification.studies
   COMMAND bash ${PM_VERIFY_DIR}/studies.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.studies PROPERTIES LABELS verification TIMEOUT 900 PROCESSORS 2)
+
+add_test(NAME verification.memory
+  COMMAND bash ${PM_VERIFY_DIR}/memory.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.memory PROPERTIES LABELS verification TIMEOUT 120)

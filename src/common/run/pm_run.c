@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pm_memory.h"
 #include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_output.h"
@@ -483,6 +484,7 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, bool quiet,
                     "not started: an earlier run was interrupted by %s",
                     signal_name(sig));
   }
+  PM_CALL(pm_memory_check(s));
   PM_CALL(s->backend->create(s, &sim));
   pm_err e = pm_run_sim(s, sim, out_dir, quiet, o);
   s->backend->destroy(sim);
@@ -491,8 +493,10 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, bool quiet,
 
 pm_err pm_plan_scene(const pm_scene *s, FILE *out) {
   void *sim = NULL;
+  PM_CALL(pm_memory_check(s));
   PM_CALL(s->backend->create(s, &sim));
   pm_err e = s->backend->plan(sim, out);
+  if (e == PM_SUCCESS) pm_memory_plan(s, out);
   s->backend->destroy(sim);
   return e;
 }
