@@ -10,6 +10,7 @@
 
 #include "pm_app.h"
 #include "pm_error.h"
+#include "pm_memory.h"
 #include "pm_probe.h"
 #include "pm_run.h"
 #include "pm_scene.h"
@@ -29,13 +30,15 @@ static void usage(FILE *out) {
   fprintf(out,
           "usage: pointmech run SCENE [--out DIR] [--set KEY=VALUE]... "
           "[--overwrite] [--quiet]\n"
+          "                 [--force-memory]\n"
           "       pointmech resume OUT [--quiet]\n"
-          "       pointmech plan SCENE [--set KEY=VALUE]...\n"
+          "       pointmech plan SCENE [--set KEY=VALUE]... [--force-memory]\n"
           "       pointmech probe OUT --points FILE.csv [--frame N]\n"
           "       pointmech convergence SCENE --set-ladder KEY=V1,V2,... "
           "[--set-ladder ...]\n"
           "                 [--reference analytic|last|fe:DIR|DIR] [--out DIR] "
           "[--set KEY=VALUE]... [--overwrite]\n"
+          "                 [--force-memory]\n"
           "       pointmech keys\n"
           "       pointmech --help | --version\n"
           "\n"
@@ -81,6 +84,11 @@ static void usage(FILE *out) {
           "  --set  override any scene value by its dotted key, e.g.\n"
           "         --set discretization.mesh_size=8.02e-3 --set "
           "boundary.3.displacement.z=-0.06\n"
+          "  --force-memory  run, plan or study a scene whose memory estimate "
+          "exceeds\n"
+          "         the memory available (MemAvailable, the cgroup limit or\n"
+          "         POINTMECH_MEMORY_LIMIT), which is otherwise refused before "
+          "setup\n"
           "\n"
           "exit status: 0 success, 1 bad input, 2 numerical failure, 3 "
           "quasi-static run not converged, 4 interrupted (SIGINT or "
@@ -154,6 +162,8 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
       a->quiet = true;
     else if (strcmp(arg, "--overwrite") == 0)
       a->overwrite = true;
+    else if (strcmp(arg, "--force-memory") == 0)
+      pm_memory_set_force(true);
     else if (arg[0] == '-') {
       fprintf(stderr, "pointmech: unknown option %s%s\n", arg,
               has_next ? "" : " (or missing value)");

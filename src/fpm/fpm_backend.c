@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_estimate.h"
 #include "fpm_gfd.h"
 #include "fpm_scene.h"
 #include "gm_cells.h"
@@ -445,6 +446,7 @@ const pm_backend fpm_backend = {
     .dt_safety = 0.9,
     .check = fpm_check_scene,
     .create = create,
+    .estimate_bytes = fpm_estimate_bytes,
     .destroy = destroy,
     .plan = plan,
     .run = run,

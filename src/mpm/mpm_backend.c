@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpm_estimate.h"
 #include "mpm_kind.h"
 #include "mpm_pipeline.h"
 #include "pm_metrics.h"
@@ -443,6 +444,7 @@ const pm_backend mpm_backend = {
     .dt_safety = 0.5,
     .check = mpm_check_scene,
     .create = create,
+    .estimate_bytes = mpm_estimate_bytes,
     .destroy = destroy,
     .plan = plan,
     .run = run,

@@ -2,7 +2,9 @@
 # command line's handling of bad input and numerical failure.
 # Each verification test runs its own OpenMP threads on every core, so
 # ctest gives it the machine (PROCESSORS 2): oversubscribed OpenMP threads
-# spin against each other and run several times slower.
+# spin against each other and run several times slower.  For a machine
+# shared with other jobs, tests/CMakeLists.txt also sets
+# OMP_WAIT_POLICY=passive for every test, these included.
 set(PM_VERIFY_DIR ${CMAKE_CURRENT_LIST_DIR})
 file(GLOB PM_VERIFY_TESTS CONFIGURE_DEPENDS ${PM_VERIFY_DIR}/verify_*.c)
 foreach(src ${PM_VERIFY_TESTS})
@@ -33,3 +35,6 @@ set_tests_properties(verification.studies PROPERTIES LABELS verification TIMEOUT
 add_test(NAME verification.restart
   COMMAND bash ${PM_VERIFY_DIR}/restart.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.restart PROPERTIES LABELS verification TIMEOUT 600 PROCESSORS 2)
+add_test(NAME verification.memory
+  COMMAND bash ${PM_VERIFY_DIR}/memory.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.memory PROPERTIES LABELS verification TIMEOUT 120)

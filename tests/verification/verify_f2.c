@@ -75,14 +75,16 @@ static void test_f2_h1(void **state) {
   run_f2("1.09e-2", CASES "f2-unconstrained-compression.yaml", "paper");
 }
 
+/* The measured spectral step (about 8 times the paper's bound here) keeps
+ * the run stable and the answer the same, at both resolutions; the finer
+ * one takes it so that the test holds on a shared machine (with the
+ * paper's bound it took most of the test's 95 s). */
 static void test_f2_h2(void **state) {
   (void)state;
   run_f2("8.02e-3", CASES "f2-unconstrained-compression-h8.02e-3.yaml",
-         "paper");
+         "spectral");
 }
 
-/* The measured spectral step (about 8 times the paper's bound here) keeps
- * the run stable and the answer the same. */
 static void test_f2_spectral(void **state) {
   (void)state;
   run_f2("1.09e-2", CASES "f2-unconstrained-compression.yaml", "spectral");

@@ -9,6 +9,7 @@
 
 #include "pm_fe.h"
 #include "pm_files.h"
+#include "pm_memory.h"
 #include "pm_metrics.h"
 #include "pm_probe.h"
 
@@ -276,10 +277,12 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
               keys[k].key, keys[k].n, keys[0].key, keys[0].n);
   }
   int n_all = keys[0].n;
-  /* Validate every level's scene before running anything. */
+  /* Validate every level's scene, and its memory estimate, before running
+   * anything. */
   bool analytic = false;
   for (int l = 0; l < n_all; l++) {
     PM_TRY(load_level(o, keys, l, &s));
+    PM_TRY(pm_memory_check(s));
     if (l == 0) {
       analytic = s->reference_mask != 0;
       if (s->reference_fe)

@@ -133,6 +133,13 @@ typedef struct pm_backend {
   /* Set up the discretization, operators and state of a loaded scene
    * (borrowed until destroy).  *sim is the backend's own. */
   pm_err (*create)(const struct pm_scene *s, void **sim);
+  /* The bytes create and run will hold (operators, state, workspace, and
+   * the mesh or grid they are built from), estimated from the scene alone
+   * without allocating: an upper bound within a factor of about 2.  Sets
+   * *points to the points (particles) it counts.  May be NULL (no
+   * estimate); the run driver refuses scenes estimated past the memory
+   * available (pm_memory). */
+  size_t (*estimate_bytes)(const struct pm_scene *s, long *points);
   void (*destroy)(void *sim);
   /* Print the pipeline, counts, time step, steps, memory and an estimated
    * run time, without running. */

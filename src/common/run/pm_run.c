@@ -9,6 +9,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "pm_memory.h"
 #include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_output.h"
@@ -728,6 +729,7 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
   void *sim = NULL;
   pm_outdir *outdir = NULL;
   PM_CALL(check_not_interrupted(o));
+  PM_CALL(pm_memory_check(s));
   /* The folder first: a busy or taken one is refused before the setup. */
   if (out_dir) PM_TRY(pm_outdir_claim(out_dir, outdir_mode(flags), &outdir));
   PM_TRY(s->backend->create(s, &sim));
@@ -777,6 +779,7 @@ pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o) {
             "cannot resume '%s': the checkpoint is of method %s, the scene "
             "now names %s",
             out_dir, rs.h.method, s->method);
+  PM_TRY(pm_memory_check(s));
   PM_TRY(s->backend->create(s, &sim));
   ret = run_sim(s, sim, out_dir, flags, o, &outdir, &rs);
 done:
@@ -790,8 +793,10 @@ done:
 
 pm_err pm_plan_scene(const pm_scene *s, FILE *out) {
   void *sim = NULL;
+  PM_CALL(pm_memory_check(s));
   PM_CALL(s->backend->create(s, &sim));
   pm_err e = s->backend->plan(sim, out);
+  if (e == PM_SUCCESS) pm_memory_plan(s, out);
   s->backend->destroy(sim);
   return e;
 }

@@ -47,7 +47,10 @@ enum {
 pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir,
                   unsigned flags, pm_outcome *o);
 
-/* Create the backend's simulation of s, run it as pm_run_sim, destroy it. */
+/* Create the backend's simulation of s, run it as pm_run_sim, destroy it.
+ * A scene estimated past the memory available is refused first with
+ * PM_ERR_MEMORY (pm_memory_check), before anything is allocated or the
+ * output folder is claimed. */
 pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
                     pm_outcome *o);
 
@@ -60,7 +63,8 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
  * it ends bit-identical to an uninterrupted run. */
 pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o);
 
-/* Create the simulation and print its plan. */
+/* Create the simulation and print its plan with the memory estimate (the
+ * same refusal first). */
 pm_err pm_plan_scene(const pm_scene *s, FILE *out);
 
 #endif

@@ -1,0 +1,54 @@
+/* fpm_estimate: bytes per point of each FPM array, times the points gmsh
+ * makes of the domain box at the scene's mesh size. */
+#include "fpm_estimate.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "fpm_gfd.h"
+#include "fpm_model.h"
+#include "fpm_scene.h"
+
+/* Support entries per point (mesh edges, both ways): 11.8-12.4 on the 3D
+ * blocks of cases/fpm, 5.4 in 2D; quadratic-fit entries per point over two
+ * rings of neighbours: 26 (3D, half the points on two rings) to 15 (2D). */
+#define NNZ_3D 12.5
+#define NNZ_2D 6.0
+#define QFIT_3D 40.0
+#define QFIT_2D 16.0
+/* The gmsh mesh and the median-dual subdomains (cells, interfaces, facets)
+ * per point: measured as peak resident memory above the operators. */
+#define MESH_BYTES 2500.0
+
+size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
+  const int dim = s->dimension;
+  const fpm_options *o = fpm_scene_options(s);
+  const bool quadratic = o->jump == FPM_JUMP_QUADRATIC;
+  /* Nodes of a structured grid of the box at the mesh size; gmsh's
+   * unstructured 2D meshes are denser (mean edge below the size). */
+  double n = dim == 2 ? 1.4 : 1.0;
+  for (int c = 0; c < dim; c++)
+    n *= (s->box_max[c] - s->box_min[c]) / s->mesh_size + 1;
+  const double d = sizeof(double);
+  const double nnz = dim == 2 ? NNZ_2D : NNZ_3D;
+  /* As fpm_model_bytes and fpm_state_bytes count them, per point; every
+   * point may sit on a prescribed face. */
+  double per_point = nnz * ((3 + FPM_EREC) * d + 2 * sizeof(int)) +
+                     (3 + 1 + 3 + 9 + 1) * d + sizeof(int) + 3 +
+                     0.5 * (36 * d + sizeof(long)) + (3 * 4 + 9 * 3 + 2) * d +
+                     3 * (d + sizeof(long)) + MESH_BYTES;
+  if (quadratic)
+    per_point +=
+        (dim == 2 ? QFIT_2D : QFIT_3D) * (FPM_QFIT * d + 3 * sizeof(int)) +
+        FPM_QFIT * d + 2 * sizeof(long) + 57 * d;
+  /* Newton's method adds the tangent (3 x 3 blocks per support entry and
+   * per point) and fpm_linear_bytes. */
+  if (s->time.qs == PM_QS_STATIC)
+    per_point += (nnz + 1) * (9 * d + sizeof(int)) +
+                 (81 + 9 + 9 + 9 + 3 + 12 + (quadratic ? 57 : 0)) * d;
+  *points = n < (double)LONG_MAX ? (long)n : LONG_MAX;
+  double bytes = n * per_point;
+  return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
+}

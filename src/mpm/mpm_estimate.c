@@ -1,0 +1,92 @@
+/* mpm_estimate: bytes per particle and per grid node, as mpm_model_bytes,
+ * mpm_state_bytes and mpm_work_bytes count them, times the particles the
+ * bodies' volumes hold and the nodes of the grid. */
+#include "mpm_estimate.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+
+#include "mpm_grid.h"
+#include "mpm_kind.h"
+#include "mpm_particles.h"
+#include "mpm_scene.h"
+#include "pm_omp.h"
+
+static const double PI = 3.14159265358979323846;
+
+/* Volume (area in 2D) of body b; the domain box's for shapes whose volume
+ * needs the shape itself (a region, a mesh). */
+static double body_volume(const pm_scene *s, const pm_scene_body *b,
+                          double box) {
+  const int dim = s->dimension;
+  double v = box;
+  switch (b->shape) {
+  case PM_BODY_BOX:
+    v = 1;
+    for (int c = 0; c < dim; c++) v *= fabs(b->b[c] - b->a[c]);
+    break;
+  case PM_BODY_SPHERE:
+    v = dim == 2 ? PI * b->radius * b->radius
+                 : 4.0 / 3.0 * PI * pow(b->radius, 3);
+    break;
+  case PM_BODY_CYLINDER: {
+    double len = 0;
+    for (int c = 0; c < 3; c++) len += b->b[c] * b->b[c];
+    v = dim == 2 ? 2 * b->radius * sqrt(len)
+                 : PI * b->radius * b->radius * sqrt(len);
+    break;
+  }
+  default: break;
+  }
+  return fmin(v, box);
+}
+
+/* Doubles per particle of the kind of material sm, as its setup lays them
+ * out: a fluid's density, energy, pressure and q; a solid's F, q and its
+ * model's state. */
+static double kind_doubles(const pm_scene_material *sm) {
+  if (mpm_kind_of(sm) == &mpm_kind_fluid) return 4;
+  return 9 + 1 + sm->mat.state_size;
+}
+
+size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
+  const int dim = s->dimension;
+  const mpm_settings *o = mpm_scene_settings(s);
+  const double h = s->mesh_size, d = sizeof(double);
+  const int ghost = o->shape == MPM_BASIS_QUADRATIC ? 1 : 0;
+  double box = 1, nodes = 1, ppc = 1, cells = 1;
+  for (int c = 0; c < dim; c++) {
+    double len = s->box_max[c] - s->box_min[c];
+    double k = fmax(1, ceil(len / h - 1e-9));
+    box *= len;
+    cells *= k;
+    nodes *= k + 1 + 2 * ghost;
+    ppc *= o->ppc[c];
+  }
+  /* Particles: per body, at most the domain's. */
+  double n = 0, own = 0;
+  for (int b = 0; b < s->n_bodies; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    double nb = body_volume(s, body, box) / pow(h, dim) * ppc;
+    n += nb;
+    own += nb * kind_doubles(&s->materials[body->material]);
+  }
+  if (n > cells * ppc) {
+    own *= cells * ppc / n;
+    n = cells * ppc;
+  }
+  /* Per particle: the common arrays, x0, mass and vol0 of the model, dx, cp
+   * and cs of the workspace, and the 9 of the output buffer. */
+  double bytes =
+      n * (mpm_particle_bytes_common() + 5 * d + 5 * d + 9 * d) + own * d;
+  /* Per node: mass, momentum, force, two velocities and the impedance, the
+   * threads' accumulators, the conditions' folds and owners, the state's
+   * previous force and fixed flags. */
+  double per_node = (1 + 3 * 4 + 3 + 2) * d +
+                    pm_omp_threads() * (MPM_ACC_BASE + 2) * d + 6 * d +
+                    3 * sizeof(short) + 3 * d + 3;
+  bytes += nodes * per_node;
+  *points = n < (double)LONG_MAX ? (long)n : LONG_MAX;
+  return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
+}
