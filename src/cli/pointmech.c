@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "pm_app.h"
 #include "pm_error.h"
@@ -204,7 +205,7 @@ static int cmd_run_or_plan(const cli_args *a, bool plan) {
     pm_outcome o;
     e = pm_run_scene(s, out, run_flags(a), &o);
     if (e) status = report(e);
-    fprintf(stderr, "results in %s\n", out);
+    if (access(out, F_OK) == 0) fprintf(stderr, "results in %s\n", out);
   }
   pm_scene_destroy(s);
   return status;
@@ -263,7 +264,8 @@ int main(int argc, char **argv) {
     pm_outcome o;
     pm_err e = pm_resume(a.scene, run_flags(&a), &o);
     int status = e ? report(e) : EXIT_OK;
-    fprintf(stderr, "results in %s\n", a.scene);
+    if (access(a.scene, F_OK) == 0)
+      fprintf(stderr, "results in %s\n", a.scene);
     return status;
   }
   if (strcmp(cmd, "keys") == 0) {
