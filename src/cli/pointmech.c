@@ -16,6 +16,7 @@
 #include "pm_run.h"
 #include "pm_scene.h"
 #include "pm_study.h"
+#include "pm_wait_policy.h"
 
 enum {
   EXIT_OK = 0,
@@ -242,6 +243,9 @@ int main(int argc, char **argv) {
     printf("pointmech %s\n", PM_VERSION);
     return EXIT_OK;
   }
+  if (strcmp(cmd, "run") == 0 || strcmp(cmd, "plan") == 0 ||
+      strcmp(cmd, "convergence") == 0)
+    pm_wait_policy_apply(argv);
   pm_err init = pm_app_init();
   if (init) return report(init);
   cli_args a;

@@ -38,3 +38,7 @@ set_tests_properties(verification.restart PROPERTIES LABELS verification TIMEOUT
 add_test(NAME verification.memory
   COMMAND bash ${PM_VERIFY_DIR}/memory.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.memory PROPERTIES LABELS verification TIMEOUT 120)
+
+add_test(NAME verification.wait_policy
+  COMMAND bash ${PM_VERIFY_DIR}/wait-policy.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.wait_policy PROPERTIES LABELS verification TIMEOUT 120)
