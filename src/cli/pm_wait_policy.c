@@ -1,8 +1,9 @@
-/* pm_wait_policy: the passive OpenMP wait policy by default.  With
- * libgomp's default (threads spin up to 300000 times at every barrier
- * before sleeping), an explicit FPM run of F2 on two threads beside another
- * such run took 15-150 s instead of 3-7 s alone; passive, 4.5-18 s, at a
- * cost of 1.4-1.7x alone (README, "A shared machine"). */
+/* pm_wait_policy: a short OpenMP spin by default.  With libgomp's default
+ * (threads spin up to 300000 times at every barrier before sleeping), an
+ * explicit FPM run of F2 on two threads beside another such run took 5-20
+ * times its time alone; with a spin of 3000 before sleeping, 2.6-3 times,
+ * at no measurable cost alone; passive waiting shares best (1.0-1.7 times)
+ * but costs 1.5-1.7 times alone (README, "A shared machine, measured"). */
 #include "pm_wait_policy.h"
 
 #include <stdlib.h>
@@ -11,14 +12,17 @@
 
 #include "pm_omp.h"
 
+/* Spins of an idle thread before it sleeps. */
+#define PM_SPINCOUNT "3000"
+
 void pm_wait_policy_apply(char **argv) {
   if (!PM_OMP_AVAILABLE) return;
   if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT")) return;
   const char *own = getenv("POINTMECH_WAIT_POLICY");
   if (own && strcmp(own, "default") == 0) return;
-  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+  if (setenv("GOMP_SPINCOUNT", PM_SPINCOUNT, 1) != 0) return;
   execv("/proc/self/exe", argv);
   /* Not restarted: the runtime keeps the policy it started with, and the
    * environment says so again. */
-  unsetenv("OMP_WAIT_POLICY");
+  unsetenv("GOMP_SPINCOUNT");
 }

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# pointmech runs its OpenMP threads with the passive wait policy unless the
-# user chose one (OMP_WAIT_POLICY or GOMP_SPINCOUNT) or asked for the
+# pointmech runs its OpenMP threads with a short spin (GOMP_SPINCOUNT=3000)
+# unless the user chose a policy (OMP_WAIT_POLICY or GOMP_SPINCOUNT) or asked for the
 # runtime's default (POINTMECH_WAIT_POLICY=default): the environment of the
 # running process (/proc/PID/environ, the same process after it restarts
 # itself) says which.
@@ -11,26 +11,31 @@ scene=$src/cases/mpm/f2-unconstrained-compression.yaml
 # shellcheck source=lib.sh
 . "$(dirname "$0")/lib.sh"
 
-# OMP_WAIT_POLICY in the environment of a run one second in ("" if unset).
-policy_of_run() { # env settings...
+# VAR (OMP_WAIT_POLICY or GOMP_SPINCOUNT) in the environment of a run one
+# second in ("" if unset).
+setting_of_run() { # variable, env settings...
+  local var=$1
+  shift
   env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT -u POINTMECH_WAIT_POLICY "$@" \
     "$bin" run "$scene" --set time.max_steps=100000000 --set time.end=1e9 \
     --out "$work/out" --quiet >/dev/null 2>&1 &
   local pid=$!
   sleep 1
-  tr '\0' '\n' <"/proc/$pid/environ" | sed -n 's/^OMP_WAIT_POLICY=//p'
+  tr '\0' '\n' <"/proc/$pid/environ" | sed -n "s/^$var=//p"
   kill -KILL $pid 2>/dev/null
   wait $pid 2>/dev/null
   rm -rf "$work/out"
 }
 
-p=$(policy_of_run)
-check "unset: the run restarts itself passive (got '$p')" test "$p" = passive
-p=$(policy_of_run OMP_WAIT_POLICY=active)
-check "OMP_WAIT_POLICY=active is kept (got '$p')" test "$p" = active
-p=$(policy_of_run GOMP_SPINCOUNT=1000)
-check "GOMP_SPINCOUNT set: no policy added (got '$p')" test -z "$p"
-p=$(policy_of_run POINTMECH_WAIT_POLICY=default)
+p=$(setting_of_run GOMP_SPINCOUNT)
+check "unset: the run restarts itself with a spin of 3000 (got '$p')" test "$p" = 3000
+p=$(setting_of_run OMP_WAIT_POLICY OMP_WAIT_POLICY=passive)
+check "OMP_WAIT_POLICY=passive is kept (got '$p')" test "$p" = passive
+p=$(setting_of_run GOMP_SPINCOUNT OMP_WAIT_POLICY=passive)
+check "OMP_WAIT_POLICY set: no spin count added (got '$p')" test -z "$p"
+p=$(setting_of_run GOMP_SPINCOUNT GOMP_SPINCOUNT=1000)
+check "GOMP_SPINCOUNT=1000 is kept (got '$p')" test "$p" = 1000
+p=$(setting_of_run GOMP_SPINCOUNT POINTMECH_WAIT_POLICY=default)
 check "POINTMECH_WAIT_POLICY=default: the runtime's default (got '$p')" test -z "$p"
 
 echo "$passes passed, $failures failed"
