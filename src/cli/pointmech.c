@@ -268,8 +268,7 @@ int main(int argc, char **argv) {
     pm_outcome o;
     pm_err e = pm_resume(a.scene, run_flags(&a), &o);
     int status = e ? report(e) : EXIT_OK;
-    if (access(a.scene, F_OK) == 0)
-      fprintf(stderr, "results in %s\n", a.scene);
+    if (access(a.scene, F_OK) == 0) fprintf(stderr, "results in %s\n", a.scene);
     return status;
   }
   if (strcmp(cmd, "keys") == 0) {

@@ -18,6 +18,7 @@
 
 void fpm_sim_destroy(fpm_sim *sim) {
   if (!sim) return;
+  fpm_static_state_free(&sim->static_state);
   fpm_state_destroy(sim->state);
   fpm_model_destroy(sim->model);
   gm_dual_destroy(sim->dual);
@@ -68,6 +69,8 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   pm_timers_start(&sim->timers, sim->tm_operators);
   PM_TRY(fpm_model_create(s, o, sim->mesh, sim->dual, &sim->model));
   PM_TRY(fpm_state_create(sim->model, &sim->state));
+  if (s->time.qs == PM_QS_STATIC)
+    PM_TRY(fpm_static_state_init(&sim->static_state, sim->model));
   PM_TRY(PM_ALLOC(sim->scratch, 11 * sim->model->n, "output buffer"));
   sim->dt_paper = fpm_stable_dt(sim->model, &sim->dt_point);
   sim->dt_stable = sim->dt_paper;
@@ -189,7 +192,8 @@ static pm_err run(void *p, const pm_observer *obs) {
   if (s->time.qs == PM_QS_STATIC) {
     fpm_static_report *r = &sim->static_report;
     double w0 = pm_wtime();
-    e = fpm_static_run(m, sim->state, observe, sim, &sim->last, r);
+    e = fpm_static_run_from(m, sim->state, &sim->static_state, observe, sim,
+                            &sim->last, r);
     double wall = pm_wtime() - w0;
     sim->obs = NULL;
     pm_stage *tm = sim->timers.stage;
@@ -397,20 +401,53 @@ static const pm_timers *timers(void *p) { return &((fpm_sim *)p)->timers; }
 
 /* The time loop's state (fpm_state: u, v and what the loop carries) and
  * what the run reports over all its steps. */
+/* A static solve's load stepping: where it is, its last two converged
+ * states over the free dofs, and its counters. */
+static pm_err checkpoint_static(fpm_sim *sim, pm_ckpt *ck) {
+  fpm_static_state *ss = &sim->static_state;
+  pm_load_report *rep = &sim->static_report.load;
+  long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,
+       linear = rep->linear_iterations;
+  PM_CALL(pm_ckpt_double(ck, "static.lambda", &ss->load.lambda));
+  PM_CALL(pm_ckpt_double(ck, "static.lambda_prev", &ss->load.lambda_prev));
+  PM_CALL(pm_ckpt_double(ck, "static.dl", &ss->load.dl));
+  PM_CALL(pm_ckpt_long(ck, "static.good", &ss->load.good));
+  PM_CALL(pm_ckpt_long(ck, "static.have_prev", &ss->load.have_prev));
+  PM_CALL(pm_ckpt_doubles(ck, "static.xc", ss->free_dofs, ss->load.xc));
+  PM_CALL(pm_ckpt_doubles(ck, "static.xprev", ss->free_dofs, ss->load.xprev));
+  PM_CALL(pm_ckpt_double(ck, "static.external_work", &ss->external_work));
+  PM_CALL(pm_ckpt_long(ck, "static.steps", &steps));
+  PM_CALL(pm_ckpt_long(ck, "static.cuts", &cuts));
+  PM_CALL(pm_ckpt_long(ck, "static.newton_iterations", &newton));
+  PM_CALL(pm_ckpt_long(ck, "static.linear_iterations", &linear));
+  PM_CALL(pm_ckpt_double(ck, "static.dlambda_min", &rep->dlambda_min));
+  rep->steps = (int)steps;
+  rep->cuts = (int)cuts;
+  rep->newton_iterations = (int)newton;
+  rep->linear_iterations = (int)linear;
+  rep->lambda = ss->load.lambda;
+  return PM_SUCCESS;
+}
+
+/* The time loop's state (fpm_state: u, v and what the loop carries; or a
+ * static solve's load stepping) and what the run reports over all its
+ * steps. */
 static pm_err checkpoint(void *p, pm_ckpt *ck) {
   fpm_sim *sim = p;
   fpm_state *st = sim->state;
   const long n3 = 3 * sim->model->n;
-  PM_CHECK(sim->scene->time.qs != PM_QS_STATIC, PM_ERR_ARG,
-           "static solves (time.quasi_static.method: static) cannot be "
-           "checkpointed: their load stepping is not part of a checkpoint yet");
-  PM_CALL(pm_ckpt_doubles(ck, "fpm.u", n3, st->u));
-  PM_CALL(pm_ckpt_doubles(ck, "fpm.v", n3, st->v));
-  PM_CALL(pm_ckpt_long(ck, "fpm.step", &st->step));
-  PM_CALL(pm_ckpt_double(ck, "fpm.t", &st->t));
-  PM_CALL(pm_ckpt_double(ck, "fpm.damping", &st->damping));
-  PM_CALL(pm_ckpt_double(ck, "fpm.external_work", &st->external_work));
-  PM_CALL(pm_ckpt_double(ck, "fpm.dissipated", &st->dissipated));
+  const bool is_static = sim->scene->time.qs == PM_QS_STATIC;
+  if (is_static) {
+    PM_CALL(checkpoint_static(sim, ck));
+  } else {
+    PM_CALL(pm_ckpt_doubles(ck, "fpm.u", n3, st->u));
+    PM_CALL(pm_ckpt_doubles(ck, "fpm.v", n3, st->v));
+    PM_CALL(pm_ckpt_long(ck, "fpm.step", &st->step));
+    PM_CALL(pm_ckpt_double(ck, "fpm.t", &st->t));
+    PM_CALL(pm_ckpt_double(ck, "fpm.damping", &st->damping));
+    PM_CALL(pm_ckpt_double(ck, "fpm.external_work", &st->external_work));
+    PM_CALL(pm_ckpt_double(ck, "fpm.dissipated", &st->dissipated));
+  }
   PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &sim->run_min_jacobian));
   PM_CALL(
       pm_ckpt_long(ck, "run.min_jacobian_step", &sim->run_min_jacobian_step));
@@ -419,11 +456,18 @@ static pm_err checkpoint(void *p, pm_ckpt *ck) {
   PM_CALL(pm_ckpt_double(ck, "run.residual0", &sim->res0));
   if (pm_ckpt_reading(ck)) {
     sim->resumed = true;
-    sim->last.step = st->step;
-    sim->last.t = st->t;
-    sim->last.damping = st->damping;
-    sim->last.external_work = st->external_work;
-    sim->last.dissipated = st->dissipated;
+    if (is_static) {
+      sim->last.step = sim->static_report.load.steps;
+      sim->last.t =
+          sim->static_state.load.lambda * pm_scene_load_end(sim->scene);
+      sim->last.external_work = sim->static_state.external_work;
+    } else {
+      sim->last.step = st->step;
+      sim->last.t = st->t;
+      sim->last.damping = st->damping;
+      sim->last.external_work = st->external_work;
+      sim->last.dissipated = st->dissipated;
+    }
   }
   return PM_SUCCESS;
 }

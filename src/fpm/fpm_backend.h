@@ -48,6 +48,7 @@ typedef struct {
   double res0;                     /* first residual after the ramps */
   double load_end;                 /* when every ramp has ended, s */
   fpm_static_report static_report; /* time.quasi_static.method: static */
+  fpm_static_state static_state;   /* its load stepping (a checkpoint's) */
   bool resumed;                    /* the state came from a checkpoint */
   long first_step;                 /* the step this run started from */
 } fpm_sim;

@@ -127,11 +127,5 @@ pm_err fpm_check_scene(const pm_scene *s) {
   if (pm_scene_has(s, "gravity"))
     return pm_scene_fail(s, "gravity", true,
                          "expected no gravity for method fpm, got gravity");
-  if (s->time.qs == PM_QS_STATIC && pm_scene_has(s, "output.checkpoint"))
-    return pm_scene_fail(
-        s, "output.checkpoint", true,
-        "expected no checkpoints with time.quasi_static.method static (its "
-        "load stepping cannot be checkpointed yet): remove output.checkpoint "
-        "or use dynamic-relaxation");
   return PM_SUCCESS;
 }

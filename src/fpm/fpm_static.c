@@ -52,12 +52,13 @@ typedef struct {
   fpm_observer observer;
   void *octx;
   fpm_step_info si;
-  double ext_work;
+  double *ext_work; /* fpm_static_state.external_work */
 } static_ctx;
 
 /* The state at the free values x (prescribed dofs as set by set_load). */
 static long evaluate(static_ctx *c, const double *x) {
-  for (long j = 0; j < c->nf; j++) c->st->u[c->dof[j]] = x[j];
+  if (x)
+    for (long j = 0; j < c->nf; j++) c->st->u[c->dof[j]] = x[j];
   return fpm_force(c->m, c->st);
 }
 
@@ -135,7 +136,7 @@ static void figures(static_ctx *c, long step) {
   }
   for (long d = 0; d < 3 * n; d++) c->du[d] = st->u[d] - c->u_old[d];
   double rr;
-  c->ext_work += fpm_support_work(m, st, c->du, 1, &rr);
+  *c->ext_work += fpm_support_work(m, st, c->du, 1, &rr);
   memcpy(c->u_old, st->u, 3 * n * sizeof(double));
   double ref = sqrt(rr) + st->bflux_norm + st->fext_norm;
   fpm_step_info *si = &c->si;
@@ -144,7 +145,7 @@ static void figures(static_ctx *c, long step) {
   si->kinetic = 0;
   si->strain = se;
   si->penalty = st->penalty_energy;
-  si->external_work = c->ext_work;
+  si->external_work = *c->ext_work;
   si->dissipated = 0;
   si->residual = ref > 0 ? sqrt(rf) / ref : sqrt(rf);
   si->damping = 0;
@@ -765,30 +766,70 @@ static pm_newton_linear linear_solver(pm_linear_solver l) {
   return PM_NEWTON_DIRECT;
 }
 
+pm_err fpm_static_state_init(fpm_static_state *s, const fpm_model *m) {
+  memset(s, 0, sizeof *s);
+  for (long d = 0; d < 3 * m->n; d++) s->free_dofs += !m->fixed[d];
+  return pm_load_state_init(&s->load, s->free_dofs > 0 ? s->free_dofs : 1);
+}
+
+void fpm_static_state_free(fpm_static_state *s) {
+  pm_load_state_free(&s->load);
+}
+
 pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
                       void *ctx, fpm_step_info *info, fpm_static_report *rep) {
+  fpm_static_state ss;
+  PM_CALL(fpm_static_state_init(&ss, m));
+  pm_err e = fpm_static_run_from(m, st, &ss, observer, ctx, info, rep);
+  fpm_static_state_free(&ss);
+  return e;
+}
+
+pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
+                           fpm_static_state *ss, fpm_observer observer,
+                           void *ctx, fpm_step_info *info,
+                           fpm_static_report *rep) {
   pm_err ret = PM_SUCCESS;
   solve_t v = {.c = {.observer = observer, .octx = ctx}};
   const pm_scene *s = m->scene;
   static_ctx *c = &v.c;
   pm_newton *solver = NULL;
+  const bool resumed = ss->load.lambda > 0;
+  const pm_load_report done_before = rep->load;
   memset(rep, 0, sizeof *rep);
+  if (resumed) rep->load = done_before;
+  c->ext_work = &ss->external_work;
   double w0 = pm_wtime();
   PM_TRY(solve_setup(m, st, &v));
   rep->unknowns = c->nf;
   rep->pattern_entries = v.ptr[c->nf];
+  PM_ENSURE(c->nf == ss->free_dofs, PM_ERR_ARG,
+            "static state of %ld free dofs for a model of %ld", ss->free_dofs,
+            c->nf);
 
-  /* The initial state, as a frame. */
-  memset(st->u, 0, 3 * m->n * sizeof(double));
-  set_load(c, 0);
-  long bad = fpm_force(m, st);
+  if (!resumed) {
+    /* The initial state, as a frame. */
+    memset(st->u, 0, 3 * m->n * sizeof(double));
+    ss->external_work = 0;
+    PM_TRY(set_load(c, 0));
+  } else {
+    /* The last converged state: its force gives the supports' forces the
+     * work of the next step starts from, as in the first run. */
+    PM_TRY(set_load(c, ss->load.lambda));
+    c->t = ss->load.lambda * c->load_end;
+    memcpy(v.x, ss->load.xc, (size_t)c->nf * sizeof *v.x);
+  }
+  long bad = evaluate(c, resumed ? v.x : NULL);
   if (bad >= 0) {
     ret = inadmissible(c, bad);
     goto done;
   }
   fpm_support_start(m, st);
-  figures(c, 0);
-  if (observer) PM_TRY(observer(ctx, m, st, &c->si, true));
+  memcpy(c->u_old, st->u, 3 * m->n * sizeof(double));
+  if (!resumed) {
+    figures(c, 0);
+    if (observer) PM_TRY(observer(ctx, m, st, &c->si, true));
+  }
 
   pm_newton_options no = pm_newton_options_default();
   no.rtol = s->time.qs_tolerance;
@@ -806,7 +847,7 @@ pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
   if (m->flux == FPM_FLUX_SIPG) no.op = PM_NEWTON_MATRIX_FREE;
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
   rep->setup_seconds = pm_wtime() - w0;
-  ret = pm_load_steps(solver, v.x, &rep->load);
+  ret = pm_load_steps_from(solver, v.x, &ss->load, &rep->load);
 done:
   if (info) *info = c->si;
   pm_newton_destroy(&solver);

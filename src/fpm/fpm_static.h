@@ -30,6 +30,28 @@ typedef struct {
 pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
                       void *ctx, fpm_step_info *info, fpm_static_report *rep);
 
+/* What a static run carries from one load step to the next, kept by the
+ * caller so that a checkpoint can write it: the load stepping's state over
+ * the free dofs, and the work of the supports and tractions so far. */
+typedef struct {
+  pm_load_state load;
+  long free_dofs; /* the length of load.xc and load.xprev */
+  double external_work;
+} fpm_static_state;
+
+/* A state for model m (from rest).  PM_ERR_MEMORY. */
+pm_err fpm_static_state_init(fpm_static_state *s, const fpm_model *m);
+void fpm_static_state_free(fpm_static_state *s);
+
+/* fpm_static_run keeping its state in *ss.  With ss->load.lambda > 0 (a
+ * checkpoint's) it continues from there without reporting the initial
+ * state, rep->load's counters going on from their values; the steps that
+ * follow are those the first run would have taken. */
+pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
+                           fpm_static_state *ss, fpm_observer observer,
+                           void *ctx, fpm_step_info *info,
+                           fpm_static_report *rep);
+
 /* Checks of the directly assembled tangent at the state u (3 n, prescribed
  * dofs included): its largest difference from the tangent coloured from
  * fpm_force_linear (*assembled_error) and from central differences of the

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Nothing lost: a run killed with SIGKILL leaves readable results up to its
 # last frame; `resume` after SIGTERM and after SIGKILL ends bit-identical to
-# an uninterrupted run (FPM and MPM); resuming a changed scene, another
+# an uninterrupted run (FPM explicit and static, MPM); resuming a changed scene, another
 # program version or a damaged checkpoint is refused; output folders that
 # are in use, hold another run, are read-only or hit the file size limit
 # fail cleanly.
@@ -96,6 +96,11 @@ fpm=$src/cases/fpm/f2-unconstrained-compression.yaml
 ckpt_every=300
 resume_case fpm "$fpm" 5 --set discretization.mesh_size=0.02 \
   --set time.max_steps=1200 --set time.end=1 --set output.every=100
+# A static solve: the load stepping's state (load factor, step size, the
+# last two converged states) is what resumes.
+ckpt_every=3
+resume_case fpm-static "$src/cases/fpm/f3-extension-60-h1.09e-2.yaml" 5 \
+  --set discretization.mesh_size=0.02 --set time.quasi_static.method=static
 mpm=$src/cases/mpm/m2-shock-tube-reduced.yaml
 ckpt_every=100
 resume_case mpm "$mpm" 4 --set time.max_steps=400 --set output.every=50

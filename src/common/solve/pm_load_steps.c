@@ -58,39 +58,69 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
   return e != PM_SUCCESS ? e : e2;
 }
 
+pm_err pm_load_state_init(pm_load_state *state, long n) {
+  memset(state, 0, sizeof *state);
+  pm_err ret = PM_SUCCESS;
+  PM_TRY(PM_ALLOC(state->xc, n, "converged state"));
+  PM_TRY(PM_ALLOC(state->xprev, n, "previous converged state"));
+done:
+  if (ret != PM_SUCCESS) pm_load_state_free(state);
+  return ret;
+}
+
+void pm_load_state_free(pm_load_state *state) {
+  free(state->xc);
+  free(state->xprev);
+  state->xc = state->xprev = NULL;
+}
+
 pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
+  pm_load_state state;
+  PM_CHECK(s, PM_ERR_ARG, "pm_load_steps: solver is required");
+  PM_CALL(pm_load_state_init(&state, pm_newton_problem_of(s)->n));
+  pm_err e = pm_load_steps_from(s, x, &state, report);
+  pm_load_state_free(&state);
+  return e;
+}
+
+pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
+                          pm_load_report *report) {
   pm_err ret = PM_SUCCESS;
   pm_load_report local;
   pm_load_report *rep = report ? report : &local;
-  double *xc = NULL, *xprev = NULL, *r = NULL, *rh = NULL;
+  double *r = NULL, *rh = NULL;
   double t0 = pm_wtime();
-  memset(rep, 0, sizeof *rep);
-  PM_CHECK(s && x, PM_ERR_ARG, "pm_load_steps: solver and x are required");
+  const bool resumed = st && st->lambda > 0;
+  if (!resumed || !report) memset(rep, 0, sizeof *rep);
+  PM_CHECK(s && x && st && st->xc && st->xprev, PM_ERR_ARG,
+           "pm_load_steps: solver, x and state are required");
   const pm_newton_problem *p = pm_newton_problem_of(s);
   const pm_newton_options *o = pm_newton_options_of(s);
   const long n = p->n;
+  double *xc = st->xc, *xprev = st->xprev;
   PM_CHECK(p->set_load, PM_ERR_ARG,
            "pm_load_steps: the problem has no set_load");
-  PM_TRY(PM_ALLOC(xc, n, "converged state"));
-  PM_TRY(PM_ALLOC(xprev, n, "previous converged state"));
   if (o->predictor) {
     PM_TRY(PM_ALLOC(r, n, "residual"));
     PM_TRY(PM_ALLOC(rh, n, "residual"));
   }
-  memcpy(xc, x, (size_t)n * sizeof *xc);
-
   const double nominal = 1.0 / o->load_steps;
-  double lambda = 0, lambda_prev = 0, dl = nominal;
-  bool have_prev = false;
-  int cuts = 0, good = 0;
-  rep->dlambda_min = nominal;
-  while (lambda < 1) {
-    double target = lambda + dl;
+  if (!resumed) {
+    memcpy(xc, x, (size_t)n * sizeof *xc);
+    st->lambda = st->lambda_prev = 0;
+    st->dl = nominal;
+    st->good = st->have_prev = 0;
+    rep->dlambda_min = nominal;
+  }
+  int cuts = 0;
+  while (st->lambda < 1) {
+    const double lambda = st->lambda, lambda_prev = st->lambda_prev;
+    double target = lambda + st->dl;
     if (target > 1 - PM_LOAD_END_SLACK) target = 1;
     PM_TRY(p->set_load(p->ctx, target));
     memcpy(x, xc, (size_t)n * sizeof *x);
     bool predicted = false;
-    if (o->predictor && have_prev && lambda > lambda_prev) {
+    if (o->predictor && st->have_prev && lambda > lambda_prev) {
       double f = (target - lambda) / (lambda - lambda_prev);
       for (long i = 0; i < n; i++) x[i] = xc[i] + f * (xc[i] - xprev[i]);
       predicted = true;
@@ -128,20 +158,23 @@ pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
     if (e == PM_SUCCESS) {
       memcpy(xprev, xc, (size_t)n * sizeof *xc);
       memcpy(xc, x, (size_t)n * sizeof *xc);
-      lambda_prev = lambda;
-      lambda = target;
-      have_prev = true;
+      st->lambda_prev = lambda;
+      st->lambda = target;
+      st->have_prev = 1;
       rep->steps++;
-      rep->lambda = lambda;
-      if (target - lambda_prev < rep->dlambda_min)
-        rep->dlambda_min = target - lambda_prev;
+      rep->lambda = target;
+      if (target - lambda < rep->dlambda_min)
+        rep->dlambda_min = target - lambda;
       cuts = 0;
-      if (p->on_step)
-        PM_TRY(p->on_step(p->ctx, rep->steps, lambda, xc, &rep->last));
-      if (dl < nominal && o->grow_after > 0 && ++good >= o->grow_after) {
-        dl = fmin(1.5 * dl, nominal);
-        good = 0;
+      /* The next step's size, before on_step: the state it sees is the
+       * one the next step starts from. */
+      if (st->dl < nominal && o->grow_after > 0 &&
+          ++st->good >= o->grow_after) {
+        st->dl = fmin(1.5 * st->dl, nominal);
+        st->good = 0;
       }
+      if (p->on_step)
+        PM_TRY(p->on_step(p->ctx, rep->steps, target, xc, &rep->last));
       continue;
     }
     if (!recoverable(e)) {
@@ -150,8 +183,8 @@ pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
       goto done;
     }
     pm_error_clear();
-    good = 0;
-    if (cuts >= o->max_cuts || dl / 2 < o->min_dlambda * (1 - 1e-12)) {
+    st->good = 0;
+    if (cuts >= o->max_cuts || st->dl / 2 < o->min_dlambda * (1 - 1e-12)) {
       ret = PM_ERROR(e,
                      "load step %d (lambda %.6g -> %.6g): %s; cut %d times to "
                      "dlambda %.3g: giving up",
@@ -161,17 +194,13 @@ pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
     }
     cuts++;
     rep->cuts++;
-    dl /= 2;
+    st->dl /= 2;
   }
 done:
-  if (xc) {
-    memcpy(x, xc, (size_t)n * sizeof *x);
-    /* The load stays that of the state returned. */
-    if (ret != PM_SUCCESS) (void)p->set_load(p->ctx, rep->lambda);
-  }
-  rep->time_total = pm_wtime() - t0;
-  free(xc);
-  free(xprev);
+  memcpy(x, xc, (size_t)n * sizeof *x);
+  /* The load stays that of the state returned. */
+  if (ret != PM_SUCCESS) (void)p->set_load(p->ctx, rep->lambda);
+  rep->time_total += pm_wtime() - t0;
   free(r);
   free(rh);
   return ret;

@@ -307,6 +307,33 @@ pm_err pm_newton_solve(pm_newton *s, double *x, pm_newton_report *report);
  * up". */
 pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report);
 
+/* What load stepping carries from one step to the next: the load factor
+ * reached and the one before, the next step's size, the converged steps
+ * since the last cut (for regrowth), and the last two converged states.
+ * At on_step it is exactly the state the next step starts from, which a
+ * checkpoint writes. */
+typedef struct {
+  double lambda, lambda_prev, dl;
+  long good;
+  long have_prev; /* xprev holds a converged state */
+  double *xc;     /* n: the last converged state */
+  double *xprev;  /* n: the one before */
+} pm_load_state;
+
+/* Allocate a state's arrays for a problem of n unknowns, zeroed (lambda 0:
+ * a start from rest).  PM_ERR_MEMORY. */
+pm_err pm_load_state_init(pm_load_state *state, long n);
+void pm_load_state_free(pm_load_state *state);
+
+/* pm_load_steps keeping its state in state (caller-owned, of the
+ * problem's n).  With state->lambda > 0 (a checkpoint's), it continues
+ * from that state instead of from x at lambda = 0, and report's counters
+ * (steps, cuts, iterations, dlambda_min) go on from their values in
+ * *report; the steps that follow are those the first run would have
+ * taken. */
+pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *state,
+                          pm_load_report *report);
+
 /* The assembled Jacobian at x (jacobian_prepare, then colouring) as values
  * in the order of the problem's pattern: val[pat_ptr[i] + k] = J_ij for j
  * = pat_idx[pat_ptr[i] + k] (a repeated column gets the value at each
