@@ -50,15 +50,21 @@ done
 # memcheck.
 bin=$build/pointmech
 f2=$root/cases/fpm/f2-unconstrained-compression.yaml
-OMP_NUM_THREADS=2 vg run-fpm-explicit "$bin" run "$f2" --set discretization.mesh_size=0.02 \
+OMP_NUM_THREADS=2 vg run-fpm-explicit "$bin" run --overwrite "$f2" --set discretization.mesh_size=0.02 \
   --set time.max_steps=40 --set output.every=20 --out "$logs/out-fpm-explicit" --quiet
-OMP_NUM_THREADS=2 vg run-fpm-static "$bin" run "$f2" --set discretization.mesh_size=0.02 \
+# A checkpoint, and the run resumed from it (the summary as if interrupted).
+OMP_NUM_THREADS=2 vg run-fpm-checkpoint "$bin" run --overwrite "$f2" \
+  --set discretization.mesh_size=0.02 --set time.max_steps=40 \
+  --set output.checkpoint.every=15 --out "$logs/out-fpm-checkpoint" --quiet
+sed -i 's/"status": "[a-z-]*"/"status": "interrupted"/' "$logs/out-fpm-checkpoint/summary.json"
+OMP_NUM_THREADS=2 vg resume-fpm "$bin" resume "$logs/out-fpm-checkpoint" --quiet
+OMP_NUM_THREADS=2 vg run-fpm-static "$bin" run --overwrite "$f2" --set discretization.mesh_size=0.02 \
   --set time.quasi_static.method=static --set time.quasi_static.load_steps=2 \
   --set time.quasi_static.tolerance=1e-6 --out "$logs/out-fpm-static" --quiet
-OMP_NUM_THREADS=2 vg run-mpm-solid "$bin" run "$root/cases/mpm/f2-unconstrained-compression.yaml" \
+OMP_NUM_THREADS=2 vg run-mpm-solid "$bin" run --overwrite "$root/cases/mpm/f2-unconstrained-compression.yaml" \
   --set discretization.mesh_size=0.02 --set time.max_steps=20 \
   --set output.every=10 --out "$logs/out-mpm-solid" --quiet
-OMP_NUM_THREADS=2 vg run-mpm-fluid "$bin" run "$root/cases/mpm/m2-shock-tube.yaml" \
+OMP_NUM_THREADS=2 vg run-mpm-fluid "$bin" run --overwrite "$root/cases/mpm/m2-shock-tube.yaml" \
   --set time.max_steps=20 --set output.every=10 --out "$logs/out-mpm-fluid" --quiet
 
 # Summary: a program fails on an error or on a definite or indirect leak

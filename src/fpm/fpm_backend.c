@@ -154,7 +154,8 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
   } else if (info->step > 0 && info->t >= load_end && sim->res0 == 0) {
     sim->res0 = info->residual;
   }
-  pm_step_report r = {.step = info->step,
+  pm_step_report r = {.last = info->last,
+                      .step = info->step,
                       .t = info->t,
                       .residual = info->residual,
                       .progress = frac};

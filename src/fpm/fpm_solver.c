@@ -327,6 +327,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     bool last = si.converged || t >= opt->t_end * (1 - 1e-12) ||
                 (opt->max_steps > 0 && step >= opt->max_steps);
     bool frame = last || (opt->frame_every > 0 && step % opt->frame_every == 0);
+    si.last = last;
     st->step = step;
     st->t = t;
     st->damping = c;

@@ -34,6 +34,7 @@ typedef struct {
   double energy_error;  /* fpm_energy_error of these figures */
   bool energy_checked;  /* the balance is held to its bound at this step */
   bool converged;
+  bool last; /* the run's last step */
 } fpm_step_info;
 
 /* Called with the initial state (step 0) and after every step: frame is

@@ -164,6 +164,7 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
   if (bad >= 0) return inadmissible(c, bad);
   figures(c, step);
   c->si.converged = lambda >= 1;
+  c->si.last = c->si.converged;
   const double jlim = c->m->scene->stability.min_jacobian;
   if (c->si.min_jacobian <= jlim)
     return PM_ERROR(PM_ERR_UNSTABLE,

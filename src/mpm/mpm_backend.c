@@ -51,9 +51,10 @@ static size_t sim_bytes(const mpm_sim *r) {
 /* ---- run ---------------------------------------------------------------- */
 
 /* Report a step (the initial state as step 0) to the run's observer. */
-static pm_err report(mpm_sim *r, bool frame) {
+static pm_err report(mpm_sim *r, bool frame, bool last) {
   const mpm_state *s = r->state;
-  pm_step_report rep = {.step = s->step,
+  pm_step_report rep = {.last = last,
+                        .step = s->step,
                         .t = s->t,
                         .residual = r->work->residual,
                         .progress = s->t / r->model->opt.t_end};
@@ -71,7 +72,7 @@ static pm_err observe(void *ctx, const mpm_model *m, const mpm_state *s,
     r->run_min_jacobian_step = s->step;
   }
   if (info->iter_max > r->iter_max_row) r->iter_max_row = info->iter_max;
-  return report(r, frame);
+  return report(r, frame, info->last);
 }
 
 static pm_err run(void *p, const pm_observer *obs) {
@@ -88,7 +89,7 @@ static pm_err run(void *p, const pm_observer *obs) {
     for (long q = 0; q < m->n; q++)
       r->run_min_jacobian =
           fmin(r->run_min_jacobian, r->state->vol[q] / m->vol0[q]);
-    e = report(r, true);
+    e = report(r, true, false);
   }
   mpm_run_options opt = {.t_end = m->opt.t_end,
                          .max_steps = m->opt.max_steps,

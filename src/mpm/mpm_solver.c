@@ -37,6 +37,7 @@ pm_err mpm_solve(const mpm_model *m, mpm_state *s, mpm_work *w,
     };
     bool last = info.converged || s->t >= opt->t_end * (1 - 1e-12) ||
                 (opt->max_steps > 0 && s->step >= opt->max_steps);
+    info.last = last;
     bool frame =
         (opt->frame_every > 0 && s->step % opt->frame_every == 0) || last;
     if (observer) {

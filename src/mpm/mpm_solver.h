@@ -20,6 +20,7 @@ typedef struct {
   double residual;  /* quasi-static residual (0 in dynamics) */
   int iter_max;     /* most iterations of a constitutive update */
   long iter_capped; /* particles whose iterations hit the cap */
+  bool last;        /* the run's last step */
   bool converged;   /* quasi-static: residual below time.quasi_static
                        tolerance, with the loads applied */
 } mpm_step_info;

@@ -147,6 +147,9 @@ EOF
 refused_resume "damaged checkpoint" "is damaged: checksum" "$out"
 head -c 3000 "$out/checkpoint.h5" >"$work/cut.h5" && mv "$work/cut.h5" "$out/checkpoint.h5"
 refused_resume "truncated checkpoint" "is damaged" "$out"
+"$bin" resume "$work/fpm-straight" >/dev/null 2>"$work/err"
+check "resume of a finished run: exit 1" test $? -eq 1
+check "resume of a finished run: says so" grep -q "its run has ended" "$work/err"
 "$bin" resume "$work/none" >/dev/null 2>"$work/err"
 check "resume of no folder: exit 1" test $? -eq 1
 

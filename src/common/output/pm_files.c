@@ -620,8 +620,7 @@ static const char *const run_files[] = {"summary.json", "history.csv",
 #define N_RUN_FILES (sizeof run_files / sizeof *run_files)
 #define LOCK_NAME ".pointmech.lock"
 
-/* The status member of dir/summary.json ("" when there is none). */
-static void summary_status(const char *dir, char *buf, size_t size) {
+void pm_summary_status(const char *dir, char *buf, size_t size) {
   char path[PM_PATH_MAX + 1], line[512];
   buf[0] = '\0';
   if (pm_path_join(path, sizeof path, dir, "summary.json")) return;
@@ -750,7 +749,7 @@ pm_err pm_outdir_claim(const char *dir, pm_outdir_mode mode, pm_outdir **out) {
   PM_TRY(take_lock(dir, &d->fd));
   if (mode == PM_OUTDIR_NEW && holds_run(dir, &which)) {
     char status[64];
-    summary_status(dir, status, sizeof status);
+    pm_summary_status(dir, status, sizeof status);
     PM_ENSURE(false, PM_ERR_IO,
               "output folder '%s' already holds the results of another run "
               "(%s%s%s%s): pass --overwrite to replace them, `pointmech "

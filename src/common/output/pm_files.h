@@ -144,6 +144,10 @@ typedef struct pm_outdir pm_outdir;
  * with pm_outdir_release. */
 pm_err pm_outdir_claim(const char *dir, pm_outdir_mode mode, pm_outdir **out);
 
+/* The status member of dir/summary.json into buf ("" when there is
+ * none). */
+void pm_summary_status(const char *dir, char *buf, size_t size);
+
 /* Unlock and free (NULL accepted).  A folder the claim created and
  * nothing was written to is removed. */
 void pm_outdir_release(pm_outdir *d);

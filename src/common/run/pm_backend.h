@@ -96,6 +96,7 @@ typedef struct {
   double t;
   double residual; /* quasi-static residual (0 in dynamics) */
   double progress; /* fraction of the run done, in [0, 1] */
+  bool last;       /* the run's last step: it ends after it */
 } pm_step_report;
 
 /* The run's observer: called after every step (frame false) and on frame

@@ -300,8 +300,10 @@ done:
 }
 
 /* A checkpoint is due after step (not the initial state). */
-static bool checkpoint_due(const run_ctx *c, long step) {
-  if (step <= 0 || step == c->ckpt_step) return false;
+static bool checkpoint_due(const run_ctx *c, const pm_step_report *r) {
+  const long step = r->step;
+  /* None after the last step: there is nothing to resume. */
+  if (step <= 0 || step == c->ckpt_step || r->last) return false;
   if (c->ckpt_every > 0 && step % c->ckpt_every == 0) return true;
   return c->ckpt_seconds > 0 &&
          pm_wtime() - c->ckpt_last_wall >= c->ckpt_seconds;
@@ -310,8 +312,8 @@ static bool checkpoint_due(const run_ctx *c, long step) {
 static pm_err observe(void *ctx, const pm_step_report *r, bool frame) {
   run_ctx *c = ctx;
   /* After a signal, the state after this step becomes the last frame and
-   * a checkpoint. */
-  const int sig = interrupt_signal;
+   * a checkpoint; on the run's last step the run simply ends. */
+  const int sig = r->last ? 0 : interrupt_signal;
   if (c->show_progress) {
     char status[96];
     snprintf(status, sizeof status, "t=%.4g s  step %ld  residual %.2e", r->t,
@@ -325,7 +327,7 @@ static pm_err observe(void *ctx, const pm_step_report *r, bool frame) {
     PM_CALL(e);
     c->extra_frame = !frame;
   }
-  if (c->results && (checkpoint_due(c, r->step) || (sig && r->step > 0))) {
+  if (c->results && (checkpoint_due(c, r) || (sig && r->step > 0))) {
     pm_err e = write_checkpoint(c, r->step);
     if (e == PM_ERR_ARG && sig) /* the method cannot: say so, go on */
       snprintf(c->ckpt_note, sizeof c->ckpt_note, "no checkpoint: %s",
@@ -763,6 +765,16 @@ pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o) {
   char *argv[256];
   PM_CALL(check_not_interrupted(o));
   PM_TRY(pm_outdir_claim(out_dir, PM_OUTDIR_RESUME, &outdir));
+  /* A run that ended by itself has nothing to resume; one that was
+   * interrupted, killed (still "running") or failed on I/O has. */
+  char status[64];
+  pm_summary_status(out_dir, status, sizeof status);
+  PM_ENSURE(!status[0] || !strcmp(status, "interrupted") ||
+                !strcmp(status, "running") || !strcmp(status, "failed"),
+            PM_ERR_ARG,
+            "cannot resume '%s': its run has ended (status \"%s\"); start a "
+            "new run (--overwrite) to run it again",
+            out_dir, status);
   PM_TRY(pm_ckpt_open(out_dir, &rs.ck));
   PM_TRY(header_items(rs.ck, &rs.h));
   PM_ENSURE(strcmp(rs.h.version, PM_VERSION) == 0, PM_ERR_ARG,
