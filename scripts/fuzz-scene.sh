@@ -12,6 +12,10 @@
 # build-fuzz/fuzz-corpus, then replace tests/fuzz/corpus with NEWDIR.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+command -v clang >/dev/null || {
+  echo "clang is not installed (Debian: apt-get install clang)" >&2
+  exit 1
+}
 limit=${1:-600}
 shift || true
 case $limit in

@@ -9,6 +9,10 @@
 # usage: scripts/valgrind.sh [PROGRAM-NAME-PATTERN]   (e.g. test_mpm, run-)
 set -uo pipefail
 cd "$(dirname "$0")/.."
+command -v valgrind >/dev/null || {
+  echo "valgrind is not installed (Debian: apt-get install valgrind)" >&2
+  exit 1
+}
 root=$PWD
 build=${PM_VALGRIND_BUILD:-$root/build-valgrind}
 pattern=${1:-}

@@ -3,8 +3,8 @@
 # Each verification test runs its own OpenMP threads on every core, so
 # ctest gives it the machine (PROCESSORS 2): oversubscribed OpenMP threads
 # spin against each other and run several times slower.  For a machine
-# shared with other jobs, tests/CMakeLists.txt also sets
-# OMP_WAIT_POLICY=passive for every test, these included.
+# shared with other jobs, tests/CMakeLists.txt also sets a short spin
+# (GOMP_SPINCOUNT=3000) for every test, these included.
 set(PM_VERIFY_DIR ${CMAKE_CURRENT_LIST_DIR})
 file(GLOB PM_VERIFY_TESTS CONFIGURE_DEPENDS ${PM_VERIFY_DIR}/verify_*.c)
 foreach(src ${PM_VERIFY_TESTS})
