@@ -105,14 +105,16 @@ mpm=$src/cases/mpm/m2-shock-tube-reduced.yaml
 ckpt_every=100
 resume_case mpm "$mpm" 4 --set time.max_steps=400 --set output.every=50
 
-# Checkpoints by wall time: every 0.1 s of a run of about a second.
+# Checkpoints by wall time: every 0.03 s of a run of 0.3 s or more.
 out=$work/minutes
 "$bin" run "$fpm" --out "$out" --quiet --set discretization.mesh_size=0.02 \
-  --set time.max_steps=1200 --set output.checkpoint.minutes=0.0017 \
+  --set time.max_steps=2400 --set output.checkpoint.minutes=0.0005 \
   >/dev/null 2>&1
 n=$(sed -n 's/^  "checkpoints": \([0-9]*\),/\1/p' "$out/summary.json")
-check "checkpoints every 0.1 s of wall time: $n written" test "${n:-0}" -ge 2
-check "checkpoints every 0.1 s: the last one readable" test -s "$out/checkpoint.h5"
+wall=$(sed -n 's/^  "wall_seconds": \([0-9.e-]*\),/\1/p' "$out/summary.json")
+check "checkpoints every 0.03 s of wall time: $n written in $wall s" \
+  awk -v n="${n:-0}" -v w="${wall:-0}" 'BEGIN { exit !(n >= 2 && n <= w / 0.03 + 1) }'
+check "checkpoints every 0.03 s: the last one readable" test -s "$out/checkpoint.h5"
 
 # Resuming what cannot be resumed.
 scene=$work/f2.yaml
@@ -182,8 +184,14 @@ as_user=()
 if [ "$(id -u)" = 0 ] && command -v setpriv >/dev/null; then
   chmod o+rx "$work"
   as_user=(setpriv --reuid=65534 --regid=65534 --clear-groups)
+  # The program must be reachable by that user (not so under /root).
+  if ! "${as_user[@]}" "$bin" --version >/dev/null 2>&1; then
+    echo "note: read-only folder not checked: user 65534 cannot run $bin"
+    as_user=()
+    skip_ro=1
+  fi
 fi
-if [ "$(id -u)" != 0 ] || [ ${#as_user[@]} -gt 0 ]; then
+if [ -z "${skip_ro:-}" ] && { [ "$(id -u)" != 0 ] || [ ${#as_user[@]} -gt 0 ]; }; then
   "${as_user[@]}" "$bin" run "$scene" --out "$ro/out" --quiet "${coarse[@]}" \
     >/dev/null 2>"$work/err"
   check "read-only folder: exit 1" test $? -eq 1
