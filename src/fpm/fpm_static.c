@@ -827,10 +827,10 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   }
   fpm_support_start(m, st);
   memcpy(c->u_old, st->u, 3 * m->n * sizeof(double));
-  if (!resumed) {
-    figures(c, 0);
-    if (observer) PM_TRY(observer(ctx, m, st, &c->si, true));
-  }
+  /* The figures of the state (a resumed one's too, for a run that fails
+   * before its next step); only the initial state is a frame. */
+  figures(c, rep->load.steps);
+  if (!resumed && observer) PM_TRY(observer(ctx, m, st, &c->si, true));
 
   pm_newton_options no = pm_newton_options_default();
   no.rtol = s->time.qs_tolerance;

@@ -214,6 +214,11 @@ static void test_outdir(void **state) {
   fclose(fp);
   snprintf(path, sizeof path, "%s/results.h5.tmp.1", out);
   fclose(fopen(path, "w"));
+  /* The user's own files are never touched, whatever their names. */
+  snprintf(path, sizeof path, "%s/notes.tmp.txt", out);
+  fclose(fopen(path, "w"));
+  snprintf(path, sizeof path, "%s/history.csv.tmp.12x", out);
+  fclose(fopen(path, "w"));
   pm_outdir_release(d);
 
   /* Not overwritten unless asked. */
@@ -229,6 +234,10 @@ static void test_outdir(void **state) {
   assert_false(exists(path));
   snprintf(path, sizeof path, "%s/results.h5.tmp.1", out);
   assert_false(exists(path));
+  snprintf(path, sizeof path, "%s/notes.tmp.txt", out);
+  assert_true(exists(path));
+  snprintf(path, sizeof path, "%s/history.csv.tmp.12x", out);
+  assert_true(exists(path));
   pm_outdir_release(d);
   /* Resuming needs the folder. */
   snprintf(path, sizeof path, "%s/none", dir);

@@ -129,6 +129,8 @@ static pm_err item(pm_ckpt *c, const char *name, long n, size_t size,
               "item %s",
               path, name);
     H5_OK(space = H5Dget_space(dset), "H5Dget_space", name, path);
+    PM_ENSURE(H5Sget_simple_extent_ndims(space) == 1, PM_ERR_IO,
+              "checkpoint '%s' is damaged: item %s is not a list", path, name);
     H5_OK(H5Sget_simple_extent_dims(space, &have, NULL),
           "H5Sget_simple_extent_dims", name, path);
     PM_ENSURE(have == dims[0], PM_ERR_IO,
@@ -207,6 +209,13 @@ pm_err pm_ckpt_finish(pm_ckpt *c) {
   if (!c) return PM_SUCCESS;
   if (c->reading) {
     attr = H5Aopen(c->file, "checksum", H5P_DEFAULT);
+    if (attr >= 0) {
+      space = H5Aget_space(attr);
+      bool two = space >= 0 && H5Sget_simple_extent_npoints(space) == 2;
+      PM_ENSURE(two, PM_ERR_IO,
+                "checkpoint '%s' is damaged: its checksum is not two numbers",
+                c->path);
+    }
     PM_ENSURE(attr >= 0 && H5Aread(attr, H5T_NATIVE_ULLONG, stored) >= 0,
               PM_ERR_IO, "checkpoint '%s' is damaged: it has no checksum",
               c->path);

@@ -684,14 +684,36 @@ static bool holds_run(const char *dir, const char **which) {
   return false;
 }
 
-/* Remove the temporary files (NAME.tmp.PID) a killed run left in dir. */
+/* Is name a temporary file of a run: RUNFILE.tmp.PID? */
+static bool run_tmp_name(const char *name) {
+  for (size_t k = 0; k < N_RUN_FILES; k++) {
+    size_t len = strlen(run_files[k]);
+    if (strncmp(name, run_files[k], len) || strncmp(name + len, ".tmp.", 5))
+      continue;
+    const char *pid = name + len + 5;
+    return *pid && strspn(pid, "0123456789") == strlen(pid);
+  }
+  return false;
+}
+
+/* Remove the temporary files (RUNFILE.tmp.PID) a killed run left in dir;
+ * nothing else of the folder's is touched. */
 static pm_err drop_tmp(const char *dir) {
   DIR *d = opendir(dir);
   PM_CHECK(d, PM_ERR_IO, "cannot read '%s': %s", dir, strerror(errno));
   struct dirent *e;
+  char path[PM_PATH_MAX + 1];
   pm_err ret = PM_SUCCESS;
-  while ((e = readdir(d)) && ret == PM_SUCCESS)
-    if (strstr(e->d_name, ".tmp.")) ret = remove_entry(dir, e->d_name);
+  while ((e = readdir(d)) && ret == PM_SUCCESS) {
+    struct stat st;
+    if (!run_tmp_name(e->d_name) ||
+        pm_path_join(path, sizeof path, dir, e->d_name) != PM_SUCCESS ||
+        lstat(path, &st) != 0 || !S_ISREG(st.st_mode))
+      continue;
+    if (unlink(path) != 0 && errno != ENOENT)
+      ret =
+          PM_ERROR(PM_ERR_IO, "cannot remove '%s': %s", path, strerror(errno));
+  }
   closedir(d);
   return ret;
 }
@@ -735,9 +757,9 @@ pm_err pm_outdir_claim(const char *dir, pm_outdir_mode mode, pm_outdir **out) {
   *out = NULL;
   bool existed = stat(dir, &st) == 0;
   if (mode == PM_OUTDIR_RESUME)
-    PM_CHECK(stat(dir, &st) == 0 && S_ISDIR(st.st_mode), PM_ERR_IO,
+    PM_CHECK(existed && S_ISDIR(st.st_mode), PM_ERR_IO,
              "cannot resume '%s': %s", dir,
-             errno ? strerror(errno) : "not a folder");
+             existed ? "not a folder" : "no such folder");
   else
     PM_CALL(pm_mkdir_p(dir));
   PM_CHECK(access(dir, W_OK | X_OK) == 0, PM_ERR_IO,

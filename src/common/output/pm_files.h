@@ -136,7 +136,8 @@ typedef struct pm_outdir pm_outdir;
 /* Claim dir for a run: create it (and its parents) unless resuming, check
  * that it is writable, lock it (DIR/.pointmech.lock holds the pid; the
  * lock dies with the process, so a killed run never blocks the next one),
- * remove temporary files left by a killed run, and apply mode to the files
+ * remove the temporary files a killed run left (RUNFILE.tmp.PID; nothing
+ * else), and apply mode to the files
  * a run writes (summary.json, history.csv, results.h5, results.xdmf,
  * checkpoint.h5, results/).  Fails with PM_ERR_IO naming the folder and the
  * reason: not writable, in use by a running pointmech (its pid), or, for

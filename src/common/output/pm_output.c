@@ -548,6 +548,7 @@ pm_err pm_results_create(const char *dir, int dim, long n_points,
   PM_TRY(pm_mkdir_p(r->sub));
   r->created = true;
   int saved = 0;
+  errno = 0;
   ret = write_mesh(r, x, cells);
   if (ret == PM_SUCCESS) ret = publish(r);
   saved = errno;
@@ -666,6 +667,8 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   H5_OK(dset = H5Dopen2(file, "cells", H5P_DEFAULT), "H5Dopen2", "/cells",
         path);
   H5_OK(space = H5Dget_space(dset), "H5Dget_space", "/cells", path);
+  PM_ENSURE(H5Sget_simple_extent_ndims(space) == 2, PM_ERR_HDF5,
+            "'%s': /cells is not a table", path);
   H5_OK(H5Sget_simple_extent_dims(space, dims, NULL),
         "H5Sget_simple_extent_dims", "/cells", path);
   r->n_cells = (long)dims[0];
@@ -675,6 +678,8 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   H5_OK(dset = H5Dopen2(file, "coordinates", H5P_DEFAULT), "H5Dopen2",
         "/coordinates", path);
   H5_OK(space = H5Dget_space(dset), "H5Dget_space", "/coordinates", path);
+  PM_ENSURE(H5Sget_simple_extent_ndims(space) == 2, PM_ERR_HDF5,
+            "'%s': /coordinates is not a table", path);
   H5_OK(H5Sget_simple_extent_dims(space, dims, NULL),
         "H5Sget_simple_extent_dims", "/coordinates", path);
   r->n_points = (long)dims[0];
@@ -684,10 +689,11 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   h5_close_quiet(&space);
   h5_close_quiet(&dset);
   h5_close_quiet(&file);
-  PM_TRY(drop_later_frames(r, n_keep));
+  /* The frames kept must all be readable before anything changes. */
   for (long k = 0; k < n_keep; k++) PM_TRY(reread_frame(r, k));
   r->n_frames = n_keep;
   PM_TRY(publish(r));
+  PM_TRY(drop_later_frames(r, n_keep));
   *out = r;
   r = NULL;
 done:
@@ -761,6 +767,7 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
     bytes += 8.0 * fields[i].ncomp * (double)r->n_points;
   PM_CALL(check_room(r->sub, path, bytes));
   xdmf_len = r->xdmf_len;
+  errno = 0;
   ret = write_frame_file(r, tmp, step, time, n_fields, fields);
   int saved = errno;
   PM_TRY(classify(ret, saved, path));
@@ -771,12 +778,18 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
   }
   PM_TRY(xdmf_frame(r, r->n_frames, step, time, n_fields, names, ncomp));
   r->n_frames++;
+  errno = 0;
   ret = publish(r);
   saved = errno;
-  if (ret != PM_SUCCESS) { /* the index still lists the frames before */
+  if (ret != PM_SUCCESS) { /* back to the frames before */
     r->n_frames--;
     r->xdmf_len = xdmf_len;
     unlink(path);
+    /* The index may already list the frame: list the others again (best
+     * effort; the earlier index and XDMF stay otherwise). */
+    pm_err first = ret;
+    if (index_commit(r) != PM_SUCCESS) pm_error_clear();
+    ret = first;
     PM_TRY(classify(ret, saved, r->index_path));
   }
 done:

@@ -279,9 +279,9 @@ static pm_err write_checkpoint(run_ctx *c, long step) {
       .checkpoint_seconds = pm_timers_seconds(&c->out_timer, c->tm_checkpoint),
   };
   char *overrides = h.overrides;
-  PM_CHECK(overrides, PM_ERR_MEMORY, "cannot join the scene's overrides");
-  PM_CHECK(c->be->checkpoint, PM_ERR_ARG, "method %s cannot write checkpoints",
-           s->method);
+  PM_ENSURE(c->be->checkpoint, PM_ERR_ARG, "method %s cannot write checkpoints",
+            s->method);
+  PM_ENSURE(overrides, PM_ERR_MEMORY, "cannot join the scene's overrides");
   pm_timers_start(&c->out_timer, c->tm_checkpoint);
   PM_TRY(pm_ckpt_create(c->out_dir, &ck));
   PM_TRY(header_items(ck, &h));
