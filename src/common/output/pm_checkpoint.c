@@ -49,8 +49,6 @@ static pm_ckpt *ckpt_new(void) {
 pm_err pm_ckpt_create(const char *dir, pm_ckpt **out) {
   pm_err ret = PM_SUCCESS;
   pm_ckpt *c = ckpt_new();
-  hid_t space = -1, attr = -1, type = -1;
-  const char *fmt = CKPT_FORMAT;
   *out = NULL;
   PM_CHECK(c, PM_ERR_MEMORY, "cannot allocate a checkpoint writer");
   PM_TRY(pm_path_join(c->path, sizeof c->path, dir, "checkpoint.h5"));
@@ -58,19 +56,10 @@ pm_err pm_ckpt_create(const char *dir, pm_ckpt **out) {
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   H5_OK(c->file = H5Fcreate(c->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
         "H5Fcreate", "/", c->tmp);
-  H5_OK(type = H5Tcopy(H5T_C_S1), "H5Tcopy", "format", c->tmp);
-  H5_OK(H5Tset_size(type, H5T_VARIABLE), "H5Tset_size", "format", c->tmp);
-  H5_OK(space = H5Screate(H5S_SCALAR), "H5Screate", "format", c->tmp);
-  H5_OK(attr = H5Acreate2(c->file, "format", type, space, H5P_DEFAULT,
-                          H5P_DEFAULT),
-        "H5Acreate2", "format", c->tmp);
-  H5_OK(H5Awrite(attr, type, &fmt), "H5Awrite", "format", c->tmp);
+  PM_TRY(pm_h5_write_string_attr(c->file, "format", CKPT_FORMAT, c->tmp));
   *out = c;
   c = NULL;
 done:
-  if (attr >= 0) H5Aclose(attr);
-  if (space >= 0) H5Sclose(space);
-  if (type >= 0) H5Tclose(type);
   pm_ckpt_abort(c);
   return ret;
 }
@@ -78,7 +67,6 @@ done:
 pm_err pm_ckpt_open(const char *dir, pm_ckpt **out) {
   pm_err ret = PM_SUCCESS;
   pm_ckpt *c = ckpt_new();
-  hid_t attr = -1, type = -1;
   char *fmt = NULL;
   *out = NULL;
   PM_CHECK(c, PM_ERR_MEMORY, "cannot allocate a checkpoint reader");
@@ -93,19 +81,15 @@ pm_err pm_ckpt_open(const char *dir, pm_ckpt **out) {
   PM_ENSURE(c->file >= 0, PM_ERR_IO,
             "checkpoint '%s' is damaged: HDF5 cannot open it (%s)", c->path,
             pm_h5_message());
-  H5_OK(type = H5Tcopy(H5T_C_S1), "H5Tcopy", "format", c->path);
-  H5_OK(H5Tset_size(type, H5T_VARIABLE), "H5Tset_size", "format", c->path);
-  attr = H5Aopen(c->file, "format", H5P_DEFAULT);
-  PM_ENSURE(attr >= 0 && H5Aread(attr, type, &fmt) >= 0 && fmt &&
-                strcmp(fmt, CKPT_FORMAT) == 0,
-            PM_ERR_IO, "'%s' is not a checkpoint of this program (format %s)",
-            c->path, fmt ? fmt : "missing");
+  if (pm_h5_read_string_attr(c->file, "format", &fmt, c->path) != PM_SUCCESS)
+    pm_error_clear();
+  PM_ENSURE(fmt && strcmp(fmt, CKPT_FORMAT) == 0, PM_ERR_IO,
+            "'%s' is not a checkpoint of this program (format %s)", c->path,
+            fmt ? fmt : "missing");
   *out = c;
   c = NULL;
 done:
-  if (fmt) H5free_memory(fmt);
-  if (attr >= 0) H5Aclose(attr);
-  if (type >= 0) H5Tclose(type);
+  free(fmt);
   pm_ckpt_abort(c);
   return ret;
 }
@@ -240,11 +224,7 @@ pm_err pm_ckpt_finish(pm_ckpt *c) {
     hid_t f = c->file;
     c->file = -1;
     H5_OK(H5Fclose(f), "H5Fclose", "/", c->tmp);
-    int fd = open(c->tmp, O_RDONLY | O_CLOEXEC);
-    int rc = fd >= 0 ? fsync(fd) : -1, e = errno;
-    if (fd >= 0) close(fd);
-    PM_ENSURE(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", c->tmp, strerror(e));
-    PM_TRY(pm_rename(c->tmp, c->path));
+    PM_TRY(pm_sync_rename(c->tmp, c->path));
     c->tmp[0] = '\0';
   }
 done:

@@ -157,6 +157,16 @@ pm_err pm_rename(const char *from, const char *to) {
   return PM_SUCCESS;
 }
 
+pm_err pm_sync_rename(const char *tmp, const char *path) {
+  int fd = open(tmp, O_RDONLY | O_CLOEXEC);
+  PM_CHECK(fd >= 0, PM_ERR_IO, "cannot reopen '%s' to sync it: %s", tmp,
+           strerror(errno));
+  int rc = fsync(fd), e = errno;
+  close(fd);
+  PM_CHECK(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", tmp, strerror(e));
+  return pm_rename(tmp, path);
+}
+
 /* ---- Atomic files ------------------------------------------------------ */
 
 struct pm_afile {
@@ -278,22 +288,19 @@ static pm_err history_truncate(const char *path, int ncols,
   in = fopen(path, "r");
   PM_CHECK(in, PM_ERR_IO, "cannot open '%s' to resume it: %s", path,
            strerror(errno));
-  PM_TRY(pm_afile_open(path, &out));
-  FILE *fp = pm_afile_stream(out);
   /* The header must be the one this run writes. */
-  csv_header(fp, ncols, names);
-  PM_ENSURE(fflush(fp) == 0, PM_ERR_IO, "cannot write '%s'", path);
-  {
-    FILE *h = open_memstream(&header, &hcap);
-    PM_ENSURE(h, PM_ERR_MEMORY, "cannot build the header of '%s'", path);
-    csv_header(h, ncols, names);
-    fclose(h);
-  }
+  FILE *h = open_memstream(&header, &hcap);
+  PM_ENSURE(h, PM_ERR_MEMORY, "cannot build the header of '%s'", path);
+  csv_header(h, ncols, names);
+  fclose(h);
   PM_ENSURE(getline(&line, &cap, in) >= 0 && strcmp(line, header) == 0,
             PM_ERR_IO,
             "'%s' does not start with the columns this run writes: it "
             "belongs to another scene or program version",
             path);
+  PM_TRY(pm_afile_open(path, &out));
+  FILE *fp = pm_afile_stream(out);
+  fputs(header, fp);
   while (rows < keep_rows && getline(&line, &cap, in) >= 0) {
     PM_ENSURE(strchr(line, '\n'), PM_ERR_IO,
               "'%s' row %ld is cut short: the checkpoint names %ld rows", path,

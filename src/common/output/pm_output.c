@@ -39,22 +39,6 @@ struct pm_results {
   char mesh_path[PM_PATH_MAX + 1];  /* dir/results/mesh.h5 */
 };
 
-/* Close an identifier if open, ignoring errors (cleanup paths only). */
-static void h5_close_quiet(hid_t *id) {
-  if (*id < 0) return;
-  switch (H5Iget_type(*id)) {
-  case H5I_FILE: H5Fclose(*id); break;
-  case H5I_GROUP: H5Gclose(*id); break;
-  case H5I_DATASET: H5Dclose(*id); break;
-  case H5I_DATASPACE: H5Sclose(*id); break;
-  case H5I_DATATYPE: H5Tclose(*id); break;
-  case H5I_ATTR: H5Aclose(*id); break;
-  case H5I_GENPROP_LST: H5Pclose(*id); break;
-  default: break;
-  }
-  *id = -1;
-}
-
 static bool field_name_ok(const char *name) {
   size_t len = name ? strlen(name) : 0;
   if (len == 0 || len > FIELD_NAME_MAX || name[0] == '.') return false;
@@ -74,25 +58,13 @@ static void tmp_name(char *buf, size_t size, const char *path) {
   snprintf(buf, size, "%s.tmp.%ld", path, (long)getpid());
 }
 
-/* Make the HDF5 file tmp durable and give it its final name.  A write the
- * system refused (full disk, file size limit) shows here at the latest. */
-static pm_err commit_file(const char *tmp, const char *path) {
-  int fd = open(tmp, O_RDONLY | O_CLOEXEC);
-  PM_CHECK(fd >= 0, PM_ERR_IO, "cannot reopen '%s' to sync it: %s", tmp,
-           strerror(errno));
-  int rc = fsync(fd), e = errno;
-  close(fd);
-  PM_CHECK(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", tmp, strerror(e));
-  return pm_rename(tmp, path);
-}
-
 /* Close the HDF5 file written under tmp and commit it to path. */
 static pm_err close_and_commit(hid_t *file, const char *tmp, const char *path) {
   hid_t f = *file;
   *file = -1;
   PM_CHECK(H5Fclose(f) >= 0, PM_ERR_HDF5, "H5Fclose(/) failed on '%s': %s", tmp,
            pm_h5_message());
-  return commit_file(tmp, path);
+  return pm_sync_rename(tmp, path);
 }
 
 /* An HDF5 failure that the system caused (no space, file too large, no
@@ -132,73 +104,7 @@ static pm_err check_room(const char *dir, const char *path, double bytes) {
 /* HDF5's own overhead of a small file, bytes (headers, attributes). */
 #define H5_OVERHEAD 16384.0
 
-/* ---- Attributes and datasets -------------------------------------------- */
-
-/* Scalar attribute name of file type ftype on loc written from value. */
-static pm_err write_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
-                         const void *value, const char *path) {
-  pm_err ret = PM_SUCCESS;
-  hid_t space = -1, attr = -1;
-  H5_OK(space = H5Screate(H5S_SCALAR), "H5Screate", name, path);
-  H5_OK(attr = H5Acreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT),
-        "H5Acreate2", name, path);
-  H5_OK(H5Awrite(attr, mtype, value), "H5Awrite", name, path);
-  H5_OK(H5Aclose(attr), "H5Aclose", name, path);
-  attr = -1;
-done:
-  h5_close_quiet(&attr);
-  h5_close_quiet(&space);
-  return ret;
-}
-
-/* Variable-length UTF-8 string attribute (no size limit: the text lives in
- * the global heap). */
-static pm_err write_string_attr(hid_t loc, const char *name, const char *text,
-                                const char *path) {
-  pm_err ret = PM_SUCCESS;
-  hid_t type = -1;
-  const char *value = text ? text : "";
-  H5_OK(type = H5Tcopy(H5T_C_S1), "H5Tcopy", name, path);
-  H5_OK(H5Tset_size(type, H5T_VARIABLE), "H5Tset_size", name, path);
-  H5_OK(H5Tset_cset(type, H5T_CSET_UTF8), "H5Tset_cset", name, path);
-  PM_TRY(write_attr(loc, name, type, type, &value, path));
-done:
-  h5_close_quiet(&type);
-  return ret;
-}
-
-/* Read scalar attribute name of loc into value (memory type mtype). */
-static pm_err read_attr(hid_t loc, const char *name, hid_t mtype, void *value,
-                        const char *obj, const char *path) {
-  pm_err ret = PM_SUCCESS;
-  hid_t attr = -1;
-  H5_OK(attr = H5Aopen(loc, name, H5P_DEFAULT), "H5Aopen", obj, path);
-  H5_OK(H5Aread(attr, mtype, value), "H5Aread", obj, path);
-  H5_OK(H5Aclose(attr), "H5Aclose", obj, path);
-  attr = -1;
-done:
-  h5_close_quiet(&attr);
-  return ret;
-}
-
-/* A variable-length string attribute as a malloc'd copy (*out). */
-static pm_err read_string_attr(hid_t loc, const char *name, char **out,
-                               const char *path) {
-  pm_err ret = PM_SUCCESS;
-  hid_t type = -1;
-  char *value = NULL;
-  *out = NULL;
-  H5_OK(type = H5Tcopy(H5T_C_S1), "H5Tcopy", name, path);
-  H5_OK(H5Tset_size(type, H5T_VARIABLE), "H5Tset_size", name, path);
-  PM_TRY(read_attr(loc, name, type, &value, name, path));
-  *out = strdup(value ? value : "");
-  PM_ENSURE(*out, PM_ERR_MEMORY, "cannot copy attribute %s of '%s'", name,
-            path);
-done:
-  if (value) H5free_memory(value);
-  h5_close_quiet(&type);
-  return ret;
-}
+/* ---- Datasets ----------------------------------------------------------- */
 
 /* Write the dataset loc/name of rank dims (file type ftype, memory mtype). */
 static pm_err write_dataset(hid_t loc, const char *name, int rank,
@@ -222,8 +128,8 @@ static pm_err write_dataset(hid_t loc, const char *name, int rank,
     dset = -1;
   }
 done:
-  h5_close_quiet(&dset);
-  h5_close_quiet(&space);
+  pm_h5_close_quiet(&dset);
+  pm_h5_close_quiet(&space);
   return ret;
 }
 
@@ -434,10 +340,12 @@ static pm_err index_commit(const pm_results *r) {
   tmp_name(tmp, sizeof tmp, r->index_path);
   H5_OK(file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
         "H5Fcreate", "/", path);
-  PM_TRY(write_string_attr(file, "scene", r->scene_text, path));
-  PM_TRY(write_string_attr(file, "version", r->version, path));
-  PM_TRY(write_attr(file, "dim", H5T_STD_I32LE, H5T_NATIVE_INT, &r->dim, path));
-  PM_TRY(write_attr(file, "frames", H5T_STD_I64LE, H5T_NATIVE_LONG, &nf, path));
+  PM_TRY(pm_h5_write_string_attr(file, "scene", r->scene_text, path));
+  PM_TRY(pm_h5_write_string_attr(file, "version", r->version, path));
+  PM_TRY(pm_h5_write_attr(file, "dim", H5T_STD_I32LE, H5T_NATIVE_INT, &r->dim,
+                          path));
+  PM_TRY(pm_h5_write_attr(file, "frames", H5T_STD_I64LE, H5T_NATIVE_LONG, &nf,
+                          path));
   H5_OK(H5Lcreate_external(RESULTS_SUBDIR "/mesh.h5", "/", file, "mesh",
                            H5P_DEFAULT, H5P_DEFAULT),
         "H5Lcreate_external", "/mesh", path);
@@ -459,9 +367,9 @@ static pm_err index_commit(const pm_results *r) {
   frames = -1;
   PM_TRY(close_and_commit(&file, tmp, r->index_path));
 done:
-  h5_close_quiet(&gcpl);
-  h5_close_quiet(&frames);
-  h5_close_quiet(&file);
+  pm_h5_close_quiet(&gcpl);
+  pm_h5_close_quiet(&frames);
+  pm_h5_close_quiet(&file);
   if (ret != PM_SUCCESS) unlink(tmp);
   return ret;
 }
@@ -501,14 +409,14 @@ static pm_err write_mesh(const pm_results *r, const double *x,
                        H5T_NATIVE_DOUBLE, x, path, NULL));
   PM_TRY(write_dataset(file, "cells", 2, cd, H5T_STD_I64LE, H5T_NATIVE_LONG,
                        cells, path, &dset));
-  PM_TRY(write_attr(dset, "nodes_per_cell", H5T_STD_I32LE, H5T_NATIVE_INT, &npc,
-                    path));
+  PM_TRY(pm_h5_write_attr(dset, "nodes_per_cell", H5T_STD_I32LE, H5T_NATIVE_INT,
+                          &npc, path));
   H5_OK(H5Dclose(dset), "H5Dclose", "/cells", path);
   dset = -1;
   PM_TRY(close_and_commit(&file, tmp, r->mesh_path));
 done:
-  h5_close_quiet(&dset);
-  h5_close_quiet(&file);
+  pm_h5_close_quiet(&dset);
+  pm_h5_close_quiet(&file);
   if (ret != PM_SUCCESS) unlink(tmp);
   return ret;
 }
@@ -604,8 +512,8 @@ static pm_err reread_frame(pm_results *r, long k) {
   frame_path(r, k, path, sizeof path);
   H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
         path);
-  PM_TRY(read_attr(file, "time", H5T_NATIVE_DOUBLE, &time, "/", path));
-  PM_TRY(read_attr(file, "step", H5T_NATIVE_LONG, &step, "/", path));
+  PM_TRY(pm_h5_read_attr(file, "time", H5T_NATIVE_DOUBLE, &time, "/", path));
+  PM_TRY(pm_h5_read_attr(file, "step", H5T_NATIVE_LONG, &step, "/", path));
   H5_OK(H5Gget_info(file, &info), "H5Gget_info", "/", path);
   PM_ENSURE(info.nlinks <= 16, PM_ERR_HDF5,
             "'%s' holds %llu fields (16 at most)", path,
@@ -630,14 +538,14 @@ static pm_err reread_frame(pm_results *r, long k) {
                   (ncomp[nf] == 1 || ncomp[nf] == 3 || ncomp[nf] == 9),
               PM_ERR_HDF5, "field %s of '%s' has %lld values for %ld points",
               names[nf], path, (long long)count, r->n_points);
-    h5_close_quiet(&space);
-    h5_close_quiet(&dset);
+    pm_h5_close_quiet(&space);
+    pm_h5_close_quiet(&dset);
   }
   PM_TRY(xdmf_frame(r, k, step, time, nf, names, ncomp));
 done:
-  h5_close_quiet(&space);
-  h5_close_quiet(&dset);
-  h5_close_quiet(&file);
+  pm_h5_close_quiet(&space);
+  pm_h5_close_quiet(&dset);
+  pm_h5_close_quiet(&file);
   return ret;
 }
 
@@ -657,10 +565,10 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   path = r->index_path;
   H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
         path);
-  PM_TRY(read_string_attr(file, "scene", &r->scene_text, path));
-  PM_TRY(read_string_attr(file, "version", &r->version, path));
-  PM_TRY(read_attr(file, "dim", H5T_NATIVE_INT, &r->dim, "/", path));
-  h5_close_quiet(&file);
+  PM_TRY(pm_h5_read_string_attr(file, "scene", &r->scene_text, path));
+  PM_TRY(pm_h5_read_string_attr(file, "version", &r->version, path));
+  PM_TRY(pm_h5_read_attr(file, "dim", H5T_NATIVE_INT, &r->dim, "/", path));
+  pm_h5_close_quiet(&file);
   path = r->mesh_path;
   H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
         path);
@@ -673,8 +581,8 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
         "H5Sget_simple_extent_dims", "/cells", path);
   r->n_cells = (long)dims[0];
   r->nodes_per_cell = (int)dims[1];
-  h5_close_quiet(&space);
-  h5_close_quiet(&dset);
+  pm_h5_close_quiet(&space);
+  pm_h5_close_quiet(&dset);
   H5_OK(dset = H5Dopen2(file, "coordinates", H5P_DEFAULT), "H5Dopen2",
         "/coordinates", path);
   H5_OK(space = H5Dget_space(dset), "H5Dget_space", "/coordinates", path);
@@ -686,9 +594,9 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   PM_ENSURE(r->n_points == n_points, PM_ERR_ARG,
             "'%s' holds %ld points, the run has %ld", path, r->n_points,
             n_points);
-  h5_close_quiet(&space);
-  h5_close_quiet(&dset);
-  h5_close_quiet(&file);
+  pm_h5_close_quiet(&space);
+  pm_h5_close_quiet(&dset);
+  pm_h5_close_quiet(&file);
   /* The frames kept must all be readable before anything changes. */
   for (long k = 0; k < n_keep; k++) PM_TRY(reread_frame(r, k));
   r->n_frames = n_keep;
@@ -697,9 +605,9 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   *out = r;
   r = NULL;
 done:
-  h5_close_quiet(&space);
-  h5_close_quiet(&dset);
-  h5_close_quiet(&file);
+  pm_h5_close_quiet(&space);
+  pm_h5_close_quiet(&dset);
+  pm_h5_close_quiet(&file);
   results_free(r);
   return ret;
 }
@@ -731,9 +639,10 @@ static pm_err write_frame_file(const pm_results *r, const char *tmp, long step,
         "H5Pset_link_creation_order", "fcpl", path);
   H5_OK(file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT), "H5Fcreate",
         "/", path);
-  PM_TRY(write_attr(file, "step", H5T_STD_I64LE, H5T_NATIVE_LONG, &step, path));
-  PM_TRY(
-      write_attr(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, path));
+  PM_TRY(pm_h5_write_attr(file, "step", H5T_STD_I64LE, H5T_NATIVE_LONG, &step,
+                          path));
+  PM_TRY(pm_h5_write_attr(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                          &time, path));
   for (int i = 0; i < n_fields; i++) {
     const pm_field *f = &fields[i];
     hsize_t dims[3] = {(hsize_t)r->n_points, 3, 3};
@@ -744,8 +653,8 @@ static pm_err write_frame_file(const pm_results *r, const char *tmp, long step,
   H5_OK(H5Fclose(file), "H5Fclose", "/", path);
   file = -1;
 done:
-  h5_close_quiet(&fcpl);
-  h5_close_quiet(&file);
+  pm_h5_close_quiet(&fcpl);
+  pm_h5_close_quiet(&file);
   return ret;
 }
 
@@ -771,7 +680,7 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
   ret = write_frame_file(r, tmp, step, time, n_fields, fields);
   int saved = errno;
   PM_TRY(classify(ret, saved, path));
-  PM_TRY(commit_file(tmp, path));
+  PM_TRY(pm_sync_rename(tmp, path));
   for (int i = 0; i < n_fields; i++) {
     names[i] = fields[i].name;
     ncomp[i] = fields[i].ncomp;

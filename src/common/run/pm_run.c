@@ -442,34 +442,10 @@ static pm_err summary_accuracy(run_ctx *c, pm_json *j) {
   return pm_json_end_object(j);
 }
 
-static pm_err write_summary(run_ctx *c, const char *out_dir) {
-  pm_err ret = PM_SUCCESS;
-  pm_json *j = NULL;
-  char path[PM_PATH_MAX + 1];
-  const pm_scene *s = c->s;
-  PM_TRY(pm_path_join(path, sizeof path, out_dir, "summary.json"));
-  PM_TRY(pm_json_open(path, &j));
-  PM_TRY(pm_json_begin_object(j, NULL));
-  PM_TRY(pm_json_run_header(j, s->path, s->name, s->method, s->n_overrides,
-                            s->overrides));
-  PM_TRY(pm_json_string(j, "status", pm_status_name(c->o->fig.status)));
-  if (c->o->message[0]) PM_TRY(pm_json_string(j, "message", c->o->message));
-  PM_TRY(pm_json_integer(j, "frames", pm_results_frames(c->results)));
-  PM_TRY(summary_figures(c, j));
-  PM_TRY(summary_cost(c, j));
-  PM_TRY(summary_accuracy(c, j));
-  if (c->be->summary) PM_TRY(c->be->summary(c->sim, j));
-  PM_TRY(pm_json_end_object(j));
-  ret = pm_json_close(j, true);
-  j = NULL;
-done:
-  if (j) pm_json_close(j, false);
-  return ret;
-}
-
-/* summary.json while the run goes on: status "running" and who runs it
- * (a killed run leaves it so; its folder's lock is then free). */
-static pm_err write_running(run_ctx *c) {
+/* OUT/summary.json.  running: while the run goes on, status "running" and
+ * who runs it (a killed run leaves it so; its folder's lock is then free);
+ * otherwise the outcome, figures, cost and accuracy. */
+static pm_err write_summary(run_ctx *c, bool running) {
   pm_err ret = PM_SUCCESS;
   pm_json *j = NULL;
   char path[PM_PATH_MAX + 1];
@@ -479,11 +455,21 @@ static pm_err write_running(run_ctx *c) {
   PM_TRY(pm_json_begin_object(j, NULL));
   PM_TRY(pm_json_run_header(j, s->path, s->name, s->method, s->n_overrides,
                             s->overrides));
-  PM_TRY(pm_json_string(j, "status", "running"));
-  PM_TRY(pm_json_integer(j, "pid", (long long)getpid()));
-  PM_TRY(pm_json_integer(j, "started", (long long)time(NULL)));
-  PM_TRY(pm_json_integer(j, "resumes", c->resumes));
-  PM_TRY(pm_json_integer(j, "resumed_from_step", c->resumed_from));
+  if (running) {
+    PM_TRY(pm_json_string(j, "status", "running"));
+    PM_TRY(pm_json_integer(j, "pid", (long long)getpid()));
+    PM_TRY(pm_json_integer(j, "started", (long long)time(NULL)));
+    PM_TRY(pm_json_integer(j, "resumes", c->resumes));
+    PM_TRY(pm_json_integer(j, "resumed_from_step", c->resumed_from));
+  } else {
+    PM_TRY(pm_json_string(j, "status", pm_status_name(c->o->fig.status)));
+    if (c->o->message[0]) PM_TRY(pm_json_string(j, "message", c->o->message));
+    PM_TRY(pm_json_integer(j, "frames", pm_results_frames(c->results)));
+    PM_TRY(summary_figures(c, j));
+    PM_TRY(summary_cost(c, j));
+    PM_TRY(summary_accuracy(c, j));
+    if (c->be->summary) PM_TRY(c->be->summary(c->sim, j));
+  }
   PM_TRY(pm_json_end_object(j));
   ret = pm_json_close(j, true);
   j = NULL;
@@ -609,7 +595,7 @@ static pm_err open_outputs(run_ctx *c, const char *out_dir, unsigned flags,
                               &c->results));
     PM_CALL(pm_history_open(out_dir, c->n_cols, c->names, -1, &c->history));
   }
-  return write_running(c);
+  return write_summary(c, true);
 }
 
 /* Read the backend's items of a checkpoint and check it whole. */
@@ -689,7 +675,7 @@ static pm_err run_sim(const pm_scene *s, void *sim, const char *out_dir,
     pm_history *h = c->history;
     c->history = NULL;
     PM_TRY(pm_history_close(h));
-    PM_TRY(write_summary(c, out_dir));
+    PM_TRY(write_summary(c, false));
   }
   if (!quiet) report(c);
   if (run_err != PM_SUCCESS)
