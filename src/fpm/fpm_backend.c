@@ -239,12 +239,12 @@ static pm_err run(void *p, const pm_observer *obs) {
 /* ---- what the run driver reads ------------------------------------------ */
 
 static void points(void *p, pm_points *pts) {
-  fpm_sim *sim = p;
-  pts->n = sim->model->n;
-  pts->x = sim->model->x;
-  pts->n_cells = sim->mesh->n_cells;
-  pts->nodes_per_cell = sim->mesh->nodes_per_cell;
-  pts->cells = sim->mesh->cells;
+  const fpm_sim *sim = p;
+  *pts = (pm_points){.n = sim->model->n,
+                     .x = sim->model->x,
+                     .n_cells = sim->mesh->n_cells,
+                     .nodes_per_cell = sim->mesh->nodes_per_cell,
+                     .cells = sim->mesh->cells};
 }
 
 static const double *displacement(void *p) { return ((fpm_sim *)p)->state->u; }

@@ -23,15 +23,23 @@
 #define OBJ_NAME_MAX 128
 #define RESULTS_SUBDIR "results"
 #define FRAME_FMT "frame_%06ld.h5"
+#define POINTS_GRID "points" /* the cells' grid beside a surface's */
+#define SURFACE_NAME "membrane"
+
+/* Text grown as it is written. */
+typedef struct {
+  char *s;
+  size_t len, cap;
+} xml_text;
 
 struct pm_results {
   int dim, nodes_per_cell;
   long n_points, n_cells, n_frames;
-  bool created; /* by pm_results_create: removed by close(!keep, no frame) */
+  long n_surface; /* triangles in mesh.h5's /surface (grid SURFACE_NAME) */
+  bool created;   /* by pm_results_create: removed by close(!keep, no frame) */
   char *scene_text, *version;
   /* The XDMF of the frames so far (one <Grid> each), rewritten whole. */
-  char *xdmf;
-  size_t xdmf_len, xdmf_cap;
+  xml_text frames;
   char dir[PM_PATH_MAX + 1];
   char sub[PM_PATH_MAX + 1];        /* dir/results */
   char index_path[PM_PATH_MAX + 1]; /* dir/results.h5 */
@@ -135,22 +143,32 @@ done:
 
 /* ---- Checks ------------------------------------------------------------- */
 
-static pm_err check_mesh(int dim, long n_points, const double *x, long n_cells,
-                         int npc, const long *cells) {
+/* n items of npc point indices each, all in [0, n_points). */
+static pm_err check_indices(const char *what, long n, int npc, const long *ids,
+                            long n_points) {
+  PM_CHECK(n >= 1 && ids, PM_ERR_ARG,
+           "results: need at least one %s (%ld given)", what, n);
+  for (long i = 0; i < n * npc; i++)
+    PM_CHECK(ids[i] >= 0 && ids[i] < n_points, PM_ERR_ARG,
+             "results: %s %ld refers to point %ld (%ld points)", what, i / npc,
+             ids[i], n_points);
+  return PM_SUCCESS;
+}
+
+static pm_err check_mesh(int dim, const pm_points *p) {
+  int npc = p->nodes_per_cell;
   PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG, "results: dim %d is not 2 or 3",
            dim);
-  PM_CHECK(n_points >= 1 && x, PM_ERR_ARG,
-           "results: need at least one point (n_points %ld)", n_points);
+  PM_CHECK(p->n >= 1 && p->x, PM_ERR_ARG,
+           "results: need at least one point (n_points %ld)", p->n);
   PM_CHECK(npc == 1 || npc == 3 || npc == 4, PM_ERR_ARG,
            "results: %d nodes per cell (1, 3 or 4 expected)", npc);
-  if (npc == 1 && !cells) return PM_SUCCESS;
-  PM_CHECK(n_cells >= 1 && cells, PM_ERR_ARG,
-           "results: need at least one cell (n_cells %ld)", n_cells);
-  for (long i = 0; i < n_cells * npc; i++)
-    PM_CHECK(cells[i] >= 0 && cells[i] < n_points, PM_ERR_ARG,
-             "results: cell %ld refers to point %ld (%ld points)", i / npc,
-             cells[i], n_points);
-  return PM_SUCCESS;
+  if (npc != 1 || p->cells)
+    PM_CALL(check_indices("cell", p->n_cells, npc, p->cells, p->n));
+  PM_CHECK(p->n_surface >= 0, PM_ERR_ARG, "results: %ld surface triangles",
+           p->n_surface);
+  if (p->n_surface == 0) return PM_SUCCESS;
+  return check_indices("surface triangle", p->n_surface, 3, p->surface, p->n);
 }
 
 /* The output directory must exist and be writable. */
@@ -208,28 +226,28 @@ static void frame_path(const pm_results *r, long k, char *buf, size_t size) {
 
 /* ---- XDMF --------------------------------------------------------------- */
 
-/* Append printf-formatted text to the frames' XDMF. */
-static pm_err xdmf_add(pm_results *r, const char *fmt, ...)
+/* Append printf-formatted text to t. */
+static pm_err text_add(xml_text *t, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
-static pm_err xdmf_add(pm_results *r, const char *fmt, ...) {
+static pm_err text_add(xml_text *t, const char *fmt, ...) {
   for (;;) {
     va_list ap;
     va_start(ap, fmt);
-    size_t room = r->xdmf_cap - r->xdmf_len;
-    int n = vsnprintf(r->xdmf ? r->xdmf + r->xdmf_len : NULL, room, fmt, ap);
+    size_t room = t->cap - t->len;
+    int n = vsnprintf(t->s ? t->s + t->len : NULL, room, fmt, ap);
     va_end(ap);
     PM_CHECK(n >= 0, PM_ERR_INTERNAL, "XDMF text formatting failed");
     if ((size_t)n < room) {
-      r->xdmf_len += (size_t)n;
+      t->len += (size_t)n;
       return PM_SUCCESS;
     }
-    size_t cap = r->xdmf_cap ? 2 * r->xdmf_cap : 16384;
-    while (cap < r->xdmf_len + (size_t)n + 1) cap *= 2;
-    char *grown = realloc(r->xdmf, cap);
+    size_t cap = t->cap ? 2 * t->cap : 16384;
+    while (cap < t->len + (size_t)n + 1) cap *= 2;
+    char *grown = realloc(t->s, cap);
     PM_CHECK(grown, PM_ERR_MEMORY, "cannot grow the XDMF text to %zu bytes",
              cap);
-    r->xdmf = grown;
-    r->xdmf_cap = cap;
+    t->s = grown;
+    t->cap = cap;
   }
 }
 
@@ -239,93 +257,138 @@ static void format_double(char *buf, size_t size, double v) {
   if (strtod(buf, NULL) != v) snprintf(buf, size, "%.17g", v);
 }
 
-/* The mesh's topology element, indented by ind. */
-static void topology_text(const pm_results *r, int ind, char *buf,
-                          size_t size) {
-  const char *topo = r->nodes_per_cell == 1   ? "Polyvertex"
-                     : r->nodes_per_cell == 3 ? "Triangle"
-                     : r->dim == 3            ? "Tetrahedron"
-                                              : "Quadrilateral";
-  snprintf(buf, size,
-           "%*s<Topology TopologyType=\"%s\" NumberOfElements=\"%ld\"%s>\n"
-           "%*s<DataItem Dimensions=\"%ld %d\" NumberType=\"Int\" "
-           "Precision=\"8\" Format=\"HDF\">" RESULTS_SUBDIR
-           "/mesh.h5:/cells</DataItem>\n%*s</Topology>\n",
-           ind, "", topo, r->n_cells,
-           r->nodes_per_cell == 1 ? " NodesPerElement=\"1\"" : "", ind + 2, "",
-           r->n_cells, r->nodes_per_cell, ind, "");
+/* A topology of n elements of npc points, mesh.h5's dataset, indented by
+ * ind. */
+static pm_err topology_add(xml_text *t, int ind, const char *type, long n,
+                           int npc, const char *dataset) {
+  return text_add(
+      t,
+      "%*s<Topology TopologyType=\"%s\" NumberOfElements=\"%ld\"%s>\n"
+      "%*s<DataItem Dimensions=\"%ld %d\" NumberType=\"Int\" "
+      "Precision=\"8\" Format=\"HDF\">" RESULTS_SUBDIR
+      "/mesh.h5:/%s</DataItem>\n%*s</Topology>\n",
+      ind, "", type, n, npc == 1 ? " NodesPerElement=\"1\"" : "", ind + 2, "",
+      n, npc, dataset, ind, "");
 }
 
-static const char *geometry_fmt =
-    "%*s<Geometry GeometryType=\"XYZ\">\n"
-    "%*s<DataItem Dimensions=\"%ld 3\" NumberType=\"Float\" Precision=\"8\" "
-    "Format=\"HDF\">" RESULTS_SUBDIR "/%s:/%s</DataItem>\n%*s</Geometry>\n";
+/* What a frame's grids show: the frame's file and its fields (file NULL
+ * and no field for the bare mesh). */
+typedef struct {
+  const char *file;
+  int nf;
+  const char *const *names;
+  const int *ncomp;
+} grid_data;
 
-/* One frame's uniform grid, from its field names and component counts. */
+/* One uniform grid's body, indented by ind: the topology of the cells (or
+ * of the surface), the geometry (the frame's "position" or the reference
+ * coordinates) and every other field as a node-centred attribute. */
+static pm_err grid_body(xml_text *t, const pm_results *r, int ind, bool surface,
+                        const grid_data *g) {
+  const char *geometry = NULL;
+  for (int i = 0; i < g->nf; i++)
+    if (g->ncomp[i] == 3 && strcmp(g->names[i], "position") == 0)
+      geometry = g->names[i];
+  if (surface) {
+    PM_CALL(topology_add(t, ind, "Triangle", r->n_surface, 3, "surface"));
+  } else {
+    const char *type = r->nodes_per_cell == 1   ? "Polyvertex"
+                       : r->nodes_per_cell == 3 ? "Triangle"
+                       : r->dim == 3            ? "Tetrahedron"
+                                                : "Quadrilateral";
+    PM_CALL(topology_add(t, ind, type, r->n_cells, r->nodes_per_cell, "cells"));
+  }
+  PM_CALL(text_add(t,
+                   "%*s<Geometry GeometryType=\"XYZ\">\n"
+                   "%*s<DataItem Dimensions=\"%ld 3\" NumberType=\"Float\" "
+                   "Precision=\"8\" Format=\"HDF\">" RESULTS_SUBDIR
+                   "/%s:/%s</DataItem>\n%*s</Geometry>\n",
+                   ind, "", ind + 2, "", r->n_points,
+                   geometry ? g->file : "mesh.h5",
+                   geometry ? "position" : "coordinates", ind, ""));
+  for (int i = 0; i < g->nf; i++) {
+    int nc = g->ncomp[i];
+    if (g->names[i] == geometry) continue;
+    PM_CALL(text_add(
+        t,
+        "%*s<Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n"
+        "%*s<DataItem Dimensions=\"%ld%s\" NumberType=\"Float\" "
+        "Precision=\"8\" Format=\"HDF\">" RESULTS_SUBDIR "/%s:/%s</DataItem>\n"
+        "%*s</Attribute>\n",
+        ind, "", g->names[i],
+        nc == 1   ? "Scalar"
+        : nc == 3 ? "Vector"
+                  : "Tensor",
+        ind + 2, "", r->n_points,
+        nc == 1   ? ""
+        : nc == 3 ? " 3"
+                  : " 3 3",
+        g->file, g->names[i], ind, ""));
+  }
+  return PM_SUCCESS;
+}
+
+/* The grid named name, indented by ind, head (its Time and Information
+ * lines, or "") first: one uniform grid, or with a surface a spatial
+ * collection of two, the cells' ("points") and the surface's. */
+static pm_err grid_add(xml_text *t, const pm_results *r, int ind,
+                       const char *name, const char *head, const grid_data *g) {
+  bool two = r->n_surface > 0;
+  PM_CALL(text_add(
+      t, "%*s<Grid Name=\"%s\" GridType=\"%s\">\n%s", ind, "", name,
+      two ? "Collection\" CollectionType=\"Spatial" : "Uniform", head));
+  if (!two) PM_CALL(grid_body(t, r, ind + 2, false, g));
+  for (int k = 0; two && k < 2; k++) {
+    PM_CALL(text_add(t, "%*s<Grid Name=\"%s\" GridType=\"Uniform\">\n", ind + 2,
+                     "", k ? SURFACE_NAME : POINTS_GRID));
+    PM_CALL(grid_body(t, r, ind + 4, k == 1, g));
+    PM_CALL(text_add(t, "%*s</Grid>\n", ind + 2, ""));
+  }
+  return text_add(t, "%*s</Grid>\n", ind, "");
+}
+
+/* Frame k's grid, from its field names and component counts, appended to
+ * the frames' XDMF. */
 static pm_err xdmf_frame(pm_results *r, long k, long step, double time, int nf,
                          const char *const *names, const int *ncomp) {
-  char tbuf[40], file[32], topo[512];
-  const char *geometry = NULL;
+  char tbuf[40], file[32], name[32], head[160];
   format_double(tbuf, sizeof tbuf, time);
   snprintf(file, sizeof file, FRAME_FMT, k);
-  for (int i = 0; i < nf; i++)
-    if (ncomp[i] == 3 && strcmp(names[i], "position") == 0) geometry = names[i];
-  PM_CALL(xdmf_add(r,
-                   "      <Grid Name=\"frame_%06ld\" GridType=\"Uniform\">\n"
-                   "        <Time Value=\"%s\"/>\n"
-                   "        <Information Name=\"step\" Value=\"%ld\"/>\n",
-                   k, tbuf, step));
-  topology_text(r, 8, topo, sizeof topo);
-  PM_CALL(xdmf_add(r, "%s", topo));
-  PM_CALL(xdmf_add(r, geometry_fmt, 8, "", 10, "", r->n_points,
-                   geometry ? file : "mesh.h5",
-                   geometry ? "position" : "coordinates", 8, ""));
-  for (int i = 0; i < nf; i++) {
-    if (names[i] == geometry) continue;
-    PM_CALL(xdmf_add(
-        r,
-        "        <Attribute Name=\"%s\" AttributeType=\"%s\" "
-        "Center=\"Node\">\n"
-        "          <DataItem Dimensions=\"%ld%s\" "
-        "NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" RESULTS_SUBDIR
-        "/%s:/%s</DataItem>\n"
-        "        </Attribute>\n",
-        names[i],
-        ncomp[i] == 1   ? "Scalar"
-        : ncomp[i] == 3 ? "Vector"
-                        : "Tensor",
-        r->n_points,
-        ncomp[i] == 1   ? ""
-        : ncomp[i] == 3 ? " 3"
-                        : " 3 3",
-        file, names[i]));
-  }
-  return xdmf_add(r, "      </Grid>\n");
+  snprintf(name, sizeof name, "frame_%06ld", k);
+  snprintf(head, sizeof head,
+           "        <Time Value=\"%s\"/>\n"
+           "        <Information Name=\"step\" Value=\"%ld\"/>\n",
+           tbuf, step);
+  grid_data g = {file, nf, names, ncomp};
+  return grid_add(&r->frames, r, 6, name, head, &g);
 }
 
-/* results.xdmf: the topology once, then the frames (or the bare mesh). */
+/* results.xdmf: the frames' temporal collection (or the bare mesh). */
 static pm_err xdmf_commit(const pm_results *r) {
+  pm_err ret = PM_SUCCESS;
   pm_afile *f = NULL;
-  PM_CALL(pm_afile_open(r->xdmf_path, &f));
+  xml_text bare = {0};
+  const xml_text *grids = &r->frames;
+  if (r->n_frames == 0) {
+    grid_data none = {NULL, 0, NULL, NULL};
+    PM_TRY(grid_add(&bare, r, 4, "mesh", "", &none));
+    grids = &bare;
+  }
+  PM_TRY(pm_afile_open(r->xdmf_path, &f));
   FILE *fp = pm_afile_stream(f);
   fprintf(fp, "<?xml version=\"1.0\" ?>\n"
               "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
               "<Xdmf Version=\"3.0\">\n  <Domain>\n");
-  if (r->n_frames == 0) {
-    char topo[512];
-    topology_text(r, 6, topo, sizeof topo);
-    fprintf(fp, "    <Grid Name=\"mesh\" GridType=\"Uniform\">\n%s", topo);
-    fprintf(fp, geometry_fmt, 6, "", 8, "", r->n_points, "mesh.h5",
-            "coordinates", 6, "");
-    fprintf(fp, "    </Grid>\n");
-  } else {
+  if (r->n_frames > 0)
     fprintf(fp, "    <Grid Name=\"pointmech\" GridType=\"Collection\" "
                 "CollectionType=\"Temporal\">\n");
-    fwrite(r->xdmf, 1, r->xdmf_len, fp);
-    fprintf(fp, "    </Grid>\n");
-  }
+  fwrite(grids->s, 1, grids->len, fp);
+  if (r->n_frames > 0) fprintf(fp, "    </Grid>\n");
   fprintf(fp, "  </Domain>\n</Xdmf>\n");
-  return pm_afile_commit(f);
+  ret = pm_afile_commit(f);
+done:
+  free(bare.s);
+  return ret;
 }
 
 /* ---- Index -------------------------------------------------------------- */
@@ -386,12 +449,12 @@ static void results_free(pm_results *r) {
   if (!r) return;
   free(r->scene_text);
   free(r->version);
-  free(r->xdmf);
+  free(r->frames.s);
   free(r);
 }
 
 static pm_err write_mesh(const pm_results *r, const double *x,
-                         const long *cells) {
+                         const long *cells, const long *surface) {
   pm_err ret = PM_SUCCESS;
   hid_t file = -1, dset = -1;
   char tmp[PM_PATH_MAX + 40];
@@ -399,10 +462,12 @@ static pm_err write_mesh(const pm_results *r, const double *x,
   int npc = r->nodes_per_cell;
   hsize_t xd[2] = {(hsize_t)r->n_points, 3};
   hsize_t cd[2] = {(hsize_t)r->n_cells, (hsize_t)npc};
+  hsize_t sd[2] = {(hsize_t)r->n_surface, 3};
   tmp_name(tmp, sizeof tmp, r->mesh_path);
   PM_TRY(check_room(r->sub, r->mesh_path,
                     H5_OVERHEAD + 8.0 * (3.0 * (double)r->n_points +
-                                         (double)r->n_cells * npc)));
+                                         (double)r->n_cells * npc +
+                                         3.0 * (double)r->n_surface)));
   H5_OK(file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
         "H5Fcreate", "/", path);
   PM_TRY(write_dataset(file, "coordinates", 2, xd, H5T_IEEE_F64LE,
@@ -413,6 +478,13 @@ static pm_err write_mesh(const pm_results *r, const double *x,
                           &npc, path));
   H5_OK(H5Dclose(dset), "H5Dclose", "/cells", path);
   dset = -1;
+  if (r->n_surface > 0) {
+    PM_TRY(write_dataset(file, "surface", 2, sd, H5T_STD_I64LE, H5T_NATIVE_LONG,
+                         surface, path, &dset));
+    PM_TRY(pm_h5_write_string_attr(dset, "name", SURFACE_NAME, path));
+    H5_OK(H5Dclose(dset), "H5Dclose", "/surface", path);
+    dset = -1;
+  }
   PM_TRY(close_and_commit(&file, tmp, r->mesh_path));
 done:
   pm_h5_close_quiet(&dset);
@@ -421,33 +493,34 @@ done:
   return ret;
 }
 
-pm_err pm_results_create(const char *dir, int dim, long n_points,
-                         const double *x, long n_cells, int nodes_per_cell,
-                         const long *cells, const char *scene_text,
-                         const char *version, pm_results **out) {
+pm_err pm_results_create_ex(const char *dir, int dim, const pm_points *p,
+                            const char *scene_text, const char *version,
+                            pm_results **out) {
   pm_err ret = PM_SUCCESS;
   pm_results *r = NULL;
   long *ids = NULL;
-  int npc = nodes_per_cell;
-  PM_CHECK(out, PM_ERR_ARG, "pm_results_create: NULL out");
+  PM_CHECK(out && p, PM_ERR_ARG, "pm_results_create: NULL out or points");
   *out = NULL;
-  PM_CALL(check_mesh(dim, n_points, x, n_cells, npc, cells));
+  PM_CALL(check_mesh(dim, p));
   PM_CALL(check_dir(dir));
   /* No clean-up at exit: after a write the system refused, HDF5's own
    * would close a file it cannot flush again. */
   H5dont_atexit();
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-  if (npc == 1 && !cells) { /* point cloud: cell i is point i */
-    PM_TRY(PM_ALLOC(ids, n_points, "point cloud cells"));
-    for (long i = 0; i < n_points; i++) ids[i] = i;
+  const long *cells = p->cells;
+  long n_cells = p->n_cells;
+  if (p->nodes_per_cell == 1 && !cells) { /* point cloud: cell i is point i */
+    PM_TRY(PM_ALLOC(ids, p->n, "point cloud cells"));
+    for (long i = 0; i < p->n; i++) ids[i] = i;
     cells = ids;
-    n_cells = n_points;
+    n_cells = p->n;
   }
   PM_TRY(PM_ALLOC(r, 1, "results writer"));
   r->dim = dim;
-  r->nodes_per_cell = npc;
-  r->n_points = n_points;
+  r->nodes_per_cell = p->nodes_per_cell;
+  r->n_points = p->n;
   r->n_cells = n_cells;
+  r->n_surface = p->n_surface;
   PM_TRY(set_paths(r, dir));
   r->scene_text = strdup(scene_text ? scene_text : "");
   r->version = strdup(version ? version : "");
@@ -457,7 +530,7 @@ pm_err pm_results_create(const char *dir, int dim, long n_points,
   r->created = true;
   int saved = 0;
   errno = 0;
-  ret = write_mesh(r, x, cells);
+  ret = write_mesh(r, p->x, cells, p->surface);
   if (ret == PM_SUCCESS) ret = publish(r);
   saved = errno;
   PM_TRY(classify(ret, saved, r->mesh_path));
@@ -470,6 +543,18 @@ done:
   }
   free(ids);
   return ret;
+}
+
+pm_err pm_results_create(const char *dir, int dim, long n_points,
+                         const double *x, long n_cells, int nodes_per_cell,
+                         const long *cells, const char *scene_text,
+                         const char *version, pm_results **out) {
+  pm_points p = {.n = n_points,
+                 .x = x,
+                 .n_cells = n_cells,
+                 .nodes_per_cell = nodes_per_cell,
+                 .cells = cells};
+  return pm_results_create_ex(dir, dim, &p, scene_text, version, out);
 }
 
 /* Remove frame files of index >= n_keep and temporary files left in
@@ -549,12 +634,56 @@ done:
   return ret;
 }
 
+/* The sizes of mesh.h5's table (a rank-2 dataset) /name. */
+static pm_err table_dims(hid_t file, const char *name, hsize_t dims[2],
+                         const char *path) {
+  pm_err ret = PM_SUCCESS;
+  hid_t dset = -1, space = -1;
+  H5_OK(dset = H5Dopen2(file, name, H5P_DEFAULT), "H5Dopen2", name, path);
+  H5_OK(space = H5Dget_space(dset), "H5Dget_space", name, path);
+  PM_ENSURE(H5Sget_simple_extent_ndims(space) == 2, PM_ERR_HDF5,
+            "'%s': /%s is not a table", path, name);
+  H5_OK(H5Sget_simple_extent_dims(space, dims, NULL),
+        "H5Sget_simple_extent_dims", name, path);
+done:
+  pm_h5_close_quiet(&space);
+  pm_h5_close_quiet(&dset);
+  return ret;
+}
+
+/* The mesh's sizes (and its surface's) from mesh.h5. */
+static pm_err reread_mesh(pm_results *r) {
+  pm_err ret = PM_SUCCESS;
+  hid_t file = -1;
+  hsize_t dims[2];
+  htri_t has_surface;
+  const char *path = r->mesh_path;
+  H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
+        path);
+  PM_TRY(table_dims(file, "cells", dims, path));
+  r->n_cells = (long)dims[0];
+  r->nodes_per_cell = (int)dims[1];
+  PM_TRY(table_dims(file, "coordinates", dims, path));
+  r->n_points = (long)dims[0];
+  H5_OK(has_surface = H5Lexists(file, "surface", H5P_DEFAULT), "H5Lexists",
+        "surface", path);
+  if (has_surface) {
+    PM_TRY(table_dims(file, "surface", dims, path));
+    PM_ENSURE(dims[0] >= 1 && dims[1] == 3, PM_ERR_HDF5,
+              "'%s': /surface is not a table of triangles (%llu x %llu)", path,
+              (unsigned long long)dims[0], (unsigned long long)dims[1]);
+    r->n_surface = (long)dims[0];
+  }
+done:
+  pm_h5_close_quiet(&file);
+  return ret;
+}
+
 pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
                          pm_results **out) {
   pm_err ret = PM_SUCCESS;
   pm_results *r = NULL;
-  hid_t file = -1, dset = -1, space = -1;
-  hsize_t dims[2];
+  hid_t file = -1;
   const char *path = "";
   PM_CHECK(out && n_keep >= 0, PM_ERR_ARG, "pm_results_reopen: bad arguments");
   *out = NULL;
@@ -569,34 +698,10 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   PM_TRY(pm_h5_read_string_attr(file, "version", &r->version, path));
   PM_TRY(pm_h5_read_attr(file, "dim", H5T_NATIVE_INT, &r->dim, "/", path));
   pm_h5_close_quiet(&file);
-  path = r->mesh_path;
-  H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
-        path);
-  H5_OK(dset = H5Dopen2(file, "cells", H5P_DEFAULT), "H5Dopen2", "/cells",
-        path);
-  H5_OK(space = H5Dget_space(dset), "H5Dget_space", "/cells", path);
-  PM_ENSURE(H5Sget_simple_extent_ndims(space) == 2, PM_ERR_HDF5,
-            "'%s': /cells is not a table", path);
-  H5_OK(H5Sget_simple_extent_dims(space, dims, NULL),
-        "H5Sget_simple_extent_dims", "/cells", path);
-  r->n_cells = (long)dims[0];
-  r->nodes_per_cell = (int)dims[1];
-  pm_h5_close_quiet(&space);
-  pm_h5_close_quiet(&dset);
-  H5_OK(dset = H5Dopen2(file, "coordinates", H5P_DEFAULT), "H5Dopen2",
-        "/coordinates", path);
-  H5_OK(space = H5Dget_space(dset), "H5Dget_space", "/coordinates", path);
-  PM_ENSURE(H5Sget_simple_extent_ndims(space) == 2, PM_ERR_HDF5,
-            "'%s': /coordinates is not a table", path);
-  H5_OK(H5Sget_simple_extent_dims(space, dims, NULL),
-        "H5Sget_simple_extent_dims", "/coordinates", path);
-  r->n_points = (long)dims[0];
+  PM_TRY(reread_mesh(r));
   PM_ENSURE(r->n_points == n_points, PM_ERR_ARG,
-            "'%s' holds %ld points, the run has %ld", path, r->n_points,
+            "'%s' holds %ld points, the run has %ld", r->mesh_path, r->n_points,
             n_points);
-  pm_h5_close_quiet(&space);
-  pm_h5_close_quiet(&dset);
-  pm_h5_close_quiet(&file);
   /* The frames kept must all be readable before anything changes. */
   for (long k = 0; k < n_keep; k++) PM_TRY(reread_frame(r, k));
   r->n_frames = n_keep;
@@ -605,8 +710,6 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   *out = r;
   r = NULL;
 done:
-  pm_h5_close_quiet(&space);
-  pm_h5_close_quiet(&dset);
   pm_h5_close_quiet(&file);
   results_free(r);
   return ret;
@@ -664,7 +767,7 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
   char path[PM_PATH_MAX + 1], tmp[PM_PATH_MAX + 40];
   const char *names[16];
   int ncomp[16];
-  size_t xdmf_len;
+  size_t frames_len;
   PM_CHECK(r, PM_ERR_ARG, "pm_results_write_frame: NULL results");
   PM_CALL(check_fields(n_fields, fields));
   PM_CHECK(n_fields <= 16, PM_ERR_ARG, "results frame: %d fields (16 at most)",
@@ -675,7 +778,7 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
   for (int i = 0; i < n_fields; i++)
     bytes += 8.0 * fields[i].ncomp * (double)r->n_points;
   PM_CALL(check_room(r->sub, path, bytes));
-  xdmf_len = r->xdmf_len;
+  frames_len = r->frames.len;
   errno = 0;
   ret = write_frame_file(r, tmp, step, time, n_fields, fields);
   int saved = errno;
@@ -692,7 +795,7 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
   saved = errno;
   if (ret != PM_SUCCESS) { /* back to the frames before */
     r->n_frames--;
-    r->xdmf_len = xdmf_len;
+    r->frames.len = frames_len;
     unlink(path);
     /* The index may already list the frame: list the others again (best
      * effort; the earlier index and XDMF stay otherwise). */

@@ -12,7 +12,10 @@
  *   OUT/results/mesh.h5          /coordinates float64 [n_points][3]
  *                                reference coordinates; /cells int64
  *                                [n_cells][nodes_per_cell] point indices,
- *                                attribute nodes_per_cell (int)
+ *                                attribute nodes_per_cell (int); with a
+ *                                surface, /surface int64 [n][3] triangles
+ *                                over the same points, attribute name
+ *                                (string: "membrane")
  *   OUT/results/frame_NNNNNN.h5  one frame, NNNNNN = frame index from
  *                                000000: root attributes step (int64) and
  *                                time (float64); one dataset per field,
@@ -28,7 +31,16 @@
  *                                external links to the frames (creation
  *                                order tracked), so that results.h5 reads
  *                                as one file (/frames/000003/displacement).
- *   OUT/results.xdmf             one uniform grid per frame. */
+ *   OUT/results.xdmf             a temporal collection of one uniform grid
+ *                                per frame (Name frame_NNNNNN; Time, and
+ *                                Information step), or before the first
+ *                                frame the bare mesh (Name mesh).  With a
+ *                                surface, each of these is instead a
+ *                                spatial collection of the same name
+ *                                holding two uniform grids, "points" (the
+ *                                cells) and "membrane" (the surface's
+ *                                triangles), with the same geometry and
+ *                                attributes. */
 #ifndef PM_OUTPUT_H
 #define PM_OUTPUT_H
 
@@ -48,23 +60,40 @@ typedef struct {
 
 typedef struct pm_results pm_results;
 
-/* Start results in dir (which must exist: see pm_mkdir_p): writes
+/* The points results are written on (and a run measures): n >= 1
+ * reference positions x[3*i + k]; for a mesh its cells, cells[c *
+ * nodes_per_cell + k] point indices (nodes_per_cell 1 = point cloud, XDMF
+ * Polyvertex, where cells may be NULL: one cell per point, n_cells
+ * ignored; 3 = triangles; 4 = tetrahedra in 3-D, quadrilaterals in 2-D);
+ * and triangles over the same points, surface[3*t + k] (an MPM membrane),
+ * written as a second grid named "membrane" (n_surface 0 / NULL: none).
+ * Indices are in [0, n).  Borrowed: a backend's, for as long as it
+ * lives. */
+typedef struct {
+  long n;
+  const double *x;
+  long n_cells;
+  int nodes_per_cell;
+  const long *cells;
+  long n_surface;
+  const long *surface;
+} pm_points;
+
+/* Start results in dir (which must exist: see pm_mkdir_p) on the points
+ * p (dim 2 or 3, stored; 2-D coordinates still carry z): writes
  * results/mesh.h5, an index with no frame and results.xdmf with the bare
- * mesh, replacing older ones.
- *   dim:            2 or 3 (stored; 2-D coordinates still carry z)
- *   n_points, x:    n_points >= 1 points, x[3*i + k] (borrowed)
- *   n_cells, nodes_per_cell, cells: cells[c*nodes_per_cell + k], indices in
- *                   [0, n_points) (borrowed).  nodes_per_cell 1 = point
- *                   cloud (XDMF Polyvertex), 3 = triangles, 4 = tetrahedra
- *                   (dim 3) or quadrilaterals (dim 2).  For a point cloud
- *                   cells may be NULL: one cell per point, n_cells ignored.
- *   scene_text, version: stored in the index (NULL stored as "").
- * *out is owned by the caller and released by pm_results_close.  Silences
- * HDF5's automatic error printing for the process.  Fails with PM_ERR_ARG
- * (bad sizes, cell index out of range), PM_ERR_IO (dir missing or not
- * writable, a write refused: naming the path and the system's reason),
- * PM_ERR_HDF5 (naming the call and object), PM_ERR_MEMORY.  On failure
- * nothing is left on disk. */
+ * mesh, replacing older ones.  scene_text, version: stored in the index
+ * (NULL stored as "").  *out is owned by the caller and released by
+ * pm_results_close.  Silences HDF5's automatic error printing for the
+ * process.  Fails with PM_ERR_ARG (bad sizes, a cell or triangle index out
+ * of range), PM_ERR_IO (dir missing or not writable, a write refused:
+ * naming the path and the system's reason), PM_ERR_HDF5 (naming the call
+ * and object), PM_ERR_MEMORY.  On failure nothing is left on disk. */
+pm_err pm_results_create_ex(const char *dir, int dim, const pm_points *p,
+                            const char *scene_text, const char *version,
+                            pm_results **out);
+
+/* pm_results_create_ex on points without a surface. */
 pm_err pm_results_create(const char *dir, int dim, long n_points,
                          const double *x, long n_cells, int nodes_per_cell,
                          const long *cells, const char *scene_text,
@@ -72,8 +101,9 @@ pm_err pm_results_create(const char *dir, int dim, long n_points,
 
 /* Continue the results in dir with their first n_keep frames (a resumed
  * run): later frames are deleted, the index and results.xdmf rewritten
- * from the frames kept.  n_points must match the mesh.  Fails with
- * PM_ERR_IO / PM_ERR_HDF5 naming what is missing or unreadable. */
+ * from the frames kept (and mesh.h5's surface, if any).  n_points must
+ * match the mesh.  Fails with PM_ERR_IO / PM_ERR_HDF5 naming what is
+ * missing or unreadable. */
 pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
                          pm_results **out);
 

@@ -107,17 +107,6 @@ typedef struct {
   pm_err (*step)(void *ctx, const pm_step_report *r, bool frame);
 } pm_observer;
 
-/* The points a run writes and measures: n reference positions [n][3] and,
- * for a mesh, its cells (nodes_per_cell indices each; NULL for a point
- * cloud).  Borrowed from the backend. */
-typedef struct {
-  long n;
-  const double *x;
-  long n_cells;
-  int nodes_per_cell;
-  const long *cells;
-} pm_points;
-
 /* Columns of a backend's own history (beyond the shared ones). */
 #define PM_HISTORY_MAX 128
 
@@ -155,7 +144,7 @@ typedef struct pm_backend {
    * numerical failure and PM_SUCCESS otherwise (not converging is a
    * status, see figures). */
   pm_err (*run)(void *sim, const pm_observer *obs);
-  /* The points the results are written on. */
+  /* The points the results are written on (pm_points, pm_output.h). */
   void (*points)(void *sim, pm_points *p);
   /* The fields of the current state (PM_FIELD_* mask wanted; a backend may
    * add its own, e.g. fluid pressure) into out[0..max); returns how many.

@@ -589,10 +589,8 @@ static pm_err open_outputs(run_ctx *c, const char *out_dir, unsigned flags,
     PM_CALL(pm_history_open(out_dir, c->n_cols, c->names, c->history_rows,
                             &c->history));
   } else {
-    PM_CALL(pm_results_create(out_dir, c->s->dimension, c->pts.n, c->pts.x,
-                              c->pts.n_cells, c->pts.nodes_per_cell,
-                              c->pts.cells, c->s->text, PM_VERSION,
-                              &c->results));
+    PM_CALL(pm_results_create_ex(out_dir, c->s->dimension, &c->pts, c->s->text,
+                                 PM_VERSION, &c->results));
     PM_CALL(pm_history_open(out_dir, c->n_cols, c->names, -1, &c->history));
   }
   return write_summary(c, true);
