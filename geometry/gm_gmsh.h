@@ -66,6 +66,12 @@ typedef struct {
  * inconsistent gmsh data, PM_ERR_MEMORY.  On failure out holds nothing. */
 pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out);
 
+/* Checks, before gmsh sees it (gmsh reports a missing file without
+ * failing), that path is a regular file this process can read: PM_ERR_IO
+ * otherwise, with "cannot open WHAT 'PATH': REASON" (what: "volume file",
+ * "surface file"). */
+pm_err gm_gmsh_check_file(const char *path, const char *what);
+
 /* Read a gmsh-readable file (.msh, .geo, .step/.stp, .brep) into out: checks
  * the file is a readable regular file (PM_ERR_IO naming it: gmsh reports a
  * missing file without failing), opens it in a session of its own, meshes

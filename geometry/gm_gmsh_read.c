@@ -232,16 +232,14 @@ done:
   return ret;
 }
 
-/* Regular readable file, checked before gmsh sees it: gmsh reports a
- * missing file without failing. */
-static pm_err check_readable(const char *path) {
+pm_err gm_gmsh_check_file(const char *path, const char *what) {
   struct stat st;
-  PM_CHECK(stat(path, &st) == 0, PM_ERR_IO, "cannot open volume file '%s': %s",
+  PM_CHECK(stat(path, &st) == 0, PM_ERR_IO, "cannot open %s '%s': %s", what,
            path, strerror(errno));
-  PM_CHECK(!S_ISDIR(st.st_mode), PM_ERR_IO, "volume file '%s' is a directory",
+  PM_CHECK(!S_ISDIR(st.st_mode), PM_ERR_IO, "%s '%s' is a directory", what,
            path);
   FILE *f = fopen(path, "rb");
-  PM_CHECK(f, PM_ERR_IO, "cannot read volume file '%s': %s", path,
+  PM_CHECK(f, PM_ERR_IO, "cannot read %s '%s': %s", what, path,
            strerror(errno));
   fclose(f);
   return PM_SUCCESS;
@@ -256,7 +254,7 @@ pm_err gm_gmsh_load(const char *path, int dim, double h, bool groups,
            "volume dimension must be 2 or 3 (got %d) for '%s'", dim, path);
   PM_CHECK(isfinite(h), PM_ERR_ARG,
            "mesh size h must be finite (got %g) for '%s'", h, path);
-  PM_CALL(check_readable(path));
+  PM_CALL(gm_gmsh_check_file(path, "volume file"));
   pm_err ret = PM_SUCCESS;
   int ierr = 0, *types = NULL;
   size_t n_types = 0;

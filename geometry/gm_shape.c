@@ -1,11 +1,13 @@
 /* gm_shape: one table entry per kind of body (how to read it from the
- * scene, contains, bounds, release): a new kind (a voxel image, a closed
- * triangulated surface) is one more entry and its functions, here. */
+ * scene, contains, bounds, release): a new kind (a voxel image) is one
+ * more entry and its functions, here.  The inside and the outside of a
+ * closed triangulated surface are two more kinds, built from the surface. */
 #include "gm_shape.h"
 
 #include <math.h>
 #include <stdlib.h>
 
+#include "gm_inside.h"
 #include "gm_volume.h"
 #include "pm_tensor.h"
 
@@ -23,6 +25,7 @@ struct gm_shape {
   double radius, axis_len2;
   const pm_expr *region; /* borrowed from the scene */
   gm_volume *volume;     /* owned */
+  gm_inside *inside;     /* owned */
 };
 
 struct shape_kind {
@@ -168,6 +171,53 @@ static void mesh_bounds(const gm_shape *s, double lo[3], double hi[3]) {
 }
 
 static void mesh_release(gm_shape *s) { gm_volume_destroy(s->volume); }
+
+/* ---- closed triangulated surface ---------------------------------------- */
+
+/* Not in the table: built from a surface, not from a scene body. */
+
+static bool inside_contains(const gm_shape *s, const double x[3]) {
+  return gm_inside_contains(s->inside, x);
+}
+
+/* The surface itself belongs to the inside. */
+static bool outside_contains(const gm_shape *s, const double x[3]) {
+  return !gm_inside_contains(s->inside, x);
+}
+
+static void inside_bounds(const gm_shape *s, double lo[3], double hi[3]) {
+  gm_inside_bounds(s->inside, lo, hi);
+}
+
+static void inside_release(gm_shape *s) { gm_inside_destroy(s->inside); }
+
+static const shape_kind inside_kind = {.key = "inside",
+                                       .thread_safe = true,
+                                       .contains = inside_contains,
+                                       .bounds = inside_bounds,
+                                       .release = inside_release};
+static const shape_kind outside_kind = {.key = "outside",
+                                        .thread_safe = true,
+                                        .contains = outside_contains,
+                                        .release = inside_release};
+
+pm_err gm_shape_from_surface(const gm_trisurf *s, bool outside,
+                             gm_shape **out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_shape_from_surface: out is NULL");
+  *out = NULL;
+  PM_CHECK(s, PM_ERR_ARG, "gm_shape_from_surface: no surface");
+  pm_err ret = PM_SUCCESS;
+  gm_shape *shape = NULL;
+  PM_TRY(PM_ALLOC(shape, 1, "shape"));
+  shape->kind = outside ? &outside_kind : &inside_kind;
+  shape->dim = 3;
+  PM_TRY(gm_inside_create(s, &shape->inside));
+  *out = shape;
+  shape = NULL;
+done:
+  gm_shape_destroy(shape);
+  return ret;
+}
 
 /* ---- the table ---------------------------------------------------------- */
 

@@ -1,11 +1,13 @@
 /* gm_shape: the shape of a scene body, whatever its kind (the domain, a
- * region expression, a box, a sphere, a cylinder, a gmsh volume): whether
- * it contains a point, its bounding box, and checks on where it lies. */
+ * region expression, a box, a sphere, a cylinder, a gmsh volume, the inside
+ * or outside of a closed surface): whether it contains a point, its
+ * bounding box, and checks on where it lies. */
 #ifndef GM_SHAPE_H
 #define GM_SHAPE_H
 
 #include <stdbool.h>
 
+#include "gm_trisurf.h"
 #include "pm_error.h"
 #include "pm_scene.h"
 
@@ -44,20 +46,36 @@ pm_err gm_shape_create(const pm_scene_body *body, int dim,
                        const double box_min[3], const double box_max[3],
                        double h, gm_shape **out);
 
-/* Frees the shape (and the volume of a mesh body); NULL is a no-op. */
+/* The inside (outside false) or the outside (outside true) of the closed,
+ * consistently oriented surface s, in 3D, for seeding particles: contains
+ * is gm_inside_contains, or its negation for the outside, so a point on
+ * the surface belongs to the inside and not to the outside.  Kinds
+ * "inside" and "outside"; bounds are the surface's for the inside, none
+ * (unbounded) for the outside; thread-safe.  s is copied (it may be freed
+ * after).  On success *out is a new shape the caller frees with
+ * gm_shape_destroy; on failure *out is NULL and the error is PM_ERR_ARG
+ * (NULL arguments, or s not closed: the message gives gm_trisurf_closed's
+ * reason) or PM_ERR_MEMORY. */
+pm_err gm_shape_from_surface(const gm_trisurf *s, bool outside, gm_shape **out);
+
+/* Frees the shape (and the volume of a mesh body, the inside test of a
+ * surface); NULL is a no-op. */
 void gm_shape_destroy(gm_shape *s);
 
 /* True when x (3 components; z ignored in 2D) lies in the shape or on its
- * boundary; false for a NULL shape or point.  See gm_shape for threads. */
+ * boundary (but for a region and the outside of a surface, whose boundary
+ * is out); false for a NULL shape or point.  See gm_shape for threads. */
 bool gm_shape_contains(const gm_shape *s, const double x[3]);
 
 /* Axis-aligned box [lo, hi] holding the shape (components beyond dim are
  * 0); true when the shape has one.  False, with lo and hi untouched, for
- * the unbounded kinds: the domain (the whole problem) and a region. */
+ * the unbounded kinds: the domain (the whole problem), a region and the
+ * outside of a surface. */
 bool gm_shape_bounds(const gm_shape *s, double lo[3], double hi[3]);
 
 /* The scene's word for the shape's kind: "domain", "region", "box",
- * "sphere", "cylinder" or "mesh" ("?" for NULL). */
+ * "sphere", "cylinder" or "mesh", or "inside" / "outside" for a shape of
+ * gm_shape_from_surface ("?" for NULL). */
 const char *gm_shape_kind(const gm_shape *s);
 
 /* Whether gm_shape_contains may run on s from several threads at once

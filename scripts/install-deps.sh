@@ -7,6 +7,7 @@ packages=(
   build-essential cmake pkg-config
   liblapacke-dev libopenblas-dev
   libgmsh-dev
+  libcgal-dev
   libhdf5-dev
   libyaml-dev
   libmatheval-dev

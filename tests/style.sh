@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Every C source is formatted with the repository's .clang-format.
+# Every C source (and the C++ of geometry/cgal) is formatted with the
+# repository's .clang-format.
 set -u
 cd "$1"
-files=$(ls src/*/*.[ch] src/common/*/*.[ch] geometry/*.[ch] tests/*/*.[ch] 2>/dev/null)
+files=$(ls src/*/*.[ch] src/common/*/*.[ch] geometry/*.[ch] geometry/cgal/*.cpp \
+  tests/*/*.[ch] 2>/dev/null)
 bad=0
 for f in $files; do
   if ! clang-format --dry-run --Werror "$f" >/dev/null 2>&1; then
