@@ -79,14 +79,27 @@ static pm_err check_materials(const pm_scene *s) {
                            "expected no artificial viscosity for method fpm "
                            "(a shock viscosity of MPM), got "
                            "artificial_viscosity");
+    if (m->damage.given)
+      return pm_scene_fail(s, PM_PATH(p, "materials.%d.damage", i), true,
+                           "expected no damage for method fpm (the "
+                           "elastodamage of MPM membranes), got damage");
   }
   return PM_SUCCESS;
 }
 
 static pm_err check_bodies(const pm_scene *s) {
   static const char *const mpm_only[] = {"velocity", "density", "pressure"};
+  static const char *const mpm_keys[] = {"membrane", "inside", "outside",
+                                         "motion", "particles_per_cell"};
   char p[64];
   for (int i = 0; i < s->n_bodies; i++) {
+    for (int k = 0; k < 5; k++)
+      if (pm_scene_has(s, PM_PATH(p, "bodies.%d.%s", i, mpm_keys[k])))
+        return pm_scene_fail(s, p, true,
+                             "expected a key of an FPM body (material, "
+                             "region, box, sphere, cylinder, mesh, fibres), "
+                             "got %s (method mpm)",
+                             mpm_keys[k]);
     for (int k = 0; k < 3; k++)
       if (pm_scene_has(s, PM_PATH(p, "bodies.%d.%s", i, mpm_only[k])))
         return pm_scene_fail(s, p, true,

@@ -4,15 +4,27 @@
 #include "mpm_backend.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "gm_inside.h"
 #include "mpm_estimate.h"
 #include "mpm_kind.h"
 #include "mpm_pipeline.h"
 #include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_tensor.h"
+
+/* Doubles per particle of the output buffer: strain energy density, J,
+ * density, pressure, internal energy, the stress's von Mises and mean, the
+ * displacement (3) and the material; with membranes their normal (3),
+ * damage and failed. */
+static long scratch_per_particle(const mpm_model *m) {
+  return 12 + (m->kinds & MPM_KIND_MEMBRANE ? 5 : 0);
+}
+
+static void history_setup(mpm_sim *r);
 
 pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
   pm_err ret = PM_SUCCESS;
@@ -24,7 +36,9 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
   PM_TRY(mpm_model_create(s, &r->model, &r->state));
   PM_TRY(mpm_work_create(r->model, &r->work));
   r->setup_wall = pm_wtime() - t0;
-  PM_TRY(PM_ALLOC(r->scratch, 11 * r->model->n, "output buffer"));
+  PM_TRY(PM_ALLOC(r->scratch, scratch_per_particle(r->model) * r->model->n,
+                  "output buffer"));
+  history_setup(r);
   *out = r;
   r = NULL;
 done:
@@ -45,7 +59,7 @@ void mpm_sim_destroy(mpm_sim *r) {
 static size_t sim_bytes(const mpm_sim *r) {
   return mpm_model_bytes(r->model) + mpm_state_bytes(r->model, r->state) +
          mpm_work_bytes(r->model, r->work) +
-         11 * sizeof(double) * (size_t)r->model->n;
+         scratch_per_particle(r->model) * sizeof(double) * (size_t)r->model->n;
 }
 
 /* ---- run ---------------------------------------------------------------- */
@@ -112,7 +126,11 @@ static pm_err run(void *p, const pm_observer *obs) {
 
 static void points(void *p, pm_points *pts) {
   const mpm_sim *r = p;
-  *pts = (pm_points){.n = r->model->n, .x = r->model->x0, .nodes_per_cell = 1};
+  *pts = (pm_points){.n = r->model->n,
+                     .x = r->model->x0,
+                     .nodes_per_cell = 1,
+                     .n_surface = r->model->n_tris,
+                     .surface = r->model->tri};
 }
 
 /* u = x - x0 into the buffer's last 3 n. */
@@ -146,11 +164,29 @@ static int fields(void *p, unsigned want, pm_field *f, int max) {
   mpm_sim *r = p;
   const mpm_state *s = r->state;
   const long n = r->model->n;
+  const mpm_model *m = r->model;
   int nf = 0;
-  if (max < 11) return 0;
+  if (max < 15) return 0;
   double *sed = r->scratch, *jac = sed + n, *rho = sed + 2 * n,
-         *pres = sed + 3 * n, *ener = sed + 4 * n;
+         *pres = sed + 3 * n, *ener = sed + 4 * n, *mat = sed + 11 * n;
   particle_fields(r);
+  /* Each particle's material (the scene's index), to colour by. */
+  for (int gi = 0; gi < m->n_groups; gi++)
+    for (long p = m->group[gi].begin; p < m->group[gi].end; p++)
+      mat[p] = m->group[gi].material;
+  f[nf++] = (pm_field){"material", 1, mat};
+  if (m->kinds & MPM_KIND_MEMBRANE) {
+    double *normal = sed + 12 * n, *damage = sed + 15 * n,
+           *failed = sed + 16 * n;
+    memset(normal, 0, 5 * sizeof(double) * (size_t)n);
+    for (int gi = 0; gi < m->n_groups; gi++)
+      if (m->group[gi].kind->surface_fields)
+        m->group[gi].kind->surface_fields(m, s, &m->group[gi], normal, damage,
+                                          failed);
+    f[nf++] = (pm_field){"normal", 3, normal};
+    f[nf++] = (pm_field){"damage", 1, damage};
+    f[nf++] = (pm_field){"failed", 1, failed};
+  }
   /* The particles' current positions are each frame's geometry. */
   f[nf++] = (pm_field){"position", 3, s->x};
   if (want & PM_FIELD_DISPLACEMENT)
@@ -248,24 +284,134 @@ static void figures(void *p, pm_figures *f, bool with_fields) {
   if (with_fields) field_figures(r, f);
 }
 
-static const char *const iter_cols[] = {"energy_iterations",
-                                        "energy_iterations_capped"};
-
-static int history_names(void *p, const char **names, int max) {
-  const mpm_sim *r = p;
-  if (!(r->model->kinds & MPM_KIND_ITERATES) || max < 2) return 0;
-  names[0] = iter_cols[0];
-  names[1] = iter_cols[1];
-  return 2;
+/* History columns: the energy iterations (kinds that iterate); each named
+ * volume body's centroid displacement; with membranes, the failed points;
+ * for each body inside or outside a membrane, the mass of its particles
+ * that lies inside the membrane's current surface (does fluid leak
+ * through?). */
+static void add_hist(mpm_sim *r, const char *fmt, const char *a,
+                     const char *b) {
+  if (r->n_hist >= PM_HISTORY_MAX) return;
+  snprintf(r->hist_store[r->n_hist], sizeof r->hist_store[0], fmt, a, b);
+  r->hist_names[r->n_hist] = r->hist_store[r->n_hist];
+  r->n_hist++;
 }
 
-/* The iterations over the steps since the previous row. */
+static void history_setup(mpm_sim *r) {
+  const mpm_model *m = r->model;
+  const pm_scene *s = r->scene;
+  r->n_hist = 0;
+  if (m->kinds & MPM_KIND_ITERATES) {
+    add_hist(r, "energy_iterations%s%s", "", "");
+    add_hist(r, "energy_iterations_capped%s%s", "", "");
+  }
+  for (int b = 0; b < s->n_bodies; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    if (!body->name || body->shape == PM_BODY_MEMBRANE ||
+        m->body_end[b] == m->body_begin[b])
+      continue;
+    for (int c = 0; c < m->dim; c++)
+      add_hist(r, "%s_u%s", body->name, (const char[]){"xyz"[c], 0});
+  }
+  if (m->kinds & MPM_KIND_MEMBRANE) add_hist(r, "failed_points%s%s", "", "");
+  for (int b = 0; b < s->n_bodies; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    if ((body->shape == PM_BODY_INSIDE || body->shape == PM_BODY_OUTSIDE) &&
+        m->body_end[b] > m->body_begin[b])
+      add_hist(r, "mass_inside_%s_%s", s->bodies[body->surface_body].name,
+               body->name ? body->name : s->materials[body->material].name);
+  }
+}
+
+static int history_names(void *p, const char **names, int max) {
+  mpm_sim *r = p;
+  int n = r->n_hist < max ? r->n_hist : max;
+  for (int k = 0; k < n; k++) names[k] = r->hist_names[k];
+  return n;
+}
+
+/* The mass of body b's particles inside membrane body mb's current
+ * surface (NAN when it cannot be built). */
+static double mass_inside(const mpm_sim *r, int b, int mb) {
+  const mpm_model *m = r->model;
+  const double *x = r->state->x;
+  /* The membrane's triangles, in its particles' current positions. */
+  long t0 = -1, t1 = -1, first = m->body_begin[mb];
+  for (long t = 0; t < m->n_tris; t++) {
+    long v = m->tri[3 * t];
+    if (v >= first && v < m->body_end[mb]) {
+      if (t0 < 0) t0 = t;
+      t1 = t + 1;
+    }
+  }
+  if (t0 < 0) return NAN;
+  gm_trisurf sf = {.n_points = m->body_end[mb] - first,
+                   .x = (double *)(x + 3 * first),
+                   .n_tris = t1 - t0,
+                   .tri = NULL};
+  double mass = NAN;
+  gm_inside *in = NULL;
+  long *tri = malloc(sizeof(long) * 3 * (size_t)sf.n_tris);
+  if (!tri) return NAN;
+  for (long j = 0; j < 3 * sf.n_tris; j++) tri[j] = m->tri[3 * t0 + j] - first;
+  sf.tri = tri;
+  if (gm_inside_create(&sf, &in) == PM_SUCCESS) {
+    double sum = 0;
+    const long begin = m->body_begin[b], end = m->body_end[b];
+    const double *mp = m->mass;
+    PM_OMP(parallel for schedule(static) default(none)
+           shared(in, x, mp, begin, end) reduction(+ : sum))
+    for (long q = begin; q < end; q++)
+      if (gm_inside_contains(in, x + 3 * q)) sum += mp[q];
+    mass = sum;
+    gm_inside_destroy(in);
+  }
+  free(tri);
+  return mass;
+}
+
 static void history_values(void *p, double *v) {
   mpm_sim *r = p;
-  v[0] = r->iter_max_row;
-  v[1] = (double)(r->state->iter_capped_total - r->iter_capped_prev);
-  r->iter_capped_prev = r->state->iter_capped_total;
-  r->iter_max_row = 0;
+  const mpm_model *m = r->model;
+  const pm_scene *s = r->scene;
+  const mpm_state *st = r->state;
+  int k = 0;
+  if (m->kinds & MPM_KIND_ITERATES) {
+    v[k++] = r->iter_max_row;
+    v[k++] = (double)(st->iter_capped_total - r->iter_capped_prev);
+    r->iter_capped_prev = st->iter_capped_total;
+    r->iter_max_row = 0;
+  }
+  for (int b = 0; b < s->n_bodies && k < r->n_hist; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    if (!body->name || body->shape == PM_BODY_MEMBRANE ||
+        m->body_end[b] == m->body_begin[b])
+      continue;
+    double u[3] = {0, 0, 0}, mt = 0;
+    for (long q = m->body_begin[b]; q < m->body_end[b]; q++) {
+      for (int c = 0; c < 3; c++)
+        u[c] += m->mass[q] * (st->x[3 * q + c] - m->x0[3 * q + c]);
+      mt += m->mass[q];
+    }
+    for (int c = 0; c < m->dim; c++) v[k++] = u[c] / mt;
+  }
+  if (m->kinds & MPM_KIND_MEMBRANE) {
+    double *normal = r->scratch + 12 * m->n, *damage = normal + 3 * m->n,
+           *failed = damage + m->n, nf = 0;
+    memset(failed, 0, sizeof(double) * (size_t)m->n);
+    for (int gi = 0; gi < m->n_groups; gi++)
+      if (m->group[gi].kind->surface_fields)
+        m->group[gi].kind->surface_fields(m, st, &m->group[gi], normal, damage,
+                                          failed);
+    for (long q = 0; q < m->n; q++) nf += failed[q];
+    v[k++] = nf;
+  }
+  for (int b = 0; b < s->n_bodies && k < r->n_hist; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    if ((body->shape == PM_BODY_INSIDE || body->shape == PM_BODY_OUTSIDE) &&
+        m->body_end[b] > m->body_begin[b])
+      v[k++] = mass_inside(r, b, body->surface_body);
+  }
 }
 
 static const char *basis_name(mpm_basis b) {
@@ -352,6 +498,40 @@ static void plan_groups(const mpm_model *m, FILE *out) {
   }
 }
 
+/* Each body's particles: membranes with their triangles, thickness and
+ * area; bodies seeded at their own density; moving bodies. */
+static void plan_bodies(const mpm_sim *r, FILE *out) {
+  const mpm_model *m = r->model;
+  const pm_scene *s = r->scene;
+  for (int b = 0; b < s->n_bodies; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    long n = m->body_end[b] - m->body_begin[b];
+    fprintf(out, "  body %d%s%s: %ld particles", b, body->name ? " " : "",
+            body->name ? body->name : "", n);
+    if (body->shape == PM_BODY_MEMBRANE) {
+      long nt = 0;
+      double area = 0;
+      for (long t = 0; t < m->n_tris; t++)
+        if (m->tri[3 * t] >= m->body_begin[b] && m->tri[3 * t] < m->body_end[b])
+          nt++;
+      for (long q = m->body_begin[b]; q < m->body_end[b]; q++)
+        area += m->vol0[q] / body->membrane.thickness;
+      fprintf(out, ", membrane of %ld triangles, thickness %g m, area %.6g m^2",
+              nt, body->membrane.thickness, area);
+    } else if (body->n_ppc) {
+      fprintf(out, ", %d x %d x %d per cell", (int)body->ppc[0],
+              (int)body->ppc[body->n_ppc == 1 ? 0 : 1],
+              m->dim == 3 ? (int)body->ppc[body->n_ppc == 1 ? 0 : 2] : 1);
+    }
+    if (body->shape == PM_BODY_INSIDE || body->shape == PM_BODY_OUTSIDE)
+      fprintf(out, ", %s membrane %s",
+              body->shape == PM_BODY_INSIDE ? "inside" : "outside",
+              s->bodies[body->surface_body].name);
+    if (body->moving) fprintf(out, ", moves as prescribed");
+    fprintf(out, "\n");
+  }
+}
+
 static pm_err plan(void *p, FILE *out) {
   mpm_sim *r = p;
   const mpm_model *m = r->model;
@@ -368,6 +548,7 @@ static pm_err plan(void *p, FILE *out) {
   fprintf(out, "particles    %ld (%d x %d x %d per cell)\n", m->n, o->ppc[0],
           o->ppc[1], m->dim == 3 ? o->ppc[2] : 1);
   plan_groups(m, out);
+  plan_bodies(r, out);
   fprintf(out, "pipeline\n");
   for (int k = 0; k < m->pipeline.n; k++)
     fprintf(out, "  %2d. %-20s %s\n", k + 1, m->pipeline.stage[k].name,

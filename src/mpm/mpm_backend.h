@@ -18,7 +18,11 @@ typedef struct {
   mpm_state *state;
   mpm_work *work;
   double setup_wall; /* s */
-  double *scratch;   /* output buffer, 11 per particle */
+  double *scratch;   /* output buffer (scratch_per_particle) */
+  /* history columns of its own: names (and their storage) */
+  const char *hist_names[PM_HISTORY_MAX];
+  char hist_store[PM_HISTORY_MAX][48];
+  int n_hist;
   /* the run */
   pm_status status;
   double energy0;          /* kinetic + strain + internal at t = 0 */

@@ -37,16 +37,38 @@ static double body_volume(const pm_scene *s, const pm_scene_body *b,
                  : PI * b->radius * b->radius * sqrt(len);
     break;
   }
+  case PM_BODY_INSIDE: {
+    const pm_scene_body *m = &s->bodies[b->surface_body];
+    if (m->membrane.surface == PM_SURFACE_SPHERE)
+      v = 4.0 / 3.0 * PI * pow(m->radius, 3);
+    break;
+  }
   default: break;
   }
   return fmin(v, box);
 }
 
-/* Doubles per particle of the kind of material sm, as its setup lays them
- * out: a fluid's density, energy, pressure and q; a solid's F, q and its
- * model's state. */
-static double kind_doubles(const pm_scene_material *sm) {
-  if (mpm_kind_of(sm) == &mpm_kind_fluid) return 4;
+/* Points of a membrane body's surface (a file's are not known before it is
+ * read: counted as none). */
+static double membrane_points(const pm_scene_body *b) {
+  switch (b->membrane.surface) {
+  case PM_SURFACE_SPHERE: return 10 * pow(4, b->membrane.refinement) + 2;
+  case PM_SURFACE_RECTANGLE:
+    return b->membrane.points[0] * b->membrane.points[1];
+  default: return 0;
+  }
+}
+
+/* Doubles per particle of the kind of body b's particles, as its setup
+ * lays them out: a fluid's density, energy, pressure and q; a solid's F, q
+ * and its model's state; a membrane's frame, strain, damage and failed,
+ * and its triangles (two per point) with their incidence and normals. */
+static double kind_doubles(const pm_scene_material *sm,
+                           const pm_scene_body *b) {
+  const mpm_kind *k = mpm_kind_of(sm, mpm_body_role_of(b));
+  if (k == &mpm_kind_fluid) return 4;
+  if (k == &mpm_kind_rigid) return 0;
+  if (k == &mpm_kind_membrane) return 9 + 3 + 2 + 2 * (3 + 6);
   return 9 + 1 + sm->mat.state_size;
 }
 
@@ -65,16 +87,27 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
     ppc *= o->ppc[c];
   }
   /* Particles: per body, at most the domain's. */
-  double n = 0, own = 0;
+  double n = 0, own = 0, top = ppc, surf = 0;
   for (int b = 0; b < s->n_bodies; b++) {
     const pm_scene_body *body = &s->bodies[b];
-    double nb = body_volume(s, body, box) / pow(h, dim) * ppc;
+    double bppc = ppc;
+    if (body->n_ppc > 0) {
+      bppc = 1;
+      for (int c = 0; c < dim; c++) bppc *= body->ppc[body->n_ppc == 1 ? 0 : c];
+    }
+    double nb = body->shape == PM_BODY_MEMBRANE
+                    ? membrane_points(body)
+                    : body_volume(s, body, box) / pow(h, dim) * bppc;
+    if (body->shape == PM_BODY_MEMBRANE) surf += nb;
+    top = fmax(top, bppc);
     n += nb;
-    own += nb * kind_doubles(&s->materials[body->material]);
+    own += nb * kind_doubles(&s->materials[body->material], body);
   }
-  if (n > cells * ppc) {
-    own *= cells * ppc / n;
-    n = cells * ppc;
+  /* At most the densest seeding over the whole domain, and the membranes'
+   * points. */
+  if (n > cells * top + surf) {
+    own *= (cells * top + surf) / n;
+    n = cells * top + surf;
   }
   /* Per particle: the common arrays, x0, mass and vol0 of the model, dx, cp
    * and cs of the workspace, and the 9 of the output buffer. */

@@ -19,8 +19,11 @@ enum {
   MPM_KIND_STRAIN_ENERGY = 1u,   /* stores elastic strain energy */
   MPM_KIND_INTERNAL_ENERGY = 2u, /* carries a specific internal energy;
                                     outputs density, pressure and energy */
-  MPM_KIND_ITERATES = 4u         /* its update iterates: it reports the
+  MPM_KIND_ITERATES = 4u,        /* its update iterates: it reports the
                                     iterations of a step */
+  MPM_KIND_MEMBRANE = 8u,        /* points of a triangulated surface: normal,
+                                    damage and failed are output fields */
+  MPM_KIND_RIGID = 16u           /* moves as prescribed: no stress */
 };
 
 typedef struct mpm_kind {
@@ -34,6 +37,8 @@ typedef struct mpm_kind {
    * PM_ERR_MEMORY on failure. */
   pm_err (*setup)(mpm_group *g, const pm_scene_material *sm,
                   const struct mpm_options *opt);
+  /* Optional: release what setup put in g->params besides the struct. */
+  void (*release)(mpm_group *g);
 
   /* Initial state of particle k (from the group's start) of body b (its
    * density, kg/m^3, pressure, Pa, and what its material's points take
@@ -42,8 +47,17 @@ typedef struct mpm_kind {
   void (*seed)(const mpm_group *g, mpm_group_state *gs, long k,
                const pm_scene_body *b, double sigma[9]);
 
+  /* Optional: once every particle is placed, what needs the whole group
+   * (a membrane's incidence and frames).  PM_ERR_SCENE / PM_ERR_MEMORY. */
+  pm_err (*finish)(const struct mpm_model *m, mpm_group *g,
+                   struct mpm_state *s);
+  /* Optional: doubles of step workspace the group needs
+   * (mpm_work.scratch[g->index]). */
+  long (*scratch)(const struct mpm_model *m, const mpm_group *g);
+
   /* The constitutive stage: velocity gradient to stress, volume and the
-   * kind's state, for the particles of group self->group. */
+   * kind's state, for the particles of group self->group (NULL: none, for
+   * particles that move as prescribed). */
   mpm_stage_fn stress;
 
   /* The constitutive stage in a line for the plan (without the group's
@@ -66,13 +80,43 @@ typedef struct mpm_kind {
   void (*fields)(const struct mpm_model *m, const struct mpm_state *s,
                  const mpm_group *g, double *sed, double *pressure,
                  double *energy);
+
+  /* Optional (MPM_KIND_MEMBRANE): unit normal (3 per particle), damage
+   * (1 - the secant factor) and failed (0 or 1) of the group's particles,
+   * indexed by p. */
+  void (*surface_fields)(const struct mpm_model *m, const struct mpm_state *s,
+                         const mpm_group *g, double *normal, double *damage,
+                         double *failed);
 } mpm_kind;
 
 extern const mpm_kind mpm_kind_solid;
 extern const mpm_kind mpm_kind_fluid;
+extern const mpm_kind mpm_kind_membrane;
+extern const mpm_kind mpm_kind_rigid;
 
-/* The kind of a scene material's particles. */
-const mpm_kind *mpm_kind_of(const pm_scene_material *sm);
+/* What a body makes of its material's particles. */
+typedef enum {
+  MPM_BODY_VOLUME = 0, /* seeded in cells: the material's kind */
+  MPM_BODY_MEMBRANE,   /* the vertices of a surface */
+  MPM_BODY_RIGID       /* moves as prescribed */
+} mpm_body_role;
+
+/* The role of body b in scene s. */
+mpm_body_role mpm_body_role_of(const pm_scene_body *b);
+
+/* The kind of the particles of a scene material whose bodies have the role
+ * given (mpm_check_scene sees that they share it). */
+const mpm_kind *mpm_kind_of(const pm_scene_material *sm, mpm_body_role role);
+
+/* Membrane law, for tests: the largest principal strain of the in-plane
+ * strain e = (e11, e22, e12), and one damage step of eqs. 38-41 at e_max
+ * (omega and failed updated), returning the secant factor. */
+double mpm_membrane_max_strain(const double e[3]);
+double mpm_membrane_damage(const pm_scene_damage *dm, double e_max,
+                           double *omega, double *failed);
+/* Carry a membrane frame f = (e1, e2, n) over a step: turn about n by phi,
+ * then by S of eqs. 9-22 from n to the unit normal n1. */
+void mpm_membrane_carry_frame(double f[9], double phi, const double n1[3]);
 
 /* D and W, the symmetric and skew parts of L (all row-major 3x3). */
 static inline void mpm_sym_skew(const double L[9], double D[9], double W[9]) {

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "mpm_grid_stages.h"
+#include "mpm_kind.h"
 #include "mpm_seed.h"
 #include "mpm_state.h"
 
@@ -91,7 +92,15 @@ done:
 
 void mpm_model_destroy(mpm_model *m) {
   if (!m) return;
-  for (int gi = 0; gi < m->n_groups; gi++) free(m->group[gi].params);
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    if (m->group[gi].kind && m->group[gi].kind->release)
+      m->group[gi].kind->release(&m->group[gi]);
+    free(m->group[gi].params);
+  }
+  free(m->body_begin);
+  free(m->body_end);
+  free(m->tri);
+  free(m->moving);
   mpm_conditions_destroy(m->bcs, m->n_bcs);
   free(m->x0);
   free(m->mass);
@@ -101,6 +110,8 @@ void mpm_model_destroy(mpm_model *m) {
 
 size_t mpm_model_bytes(const mpm_model *m) {
   size_t bytes = 5 * sizeof(double) * (size_t)m->n; /* x0, mass, vol0 */
+  /* membrane triangles and incidence */
+  bytes += 6 * sizeof(long) * (size_t)m->n_tris;
   for (int b = 0; b < m->n_bcs; b++)
     bytes += sizeof(long) * (size_t)m->bcs[b].n_cols;
   return bytes;

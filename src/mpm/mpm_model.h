@@ -9,6 +9,7 @@
 
 #include "mpm_conditions.h"
 #include "mpm_grid.h"
+#include "mpm_motion.h"
 #include "mpm_particles.h"
 #include "mpm_pipeline.h"
 #include "mpm_scene.h"
@@ -53,6 +54,18 @@ typedef struct mpm_model {
   mpm_group group[MPM_MAX_GROUPS];
   int n_groups;
   unsigned kinds; /* the groups' kinds' flags, or-ed (MPM_KIND_*) */
+  /* bodies: the particles of scene body b are [body_begin[b], body_end[b])
+   * (within its material's group) */
+  int n_bodies;
+  long *body_begin, *body_end;
+  /* membranes: triangles of 3 particle indices, those of group g in
+   * [tri_begin[g], tri_end[g]) (empty for other kinds) */
+  long n_tris;
+  long *tri;
+  long tri_begin[MPM_MAX_GROUPS], tri_end[MPM_MAX_GROUPS];
+  /* bodies that move as prescribed */
+  int n_moving;
+  mpm_motion *moving;
   /* boundary conditions */
   mpm_bc *bcs;
   int n_bcs;

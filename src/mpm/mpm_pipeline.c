@@ -7,6 +7,7 @@
 
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
+#include "mpm_motion.h"
 #include "mpm_state.h"
 #include "mpm_transfer.h"
 
@@ -22,6 +23,7 @@ static mpm_stage *add(mpm_pipeline *pl, const char *name, mpm_stage_fn fn) {
 static void add_stress(mpm_model *m) {
   for (int gi = 0; gi < m->n_groups; gi++) {
     const mpm_group *g = &m->group[gi];
+    if (!g->kind->stress) continue; /* moves as prescribed */
     mpm_stage *st = add(&m->pipeline, g->kind->stage_name, g->kind->stress);
     st->group = gi;
     int len = snprintf(st->detail, sizeof st->detail, "%s: ", g->name);
@@ -91,15 +93,23 @@ void mpm_pipeline_build(mpm_model *m) {
   add_grid_forces(m);
   st = add(pl, "grid update", mpm_stage_grid_update);
   /* The conditions belong to the update: it books their work. */
-  st->books = m->n_bcs > 0 ? MPM_BOOKS_WORK : 0;
+  st->books = m->n_bcs > 0 || m->n_moving > 0 ? MPM_BOOKS_WORK : 0;
   pl->update = st->index;
   snprintf(st->detail, sizeof st->detail,
-           "v^L = v + dt f / m, %d boundary condition%s%s", m->n_bcs,
+           "v^L = v + dt f / m, %d boundary condition%s%s%s", m->n_bcs,
            m->n_bcs == 1 ? "" : "s",
-           o->null_velocity ? ", null directions" : "");
+           o->null_velocity ? ", null directions" : "",
+           m->n_moving ? ", nodes of moving bodies at their velocity" : "");
   st = add(pl, "g2p", mpm_stage_g2p);
   snprintf(st->detail, sizeof st->detail,
            "particle velocities (FLIP %g / PIC %g)", o->flip, 1 - o->flip);
+  if (m->n_moving > 0) {
+    st = add(pl, "motion", mpm_stage_motion);
+    snprintf(st->detail, sizeof st->detail,
+             "%d bod%s moving as prescribed: velocity and position of the "
+             "expressions of t",
+             m->n_moving, m->n_moving == 1 ? "y" : "ies");
+  }
   if (o->update == MPM_MUSL) {
     st = add(pl, "remap", mpm_stage_remap);
     snprintf(st->detail, sizeof st->detail,

@@ -6,8 +6,8 @@
 #include "mpm_particles.h"
 #include "mpm_stage.h"
 
-/* Fixed stages (at most 11) and one constitutive stage per group. */
-#define MPM_MAX_STAGES (12 + MPM_MAX_GROUPS)
+/* Fixed stages (at most 12) and one constitutive stage per group. */
+#define MPM_MAX_STAGES (13 + MPM_MAX_GROUPS)
 
 typedef struct {
   mpm_stage stage[MPM_MAX_STAGES];

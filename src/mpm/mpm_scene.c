@@ -4,6 +4,9 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <string.h>
+
+#include "mpm_kind.h"
 
 static const pm_name shape_names[] = {
     {"linear", MPM_BASIS_LINEAR}, {"quadratic", MPM_BASIS_QUADRATIC}, {0}};
@@ -115,8 +118,75 @@ const mpm_settings *mpm_scene_settings(const pm_scene *s) {
   return pm_scene_section(s, "mpm");
 }
 
+static const char *role_name(mpm_body_role r) {
+  return r == MPM_BODY_MEMBRANE ? "a membrane"
+         : r == MPM_BODY_RIGID  ? "a body with motion"
+                                : "a volume body";
+}
+
+/* Membranes, moving bodies and their materials: each material makes one
+ * kind of particle. */
+static pm_err check_bodies(const pm_scene *s) {
+  char p[PM_SDOC_PATH];
+  for (int i = 0; i < s->n_bodies; i++) {
+    const pm_scene_body *b = &s->bodies[i];
+    const pm_scene_material *sm = &s->materials[b->material];
+    mpm_body_role role = mpm_body_role_of(b);
+    if (b->n_ppc != 0 && b->n_ppc != 1 && b->n_ppc != s->dimension)
+      return pm_scene_fail(s, PM_PATH(p, "bodies.%d.particles_per_cell", i),
+                           false,
+                           "expected 1 or %d integers (dimension %d), got %d",
+                           s->dimension, s->dimension, b->n_ppc);
+    if (b->moving && pm_scene_has(s, PM_PATH(p, "bodies.%d.velocity", i)))
+      return pm_scene_fail(s, p, true,
+                           "expected motion or velocity, got both (a body "
+                           "with motion starts at its motion's velocity)");
+    if (role == MPM_BODY_MEMBRANE) {
+      if (b->moving)
+        return pm_scene_fail(s, PM_PATH(p, "bodies.%d.motion", i), true,
+                             "expected a membrane without motion, got "
+                             "motion");
+      if (b->n_ppc)
+        return pm_scene_fail(
+            s, PM_PATH(p, "bodies.%d.particles_per_cell", i), true,
+            "expected no particles_per_cell for a membrane (its points are "
+            "its surface's vertices), got particles_per_cell");
+      if (strcmp(sm->mat.model->name, "linear-elastic") != 0)
+        return pm_scene_fail(
+            s, PM_PATH(p, "materials.%d.model", b->material), false,
+            "expected linear-elastic for material %s of membrane bodies.%d "
+            "(plane stress in its tangent plane, eqs. 1-2), got %s",
+            sm->name, i, sm->mat.model->name);
+    }
+    for (int j = 0; j < i; j++)
+      if (s->bodies[j].material == b->material &&
+          mpm_body_role_of(&s->bodies[j]) != role)
+        return pm_scene_fail(
+            s, PM_PATH(p, "bodies.%d.material", i), false,
+            "expected a material of %s only, got %s, which bodies.%d (%s) "
+            "uses: give each its own material",
+            role_name(role), sm->name, j,
+            role_name(mpm_body_role_of(&s->bodies[j])));
+  }
+  for (int mi = 0; mi < s->n_materials; mi++) {
+    if (!s->materials[mi].damage.given) continue;
+    bool membrane = false;
+    for (int i = 0; i < s->n_bodies; i++)
+      if (s->bodies[i].material == mi &&
+          mpm_body_role_of(&s->bodies[i]) == MPM_BODY_MEMBRANE)
+        membrane = true;
+    if (!membrane)
+      return pm_scene_fail(s, PM_PATH(p, "materials.%d.damage", mi), true,
+                           "expected damage only on a material of membranes "
+                           "(eqs. 38-41), got damage on %s",
+                           s->materials[mi].name);
+  }
+  return PM_SUCCESS;
+}
+
 pm_err mpm_check_scene(const pm_scene *s) {
   char p[64], what[192];
+  PM_CALL(check_bodies(s));
   /* The box faces are grid planes, where conditions act. */
   for (int c = 0; c < s->dimension; c++) {
     double cells = (s->box_max[c] - s->box_min[c]) / s->mesh_size;

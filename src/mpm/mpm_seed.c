@@ -1,4 +1,9 @@
-/* mpm_seed: particle seeding by body shape. */
+/* mpm_seed: particles from the scene's bodies.  A volume body is seeded n
+ * per direction regularly in each cell (its own particles_per_cell, or the
+ * scene's) where it is the last body containing the point; a membrane's
+ * particles are the vertices of its surface.  Particles are grouped by
+ * material, and within a group by body, so that each body's particles are
+ * one range. */
 #include "mpm_seed.h"
 
 #include <math.h>
@@ -7,28 +12,113 @@
 #include <string.h>
 
 #include "gm_shape.h"
+#include "gm_trisurf.h"
 #include "mpm_kind.h"
 #include "pm_tensor.h"
 
 typedef struct {
   const pm_scene *s;
-  gm_shape **shape; /* per body */
+  gm_shape **shape; /* per body: volume bodies (NULL for membranes) */
+  gm_trisurf *surf; /* per body: membranes' surfaces */
+  int (*ppc)[3];    /* per body: particles per cell and direction */
 } seeder;
 
-/* The last body containing x (later bodies take precedence), or -1. */
+/* The last volume body containing x (later bodies take precedence), or
+ * -1. */
 static int body_at(const seeder *sd, const double x[3]) {
   return gm_shape_last_containing((const gm_shape *const *)sd->shape,
                                   sd->s->n_bodies, x);
 }
 
-/* Every body's shape, each inside the grid (domain.box): a particle
- * outside it would have no nodes.  Failures name the body's position. */
-static pm_err make_shapes(seeder *sd) {
+/* A located failure at bodies.B(.KEY): the message of the call that
+ * failed, after the scene position. */
+static pm_err body_fail(const pm_scene *s, int b, const char *key,
+                        const char *what) {
+  char p[PM_SDOC_PATH], msg[1024];
+  snprintf(msg, sizeof msg, "%s", pm_error_message());
+  if (key)
+    snprintf(p, sizeof p, "bodies.%d.%s", b, key);
+  else
+    snprintf(p, sizeof p, "bodies.%d", b);
+  return pm_scene_fail(s, p, key != NULL, "%s: %s", what, msg);
+}
+
+/* The surface of membrane body b, and its points inside the grid. */
+static pm_err make_surface(const pm_scene *s, int b, gm_trisurf *out) {
+  const pm_scene_body *body = &s->bodies[b];
+  pm_err e = PM_SUCCESS;
+  const char *key = "membrane";
+  switch (body->membrane.surface) {
+  case PM_SURFACE_SPHERE:
+    e = gm_trisurf_sphere(body->a, body->radius, (int)body->membrane.refinement,
+                          out);
+    key = "membrane.sphere";
+    break;
+  case PM_SURFACE_RECTANGLE:
+    e = gm_trisurf_rectangle(body->a, body->b, body->membrane.edge_v,
+                             (long)body->membrane.points[0],
+                             (long)body->membrane.points[1], out);
+    key = "membrane.rectangle";
+    break;
+  case PM_SURFACE_FILE:
+    e = gm_trisurf_load(body->membrane.file, out);
+    key = "membrane.file";
+    break;
+  }
+  if (e) return body_fail(s, b, key, "expected a surface");
+  double lo[3], hi[3];
+  gm_trisurf_bounds(out, lo, hi);
+  for (int c = 0; c < 3; c++) {
+    double tol = 1e-9 * (s->box_max[c] - s->box_min[c]);
+    if (lo[c] < s->box_min[c] - tol || hi[c] > s->box_max[c] + tol) {
+      char p[PM_SDOC_PATH];
+      return pm_scene_fail(s, PM_PATH(p, "bodies.%d.%s", b, key), true,
+                           "expected a surface inside domain.box (%c in [%g, "
+                           "%g]), got one reaching %c = %g: its particles "
+                           "would be outside the grid",
+                           "xyz"[c], s -> box_min[c], s -> box_max[c], "xyz"[c],
+                           lo[c] < s -> box_min[c] ? lo[c] : hi[c]);
+    }
+  }
+  return PM_SUCCESS;
+}
+
+/* Every body's shape or surface, each inside the grid (domain.box): a
+ * particle outside it would have no nodes.  Failures name the body's
+ * position. */
+static pm_err make_shapes(seeder *sd, const mpm_options *o) {
   const pm_scene *s = sd->s;
-  PM_CALL(PM_ALLOC(sd->shape, s->n_bodies, "body shapes"));
-  for (int b = 0; b < s->n_bodies; b++) {
+  const int nb = s->n_bodies;
+  PM_CALL(PM_ALLOC(sd->shape, nb, "body shapes"));
+  PM_CALL(PM_ALLOC(sd->surf, nb, "membrane surfaces"));
+  PM_CALL(PM_ALLOC(sd->ppc, nb, "particles per cell"));
+  for (int b = 0; b < nb; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    for (int c = 0; c < 3; c++)
+      sd->ppc[b][c] = c >= s->dimension  ? 1
+                      : body->n_ppc == 0 ? o->ppc[c]
+                      : body->n_ppc == 1 ? (int)body->ppc[0]
+                                         : (int)body->ppc[c];
+    if (body->shape == PM_BODY_MEMBRANE)
+      PM_CALL(make_surface(s, b, &sd->surf[b]));
+  }
+  for (int b = 0; b < nb; b++) {
     const pm_scene_body *body = &s->bodies[b];
     char msg[1024];
+    if (body->shape == PM_BODY_MEMBRANE) continue;
+    if (body->shape == PM_BODY_INSIDE || body->shape == PM_BODY_OUTSIDE) {
+      bool outside = body->shape == PM_BODY_OUTSIDE;
+      if (gm_shape_from_surface(&sd->surf[body->surface_body], outside,
+                                &sd->shape[b]) != PM_SUCCESS) {
+        char what[256];
+        snprintf(what, sizeof what,
+                 "expected the name of a closed membrane (bodies.%d, whose "
+                 "surface splits the domain into an inside and an outside)",
+                 body->surface_body);
+        return body_fail(s, b, outside ? "outside" : "inside", what);
+      }
+      continue;
+    }
     if (gm_shape_create(body, s->dimension, s->box_min, s->box_max,
                         0.5 * s->mesh_size, &sd->shape[b]) != PM_SUCCESS) {
       snprintf(msg, sizeof msg, "%s", pm_error_message());
@@ -46,23 +136,30 @@ static pm_err make_shapes(seeder *sd) {
   return PM_SUCCESS;
 }
 
-/* Visit every seed position: ppc per direction in each cell of the domain
- * box, regularly spaced, in cell order.  Calls fn(ctx, x, body) for
- * positions in a body. */
+/* Visit the seed positions of volume body b: its particles per cell and
+ * direction regularly in each cell of the domain box (those cells that
+ * meet its bounds), in cell order, where b is the last body containing the
+ * point.  Calls fn(ctx, x, b). */
 typedef void (*seed_fn)(void *ctx, const double x[3], int body);
 
-static void for_each_seed(const seeder *sd, const mpm_grid *g,
-                          const int ppc_opt[3], seed_fn fn, void *ctx) {
+static void for_each_seed(const seeder *sd, const mpm_grid *g, int b,
+                          seed_fn fn, void *ctx) {
   const pm_scene *s = sd->s;
-  long cells[3] = {1, 1, 1};
-  int ppc[3] = {1, 1, 1};
+  long lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const int *ppc = sd->ppc[b];
+  double blo[3], bhi[3];
+  bool bounded = gm_shape_bounds(sd->shape[b], blo, bhi);
   for (int c = 0; c < g->dim; c++) {
-    cells[c] = g->nn[c] - 1 - 2 * g->ghost;
-    ppc[c] = ppc_opt[c];
+    hi[c] = g->nn[c] - 1 - 2 * g->ghost;
+    if (!bounded) continue;
+    long a = (long)floor((blo[c] - s->box_min[c]) * g->inv_h) - 1;
+    long z = (long)ceil((bhi[c] - s->box_min[c]) * g->inv_h) + 1;
+    lo[c] = a > 0 ? a : 0;
+    if (z < hi[c]) hi[c] = z;
   }
-  for (long k = 0; k < cells[2]; k++)
-    for (long j = 0; j < cells[1]; j++)
-      for (long i = 0; i < cells[0]; i++) {
+  for (long k = lo[2]; k < hi[2]; k++)
+    for (long j = lo[1]; j < hi[1]; j++)
+      for (long i = lo[0]; i < hi[0]; i++) {
         long cell[3] = {i, j, k};
         for (int c2 = 0; c2 < ppc[2]; c2++)
           for (int c1 = 0; c1 < ppc[1]; c1++)
@@ -75,97 +172,169 @@ static void for_each_seed(const seeder *sd, const mpm_grid *g,
                     s->box_min[c] + (cell[c] + (sub[c] + 0.5) / ppc[c]) * g->h;
                 if (x[c] > s->box_max[c]) inside = false;
               }
-              if (!inside) continue;
-              int b = body_at(sd, x);
-              if (b >= 0) fn(ctx, x, b);
+              if (inside && body_at(sd, x) == b) fn(ctx, x, b);
             }
       }
 }
 
 typedef struct {
   const pm_scene *s;
-  long count[MPM_MAX_GROUPS]; /* per scene material */
-  long next[MPM_MAX_GROUPS];  /* fill position per material */
+  const seeder *sd;
+  long *count; /* per body */
+  long *next;  /* per body: fill position */
   int group_of[MPM_MAX_GROUPS];
   mpm_model *m;
   mpm_state *st;
-  double vol;
 } seed_ctx;
 
 static void count_seed(void *ctx, const double x[3], int body) {
   seed_ctx *c = ctx;
   (void)x;
-  c->count[c->s->bodies[body].material]++;
+  c->count[body]++;
 }
 
-static void place_seed(void *ctx, const double x[3], int body) {
-  seed_ctx *c = ctx;
+/* Particle p of body b at x with volume vol: constants, state, and its
+ * kind's initial state. */
+static void place(seed_ctx *c, int b, long p, const double x[3], double vol) {
   mpm_model *m = c->m;
   mpm_state *st = c->st;
-  const pm_scene_body *b = &c->s->bodies[body];
-  int gi = c->group_of[b->material];
+  const pm_scene_body *body = &c->s->bodies[b];
+  int gi = c->group_of[body->material];
   const mpm_group *g = &m->group[gi];
-  long p = c->next[b->material]++;
   for (int d = 0; d < 3; d++) {
     m->x0[3 * p + d] = x[d];
     st->x[3 * p + d] = x[d];
-    st->v[3 * p + d] = b->velocity[d];
-  }
-  /* The particle's share of its cell, clipped to the domain box where the
-   * box is not a whole number of sub-cells. */
-  double vol = c->vol;
-  for (int d = 0; d < c->s->dimension; d++) {
-    double hs = m->grid.h / m->opt.ppc[d];
-    double top = x[d] + 0.5 * hs, end = c->s->box_max[d];
-    if (top > end + 1e-12 * hs) vol *= (end - (x[d] - 0.5 * hs)) / hs;
+    st->v[3 * p + d] = body->velocity[d];
   }
   m->vol0[p] = vol;
   st->vol[p] = vol;
-  m->mass[p] = b->density * vol;
-  g->kind->seed(g, &st->group[gi], p - g->begin, b, st->sigma + 9 * p);
+  m->mass[p] = body->density * vol;
+  g->kind->seed(g, &st->group[gi], p - g->begin, body, st->sigma + 9 * p);
+}
+
+static void place_seed(void *ctx, const double x[3], int b) {
+  seed_ctx *c = ctx;
+  const mpm_model *m = c->m;
+  const int *ppc = c->sd->ppc[b];
+  /* The particle's share of its cell, clipped to the domain box where the
+   * box is not a whole number of sub-cells. */
+  double vol = m->grid.node_volume;
+  for (int d = 0; d < c->s->dimension; d++) {
+    double hs = m->grid.h / ppc[d];
+    double top = x[d] + 0.5 * hs, end = c->s->box_max[d];
+    vol /= ppc[d];
+    if (top > end + 1e-12 * hs) vol *= (end - (x[d] - 0.5 * hs)) / hs;
+  }
+  place(c, b, c->next[b]++, x, vol);
+}
+
+/* Membrane body b: its surface's vertices, each with its share of the
+ * area times the thickness, and its triangles from *t on. */
+static pm_err place_membrane(seed_ctx *c, int b, long *t) {
+  const gm_trisurf *sf = &c->sd->surf[b];
+  mpm_model *m = c->m;
+  double *area = NULL;
+  PM_CALL(PM_ALLOC(area, sf->n_points, "membrane point areas"));
+  gm_trisurf_point_areas(sf, area);
+  const long first = c->next[b];
+  for (long k = 0; k < sf->n_points; k++)
+    place(c, b, c->next[b]++, sf->x + 3 * k,
+          area[k] * c->s->bodies[b].membrane.thickness);
+  free(area);
+  for (long j = 0; j < 3 * sf->n_tris; j++)
+    m->tri[3 * *t + j] = first + sf->tri[j];
+  *t += sf->n_tris;
+  return PM_SUCCESS;
 }
 
 /* One group per material that has particles, in material order, each set
- * up by its kind.  Returns the particle count in *total. */
+ * up by its kind; each body's range within its group, in body order.
+ * Returns the particle count in *total. */
 static pm_err make_groups(seed_ctx *c, long *total) {
   const pm_scene *s = c->s;
   mpm_model *m = c->m;
   *total = 0;
   for (int mi = 0; mi < s->n_materials; mi++) {
     c->group_of[mi] = -1;
-    if (c->count[mi] == 0) continue;
+    long n = 0;
+    int first = -1;
+    for (int b = 0; b < s->n_bodies; b++)
+      if (s->bodies[b].material == mi) {
+        n += c->count[b];
+        if (first < 0 && c->count[b] > 0) first = b;
+      }
+    if (n == 0) continue;
     const pm_scene_material *sm = &s->materials[mi];
     mpm_group *g = &m->group[m->n_groups];
     c->group_of[mi] = m->n_groups;
     g->index = m->n_groups++;
     g->material = mi;
     g->name = sm->name;
-    g->kind = mpm_kind_of(sm);
+    g->kind = mpm_kind_of(sm, mpm_body_role_of(&s->bodies[first]));
     g->c0 = sm->av_c0;
     g->c1 = sm->av_c1;
     g->begin = *total;
-    g->end = *total + c->count[mi];
-    c->next[mi] = *total;
-    *total += c->count[mi];
+    g->end = *total + n;
+    for (int b = 0; b < s->n_bodies; b++)
+      if (s->bodies[b].material == mi) {
+        c->next[b] = m->body_begin[b] = *total;
+        *total += c->count[b];
+        m->body_end[b] = *total;
+      }
     PM_CALL(g->kind->setup(g, sm, &m->opt));
     m->kinds |= g->kind->flags;
   }
   return PM_SUCCESS;
 }
 
+/* The triangles' ranges per group, and the moving bodies. */
+static pm_err make_lists(seed_ctx *c) {
+  const pm_scene *s = c->s;
+  mpm_model *m = c->m;
+  for (int b = 0; b < s->n_bodies; b++) {
+    m->n_tris += c->sd->surf[b].n_tris;
+    if (s->bodies[b].moving && c->count[b] > 0) m->n_moving++;
+  }
+  if (m->n_tris) PM_CALL(PM_ALLOC(m->tri, 3 * m->n_tris, "membrane triangles"));
+  if (m->n_moving) PM_CALL(PM_ALLOC(m->moving, m->n_moving, "moving bodies"));
+  int k = 0;
+  for (int b = 0; b < s->n_bodies; b++) {
+    const pm_scene_body *body = &s->bodies[b];
+    if (!body->moving || c->count[b] == 0) continue;
+    mpm_motion *mv = &m->moving[k++];
+    mv->body = b;
+    mv->begin = m->body_begin[b];
+    mv->end = m->body_end[b];
+    for (int d = 0; d < 3; d++) mv->v[d] = body->motion[d];
+  }
+  return PM_SUCCESS;
+}
+
 pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   pm_err ret = PM_SUCCESS;
-  seeder sd = {.s = s, .shape = NULL};
+  seeder sd = {.s = s};
   seed_ctx c;
   memset(&c, 0, sizeof c);
   c.s = s;
+  c.sd = &sd;
   c.m = m;
   *state = NULL;
-  PM_TRY(make_shapes(&sd));
+  const int nb = s->n_bodies;
   PM_ENSURE(s->n_materials <= MPM_MAX_GROUPS, PM_ERR_SCENE,
             "%s: at most %d materials are supported by method mpm, got %d",
             s->path, MPM_MAX_GROUPS, s->n_materials);
-  for_each_seed(&sd, &m->grid, m->opt.ppc, count_seed, &c);
+  PM_TRY(make_shapes(&sd, &m->opt));
+  PM_TRY(PM_ALLOC(c.count, nb, "body counts"));
+  PM_TRY(PM_ALLOC(c.next, nb, "body counts"));
+  PM_TRY(PM_ALLOC(m->body_begin, nb, "body ranges"));
+  PM_TRY(PM_ALLOC(m->body_end, nb, "body ranges"));
+  m->n_bodies = nb;
+  for (int b = 0; b < nb; b++) {
+    if (s->bodies[b].shape == PM_BODY_MEMBRANE)
+      c.count[b] = sd.surf[b].n_points;
+    else
+      for_each_seed(&sd, &m->grid, b, count_seed, &c);
+  }
   long total;
   PM_TRY(make_groups(&c, &total));
   PM_ENSURE(total > 0, PM_ERR_SCENE,
@@ -176,16 +345,34 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   PM_TRY(PM_ALLOC(m->x0, 3 * total, "particle positions"));
   PM_TRY(PM_ALLOC(m->mass, total, "particle masses"));
   PM_TRY(PM_ALLOC(m->vol0, total, "particle volumes"));
+  PM_TRY(make_lists(&c));
   PM_TRY(mpm_state_create(m, &c.st));
-  c.vol = m->grid.node_volume / (m->opt.ppc[0] * (double)m->opt.ppc[1] *
-                                 (s->dimension == 3 ? m->opt.ppc[2] : 1));
-  for_each_seed(&sd, &m->grid, m->opt.ppc, place_seed, &c);
+  /* Triangles group by group, in body order within a group. */
+  long t = 0;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    m->tri_begin[gi] = t;
+    for (int b = 0; b < nb; b++) {
+      if (c.group_of[s->bodies[b].material] != gi) continue;
+      if (s->bodies[b].shape == PM_BODY_MEMBRANE)
+        PM_TRY(place_membrane(&c, b, &t));
+      else
+        for_each_seed(&sd, &m->grid, b, place_seed, &c);
+    }
+    m->tri_end[gi] = t;
+  }
+  for (int gi = 0; gi < m->n_groups; gi++)
+    if (m->group[gi].kind->finish)
+      PM_TRY(m->group[gi].kind->finish(m, &m->group[gi], c.st));
   *state = c.st;
   c.st = NULL;
 done:
   mpm_state_destroy(c.st);
-  if (sd.shape)
-    for (int b = 0; b < s->n_bodies; b++) gm_shape_destroy(sd.shape[b]);
+  for (int b = 0; sd.shape && b < nb; b++) gm_shape_destroy(sd.shape[b]);
+  for (int b = 0; sd.surf && b < nb; b++) gm_trisurf_free(&sd.surf[b]);
   free(sd.shape);
+  free(sd.surf);
+  free(sd.ppc);
+  free(c.count);
+  free(c.next);
   return ret;
 }

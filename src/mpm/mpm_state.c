@@ -1,6 +1,8 @@
 /* mpm_state: allocation and copy of a run's state and workspace. */
 #include "mpm_state.h"
 
+#include "mpm_kind.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -105,6 +107,14 @@ pm_err mpm_work_create(const mpm_model *m, mpm_work **out) {
   PM_TRY(PM_ALLOC(w->dx, 3 * n, "particle increments"));
   PM_TRY(PM_ALLOC(w->cp, n, "particle wave speeds"));
   if (m->has_absorbing) PM_TRY(PM_ALLOC(w->cs, n, "particle wave speeds"));
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    w->n_scratch[gi] = g->kind->scratch ? g->kind->scratch(m, g) : 0;
+    if (w->n_scratch[gi] > 0)
+      PM_TRY(PM_ALLOC(w->scratch[gi], w->n_scratch[gi], "kind workspace"));
+  }
+  if (m->n_moving > 0)
+    PM_TRY(PM_ALLOC(w->rigid_mass, m->grid.n_nodes, "moving bodies' masses"));
   pm_timers_init(&w->timers);
   for (int k = 0; k < m->pipeline.n; k++)
     w->timer[k] = pm_timers_add(&w->timers, m->pipeline.stage[k].name);
@@ -122,14 +132,20 @@ void mpm_work_destroy(mpm_work *w) {
   free(w->dx);
   free(w->cp);
   free(w->cs);
+  for (int gi = 0; gi < MPM_MAX_GROUPS; gi++) free(w->scratch[gi]);
+  free(w->rigid_mass);
   free(w);
 }
 
 size_t mpm_work_bytes(const mpm_model *m, const mpm_work *w) {
   size_t per_particle = 3 + 1 + (w->cs ? 1 : 0); /* dx, cp, cs */
+  size_t scratch = 0;
+  for (int gi = 0; gi < m->n_groups; gi++)
+    scratch += sizeof(double) * (size_t)w->n_scratch[gi];
+  if (w->rigid_mass) scratch += sizeof(double) * (size_t)m->grid.n_nodes;
   return mpm_nodes_bytes(&w->nodes, &m->grid) +
          mpm_cond_work_bytes(&w->cond, &m->grid) +
-         per_particle * sizeof(double) * (size_t)m->n;
+         per_particle * sizeof(double) * (size_t)m->n + scratch;
 }
 
 pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck) {

@@ -49,6 +49,11 @@ typedef struct mpm_work {
   double *dx; /* 3 per particle: position increment of the step */
   double *cp; /* per particle: dilatational wave speed */
   double *cs; /* per particle: shear wave speed (absorbing faces only) */
+  /* each group's own workspace (its kind's scratch; NULL: none) */
+  double *scratch[MPM_MAX_GROUPS];
+  long n_scratch[MPM_MAX_GROUPS];
+  double *rigid_mass; /* per node: a moving body's mass (bodies with
+                         motion only) */
   /* figures of the last step */
   double max_div;      /* largest |tr D| of the stress update, 1/s */
   double min_jacobian; /* smallest volume ratio J of the stress update */

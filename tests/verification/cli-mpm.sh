@@ -23,24 +23,6 @@ export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 not_in() { ! grep -qF -- "$1" "$2"; } # word, file
 no_tmp() { ! compgen -G "$1/*.tmp.*" >/dev/null; } # dir: no FILE.tmp.PID
 
-# A bad scene: exit 1, message "FILE:LINE:COL: ... MESSAGE", no output dir.
-bad_scene() { # name, scene, sed expression, line pattern, message
-  local name=$1 scene=$2 expr=$3 pattern=$4 msg=$5 f="$work/$1.yaml"
-  sed "$expr" "$scene" >"$f"
-  if cmp -s "$f" "$scene"; then # the sed expression must change the scene
-    check "$name: sed expression applies" false
-    return
-  fi
-  local line
-  line=$(grep -n -- "$pattern" "$f" | head -1 | cut -d: -f1)
-  "$bin" run "$f" --out "$work/out-$name" --quiet >/dev/null 2>"$work/err"
-  local rc=$?
-  check "$name: exit status 1 (got $rc)" test $rc -eq 1
-  check "$name: names $f:$line:<col>" grep -Eq "$f:$line:[0-9]+: " "$work/err"
-  check "$name: says '$msg'" grep -qF -- "$msg" "$work/err"
-  check "$name: no output created" test ! -e "$work/out-$name"
-}
-
 bad_scene fluid-without-eos "$tube" '/eos:/d' '- name: gas' \
   'materials.0.eos: missing required key'
 bad_scene negative-cell "$tube" 's/mesh_size: 5.0e-3/mesh_size: -0.01/' \

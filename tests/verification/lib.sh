@@ -39,3 +39,23 @@ refused() { # label, text, out, command...
   check "$label: message" grep -qF -- "$text" "$work/err"
   check "$label: nothing written" test ! -e "$out"
 }
+
+# A bad scene made from SCENE by a sed expression: exit 1 from
+# `run`, the message "FILE:LINE:COL: ... MESSAGE" at the line matching
+# PATTERN, and no output dir ($bin and $work set by the caller).
+bad_scene() { # name, scene, sed expression, line pattern, message
+  local name=$1 scene=$2 expr=$3 pattern=$4 msg=$5 f="$work/$1.yaml"
+  sed "$expr" "$scene" >"$f"
+  if cmp -s "$f" "$scene"; then # the sed expression must change the scene
+    check "$name: sed expression applies" false
+    return
+  fi
+  local line
+  line=$(grep -n -- "$pattern" "$f" | head -1 | cut -d: -f1)
+  "$bin" run "$f" --out "$work/out-$name" --quiet >/dev/null 2>"$work/err"
+  local rc=$?
+  check "$name: exit status 1 (got $rc)" test $rc -eq 1
+  check "$name: names $f:$line:<col>" grep -Eq "$f:$line:[0-9]+: " "$work/err"
+  check "$name: says '$msg'" grep -qF -- "$msg" "$work/err"
+  check "$name: no output created" test ! -e "$work/out-$name"
+}

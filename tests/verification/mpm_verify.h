@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "mpm_backend.h"
@@ -73,6 +74,26 @@ static inline void verify_destroy(verify_run *r) {
   if (!r) return;
   mpm_sim_destroy(r->sim);
   free(r);
+}
+
+/* One line of the table: measured against expected, with the error
+ * relative to `scale` (the expected value when scale is 0) and its bound.
+ * NaN-safe: a NaN fails.  Returns whether the check holds. */
+static inline bool row(const char *what, double measured, double expected,
+                       double scale, double tol) {
+  double ref = scale > 0 ? scale : fabs(expected);
+  double err =
+      ref > 0 ? fabs(measured - expected) / ref : fabs(measured - expected);
+  bool ok = err <= tol;
+  printf("  %-46s %13.6g %13.6g %10.2e %9.2e  %s\n", what, measured, expected,
+         err, tol, ok ? "ok" : "FAIL");
+  return ok;
+}
+
+/* The head of a table of rows. */
+static inline void table_head(const char *title) {
+  printf("\n%s\n  %-46s %13s %13s %10s %9s\n", title, "quantity", "measured",
+         "expected", "rel. err", "bound");
 }
 
 #endif

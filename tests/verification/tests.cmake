@@ -42,3 +42,7 @@ set_tests_properties(verification.memory PROPERTIES LABELS verification TIMEOUT 
 add_test(NAME verification.wait_policy
   COMMAND bash ${PM_VERIFY_DIR}/wait-policy.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.wait_policy PROPERTIES LABELS verification TIMEOUT 120)
+
+add_test(NAME verification.membranes
+  COMMAND bash ${PM_VERIFY_DIR}/membranes.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.membranes PROPERTIES LABELS verification TIMEOUT 900 PROCESSORS 2)

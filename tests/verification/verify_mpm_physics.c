@@ -34,28 +34,9 @@ static verify_run *run_driver(const pm_scene *s, pm_status expected) {
   return r;
 }
 
-/* One line of the table: measured against expected, with the error
- * relative to `scale` (the expected value when scale is 0) and its bound.
- * NaN-safe: a NaN fails.  Returns whether the check holds. */
-static bool row(const char *what, double measured, double expected,
-                double scale, double tol) {
-  double ref = scale > 0 ? scale : fabs(expected);
-  double err =
-      ref > 0 ? fabs(measured - expected) / ref : fabs(measured - expected);
-  bool ok = err <= tol;
-  printf("  %-46s %13.6g %13.6g %10.2e %9.2e  %s\n", what, measured, expected,
-         err, tol, ok ? "ok" : "FAIL");
-  return ok;
-}
-
 /* A figure printed for information, with no bound. */
 static void info(const char *what, double measured, double expected) {
   printf("  %-46s %13.6g %13.6g\n", what, measured, expected);
-}
-
-static void table_head(const char *title) {
-  printf("\n%s\n  %-46s %13s %13s %10s %9s\n", title, "quantity", "measured",
-         "expected", "rel. err", "bound");
 }
 
 /* ---- 1. free fall ------------------------------------------------------- */

@@ -52,10 +52,21 @@ enum {
   PM_FIELD_FORCE = 1u << 5 /* residual (out-of-balance) force */
 };
 
+/* Elastodamage of a membrane (eqs. 38-41 of the fluid-membrane paper):
+ * damage surface f = eps_max - S_L (1 + omega), secant stiffness
+ * E^e (1 + 2 c0 (exp(-c1 omega) - 1)), failure at eps_max >= failure. */
+typedef struct {
+  bool given;
+  double c0, c1;
+  double elastic_limit; /* S_L: eps_max at the elastic limit */
+  double failure;       /* eps_max at which a point fails */
+} pm_scene_damage;
+
 typedef struct {
   char *name;
-  pm_material mat;     /* the model of the table and its constants */
-  double av_c0, av_c1; /* artificial viscosity (eq. 32); 0: none */
+  pm_material mat;        /* the model of the table and its constants */
+  double av_c0, av_c1;    /* artificial viscosity (eq. 32); 0: none */
+  pm_scene_damage damage; /* membranes: elastodamage */
   pm_scene_mark mark;
 } pm_scene_material;
 
@@ -67,12 +78,25 @@ typedef enum {
   PM_BODY_SPHERE,     /* sphere: {center, radius} (a disk in 2D) */
   PM_BODY_CYLINDER,   /* cylinder: {base, axis, radius}; axis from the base
                           to the top face */
-  PM_BODY_MESH        /* mesh: a gmsh-readable volume (surface in 2D) */
+  PM_BODY_MESH,       /* mesh: a gmsh-readable volume (surface in 2D) */
+  PM_BODY_MEMBRANE,   /* membrane: a triangulated surface of a thickness
+                         (MPM, 3D): its points are the surface's vertices */
+  PM_BODY_INSIDE,     /* inside: the inside of a closed membrane body */
+  PM_BODY_OUTSIDE     /* outside: the domain outside a closed membrane */
 } pm_body_shape;
+
+/* The surface of a membrane body. */
+typedef enum {
+  PM_SURFACE_SPHERE = 0, /* membrane.sphere: {center, radius, refinement} */
+  PM_SURFACE_RECTANGLE,  /* membrane.rectangle: {origin, edge_u, edge_v,
+                            points} */
+  PM_SURFACE_FILE        /* membrane.file: a gmsh-readable surface */
+} pm_surface_kind;
 
 typedef struct {
   int material;        /* index into materials */
   char *material_name; /* as the scene gives it */
+  char *name;          /* bodies.N.name (NULL when not given) */
   pm_body_shape shape;
   pm_expr *region;   /* PM_BODY_REGION: inside where expr > 0 */
   double a[3], b[3]; /* box: min, max; sphere: center; cylinder: base, axis */
@@ -85,6 +109,30 @@ typedef struct {
   double pressure;    /* fluids: initial pressure, Pa */
   pm_material_point point; /* what its material's points take from it
                               (fibre directions, unit) */
+  /* PM_BODY_MEMBRANE: the surface (sphere: a = center, radius; rectangle:
+   * a = origin, b = edge_u, edge_v; file) and the thickness. */
+  struct {
+    pm_surface_kind surface;
+    double thickness; /* m */
+    long refinement;  /* sphere: icosahedron subdivisions */
+    double edge_v[3]; /* rectangle */
+    double points[2]; /* rectangle: points along edge_u and edge_v */
+    int n_points;
+    char *file; /* relative paths resolved against the scene's
+                   folder */
+  } membrane;
+  char *inside, *outside; /* PM_BODY_INSIDE / OUTSIDE: the membrane body's
+                             name */
+  int surface_body;       /* ... and its index */
+  /* MPM: particles per cell of this body (n_ppc 0: mpm.particles_per_cell) */
+  double ppc[3];
+  int n_ppc;
+  /* Prescribed motion (MPM): the body moves rigidly with the velocity
+   * motion[c](t) (components in motion_mask) and imposes it on the grid
+   * nodes its particles touch. */
+  bool moving; /* motion given */
+  unsigned motion_mask;
+  pm_expr *motion[3];
   pm_scene_mark mark;
 } pm_scene_body;
 

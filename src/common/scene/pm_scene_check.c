@@ -34,21 +34,62 @@ static pm_err relative_to_scene(const pm_scene *s, char **path) {
   return PM_SUCCESS;
 }
 
+/* A membrane: exactly one surface, in 3D. */
+static pm_err finish_membrane(pm_reader *r, pm_scene *s, int i,
+                              pm_scene_body *b) {
+  static const char *const keys[] = {"sphere", "rectangle", "file"};
+  char p[PM_SDOC_PATH];
+  if (s->dimension != 3)
+    return pm_reader_fail(r, PM_PATH(p, "bodies.%d.membrane", i), true,
+                          "expected a body of dimension 3 (membranes are "
+                          "triangulated surfaces), got a membrane in "
+                          "dimension 2");
+  int given = -1;
+  for (int k = 0; k < 3; k++) {
+    if (!pm_reader_has(r, PM_PATH(p, "bodies.%d.membrane.%s", i, keys[k])))
+      continue;
+    if (given >= 0)
+      return pm_reader_fail(r, p, true,
+                            "expected one surface (sphere, rectangle or "
+                            "file), got %s and %s",
+                            keys[given], keys[k]);
+    given = k;
+  }
+  if (given < 0)
+    return pm_reader_fail(r, PM_PATH(p, "bodies.%d.membrane", i), false,
+                          "missing required key sphere, rectangle or file "
+                          "(the membrane's surface)");
+  b->membrane.surface = (pm_surface_kind)given;
+  if (b->membrane.surface == PM_SURFACE_RECTANGLE) {
+    double n[3];
+    pm_v_cross(b->b, b->membrane.edge_v, n);
+    if (!(pm_v_norm(n) > 0))
+      return pm_reader_expected(
+          r, PM_PATH(p, "bodies.%d.membrane.rectangle.edge_v", i),
+          "an edge not parallel to edge_u");
+  }
+  if (b->membrane.surface == PM_SURFACE_FILE)
+    return relative_to_scene(s, &b->membrane.file);
+  return PM_SUCCESS;
+}
+
 /* Exactly one shape key; the shape's own checks. */
 static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
-  static const char *const keys[] = {"region", "box", "sphere", "cylinder",
-                                     "mesh"};
-  static const pm_body_shape shapes[] = {PM_BODY_REGION, PM_BODY_BOX,
-                                         PM_BODY_SPHERE, PM_BODY_CYLINDER,
-                                         PM_BODY_MESH};
+  static const char *const keys[] = {"region", "box",      "sphere", "cylinder",
+                                     "mesh",   "membrane", "inside", "outside"};
+  static const pm_body_shape shapes[] = {
+      PM_BODY_REGION, PM_BODY_BOX,      PM_BODY_SPHERE, PM_BODY_CYLINDER,
+      PM_BODY_MESH,   PM_BODY_MEMBRANE, PM_BODY_INSIDE, PM_BODY_OUTSIDE};
+  enum { N_SHAPES = sizeof shapes / sizeof shapes[0] };
   char p[PM_SDOC_PATH];
   int given = -1;
-  for (int k = 0; k < 5; k++) {
+  for (int k = 0; k < N_SHAPES; k++) {
     if (!pm_reader_has(r, PM_PATH(p, "bodies.%d.%s", i, keys[k]))) continue;
     if (given >= 0)
       return pm_reader_fail(r, p, true,
                             "expected one shape (region, box, sphere, "
-                            "cylinder or mesh), got %s and %s",
+                            "cylinder, mesh, membrane, inside or outside), "
+                            "got %s and %s",
                             keys[given], keys[k]);
     given = k;
   }
@@ -74,8 +115,38 @@ static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
                                 "a non-zero vector (base to top face)");
     return PM_SUCCESS;
   case PM_BODY_MESH: return relative_to_scene(s, &b->mesh);
+  case PM_BODY_MEMBRANE: return finish_membrane(r, s, i, b);
   default: return PM_SUCCESS;
   }
+}
+
+/* Body names are unique; inside and outside name a membrane body. */
+static pm_err finish_body_names(pm_reader *r, pm_scene *s) {
+  char p[PM_SDOC_PATH];
+  for (int i = 0; i < s->n_bodies; i++) {
+    pm_scene_body *b = &s->bodies[i];
+    for (int j = 0; b->name && j < i; j++)
+      if (s->bodies[j].name && strcmp(s->bodies[j].name, b->name) == 0)
+        return pm_reader_expected(r, PM_PATH(p, "bodies.%d.name", i),
+                                  "a name not used by an earlier body");
+    if (b->shape != PM_BODY_INSIDE && b->shape != PM_BODY_OUTSIDE) continue;
+    const char *want = b->shape == PM_BODY_INSIDE ? b->inside : b->outside;
+    const char *key = b->shape == PM_BODY_INSIDE ? "inside" : "outside";
+    b->surface_body = -1;
+    for (int j = 0; j < s->n_bodies; j++)
+      if (s->bodies[j].name && strcmp(s->bodies[j].name, want) == 0)
+        b->surface_body = j;
+    PM_PATH(p, "bodies.%d.%s", i, key);
+    if (b->surface_body < 0)
+      return pm_reader_expected(r, p,
+                                "the name of a membrane body (bodies.N.name)");
+    if (s->bodies[b->surface_body].shape != PM_BODY_MEMBRANE)
+      return pm_reader_fail(r, p, true,
+                            "expected the name of a membrane body, got %s "
+                            "(bodies.%d is not a membrane)",
+                            want, b->surface_body);
+  }
+  return PM_SUCCESS;
 }
 
 /* The initial state a body's material needs: density, pressure for
@@ -155,9 +226,10 @@ static pm_err finish_bodies(pm_reader *r, pm_scene *s) {
     b->mark = pm_sdoc_mark(
         r->doc, pm_sdoc_find(r->doc, PM_PATH(p, "bodies.%d", i), false));
     PM_CALL(finish_shape(r, s, i, b));
+    b->moving = pm_reader_has(r, PM_PATH(p, "bodies.%d.motion", i));
     PM_CALL(finish_body_state(r, i, b, &s->materials[m]));
   }
-  return PM_SUCCESS;
+  return finish_body_names(r, s);
 }
 
 static pm_err finish_time(pm_reader *r, pm_scene *s) {

@@ -27,6 +27,39 @@ static const pm_key av_keys[] = {{.name = "c0",
                                   .doc = "linear coefficient of eq. 32"},
                                  {0}};
 
+#define D(field) M(damage) + offsetof(pm_scene_damage, field)
+static const pm_key damage_keys[] = {
+    {.name = "c0",
+     .type = PM_KEY_NUMBER,
+     .offset = D(c0),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GE,
+     .unit = "",
+     .doc = "c0 of eq. 39: E^d = 2 c0 E^e (exp(-c1 omega) - 1)"},
+    {.name = "c1",
+     .type = PM_KEY_NUMBER,
+     .offset = D(c1),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GE,
+     .unit = "",
+     .doc = "c1 of eq. 39"},
+    {.name = "elastic_limit",
+     .type = PM_KEY_NUMBER,
+     .offset = D(elastic_limit),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .unit = "",
+     .doc = "S_L of eq. 40: largest principal strain at the elastic limit"},
+    {.name = "failure_strain",
+     .type = PM_KEY_NUMBER,
+     .offset = D(failure),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .unit = "",
+     .doc = "largest principal strain at which a point fails (its stress "
+            "is zero from then on)"},
+    {0}};
+
 /* The keys every material has; the rest are its model's. */
 const pm_key pm_scene_material_keys[] = {
     {.name = "name",
@@ -51,6 +84,11 @@ const pm_key pm_scene_material_keys[] = {
      .type = PM_KEY_MAPPING,
      .keys = av_keys,
      .doc = "shock viscosity of eq. 32 {c0, c1} (MPM)"},
+    {.name = "damage",
+     .type = PM_KEY_MAPPING,
+     .keys = damage_keys,
+     .doc = "membrane elastodamage of eqs. 38-41 {c0, c1, elastic_limit, "
+            "failure_strain} (MPM membranes)"},
     {0}};
 
 static pm_err skip_value(pm_reader *r, int id, const char *path,
@@ -84,7 +122,8 @@ static pm_err read_material(pm_reader *r, int id, const char *path,
   common[1].read = skip_value;
   size_t used = (size_t)snprintf(expected, sizeof expected,
                                  "name, model, density, "
-                                 "artificial_viscosity, and model %s's ",
+                                 "artificial_viscosity, damage, and model "
+                                 "%s's ",
                                  md->name);
   for (const pm_key *k = md->keys; k->type != PM_KEY_END; k++)
     used += (size_t)snprintf(expected + used, sizeof expected - used, "%s%s",
@@ -92,6 +131,13 @@ static pm_err read_material(pm_reader *r, int id, const char *path,
   const pm_key *tables[2] = {common, md->keys};
   void *bases[2] = {out, &out->mat};
   PM_CALL(pm_reader_mapping(r, id, path, 2, tables, bases, expected));
+  snprintf(sub, sizeof sub, "%s.damage", path);
+  out->damage.given = pm_reader_has(r, sub);
+  if (out->damage.given && !(out->damage.failure >= out->damage.elastic_limit))
+    return pm_reader_expected(
+        r, PM_PATH(sub, "%s.damage.failure_strain", path),
+        "a strain >= damage.elastic_limit (failure follows the elastic "
+        "limit)");
   const char *bad = NULL;
   if (md->init(&out->mat, &bad) != PM_SUCCESS) {
     char msg[PM_SDOC_WHERE];

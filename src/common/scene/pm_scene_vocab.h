@@ -12,7 +12,7 @@ extern const pm_key pm_scene_keys[];
 /* The keys every material has (name, model, density, artificial
  * viscosity); the rest are its model's.  PM_MATERIAL_KEYS entries with the
  * end. */
-#define PM_MATERIAL_KEYS 5
+#define PM_MATERIAL_KEYS 6
 extern const pm_key pm_scene_material_keys[PM_MATERIAL_KEYS];
 
 /* The materials list (a CUSTOM key of pm_scene_keys): each entry against

@@ -1,0 +1,75 @@
+#!/bin/bash
+# Cases M1 and M3 of the fluid-membrane paper at the paper's three cell
+# sizes each, their curves as PNG from history.csv, and a table of the
+# figures with the wall time of each run:
+#   OUT/m1/cuboid-uz.png    z-displacement of the cuboid's centre, cells
+#                           0.05, 0.025, 0.02 m
+#   OUT/m3/cube-uz.png      z-displacement of the cube's centroid, cells
+#                           0.04, 0.02, 0.01 m
+#   OUT/membranes.md        per run: particles, steps, wall time, the
+#                           displacement at the paper's times, and its change
+#                           from the next coarser cell
+# usage: scripts/study-membranes.sh [BUILD_DIR] [OUT] [m1|m3|all]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build}
+out=${2:-out/membranes}
+which=${3:-all}
+mkdir -p "$out"
+
+run() { # case, cell, dir
+  "$build/pointmech" run --overwrite "cases/mpm/$1.yaml" --quiet \
+    --set discretization.mesh_size="$2" --set output.every=20 --out "$3"
+}
+
+if [ "$which" = all ] || [ "$which" = m1 ]; then
+  args=()
+  for h in 0.05 0.025 0.02; do
+    run m1-cuboid-net $h "$out/m1/h$h"
+    args+=("cell $h m=$out/m1/h$h")
+  done
+  /usr/bin/python3 tools/plot-history.py --columns cuboid_uz \
+    --title "M1: z-displacement of the cuboid's centre (m)" \
+    --out "$out/m1/cuboid-uz.png" "${args[@]}"
+fi
+if [ "$which" = all ] || [ "$which" = m3 ]; then
+  args=()
+  for h in 0.04 0.02 0.01; do
+    run m3-gas-box-membrane $h "$out/m3/h$h"
+    args+=("cell $h m=$out/m3/h$h")
+  done
+  /usr/bin/python3 tools/plot-history.py --columns cube_uz \
+    --title "M3: z-displacement of the cube's centroid (m)" \
+    --out "$out/m3/cube-uz.png" "${args[@]}"
+fi
+/usr/bin/python3 - "$out" <<'PY'
+import csv, json, os, sys
+out = sys.argv[1]
+cases = [("m1", "cuboid_uz", [0.05, 0.1, 0.15, 0.2], ["0.05", "0.025", "0.02"]),
+         ("m3", "cube_uz", [0.01, 0.02, 0.03], ["0.04", "0.02", "0.01"])]
+lines = ["# M1 and M3 at three cell sizes", ""]
+for name, col, times, cells in cases:
+    runs = [os.path.join(out, name, "h" + h) for h in cells]
+    if not all(os.path.exists(os.path.join(r, "history.csv")) for r in runs):
+        continue
+    lines += ["## %s: %s (m) at t (s)" % (name.upper(), col), "",
+              "| cell (m) | particles | steps | wall (s) | " +
+              " | ".join("t = %g" % t for t in times) + " | change from coarser |",
+              "|---|---|---|---|" + "---|" * len(times) + "---|"]
+    prev = None
+    for h, r in zip(cells, runs):
+        rows = list(csv.DictReader(open(os.path.join(r, "history.csv"))))
+        s = json.load(open(os.path.join(r, "summary.json")))
+        vals = []
+        for t in times:
+            best = min(rows, key=lambda q: abs(float(q["time"]) - t))
+            vals.append(float(best[col]))
+        change = "" if prev is None else "%.3g" % max(abs(a - b) for a, b in zip(vals, prev))
+        lines.append("| %s | %d | %d | %.1f | %s | %s |" % (
+            h, s["points"], s["steps"], s["wall_seconds"],
+            " | ".join("%.4g" % v for v in vals), change))
+        prev = vals
+    lines.append("")
+open(os.path.join(out, "membranes.md"), "w").write("\n".join(lines) + "\n")
+print("\n".join(lines))
+PY

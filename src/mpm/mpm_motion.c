@@ -1,0 +1,89 @@
+/* mpm_motion: prescribed rigid motion of bodies. */
+#include "mpm_motion.h"
+
+#include <math.h>
+
+#include "mpm_state.h"
+
+void mpm_motion_velocity(const mpm_motion *mv, double t, double v[3]) {
+  for (int c = 0; c < 3; c++)
+    v[c] = mv->v[c] ? pm_expr_eval(mv->v[c], 0, 0, 0, t) : 0.0;
+}
+
+/* The body's velocity, or a failure at its first particle. */
+static bool velocity_at(const mpm_ctx *ctx, const mpm_motion *mv, double t,
+                        double v[3]) {
+  mpm_motion_velocity(mv, t, v);
+  if (isfinite(v[0] + v[1] + v[2])) return true;
+  mpm_fail(ctx->work, mv->begin,
+           "the prescribed velocity of its body (motion.velocity) is not "
+           "finite at t = %g s (|v|^2 = %g)",
+           t, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  return false;
+}
+
+double mpm_motion_apply(const mpm_ctx *ctx, double *vel, bool book) {
+  const mpm_model *m = ctx->model;
+  const mpm_nodes *nd = &ctx->work->nodes;
+  double *rm = ctx->work->rigid_mass;
+  const double t = ctx->state->t, dt = ctx->state->dt;
+  const int dim = m->dim;
+  double work = 0;
+  /* Serial: a few thousand particles, and nodes shared between them. */
+  for (int b = 0; b < m->n_moving; b++) {
+    const mpm_motion *mv = &m->moving[b];
+    double v[3];
+    if (!velocity_at(ctx, mv, t + 0.5 * dt, v)) return 0;
+    /* The body's mass at its nodes. */
+    for (long p = mv->begin; p < mv->end; p++) {
+      mpm_stencil st;
+      mpm_stencil_at(&m->grid, ctx->state->x + 3 * p, MPM_STENCIL_W, &st);
+      for (int k = 0; k < st.n; k++) rm[st.node[k]] = 0;
+    }
+    for (long p = mv->begin; p < mv->end; p++) {
+      mpm_stencil st;
+      mpm_stencil_at(&m->grid, ctx->state->x + 3 * p, MPM_STENCIL_W, &st);
+      for (int k = 0; k < st.n; k++) rm[st.node[k]] += st.w[k] * m->mass[p];
+    }
+    /* Each node once (its share then marked as done): the velocity blended
+     * towards the body's by the body's share of the node's mass, so that a
+     * node the body starts to touch takes its velocity gradually. */
+    for (long p = mv->begin; p < mv->end; p++) {
+      mpm_stencil st;
+      mpm_stencil_at(&m->grid, ctx->state->x + 3 * p, MPM_STENCIL_W, &st);
+      for (int k = 0; k < st.n; k++) {
+        const long i = st.node[k];
+        if (!(rm[i] > 0) || !(nd->mass[i] > 0)) continue;
+        const double a = fmin(1.0, rm[i] / nd->mass[i]);
+        rm[i] = -1;
+        for (int c = 0; c < dim; c++) {
+          double *vi = vel + 3 * i + c, set = *vi + a * (v[c] - *vi);
+          if (book)
+            work +=
+                nd->mass[i] * (set - *vi) * 0.5 * (nd->vel0[3 * i + c] + set);
+          *vi = set;
+        }
+      }
+    }
+  }
+  return work;
+}
+
+pm_err mpm_stage_motion(mpm_ctx *ctx, const mpm_stage *self) {
+  const mpm_model *m = ctx->model;
+  mpm_state *s = ctx->state;
+  double *dx = ctx->work->dx;
+  for (int b = 0; b < m->n_moving; b++) {
+    const mpm_motion *mv = &m->moving[b];
+    double vm[3], ve[3];
+    if (!velocity_at(ctx, mv, s->t + 0.5 * s->dt, vm) ||
+        !velocity_at(ctx, mv, s->t + s->dt, ve))
+      break;
+    for (long p = mv->begin; p < mv->end; p++)
+      for (int c = 0; c < 3; c++) {
+        s->v[3 * p + c] = ve[c];
+        dx[3 * p + c] = s->dt * vm[c];
+      }
+  }
+  return mpm_stage_status(ctx, self);
+}

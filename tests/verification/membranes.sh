@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# MPM membranes end to end through the program: bad membrane scenes are
+# refused with file:line:col and nothing written; plan shows the membrane's
+# stage and arrays, and a scene without membranes has none of them; the
+# reduced oocyte (case M4) runs to its end with no NaN, its energy
+# accounted for, and its zona failing only near the injection pipette.
+set -u
+bin=$1
+src=$2
+mpm=$src/cases/mpm
+oocyte=$mpm/m4-oocyte-reduced.yaml
+tube=$mpm/m2-shock-tube-reduced.yaml
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-2}
+# shellcheck source=lib.sh
+. "$(dirname "$0")/lib.sh"
+py=/usr/bin/python3
+
+bad_scene membrane-without-thickness "$oocyte" \
+  's/membrane: {thickness: 8.0e-6, /membrane: {/' 'membrane: {sphere' \
+  'bodies.0.membrane.thickness: missing required key'
+bad_scene inside-open-surface "$oocyte" \
+  's/sphere: {center: \[70.0e-6, 65.0e-6, 65.0e-6\], radius: 50.0e-6, refinement: 4}/rectangle: {origin: [20.0e-6, 20.0e-6, 65.0e-6], edge_u: [100.0e-6, 0, 0], edge_v: [0, 90.0e-6, 0], points: [11, 11]}/' \
+  'outside: zona' 'bodies.1.outside: expected the name of a closed membrane'
+# An open surface from a file: one square of two triangles.
+cat >"$work/open.stl" <<'STL'
+solid open
+facet normal 0 0 1
+outer loop
+vertex 20e-6 20e-6 65e-6
+vertex 120e-6 20e-6 65e-6
+vertex 120e-6 110e-6 65e-6
+endloop
+endfacet
+facet normal 0 0 1
+outer loop
+vertex 20e-6 20e-6 65e-6
+vertex 120e-6 110e-6 65e-6
+vertex 20e-6 110e-6 65e-6
+endloop
+endfacet
+endsolid open
+STL
+bad_scene inside-open-file "$oocyte" \
+  "s|sphere: {center: \[70.0e-6, 65.0e-6, 65.0e-6\], radius: 50.0e-6, refinement: 4}|file: $work/open.stl|" \
+  'outside: zona' 'expected the name of a closed membrane'
+check "inside-open-file: gives the reason" grep -qF 'hole' "$work/err"
+bad_scene motion-does-not-parse "$oocyte" 's/cos(2 \* pi/cos(2 ** pi/' \
+  'motion: {velocity: {y:' 'bodies.4.motion.velocity.y'
+bad_scene motion-in-x-y-z "$oocyte" 's/cos(2 \* pi \* t/cos(2 * pi * x/' \
+  'motion: {velocity: {y:' 'bodies.4.motion.velocity.y'
+bad_scene membrane-neo-hookean "$oocyte" '0,/model: linear-elastic/s//model: neo-hookean/' \
+  'model: neo-hookean' 'expected linear-elastic for material zona'
+bad_scene damage-on-a-solid "$oocyte" \
+  's/{name: holding, model: linear-elastic, density: 2300,/{name: holding, model: linear-elastic, density: 2300, damage: {c0: 1, c1: 1, elastic_limit: 0.1, failure_strain: 0.2},/' \
+  'name: holding' 'expected damage only on a material of membranes'
+
+# plan: the membrane's stage and arrays; none in a scene without one.
+"$bin" plan "$oocyte" >"$work/plan" 2>"$work/err"
+check "plan: exit 0" test $? -eq 0
+check "plan: membrane stage" grep -qF 'stress: membrane' "$work/plan"
+check "plan: frame and strain arrays" grep -qF 'frame membrane_strain omega failed' "$work/plan"
+check "plan: moving bodies" grep -qF 'moving as prescribed' "$work/plan"
+"$bin" plan "$tube" >"$work/plan-tube" 2>"$work/err"
+check "plan without membranes: no membrane stage" \
+  bash -c "! grep -qiE 'membrane|motion' '$work/plan-tube'"
+
+# The reduced oocyte to its end.
+out=$work/oocyte
+"$bin" run "$oocyte" --out "$out" --quiet >"$work/log" 2>"$work/err"
+rc=$?
+check "reduced M4: exit 0 (got $rc)" test $rc -eq 0
+check "reduced M4: completed" grep -qF '"status": "completed"' "$out/summary.json"
+"$py" - "$out" >"$work/m4.txt" 2>&1 <<'PY'
+import json, sys
+import h5py, numpy as np
+out = sys.argv[1]
+s = json.load(open(out + "/summary.json"))
+f = h5py.File(out + "/results.h5", "r")
+frames = sorted(f["frames"].keys())
+last = f["frames"][frames[-1]]
+x0 = f["mesh/coordinates"][:]
+failed = last["failed"][:] > 0.5
+ok = True
+for k in ("position", "velocity", "stress"):
+    if not np.all(np.isfinite(last[k][:])):
+        print("FAIL: %s not finite" % k); ok = False
+err = abs(s["energy"]["error"]) if "energy" in s else abs(s["energy_error"])
+print("energy error %.3e" % err)
+# The contact: the zona point nearest the injection pipette's mouth.
+contact = np.array([120e-6, 65e-6, 65e-6])
+d = np.linalg.norm(x0[failed] - contact, axis=1) if failed.any() else np.zeros(0)
+print("failed points %d, farthest from the contact %.3g um" %
+      (failed.sum(), 1e6 * d.max() if d.size else 0))
+if not failed.any(): print("FAIL: no point failed"); ok = False
+if d.size and d.max() > 30e-6: print("FAIL: failures away from the contact"); ok = False
+if err > 0.05: print("FAIL: energy error"); ok = False
+print("OK" if ok else "NOT OK")
+PY
+cat "$work/m4.txt" | sed 's/^/  /'
+check "reduced M4: finite, energy, failures near the contact" grep -qx OK "$work/m4.txt"
+
+echo "membranes: $passes passed, $failures failed"
+[ "$failures" -eq 0 ]
