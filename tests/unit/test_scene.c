@@ -302,7 +302,8 @@ static void test_model_keys_and_methods(void **state) {
       {"materials.0={name: gel, model: mooney-rivlin, density: 1000, c10: 300, "
        "c01: 100, youngs_modulus: 3}",
        "materials.0.youngs_modulus: unknown key (expected one of name, model, "
-       "density, artificial_viscosity, damage, and model mooney-rivlin's c10, c01, "
+       "density, artificial_viscosity, damage, and model mooney-rivlin's c10, "
+       "c01, "
        "bulk_modulus)",
        NULL},
       {"materials.0={name: gel, model: mooney-rivlin, density: 1000, c10: "
