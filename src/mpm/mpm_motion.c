@@ -72,18 +72,23 @@ double mpm_motion_apply(const mpm_ctx *ctx, double *vel, bool book) {
 pm_err mpm_stage_motion(mpm_ctx *ctx, const mpm_stage *self) {
   const mpm_model *m = ctx->model;
   mpm_state *s = ctx->state;
-  double *dx = ctx->work->dx;
+  double *dx = ctx->work->dx, work = 0;
   for (int b = 0; b < m->n_moving; b++) {
     const mpm_motion *mv = &m->moving[b];
     double vm[3], ve[3];
     if (!velocity_at(ctx, mv, s->t + 0.5 * s->dt, vm) ||
         !velocity_at(ctx, mv, s->t + s->dt, ve))
       break;
+    /* What sets the body's velocity works on it: the change of its
+     * particles' kinetic energy from what the grid gave them. */
     for (long p = mv->begin; p < mv->end; p++)
       for (int c = 0; c < 3; c++) {
-        s->v[3 * p + c] = ve[c];
+        double *vp = s->v + 3 * p + c;
+        work += 0.5 * m->mass[p] * (ve[c] * ve[c] - *vp * *vp);
+        *vp = ve[c];
         dx[3 * p + c] = s->dt * vm[c];
       }
   }
+  mpm_book_work(ctx, self, work);
   return mpm_stage_status(ctx, self);
 }

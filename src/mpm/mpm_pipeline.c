@@ -105,6 +105,7 @@ void mpm_pipeline_build(mpm_model *m) {
            "particle velocities (FLIP %g / PIC %g)", o->flip, 1 - o->flip);
   if (m->n_moving > 0) {
     st = add(pl, "motion", mpm_stage_motion);
+    st->books = MPM_BOOKS_WORK;
     snprintf(st->detail, sizeof st->detail,
              "%d bod%s moving as prescribed: velocity and position of the "
              "expressions of t",
