@@ -4,7 +4,12 @@
 #   - a 3-D neo-Hookean block with quadratic B-splines, MUSL, 8 particles
 #     per cell (cases/mpm/bench-block.yaml, 110592 particles), and
 #   - the shock tube at the paper's size (cases/mpm/m2-shock-tube.yaml,
-#     20000 gas particles, linear B-splines, iterative energy update).
+#     20000 gas particles, linear B-splines, iterative energy update),
+#   - membranes with fluids: the gas-filled sphere
+#     (cases/mpm/membrane-sphere-gas.yaml, 2562 membrane and 4224 gas
+#     particles) and the reduced oocyte (cases/mpm/m4-oocyte-reduced.yaml:
+#     a zona with elastodamage, two stiffened-gas fluids, two moving
+#     bodies, absorbing faces; 8967 particles).
 # usage: scripts/bench-mpm.sh [BUILD_DIR]   (STEPS: steps per run, 100)
 bench_name=mpm
 source "$(dirname "$0")/bench-lib.sh"
@@ -12,7 +17,8 @@ steps=${STEPS:-100}
 cores=$(nproc)
 printf '%-28s %8s %7s %8s %14s %14s\n' case particles threads steps \
   "p-steps/s" "p-steps/s/core"
-for scene in cases/mpm/bench-block.yaml cases/mpm/m2-shock-tube.yaml; do
+for scene in cases/mpm/bench-block.yaml cases/mpm/m2-shock-tube.yaml \
+  cases/mpm/membrane-sphere-gas.yaml cases/mpm/m4-oocyte-reduced.yaml; do
   name=$(basename "$scene" .yaml)
   for threads in 1 "$cores"; do
     dir="$out/$name-t$threads"

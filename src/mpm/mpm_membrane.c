@@ -323,7 +323,12 @@ static pm_err membrane_stress(mpm_ctx *ctx, const mpm_stage *self) {
   const double dt = s->dt, jmin = m->opt.min_jacobian;
   const double ez_of = -mp->nu / (1 - mp->nu); /* eq. 1 */
   double *tn = w->scratch[gi];
-  const double *vel = w->nodes.vel_stress, *x = s->x, *vol0 = m->vol0;
+  /* The strain follows the velocity that moves the points (MUSL's remapped
+   * velocity differs from it by the particles' noise, and a membrane whose
+   * strain and positions part creeps without stretching). */
+  const double *vel =
+      m->opt.update == MPM_MUSL ? w->nodes.vel_new : w->nodes.vel_stress;
+  const double *x = s->x, *vol0 = m->vol0;
   mpm_group_state *gs = &s->group[gi];
   double *frame = gs->array[MEM_FRAME].data, *eps = gs->array[MEM_STRAIN].data;
   double *om = mp->damage ? gs->array[MEM_OMEGA].data : NULL;

@@ -99,6 +99,8 @@ static void test_frame_rotation(void **state) {
                    g->origin[2] + iz * g->h};
     pm_v_cross(om, x, vel + 3 * i);
   }
+  /* The velocity the membrane's strain follows (MUSL: the updated one). */
+  memcpy(w->nodes.vel_new, vel, sizeof(double) * 3 * (size_t)g->n_nodes);
   w->nodes.vel_stress = vel;
   const double dt = 1e-3;
   st->dt = dt;
@@ -383,7 +385,7 @@ static double sphere_equilibrium(double R0, double t, double E, double nu,
 
 static void test_gas_sphere(void **state) {
   (void)state;
-  const char *sets[] = {"time.end=0.5"};
+  const char *sets[] = {"time.end=0.3"};
   pm_scene *s = load_scene(CASES "membrane-sphere-gas.yaml", 1, sets);
   verify_run *r = verify_create(s);
   const mpm_model *m = r->sim->model;
@@ -428,8 +430,10 @@ static void test_gas_sphere(void **state) {
     if (rq > rmin_mem) out++;
   }
   table_head("Gas-filled sphere at rest against the balance of pressure and "
-             "tension (h = 0.1 m, 2562 membrane points, 0.4-0.5 s)");
+             "tension (h = 0.1 m, 2562 membrane points, 0.24-0.3 s)");
   bool ok = true;
+  ok &= row("radial displacement of the points R - R0 (m)", R - R0, Req - R0, 0,
+            0.05);
   ok &= row("membrane strain, as R0 exp(eps) - R0 (m)", R0 * exp(e) - R0,
             Req - R0, 0, 0.05);
   ok &= row("gas pressure against 2 t sigma / R (Pa)", p, p_tension, 0, 0.02);
