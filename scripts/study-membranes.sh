@@ -9,7 +9,13 @@
 #   OUT/membranes.md        per run: particles, steps, wall time, the
 #                           displacement at the paper's times, and its change
 #                           from the next coarser cell
-# usage: scripts/study-membranes.sh [BUILD_DIR] [OUT] [m1|m3|all]
+#   OUT/leak.md             does gas leak through a membrane one point thick?
+#                           The gas-filled sphere (cell 0.1 m) with 42 to 2562
+#                           membrane points: the gas mass inside the
+#                           membrane's current surface at the end (0.3 s)
+#                           against the start, by cell size over point
+#                           spacing
+# usage: scripts/study-membranes.sh [BUILD_DIR] [OUT] [m1|m3|leak|all]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -41,6 +47,33 @@ if [ "$which" = all ] || [ "$which" = m3 ]; then
   /usr/bin/python3 tools/plot-history.py --columns cube_uz \
     --title "M3: z-displacement of the cube's centroid (m)" \
     --out "$out/m3/cube-uz.png" "${args[@]}"
+fi
+if [ "$which" = all ] || [ "$which" = leak ]; then
+  for r in 1 2 3 4; do
+    "$build/pointmech" run --overwrite cases/mpm/membrane-sphere-gas.yaml \
+      --quiet --set time.end=0.3 --set output.every=100 \
+      --set bodies.0.membrane.sphere.refinement=$r --out "$out/leak/r$r" ||
+      echo "refinement $r: the run stopped (see $out/leak/r$r/summary.json)"
+  done
+  /usr/bin/python3 - "$out" <<'PY'
+import csv, math, os, sys
+out = sys.argv[1]
+lines = ["# Gas inside a closed membrane (sphere R = 0.5 m, cell 0.1 m, 0.3 s)", "",
+         "| refinement | membrane points | edge (m) | cell / edge | gas mass inside at 0 | at the end | end (s) | lost |",
+         "|---|---|---|---|---|---|---|---|"]
+for r in (1, 2, 3, 4):
+    d = os.path.join(out, "leak", "r%d" % r)
+    rows = list(csv.DictReader(open(os.path.join(d, "history.csv"))))
+    col = "mass_inside_membrane_gas"
+    m0, m1 = float(rows[0][col]), float(rows[-1][col])
+    end = float(rows[-1]["time"])
+    n = 10 * 4 ** r + 2
+    edge = math.sqrt(4 * 4 * math.pi * 0.25 / (math.sqrt(3) * 20 * 4 ** r))
+    lines.append("| %d | %d | %.3f | %.2f | %.4f | %.4f | %.3g | %.2f%% |" % (
+        r, n, edge, 0.1 / edge, m0, m1, end, 100 * (m0 - m1) / m0))
+open(os.path.join(out, "leak.md"), "w").write("\n".join(lines) + "\n")
+print("\n".join(lines))
+PY
 fi
 /usr/bin/python3 - "$out" <<'PY'
 import csv, json, os, sys
