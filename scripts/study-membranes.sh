@@ -28,25 +28,25 @@ run() { # case, cell, dir
     --set discretization.mesh_size="$2" --set output.every=20 --out "$3"
 }
 
-if [ "$which" = all ] || [ "$which" = m1 ]; then
-  args=()
-  for h in 0.05 0.025 0.02; do
-    run m1-cuboid-net $h "$out/m1/h$h"
-    args+=("cell $h m=$out/m1/h$h")
+# One case at its three cells and the PNG of one history column.
+study() { # name, scene, column, png, title, cells...
+  local name=$1 scene=$2 col=$3 png=$4 title=$5 args=()
+  shift 5
+  for h in "$@"; do
+    run "$scene" "$h" "$out/$name/h$h"
+    args+=("cell $h m=$out/$name/h$h")
   done
-  /usr/bin/python3 tools/plot-history.py --columns cuboid_uz \
-    --title "M1: z-displacement of the cuboid's centre (m)" \
-    --out "$out/m1/cuboid-uz.png" "${args[@]}"
+  /usr/bin/python3 tools/plot-history.py --columns "$col" --title "$title" \
+    --out "$out/$name/$png" "${args[@]}"
+}
+
+if [ "$which" = all ] || [ "$which" = m1 ]; then
+  study m1 m1-cuboid-net cuboid_uz cuboid-uz.png \
+    "M1: z-displacement of the cuboid's centre (m)" 0.05 0.025 0.02
 fi
 if [ "$which" = all ] || [ "$which" = m3 ]; then
-  args=()
-  for h in 0.04 0.02 0.01; do
-    run m3-gas-box-membrane $h "$out/m3/h$h"
-    args+=("cell $h m=$out/m3/h$h")
-  done
-  /usr/bin/python3 tools/plot-history.py --columns cube_uz \
-    --title "M3: z-displacement of the cube's centroid (m)" \
-    --out "$out/m3/cube-uz.png" "${args[@]}"
+  study m3 m3-gas-box-membrane cube_uz cube-uz.png \
+    "M3: z-displacement of the cube's centroid (m)" 0.04 0.02 0.01
 fi
 if [ "$which" = all ] || [ "$which" = leak ]; then
   for r in 1 2 3 4; do
