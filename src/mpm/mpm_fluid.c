@@ -201,11 +201,13 @@ static void fluid_energies(const mpm_model *m, const mpm_state *s,
   (void)strain;
   const long begin = g->begin, end = g->end;
   const double *e = s->group[g->index].array[FLUID_E].data, *mass = m->mass;
-  double ie = *internal;
+  /* From zero, then added: with two threads the sum is then the same
+   * whichever thread's share comes first. */
+  double ie = 0;
   PM_OMP(parallel for schedule(static) default(none)
          shared(begin, end, e, mass) reduction(+ : ie))
   for (long p = begin; p < end; p++) ie += mass[p] * e[p - begin];
-  *internal = ie;
+  *internal += ie;
 }
 
 static void fluid_fields(const mpm_model *m, const mpm_state *s,

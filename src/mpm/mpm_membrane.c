@@ -411,14 +411,14 @@ static void membrane_energies(const mpm_model *m, const mpm_state *s,
   const double *om = mp->damage ? gs->array[MEM_OMEGA].data : NULL;
   const double *failed = mp->damage ? gs->array[MEM_FAILED].data : NULL;
   const long begin = g->begin, end = g->end;
-  double se = *strain;
+  double se = 0; /* from zero, then added (as mpm_fluid.c) */
   PM_OMP(parallel for schedule(static) default(none)
          shared(mp, eps, vol0, om, failed, begin, end) reduction(+ : se))
   for (long p = begin; p < end; p++) {
     const long k = p - begin;
     se += vol0[p] * plane_energy(mp, eps + 3 * k, factor_of(mp, om, failed, k));
   }
-  *strain = se;
+  *strain += se;
 }
 
 static void membrane_fields(const mpm_model *m, const mpm_state *s,

@@ -182,7 +182,7 @@ static void solid_energies(const mpm_model *m, const mpm_state *s,
   long mss;
   const double *ms = model_state(g, s, &mss);
   const double *F = s->group[g->index].array[SOLID_F].data, *vol0 = m->vol0;
-  double se = *strain;
+  double se = 0; /* from zero, then added (as mpm_fluid.c) */
   PM_OMP(parallel for schedule(static) default(none)
          shared(mat, ms, mss, begin, end, F, vol0) reduction(+ : se))
   for (long p = begin; p < end; p++) {
@@ -190,7 +190,7 @@ static void solid_energies(const mpm_model *m, const mpm_state *s,
     se +=
         vol0[p] * pm_material_energy(mat, F + 9 * k, ms ? ms + mss * k : NULL);
   }
-  *strain = se;
+  *strain += se;
 }
 
 static void solid_fields(const mpm_model *m, const mpm_state *s,

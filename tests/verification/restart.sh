@@ -45,7 +45,10 @@ with h5py.File(os.path.join(out, "results.h5"), "r") as f:
     assert f.attrs["frames"] == n
     for k in f["frames"]:
         assert "displacement" in f["frames"][k] or "position" in f["frames"][k]
-grids = ET.parse(os.path.join(out, "results.xdmf")).getroot().findall(".//Grid/Grid")
+# One grid per frame under the temporal collection (a spatial collection
+# of the points and the membrane's triangles when there is a membrane).
+grids = ET.parse(os.path.join(out, "results.xdmf")).getroot().findall(
+    ".//Grid[@CollectionType='Temporal']/Grid")
 assert len(grids) == n, (len(grids), n)
 for item in ET.parse(os.path.join(out, "results.xdmf")).getroot().iter("DataItem"):
     assert os.path.exists(os.path.join(out, item.text.split(":")[0])), item.text
@@ -104,6 +107,11 @@ resume_case fpm-static "$src/cases/fpm/f3-extension-60-h1.09e-2.yaml" 5 \
 mpm=$src/cases/mpm/m2-shock-tube-reduced.yaml
 ckpt_every=100
 resume_case mpm "$mpm" 4 --set time.max_steps=400 --set output.every=50
+# Membranes (frames, strains, damage), two fluids and moving bodies: the
+# reduced oocyte.
+ckpt_every=200
+resume_case membranes "$src/cases/mpm/m4-oocyte-reduced.yaml" 4 \
+  --set time.max_steps=1000 --set output.every=100
 
 # Checkpoints by wall time: every 0.03 s of a run of 0.3 s or more.
 out=$work/minutes
