@@ -24,7 +24,7 @@ static long scratch_per_particle(const mpm_model *m) {
   return 12 + (m->kinds & MPM_KIND_MEMBRANE ? 5 : 0);
 }
 
-static void history_setup(mpm_sim *r);
+static pm_err history_setup(mpm_sim *r);
 
 pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
   pm_err ret = PM_SUCCESS;
@@ -38,7 +38,7 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
   r->setup_wall = pm_wtime() - t0;
   PM_TRY(PM_ALLOC(r->scratch, scratch_per_particle(r->model) * r->model->n,
                   "output buffer"));
-  history_setup(r);
+  PM_TRY(history_setup(r));
   *out = r;
   r = NULL;
 done:
@@ -51,6 +51,9 @@ void mpm_sim_destroy(mpm_sim *r) {
   mpm_work_destroy(r->work);
   mpm_state_destroy(r->state);
   mpm_model_destroy(r->model);
+  for (int b = 0; r->surface && b < r->scene->n_bodies; b++)
+    free(r->surface[b]);
+  free(r->surface);
   free(r->scratch);
   free(r);
 }
@@ -297,10 +300,11 @@ static void add_hist(mpm_sim *r, const char *fmt, const char *a,
   r->n_hist++;
 }
 
-static void history_setup(mpm_sim *r) {
+static pm_err history_setup(mpm_sim *r) {
   const mpm_model *m = r->model;
   const pm_scene *s = r->scene;
   r->n_hist = 0;
+  PM_CALL(PM_ALLOC(r->surface, s->n_bodies, "membrane surfaces"));
   if (m->kinds & MPM_KIND_ITERATES) {
     add_hist(r, "energy_iterations%s%s", "", "");
     add_hist(r, "energy_iterations_capped%s%s", "", "");
@@ -317,10 +321,17 @@ static void history_setup(mpm_sim *r) {
   for (int b = 0; b < s->n_bodies; b++) {
     const pm_scene_body *body = &s->bodies[b];
     if ((body->shape == PM_BODY_INSIDE || body->shape == PM_BODY_OUTSIDE) &&
-        m->body_end[b] > m->body_begin[b])
-      add_hist(r, "mass_inside_%s_%s", s->bodies[body->surface_body].name,
+        m->body_end[b] > m->body_begin[b]) {
+      const int mb = body->surface_body;
+      add_hist(r, "mass_inside_%s_%s", s->bodies[mb].name,
                body->name ? body->name : s->materials[body->material].name);
+      if (!r->surface[mb])
+        PM_CALL(mpm_triangles_local(m, m->body_tri_begin[mb],
+                                    m->body_tri_end[mb], m->body_begin[mb],
+                                    &r->surface[mb]));
+    }
   }
+  return PM_SUCCESS;
 }
 
 static int history_names(void *p, const char **names, int max) {
@@ -331,43 +342,26 @@ static int history_names(void *p, const char **names, int max) {
 }
 
 /* The mass of body b's particles inside membrane body mb's current
- * surface (NAN when it cannot be built). */
+ * surface (NAN when it cannot be built).  The inside test is built anew
+ * for each history row: the surface moves. */
 static double mass_inside(const mpm_sim *r, int b, int mb) {
   const mpm_model *m = r->model;
   const double *x = r->state->x;
-  /* The membrane's triangles, in its particles' current positions. */
-  long t0 = -1, t1 = -1, first = m->body_begin[mb];
-  for (long t = 0; t < m->n_tris; t++) {
-    long v = m->tri[3 * t];
-    if (v >= first && v < m->body_end[mb]) {
-      if (t0 < 0) t0 = t;
-      t1 = t + 1;
-    }
-  }
-  if (t0 < 0) return NAN;
-  gm_trisurf sf = {.n_points = m->body_end[mb] - first,
-                   .x = (double *)(x + 3 * first),
-                   .n_tris = t1 - t0,
-                   .tri = NULL};
-  double mass = NAN;
+  const gm_trisurf sf = {.n_points = m->body_end[mb] - m->body_begin[mb],
+                         .x = (double *)(x + 3 * m->body_begin[mb]),
+                         .n_tris = m->body_tri_end[mb] - m->body_tri_begin[mb],
+                         .tri = r->surface[mb]};
   gm_inside *in = NULL;
-  long *tri = malloc(sizeof(long) * 3 * (size_t)sf.n_tris);
-  if (!tri) return NAN;
-  for (long j = 0; j < 3 * sf.n_tris; j++) tri[j] = m->tri[3 * t0 + j] - first;
-  sf.tri = tri;
-  if (gm_inside_create(&sf, &in) == PM_SUCCESS) {
-    double sum = 0;
-    const long begin = m->body_begin[b], end = m->body_end[b];
-    const double *mp = m->mass;
-    PM_OMP(parallel for schedule(static) default(none)
-           shared(in, x, mp, begin, end) reduction(+ : sum))
-    for (long q = begin; q < end; q++)
-      if (gm_inside_contains(in, x + 3 * q)) sum += mp[q];
-    mass = sum;
-    gm_inside_destroy(in);
-  }
-  free(tri);
-  return mass;
+  if (gm_inside_create(&sf, &in) != PM_SUCCESS) return NAN;
+  double sum = 0;
+  const long begin = m->body_begin[b], end = m->body_end[b];
+  const double *mp = m->mass;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(in, x, mp, begin, end) reduction(+ : sum))
+  for (long q = begin; q < end; q++)
+    if (gm_inside_contains(in, x + 3 * q)) sum += mp[q];
+  gm_inside_destroy(in);
+  return sum;
 }
 
 static void history_values(void *p, double *v) {
@@ -509,11 +503,8 @@ static void plan_bodies(const mpm_sim *r, FILE *out) {
     fprintf(out, "  body %d%s%s: %ld particles", b, body->name ? " " : "",
             body->name ? body->name : "", n);
     if (body->shape == PM_BODY_MEMBRANE) {
-      long nt = 0;
+      long nt = m->body_tri_end[b] - m->body_tri_begin[b];
       double area = 0;
-      for (long t = 0; t < m->n_tris; t++)
-        if (m->tri[3 * t] >= m->body_begin[b] && m->tri[3 * t] < m->body_end[b])
-          nt++;
       for (long q = m->body_begin[b]; q < m->body_end[b]; q++)
         area += m->vol0[q] / body->membrane.thickness;
       fprintf(out, ", membrane of %ld triangles, thickness %g m, area %.6g m^2",

@@ -23,6 +23,9 @@ typedef struct {
   const char *hist_names[PM_HISTORY_MAX];
   char hist_store[PM_HISTORY_MAX][48];
   int n_hist;
+  /* per scene body: a membrane's triangles counted from its first point
+   * (those a body lies inside or outside of; else NULL) */
+  long **surface;
   /* the run */
   pm_status status;
   double energy0;          /* kinetic + strain + internal at t = 0 */

@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gm_trisurf.h"
 #include "mpm_kind.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
@@ -42,7 +43,8 @@ typedef struct {
   double c0, c1;  /* eq. 39 */
   double limit;   /* S_L, eq. 40 */
   double failure; /* eps_max at failure */
-  /* point -> triangles (global triangle indices), group-local rows */
+  /* point -> triangles, both counted within the group (gm_trisurf's
+   * incidence of the group's surface) */
   long *inc_start, *inc_tri;
 } membrane_params;
 
@@ -182,11 +184,11 @@ static void triangle_normals(const mpm_model *m, const double *x, long t0,
 
 /* The mean of point k's triangles' unit normals, normalised (eq. 8); false
  * when it vanishes. */
-static inline bool point_normal(const membrane_params *mp, long k, long t0,
+static inline bool point_normal(const membrane_params *mp, long k,
                                 const double *tn, double n[3]) {
   n[0] = n[1] = n[2] = 0;
   for (long j = mp->inc_start[k]; j < mp->inc_start[k + 1]; j++) {
-    const double *a = tn + 3 * (mp->inc_tri[j] - t0);
+    const double *a = tn + 3 * mp->inc_tri[j];
     for (int i = 0; i < 3; i++) n[i] += a[i];
   }
   double len = pm_v_norm(n);
@@ -271,28 +273,22 @@ static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
   const long np = g->end - g->begin;
   double *tn = NULL;
   pm_err ret = PM_SUCCESS;
-  /* Incidence: each point's triangles, in triangle order. */
-  PM_TRY(PM_ALLOC(mp->inc_start, np + 1, "membrane incidence"));
-  PM_TRY(PM_ALLOC(mp->inc_tri, 3 * (t1 - t0) + 1, "membrane incidence"));
-  for (long t = t0; t < t1; t++)
-    for (int c = 0; c < 3; c++)
-      mp->inc_start[m->tri[3 * t + c] - g->begin + 1]++;
-  for (long k = 0; k < np; k++) mp->inc_start[k + 1] += mp->inc_start[k];
-  {
-    long *fill = NULL;
-    PM_TRY(PM_ALLOC(fill, np + 1, "membrane incidence"));
-    memcpy(fill, mp->inc_start, sizeof(long) * (np + 1));
-    for (long t = t0; t < t1; t++)
-      for (int c = 0; c < 3; c++)
-        mp->inc_tri[fill[m->tri[3 * t + c] - g->begin]++] = t;
-    free(fill);
-  }
+  /* Incidence: each point's triangles, of the group's surface. */
+  long *local = NULL;
+  PM_TRY(mpm_triangles_local(m, t0, t1, g->begin, &local));
+  gm_trisurf sf = {.n_points = np,
+                   .x = s->x + 3 * g->begin,
+                   .n_tris = t1 - t0,
+                   .tri = local};
+  ret = gm_trisurf_incidence(&sf, &mp->inc_start, &mp->inc_tri);
+  free(local);
+  if (ret) goto done;
   PM_TRY(PM_ALLOC(tn, 3 * (t1 - t0) + 3, "triangle normals"));
   triangle_normals(m, s->x, t0, t1, tn);
   double *frame = s->group[g->index].array[MEM_FRAME].data;
   for (long k = 0; k < np; k++) {
     double n[3];
-    PM_ENSURE(point_normal(mp, k, t0, tn, n), PM_ERR_SCENE,
+    PM_ENSURE(point_normal(mp, k, tn, n), PM_ERR_SCENE,
               "membrane %s: point %ld at (%g, %g, %g) has no normal (it "
               "belongs to no triangle, or its triangles' normals cancel)",
               g->name, g->begin + k, s->x[3 * (g->begin + k)],
@@ -337,7 +333,7 @@ static pm_err membrane_stress(mpm_ctx *ctx, const mpm_stage *self) {
   double lost = 0, Jlow = INFINITY;
   triangle_normals(m, x, t0, t1, tn);
   PM_OMP(parallel for schedule(static) default(none)
-         shared(g, mp, w, t0, begin, end, dt, jmin, ez_of, tn, vel, x, vol0,
+         shared(g, mp, w, begin, end, dt, jmin, ez_of, tn, vel, x, vol0,
                 frame, eps, om, failed, vol, sigma)
          reduction(+ : lost) reduction(min : Jlow))
   for (long p = begin; p < end; p++) {
@@ -349,7 +345,7 @@ static pm_err membrane_stress(mpm_ctx *ctx, const mpm_stage *self) {
     /* The spin about the normal: the axial vector of W along n. */
     const double *n0 = f + 6;
     double spin = W[7] * n0[0] + W[2] * n0[1] + W[3] * n0[2];
-    if (!point_normal(mp, k, t0, tn, n1)) memcpy(n1, n0, sizeof n1);
+    if (!point_normal(mp, k, tn, n1)) memcpy(n1, n0, sizeof n1);
     mpm_membrane_carry_frame(f, spin * dt, n1);
     /* The strain increment in the frame. */
     const double *e1 = f, *e2 = f + 3;

@@ -99,6 +99,8 @@ void mpm_model_destroy(mpm_model *m) {
   }
   free(m->body_begin);
   free(m->body_end);
+  free(m->body_tri_begin);
+  free(m->body_tri_end);
   free(m->tri);
   free(m->moving);
   mpm_conditions_destroy(m->bcs, m->n_bcs);
@@ -106,6 +108,14 @@ void mpm_model_destroy(mpm_model *m) {
   free(m->mass);
   free(m->vol0);
   free(m);
+}
+
+pm_err mpm_triangles_local(const mpm_model *m, long t0, long t1, long first,
+                           long **out) {
+  PM_CALL(PM_ALLOC(*out, 3 * (t1 - t0) + 1, "membrane triangles"));
+  for (long j = 0; j < 3 * (t1 - t0); j++)
+    (*out)[j] = m->tri[3 * t0 + j] - first;
+  return PM_SUCCESS;
 }
 
 size_t mpm_model_bytes(const mpm_model *m) {

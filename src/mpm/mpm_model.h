@@ -63,6 +63,7 @@ typedef struct mpm_model {
   long n_tris;
   long *tri;
   long tri_begin[MPM_MAX_GROUPS], tri_end[MPM_MAX_GROUPS];
+  long *body_tri_begin, *body_tri_end; /* per scene body (membranes) */
   /* bodies that move as prescribed */
   int n_moving;
   mpm_motion *moving;
@@ -87,6 +88,12 @@ pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
                         struct mpm_state **state);
 /* Release a model (NULL accepted); its states and workspaces first. */
 void mpm_model_destroy(mpm_model *m);
+
+/* Triangles [t0, t1) of m with their corners counted from particle
+ * `first` (a group's or a body's surface as gm_trisurf wants it): a new
+ * array of 3 (t1 - t0) indices the caller frees.  PM_ERR_MEMORY. */
+pm_err mpm_triangles_local(const mpm_model *m, long t0, long t1, long first,
+                           long **out);
 
 /* Bytes of the model's arrays (particle constants, condition columns). */
 size_t mpm_model_bytes(const mpm_model *m);

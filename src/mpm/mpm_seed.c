@@ -243,7 +243,9 @@ static pm_err place_membrane(seed_ctx *c, int b, long *t) {
   free(area);
   for (long j = 0; j < 3 * sf->n_tris; j++)
     m->tri[3 * *t + j] = first + sf->tri[j];
+  m->body_tri_begin[b] = *t;
   *t += sf->n_tris;
+  m->body_tri_end[b] = *t;
   return PM_SUCCESS;
 }
 
@@ -328,6 +330,8 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   PM_TRY(PM_ALLOC(c.next, nb, "body counts"));
   PM_TRY(PM_ALLOC(m->body_begin, nb, "body ranges"));
   PM_TRY(PM_ALLOC(m->body_end, nb, "body ranges"));
+  PM_TRY(PM_ALLOC(m->body_tri_begin, nb, "body ranges"));
+  PM_TRY(PM_ALLOC(m->body_tri_end, nb, "body ranges"));
   m->n_bodies = nb;
   for (int b = 0; b < nb; b++) {
     if (s->bodies[b].shape == PM_BODY_MEMBRANE)
