@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "gm_curve.h"
 #include "gm_inside.h"
 #include "gm_volume.h"
 #include "pm_tensor.h"
@@ -26,6 +27,7 @@ struct gm_shape {
   const pm_expr *region; /* borrowed from the scene */
   gm_volume *volume;     /* owned */
   gm_inside *inside;     /* owned */
+  gm_polygon polygon;    /* owned: the region a 2-D membrane encloses */
 };
 
 struct shape_kind {
@@ -212,6 +214,67 @@ pm_err gm_shape_from_surface(const gm_trisurf *s, bool outside,
   shape->kind = outside ? &outside_kind : &inside_kind;
   shape->dim = 3;
   PM_TRY(gm_inside_create(s, &shape->inside));
+  *out = shape;
+  shape = NULL;
+done:
+  gm_shape_destroy(shape);
+  return ret;
+}
+
+/* ---- the region a 2-D membrane encloses ---------------------------------- */
+
+/* The curve's points belong to the inside, as a surface's do (a point on
+ * the polygon's edge is in or out by the crossing rule; seeds are not
+ * placed on the membrane). */
+static bool polygon_contains(const gm_shape *s, const double x[3]) {
+  return gm_polygon_contains(&s->polygon, x);
+}
+
+static bool polygon_outside_contains(const gm_shape *s, const double x[3]) {
+  return !gm_polygon_contains(&s->polygon, x);
+}
+
+static void polygon_bounds(const gm_shape *s, double lo[3], double hi[3]) {
+  for (int c = 0; c < 3; c++) lo[c] = hi[c] = 0;
+  for (int c = 0; c < 2; c++) {
+    lo[c] = INFINITY;
+    hi[c] = -INFINITY;
+  }
+  for (long k = 0; k < s->polygon.n; k++)
+    for (int c = 0; c < 2; c++) {
+      lo[c] = fmin(lo[c], s->polygon.xy[2 * k + c]);
+      hi[c] = fmax(hi[c], s->polygon.xy[2 * k + c]);
+    }
+}
+
+static void polygon_release(gm_shape *s) { gm_polygon_free(&s->polygon); }
+
+static const shape_kind polygon_inside_kind = {.key = "inside",
+                                               .thread_safe = true,
+                                               .contains = polygon_contains,
+                                               .bounds = polygon_bounds,
+                                               .release = polygon_release};
+static const shape_kind polygon_outside_kind = {.key = "outside",
+                                                .thread_safe = true,
+                                                .contains =
+                                                    polygon_outside_contains,
+                                                .release = polygon_release};
+
+pm_err gm_shape_from_curve(long n, const double *x, bool closed,
+                           const double box_min[3], const double box_max[3],
+                           bool outside, gm_shape **out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_shape_from_curve: out is NULL");
+  *out = NULL;
+  pm_err ret = PM_SUCCESS;
+  gm_shape *shape = NULL;
+  PM_TRY(PM_ALLOC(shape, 1, "shape"));
+  shape->kind = outside ? &polygon_outside_kind : &polygon_inside_kind;
+  shape->dim = 2;
+  double tol = 0;
+  for (int c = 0; c < 2; c++)
+    tol = fmax(tol, GM_SHAPE_BOX_TOL * 1e3 * (box_max[c] - box_min[c]));
+  PM_TRY(
+      gm_curve_polygon(n, x, closed, box_min, box_max, tol, &shape->polygon));
   *out = shape;
   shape = NULL;
 done:

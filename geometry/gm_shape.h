@@ -58,6 +58,17 @@ pm_err gm_shape_create(const pm_scene_body *body, int dim,
  * reason) or PM_ERR_MEMORY. */
 pm_err gm_shape_from_surface(const gm_trisurf *s, bool outside, gm_shape **out);
 
+/* The inside (outside false) or the outside (outside true) of the region
+ * a 2-D membrane encloses: the polygon of its n points x (3 each, in
+ * order), closed directly when closed, else along the boundary of the box
+ * [box_min, box_max] on which its ends lie (gm_curve_polygon, ends within
+ * 1e-6 of the box's size).  Thread-safe; x is copied.  PM_ERR_GEOMETRY
+ * (an open curve whose ends are not on the box's boundary: the message
+ * says which end) or PM_ERR_MEMORY; *out NULL on failure. */
+pm_err gm_shape_from_curve(long n, const double *x, bool closed,
+                           const double box_min[3], const double box_max[3],
+                           bool outside, gm_shape **out);
+
 /* Frees the shape (and the volume of a mesh body, the inside test of a
  * surface); NULL is a no-op. */
 void gm_shape_destroy(gm_shape *s);

@@ -4,8 +4,10 @@
 #include "fpm_backend.h"
 #include "mpm_backend.h"
 #include "pm_backend.h"
+#include "pm_omp.h"
 
 pm_err pm_app_init(void) {
+  pm_blas_single_thread();
   PM_CALL(pm_backend_register(&fpm_backend));
   PM_CALL(pm_backend_register(&mpm_backend));
   return PM_SUCCESS;

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "gm_inside.h"
+#include "gm_shape.h"
 #include "mpm_estimate.h"
 #include "mpm_kind.h"
 #include "mpm_pipeline.h"
@@ -300,6 +301,24 @@ static void add_hist(mpm_sim *r, const char *fmt, const char *a,
   r->n_hist++;
 }
 
+/* The kind of scene body b's particles. */
+static const mpm_kind *body_kind(const mpm_model *m, int b) {
+  for (int gi = 0; gi < m->n_groups; gi++)
+    if (m->body_begin[b] >= m->group[gi].begin &&
+        m->body_end[b] <= m->group[gi].end)
+      return m->group[gi].kind;
+  return m->group[0].kind;
+}
+
+/* Whether some membrane's normals come by isosurface least squares. */
+static bool iso_normals_used(const mpm_model *m) {
+  for (int b = 0; b < m->n_bodies; b++)
+    if (m->body_end[b] > m->body_begin[b] &&
+        m->body_normals[b] != PM_NORMALS_CONNECTIVITY)
+      return true;
+  return false;
+}
+
 static pm_err history_setup(mpm_sim *r) {
   const mpm_model *m = r->model;
   const pm_scene *s = r->scene;
@@ -316,8 +335,15 @@ static pm_err history_setup(mpm_sim *r) {
       continue;
     for (int c = 0; c < m->dim; c++)
       add_hist(r, "%s_u%s", body->name, (const char[]){"xyz"[c], 0});
+    if (body_kind(m, b)->flags & MPM_KIND_INTERNAL_ENERGY)
+      add_hist(r, "%s_pressure%s", body->name, "");
   }
   if (m->kinds & MPM_KIND_MEMBRANE) add_hist(r, "failed_points%s%s", "", "");
+  if (iso_normals_used(m)) {
+    add_hist(r, "normals_max_condition%s%s", "", "");
+    add_hist(r, "normals_degenerate%s%s", "", "");
+    add_hist(r, "normals_merged_cells%s%s", "", "");
+  }
   for (int b = 0; b < s->n_bodies; b++) {
     const pm_scene_body *body = &s->bodies[b];
     if ((body->shape == PM_BODY_INSIDE || body->shape == PM_BODY_OUTSIDE) &&
@@ -325,7 +351,7 @@ static pm_err history_setup(mpm_sim *r) {
       const int mb = body->surface_body;
       add_hist(r, "mass_inside_%s_%s", s->bodies[mb].name,
                body->name ? body->name : s->materials[body->material].name);
-      if (!r->surface[mb])
+      if (!r->surface[mb] && m->dim == 3)
         PM_CALL(mpm_triangles_local(m, m->body_tri_begin[mb],
                                     m->body_tri_end[mb], m->body_begin[mb],
                                     &r->surface[mb]));
@@ -341,12 +367,30 @@ static int history_names(void *p, const char **names, int max) {
   return n;
 }
 
+/* In 2D: inside the region membrane body mb's curve encloses now. */
+static double mass_inside_curve(const mpm_sim *r, int b, int mb) {
+  const mpm_model *m = r->model;
+  const double *x = r->state->x;
+  gm_shape *in = NULL;
+  if (gm_shape_from_curve(m->body_end[mb] - m->body_begin[mb],
+                          x + 3 * m->body_begin[mb],
+                          m->body_links[mb] == MPM_LINKS_LOOP, m->box_min,
+                          m->box_max, false, &in) != PM_SUCCESS)
+    return NAN;
+  double sum = 0;
+  for (long q = m->body_begin[b]; q < m->body_end[b]; q++)
+    if (gm_shape_contains(in, x + 3 * q)) sum += m->mass[q];
+  gm_shape_destroy(in);
+  return sum;
+}
+
 /* The mass of body b's particles inside membrane body mb's current
  * surface (NAN when it cannot be built).  The inside test is built anew
  * for each history row: the surface moves. */
 static double mass_inside(const mpm_sim *r, int b, int mb) {
   const mpm_model *m = r->model;
   const double *x = r->state->x;
+  if (m->dim == 2) return mass_inside_curve(r, b, mb);
   const gm_trisurf sf = {.n_points = m->body_end[mb] - m->body_begin[mb],
                          .x = (double *)(x + 3 * m->body_begin[mb]),
                          .n_tris = m->body_tri_end[mb] - m->body_tri_begin[mb],
@@ -362,6 +406,23 @@ static double mass_inside(const mpm_sim *r, int b, int mb) {
     if (gm_inside_contains(in, x + 3 * q)) sum += mp[q];
   gm_inside_destroy(in);
   return sum;
+}
+
+/* The mean pressure of body b's particles, weighted by their volumes. */
+static double body_pressure(const mpm_sim *r, int b) {
+  const mpm_model *m = r->model;
+  const mpm_state *st = r->state;
+  double *sed = r->scratch, *p = sed + m->n, *e = p + m->n, pv = 0, v = 0;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    if (m->body_begin[b] < g->begin || m->body_end[b] > g->end) continue;
+    g->kind->fields(m, st, g, sed, p, e);
+  }
+  for (long q = m->body_begin[b]; q < m->body_end[b]; q++) {
+    pv += p[q] * st->vol[q];
+    v += st->vol[q];
+  }
+  return v > 0 ? pv / v : 0;
 }
 
 static void history_values(void *p, double *v) {
@@ -388,6 +449,8 @@ static void history_values(void *p, double *v) {
       mt += m->mass[q];
     }
     for (int c = 0; c < m->dim; c++) v[k++] = u[c] / mt;
+    if (body_kind(m, b)->flags & MPM_KIND_INTERNAL_ENERGY)
+      v[k++] = body_pressure(r, b);
   }
   if (m->kinds & MPM_KIND_MEMBRANE) {
     double *normal = r->scratch + 12 * m->n, *damage = normal + 3 * m->n,
@@ -399,6 +462,12 @@ static void history_values(void *p, double *v) {
                                           failed);
     for (long q = 0; q < m->n; q++) nf += failed[q];
     v[k++] = nf;
+  }
+  if (iso_normals_used(m)) {
+    v[k++] = r->work->iso.max_condition;
+    v[k++] = (double)r->work->iso.degenerate;
+    v[k++] = (double)(r->work->iso.cells[2] + r->work->iso.cells[3]);
+    memset(&r->work->iso, 0, sizeof r->work->iso); /* per row */
   }
   for (int b = 0; b < s->n_bodies && k < r->n_hist; b++) {
     const pm_scene_body *body = &s->bodies[b];
@@ -503,12 +572,24 @@ static void plan_bodies(const mpm_sim *r, FILE *out) {
     fprintf(out, "  body %d%s%s: %ld particles", b, body->name ? " " : "",
             body->name ? body->name : "", n);
     if (body->shape == PM_BODY_MEMBRANE) {
+      static const char *const normals[] = {"connectivity", "isosurface-linear",
+                                            "isosurface-quadratic", "hybrid"};
       long nt = m->body_tri_end[b] - m->body_tri_begin[b];
       double area = 0;
       for (long q = m->body_begin[b]; q < m->body_end[b]; q++)
         area += m->vol0[q] / body->membrane.thickness;
-      fprintf(out, ", membrane of %ld triangles, thickness %g m, area %.6g m^2",
-              nt, body->membrane.thickness, area);
+      const int links = m->body_links[b];
+      if (links == MPM_LINKS_TRIANGLES)
+        fprintf(out, ", membrane of %ld triangles", nt);
+      else if (links == MPM_LINKS_NONE)
+        fprintf(out, ", membrane of unconnected points");
+      else
+        fprintf(out, ", membrane along a%s curve",
+                links == MPM_LINKS_LOOP ? " closed" : "n open");
+      fprintf(out, ", thickness %g m, %s %.6g m%s, normals: %s",
+              body->membrane.thickness, m->dim == 3 ? "area" : "length", area,
+              m->dim == 3 ? "^2" : " (per unit depth)",
+              normals[m->body_normals[b]]);
     } else if (body->n_ppc) {
       fprintf(out, ", %d x %d x %d per cell", (int)body->ppc[0],
               (int)body->ppc[body->n_ppc == 1 ? 0 : 1],

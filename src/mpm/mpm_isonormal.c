@@ -18,7 +18,6 @@
 #define RCOND_MIN 1e-13
 /* |grad phi| H below this is no gradient: phi ~ 1 at the points, so its
  * logical gradient is of order one where the surface is resolved. */
-#define GRAD_MIN 1e-8
 /* Rows a workspace may hold (the matrix is 2^20 x 27 doubles at most). */
 #define MAX_POINTS_LIMIT (1 << 20)
 #define MAX_UNKNOWNS 27
@@ -53,7 +52,8 @@ mpm_iso_config mpm_iso_config_default(int dim, int order) {
                           .order = order,
                           .max_points = 256,
                           .max_condition = 1e12,
-                          .max_draws = 4};
+                          .max_draws = 4,
+                          .min_gradient = 0.1};
 }
 
 int mpm_iso_unknowns(int dim, int order) {
@@ -554,7 +554,7 @@ pm_err mpm_iso_fit(mpm_iso_work *w, const double lo[3], double H, long n,
     evaluate(w, w->coef, xi, g);
     /* The logical gradient is H grad phi, and points the same way. */
     const double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-    if (!(isfinite(len) && len >= GRAD_MIN)) {
+    if (!(isfinite(len) && len >= w->c.min_gradient)) {
       rep.degenerate++;
       continue;
     }

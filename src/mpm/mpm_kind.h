@@ -55,6 +55,20 @@ typedef struct mpm_kind {
    * (mpm_work.scratch[g->index]). */
   long (*scratch)(const struct mpm_model *m, const mpm_group *g);
 
+  /* Optional: a step workspace that is more than doubles (a membrane's
+   * per-thread least-squares fits): created with the run's workspace into
+   * *out, released by work_free; *bytes its size.  PM_ERR_MEMORY. */
+  pm_err (*work_create)(const struct mpm_model *m, const mpm_group *g,
+                        void **out, size_t *bytes);
+  void (*work_free)(void *w);
+
+  /* Optional: a stage run just before the constitutive stage (membranes:
+   * their normals), named pre_stage_name, described by describe_pre. */
+  mpm_stage_fn pre_stress;
+  const char *pre_stage_name;
+  void (*describe_pre)(const struct mpm_model *m, const mpm_group *g, char *buf,
+                       size_t size);
+
   /* The constitutive stage: velocity gradient to stress, volume and the
    * kind's state, for the particles of group self->group (NULL: none, for
    * particles that move as prescribed). */

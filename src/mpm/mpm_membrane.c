@@ -5,9 +5,14 @@
  * plane, n the normal), its in-plane strain in that frame, and, with
  * damage, the damage variable omega and a failed flag.
  *
- * Each step:
- *   1. the triangles' unit normals from the current positions;
- *   2. each point's normal, the mean of its triangles' (eq. 8);
+ * Each step, a normal stage and then the stress stage:
+ *   1. each point's normal from the current positions, by the body's
+ *      method: the mean of its triangles' unit normals (eq. 8); along a
+ *      2-D curve, perpendicular to the chord of its neighbours; or, with
+ *      no connectivity, the gradient of a function fitted per grid cell to
+ *      be 1 on the points (papers/mpm-membrane-normals-without-
+ *      connectivity.txt, mpm_isonormal.h), turned to agree with the point's
+ *      previous normal (the fit does not tell inside from outside);
  *   3. the frame carried to it: first turned about the old normal by the
  *      grid's in-plane spin, then by the rotation S of eqs. 9-22 that takes
  *      the old normal to the new one and keeps what is perpendicular to
@@ -21,13 +26,20 @@
  * total; a membrane that turns then sees its strain turn out of its plane.
  * Keeping the strain in the frame and the frame turning with the material
  * makes a rigid rotation leave the stress unchanged in the frame (the
- * frame-update test checks it). */
+ * frame-update test checks it).
+ *
+ * In 2-D (plane strain) a membrane is a line of points, each a strip of
+ * unit depth: the frame is (z, the tangent, the in-plane normal), the
+ * strain along z stays 0 and the law is the same, which makes the tension
+ * E t eps / (1 - nu^2) along the tangent, per unit depth. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "gm_curve.h"
 #include "gm_trisurf.h"
+#include "mpm_isonormal.h"
 #include "mpm_kind.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
@@ -46,6 +58,16 @@ typedef struct {
   /* point -> triangles, both counted within the group (gm_trisurf's
    * incidence of the group's surface) */
   long *inc_start, *inc_tri;
+  /* the group's bodies: points [begin, end) counted within the group,
+   * their links (MPM_LINKS_*) and normal method (pm_normals_method) */
+  int n_bodies;
+  struct membrane_body {
+    int body;
+    long begin, end;
+    int links, method;
+  } * bodies;
+  bool iso;      /* some body's normals by isosurface least squares */
+  long max_body; /* most points in one body */
 } membrane_params;
 
 static pm_err membrane_setup(mpm_group *g, const pm_scene_material *sm,
@@ -78,6 +100,7 @@ static void membrane_release(mpm_group *g) {
   if (!mp) return;
   free(mp->inc_start);
   free(mp->inc_tri);
+  free(mp->bodies);
 }
 
 static void membrane_seed(const mpm_group *g, mpm_group_state *gs, long k,
@@ -91,14 +114,13 @@ static void membrane_describe(const mpm_group *g, char *buf, size_t size) {
   const membrane_params *mp = g->params;
   if (mp->damage)
     snprintf(buf, size,
-             "membrane: normals by connectivity (eq. 8), frame by S (eqs. "
-             "9-22), plane stress E = %g, nu = %g, elastodamage (eqs. 38-41, "
-             "c0 = %g, c1 = %g, S_L = %g), fails at eps_max = %g",
+             "membrane: frame by S (eqs. 9-22), plane stress E = %g, nu = "
+             "%g, elastodamage (eqs. 38-41, c0 = %g, c1 = %g, S_L = %g), "
+             "fails at eps_max = %g",
              mp->E, mp->nu, mp->c0, mp->c1, mp->limit, mp->failure);
   else
     snprintf(buf, size,
-             "membrane: normals by connectivity (eq. 8), frame by S (eqs. "
-             "9-22), plane stress E = %g, nu = %g",
+             "membrane: frame by S (eqs. 9-22), plane stress E = %g, nu = %g",
              mp->E, mp->nu);
 }
 
@@ -266,13 +288,364 @@ static inline void to_global(const double f[9], const double s[3],
                        s[2] * (e1[i] * e2[j] + e2[i] * e1[j]);
 }
 
-/* Normals by connectivity and frames of the group's points (setup). */
+/* ---- normals by isosurface least squares ---------------------------------
+ * Per body, each step: the points sorted by grid cell; each cell fitted on
+ * its own (quadratic or linear by the method, or by the hybrid rule), or,
+ * with too few points for the hybrid rule, with the points of the block of
+ * 2, then 4 cells a side around it taken as one larger element (the block
+ * placed so that the cell's points are nearest its middle).  The fits of
+ * different cells are independent: one thread each. */
+
+enum { ISO_MERGE_LEVELS = 3 }; /* blocks of 2, 4 and 8 cells a side */
+
+typedef struct {
+  long key, k; /* cell key, point (within the body) */
+} cell_point;
+
+/* One thread's fits. */
+typedef struct {
+  mpm_iso_work *fit[2]; /* linear, quadratic */
+  long *gather;         /* points of a merged block */
+  double *normal;       /* 3 per point of a body: a merged block's normals */
+} iso_thread;
+
+typedef struct {
+  int threads;
+  iso_thread *t;
+  cell_point *cp; /* per point of a body */
+  long *order;    /* the points in cell order */
+  long *run;      /* start of each cell's points in order, and the end */
+} iso_work;
+
+static void iso_work_free(void *p) {
+  iso_work *w = p;
+  if (!w) return;
+  for (int t = 0; w->t && t < w->threads; t++) {
+    mpm_iso_work_destroy(w->t[t].fit[0]);
+    mpm_iso_work_destroy(w->t[t].fit[1]);
+    free(w->t[t].gather);
+    free(w->t[t].normal);
+  }
+  free(w->t);
+  free(w->cp);
+  free(w->order);
+  free(w->run);
+  free(w);
+}
+
+static pm_err iso_work_create(const mpm_model *m, const mpm_group *g,
+                              void **out, size_t *bytes) {
+  const membrane_params *mp = g->params;
+  *out = NULL;
+  *bytes = 0;
+  if (!mp->iso) return PM_SUCCESS;
+  pm_err ret = PM_SUCCESS;
+  iso_work *w = NULL;
+  const long n = mp->max_body;
+  PM_TRY(PM_ALLOC(w, 1, "membrane normal fits"));
+  w->threads = pm_omp_threads();
+  PM_TRY(PM_ALLOC(w->t, w->threads, "membrane normal fits"));
+  PM_TRY(PM_ALLOC(w->cp, n, "membrane points by cell"));
+  PM_TRY(PM_ALLOC(w->order, n, "membrane points by cell"));
+  PM_TRY(PM_ALLOC(w->run, n + 1, "membrane cells"));
+  *bytes = sizeof *w + (size_t)n * (sizeof(cell_point) + 2 * sizeof(long));
+  for (int t = 0; t < w->threads; t++) {
+    for (int o = 0; o < 2; o++) {
+      mpm_iso_config c = mpm_iso_config_default(m->dim, o + 1);
+      PM_TRY(mpm_iso_work_create(&c, &w->t[t].fit[o]));
+      *bytes += mpm_iso_work_bytes(w->t[t].fit[o]);
+    }
+    PM_TRY(PM_ALLOC(w->t[t].gather, n, "membrane merged cells"));
+    PM_TRY(PM_ALLOC(w->t[t].normal, 3 * n, "membrane merged cells"));
+    *bytes += (size_t)n * (sizeof(long) + 3 * sizeof(double));
+  }
+  *out = w;
+  w = NULL;
+done:
+  iso_work_free(w);
+  return ret;
+}
+
+static int cell_point_cmp(const void *a, const void *b) {
+  const cell_point *p = a, *q = b;
+  if (p->key != q->key) return p->key < q->key ? -1 : 1;
+  return (p->k > q->k) - (p->k < q->k);
+}
+
+/* The cell of x (indices of its lower node), its key. */
+static inline long cell_of(const mpm_grid *g, const double x[3], long c[3]) {
+  c[2] = 0;
+  for (int d = 0; d < g->dim; d++)
+    c[d] = (long)floor((x[d] - g->origin[d]) * g->inv_h);
+  return c[0] + g->nn[0] * (c[1] + g->nn[1] * c[2]);
+}
+
+/* The points of the cell at key in cell order [*lo, *hi), found by
+ * bisection of the sorted cells; false when it has none. */
+static bool cell_range(const iso_work *w, long n_cells, long key, long *lo,
+                       long *hi) {
+  long a = 0, b = n_cells;
+  while (a < b) {
+    long mid = (a + b) / 2;
+    long km = w->cp[w->run[mid]].key;
+    if (km < key)
+      a = mid + 1;
+    else
+      b = mid;
+  }
+  if (a >= n_cells || w->cp[w->run[a]].key != key) return false;
+  *lo = w->run[a];
+  *hi = w->run[a + 1];
+  return true;
+}
+
+/* A fit's seed: the step, the body, the cell and the block level mixed
+ * (splitmix64's finaliser), so that a run repeats bit for bit whatever
+ * thread fits which cell. */
+static inline uint64_t fit_seed(long step, int body, long key, int level) {
+  uint64_t z = (uint64_t)step * 0x9E3779B97F4A7C15ull ^ ((uint64_t)body << 56) ^
+               ((uint64_t)level << 48) ^ (uint64_t)key * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+typedef struct {
+  long cells[4], points, degenerate, draws;
+  double max_condition;
+} iso_stats;
+
+static void stats_add(iso_stats *a, const mpm_iso_report *r, long points) {
+  a->points += points;
+  a->degenerate += r->degenerate;
+  a->draws += r->draws;
+  if (r->condition > a->max_condition) a->max_condition = r->condition;
+}
+
+/* Normals nn (3 per point of the body, holding its previous normals on
+ * entry) of the body's n points at x (3 each), by method, at step `step`. */
+static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
+                          long n, const double *x, long step, double *nn,
+                          iso_stats *st) {
+  const int dim = g->dim;
+  for (long k = 0; k < n; k++) {
+    long c[3];
+    w->cp[k].key = cell_of(g, x + 3 * k, c);
+    w->cp[k].k = k;
+  }
+  qsort(w->cp, (size_t)n, sizeof *w->cp, cell_point_cmp);
+  long n_cells = 0;
+  for (long k = 0; k < n; k++) {
+    w->order[k] = w->cp[k].k;
+    if (k == 0 || w->cp[k].key != w->cp[k - 1].key) w->run[n_cells++] = k;
+  }
+  w->run[n_cells] = n;
+  pm_err err = PM_SUCCESS;
+  iso_stats sum = {0};
+  PM_OMP(parallel default(none) shared(g, w, body, method, n, x, step, nn,
+                                       n_cells, dim, err, sum)) {
+    iso_stats my = {0};
+    iso_thread *th = &w->t[pm_omp_thread()];
+    PM_OMP(for schedule(dynamic, 8))
+    for (long ci = 0; ci < n_cells; ci++) {
+      const long r0 = w->run[ci], r1 = w->run[ci + 1], cnt = r1 - r0;
+      const long key = w->cp[r0].key;
+      long cell[3];
+      cell_of(g, x + 3 * w->order[r0], cell);
+      int order = method == PM_NORMALS_ISO_LINEAR ? 1
+                  : method == PM_NORMALS_ISO_QUADRATIC
+                      ? 2
+                      : mpm_iso_hybrid_order(dim, cnt);
+      mpm_iso_report rep;
+      double lo[3] = {0, 0, 0};
+      if (order > 0) {
+        for (int d = 0; d < dim; d++) lo[d] = g->origin[d] + cell[d] * g->h;
+        pm_err e =
+            mpm_iso_fit(th->fit[order - 1], lo, g->h, cnt, x, w->order + r0,
+                        fit_seed(step, body, key, 0), nn, &rep);
+        if (e) {
+          PM_OMP(critical(membrane_iso)) err = e;
+          continue;
+        }
+        my.cells[order == 2 ? 0 : 1]++;
+        stats_add(&my, &rep, cnt);
+        continue;
+      }
+      /* Too few points: the block of B cells a side around the cell, B =
+       * 2, 4, 8, until it has enough for a linear fit. */
+      double mid[3] = {0, 0, 0};
+      for (long r = r0; r < r1; r++)
+        for (int d = 0; d < dim; d++)
+          mid[d] += (x[3 * w->order[r] + d] - g->origin[d]) * g->inv_h / cnt;
+      bool done_cell = false;
+      for (int level = 1; level <= ISO_MERGE_LEVELS && !done_cell; level++) {
+        const long B = 1L << level;
+        long first[3] = {0, 0, 0}, span[3] = {1, 1, 1};
+        for (int d = 0; d < dim; d++) {
+          long f = lround(mid[d] - 0.5 * (double)B);
+          if (f > cell[d]) f = cell[d];
+          if (f < cell[d] - B + 1) f = cell[d] - B + 1;
+          first[d] = f;
+          span[d] = B;
+        }
+        long m = 0;
+        for (long c2 = 0; c2 < span[2]; c2++)
+          for (long c1 = 0; c1 < span[1]; c1++)
+            for (long c0 = 0; c0 < span[0]; c0++) {
+              long q[3] = {first[0] + c0, first[1] + c1, first[2] + c2}, a, z;
+              bool in = true;
+              for (int d = 0; d < dim; d++)
+                if (q[d] < 0 || q[d] >= g->nn[d] - 1) in = false;
+              if (!in || !cell_range(w, n_cells,
+                                     q[0] + g->nn[0] * (q[1] + g->nn[1] * q[2]),
+                                     &a, &z))
+                continue;
+              for (long r = a; r < z; r++) th->gather[m++] = w->order[r];
+            }
+        /* Linear on the larger element, as the paper does: it has enough
+         * points for it, or is the largest block and has what it has. */
+        if (mpm_iso_hybrid_order(dim, m) == 0 && level < ISO_MERGE_LEVELS)
+          continue;
+        order = 1;
+        for (int d = 0; d < dim; d++) lo[d] = g->origin[d] + first[d] * g->h;
+        for (long r = r0; r < r1; r++)
+          for (int d = 0; d < 3; d++)
+            th->normal[3 * w->order[r] + d] = nn[3 * w->order[r] + d];
+        pm_err e = mpm_iso_fit(th->fit[order - 1], lo, (double)B * g->h, m, x,
+                               th->gather, fit_seed(step, body, key, level),
+                               th->normal, &rep);
+        if (e) {
+          PM_OMP(critical(membrane_iso)) err = e;
+          break;
+        }
+        for (long r = r0; r < r1; r++)
+          for (int d = 0; d < 3; d++)
+            nn[3 * w->order[r] + d] = th->normal[3 * w->order[r] + d];
+        my.cells[mpm_iso_hybrid_order(dim, m) > 0 ? 2 : 3]++;
+        stats_add(&my, &rep, cnt);
+        done_cell = true;
+      }
+    }
+    PM_OMP(critical(membrane_iso_stats)) {
+      for (int i = 0; i < 4; i++) sum.cells[i] += my.cells[i];
+      sum.points += my.points;
+      sum.degenerate += my.degenerate;
+      sum.draws += my.draws;
+      if (my.max_condition > sum.max_condition)
+        sum.max_condition = my.max_condition;
+    }
+  }
+  for (int i = 0; i < 4; i++) st->cells[i] += sum.cells[i];
+  st->points += sum.points;
+  st->degenerate += sum.degenerate;
+  st->draws += sum.draws;
+  if (sum.max_condition > st->max_condition)
+    st->max_condition = sum.max_condition;
+  return err;
+}
+
+/* ---- normals of every body of the group ---------------------------------- */
+
+/* Each point's new unit normal into nn (3 per point of the group, holding
+ * the previous normals n0 on entry; a point without one keeps n0), by its
+ * body's method.  tn: 3 per triangle of the group. */
+static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
+                            const double *x, long step, iso_work *iw,
+                            double *tn, double *nn, iso_stats *st) {
+  const membrane_params *mp = gr->params;
+  const long t0 = m->tri_begin[gr->index], t1 = m->tri_end[gr->index];
+  if (t1 > t0) triangle_normals(m, x, t0, t1, tn);
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    const long n = b->end - b->begin;
+    const double *xb = x + 3 * (gr->begin + b->begin);
+    double *nb = nn + 3 * b->begin;
+    if (b->method != PM_NORMALS_CONNECTIVITY) {
+      PM_CALL(
+          iso_normals(&m->grid, iw, b->body, b->method, n, xb, step, nb, st));
+      continue;
+    }
+    if (b->links == MPM_LINKS_TRIANGLES) {
+      for (long k = b->begin; k < b->end; k++) {
+        double n1[3];
+        if (point_normal(mp, k, tn, n1)) memcpy(nn + 3 * k, n1, sizeof n1);
+      }
+      continue;
+    }
+    /* A curve: perpendicular to the chord of the neighbours (a point whose
+     * chord vanishes gets 0, and the stress stage keeps its normal). */
+    gm_curve_normals(n, xb, b->links == MPM_LINKS_LOOP, nb);
+  }
+  return PM_SUCCESS;
+}
+
+static const char *const method_words[] = {
+    "connectivity", "isosurface least squares, linear B-splines",
+    "isosurface least squares, quadratic B-splines",
+    "isosurface least squares, hybrid (quadratic, linear, or merged cells)"};
+
+static void membrane_describe_normals(const mpm_model *m, const mpm_group *g,
+                                      char *buf, size_t size) {
+  (void)m;
+  const membrane_params *mp = g->params;
+  size_t used = 0;
+  for (int bi = 0; bi < mp->n_bodies && used < size; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    const char *how = method_words[b->method];
+    if (b->method == PM_NORMALS_CONNECTIVITY)
+      how = b->links == MPM_LINKS_TRIANGLES
+                ? "mean of the triangles' (eq. 8)"
+                : "perpendicular to the neighbours' "
+                  "chord";
+    int len = snprintf(buf + used, size - used, "%sbodies.%d: %s",
+                       bi ? "; " : "", b->body, how);
+    if (len < 0) break;
+    used += (size_t)len;
+  }
+}
+
+/* The centre of body b (the mean of its points, x counted within the
+ * group). */
+static void body_centre(const double *x, const struct membrane_body *b,
+                        double c[3]) {
+  c[0] = c[1] = c[2] = 0;
+  for (long j = b->begin; j < b->end; j++)
+    for (int d = 0; d < 3; d++)
+      c[d] += x[3 * j + d] / (double)(b->end - b->begin);
+}
+
+/* The unit vector from c to point k, or 0. */
+static void away_from(const double *x, const double c[3], long k, double v[3]) {
+  for (int d = 0; d < 3; d++) v[d] = x[3 * k + d] - c[d];
+  double len = pm_v_norm(v);
+  for (int d = 0; d < 3; d++) v[d] = len > 0 ? v[d] / len : 0;
+}
+
+/* The group's bodies, its incidence, and each point's first normal and
+ * frame (setup).  Without connectivity, the first normals are turned to
+ * point away from the body's centre. */
 static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
   membrane_params *mp = g->params;
   const long t0 = m->tri_begin[g->index], t1 = m->tri_end[g->index];
   const long np = g->end - g->begin;
-  double *tn = NULL;
+  double *tn = NULL, *nn = NULL;
+  void *iw = NULL;
+  size_t iw_bytes;
   pm_err ret = PM_SUCCESS;
+  PM_TRY(PM_ALLOC(mp->bodies, m->n_bodies, "membrane bodies"));
+  for (int b = 0; b < m->n_bodies; b++) {
+    if (m->body_end[b] <= m->body_begin[b] || m->body_begin[b] < g->begin ||
+        m->body_end[b] > g->end)
+      continue;
+    struct membrane_body *mb = &mp->bodies[mp->n_bodies++];
+    mb->body = b;
+    mb->begin = m->body_begin[b] - g->begin;
+    mb->end = m->body_end[b] - g->begin;
+    mb->links = m->body_links[b];
+    mb->method = m->body_normals[b];
+    if (mb->method != PM_NORMALS_CONNECTIVITY) mp->iso = true;
+    if (mb->end - mb->begin > mp->max_body) mp->max_body = mb->end - mb->begin;
+  }
   /* Incidence: each point's triangles, of the group's surface. */
   long *local = NULL;
   PM_TRY(mpm_triangles_local(m, t0, t1, g->begin, &local));
@@ -284,24 +657,77 @@ static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
   free(local);
   if (ret) goto done;
   PM_TRY(PM_ALLOC(tn, 3 * (t1 - t0) + 3, "triangle normals"));
-  triangle_normals(m, s->x, t0, t1, tn);
+  PM_TRY(PM_ALLOC(nn, 3 * np, "membrane normals"));
+  PM_TRY(iso_work_create(m, g, &iw, &iw_bytes));
+  /* The previous normals of the first fit: away from the body's centre. */
+  const double *xg = s->x + 3 * g->begin;
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    double c[3];
+    body_centre(xg, &mp->bodies[bi], c);
+    for (long k = mp->bodies[bi].begin; k < mp->bodies[bi].end; k++)
+      away_from(xg, c, k, nn + 3 * k);
+  }
+  iso_stats st = {0};
+  PM_TRY(group_normals(m, g, s->x, -1, iw, tn, nn, &st));
   double *frame = s->group[g->index].array[MEM_FRAME].data;
-  for (long k = 0; k < np; k++) {
-    double n[3];
-    PM_ENSURE(point_normal(mp, k, tn, n), PM_ERR_SCENE,
-              "membrane %s: point %ld at (%g, %g, %g) has no normal (it "
-              "belongs to no triangle, or its triangles' normals cancel)",
-              g->name, g->begin + k, s->x[3 * (g->begin + k)],
-              s->x[3 * (g->begin + k) + 1], s->x[3 * (g->begin + k) + 2]);
-    frame_from_normal(n, frame + 9 * k);
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    double c[3];
+    body_centre(xg, b, c);
+    for (long k = b->begin; k < b->end; k++) {
+      double *n = nn + 3 * k, *xp = s->x + 3 * (g->begin + k), out[3];
+      /* A fitted normal's sign is arbitrary: away from the centre. */
+      away_from(xg, c, k, out);
+      if (b->method != PM_NORMALS_CONNECTIVITY && pm_v_dot(n, out) < 0)
+        for (int d = 0; d < 3; d++) n[d] = -n[d];
+      bool has = pm_v_norm(n) > 0.5;
+      if (has && b->method == PM_NORMALS_CONNECTIVITY &&
+          b->links == MPM_LINKS_TRIANGLES) {
+        double n1[3];
+        has = point_normal(mp, k, tn, n1);
+      }
+      PM_ENSURE(has, PM_ERR_SCENE,
+                "membrane %s: point %ld at (%g, %g, %g) has no normal (it "
+                "belongs to no triangle, or its triangles' normals cancel)",
+                g->name, g->begin + k, xp[0], xp[1], xp[2]);
+      frame_from_normal(n, frame + 9 * k);
+    }
   }
 done:
+  iso_work_free(iw);
   free(tn);
+  free(nn);
   return ret;
 }
 
+/* Doubles of step workspace: each point's new normal, each triangle's. */
 static long membrane_scratch(const mpm_model *m, const mpm_group *g) {
-  return 3 * (m->tri_end[g->index] - m->tri_begin[g->index]);
+  return 3 * (g->end - g->begin) +
+         3 * (m->tri_end[g->index] - m->tri_begin[g->index]);
+}
+
+/* The normal stage: each point's new normal into the group's workspace. */
+static pm_err membrane_normals(mpm_ctx *ctx, const mpm_stage *self) {
+  const mpm_model *m = ctx->model;
+  mpm_state *s = ctx->state;
+  mpm_work *w = ctx->work;
+  const int gi = self->group;
+  const mpm_group *gr = &m->group[gi];
+  const long np = gr->end - gr->begin;
+  double *nn = w->scratch[gi], *tn = nn + 3 * np;
+  const double *frame = s->group[gi].array[MEM_FRAME].data;
+  for (long k = 0; k < np; k++)
+    for (int d = 0; d < 3; d++) nn[3 * k + d] = frame[9 * k + 6 + d];
+  iso_stats st = {0};
+  pm_err e = group_normals(m, gr, s->x, s->step, w->kind_work[gi], tn, nn, &st);
+  if (e) return e;
+  for (int i = 0; i < 4; i++) w->iso.cells[i] += st.cells[i];
+  w->iso.points += st.points;
+  w->iso.degenerate += st.degenerate;
+  w->iso.draws += st.draws;
+  if (st.max_condition > w->iso.max_condition)
+    w->iso.max_condition = st.max_condition;
+  return PM_SUCCESS;
 }
 
 /* ---- the stage ---------------------------------------------------------- */
@@ -314,11 +740,10 @@ static pm_err membrane_stress(mpm_ctx *ctx, const mpm_stage *self) {
   const mpm_group *gr = &m->group[gi];
   const mpm_grid *g = &m->grid;
   const membrane_params *mp = gr->params;
-  const long t0 = m->tri_begin[gi], t1 = m->tri_end[gi];
   const long begin = gr->begin, end = gr->end;
   const double dt = s->dt, jmin = m->opt.min_jacobian;
   const double ez_of = -mp->nu / (1 - mp->nu); /* eq. 1 */
-  double *tn = w->scratch[gi];
+  const double *nn = w->scratch[gi];           /* the normal stage's */
   /* The strain follows the velocity that moves the points (MUSL's remapped
    * velocity differs from it by the particles' noise, and a membrane whose
    * strain and positions part creeps without stretching). */
@@ -331,9 +756,8 @@ static pm_err membrane_stress(mpm_ctx *ctx, const mpm_stage *self) {
   double *failed = mp->damage ? gs->array[MEM_FAILED].data : NULL;
   double *vol = s->vol, *sigma = s->sigma;
   double lost = 0, Jlow = INFINITY;
-  triangle_normals(m, x, t0, t1, tn);
   PM_OMP(parallel for schedule(static) default(none)
-         shared(g, mp, w, begin, end, dt, jmin, ez_of, tn, vel, x, vol0,
+         shared(g, mp, w, begin, end, dt, jmin, ez_of, nn, vel, x, vol0,
                 frame, eps, om, failed, vol, sigma)
          reduction(+ : lost) reduction(min : Jlow))
   for (long p = begin; p < end; p++) {
@@ -345,7 +769,12 @@ static pm_err membrane_stress(mpm_ctx *ctx, const mpm_stage *self) {
     /* The spin about the normal: the axial vector of W along n. */
     const double *n0 = f + 6;
     double spin = W[7] * n0[0] + W[2] * n0[1] + W[3] * n0[2];
-    if (!point_normal(mp, k, tn, n1)) memcpy(n1, n0, sizeof n1);
+    /* The new normal, on the side of the old one (a fitted normal's sign
+     * is arbitrary; S must not see a flip). */
+    memcpy(n1, nn + 3 * k, sizeof n1);
+    if (!(pm_v_norm(n1) > 0.5)) memcpy(n1, n0, sizeof n1);
+    if (pm_v_dot(n1, n0) < 0)
+      for (int d = 0; d < 3; d++) n1[d] = -n1[d];
     mpm_membrane_carry_frame(f, spin * dt, n1);
     /* The strain increment in the frame. */
     const double *e1 = f, *e2 = f + 3;
@@ -461,6 +890,11 @@ const mpm_kind mpm_kind_membrane = {
     .seed = membrane_seed,
     .finish = membrane_finish,
     .scratch = membrane_scratch,
+    .work_create = iso_work_create,
+    .work_free = iso_work_free,
+    .pre_stress = membrane_normals,
+    .pre_stage_name = "normals: membrane",
+    .describe_pre = membrane_describe_normals,
     .stress = membrane_stress,
     .describe = membrane_describe,
     .wave_speeds = membrane_wave_speeds,

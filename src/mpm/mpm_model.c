@@ -101,6 +101,8 @@ void mpm_model_destroy(mpm_model *m) {
   free(m->body_end);
   free(m->body_tri_begin);
   free(m->body_tri_end);
+  free(m->body_links);
+  free(m->body_normals);
   free(m->tri);
   free(m->moving);
   mpm_conditions_destroy(m->bcs, m->n_bcs);

@@ -64,6 +64,9 @@ typedef struct mpm_model {
   long *tri;
   long tri_begin[MPM_MAX_GROUPS], tri_end[MPM_MAX_GROUPS];
   long *body_tri_begin, *body_tri_end; /* per scene body (membranes) */
+  /* per scene body (membranes): what links its points (MPM_LINKS_*) and
+   * how its normals are found (pm_normals_method) */
+  unsigned char *body_links, *body_normals;
   /* bodies that move as prescribed */
   int n_moving;
   mpm_motion *moving;
@@ -73,6 +76,14 @@ typedef struct mpm_model {
   bool has_absorbing;
   mpm_pipeline pipeline;
 } mpm_model;
+
+/* What links a membrane body's points (mpm_model.body_links). */
+enum {
+  MPM_LINKS_NONE = 0,  /* a point cloud (or not a membrane) */
+  MPM_LINKS_TRIANGLES, /* a triangulated surface (3D) */
+  MPM_LINKS_CHAIN,     /* a curve, open: neighbours in the list (2D) */
+  MPM_LINKS_LOOP       /* a closed curve */
+};
 
 /* Copy what the model needs from the scene into o (the one place that reads
  * the scene's mpm section). */

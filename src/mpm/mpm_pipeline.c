@@ -24,7 +24,15 @@ static void add_stress(mpm_model *m) {
   for (int gi = 0; gi < m->n_groups; gi++) {
     const mpm_group *g = &m->group[gi];
     if (!g->kind->stress) continue; /* moves as prescribed */
-    mpm_stage *st = add(&m->pipeline, g->kind->stage_name, g->kind->stress);
+    mpm_stage *st;
+    if (g->kind->pre_stress) {
+      st = add(&m->pipeline, g->kind->pre_stage_name, g->kind->pre_stress);
+      st->group = gi;
+      int len = snprintf(st->detail, sizeof st->detail, "%s: ", g->name);
+      if (len >= 0 && (size_t)len < sizeof st->detail)
+        g->kind->describe_pre(m, g, st->detail + len, sizeof st->detail - len);
+    }
+    st = add(&m->pipeline, g->kind->stage_name, g->kind->stress);
     st->group = gi;
     int len = snprintf(st->detail, sizeof st->detail, "%s: ", g->name);
     if (len >= 0 && (size_t)len < sizeof st->detail)

@@ -6,8 +6,9 @@
 #include "mpm_particles.h"
 #include "mpm_stage.h"
 
-/* Fixed stages (at most 12) and one constitutive stage per group. */
-#define MPM_MAX_STAGES (13 + MPM_MAX_GROUPS)
+/* Fixed stages (at most 12), and per group a constitutive stage and the
+ * stage before it (membranes: normals). */
+#define MPM_MAX_STAGES (13 + 2 * MPM_MAX_GROUPS)
 
 typedef struct {
   mpm_stage stage[MPM_MAX_STAGES];

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gm_curve.h"
 #include "gm_shape.h"
 #include "gm_trisurf.h"
 #include "mpm_kind.h"
@@ -19,7 +20,8 @@
 typedef struct {
   const pm_scene *s;
   gm_shape **shape; /* per body: volume bodies (NULL for membranes) */
-  gm_trisurf *surf; /* per body: membranes' surfaces */
+  gm_trisurf *surf; /* per body: membranes' points (and triangles) */
+  double **share;   /* per body: each membrane point's area (2D: length) */
   int (*ppc)[3];    /* per body: particles per cell and direction */
 } seeder;
 
@@ -43,11 +45,37 @@ static pm_err body_fail(const pm_scene *s, int b, const char *key,
   return pm_scene_fail(s, p, key != NULL, "%s: %s", what, msg);
 }
 
-/* The surface of membrane body b, and its points inside the grid. */
-static pm_err make_surface(const pm_scene *s, int b, gm_trisurf *out) {
+/* A curve's or point cloud's points as a surface without triangles. */
+static void points_only(long n, double *x, gm_trisurf *out) {
+  *out = (gm_trisurf){.n_points = n, .x = x};
+}
+
+/* Each point's share of the point cloud of body b: the file's column, or
+ * membrane.area shared equally. */
+static pm_err cloud_shares(const pm_scene *s, int b, long n, double **share) {
+  const pm_scene_body *body = &s->bodies[b];
+  if (*share) return PM_SUCCESS;
+  char p[PM_SDOC_PATH];
+  if (!(body->membrane.area > 0))
+    return pm_scene_fail(s, PM_PATH(p, "bodies.%d.membrane.points", b), true,
+                         "expected a file with an area per point (a last "
+                         "column), or membrane.area: the file %s gives none",
+                         body->membrane.file);
+  PM_CALL(PM_ALLOC(*share, n, "membrane point areas"));
+  for (long k = 0; k < n; k++) (*share)[k] = body->membrane.area / (double)n;
+  return PM_SUCCESS;
+}
+
+/* The points of membrane body b (and its triangles), each point's share
+ * of its area (length in 2D), all inside the grid. */
+static pm_err make_surface(const pm_scene *s, int b, gm_trisurf *out,
+                           double **share) {
   const pm_scene_body *body = &s->bodies[b];
   pm_err e = PM_SUCCESS;
   const char *key = "membrane";
+  gm_curve cv = {0};
+  long n = 0;
+  double *x = NULL;
   switch (body->membrane.surface) {
   case PM_SURFACE_SPHERE:
     e = gm_trisurf_sphere(body->a, body->radius, (int)body->membrane.refinement,
@@ -64,11 +92,39 @@ static pm_err make_surface(const pm_scene *s, int b, gm_trisurf *out) {
     e = gm_trisurf_load(body->membrane.file, out);
     key = "membrane.file";
     break;
+  case PM_SURFACE_CURVE:
+    key = "membrane.curve";
+    e = gm_curve_parametric(
+        body->membrane.curve[0], body->membrane.curve[1],
+        body->membrane.curve_range[0], body->membrane.curve_range[1],
+        body->membrane.curve_points, body->membrane.closed, &cv);
+    if (e) break;
+    points_only(cv.n, cv.x, out);
+    e = PM_ALLOC(*share, cv.n, "membrane point lengths");
+    if (!e) gm_curve_point_lengths(&cv, *share);
+    break;
+  case PM_SURFACE_POINTS:
+    key = "membrane.points";
+    e = gm_points_load(body->membrane.file, s->dimension, &n, &x, share);
+    if (e) {
+      /* The reader's message names the file, line and column. */
+      char p[PM_SDOC_PATH], msg[1024];
+      snprintf(msg, sizeof msg, "%s", pm_error_message());
+      return pm_scene_fail(s, PM_PATH(p, "bodies.%d.%s", b, key), true, "%s",
+                           msg);
+    }
+    points_only(n, x, out);
+    PM_CALL(cloud_shares(s, b, n, share));
+    break;
   }
   if (e) return body_fail(s, b, key, "expected a surface");
+  if (!*share) {
+    PM_CALL(PM_ALLOC(*share, out->n_points, "membrane point areas"));
+    gm_trisurf_point_areas(out, *share);
+  }
   double lo[3], hi[3];
   gm_trisurf_bounds(out, lo, hi);
-  for (int c = 0; c < 3; c++) {
+  for (int c = 0; c < s->dimension; c++) {
     double tol = 1e-9 * (s->box_max[c] - s->box_min[c]);
     if (lo[c] < s->box_min[c] - tol || hi[c] > s->box_max[c] + tol) {
       char p[PM_SDOC_PATH];
@@ -83,6 +139,33 @@ static pm_err make_surface(const pm_scene *s, int b, gm_trisurf *out) {
   return PM_SUCCESS;
 }
 
+/* The inside or outside of membrane body mb for body b: of its closed
+ * surface (3D) or of the region its curve encloses (2D). */
+static pm_err membrane_region(const seeder *sd, int b, int mb, gm_shape **out) {
+  const pm_scene *s = sd->s;
+  const pm_scene_body *body = &s->bodies[b];
+  const bool outside = body->shape == PM_BODY_OUTSIDE;
+  const gm_trisurf *sf = &sd->surf[mb];
+  pm_err e;
+  if (s->dimension == 3)
+    e = gm_shape_from_surface(sf, outside, out);
+  else if (s->bodies[mb].membrane.surface == PM_SURFACE_CURVE)
+    e = gm_shape_from_curve(sf->n_points, sf->x, s->bodies[mb].membrane.closed,
+                            s->box_min, s->box_max, outside, out);
+  else
+    e = PM_ERROR(PM_ERR_GEOMETRY,
+                 "bodies.%d is a point cloud: its points are in no order, "
+                 "so they enclose nothing",
+                 mb);
+  if (e == PM_SUCCESS) return PM_SUCCESS;
+  char what[256];
+  snprintf(what, sizeof what,
+           "expected the name of a closed membrane (bodies.%d, whose "
+           "surface splits the domain into an inside and an outside)",
+           mb);
+  return body_fail(s, b, outside ? "outside" : "inside", what);
+}
+
 /* Every body's shape or surface, each inside the grid (domain.box): a
  * particle outside it would have no nodes.  Failures name the body's
  * position. */
@@ -91,6 +174,7 @@ static pm_err make_shapes(seeder *sd, const mpm_options *o) {
   const int nb = s->n_bodies;
   PM_CALL(PM_ALLOC(sd->shape, nb, "body shapes"));
   PM_CALL(PM_ALLOC(sd->surf, nb, "membrane surfaces"));
+  PM_CALL(PM_ALLOC(sd->share, nb, "membrane point shares"));
   PM_CALL(PM_ALLOC(sd->ppc, nb, "particles per cell"));
   for (int b = 0; b < nb; b++) {
     const pm_scene_body *body = &s->bodies[b];
@@ -100,23 +184,14 @@ static pm_err make_shapes(seeder *sd, const mpm_options *o) {
                       : body->n_ppc == 1 ? (int)body->ppc[0]
                                          : (int)body->ppc[c];
     if (body->shape == PM_BODY_MEMBRANE)
-      PM_CALL(make_surface(s, b, &sd->surf[b]));
+      PM_CALL(make_surface(s, b, &sd->surf[b], &sd->share[b]));
   }
   for (int b = 0; b < nb; b++) {
     const pm_scene_body *body = &s->bodies[b];
     char msg[1024];
     if (body->shape == PM_BODY_MEMBRANE) continue;
     if (body->shape == PM_BODY_INSIDE || body->shape == PM_BODY_OUTSIDE) {
-      bool outside = body->shape == PM_BODY_OUTSIDE;
-      if (gm_shape_from_surface(&sd->surf[body->surface_body], outside,
-                                &sd->shape[b]) != PM_SUCCESS) {
-        char what[256];
-        snprintf(what, sizeof what,
-                 "expected the name of a closed membrane (bodies.%d, whose "
-                 "surface splits the domain into an inside and an outside)",
-                 body->surface_body);
-        return body_fail(s, b, outside ? "outside" : "inside", what);
-      }
+      PM_CALL(membrane_region(sd, b, body->surface_body, &sd->shape[b]));
       continue;
     }
     if (gm_shape_create(body, s->dimension, s->box_min, s->box_max,
@@ -232,15 +307,19 @@ static void place_seed(void *ctx, const double x[3], int b) {
  * area times the thickness, and its triangles from *t on. */
 static pm_err place_membrane(seed_ctx *c, int b, long *t) {
   const gm_trisurf *sf = &c->sd->surf[b];
+  const pm_scene_body *body = &c->s->bodies[b];
   mpm_model *m = c->m;
-  double *area = NULL;
-  PM_CALL(PM_ALLOC(area, sf->n_points, "membrane point areas"));
-  gm_trisurf_point_areas(sf, area);
+  const double *area = c->sd->share[b];
   const long first = c->next[b];
   for (long k = 0; k < sf->n_points; k++)
     place(c, b, c->next[b]++, sf->x + 3 * k,
-          area[k] * c->s->bodies[b].membrane.thickness);
-  free(area);
+          area[k] * body->membrane.thickness);
+  m->body_links[b] = sf->n_tris > 0 ? MPM_LINKS_TRIANGLES
+                     : body->membrane.surface != PM_SURFACE_CURVE
+                         ? MPM_LINKS_NONE
+                     : body->membrane.closed ? MPM_LINKS_LOOP
+                                             : MPM_LINKS_CHAIN;
+  m->body_normals[b] = (unsigned char)body->membrane.normals;
   for (long j = 0; j < 3 * sf->n_tris; j++)
     m->tri[3 * *t + j] = first + sf->tri[j];
   m->body_tri_begin[b] = *t;
@@ -332,6 +411,8 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   PM_TRY(PM_ALLOC(m->body_end, nb, "body ranges"));
   PM_TRY(PM_ALLOC(m->body_tri_begin, nb, "body ranges"));
   PM_TRY(PM_ALLOC(m->body_tri_end, nb, "body ranges"));
+  PM_TRY(PM_ALLOC(m->body_links, nb, "body links"));
+  PM_TRY(PM_ALLOC(m->body_normals, nb, "body normal methods"));
   m->n_bodies = nb;
   for (int b = 0; b < nb; b++) {
     if (s->bodies[b].shape == PM_BODY_MEMBRANE)
@@ -373,6 +454,8 @@ done:
   mpm_state_destroy(c.st);
   for (int b = 0; sd.shape && b < nb; b++) gm_shape_destroy(sd.shape[b]);
   for (int b = 0; sd.surf && b < nb; b++) gm_trisurf_free(&sd.surf[b]);
+  for (int b = 0; sd.share && b < nb; b++) free(sd.share[b]);
+  free(sd.share);
   free(sd.shape);
   free(sd.surf);
   free(sd.ppc);

@@ -112,6 +112,11 @@ pm_err mpm_work_create(const mpm_model *m, mpm_work **out) {
     w->n_scratch[gi] = g->kind->scratch ? g->kind->scratch(m, g) : 0;
     if (w->n_scratch[gi] > 0)
       PM_TRY(PM_ALLOC(w->scratch[gi], w->n_scratch[gi], "kind workspace"));
+    if (g->kind->work_create) {
+      w->kind_work_free[gi] = g->kind->work_free;
+      PM_TRY(g->kind->work_create(m, g, &w->kind_work[gi],
+                                  &w->kind_work_bytes[gi]));
+    }
   }
   if (m->n_moving > 0)
     PM_TRY(PM_ALLOC(w->rigid_mass, m->grid.n_nodes, "moving bodies' masses"));
@@ -132,7 +137,10 @@ void mpm_work_destroy(mpm_work *w) {
   free(w->dx);
   free(w->cp);
   free(w->cs);
-  for (int gi = 0; gi < MPM_MAX_GROUPS; gi++) free(w->scratch[gi]);
+  for (int gi = 0; gi < MPM_MAX_GROUPS; gi++) {
+    free(w->scratch[gi]);
+    if (w->kind_work[gi]) w->kind_work_free[gi](w->kind_work[gi]);
+  }
   free(w->rigid_mass);
   free(w);
 }
@@ -141,7 +149,8 @@ size_t mpm_work_bytes(const mpm_model *m, const mpm_work *w) {
   size_t per_particle = 3 + 1 + (w->cs ? 1 : 0); /* dx, cp, cs */
   size_t scratch = 0;
   for (int gi = 0; gi < m->n_groups; gi++)
-    scratch += sizeof(double) * (size_t)w->n_scratch[gi];
+    scratch +=
+        sizeof(double) * (size_t)w->n_scratch[gi] + w->kind_work_bytes[gi];
   if (w->rigid_mass) scratch += sizeof(double) * (size_t)m->grid.n_nodes;
   return mpm_nodes_bytes(&w->nodes, &m->grid) +
          mpm_cond_work_bytes(&w->cond, &m->grid) +

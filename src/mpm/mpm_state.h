@@ -52,8 +52,22 @@ typedef struct mpm_work {
   /* each group's own workspace (its kind's scratch; NULL: none) */
   double *scratch[MPM_MAX_GROUPS];
   long n_scratch[MPM_MAX_GROUPS];
+  /* each group's workspace that is more than doubles (mpm_kind.work_create) */
+  void *kind_work[MPM_MAX_GROUPS];
+  void (*kind_work_free[MPM_MAX_GROUPS])(void *);
+  size_t kind_work_bytes[MPM_MAX_GROUPS];
   double *rigid_mass; /* per node: a moving body's mass (bodies with
                          motion only) */
+  /* membranes' normals by isosurface least squares, summed over the steps
+   * since the history's last row (which resets them) */
+  struct {
+    long cells[4];        /* cells fitted quadratic, linear, merged into a
+                             larger element, left with too few points */
+    long points;          /* points whose normals were fitted */
+    long degenerate;      /* points where grad phi vanished (normal kept) */
+    long draws;           /* random points drawn */
+    double max_condition; /* largest cond(T) of a fit kept */
+  } iso;
   /* figures of the last step */
   double max_div;      /* largest |tr D| of the stress update, 1/s */
   double min_jacobian; /* smallest volume ratio J of the stress update */

@@ -10,11 +10,22 @@
 #define PM_OMP(...) PM_PRAGMA_(omp __VA_ARGS__)
 static inline int pm_omp_threads(void) { return omp_get_max_threads(); }
 static inline void pm_omp_set_threads(int n) { omp_set_num_threads(n); }
+static inline int pm_omp_thread(void) { return omp_get_thread_num(); }
 #else
 #define PM_OMP_AVAILABLE 0
 #define PM_OMP(...)
 static inline int pm_omp_threads(void) { return 1; }
 static inline void pm_omp_set_threads(int n) { (void)n; }
+static inline int pm_omp_thread(void) { return 0; }
 #endif
+
+/* LAPACK runs on small matrices inside OpenMP loops (the membranes' normal
+ * fits, FPM's gradients): OpenBLAS's own threads would only spin against
+ * OpenMP's (a 2-D membrane run took 6 times as long).  One thread for
+ * OpenBLAS when it is the BLAS loaded; nothing with another BLAS. */
+void openblas_set_num_threads(int n) __attribute__((weak));
+static inline void pm_blas_single_thread(void) {
+  if (openblas_set_num_threads) openblas_set_num_threads(1);
+}
 
 #endif

@@ -79,8 +79,9 @@ typedef enum {
   PM_BODY_CYLINDER,   /* cylinder: {base, axis, radius}; axis from the base
                           to the top face */
   PM_BODY_MESH,       /* mesh: a gmsh-readable volume (surface in 2D) */
-  PM_BODY_MEMBRANE,   /* membrane: a triangulated surface of a thickness
-                         (MPM, 3D): its points are the surface's vertices */
+  PM_BODY_MEMBRANE,   /* membrane: one layer of points of a thickness
+                         (MPM): a triangulated surface's vertices (3D), a
+                         curve's points (2D) or a point cloud */
   PM_BODY_INSIDE,     /* inside: the inside of a closed membrane body */
   PM_BODY_OUTSIDE     /* outside: the domain outside a closed membrane */
 } pm_body_shape;
@@ -90,8 +91,23 @@ typedef enum {
   PM_SURFACE_SPHERE = 0, /* membrane.sphere: {center, radius, refinement} */
   PM_SURFACE_RECTANGLE,  /* membrane.rectangle: {origin, edge_u, edge_v,
                             points} */
-  PM_SURFACE_FILE        /* membrane.file: a gmsh-readable surface */
+  PM_SURFACE_FILE,       /* membrane.file: a gmsh-readable surface */
+  PM_SURFACE_CURVE,      /* membrane.curve: {x, y, from, to, points,
+                            closed}, a line of points (2D) */
+  PM_SURFACE_POINTS      /* membrane.points: a point cloud file, no
+                            connectivity */
 } pm_surface_kind;
+
+/* How a membrane's normals are found each step. */
+typedef enum {
+  PM_NORMALS_CONNECTIVITY = 0, /* from the triangles (3D) or the neighbours
+                                  in the list (2D) */
+  PM_NORMALS_ISO_LINEAR,       /* isosurface least squares, linear B-splines
+                                  (papers/mpm-membrane-normals-...) */
+  PM_NORMALS_ISO_QUADRATIC,    /* ..., quadratic B-splines */
+  PM_NORMALS_HYBRID            /* quadratic, linear or merged cells by the
+                                  points in each cell (section 8) */
+} pm_normals_method;
 
 typedef struct {
   int material;        /* index into materials */
@@ -118,8 +134,15 @@ typedef struct {
     double edge_v[3]; /* rectangle */
     double points[2]; /* rectangle: points along edge_u and edge_v */
     int n_points;
-    char *file; /* relative paths resolved against the scene's
-                   folder */
+    char *file; /* file, points: relative paths resolved against the
+                   scene's folder */
+    pm_normals_method normals;
+    pm_expr *curve[2];     /* curve: x(t), y(t) */
+    double curve_range[2]; /* curve: t from, to */
+    long curve_points;
+    bool closed;
+    double area; /* points: total area (3D) or length (2D) shared equally
+                    when the file gives none per point; 0: not given */
   } membrane;
   char *inside, *outside; /* PM_BODY_INSIDE / OUTSIDE: the membrane body's
                              name */

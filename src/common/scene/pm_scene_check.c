@@ -34,32 +34,54 @@ static pm_err relative_to_scene(const pm_scene *s, char **path) {
   return PM_SUCCESS;
 }
 
-/* A membrane: exactly one surface, in 3D. */
+/* A membrane: exactly one surface (sphere, rectangle, file in 3D; curve in
+ * 2D; points in either), and a normal method it can use. */
 static pm_err finish_membrane(pm_reader *r, pm_scene *s, int i,
                               pm_scene_body *b) {
-  static const char *const keys[] = {"sphere", "rectangle", "file"};
+  static const char *const keys[] = {"sphere", "rectangle", "file", "curve",
+                                     "points"};
   char p[PM_SDOC_PATH];
-  if (s->dimension != 3)
-    return pm_reader_fail(r, PM_PATH(p, "bodies.%d.membrane", i), true,
-                          "expected a body of dimension 3 (membranes are "
-                          "triangulated surfaces), got a membrane in "
-                          "dimension 2");
   int given = -1;
-  for (int k = 0; k < 3; k++) {
+  for (int k = 0; k < 5; k++) {
     if (!pm_reader_has(r, PM_PATH(p, "bodies.%d.membrane.%s", i, keys[k])))
       continue;
     if (given >= 0)
       return pm_reader_fail(r, p, true,
-                            "expected one surface (sphere, rectangle or "
-                            "file), got %s and %s",
+                            "expected one surface (sphere, rectangle, file, "
+                            "curve or points), got %s and %s",
                             keys[given], keys[k]);
     given = k;
   }
   if (given < 0)
     return pm_reader_fail(r, PM_PATH(p, "bodies.%d.membrane", i), false,
-                          "missing required key sphere, rectangle or file "
-                          "(the membrane's surface)");
+                          "missing required key sphere, rectangle, file, "
+                          "curve or points (the membrane's surface)");
   b->membrane.surface = (pm_surface_kind)given;
+  const bool curve = b->membrane.surface == PM_SURFACE_CURVE;
+  const bool cloud = b->membrane.surface == PM_SURFACE_POINTS;
+  if (!cloud && (s->dimension == 3) == curve)
+    return pm_reader_fail(
+        r, PM_PATH(p, "bodies.%d.membrane.%s", i, keys[given]), true,
+        "expected %s in dimension %d, got %s",
+        s->dimension == 3 ? "a surface (sphere, rectangle, file or points)"
+                          : "a curve or points",
+        s->dimension, keys[given]);
+  const bool normals_given =
+      pm_reader_has(r, PM_PATH(p, "bodies.%d.membrane.normals", i));
+  if (cloud && !normals_given) b->membrane.normals = PM_NORMALS_HYBRID;
+  if (cloud && b->membrane.normals == PM_NORMALS_CONNECTIVITY)
+    return pm_reader_fail(r, p, true,
+                          "expected isosurface-linear, isosurface-quadratic "
+                          "or hybrid (a point cloud has no connectivity to "
+                          "take normals from), got connectivity");
+  if (pm_reader_has(r, PM_PATH(p, "bodies.%d.membrane.area", i)) && !cloud)
+    return pm_reader_fail(r, p, true,
+                          "expected area only with points (a surface or "
+                          "curve gives each point its share)");
+  if (curve && !(b->membrane.curve_range[1] != b->membrane.curve_range[0]))
+    return pm_reader_expected(
+        r, PM_PATH(p, "bodies.%d.membrane.curve.to", i),
+        "a number other than curve.from (the curve's parameter range)");
   if (b->membrane.surface == PM_SURFACE_RECTANGLE) {
     double n[3];
     pm_v_cross(b->b, b->membrane.edge_v, n);
@@ -68,7 +90,7 @@ static pm_err finish_membrane(pm_reader *r, pm_scene *s, int i,
           r, PM_PATH(p, "bodies.%d.membrane.rectangle.edge_v", i),
           "an edge not parallel to edge_u");
   }
-  if (b->membrane.surface == PM_SURFACE_FILE)
+  if (b->membrane.surface == PM_SURFACE_FILE || cloud)
     return relative_to_scene(s, &b->membrane.file);
   return PM_SUCCESS;
 }

@@ -1,0 +1,84 @@
+#!/usr/bin/python3
+"""Draw 2-D membranes with their normals at chosen times: one column per
+run, one row per time (as figs. 12 and 14 of the membrane-normals paper).
+
+usage: plot-membrane-2d.py --times T1,T2 [--scale S] --out PNG LABEL=RUN_DIR ...
+
+Each RUN_DIR holds results.h5 of a 2-D MPM run with a membrane.  For each
+time the frame nearest in time is drawn: the other particles as grey dots,
+the membrane's points (those whose "normal" field is a unit vector) in
+black with their normals as arrows of length S (default: the cell size,
+from the grid of the results' metadata when it has one, else 0.1).
+"""
+import argparse
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def fail(msg):
+    sys.exit(f"plot-membrane-2d: {msg}")
+
+
+def frames(f, path):
+    if "frames" not in f or len(f["frames"]) == 0:
+        fail(f"{path}: no frame")
+    return sorted((float(f["frames"][n].attrs["time"]), n) for n in f["frames"])
+
+
+def load(path, t):
+    try:
+        f = h5py.File(f"{path}/results.h5", "r")
+    except OSError as e:
+        fail(f"{path}/results.h5: {e}")
+    with f:
+        table = frames(f, path)
+        time, name = min(table, key=lambda tn: abs(tn[0] - t))
+        g = f["frames"][name]
+        x0 = np.asarray(f["mesh/coordinates"][()], dtype=float)
+        x = x0 + np.asarray(g["displacement"][()], dtype=float) \
+            if "displacement" in g else x0
+        if "normal" not in g:
+            fail(f"{path}: frame {name} has no normal field (no membrane?)")
+        n = np.asarray(g["normal"][()], dtype=float)
+        return time, x, n
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("runs", nargs="+", metavar="LABEL=RUN_DIR")
+    ap.add_argument("--times", required=True)
+    ap.add_argument("--scale", type=float, default=0.1)
+    ap.add_argument("--out", required=True)
+    a = ap.parse_args()
+    try:
+        times = [float(v) for v in a.times.split(",") if v]
+    except ValueError:
+        fail(f"--times '{a.times}' is not a list of numbers")
+    runs = [r.partition("=") for r in a.runs]
+    fig, axes = plt.subplots(len(times), len(runs), squeeze=False,
+                             figsize=(4.2 * len(runs), 4.2 * len(times)))
+    for j, (label, _, d) in enumerate(runs):
+        for i, t in enumerate(times):
+            time, x, n = load(d, t)
+            ax = axes[i][j]
+            mem = np.linalg.norm(n, axis=1) > 0.5
+            ax.plot(x[~mem, 0], x[~mem, 1], ".", ms=1.5, color="0.7")
+            ax.plot(x[mem, 0], x[mem, 1], "k.", ms=3)
+            ax.quiver(x[mem, 0], x[mem, 1], n[mem, 0], n[mem, 1],
+                      angles="xy", scale_units="xy", scale=1 / a.scale,
+                      width=0.004, color="tab:red")
+            ax.set_aspect("equal")
+            ax.set_title(f"{label}, t = {time:.4g}")
+    fig.tight_layout()
+    fig.savefig(a.out, dpi=110)
+    print(f"plot-membrane-2d: wrote {a.out}")
+
+
+if __name__ == "__main__":
+    main()
