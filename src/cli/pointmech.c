@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "mpm_isonormal.h"
 #include "pm_app.h"
 #include "pm_error.h"
 #include "pm_memory.h"
@@ -42,6 +43,7 @@ static void usage(FILE *out) {
           "[--set KEY=VALUE]... [--overwrite]\n"
           "                 [--force-memory]\n"
           "       pointmech keys\n"
+          "       pointmech normals\n"
           "       pointmech --help | --version\n"
           "\n"
           "  run    simulate SCENE (YAML); writes OUT/results.h5 + "
@@ -83,6 +85,9 @@ static void usage(FILE *out) {
           "         tools/plot-convergence.py\n"
           "  keys   print every scene key: meaning, type, range, unit, "
           "default\n"
+          "  normals print the membrane-normals paper's static cases (M6: "
+          "Tables I-III,\n"
+          "         figs. 4-11) beside ours, with the time per fit\n"
           "  --set  override any scene value by its dotted key, e.g.\n"
           "         --set discretization.mesh_size=8.02e-3 --set "
           "boundary.3.displacement.z=-0.06\n"
@@ -274,6 +279,10 @@ int main(int argc, char **argv) {
   if (strcmp(cmd, "keys") == 0) {
     pm_scene_print_keys(stdout);
     return EXIT_OK;
+  }
+  if (strcmp(cmd, "normals") == 0) {
+    pm_err e = mpm_iso_tables(stdout, 1);
+    return e ? report(e) : EXIT_OK;
   }
   if (strcmp(cmd, "convergence") == 0) {
     if (!a.scene) {

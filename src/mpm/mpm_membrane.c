@@ -399,6 +399,30 @@ static bool cell_range(const iso_work *w, long n_cells, long key, long *lo,
   return true;
 }
 
+/* Whether the n points x + 3 idx[k] spread over a surface in 3D, not
+ * along a line: the second principal variance of their covariance at least
+ * ISO_SPREAD of the largest (m2 / tr^2, m2 the sum of its principal 2 x 2
+ * minors, is that ratio when the third vanishes).  Points along a line do
+ * not fix the plane through them: a fit takes some plane, and a flat sheet
+ * turned rigidly got normals 9 degrees off.  Always true in 2D (a curve). */
+#define ISO_SPREAD 0.01
+static bool spread(int dim, const double *x, const long *idx, long n) {
+  if (dim == 2) return true;
+  double c[3] = {0, 0, 0}, C[3][3] = {{0}};
+  for (long k = 0; k < n; k++)
+    for (int d = 0; d < 3; d++) c[d] += x[3 * idx[k] + d] / (double)n;
+  for (long k = 0; k < n; k++) {
+    double u[3];
+    for (int d = 0; d < 3; d++) u[d] = x[3 * idx[k] + d] - c[d];
+    for (int a = 0; a < 3; a++)
+      for (int b = 0; b < 3; b++) C[a][b] += u[a] * u[b];
+  }
+  const double tr = C[0][0] + C[1][1] + C[2][2];
+  const double m2 = C[0][0] * C[1][1] - C[0][1] * C[0][1] + C[0][0] * C[2][2] -
+                    C[0][2] * C[0][2] + C[1][1] * C[2][2] - C[1][2] * C[1][2];
+  return m2 > ISO_SPREAD * tr * tr;
+}
+
 /* A fit's seed: the step, the body, the cell and the block level mixed
  * (splitmix64's finaliser), so that a run repeats bit for bit whatever
  * thread fits which cell. */
@@ -456,10 +480,16 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
                   : method == PM_NORMALS_ISO_QUADRATIC
                       ? 2
                       : mpm_iso_hybrid_order(dim, cnt);
+      if (method == PM_NORMALS_HYBRID && order > 0 &&
+          !spread(dim, x, w->order + r0, cnt))
+        order = 0;
       mpm_iso_report rep;
       double lo[3] = {0, 0, 0};
       if (order > 0) {
         for (int d = 0; d < dim; d++) lo[d] = g->origin[d] + cell[d] * g->h;
+        for (long r = r0; r < r1; r++)
+          for (int d = 0; d < 3; d++)
+            th->normal[3 * w->order[r] + d] = nn[3 * w->order[r] + d];
         pm_err e =
             mpm_iso_fit(th->fit[order - 1], lo, g->h, cnt, x, w->order + r0,
                         fit_seed(step, body, key, 0), nn, &rep);
@@ -467,12 +497,23 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
           PM_OMP(critical(membrane_iso)) err = e;
           continue;
         }
-        my.cells[order == 2 ? 0 : 1]++;
-        stats_add(&my, &rep, cnt);
-        continue;
+        /* Hybrid: points in a special position (on a line or a conic of
+         * the surface) leave S rank deficient, and the minimum-norm phi is
+         * not constant along the surface (7 points of a flat sheet gave a
+         * normal 2.7 degrees off): the cell is merged as a sparse one. */
+        if (method != PM_NORMALS_HYBRID ||
+            rep.rank == mpm_iso_unknowns(dim, order)) {
+          my.cells[order == 2 ? 0 : 1]++;
+          stats_add(&my, &rep, cnt);
+          continue;
+        }
+        for (long r = r0; r < r1; r++)
+          for (int d = 0; d < 3; d++)
+            nn[3 * w->order[r] + d] = th->normal[3 * w->order[r] + d];
       }
-      /* Too few points: the block of B cells a side around the cell, B =
-       * 2, 4, 8, until it has enough for a linear fit. */
+      /* Too few points (or, by the hybrid rule, points that do not fix the
+       * surface): the block of B cells a side around the cell, B = 2, 4, 8,
+       * until it has enough for a full-rank linear fit. */
       double mid[3] = {0, 0, 0};
       for (long r = r0; r < r1; r++)
         for (int d = 0; d < dim; d++)
@@ -504,7 +545,9 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
             }
         /* Linear on the larger element, as the paper does: it has enough
          * points for it, or is the largest block and has what it has. */
-        if (mpm_iso_hybrid_order(dim, m) == 0 && level < ISO_MERGE_LEVELS)
+        if ((mpm_iso_hybrid_order(dim, m) == 0 ||
+             !spread(dim, x, th->gather, m)) &&
+            level < ISO_MERGE_LEVELS)
           continue;
         order = 1;
         for (int d = 0; d < dim; d++) lo[d] = g->origin[d] + first[d] * g->h;
@@ -518,6 +561,8 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
           PM_OMP(critical(membrane_iso)) err = e;
           break;
         }
+        if (rep.rank < mpm_iso_unknowns(dim, 1) && level < ISO_MERGE_LEVELS)
+          continue;
         for (long r = r0; r < r1; r++)
           for (int d = 0; d < 3; d++)
             nn[3 * w->order[r] + d] = th->normal[3 * w->order[r] + d];
@@ -628,7 +673,7 @@ static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
   membrane_params *mp = g->params;
   const long t0 = m->tri_begin[g->index], t1 = m->tri_end[g->index];
   const long np = g->end - g->begin;
-  double *tn = NULL, *nn = NULL;
+  double *tn = NULL, *nn = NULL, *ref = NULL;
   void *iw = NULL;
   size_t iw_bytes;
   pm_err ret = PM_SUCCESS;
@@ -659,26 +704,34 @@ static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
   PM_TRY(PM_ALLOC(tn, 3 * (t1 - t0) + 3, "triangle normals"));
   PM_TRY(PM_ALLOC(nn, 3 * np, "membrane normals"));
   PM_TRY(iso_work_create(m, g, &iw, &iw_bytes));
-  /* The previous normals of the first fit: away from the body's centre. */
+  /* The reference of the first normals' sides: the connectivity's
+   * normals where the body has connectivity, else away from its centre;
+   * they are also the fit's previous normals. */
+  PM_TRY(PM_ALLOC(ref, 3 * np, "membrane normals"));
   const double *xg = s->x + 3 * g->begin;
+  if (t1 > t0) triangle_normals(m, s->x, t0, t1, tn);
   for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    if (b->links == MPM_LINKS_CHAIN || b->links == MPM_LINKS_LOOP)
+      gm_curve_normals(b->end - b->begin, xg + 3 * b->begin,
+                       b->links == MPM_LINKS_LOOP, ref + 3 * b->begin);
     double c[3];
-    body_centre(xg, &mp->bodies[bi], c);
-    for (long k = mp->bodies[bi].begin; k < mp->bodies[bi].end; k++)
-      away_from(xg, c, k, nn + 3 * k);
+    body_centre(xg, b, c);
+    for (long k = b->begin; k < b->end; k++) {
+      if (b->links == MPM_LINKS_TRIANGLES) point_normal(mp, k, tn, ref + 3 * k);
+      if (!(pm_v_norm(ref + 3 * k) > 0.5)) away_from(xg, c, k, ref + 3 * k);
+    }
   }
+  memcpy(nn, ref, sizeof(double) * 3 * (size_t)np);
   iso_stats st = {0};
   PM_TRY(group_normals(m, g, s->x, -1, iw, tn, nn, &st));
   double *frame = s->group[g->index].array[MEM_FRAME].data;
   for (int bi = 0; bi < mp->n_bodies; bi++) {
     const struct membrane_body *b = &mp->bodies[bi];
-    double c[3];
-    body_centre(xg, b, c);
     for (long k = b->begin; k < b->end; k++) {
-      double *n = nn + 3 * k, *xp = s->x + 3 * (g->begin + k), out[3];
-      /* A fitted normal's sign is arbitrary: away from the centre. */
-      away_from(xg, c, k, out);
-      if (b->method != PM_NORMALS_CONNECTIVITY && pm_v_dot(n, out) < 0)
+      double *n = nn + 3 * k, *xp = s->x + 3 * (g->begin + k);
+      /* A fitted normal's sign is arbitrary: the reference's side. */
+      if (pm_v_dot(n, ref + 3 * k) < 0)
         for (int d = 0; d < 3; d++) n[d] = -n[d];
       bool has = pm_v_norm(n) > 0.5;
       if (has && b->method == PM_NORMALS_CONNECTIVITY &&
@@ -697,6 +750,7 @@ done:
   iso_work_free(iw);
   free(tn);
   free(nn);
+  free(ref);
   return ret;
 }
 

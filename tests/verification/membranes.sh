@@ -54,6 +54,46 @@ bad_scene damage-on-a-solid "$oocyte" \
   's/{name: holding, model: linear-elastic, density: 2300,/{name: holding, model: linear-elastic, density: 2300, damage: {c0: 1, c1: 1, elastic_limit: 0.1, failure_strain: 0.2},/' \
   'name: holding' 'expected damage only on a material of membranes'
 
+# Membranes in 2D and as point clouds (cases M5).
+circle=$mpm/m5-gas-circle.yaml
+awk 'BEGIN { pi = atan2(0, -1); print "x,y,length";
+  for (k = 0; k <= 90; k++) { a = pi / 2 * k / 90;
+    printf "%.15g,%.15g,%.15g\n", 0.5 * cos(a), 0.5 * sin(a), (k == 0 || k == 90 ? 0.5 : 1) * pi / 4 / 90 } }' \
+  >"$work/ring.csv"
+cloud_expr="s|curve: {x: \"0.5\*cos(pi/2\*t)\", y: \"0.5\*sin(pi/2\*t)\", from: 0, to: 1, points: 91}|points: $work/ring.csv|"
+bad_scene cloud-with-connectivity "$circle" \
+  "$cloud_expr; s|normals: hybrid|normals: connectivity|" 'normals: connectivity' \
+  'got connectivity'
+check "cloud-with-connectivity: says why" grep -qF 'a point cloud has no connectivity' "$work/err"
+awk 'NR == 12 { $0 = "0.49,abc,0.0087" } { print }' "$work/ring.csv" >"$work/ring-bad.csv"
+bad_scene cloud-bad-line "$circle" \
+  "$cloud_expr; s|ring.csv|ring-bad.csv|" 'ring-bad.csv' "ring-bad.csv:12:6: expected a number"
+bad_scene curve-in-3d "$oocyte" \
+  's/sphere: {center: \[70.0e-6, 65.0e-6, 65.0e-6\], radius: 50.0e-6, refinement: 4}/curve: {x: "1e-5*t", y: "1e-5*t", points: 10}/' \
+  'curve: {x:' 'got curve'
+bad_scene normals-unknown "$circle" 's/normals: hybrid/normals: isosurface/' \
+  'normals: isosurface' 'expected one of connectivity'
+# plan: the normal method changes the normal stage only.
+"$bin" plan "$circle" >"$work/plan-iso" 2>"$work/err"
+check "plan 2D: exit 0" test $? -eq 0
+check "plan 2D: hybrid normal stage" grep -qF 'normals: membrane    skin: bodies.0: isosurface least squares, hybrid' "$work/plan-iso"
+"$bin" plan "$circle" --set bodies.0.membrane.normals=connectivity \
+  >"$work/plan-con" 2>"$work/err"
+diff <(grep -E '^ +[0-9]+\. ' "$work/plan-iso") <(grep -E '^ +[0-9]+\. ' "$work/plan-con") \
+  >"$work/plan-diff"
+check "plan 2D: one stage differs" test "$(grep -c '^<' "$work/plan-diff")" -eq 1
+check "plan 2D: it is the normal stage" grep -qF '< ' "$work/plan-diff"
+check "plan 2D: connectivity normals" grep -qF "perpendicular to the neighbours' chord" "$work/plan-con"
+# A point cloud runs (its gas seeded in a disk).
+sed -e "$cloud_expr" -e 's|inside: membrane|region: "0.25 - x*x - y*y"|' \
+  "$circle" >"$work/cloud.yaml"
+"$bin" run "$work/cloud.yaml" --set time.end=0.02 --out "$work/cloud" --quiet \
+  >/dev/null 2>"$work/err"
+check "point cloud 2D: exit 0" test $? -eq 0
+check "point cloud 2D: completed" grep -qF '"status": "completed"' "$work/cloud/summary.json"
+check "point cloud 2D: plan says unconnected" bash -c \
+  "'$bin' plan '$work/cloud.yaml' | grep -qF 'membrane of unconnected points'"
+
 # plan: the membrane's stage and arrays; none in a scene without one.
 "$bin" plan "$oocyte" >"$work/plan" 2>"$work/err"
 check "plan: exit 0" test $? -eq 0
