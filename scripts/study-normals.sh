@@ -1,6 +1,7 @@
 #!/bin/bash
 # Normals without connectivity (the membrane-normals paper; cases M5, M6),
-# each membrane run by both methods, hybrid isosurface and connectivity:
+# each membrane run by three methods: the paper's hybrid rule,
+# hybrid-quadratic and connectivity:
 #   OUT/tables.md           M6: the paper's static Tables I-III and figs.
 #                           4-11 beside ours (pointmech normals)
 #   OUT/m5-circle.png       the circle at t = 0 and at rest, normals drawn
@@ -32,10 +33,10 @@ run() { # scene, method, dir, extra --set...
   "$build/pointmech" run --overwrite "cases/mpm/$scene.yaml" --quiet \
     --set bodies.0.membrane.normals="$method" "$@" --out "$dir"
 }
-for m in hybrid connectivity; do
+for m in hybrid hybrid-quadratic connectivity; do
   run m5-gas-circle $m "$out/circle-$m" --set time.end=0.5
   run m5-gas-dogbone $m "$out/dogbone-$m" --set time.end=0.5
-  run m5-gas-dogbone $m "$out/dogbone-early-$m" --set time.end=2.5e-4 \
+  run m5-gas-dogbone $m "$out/dogbone-early-$m" --set time.end=5e-4 \
     --set output.every=1
   run membrane-sphere-gas $m "$out/sphere-$m" --set time.end=0.3 \
     --set output.every=200
@@ -43,18 +44,21 @@ for m in hybrid connectivity; do
 done
 $py tools/plot-membrane-2d.py --times 0,0.5 --scale 0.1 \
   --out "$out/m5-circle.png" "hybrid=$out/circle-hybrid" \
-  "connectivity=$out/circle-connectivity"
+  "hybrid-quadratic=$out/circle-hybrid-quadratic" "connectivity=$out/circle-connectivity"
 $py tools/plot-membrane-2d.py --times 0,0.5 --scale 0.2 \
   --out "$out/m5-dogbone.png" "hybrid=$out/dogbone-hybrid" \
-  "connectivity=$out/dogbone-connectivity"
+  "hybrid-quadratic=$out/dogbone-hybrid-quadratic" "connectivity=$out/dogbone-connectivity"
 dt=$($py -c "import csv; r = list(csv.DictReader(open('$out/dogbone-early-hybrid/history.csv'))); print(r[1]['dt'])")
 $py tools/plot-membrane-2d.py --times "$($py -c "print(4 * $dt)"),$($py -c "print(7 * $dt)")" \
   --scale 0.2 --out "$out/m5-dogbone-early.png" \
-  "hybrid=$out/dogbone-early-hybrid" "connectivity=$out/dogbone-early-connectivity"
+  "hybrid=$out/dogbone-early-hybrid" \
+  "hybrid-quadratic=$out/dogbone-early-hybrid-quadratic" \
+  "connectivity=$out/dogbone-early-connectivity"
 for c in circle dogbone; do
   $py tools/plot-history.py --columns gas_pressure \
     --title "M5 $c: gas pressure" --out "$out/m5-$c-p.png" \
-    "hybrid=$out/$c-hybrid" "connectivity=$out/$c-connectivity"
+    "hybrid=$out/$c-hybrid" "hybrid-quadratic=$out/$c-hybrid-quadratic" \
+    "connectivity=$out/$c-connectivity"
 done
 
 $py - "$out" <<'PY'
@@ -65,7 +69,7 @@ rows = ["| run | method | steps | wall (s) | normal stage per point-step (us) "
         "|---|---|---|---|---|---|---|---|---|"]
 for case, npts in (("circle", 91), ("dogbone", 100), ("sphere", 2562),
                    ("oocyte", 2562)):
-    for m in ("hybrid", "connectivity"):
+    for m in ("hybrid", "hybrid-quadratic", "connectivity"):
         d = f"{out}/{case}-{m}"
         s = json.load(open(f"{d}/summary.json"))
         h = list(csv.DictReader(open(f"{d}/history.csv")))
@@ -84,15 +88,16 @@ for case, npts in (("circle", 91), ("dogbone", 100), ("sphere", 2562),
                     f"| {case} | {m} | {s['steps']} | {s['wall_seconds']:.1f} "
                     f"| {us:.3f} | | {rms:.2f} | {big:.1f} | {n10} |")
 rows.append("")
-rows.append("The reduced oocyte by frame, hybrid normals against the "
-            "connectivity's (points next to a failed point | the others):")
-rows.append("```")
-rows.append(subprocess.run(["/usr/bin/python3", "tools/normal-angles.py",
-                            "--failed", f"{out}/oocyte-hybrid"],
-                           capture_output=True, text=True,
-                           check=True).stdout.rstrip())
-rows.append("```")
-for m in ("hybrid", "connectivity"):
+for m in ("hybrid", "hybrid-quadratic"):
+    rows.append(f"The reduced oocyte by frame, {m} normals against the "
+                "connectivity's (points next to a failed point | the others):")
+    rows.append("```")
+    rows.append(subprocess.run(["/usr/bin/python3", "tools/normal-angles.py",
+                                "--failed", f"{out}/oocyte-{m}"],
+                               capture_output=True, text=True,
+                               check=True).stdout.rstrip())
+    rows.append("```")
+for m in ("hybrid", "hybrid-quadratic", "connectivity"):
     h = list(csv.DictReader(open(f"{out}/oocyte-{m}/history.csv")))
     rows.append(f"- oocyte, {m}: failed points at the end {h[-1]['failed_points']}, "
                 f"zona inside mass of cytoplasm {h[-1].get('mass_inside_zona_cytoplasm', '')}")

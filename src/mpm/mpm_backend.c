@@ -573,7 +573,8 @@ static void plan_bodies(const mpm_sim *r, FILE *out) {
             body->name ? body->name : "", n);
     if (body->shape == PM_BODY_MEMBRANE) {
       static const char *const normals[] = {"connectivity", "isosurface-linear",
-                                            "isosurface-quadratic", "hybrid"};
+                                            "isosurface-quadratic", "hybrid",
+                                            "hybrid-quadratic"};
       long nt = m->body_tri_end[b] - m->body_tri_begin[b];
       double area = 0;
       for (long q = m->body_begin[b]; q < m->body_end[b]; q++)

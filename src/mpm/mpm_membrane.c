@@ -480,8 +480,13 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
                   : method == PM_NORMALS_ISO_QUADRATIC
                       ? 2
                       : mpm_iso_hybrid_order(dim, cnt);
-      if (method == PM_NORMALS_HYBRID && order > 0 &&
-          !spread(dim, x, w->order + r0, cnt))
+      /* hybrid-quadratic: quadratic or merged; linear only on the largest
+       * block. */
+      const bool hybrid =
+          method == PM_NORMALS_HYBRID || method == PM_NORMALS_HYBRID_QUADRATIC;
+      const int block_order = method == PM_NORMALS_HYBRID_QUADRATIC ? 2 : 1;
+      if (hybrid && order > 0 &&
+          (order < block_order || !spread(dim, x, w->order + r0, cnt)))
         order = 0;
       mpm_iso_report rep;
       double lo[3] = {0, 0, 0};
@@ -501,8 +506,7 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
          * the surface) leave S rank deficient, and the minimum-norm phi is
          * not constant along the surface (7 points of a flat sheet gave a
          * normal 2.7 degrees off): the cell is merged as a sparse one. */
-        if (method != PM_NORMALS_HYBRID ||
-            rep.rank == mpm_iso_unknowns(dim, order)) {
+        if (!hybrid || rep.rank == mpm_iso_unknowns(dim, order)) {
           my.cells[order == 2 ? 0 : 1]++;
           stats_add(&my, &rep, cnt);
           continue;
@@ -543,13 +547,15 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
                 continue;
               for (long r = a; r < z; r++) th->gather[m++] = w->order[r];
             }
-        /* Linear on the larger element, as the paper does: it has enough
-         * points for it, or is the largest block and has what it has. */
-        if ((mpm_iso_hybrid_order(dim, m) == 0 ||
-             !spread(dim, x, th->gather, m)) &&
+        /* The larger element's fit: linear as the paper does (hybrid), or
+         * quadratic when the block has enough points (hybrid-quadratic);
+         * else the next block, and the largest block's fit whatever it
+         * has (linear). */
+        order = mpm_iso_hybrid_order(dim, m) >= block_order ? block_order : 0;
+        if ((order == 0 || !spread(dim, x, th->gather, m)) &&
             level < ISO_MERGE_LEVELS)
           continue;
-        order = 1;
+        if (order == 0) order = 1;
         for (int d = 0; d < dim; d++) lo[d] = g->origin[d] + first[d] * g->h;
         for (long r = r0; r < r1; r++)
           for (int d = 0; d < 3; d++)
@@ -561,12 +567,12 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
           PM_OMP(critical(membrane_iso)) err = e;
           break;
         }
-        if (rep.rank < mpm_iso_unknowns(dim, 1) && level < ISO_MERGE_LEVELS)
+        if (rep.rank < mpm_iso_unknowns(dim, order) && level < ISO_MERGE_LEVELS)
           continue;
         for (long r = r0; r < r1; r++)
           for (int d = 0; d < 3; d++)
             nn[3 * w->order[r] + d] = th->normal[3 * w->order[r] + d];
-        my.cells[mpm_iso_hybrid_order(dim, m) > 0 ? 2 : 3]++;
+        my.cells[rep.rank == mpm_iso_unknowns(dim, order) ? 2 : 3]++;
         stats_add(&my, &rep, cnt);
         done_cell = true;
       }
@@ -627,7 +633,9 @@ static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
 static const char *const method_words[] = {
     "connectivity", "isosurface least squares, linear B-splines",
     "isosurface least squares, quadratic B-splines",
-    "isosurface least squares, hybrid (quadratic, linear, or merged cells)"};
+    "isosurface least squares, hybrid (quadratic, linear, or merged cells)",
+    "isosurface least squares, hybrid-quadratic (quadratic on the smallest "
+    "block of cells with enough points)"};
 
 static void membrane_describe_normals(const mpm_model *m, const mpm_group *g,
                                       char *buf, size_t size) {

@@ -105,8 +105,10 @@ typedef enum {
   PM_NORMALS_ISO_LINEAR,       /* isosurface least squares, linear B-splines
                                   (papers/mpm-membrane-normals-...) */
   PM_NORMALS_ISO_QUADRATIC,    /* ..., quadratic B-splines */
-  PM_NORMALS_HYBRID            /* quadratic, linear or merged cells by the
+  PM_NORMALS_HYBRID,           /* quadratic, linear or merged cells by the
                                   points in each cell (section 8) */
+  PM_NORMALS_HYBRID_QUADRATIC  /* quadratic on the smallest block of cells
+                                  (1, 2, 4, 8 a side) with enough points */
 } pm_normals_method;
 
 typedef struct {

@@ -68,12 +68,14 @@ static pm_err finish_membrane(pm_reader *r, pm_scene *s, int i,
         s->dimension, keys[given]);
   const bool normals_given =
       pm_reader_has(r, PM_PATH(p, "bodies.%d.membrane.normals", i));
-  if (cloud && !normals_given) b->membrane.normals = PM_NORMALS_HYBRID;
+  if (cloud && !normals_given)
+    b->membrane.normals = PM_NORMALS_HYBRID_QUADRATIC;
   if (cloud && b->membrane.normals == PM_NORMALS_CONNECTIVITY)
     return pm_reader_fail(r, p, true,
-                          "expected isosurface-linear, isosurface-quadratic "
-                          "or hybrid (a point cloud has no connectivity to "
-                          "take normals from), got connectivity");
+                          "expected isosurface-linear, isosurface-quadratic, "
+                          "hybrid or hybrid-quadratic (a point cloud has no "
+                          "connectivity to take normals from), got "
+                          "connectivity");
   if (pm_reader_has(r, PM_PATH(p, "bodies.%d.membrane.area", i)) && !cloud)
     return pm_reader_fail(r, p, true,
                           "expected area only with points (a surface or "

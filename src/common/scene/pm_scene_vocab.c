@@ -250,6 +250,7 @@ static const pm_name normals_names[] = {
     {"isosurface-linear", PM_NORMALS_ISO_LINEAR},
     {"isosurface-quadratic", PM_NORMALS_ISO_QUADRATIC},
     {"hybrid", PM_NORMALS_HYBRID},
+    {"hybrid-quadratic", PM_NORMALS_HYBRID_QUADRATIC},
     {NULL, 0}};
 static const pm_key membrane_curve_keys[] = {
     {.name = "x",
@@ -333,8 +334,8 @@ static const pm_key membrane_keys[] = {
      .def = "connectivity",
      .names = normals_names,
      .doc = "connectivity (triangles, or neighbours along a curve), "
-            "isosurface-linear, isosurface-quadratic or hybrid (default "
-            "hybrid for points)"},
+            "isosurface-linear, isosurface-quadratic, hybrid (the paper's "
+            "rule) or hybrid-quadratic (default for points)"},
     {0}};
 static const pm_key motion_keys[] = {
     {.name = "velocity",
