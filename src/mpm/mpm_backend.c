@@ -464,10 +464,9 @@ static void history_values(void *p, double *v) {
     v[k++] = nf;
   }
   if (iso_normals_used(m)) {
-    v[k++] = r->work->iso.max_condition;
-    v[k++] = (double)r->work->iso.degenerate;
-    v[k++] = (double)(r->work->iso.cells[2] + r->work->iso.cells[3]);
-    memset(&r->work->iso, 0, sizeof r->work->iso); /* per row */
+    v[k++] = st->iso.max_condition;
+    v[k++] = st->iso.degenerate;
+    v[k++] = st->iso.cells[2] + st->iso.cells[3];
   }
   for (int b = 0; b < s->n_bodies && k < r->n_hist; b++) {
     const pm_scene_body *body = &s->bodies[b];

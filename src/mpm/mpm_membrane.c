@@ -783,12 +783,11 @@ static pm_err membrane_normals(mpm_ctx *ctx, const mpm_stage *self) {
   iso_stats st = {0};
   pm_err e = group_normals(m, gr, s->x, s->step, w->kind_work[gi], tn, nn, &st);
   if (e) return e;
-  for (int i = 0; i < 4; i++) w->iso.cells[i] += st.cells[i];
-  w->iso.points += st.points;
-  w->iso.degenerate += st.degenerate;
-  w->iso.draws += st.draws;
-  if (st.max_condition > w->iso.max_condition)
-    w->iso.max_condition = st.max_condition;
+  for (int i = 0; i < 4; i++) s->iso.cells[i] += (double)st.cells[i];
+  s->iso.points += (double)st.points;
+  s->iso.degenerate += (double)st.degenerate;
+  s->iso.draws += (double)st.draws;
+  s->iso.max_condition = st.max_condition;
   return PM_SUCCESS;
 }
 

@@ -174,6 +174,8 @@ pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck) {
     PM_CALL(pm_ckpt_doubles(ck, name, a[k].ncomp * a[k].count, a[k].data));
   }
   PM_CALL(pm_ckpt_doubles(ck, "mpm.energy", n_acc, (double *)s->energy));
+  PM_CALL(pm_ckpt_doubles(ck, "mpm.iso", (long)(sizeof s->iso / sizeof(double)),
+                          (double *)&s->iso));
   PM_CALL(pm_ckpt_double(ck, "mpm.external_work", &s->external_work));
   PM_CALL(pm_ckpt_double(ck, "mpm.dissipated", &s->dissipated));
   PM_CALL(pm_ckpt_double(ck, "mpm.damping", &s->damping));

@@ -35,6 +35,18 @@ typedef struct mpm_state {
                            damping (dynamic relaxation) */
   unsigned char *fixed; /* 3 per node: dofs the conditions set in the last
                            step, which dynamic relaxation leaves out */
+  /* membranes' normals by isosurface least squares: totals over the run,
+   * and the largest cond(T) of the last step's fits (history.csv reports
+   * them as they are: a row between two others would otherwise change
+   * what the next row counts, and a stop writes one) */
+  struct {
+    double cells[4];      /* cells fitted quadratic, linear, merged into a
+                             larger element, left rank deficient */
+    double points;        /* points whose normals were fitted */
+    double degenerate;    /* points where grad phi vanished (normal kept) */
+    double draws;         /* random points drawn */
+    double max_condition; /* largest cond(T) of a fit kept, last step */
+  } iso;
   /* iterations of the constitutive updates over the run */
   int iter_max_total;
   long iter_capped_total;
@@ -58,16 +70,6 @@ typedef struct mpm_work {
   size_t kind_work_bytes[MPM_MAX_GROUPS];
   double *rigid_mass; /* per node: a moving body's mass (bodies with
                          motion only) */
-  /* membranes' normals by isosurface least squares, summed over the steps
-   * since the history's last row (which resets them) */
-  struct {
-    long cells[4];        /* cells fitted quadratic, linear, merged into a
-                             larger element, left with too few points */
-    long points;          /* points whose normals were fitted */
-    long degenerate;      /* points where grad phi vanished (normal kept) */
-    long draws;           /* random points drawn */
-    double max_condition; /* largest cond(T) of a fit kept */
-  } iso;
   /* figures of the last step */
   double max_div;      /* largest |tr D| of the stress update, 1/s */
   double min_jacobian; /* smallest volume ratio J of the stress update */

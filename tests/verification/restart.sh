@@ -47,9 +47,11 @@ with h5py.File(os.path.join(out, "results.h5"), "r") as f:
         assert "displacement" in f["frames"][k] or "position" in f["frames"][k]
 # One grid per frame under the temporal collection (a spatial collection
 # of the points and the membrane's triangles when there is a membrane).
+# The index is committed before the XDMF: a kill between the two leaves the
+# XDMF one frame behind, never ahead.
 grids = ET.parse(os.path.join(out, "results.xdmf")).getroot().findall(
     ".//Grid[@CollectionType='Temporal']/Grid")
-assert len(grids) == n, (len(grids), n)
+assert len(grids) in (n, n - 1), (len(grids), n)
 for item in ET.parse(os.path.join(out, "results.xdmf")).getroot().iter("DataItem"):
     assert os.path.exists(os.path.join(out, item.text.split(":")[0])), item.text
 print(n)
@@ -96,7 +98,10 @@ resume_case() { # label, scene, lines before the signals, args...
 }
 
 fpm=$src/cases/fpm/f2-unconstrained-compression.yaml
-ckpt_every=300
+# A checkpoint before the SIGKILL, which comes at the 8th row (step 700):
+# with one every 1000 steps, whether one existed depended on how fast the
+# run outpaced the poll.
+ckpt_every=500
 resume_case fpm "$fpm" 5 --set discretization.mesh_size=0.02 \
   --set time.max_steps=1200 --set time.end=1 --set output.every=100
 # A static solve: the load stepping's state (load factor, step size, the
@@ -112,6 +117,11 @@ resume_case mpm "$mpm" 4 --set time.max_steps=400 --set output.every=50
 ckpt_every=200
 resume_case membranes "$src/cases/mpm/m4-oocyte-reduced.yaml" 4 \
   --set time.max_steps=1000 --set output.every=100
+# Normals by isosurface least squares (random points drawn per step, cell
+# and block; normals oriented against the last step's): the M5 circle.
+ckpt_every=1000
+resume_case membranes-2d "$src/cases/mpm/m5-gas-circle.yaml" 4 \
+  --set time.max_steps=6000 --set output.every=500
 
 # Checkpoints by wall time: every 0.03 s of a run of 0.3 s or more.
 out=$work/minutes
