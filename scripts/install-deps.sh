@@ -12,6 +12,7 @@ packages=(
   libyaml-dev
   libmatheval-dev
   libcmocka-dev
+  libtiff-dev
   libpetsc-real-dev
   clang-format python3-matplotlib python3-numpy python3-h5py
 )

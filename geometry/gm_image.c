@@ -1,0 +1,345 @@
+/* gm_image: labelled volumetric images from TIFF stacks, raw volumes and
+ * point files, and TIFF output (see gm_image.h). */
+#include "gm_image.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <tiffio.h>
+#include <unistd.h>
+
+/* libtiff reports through a handler: its last message, for ours. */
+static char tiff_msg[512];
+
+static void tiff_handler(const char *module, const char *fmt, va_list ap) {
+  int k = snprintf(tiff_msg, sizeof tiff_msg, "%s: ", module ? module : "");
+  if (k < 0 || (size_t)k >= sizeof tiff_msg) k = 0;
+  vsnprintf(tiff_msg + k, sizeof tiff_msg - (size_t)k, fmt, ap);
+}
+
+void gm_image_free(gm_image *im) {
+  if (!im) return;
+  free(im->v);
+  memset(im, 0, sizeof *im);
+}
+
+static pm_err image_alloc(gm_image *im, const long n[3], const double d[3],
+                          const double o[3]) {
+  memset(im, 0, sizeof *im);
+  for (int c = 0; c < 3; c++) {
+    PM_CHECK(n[c] > 0, PM_ERR_ARG,
+             "image: expected a positive size along %c, got %ld", "xyz"[c],
+             n[c]);
+    PM_CHECK(d[c] > 0 && isfinite(d[c]), PM_ERR_ARG,
+             "image: expected a positive voxel size along %c, got %g", "xyz"[c],
+             d[c]);
+    im->n[c] = n[c];
+    im->d[c] = d[c];
+    im->o[c] = o ? o[c] : 0;
+  }
+  return PM_ALLOC(im->v, n[0] * n[1] * n[2], "image voxels");
+}
+
+/* ---- TIFF ---------------------------------------------------------------- */
+
+/* One page's size and depth; false (with the reason in why) when it is not
+ * 8- or 16-bit grey of one sample. */
+static bool page_format(TIFF *t, uint32_t *w, uint32_t *h, uint16_t *bits,
+                        char *why, size_t size) {
+  uint16_t spp = 1, photo = PHOTOMETRIC_MINISBLACK, fmt = SAMPLEFORMAT_UINT;
+  TIFFGetField(t, TIFFTAG_IMAGEWIDTH, w);
+  TIFFGetField(t, TIFFTAG_IMAGELENGTH, h);
+  TIFFGetFieldDefaulted(t, TIFFTAG_BITSPERSAMPLE, bits);
+  TIFFGetFieldDefaulted(t, TIFFTAG_SAMPLESPERPIXEL, &spp);
+  TIFFGetFieldDefaulted(t, TIFFTAG_SAMPLEFORMAT, &fmt);
+  TIFFGetField(t, TIFFTAG_PHOTOMETRIC, &photo);
+  if (spp != 1 || (*bits != 8 && *bits != 16) || fmt != SAMPLEFORMAT_UINT ||
+      (photo != PHOTOMETRIC_MINISBLACK && photo != PHOTOMETRIC_MINISWHITE)) {
+    snprintf(why, size,
+             "expected 8- or 16-bit unsigned grey of one sample, got %u "
+             "sample(s) of %u bits (format %u, photometric %u)",
+             (unsigned)spp, (unsigned)*bits, (unsigned)fmt, (unsigned)photo);
+    return false;
+  }
+  return true;
+}
+
+/* Page p of t (w x h of `bits`) into dst (w h values), row by row (or tile
+ * by tile); false on a read error (tiff_msg says why). */
+static bool read_page(TIFF *t, uint32_t w, uint32_t h, uint16_t bits,
+                      uint16_t *dst) {
+  const size_t bps = bits / 8;
+  uint16_t photo = PHOTOMETRIC_MINISBLACK;
+  TIFFGetField(t, TIFFTAG_PHOTOMETRIC, &photo);
+  const uint16_t top = bits == 8 ? 255 : 65535;
+  bool ok = true;
+  if (TIFFIsTiled(t)) {
+    uint32_t tw = 0, th = 0;
+    TIFFGetField(t, TIFFTAG_TILEWIDTH, &tw);
+    TIFFGetField(t, TIFFTAG_TILELENGTH, &th);
+    unsigned char *buf = _TIFFmalloc(TIFFTileSize(t));
+    if (!buf) return false;
+    for (uint32_t y0 = 0; ok && y0 < h; y0 += th)
+      for (uint32_t x0 = 0; ok && x0 < w; x0 += tw) {
+        if (TIFFReadTile(t, buf, x0, y0, 0, 0) < 0) {
+          ok = false;
+          break;
+        }
+        for (uint32_t y = y0; y < y0 + th && y < h; y++)
+          for (uint32_t x = x0; x < x0 + tw && x < w; x++) {
+            size_t k = (size_t)(y - y0) * tw + (x - x0);
+            dst[(size_t)y * w + x] =
+                bps == 1 ? buf[k] : ((uint16_t *)(void *)buf)[k];
+          }
+      }
+    _TIFFfree(buf);
+  } else {
+    unsigned char *row = _TIFFmalloc(TIFFScanlineSize(t));
+    if (!row) return false;
+    for (uint32_t y = 0; y < h; y++) {
+      if (TIFFReadScanline(t, row, y, 0) < 0) {
+        ok = false;
+        break;
+      }
+      for (uint32_t x = 0; x < w; x++)
+        dst[(size_t)y * w + x] =
+            bps == 1 ? row[x] : ((uint16_t *)(void *)row)[x];
+    }
+    _TIFFfree(row);
+  }
+  if (ok && photo == PHOTOMETRIC_MINISWHITE)
+    for (size_t k = 0; k < (size_t)w * h; k++) dst[k] = top - dst[k];
+  return ok;
+}
+
+/* The pages of files[0..nfiles): count and size (first pass), then their
+ * values (second, into im). */
+static pm_err tiff_pass(int nfiles, const char *const *files, gm_image *im,
+                        long *pages, uint32_t *w0, uint32_t *h0, uint16_t *b0) {
+  *pages = 0;
+  for (int f = 0; f < nfiles; f++) {
+    tiff_msg[0] = '\0';
+    TIFF *t = TIFFOpen(files[f], "r");
+    PM_CHECK(t, PM_ERR_IO, "%s: cannot read it as a TIFF (%s)", files[f],
+             tiff_msg[0] ? tiff_msg : strerror(errno));
+    long p = 0, expect = 0;
+    do {
+      uint32_t w = 0, h = 0;
+      uint16_t bits = 0;
+      char why[256];
+      if (!page_format(t, &w, &h, &bits, why, sizeof why)) {
+        TIFFClose(t);
+        return PM_ERROR(PM_ERR_ARG, "%s: page %ld: %s", files[f], p + 1, why);
+      }
+      if (*pages == 0) {
+        *w0 = w, *h0 = h, *b0 = bits;
+      } else if (w != *w0 || h != *h0 || bits != *b0) {
+        TIFFClose(t);
+        return PM_ERROR(PM_ERR_ARG,
+                        "%s: page %ld: expected %u x %u pixels of %u bits "
+                        "like the first page, got %u x %u of %u",
+                        files[f], p + 1, *w0, *h0, (unsigned)*b0, w, h,
+                        (unsigned)bits);
+      }
+      if (im &&
+          !read_page(t, w, h, bits, im->v + (size_t)*pages * (size_t)w * h)) {
+        TIFFClose(t);
+        return PM_ERROR(PM_ERR_IO, "%s: page %ld: cannot read it (%s)",
+                        files[f], p + 1,
+                        tiff_msg[0] ? tiff_msg : "truncated or damaged");
+      }
+      uint16_t page = 0, total = 0;
+      if (TIFFGetField(t, TIFFTAG_PAGENUMBER, &page, &total) && total > 0)
+        expect = total;
+      (*pages)++;
+      p++;
+      tiff_msg[0] = '\0';
+    } while (TIFFReadDirectory(t));
+    TIFFClose(t);
+    /* The end of the chain of pages, or a damaged one: libtiff says which
+     * only through its handler.  A file that announces its page count
+     * (PageNumber) must hold them all. */
+    PM_CHECK(!tiff_msg[0], PM_ERR_IO,
+             "%s: cannot read page %ld: truncated or damaged (%s)", files[f],
+             p + 1, tiff_msg);
+    PM_CHECK(expect == 0 || p >= expect, PM_ERR_IO,
+             "%s: expected %ld pages (its PageNumber tag), got %ld: truncated",
+             files[f], expect, p);
+  }
+  return PM_SUCCESS;
+}
+
+pm_err gm_image_read_tiff(int nfiles, const char *const *files,
+                          const double d[3], const double o[3], gm_image *out) {
+  PM_CHECK(out && files && nfiles > 0, PM_ERR_ARG,
+           "gm_image_read_tiff: no file");
+  memset(out, 0, sizeof *out);
+  TIFFErrorHandler old_e = TIFFSetErrorHandler(tiff_handler);
+  TIFFErrorHandler old_w = TIFFSetWarningHandler(NULL);
+  pm_err ret = PM_SUCCESS;
+  long pages = 0;
+  uint32_t w = 0, h = 0;
+  uint16_t bits = 0;
+  PM_TRY(tiff_pass(nfiles, files, NULL, &pages, &w, &h, &bits));
+  const long n[3] = {(long)w, (long)h, pages};
+  PM_TRY(image_alloc(out, n, d, o));
+  out->bits = bits;
+  PM_TRY(tiff_pass(nfiles, files, out, &pages, &w, &h, &bits));
+done:
+  TIFFSetErrorHandler(old_e);
+  TIFFSetWarningHandler(old_w);
+  if (ret) gm_image_free(out);
+  return ret;
+}
+
+pm_err gm_image_write_tiff(const gm_image *im, const char *file) {
+  PM_CHECK(im && im->v && file, PM_ERR_ARG, "gm_image_write_tiff: no image");
+  const size_t nv = (size_t)im->n[0] * im->n[1] * im->n[2];
+  uint16_t bits = 8;
+  for (size_t k = 0; k < nv; k++)
+    if (im->v[k] > 255) bits = 16;
+  char tmp[4096];
+  snprintf(tmp, sizeof tmp, "%s.tmp-%ld", file, (long)getpid());
+  TIFFErrorHandler old_e = TIFFSetErrorHandler(tiff_handler);
+  tiff_msg[0] = '\0';
+  TIFF *t = TIFFOpen(tmp, "w");
+  pm_err ret = PM_SUCCESS;
+  unsigned char *row = NULL;
+  PM_ENSURE(t, PM_ERR_IO, "%s: cannot write it (%s)", tmp,
+            tiff_msg[0] ? tiff_msg : strerror(errno));
+  PM_TRY(PM_ALLOC(row, (size_t)im->n[0] * 2, "image row"));
+  for (long z = 0; z < im->n[2]; z++) {
+    TIFFSetField(t, TIFFTAG_IMAGEWIDTH, (uint32_t)im->n[0]);
+    TIFFSetField(t, TIFFTAG_IMAGELENGTH, (uint32_t)im->n[1]);
+    TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, bits);
+    TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, (uint16_t)1);
+    TIFFSetField(t, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
+    TIFFSetField(t, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
+    TIFFSetField(t, TIFFTAG_COMPRESSION, COMPRESSION_ADOBE_DEFLATE);
+    TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(t, 0));
+    TIFFSetField(t, TIFFTAG_SUBFILETYPE, FILETYPE_PAGE);
+    TIFFSetField(t, TIFFTAG_PAGENUMBER, (uint16_t)z, (uint16_t)im->n[2]);
+    for (long y = 0; y < im->n[1]; y++) {
+      const uint16_t *src = im->v + (size_t)im->n[0] * (y + im->n[1] * z);
+      for (long x = 0; x < im->n[0]; x++) {
+        if (bits == 8)
+          row[x] = (unsigned char)src[x];
+        else
+          ((uint16_t *)(void *)row)[x] = src[x];
+      }
+      PM_ENSURE(TIFFWriteScanline(t, row, (uint32_t)y, 0) >= 0, PM_ERR_IO,
+                "%s: cannot write row %ld of page %ld (%s)", tmp, y, z + 1,
+                tiff_msg);
+    }
+    PM_ENSURE(TIFFWriteDirectory(t), PM_ERR_IO,
+              "%s: cannot write page %ld (%s)", tmp, z + 1, tiff_msg);
+  }
+  TIFFClose(t);
+  t = NULL;
+  PM_ENSURE(rename(tmp, file) == 0, PM_ERR_IO,
+            "%s: cannot rename %s to it (%s)", file, tmp, strerror(errno));
+done:
+  if (t) TIFFClose(t);
+  if (ret) unlink(tmp);
+  free(row);
+  TIFFSetErrorHandler(old_e);
+  return ret;
+}
+
+/* ---- raw ----------------------------------------------------------------- */
+
+pm_err gm_image_read_raw(const char *file, const long n[3], int bits,
+                         const double d[3], const double o[3], gm_image *out) {
+  PM_CHECK(out && file, PM_ERR_ARG, "gm_image_read_raw: no file");
+  memset(out, 0, sizeof *out);
+  PM_CHECK(bits == 8 || bits == 16, PM_ERR_ARG,
+           "%s: expected 8 or 16 bits per voxel, got %d", file, bits);
+  pm_err ret = PM_SUCCESS;
+  FILE *f = fopen(file, "rb");
+  unsigned char *buf = NULL;
+  PM_ENSURE(f, PM_ERR_IO, "%s: cannot open it (%s)", file, strerror(errno));
+  PM_TRY(image_alloc(out, n, d, o));
+  out->bits = bits;
+  const size_t bytes = (size_t)bits / 8, nx = (size_t)n[0];
+  const size_t want = nx * n[1] * n[2] * bytes;
+  fseek(f, 0, SEEK_END);
+  long have = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  PM_ENSURE(have >= 0 && (size_t)have == want, PM_ERR_IO,
+            "%s: expected %zu bytes (%ld x %ld x %ld voxels of %d bits), "
+            "got %ld",
+            file, want, n[0], n[1], n[2], bits, have);
+  PM_TRY(PM_ALLOC(buf, nx * bytes, "image row"));
+  for (long r = 0; r < n[1] * n[2]; r++) {
+    PM_ENSURE(fread(buf, bytes, nx, f) == nx, PM_ERR_IO,
+              "%s: cannot read row %ld (%s)", file, r, strerror(errno));
+    for (size_t x = 0; x < nx; x++)
+      out->v[(size_t)r * nx + x] =
+          bytes == 1 ? buf[x] : (uint16_t)(buf[2 * x] | buf[2 * x + 1] << 8);
+  }
+done:
+  if (f) fclose(f);
+  free(buf);
+  if (ret) gm_image_free(out);
+  return ret;
+}
+
+/* ---- point files --------------------------------------------------------- */
+
+pm_err gm_image_read_points(const char *file, double unit, const long n[3],
+                            const double d[3], const double o[3],
+                            gm_image *out) {
+  PM_CHECK(out && file, PM_ERR_ARG, "gm_image_read_points: no file");
+  memset(out, 0, sizeof *out);
+  pm_err ret = PM_SUCCESS;
+  FILE *f = fopen(file, "r");
+  char line[1024];
+  long ln = 0;
+  PM_ENSURE(f, PM_ERR_IO, "%s: cannot open it (%s)", file, strerror(errno));
+  PM_TRY(image_alloc(out, n, d, o));
+  out->bits = 8;
+  while (fgets(line, sizeof line, f)) {
+    ln++;
+    char *hash = strchr(line, '#');
+    if (hash) *hash = '\0';
+    double x[3] = {0, 0, 0};
+    char *p = line, *end;
+    int got = 0;
+    while (got < 3) {
+      while (*p == ' ' || *p == '\t' || *p == ',') p++;
+      if (*p == '\0' || *p == '\n' || *p == '\r') break;
+      x[got] = strtod(p, &end);
+      PM_ENSURE(end != p && isfinite(x[got]), PM_ERR_SCENE,
+                "%s:%ld:%ld: expected a number (x y [z]), got '%.20s'", file,
+                ln, (long)(p - line) + 1, p);
+      p = end;
+      got++;
+    }
+    if (got == 0) continue;
+    PM_ENSURE(got >= 2, PM_ERR_SCENE,
+              "%s:%ld:1: expected 2 or 3 coordinates, got %d", file, ln, got);
+    long idx[3] = {0, 0, 0};
+    for (int c = 0; c < 3; c++) {
+      if (c >= got) continue;
+      double u = (x[c] * unit - out->o[c]) / out->d[c] - 0.5;
+      long i = lround(u);
+      PM_ENSURE(fabs(u - (double)i) <= 1e-3 && i >= 0 && i < n[c], PM_ERR_SCENE,
+                "%s:%ld:1: expected a voxel centre on the %ld x %ld x %ld "
+                "grid of voxels of %g m from (%g, %g, %g) m, got %c = %g",
+                file, ln, n[0], n[1], n[2], out->d[c], out->o[0], out->o[1],
+                out->o[2], "xyz"[c], x[c]);
+      idx[c] = i;
+    }
+    out->v[idx[0] + n[0] * (idx[1] + n[1] * idx[2])] = 255;
+  }
+  PM_ENSURE(!ferror(f), PM_ERR_IO, "%s: read error (%s)", file,
+            strerror(errno));
+done:
+  if (f) fclose(f);
+  if (ret) gm_image_free(out);
+  return ret;
+}
