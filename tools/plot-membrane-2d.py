@@ -7,8 +7,8 @@ usage: plot-membrane-2d.py --times T1,T2 [--scale S] --out PNG LABEL=RUN_DIR ...
 Each RUN_DIR holds results.h5 of a 2-D MPM run with a membrane.  For each
 time the frame nearest in time is drawn: the other particles as grey dots,
 the membrane's points (those whose "normal" field is a unit vector) in
-black with their normals as arrows of length S (default: the cell size,
-from the grid of the results' metadata when it has one, else 0.1).
+black with their normals as arrows of length S (default 0.1, in the
+results' length unit).
 """
 import argparse
 import sys

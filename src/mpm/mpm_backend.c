@@ -571,9 +571,6 @@ static void plan_bodies(const mpm_sim *r, FILE *out) {
     fprintf(out, "  body %d%s%s: %ld particles", b, body->name ? " " : "",
             body->name ? body->name : "", n);
     if (body->shape == PM_BODY_MEMBRANE) {
-      static const char *const normals[] = {"connectivity", "isosurface-linear",
-                                            "isosurface-quadratic", "hybrid",
-                                            "hybrid-quadratic"};
       long nt = m->body_tri_end[b] - m->body_tri_begin[b];
       double area = 0;
       for (long q = m->body_begin[b]; q < m->body_end[b]; q++)
@@ -589,7 +586,7 @@ static void plan_bodies(const mpm_sim *r, FILE *out) {
       fprintf(out, ", thickness %g m, %s %.6g m%s, normals: %s",
               body->membrane.thickness, m->dim == 3 ? "area" : "length", area,
               m->dim == 3 ? "^2" : " (per unit depth)",
-              normals[m->body_normals[b]]);
+              pm_key_name_of(pm_normals_names, m->body_normals[b]));
     } else if (body->n_ppc) {
       fprintf(out, ", %d x %d x %d per cell", (int)body->ppc[0],
               (int)body->ppc[body->n_ppc == 1 ? 0 : 1],

@@ -292,9 +292,7 @@ static void put_row(mpm_iso_work *w, int r, const double xi[3], double value) {
 
 static const uint64_t GOLDEN = 0x9E3779B97F4A7C15u;
 
-/* splitmix64's output function: a bijection of 64-bit words whose outputs
- * for consecutive inputs pass the usual statistical tests. */
-static uint64_t mix64(uint64_t z) {
+uint64_t mpm_iso_mix(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9u;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBu;
   return z ^ (z >> 31);
@@ -304,8 +302,9 @@ static uint64_t mix64(uint64_t z) {
  * uniform in [0, 1): a function of (seed, d, c) alone, so a fit does not
  * depend on which thread runs it or what ran before. */
 static double uniform(uint64_t seed, int d, int c) {
-  const uint64_t key = mix64(seed + GOLDEN);
-  const uint64_t z = mix64(key + ((uint64_t)d * 8 + (uint64_t)c + 1) * GOLDEN);
+  const uint64_t key = mpm_iso_mix(seed + GOLDEN);
+  const uint64_t z =
+      mpm_iso_mix(key + ((uint64_t)d * 8 + (uint64_t)c + 1) * GOLDEN);
   return (double)(z >> 11) * 0x1.0p-53;
 }
 

@@ -114,6 +114,11 @@ pm_err mpm_iso_fit(mpm_iso_work *w, const double lo[3], double H, long n,
                    const double *x, const long *idx, uint64_t seed,
                    double *normal, mpm_iso_report *report);
 
+/* splitmix64's output function: a bijection of 64-bit words whose outputs
+ * for consecutive inputs pass the usual statistical tests.  Callers make a
+ * fit's seed with it from what identifies the fit (step, cell, ...). */
+uint64_t mpm_iso_mix(uint64_t z);
+
 /* phi at x of the last fit of w (for contour plots and tests); 0 before
  * any fit. */
 double mpm_iso_phi(const mpm_iso_work *w, const double x[3]);

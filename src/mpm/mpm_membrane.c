@@ -427,17 +427,23 @@ static bool spread(int dim, const double *x, const long *idx, long n) {
  * (splitmix64's finaliser), so that a run repeats bit for bit whatever
  * thread fits which cell. */
 static inline uint64_t fit_seed(long step, int body, long key, int level) {
-  uint64_t z = (uint64_t)step * 0x9E3779B97F4A7C15ull ^ ((uint64_t)body << 56) ^
-               ((uint64_t)level << 48) ^ (uint64_t)key * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
+  return mpm_iso_mix((uint64_t)step * 0x9E3779B97F4A7C15ull ^
+                     ((uint64_t)body << 56) ^ ((uint64_t)level << 48) ^
+                     (uint64_t)key * 0xBF58476D1CE4E5B9ull);
 }
 
 typedef struct {
   long cells[4], points, degenerate, draws;
   double max_condition;
 } iso_stats;
+
+static void stats_merge(iso_stats *a, const iso_stats *b) {
+  for (int i = 0; i < 4; i++) a->cells[i] += b->cells[i];
+  a->points += b->points;
+  a->degenerate += b->degenerate;
+  a->draws += b->draws;
+  if (b->max_condition > a->max_condition) a->max_condition = b->max_condition;
+}
 
 static void stats_add(iso_stats *a, const mpm_iso_report *r, long points) {
   a->points += points;
@@ -577,21 +583,9 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
         done_cell = true;
       }
     }
-    PM_OMP(critical(membrane_iso_stats)) {
-      for (int i = 0; i < 4; i++) sum.cells[i] += my.cells[i];
-      sum.points += my.points;
-      sum.degenerate += my.degenerate;
-      sum.draws += my.draws;
-      if (my.max_condition > sum.max_condition)
-        sum.max_condition = my.max_condition;
-    }
+    PM_OMP(critical(membrane_iso_stats)) stats_merge(&sum, &my);
   }
-  for (int i = 0; i < 4; i++) st->cells[i] += sum.cells[i];
-  st->points += sum.points;
-  st->degenerate += sum.degenerate;
-  st->draws += sum.draws;
-  if (sum.max_condition > st->max_condition)
-    st->max_condition = sum.max_condition;
+  stats_merge(st, &sum);
   return err;
 }
 

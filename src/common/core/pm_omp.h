@@ -20,9 +20,9 @@ static inline int pm_omp_thread(void) { return 0; }
 #endif
 
 /* LAPACK runs on small matrices inside OpenMP loops (the membranes' normal
- * fits, FPM's gradients): OpenBLAS's own threads would only spin against
- * OpenMP's (a 2-D membrane run took 6 times as long).  One thread for
- * OpenBLAS when it is the BLAS loaded; nothing with another BLAS. */
+ * fits, FPM's gradients), where OpenBLAS's own threads can only compete
+ * with OpenMP's for the cores.  One thread for OpenBLAS when it is the BLAS
+ * loaded; nothing with another BLAS. */
 void openblas_set_num_threads(int n) __attribute__((weak));
 static inline void pm_blas_single_thread(void) {
   if (openblas_set_num_threads) openblas_set_num_threads(1);

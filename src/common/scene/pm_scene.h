@@ -12,6 +12,7 @@
 #include "pm_error.h"
 #include "pm_expr.h"
 #include "pm_face.h"
+#include "pm_keys.h"
 #include "pm_material.h"
 #include "pm_scene_doc.h"
 
@@ -110,6 +111,9 @@ typedef enum {
   PM_NORMALS_HYBRID_QUADRATIC  /* quadratic on the smallest block of cells
                                   (1, 2, 4, 8 a side) with enough points */
 } pm_normals_method;
+
+/* The scene's words for them (membrane.normals). */
+extern const pm_name pm_normals_names[];
 
 typedef struct {
   int material;        /* index into materials */

@@ -245,7 +245,7 @@ static const pm_key membrane_rectangle_keys[] = {
      .max_count = 2,
      .doc = "[nu, nv] points along the edges"},
     {0}};
-static const pm_name normals_names[] = {
+const pm_name pm_normals_names[] = {
     {"connectivity", PM_NORMALS_CONNECTIVITY},
     {"isosurface-linear", PM_NORMALS_ISO_LINEAR},
     {"isosurface-quadratic", PM_NORMALS_ISO_QUADRATIC},
@@ -332,7 +332,7 @@ static const pm_key membrane_keys[] = {
      .type = PM_KEY_ENUM,
      .offset = B(membrane.normals),
      .def = "connectivity",
-     .names = normals_names,
+     .names = pm_normals_names,
      .doc = "connectivity (triangles, or neighbours along a curve), "
             "isosurface-linear, isosurface-quadratic, hybrid (the paper's "
             "rule) or hybrid-quadratic (default for points)"},
