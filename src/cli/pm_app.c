@@ -10,5 +10,6 @@ pm_err pm_app_init(void) {
   pm_blas_single_thread();
   PM_CALL(pm_backend_register(&fpm_backend));
   PM_CALL(pm_backend_register(&mpm_backend));
+  PM_CALL(pm_backend_register(&mpm_implicit_backend));
   return PM_SUCCESS;
 }

@@ -207,14 +207,7 @@ static pm_err run(void *p, const pm_observer *obs) {
     tm[sim->tm_update].seconds += wall - r->load.time_residual -
                                   r->load.time_assembly - r->load.time_linear;
     tm[sim->tm_update].calls += r->load.steps;
-    if (e == PM_ERR_UNSTABLE)
-      sim->status = PM_STATUS_UNSTABLE;
-    else if (e == PM_ERR_NOT_CONVERGED)
-      sim->status = PM_STATUS_NOT_CONVERGED;
-    else if (e != PM_SUCCESS)
-      sim->status = PM_STATUS_FAILED;
-    else
-      sim->status = PM_STATUS_CONVERGED;
+    sim->status = pm_static_status(e);
     return e;
   }
   sim->first_step = sim->state->step;
@@ -406,28 +399,9 @@ static const pm_timers *timers(void *p) { return &((fpm_sim *)p)->timers; }
  * states over the free dofs, and its counters. */
 static pm_err checkpoint_static(fpm_sim *sim, pm_ckpt *ck) {
   fpm_static_state *ss = &sim->static_state;
-  pm_load_report *rep = &sim->static_report.load;
-  long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,
-       linear = rep->linear_iterations;
-  PM_CALL(pm_ckpt_double(ck, "static.lambda", &ss->load.lambda));
-  PM_CALL(pm_ckpt_double(ck, "static.lambda_prev", &ss->load.lambda_prev));
-  PM_CALL(pm_ckpt_double(ck, "static.dl", &ss->load.dl));
-  PM_CALL(pm_ckpt_long(ck, "static.good", &ss->load.good));
-  PM_CALL(pm_ckpt_long(ck, "static.have_prev", &ss->load.have_prev));
-  PM_CALL(pm_ckpt_doubles(ck, "static.xc", ss->free_dofs, ss->load.xc));
-  PM_CALL(pm_ckpt_doubles(ck, "static.xprev", ss->free_dofs, ss->load.xprev));
-  PM_CALL(pm_ckpt_double(ck, "static.external_work", &ss->external_work));
-  PM_CALL(pm_ckpt_long(ck, "static.steps", &steps));
-  PM_CALL(pm_ckpt_long(ck, "static.cuts", &cuts));
-  PM_CALL(pm_ckpt_long(ck, "static.newton_iterations", &newton));
-  PM_CALL(pm_ckpt_long(ck, "static.linear_iterations", &linear));
-  PM_CALL(pm_ckpt_double(ck, "static.dlambda_min", &rep->dlambda_min));
-  rep->steps = (int)steps;
-  rep->cuts = (int)cuts;
-  rep->newton_iterations = (int)newton;
-  rep->linear_iterations = (int)linear;
-  rep->lambda = ss->load.lambda;
-  return PM_SUCCESS;
+  PM_CALL(pm_load_checkpoint(ck, "static", ss->free_dofs, &ss->load,
+                             &sim->static_report.load));
+  return pm_ckpt_double(ck, "static.external_work", &ss->external_work);
 }
 
 /* The time loop's state (fpm_state: u, v and what the loop carries; or a

@@ -756,17 +756,6 @@ static double force_floor(const fpm_model *m) {
   return 1e-12 * emax * diag2;
 }
 
-/* The solver layer's name for the scene's linear solver. */
-static pm_newton_linear linear_solver(pm_linear_solver l) {
-  switch (l) {
-  case PM_LINEAR_GMRES_GAMG: return PM_NEWTON_GMRES_GAMG;
-  case PM_LINEAR_CG_JACOBI: return PM_NEWTON_CG_JACOBI;
-  case PM_LINEAR_GMRES_ILU: return PM_NEWTON_GMRES_ILU;
-  case PM_LINEAR_DIRECT: break;
-  }
-  return PM_NEWTON_DIRECT;
-}
-
 pm_err fpm_static_state_init(fpm_static_state *s, const fpm_model *m) {
   memset(s, 0, sizeof *s);
   for (long d = 0; d < 3 * m->n; d++) s->free_dofs += !m->fixed[d];
@@ -839,7 +828,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   /* A step Newton creeps through (short line-search steps from a state
    * outside its basin) is cut sooner than at max_iter. */
   no.stall_after = 6;
-  no.linear = linear_solver(s->time.qs_linear);
+  no.linear = pm_newton_linear_of(s->time.qs_linear);
   no.load_steps = (int)s->time.qs_load_steps;
   no.predictor = true;
   no.petsc_options = s->time.qs_solver_options;

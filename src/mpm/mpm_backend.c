@@ -11,6 +11,7 @@
 #include "gm_inside.h"
 #include "gm_shape.h"
 #include "mpm_estimate.h"
+#include "mpm_implicit.h"
 #include "mpm_kind.h"
 #include "mpm_pipeline.h"
 #include "pm_metrics.h"
@@ -27,7 +28,9 @@ static long scratch_per_particle(const mpm_model *m) {
 
 static pm_err history_setup(mpm_sim *r);
 
-pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
+/* The simulation of s: explicit (its step's workspace) or implicit (its
+ * solver; the workspace holds only the reactions and the timers). */
+static pm_err sim_create(const pm_scene *s, bool implicit, mpm_sim **out) {
   pm_err ret = PM_SUCCESS;
   mpm_sim *r = NULL;
   *out = NULL;
@@ -35,7 +38,15 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
   r->scene = s;
   double t0 = pm_wtime();
   PM_TRY(mpm_model_create(s, &r->model, &r->state));
-  PM_TRY(mpm_work_create(r->model, &r->work));
+  if (implicit) {
+    PM_TRY(PM_ALLOC(r->work, 1, "MPM workspace"));
+    PM_TRY(
+        PM_ALLOC(r->work->cond.reaction, 3 * r->model->n_bcs + 1, "reactions"));
+    PM_TRY(mpm_implicit_create(s, r->model, r->state, &r->imp));
+    r->run_min_jacobian = 1;
+  } else {
+    PM_TRY(mpm_work_create(r->model, &r->work));
+  }
   r->setup_wall = pm_wtime() - t0;
   PM_TRY(PM_ALLOC(r->scratch, scratch_per_particle(r->model) * r->model->n,
                   "output buffer"));
@@ -47,8 +58,13 @@ done:
   return ret;
 }
 
+pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
+  return sim_create(s, false, out);
+}
+
 void mpm_sim_destroy(mpm_sim *r) {
   if (!r) return;
+  mpm_implicit_destroy(r->imp);
   mpm_work_destroy(r->work);
   mpm_state_destroy(r->state);
   mpm_model_destroy(r->model);
@@ -285,6 +301,13 @@ static void figures(void *p, pm_figures *f, bool with_fields) {
   f->step_seconds = 0;
   for (int k = 0; k < t->n; k++) f->step_seconds += t->stage[k].seconds;
   f->memory_bytes = sim_bytes(r);
+  if (r->imp) { /* no time steps, no energy balance: load steps */
+    f->dt = f->dt_stable = 0;
+    f->energy_error = NAN;
+    f->residual = mpm_implicit_residual(r->imp);
+    const pm_load_report *lr = mpm_implicit_report(r->imp);
+    f->step_seconds = lr->time_total;
+  }
   if (with_fields) field_figures(r, f);
 }
 
@@ -324,6 +347,11 @@ static pm_err history_setup(mpm_sim *r) {
   const pm_scene *s = r->scene;
   r->n_hist = 0;
   PM_CALL(PM_ALLOC(r->surface, s->n_bodies, "membrane surfaces"));
+  if (r->imp) {
+    add_hist(r, "newton_iterations%s%s", "", "");
+    add_hist(r, "linear_iterations%s%s", "", "");
+    add_hist(r, "load_cuts%s%s", "", "");
+  }
   if (m->kinds & MPM_KIND_ITERATES) {
     add_hist(r, "energy_iterations%s%s", "", "");
     add_hist(r, "energy_iterations_capped%s%s", "", "");
@@ -431,6 +459,11 @@ static void history_values(void *p, double *v) {
   const pm_scene *s = r->scene;
   const mpm_state *st = r->state;
   int k = 0;
+  if (r->imp) {
+    v[k++] = r->imp_newton;
+    v[k++] = r->imp_linear;
+    v[k++] = mpm_implicit_report(r->imp)->cuts;
+  }
   if (m->kinds & MPM_KIND_ITERATES) {
     v[k++] = r->iter_max_row;
     v[k++] = (double)(st->iter_capped_total - r->iter_capped_prev);
@@ -708,4 +741,157 @@ const pm_backend mpm_backend = {
     .summary = summary,
     .timers = timers,
     .checkpoint = checkpoint,
+};
+
+/* ---- method mpm-implicit ------------------------------------------------ */
+
+static pm_err implicit_create(const pm_scene *s, void **out) {
+  mpm_sim *r = NULL;
+  PM_CALL(sim_create(s, true, &r));
+  *out = r;
+  return PM_SUCCESS;
+}
+
+/* Each converged load step is a step of the run: t = lambda t_load. */
+static pm_err implicit_observe(void *ctx, const mpm_implicit_step *step) {
+  mpm_sim *r = ctx;
+  const mpm_model *m = r->model;
+  mpm_state *st = r->state;
+  st->step = step->step;
+  st->t = step->lambda * m->opt.t_load;
+  r->imp_newton = step->newton;
+  r->imp_linear = step->linear;
+  memcpy(r->work->cond.reaction, mpm_implicit_reactions(r->imp),
+         3 * sizeof(double) * (size_t)m->n_bcs);
+  r->work->residual = step->residual;
+  if (step->min_jacobian < r->run_min_jacobian) {
+    r->run_min_jacobian = step->min_jacobian;
+    r->run_min_jacobian_step = step->step;
+  }
+  const bool last = step->lambda >= 1;
+  const long every = r->scene->output.every;
+  pm_step_report rep = {.last = last,
+                        .step = st->step,
+                        .t = st->t,
+                        .residual = step->residual,
+                        .progress = step->lambda};
+  return r->obs ? r->obs->step(r->obs->ctx, &rep,
+                               last || (every > 0 && st->step % every == 0))
+                : PM_SUCCESS;
+}
+
+static pm_err implicit_run(void *p, const pm_observer *obs) {
+  mpm_sim *r = p;
+  pm_err e = PM_SUCCESS;
+  r->obs = obs;
+  if (!r->resumed) {
+    r->energy0 = 0;
+    r->run_min_jacobian_step = 0;
+    e = report(r, true, false);
+  }
+  if (!e) e = mpm_implicit_run(r->imp, implicit_observe, r);
+  r->obs = NULL;
+  /* the solver's time, as stages */
+  const pm_load_report *lr = mpm_implicit_report(r->imp);
+  pm_timers *t = &r->work->timers;
+  pm_timers_init(t);
+  t->stage[pm_timers_add(t, "residual")].seconds = lr->time_residual;
+  t->stage[pm_timers_add(t, "tangent")].seconds = lr->time_assembly;
+  t->stage[pm_timers_add(t, "linear solve")].seconds = lr->time_linear;
+  t->stage[pm_timers_add(t, "other (line search, vectors)")].seconds =
+      fmax(0, lr->time_total - lr->time_residual - lr->time_assembly -
+                  lr->time_linear);
+  r->status = pm_static_status(e);
+  return e == PM_ERR_NOT_CONVERGED ? PM_ERR_UNSTABLE : e;
+}
+
+static pm_err implicit_summary(void *p, pm_json *j) {
+  const mpm_sim *r = p;
+  const mpm_model *m = r->model;
+  const pm_load_report *lr = mpm_implicit_report(r->imp);
+  const mpm_settings *ms = mpm_scene_settings(r->scene);
+  long unknowns, entries;
+  mpm_implicit_size(r->imp, &unknowns, &entries);
+  PM_CALL(pm_json_integer(j, "particles", m->n));
+  PM_CALL(summary_groups(j, m));
+  PM_CALL(pm_json_integer(j, "grid_nodes", m->grid.n_nodes));
+  PM_CALL(pm_json_number(j, "cell_size", m->grid.h));
+  PM_CALL(pm_json_string(j, "shape", basis_name(m->opt.shape)));
+  PM_CALL(pm_json_string(
+      j, "grid", ms->implicit.grid == MPM_GRID_KEPT ? "kept" : "reset"));
+  PM_CALL(pm_json_string(j, "operator",
+                         ms->implicit.op == MPM_OP_MATRIX_FREE ? "matrix-free"
+                                                               : "assembled"));
+  PM_CALL(pm_json_integer(j, "unknowns", unknowns));
+  PM_CALL(pm_json_integer(j, "jacobian_entries", entries));
+  PM_CALL(pm_json_number(j, "load_reached", mpm_implicit_lambda(r->imp)));
+  PM_CALL(pm_json_integer(j, "load_steps", lr->steps));
+  PM_CALL(pm_json_integer(j, "load_cuts", lr->cuts));
+  PM_CALL(pm_json_integer(j, "newton_iterations", lr->newton_iterations));
+  PM_CALL(pm_json_integer(j, "linear_iterations", lr->linear_iterations));
+  PM_CALL(pm_json_number(j, "residual_seconds", lr->time_residual));
+  PM_CALL(pm_json_number(j, "tangent_seconds", lr->time_assembly));
+  PM_CALL(pm_json_number(j, "linear_seconds", lr->time_linear));
+  return PM_SUCCESS;
+}
+
+static pm_err implicit_plan(void *p, FILE *out) {
+  mpm_sim *r = p;
+  const mpm_model *m = r->model;
+  const pm_scene *s = r->scene;
+  const mpm_grid *g = &m->grid;
+  fprintf(out, "scene        %s (%s)\n", s->name, s->path);
+  fprintf(out, "method       mpm-implicit, %dD%s, %s B-splines, quasi-static\n",
+          m->dim, m->dim == 2 ? " plane strain" : "", basis_name(m->opt.shape));
+  fprintf(out,
+          "grid         %ld x %ld x %ld nodes over domain.box, cell %g m\n",
+          g->nn[0], g->nn[1], g->nn[2], g->h);
+  fprintf(out, "particles    %ld\n", m->n);
+  plan_groups(m, out);
+  plan_bodies(r, out);
+  mpm_implicit_plan(r->imp, out);
+  fprintf(out,
+          "memory       %.1f MiB (model %.1f, state %.1f, output %.1f; "
+          "PETSc's matrix and solver besides)\n",
+          sim_bytes(r) / 1048576.0, mpm_model_bytes(m) / 1048576.0,
+          mpm_state_bytes(m, r->state) / 1048576.0,
+          scratch_per_particle(m) * sizeof(double) * (size_t)m->n / 1048576.0);
+  return PM_SUCCESS;
+}
+
+static pm_err implicit_checkpoint(void *p, pm_ckpt *ck) {
+  mpm_sim *r = p;
+  PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
+  PM_CALL(mpm_implicit_checkpoint(r->imp, ck));
+  PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &r->run_min_jacobian));
+  PM_CALL(pm_ckpt_long(ck, "run.min_jacobian_step", &r->run_min_jacobian_step));
+  if (pm_ckpt_reading(ck)) {
+    r->resumed = true;
+    memcpy(r->work->cond.reaction, mpm_implicit_reactions(r->imp),
+           3 * sizeof(double) * (size_t)r->model->n_bcs);
+  }
+  return PM_SUCCESS;
+}
+
+const pm_backend mpm_implicit_backend = {
+    .method = "mpm-implicit",
+    .description = "implicit quasi-static Material Point Method (Newton on "
+                   "the grid, PETSc)",
+    .section = NULL,
+    .dt_safety = 0.5,
+    .check = mpm_implicit_check_scene,
+    .create = implicit_create,
+    .estimate_bytes = mpm_estimate_bytes,
+    .destroy = destroy,
+    .plan = implicit_plan,
+    .run = implicit_run,
+    .points = points,
+    .fields = fields,
+    .displacement = displacement,
+    .figures = figures,
+    .history_names = history_names,
+    .history_values = history_values,
+    .summary = implicit_summary,
+    .timers = timers,
+    .checkpoint = implicit_checkpoint,
 };

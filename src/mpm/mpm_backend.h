@@ -10,6 +10,11 @@
 #include "pm_scene.h"
 
 extern const pm_backend mpm_backend;
+/* Quasi-static implicit MPM (mpm_implicit.h) on the same model, state,
+ * fields, figures and output. */
+extern const pm_backend mpm_implicit_backend;
+
+struct mpm_implicit;
 
 /* A prepared simulation.  Fields are read-only for callers. */
 typedef struct {
@@ -17,8 +22,10 @@ typedef struct {
   mpm_model *model;
   mpm_state *state;
   mpm_work *work;
-  double setup_wall; /* s */
-  double *scratch;   /* output buffer (scratch_per_particle) */
+  struct mpm_implicit *imp;   /* method mpm-implicit: its solver (else NULL) */
+  int imp_newton, imp_linear; /* the last load step's iterations */
+  double setup_wall;          /* s */
+  double *scratch;            /* output buffer (scratch_per_particle) */
   /* history columns of its own: names (and their storage) */
   const char *hist_names[PM_HISTORY_MAX];
   char hist_store[PM_HISTORY_MAX][48];

@@ -6,10 +6,12 @@
 #ifndef MPM_KIND_H
 #define MPM_KIND_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "mpm_particles.h"
 #include "mpm_stage.h"
+#include "pm_material.h"
 #include "pm_scene.h"
 
 struct mpm_options;
@@ -131,6 +133,21 @@ double mpm_membrane_damage(const pm_scene_damage *dm, double e_max,
 /* Carry a membrane frame f = (e1, e2, n) over a step: turn about n by phi,
  * then by S of eqs. 9-22 from n to the unit normal n1. */
 void mpm_membrane_carry_frame(double f[9], double phi, const double n1[3]);
+
+/* A solid group's model and arrays, for solvers other than the explicit
+ * step (implicit MPM): the material, F (9 per particle from the group's
+ * start) and the model's per-particle state (mstride per particle, NULL
+ * when none). */
+typedef struct {
+  const pm_material *mat;
+  double *F;
+  const double *mstate;
+  long mstride;
+} mpm_solid_view;
+
+/* Fill v for group g of state s; false when g is not of the solid kind. */
+bool mpm_solid_access(const mpm_group *g, struct mpm_state *s,
+                      mpm_solid_view *v);
 
 /* D and W, the symmetric and skew parts of L (all row-major 3x3). */
 static inline void mpm_sym_skew(const double L[9], double D[9], double W[9]) {

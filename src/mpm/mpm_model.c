@@ -60,8 +60,9 @@ pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
   mpm_state *st = NULL;
   *model = NULL;
   *state = NULL;
-  PM_ENSURE(s->method && strcmp(s->method, "mpm") == 0, PM_ERR_ARG,
-            "mpm_model_create: scene %s has method %s", s->path,
+  PM_ENSURE(s->method && (strcmp(s->method, "mpm") == 0 ||
+                          strcmp(s->method, "mpm-implicit") == 0),
+            PM_ERR_ARG, "mpm_model_create: scene %s has method %s", s->path,
             s->method ? s->method : "(none)");
   PM_TRY(PM_ALLOC(m, 1, "MPM model"));
   mpm_options_from_scene(s, &m->opt);

@@ -16,6 +16,12 @@ static const pm_name energy_update_names[] = {
     {"iterative", MPM_ENERGY_ITERATIVE},
     {"non-iterative", MPM_ENERGY_NON_ITERATIVE},
     {0}};
+static const pm_name grid_mode_names[] = {
+    {"kept", MPM_GRID_KEPT}, {"reset", MPM_GRID_RESET}, {0}};
+static const pm_name operator_names[] = {
+    {"assembled", MPM_OP_ASSEMBLED}, {"matrix-free", MPM_OP_MATRIX_FREE}, {0}};
+static const pm_name convergence_names[] = {
+    {"residual", MPM_CONV_RESIDUAL}, {"paper", MPM_CONV_PAPER}, {0}};
 static const pm_name axis_names[] = {
     {"x", 1u << 0}, {"y", 1u << 1}, {"z", 1u << 2}, {0}};
 
@@ -44,6 +50,47 @@ static const pm_key fluid_keys[] = {
      .lo = 1,
      .hi = 10000,
      .doc = "cap on the iterations of one particle-step"},
+    {0}};
+
+static const pm_key implicit_keys[] = {
+    {.name = "grid",
+     .type = PM_KEY_ENUM,
+     .offset = O(implicit.grid),
+     .def = "kept",
+     .names = grid_mode_names,
+     .doc = "kept: the grid moves with the particles (the implicit paper's "
+            "modified algorithm); reset: back to its rectilinear place after "
+            "each load step (the standard algorithm)"},
+    {.name = "operator",
+     .type = PM_KEY_ENUM,
+     .offset = O(implicit.op),
+     .def = "assembled",
+     .names = operator_names,
+     .doc = "assembled (the tangent as a sparse matrix) or matrix-free (the "
+            "tangent applied particle by particle, preconditioned by its "
+            "diagonal: cg-jacobi)"},
+    {.name = "convergence",
+     .type = PM_KEY_ENUM,
+     .offset = O(implicit.convergence),
+     .def = "residual",
+     .names = convergence_names,
+     .doc = "residual (time.quasi_static.tolerance, relative to the first "
+            "iteration) or paper (eq. 9: displacement and energy norms, "
+            "both)"},
+    {.name = "displacement_tolerance",
+     .type = PM_KEY_NUMBER,
+     .offset = O(implicit.dtol),
+     .def = "1e-8",
+     .range = PM_RANGE_GT,
+     .unit = "",
+     .doc = "convergence paper: |du_k| over the step's displacement"},
+    {.name = "energy_tolerance",
+     .type = PM_KEY_NUMBER,
+     .offset = O(implicit.etol),
+     .def = "1e-14",
+     .range = PM_RANGE_GT,
+     .unit = "",
+     .doc = "convergence paper: |du_k . Q_k| over |du_0 . Q_0|"},
     {0}};
 
 static const pm_key mpm_keys[] = {
@@ -89,6 +136,11 @@ static const pm_key mpm_keys[] = {
      .type = PM_KEY_MAPPING,
      .keys = fluid_keys,
      .doc = "{energy_update, tolerance, max_iterations}"},
+    {.name = "implicit",
+     .type = PM_KEY_MAPPING,
+     .keys = implicit_keys,
+     .doc = "{grid, operator, convergence, displacement_tolerance, "
+            "energy_tolerance}: method mpm-implicit"},
     {0}};
 
 static pm_err check_section(const pm_scene *s, void *opts) {
@@ -223,5 +275,41 @@ pm_err mpm_check_scene(const pm_scene *s) {
     return pm_scene_expected(s, "time.dt_rule",
                              "paper for method mpm (its stable step is the "
                              "CFL bound of every step)");
+  return PM_SUCCESS;
+}
+
+pm_err mpm_implicit_check_scene(const pm_scene *s) {
+  char p[PM_SDOC_PATH];
+  PM_CALL(mpm_check_scene(s));
+  for (int i = 0; i < s->n_bodies; i++) {
+    const pm_scene_body *b = &s->bodies[i];
+    const pm_scene_material *sm = &s->materials[b->material];
+    if (b->shape == PM_BODY_MEMBRANE)
+      return pm_scene_fail(s, PM_PATH(p, "bodies.%d.membrane", i), true,
+                           "expected a volume body for method mpm-implicit "
+                           "(quasi-static solids), got a membrane");
+    if (b->moving)
+      return pm_scene_fail(s, PM_PATH(p, "bodies.%d.motion", i), true,
+                           "expected no motion for method mpm-implicit "
+                           "(quasi-static: give displacements on faces)");
+    if (pm_material_is_fluid(&sm->mat) || !sm->mat.model->tangent)
+      return pm_scene_fail(
+          s, PM_PATH(p, "materials.%d.model", b->material), false,
+          "expected a solid model with a tangent for method mpm-implicit "
+          "(Newton's method on the grid), got %s for material %s",
+          sm->mat.model->name, sm->name);
+  }
+  for (int i = 0; i < s->n_bcs; i++) {
+    const pm_scene_bc *bc = &s->bcs[i];
+    if (bc->velocity_mask || bc->absorbing)
+      return pm_scene_fail(
+          s,
+          PM_PATH(p, "boundary.%d.%s", i,
+                  bc->absorbing ? "absorbing" : "velocity"),
+          true,
+          "expected displacement for method mpm-implicit (quasi-static load "
+          "steps have no velocity), got %s",
+          bc->absorbing ? "absorbing" : "velocity");
+  }
   return PM_SUCCESS;
 }

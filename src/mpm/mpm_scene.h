@@ -9,6 +9,13 @@
 /* Grid basis functions, update variants and the fluid energy update. */
 typedef enum { MPM_BASIS_LINEAR = 0, MPM_BASIS_QUADRATIC } mpm_basis;
 typedef enum { MPM_USF = 0, MPM_USL, MPM_MUSL } mpm_update;
+/* Implicit MPM (method mpm-implicit): the grid kept with the particles
+ * (the implicit paper's modified algorithm) or reset after each load step
+ * (the standard one); the Jacobian assembled or applied matrix-free; the
+ * convergence test on the residual or on the paper's eq. 9. */
+typedef enum { MPM_GRID_KEPT = 0, MPM_GRID_RESET } mpm_grid_mode;
+typedef enum { MPM_OP_ASSEMBLED = 0, MPM_OP_MATRIX_FREE } mpm_operator;
+typedef enum { MPM_CONV_RESIDUAL = 0, MPM_CONV_PAPER } mpm_convergence;
 typedef enum {
   MPM_ENERGY_ITERATIVE = 0, /* steps (1)-(6) of the fluid paper, eqs. 27-31 */
   MPM_ENERGY_NON_ITERATIVE  /* energy from the previous stress (eq. 27) */
@@ -31,6 +38,12 @@ typedef struct {
     double tolerance;    /* relative change that ends the iteration */
     long max_iterations; /* cap on the iterations per particle-step */
   } fluid;
+  struct {
+    int grid;          /* mpm_grid_mode */
+    int op;            /* mpm_operator */
+    int convergence;   /* mpm_convergence */
+    double dtol, etol; /* eq. 9: displacement and energy tolerances */
+  } implicit;
 } mpm_settings;
 
 extern const pm_section mpm_section;
@@ -42,5 +55,10 @@ const mpm_settings *mpm_scene_settings(const pm_scene *s);
  * size that does not divide the box, named surfaces, ...), failing at the
  * key with pm_scene_fail. */
 pm_err mpm_check_scene(const pm_scene *s);
+
+/* What method mpm-implicit cannot honour besides: fluids, membranes,
+ * moving bodies, velocity and absorbing conditions, models without a
+ * tangent. */
+pm_err mpm_implicit_check_scene(const pm_scene *s);
 
 #endif

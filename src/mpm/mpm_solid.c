@@ -225,3 +225,14 @@ const mpm_kind mpm_kind_solid = {
     .energies = solid_energies,
     .fields = solid_fields,
 };
+
+bool mpm_solid_access(const mpm_group *g, mpm_state *s, mpm_solid_view *v) {
+  if (g->kind != &mpm_kind_solid) return false;
+  const solid_params *sp = g->params;
+  v->mat = &sp->mat;
+  v->F = s->group[g->index].array[SOLID_F].data;
+  v->mstate =
+      sp->mstate >= 0 ? s->group[g->index].array[sp->mstate].data : NULL;
+  v->mstride = sp->mat.state_size;
+  return true;
+}

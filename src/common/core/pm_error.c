@@ -80,3 +80,16 @@ pm_err pm_calloc(void **ptr, size_t count, size_t size, const char *what) {
                     count * size, what);
   return PM_SUCCESS;
 }
+
+pm_err pm_realloc(void **ptr, size_t count, size_t size, const char *what) {
+  if (count == 0) count = 1;
+  if (size != 0 && count > (size_t)-1 / size)
+    return PM_ERROR(PM_ERR_MEMORY, "%s: %zu x %zu bytes overflows", what, count,
+                    size);
+  void *q = realloc(*ptr, count * size);
+  if (!q)
+    return PM_ERROR(PM_ERR_MEMORY, "cannot allocate %zu bytes for %s",
+                    count * size, what);
+  *ptr = q;
+  return PM_SUCCESS;
+}

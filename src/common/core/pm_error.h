@@ -95,6 +95,12 @@ pm_err pm_calloc(void **ptr, size_t count, size_t size, const char *what);
 #define PM_ALLOC(ptr, count, what)                                             \
   pm_calloc((void **)&(ptr), (size_t)(count), sizeof(*(ptr)), (what))
 
+/* Resize *ptr to count elements (at least one), keeping its contents (new
+ * elements uninitialised); *ptr unchanged on failure (PM_ERR_MEMORY). */
+pm_err pm_realloc(void **ptr, size_t count, size_t size, const char *what);
+#define PM_REALLOC(ptr, count, what)                                           \
+  pm_realloc((void **)&(ptr), (size_t)(count), sizeof(*(ptr)), (what))
+
 /* Internal invariant (not user input): compiled out with NDEBUG. */
 #ifdef NDEBUG
 #define PM_ASSERT(cond) ((void)0)

@@ -49,3 +49,10 @@ double pm_energy_error(double E0, double E, double D, double W) {
   if (!(scale > 0)) scale = fabs(E + D);
   return scale > 0 ? (E - E0 + D - W) / scale : 0.0;
 }
+
+pm_status pm_static_status(pm_err e) {
+  return e == PM_SUCCESS             ? PM_STATUS_CONVERGED
+         : e == PM_ERR_UNSTABLE      ? PM_STATUS_UNSTABLE
+         : e == PM_ERR_NOT_CONVERGED ? PM_STATUS_NOT_CONVERGED
+                                     : PM_STATUS_FAILED;
+}

@@ -31,6 +31,10 @@ typedef enum {
  * "interrupted", "not-run". */
 const char *pm_status_name(pm_status s);
 
+/* The status of a solve by load steps that returned e: converged,
+ * unstable, not-converged, or failed. */
+pm_status pm_static_status(pm_err e);
+
 /* A backend's own top-level scene section ("fpm:", "mpm:"): its keys, each
  * with its default, into an options struct of `size` bytes that the loader
  * allocates (zeroed), fills and keeps in the scene. */

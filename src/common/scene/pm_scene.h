@@ -34,7 +34,8 @@ typedef enum {
   PM_LINEAR_DIRECT = 0, /* LU (MUMPS) */
   PM_LINEAR_GMRES_GAMG, /* GMRES + algebraic multigrid */
   PM_LINEAR_CG_JACOBI,  /* CG + Jacobi (symmetric problems) */
-  PM_LINEAR_GMRES_ILU   /* GMRES + ILU(0) */
+  PM_LINEAR_GMRES_ILU,  /* GMRES + ILU(0) */
+  PM_LINEAR_CG_GAMG     /* CG + algebraic multigrid (symmetric problems) */
 } pm_linear_solver;
 
 /* How the stable time step is found. */

@@ -22,11 +22,10 @@ static const pm_name qs_names[] = {
     {"damping", PM_QS_DAMPING},
     {"static", PM_QS_STATIC},
     {NULL, 0}};
-static const pm_name linear_names[] = {{"direct", PM_LINEAR_DIRECT},
-                                       {"gmres-gamg", PM_LINEAR_GMRES_GAMG},
-                                       {"cg-jacobi", PM_LINEAR_CG_JACOBI},
-                                       {"gmres-ilu", PM_LINEAR_GMRES_ILU},
-                                       {NULL, 0}};
+static const pm_name linear_names[] = {
+    {"direct", PM_LINEAR_DIRECT},       {"gmres-gamg", PM_LINEAR_GMRES_GAMG},
+    {"cg-jacobi", PM_LINEAR_CG_JACOBI}, {"gmres-ilu", PM_LINEAR_GMRES_ILU},
+    {"cg-gamg", PM_LINEAR_CG_GAMG},     {NULL, 0}};
 static const pm_name dt_rule_names[] = {
     {"paper", PM_DT_PAPER}, {"spectral", PM_DT_SPECTRAL}, {NULL, 0}};
 static const pm_name field_names[] = {
@@ -528,7 +527,8 @@ static const pm_key quasi_static_keys[] = {
      .offset = S(time.qs_linear),
      .def = "direct",
      .names = linear_names,
-     .doc = "method static: direct (LU), gmres-gamg, gmres-ilu or cg-jacobi"},
+     .doc = "method static and mpm-implicit: direct (LU), gmres-gamg, "
+            "gmres-ilu, cg-jacobi or cg-gamg (symmetric problems)"},
     {.name = "solver_options",
      .type = PM_KEY_STRING,
      .offset = S(time.qs_solver_options),

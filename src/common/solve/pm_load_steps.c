@@ -205,3 +205,32 @@ done:
   free(rh);
   return ret;
 }
+
+pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
+                          pm_load_state *st, pm_load_report *rep) {
+  char name[96];
+#define NAME(item) (snprintf(name, sizeof name, "%s.%s", prefix, item), name)
+  if (st) {
+    PM_CALL(pm_ckpt_double(ck, NAME("lambda"), &st->lambda));
+    PM_CALL(pm_ckpt_double(ck, NAME("lambda_prev"), &st->lambda_prev));
+    PM_CALL(pm_ckpt_double(ck, NAME("dl"), &st->dl));
+    PM_CALL(pm_ckpt_long(ck, NAME("good"), &st->good));
+    PM_CALL(pm_ckpt_long(ck, NAME("have_prev"), &st->have_prev));
+    PM_CALL(pm_ckpt_doubles(ck, NAME("xc"), n, st->xc));
+    PM_CALL(pm_ckpt_doubles(ck, NAME("xprev"), n, st->xprev));
+  }
+  long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,
+       linear = rep->linear_iterations;
+  PM_CALL(pm_ckpt_long(ck, NAME("steps"), &steps));
+  PM_CALL(pm_ckpt_long(ck, NAME("cuts"), &cuts));
+  PM_CALL(pm_ckpt_long(ck, NAME("newton_iterations"), &newton));
+  PM_CALL(pm_ckpt_long(ck, NAME("linear_iterations"), &linear));
+  PM_CALL(pm_ckpt_double(ck, NAME("dlambda_min"), &rep->dlambda_min));
+#undef NAME
+  rep->steps = (int)steps;
+  rep->cuts = (int)cuts;
+  rep->newton_iterations = (int)newton;
+  rep->linear_iterations = (int)linear;
+  if (st) rep->lambda = st->lambda;
+  return PM_SUCCESS;
+}

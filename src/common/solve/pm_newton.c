@@ -404,7 +404,7 @@ static pm_err check_options(const pm_newton_options *o) {
   PM_CHECK(o->max_iter >= 1 && o->max_iter <= PM_NEWTON_MAX_ITER, PM_ERR_ARG,
            "Newton max_iter must be in [1, %d] (got %d)", PM_NEWTON_MAX_ITER,
            o->max_iter);
-  PM_CHECK(o->linear >= PM_NEWTON_DIRECT && o->linear <= PM_NEWTON_GMRES_ILU,
+  PM_CHECK(o->linear >= PM_NEWTON_DIRECT && o->linear <= PM_NEWTON_CG_GAMG,
            PM_ERR_ARG, "unknown linear solver %d", (int)o->linear);
   PM_CHECK(o->op >= PM_NEWTON_ASSEMBLED &&
                o->op <= PM_NEWTON_MATRIX_FREE_CHEAP_PC,
@@ -488,6 +488,10 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
   case PM_NEWTON_GMRES_ILU:
     PM_PETSC(KSPSetType(ksp, KSPGMRES));
     PM_PETSC(PCSetType(pc, PCILU));
+    break;
+  case PM_NEWTON_CG_GAMG:
+    PM_PETSC(KSPSetType(ksp, KSPCG));
+    PM_PETSC(PCSetType(pc, PCGAMG));
     break;
   }
   PM_PETSC(KSPSetTolerances(ksp, o->linear_rtol, PETSC_DEFAULT, PETSC_DEFAULT,
@@ -992,4 +996,15 @@ done:
   free(rm);
   free(column);
   return ret;
+}
+
+pm_newton_linear pm_newton_linear_of(pm_linear_solver l) {
+  switch (l) {
+  case PM_LINEAR_GMRES_GAMG: return PM_NEWTON_GMRES_GAMG;
+  case PM_LINEAR_CG_JACOBI: return PM_NEWTON_CG_JACOBI;
+  case PM_LINEAR_GMRES_ILU: return PM_NEWTON_GMRES_ILU;
+  case PM_LINEAR_CG_GAMG: return PM_NEWTON_CG_GAMG;
+  case PM_LINEAR_DIRECT: break;
+  }
+  return PM_NEWTON_DIRECT;
 }

@@ -55,8 +55,10 @@
 
 #include <stdbool.h>
 
+#include "pm_checkpoint.h"
 #include "pm_coloring.h"
 #include "pm_error.h"
+#include "pm_scene.h"
 
 /* The most Newton iterations one solve may take (the length of the
  * per-iteration arrays of a report, less one). */
@@ -118,7 +120,9 @@ typedef enum {
                            ICNTL(24) = 1), else PETSc's own */
   PM_NEWTON_GMRES_GAMG, /* GMRES + algebraic multigrid */
   PM_NEWTON_CG_JACOBI,  /* CG + Jacobi: symmetric positive definite J only */
-  PM_NEWTON_GMRES_ILU   /* GMRES + ILU(0) */
+  PM_NEWTON_GMRES_ILU,  /* GMRES + ILU(0) */
+  PM_NEWTON_CG_GAMG     /* CG + algebraic multigrid: symmetric positive
+                           definite J only */
 } pm_newton_linear;
 
 /* What the linear solver multiplies by, and what it preconditions with. */
@@ -199,6 +203,9 @@ typedef struct {
    * above, so they override them; they are this solver's alone. */
   const char *petsc_options;
 } pm_newton_options;
+
+/* The solver of a scene's time.quasi_static.linear_solver. */
+pm_newton_linear pm_newton_linear_of(pm_linear_solver l);
 
 /* The options above with their defaults. */
 pm_newton_options pm_newton_options_default(void);
@@ -333,6 +340,12 @@ void pm_load_state_free(pm_load_state *state);
  * taken. */
 pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *state,
                           pm_load_report *report);
+
+/* Write or read load stepping's state (st, over n unknowns; NULL: none)
+ * and the counters of rep, as checkpoint items named PREFIX.lambda, ...
+ * (pm_checkpoint.h: the same calls write and read). */
+pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
+                          pm_load_state *st, pm_load_report *rep);
 
 /* The assembled Jacobian at x (jacobian_prepare, then colouring) as values
  * in the order of the problem's pattern: val[pat_ptr[i] + k] = J_ij for j
