@@ -1,5 +1,6 @@
 /* gm_image: labelled volumetric images from TIFF stacks, raw volumes and
- * point files, and TIFF output (see gm_image.h). */
+ * point files, TIFF output, and the connected components of the set voxels
+ * (see gm_image.h). */
 #include "gm_image.h"
 
 #include <errno.h>
@@ -27,8 +28,8 @@ void gm_image_free(gm_image *im) {
   memset(im, 0, sizeof *im);
 }
 
-static pm_err image_alloc(gm_image *im, const long n[3], const double d[3],
-                          const double o[3]) {
+pm_err gm_image_alloc(gm_image *im, const long n[3], const double d[3],
+                      const double o[3]) {
   memset(im, 0, sizeof *im);
   for (int c = 0; c < 3; c++) {
     PM_CHECK(n[c] > 0, PM_ERR_ARG,
@@ -42,6 +43,58 @@ static pm_err image_alloc(gm_image *im, const long n[3], const double d[3],
     im->o[c] = o ? o[c] : 0;
   }
   return PM_ALLOC(im->v, n[0] * n[1] * n[2], "image voxels");
+}
+
+/* ---- connected components ------------------------------------------------ */
+
+static bool seen_bit(const unsigned char *bits, long q) {
+  return bits[q >> 3] & (1u << (q & 7));
+}
+
+static void mark_bit(unsigned char *bits, long q) {
+  bits[q >> 3] |= (unsigned char)(1u << (q & 7));
+}
+
+pm_err gm_image_components(const gm_image *im, long *components,
+                           long *largest) {
+  *components = *largest = 0;
+  const long nx = im->n[0], ny = im->n[1], nz = im->n[2];
+  const long nv = nx * ny * nz;
+  long set = 0;
+  for (long q = 0; q < nv; q++) set += im->v[q] != 0;
+  if (set == 0) return PM_SUCCESS;
+  pm_err ret = PM_SUCCESS;
+  unsigned char *seen = NULL; /* a bit per voxel */
+  long *stack = NULL;         /* each set voxel enters it once */
+  PM_TRY(PM_ALLOC(seen, nv / 8 + 1, "voxel marks"));
+  PM_TRY(PM_ALLOC(stack, set, "flood-fill stack"));
+  for (long q0 = 0; q0 < nv; q0++) {
+    if (!im->v[q0] || seen_bit(seen, q0)) continue;
+    long top = 0, size = 0;
+    mark_bit(seen, q0);
+    stack[top++] = q0;
+    while (top > 0) {
+      const long q = stack[--top];
+      size++;
+      const long i = q % nx, j = (q / nx) % ny, k = q / (nx * ny);
+      const long nb[6] = {
+          i > 0 ? q - 1 : -1,       i < nx - 1 ? q + 1 : -1,
+          j > 0 ? q - nx : -1,      j < ny - 1 ? q + nx : -1,
+          k > 0 ? q - nx * ny : -1, k < nz - 1 ? q + nx * ny : -1};
+      for (int m = 0; m < 6; m++) {
+        const long p = nb[m];
+        if (p < 0 || !im->v[p] || seen_bit(seen, p)) continue;
+        mark_bit(seen, p);
+        stack[top++] = p;
+      }
+    }
+    (*components)++;
+    if (size > *largest) *largest = size;
+  }
+done:
+  free(seen);
+  free(stack);
+  return ret;
 }
 
 /* ---- TIFF ---------------------------------------------------------------- */
@@ -186,7 +239,7 @@ pm_err gm_image_read_tiff(int nfiles, const char *const *files,
   uint16_t bits = 0;
   PM_TRY(tiff_pass(nfiles, files, NULL, &pages, &w, &h, &bits));
   const long n[3] = {(long)w, (long)h, pages};
-  PM_TRY(image_alloc(out, n, d, o));
+  PM_TRY(gm_image_alloc(out, n, d, o));
   out->bits = bits;
   PM_TRY(tiff_pass(nfiles, files, out, &pages, &w, &h, &bits));
 done:
@@ -262,7 +315,7 @@ pm_err gm_image_read_raw(const char *file, const long n[3], int bits,
   FILE *f = fopen(file, "rb");
   unsigned char *buf = NULL;
   PM_ENSURE(f, PM_ERR_IO, "%s: cannot open it (%s)", file, strerror(errno));
-  PM_TRY(image_alloc(out, n, d, o));
+  PM_TRY(gm_image_alloc(out, n, d, o));
   out->bits = bits;
   const size_t bytes = (size_t)bits / 8, nx = (size_t)n[0];
   const size_t want = nx * n[1] * n[2] * bytes;
@@ -300,7 +353,7 @@ pm_err gm_image_read_points(const char *file, double unit, const long n[3],
   char line[1024];
   long ln = 0;
   PM_ENSURE(f, PM_ERR_IO, "%s: cannot open it (%s)", file, strerror(errno));
-  PM_TRY(image_alloc(out, n, d, o));
+  PM_TRY(gm_image_alloc(out, n, d, o));
   out->bits = 8;
   while (fgets(line, sizeof line, f)) {
     ln++;

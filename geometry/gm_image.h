@@ -54,6 +54,17 @@ pm_err gm_image_read_points(const char *file, double unit, const long n[3],
  * renamed).  PM_ERR_IO. */
 pm_err gm_image_write_tiff(const gm_image *im, const char *file);
 
+/* A new image of n voxels of size d with corner o (NULL: 0), every value
+ * 0, bits unset.  PM_ERR_ARG (a size or voxel size not positive),
+ * PM_ERR_MEMORY; on failure *im is empty. */
+pm_err gm_image_alloc(gm_image *im, const long n[3], const double d[3],
+                      const double o[3]);
+
+/* The 6-connected components of the nonzero voxels of im: their number and
+ * the voxel count of the largest (both 0 when no voxel is set).
+ * PM_ERR_MEMORY. */
+pm_err gm_image_components(const gm_image *im, long *components, long *largest);
+
 /* The intensity at voxel (i, j, k). */
 static inline uint16_t gm_image_at(const gm_image *im, long i, long j, long k) {
   return im->v[i + im->n[0] * (j + im->n[1] * k)];

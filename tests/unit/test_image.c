@@ -2,7 +2,7 @@
  * of the same voxels give the same image; TIFF output reads back; a
  * truncated TIFF, a raw file of the wrong size and a point off the grid
  * fail with the file named (and where); the vessel slice of case I2 reads
- * with its published pixel count. */
+ * with its published pixel count; 6-connected components are counted. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -152,6 +152,30 @@ static void test_vessel_slice(void **state) {
   gm_image_free(&im);
 }
 
+/* Two components on a 4 x 3 x 2 grid: {(0,0,0), (1,0,0), (1,1,0),
+ * (1,1,1)} (4 voxels, the last joined through z) and {(2,2,0), (2,2,1),
+ * (3,2,1)} (3), which touch the first only along edges; none in an empty
+ * image. */
+static void test_components(void **state) {
+  (void)state;
+  gm_image im;
+  const long n[3] = {4, 3, 2};
+  const double d[3] = {1, 1, 1};
+  assert_int_equal(gm_image_alloc(&im, n, d, NULL), PM_SUCCESS);
+  long comps = -1, largest = -1;
+  assert_int_equal(gm_image_components(&im, &comps, &largest), PM_SUCCESS);
+  assert_int_equal(comps, 0);
+  assert_int_equal(largest, 0);
+  const long set[7][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {1, 1, 1},
+                          {2, 2, 0}, {2, 2, 1}, {3, 2, 1}};
+  for (int m = 0; m < 7; m++)
+    im.v[set[m][0] + 4 * (set[m][1] + 3 * set[m][2])] = 255;
+  assert_int_equal(gm_image_components(&im, &comps, &largest), PM_SUCCESS);
+  assert_int_equal(comps, 2);
+  assert_int_equal(largest, 4);
+  gm_image_free(&im);
+}
+
 static int setup(void **state) {
   (void)state;
   snprintf(dir, sizeof dir, "/tmp/pm-image-XXXXXX");
@@ -175,6 +199,7 @@ int main(void) {
       cmocka_unit_test(test_three_sources),
       cmocka_unit_test(test_bad_files),
       cmocka_unit_test(test_vessel_slice),
+      cmocka_unit_test(test_components),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
