@@ -10,6 +10,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <dirent.h>
+#include <sys/stat.h>
 #include <tiffio.h>
 #include <unistd.h>
 
@@ -226,27 +229,124 @@ static pm_err tiff_pass(int nfiles, const char *const *files, gm_image *im,
   return PM_SUCCESS;
 }
 
+/* tiff_pass with libtiff's messages caught for ours: n the voxels per
+ * axis, bits the depth. */
+static pm_err tiff_run(int nfiles, const char *const *files, gm_image *im,
+                       long n[3], uint16_t *bits) {
+  TIFFErrorHandler old_e = TIFFSetErrorHandler(tiff_handler);
+  TIFFErrorHandler old_w = TIFFSetWarningHandler(NULL);
+  long pages = 0;
+  uint32_t w = 0, h = 0;
+  pm_err e = tiff_pass(nfiles, files, im, &pages, &w, &h, bits);
+  TIFFSetErrorHandler(old_e);
+  TIFFSetWarningHandler(old_w);
+  n[0] = (long)w;
+  n[1] = (long)h;
+  n[2] = pages;
+  return e;
+}
+
 pm_err gm_image_read_tiff(int nfiles, const char *const *files,
                           const double d[3], const double o[3], gm_image *out) {
   PM_CHECK(out && files && nfiles > 0, PM_ERR_ARG,
            "gm_image_read_tiff: no file");
   memset(out, 0, sizeof *out);
-  TIFFErrorHandler old_e = TIFFSetErrorHandler(tiff_handler);
-  TIFFErrorHandler old_w = TIFFSetWarningHandler(NULL);
   pm_err ret = PM_SUCCESS;
-  long pages = 0;
-  uint32_t w = 0, h = 0;
+  long n[3];
   uint16_t bits = 0;
-  PM_TRY(tiff_pass(nfiles, files, NULL, &pages, &w, &h, &bits));
-  const long n[3] = {(long)w, (long)h, pages};
+  PM_TRY(tiff_run(nfiles, files, NULL, n, &bits));
   PM_TRY(gm_image_alloc(out, n, d, o));
   out->bits = bits;
-  PM_TRY(tiff_pass(nfiles, files, out, &pages, &w, &h, &bits));
+  PM_TRY(tiff_run(nfiles, files, out, n, &bits));
 done:
-  TIFFSetErrorHandler(old_e);
-  TIFFSetWarningHandler(old_w);
   if (ret) gm_image_free(out);
   return ret;
+}
+
+static bool is_tiff_name(const char *name) {
+  const char *dot = strrchr(name, '.');
+  return dot && (strcasecmp(dot, ".tif") == 0 || strcasecmp(dot, ".tiff") == 0);
+}
+
+static int name_order(const void *a, const void *b) {
+  return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+static void free_names(int n, char **names) {
+  for (int k = 0; names && k < n; k++) free(names[k]);
+  free(names);
+}
+
+/* The files of a TIFF source: path itself, or the TIFF files of the folder
+ * path in the order of their names.  *files (*n of them) is the caller's
+ * (free_names). */
+static pm_err tiff_files(const char *path, int *n, char ***files) {
+  struct stat st;
+  *n = 0;
+  *files = NULL;
+  pm_err ret = PM_SUCCESS;
+  char **names = NULL;
+  int count = 0, cap = 0;
+  DIR *dir = NULL;
+  if (stat(path, &st) != 0 || !S_ISDIR(st.st_mode)) {
+    PM_TRY(PM_ALLOC(names, 1, "image file name"));
+    names[0] = strdup(path);
+    PM_ENSURE(names[0], PM_ERR_MEMORY, "cannot copy %s", path);
+    count = 1;
+  } else {
+    dir = opendir(path);
+    PM_ENSURE(dir, PM_ERR_IO, "%s: cannot list the folder (%s)", path,
+              strerror(errno));
+    for (struct dirent *e; (e = readdir(dir));) {
+      if (!is_tiff_name(e->d_name)) continue;
+      if (count == cap) {
+        cap = cap ? 2 * cap : 64;
+        char **grown = realloc(names, (size_t)cap * sizeof *names);
+        PM_ENSURE(grown, PM_ERR_MEMORY, "%s: cannot list the folder", path);
+        names = grown;
+      }
+      size_t len = strlen(path) + 1 + strlen(e->d_name) + 1;
+      names[count] = malloc(len);
+      PM_ENSURE(names[count], PM_ERR_MEMORY, "%s: cannot list the folder",
+                path);
+      snprintf(names[count++], len, "%s/%s", path, e->d_name);
+    }
+    PM_ENSURE(count > 0, PM_ERR_IO,
+              "%s: expected a folder of TIFF files (*.tif, *.tiff), found "
+              "none",
+              path);
+    qsort(names, (size_t)count, sizeof *names, name_order);
+  }
+  *n = count;
+  *files = names;
+  names = NULL;
+done:
+  if (dir) closedir(dir);
+  if (ret) free_names(count, names);
+  return ret;
+}
+
+pm_err gm_image_read_tiff_path(const char *path, const double d[3],
+                               const double o[3], gm_image *out) {
+  PM_CHECK(out && path, PM_ERR_ARG, "gm_image_read_tiff_path: no path");
+  memset(out, 0, sizeof *out);
+  int n = 0;
+  char **files = NULL;
+  PM_CALL(tiff_files(path, &n, &files));
+  pm_err e = gm_image_read_tiff(n, (const char *const *)files, d, o, out);
+  free_names(n, files);
+  return e;
+}
+
+pm_err gm_image_tiff_size(const char *path, long n[3]) {
+  PM_CHECK(path && n, PM_ERR_ARG, "gm_image_tiff_size: no path");
+  int nf = 0;
+  char **files = NULL;
+  uint16_t bits = 0;
+  PM_CALL(tiff_files(path, &nf, &files));
+  pm_err e = tiff_run(nf, (const char *const *)files, NULL, n, &bits);
+  free_names(nf, files);
+  return e;
 }
 
 pm_err gm_image_write_tiff(const gm_image *im, const char *file) {
@@ -395,4 +495,148 @@ done:
   if (f) fclose(f);
   if (ret) gm_image_free(out);
   return ret;
+}
+
+/* ---- an image body's voxels ---------------------------------------------- */
+
+bool gm_image_part_contains(const gm_image_part *p, int dim,
+                            const double x[3]) {
+  const gm_image *im = p->im;
+  long idx[3] = {0, 0, p->lo[2]};
+  for (int c = 0; c < dim; c++) {
+    double u = floor((x[c] - im->o[c]) / im->d[c]);
+    if (!(u >= (double)p->lo[c] && u < (double)p->hi[c])) return false;
+    idx[c] = (long)u;
+  }
+  uint16_t v = gm_image_at(im, idx[0], idx[1], idx[2]);
+  return v >= p->label[0] && v <= p->label[1];
+}
+
+long gm_image_part_voxels(const gm_image_part *p) {
+  return gm_image_seeds(p, 3, 1, NULL, NULL);
+}
+
+void gm_image_part_box(const gm_image_part *p, int dim, double lo[3],
+                       double hi[3]) {
+  for (int c = 0; c < 3; c++) {
+    lo[c] = c < dim ? p->im->o[c] + (double)p->lo[c] * p->im->d[c] : 0;
+    hi[c] = c < dim ? p->im->o[c] + (double)p->hi[c] * p->im->d[c] : 0;
+  }
+}
+
+long gm_image_seeds(const gm_image_part *p, int dim, int n, gm_image_seed_fn fn,
+                    void *ctx) {
+  const gm_image *im = p->im;
+  const int nz = dim == 3 ? n : 1;
+  double vol = 1;
+  for (int c = 0; c < dim; c++) vol *= im->d[c] / n;
+  long count = 0;
+  for (long k = p->lo[2]; k < p->hi[2]; k++)
+    for (long j = p->lo[1]; j < p->hi[1]; j++)
+      for (long i = p->lo[0]; i < p->hi[0]; i++) {
+        uint16_t v = gm_image_at(im, i, j, k);
+        if (v < p->label[0] || v > p->label[1]) continue;
+        count += (long)n * n * nz;
+        if (!fn) continue;
+        const long idx[3] = {i, j, k};
+        for (int s2 = 0; s2 < nz; s2++)
+          for (int s1 = 0; s1 < n; s1++)
+            for (int s0 = 0; s0 < n; s0++) {
+              const int sub[3] = {s0, s1, s2};
+              double x[3] = {0, 0, 0};
+              for (int c = 0; c < dim; c++)
+                x[c] =
+                    im->o[c] + ((double)idx[c] + (sub[c] + 0.5) / n) * im->d[c];
+              fn(ctx, x, vol);
+            }
+      }
+  return count;
+}
+
+/* Voxel size, corner and size in voxels of image body b (z: 1 m, 0 and 1
+ * voxel when not given). */
+static void body_frame(const pm_scene_body *b, double d[3], double o[3],
+                       long n[3]) {
+  for (int c = 0; c < 3; c++) {
+    d[c] = c < b->image.n_voxel ? b->image.voxel[c] : 1;
+    o[c] = c < b->image.n_origin ? b->image.origin[c] : 0;
+    n[c] = c < b->image.n_size ? (long)b->image.size[c] : 1;
+  }
+}
+
+const char *gm_image_source_key(const pm_scene_body *b) {
+  static const char *const keys[] = {[PM_IMAGE_TIFF] = "file",
+                                     [PM_IMAGE_RAW] = "raw",
+                                     [PM_IMAGE_POINTS] = "points"};
+  return keys[b->image.source];
+}
+
+pm_err gm_image_of_body(const pm_scene_body *b, gm_image *out) {
+  PM_CHECK(b && out && b->image.file, PM_ERR_ARG,
+           "gm_image_of_body: no image body");
+  double d[3], o[3];
+  long n[3];
+  body_frame(b, d, o, n);
+  switch (b->image.source) {
+  case PM_IMAGE_RAW:
+    return gm_image_read_raw(b->image.file, n, b->image.bits, d, o, out);
+  case PM_IMAGE_POINTS:
+    return gm_image_read_points(b->image.file, b->image.unit, n, d, o, out);
+  default: return gm_image_read_tiff_path(b->image.file, d, o, out);
+  }
+}
+
+bool gm_image_same_source(const pm_scene_body *a, const pm_scene_body *b) {
+  if (a->image.source != b->image.source || !a->image.file || !b->image.file ||
+      strcmp(a->image.file, b->image.file) != 0)
+    return false;
+  double da[3], oa[3], db[3], ob[3];
+  long na[3], nb[3];
+  body_frame(a, da, oa, na);
+  body_frame(b, db, ob, nb);
+  for (int c = 0; c < 3; c++)
+    if (da[c] != db[c] || oa[c] != ob[c] || na[c] != nb[c]) return false;
+  return a->image.bits == b->image.bits && a->image.unit == b->image.unit;
+}
+
+pm_err gm_image_body_size(const pm_scene_body *b, long n[3]) {
+  PM_CHECK(b && n && b->image.file, PM_ERR_ARG,
+           "gm_image_body_size: no image body");
+  if (b->image.source == PM_IMAGE_TIFF)
+    return gm_image_tiff_size(b->image.file, n);
+  double d[3], o[3];
+  body_frame(b, d, o, n);
+  return PM_SUCCESS;
+}
+
+pm_err gm_image_body_part(const gm_image *im, const pm_scene_body *b, int dim,
+                          gm_image_part *out, const char **key) {
+  PM_CHECK(im && b && out && key, PM_ERR_ARG, "gm_image_body_part: NULL");
+  memset(out, 0, sizeof *out);
+  const int nc = b->image.n_crop_min;
+  *key = gm_image_source_key(b);
+  out->im = im;
+  for (int c = 0; c < 3; c++) {
+    out->lo[c] = c < nc ? (long)b->image.crop_min[c] : 0;
+    out->hi[c] = c < nc ? (long)b->image.crop_max[c] : im->n[c];
+    if (out->hi[c] > im->n[c]) {
+      *key = "crop.max";
+      return PM_ERROR(PM_ERR_ARG,
+                      "expected a crop inside the image (%ld x %ld x %ld "
+                      "voxels of %s), got max.%d = %ld",
+                      im->n[0], im->n[1], im->n[2], b->image.file, c,
+                      out->hi[c]);
+    }
+  }
+  if (dim == 2 && out->hi[2] - out->lo[2] != 1) {
+    if (nc == 3) *key = "crop.max";
+    return PM_ERROR(PM_ERR_ARG,
+                    "expected an image of one slice for dimension 2 (or a "
+                    "crop of one: crop: {min: [i0, j0, k], max: [i1, j1, k + "
+                    "1]}), got %ld slices of %s",
+                    out->hi[2] - out->lo[2], b->image.file);
+  }
+  out->label[0] = (uint16_t)b->image.label[0];
+  out->label[1] = (uint16_t)b->image.label[1];
+  return PM_SUCCESS;
 }

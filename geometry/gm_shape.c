@@ -1,6 +1,6 @@
 /* gm_shape: one table entry per kind of body (how to read it from the
- * scene, contains, bounds, release): a new kind (a voxel image) is one
- * more entry and its functions, here.  The inside and the outside of a
+ * scene, contains, bounds, release): a new kind is one more entry and its
+ * functions, here.  The inside and the outside of a
  * closed triangulated surface are two more kinds, built from the surface. */
 #include "gm_shape.h"
 
@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "gm_curve.h"
+#include "gm_image.h"
 #include "gm_inside.h"
 #include "gm_volume.h"
 #include "pm_tensor.h"
@@ -28,6 +29,8 @@ struct gm_shape {
   gm_volume *volume;     /* owned */
   gm_inside *inside;     /* owned */
   gm_polygon polygon;    /* owned: the region a 2-D membrane encloses */
+  gm_image *image;       /* owned when read by gm_shape_create */
+  gm_image_part part;    /* an image body's voxels (image borrowed) */
 };
 
 struct shape_kind {
@@ -174,6 +177,31 @@ static void mesh_bounds(const gm_shape *s, double lo[3], double hi[3]) {
 
 static void mesh_release(gm_shape *s) { gm_volume_destroy(s->volume); }
 
+/* ---- labelled image ----------------------------------------------------- */
+
+/* The image read for this shape alone (gm_shape_create); a seeder that
+ * shares one image among bodies uses gm_shape_from_image. */
+static pm_err image_init(gm_shape *s, const pm_scene_body *b, double h) {
+  (void)h;
+  const char *key;
+  PM_CALL(PM_ALLOC(s->image, 1, "image"));
+  PM_CALL(gm_image_of_body(b, s->image));
+  return gm_image_body_part(s->image, b, s->dim, &s->part, &key);
+}
+
+static bool image_contains(const gm_shape *s, const double x[3]) {
+  return gm_image_part_contains(&s->part, s->dim, x);
+}
+
+static void image_bounds(const gm_shape *s, double lo[3], double hi[3]) {
+  gm_image_part_box(&s->part, s->dim, lo, hi);
+}
+
+static void image_release(gm_shape *s) {
+  gm_image_free(s->image);
+  free(s->image);
+}
+
 /* ---- closed triangulated surface ---------------------------------------- */
 
 /* Not in the table: built from a surface, not from a scene body. */
@@ -295,6 +323,8 @@ static const shape_kind kinds[] = {
                           cylinder_bounds, NULL},
     [PM_BODY_MESH] = {"mesh", true, mesh_init, mesh_contains, mesh_bounds,
                       mesh_release},
+    [PM_BODY_IMAGE] = {"image", true, image_init, image_contains, image_bounds,
+                       image_release},
 };
 
 #define N_KINDS ((int)(sizeof kinds / sizeof kinds[0]))
@@ -331,6 +361,31 @@ pm_err gm_shape_create(const pm_scene_body *body, int dim,
 done:
   gm_shape_destroy(s);
   return ret;
+}
+
+pm_err gm_shape_from_image(const gm_image *im, const pm_scene_body *body,
+                           int dim, gm_shape **out, const char **key) {
+  PM_CHECK(out && key, PM_ERR_ARG, "gm_shape_from_image: out is NULL");
+  *out = NULL;
+  *key = "image";
+  PM_CHECK(im && body, PM_ERR_ARG, "gm_shape_from_image: no image or body");
+  PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG,
+           "shape dimension must be 2 or 3 (got %d)", dim);
+  pm_err ret = PM_SUCCESS;
+  gm_shape *s = NULL;
+  PM_TRY(PM_ALLOC(s, 1, "shape"));
+  s->kind = &kinds[PM_BODY_IMAGE];
+  s->dim = dim;
+  PM_TRY(gm_image_body_part(im, body, dim, &s->part, key));
+  *out = s;
+  s = NULL;
+done:
+  gm_shape_destroy(s);
+  return ret;
+}
+
+const gm_image_part *gm_shape_image(const gm_shape *s) {
+  return s && s->kind == &kinds[PM_BODY_IMAGE] ? &s->part : NULL;
 }
 
 void gm_shape_destroy(gm_shape *s) {

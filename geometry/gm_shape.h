@@ -1,12 +1,13 @@
 /* gm_shape: the shape of a scene body, whatever its kind (the domain, a
  * region expression, a box, a sphere, a cylinder, a gmsh volume, the inside
- * or outside of a closed surface): whether it contains a point, its
- * bounding box, and checks on where it lies. */
+ * or outside of a closed surface, the labelled voxels of an image): whether
+ * it contains a point, its bounding box, and checks on where it lies. */
 #ifndef GM_SHAPE_H
 #define GM_SHAPE_H
 
 #include <stdbool.h>
 
+#include "gm_image.h"
 #include "gm_trisurf.h"
 #include "pm_error.h"
 #include "pm_scene.h"
@@ -34,14 +35,19 @@ typedef struct gm_shape gm_shape;
  *   PM_BODY_MESH      the gmsh volume of file mesh (surface in 2D), read
  *                     with gm_volume_load at element size h (h <= 0: the
  *                     file's own sizes; a mesh in the file is used as is)
- * Boundaries count as inside, but for a region: its zero set is outside.
+ *   PM_BODY_IMAGE     the voxels of the crop of the image (read with
+ *                     gm_image_of_body) whose intensity is in the label
+ *                     range (gm_image_body_part); bounds: the crop's box
+ * Boundaries count as inside, but for a region: its zero set is outside,
+ * and for an image: a voxel's upper faces are its neighbour's.
  * On success *out is a new shape the caller
  * frees with gm_shape_destroy; on failure *out is NULL and the error is
  * PM_ERR_ARG (NULL arguments, dim not 2 or 3, an empty domain box, a body
  * whose numbers make no shape: min >= max, radius <= 0, a zero axis, a
- * cylinder in 2D, no region or file), PM_ERR_UNSUPPORTED (a kind without
- * geometry), PM_ERR_MEMORY, or gm_volume_load's errors for a mesh body
- * (they name the file).  Not thread-safe for a mesh body. */
+ * cylinder in 2D, no region or file, an image crop outside the image),
+ * PM_ERR_UNSUPPORTED (a kind without geometry), PM_ERR_MEMORY, or
+ * gm_volume_load's errors for a mesh body and the image readers' for an
+ * image body (they name the file).  Not thread-safe for a mesh body. */
 pm_err gm_shape_create(const pm_scene_body *body, int dim,
                        const double box_min[3], const double box_max[3],
                        double h, gm_shape **out);
@@ -69,6 +75,18 @@ pm_err gm_shape_from_curve(long n, const double *x, bool closed,
                            const double box_min[3], const double box_max[3],
                            bool outside, gm_shape **out);
 
+/* The shape of image body `body` on the image im, read once (by
+ * gm_image_of_body) for every body that shares it: im is borrowed and must
+ * outlive the shape.  Kind "image", thread-safe.  On failure *out is NULL
+ * and the error is PM_ERR_ARG, PM_ERR_MEMORY or gm_image_body_part's
+ * (with *key the key of the body's image at fault). */
+pm_err gm_shape_from_image(const gm_image *im, const pm_scene_body *body,
+                           int dim, gm_shape **out, const char **key);
+
+/* The voxels of an image shape (for seeding them, gm_image_seeds), or
+ * NULL for a shape of another kind. */
+const gm_image_part *gm_shape_image(const gm_shape *s);
+
 /* Frees the shape (and the volume of a mesh body, the inside test of a
  * surface); NULL is a no-op. */
 void gm_shape_destroy(gm_shape *s);
@@ -85,8 +103,8 @@ bool gm_shape_contains(const gm_shape *s, const double x[3]);
 bool gm_shape_bounds(const gm_shape *s, double lo[3], double hi[3]);
 
 /* The scene's word for the shape's kind: "domain", "region", "box",
- * "sphere", "cylinder" or "mesh", or "inside" / "outside" for a shape of
- * gm_shape_from_surface ("?" for NULL). */
+ * "sphere", "cylinder", "mesh" or "image", or "inside" / "outside" for a shape
+ * of gm_shape_from_surface ("?" for NULL). */
 const char *gm_shape_kind(const gm_shape *s);
 
 /* Whether gm_shape_contains may run on s from several threads at once

@@ -89,11 +89,11 @@ static pm_err check_materials(const pm_scene *s) {
 
 static pm_err check_bodies(const pm_scene *s) {
   static const char *const mpm_only[] = {"velocity", "density", "pressure"};
-  static const char *const mpm_keys[] = {"membrane", "inside", "outside",
-                                         "motion", "particles_per_cell"};
+  static const char *const mpm_keys[] = {
+      "membrane", "inside", "outside", "motion", "particles_per_cell", "image"};
   char p[64];
   for (int i = 0; i < s->n_bodies; i++) {
-    for (int k = 0; k < 5; k++)
+    for (int k = 0; k < 6; k++)
       if (pm_scene_has(s, PM_PATH(p, "bodies.%d.%s", i, mpm_keys[k])))
         return pm_scene_fail(s, p, true,
                              "expected a key of an FPM body (material, "

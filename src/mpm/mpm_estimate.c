@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "gm_image.h"
 #include "mpm_grid.h"
 #include "mpm_kind.h"
 #include "mpm_particles.h"
@@ -59,6 +60,48 @@ static double membrane_points(const pm_scene_body *b) {
   }
 }
 
+/* Whether image bodies a and b take their voxels from one crop of one
+ * image (one label range each, usually disjoint). */
+static bool same_voxels(const pm_scene_body *a, const pm_scene_body *b) {
+  if (a->shape != PM_BODY_IMAGE || !gm_image_same_source(a, b) ||
+      a->image.n_crop_min != b->image.n_crop_min)
+    return false;
+  for (int c = 0; c < a->image.n_crop_min; c++)
+    if (a->image.crop_min[c] != b->image.crop_min[c] ||
+        a->image.crop_max[c] != b->image.crop_max[c])
+      return false;
+  return true;
+}
+
+/* Particles of image body b: at most n^d per voxel of its crop, or of the
+ * whole image (its size from the file's headers, or the one given), and no
+ * more voxels than the domain box holds (box: its volume).  Bodies on the
+ * same voxels hold at most the largest n^d per voxel together: b adds
+ * what its n^d exceeds the earlier ones' by. */
+static double image_particles(const pm_scene *s, int b, double box) {
+  const pm_scene_body *body = &s->bodies[b];
+  const int dim = s->dimension;
+  double voxel = 1, voxels = 1, prev = 0;
+  long size[3] = {0, 0, 0};
+  bool known = body->image.n_crop_min > 0;
+  if (!known) {
+    known = gm_image_body_size(body, size) == PM_SUCCESS;
+    if (!known) pm_error_clear(); /* the seeder reports it, at the key */
+  }
+  for (int c = 0; c < dim; c++) {
+    voxel *= body->image.voxel[c];
+    voxels *= body->image.n_crop_min > 0
+                  ? body->image.crop_max[c] - body->image.crop_min[c]
+                  : (double)size[c];
+  }
+  for (int a = 0; a < b; a++)
+    if (same_voxels(&s->bodies[a], body))
+      prev = fmax(prev, pow((double)s->bodies[a].image.per_voxel, dim));
+  double fit = box / voxel;
+  double n = pow((double)body->image.per_voxel, dim);
+  return (known ? fmin(voxels, fit) : fit) * fmax(0, n - prev);
+}
+
 /* Doubles per particle of the kind of body b's particles, as its setup
  * lays them out: a fluid's density, energy, pressure and q; a solid's F, q
  * and its model's state; a membrane's frame, strain, damage and failed,
@@ -86,8 +129,9 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
     nodes *= k + 1 + 2 * ghost;
     ppc *= o->ppc[c];
   }
-  /* Particles: per body, at most the domain's. */
-  double n = 0, own = 0, top = ppc, surf = 0;
+  /* Particles: per body, at most the domain's.  Membranes' points and
+   * image voxels' particles are not seeded in cells: apart. */
+  double n = 0, own = 0, top = ppc, apart = 0;
   for (int b = 0; b < s->n_bodies; b++) {
     const pm_scene_body *body = &s->bodies[b];
     double bppc = ppc;
@@ -95,19 +139,23 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
       bppc = 1;
       for (int c = 0; c < dim; c++) bppc *= body->ppc[body->n_ppc == 1 ? 0 : c];
     }
-    double nb = body->shape == PM_BODY_MEMBRANE
-                    ? membrane_points(body)
-                    : body_volume(s, body, box) / pow(h, dim) * bppc;
-    if (body->shape == PM_BODY_MEMBRANE) surf += nb;
-    top = fmax(top, bppc);
+    double nb;
+    if (body->shape == PM_BODY_MEMBRANE || body->shape == PM_BODY_IMAGE) {
+      nb = body->shape == PM_BODY_MEMBRANE ? membrane_points(body)
+                                           : image_particles(s, b, box);
+      apart += nb;
+    } else {
+      nb = body_volume(s, body, box) / pow(h, dim) * bppc;
+      top = fmax(top, bppc);
+    }
     n += nb;
     own += nb * kind_doubles(&s->materials[body->material], body);
   }
-  /* At most the densest seeding over the whole domain, and the membranes'
-   * points. */
-  if (n > cells * top + surf) {
-    own *= (cells * top + surf) / n;
-    n = cells * top + surf;
+  /* At most the densest seeding over the whole domain, and the particles
+   * seeded apart. */
+  if (n > cells * top + apart) {
+    own *= (cells * top + apart) / n;
+    n = cells * top + apart;
   }
   /* Per particle: the common arrays, x0, mass and vol0 of the model, dx, cp
    * and cs of the workspace, and the 9 of the output buffer. */

@@ -189,6 +189,12 @@ static pm_err check_bodies(const pm_scene *s) {
                            false,
                            "expected 1 or %d integers (dimension %d), got %d",
                            s->dimension, s->dimension, b->n_ppc);
+    if (b->shape == PM_BODY_IMAGE && b->n_ppc)
+      return pm_scene_fail(
+          s, PM_PATH(p, "bodies.%d.particles_per_cell", i), true,
+          "expected no particles_per_cell for an image body (it is seeded "
+          "per voxel: use image.particles_per_voxel), got "
+          "particles_per_cell");
     if (b->moving && pm_scene_has(s, PM_PATH(p, "bodies.%d.velocity", i)))
       return pm_scene_fail(s, p, true,
                            "expected motion or velocity, got both (a body "

@@ -1,9 +1,10 @@
 /* mpm_seed: particles from the scene's bodies.  A volume body is seeded n
  * per direction regularly in each cell (its own particles_per_cell, or the
  * scene's) where it is the last body containing the point; a membrane's
- * particles are the vertices of its surface.  Particles are grouped by
- * material, and within a group by body, so that each body's particles are
- * one range. */
+ * particles are the vertices of its surface; an image body's, n^d per
+ * labelled voxel, apart from the cells and from the other bodies.
+ * Particles are grouped by material, and within a group by body, so that
+ * each body's particles are one range. */
 #include "mpm_seed.h"
 
 #include <math.h>
@@ -12,6 +13,7 @@
 #include <string.h>
 
 #include "gm_curve.h"
+#include "gm_image.h"
 #include "gm_shape.h"
 #include "gm_trisurf.h"
 #include "mpm_kind.h"
@@ -19,10 +21,16 @@
 
 typedef struct {
   const pm_scene *s;
-  gm_shape **shape; /* per body: volume bodies (NULL for membranes) */
-  gm_trisurf *surf; /* per body: membranes' points (and triangles) */
-  double **share;   /* per body: each membrane point's area (2D: length) */
-  int (*ppc)[3];    /* per body: particles per cell and direction */
+  gm_shape **shape;  /* per body: volume bodies seeded in cells (NULL for
+                        membranes and images, which take no part in the
+                        bodies' precedence) */
+  gm_trisurf *surf;  /* per body: membranes' points (and triangles) */
+  double **share;    /* per body: each membrane point's area (2D: length) */
+  int (*ppc)[3];     /* per body: particles per cell and direction */
+  gm_image *image;   /* per body: the image an image body reads first (each
+                        image is read once) */
+  gm_shape **voxels; /* per body: an image body's voxels, on image[b] of
+                        the first body that reads the same image */
 } seeder;
 
 /* The last volume body containing x (later bodies take precedence), or
@@ -166,6 +174,49 @@ static pm_err membrane_region(const seeder *sd, int b, int mb, gm_shape **out) {
   return body_fail(s, b, outside ? "outside" : "inside", what);
 }
 
+/* A failure located at the value of bodies.b.image.KEY: what (if any),
+ * then the message of the call that failed. */
+static pm_err image_fail(const pm_scene *s, int b, const char *key,
+                         const char *what) {
+  char p[PM_SDOC_PATH], msg[1024];
+  snprintf(msg, sizeof msg, "%s", pm_error_message());
+  return pm_scene_fail(s, PM_PATH(p, "bodies.%d.image.%s", b, key), false,
+                       "%s%s%s", what, what[0] ? ": " : "", msg);
+}
+
+/* The voxels of image body b in *out, on its image, read only for the
+ * first body that reads it; a label range that matches no voxel fails.
+ * Failures name the key of bodies.b.image at fault. */
+static pm_err make_voxels(seeder *sd, int b, gm_shape **out) {
+  const pm_scene *s = sd->s;
+  const pm_scene_body *body = &s->bodies[b];
+  int src = b;
+  for (int a = 0; a < b && src == b; a++)
+    if (sd->image[a].v && gm_image_same_source(&s->bodies[a], body)) src = a;
+  if (src == b && gm_image_of_body(body, &sd->image[b]) != PM_SUCCESS)
+    return image_fail(
+        s, b, gm_image_source_key(body),
+        body->image.source == PM_IMAGE_TIFF
+            ? "expected a TIFF of 8- or 16-bit grey pages, or a folder of them"
+        : body->image.source == PM_IMAGE_RAW
+            ? "expected a raw volume of the given size"
+            : "expected a point file of voxel centres on the given grid");
+  const char *key = NULL;
+  if (gm_shape_from_image(&sd->image[src], body, s->dimension, out, &key) !=
+      PM_SUCCESS)
+    return image_fail(s, b, key, "");
+  const gm_image_part *part = gm_shape_image(*out);
+  if (gm_image_part_voxels(part) > 0) return PM_SUCCESS;
+  char p[PM_SDOC_PATH];
+  return pm_scene_fail(
+      s, PM_PATH(p, "bodies.%d.image.label", b), false,
+      "expected a range matching some voxel of %s (crop [%ld, %ld) x [%ld, "
+      "%ld) x [%ld, %ld)), got [%u, %u]: no voxel",
+      body->image.file, part->lo[0], part->hi[0], part->lo[1], part->hi[1],
+      part->lo[2], part->hi[2], (unsigned)part->label[0],
+      (unsigned)part->label[1]);
+}
+
 /* Every body's shape or surface, each inside the grid (domain.box): a
  * particle outside it would have no nodes.  Failures name the body's
  * position. */
@@ -176,6 +227,8 @@ static pm_err make_shapes(seeder *sd, const mpm_options *o) {
   PM_CALL(PM_ALLOC(sd->surf, nb, "membrane surfaces"));
   PM_CALL(PM_ALLOC(sd->share, nb, "membrane point shares"));
   PM_CALL(PM_ALLOC(sd->ppc, nb, "particles per cell"));
+  PM_CALL(PM_ALLOC(sd->image, nb, "body images"));
+  PM_CALL(PM_ALLOC(sd->voxels, nb, "body voxels"));
   for (int b = 0; b < nb; b++) {
     const pm_scene_body *body = &s->bodies[b];
     for (int c = 0; c < 3; c++)
@@ -194,13 +247,17 @@ static pm_err make_shapes(seeder *sd, const mpm_options *o) {
       PM_CALL(membrane_region(sd, b, body->surface_body, &sd->shape[b]));
       continue;
     }
-    if (gm_shape_create(body, s->dimension, s->box_min, s->box_max,
-                        0.5 * s->mesh_size, &sd->shape[b]) != PM_SUCCESS) {
+    gm_shape **shape = &sd->shape[b];
+    if (body->shape == PM_BODY_IMAGE) {
+      shape = &sd->voxels[b];
+      PM_CALL(make_voxels(sd, b, shape));
+    } else if (gm_shape_create(body, s->dimension, s->box_min, s->box_max,
+                               0.5 * s->mesh_size, shape) != PM_SUCCESS) {
       snprintf(msg, sizeof msg, "%s", pm_error_message());
       return PM_ERROR(PM_ERR_SCENE, "%s:%d:%d: bodies.%d: %s", s->path,
                       body->mark.line, body->mark.col, b, msg);
     }
-    if (gm_shape_check_inside(sd->shape[b], b, s->box_min, s->box_max) !=
+    if (gm_shape_check_inside(*shape, b, s->box_min, s->box_max) !=
         PM_SUCCESS) {
       snprintf(msg, sizeof msg, "%s", pm_error_message());
       return PM_ERROR(PM_ERR_SCENE,
@@ -258,6 +315,7 @@ typedef struct {
   long *count; /* per body */
   long *next;  /* per body: fill position */
   int group_of[MPM_MAX_GROUPS];
+  int body; /* the image body being seeded */
   mpm_model *m;
   mpm_state *st;
 } seed_ctx;
@@ -301,6 +359,18 @@ static void place_seed(void *ctx, const double x[3], int b) {
     if (top > end + 1e-12 * hs) vol *= (end - (x[d] - 0.5 * hs)) / hs;
   }
   place(c, b, c->next[b]++, x, vol);
+}
+
+static void place_voxel(void *ctx, const double x[3], double vol) {
+  seed_ctx *c = ctx;
+  place(c, c->body, c->next[c->body]++, x, vol);
+}
+
+/* Image body b's particles (place NULL: their count). */
+static long seed_voxels(seed_ctx *c, int b, gm_image_seed_fn place) {
+  c->body = b;
+  return gm_image_seeds(gm_shape_image(c->sd->voxels[b]), c->s->dimension,
+                        (int)c->s->bodies[b].image.per_voxel, place, c);
 }
 
 /* Membrane body b: its surface's vertices, each with its share of the
@@ -417,6 +487,8 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   for (int b = 0; b < nb; b++) {
     if (s->bodies[b].shape == PM_BODY_MEMBRANE)
       c.count[b] = sd.surf[b].n_points;
+    else if (s->bodies[b].shape == PM_BODY_IMAGE)
+      c.count[b] = seed_voxels(&c, b, NULL);
     else
       for_each_seed(&sd, &m->grid, b, count_seed, &c);
   }
@@ -440,6 +512,8 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
       if (c.group_of[s->bodies[b].material] != gi) continue;
       if (s->bodies[b].shape == PM_BODY_MEMBRANE)
         PM_TRY(place_membrane(&c, b, &t));
+      else if (s->bodies[b].shape == PM_BODY_IMAGE)
+        seed_voxels(&c, b, place_voxel);
       else
         for_each_seed(&sd, &m->grid, b, place_seed, &c);
     }
@@ -453,12 +527,16 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
 done:
   mpm_state_destroy(c.st);
   for (int b = 0; sd.shape && b < nb; b++) gm_shape_destroy(sd.shape[b]);
+  for (int b = 0; sd.voxels && b < nb; b++) gm_shape_destroy(sd.voxels[b]);
+  for (int b = 0; sd.image && b < nb; b++) gm_image_free(&sd.image[b]);
   for (int b = 0; sd.surf && b < nb; b++) gm_trisurf_free(&sd.surf[b]);
   for (int b = 0; sd.share && b < nb; b++) free(sd.share[b]);
   free(sd.share);
   free(sd.shape);
   free(sd.surf);
   free(sd.ppc);
+  free(sd.voxels);
+  free(sd.image);
   free(c.count);
   free(c.next);
   return ret;

@@ -90,4 +90,17 @@ static inline void pm_test_write_file(const char *dir, const char *name,
   assert_int_equal(fclose(f), 0);
 }
 
+/* "path:line:col" of the first occurrence of needle in text (where a
+ * located message about it points). */
+static inline void pm_test_locate(const char *path, const char *text,
+                                  const char *needle, char *buf, size_t size) {
+  const char *at = strstr(text, needle);
+  assert_non_null(at);
+  int line = 1;
+  const char *bol = text;
+  for (const char *c = text; c < at; c++)
+    if (*c == '\n') line++, bol = c + 1;
+  snprintf(buf, size, "%s:%d:%d", path, line, (int)(at - bol) + 1);
+}
+
 #endif

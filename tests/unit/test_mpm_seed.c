@@ -12,18 +12,6 @@
 /* ---- 4. bad scenes --------------------------------------------------------
  */
 
-/* "path:line:col" of the first occurrence of needle in text. */
-static void locate(const char *path, const char *text, const char *needle,
-                   char *buf, size_t size) {
-  const char *at = strstr(text, needle);
-  assert_non_null(at);
-  int line = 1;
-  const char *bol = text;
-  for (const char *c = text; c < at; c++)
-    if (*c == '\n') line++, bol = c + 1;
-  snprintf(buf, size, "%s:%d:%d", path, line, (int)(at - bol) + 1);
-}
-
 static void assert_message(const char *f1, const char *f2, const char *f3) {
   const char *msg = pm_error_message();
   const char *frag[] = {f1, f2, f3};
@@ -90,7 +78,7 @@ static void test_bad_scenes(void **state) {
   char path[512], at[600];
   for (size_t k = 0; k < sizeof BAD / sizeof BAD[0]; k++) {
     pm_test_write_file(*state, BAD[k].name, BAD[k].text, path);
-    locate(path, BAD[k].text, BAD[k].at, at, sizeof at);
+    pm_test_locate(path, BAD[k].text, BAD[k].at, at, sizeof at);
     pm_scene *s = (pm_scene *)&s; /* must be reset to NULL */
     pm_error_clear();
     if (!BAD[k].at_create) {
@@ -113,7 +101,7 @@ static void test_bad_scenes(void **state) {
   }
   /* The same sphere reaching below y = 0 names that side. */
   pm_test_write_file(*state, "sphere-low.yaml", BAD[2].text, path);
-  locate(path, BAD[2].text, BAD[2].at, at, sizeof at);
+  pm_test_locate(path, BAD[2].text, BAD[2].at, at, sizeof at);
   const char *low = "bodies.1.sphere.center=[0.5, 0.1, 0.5]";
   pm_scene *s = NULL;
   assert_ok(pm_scene_load(path, 1, &low, &s));

@@ -85,8 +85,17 @@ typedef enum {
                          (MPM): a triangulated surface's vertices (3D), a
                          curve's points (2D) or a point cloud */
   PM_BODY_INSIDE,     /* inside: the inside of a closed membrane body */
-  PM_BODY_OUTSIDE     /* outside: the domain outside a closed membrane */
+  PM_BODY_OUTSIDE,    /* outside: the domain outside a closed membrane */
+  PM_BODY_IMAGE       /* image: the voxels of a labelled volumetric image
+                         whose intensity is in a range (MPM) */
 } pm_body_shape;
+
+/* Where an image body's voxels come from (image.file, .raw, .points). */
+typedef enum {
+  PM_IMAGE_TIFF = 0, /* a multi-page TIFF, or a folder of TIFF files */
+  PM_IMAGE_RAW,      /* raw: {file, size, bits}, x fastest */
+  PM_IMAGE_POINTS    /* points: {file, size, unit}: voxel centres */
+} pm_image_source;
 
 /* The surface of a membrane body. */
 typedef enum {
@@ -151,6 +160,29 @@ typedef struct {
     double area; /* points: total area (3D) or length (2D) shared equally
                     when the file gives none per point; 0: not given */
   } membrane;
+  /* PM_BODY_IMAGE: n^d particles in each voxel of the crop whose
+   * intensity is in [label[0], label[1]]. */
+  struct {
+    pm_image_source source;
+    /* The TIFF file or folder, raw file or point file: relative paths
+     * resolved against the scene's folder. */
+    char *file;
+    double size[3]; /* raw, points: voxels per axis (n_size of them) */
+    int n_size;
+    int bits;        /* raw: 8 or 16 */
+    double unit;     /* points: metres per unit of the file */
+    double voxel[3]; /* voxel size, m (n_voxel of them; in 2D z only
+                        places a point file's centres) */
+    int n_voxel;
+    double origin[3]; /* corner of voxel (0, 0, 0), m (likewise) */
+    int n_origin;
+    double crop_min[3], crop_max[3]; /* voxel indices, half-open; n_crop 0:
+                                        the whole image */
+    int n_crop_min, n_crop_max;
+    double label[2]; /* inclusive intensity range */
+    int n_label;
+    long per_voxel; /* n: particles per voxel and direction */
+  } image;
   char *inside, *outside; /* PM_BODY_INSIDE / OUTSIDE: the membrane body's
                              name */
   int surface_body;       /* ... and its index */

@@ -34,6 +34,26 @@ static pm_err relative_to_scene(const pm_scene *s, char **path) {
   return PM_SUCCESS;
 }
 
+/* Which of keys[0 .. n) the mapping at path holds, in *given: one at
+ * most (two fail: "expected one WHAT, got A and B", at the second);
+ * none is -1, or, with missing, fails as the missing key(s) missing. */
+static pm_err one_key(pm_reader *r, const char *path, const char *const *keys,
+                      int n, const char *what, const char *missing,
+                      int *given) {
+  char p[2 * PM_SDOC_PATH];
+  *given = -1;
+  for (int k = 0; k < n; k++) {
+    if (!pm_reader_has(r, PM_PATH(p, "%s.%s", path, keys[k]))) continue;
+    if (*given >= 0)
+      return pm_reader_fail(r, p, true, "expected one %s, got %s and %s", what,
+                            keys[*given], keys[k]);
+    *given = k;
+  }
+  if (*given < 0 && missing)
+    return pm_reader_fail(r, path, false, "missing required key %s", missing);
+  return PM_SUCCESS;
+}
+
 /* A membrane: exactly one surface (sphere, rectangle, file in 3D; curve in
  * 2D; points in either), and a normal method it can use. */
 static pm_err finish_membrane(pm_reader *r, pm_scene *s, int i,
@@ -41,21 +61,12 @@ static pm_err finish_membrane(pm_reader *r, pm_scene *s, int i,
   static const char *const keys[] = {"sphere", "rectangle", "file", "curve",
                                      "points"};
   char p[PM_SDOC_PATH];
-  int given = -1;
-  for (int k = 0; k < 5; k++) {
-    if (!pm_reader_has(r, PM_PATH(p, "bodies.%d.membrane.%s", i, keys[k])))
-      continue;
-    if (given >= 0)
-      return pm_reader_fail(r, p, true,
-                            "expected one surface (sphere, rectangle, file, "
-                            "curve or points), got %s and %s",
-                            keys[given], keys[k]);
-    given = k;
-  }
-  if (given < 0)
-    return pm_reader_fail(r, PM_PATH(p, "bodies.%d.membrane", i), false,
-                          "missing required key sphere, rectangle, file, "
-                          "curve or points (the membrane's surface)");
+  int given;
+  PM_CALL(one_key(r, PM_PATH(p, "bodies.%d.membrane", i), keys, 5,
+                  "surface (sphere, rectangle, file, curve or points)",
+                  "sphere, rectangle, file, curve or points (the membrane's "
+                  "surface)",
+                  &given));
   b->membrane.surface = (pm_surface_kind)given;
   const bool curve = b->membrane.surface == PM_SURFACE_CURVE;
   const bool cloud = b->membrane.surface == PM_SURFACE_POINTS;
@@ -97,26 +108,66 @@ static pm_err finish_membrane(pm_reader *r, pm_scene *s, int i,
   return PM_SUCCESS;
 }
 
+/* An image: exactly one source (file, raw or points), as many numbers as
+ * the dimension asks (2 or 3 in 2D, where z is unused or selects a slice),
+ * a crop of at least one voxel and a label range lo <= hi.  What needs
+ * the image itself (a crop inside it, a label matching some voxel) is
+ * checked when it is read. */
+static pm_err finish_image(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
+  static const char *const keys[] = {"file", "raw", "points"};
+  char p[PM_SDOC_PATH];
+  int given;
+  PM_CALL(one_key(r, PM_PATH(p, "bodies.%d.image", i), keys, 3,
+                  "source (file, raw or points)",
+                  "file, raw or points (the image's voxels)", &given));
+  b->image.source = (pm_image_source)given;
+  const struct {
+    const char *key;
+    int n;
+  } counts[] = {
+      {"voxel", b->image.n_voxel},
+      {"origin", b->image.n_origin},
+      {"crop.min", b->image.n_crop_min},
+      {"crop.max", b->image.n_crop_max},
+      {given == PM_IMAGE_RAW ? "raw.size" : "points.size", b->image.n_size}};
+  for (int k = 0; k < 5; k++)
+    if (counts[k].n != 0 && counts[k].n < s->dimension)
+      return pm_reader_fail(r,
+                            PM_PATH(p, "bodies.%d.image.%s", i, counts[k].key),
+                            false, "expected %d numbers (dimension %d), got %d",
+                            s->dimension, s->dimension, counts[k].n);
+  if (b->image.n_crop_max != b->image.n_crop_min)
+    return pm_reader_fail(r, PM_PATH(p, "bodies.%d.image.crop.max", i), false,
+                          "expected %d numbers like crop.min, got %d",
+                          b->image.n_crop_min, b->image.n_crop_max);
+  for (int c = 0; c < b->image.n_crop_min; c++)
+    if (!(b->image.crop_max[c] > b->image.crop_min[c]))
+      return pm_reader_expected(
+          r, PM_PATH(p, "bodies.%d.image.crop.max.%d", i, c),
+          "an index > crop.min (a crop of at least one voxel)");
+  if (b->image.label[1] < b->image.label[0])
+    return pm_reader_fail(r, PM_PATH(p, "bodies.%d.image.label", i), false,
+                          "expected [lo, hi] with lo <= hi, got [%g, %g]",
+                          b->image.label[0], b->image.label[1]);
+  return relative_to_scene(s, &b->image.file);
+}
+
 /* Exactly one shape key; the shape's own checks. */
 static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
-  static const char *const keys[] = {"region", "box",      "sphere", "cylinder",
-                                     "mesh",   "membrane", "inside", "outside"};
+  static const char *const keys[] = {"region",   "box",     "sphere",
+                                     "cylinder", "mesh",    "membrane",
+                                     "inside",   "outside", "image"};
   static const pm_body_shape shapes[] = {
-      PM_BODY_REGION, PM_BODY_BOX,      PM_BODY_SPHERE, PM_BODY_CYLINDER,
-      PM_BODY_MESH,   PM_BODY_MEMBRANE, PM_BODY_INSIDE, PM_BODY_OUTSIDE};
+      PM_BODY_REGION,   PM_BODY_BOX,     PM_BODY_SPHERE,
+      PM_BODY_CYLINDER, PM_BODY_MESH,    PM_BODY_MEMBRANE,
+      PM_BODY_INSIDE,   PM_BODY_OUTSIDE, PM_BODY_IMAGE};
   enum { N_SHAPES = sizeof shapes / sizeof shapes[0] };
   char p[PM_SDOC_PATH];
-  int given = -1;
-  for (int k = 0; k < N_SHAPES; k++) {
-    if (!pm_reader_has(r, PM_PATH(p, "bodies.%d.%s", i, keys[k]))) continue;
-    if (given >= 0)
-      return pm_reader_fail(r, p, true,
-                            "expected one shape (region, box, sphere, "
-                            "cylinder, mesh, membrane, inside or outside), "
-                            "got %s and %s",
-                            keys[given], keys[k]);
-    given = k;
-  }
+  int given;
+  PM_CALL(one_key(r, PM_PATH(p, "bodies.%d", i), keys, N_SHAPES,
+                  "shape (region, box, sphere, cylinder, mesh, membrane, "
+                  "inside, outside or image)",
+                  NULL, &given));
   if (given < 0) {
     b->shape = PM_BODY_DOMAIN;
     return PM_SUCCESS;
@@ -140,6 +191,7 @@ static pm_err finish_shape(pm_reader *r, pm_scene *s, int i, pm_scene_body *b) {
     return PM_SUCCESS;
   case PM_BODY_MESH: return relative_to_scene(s, &b->mesh);
   case PM_BODY_MEMBRANE: return finish_membrane(r, s, i, b);
+  case PM_BODY_IMAGE: return finish_image(r, s, i, b);
   default: return PM_SUCCESS;
   }
 }

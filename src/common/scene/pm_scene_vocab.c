@@ -346,6 +346,133 @@ static const pm_key motion_keys[] = {
      .doc = "{x, y, z}: velocity f(t) of the rigid body (unset: 0)"},
     {0}};
 
+/* image: a labelled volumetric image, one body per intensity range.  Raw
+ * volumes and point files are given their size. */
+#define IMAGE_SIZE_KEY                                                         \
+  {                                                                            \
+    .name = "size", .type = PM_KEY_NUMBERS, .offset = B(image.size),           \
+    .count_offset = B(image.n_size), .flags = PM_KEY_REQUIRED | PM_KEY_WHOLE,  \
+    .range = PM_RANGE_GE, .lo = 1, .min_count = 2, .max_count = 3,             \
+    .doc = "[nx, ny(, nz)] voxels"                                             \
+  }
+static const pm_name image_bits_names[] = {{"8", 8}, {"16", 16}, {NULL, 0}};
+static const pm_key image_raw_keys[] = {
+    {.name = "file",
+     .type = PM_KEY_STRING,
+     .offset = B(image.file),
+     .flags = PM_KEY_REQUIRED,
+     .doc = "nx ny nz values (x fastest, little-endian, no header), relative "
+            "to the scene"},
+    IMAGE_SIZE_KEY,
+    {.name = "bits",
+     .type = PM_KEY_ENUM,
+     .offset = B(image.bits),
+     .def = "8",
+     .names = image_bits_names,
+     .doc = "8 or 16 bits per voxel"},
+    {0}};
+static const pm_key image_points_keys[] = {
+    {.name = "file",
+     .type = PM_KEY_STRING,
+     .offset = B(image.file),
+     .flags = PM_KEY_REQUIRED,
+     .doc = "one voxel centre per line (x y [z]; '#' comments), relative to "
+            "the scene: those voxels 255, the others 0"},
+    IMAGE_SIZE_KEY,
+    {.name = "unit",
+     .type = PM_KEY_NUMBER,
+     .offset = B(image.unit),
+     .def = "1",
+     .range = PM_RANGE_GT,
+     .unit = "m",
+     .doc = "metres per unit of the file (1e-6: micrometres)"},
+    {0}};
+static const pm_key image_crop_keys[] = {
+    {.name = "min",
+     .type = PM_KEY_NUMBERS,
+     .offset = B(image.crop_min),
+     .count_offset = B(image.n_crop_min),
+     .flags = PM_KEY_REQUIRED | PM_KEY_WHOLE,
+     .range = PM_RANGE_GE,
+     .lo = 0,
+     .min_count = 2,
+     .max_count = 3,
+     .doc = "[i0, j0(, k0)]: the first voxel"},
+    {.name = "max",
+     .type = PM_KEY_NUMBERS,
+     .offset = B(image.crop_max),
+     .count_offset = B(image.n_crop_max),
+     .flags = PM_KEY_REQUIRED | PM_KEY_WHOLE,
+     .range = PM_RANGE_GE,
+     .lo = 1,
+     .min_count = 2,
+     .max_count = 3,
+     .doc = "[i1, j1(, k1)]: one past the last"},
+    {0}};
+static const pm_key image_keys[] = {
+    {.name = "file",
+     .type = PM_KEY_STRING,
+     .offset = B(image.file),
+     .doc = "a multi-page TIFF, or a folder of TIFFs (read in the order of "
+            "their names), 8- or 16-bit grey; relative to the scene"},
+    {.name = "raw",
+     .type = PM_KEY_MAPPING,
+     .keys = image_raw_keys,
+     .doc = "{file, size, bits}: a raw volume (instead of file)"},
+    {.name = "points",
+     .type = PM_KEY_MAPPING,
+     .keys = image_points_keys,
+     .doc = "{file, size, unit}: a point file of voxel centres (instead of "
+            "file)"},
+    {.name = "voxel",
+     .type = PM_KEY_NUMBERS,
+     .offset = B(image.voxel),
+     .count_offset = B(image.n_voxel),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .min_count = 2,
+     .max_count = 3,
+     .unit = "m",
+     .doc = "voxel size [dx, dy(, dz)] (in 2D, dz only places a point file's "
+            "centres)"},
+    {.name = "origin",
+     .type = PM_KEY_NUMBERS,
+     .offset = B(image.origin),
+     .count_offset = B(image.n_origin),
+     .def = "0, 0, 0",
+     .min_count = 2,
+     .max_count = 3,
+     .unit = "m",
+     .doc = "the corner of voxel (0, 0, 0) (in 2D, z only places a point "
+            "file's centres; the particles are at z = 0)"},
+    {.name = "crop",
+     .type = PM_KEY_MAPPING,
+     .keys = image_crop_keys,
+     .doc = "{min, max}: voxel indices, half-open (default: the whole "
+            "image; in 2D one slice)"},
+    {.name = "label",
+     .type = PM_KEY_NUMBERS,
+     .offset = B(image.label),
+     .count_offset = B(image.n_label),
+     .flags = PM_KEY_REQUIRED | PM_KEY_WHOLE,
+     .range = PM_RANGE_GE | PM_RANGE_LE,
+     .lo = 0,
+     .hi = 65535,
+     .min_count = 2,
+     .max_count = 2,
+     .doc = "[lo, hi]: the intensities of this body's voxels, inclusive; "
+            "one body per range maps labels to materials"},
+    {.name = "particles_per_voxel",
+     .type = PM_KEY_INTEGER,
+     .offset = B(image.per_voxel),
+     .def = "1",
+     .range = PM_RANGE_GE | PM_RANGE_LE,
+     .lo = 1,
+     .hi = 16,
+     .doc = "n per direction: n^d particles at the sub-voxel centres, each "
+            "of 1/n^d of the voxel's volume"},
+    {0}};
+
 static const pm_key body_keys[] = {
     {.name = "name",
      .type = PM_KEY_STRING,
@@ -385,6 +512,13 @@ static const pm_key body_keys[] = {
      .keys = membrane_keys,
      .doc = "{thickness, sphere | rectangle | file | curve | points, normals}: "
             "a membrane (MPM)"},
+    {.name = "image",
+     .type = PM_KEY_MAPPING,
+     .keys = image_keys,
+     .doc = "{file | raw | points, voxel, origin, crop, label, "
+            "particles_per_voxel}: the voxels of a labelled image whose "
+            "intensity is in label (MPM), seeded per voxel, not per cell, "
+            "apart from other bodies' precedence"},
     {.name = "inside",
      .type = PM_KEY_STRING,
      .offset = B(inside),
