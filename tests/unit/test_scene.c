@@ -273,8 +273,8 @@ static void test_bad_overrides(void **state) {
   bad_override(F2, "mesh_size", "--set mesh_size: expected KEY=VALUE", NULL);
   bad_override(F2, "boundary.4.traction.x=2*w", "--set boundary.4.traction.x",
                "unknown variable w");
-  bad_override(F2, "method=sph",
-               "--set method=sph: ", "expected one of fpm, mpm, mpm-implicit, got sph");
+  bad_override(F2, "method=sph", "--set method=sph: ",
+               "expected one of fpm, mpm, mpm-implicit, got sph");
   bad_override(MINIMAL, "boundary.0.on=xmin",
                "--set boundary.0.on=xmin: ", "boundary is not in the scene");
   /* A value nested past any key's needs is refused as such, not as a
