@@ -60,6 +60,7 @@ struct mpm_implicit {
   double residual;
   double jmin; /* stability.min_jacobian */
   bool matrix_free;
+  bool fbar; /* mpm.fbar: cell (the stress from the bucket's Jbar) */
   int threads;
   double *tmin;        /* per thread: smallest J of a force evaluation */
   double min_jacobian; /* of the last force evaluation */
@@ -154,9 +155,206 @@ static void note_failure(mpm_implicit *im, long p, const char *what, double J) {
     }                                                                          \
   }
 
+/* Visit the buckets (the particles sharing a cell: linear B-splines; a
+ * stencil: quadratic), colour by colour: BODY sees q0, q1, the bucket's
+ * range in im->order. */
+#define FOR_BUCKETS(im, ...)                                                   \
+  for (int col_ = 0; col_ < (im)->ncol; col_++) {                              \
+    const long c0_ = (im)->cptr[col_], c1_ = (im)->cptr[col_ + 1];             \
+    PM_OMP(parallel for schedule(dynamic, 16))                                 \
+    for (long b_ = c0_; b_ < c1_; b_++) {                                      \
+      const long bk_ = (im)->cbuck[b_];                                        \
+      const long q0 = (im)->bucket[bk_], q1 = (im)->bucket[bk_ + 1];           \
+      __VA_ARGS__                                                              \
+    }                                                                          \
+  }
+
+/* ---- F-bar (mpm.fbar: cell) ----------------------------------------------
+ * The stress of particle q comes from Fbar = a F, a = (Jbar / J)^(1/d) on
+ * the first d rows and columns (plane strain keeps the out-of-plane
+ * stretch), Jbar = sum_c w_p J_p over the particles of q's bucket, w_p =
+ * V0_p / sum_c V0.  The residual is the derivative of sum V0 W(Fbar):
+ *   T_q = V0 a P(Fbar) - s_q G_q + (S / Jbar) w_q J_q G_q,
+ *   s_q = V0 a (P(Fbar) : F_d) / d,  S = sum_c s_p,  G = F^-T,
+ * F_d: F's first d rows and columns; f_I = sum_q T_q F_b^T grad S_I.  Its
+ * directional derivative (below) is the exact tangent; it couples the
+ * particles of a bucket only, which share their stencil, so the Jacobian's
+ * pattern is unchanged. */
+
+/* What F-bar needs of one particle at u (and, with du, its derivative). */
+typedef struct {
+  double F[9], G[9], Fd[9], J;
+  double dF[9], dJ;
+} fbar_point;
+
+static inline void fbar_point_at(const mpm_implicit *im, long p,
+                                 const mpm_stencil *st, const double *u,
+                                 const double *du, fbar_point *fp) {
+  particle_F(im, p, st, u, fp->F);
+  fp->J = pm_t_det(fp->F);
+  double Finv[9];
+  pm_t_inverse(fp->F, Finv);
+  pm_t_transpose(Finv, fp->G);
+  memcpy(fp->Fd, fp->F, sizeof fp->Fd);
+  if (im->dim == 2) fp->Fd[8] = 0;
+  if (!du) return;
+  double dD[9] = {0};
+  for (int k = 0; k < st->n; k++) {
+    const double *uk = du + 3 * st->node[k];
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) dD[3 * i + j] += uk[i] * st->grad[k][j];
+  }
+  const double *Fb = base_F(im, p);
+  if (Fb)
+    pm_t_mul(dD, Fb, fp->dF);
+  else
+    memcpy(fp->dF, dD, sizeof dD);
+  fp->dJ = fp->J * pm_t_ddot(fp->G, fp->dF);
+}
+
+/* Fbar = a F on the first d rows and columns. */
+static inline void fbar_scale(int dim, double a, const double F[9],
+                              double Fbar[9]) {
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      Fbar[3 * i + j] = (i < dim && j < dim ? a : 1.0) * F[3 * i + j];
+}
+
+/* The bucket [q0, q1)'s sums: Jbar, sum V0, and with du dJbar. */
+static inline void fbar_bucket_J(const mpm_implicit *im, long q0, long q1,
+                                 const double *u, const double *du,
+                                 double *Jbar, double *V, double *dJbar) {
+  double sv = 0, sj = 0, sd = 0;
+  for (long q = q0; q < q1; q++) {
+    const long p = im->order[q];
+    mpm_stencil st;
+    mpm_stencil_at(&im->g, im->xb + 3 * p, MPM_STENCIL_GRAD, &st);
+    fbar_point fp;
+    fbar_point_at(im, p, &st, u, du, &fp);
+    const double V0 = im->m->vol0[p];
+    sv += V0;
+    sj += V0 * fp.J;
+    if (du) sd += V0 * fp.dJ;
+  }
+  *V = sv;
+  *Jbar = sj / sv;
+  if (dJbar) *dJbar = sd / sv;
+}
+
+/* T_q of particle p (with dT when du: then dS and dJbar are the bucket's
+ * sums' derivatives), from the bucket's Jbar, S and sum V0.  Also s_q (and
+ * ds_q) for the sums' pass.  False when the stress or tangent fails. */
+static bool fbar_particle(const mpm_implicit *im, long p, const fbar_point *fp,
+                          double Jbar, double S, double V, double dJbar,
+                          double dS, bool with_d, double T[9], double dT[9],
+                          double *s_out, double *ds_out) {
+  const int d = im->dim;
+  const mpm_solid_view *v = &im->view[im->grp[p]];
+  const double *ms = model_state(im, p);
+  const double V0 = im->m->vol0[p], w = V0 / V;
+  if (!(fp->J > 0) || !(Jbar > 0)) return false;
+  const double a = pow(Jbar / fp->J, 1.0 / d);
+  double Fbar[9], P[9];
+  fbar_scale(d, a, fp->F, Fbar);
+  if (!pm_material_stress(v->mat, Fbar, ms, P, NULL, NULL)) return false;
+  const double PF = pm_t_ddot(P, fp->Fd);
+  const double s = V0 * a * PF / d;
+  if (s_out) *s_out = s;
+  if (T)
+    for (int k = 0; k < 9; k++)
+      T[k] = V0 * a * P[k] - s * fp->G[k] + (S / Jbar) * w * fp->J * fp->G[k];
+  if (!with_d) return true;
+  const double da = (a / d) * (dJbar / Jbar - fp->dJ / fp->J);
+  double dFbar[9], dP[9];
+  fbar_scale(d, a, fp->dF, dFbar);
+  for (int k = 0; k < 9; k++) dFbar[k] += da * fp->Fd[k];
+  if (!pm_material_tangent(v->mat, Fbar, ms, dFbar, dP)) return false;
+  double dFd[9];
+  memcpy(dFd, fp->dF, sizeof dFd);
+  if (d == 2) dFd[8] = 0;
+  const double ds = V0 / d * (da * PF + a * (pm_t_ddot(dP, fp->Fd) +
+                                            pm_t_ddot(P, dFd)));
+  if (ds_out) *ds_out = ds;
+  if (!dT) return true;
+  /* dG = -G dF^T G */
+  double dFT[9], t1[9], dG[9];
+  pm_t_transpose(fp->dF, dFT);
+  pm_t_mul(fp->G, dFT, t1);
+  pm_t_mul(t1, fp->G, dG);
+  for (int k = 0; k < 9; k++) dG[k] = -dG[k];
+  const double r = S / Jbar, dr = dS / Jbar - S * dJbar / (Jbar * Jbar);
+  for (int k = 0; k < 9; k++)
+    dT[k] = V0 * (da * P[k] + a * dP[k]) - ds * fp->G[k] - s * dG[k] +
+            dr * w * fp->J * fp->G[k] +
+            r * w * (fp->dJ * fp->G[k] + fp->J * dG[k]);
+  return true;
+}
+
+/* Nodal force (du NULL) or its derivative along du (into f) with F-bar.
+ * False on a failed particle (im->fail_msg). */
+static bool fbar_force(mpm_implicit *im, const double *u, const double *du,
+                       double *f) {
+  const mpm_model *m = im->m;
+  const double lam = im->lam0 + im->lam_local * (im->lam1 - im->lam0);
+  memset(f, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
+  im->fail_p = -1;
+  for (int t = 0; t < im->threads; t++) im->tmin[t] = INFINITY;
+  FOR_BUCKETS(im, {
+    double Jbar, V, dJbar = 0, S = 0, dS = 0;
+    fbar_bucket_J(im, q0, q1, u, du, &Jbar, &V, du ? &dJbar : NULL);
+    bool ok = Jbar > im->jmin;
+    for (long q = q0; q < q1 && ok; q++) {
+      const long p = im->order[q];
+      mpm_stencil st;
+      mpm_stencil_at(&im->g, im->xb + 3 * p, MPM_STENCIL_GRAD, &st);
+      fbar_point fp;
+      fbar_point_at(im, p, &st, u, du, &fp);
+      double s, ds = 0;
+      ok = fbar_particle(im, p, &fp, Jbar, 0, V, dJbar, 0, du != NULL, NULL,
+                         NULL, &s, du ? &ds : NULL);
+      S += s;
+      dS += ds;
+    }
+    if (!ok) {
+      note_failure(im, im->order[q0], "F-bar: J or the cell's Jbar failed",
+                   Jbar);
+      continue;
+    }
+    double *tl = im->tmin + pm_omp_thread();
+    if (Jbar < *tl) *tl = Jbar;
+    for (long q = q0; q < q1; q++) {
+      const long p = im->order[q];
+      mpm_stencil st;
+      mpm_stencil_at(&im->g, im->xb + 3 * p, MPM_STENCIL_W | MPM_STENCIL_GRAD,
+                     &st);
+      fbar_point fp;
+      fbar_point_at(im, p, &st, u, du, &fp);
+      double T[9], dT[9], Q[9];
+      fbar_particle(im, p, &fp, Jbar, S, V, dJbar, dS, du != NULL,
+                    du ? NULL : T, du ? dT : NULL, NULL, NULL);
+      to_base(base_F(im, p), du ? dT : T, Q);
+      const double mg = lam * m->mass[p];
+      for (int k = 0; k < st.n; k++) {
+        double *fk = f + 3 * st.node[k];
+        const double *gk = st.grad[k];
+        for (int i = 0; i < 3; i++)
+          fk[i] += Q[3 * i] * gk[0] + Q[3 * i + 1] * gk[1] +
+                   Q[3 * i + 2] * gk[2];
+        if (im->has_gravity && !du)
+          for (int i = 0; i < 3; i++) fk[i] -= mg * st.w[k] * im->gravity[i];
+      }
+    }
+  })
+  im->min_jacobian = INFINITY;
+  for (int t = 0; t < im->threads; t++)
+    im->min_jacobian = fmin(im->min_jacobian, im->tmin[t]);
+  return im->fail_p < 0;
+}
+
 /* Nodal force f = f_int - lambda f_gravity from the nodal values u.
  * Returns false when a particle's stress fails (im->fail_msg). */
 static bool nodal_force(mpm_implicit *im, const double *u, double *f) {
+  if (im->fbar) return fbar_force(im, u, NULL, f);
   const mpm_model *m = im->m;
   const double lam = im->lam0 + im->lam_local * (im->lam1 - im->lam0);
   memset(f, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
@@ -226,6 +424,12 @@ static pm_err cb_apply(void *ctx, const double *x, const double *dx,
   fill_u(im, x);
   memset(im->du, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
   for (long k = 0; k < im->nunk; k++) im->du[im->unk_dof[k]] = dx[k];
+  if (im->fbar) {
+    if (!fbar_force(im, im->u, im->du, im->df))
+      return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
+    for (long k = 0; k < im->nunk; k++) dr[k] = im->df[im->unk_dof[k]];
+    return PM_SUCCESS;
+  }
   memset(im->df, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
   const double *du = im->du;
   double *df = im->df;
@@ -680,7 +884,7 @@ static pm_err make_solver(mpm_implicit *im) {
       .residual = cb_residual,
       .jacobian_apply = cb_apply,
       .jacobian_prepare = cb_prepare,
-      .jacobian_values = im->matrix_free ? NULL : cb_values,
+      .jacobian_values = im->matrix_free || im->fbar ? NULL : cb_values,
       .pat_ptr = im->pat_ptr,
       .pat_idx = im->pat_idx,
       .precond_apply = im->matrix_free ? cb_precond : NULL,
@@ -721,6 +925,30 @@ static pm_err commit(mpm_implicit *im, const double *x) {
   for (long k = 0; k < im->nunk; k++)
     rr += im->f[im->unk_dof[k]] * im->f[im->unk_dof[k]];
   im->residual = rf > 0 ? sqrt(rr / rf) : sqrt(rr);
+  if (im->fbar) /* the stress from Fbar, before F_b changes */
+    FOR_BUCKETS(im, {
+      double Jbar, V;
+      fbar_bucket_J(im, q0, q1, im->u, NULL, &Jbar, &V, NULL);
+      for (long q = q0; q < q1; q++) {
+        const long p = im->order[q];
+        mpm_stencil stn;
+        mpm_stencil_at(&im->g, im->xb + 3 * p, MPM_STENCIL_GRAD, &stn);
+        double F[9], Fbar[9], P[9];
+        particle_F(im, p, &stn, im->u, F);
+        fbar_scale(im->dim, pow(Jbar / pm_t_det(F), 1.0 / im->dim), F, Fbar);
+        const mpm_solid_view *v = &im->view[im->grp[p]];
+        if (!pm_material_stress(v->mat, Fbar, model_state(im, p), P, NULL,
+                                NULL))
+          continue; /* nodal_force succeeded on the same state */
+        double *sig = st->sigma + 9 * p;
+        for (int i = 0; i < 3; i++)
+          for (int j = 0; j < 3; j++)
+            sig[3 * i + j] =
+                (P[3 * i] * Fbar[3 * j] + P[3 * i + 1] * Fbar[3 * j + 1] +
+                 P[3 * i + 2] * Fbar[3 * j + 2]) /
+                Jbar;
+      }
+    })
   const long n = im->n;
   const double *u = im->u;
   long bad = -1;
@@ -740,11 +968,12 @@ static pm_err commit(mpm_implicit *im, const double *x) {
       continue;
     }
     double *sig = st->sigma + 9 * p;
-    for (int i = 0; i < 3; i++)
-      for (int j = 0; j < 3; j++)
-        sig[3 * i + j] = (P[3 * i] * F[3 * j] + P[3 * i + 1] * F[3 * j + 1] +
-                          P[3 * i + 2] * F[3 * j + 2]) /
-                         J;
+    if (!im->fbar)
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+          sig[3 * i + j] = (P[3 * i] * F[3 * j] + P[3 * i + 1] * F[3 * j + 1] +
+                            P[3 * i + 2] * F[3 * j + 2]) /
+                           J;
     memcpy(v->F + 9 * (p - im->group_begin[gi]), F, sizeof F);
     st->vol[p] = m->vol0[p] * J;
     for (int c = 0; c < 3; c++) {
