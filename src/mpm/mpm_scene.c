@@ -16,6 +16,10 @@ static const pm_name energy_update_names[] = {
     {"iterative", MPM_ENERGY_ITERATIVE},
     {"non-iterative", MPM_ENERGY_NON_ITERATIVE},
     {0}};
+static const pm_name fbar_names[] = {{"none", MPM_FBAR_NONE},
+                                     {"cell", MPM_FBAR_CELL},
+                                     {"patch", MPM_FBAR_PATCH},
+                                     {0}};
 static const pm_name axis_names[] = {
     {"x", 1u << 0}, {"y", 1u << 1}, {"z", 1u << 2}, {0}};
 
@@ -85,6 +89,14 @@ static const pm_key mpm_keys[] = {
      .names = axis_names,
      .doc = "grid velocity components held at zero (1-D runs in the 3-D "
             "code)"},
+    {.name = "fbar",
+     .type = PM_KEY_ENUM,
+     .offset = O(fbar),
+     .def = "none",
+     .names = fbar_names,
+     .doc = "F-bar for solids against volumetric locking: the stress sees "
+            "J averaged over the particles of each cell (cell) or over the "
+            "nodes' patches (patch); none: each particle's own"},
     {.name = "fluid",
      .type = PM_KEY_MAPPING,
      .keys = fluid_keys,
