@@ -104,15 +104,17 @@ static double image_particles(const pm_scene *s, int b, double box) {
 
 /* Doubles per particle of the kind of body b's particles, as its setup
  * lays them out: a fluid's density, energy, pressure and q; a solid's F, q
- * and its model's state; a membrane's frame, strain, damage and failed,
- * and its triangles (two per point) with their incidence and normals. */
-static double kind_doubles(const pm_scene_material *sm,
-                           const pm_scene_body *b) {
+ * and its model's state, and with F-bar its Jbar - 1 and the workspace's
+ * J - 1 and cell or patch average; a membrane's frame, strain, damage and
+ * failed, and its triangles (two per point) with their incidence and
+ * normals. */
+static double kind_doubles(const pm_scene_material *sm, const pm_scene_body *b,
+                           bool fbar) {
   const mpm_kind *k = mpm_kind_of(sm, mpm_body_role_of(b));
   if (k == &mpm_kind_fluid) return 4;
   if (k == &mpm_kind_rigid) return 0;
   if (k == &mpm_kind_membrane) return 9 + 3 + 2 + 2 * (3 + 6);
-  return 9 + 1 + sm->mat.state_size;
+  return 9 + 1 + sm->mat.state_size + (fbar ? 3 : 0);
 }
 
 size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
@@ -129,6 +131,7 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
     nodes *= k + 1 + 2 * ghost;
     ppc *= o->ppc[c];
   }
+  const bool fbar = o->fbar != MPM_FBAR_NONE;
   /* Particles: per body, at most the domain's.  Membranes' points and
    * image voxels' particles are not seeded in cells: apart. */
   double n = 0, own = 0, top = ppc, apart = 0;
@@ -149,7 +152,7 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
       top = fmax(top, bppc);
     }
     n += nb;
-    own += nb * kind_doubles(&s->materials[body->material], body);
+    own += nb * kind_doubles(&s->materials[body->material], body, fbar);
   }
   /* At most the densest seeding over the whole domain, and the particles
    * seeded apart. */
@@ -163,10 +166,12 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
       n * (mpm_particle_bytes_common() + 5 * d + 5 * d + 9 * d) + own * d;
   /* Per node: mass, momentum, force, two velocities and the impedance, the
    * threads' accumulators, the conditions' folds and owners, the state's
-   * previous force and fixed flags. */
+   * previous force and fixed flags, and F-bar's partial sums and
+   * averages. */
   double per_node = (1 + 3 * 4 + 3 + 2) * d +
                     pm_omp_threads() * (MPM_ACC_BASE + 2) * d + 6 * d +
-                    3 * sizeof(short) + 3 * d + 3;
+                    3 * sizeof(short) + 3 * d + 3 +
+                    (fbar ? (2 * pm_omp_threads() + 1) * d : 0);
   bytes += nodes * per_node;
   *points = n < (double)LONG_MAX ? (long)n : LONG_MAX;
   return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;

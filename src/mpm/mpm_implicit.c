@@ -1146,6 +1146,7 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   im->dim = m->dim;
   im->mode = (mpm_grid_mode)ms->implicit.grid;
   im->matrix_free = ms->implicit.op == MPM_OP_MATRIX_FREE;
+  im->fbar = ms->fbar == MPM_FBAR_CELL;
   im->jmin = s->stability.min_jacobian;
   im->has_gravity = m->opt.has_gravity;
   for (int c = 0; c < 3; c++) im->gravity[c] = m->opt.gravity[c];
@@ -1389,7 +1390,9 @@ pm_err mpm_implicit_check_tangent(mpm_implicit *im, double lambda, double amp,
   PM_TRY(PM_ALLOC(fd, nz, "check"));
   im->lam_local = lambda;
   smooth_field(im, amp, x);
-  PM_TRY(cb_values(im, x, val));
+  /* the values the solver assembles (directly, or coloured from the
+   * product with F-bar) */
+  PM_TRY(pm_newton_jacobian_values(im->solver, x, val));
   /* central differences, column by column */
   double dmax = 0, err_a = 0, err_m = 0;
   for (long j = 0; j < n; j++) {

@@ -17,6 +17,7 @@ void mpm_options_from_scene(const pm_scene *s, mpm_options *o) {
       .update = (mpm_update)set->update,
       .flip = set->flip,
       .null_velocity = set->null_velocity,
+      .fbar = (mpm_fbar_mode)set->fbar,
       .energy_update = (mpm_energy_update)set->fluid.energy_update,
       .energy_tolerance = set->fluid.tolerance,
       .max_iterations = (int)set->fluid.max_iterations,

@@ -25,6 +25,7 @@ typedef struct mpm_options {
   double flip;            /* FLIP fraction of the particle velocity update */
   int ppc[3];             /* particles per cell and direction */
   unsigned null_velocity; /* grid velocity components held at zero (mask) */
+  mpm_fbar_mode fbar;     /* F-bar of the solids' stress */
   mpm_energy_update energy_update; /* kinds with an energy equation */
   double energy_tolerance;
   int max_iterations;

@@ -22,6 +22,10 @@ static const pm_name operator_names[] = {
     {"assembled", MPM_OP_ASSEMBLED}, {"matrix-free", MPM_OP_MATRIX_FREE}, {0}};
 static const pm_name convergence_names[] = {
     {"residual", MPM_CONV_RESIDUAL}, {"paper", MPM_CONV_PAPER}, {0}};
+static const pm_name fbar_names[] = {{"none", MPM_FBAR_NONE},
+                                     {"cell", MPM_FBAR_CELL},
+                                     {"patch", MPM_FBAR_PATCH},
+                                     {0}};
 static const pm_name axis_names[] = {
     {"x", 1u << 0}, {"y", 1u << 1}, {"z", 1u << 2}, {0}};
 
@@ -132,6 +136,14 @@ static const pm_key mpm_keys[] = {
      .names = axis_names,
      .doc = "grid velocity components held at zero (1-D runs in the 3-D "
             "code)"},
+    {.name = "fbar",
+     .type = PM_KEY_ENUM,
+     .offset = O(fbar),
+     .def = "none",
+     .names = fbar_names,
+     .doc = "F-bar for solids against volumetric locking: the stress sees "
+            "J averaged over the particles of each cell (cell) or over the "
+            "nodes' patches (patch); none: each particle's own"},
     {.name = "fluid",
      .type = PM_KEY_MAPPING,
      .keys = fluid_keys,
@@ -287,6 +299,11 @@ pm_err mpm_check_scene(const pm_scene *s) {
 pm_err mpm_implicit_check_scene(const pm_scene *s) {
   char p[PM_SDOC_PATH];
   PM_CALL(mpm_check_scene(s));
+  if (mpm_scene_settings(s)->fbar == MPM_FBAR_PATCH)
+    return pm_scene_expected(s, "mpm.fbar",
+                             "none or cell for method mpm-implicit (a node's "
+                             "patch would couple cells beyond the tangent's "
+                             "stencil)");
   for (int i = 0; i < s->n_bodies; i++) {
     const pm_scene_body *b = &s->bodies[i];
     const pm_scene_material *sm = &s->materials[b->material];

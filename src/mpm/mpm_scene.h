@@ -20,6 +20,13 @@ typedef enum {
   MPM_ENERGY_ITERATIVE = 0, /* steps (1)-(6) of the fluid paper, eqs. 27-31 */
   MPM_ENERGY_NON_ITERATIVE  /* energy from the previous stress (eq. 27) */
 } mpm_energy_update;
+/* F-bar for solids (mpm_fbar.h): the volume ratio J the stress sees,
+ * averaged over each grid cell's particles, over a node's patch, or not. */
+typedef enum {
+  MPM_FBAR_NONE = 0,
+  MPM_FBAR_CELL, /* the particles of the cell (of the same material) */
+  MPM_FBAR_PATCH /* J carried to the nodes and back with the shape weights */
+} mpm_fbar_mode;
 
 /* Settings of the mpm section (what the scene says; the model copies what it
  * uses into mpm_options). */
@@ -33,6 +40,7 @@ typedef struct {
                              2D), from mpm.particles_per_cell */
   unsigned null_velocity; /* mpm.null_velocity: grid velocity components
                              held at zero (mask) */
+  int fbar;               /* mpm_fbar_mode: mpm.fbar */
   struct {
     int energy_update;   /* mpm_energy_update */
     double tolerance;    /* relative change that ends the iteration */

@@ -1,11 +1,13 @@
 /* mpm_solid: the solid particle kind: a deformation gradient per particle,
  * F <- (I + dt L) F, and the stress of the material model (neo-Hookean from
- * F, or linear elasticity in the objective Jaumann rate form).  The only
- * file of the MPM that calls the material model. */
+ * F, or linear elasticity in the objective Jaumann rate form), with F-bar
+ * (mpm.fbar) when the scene asks for it.  The only file of the MPM that
+ * calls the material model. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "mpm_fbar.h"
 #include "mpm_kind.h"
 #include "mpm_state.h"
 #include "pm_material.h"
@@ -15,17 +17,19 @@ enum { SOLID_F = 0 }; /* state array slots: F, then q and the model's */
 
 typedef struct {
   pm_material mat;
-  int q;      /* slot of the artificial viscosity pressure, or -1 */
-  int mstate; /* slot of the model's per-particle state, or -1 */
+  int q;              /* slot of the artificial viscosity pressure, or -1 */
+  int mstate;         /* slot of the model's per-particle state, or -1 */
+  int jbar;           /* slot of Jbar - 1 (F-bar), or -1 */
+  mpm_fbar_mode fbar; /* what Jbar averages over */
 } solid_params;
 
 static pm_err solid_setup(mpm_group *g, const pm_scene_material *sm,
                           const mpm_options *opt) {
-  (void)opt;
   solid_params *sp = NULL;
   PM_CALL(PM_ALLOC(sp, 1, "solid constants"));
   sp->mat = sm->mat;
-  sp->q = sp->mstate = -1;
+  sp->q = sp->mstate = sp->jbar = -1;
+  sp->fbar = opt->fbar;
   g->params = sp;
   g->viscosity = 0;
   mpm_group_add_array(g, "F", 9);
@@ -38,6 +42,13 @@ static pm_err solid_setup(mpm_group *g, const pm_scene_material *sm,
   if (sp->mat.state_size > 0) {
     sp->mstate = g->n_arrays;
     mpm_group_add_array(g, "material_state", sp->mat.state_size);
+  }
+  /* The last step's averaged volume ratio: what a rate form's volumetric
+   * rate is measured from, and what the energies are of (0 at the start,
+   * where F = I). */
+  if (sp->fbar != MPM_FBAR_NONE) {
+    sp->jbar = g->n_arrays;
+    mpm_group_add_array(g, "Jbar_minus_1", 1);
   }
   return PM_SUCCESS;
 }
@@ -61,14 +72,38 @@ static const double *model_state(const mpm_group *g, const mpm_state *s,
   return sp->mstate >= 0 ? s->group[g->index].array[sp->mstate].data : NULL;
 }
 
+/* The group's Jbar - 1 (F-bar), or NULL. */
+static double *jbar_of(const solid_params *sp, const mpm_group *g,
+                       const mpm_state *s) {
+  return sp->jbar >= 0 ? s->group[g->index].array[sp->jbar].data : NULL;
+}
+
+/* The deformation gradient the stress and the energy are of: F, or with
+ * F-bar Fbar (into Fbar) from Jbar - 1 (jbar, NULL without F-bar). */
+static inline const double *stress_F(int dim, const double *F,
+                                     const double *jbar, double Fbar[9]) {
+  if (!jbar) return F;
+  double H[9];
+  for (int i = 0; i < 9; i++) H[i] = F[i] - (i % 4 == 0);
+  mpm_fbar_apply(dim, pm_t_det_minus_one(H), *jbar, F, Fbar);
+  return Fbar;
+}
+
 static void solid_describe(const mpm_group *g, char *buf, size_t size) {
   const solid_params *sp = g->params;
+  const char *fbar = sp->fbar == MPM_FBAR_CELL
+                         ? ", F-bar: J averaged over each cell's particles"
+                     : sp->fbar == MPM_FBAR_PATCH
+                         ? ", F-bar: J averaged over the nodes' patches"
+                         : "";
   if (sp->mat.model->rate)
-    snprintf(buf, size, "%s, Jaumann rate form%s", sp->mat.model->name,
-             sp->q >= 0 ? ", artificial viscosity (eq. 32)" : "");
+    snprintf(buf, size, "%s, Jaumann rate form%s%s%s", sp->mat.model->name,
+             sp->fbar != MPM_FBAR_NONE ? " with the averaged tr D" : "",
+             sp->q >= 0 ? ", artificial viscosity (eq. 32)" : "", fbar);
   else
-    snprintf(buf, size, "%s from F%s", sp->mat.model->name,
-             sp->q >= 0 ? ", artificial viscosity (eq. 32)" : "");
+    snprintf(buf, size, "%s from F%s%s%s", sp->mat.model->name,
+             sp->fbar != MPM_FBAR_NONE ? "bar" : "",
+             sp->q >= 0 ? ", artificial viscosity (eq. 32)" : "", fbar);
 }
 
 /* Dilatational wave speed at density rho. */
@@ -76,84 +111,212 @@ static inline double p_wave_speed(const pm_material *mat, double rho) {
   return sqrt(mat->wave_modulus / rho);
 }
 
-static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
+/* Cauchy stress sigma = P F^T / J of the model at F (J its determinant);
+ * false when P is not finite. */
+static inline bool cauchy(const pm_material *mat, const double F[9],
+                          const double *ms, double J, double sig[9]) {
+  double P[9];
+  if (!pm_material_stress(mat, F, ms, P, NULL, NULL)) return false;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      sig[3 * i + j] = (P[3 * i] * F[3 * j] + P[3 * i + 1] * F[3 * j + 1] +
+                        P[3 * i + 2] * F[3 * j + 2]) /
+                       J;
+  return true;
+}
+
+/* The artificial viscosity pressure of eq. 32 at density rho and volume
+ * rate trD into *q, taken off the normal stresses. */
+static inline void viscosity(const pm_material *mat, double c0, double c1,
+                             double h, double rho, double trD, double *q,
+                             double sig[9]) {
+  *q = pm_artificial_viscosity(c0, c1, rho, h, p_wave_speed(mat, rho), trD);
+  sig[0] -= *q;
+  sig[4] -= *q;
+  sig[8] -= *q;
+}
+
+/* F <- (I + dt L) F. */
+static inline void advance_F(double dt, const double L[9], double F[9]) {
+  double A[9], Fn[9];
+  for (int i = 0; i < 9; i++) A[i] = dt * L[i];
+  A[0] += 1;
+  A[4] += 1;
+  A[8] += 1;
+  pm_t_mul(A, F, Fn);
+  memcpy(F, Fn, sizeof Fn);
+}
+
+/* A volume ratio J that stops the run: at or below the bound, or not
+ * finite (recorded for particle p).  True when J is fine. */
+static inline bool jacobian_ok(mpm_work *w, long p, double J, double jmin) {
+  if (J > jmin && isfinite(J)) return true;
+  mpm_fail(w, p,
+           J > 0 ? "volume ratio J = %g <= stability.min_jacobian = %g"
+                 : "volume ratio J = %g <= 0: inverted (bound %g)",
+           J, jmin);
+  return false;
+}
+
+/* What the stress stage reads and writes of a group, bound once for its
+ * passes; each thread takes its own copy (firstprivate), so that the
+ * fields stay in registers beside the stores to the arrays. */
+typedef struct {
+  const mpm_grid *g;
+  const pm_material *mat;
+  const double *ms; /* the model's state, or NULL */
+  long mss;         /* its stride */
+  double dt, h, c0, c1, jmin;
+  bool rate;
+  int dim;
+  long begin, end;
+  const double *vel, *x, *mass, *vol0;
+  double *F, *vol, *sigma;
+  double *q;    /* artificial viscosity pressure, or NULL */
+  double *jbar; /* Jbar - 1 (F-bar), or NULL */
+} solid_view;
+
+static solid_view view_of(const mpm_ctx *ctx, const mpm_group *gr) {
   const mpm_model *m = ctx->model;
   mpm_state *s = ctx->state;
-  mpm_work *w = ctx->work;
-  const mpm_group *gr = &m->group[self->group];
-  const mpm_grid *g = &m->grid;
   const solid_params *sp = gr->params;
-  const pm_material *mat = &sp->mat;
-  long mss;
-  const double *ms = model_state(gr, s, &mss);
-  const double dt = s->dt, h = g->h, c0 = gr->c0, c1 = gr->c1;
-  const bool rate = mat->model->rate != NULL;
-  const double jmin = m->opt.min_jacobian;
-  const long begin = gr->begin, end = gr->end;
-  const double *vel = w->nodes.vel_stress, *x = s->x, *mass = m->mass,
-               *vol0 = m->vol0;
-  double *Fa = s->group[self->group].array[SOLID_F].data, *vol = s->vol,
-         *sigma = s->sigma;
-  double *qa = sp->q >= 0 ? s->group[self->group].array[sp->q].data : NULL;
+  solid_view v = {
+      .g = &m->grid,
+      .mat = &sp->mat,
+      .dt = s->dt,
+      .h = m->grid.h,
+      .c0 = gr->c0,
+      .c1 = gr->c1,
+      .jmin = m->opt.min_jacobian,
+      .rate = sp->mat.model->rate != NULL,
+      .dim = m->dim,
+      .begin = gr->begin,
+      .end = gr->end,
+      .vel = ctx->work->nodes.vel_stress,
+      .x = s->x,
+      .mass = m->mass,
+      .vol0 = m->vol0,
+      .F = s->group[gr->index].array[SOLID_F].data,
+      .vol = s->vol,
+      .sigma = s->sigma,
+      .q = sp->q >= 0 ? s->group[gr->index].array[sp->q].data : NULL,
+      .jbar = jbar_of(sp, gr, s),
+  };
+  v.ms = model_state(gr, s, &v.mss);
+  return v;
+}
+
+/* Each particle's own F: deformation and stress in one pass. */
+static void stress_own(mpm_ctx *ctx, const mpm_group *gr) {
+  mpm_work *w = ctx->work;
+  const solid_view v = view_of(ctx, gr);
   double maxdiv = 0, Jlow = INFINITY;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(g, mat, ms, mss, w, dt, h, c0, c1, rate, jmin, begin, end, vel,
-                x, mass, vol0, Fa, vol, sigma, qa)
-         reduction(max : maxdiv) reduction(min : Jlow))
-  for (long p = begin; p < end; p++) {
-    long k = p - begin;
-    double L[9], D[9], W[9], A[9], Fn[9];
-    mpm_velocity_gradient(g, vel, x + 3 * p, L);
-    double *F = Fa + 9 * k, *sig = sigma + 9 * p;
-    for (int i = 0; i < 9; i++) A[i] = dt * L[i];
-    A[0] += 1;
-    A[4] += 1;
-    A[8] += 1;
-    pm_t_mul(A, F, Fn);
-    memcpy(F, Fn, sizeof Fn);
+  PM_OMP(parallel for schedule(static) default(none) firstprivate(v)
+         shared(w) reduction(max : maxdiv) reduction(min : Jlow))
+  for (long p = v.begin; p < v.end; p++) {
+    long k = p - v.begin;
+    double L[9], D[9], W[9];
+    mpm_velocity_gradient(v.g, v.vel, v.x + 3 * p, L);
+    double *F = v.F + 9 * k, *sig = v.sigma + 9 * p;
+    advance_F(v.dt, L, F);
     double J = pm_t_det(F);
-    if (!(J > jmin) || !isfinite(J)) {
-      mpm_fail(w, p,
-               J > 0 ? "volume ratio J = %g <= stability.min_jacobian = %g"
-                     : "volume ratio J = %g <= 0: inverted (bound %g)",
-               J, jmin);
-      continue;
-    }
-    vol[p] = vol0[p] * J;
+    if (!jacobian_ok(w, p, J, v.jmin)) continue;
+    v.vol[p] = v.vol0[p] * J;
     Jlow = fmin(Jlow, J);
     mpm_sym_skew(L, D, W);
     double trD = D[0] + D[4] + D[8];
     maxdiv = fmax(maxdiv, fabs(trD));
-    if (rate) {
-      mat->model->rate(mat, D, W, dt, sig);
-      if (qa) sig[0] += qa[k], sig[4] += qa[k], sig[8] += qa[k];
-    } else {
-      double P[9];
-      if (!pm_material_stress(mat, F, ms ? ms + mss * k : NULL, P, NULL,
-                              NULL)) {
-        mpm_fail(w, p, "stress is not finite (J = %g, |F| = %g)", J,
-                 pm_t_norm(F));
-        continue;
-      }
-      /* sigma = P F^T / J */
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-          sig[3 * i + j] = (P[3 * i] * F[3 * j] + P[3 * i + 1] * F[3 * j + 1] +
-                            P[3 * i + 2] * F[3 * j + 2]) /
-                           J;
+    if (v.rate) {
+      v.mat->model->rate(v.mat, D, W, v.dt, sig);
+      if (v.q) sig[0] += v.q[k], sig[4] += v.q[k], sig[8] += v.q[k];
+    } else if (!cauchy(v.mat, F, v.ms ? v.ms + v.mss * k : NULL, J, sig)) {
+      mpm_fail(w, p, "stress is not finite (J = %g, |F| = %g)", J,
+               pm_t_norm(F));
+      continue;
     }
-    if (qa) {
-      double rho = mass[p] / vol[p];
-      double q =
-          pm_artificial_viscosity(c0, c1, rho, h, p_wave_speed(mat, rho), trD);
-      qa[k] = q;
-      sig[0] -= q;
-      sig[4] -= q;
-      sig[8] -= q;
-    }
+    if (v.q)
+      viscosity(v.mat, v.c0, v.c1, v.h, v.mass[p] / v.vol[p], trD, v.q + k,
+                sig);
   }
   if (maxdiv > w->max_div) w->max_div = maxdiv;
   if (Jlow < w->min_jacobian) w->min_jacobian = Jlow;
+}
+
+/* F-bar: every particle's F and J first, then the averages of J, then the
+ * stress of Fbar = (Jbar / J)^(1/d) F.  A rate form takes the volumetric
+ * part of its rate from Jbar, tr Dbar = ln(Jbar / Jbar_last) / dt, and the
+ * artificial viscosity sees tr Dbar too; the particle keeps its own F and
+ * volume. */
+static void stress_fbar(mpm_ctx *ctx, const mpm_group *gr) {
+  mpm_work *w = ctx->work;
+  mpm_fbar_work *fw = &w->fbar;
+  const solid_view v = view_of(ctx, gr);
+  double *jm1 = fw->jm1, *qbar = fw->qbar;
+  long *cell = fw->cell;
+  double maxdiv = 0, Jlow = INFINITY;
+  PM_OMP(parallel for schedule(static) default(none) firstprivate(v)
+         shared(w, jm1, cell) reduction(max : maxdiv) reduction(min : Jlow))
+  for (long p = v.begin; p < v.end; p++) {
+    double L[9], H[9];
+    mpm_velocity_gradient(v.g, v.vel, v.x + 3 * p, L);
+    double *F = v.F + 9 * (p - v.begin);
+    advance_F(v.dt, L, F);
+    for (int i = 0; i < 9; i++) H[i] = F[i] - (i % 4 == 0);
+    jm1[p] = pm_t_det_minus_one(H);
+    if (!jacobian_ok(w, p, 1 + jm1[p], v.jmin)) continue;
+    v.vol[p] = v.vol0[p] * (1 + jm1[p]);
+    Jlow = fmin(Jlow, 1 + jm1[p]);
+    maxdiv = fmax(maxdiv, fabs(L[0] + L[4] + L[8]));
+    if (cell) cell[p] = mpm_fbar_cell(v.g, v.x + 3 * p);
+  }
+  if (maxdiv > w->max_div) w->max_div = maxdiv;
+  if (Jlow < w->min_jacobian) w->min_jacobian = Jlow;
+  if (w->fail.failed) return; /* no average of a failed J */
+  const long b = v.begin, n = v.end - v.begin;
+  if (cell)
+    mpm_fbar_cell_average(fw, n, cell + b, jm1 + b, v.vol0 + b, fw->mean);
+  else
+    mpm_fbar_patch_average(fw, v.g, n, v.x + 3 * b, jm1 + b, v.vol0 + b,
+                           qbar + b);
+  const double *mean = fw->mean;
+  PM_OMP(parallel for schedule(static) default(none) firstprivate(v)
+         shared(w, jm1, qbar, cell, mean))
+  for (long p = v.begin; p < v.end; p++) {
+    const long k = p - v.begin;
+    const double jb = cell ? mean[cell[p]] : qbar[p];
+    const double trDbar = (log1p(jb) - log1p(v.jbar[k])) / v.dt;
+    double *F = v.F + 9 * k, *sig = v.sigma + 9 * p;
+    v.jbar[k] = jb;
+    if (v.rate) {
+      /* D with its in-plane (2-D) or whole (3-D) trace replaced. */
+      double L[9], D[9], W[9];
+      mpm_velocity_gradient(v.g, v.vel, v.x + 3 * p, L);
+      mpm_sym_skew(L, D, W);
+      const double shift = (trDbar - (D[0] + D[4] + D[8])) / v.dim;
+      for (int c = 0; c < v.dim; c++) D[4 * c] += shift;
+      v.mat->model->rate(v.mat, D, W, v.dt, sig);
+      if (v.q) sig[0] += v.q[k], sig[4] += v.q[k], sig[8] += v.q[k];
+    } else {
+      double Fbar[9];
+      mpm_fbar_apply(v.dim, jm1[p], jb, F, Fbar);
+      if (!cauchy(v.mat, Fbar, v.ms ? v.ms + v.mss * k : NULL, 1 + jb, sig)) {
+        mpm_fail(w, p, "stress is not finite (Jbar = %g, |Fbar| = %g)", 1 + jb,
+                 pm_t_norm(Fbar));
+        continue;
+      }
+    }
+    if (v.q)
+      viscosity(v.mat, v.c0, v.c1, v.h, v.mass[p] / v.vol[p], trDbar, v.q + k,
+                sig);
+  }
+}
+
+static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
+  const mpm_group *gr = &ctx->model->group[self->group];
+  if (((const solid_params *)gr->params)->fbar == MPM_FBAR_NONE)
+    stress_own(ctx, gr);
+  else
+    stress_fbar(ctx, gr);
   return mpm_stage_status(ctx, self);
 }
 
@@ -182,13 +345,17 @@ static void solid_energies(const mpm_model *m, const mpm_state *s,
   long mss;
   const double *ms = model_state(g, s, &mss);
   const double *F = s->group[g->index].array[SOLID_F].data, *vol0 = m->vol0;
+  const double *jbar = jbar_of(g->params, g, s);
+  const int dim = m->dim;
   double se = 0; /* from zero, then added (as mpm_fluid.c) */
+  /* With F-bar, the energy of Fbar: that of the stress the step used. */
   PM_OMP(parallel for schedule(static) default(none)
-         shared(mat, ms, mss, begin, end, F, vol0) reduction(+ : se))
+         shared(mat, ms, mss, begin, end, F, vol0, jbar, dim) reduction(+ : se))
   for (long p = begin; p < end; p++) {
     const long k = p - begin;
-    se +=
-        vol0[p] * pm_material_energy(mat, F + 9 * k, ms ? ms + mss * k : NULL);
+    double Fbar[9];
+    const double *Fs = stress_F(dim, F + 9 * k, jbar ? jbar + k : NULL, Fbar);
+    se += vol0[p] * pm_material_energy(mat, Fs, ms ? ms + mss * k : NULL);
   }
   *strain += se;
 }
@@ -196,18 +363,22 @@ static void solid_energies(const mpm_model *m, const mpm_state *s,
 static void solid_fields(const mpm_model *m, const mpm_state *s,
                          const mpm_group *g, double *sed, double *pressure,
                          double *energy) {
-  (void)m;
   const pm_material *mat = &((const solid_params *)g->params)->mat;
   const long begin = g->begin, end = g->end;
   long mss;
   const double *ms = model_state(g, s, &mss);
   const double *F = s->group[g->index].array[SOLID_F].data, *sigma = s->sigma;
+  const double *jbar = jbar_of(g->params, g, s);
+  const int dim = m->dim;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(mat, ms, mss, begin, end, F, sigma, sed, pressure, energy))
+         shared(mat, ms, mss, begin, end, F, sigma, sed, pressure, energy, jbar,
+                dim))
   for (long p = begin; p < end; p++) {
     const double *sg = sigma + 9 * p;
     const long k = p - begin;
-    sed[p] = pm_material_energy(mat, F + 9 * k, ms ? ms + mss * k : NULL);
+    double Fbar[9];
+    const double *Fs = stress_F(dim, F + 9 * k, jbar ? jbar + k : NULL, Fbar);
+    sed[p] = pm_material_energy(mat, Fs, ms ? ms + mss * k : NULL);
     pressure[p] = -(sg[0] + sg[4] + sg[8]) / 3.0;
     energy[p] = 0;
   }

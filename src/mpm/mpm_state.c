@@ -120,6 +120,12 @@ pm_err mpm_work_create(const mpm_model *m, mpm_work **out) {
   }
   if (m->n_moving > 0)
     PM_TRY(PM_ALLOC(w->rigid_mass, m->grid.n_nodes, "moving bodies' masses"));
+  bool solids = false;
+  for (int gi = 0; gi < m->n_groups; gi++)
+    solids |= m->group[gi].kind == &mpm_kind_solid;
+  if (m->opt.fbar != MPM_FBAR_NONE && solids)
+    PM_TRY(mpm_fbar_work_create(&w->fbar, m->opt.fbar, n, m->grid.n_nodes,
+                                pm_omp_threads()));
   pm_timers_init(&w->timers);
   for (int k = 0; k < m->pipeline.n; k++)
     w->timer[k] = pm_timers_add(&w->timers, m->pipeline.stage[k].name);
@@ -142,6 +148,7 @@ void mpm_work_destroy(mpm_work *w) {
     if (w->kind_work[gi]) w->kind_work_free[gi](w->kind_work[gi]);
   }
   free(w->rigid_mass);
+  mpm_fbar_work_destroy(&w->fbar);
   free(w);
 }
 
@@ -154,6 +161,7 @@ size_t mpm_work_bytes(const mpm_model *m, const mpm_work *w) {
   if (w->rigid_mass) scratch += sizeof(double) * (size_t)m->grid.n_nodes;
   return mpm_nodes_bytes(&w->nodes, &m->grid) +
          mpm_cond_work_bytes(&w->cond, &m->grid) +
+         mpm_fbar_work_bytes(&w->fbar) +
          per_particle * sizeof(double) * (size_t)m->n + scratch;
 }
 

@@ -4,6 +4,7 @@
 #ifndef MPM_STATE_H
 #define MPM_STATE_H
 
+#include "mpm_fbar.h"
 #include "mpm_model.h"
 #include "pm_checkpoint.h"
 #include "pm_progress.h"
@@ -70,6 +71,7 @@ typedef struct mpm_work {
   size_t kind_work_bytes[MPM_MAX_GROUPS];
   double *rigid_mass; /* per node: a moving body's mass (bodies with
                          motion only) */
+  mpm_fbar_work fbar; /* F-bar's averages (mpm.fbar and a solid only) */
   /* figures of the last step */
   double max_div;      /* largest |tr D| of the stress update, 1/s */
   double min_jacobian; /* smallest volume ratio J of the stress update */

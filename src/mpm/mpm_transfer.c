@@ -82,11 +82,7 @@ p2g_groups(const mpm_model *m, const mpm_state *s, const mpm_work *w,
  * (inside the parallel region). */
 static void reduce_nodes(mpm_nodes *nd, long nn, int mode, bool imp) {
   const int S = nd->acc_stride;
-#ifdef _OPENMP
-  const int T = omp_get_num_threads();
-#else
-  const int T = 1;
-#endif
+  const int T = pm_omp_team();
   PM_OMP(for schedule(static))
   for (long i = 0; i < nn; i++) {
     double sum[MPM_ACC_BASE + 2] = {0};

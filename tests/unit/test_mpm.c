@@ -1,6 +1,7 @@
 /* test_mpm: the explicit MPM backend's pieces: B-spline weights and their
  * tensor products, mass and momentum conservation of the transfers and the
- * step, and state and stages built only for what a scene holds. */
+ * step, state and stages built only for what a scene holds, and F-bar's
+ * averages. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -8,6 +9,7 @@
 
 #include <cmocka.h>
 
+#include "mpm_fbar.h"
 #include "mpm_testing.h"
 
 /* ---- 1. shape functions ------------------------------------------------- */
@@ -472,6 +474,96 @@ static void test_fluid_state_and_stages(void **state) {
   pm_scene_destroy(s);
 }
 
+/* ---- F-bar ----------------------------------------------------------------
+ */
+
+/* F-bar's state, workspace and stage line exist only when asked for; the
+ * cell average is the volume-weighted mean of each cell's particles, the
+ * patch average reproduces a constant, and Fbar has the averaged volume
+ * ratio with the out-of-plane stretch of plane strain left alone. */
+static void test_fbar(void **state) {
+  (void)state;
+  model m = make_model(MINIMAL, 0, NULL);
+  assert_null(group_array(&m, 0, "Jbar_minus_1"));
+  assert_null(m.work->fbar.partial);
+  assert_null(m.work->fbar.jm1);
+  assert_int_equal(mpm_fbar_work_bytes(&m.work->fbar), 0);
+  assert_null(strstr(find_stage(m.model, "stress: solid")->detail, "F-bar"));
+  drop_model(&m);
+
+  const char *cell = "mpm.fbar=cell", *patch = "mpm.fbar=patch";
+  m = make_model(MINIMAL, 1, &cell);
+  assert_non_null(group_array(&m, 0, "Jbar_minus_1"));
+  assert_non_null(m.work->fbar.cell);
+  assert_null(m.work->fbar.qbar);
+  assert_contains(find_stage(m.model, "stress: solid")->detail,
+                  "F-bar: J averaged over each cell's particles");
+  /* The particles' cells: each its own, the one its x lies in. */
+  const mpm_grid *g = &m.model->grid;
+  for (long p = 0; p < m.model->n; p++) {
+    const double *x = m.state->x + 3 * p;
+    long c = mpm_fbar_cell(g, x);
+    double lo[2] = {g->origin[0] + (double)(c % g->stride[1]) * g->h,
+                    g->origin[1] + (double)(c / g->stride[1]) * g->h};
+    for (int k = 0; k < 2; k++)
+      assert_true(x[k] >= lo[k] && x[k] < lo[k] + g->h);
+  }
+  /* Random J - 1 and volumes on random cells, one cell left empty. */
+  mpm_fbar_work *fw = &m.work->fbar;
+  const long n = m.model->n, ns = fw->n_slots;
+  double *q = malloc(sizeof(double) * n), *v0 = malloc(sizeof(double) * n);
+  long *cl = malloc(sizeof(long) * n);
+  double *num = calloc(ns, sizeof(double)), *den = calloc(ns, sizeof(double));
+  assert_true(q && v0 && cl && num && den);
+  for (long p = 0; p < n; p++) {
+    cl[p] = 1 + (long)(uniform() * (ns - 1)); /* never slot 0 */
+    q[p] = 0.1 * (uniform() - 0.5);
+    v0[p] = 0.5 + uniform();
+    num[cl[p]] += v0[p] * q[p];
+    den[cl[p]] += v0[p];
+  }
+  mpm_fbar_cell_average(fw, n, cl, q, v0, fw->mean);
+  assert_true(fw->mean[0] == 0);
+  for (long c = 1; c < ns; c++)
+    assert_near(fw->mean[c], den[c] > 0 ? num[c] / den[c] : 0, 1e-15);
+  drop_model(&m);
+
+  m = make_model(MINIMAL, 1, &patch);
+  fw = &m.work->fbar;
+  assert_non_null(m.work->fbar.qbar);
+  assert_null(m.work->fbar.cell);
+  assert_contains(find_stage(m.model, "stress: solid")->detail,
+                  "F-bar: J averaged over the nodes' patches");
+  for (long p = 0; p < n; p++) q[p] = 0.0123;
+  mpm_fbar_patch_average(fw, &m.model->grid, n, m.state->x, q, m.model->vol0,
+                         fw->qbar);
+  for (long p = 0; p < n; p++) assert_near(fw->qbar[p], 0.0123, 1e-16);
+  drop_model(&m);
+  free(q);
+  free(v0);
+  free(cl);
+  free(num);
+  free(den);
+
+  /* Fbar: det = Jbar in 2-D (the 2 x 2 block scaled, F_33 = 1 kept) and in
+   * 3-D. */
+  const double F2[9] = {1.01, 0.02, 0, -0.015, 0.995, 0, 0, 0, 1};
+  const double F3[9] = {1.01, 0.02,  0.003, -0.015, 0.995,
+                        0.01, 0.004, -0.02, 1.007};
+  const double jbm1 = -2.5e-3;
+  double Fb[9];
+  mpm_fbar_apply(2, pm_t_det(F2) - 1, jbm1, F2, Fb);
+  assert_near(pm_t_det(Fb), 1 + jbm1, 1e-15);
+  assert_true(Fb[8] == 1 && Fb[2] == 0 && Fb[5] == 0 && Fb[6] == 0);
+  assert_near(Fb[1] / Fb[0], F2[1] / F2[0], 1e-15);
+  mpm_fbar_apply(3, pm_t_det(F3) - 1, jbm1, F3, Fb);
+  assert_near(pm_t_det(Fb), 1 + jbm1, 1e-15);
+  assert_near(Fb[7] / Fb[8], F3[7] / F3[8], 1e-15);
+  /* Jbar = J leaves F as it is. */
+  mpm_fbar_apply(3, pm_t_det(F3) - 1, pm_t_det(F3) - 1, F3, Fb);
+  for (int k = 0; k < 9; k++) assert_true(Fb[k] == F3[k]);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_shape_1d),
@@ -485,6 +577,7 @@ int main(void) {
       cmocka_unit_test(test_solid_state_and_stages),
       cmocka_unit_test_setup_teardown(test_fluid_state_and_stages,
                                       pm_test_make_dir, pm_test_drop_dir),
+      cmocka_unit_test(test_fbar),
   };
   if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);

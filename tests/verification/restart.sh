@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Nothing lost: a run killed with SIGKILL leaves readable results up to its
 # last frame; `resume` after SIGTERM and after SIGKILL ends bit-identical to
-# an uninterrupted run (FPM explicit and static, MPM); resuming a changed scene, another
-# program version or a damaged checkpoint is refused; output folders that
-# are in use, hold another run, are read-only or hit the file size limit
-# fail cleanly.
+# an uninterrupted run (FPM explicit and static, MPM, MPM with F-bar);
+# resuming a changed scene, another program version or a damaged checkpoint
+# is refused; output folders that are in use, hold another run, are
+# read-only or hit the file size limit fail cleanly.
 set -u
 bin=$1
 src=$2
@@ -112,6 +112,13 @@ resume_case fpm-static "$src/cases/fpm/f3-extension-60-h1.09e-2.yaml" 5 \
 mpm=$src/cases/mpm/m2-shock-tube-reduced.yaml
 ckpt_every=100
 resume_case mpm "$mpm" 4 --set time.max_steps=400 --set output.every=50
+# F-bar: the solid's last averaged J, which the rate form's volumetric
+# rate is measured from (linear elasticity, averages over the nodes'
+# patches).
+ckpt_every=800
+resume_case mpm-fbar "$src/cases/mpm/locking-beam.yaml" 4 \
+  --set mpm.fbar=patch --set materials.0.model=linear-elastic \
+  --set time.max_steps=4000 --set output.every=400
 # Membranes (frames, strains, damage), two fluids and moving bodies: the
 # reduced oocyte.
 ckpt_every=200

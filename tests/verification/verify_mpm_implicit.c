@@ -23,7 +23,7 @@
 /* A block [0, 1]^d of a Simo-Hughes neo-Hookean solid (nu 0.3), clamped
  * at ymin and moved at ymax by (0.05, -0.1(, 0.02)): inhomogeneous. */
 static pm_scene *block_scene(int dim, const char *shape, const char *grid,
-                             int cells, int steps) {
+                             int cells, int steps, const char *fbar) {
   char text[2048];
   snprintf(text, sizeof text,
            "name: block\nmethod: mpm-implicit\ndimension: %d\n"
@@ -35,12 +35,13 @@ static pm_scene *block_scene(int dim, const char *shape, const char *grid,
            "boundary:\n"
            "  - {on: ymin, displacement: {x: 0, y: 0%s}}\n"
            "  - {on: ymax, displacement: {x: 0.05, y: -0.1%s}}\n"
-           "mpm: {shape: %s, particles_per_cell: [2], implicit: {grid: %s}}\n"
+           "mpm: {shape: %s, particles_per_cell: [2], fbar: %s, implicit: "
+           "{grid: %s}}\n"
            "time: {end: 1, ramp: 1, quasi_static: {load_steps: %d, "
            "tolerance: 1e-12, max_iterations: 30, linear_solver: direct}}\n",
            dim, dim == 3 ? ", 0" : "", dim == 3 ? ", 1" : "", 1.0 / cells,
-           dim == 3 ? ", z: 0" : "", dim == 3 ? ", z: 0.02" : "", shape, grid,
-           steps);
+           dim == 3 ? ", z: 0" : "", dim == 3 ? ", z: 0.02" : "", shape, fbar,
+           grid, steps);
   pm_scene *s = NULL;
   if (pm_app_init() != PM_SUCCESS) fail_msg("%s", pm_error_message());
   if (pm_scene_load_text(text, strlen(text), "block.yaml", 0, NULL, &s) !=
@@ -58,10 +59,12 @@ static mpm_sim *implicit_sim(const pm_scene *s) {
 
 /* Central differences agree with the tangent to about the differences'
  * own error, h^2 |r'''| ~ 1e-9 relative: bound 1e-6. */
-static void check_tangent(int dim, const char *shape, const char *grid) {
+static void check_tangent(int dim, const char *shape, const char *grid,
+                          const char *fbar) {
   /* reset: the stencils of the face layers take two node planes each */
   const bool reset = strcmp(grid, "reset") == 0;
-  pm_scene *s = block_scene(dim, shape, grid, reset ? 6 : dim == 3 ? 3 : 4, 2);
+  pm_scene *s =
+      block_scene(dim, shape, grid, reset ? 6 : dim == 3 ? 3 : 4, 2, fbar);
   mpm_sim *r = implicit_sim(s);
   if (reset) {
     /* a deformed base: run the first two load steps */
@@ -73,9 +76,9 @@ static void check_tangent(int dim, const char *shape, const char *grid) {
     fail_msg("%s", pm_error_message());
   long unk, nz;
   mpm_implicit_size(r->imp, &unk, &nz);
-  print_message("tangent %dD %-9s grid %-5s: %4ld unknowns, assembled %.2e, "
-                "matrix-free %.2e (bound 1e-6)\n",
-                dim, shape, grid, unk, ea, em);
+  print_message("tangent %dD %-9s grid %-5s F-bar %-4s: %4ld unknowns, "
+                "assembled %.2e, matrix-free %.2e (bound 1e-6)\n",
+                dim, shape, grid, fbar, unk, ea, em);
   assert_true(ea < 1e-6);
   assert_true(em < 1e-6);
   mpm_implicit_backend.destroy(r);
@@ -84,11 +87,15 @@ static void check_tangent(int dim, const char *shape, const char *grid) {
 
 static void test_tangent(void **state) {
   (void)state;
-  check_tangent(2, "linear", "kept");
-  check_tangent(2, "quadratic", "kept");
-  check_tangent(3, "linear", "kept");
-  check_tangent(2, "linear", "reset");
-  check_tangent(3, "linear", "reset");
+  check_tangent(2, "linear", "kept", "none");
+  check_tangent(2, "quadratic", "kept", "none");
+  check_tangent(3, "linear", "kept", "none");
+  check_tangent(2, "linear", "reset", "none");
+  check_tangent(3, "linear", "reset", "none");
+  check_tangent(2, "linear", "kept", "cell");
+  check_tangent(3, "linear", "kept", "cell");
+  check_tangent(2, "linear", "reset", "cell");
+  check_tangent(2, "quadratic", "kept", "cell");
 }
 
 /* The residual norms of the single load step's Newton solve. */
@@ -109,7 +116,7 @@ static pm_err keep_history(void *ctx, const mpm_implicit_step *st) {
  * above roundoff tends to 2. */
 static void test_quadratic(void **state) {
   (void)state;
-  pm_scene *s = block_scene(2, "linear", "kept", 8, 1);
+  pm_scene *s = block_scene(2, "linear", "kept", 8, 1, "none");
   mpm_sim *r = implicit_sim(s);
   history h = {0};
   if (mpm_implicit_run(r->imp, keep_history, &h) != PM_SUCCESS)

@@ -11,12 +11,15 @@
 static inline int pm_omp_threads(void) { return omp_get_max_threads(); }
 static inline void pm_omp_set_threads(int n) { omp_set_num_threads(n); }
 static inline int pm_omp_thread(void) { return omp_get_thread_num(); }
+/* Threads of the team running this (inside a parallel region). */
+static inline int pm_omp_team(void) { return omp_get_num_threads(); }
 #else
 #define PM_OMP_AVAILABLE 0
 #define PM_OMP(...)
 static inline int pm_omp_threads(void) { return 1; }
 static inline void pm_omp_set_threads(int n) { (void)n; }
 static inline int pm_omp_thread(void) { return 0; }
+static inline int pm_omp_team(void) { return 1; }
 #endif
 
 /* LAPACK runs on small matrices inside OpenMP loops (the membranes' normal
