@@ -802,7 +802,7 @@ static pm_err implicit_run(void *p, const pm_observer *obs) {
       fmax(0, lr->time_total - lr->time_residual - lr->time_assembly -
                   lr->time_linear);
   r->status = pm_static_status(e);
-  return e == PM_ERR_NOT_CONVERGED ? PM_ERR_UNSTABLE : e;
+  return e;
 }
 
 static pm_err implicit_summary(void *p, pm_json *j) {

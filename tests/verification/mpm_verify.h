@@ -51,8 +51,11 @@ typedef struct {
 /* The simulation of s, or fail the test. */
 static inline verify_run *verify_create(const pm_scene *s) {
   verify_run *r = calloc(1, sizeof *r);
-  if (!r || mpm_sim_create(s, &r->sim) != PM_SUCCESS)
+  void *sim = NULL;
+  /* the scene's backend: mpm or mpm-implicit, both an mpm_sim */
+  if (!r || s->backend->create(s, &sim) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
+  r->sim = sim;
   return r;
 }
 
@@ -72,7 +75,7 @@ static inline void verify_go(verify_run *r, pm_status expected) {
 
 static inline void verify_destroy(verify_run *r) {
   if (!r) return;
-  mpm_sim_destroy(r->sim);
+  r->sim->scene->backend->destroy(r->sim);
   free(r);
 }
 

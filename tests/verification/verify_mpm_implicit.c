@@ -63,8 +63,11 @@ static void check_tangent(int dim, const char *shape, const char *grid,
                           const char *fbar) {
   /* reset: the stencils of the face layers take two node planes each */
   const bool reset = strcmp(grid, "reset") == 0;
-  pm_scene *s =
-      block_scene(dim, shape, grid, reset ? 6 : dim == 3 ? 3 : 4, 2, fbar);
+  pm_scene *s = block_scene(dim, shape, grid,
+                            reset      ? 6
+                            : dim == 3 ? 3
+                                       : 4,
+                            2, fbar);
   mpm_sim *r = implicit_sim(s);
   if (reset) {
     /* a deformed base: run the first two load steps */

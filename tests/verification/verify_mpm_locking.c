@@ -253,10 +253,39 @@ static void test_repeats_bit_for_bit(void **state) {
     }
 }
 
+/* The same beam by the implicit MPM (grid kept, Newton to the
+ * equilibrium: no relaxation's residual), with each particle's own J and
+ * with F-bar over the cells, at every nu. */
+static void test_implicit(void **state) {
+  (void)state;
+  const char *const more[] = {"method=mpm-implicit",
+                              "time.quasi_static.tolerance=1e-10"};
+  const char *const imodes[] = {"none", "cell"};
+  printf("\nThe same beam by the implicit MPM (grid kept):\n");
+  printf("  %-6s %-6s %12s %12s %9s %10s %7s\n", "nu", "fbar", "deflection",
+         "Timoshenko", "error", "pressure", "wall");
+  double err[N_NU][2], pe[N_NU][2];
+  for (int i = 0; i < N_NU; i++)
+    for (int j = 0; j < 2; j++) {
+      const beam_result b = run_beam(nus[i], imodes[j], 2, more);
+      err[i][j] = b.deflection / b.reference - 1;
+      pe[i][j] = b.pressure_error;
+      printf("  %-6g %-6s %12.5e %12.5e %+9.4f %10.3f %6.2fs\n", nus[i],
+             imodes[j], b.deflection, b.reference, err[i][j], pe[i][j], b.wall);
+    }
+  fflush(stdout);
+  for (int i = 0; i < N_NU; i++) {
+    assert_true(fabs(err[i][1]) <= FBAR_DEFLECTION_BOUND);
+    assert_true(pe[i][1] < pe[i][0]);
+  }
+  assert_true(-err[N_NU - 1][0] >= LOCKED_DEFLECTION_MIN);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_locking_beam),
       cmocka_unit_test(test_rate_form),
+      cmocka_unit_test(test_implicit),
       cmocka_unit_test(test_repeats_bit_for_bit),
   };
   if (pm_app_init() != PM_SUCCESS) return 1;

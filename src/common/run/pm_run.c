@@ -513,9 +513,16 @@ static void conclude(run_ctx *c, pm_err run_err) {
   if (run_err == PM_ERR_INTERRUPTED) {
     f->status = PM_STATUS_INTERRUPTED;
     snprintf(o->message, sizeof o->message, "%s", pm_error_message());
+  } else if (run_err == PM_ERR_NOT_CONVERGED) {
+    /* A solve by load steps that could not go on: its message names the
+     * step, the load and the cause. */
+    f->status = PM_STATUS_NOT_CONVERGED;
+    snprintf(o->message, sizeof o->message, "%s", pm_error_message());
   } else if (run_err == PM_ERR_UNSTABLE &&
-             strstr(pm_error_message(), PM_EXPR_NOT_FINITE)) {
-    /* A condition's expression, not the step: no advice on dt. */
+             (strstr(pm_error_message(), PM_EXPR_NOT_FINITE) ||
+              s->time.qs == PM_QS_STATIC || f->dt == 0)) {
+    /* A condition's expression, or a static solve (load steps, no time
+     * step), not the step: no advice on dt. */
     f->status = PM_STATUS_UNSTABLE;
     snprintf(o->message, sizeof o->message, "%s", pm_error_message());
   } else if (run_err == PM_ERR_UNSTABLE) {
