@@ -1366,9 +1366,10 @@ pm_err mpm_implicit_checkpoint(mpm_implicit *im, pm_ckpt *ck) {
       pm_ckpt_doubles(ck, "implicit.reaction", 3 * im->m->n_bcs, im->reaction));
   PM_CALL(pm_ckpt_double(ck, "implicit.residual", &im->residual));
   if (im->mode == MPM_GRID_KEPT)
-    PM_CALL(pm_load_checkpoint(ck, "implicit", im->nunk, &im->ls, &im->rep));
+    PM_CALL(
+        pm_load_checkpoint(ck, "implicit.load", im->nunk, &im->ls, &im->rep));
   else
-    PM_CALL(pm_load_checkpoint(ck, "implicit", 0, NULL, &im->rep));
+    PM_CALL(pm_load_checkpoint(ck, "implicit.load", 0, NULL, &im->rep));
   if (pm_ckpt_reading(ck) && im->mode == MPM_GRID_RESET) im->built_for = -1;
   return PM_SUCCESS;
 }
