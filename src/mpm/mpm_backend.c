@@ -620,6 +620,11 @@ static void plan_bodies(const mpm_sim *r, FILE *out) {
               body->membrane.thickness, m->dim == 3 ? "area" : "length", area,
               m->dim == 3 ? "^2" : " (per unit depth)",
               pm_key_name_of(pm_normals_names, m->body_normals[b]));
+    } else if (body->shape == PM_BODY_IMAGE) {
+      fprintf(out,
+              ", voxels of %s with intensity in [%g, %g], %ld^%d per voxel",
+              body->image.file, body->image.label[0], body->image.label[1],
+              body->image.per_voxel, m->dim);
     } else if (body->n_ppc) {
       fprintf(out, ", %d x %d x %d per cell", (int)body->ppc[0],
               (int)body->ppc[body->n_ppc == 1 ? 0 : 1],
