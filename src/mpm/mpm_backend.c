@@ -639,6 +639,18 @@ static void plan_bodies(const mpm_sim *r, FILE *out) {
   }
 }
 
+/* How the grid was laid when the loader chose it (a scene made for FPM). */
+static void plan_layout(const mpm_model *m, FILE *out) {
+  const mpm_layout *l = &m->layout;
+  if (!l->mapped) return;
+  fprintf(out, "             chosen for this scene: the largest cell up to "
+               "discretization.mesh_size that divides domain.box; room beyond "
+               "its faces (cells below/above):");
+  for (int c = 0; c < m->dim; c++)
+    fprintf(out, " %c %ld/%ld", "xyz"[c], l -> room[c][0], l -> room[c][1]);
+  fprintf(out, "\n");
+}
+
 static pm_err plan(void *p, FILE *out) {
   mpm_sim *r = p;
   const mpm_model *m = r->model;
@@ -652,6 +664,7 @@ static pm_err plan(void *p, FILE *out) {
           update_name(o->update, true), o->flip);
   fprintf(out, "grid         %ld x %ld x %ld nodes, cell %g m\n", g->nn[0],
           g->nn[1], g->nn[2], g->h);
+  plan_layout(m, out);
   fprintf(out, "particles    %ld (%d x %d x %d per cell)\n", m->n, o->ppc[0],
           o->ppc[1], m->dim == 3 ? o->ppc[2] : 1);
   plan_groups(m, out);
@@ -848,9 +861,9 @@ static pm_err implicit_plan(void *p, FILE *out) {
   fprintf(out, "scene        %s (%s)\n", s->name, s->path);
   fprintf(out, "method       mpm-implicit, %dD%s, %s B-splines, quasi-static\n",
           m->dim, m->dim == 2 ? " plane strain" : "", basis_name(m->opt.shape));
-  fprintf(out,
-          "grid         %ld x %ld x %ld nodes over domain.box, cell %g m\n",
-          g->nn[0], g->nn[1], g->nn[2], g->h);
+  fprintf(out, "grid         %ld x %ld x %ld nodes, cell %g m\n", g->nn[0],
+          g->nn[1], g->nn[2], g->h);
+  plan_layout(m, out);
   fprintf(out, "particles    %ld\n", m->n);
   plan_groups(m, out);
   plan_bodies(r, out);

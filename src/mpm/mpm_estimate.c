@@ -120,7 +120,9 @@ static double kind_doubles(const pm_scene_material *sm, const pm_scene_body *b,
 size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
   const int dim = s->dimension;
   const mpm_settings *o = mpm_scene_settings(s);
-  const double h = s->mesh_size, d = sizeof(double);
+  mpm_layout lay;
+  if (!mpm_grid_layout(s, &lay)) lay.h = s->mesh_size;
+  const double h = lay.h, d = sizeof(double);
   const int ghost = o->shape == MPM_BASIS_QUADRATIC ? 1 : 0;
   double box = 1, nodes = 1, ppc = 1, cells = 1;
   for (int c = 0; c < dim; c++) {
@@ -128,7 +130,7 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
     double k = fmax(1, ceil(len / h - 1e-9));
     box *= len;
     cells *= k;
-    nodes *= k + 1 + 2 * ghost;
+    nodes *= k + 1 + 2 * ghost + (double)(lay.room[c][0] + lay.room[c][1]);
     ppc *= o->ppc[c];
   }
   const bool fbar = o->fbar != MPM_FBAR_NONE;

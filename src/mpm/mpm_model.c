@@ -72,8 +72,11 @@ pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
     m->box_min[c] = s->box_min[c];
     m->box_max[c] = s->box_max[c];
   }
-  PM_TRY(mpm_grid_init(&m->grid, s->dimension, m->opt.shape, s->mesh_size,
-                       s->box_min, s->box_max, s->path));
+  PM_ENSURE(mpm_grid_layout(s, &m->layout), PM_ERR_SCENE,
+            "%s: discretization.mesh_size: no cell divides domain.box",
+            s->path);
+  PM_TRY(mpm_grid_init(&m->grid, s->dimension, m->opt.shape, m->layout.h,
+                       m->layout.lo, m->layout.hi, s->path));
   PM_TRY(mpm_conditions_create(s, &m->grid, &m->bcs, &m->n_bcs));
   for (int b = 0; b < m->n_bcs; b++)
     if (m->bcs[b].absorbing) m->has_absorbing = true;

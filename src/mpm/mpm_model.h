@@ -47,6 +47,7 @@ typedef struct mpm_model {
   int dim;
   double box_min[3], box_max[3];
   mpm_grid grid;
+  mpm_layout layout; /* the box the grid covers and its cell (mpm_scene.h) */
   /* particles: count and constants, 3 or 1 per particle */
   long n;
   double *x0;   /* reference position */

@@ -258,15 +258,13 @@ pm_err mpm_check_scene(const pm_scene *s) {
   char p[64], what[192];
   PM_CALL(check_bodies(s));
   /* The box faces are grid planes, where conditions act. */
-  for (int c = 0; c < s->dimension; c++) {
-    double cells = (s->box_max[c] - s->box_min[c]) / s->mesh_size;
-    if (fabs(cells - round(cells)) > 1e-6 * cells) {
-      snprintf(what, sizeof what,
-               "a cell size that divides domain.box (%g m along %c: %.4g "
-               "cells)",
-               s->box_max[c] - s->box_min[c], "xyz"[c], cells);
-      return pm_scene_expected(s, "discretization.mesh_size", what);
-    }
+  mpm_layout lay;
+  if (!mpm_grid_layout(s, &lay)) {
+    snprintf(what, sizeof what,
+             "a cell size that divides domain.box, or one that can be made "
+             "to by at most 4 times as many cells (%g m along x)",
+             s->box_max[0] - s->box_min[0]);
+    return pm_scene_expected(s, "discretization.mesh_size", what);
   }
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
@@ -335,4 +333,90 @@ pm_err mpm_implicit_check_scene(const pm_scene *s) {
           bc->absorbing ? "absorbing" : "velocity");
   }
   return PM_SUCCESS;
+}
+
+/* Whether n cells of the box's first edge divide every edge. */
+static bool divides(const pm_scene *s, double h) {
+  for (int c = 0; c < s->dimension; c++) {
+    double cells = (s->box_max[c] - s->box_min[c]) / h;
+    if (fabs(cells - round(cells)) > 1e-6 * cells || round(cells) < 1)
+      return false;
+  }
+  return true;
+}
+
+/* The largest prescribed displacement of condition b's component comp at
+ * full load, over its face's corners and centre: its magnitude (sign 0),
+ * or its largest part along sign (the face's outward direction, for its
+ * normal component; 0 when it only moves inward). */
+static double largest_displacement(const pm_scene *s, int b, int comp,
+                                   double sign) {
+  const pm_scene_bc *bc = &s->bcs[b];
+  double T = pm_scene_load_end(s), umax = 0;
+  if (!bc->disp[comp]) return 0;
+  for (int corner = 0; corner < 9; corner++) {
+    double x[3];
+    for (int a = 0; a < 3; a++)
+      x[a] = corner == 8         ? 0.5 * (s->box_min[a] + s->box_max[a])
+             : (corner >> a) & 1 ? s->box_max[a]
+                                 : s->box_min[a];
+    int ax = pm_face_axis(bc->face);
+    x[ax] = pm_face_plane(bc->face, s->box_min, s->box_max);
+    double u = pm_ramp_factor(bc->ramp, bc->ramp_time, T) *
+               pm_expr_eval(bc->disp[comp], x[0], x[1], x[2], T);
+    if (isfinite(u)) umax = fmax(umax, sign != 0 ? sign * u : fabs(u));
+  }
+  return umax;
+}
+
+bool mpm_grid_layout(const pm_scene *s, mpm_layout *lay) {
+  memset(lay, 0, sizeof *lay);
+  for (int c = 0; c < 3; c++) {
+    lay->lo[c] = s->box_min[c];
+    lay->hi[c] = s->box_max[c];
+  }
+  lay->h = s->mesh_size;
+  if (divides(s, s->mesh_size)) return true;
+  /* A scene made for FPM (mesh_size a gmsh element size): the largest
+   * cell no larger than it that puts every face on a grid plane, found
+   * from the first edge's whole numbers of cells. */
+  const double L = s->box_max[0] - s->box_min[0];
+  const long n0 = (long)ceil(L / s->mesh_size - 1e-9);
+  lay->h = 0;
+  for (long n = n0; n <= 4 * n0 && lay->h == 0; n++)
+    if (divides(s, L / n)) lay->h = L / n;
+  if (lay->h == 0) return false;
+  lay->mapped = true;
+  /* Room: beyond each face of the box, for the body to deform into.  A
+   * face whose condition holds its normal component gets the outward
+   * part of that displacement; a free face the largest displacement any
+   * condition prescribes (what a Poisson expansion stays under); each a
+   * cell more. */
+  double umax = 0;
+  for (int b = 0; b < s->n_bcs; b++)
+    for (int c = 0; c < s->dimension; c++)
+      umax = fmax(umax, largest_displacement(s, b, c, 0));
+  for (int c = 0; c < s->dimension; c++)
+    for (int side = 0; side < 2; side++) {
+      double need = umax;
+      for (int b = 0; b < s->n_bcs; b++) {
+        const pm_scene_bc *bc = &s->bcs[b];
+        if (bc->on != PM_ON_FACE || pm_face_axis(bc->face) != c) continue;
+        const bool is_max = bc->face == PM_FACE_XMAX ||
+                            bc->face == PM_FACE_YMAX ||
+                            bc->face == PM_FACE_ZMAX;
+        if (is_max != (side == 1)) continue;
+        if (bc->velocity_mask & (1u << c))
+          need = umax;
+        else if (bc->disp_mask & (1u << c))
+          need = largest_displacement(s, b, c, is_max ? 1.0 : -1.0);
+      }
+      const long cells = need > 0 ? (long)ceil(need / lay->h - 1e-9) + 1 : 0;
+      lay->room[c][side] = cells;
+      if (side == 0)
+        lay->lo[c] = s->box_min[c] - (double)cells * lay->h;
+      else
+        lay->hi[c] = s->box_max[c] + (double)cells * lay->h;
+    }
+  return true;
 }

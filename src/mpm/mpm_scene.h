@@ -3,6 +3,8 @@
 #ifndef MPM_SCENE_H
 #define MPM_SCENE_H
 
+#include <stdbool.h>
+
 #include "pm_backend.h"
 #include "pm_scene.h"
 
@@ -63,6 +65,26 @@ const mpm_settings *mpm_scene_settings(const pm_scene *s);
  * size that does not divide the box, named surfaces, ...), failing at the
  * key with pm_scene_fail. */
 pm_err mpm_check_scene(const pm_scene *s);
+
+/* The grid MPM lays over a scene.  A box that the cell size
+ * (discretization.mesh_size) divides is the grid, as the scene gives it.
+ * Otherwise (a scene made for FPM, whose mesh_size is an element size) the
+ * cell is the largest no larger than mesh_size that divides every edge of
+ * domain.box (from 1 to 4 times as many cells along x), and the grid
+ * reaches past the box by the room the body may deform into: beyond a face
+ * whose condition holds its normal component, the outward part of that
+ * displacement; beyond a free face, the largest displacement of any
+ * condition; each a cell more (none beyond a face held in place).  The
+ * box's faces stay grid planes, where the conditions act. */
+typedef struct {
+  double h;            /* cell size, m */
+  double lo[3], hi[3]; /* the box the grid covers (ghost layers besides) */
+  long room[3][2];     /* cells added below and above the box, per axis */
+  bool mapped;         /* chosen here (true) or the scene's own (false) */
+} mpm_layout;
+
+/* The layout of scene s; false when no cell divides the box. */
+bool mpm_grid_layout(const pm_scene *s, mpm_layout *lay);
 
 /* What method mpm-implicit cannot honour besides: fluids, membranes,
  * moving bodies, velocity and absorbing conditions, models without a

@@ -282,7 +282,8 @@ static void for_each_seed(const seeder *sd, const mpm_grid *g, int b,
   double blo[3], bhi[3];
   bool bounded = gm_shape_bounds(sd->shape[b], blo, bhi);
   for (int c = 0; c < g->dim; c++) {
-    hi[c] = g->nn[c] - 1 - 2 * g->ghost;
+    /* the cells of the domain box (the grid may reach past it: room) */
+    hi[c] = lround((s->box_max[c] - s->box_min[c]) * g->inv_h);
     if (!bounded) continue;
     long a = (long)floor((blo[c] - s->box_min[c]) * g->inv_h) - 1;
     long z = (long)ceil((bhi[c] - s->box_min[c]) * g->inv_h) + 1;
