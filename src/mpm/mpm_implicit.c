@@ -87,12 +87,12 @@ static inline const double *base_F(const mpm_implicit *im, long p) {
   return im->view[gi].F + 9 * (p - im->group_begin[gi]);
 }
 
-/* F = (I + sum_I u_I (x) grad S_I) F_b at particle p from the nodal values
- * u, with the stencil st at its base position. */
-static inline void particle_F(const mpm_implicit *im, long p,
-                              const mpm_stencil *st, const double *u,
-                              double F[9]) {
-  double D[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+/* D + sum_I u_I (x) grad S_I over the stencil st, times F_b of particle
+ * p (F_b = I when the base is the reference): F from D = I, its change
+ * along a nodal direction from D = 0. */
+static inline void gradient_times_base(const mpm_implicit *im, long p,
+                                       const mpm_stencil *st, const double *u,
+                                       double D[9], double out[9]) {
   for (int k = 0; k < st->n; k++) {
     const double *uk = u + 3 * st->node[k];
     for (int i = 0; i < 3; i++)
@@ -100,9 +100,18 @@ static inline void particle_F(const mpm_implicit *im, long p,
   }
   const double *Fb = base_F(im, p);
   if (Fb)
-    pm_t_mul(D, Fb, F);
+    pm_t_mul(D, Fb, out);
   else
-    memcpy(F, D, sizeof D);
+    memcpy(out, D, 9 * sizeof(double));
+}
+
+/* F = (I + sum_I u_I (x) grad S_I) F_b at particle p from the nodal values
+ * u, with the stencil st at its base position. */
+static inline void particle_F(const mpm_implicit *im, long p,
+                              const mpm_stencil *st, const double *u,
+                              double F[9]) {
+  double D[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  gradient_times_base(im, p, st, u, D, F);
 }
 
 /* The model's state of particle p (NULL when its model has none). */
@@ -200,16 +209,7 @@ static inline void fbar_point_at(const mpm_implicit *im, long p,
   if (im->dim == 2) fp->Fd[8] = 0;
   if (!du) return;
   double dD[9] = {0};
-  for (int k = 0; k < st->n; k++) {
-    const double *uk = du + 3 * st->node[k];
-    for (int i = 0; i < 3; i++)
-      for (int j = 0; j < 3; j++) dD[3 * i + j] += uk[i] * st->grad[k][j];
-  }
-  const double *Fb = base_F(im, p);
-  if (Fb)
-    pm_t_mul(dD, Fb, fp->dF);
-  else
-    memcpy(fp->dF, dD, sizeof dD);
+  gradient_times_base(im, p, st, du, dD, fp->dF);
   fp->dJ = fp->J * pm_t_ddot(fp->G, fp->dF);
 }
 
@@ -438,16 +438,8 @@ static pm_err cb_apply(void *ctx, const double *x, const double *dx,
   FOR_PARTICLES(im, {
     double F[9], dD[9] = {0}, dF[9], dP[9], dQ[9];
     particle_F(im, p, &st, im->u, F);
-    for (int k = 0; k < st.n; k++) {
-      const double *uk = du + 3 * st.node[k];
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) dD[3 * i + j] += uk[i] * st.grad[k][j];
-    }
+    gradient_times_base(im, p, &st, du, dD, dF);
     const double *Fb = base_F(im, p);
-    if (Fb)
-      pm_t_mul(dD, Fb, dF);
-    else
-      memcpy(dF, dD, sizeof dF);
     const mpm_solid_view *v = &im->view[im->grp[p]];
     if (!pm_material_tangent(v->mat, F, model_state(im, p), dF, dP)) {
       note_failure(im, p, "no tangent: J <= 0", pm_t_det(F));
@@ -1045,9 +1037,7 @@ pm_err mpm_implicit_run(mpm_implicit *im, mpm_implicit_observer obs,
       im->lam0 = (double)k / N;
       im->lam1 = (double)(k + 1) / N;
       im->lam_local = 0;
-      if (k > (int)llround(im->lambda * N) || im->solver == NULL ||
-          im->built_for != k)
-        e = rebuild(im);
+      if (im->built_for != k) e = rebuild(im); /* create built the first */
       im->built_for = -1;
       if (e) break;
       memset(im->x_unk, 0, sizeof(double) * (size_t)im->nunk);
@@ -1111,18 +1101,8 @@ static pm_err reset_grid(mpm_implicit *im, const pm_scene *s) {
   const mpm_model *m = im->m;
   double umax = 0;
   for (int b = 0; b < m->n_bcs; b++)
-    for (int c = 0; c < im->dim; c++) {
-      if (!(m->bcs[b].disp_mask & (1u << c))) continue;
-      /* the face's corners and centre */
-      for (int corner = 0; corner < 9; corner++) {
-        double x[3];
-        for (int a = 0; a < 3; a++)
-          x[a] = corner == 8         ? 0.5 * (m->box_min[a] + m->box_max[a])
-                 : (corner >> a) & 1 ? m->box_max[a]
-                                     : m->box_min[a];
-        umax = fmax(umax, fabs(bc_value(im, b, c, x)));
-      }
-    }
+    for (int c = 0; c < im->dim; c++)
+      umax = fmax(umax, mpm_bc_largest_displacement(s, b, c, 0));
   const double h = m->grid.h;
   const double room = (ceil(umax / h) + 1) * h;
   double lo[3], hi[3];
@@ -1244,8 +1224,8 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   o->linear_max_iter = 20000;
   o->petsc_options = s->time.qs_solver_options;
   if (im->mode == MPM_GRID_RESET) im->lam1 = 1.0 / im->opt_steps;
-  PM_TRY(rebuild(im));
-  im->built_for = 0;
+  make_buckets(im);
+  PM_TRY(make_dofs(im));
   /* An absolute floor on the residual: a hundred times its roundoff, eps
    * times the stiffest material's P-wave modulus times a node's share of
    * a face (h^(d-1)), over the unknowns.  Below it the relative test
@@ -1256,8 +1236,8 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
     M = fmax(M, im->view[gi].mat->wave_modulus);
   o->atol = 100 * DBL_EPSILON * M * pow(m->grid.h, im->dim - 1) *
             sqrt((double)im->nunk);
-  pm_newton_destroy(&im->solver); /* with the floor */
   PM_TRY(make_solver(im));
+  im->built_for = 0;
   if (im->mode == MPM_GRID_KEPT) PM_TRY(pm_load_state_init(&im->ls, im->nunk));
   /* the initial state's reactions (zero load) */
   for (int b = 0; b < 3 * m->n_bcs; b++) im->reaction[b] = 0;
@@ -1393,8 +1373,8 @@ pm_err mpm_implicit_check_tangent(mpm_implicit *im, double lambda, double amp,
   if (im->mode == MPM_GRID_RESET) PM_CALL(rebuild(im));
   const long n = im->nunk;
   const long nz = im->pat_ptr[n];
-  double *x = NULL, *val = NULL, *fd = NULL, *xp = NULL, *r1 = NULL, *r2 = NULL,
-         *e = NULL, *ke = NULL;
+  double *x = NULL, *val = NULL, *xp = NULL, *r1 = NULL, *r2 = NULL, *e = NULL,
+         *ke = NULL;
   PM_TRY(PM_ALLOC(x, n, "check"));
   PM_TRY(PM_ALLOC(xp, n, "check"));
   PM_TRY(PM_ALLOC(r1, n, "check"));
@@ -1402,7 +1382,6 @@ pm_err mpm_implicit_check_tangent(mpm_implicit *im, double lambda, double amp,
   PM_TRY(PM_ALLOC(e, n, "check"));
   PM_TRY(PM_ALLOC(ke, n, "check"));
   PM_TRY(PM_ALLOC(val, nz, "check"));
-  PM_TRY(PM_ALLOC(fd, nz, "check"));
   im->lam_local = lambda;
   smooth_field(im, amp, x);
   /* the values the solver assembles (directly, or coloured from the
@@ -1441,6 +1420,5 @@ done:
   free(e);
   free(ke);
   free(val);
-  free(fd);
   return ret;
 }

@@ -345,11 +345,7 @@ static bool divides(const pm_scene *s, double h) {
   return true;
 }
 
-/* The largest prescribed displacement of condition b's component comp at
- * full load, over its face's corners and centre: its magnitude (sign 0),
- * or its largest part along sign (the face's outward direction, for its
- * normal component; 0 when it only moves inward). */
-static double largest_displacement(const pm_scene *s, int b, int comp,
+double mpm_bc_largest_displacement(const pm_scene *s, int b, int comp,
                                    double sign) {
   const pm_scene_bc *bc = &s->bcs[b];
   double T = pm_scene_load_end(s), umax = 0;
@@ -395,7 +391,7 @@ bool mpm_grid_layout(const pm_scene *s, mpm_layout *lay) {
   double umax = 0;
   for (int b = 0; b < s->n_bcs; b++)
     for (int c = 0; c < s->dimension; c++)
-      umax = fmax(umax, largest_displacement(s, b, c, 0));
+      umax = fmax(umax, mpm_bc_largest_displacement(s, b, c, 0));
   for (int c = 0; c < s->dimension; c++)
     for (int side = 0; side < 2; side++) {
       double need = umax;
@@ -409,7 +405,7 @@ bool mpm_grid_layout(const pm_scene *s, mpm_layout *lay) {
         if (bc->velocity_mask & (1u << c))
           need = umax;
         else if (bc->disp_mask & (1u << c))
-          need = largest_displacement(s, b, c, is_max ? 1.0 : -1.0);
+          need = mpm_bc_largest_displacement(s, b, c, is_max ? 1.0 : -1.0);
       }
       const long cells = need > 0 ? (long)ceil(need / lay->h - 1e-9) + 1 : 0;
       lay->room[c][side] = cells;

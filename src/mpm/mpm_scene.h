@@ -83,6 +83,13 @@ typedef struct {
   bool mapped;         /* chosen here (true) or the scene's own (false) */
 } mpm_layout;
 
+/* The largest prescribed displacement of condition b's component comp at
+ * full load, over its face's corners and centre: its magnitude (sign 0),
+ * or its largest part along sign (the face's outward direction, for its
+ * normal component; 0 when it only moves inward). */
+double mpm_bc_largest_displacement(const pm_scene *s, int b, int comp,
+                                   double sign);
+
 /* The layout of scene s; false when no cell divides the box. */
 bool mpm_grid_layout(const pm_scene *s, mpm_layout *lay);
 
