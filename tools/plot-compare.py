@@ -130,9 +130,12 @@ def main():
         fig.savefig(path, dpi=120)
         plt.close(fig)
         written.append(path)
-    if not written:
-        fail("nothing to draw: fewer than two methods and no reference", 2)
-    print("pictures: " + ", ".join(written))
+    if not pairs:
+        print("plot-compare: nothing to draw: one method and no reference")
+    elif not written:
+        fail("no comparison has points to draw", 2)
+    else:
+        print("pictures: " + ", ".join(written))
 
 
 if __name__ == "__main__":

@@ -281,17 +281,24 @@ static void draw_differences(const char *dir) {
              *tool = PM_TOOLS_DIR "/plot-compare.py";
   char *const args[] = {(char *)python, (char *)tool, (char *)dir, NULL};
   pid_t pid;
-  int st;
+  int st = 0;
   extern char **environ;
+  const char *why = "no /usr/bin/python3 or no tools/plot-compare.py here";
   /* posix_spawn, not fork: no atfork handlers (MPI's) run in the child. */
-  if (access(python, X_OK) == 0 && access(tool, R_OK) == 0 &&
-      posix_spawn(&pid, python, NULL, NULL, args, environ) == 0 &&
-      waitpid(pid, &st, 0) == pid && WIFEXITED(st) && WEXITSTATUS(st) == 0)
-    return;
+  if (access(python, X_OK) == 0 && access(tool, R_OK) == 0) {
+    if (posix_spawn(&pid, python, NULL, NULL, args, environ) != 0 ||
+        waitpid(pid, &st, 0) != pid || !WIFEXITED(st))
+      why = "the plotting tool did not run to its end";
+    else if (WEXITSTATUS(st) == 0)
+      return;
+    else
+      why = WEXITSTATUS(st) == 3 ? "no matplotlib for /usr/bin/python3"
+                                 : "the plotting tool failed";
+  }
   fprintf(stderr,
-          "pointmech: no pictures drawn; draw them with: python3 %s %s "
-          "(needs matplotlib)\n",
-          tool, dir);
+          "pointmech: no pictures drawn (%s); draw them with: python3 %s "
+          "%s\n",
+          why, tool, dir);
 }
 
 static int cmd_compare(const cli_args *a) {

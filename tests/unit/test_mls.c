@@ -1,7 +1,8 @@
 /* test_mls: moving least squares reproduces linear fields to round-off on
  * scattered points in 3-D and 2-D, whatever the units, inside the cloud, on
  * its corners and a little outside; a point with too few neighbours within
- * the reach is flagged; degenerate clouds are refused. */
+ * the reach is flagged; nearest distances; degenerate clouds are
+ * refused. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -119,6 +120,33 @@ static void test_too_few(void **state) {
   free(f);
 }
 
+/* On a regular lattice of spacing h: every point's nearest neighbour is h
+ * away, and a query's nearest point is where geometry puts it. */
+static void test_nearest(void **state) {
+  (void)state;
+  const int side = 5;
+  const double h = 0.1;
+  double x[3 * 5 * 5 * 5];
+  long n = 0;
+  pm_mls *m = NULL;
+  for (int a = 0; a < side; a++)
+    for (int b = 0; b < side; b++)
+      for (int c = 0; c < side; c++, n++) {
+        x[3 * n] = a * h;
+        x[3 * n + 1] = b * h;
+        x[3 * n + 2] = c * h;
+      }
+  assert_ok(pm_mls_create(n, x, "the lattice", &m));
+  assert_close(pm_mls_gap(m), h, 1e-12, 0);
+  const double on[3] = {0.2, 0.3, 0.1}, off[3] = {-0.3, 0.2, 0.2};
+  const double inside[3] = {0.25, 0.25, 0.25}, far[3] = {2.0, 2.0, 2.0};
+  assert_close(pm_mls_nearest(m, on), 0, 0, 1e-15);
+  assert_close(pm_mls_nearest(m, off), 0.3, 1e-12, 0);
+  assert_close(pm_mls_nearest(m, inside), sqrt(3) * 0.05, 1e-12, 0);
+  assert_close(pm_mls_nearest(m, far), sqrt(3) * 1.6, 1e-12, 0);
+  pm_mls_free(m);
+}
+
 static void test_degenerate(void **state) {
   (void)state;
   double x[9] = {1, 2, 3, 1, 2, 3, 1, 2, 3};
@@ -136,6 +164,7 @@ static void test_degenerate(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_linear_3d), cmocka_unit_test(test_linear_2d),
-      cmocka_unit_test(test_too_few), cmocka_unit_test(test_degenerate)};
+      cmocka_unit_test(test_too_few), cmocka_unit_test(test_nearest),
+      cmocka_unit_test(test_degenerate)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

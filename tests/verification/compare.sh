@@ -10,6 +10,7 @@
 #  - a method the loader refuses, and one that goes unstable, tabulated
 #    with their diagnosis while the other still runs;
 #  - FPM alone on the FPM scene, on the FE lattice the scene names;
+#  - lattice points off the bodies flagged, those on them fitted;
 #  - bad options refused before anything runs.
 set -u
 bin=$1
@@ -157,6 +158,30 @@ for col in nrmse_analytic nrmse_fe; do
 done
 check "FPM F2: one method, no pair table" \
   not_grep '## Between methods' "$out/compare.md"
+
+# ---- lattice points off the bodies: flagged -------------------------------
+# Two disks of radius 0.2 m (MPM, particles 0.025 m apart) on a 9 x 9
+# lattice over [0, 1]^2: each of the 16 lattice points inside a disk is
+# fitted, none farther than 1.5 particle spacings beyond one.
+out=$work/disks
+"$bin" compare "$src/cases/mpm/disks-collision.yaml" --methods mpm \
+  --set time.end=0.1 --out "$out" --quiet >"$out.log" 2>&1
+rc=$?
+check "disks: exit 0 (got $rc)" test $rc -eq 0
+n=$(field "$out/compare.csv" mpm flagged_points)
+check "disks: $n of 81 lattice points flagged, in [57, 65]" \
+  awk -v n="$n" 'BEGIN { exit !(n != "" && n >= 57 && n <= 65) }'
+# shellcheck disable=SC2016
+check "disks: fitted inside the disks, flagged off them" awk -F, '
+  function d(x, y, a, b) { return sqrt((x - a) ^ 2 + (y - b) ^ 2) }
+  NR > 1 {
+    r = d($1, $2, 0.2, 0.2); s = d($1, $2, 0.8, 0.8); if (s < r) r = s
+    fitted = $4 != "nan"
+    if (r <= 0.2 && !fitted) bad++
+    if (r > 0.2 + 1.5 * 0.025 && fitted) bad++
+    rows++
+  }
+  END { exit !(rows == 81 && bad == 0) }' "$out/midplane.csv"
 
 # ---- bad options: refused before anything runs -----------------------------
 refused "unknown method in --set" \

@@ -13,10 +13,14 @@
 #include "pm_mls.h"
 #include "pm_probe.h"
 
-/* How far a lattice point's fit may reach, in mean point spacings: a point
- * farther than that from enough of the method's points (outside its body)
- * is flagged rather than extrapolated to. */
+/* How far a lattice point's fit may reach, in mean point spacings, and
+ * how far its nearest point may be, in mean nearest-neighbour distances: a
+ * point farther than that (off the method's body) is flagged rather than
+ * extrapolated to.  A corner of a body whose points are inset by half their
+ * spacing (MPM particles) is 0.87 of it from its nearest point; a point on
+ * a face of a mesh, at most 0.58 of an edge. */
 #define CMP_REACH 5.0
+#define CMP_GAP 1.5
 /* Regular lattice: points along a long axis at most this many times the
  * shortest axis's intervals. */
 #define CMP_ASPECT_MAX 8
@@ -214,12 +218,22 @@ done:
 
 /* The field u of the cloud mls at every lattice point into out ([m][3]),
  * NaN where flagged; returns the flagged count. */
+/* The field f (ncomp components) at q into v when q lies on the cloud
+ * and a regular fit reaches it; false (v NaN) when q is flagged. */
+static bool fit_on_cloud(pm_mls *mls, const double *q, int ncomp,
+                         const double *f, double *v) {
+  if (pm_mls_nearest(mls, q) <= CMP_GAP * pm_mls_gap(mls) &&
+      pm_mls_fit(mls, q, ncomp, f, CMP_REACH, v) > 0)
+    return true;
+  for (int k = 0; k < ncomp; k++) v[k] = NAN;
+  return false;
+}
+
 static long map_lattice(const cmp_study *c, pm_mls *mls, const double *u,
                         double *out) {
   long flagged = 0;
   for (long i = 0; i < c->m; i++)
-    if (pm_mls_fit(mls, c->x + 3 * i, 3, u, CMP_REACH, out + 3 * i) == 0)
-      flagged++;
+    flagged += !fit_on_cloud(mls, c->x + 3 * i, 3, u, out + 3 * i);
   return flagged;
 }
 
@@ -304,7 +318,7 @@ static pm_err map_method(cmp_study *c, cmp_method *M, const pm_backend *be,
   M->flagged = map_lattice(c, mls, be->displacement(sim), M->u);
   M->mapped = true;
   PM_TRY(von_mises_of(be, sim, p.n, &own, &vm));
-  if (vm) pm_mls_fit(mls, c->centre, 1, vm, CMP_REACH, &M->von_mises_centre);
+  if (vm) fit_on_cloud(mls, c->centre, 1, vm, &M->von_mises_centre);
 done:
   pm_mls_free(mls);
   free(own);

@@ -235,8 +235,10 @@ static void md_notes(const cmp_study *c, FILE *m) {
             c->run_dir);
   fprintf(m, "  Fields are mapped by linear moving least squares (cubic "
              "B-spline weight over 2.2 to 5 mean point spacings); a lattice "
-             "point without enough of a method's points within that reach "
-             "is flagged and left out of every figure.\n");
+             "point farther from a method's points than 1.5 times their mean "
+             "nearest-neighbour distance (off its body), or without enough "
+             "of them within that reach, is flagged and left out of every "
+             "figure.\n");
 }
 
 static void write_md(const cmp_study *c, FILE *m) {

@@ -21,6 +21,7 @@ struct pm_mls {
   long nc[3];          /* cells per axis (1 on flat axes) */
   long *start, *pts;   /* cell c holds pts[start[c] .. start[c+1]) */
   long *near;          /* scratch: the neighbours of one query point */
+  double gap;          /* mean nearest-neighbour distance (< 0: unknown) */
 };
 
 /* ---- Bucket grid ------------------------------------------------------- */
@@ -103,6 +104,7 @@ pm_err pm_mls_create(long n, const double *x, const char *what, pm_mls **out) {
   PM_TRY(PM_ALLOC(c, 1, "moving-least-squares cloud"));
   c->n = n;
   c->x = x;
+  c->gap = -1;
   PM_TRY(build_grid(c, what));
   *out = c;
   c = NULL;
@@ -217,6 +219,39 @@ static bool fit(const pm_mls *c, const double *q, long m, double R, int nc,
     }
   for (int k = 0; k < nc; k++) v[k] = sol[0][k];
   return true;
+}
+
+/* The nearest of the points within growing radii of q, other than point
+ * self (-1: none); its distance. */
+static double nearest_other(pm_mls *m, const double *q, long self) {
+  double R = m->spacing, rmax2 = 0.0;
+  for (int a = 0; a < m->d; a++) {
+    int k = m->axis[a];
+    double dx = fmax(fabs(q[k] - m->lo[k]), fabs(q[k] - m->hi[k]));
+    rmax2 += dx * dx;
+  }
+  for (;;) {
+    long found = gather(m, q, R);
+    double best = INFINITY;
+    for (long j = 0; j < found; j++)
+      if (m->near[j] != self) best = fmin(best, dist2(m, q, m->near[j]));
+    /* Every point within R was gathered: the nearest is among them. */
+    if (isfinite(best) || R * R > rmax2) return sqrt(best);
+    R *= 2;
+  }
+}
+
+double pm_mls_nearest(pm_mls *m, const double *q) {
+  return nearest_other(m, q, -1);
+}
+
+double pm_mls_gap(pm_mls *m) {
+  if (m->gap >= 0) return m->gap;
+  double sum = 0;
+  for (long i = 0; i < m->n && m->n > 1; i++)
+    sum += nearest_other(m, m->x + 3 * i, i);
+  m->gap = m->n > 1 ? sum / (double)m->n : 0;
+  return m->gap;
 }
 
 long pm_mls_fit(pm_mls *m, const double *q, int ncomp, const double *f,

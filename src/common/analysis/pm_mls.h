@@ -26,6 +26,14 @@ void pm_mls_free(pm_mls *m);
 int pm_mls_dim(const pm_mls *m);
 double pm_mls_spacing(const pm_mls *m);
 
+/* The distance from q to the nearest point of the cloud, along its axes. */
+double pm_mls_nearest(pm_mls *m, const double *q);
+
+/* The mean distance from a point of the cloud to its nearest other point
+ * (computed at the first call; 0 for a single point): the spacing a query
+ * point farther than about that from every point lies off the cloud by. */
+double pm_mls_gap(pm_mls *m);
+
 /* The field f ([n][ncomp], ncomp in [1, PM_MLS_MAX_COMP]) at the point q
  * into v[ncomp]: the value at q of the fit f ~ a + B (x - q) over the
  * points within a radius R, weighted by the cubic B-spline of |x - q| / R.
