@@ -6,11 +6,14 @@
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <spawn.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "mpm_isonormal.h"
 #include "pm_app.h"
+#include "pm_compare.h"
 #include "pm_error.h"
 #include "pm_memory.h"
 #include "pm_probe.h"
@@ -41,6 +44,11 @@ static void usage(FILE *out) {
           "[--set-ladder ...]\n"
           "                 [--reference analytic|last|fe:DIR|DIR] [--out DIR] "
           "[--set KEY=VALUE]... [--overwrite]\n"
+          "                 [--force-memory]\n"
+          "       pointmech compare SCENE --methods M1,M2,... "
+          "[--reference analytic|fe:DIR|DIR]\n"
+          "                 [--set [METHOD:]KEY=VALUE]... [--lattice N] "
+          "[--out DIR] [--overwrite]\n"
           "                 [--force-memory]\n"
           "       pointmech keys\n"
           "       pointmech normals\n"
@@ -83,6 +91,26 @@ static void usage(FILE *out) {
           "OUT/convergence.{md,csv}\n"
           "         (default OUT: out/NAME-convergence); plot with\n"
           "         tools/plot-convergence.py\n"
+          "  compare  run SCENE once per method into OUT/M, one after "
+          "the other (method=M,\n"
+          "         then every --set; --set M:KEY=VALUE for method M alone); "
+          "map the\n"
+          "         displacements onto one lattice (the FE referee's, else N "
+          "points\n"
+          "         along the bodies' shortest side, default 9) by moving "
+          "least squares;\n"
+          "         tabulate the NRMSE of every pair and against the "
+          "analytic field, the\n"
+          "         FE referee or a run's folder DIR, reactions, mean strain "
+          "energy\n"
+          "         density, von Mises stress at the centre, smallest J, "
+          "wall time and\n"
+          "         memory in OUT/compare.{md,csv} (default OUT: "
+          "out/NAME-compare);\n"
+          "         the mid-plane in OUT/midplane.csv, drawn by "
+          "tools/plot-compare.py; a\n"
+          "         method that fails is tabulated with its diagnosis and "
+          "the others run\n"
           "  keys   print every scene key: meaning, type, range, unit, "
           "default\n"
           "  normals print the membrane-normals paper's static cases (M6: "
@@ -121,6 +149,8 @@ typedef struct {
   const char *out;
   const char *points;
   const char *reference;
+  const char *methods;
+  long lattice;
   int n_ladders;
   const char *ladders[PM_STUDY_MAX_KEYS];
   long frame;
@@ -142,7 +172,18 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
       a->points = argv[++k];
     else if (strcmp(arg, "--reference") == 0 && has_next)
       a->reference = argv[++k];
-    else if (strcmp(arg, "--set-ladder") == 0 && has_next) {
+    else if (strcmp(arg, "--methods") == 0 && has_next)
+      a->methods = argv[++k];
+    else if (strcmp(arg, "--lattice") == 0 && has_next) {
+      char *end;
+      a->lattice = strtol(argv[++k], &end, 10);
+      if (*end || a->lattice < 3) {
+        fprintf(stderr,
+                "pointmech: --lattice expects an integer >= 3, got %s\n",
+                argv[k]);
+        return -1;
+      }
+    } else if (strcmp(arg, "--set-ladder") == 0 && has_next) {
       if (a->n_ladders == PM_STUDY_MAX_KEYS) {
         fprintf(stderr, "pointmech: at most %d --set-ladder options\n",
                 PM_STUDY_MAX_KEYS);
@@ -233,6 +274,54 @@ static int cmd_convergence(const cli_args *a) {
   return e ? report(e) : EXIT_OK;
 }
 
+/* Draw the difference pictures of the comparison in dir with
+ * tools/plot-compare.py, or say how. */
+static void draw_differences(const char *dir) {
+  const char *python = "/usr/bin/python3",
+             *tool = PM_TOOLS_DIR "/plot-compare.py";
+  char *const args[] = {(char *)python, (char *)tool, (char *)dir, NULL};
+  pid_t pid;
+  int st = 0;
+  extern char **environ;
+  const char *why = "no /usr/bin/python3 or no tools/plot-compare.py here";
+  /* posix_spawn, not fork: no atfork handlers (MPI's) run in the child. */
+  if (access(python, X_OK) == 0 && access(tool, R_OK) == 0) {
+    if (posix_spawn(&pid, python, NULL, NULL, args, environ) != 0 ||
+        waitpid(pid, &st, 0) != pid || !WIFEXITED(st))
+      why = "the plotting tool did not run to its end";
+    else if (WEXITSTATUS(st) == 0)
+      return;
+    else
+      why = WEXITSTATUS(st) == 3 ? "no matplotlib for /usr/bin/python3"
+                                 : "the plotting tool failed";
+  }
+  fprintf(stderr,
+          "pointmech: no pictures drawn (%s); draw them with: python3 %s "
+          "%s\n",
+          why, tool, dir);
+}
+
+static int cmd_compare(const cli_args *a) {
+  pm_compare_options o = {
+      .scene = a->scene,
+      .methods = a->methods,
+      .n_sets = a->n_sets,
+      .sets = a->sets,
+      .reference = a->reference,
+      .lattice = a->lattice,
+      .out_dir = a->out,
+      .quiet = a->quiet,
+      .overwrite = a->overwrite,
+  };
+  char dir[1024];
+  pm_err e = pm_compare_run(&o, stdout, dir, sizeof dir);
+  fflush(stdout);
+  char mid[1100];
+  snprintf(mid, sizeof mid, "%s/midplane.csv", dir);
+  if (dir[0] && access(mid, R_OK) == 0) draw_differences(dir);
+  return e ? report(e) : EXIT_OK;
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
     usage(stderr);
@@ -249,7 +338,7 @@ int main(int argc, char **argv) {
     return EXIT_OK;
   }
   if (strcmp(cmd, "run") == 0 || strcmp(cmd, "plan") == 0 ||
-      strcmp(cmd, "convergence") == 0)
+      strcmp(cmd, "convergence") == 0 || strcmp(cmd, "compare") == 0)
     pm_wait_policy_apply(argv);
   pm_err init = pm_app_init();
   if (init) return report(init);
@@ -290,6 +379,14 @@ int main(int argc, char **argv) {
       return EXIT_INPUT;
     }
     return cmd_convergence(&a);
+  }
+  if (strcmp(cmd, "compare") == 0) {
+    if (!a.scene || !a.methods) {
+      fprintf(stderr, "pointmech: compare needs a SCENE file and --methods "
+                      "M1,M2,...\n");
+      return EXIT_INPUT;
+    }
+    return cmd_compare(&a);
   }
   if (strcmp(cmd, "probe") == 0) {
     if (!a.scene || !a.points) {

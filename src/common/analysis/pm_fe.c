@@ -397,6 +397,18 @@ double pm_fe_nrmse_interior(const pm_fe_reference *r, const double *mapped) {
   return sqrt(sum / (double)m) / big;
 }
 
+void pm_fe_errors_of(const pm_fe_reference *r, const double *mapped,
+                     const pm_outcome *o, pm_fe_errors *e) {
+  e->nrmse = pm_nrmse_vector(r->n, r->dim == 2 ? 3u : 7u, mapped, r->u);
+  e->nrmse_interior = pm_fe_nrmse_interior(r, mapped);
+  e->reaction_error = NAN;
+  int axis = o->loaded_axis;
+  if (axis >= 0 && axis < 3)
+    e->reaction_error =
+        (o->loaded_reaction - r->reaction[axis]) / r->reaction[axis];
+  e->sed_error = (o->fig.mean_sed - r->mean_sed) / r->mean_sed;
+}
+
 pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
                      const pm_outcome *o, pm_fe_errors *e) {
   pm_err ret = PM_SUCCESS;
@@ -404,13 +416,7 @@ pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
   e->nrmse = e->nrmse_interior = e->reaction_error = e->sed_error = NAN;
   PM_TRY(PM_ALLOC(mapped, 3 * r->n, "displacement at the FE lattice"));
   PM_TRY(pm_probe_map(out_dir, -1, r->n, r->x, mapped));
-  e->nrmse = pm_nrmse_vector(r->n, r->dim == 2 ? 3u : 7u, mapped, r->u);
-  e->nrmse_interior = pm_fe_nrmse_interior(r, mapped);
-  int axis = o->loaded_axis;
-  if (axis >= 0 && axis < 3)
-    e->reaction_error =
-        (o->loaded_reaction - r->reaction[axis]) / r->reaction[axis];
-  e->sed_error = (o->fig.mean_sed - r->mean_sed) / r->mean_sed;
+  pm_fe_errors_of(r, mapped, o, e);
 done:
   free(mapped);
   return ret;

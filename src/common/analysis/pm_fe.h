@@ -87,6 +87,11 @@ typedef struct {
  * lattice's figure; NaN when no point is inside. */
 double pm_fe_nrmse_interior(const pm_fe_reference *r, const double *mapped);
 
+/* The errors of a run whose displacement at the lattice is mapped
+ * ([r->n][3]) and whose outcome is o. */
+void pm_fe_errors_of(const pm_fe_reference *r, const double *mapped,
+                     const pm_outcome *o, pm_fe_errors *e);
+
 /* Compare the run written to out_dir (its last frame, mapped onto the
  * lattice by moving least squares) and its outcome o with r.  The
  * reaction error is NaN when o has no loaded face. */

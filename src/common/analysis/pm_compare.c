@@ -1,0 +1,621 @@
+/* pm_compare: the methods' runs of one scene, their fields on one lattice
+ * (moving least squares) and their errors against each other and the
+ * references. */
+#include "pm_compare.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_compare_impl.h"
+#include "pm_memory.h"
+#include "pm_metrics.h"
+#include "pm_mls.h"
+#include "pm_probe.h"
+
+/* How far a lattice point's fit may reach, in mean point spacings, and
+ * how far its nearest point may be, in mean nearest-neighbour distances: a
+ * point farther than that (off the method's body) is flagged rather than
+ * extrapolated to.  A corner of a body whose points are inset by half their
+ * spacing (MPM particles) is 0.87 of it from its nearest point; a point on
+ * a face of a mesh, at most 0.58 of an edge. */
+#define CMP_REACH 5.0
+#define CMP_GAP 1.5
+/* Regular lattice: points along a long axis at most this many times the
+ * shortest axis's intervals. */
+#define CMP_ASPECT_MAX 8
+#define CMP_SETS_MAX 66 /* method=M and the --set overrides */
+#define CMP_FIELDS_MAX 16
+
+/* ---- options ------------------------------------------------------------ */
+
+/* The comma-separated method names into c->meth[].name. */
+static pm_err parse_methods(const char *list, cmp_study *c) {
+  char buf[PM_COMPARE_MAX_METHODS * CMP_NAME_MAX],
+      *names[PM_COMPARE_MAX_METHODS];
+  PM_CHECK(list && *list, PM_ERR_SCENE,
+           "compare needs --methods M1,M2,... (e.g. fpm,mpm,mpm-implicit)");
+  PM_CHECK(strlen(list) < sizeof buf, PM_ERR_SCENE,
+           "--methods %.40s...: at most %zu characters", list, sizeof buf - 1);
+  snprintf(buf, sizeof buf, "%s", list);
+  c->n = pm_split_fields(buf, names, PM_COMPARE_MAX_METHODS);
+  PM_CHECK(c->n <= PM_COMPARE_MAX_METHODS, PM_ERR_SCENE,
+           "--methods %s: at most %d methods", list, PM_COMPARE_MAX_METHODS);
+  for (int k = 0; k < c->n; k++) {
+    size_t len = strlen(names[k]);
+    PM_CHECK(len > 0 && len < CMP_NAME_MAX, PM_ERR_SCENE,
+             "--methods %s: expected method names of 1 to %d characters "
+             "separated by commas",
+             list, CMP_NAME_MAX - 1);
+    for (int l = 0; l < k; l++)
+      PM_CHECK(strcmp(c->meth[l].name, names[k]) != 0, PM_ERR_SCENE,
+               "--methods %s: %s is named twice", list, names[k]);
+    memcpy(c->meth[k].name, names[k], len + 1);
+  }
+  return PM_SUCCESS;
+}
+
+/* The method a "METHOD:KEY=VALUE" override is for, as a length (0: every
+ * method).  Keys hold no ':', values may. */
+static size_t scope_of(const char *set) {
+  const char *colon = strchr(set, ':'), *eq = strchr(set, '=');
+  return colon && (!eq || colon < eq) ? (size_t)(colon - set) : 0;
+}
+
+/* Every scoped override names one of the methods; none sets the method. */
+static pm_err check_sets(const pm_compare_options *o, const cmp_study *c) {
+  PM_CHECK(o->n_sets <= CMP_SETS_MAX - 1, PM_ERR_SCENE,
+           "compare: at most %d --set options", CMP_SETS_MAX - 1);
+  for (int k = 0; k < o->n_sets; k++) {
+    const char *set = o->sets[k];
+    size_t len = scope_of(set);
+    const char *key = len ? set + len + 1 : set;
+    bool known = len == 0;
+    for (int m = 0; m < c->n && !known; m++)
+      known = strlen(c->meth[m].name) == len &&
+              strncmp(c->meth[m].name, set, len) == 0;
+    PM_CHECK(known, PM_ERR_SCENE,
+             "--set %s: %.*s is not one of the --methods (%s)", set, (int)len,
+             set, o->methods);
+    PM_CHECK(strncmp(key, "method=", 7) != 0, PM_ERR_SCENE,
+             "--set %s: compare sets the method of each run from --methods",
+             set);
+  }
+  return PM_SUCCESS;
+}
+
+/* Load the scene for method (NULL: the scene as given): method=METHOD,
+ * the overrides for every method, then the method's own. */
+static pm_err load_scene(const pm_compare_options *o, const char *method,
+                         pm_scene **s) {
+  const char *sets[CMP_SETS_MAX];
+  char first[CMP_NAME_MAX + 8];
+  int n = 0;
+  if (method) {
+    snprintf(first, sizeof first, "method=%s", method);
+    sets[n++] = first;
+  }
+  for (int pass = 0; pass < (method ? 2 : 1); pass++)
+    for (int k = 0; k < o->n_sets; k++) {
+      size_t len = scope_of(o->sets[k]);
+      if (pass == 0 && len == 0)
+        sets[n++] = o->sets[k];
+      else if (pass == 1 && len == strlen(method) &&
+               strncmp(o->sets[k], method, len) == 0)
+        sets[n++] = o->sets[k] + len + 1;
+    }
+  return pm_scene_load(o->scene, n, sets, s);
+}
+
+/* ---- the lattice -------------------------------------------------------- */
+
+static void grow(double lo[3], double hi[3], const double *p, double r) {
+  for (int k = 0; k < 3; k++) {
+    lo[k] = fmin(lo[k], p[k] - r);
+    hi[k] = fmax(hi[k], p[k] + r);
+  }
+}
+
+/* The reference box of the scene's bodies: their shapes' bounds, the
+ * domain box for shapes given by a region, a mesh, an image or a
+ * membrane (where the lattice points off the body are then flagged). */
+static void bodies_box(const pm_scene *s, double lo[3], double hi[3]) {
+  for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
+  for (int b = 0; b < s->n_bodies; b++) {
+    const pm_scene_body *B = &s->bodies[b];
+    double top[3];
+    switch (B->shape) {
+    case PM_BODY_BOX:
+      grow(lo, hi, B->a, 0);
+      grow(lo, hi, B->b, 0);
+      break;
+    case PM_BODY_SPHERE: grow(lo, hi, B->a, B->radius); break;
+    case PM_BODY_CYLINDER:
+      for (int k = 0; k < 3; k++) top[k] = B->a[k] + B->b[k];
+      grow(lo, hi, B->a, B->radius);
+      grow(lo, hi, top, B->radius);
+      break;
+    default:
+      grow(lo, hi, s->box_min, 0);
+      grow(lo, hi, s->box_max, 0);
+      break;
+    }
+  }
+  for (int k = 0; k < 3; k++) {
+    if (!(lo[k] <= hi[k])) lo[k] = s->box_min[k], hi[k] = s->box_max[k];
+    /* Within the domain: a shape cannot reach past it. */
+    lo[k] = fmax(lo[k], s->box_min[k]);
+    hi[k] = fmin(hi[k], s->box_max[k]);
+  }
+  if (s->dimension == 2) lo[2] = hi[2] = 0;
+}
+
+/* n points along the shortest axis of the bodies' box, the other axes at
+ * about the same spacing, x outermost and z innermost. */
+static pm_err regular_lattice(cmp_study *c, long n) {
+  pm_err ret = PM_SUCCESS;
+  double lo[3], hi[3], shortest = INFINITY;
+  bodies_box(c->base, lo, hi);
+  for (int k = 0; k < c->dim; k++) {
+    PM_CHECK(hi[k] > lo[k], PM_ERR_SCENE,
+             "%s: the bodies' box is flat along %c ([%g, %g] m): no lattice",
+             c->base->path, "xyz"[k], lo[k], hi[k]);
+    shortest = fmin(shortest, hi[k] - lo[k]);
+  }
+  const double spacing = shortest / (double)(n - 1);
+  c->m = 1;
+  for (int k = 0; k < 3; k++) {
+    c->side[k] = 1;
+    if (k < c->dim) {
+      double cells = ceil((hi[k] - lo[k]) / spacing - 1e-9);
+      c->side[k] = 1 + (long)fmin(cells, CMP_ASPECT_MAX * (double)(n - 1));
+    }
+    c->m *= c->side[k];
+    c->centre[k] = 0.5 * (lo[k] + hi[k]);
+  }
+  PM_TRY(PM_ALLOC(c->x, 3 * c->m, "lattice"));
+  long i = 0;
+  for (long a = 0; a < c->side[0]; a++)
+    for (long b = 0; b < c->side[1]; b++)
+      for (long d = 0; d < c->side[2]; d++, i++) {
+        const long idx[3] = {a, b, d};
+        for (int k = 0; k < 3; k++)
+          c->x[3 * i + k] = c->side[k] > 1
+                                ? lo[k] + (hi[k] - lo[k]) * (double)idx[k] /
+                                              (double)(c->side[k] - 1)
+                                : lo[k];
+      }
+  int len = snprintf(c->lattice_label, sizeof c->lattice_label,
+                     "a regular lattice of %ld", c->side[0]);
+  for (int k = 1; k < c->dim; k++)
+    len += snprintf(c->lattice_label + len, sizeof c->lattice_label - len,
+                    " x %ld", c->side[k]);
+  len += snprintf(c->lattice_label + len, sizeof c->lattice_label - len,
+                  " points over the bodies' box [%g, %g]", lo[0], hi[0]);
+  for (int k = 1; k < c->dim; k++)
+    len += snprintf(c->lattice_label + len, sizeof c->lattice_label - len,
+                    " x [%g, %g]", lo[k], hi[k]);
+  snprintf(c->lattice_label + len, sizeof c->lattice_label - len, " m");
+done:
+  return ret;
+}
+
+/* The FE referee's lattice points, and its centre. */
+static pm_err fe_lattice(cmp_study *c) {
+  pm_err ret = PM_SUCCESS;
+  const pm_fe_reference *fe = c->fe;
+  c->m = fe->n;
+  c->dim = fe->dim == 2 ? 2 : 3;
+  PM_TRY(PM_ALLOC(c->x, 3 * c->m, "lattice"));
+  memcpy(c->x, fe->x, sizeof *c->x * 3 * (size_t)c->m);
+  memcpy(c->centre, fe->centre, sizeof c->centre);
+  snprintf(c->lattice_label, sizeof c->lattice_label,
+           "the FE referee's lattice (%s/lattice.csv, %ld points)", fe->dir,
+           fe->n);
+done:
+  return ret;
+}
+
+/* The field u of the cloud mls at every lattice point into out ([m][3]),
+ * NaN where flagged; returns the flagged count. */
+/* The field f (ncomp components) at q into v when q lies on the cloud
+ * and a regular fit reaches it; false (v NaN) when q is flagged. */
+static bool fit_on_cloud(pm_mls *mls, const double *q, int ncomp,
+                         const double *f, double *v) {
+  if (pm_mls_nearest(mls, q) <= CMP_GAP * pm_mls_gap(mls) &&
+      pm_mls_fit(mls, q, ncomp, f, CMP_REACH, v) > 0)
+    return true;
+  for (int k = 0; k < ncomp; k++) v[k] = NAN;
+  return false;
+}
+
+static long map_lattice(const cmp_study *c, pm_mls *mls, const double *u,
+                        double *out) {
+  long flagged = 0;
+  for (long i = 0; i < c->m; i++)
+    flagged += !fit_on_cloud(mls, c->x + 3 * i, 3, u, out + 3 * i);
+  return flagged;
+}
+
+/* The last frame of the reference run, on the lattice. */
+static pm_err map_run(cmp_study *c) {
+  pm_err ret = PM_SUCCESS;
+  long n = 0;
+  double *x = NULL, *u = NULL;
+  pm_mls *mls = NULL;
+  char what[PM_PATH_MAX + 64];
+  PM_TRY(pm_results_read(c->run_dir, -1, &n, &x, &u));
+  snprintf(what, sizeof what, "the reference run %s", c->run_dir);
+  PM_TRY(pm_mls_create(n, x, what, &mls));
+  PM_TRY(PM_ALLOC(c->run_u, 3 * c->m, "reference at the lattice"));
+  map_lattice(c, mls, u, c->run_u);
+done:
+  pm_mls_free(mls);
+  free(x);
+  free(u);
+  return ret;
+}
+
+void cmp_analytic(const cmp_study *c, double t, double *ref) {
+  const pm_scene *s = c->base;
+  for (long i = 0; i < c->m; i++) {
+    const double *X = c->x + 3 * i;
+    for (int k = 0; k < 3; k++)
+      ref[3 * i + k] = s->reference_mask >> k & 1u
+                           ? pm_expr_eval(s->reference[k], X[0], X[1], X[2], t)
+                           : 0.0;
+  }
+}
+
+/* ---- one method --------------------------------------------------------- */
+
+/* Record why method M stopped: its error, a status, the message. */
+static pm_err method_failed(cmp_method *M, pm_err e, const char *status,
+                            const char *message) {
+  M->err = e;
+  if (status) snprintf(M->status, sizeof M->status, "%s", status);
+  snprintf(M->message, sizeof M->message, "%s",
+           message && *message ? message : pm_error_message());
+  return e;
+}
+
+/* The von Mises stress of sim's points: the backend's field, or from its
+ * Cauchy stress into *own; NULL when it gives neither. */
+static pm_err von_mises_of(const pm_backend *be, void *sim, long n,
+                           double **own, const double **vm) {
+  pm_field f[CMP_FIELDS_MAX];
+  int nf = be->fields(sim, PM_FIELD_STRESS, f, CMP_FIELDS_MAX);
+  *vm = NULL;
+  for (int k = 0; k < nf; k++)
+    if (f[k].ncomp == 1 && strcmp(f[k].name, "von_mises") == 0) {
+      *vm = f[k].data;
+      return PM_SUCCESS;
+    }
+  for (int k = 0; k < nf; k++)
+    if (f[k].ncomp == 9 && strcmp(f[k].name, "stress") == 0) {
+      PM_CALL(PM_ALLOC(*own, n, "von Mises stress"));
+      pm_stress_invariants(n, f[k].data, *own, NULL);
+      *vm = *own;
+      return PM_SUCCESS;
+    }
+  return PM_SUCCESS;
+}
+
+/* The displacement at the lattice and von Mises stress at the centre of
+ * the simulation sim after its run. */
+static pm_err map_method(cmp_study *c, cmp_method *M, const pm_backend *be,
+                         void *sim) {
+  pm_err ret = PM_SUCCESS;
+  pm_points p;
+  pm_mls *mls = NULL;
+  double *own = NULL;
+  const double *vm = NULL;
+  char what[CMP_NAME_MAX + 32];
+  be->points(sim, &p);
+  snprintf(what, sizeof what, "the points of %s", M->name);
+  PM_TRY(pm_mls_create(p.n, p.x, what, &mls));
+  PM_TRY(PM_ALLOC(M->u, 3 * c->m, "displacement at the lattice"));
+  M->flagged = map_lattice(c, mls, be->displacement(sim), M->u);
+  M->mapped = true;
+  PM_TRY(von_mises_of(be, sim, p.n, &own, &vm));
+  if (vm) fit_on_cloud(mls, c->centre, 1, vm, &M->von_mises_centre);
+done:
+  pm_mls_free(mls);
+  free(own);
+  return ret;
+}
+
+/* Load, run and map method k; its failures are its own (recorded in it
+ * and returned), the others' runs go on. */
+static pm_err run_method(cmp_study *c, int k, FILE *out) {
+  const pm_compare_options *o = c->o;
+  cmp_method *M = &c->meth[k];
+  pm_scene *s = NULL;
+  void *sim = NULL;
+  pm_err e;
+  M->von_mises_centre = NAN;
+  snprintf(M->status, sizeof M->status, "refused");
+  if (out)
+    fprintf(out, "method %d/%d: %s -> %s\n", k + 1, c->n, M->name, M->dir);
+  e = load_scene(o, M->name, &s);
+  if (e == PM_SUCCESS) e = pm_memory_check(s);
+  if (e != PM_SUCCESS) {
+    method_failed(M, e, NULL, NULL);
+    goto done;
+  }
+  M->n_bcs = s->n_bcs;
+  e = s->backend->create(s, &sim);
+  if (e != PM_SUCCESS) {
+    method_failed(M, e, "failed", NULL);
+    goto done;
+  }
+  unsigned flags =
+      (o->quiet ? PM_RUN_QUIET : 0u) | (o->overwrite ? PM_RUN_OVERWRITE : 0u);
+  e = pm_run_sim(s, sim, M->dir, flags, &M->out);
+  const pm_status st = M->out.fig.status;
+  snprintf(M->status, sizeof M->status, "%s", pm_status_name(st));
+  if (e != PM_SUCCESS) method_failed(M, e, NULL, M->out.message);
+  /* As the run reports its error: a field that went unstable or was never
+   * finished is not compared. */
+  if (st == PM_STATUS_COMPLETED || st == PM_STATUS_CONVERGED ||
+      st == PM_STATUS_NOT_CONVERGED) {
+    pm_err m = map_method(c, M, s->backend, sim);
+    if (m != PM_SUCCESS && e == PM_SUCCESS) e = method_failed(M, m, NULL, NULL);
+  }
+done:
+  if (e != PM_SUCCESS && out) fprintf(out, "  %s: %s\n", M->status, M->message);
+  if (sim) s->backend->destroy(sim);
+  pm_scene_destroy(s);
+  return e;
+}
+
+/* ---- errors ------------------------------------------------------------- */
+
+/* The rows of a ([m][3]) at the valid lattice points into b. */
+static void compact(const cmp_study *c, const double *a, double *b) {
+  long j = 0;
+  for (long i = 0; i < c->m; i++)
+    if (c->valid[i]) {
+      memcpy(b + 3 * j, a + 3 * i, 3 * sizeof *a);
+      j++;
+    }
+}
+
+static double largest(long n, unsigned mask, const double *u) {
+  double big = 0;
+  for (long j = 0; j < n; j++) {
+    double r2 = 0;
+    for (int k = 0; k < 3; k++)
+      if (mask >> k & 1u) r2 += u[3 * j + k] * u[3 * j + k];
+    big = fmax(big, sqrt(r2));
+  }
+  return big;
+}
+
+/* Root mean square of |a - b| over n points, over scale. */
+static double rms_over(long n, unsigned mask, const double *a, const double *b,
+                       double scale) {
+  double sum = 0;
+  for (long j = 0; j < n; j++)
+    for (int k = 0; k < 3; k++)
+      if (mask >> k & 1u) {
+        double d = a[3 * j + k] - b[3 * j + k];
+        sum += d * d;
+      }
+  return n > 0 && scale > 0 ? sqrt(sum / (double)n) / scale : NAN;
+}
+
+/* The NRMSE against the analytic field as a run reports it (pm_run): a
+ * single component's own (over its range), several as a vector. */
+static double analytic_nrmse(long n, unsigned mask, const double *u,
+                             const double *ref) {
+  int count = 0, last = 0;
+  for (int k = 0; k < 3; k++)
+    if (mask >> k & 1u) count++, last = k;
+  if (count == 1) return pm_nrmse(n, 3, u + last, ref + last);
+  return pm_nrmse_vector(n, mask, u, ref);
+}
+
+/* The lattice points every mapped method and the reference run fit. */
+static void find_valid(cmp_study *c) {
+  c->n_valid = 0;
+  for (long i = 0; i < c->m; i++) {
+    bool ok = true;
+    for (int k = 0; k < c->n && ok; k++)
+      if (c->meth[k].mapped) ok = isfinite(c->meth[k].u[3 * i]);
+    if (c->run_u) ok = ok && isfinite(c->run_u[3 * i]);
+    c->valid[i] = ok;
+    c->n_valid += ok;
+  }
+}
+
+/* Every method against the references, the pairs against each other. */
+static pm_err compute_errors(cmp_study *c) {
+  pm_err ret = PM_SUCCESS;
+  double *full = NULL, *a = NULL, *b = NULL, *r = NULL, *xv = NULL, *fu = NULL;
+  const unsigned mask = cmp_mask(c);
+  PM_TRY(PM_ALLOC(c->valid, c->m, "lattice flags"));
+  find_valid(c);
+  const long nv = c->n_valid;
+  PM_TRY(PM_ALLOC(full, 3 * c->m, "analytic field"));
+  PM_TRY(PM_ALLOC(a, 3 * c->m + 3, "lattice values"));
+  PM_TRY(PM_ALLOC(b, 3 * c->m + 3, "lattice values"));
+  PM_TRY(PM_ALLOC(r, 3 * c->m + 3, "lattice values"));
+  pm_fe_reference view = {.n = 0};
+  if (c->fe) {
+    PM_TRY(PM_ALLOC(xv, 3 * c->m + 3, "lattice points"));
+    PM_TRY(PM_ALLOC(fu, 3 * c->m + 3, "FE values"));
+    compact(c, c->fe->x, xv);
+    compact(c, c->fe->u, fu);
+    view = *c->fe;
+    view.n = nv;
+    view.x = xv;
+    view.u = fu;
+  }
+  /* One scale for the pairs: the reference's largest |u|, else the
+   * methods'. */
+  c->scale = 0;
+  if (c->fe) {
+    c->scale = largest(nv, mask, fu);
+    snprintf(c->scale_label, sizeof c->scale_label, "the FE referee's");
+  } else if (c->run_u) {
+    compact(c, c->run_u, r);
+    c->scale = largest(nv, mask, r);
+    snprintf(c->scale_label, sizeof c->scale_label, "the reference run's");
+  } else {
+    for (int k = 0; k < c->n; k++)
+      if (c->meth[k].mapped) {
+        compact(c, c->meth[k].u, a);
+        c->scale = fmax(c->scale, largest(nv, mask, a));
+      }
+    snprintf(c->scale_label, sizeof c->scale_label, "the methods' own");
+  }
+  for (int k = 0; k < c->n; k++) {
+    cmp_method *M = &c->meth[k];
+    M->e_analytic = M->e_fe = M->e_fe_interior = NAN;
+    M->reaction_fe = M->sed_fe = M->e_run = NAN;
+    for (int l = 0; l < c->n; l++) c->pair[k][l] = NAN;
+    if (!M->mapped || nv == 0) continue;
+    compact(c, M->u, a);
+    if (c->analytic) {
+      cmp_analytic(c, M->out.fig.time, full);
+      compact(c, full, r);
+      M->e_analytic = analytic_nrmse(nv, c->base->reference_mask, a, r);
+    }
+    if (c->fe) {
+      pm_fe_errors e;
+      pm_fe_errors_of(&view, a, &M->out, &e);
+      M->e_fe = e.nrmse;
+      M->e_fe_interior = e.nrmse_interior;
+      M->reaction_fe = e.reaction_error;
+      M->sed_fe = e.sed_error;
+    }
+    if (c->run_u) {
+      compact(c, c->run_u, r);
+      M->e_run = pm_nrmse_vector(nv, mask, a, r);
+    }
+    for (int l = 0; l < k; l++)
+      if (c->meth[l].mapped) {
+        compact(c, c->meth[l].u, b);
+        c->pair[k][l] = c->pair[l][k] = rms_over(nv, mask, a, b, c->scale);
+      }
+  }
+done:
+  free(full);
+  free(a);
+  free(b);
+  free(r);
+  free(xv);
+  free(fu);
+  return ret;
+}
+
+/* ---- the comparison ----------------------------------------------------- */
+
+/* The references --reference and the scene name; the FE referee is loaded
+ * into *fe. */
+static pm_err choose_references(cmp_study *c, pm_fe_reference **fe) {
+  const pm_compare_options *o = c->o;
+  const pm_scene *s = c->base;
+  const char *ref = o->reference;
+  char fe_dir[PM_PATH_MAX + 1] = "";
+  c->analytic = s->reference_mask != 0;
+  if (!ref) {
+    if (s->reference_fe) snprintf(fe_dir, sizeof fe_dir, "%s", s->reference_fe);
+  } else if (strcmp(ref, "analytic") == 0) {
+    PM_CHECK(c->analytic, PM_ERR_SCENE,
+             "%s: --reference analytic: the scene has no reference field "
+             "(reference.displacement)",
+             o->scene);
+  } else if (!pm_fe_names_reference(ref, fe_dir, sizeof fe_dir)) {
+    PM_CHECK(strncmp(ref, "fe:", 3) != 0, PM_ERR_SCENE,
+             "--reference %s: expected fe:DIR", ref);
+    snprintf(c->run_dir, sizeof c->run_dir, "%s", ref);
+  }
+  if (fe_dir[0]) {
+    PM_CALL(pm_fe_load(fe_dir, fe));
+    c->fe = *fe;
+  }
+  return PM_SUCCESS;
+}
+
+/* Which methods failed, for the error returned. */
+static void failed_names(const cmp_study *c, char *buf, size_t size) {
+  size_t len = 0;
+  buf[0] = 0;
+  for (int k = 0; k < c->n && len < size; k++)
+    if (c->meth[k].err != PM_SUCCESS)
+      len += (size_t)snprintf(buf + len, size - len, "%s%s %s", len ? ", " : "",
+                              c->meth[k].name, c->meth[k].status);
+}
+
+pm_err pm_compare_run(const pm_compare_options *o, FILE *out, char *dir,
+                      size_t size) {
+  pm_err ret = PM_SUCCESS, first_fail = PM_SUCCESS;
+  cmp_study *c = NULL;
+  pm_scene *base = NULL;
+  pm_fe_reference *fe = NULL;
+  const long n_lattice = o->lattice ? o->lattice : PM_COMPARE_LATTICE;
+  if (dir && size) dir[0] = 0;
+  PM_ENSURE(n_lattice >= 3, PM_ERR_SCENE,
+            "--lattice %ld: expected at least 3 points", o->lattice);
+  PM_TRY(PM_ALLOC(c, 1, "comparison"));
+  c->o = o;
+  PM_TRY(parse_methods(o->methods, c));
+  PM_TRY(check_sets(o, c));
+  /* The scene as given sets the name, the conditions, the references and
+   * the bodies' box, the same for every method. */
+  PM_TRY(load_scene(o, NULL, &base));
+  c->base = base;
+  c->dim = base->dimension;
+  if (o->out_dir)
+    snprintf(c->out_dir, sizeof c->out_dir, "%s", o->out_dir);
+  else
+    snprintf(c->out_dir, sizeof c->out_dir, "out/%s-compare", base->name);
+  if (dir && size) snprintf(dir, size, "%s", c->out_dir);
+  PM_TRY(choose_references(c, &fe));
+  if (c->fe)
+    PM_TRY(fe_lattice(c));
+  else
+    PM_TRY(regular_lattice(c, n_lattice));
+  if (c->run_dir[0]) PM_TRY(map_run(c));
+  PM_TRY(pm_mkdir_p(c->out_dir));
+  for (int k = 0; k < c->n; k++)
+    PM_TRY(pm_path_join(c->meth[k].dir, sizeof c->meth[k].dir, c->out_dir,
+                        c->meth[k].name));
+  for (int k = 0; k < c->n; k++) {
+    pm_err e = run_method(c, k, out);
+    if (e != PM_SUCCESS && first_fail == PM_SUCCESS) first_fail = e;
+    if (e == PM_ERR_INTERRUPTED) {
+      first_fail = e;
+      for (int l = k + 1; l < c->n; l++) {
+        cmp_method *L = &c->meth[l];
+        snprintf(L->status, sizeof L->status, "not-run");
+        snprintf(L->message, sizeof L->message,
+                 "not started: the comparison was interrupted");
+        L->von_mises_centre = NAN;
+      }
+      break;
+    }
+  }
+  PM_TRY(compute_errors(c));
+  PM_TRY(cmp_write_report(c, out));
+  if (out) fprintf(out, "tables in %s/compare.{md,csv}\n", c->out_dir);
+  if (first_fail != PM_SUCCESS) {
+    char names[512];
+    failed_names(c, names, sizeof names);
+    ret = PM_ERROR(first_fail, "%s: not every method ran through: %s; see %s",
+                   o->scene, names[0] ? names : "interrupted", c->out_dir);
+  }
+done:
+  if (c) {
+    for (int k = 0; k < c->n; k++) free(c->meth[k].u);
+    free(c->x);
+    free(c->valid);
+    free(c->run_u);
+  }
+  free(c);
+  pm_fe_free(fe);
+  pm_scene_destroy(base);
+  return ret;
+}
