@@ -414,6 +414,7 @@ pm_err gm_dual_build(const gm_mesh *m, gm_dual **out) {
   gm_dual *d = NULL;
   long *inc_ptr = NULL, *inc = NULL;
   PM_TRY(PM_ALLOC(d, 1, "dual"));
+  d->min_quality_point = -1;
   d->dim = m->dim;
   d->n_points = m->n_nodes;
   PM_TRY(PM_ALLOC(d->x, 3 * m->n_nodes, "dual points"));

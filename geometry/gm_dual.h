@@ -50,6 +50,12 @@ typedef struct {
   double *facet_moment;   /* 9 * n_facets */
   double *facet_centroid; /* 3 * n_facets */
   double *facet_area;     /* n_facets */
+  /* What the builder reports of the cells' shapes (zeros from a builder
+   * that does not assess them): */
+  long n_dropped_faces;   /* faces of round-off size dropped */
+  long n_slivers;         /* cells below the builder's quality bound */
+  double min_quality;     /* the lowest cell quality (1 for a cube) */
+  long min_quality_point; /* its point, -1 when not assessed */
 } gm_dual;
 
 /* Median-dual subdomains of mesh m (read during the call only: the dual
