@@ -66,6 +66,11 @@ typedef struct {
  * PM_ERR_MEMORY. */
 pm_err gm_dual_build(const gm_mesh *m, gm_dual **out);
 
+/* For cell builders: sets d->n_facets = nf and allocates the facet arrays
+ * (zeroed; none for nf = 0).  PM_ERR_MEMORY when they do not fit: the
+ * arrays allocated stay for gm_dual_destroy. */
+pm_err gm_dual_alloc_facets(gm_dual *d, long nf);
+
 /* Frees the dual and all its arrays; NULL is a no-op. */
 void gm_dual_destroy(gm_dual *d);
 

@@ -114,20 +114,113 @@ void finish_face(Face &f) {
     for (double &c : f.c) c /= f.area;
 }
 
-/* A convex polyhedron: vertices and faces (vertex cycles counter-clockwise
- * seen from outside), each face labelled.  Scratch arrays live here so that
- * cutting the cells one after the other reuses their memory. */
+/* What a plane does to a convex cell: leaves it whole, leaves nothing, or
+ * cuts it. */
+enum Side { KEEP, EMPTY, CUT };
+
+/* The signed distances d[k] = n . (v[k] - m) of the vertices, and what the
+ * plane does to the cell they span (the part n . (y - m) <= 0 is kept). */
+Side sides(const std::vector<Vec> &v, const Vec &n, const Vec &m,
+           std::vector<double> &d) {
+  d.resize(v.size());
+  bool any_out = false, any_in = false;
+  for (std::size_t k = 0; k < v.size(); k++) {
+    d[k] = dot(n, sub(v[k], m));
+    any_out |= d[k] > 0;
+    any_in |= d[k] < 0;
+  }
+  return !any_out ? KEEP : !any_in ? EMPTY : CUT;
+}
+
+/* Replaces vertex p of the cell of point i by the point where the planes
+ * labelled lab[0 .. dim) meet: equidistant from i and the neighbours
+ * among the labels, on the box planes among them.  Computed from the set
+ * of points and planes alone (sorted, relative to the lowest point), so
+ * every cell that has the vertex gets the same coordinates to the bit and
+ * the faces of neighbouring cells close exactly.  Keeps p (the clip's own
+ * coordinates) and returns false when the planes do not meet in one
+ * point, or meet farther than tol from p: more than three planes through
+ * a vertex, some of them nearly parallel (four nearly cocircular points
+ * in a plane), make the point of these three ill-conditioned. */
+bool canonical_vertex(int dim, const double *x, long i, const long *lab,
+                      const double lo[3], const double hi[3], double tol,
+                      Vec &p) {
+  long g[4] = {i, 0, 0, 0};
+  int b[3] = {0, 0, 0}, ng = 1, nb = 0;
+  for (int k = 0; k < dim; k++)
+    if (lab[k] >= 0)
+      g[ng++] = lab[k];
+    else
+      b[nb++] = static_cast<int>(-1 - lab[k]);
+  std::sort(g, g + ng);
+  std::sort(b, b + nb);
+  const double *base = x + 3 * g[0];
+  double A[3][4];
+  for (int r = 0; r + 1 < ng; r++) {
+    const double *xg = x + 3 * g[r + 1];
+    double rhs = 0;
+    for (int c = 0; c < dim; c++) {
+      A[r][c] = xg[c] - base[c];
+      rhs += A[r][c] * A[r][c];
+    }
+    A[r][dim] = 0.5 * rhs;
+  }
+  for (int r = 0; r < nb; r++) {
+    int axis = b[r] / 2;
+    double *row = A[ng - 1 + r];
+    for (int c = 0; c < dim; c++) row[c] = c == axis;
+    row[dim] = pm_face_plane(b[r], lo, hi) - base[axis];
+  }
+  /* Gaussian elimination with partial pivoting. */
+  for (int c = 0; c < dim; c++) {
+    int piv = c;
+    for (int r = c + 1; r < dim; r++)
+      if (std::fabs(A[r][c]) > std::fabs(A[piv][c])) piv = r;
+    if (!(std::fabs(A[piv][c]) > 0)) return false;
+    for (int k = 0; k <= dim; k++) std::swap(A[c][k], A[piv][k]);
+    for (int r = c + 1; r < dim; r++) {
+      double f = A[r][c] / A[c][c];
+      for (int k = c; k <= dim; k++) A[r][k] -= f * A[c][k];
+    }
+  }
+  double y[3] = {0, 0, 0};
+  for (int c = dim - 1; c >= 0; c--) {
+    double s = A[c][dim];
+    for (int k = c + 1; k < dim; k++) s -= A[c][k] * y[k];
+    y[c] = s / A[c][c];
+  }
+  Vec q = {0, 0, 0};
+  for (int c = 0; c < dim; c++) q[c] = base[c] + y[c];
+  for (int r = 0; r < nb; r++) q[b[r] / 2] = pm_face_plane(b[r], lo, hi);
+  if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+    return false;
+  if (!(norm(sub(p, q)) <= tol)) return false;
+  p = q;
+  return true;
+}
+
+/* A convex polyhedron: vertices, each with the labels of three faces
+ * through it, and faces (vertex cycles counter-clockwise seen from
+ * outside), each labelled.  Scratch arrays live here so that cutting the
+ * cells one after the other reuses their memory. */
+using Labels = std::array<long, 3>;
 class Polyhedron {
 public:
   std::vector<Vec> v;
+  std::vector<Labels> vlab;
   std::vector<std::vector<int>> face;
   std::vector<long> label;
 
   void box(const double lo[3], const double hi[3]) {
     v.clear();
-    for (int k = 0; k < 8; k++)
+    vlab.clear();
+    for (int k = 0; k < 8; k++) {
       v.push_back({k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
                    k & 4 ? hi[2] : lo[2]});
+      vlab.push_back({-1 - (k & 1 ? PM_FACE_XMAX : PM_FACE_XMIN),
+                      -1 - (k & 2 ? PM_FACE_YMAX : PM_FACE_YMIN),
+                      -1 - (k & 4 ? PM_FACE_ZMAX : PM_FACE_ZMIN)});
+    }
     /* Corners k = x + 2 y + 4 z; faces in pm_face order, outward. */
     static const int quad[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
                                    {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
@@ -143,23 +236,18 @@ public:
    * Returns false when nothing is left. */
   bool cut(const Vec &n, const Vec &m, long lab) {
     const std::size_t nv = v.size();
-    d.resize(nv);
-    bool any_out = false, any_in = false;
-    for (std::size_t k = 0; k < nv; k++) {
-      d[k] = dot(n, sub(v[k], m));
-      any_out |= d[k] > 0;
-      any_in |= d[k] < 0;
-    }
-    if (!any_out) return true;
-    if (!any_in) return false;
+    const int side = sides(v, n, m, d);
+    if (side != CUT) return side == KEEP;
     /* Kept vertices, then the new ones, each edge's made once. */
     nv2.clear();
+    nlab2.clear();
     on.clear();
     idx.assign(nv, -1);
     for (std::size_t k = 0; k < nv; k++)
       if (d[k] <= 0) {
         idx[k] = static_cast<int>(nv2.size());
         nv2.push_back(v[k]);
+        nlab2.push_back(vlab[k]);
         on.push_back(d[k] == 0);
       }
     made.clear();
@@ -176,7 +264,7 @@ public:
           all_on &= d[a] == 0;
         }
         if ((d[a] < 0 && d[b] > 0) || (d[a] > 0 && d[b] < 0))
-          out.push_back(edge_vertex(a, b));
+          out.push_back(edge_vertex(a, b, label[f], lab));
       }
       /* A face lying in the plane is replaced by the cut face. */
       if (out.size() < 3 || all_on) continue;
@@ -185,6 +273,7 @@ public:
     }
     cap(n, lab);
     v.swap(nv2);
+    vlab.swap(nlab2);
     face.swap(nface);
     label.swap(nlabel);
     return true;
@@ -193,13 +282,28 @@ public:
 private:
   std::vector<double> d, ang;
   std::vector<Vec> nv2;
+  std::vector<Labels> nlab2;
   std::vector<char> on;
   std::vector<int> idx, out, order;
   std::vector<std::array<int, 3>> made;
   std::vector<std::vector<int>> nface;
   std::vector<long> nlabel;
 
-  int edge_vertex(int a, int b) {
+  /* The label of the face other than the one labelled fl that holds the
+   * edge a -> b (it runs b -> a there). */
+  long other_face(int a, int b, long fl) const {
+    for (std::size_t g = 0; g < face.size(); g++) {
+      const std::vector<int> &fv = face[g];
+      for (std::size_t k = 0; k < fv.size(); k++)
+        if (fv[k] == b && fv[(k + 1) % fv.size()] == a && label[g] != fl)
+          return label[g];
+    }
+    return fl;
+  }
+
+  /* The vertex where edge a - b of the face labelled fl meets the cut
+   * labelled lab. */
+  int edge_vertex(int a, int b, long fl, long lab) {
     int lo = std::min(a, b), hi = std::max(a, b);
     for (const auto &e : made)
       if (e[0] == lo && e[1] == hi) return e[2];
@@ -210,6 +314,7 @@ private:
     for (int k = 0; k < 3; k++) p[k] = v[in][k] + t * (v[ex][k] - v[in][k]);
     int id = static_cast<int>(nv2.size());
     nv2.push_back(p);
+    nlab2.push_back({fl, other_face(a, b, fl), lab});
     on.push_back(1);
     made.push_back({lo, hi, id});
     return id;
@@ -255,7 +360,9 @@ public:
   std::vector<long> label;
 
   void box(const double lo[3], const double hi[3]) {
-    v = {{lo[0], lo[1], 0}, {hi[0], lo[1], 0}, {hi[0], hi[1], 0},
+    v = {{lo[0], lo[1], 0},
+         {hi[0], lo[1], 0},
+         {hi[0], hi[1], 0},
          {lo[0], hi[1], 0}};
     label = {-1 - PM_FACE_YMIN, -1 - PM_FACE_XMAX, -1 - PM_FACE_YMAX,
              -1 - PM_FACE_XMIN};
@@ -265,15 +372,8 @@ public:
    * false when nothing is left. */
   bool cut(const Vec &n, const Vec &m, long lab) {
     const std::size_t nv = v.size();
-    d.resize(nv);
-    bool any_out = false, any_in = false;
-    for (std::size_t k = 0; k < nv; k++) {
-      d[k] = dot(n, sub(v[k], m));
-      any_out |= d[k] > 0;
-      any_in |= d[k] < 0;
-    }
-    if (!any_out) return true;
-    if (!any_in) return false;
+    const int side = sides(v, n, m, d);
+    if (side != CUT) return side == KEEP;
     nv2.clear();
     nl.clear();
     for (std::size_t k = 0; k < nv; k++) {
@@ -314,8 +414,8 @@ private:
  * neighbour in nbr; its own enclosed volume (divergence theorem about the
  * point) in *vol.  False when the cell is empty. */
 bool cell_faces_3d(Polyhedron &P, const double lo[3], const double hi[3],
-                   const double *x, long i, const long *nbr, long nn,
-                   std::vector<Face> &faces, double *vol) {
+                   double tol, const double *x, long i, const long *nbr,
+                   long nn, std::vector<Face> &faces, double *vol) {
   const Vec xi = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
   P.box(lo, hi);
   for (long k = 0; k < nn; k++) {
@@ -326,6 +426,8 @@ bool cell_faces_3d(Polyhedron &P, const double lo[3], const double hi[3],
                    0.5 * (xi[2] + xj[2])};
     if (!P.cut(n, m, j)) return false;
   }
+  for (std::size_t k = 0; k < P.v.size(); k++)
+    canonical_vertex(3, x, i, P.vlab[k].data(), lo, hi, tol, P.v[k]);
   faces.clear();
   *vol = 0;
   for (std::size_t f = 0; f < P.face.size(); f++) {
@@ -354,8 +456,8 @@ bool cell_faces_3d(Polyhedron &P, const double lo[3], const double hi[3],
 /* The same in 2D: the rectangle cut by the bisector lines; each edge's
  * area vector is its outward normal times its length. */
 bool cell_faces_2d(Polygon &P, const double lo[3], const double hi[3],
-                   const double *x, long i, const long *nbr, long nn,
-                   std::vector<Face> &faces, double *vol) {
+                   double tol, const double *x, long i, const long *nbr,
+                   long nn, std::vector<Face> &faces, double *vol) {
   const Vec xi = {x[3 * i], x[3 * i + 1], 0};
   P.box(lo, hi);
   for (long k = 0; k < nn; k++) {
@@ -365,9 +467,13 @@ bool cell_faces_2d(Polygon &P, const double lo[3], const double hi[3],
     const Vec m = {0.5 * (xi[0] + xj[0]), 0.5 * (xi[1] + xj[1]), 0};
     if (!P.cut(n, m, j)) return false;
   }
+  const std::size_t nv = P.v.size();
+  for (std::size_t k = 0; k < nv; k++) {
+    const long lab[2] = {P.label[(k + nv - 1) % nv], P.label[k]};
+    canonical_vertex(2, x, i, lab, lo, hi, tol, P.v[k]);
+  }
   faces.clear();
   *vol = 0;
-  const std::size_t nv = P.v.size();
   for (std::size_t k = 0; k < nv; k++) {
     const Vec &p = P.v[k], &q = P.v[(k + 1) % nv];
     Face F = empty_face(P.label[k]);
@@ -387,8 +493,7 @@ pm_err check_points(int dim, long n, const double *x, const double lo[3],
                     const double hi[3], double tol) {
   for (long i = 0; i < n; i++) {
     const double *p = x + 3 * i;
-    PM_CHECK(std::isfinite(p[0]) && std::isfinite(p[1]) &&
-                 std::isfinite(p[2]),
+    PM_CHECK(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]),
              PM_ERR_ARG, "point %ld has a non-finite coordinate (%g, %g, %g)",
              i, p[0], p[1], p[2]);
     for (int k = 0; k < dim; k++)
@@ -489,20 +594,13 @@ pm_err fill_dual(int dim, long n, const double *x, const Cells &cells,
   for (long i = 0; i < n; i++)
     for (const Face &F : cells.faces[i])
       if (F.label < 0 && F.area >= tiny) nf++;
-  d->n_facets = nf;
-  PM_TRY(PM_ALLOC(d->facet_point, nf, "facet points"));
-  PM_TRY(PM_ALLOC(d->facet_surface, nf, "facet surfaces"));
-  PM_TRY(PM_ALLOC(d->facet_area_vec, 3 * nf, "facet area vectors"));
-  PM_TRY(PM_ALLOC(d->facet_moment, 9 * nf, "facet moments"));
-  PM_TRY(PM_ALLOC(d->facet_centroid, 3 * nf, "facet centroids"));
-  PM_TRY(PM_ALLOC(d->facet_area, nf, "facet areas"));
+  PM_TRY(gm_dual_alloc_facets(d, nf));
   for (long i = 0; i < n; i++)
     for (const Face &F : cells.faces[i]) {
       if (F.label >= 0 || F.area < tiny) continue;
       int box_face = static_cast<int>(-1 - F.label);
       d->facet_point[f] = i;
-      d->facet_surface[f] =
-          face_surface ? face_surface[box_face] : box_face;
+      d->facet_surface[f] = face_surface ? face_surface[box_face] : box_face;
       std::memcpy(d->facet_area_vec + 3 * f, F.a, sizeof F.a);
       std::memcpy(d->facet_moment + 9 * f, F.M, sizeof F.M);
       std::memcpy(d->facet_centroid + 3 * f, F.c, sizeof F.c);
@@ -543,8 +641,8 @@ pm_err finish_cells(gm_dual *d, const Cells &cells) {
       add(1.0, d->facet_area_vec + 3 * f, d->facet_moment + 9 * f,
           d->facet_area[f]);
     double V = tr / dim;
-    double closure = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] +
-                               sum[2] * sum[2]);
+    double closure =
+        std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
     PM_CHECK(V > 0 && std::fabs(V - cells.volume[i]) <= 1e-9 * V,
              PM_ERR_GEOMETRY,
              "the faces of the Voronoi cell of point %ld at (%g, %g, %g) "
@@ -578,6 +676,13 @@ pm_err build(int dim, long n, const double *x, const double lo[3],
   PM_CALL(check_points(dim, n, x, lo, hi, 1e-10 * size));
   const double spacing = std::pow(vbox / n, 1.0 / dim);
   const double tiny = GM_VORONOI_TINY_FACE * std::pow(spacing, dim - 1);
+  /* A vertex computed twice differs by some epsilons of its coordinates
+   * (of the box's size at most) when well-conditioned; by a fair part of
+   * the spacing when not (canonical_vertex). */
+  double xmax = 0;
+  for (int k = 0; k < dim; k++)
+    xmax = std::max(xmax, std::max(std::fabs(lo[k]), std::fabs(hi[k])));
+  const double vtol = 1e-10 * spacing + 1e-13 * xmax;
 
   /* Voronoi neighbours, both ways (CSR), refusing near-duplicates. */
   std::vector<std::pair<long, long>> edges = delaunay_edges(dim, n, x);
@@ -591,8 +696,8 @@ pm_err build(int dim, long n, const double *x, const double lo[3],
              "points %ld at (%.17g, %.17g, %.17g) and %ld at (%.17g, %.17g, "
              "%.17g) are %g apart, below 1e-10 of the mean spacing %g: "
              "duplicates",
-             a, x[3 * a], x[3 * a + 1], x[3 * a + 2], b, x[3 * b],
-             x[3 * b + 1], x[3 * b + 2], std::sqrt(r2), spacing);
+             a, x[3 * a], x[3 * a + 1], x[3 * a + 2], b, x[3 * b], x[3 * b + 1],
+             x[3 * b + 2], std::sqrt(r2), spacing);
     ptr[a + 1]++;
     ptr[b + 1]++;
   }
@@ -613,9 +718,9 @@ pm_err build(int dim, long n, const double *x, const double lo[3],
   for (long i = 0; i < n; i++) {
     const long *ni = nbr.data() + ptr[i];
     const long nn = ptr[i + 1] - ptr[i];
-    bool ok = dim == 3 ? cell_faces_3d(P3, lo, hi, x, i, ni, nn,
+    bool ok = dim == 3 ? cell_faces_3d(P3, lo, hi, vtol, x, i, ni, nn,
                                        cells.faces[i], &cells.volume[i])
-                       : cell_faces_2d(P2, lo, hi, x, i, ni, nn,
+                       : cell_faces_2d(P2, lo, hi, vtol, x, i, ni, nn,
                                        cells.faces[i], &cells.volume[i]);
     PM_CHECK(ok && cells.volume[i] > 0, PM_ERR_GEOMETRY,
              "the Voronoi cell of point %ld at (%g, %g, %g) is empty", i,
@@ -678,8 +783,9 @@ extern "C" pm_err gm_voronoi_build(int dim, long n, const double *x,
   try {
     return build(dim, n, x, lo, hi, face_surface, out);
   } catch (const std::bad_alloc &) {
-    return PM_ERROR(PM_ERR_MEMORY, "no memory for the Voronoi cells of %ld "
-                                   "points",
+    return PM_ERROR(PM_ERR_MEMORY,
+                    "no memory for the Voronoi cells of %ld "
+                    "points",
                     n);
   } catch (const std::exception &e) {
     return PM_ERROR(PM_ERR_GEOMETRY,

@@ -265,9 +265,8 @@ static void patch_f2(const char *model, int k, int cells) {
                 "%.3g, top reaction %.6g N (exact %.6g N)\n",
                 cell_names[cells], model,
                 m->flux == FPM_FLUX_SIPG ? "SIPG" : "IIPG",
-                m->jump == FPM_JUMP_QUADRATIC ? "quadratic" : "linear",
-                penalty, m->n, lat[0], lat[1], worst / scale, R[2],
-                Pzz * 0.01);
+                m->jump == FPM_JUMP_QUADRATIC ? "quadratic" : "linear", penalty,
+                m->n, lat[0], lat[1], worst / scale, R[2], Pzz * 0.01);
   /* Round-off: the penalty's terms are p times the stress's and cancel
    * to zero, so the residual is some 1000 machine epsilons of (1 + p)
    * |P| h^2 (the worst measured: 1.02e-11 at p = 100 on an AMD EPYC,

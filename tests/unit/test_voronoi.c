@@ -155,48 +155,242 @@ static void test_random_points(void **state) {
     }
 }
 
-static void test_gmsh_nodes(void **state) {
+/* Regular lattices: cell-centred points give cells that are the lattice's
+ * boxes, with the axis neighbours as the only interfaces (the diagonal
+ * neighbours of the degenerate Delaunay triangulation touch along an edge
+ * or a corner: dropped or never cut); a lattice of nodes, boundary
+ * included, gives half and quarter boxes on the boundary. */
+static void test_lattice(void **state) {
   (void)state;
-  const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
-  double hs[] = {8.72e-3, 6.4e-3, 4.15e-3};
+  const double lo[3] = {0.0, -1.0, 2.0}, hi[3] = {0.4, 0.5, 3.0};
+  const int nc[3] = {4, 3, 5};
   for (int dim = 2; dim <= 3; dim++)
-  for (int t = 0; t < 3; t++) {
-    gm_mesh *m = NULL;
-    gm_dual *d = NULL;
-    assert_ok(gm_mesh_box(dim, lo, hi, hs[t] / (dim == 2 ? 2 : 1), &m));
-    assert_ok(gm_cells_find("voronoi")->build(m, &d));
-    double closure = check_cells(d, lo, hi);
-    long off = 0, offpts = 0;
-    double maxoff = 0;
-    char *seen = calloc(d->n_points, 1);
-    for (long f = 0; f < d->n_facets; f++) {
-      int b = d->facet_surface[f];
-      double plane = b % 2 ? hi[b / 2] : lo[b / 2];
-      double dist = fabs(d->x[3 * d->facet_point[f] + b / 2] - plane);
-      if (dist > 1e-12) {
-        off++;
-        if (!seen[d->facet_point[f]]) offpts++;
-        seen[d->facet_point[f]] = 1;
-        maxoff = fmax(maxoff, dist);
+    for (int nodes = 0; nodes <= 1; nodes++) {
+      int np[3] = {1, 1, 1};
+      double h[3] = {0, 0, 0}, box = 1;
+      long n = 1;
+      for (int k = 0; k < dim; k++) {
+        np[k] = nc[k] + nodes;
+        h[k] = (hi[k] - lo[k]) / nc[k];
+        box *= h[k];
+        n *= np[k];
       }
+      double *x = calloc(3 * (size_t)n, sizeof *x);
+      int *ijk = calloc(3 * (size_t)n, sizeof *ijk);
+      for (long p = 0; p < n; p++) {
+        long r = p;
+        for (int k = 0; k < dim; k++) {
+          ijk[3 * p + k] = (int)(r % np[k]);
+          r /= np[k];
+          x[3 * p + k] = lo[k] + (ijk[3 * p + k] + (nodes ? 0.0 : 0.5)) * h[k];
+        }
+      }
+      gm_dual *d = NULL;
+      assert_ok(gm_voronoi_build(dim, n, x, lo, hi, NULL, &d));
+      check_cells(d, lo, hi);
+      for (long p = 0; p < n; p++) {
+        /* a node on b box faces owns 1 / 2^b of a box */
+        double expect = box;
+        int axis_nbrs = 0;
+        for (int k = 0; k < dim; k++) {
+          int at = ijk[3 * p + k];
+          if (nodes && (at == 0 || at == np[k] - 1)) expect *= 0.5;
+          axis_nbrs += (at > 0) + (at < np[k] - 1);
+        }
+        assert_close(d->volume[p], expect, 1e-13, 0);
+        assert_int_equal(d->nbr_ptr[p + 1] - d->nbr_ptr[p], axis_nbrs);
+        for (long e = d->nbr_ptr[p]; e < d->nbr_ptr[p + 1]; e++) {
+          long q = d->nbr[e], f = d->nbr_iface[e];
+          int differ = 0, axis = 0;
+          for (int k = 0; k < dim; k++)
+            if (ijk[3 * p + k] != ijk[3 * q + k]) {
+              differ++;
+              axis = k;
+            }
+          assert_int_equal(differ, 1);
+          /* the face's area: the box's face, halved per boundary crossed */
+          double area = box / h[axis];
+          for (int k = 0; k < dim; k++) {
+            int at = ijk[3 * p + k];
+            if (k != axis && nodes && (at == 0 || at == np[k] - 1)) area *= 0.5;
+          }
+          assert_close(d->if_area[f], area, 1e-13, 0);
+          for (int k = 0; k < dim; k++) {
+            double mid = 0.5 * (x[3 * p + k] + x[3 * q + k]);
+            if (k == axis)
+              assert_close(d->if_centroid[3 * f + k], mid, 0,
+                           1e-13 * (hi[k] - lo[k]));
+          }
+        }
+      }
+      print_message("%dD lattice of %s, %ld points: %ld interfaces, %ld "
+                    "round-off faces dropped, lowest quality %.3f\n",
+                    dim, nodes ? "nodes" : "cell centres", n, d->n_ifaces,
+                    d->n_dropped_faces, d->min_quality);
+      gm_dual_destroy(d);
+      free(x);
+      free(ijk);
     }
-    free(seen);
-    print_message("%dD gmsh h %g: %ld points, %ld interfaces (median dual "
-                  "%ld), %ld facets, closure %.2g, dropped %ld, slivers %ld, "
-                  "lowest quality %.3f; %ld facets of %ld points off their "
-                  "face (up to %.3g)\n",
-                  dim, hs[t], d->n_points, d->n_ifaces, 0L, d->n_facets,
-                  closure, d->n_dropped_faces, d->n_slivers, d->min_quality,
-                  off, offpts, maxoff);
+}
+
+/* Three points on a line across the unit square: the middle one's cell is
+ * a strip 0.05 by 1, quality 16 A / P^2 = 0.18: the one sliver. */
+static void test_sliver_reported(void **state) {
+  (void)state;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
+  const double x[9] = {0.5, 0.45, 0, 0.5, 0.5, 0, 0.5, 0.55, 0};
+  gm_dual *d = NULL;
+  assert_ok(gm_voronoi_build(2, 3, x, lo, hi, NULL, &d));
+  check_cells(d, lo, hi);
+  assert_int_equal(d->n_slivers, 1);
+  assert_int_equal(d->min_quality_point, 1);
+  assert_close(d->min_quality, 16 * 0.05 / (2.1 * 2.1), 1e-12, 0);
+  gm_dual_destroy(d);
+}
+
+/* Bad point sets are refused, naming the points. */
+static void test_bad_points(void **state) {
+  (void)state;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 2, 3};
+  const long n = 50;
+  double *x = random_points(3, n, lo, hi, 5);
+  gm_dual *d = (gm_dual *)1;
+  int surf[6] = {0, 1, 2, 3, 4, 5};
+  x[3 * 31 + 2] = hi[2] + 1e-3; /* outside */
+  assert_fails(gm_voronoi_build(3, n, x, lo, hi, surf, &d), PM_ERR_ARG,
+               "point 31 at (");
+  assert_null(d);
+  print_message("%s\n", pm_error_message());
+  assert_non_null(strstr(pm_error_message(), "outside the domain box"));
+  x[3 * 31 + 2] = hi[2]; /* on the boundary: in */
+  assert_ok(gm_voronoi_build(3, n, x, lo, hi, surf, &d));
+  gm_dual_destroy(d);
+  memcpy(x + 3 * 40, x + 3 * 12, 3 * sizeof *x); /* exact duplicate */
+  assert_fails(gm_voronoi_build(3, n, x, lo, hi, surf, &d), PM_ERR_ARG,
+               "points 12 and 40 are duplicates, both at (");
+  print_message("%s\n", pm_error_message());
+  x[3 * 40] *= 1 + 1e-14; /* closer than 1e-10 of the spacing */
+  assert_fails(gm_voronoi_build(3, n, x, lo, hi, surf, &d), PM_ERR_ARG,
+               "points 12 at (");
+  assert_non_null(strstr(pm_error_message(), "and 40 at ("));
+  assert_non_null(strstr(pm_error_message(), "duplicates"));
+  print_message("%s\n", pm_error_message());
+  x[3 * 40] = NAN;
+  assert_fails(gm_voronoi_build(3, n, x, lo, hi, surf, &d), PM_ERR_ARG,
+               "point 40 has a non-finite coordinate");
+  assert_fails(gm_voronoi_build(3, 0, x, lo, hi, surf, &d), PM_ERR_ARG,
+               "Voronoi cells of 0 points");
+  assert_fails(gm_voronoi_build(4, n, x, lo, hi, surf, &d), PM_ERR_ARG,
+               "expected 2 or 3");
+  const double flat[3] = {1, 0, 3};
+  assert_fails(gm_voronoi_build(3, n, x, lo, flat, surf, &d), PM_ERR_ARG,
+               "empty along axis 1");
+  assert_fails(gm_voronoi_build(3, n, x, lo, hi, surf, NULL), PM_ERR_ARG,
+               "out is NULL");
+  free(x);
+}
+
+/* The "voronoi" builder of gm_cells on gmsh box meshes (the F2 cube, the
+ * square): the cells of the mesh nodes, facets tagged with the mesh's box
+ * surfaces, every facet's point on its face; the median duals of the same
+ * mesh fill the same volume. */
+static void test_builder_box_mesh(void **state) {
+  (void)state;
+  const gm_cells_builder *b = gm_cells_find("voronoi");
+  assert_non_null(b);
+  assert_non_null(b->summary);
+  const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
+  for (int dim = 2; dim <= 3; dim++) {
+    gm_mesh *m = NULL;
+    gm_dual *d = NULL, *md = NULL;
+    assert_ok(gm_mesh_box(dim, lo, hi, dim == 3 ? 8.72e-3 : 4e-3, &m));
+    assert_ok(b->build(m, &d));
+    assert_ok(gm_dual_build(m, &md));
+    assert_int_equal(d->n_points, m->n_nodes);
+    assert_int_equal(md->min_quality_point, -1);
+    double closure = check_cells(d, lo, hi);
+    for (long f = 0; f < d->n_facets; f++) {
+      int face = d->facet_surface[f];
+      assert_string_equal(gm_mesh_surface_name(m, face), pm_face_name(face));
+      assert_close(d->x[3 * d->facet_point[f] + face / 2],
+                   pm_face_plane(face, lo, hi), 0, 1e-15);
+    }
+    double vm = 0, vv = 0;
+    for (long i = 0; i < m->n_nodes; i++) {
+      vm += md->volume[i];
+      vv += d->volume[i];
+    }
+    assert_close(vv, vm, 1e-13, 0);
+    print_message("%dD gmsh box: %ld nodes, %ld Voronoi interfaces (median "
+                  "duals %ld), %ld facets (%ld), closure %.2g, %ld faces "
+                  "dropped, %ld slivers, lowest quality %.3f\n",
+                  dim, d->n_points, d->n_ifaces, md->n_ifaces, d->n_facets,
+                  md->n_facets, closure, d->n_dropped_faces, d->n_slivers,
+                  d->min_quality);
     gm_dual_destroy(d);
+    gm_dual_destroy(md);
     gm_mesh_destroy(m);
   }
+}
+
+/* What the builder refuses: a mesh that does not fill its box, a box face
+ * with two surfaces, a node inside whose cell reaches the boundary. */
+static void test_builder_refusals(void **state) {
+  (void)state;
+  const gm_cells_builder *b = gm_cells_find("voronoi");
+  gm_mesh *m = NULL;
+  gm_dual *d = NULL;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const double tet[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const long tcell[4] = {0, 1, 2, 3};
+  assert_ok(gm_mesh_from_arrays(3, 4, tet, 1, tcell, lo, hi, &m));
+  assert_fails(b->build(m, &d), PM_ERR_UNSUPPORTED, "the domain is not one");
+  print_message("%s\n", pm_error_message());
+  assert_null(d);
+  gm_mesh_destroy(m);
+
+  /* [0, 2] x [0, 1] in four triangles; one of the two edges on y = 0
+   * re-tagged xmin */
+  const double rect[18] = {0, 0, 0, 1, 0, 0, 2, 0, 0,
+                           0, 1, 0, 1, 1, 0, 2, 1, 0};
+  const long rcells[12] = {0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4};
+  const double rhi[3] = {2, 1, 0};
+  assert_ok(gm_mesh_from_arrays(2, 6, rect, 4, rcells, lo, rhi, &m));
+  assert_ok(b->build(m, &d));
+  gm_dual_destroy(d);
+  int done = 0;
+  for (long c = 0; c < m->n_cells && !done; c++)
+    for (int o = 0; o < 3 && !done; o++)
+      if (m->face_surface[3 * c + o] == PM_FACE_YMIN) {
+        m->face_surface[3 * c + o] = PM_FACE_XMIN;
+        done = 1;
+      }
+  assert_true(done);
+  assert_fails(b->build(m, &d), PM_ERR_UNSUPPORTED,
+               "the box face ymin of the mesh carries two surfaces");
+  print_message("%s\n", pm_error_message());
+  gm_mesh_destroy(m);
+
+  /* the unit square's corners and a node 0.01 above the bottom */
+  const double fan[15] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.01, 0};
+  const long fcells[12] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
+  assert_ok(gm_mesh_from_arrays(2, 5, fan, 4, fcells, lo, hi, &m));
+  assert_fails(b->build(m, &d), PM_ERR_UNSUPPORTED,
+               "the Voronoi cell of node 4 at (0.5, 0.01, 0) reaches the box "
+               "face ymin");
+  print_message("%s\n", pm_error_message());
+  assert_null(d);
+  gm_mesh_destroy(m);
 }
 
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_random_points),
-      cmocka_unit_test(test_gmsh_nodes),
+      cmocka_unit_test(test_lattice),
+      cmocka_unit_test(test_sliver_reported),
+      cmocka_unit_test(test_bad_points),
+      cmocka_unit_test(test_builder_box_mesh),
+      cmocka_unit_test(test_builder_refusals),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
