@@ -1,6 +1,7 @@
-/* gm_dual: the median-dual subdomains of a simplex mesh: one cell per mesh
- * node, interfaces between edge neighbours, boundary facets tagged with the
- * mesh's named surfaces. */
+/* gm_dual: FPM subdomains, one cell per point, with the interfaces between
+ * neighbouring cells and the boundary facets tagged with the mesh's named
+ * surfaces; built here as the median duals of a simplex mesh (other
+ * builders fill the same struct: gm_voronoi). */
 #ifndef GM_DUAL_H
 #define GM_DUAL_H
 

@@ -1,9 +1,9 @@
 /* gm_voronoi: Voronoi cells clipped to a box behind the C interface of
  * gm_voronoi.h.  CGAL's Delaunay triangulation gives each point its Voronoi
- * neighbours; the cell is the box cut by the bisector planes of those
- * neighbours (a convex clip written here, exact for a convex cell), each
- * face remembering the neighbour or box face that made it.  No exception
- * leaves this file. */
+ * neighbours; the clipped cell, convex, is the box cut by the bisector
+ * planes of those neighbours (the clip is written here), each face
+ * remembering the neighbour or box face that made it.  No exception leaves
+ * this file. */
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
