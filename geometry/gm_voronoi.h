@@ -36,7 +36,9 @@
  * closure error that leaves is below that fraction); the volume of a cell
  * is the one its faces enclose (one third of the trace of sum over faces of
  * the moments about the point: two in 2D), so the volume, area vectors and
- * moments integrate constant and linear fields consistently.
+ * moments integrate constant and linear fields consistently.  The report
+ * fields of the dual count the faces dropped and the slivers, and name the
+ * cell of lowest quality.
  * Refused with PM_ERR_ARG: NULL arguments, n < 1, a box without volume,
  * a non-finite coordinate, a point outside the box by more than 1e-10 of
  * its size, two points closer than 1e-10 of the mean spacing (duplicates);
