@@ -1,6 +1,7 @@
 /* gm_cells: the table of partitions of a mesh into FPM cells (subdomains),
- * looked up by name: "median-dual" today; another partition (Voronoi cells
- * through the CGAL shim) is one more entry in gm_cells.c. */
+ * looked up by name: "median-dual" (gm_dual_build) and "voronoi" (the
+ * Voronoi cells of the mesh nodes clipped to its box, gm_voronoi_build);
+ * another partition is one more entry in gm_cells.c. */
 #ifndef GM_CELLS_H
 #define GM_CELLS_H
 

@@ -311,6 +311,17 @@ static int face_shared(long c, const long *fn, int nf, const gm_mesh *m,
   return 0;
 }
 
+pm_err gm_dual_alloc_facets(gm_dual *d, long nf) {
+  d->n_facets = nf;
+  PM_CALL(PM_ALLOC(d->facet_point, nf, "facet points"));
+  PM_CALL(PM_ALLOC(d->facet_surface, nf, "facet surfaces"));
+  PM_CALL(PM_ALLOC(d->facet_area_vec, 3 * nf, "facet area vectors"));
+  PM_CALL(PM_ALLOC(d->facet_moment, 9 * nf, "facet moments"));
+  PM_CALL(PM_ALLOC(d->facet_centroid, 3 * nf, "facet centroids"));
+  PM_CALL(PM_ALLOC(d->facet_area, nf, "facet areas"));
+  return PM_SUCCESS;
+}
+
 /* Boundary facets: faces of one cell only, split among their nodes. */
 static pm_err build_facets(const gm_mesh *m, const long *inc_ptr,
                            const long *inc, gm_dual *d) {
@@ -332,13 +343,7 @@ static pm_err build_facets(const gm_mesh *m, const long *inc_ptr,
     }
   }
   const long nf = n_bnd * dim;
-  d->n_facets = nf;
-  PM_TRY(PM_ALLOC(d->facet_point, nf, "facet points"));
-  PM_TRY(PM_ALLOC(d->facet_surface, nf, "facet surfaces"));
-  PM_TRY(PM_ALLOC(d->facet_area_vec, 3 * nf, "facet area vectors"));
-  PM_TRY(PM_ALLOC(d->facet_moment, 9 * nf, "facet moments"));
-  PM_TRY(PM_ALLOC(d->facet_centroid, 3 * nf, "facet centroids"));
-  PM_TRY(PM_ALLOC(d->facet_area, nf, "facet areas"));
+  PM_TRY(gm_dual_alloc_facets(d, nf));
 
   long f = 0;
   for (long c = 0; c < m->n_cells; c++) {
@@ -414,6 +419,7 @@ pm_err gm_dual_build(const gm_mesh *m, gm_dual **out) {
   gm_dual *d = NULL;
   long *inc_ptr = NULL, *inc = NULL;
   PM_TRY(PM_ALLOC(d, 1, "dual"));
+  d->min_quality_point = -1;
   d->dim = m->dim;
   d->n_points = m->n_nodes;
   PM_TRY(PM_ALLOC(d->x, 3 * m->n_nodes, "dual points"));

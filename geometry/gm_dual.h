@@ -1,6 +1,7 @@
-/* gm_dual: the median-dual subdomains of a simplex mesh: one cell per mesh
- * node, interfaces between edge neighbours, boundary facets tagged with the
- * mesh's named surfaces. */
+/* gm_dual: FPM subdomains, one cell per point, with the interfaces between
+ * neighbouring cells and the boundary facets tagged with the mesh's named
+ * surfaces; built here as the median duals of a simplex mesh (other
+ * builders fill the same struct: gm_voronoi). */
 #ifndef GM_DUAL_H
 #define GM_DUAL_H
 
@@ -50,6 +51,12 @@ typedef struct {
   double *facet_moment;   /* 9 * n_facets */
   double *facet_centroid; /* 3 * n_facets */
   double *facet_area;     /* n_facets */
+  /* What the builder reports of the cells' shapes (zeros from a builder
+   * that does not assess them): */
+  long n_dropped_faces;   /* faces of round-off size dropped */
+  long n_slivers;         /* cells below the builder's quality bound */
+  double min_quality;     /* the lowest cell quality (1 for a cube) */
+  long min_quality_point; /* its point, -1 when not assessed */
 } gm_dual;
 
 /* Median-dual subdomains of mesh m (read during the call only: the dual
@@ -59,6 +66,11 @@ typedef struct {
  * cell, a badly oriented cell, a zero-area interface or facet) or
  * PM_ERR_MEMORY. */
 pm_err gm_dual_build(const gm_mesh *m, gm_dual **out);
+
+/* For cell builders: sets d->n_facets = nf and allocates the facet arrays
+ * (zeroed; none for nf = 0).  PM_ERR_MEMORY when they do not fit: the
+ * arrays allocated stay for gm_dual_destroy. */
+pm_err gm_dual_alloc_facets(gm_dual *d, long nf);
 
 /* Frees the dual and all its arrays; NULL is a no-op. */
 void gm_dual_destroy(gm_dual *d);

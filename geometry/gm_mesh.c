@@ -304,6 +304,15 @@ static int cmp_u64(const void *a, const void *b) {
 
 /* Each edge counted once however many cells share it; NAN when memory for
  * the edge list cannot be had (a reporting figure, not worth an error). */
+double gm_mesh_volume(const gm_mesh *m) {
+  if (!m || !m->x || !m->cells) return 0.0;
+  double vol = 0.0, h;
+  for (long c = 0; c < m->n_cells; c++)
+    vol += fabs(cell_measure(m->dim, m->x,
+                             m->cells + (size_t)m->nodes_per_cell * c, &h));
+  return vol;
+}
+
 double gm_mesh_mean_edge(const gm_mesh *m) {
   if (!m || m->n_cells <= 0) return NAN;
   const int npc = m->nodes_per_cell;

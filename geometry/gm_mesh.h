@@ -82,6 +82,10 @@ void gm_mesh_destroy(gm_mesh *m);
  * report); NAN for an empty mesh or when memory runs out. */
 double gm_mesh_mean_edge(const gm_mesh *m);
 
+/* Volume (3D) or area (2D) of the mesh: the sum of its cells' measures;
+ * 0 for NULL or an empty mesh. */
+double gm_mesh_volume(const gm_mesh *m);
+
 /* Index of the surface called name, or -1 (no such surface, NULL
  * arguments).  Names compare exactly. */
 int gm_mesh_surface_find(const gm_mesh *m, const char *name);

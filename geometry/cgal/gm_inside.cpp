@@ -1,6 +1,6 @@
 /* gm_inside: CGAL's side-of-triangle-mesh test (a ray cast through an AABB
- * tree, exact predicates) behind the C interface of gm_inside.h.  The one
- * C++ file of pointmech: no exception leaves it. */
+ * tree, exact predicates) behind the C interface of gm_inside.h.  No
+ * exception leaves this file. */
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>

@@ -507,9 +507,17 @@ static pm_err plan(void *p, FILE *out) {
           m->dim == 2 ? "plane strain" : "solid");
   fprintf(out, "points       %ld (mesh size %g m, mean edge %.4g m)\n", m->n,
           s->mesh_size, sim->mean_edge);
+  const gm_dual *d = sim->dual;
   fprintf(out,
-          "cells        %ld simplices, %ld interfaces, %ld boundary facets\n",
-          sim->mesh->n_cells, sim->dual->n_ifaces, sim->dual->n_facets);
+          "cells        %s, one per node of %ld simplices: %ld interfaces, %ld "
+          "facets\n",
+          sim->cells->name, sim->mesh->n_cells, d->n_ifaces, d->n_facets);
+  if (d->min_quality_point >= 0)
+    fprintf(out,
+            "             %ld faces of round-off size dropped, %ld slivers; "
+            "lowest quality %.3g (1 for a cube) at point %ld\n",
+            d->n_dropped_faces, d->n_slivers, d->min_quality,
+            d->min_quality_point);
   fprintf(out, "pipeline     1. stress per point (");
   for (int k = 0; k < m->n_mats; k++)
     fprintf(out, "%s%s", k ? ", " : "", m->mats[k].model->name);

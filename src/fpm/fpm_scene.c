@@ -42,7 +42,9 @@ static const pm_key fpm_keys[] = {
      .type = PM_KEY_STRING,
      .offset = offsetof(fpm_options, cells),
      .def = "median-dual",
-     .doc = "the partition into subdomains (median-dual of the gmsh mesh)"},
+     .doc = "the partition into subdomains: median-dual (of the gmsh "
+            "mesh's simplices) or voronoi (Voronoi cells of the mesh nodes "
+            "clipped to the domain box; box domains only)"},
     {0}};
 
 static pm_err check_section(const pm_scene *s, void *opts) {

@@ -15,8 +15,11 @@
 #include "fpm_model.h"
 #include "fpm_solver.h"
 #include "fpm_static.h"
+#include "gm_cells.h"
 #include "gm_dual.h"
+#include "gm_voronoi.h"
 #include "pm_omp.h"
+#include "pm_random.h"
 
 typedef struct {
   gm_mesh *mesh;
@@ -198,63 +201,102 @@ static void gel_model(const char *model, pm_scene_material *out,
   assert_int_equal(pm_material_finish(m), PM_SUCCESS);
 }
 
-/* The finite-strain patch test of case F2, for every solid model of the
- * table: the exact uniaxial-stress state (u_z = -0.4 z, lateral stretches
- * from P_xx = P_yy = 0) on every point, roller conditions on three faces
- * and the top displacement: zero force on every free dof, boundary points
- * included.  Round-off, whatever the model: the discrete operator
- * integrates any constant stress exactly. */
+/* The cells of variant `cells` in place of the fixture's median duals:
+ * 1 the Voronoi cells of its mesh nodes (the "voronoi" builder), 2 those
+ * of n seeded random points in the box (no point on the boundary: the
+ * facets belong to points inside).  The mesh still names the box faces. */
+static void fixture_cells(fixture *fx, int cells, long n) {
+  if (cells == 0) return;
+  gm_dual_destroy(fx->dual);
+  fx->dual = NULL;
+  if (cells == 1) {
+    assert_int_equal(gm_cells_find("voronoi")->build(fx->mesh, &fx->dual),
+                     PM_SUCCESS);
+    return;
+  }
+  double *x = calloc(3 * (size_t)n, sizeof *x);
+  pm_random r = pm_random_seed(2024);
+  for (long i = 0; i < 3 * n; i++)
+    x[i] = i % 3 < fx->mesh->dim ? 0.1 * pm_random_uniform(&r) : 0;
+  assert_int_equal(gm_voronoi_build(fx->mesh->dim, n, x, fx->mesh->box_min,
+                                    fx->mesh->box_max, NULL, &fx->dual),
+                   PM_SUCCESS);
+  free(x);
+}
+
+/* The finite-strain patch test of case F2 for one solid model, flux and
+ * jump variant k (0: p = 0; 1: IIPG p = 20; 2: SIPG p = 100; 3, 4: the
+ * same with the quadratic jump) on the cells of variant `cells` (see
+ * fixture_cells): the exact uniaxial-stress state (u_z = -0.4 z, lateral
+ * stretches from P_xx = P_yy = 0) on every point, roller conditions on
+ * three faces and the top displacement: zero force on every free dof,
+ * boundary points included.  Round-off, whatever the model and the cells:
+ * the discrete operator integrates any constant stress exactly. */
+static void patch_f2(const char *model, int k, int cells) {
+  double penalty = k == 0 ? 0 : k == 1 || k == 3 ? 20 : 100;
+  fixture *fx = fixture_new(3, 0.02, penalty, true);
+  fixture_cells(fx, cells, 400);
+  gel_model(model, &fx->mat, &fx->body);
+  if (k == 2 || k == 4) fx->opt.flux = FPM_FLUX_SIPG;
+  if (k >= 3) fx->opt.jump = FPM_JUMP_QUADRATIC;
+  fpm_model *m;
+  fpm_state *st;
+  fixture_model(fx, &m, &st);
+  double lat[2];
+  assert_int_equal(pm_material_uniaxial(&m->mats[0], m->mstate, 0.6, lat),
+                   PM_SUCCESS);
+  for (long i = 0; i < m->n; i++) {
+    st->u[3 * i] = (lat[0] - 1) * m->x[3 * i];
+    st->u[3 * i + 1] = (lat[1] - 1) * m->x[3 * i + 1];
+    st->u[3 * i + 2] = -0.4 * m->x[3 * i + 2];
+  }
+  assert_int_equal(fpm_force(m, st), -1);
+  double scale = fabs(st->P[8]) * 0.02 * 0.02, worst = 0;
+  for (long i = 0; i < 3 * m->n; i++)
+    if (!m->fixed[i]) worst = fmax(worst, fabs(st->f[i]));
+  /* The support's force on the top face is the uniaxial force P_zz L^2;
+   * the lateral roller faces carry none. */
+  double R[3], Pzz = st->P[8];
+  fpm_reaction(m, st, 3, R);
+  static const char *const cell_names[] = {"median duals", "Voronoi cells",
+                                           "Voronoi cells of random points"};
+  print_message("F2 patch on %s, %s, %s %s jump, p = %g: %ld points, "
+                "lateral stretches %.6f %.6f, max free |f| / (|P| h^2) = "
+                "%.3g, top reaction %.6g N (exact %.6g N)\n",
+                cell_names[cells], model,
+                m->flux == FPM_FLUX_SIPG ? "SIPG" : "IIPG",
+                m->jump == FPM_JUMP_QUADRATIC ? "quadratic" : "linear", penalty,
+                m->n, lat[0], lat[1], worst / scale, R[2], Pzz * 0.01);
+  /* Round-off: the penalty's terms are p times the stress's and cancel
+   * to zero, so the residual is some 1000 machine epsilons of (1 + p)
+   * |P| h^2 (the worst measured: 1.02e-11 at p = 100 on an AMD EPYC,
+   * against 2.2e-11; 5e-14 at p = 0 against 2.2e-13). */
+  assert_true(worst <= 1000 * DBL_EPSILON * (1 + penalty) * scale);
+  assert_true(fabs(R[2] - Pzz * 0.01) <= 1e-10 * fabs(Pzz * 0.01));
+  fpm_reaction(m, st, 0, R);
+  assert_true(fabs(R[0]) <= 1e-10 * fabs(Pzz * 0.01));
+  fpm_state_destroy(st);
+  fpm_model_destroy(m);
+  fixture_free(fx);
+}
+
+static const char *const solid_models[] = {
+    "neo-hookean", "neo-hookean-log",        "mooney-rivlin",
+    "ogden",       "holzapfel-gasser-ogden", "linear-elastic"};
+
+/* Every solid model of the table, every flux and jump, on median duals. */
 static void test_patch_f2(void **state) {
   (void)state;
-  const char *models[] = {
-      "neo-hookean", "neo-hookean-log",        "mooney-rivlin",
-      "ogden",       "holzapfel-gasser-ogden", "linear-elastic"};
   for (int mi = 0; mi < 6; mi++)
-    for (int k = 0; k < 5; k++) {
-      /* p = 0; IIPG p = 20; SIPG p = 100; both with the quadratic jump */
-      double penalty = k == 0 ? 0 : k == 1 || k == 3 ? 20 : 100;
-      fixture *fx = fixture_new(3, 0.02, penalty, true);
-      gel_model(models[mi], &fx->mat, &fx->body);
-      if (k == 2 || k == 4) fx->opt.flux = FPM_FLUX_SIPG;
-      if (k >= 3) fx->opt.jump = FPM_JUMP_QUADRATIC;
-      fpm_model *m;
-      fpm_state *st;
-      fixture_model(fx, &m, &st);
-      double lat[2];
-      assert_int_equal(pm_material_uniaxial(&m->mats[0], m->mstate, 0.6, lat),
-                       PM_SUCCESS);
-      for (long i = 0; i < m->n; i++) {
-        st->u[3 * i] = (lat[0] - 1) * m->x[3 * i];
-        st->u[3 * i + 1] = (lat[1] - 1) * m->x[3 * i + 1];
-        st->u[3 * i + 2] = -0.4 * m->x[3 * i + 2];
-      }
-      assert_int_equal(fpm_force(m, st), -1);
-      double scale = fabs(st->P[8]) * 0.02 * 0.02, worst = 0;
-      for (long i = 0; i < 3 * m->n; i++)
-        if (!m->fixed[i]) worst = fmax(worst, fabs(st->f[i]));
-      /* The support's force on the top face is the uniaxial force P_zz L^2;
-       * the lateral roller faces carry none. */
-      double R[3], Pzz = st->P[8];
-      fpm_reaction(m, st, 3, R);
-      print_message(
-          "F2 patch, %s, %s %s jump, p = %g: %ld points, lateral stretches "
-          "%.6f %.6f, max free |f| / (|P| h^2) = %.3g, top "
-          "reaction %.6g N (exact %.6g N)\n",
-          models[mi], m->flux == FPM_FLUX_SIPG ? "SIPG" : "IIPG",
-          m->jump == FPM_JUMP_QUADRATIC ? "quadratic" : "linear", penalty, m->n,
-          lat[0], lat[1], worst / scale, R[2], Pzz * 0.01);
-      /* Round-off: the penalty's terms are p times the stress's and cancel
-       * to zero, so the residual is some 1000 machine epsilons of (1 + p)
-       * |P| h^2 (the worst measured: 1.02e-11 at p = 100 on an AMD EPYC,
-       * against 2.2e-11; 5e-14 at p = 0 against 2.2e-13). */
-      assert_true(worst <= 1000 * DBL_EPSILON * (1 + penalty) * scale);
-      assert_true(fabs(R[2] - Pzz * 0.01) <= 1e-10 * fabs(Pzz * 0.01));
-      fpm_reaction(m, st, 0, R);
-      assert_true(fabs(R[0]) <= 1e-10 * fabs(Pzz * 0.01));
-      fpm_state_destroy(st);
-      fpm_model_destroy(m);
-      fixture_free(fx);
-    }
+    for (int k = 0; k < 5; k++) patch_f2(solid_models[mi], k, 0);
+}
+
+/* The same on Voronoi cells, of the mesh nodes and of random points. */
+static void test_patch_f2_voronoi(void **state) {
+  (void)state;
+  for (int cells = 1; cells <= 2; cells++)
+    for (int mi = 0; mi < 6; mi++)
+      for (int k = 0; k < 5; k++) patch_f2(solid_models[mi], k, cells);
 }
 
 /* A smooth finite deformation u_a = smooth x_(a+1) x_a / 0.1 plus a rough
@@ -466,6 +508,7 @@ int main(void) {
       cmocka_unit_test(test_homogeneous_p0),
       cmocka_unit_test(test_homogeneous_p20),
       cmocka_unit_test(test_patch_f2),
+      cmocka_unit_test(test_patch_f2_voronoi),
       cmocka_unit_test(test_sipg_is_gradient),
       cmocka_unit_test(test_force_linearisation),
       cmocka_unit_test(test_static_tangent),

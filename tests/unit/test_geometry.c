@@ -447,7 +447,7 @@ static void test_cells_table(void **state) {
   assert_string_equal(b->name, "median-dual");
   assert_non_null(b->summary);
   assert_true(b->build == gm_dual_build);
-  assert_null(gm_cells_find("voronoi"));
+  assert_null(gm_cells_find("delaunay"));
   assert_null(gm_cells_find("Median-Dual"));
   assert_null(gm_cells_find(""));
   assert_null(gm_cells_find(NULL));
