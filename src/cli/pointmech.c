@@ -17,6 +17,7 @@
 #include "pm_error.h"
 #include "pm_memory.h"
 #include "pm_probe.h"
+#include "pm_bench.h"
 #include "pm_run.h"
 #include "pm_scene.h"
 #include "pm_study.h"
@@ -50,6 +51,9 @@ static void usage(FILE *out) {
           "                 [--set [METHOD:]KEY=VALUE]... [--lattice N] "
           "[--out DIR] [--overwrite]\n"
           "                 [--force-memory]\n"
+          "       pointmech bench SUITE [--only NAME] [--set KEY=VALUE]... "
+          "[--out DIR]\n"
+          "                 [--overwrite] [--quiet]\n"
           "       pointmech keys\n"
           "       pointmech normals\n"
           "       pointmech --help | --version\n"
@@ -111,6 +115,22 @@ static void usage(FILE *out) {
           "tools/plot-compare.py; a\n"
           "         method that fails is tabulated with its diagnosis and "
           "the others run\n"
+          "  bench  run a benchmark suite (cases/bench/*.yaml: scenes, "
+          "methods as\n"
+          "         {label, method, set}, resolutions): each case at each "
+          "resolution is\n"
+          "         one compare into OUT/CASE/h-RES; OUT/bench.{md,csv} "
+          "tabulate every\n"
+          "         run's NRMSE and reaction error against the FE referee "
+          "(or the\n"
+          "         analytic field) beside its wall time and memory, with the "
+          "referee's\n"
+          "         own ladder; OUT/accuracy-cost.png by tools/plot-bench.py "
+          "(default OUT:\n"
+          "         out/NAME-bench); a failed case is listed with its "
+          "diagnosis and the\n"
+          "         suite goes on; --only runs the cases whose name holds "
+          "NAME\n"
           "  keys   print every scene key: meaning, type, range, unit, "
           "default\n"
           "  normals print the membrane-normals paper's static cases (M6: "
@@ -150,6 +170,7 @@ typedef struct {
   const char *points;
   const char *reference;
   const char *methods;
+  const char *only;
   long lattice;
   int n_ladders;
   const char *ladders[PM_STUDY_MAX_KEYS];
@@ -174,6 +195,8 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
       a->reference = argv[++k];
     else if (strcmp(arg, "--methods") == 0 && has_next)
       a->methods = argv[++k];
+    else if (strcmp(arg, "--only") == 0 && has_next)
+      a->only = argv[++k];
     else if (strcmp(arg, "--lattice") == 0 && has_next) {
       char *end;
       a->lattice = strtol(argv[++k], &end, 10);
@@ -274,16 +297,15 @@ static int cmd_convergence(const cli_args *a) {
   return e ? report(e) : EXIT_OK;
 }
 
-/* Draw the difference pictures of the comparison in dir with
- * tools/plot-compare.py, or say how. */
-static void draw_differences(const char *dir) {
-  const char *python = "/usr/bin/python3",
-             *tool = PM_TOOLS_DIR "/plot-compare.py";
+/* Draw the pictures of the comparison or bench in dir with the tool
+ * (tools/plot-compare.py, tools/plot-bench.py), or say how. */
+static void draw_pictures(const char *dir, const char *tool) {
+  const char *python = "/usr/bin/python3";
   char *const args[] = {(char *)python, (char *)tool, (char *)dir, NULL};
   pid_t pid;
   int st = 0;
   extern char **environ;
-  const char *why = "no /usr/bin/python3 or no tools/plot-compare.py here";
+  const char *why = "no /usr/bin/python3 or no plotting tool here";
   /* posix_spawn, not fork: no atfork handlers (MPI's) run in the child. */
   if (access(python, X_OK) == 0 && access(tool, R_OK) == 0) {
     if (posix_spawn(&pid, python, NULL, NULL, args, environ) != 0 ||
@@ -318,7 +340,28 @@ static int cmd_compare(const cli_args *a) {
   fflush(stdout);
   char mid[1100];
   snprintf(mid, sizeof mid, "%s/midplane.csv", dir);
-  if (dir[0] && access(mid, R_OK) == 0) draw_differences(dir);
+  if (dir[0] && access(mid, R_OK) == 0)
+    draw_pictures(dir, PM_TOOLS_DIR "/plot-compare.py");
+  return e ? report(e) : EXIT_OK;
+}
+
+static int cmd_bench(const cli_args *a) {
+  pm_bench_options o = {
+      .suite = a->scene,
+      .only = a->only,
+      .n_sets = a->n_sets,
+      .sets = a->sets,
+      .out_dir = a->out,
+      .quiet = a->quiet,
+      .overwrite = a->overwrite,
+  };
+  char dir[1024];
+  pm_err e = pm_bench_run(&o, stdout, dir, sizeof dir);
+  fflush(stdout);
+  char csv[1100];
+  snprintf(csv, sizeof csv, "%s/bench.csv", dir);
+  if (dir[0] && access(csv, R_OK) == 0)
+    draw_pictures(dir, PM_TOOLS_DIR "/plot-bench.py");
   return e ? report(e) : EXIT_OK;
 }
 
@@ -338,7 +381,8 @@ int main(int argc, char **argv) {
     return EXIT_OK;
   }
   if (strcmp(cmd, "run") == 0 || strcmp(cmd, "plan") == 0 ||
-      strcmp(cmd, "convergence") == 0 || strcmp(cmd, "compare") == 0)
+      strcmp(cmd, "convergence") == 0 || strcmp(cmd, "compare") == 0 ||
+      strcmp(cmd, "bench") == 0)
     pm_wait_policy_apply(argv);
   pm_err init = pm_app_init();
   if (init) return report(init);
@@ -387,6 +431,13 @@ int main(int argc, char **argv) {
       return EXIT_INPUT;
     }
     return cmd_compare(&a);
+  }
+  if (strcmp(cmd, "bench") == 0) {
+    if (!a.scene) {
+      fprintf(stderr, "pointmech: bench needs a SUITE file\n");
+      return EXIT_INPUT;
+    }
+    return cmd_bench(&a);
   }
   if (strcmp(cmd, "probe") == 0) {
     if (!a.scene || !a.points) {

@@ -640,12 +640,16 @@ static void plan_bodies(const mpm_sim *r, FILE *out) {
 }
 
 /* How the grid was laid when the loader chose it (a scene made for FPM). */
-static void plan_layout(const mpm_model *m, FILE *out) {
+static void plan_layout(const mpm_model *m, const pm_scene *s, FILE *out) {
   const mpm_layout *l = &m->layout;
   if (!l->mapped) return;
-  fprintf(out, "             chosen for this scene: the largest cell up to "
-               "discretization.mesh_size that divides domain.box; room beyond "
-               "its faces (cells below/above):");
+  fprintf(out,
+          "             chosen for this scene: %s; room beyond "
+          "its faces for the body to deform into (cells below/above):",
+          l->h == s->mesh_size
+              ? "the cell discretization.mesh_size"
+              : "the largest cell up to discretization.mesh_size that "
+                "divides domain.box");
   for (int c = 0; c < m->dim; c++)
     fprintf(out, " %c %ld/%ld", "xyz"[c], l -> room[c][0], l -> room[c][1]);
   fprintf(out, "\n");
@@ -664,7 +668,7 @@ static pm_err plan(void *p, FILE *out) {
           update_name(o->update, true), o->flip);
   fprintf(out, "grid         %ld x %ld x %ld nodes, cell %g m\n", g->nn[0],
           g->nn[1], g->nn[2], g->h);
-  plan_layout(m, out);
+  plan_layout(m, r->scene, out);
   fprintf(out, "particles    %ld (%d x %d x %d per cell)\n", m->n, o->ppc[0],
           o->ppc[1], m->dim == 3 ? o->ppc[2] : 1);
   plan_groups(m, out);
@@ -863,7 +867,7 @@ static pm_err implicit_plan(void *p, FILE *out) {
           m->dim, m->dim == 2 ? " plane strain" : "", basis_name(m->opt.shape));
   fprintf(out, "grid         %ld x %ld x %ld nodes, cell %g m\n", g->nn[0],
           g->nn[1], g->nn[2], g->h);
-  plan_layout(m, out);
+  plan_layout(m, r->scene, out);
   fprintf(out, "particles    %ld\n", m->n);
   plan_groups(m, out);
   plan_bodies(r, out);

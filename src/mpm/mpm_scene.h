@@ -67,11 +67,13 @@ const mpm_settings *mpm_scene_settings(const pm_scene *s);
 pm_err mpm_check_scene(const pm_scene *s);
 
 /* The grid MPM lays over a scene.  A box that the cell size
- * (discretization.mesh_size) divides is the grid, as the scene gives it.
- * Otherwise (a scene made for FPM, whose mesh_size is an element size) the
- * cell is the largest no larger than mesh_size that divides every edge of
- * domain.box (from 1 to 4 times as many cells along x), and the grid
- * reaches past the box by the room the body may deform into: beyond a face
+ * (discretization.mesh_size) divides is the grid, as the scene gives it,
+ * unless a body fills the box (region: domain) and a condition displaces
+ * it.  Otherwise (a scene made for FPM, whose mesh_size is an element
+ * size) the cell is the largest no larger than mesh_size that divides
+ * every edge of domain.box (from 1 to 4 times as many cells along x; the
+ * scene's own when it divides), and the grid reaches past the box by the
+ * room the body may deform into: beyond a face
  * whose condition holds its normal component, the outward part of that
  * displacement; beyond a free face, the largest displacement of any
  * condition; each a cell more (none beyond a face held in place).  The

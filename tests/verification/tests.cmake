@@ -50,3 +50,7 @@ set_tests_properties(verification.membranes PROPERTIES LABELS verification TIMEO
 add_test(NAME verification.compare
   COMMAND bash ${PM_VERIFY_DIR}/compare.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.compare PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)
+
+add_test(NAME verification.bench
+  COMMAND bash ${PM_VERIFY_DIR}/bench.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)

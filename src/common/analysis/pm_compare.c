@@ -47,10 +47,22 @@ static pm_err parse_methods(const char *list, cmp_study *c) {
              "--methods %s: expected method names of 1 to %d characters "
              "separated by commas",
              list, CMP_NAME_MAX - 1);
+    /* LABEL=METHOD: a variant of a method under a label of its own (its
+     * folder, its rows and the scope of its --set LABEL:KEY=VALUE). */
+    char *eq = strchr(names[k], '=');
+    const char *method = eq ? eq + 1 : names[k];
+    if (eq) *eq = 0;
+    PM_CHECK(*names[k] && *method && !strpbrk(names[k], ":/ ") &&
+                 !strpbrk(method, "=:/ "),
+             PM_ERR_SCENE,
+             "--methods %s: expected METHOD or LABEL=METHOD, labels without "
+             "':', '/' or spaces, got '%s%s%s'",
+             list, names[k], eq ? "=" : "", eq ? method : "");
     for (int l = 0; l < k; l++)
       PM_CHECK(strcmp(c->meth[l].name, names[k]) != 0, PM_ERR_SCENE,
                "--methods %s: %s is named twice", list, names[k]);
-    memcpy(c->meth[k].name, names[k], len + 1);
+    memcpy(c->meth[k].name, names[k], strlen(names[k]) + 1);
+    memcpy(c->meth[k].method, method, strlen(method) + 1);
   }
   return PM_SUCCESS;
 }
@@ -84,10 +96,11 @@ static pm_err check_sets(const pm_compare_options *o, const cmp_study *c) {
   return PM_SUCCESS;
 }
 
-/* Load the scene for method (NULL: the scene as given): method=METHOD,
- * the overrides for every method, then the method's own. */
-static pm_err load_scene(const pm_compare_options *o, const char *method,
-                         pm_scene **s) {
+/* Load the scene for the method labelled label (NULL: the scene as
+ * given): method=METHOD, the overrides for every method, then the
+ * label's own. */
+static pm_err load_scene(const pm_compare_options *o, const char *label,
+                         const char *method, pm_scene **s) {
   const char *sets[CMP_SETS_MAX];
   char first[CMP_NAME_MAX + 8];
   int n = 0;
@@ -100,8 +113,8 @@ static pm_err load_scene(const pm_compare_options *o, const char *method,
       size_t len = scope_of(o->sets[k]);
       if (pass == 0 && len == 0)
         sets[n++] = o->sets[k];
-      else if (pass == 1 && len == strlen(method) &&
-               strncmp(o->sets[k], method, len) == 0)
+      else if (pass == 1 && len == strlen(label) &&
+               strncmp(o->sets[k], label, len) == 0)
         sets[n++] = o->sets[k] + len + 1;
     }
   return pm_scene_load(o->scene, n, sets, s);
@@ -337,7 +350,7 @@ static pm_err run_method(cmp_study *c, int k, FILE *out) {
   snprintf(M->status, sizeof M->status, "refused");
   if (out)
     fprintf(out, "method %d/%d: %s -> %s\n", k + 1, c->n, M->name, M->dir);
-  e = load_scene(o, M->name, &s);
+  e = load_scene(o, M->name, M->method, &s);
   if (e == PM_SUCCESS) e = pm_memory_check(s);
   if (e != PM_SUCCESS) {
     method_failed(M, e, NULL, NULL);
@@ -539,6 +552,36 @@ static pm_err choose_references(cmp_study *c, pm_fe_reference **fe) {
   return PM_SUCCESS;
 }
 
+/* The methods' figures for the caller. */
+static void fill_rows(const cmp_study *c, pm_compare_row *rows, int *n) {
+  for (int k = 0; k < c->n; k++) {
+    const cmp_method *M = &c->meth[k];
+    const pm_figures *g = &M->out.fig;
+    pm_compare_row *r = &rows[k];
+    memset(r, 0, sizeof *r);
+    memcpy(r->name, M->name, sizeof r->name);
+    memcpy(r->method, M->method, sizeof r->method);
+    memcpy(r->status, M->status, sizeof r->status);
+    memcpy(r->message, M->message, sizeof r->message);
+    r->ran = g->status != PM_STATUS_NOT_RUN;
+    r->points = g->points;
+    r->steps = g->steps;
+    r->flagged = M->mapped ? M->flagged : -1;
+    r->h = r->ran ? g->h : NAN;
+    r->wall_seconds = r->ran ? g->wall_seconds : NAN;
+    r->setup_seconds = r->ran ? g->setup_seconds : NAN;
+    r->memory_bytes = g->memory_bytes;
+    r->e_analytic = M->e_analytic;
+    r->e_fe = M->e_fe;
+    r->e_run = M->e_run;
+    r->reaction_fe = M->reaction_fe;
+    r->sed_fe = M->sed_fe;
+    r->loaded_reaction = r->ran ? M->out.loaded_reaction : NAN;
+    r->min_jacobian = r->ran ? g->min_jacobian : NAN;
+  }
+  if (n) *n = c->n;
+}
+
 /* Which methods failed, for the error returned. */
 static void failed_names(const cmp_study *c, char *buf, size_t size) {
   size_t len = 0;
@@ -565,7 +608,7 @@ pm_err pm_compare_run(const pm_compare_options *o, FILE *out, char *dir,
   PM_TRY(check_sets(o, c));
   /* The scene as given sets the name, the conditions, the references and
    * the bodies' box, the same for every method. */
-  PM_TRY(load_scene(o, NULL, &base));
+  PM_TRY(load_scene(o, NULL, NULL, &base));
   c->base = base;
   c->dim = base->dimension;
   if (o->out_dir)
@@ -600,6 +643,7 @@ pm_err pm_compare_run(const pm_compare_options *o, FILE *out, char *dir,
   }
   PM_TRY(compute_errors(c));
   PM_TRY(cmp_write_report(c, out));
+  if (o->rows) fill_rows(c, o->rows, o->n_rows);
   if (out) fprintf(out, "tables in %s/compare.{md,csv}\n", c->out_dir);
   if (first_fail != PM_SUCCESS) {
     char names[512];

@@ -12,10 +12,31 @@
 
 #define PM_COMPARE_MAX_METHODS 8
 #define PM_COMPARE_LATTICE 9 /* default points along the shortest axis */
+#define PM_COMPARE_NAME_MAX 64
+#define PM_COMPARE_MESSAGE_MAX 1024
+
+/* One method's figures, for callers that tabulate several comparisons
+ * (pointmech bench).  NaN where there is no such figure. */
+typedef struct {
+  char name[PM_COMPARE_NAME_MAX];   /* its label */
+  char method[PM_COMPARE_NAME_MAX]; /* the method it ran */
+  char status[32];                  /* pm_status_name, "refused", "not-run" */
+  char message[PM_COMPARE_MESSAGE_MAX]; /* why it failed ("" if it did not) */
+  bool ran;                             /* it has a run's figures */
+  long points, steps, flagged;
+  double h, wall_seconds, setup_seconds;
+  size_t memory_bytes;
+  /* NRMSE against the analytic field, the FE lattice, a reference run;
+   * the loaded face's reaction and the mean SED against FE's (relative). */
+  double e_analytic, e_fe, e_run, reaction_fe, sed_fe;
+  double loaded_reaction, min_jacobian;
+} pm_compare_row;
 
 typedef struct {
-  const char *scene;   /* scene file */
-  const char *methods; /* comma-separated method names: "fpm,mpm" */
+  const char *scene; /* scene file */
+  /* Comma-separated methods: "fpm,mpm"; LABEL=METHOD runs METHOD under
+   * LABEL (its folder, rows and --set scope): "paper=fpm,best=fpm". */
+  const char *methods;
   /* Overrides: "KEY=VALUE" for every method, "METHOD:KEY=VALUE" for that
    * method alone (after the others).  Each method's scene is the file with
    * method=METHOD, then these. */
@@ -34,6 +55,10 @@ typedef struct {
   const char *out_dir; /* NULL: out/NAME-compare */
   bool quiet;
   bool overwrite; /* replace the files of an earlier comparison's runs */
+  /* NULL, or room for PM_COMPARE_MAX_METHODS rows: filled with each
+   * method's figures once the tables are written (*n_rows of them). */
+  pm_compare_row *rows;
+  int *n_rows;
 } pm_compare_options;
 
 /* Run the scene once per method into OUT/METHOD (pm_run_sim, in this
@@ -52,5 +77,14 @@ typedef struct {
  * known ("" before). */
 pm_err pm_compare_run(const pm_compare_options *o, FILE *out, char *dir,
                       size_t size);
+
+/* Table helpers shared by the reports (compare, bench): a number with
+ * digits significant digits ("" when it is not finite) into b; a CSV
+ * field quoted, its quotes doubled and line breaks made blanks; a
+ * Markdown table cell's text without '|' and line breaks. */
+#define PM_TABLE_NUMBER 32
+const char *pm_table_number(char b[PM_TABLE_NUMBER], double v, int digits);
+void pm_csv_text(FILE *f, const char *s);
+void pm_md_text(FILE *f, const char *s);
 
 #endif

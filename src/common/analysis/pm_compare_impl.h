@@ -12,12 +12,13 @@
 #include "pm_run.h"
 #include "pm_scene.h"
 
-#define CMP_NAME_MAX 64
-#define CMP_MESSAGE_MAX 1024
+#define CMP_NAME_MAX PM_COMPARE_NAME_MAX
+#define CMP_MESSAGE_MAX PM_COMPARE_MESSAGE_MAX
 
 /* One method's run and its figures on the lattice. */
 typedef struct {
-  char name[CMP_NAME_MAX];
+  char name[CMP_NAME_MAX];   /* its label: the method's name or LABEL */
+  char method[CMP_NAME_MAX]; /* the method it runs */
   char dir[PM_PATH_MAX + 1];
   pm_err err;                    /* of its load or run (PM_SUCCESS: none) */
   char status[32];               /* pm_status_name, "refused" or "not-run" */

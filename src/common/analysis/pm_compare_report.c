@@ -8,24 +8,22 @@
 #include "pm_compare_impl.h"
 
 #define MIB (1024.0 * 1024.0)
-#define NUM_MAX 32
+#define NUM_MAX PM_TABLE_NUMBER
 
-/* A number for a table (4 digits; "" when there is none), and for the
- * CSV file (10 digits: enough to compare figures in it). */
-static const char *num_digits(char b[NUM_MAX], double v, int digits) {
+const char *pm_table_number(char b[PM_TABLE_NUMBER], double v, int digits) {
   if (isfinite(v))
-    snprintf(b, NUM_MAX, "%.*g", digits, v);
+    snprintf(b, PM_TABLE_NUMBER, "%.*g", digits, v);
   else
     b[0] = 0;
   return b;
 }
 
 static const char *num(char b[NUM_MAX], double v) {
-  return num_digits(b, v, 4);
+  return pm_table_number(b, v, 4);
 }
 
 static const char *cnum(char b[NUM_MAX], double v) {
-  return num_digits(b, v, 10);
+  return pm_table_number(b, v, 10);
 }
 
 /* The label of condition b, as history.csv and summary.json name it. */
@@ -48,8 +46,7 @@ static double reaction(const cmp_method *M, int b, int k) {
              : NAN;
 }
 
-/* A CSV field quoted, its quotes doubled and line breaks made blanks. */
-static void csv_text(FILE *f, const char *s) {
+void pm_csv_text(FILE *f, const char *s) {
   fputc('"', f);
   for (; *s; s++) {
     if (*s == '"') fputc('"', f);
@@ -58,8 +55,7 @@ static void csv_text(FILE *f, const char *s) {
   fputc('"', f);
 }
 
-/* A message in a Markdown table: no '|' and no line break. */
-static void md_text(FILE *f, const char *s) {
+void pm_md_text(FILE *f, const char *s) {
   for (; *s; s++) fputc(*s == '|' ? '/' : *s == '\n' ? ' ' : *s, f);
 }
 
@@ -203,7 +199,7 @@ static void md_failures(const cmp_study *c, FILE *m) {
     if (!any) fprintf(m, "\n## Failures\n\n");
     any = true;
     fprintf(m, "- %s (%s): ", M->name, M->status);
-    md_text(m, M->message);
+    pm_md_text(m, M->message);
     fprintf(m, "\n");
   }
 }
@@ -245,14 +241,17 @@ static void write_md(const cmp_study *c, FILE *m) {
   const pm_compare_options *o = c->o;
   fprintf(m, "# Comparison of methods: %s\n\nScene %s; methods", c->base->name,
           o->scene);
-  for (int k = 0; k < c->n; k++)
-    fprintf(m, "%s %s", k ? "," : "", c->meth[k].name);
+  for (int k = 0; k < c->n; k++) {
+    const cmp_method *M = &c->meth[k];
+    fprintf(m, "%s %s", k ? "," : "", M->name);
+    if (strcmp(M->name, M->method) != 0) fprintf(m, " (%s)", M->method);
+  }
   if (o->n_sets) {
     fprintf(m, "; overrides");
     for (int k = 0; k < o->n_sets; k++) fprintf(m, " `%s`", o->sets[k]);
   }
   fprintf(m,
-          ".  Runs in %s/METHOD.\n\nLattice: %s; %ld of its %ld points "
+          ".  Runs in %s/LABEL.\n\nLattice: %s; %ld of its %ld points "
           "fitted by every method.\n\n",
           c->out_dir, c->lattice_label, c->n_valid, c->m);
   md_accuracy(c, m);
@@ -312,7 +311,7 @@ static void csv_method(const cmp_study *c, const cmp_method *M, FILE *f) {
       if (bc_mask(s, bc) >> k & 1u)
         fprintf(f, ",%s", cnum(b[12], reaction(M, bc, k)));
   fputc(',', f);
-  csv_text(f, M->message);
+  pm_csv_text(f, M->message);
   fputc('\n', f);
 }
 

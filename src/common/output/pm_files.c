@@ -820,3 +820,36 @@ void pm_outdir_release(pm_outdir *d) {
   if (d->fd >= 0) close(d->fd); /* releases the lock */
   free(d);
 }
+
+pm_err pm_read_text(const char *path, const char *what, char **text,
+                    size_t *len) {
+  pm_err ret = PM_SUCCESS;
+  FILE *f = fopen(path, "rb");
+  char *buf = NULL;
+  size_t cap = 0, n = 0;
+  *text = NULL;
+  *len = 0;
+  PM_ENSURE(f, PM_ERR_IO, "cannot open %s %s: %s", what, path, strerror(errno));
+  for (;;) {
+    if (n + 4096 + 1 > cap) {
+      cap = 2 * (n + 4096 + 1);
+      char *grown = realloc(buf, cap);
+      PM_ENSURE(grown, PM_ERR_MEMORY, "cannot read %s %s: out of memory", what,
+                path);
+      buf = grown;
+    }
+    size_t got = fread(buf + n, 1, cap - n - 1, f);
+    n += got;
+    if (got == 0) break;
+  }
+  PM_ENSURE(!ferror(f), PM_ERR_IO, "cannot read %s %s: %s", what, path,
+            strerror(errno));
+  buf[n] = '\0';
+  *text = buf;
+  *len = n;
+  buf = NULL;
+done:
+  free(buf);
+  if (f) fclose(f);
+  return ret;
+}

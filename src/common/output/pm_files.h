@@ -57,6 +57,11 @@ int pm_split_fields(char *s, char **fields, int max);
  * are numbers).  False when the field holds anything else. */
 bool pm_parse_number(const char *s, double *v);
 
+/* The whole of file path as text (NUL-terminated, *len bytes before the
+ * NUL; free it).  what names the file in messages ("scene"). */
+pm_err pm_read_text(const char *path, const char *what, char **text,
+                    size_t *len);
+
 /* ---- Atomic files ------------------------------------------------------ */
 
 /* A file being written under FINAL.tmp.<pid>; renamed to FINAL on commit. */

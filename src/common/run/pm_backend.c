@@ -3,6 +3,7 @@
 #include "pm_backend.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 static const pm_backend *registry[PM_BACKENDS_MAX];
@@ -55,4 +56,12 @@ pm_status pm_static_status(pm_err e) {
          : e == PM_ERR_UNSTABLE      ? PM_STATUS_UNSTABLE
          : e == PM_ERR_NOT_CONVERGED ? PM_STATUS_NOT_CONVERGED
                                      : PM_STATUS_FAILED;
+}
+
+void pm_backend_names(char *buf, size_t size) {
+  size_t used = 0;
+  if (size) buf[0] = '\0';
+  for (int k = 0; k < n_registered && used < size; k++)
+    used += (size_t)snprintf(buf + used, size - used, "%s%s", k ? ", " : "",
+                             registry[k]->method);
 }

@@ -187,5 +187,7 @@ int pm_backend_count(void);
 const pm_backend *pm_backend_at(int k);
 /* The backend of a method name, or NULL. */
 const pm_backend *pm_backend_find(const char *method);
+/* The registered methods' names, comma-separated, into buf. */
+void pm_backend_names(char *buf, size_t size);
 
 #endif

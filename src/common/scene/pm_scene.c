@@ -11,39 +11,8 @@
 #include <string.h>
 
 #include "pm_backend.h"
+#include "pm_files.h"
 #include "pm_scene_vocab.h"
-
-static pm_err read_text(const char *path, char **text, size_t *len) {
-  pm_err ret = PM_SUCCESS;
-  FILE *f = fopen(path, "rb");
-  char *buf = NULL;
-  size_t cap = 0, n = 0;
-  *text = NULL;
-  *len = 0;
-  PM_ENSURE(f, PM_ERR_IO, "cannot open scene %s: %s", path, strerror(errno));
-  for (;;) {
-    if (n + 4096 + 1 > cap) {
-      cap = 2 * (n + 4096 + 1);
-      char *grown = realloc(buf, cap);
-      PM_ENSURE(grown, PM_ERR_MEMORY, "cannot read scene %s: out of memory",
-                path);
-      buf = grown;
-    }
-    size_t got = fread(buf + n, 1, cap - n - 1, f);
-    n += got;
-    if (got == 0) break;
-  }
-  PM_ENSURE(!ferror(f), PM_ERR_IO, "cannot read scene %s: %s", path,
-            strerror(errno));
-  buf[n] = '\0';
-  *text = buf;
-  *len = n;
-  buf = NULL;
-done:
-  free(buf);
-  if (f) fclose(f);
-  return ret;
-}
 
 /* Keep the overrides in the scene, and as comment lines at the end of its
  * text, so that the text stored with the results reproduces the run. */
@@ -94,13 +63,9 @@ static void gather_sections(section_tables *t) {
 
 static pm_err resolve_method(pm_reader *r, pm_scene *s) {
   char names[256], what[300];
-  size_t used = 0;
   s->backend = pm_backend_find(s->method);
   if (s->backend) return PM_SUCCESS;
-  names[0] = '\0';
-  for (int k = 0; k < pm_backend_count() && used < sizeof names; k++)
-    used += (size_t)snprintf(names + used, sizeof names - used, "%s%s",
-                             k ? ", " : "", pm_backend_at(k)->method);
+  pm_backend_names(names, sizeof names);
   PM_CHECK(pm_backend_count() > 0, PM_ERR_INTERNAL,
            "%s: no method is registered (pm_backend_register)", s->path);
   snprintf(what, sizeof what, "one of %s", names);
@@ -165,7 +130,7 @@ static pm_err load(const char *path, const char *text, size_t len,
     PM_TRY(PM_ALLOC(s->text, len + 1, "scene text"));
     memcpy(s->text, text, len);
   } else {
-    PM_TRY(read_text(path, &s->text, &len));
+    PM_TRY(pm_read_text(path, "scene", &s->text, &len));
   }
   PM_TRY(load_scene(s, len, n_overrides, overrides));
   *out = s;

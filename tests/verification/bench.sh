@@ -1,0 +1,136 @@
+#!/usr/bin/env bash
+# `pointmech bench`:
+#  - the CI suite (cases/bench/tiny.yaml: F2 coarse by FPM, the explicit and
+#    the implicit MPM) writes its report, every method within its own
+#    tolerance of the exact field (FPM and implicit MPM 1e-6, explicit MPM
+#    5e-3, the bound of verify_mpm_f2) and of the FE referee's reaction;
+#  - a two-case suite whose second case goes unstable: the failure is
+#    listed with its diagnosis, the first case still reported, exit 2;
+#  - variants of one method under labels, with their own overrides;
+#  - a bad suite refused at its FILE:LINE:COL before anything runs.
+set -u
+bin=$1
+src=$2
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+VERBOSE_CHECKS=1
+# shellcheck source=lib.sh
+. "$(dirname "$0")/lib.sh"
+le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 <= b + 0) }'; }
+lt() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 < b + 0) }'; }
+# Column NAME of the method row (CASE, LABEL) of a bench.csv.
+field() { # csv, case, label, name
+  /usr/bin/python3 - "$@" <<'EOF'
+import csv, sys
+path, case, label, name = sys.argv[1:5]
+for r in csv.DictReader(open(path, newline="")):
+    if r["kind"] == "method" and r["case"] == case and r["label"] == label:
+        print(r[name])
+        break
+EOF
+}
+
+# ---- the CI suite --------------------------------------------------------
+out=$work/tiny
+"$bin" bench "$src/cases/bench/tiny.yaml" --out "$out" --quiet >"$out.log" \
+  2>"$work/err"
+rc=$?
+cat "$out.log"
+check "tiny: exit 0 (got $rc)" test $rc -eq 0
+for f in bench.md bench.csv f2/h-0.02/compare.md f2/h-0.02/fpm/summary.json \
+  f2/h-0.02/mpm/summary.json f2/h-0.02/mpm-implicit/summary.json; do
+  check "tiny: $f written" test -s "$out/$f"
+done
+check "tiny: progress printed" grep -qF "[1/1] f2 at 0.02" "$out.log"
+csv=$out/bench.csv
+for m in fpm mpm mpm-implicit; do
+  s=$(field "$csv" f2 $m status)
+  check "tiny: $m converged ($s)" test "$s" = converged
+done
+# Measured: FPM 1.7e-16, implicit MPM 8e-15, explicit MPM 1.8e-3 against
+# the exact field; reactions against FE 2.6e-8, 2.6e-8, 3.3e-5.
+for m in fpm mpm-implicit; do
+  e=$(field "$csv" f2 $m nrmse_analytic)
+  check "tiny: $m NRMSE $e < 1e-6" lt "$e" 1e-6
+done
+e=$(field "$csv" f2 mpm nrmse_analytic)
+check "tiny: mpm NRMSE $e <= 5e-3" le "$e" 5e-3
+for m in fpm mpm mpm-implicit; do
+  r=$(field "$csv" f2 $m reaction_error_fe)
+  check "tiny: $m reaction error $r within 1%" \
+    awk -v r="$r" 'BEGIN { exit !(r != "" && r * r <= 1e-4) }'
+  t=$(field "$csv" f2 $m wall_seconds)
+  check "tiny: $m wall time $t tabulated" lt 0 "$t"
+done
+check "tiny: the FE referee's ladder tabulated" \
+  grep -q '^fe,f2,,fe,CalculiX' "$csv"
+check "tiny: bench.md table" \
+  grep -Eq '^\| f2 \| 0.02 \| mpm-implicit \| converged \|' "$out/bench.md"
+if /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then
+  check "tiny: accuracy-cost.png drawn" test -s "$out/accuracy-cost.png"
+fi
+refused "tiny again: refused without --overwrite" \
+  'already holds a bench' "$out/none" \
+  "$bin" bench "$src/cases/bench/tiny.yaml" --out "$out" --quiet
+
+# ---- a failing case does not stop the suite ------------------------------
+# The second case runs the explicit MPM at 25 times its stable step.
+suite=$work/two.yaml
+cat >"$suite" <<EOF
+name: two
+methods:
+  - {label: linear, method: mpm-implicit}
+  - {label: quadratic, method: mpm-implicit, set: [mpm.shape=quadratic, time.quasi_static.linear_solver=direct]}
+  - {label: explicit, method: mpm}
+cases:
+  - {name: unstable, scene: $src/cases/mpm/f2-unconstrained-compression.yaml,
+     methods: [explicit], resolutions: [2e-2], set: [time.dt=0.05]}
+  - {name: variants, scene: $src/cases/fpm/f2-unconstrained-compression.yaml,
+     methods: [linear, quadratic], resolutions: [2e-2]}
+EOF
+out=$work/two
+"$bin" bench "$suite" --out "$out" --quiet >"$out.log" 2>"$work/err"
+rc=$?
+cat "$out.log"
+check "two: exit 2, a numerical failure (got $rc)" test $rc -eq 2
+check "two: the error names the failed case" \
+  grep -qF '1 of 2 comparisons had a failure (the first: unstable' "$work/err"
+check "two: progress of the second case" grep -qF "[2/2] variants" "$out.log"
+s=$(field "$out/bench.csv" unstable explicit status)
+check "two: the failed case's status ($s)" test "$s" = unstable
+check "two: its diagnosis listed (step, cause)" \
+  grep -Eq '^- unstable at 0.02, explicit \(unstable\): step [0-9]+' \
+  "$out/bench.md"
+for m in linear quadratic; do
+  s=$(field "$out/bench.csv" variants $m status)
+  check "two: variant $m ran after the failure ($s)" test "$s" = converged
+done
+# The labels run one method with their own overrides: linear shape
+# functions hold F2's homogeneous state, quadratic ones held at the nodes
+# beyond a face bend it (measured 8e-15 and 3.1e-2; 1.8e-8 and 9.0e-2
+# against FE).
+e=$(field "$out/bench.csv" variants linear nrmse_analytic)
+check "two: linear variant exact ($e < 1e-6)" lt "$e" 1e-6
+e=$(field "$out/bench.csv" variants quadratic nrmse_analytic)
+check "two: quadratic variant its own ($e > 1e-3)" lt 1e-3 "$e"
+
+# ---- a bad suite: refused before anything runs --------------------------
+bad() { # label, sed expression, text
+  sed "$2" "$suite" >"$work/bad.yaml"
+  refused "$1" "$3" "$work/bad-out" "$bin" bench "$work/bad.yaml" \
+    --out "$work/bad-out"
+}
+bad "unknown key" 's/  - {name: variants,/  - {nmae: variants,/' \
+  "bad.yaml:9:6: cases.1.nmae: unknown key (expected one of name,"
+bad "unknown label" 's/methods: \[linear, quadratic\]/methods: [linear, cubic]/' \
+  "cases.1.methods.1: cubic is neither a label of the suite's methods nor a method"
+bad "unknown method" 's/method: mpm}/method: mpn}/' \
+  "methods.2.method: expected one of"
+bad "bad resolution" 's/resolutions: \[2e-2\]}/resolutions: [-1]}/' \
+  "bad.yaml:10:50: cases.1.resolutions.0: expected a size above 0 (m), got -1"
+bad "method as an override" 's/set: \[time.dt=0.05\]/set: [method=fpm]/' \
+  "not an override"
+bad "missing scene" 's#cases/mpm/f2-unconstrained-compression.yaml#no-such.yaml#' \
+  "cases.0.scene: cannot read scene"
+
+echo "bench: $passes passed, $failures failed"
+[ "$failures" -eq 0 ]
