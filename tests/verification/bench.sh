@@ -17,15 +17,17 @@ VERBOSE_CHECKS=1
 . "$(dirname "$0")/lib.sh"
 le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 <= b + 0) }'; }
 lt() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 < b + 0) }'; }
-# Column NAME of the method row (CASE, LABEL) of a bench.csv.
+# Column NAME of the method row (CASE, LABEL) of a bench.csv, at its last
+# (finest) resolution.
 field() { # csv, case, label, name
   /usr/bin/python3 - "$@" <<'EOF'
 import csv, sys
 path, case, label, name = sys.argv[1:5]
+last = ""
 for r in csv.DictReader(open(path, newline="")):
     if r["kind"] == "method" and r["case"] == case and r["label"] == label:
-        print(r[name])
-        break
+        last = r[name]
+print(last)
 EOF
 }
 
@@ -36,11 +38,11 @@ out=$work/tiny
 rc=$?
 cat "$out.log"
 check "tiny: exit 0 (got $rc)" test $rc -eq 0
-for f in bench.md bench.csv f2/h-0.02/compare.md f2/h-0.02/fpm/summary.json \
+for f in bench.md bench.csv f2/h-0.0125/compare.md f2/h-0.02/fpm/summary.json \
   f2/h-0.02/mpm/summary.json f2/h-0.02/mpm-implicit/summary.json; do
   check "tiny: $f written" test -s "$out/$f"
 done
-check "tiny: progress printed" grep -qF "[1/1] f2 at 0.02" "$out.log"
+check "tiny: progress printed" grep -qF "[2/2] f2 at 0.0125" "$out.log"
 csv=$out/bench.csv
 for m in fpm mpm mpm-implicit; do
   s=$(field "$csv" f2 $m status)
@@ -65,6 +67,13 @@ check "tiny: the FE referee's ladder tabulated" \
   grep -q '^fe,f2,,fe,CalculiX' "$csv"
 check "tiny: bench.md table" \
   grep -Eq '^\| f2 \| 0.02 \| mpm-implicit \| converged \|' "$out/bench.md"
+# The verdict: FPM and the implicit MPM hold F2's exact state at both
+# resolutions, within the referee's own tolerance (1e-5 on the reaction).
+for m in fpm mpm-implicit; do
+  check "tiny: verdict on $m" grep -Eq \
+    "^\| f2 \| $m \| [0-9]+ -> [0-9]+ \|.*\| agrees with FE within its tolerance \|$" \
+    "$out/bench.md"
+done
 if /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then
   check "tiny: accuracy-cost.png drawn" test -s "$out/accuracy-cost.png"
 fi

@@ -63,6 +63,7 @@ typedef struct {
   int n;
   pm_fe_row rows[BENCH_FE_ROWS];
   double reaction; /* the referee's loaded reaction, N */
+  double tol;      /* its relative reaction tolerance (NaN: none) */
   int axis;
 } bench_fe;
 
@@ -328,6 +329,21 @@ static pm_err read_suite(const char *path, bench_suite *S) {
 /* ---- running --------------------------------------------------------------
  */
 
+/* Whether case name is selected by only (NULL: every case; else a
+ * comma-separated list of names, each selecting the cases whose name holds
+ * it). */
+static bool selected(const char *only, const char *name) {
+  if (!only) return true;
+  for (const char *p = only; *p;) {
+    const char *e = strchr(p, ',');
+    size_t n = e ? (size_t)(e - p) : strlen(p);
+    for (const char *q = name; n && strlen(q) >= n; q++)
+      if (strncmp(q, p, n) == 0) return true;
+    p += n + (e ? 1 : 0);
+  }
+  return false;
+}
+
 static const char *label_of(const bench_suite *S, const bench_case *C, int k) {
   return C->method[k] >= 0 ? S->m[C->method[k]].label : C->plain[k];
 }
@@ -453,6 +469,7 @@ static void case_fe(const bench_suite *S, const bench_case *C, bench_fe *F) {
     for (int k = 1; k < 3; k++)
       if (fabs(r->reaction[k]) > fabs(r->reaction[F->axis])) F->axis = k;
     F->reaction = r->reaction[F->axis];
+    F->tol = r->tolerance.reaction;
     F->n = r->n_rows < BENCH_FE_ROWS ? r->n_rows : BENCH_FE_ROWS;
     for (int k = 0; k < F->n; k++) F->rows[k] = r->rows[k];
   }
@@ -470,6 +487,72 @@ static void res_text(char *b, size_t size, double res) {
     snprintf(b, size, "%g", res);
   else
     snprintf(b, size, "scene");
+}
+
+/* Whether a run reached a state its figures are of. */
+static bool reached(const pm_compare_row *r) {
+  return strcmp(r->status, "converged") == 0 ||
+         strcmp(r->status, "completed") == 0;
+}
+
+/* Cross-validation: for each case with an FE referee and each method run
+ * at two or more resolutions, the reaction error of its finest run
+ * against the change its last refinement made.  A method converging
+ * toward the referee at first order or better has an error no larger than
+ * that change (h halved: e_f = (e_c - e_f) / (2^q - 1) <= e_c - e_f for q
+ * >= 1); an error well beyond it (more than twice) is the method's bias,
+ * which its own refinement does not show. */
+static void md_verdict(const bench_suite *S, const bench_run *runs, int n_runs,
+                       const bench_fe *fe, FILE *m) {
+  bool header = false;
+  char b[4][PM_TABLE_NUMBER];
+  for (int c = 0; c < S->n_cases; c++) {
+    const bench_case *C = &S->c[c];
+    if (!fe[c].have) continue;
+    for (int k = 0; k < C->n_methods; k++) {
+      const pm_compare_row *coarse = NULL, *fine = NULL;
+      for (int i = 0; i < n_runs; i++) {
+        if (runs[i].c != c || k >= runs[i].n_rows) continue;
+        const pm_compare_row *r = &runs[i].rows[k];
+        if (!reached(r) || !isfinite(r->reaction_fe)) continue;
+        if (!fine || r->points > fine->points) {
+          coarse = fine;
+          fine = r;
+        } else if (!coarse || r->points > coarse->points) {
+          coarse = r;
+        }
+      }
+      if (!coarse) continue;
+      if (!header) {
+        fprintf(m, "\n## Convergence toward the referee\n\n| case | "
+                   "method | points | reaction error (%%) | change by the "
+                   "last refinement (%%) | NRMSE | verdict |\n"
+                   "|---|---|---|---|---|---|---|\n");
+        header = true;
+      }
+      const double e = fine->reaction_fe, d = coarse->reaction_fe - e;
+      const double tol = fe[c].tol;
+      const char *verdict =
+          isfinite(tol) && fabs(e) <= tol
+              ? "agrees with FE within its tolerance"
+          : fabs(e) >= fabs(e + d)
+              ? "not converging toward FE: its error grew with refinement"
+          : fabs(e) <= 2 * fabs(d)
+              ? "converging toward FE"
+              : "biased: its refinement does not show its error";
+      fprintf(m, "| %s | %s | %ld -> %ld | %s | %s | %s | %s |\n", C->name,
+              fine->name, coarse->points, fine->points,
+              pm_table_number(b[0], 100 * e, 3),
+              pm_table_number(b[1], 100 * d, 3),
+              pm_table_number(b[2], fine->e_fe, 3), verdict);
+    }
+  }
+  if (header)
+    fprintf(m, "\nA method whose error at its finest run is at most twice "
+               "the change its last refinement made converges toward the "
+               "referee (at order 1 or better in h); one whose error shrank "
+               "by less than that is biased: a denser run of it alone "
+               "would agree with itself and not with FE.\n");
 }
 
 static void write_md(const bench_suite *S, const bench_run *runs, int n_runs,
@@ -538,6 +621,7 @@ static void write_md(const bench_suite *S, const bench_run *runs, int n_runs,
                "levels show what FE accuracy costs in time (CalculiX, its "
                "recorded wall time).\n");
   }
+  md_verdict(S, runs, n_runs, fe, m);
   if (n_fail) {
     fprintf(m, "\n## Failures\n\n");
     for (int i = 0; i < n_runs; i++) {
@@ -681,15 +765,15 @@ pm_err pm_bench_run(const pm_bench_options *o, FILE *out, char *dir,
   /* The runs: each selected case at each resolution. */
   int total = 0;
   for (int c = 0; c < S->n_cases; c++)
-    if (!o->only || strstr(S->c[c].name, o->only))
+    if (selected(o->only, S->c[c].name))
       total += S->c[c].n_res ? S->c[c].n_res : 1;
-  PM_ENSURE(total > 0, PM_ERR_SCENE, "%s: no case's name holds '%s' (--only)",
-            o->suite, o->only);
+  PM_ENSURE(total > 0, PM_ERR_SCENE,
+            "%s: no case's name holds any of '%s' (--only)", o->suite, o->only);
   PM_TRY(PM_ALLOC(runs, (size_t)total, "bench runs"));
   PM_TRY(PM_ALLOC(fe, (size_t)S->n_cases, "bench FE ladders"));
   for (int c = 0; c < S->n_cases; c++) {
     const bench_case *C = &S->c[c];
-    if (o->only && !strstr(C->name, o->only)) continue;
+    if (!selected(o->only, C->name)) continue;
     case_fe(S, C, &fe[c]);
     for (int j = 0; j < (C->n_res ? C->n_res : 1); j++) {
       bench_run *R = &runs[n_runs++];

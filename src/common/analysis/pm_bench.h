@@ -30,7 +30,8 @@
 
 typedef struct {
   const char *suite; /* suite file */
-  const char *only;  /* NULL, or run only the cases whose name holds it */
+  const char *only;  /* NULL, or run only the cases whose name holds one of
+                        these comma-separated names */
   int n_sets;        /* overrides for every run, after the suite's */
   const char *const *sets;
   const char *out_dir; /* NULL: out/NAME-bench */
