@@ -16,6 +16,7 @@
 #include "pm_compare.h"
 #include "pm_error.h"
 #include "pm_memory.h"
+#include "pm_par.h"
 #include "pm_probe.h"
 #include "pm_bench.h"
 #include "pm_run.h"
@@ -152,7 +153,9 @@ static void usage(FILE *out) {
 }
 
 static int report(pm_err e) {
-  fprintf(stderr, "pointmech: error: %s\n", pm_error_message());
+  /* Across ranks every rank has the same error: rank 0 says it. */
+  if (pm_par_root())
+    fprintf(stderr, "pointmech: error: %s\n", pm_error_message());
   if (getenv("POINTMECH_TRACE"))
     fprintf(stderr, "trace:\n%s", pm_error_traceback());
   switch (e) {
@@ -275,7 +278,8 @@ static int cmd_run_or_plan(const cli_args *a, bool plan) {
     pm_outcome o;
     e = pm_run_scene(s, out, run_flags(a), &o);
     if (e) status = report(e);
-    if (access(out, F_OK) == 0) fprintf(stderr, "results in %s\n", out);
+    if (pm_par_root() && access(out, F_OK) == 0)
+      fprintf(stderr, "results in %s\n", out);
   }
   pm_scene_destroy(s);
   return status;
@@ -385,7 +389,19 @@ int main(int argc, char **argv) {
       strcmp(cmd, "bench") == 0)
     pm_wait_policy_apply(argv);
   pm_err init = pm_app_init();
+  if (!init) init = pm_par_init(&argc, &argv);
   if (init) return report(init);
+  /* Across ranks, rank 0 prints; the others' output would repeat it. */
+  if (!pm_par_root() && !freopen("/dev/null", "w", stdout))
+    pm_par_abort(EXIT_INPUT, "cannot silence the output of this rank");
+  if (pm_par_active() && strcmp(cmd, "run") != 0 && strcmp(cmd, "plan") != 0) {
+    if (pm_par_root())
+      fprintf(stderr,
+              "pointmech: %s runs on one process (this run has %d ranks): "
+              "start it without mpirun; run and plan go across ranks\n",
+              cmd, pm_par_size());
+    return EXIT_INPUT;
+  }
   cli_args a;
   if (parse_args(argc, argv, 2, &a) != 0) {
     usage(stderr);

@@ -13,9 +13,11 @@
 #include "mpm_estimate.h"
 #include "mpm_implicit.h"
 #include "mpm_kind.h"
+#include "mpm_par.h"
 #include "mpm_pipeline.h"
 #include "pm_metrics.h"
 #include "pm_omp.h"
+#include "pm_par.h"
 #include "pm_tensor.h"
 
 /* Doubles per particle of the output buffer: strain energy density, J,
@@ -28,6 +30,29 @@ static long scratch_per_particle(const mpm_model *m) {
 
 static pm_err history_setup(mpm_sim *r);
 
+/* A workspace that holds only the figures of a step (reactions, residual)
+ * and the timers: the implicit solver's, and rank 0's view of a run
+ * across ranks. */
+static pm_err figures_work(const mpm_model *m, mpm_work **out) {
+  PM_CALL(PM_ALLOC(*out, 1, "MPM workspace"));
+  return PM_ALLOC((*out)->cond.reaction, 3 * m->n_bcs + 1, "reactions");
+}
+
+/* Across ranks: this rank's share of the model every rank set up, which
+ * rank 0 alone keeps (collective; every rank returns the same error). */
+static pm_err ranks_setup(mpm_sim *r) {
+  const pm_scene *s = r->scene;
+  PM_CALL(pm_par_agree(
+      mpm_par_create(s, r->model, r->state, &r->local_model, &r->local_state)));
+  PM_CALL(pm_par_agree(mpm_work_create(r->local_model, &r->local_work)));
+  if (pm_par_root()) return pm_par_agree(figures_work(r->model, &r->work));
+  mpm_state_destroy(r->state);
+  mpm_model_destroy(r->model);
+  r->state = NULL;
+  r->model = NULL;
+  return pm_par_agree(PM_SUCCESS);
+}
+
 /* The simulation of s: explicit (its step's workspace) or implicit (its
  * solver; the workspace holds only the reactions and the timers). */
 static pm_err sim_create(const pm_scene *s, bool implicit, mpm_sim **out) {
@@ -37,20 +62,22 @@ static pm_err sim_create(const pm_scene *s, bool implicit, mpm_sim **out) {
   PM_TRY(PM_ALLOC(r, 1, "MPM simulation"));
   r->scene = s;
   double t0 = pm_wtime();
-  PM_TRY(mpm_model_create(s, &r->model, &r->state));
+  PM_TRY(pm_par_agree(mpm_model_create(s, &r->model, &r->state)));
   if (implicit) {
-    PM_TRY(PM_ALLOC(r->work, 1, "MPM workspace"));
-    PM_TRY(
-        PM_ALLOC(r->work->cond.reaction, 3 * r->model->n_bcs + 1, "reactions"));
+    PM_TRY(figures_work(r->model, &r->work));
     PM_TRY(mpm_implicit_create(s, r->model, r->state, &r->imp));
     r->run_min_jacobian = 1;
+  } else if (pm_par_active()) {
+    PM_TRY(ranks_setup(r));
   } else {
     PM_TRY(mpm_work_create(r->model, &r->work));
   }
   r->setup_wall = pm_wtime() - t0;
-  PM_TRY(PM_ALLOC(r->scratch, scratch_per_particle(r->model) * r->model->n,
-                  "output buffer"));
-  PM_TRY(history_setup(r));
+  if (r->model) { /* the outputs' (rank 0's across ranks) */
+    PM_TRY(PM_ALLOC(r->scratch, scratch_per_particle(r->model) * r->model->n,
+                    "output buffer"));
+    PM_TRY(history_setup(r));
+  }
   *out = r;
   r = NULL;
 done:
@@ -64,54 +91,187 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
 
 void mpm_sim_destroy(mpm_sim *r) {
   if (!r) return;
+  mpm_work_destroy(r->local_work);
+  mpm_state_destroy(r->local_state);
+  mpm_model_destroy(r->local_model);
   mpm_implicit_destroy(r->imp);
   mpm_work_destroy(r->work);
   mpm_state_destroy(r->state);
   mpm_model_destroy(r->model);
-  for (int b = 0; r->surface && b < r->scene->n_bodies; b++)
+  for (int b = 0; r->surface && r->model && b < r->scene->n_bodies; b++)
     free(r->surface[b]);
   free(r->surface);
   free(r->scratch);
   free(r);
 }
 
-/* Everything the simulation holds: model, state, workspace and buffer. */
+/* Everything the simulation holds: model, state, workspace and buffer
+ * (across ranks, rank 0's: its share and the whole run's view). */
 static size_t sim_bytes(const mpm_sim *r) {
-  return mpm_model_bytes(r->model) + mpm_state_bytes(r->model, r->state) +
-         mpm_work_bytes(r->model, r->work) +
-         scratch_per_particle(r->model) * sizeof(double) * (size_t)r->model->n;
+  size_t bytes =
+      mpm_model_bytes(r->model) + mpm_state_bytes(r->model, r->state) +
+      mpm_work_bytes(r->model, r->work) +
+      scratch_per_particle(r->model) * sizeof(double) * (size_t)r->model->n;
+  if (r->local_model)
+    bytes += mpm_model_bytes(r->local_model) +
+             mpm_state_bytes(r->local_model, r->local_state) +
+             mpm_work_bytes(r->local_model, r->local_work);
+  return bytes;
 }
 
 /* ---- run ---------------------------------------------------------------- */
 
-/* Report a step (the initial state as step 0) to the run's observer. */
-static pm_err report(mpm_sim *r, bool frame, bool last) {
+/* The report of the step the state is at (the initial state as step 0). */
+static pm_step_report step_report(const mpm_sim *r, bool last) {
   const mpm_state *s = r->state;
-  pm_step_report rep = {.last = last,
-                        .step = s->step,
-                        .t = s->t,
-                        .residual = r->work->residual,
-                        .progress = s->t / r->model->opt.t_end};
+  return (pm_step_report){.last = last,
+                          .step = s->step,
+                          .t = s->t,
+                          .residual = r->work->residual,
+                          .progress = s->t / r->model->opt.t_end};
+}
+
+/* Report a step to the run's observer. */
+static pm_err report(mpm_sim *r, bool frame, bool last) {
+  pm_step_report rep = step_report(r, last);
   return r->obs ? r->obs->step(r->obs->ctx, &rep, frame) : PM_SUCCESS;
 }
 
-static pm_err observe(void *ctx, const mpm_model *m, const mpm_state *s,
-                      const mpm_work *w, const mpm_step_info *info,
-                      bool frame) {
-  (void)m;
-  mpm_sim *r = ctx;
+/* What the run keeps of a step's figures over all its steps. */
+static void note_step(mpm_sim *r, const mpm_state *s, const mpm_work *w,
+                      const mpm_step_info *info) {
   r->last = *info;
   if (w->min_jacobian < r->run_min_jacobian) {
     r->run_min_jacobian = w->min_jacobian;
     r->run_min_jacobian_step = s->step;
   }
   if (info->iter_max > r->iter_max_row) r->iter_max_row = info->iter_max;
-  return report(r, frame, info->last);
+}
+
+static pm_err observe(void *ctx, const mpm_model *m, const mpm_state *s,
+                      const mpm_work *w, const mpm_step_info *info,
+                      bool frame) {
+  (void)m;
+  note_step(ctx, s, w, info);
+  return report(ctx, frame, info->last);
+}
+
+/* ---- across ranks ---- */
+
+/* Rank 0's view of the last step: the figures every rank shares (the
+ * residual, the reactions, the smallest J) and its own timers. */
+static void view_figures(mpm_sim *r) {
+  const mpm_work *lw = r->local_work;
+  mpm_work *w = r->work;
+  w->residual = lw->residual;
+  w->min_jacobian = lw->min_jacobian;
+  w->iter_max = lw->iter_max;
+  w->iter_capped = lw->iter_capped;
+  memcpy(w->cond.reaction, lw->cond.reaction,
+         3 * sizeof(double) * (size_t)r->model->n_bcs);
+  w->timers = lw->timers;
+  mpm_state *v = r->state;
+  const mpm_state *ls = r->local_state;
+  v->t = ls->t;
+  v->step = ls->step;
+  v->dt = ls->dt;
+  v->dt_stable = ls->dt_stable;
+}
+
+/* Every rank's particles into rank 0's view (collective). */
+static pm_err gather(mpm_sim *r) {
+  PM_CALL(pm_par_agree(
+      mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
+  if (r->model) view_figures(r);
+  return PM_SUCCESS;
+}
+
+/* A step of a run across ranks (collective): rank 0 decides whether its
+ * observer will read the state; if so every rank sends its particles; rank
+ * 0 reports, and every rank returns its observer's answer. */
+static pm_err share(mpm_sim *r, bool frame, bool last) {
+  int want = frame;
+  if (r->model) {
+    view_figures(r);
+    pm_step_report rep = step_report(r, last);
+    if (r->obs && r->obs->wants)
+      want = want || r->obs->wants(r->obs->ctx, &rep, frame);
+  }
+  pm_par_bcast(&want, sizeof want);
+  if (want) PM_CALL(gather(r));
+  return pm_par_agree(r->model ? report(r, frame, last) : PM_SUCCESS);
+}
+
+static pm_err observe_ranks(void *ctx, const mpm_model *m, const mpm_state *s,
+                            const mpm_work *w, const mpm_step_info *info,
+                            bool frame) {
+  (void)m;
+  note_step(ctx, s, w, info);
+  return share(ctx, frame, info->last);
+}
+
+/* The time loop across ranks: every rank steps its share; rank 0's view
+ * is gathered where the run writes, and at the end. */
+static pm_err run_ranks(mpm_sim *r, const pm_observer *obs) {
+  mpm_model *lm = r->local_model;
+  pm_err e = PM_SUCCESS;
+  r->obs = obs;
+  if (!r->resumed) {
+    r->run_min_jacobian = INFINITY;
+    r->run_min_jacobian_step = 0;
+    if (r->model) { /* the initial state, which rank 0's view holds */
+      double kin, strain, internal;
+      mpm_energies(r->model, r->state, &kin, &strain, &internal);
+      r->energy0 = kin + strain + internal;
+      for (long q = 0; q < r->model->n; q++)
+        r->run_min_jacobian =
+            fmin(r->run_min_jacobian, r->state->vol[q] / r->model->vol0[q]);
+    }
+    e = share(r, true, false);
+  }
+  mpm_run_options opt = {.t_end = lm->opt.t_end,
+                         .max_steps = lm->opt.max_steps,
+                         .frame_every = r->scene->output.every};
+  if (!e)
+    e = mpm_solve(lm, r->local_state, r->local_work, &opt, observe_ranks, r,
+                  &r->last);
+  /* The state the run ended in, for the figures (a failure's too). */
+  pm_err g = gather(r);
+  if (!e) e = g;
+  r->obs = NULL;
+  mpm_par_counts c;
+  mpm_par_get_counts(lm, &c);
+  double sums[4] = {c.halo_bytes, c.migrate_bytes, (double)c.migrated,
+                    (double)c.grown},
+         most[2] = {c.halo_seconds, c.migrate_seconds};
+  pm_par_sum(sums, 4);
+  pm_par_max(most, 2);
+  memcpy(r->ranks_counts, sums, sizeof sums);
+  memcpy(r->ranks_counts + 4, most, sizeof most);
+  return e;
+}
+
+/* The run's status from the loop's error. */
+static void conclude(mpm_sim *r, const mpm_model *m, pm_err e) {
+  if (e == PM_ERR_UNSTABLE)
+    r->status = PM_STATUS_UNSTABLE;
+  else if (e != PM_SUCCESS)
+    r->status = PM_STATUS_FAILED;
+  else if (m->opt.qs == PM_QS_NONE)
+    r->status = PM_STATUS_COMPLETED;
+  else
+    r->status =
+        r->last.converged ? PM_STATUS_CONVERGED : PM_STATUS_NOT_CONVERGED;
 }
 
 static pm_err run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
-  const mpm_model *m = r->model;
+  if (r->local_model) {
+    pm_err e = run_ranks(r, obs);
+    conclude(r, r->local_model, e);
+    return e;
+  }
+  mpm_model *m = r->model;
   pm_err e = PM_SUCCESS;
   r->obs = obs;
   if (!r->resumed) { /* a resumed run has these from its checkpoint */
@@ -130,15 +290,7 @@ static pm_err run(void *p, const pm_observer *obs) {
                          .frame_every = r->scene->output.every};
   if (!e) e = mpm_solve(m, r->state, r->work, &opt, observe, r, &r->last);
   r->obs = NULL;
-  if (e == PM_ERR_UNSTABLE)
-    r->status = PM_STATUS_UNSTABLE;
-  else if (e != PM_SUCCESS)
-    r->status = PM_STATUS_FAILED;
-  else if (m->opt.qs == PM_QS_NONE)
-    r->status = PM_STATUS_COMPLETED;
-  else
-    r->status =
-        r->last.converged ? PM_STATUS_CONVERGED : PM_STATUS_NOT_CONVERGED;
+  conclude(r, m, e);
   return e;
 }
 
@@ -552,6 +704,30 @@ static pm_err summary_stage_energy(pm_json *j, const mpm_model *m,
   return pm_json_end_object(j);
 }
 
+/* The decomposition and what the exchanges cost (summed over the ranks;
+ * seconds of the slowest rank). */
+static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
+  const mpm_decomp *d = mpm_par_decomp(r->local_model);
+  const double *c = r->ranks_counts;
+  const double steps = r->state->step > 0 ? (double)r->state->step : 1;
+  PM_CALL(pm_json_begin_object(j, "ranks"));
+  PM_CALL(pm_json_integer(j, "count", d->size));
+  PM_CALL(pm_json_begin_array(j, "boxes"));
+  for (int a = 0; a < 3; a++) PM_CALL(pm_json_integer(j, NULL, d->dims[a]));
+  PM_CALL(pm_json_end_array(j));
+  PM_CALL(pm_json_begin_array(j, "particles_at_start"));
+  for (int k = 0; k < d->size; k++)
+    PM_CALL(pm_json_integer(j, NULL, d->count[k]));
+  PM_CALL(pm_json_end_array(j));
+  PM_CALL(pm_json_number(j, "node_bytes_per_step", c[0] / steps));
+  PM_CALL(pm_json_number(j, "particle_bytes_per_step", c[1] / steps));
+  PM_CALL(pm_json_number(j, "particles_migrated", c[2]));
+  PM_CALL(pm_json_number(j, "arrays_grown", c[3]));
+  PM_CALL(pm_json_number(j, "node_exchange_seconds", c[4]));
+  PM_CALL(pm_json_number(j, "migration_seconds", c[5]));
+  return pm_json_end_object(j);
+}
+
 static pm_err summary(void *p, pm_json *j) {
   const mpm_sim *r = p;
   const mpm_model *m = r->model;
@@ -568,6 +744,7 @@ static pm_err summary(void *p, pm_json *j) {
     PM_CALL(
         pm_json_integer(j, "energy_iterations_capped", s->iter_capped_total));
   }
+  if (r->local_model) PM_CALL(summary_ranks(j, r));
   return summary_stage_energy(j, m, s);
 }
 
@@ -655,10 +832,10 @@ static void plan_layout(const mpm_model *m, const pm_scene *s, FILE *out) {
   fprintf(out, "\n");
 }
 
-static pm_err plan(void *p, FILE *out) {
-  mpm_sim *r = p;
+/* The plan's lines from the scene to the number of steps; the steps. */
+static double plan_head(const mpm_sim *r, FILE *out) {
   const mpm_model *m = r->model;
-  mpm_state *st = r->state;
+  const mpm_state *st = r->state;
   const pm_scene *s = r->scene;
   const mpm_grid *g = &m->grid;
   const mpm_options *o = &m->opt;
@@ -689,6 +866,47 @@ static pm_err plan(void *p, FILE *out) {
   fprintf(out, "steps        %.0f to t = %g s%s%s\n", steps, o->t_end,
           o->qs != PM_QS_NONE ? " (at most: stops when converged)" : "",
           o->dt_fixed > 0 ? "" : " (at the first step's dt; the step adapts)");
+  return steps;
+}
+
+static void plan_estimate(double per, double steps, long n, double setup,
+                          FILE *out) {
+  fprintf(out,
+          "estimate     %.3g s per step, %.3g s for %.0f steps on %d "
+          "thread%s%s (%.3g particle-steps/s; setup took %.3g s)\n",
+          per, per * steps, steps, pm_omp_threads(),
+          pm_omp_threads() == 1 ? "" : "s", pm_par_active() ? " per rank" : "",
+          n / per, setup);
+}
+
+/* The plan across ranks (collective): rank 0's view prints the scene's
+ * lines, every rank its share, and a few steps of the shares are timed. */
+static pm_err plan_ranks(mpm_sim *r, FILE *out) {
+  double steps = r->model ? plan_head(r, out) : 0;
+  mpm_par_plan(r->local_model, r->local_work, r->model ? out : NULL);
+  double t0 = pm_wtime();
+  int reps = 0, more = 1;
+  for (;;) {
+    more = pm_wtime() - t0 < 0.3 && reps < 200;
+    pm_par_bcast(&more, sizeof more);
+    if (!more) break;
+    pm_err e = mpm_step(r->local_model, r->local_state, r->local_work);
+    if (!e) e = mpm_par_migrate(r->local_model, r->local_state, r->local_work);
+    if (e) break; /* agreed by every rank */
+    reps++;
+  }
+  if (r->model && reps > 0)
+    plan_estimate((pm_wtime() - t0) / reps, steps, r->model->n, r->setup_wall,
+                  out);
+  return PM_SUCCESS;
+}
+
+static pm_err plan(void *p, FILE *out) {
+  mpm_sim *r = p;
+  if (r->local_model) return plan_ranks(r, out);
+  const mpm_model *m = r->model;
+  mpm_state *st = r->state;
+  const double steps = plan_head(r, out);
   fprintf(out,
           "memory       %.1f MiB (model %.1f, state %.1f, workspace %.1f "
           "with %d thread accumulators, output buffers %.1f)\n",
@@ -703,14 +921,8 @@ static pm_err plan(void *p, FILE *out) {
     if (mpm_step(m, st, r->work) != PM_SUCCESS) break;
     reps++;
   }
-  if (reps > 0) {
-    double per = (pm_wtime() - t0) / reps;
-    fprintf(out,
-            "estimate     %.3g s per step, %.3g s for %.0f steps on %d "
-            "thread%s (%.3g particle-steps/s; setup took %.3g s)\n",
-            per, per * steps, steps, pm_omp_threads(),
-            pm_omp_threads() == 1 ? "" : "s", m->n / per, r->setup_wall);
-  }
+  if (reps > 0)
+    plan_estimate((pm_wtime() - t0) / reps, steps, m->n, r->setup_wall, out);
   return PM_SUCCESS;
 }
 
@@ -748,6 +960,7 @@ const pm_backend mpm_backend = {
     .description = "explicit Material Point Method",
     .section = &mpm_section,
     .dt_safety = 0.5,
+    .ranks = true,
     .check = mpm_check_scene,
     .create = create,
     .estimate_bytes = mpm_estimate_bytes,

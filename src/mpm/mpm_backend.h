@@ -16,12 +16,22 @@ extern const pm_backend mpm_implicit_backend;
 
 struct mpm_implicit;
 
-/* A prepared simulation.  Fields are read-only for callers. */
+/* A prepared simulation.  Fields are read-only for callers.  Across MPI
+ * ranks (mpm_par.h) the time loop steps this rank's share (local_*), and
+ * model, state and work are rank 0's view of the whole run, gathered into
+ * when the run writes (NULL on the other ranks); work then holds only the
+ * figures of the last step and the timers. */
 typedef struct {
   const pm_scene *scene; /* borrowed: must outlive the simulation */
   mpm_model *model;
   mpm_state *state;
   mpm_work *work;
+  mpm_model *local_model;
+  mpm_state *local_state;
+  mpm_work *local_work;
+  /* across ranks, at the end of the run: the exchanges' bytes and
+   * particles summed over the ranks, their seconds the slowest rank's */
+  double ranks_counts[6];
   struct mpm_implicit *imp;   /* method mpm-implicit: its solver (else NULL) */
   int imp_newton, imp_linear; /* the last load step's iterations */
   double setup_wall;          /* s */

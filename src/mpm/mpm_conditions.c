@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mpm_state.h"
+#include "pm_par.h"
 
 pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
                              int *n_bcs) {
@@ -39,7 +40,12 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
     long n1 = g->nn[t1], n2 = g->nn[t2];
     bc->n_cols = n1 * n2;
     PM_CALL(PM_ALLOC(bc->col, bc->n_cols, "boundary columns"));
-    long ia = (long)llround((bc->plane - g->origin[a]) * g->inv_h);
+    long ia =
+        (long)llround((bc->plane - g->origin[a]) * g->inv_h) - g->offset[a];
+    if (ia < 0 || ia >= g->nn[a]) { /* another rank's face */
+      bc->n_cols = 0;
+      continue;
+    }
     for (long j2 = 0; j2 < n2; j2++)
       for (long j1 = 0; j1 < n1; j1++)
         bc->col[j1 + n1 * j2] =
@@ -176,7 +182,7 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
       for (int c = 2; c >= 0; c--) {
         long i = rem / g->stride[c];
         rem -= i * g->stride[c];
-        x[c] = g->origin[c] + i * g->h;
+        x[c] = g->origin[c] + (i + g->offset[c]) * g->h;
       }
       x[a] = bc->plane;
       double v[3] = {0, 0, 0};
@@ -192,10 +198,12 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
       if (!isfinite(wall)) note_not_finite(cw, bc->disp[a], col, x, t, 0);
       /* The first node inside the wall, and the anchor of the prescribed
        * components. */
-      long ia_face = (long)llround((bc->plane - g->origin[a]) * g->inv_h);
+      long ia_face =
+          (long)llround((bc->plane - g->origin[a]) * g->inv_h) - g->offset[a];
       long i_start = bc->outward > 0 ? g->nn[a] - 1 : 0;
       long di = bc->outward > 0 ? -1 : 1;
-#define DIST(i) ((g->origin[a] + (i)*g->h - wall) * bc->outward)
+#define DIST(i)                                                                \
+  ((g->origin[a] + ((i) + g->offset[a]) * g->h - wall) * bc->outward)
 #define INSIDE(i) ((i) >= 0 && (i) < g->nn[a])
 #define NODE(i) (col + ((i)-ia_face) * step_a)
       long i_in = i_start;
@@ -292,12 +300,14 @@ double mpm_conditions_apply(const mpm_ctx *ctx, double *vel, bool reactions) {
     double fold = cw->fold ? cw->fold[i] : 0.0;
     if (!o && fold == 0) continue;
     long node = i / 3;
-    if (!(nd->mass[node] > 0)) continue;
+    if (!(nd->mass[node] > 0) || !mpm_node_owned(nd, node)) continue;
     double R = nd->mass[node] * (vel[i] - nd->vel0[i]) / dt - nd->force[i];
     if (o)
       cw->reaction[3 * ((o > 0 ? o : -o) - 1) + i % 3] +=
           R - fold + (cw->fold_out ? cw->fold_out[i] : 0.0);
     work += R * 0.5 * (nd->vel0[i] + vel[i]) * dt;
   }
+  /* Every rank's share of the reactions: the residual's scale. */
+  if (m->par) pm_par_sum(cw->reaction, 3 * m->n_bcs);
   return work;
 }

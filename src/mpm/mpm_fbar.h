@@ -53,7 +53,8 @@ size_t mpm_fbar_work_bytes(const mpm_fbar_work *fw);
 static inline long mpm_fbar_cell(const mpm_grid *g, const double x[3]) {
   long c = 0;
   for (int k = 0; k < g->dim; k++)
-    c += (long)floor((x[k] - g->origin[k]) * g->inv_h) * g->stride[k];
+    c += ((long)floor((x[k] - g->origin[k]) * g->inv_h) - g->offset[k]) *
+         g->stride[k];
   return c;
 }
 

@@ -16,6 +16,7 @@ pm_err mpm_grid_init(mpm_grid *g, int dim, mpm_basis shape, double h,
   g->node_volume = 1;
   g->n_nodes = 1;
   for (int c = 0; c < 3; c++) {
+    g->offset[c] = 0;
     if (c >= dim) {
       g->origin[c] = 0;
       g->nn[c] = 1;
@@ -83,6 +84,7 @@ void mpm_nodes_destroy(mpm_nodes *n) {
 }
 
 size_t mpm_nodes_bytes(const mpm_nodes *n, const mpm_grid *g) {
+  if (!n->mass) return 0;      /* a workspace without nodal arrays */
   size_t per_node = 1 + 3 * 4; /* mass, mom, force, vel0, vel_new */
   if (n->vel) per_node += 3;
   if (n->impedance) per_node += 2;

@@ -13,7 +13,11 @@
 #include "pm_error.h"
 
 /* Geometry of a uniform Cartesian grid over the domain box, with `ghost`
- * node layers outside it.  Part of the model: nothing here changes. */
+ * node layers outside it.  Part of the model: nothing here changes.  On a
+ * rank of a run across ranks (mpm_par.h) it is the rank's block of the
+ * whole grid: nn nodes per axis from global node `offset`, with the whole
+ * grid's origin and reach, so that a node's position and a particle's
+ * weights are computed exactly as on one process. */
 typedef struct {
   int dim;
   mpm_basis shape;
@@ -22,6 +26,7 @@ typedef struct {
   double h, inv_h;
   double origin[3]; /* node (0, 0, 0) */
   long nn[3];       /* nodes per axis (1 on z in 2-D) */
+  long offset[3];   /* global index of node (0, 0, 0): 0 on one process */
   long stride[3];   /* index step per axis */
   long n_nodes;
   double lo[3], hi[3]; /* where a particle's stencil lies inside the grid */
@@ -49,7 +54,16 @@ typedef struct {
   int threads;
   double *impedance; /* 2 per node: sum w m c_p, sum w m c_s (absorbing
                         faces only) */
+  /* Across ranks: 1 where this rank owns the node, 0 at a ghost node whose
+   * values it computes too but whose sums belong to another rank (NULL on
+   * one process).  Borrowed from the model's mpm_par. */
+  const unsigned char *owned;
 } mpm_nodes;
+
+/* Whether sums over nodes count node i on this rank. */
+static inline bool mpm_node_owned(const mpm_nodes *n, long i) {
+  return !n->owned || n->owned[i];
+}
 
 /* Lay the grid over the box [box_min, box_max] in cells of h (dim 2 or 3).
  * Fails with PM_ERR_SCENE, naming the scene file `path` and
@@ -100,7 +114,7 @@ mpm_stencil_expand(const mpm_grid *g, const double x[3], int what,
     long i0;
     mpm_shape_1d(shape, (x[c] - g->origin[c]) * g->inv_h, g->inv_h, &i0, w[c],
                  dw[c]);
-    base += i0 * g->stride[c];
+    base += (i0 - g->offset[c]) * g->stride[c];
   }
   int k = 0;
   for (int c = 0; c < nz; c++)

@@ -9,6 +9,7 @@
 #include "mpm_kind.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
+#include "pm_par.h"
 
 /* ---- stable step -------------------------------------------------------- */
 
@@ -37,6 +38,7 @@ double mpm_stable_dt(const mpm_model *m, const mpm_state *s, double *cp) {
     }
     worst = fmax(worst, w);
   }
+  if (m->par) pm_par_max(&worst, 1);
   return worst > 0 ? m->opt.dt_safety * h / worst : INFINITY;
 }
 
@@ -83,10 +85,10 @@ pm_err mpm_book_gravity(mpm_ctx *ctx, const mpm_stage *self) {
                          *restrict vel_new = nd->vel_new;
   double work = 0;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(nn, gv, mass, vel0, vel_new) reduction(+ : work))
+         shared(nd, nn, gv, mass, vel0, vel_new) reduction(+ : work))
   for (long i = 0; i < nn; i++) {
     double m = mass[i];
-    if (m <= 0) continue;
+    if (m <= 0 || !mpm_node_owned(nd, i)) continue;
     for (int k = 0; k < 3; k++)
       work += m * gv[k] * 0.5 * (vel0[3 * i + k] + vel_new[3 * i + k]);
   }
@@ -128,7 +130,7 @@ pm_err mpm_stage_absorbing(mpm_ctx *ctx, const mpm_stage *self) {
           double keep = 1.0 / (1.0 + dt * z * area / mn);
           double f = -(1.0 - keep) * (mn * v / dt + nd->force[3 * node + c]);
           nd->force[3 * node + c] += f;
-          lost -= f * v * dt;
+          if (mpm_node_owned(nd, node)) lost -= f * v * dt;
         }
       }
   }
@@ -139,11 +141,11 @@ pm_err mpm_stage_absorbing(mpm_ctx *ctx, const mpm_stage *self) {
 /* Mass-proportional damping (quasi-static): f -= c m v. */
 pm_err mpm_stage_damping(mpm_ctx *ctx, const mpm_stage *self) {
   mpm_state *s = ctx->state;
+  const mpm_nodes *nd = &ctx->work->nodes;
   const long nn = ctx->model->grid.n_nodes;
   const double dt = s->dt;
-  const double *restrict mass = ctx->work->nodes.mass, *restrict mom =
-                                                           ctx->work->nodes.mom;
-  double *restrict force = ctx->work->nodes.force;
+  const double *restrict mass = nd->mass, *restrict mom = nd->mom;
+  double *restrict force = nd->force;
   if (s->force_prev) {
     /* Dynamic relaxation: c = 2 sqrt(v.K v / v.M v), with K v estimated by
      * the change of the internal force over the step.  Free dofs only
@@ -151,21 +153,27 @@ pm_err mpm_stage_damping(mpm_ctx *ctx, const mpm_stage *self) {
      * forces change by what the conditions impose). */
     double *restrict prev = s->force_prev;
     const unsigned char *restrict fixed = s->fixed;
-    double num = 0, den = 0;
+    double sums[2] = {0, 0}, num = 0, den = 0;
     PM_OMP(parallel for schedule(static) default(none)
-           shared(nn, mass, mom, force, prev, fixed) reduction(+ : num, den))
+           shared(nd, nn, mass, mom, force, prev, fixed) reduction(+ : num, den))
     for (long i = 0; i < nn; i++) {
       double m = mass[i];
       if (m <= 0) continue;
+      const bool own = mpm_node_owned(nd, i);
       for (int c = 0; c < 3; c++) {
         double v = mom[3 * i + c] / m;
-        if (!fixed || !fixed[3 * i + c]) {
+        if (own && (!fixed || !fixed[3 * i + c])) {
           num += v * (prev[3 * i + c] - force[3 * i + c]);
           den += m * v * v;
         }
         prev[3 * i + c] = force[3 * i + c];
       }
     }
+    sums[0] = num;
+    sums[1] = den;
+    if (ctx->model->par) pm_par_sum(sums, 2);
+    num = sums[0];
+    den = sums[1];
     if (den > 0 && s->step > 0) {
       double lambda = num / (dt * den);
       double c = lambda > 0 ? 2.0 * sqrt(lambda) : 0.0;
@@ -177,14 +185,15 @@ pm_err mpm_stage_damping(mpm_ctx *ctx, const mpm_stage *self) {
   const double c = s->damping;
   double lost = 0;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(nn, mass, mom, force, c, dt) reduction(+ : lost))
+         shared(nd, nn, mass, mom, force, c, dt) reduction(+ : lost))
   for (long i = 0; i < nn; i++) {
     double m = mass[i];
     if (m <= 0) continue;
+    const bool own = mpm_node_owned(nd, i);
     for (int k = 0; k < 3; k++) {
       double v = mom[3 * i + k] / m;
       force[3 * i + k] -= c * m * v;
-      lost += c * m * v * v * dt;
+      if (own) lost += c * m * v * v * dt;
     }
   }
   mpm_book_dissipated(ctx, self, lost);
@@ -222,7 +231,7 @@ static double residual(const mpm_ctx *ctx) {
          shared(nd, nul, nn, c, fold, owner) reduction(+ : r2, f2))
   for (long i = 0; i < nn; i++) {
     double m = nd->mass[i];
-    if (m <= 0) continue;
+    if (m <= 0 || !mpm_node_owned(nd, i)) continue;
     for (int k = 0; k < 3; k++) {
       if (nul >> k & 1u) continue;
       double f = nd->force[3 * i + k] + c * m * nd->vel0[3 * i + k] +
@@ -230,6 +239,12 @@ static double residual(const mpm_ctx *ctx) {
       f2 += f * f;
       if (!owner || !owner[3 * i + k]) r2 += f * f;
     }
+  }
+  if (m->par) {
+    double sums[2] = {r2, f2};
+    pm_par_sum(sums, 2);
+    r2 = sums[0];
+    f2 = sums[1];
   }
   double scale = 0;
   for (int b = 0; b < m->n_bcs; b++)

@@ -7,6 +7,7 @@
 
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
+#include "mpm_par.h"
 #include "mpm_seed.h"
 #include "mpm_state.h"
 
@@ -114,6 +115,8 @@ void mpm_model_destroy(mpm_model *m) {
   free(m->x0);
   free(m->mass);
   free(m->vol0);
+  free(m->gid);
+  mpm_par_destroy(m->par);
   free(m);
 }
 
@@ -126,7 +129,9 @@ pm_err mpm_triangles_local(const mpm_model *m, long t0, long t1, long first,
 }
 
 size_t mpm_model_bytes(const mpm_model *m) {
-  size_t bytes = 5 * sizeof(double) * (size_t)m->n; /* x0, mass, vol0 */
+  /* x0, mass, vol0, and across ranks the indices */
+  size_t bytes = (5 * sizeof(double) + (m->gid ? sizeof(long) : 0)) *
+                 (size_t)mpm_model_room(m);
   /* membrane triangles and incidence */
   bytes += 6 * sizeof(long) * (size_t)m->n_tris;
   for (int b = 0; b < m->n_bcs; b++)

@@ -16,6 +16,7 @@
 #include "pm_scene.h"
 
 struct mpm_state;
+struct mpm_par;
 
 /* What the model takes from the scene, copied at creation so that nothing
  * after it reads the scene's mpm, time or stability sections. */
@@ -53,6 +54,13 @@ typedef struct mpm_model {
   double *x0;   /* reference position */
   double *mass; /* mass, kg */
   double *vol0; /* initial volume */
+  /* Across ranks (mpm_par.h): this rank's share of the run, the particles
+   * it holds (their arrays have room for cap), each one's index on one
+   * process (gid, increasing), and the exchanges with the other ranks.
+   * On one process par and gid are NULL and cap is n. */
+  struct mpm_par *par;
+  long *gid;
+  long cap;
   mpm_group group[MPM_MAX_GROUPS];
   int n_groups;
   unsigned kinds; /* the groups' kinds' flags, or-ed (MPM_KIND_*) */
@@ -78,6 +86,11 @@ typedef struct mpm_model {
   bool has_absorbing;
   mpm_pipeline pipeline;
 } mpm_model;
+
+/* Particles the model's and its states' arrays have room for. */
+static inline long mpm_model_room(const mpm_model *m) {
+  return m->cap > m->n ? m->cap : m->n;
+}
 
 /* What links a membrane body's points (mpm_model.body_links). */
 enum {

@@ -35,10 +35,11 @@ size_t mpm_group_bytes_per_particle(const mpm_group *g) {
 }
 
 pm_err mpm_group_state_alloc(const mpm_group *g, mpm_group_state *gs) {
+  const long room = g->cap > g->end - g->begin ? g->cap : g->end - g->begin;
   gs->n = g->n_arrays;
   for (int k = 0; k < g->n_arrays; k++) {
     gs->array[k] = g->layout[k];
-    PM_CALL(PM_ALLOC(gs->array[k].data, g->layout[k].ncomp * g->layout[k].count,
+    PM_CALL(PM_ALLOC(gs->array[k].data, g->layout[k].ncomp * room,
                      g->layout[k].name));
   }
   return PM_SUCCESS;

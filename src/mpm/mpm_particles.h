@@ -32,6 +32,9 @@ typedef struct {
   const char *name; /* the material's name (borrowed from the scene) */
   const struct mpm_kind *kind;
   long begin, end;
+  long cap;         /* particles its state arrays have room for (>= end -
+                       begin; more across ranks, where groups grow and
+                       shrink as particles move between ranks) */
   double c0, c1;    /* artificial viscosity (eq. 32); both 0: none */
   double viscosity; /* dynamic viscosity of the kind's viscous stress, Pa s,
                        for the stable step (0: none) */

@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "mpm_kind.h"
+#include "mpm_par.h"
+#include "pm_par.h"
 
 static const pm_name shape_names[] = {
     {"linear", MPM_BASIS_LINEAR}, {"quadratic", MPM_BASIS_QUADRATIC}, {0}};
@@ -300,6 +302,7 @@ pm_err mpm_check_scene(const pm_scene *s) {
     return pm_scene_expected(s, "time.dt_rule",
                              "paper for method mpm (its stable step is the "
                              "CFL bound of every step)");
+  if (pm_par_active()) PM_CALL(mpm_par_check(s));
   return PM_SUCCESS;
 }
 

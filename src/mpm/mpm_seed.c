@@ -499,7 +499,7 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
             "%s: no particles: no seed position (%d x %d x %d per cell of "
             "size %g) lies in a body",
             s->path, m->opt.ppc[0], m->opt.ppc[1], m->opt.ppc[2], s->mesh_size);
-  m->n = total;
+  m->n = m->cap = total;
   PM_TRY(PM_ALLOC(m->x0, 3 * total, "particle positions"));
   PM_TRY(PM_ALLOC(m->mass, total, "particle masses"));
   PM_TRY(PM_ALLOC(m->vol0, total, "particle volumes"));

@@ -1,13 +1,14 @@
 /* mpm_solver: the explicit time loop. */
 #include "mpm_solver.h"
 
+#include "mpm_par.h"
 #include "mpm_pipeline.h"
 
 /* Quasi-static convergence is tested only after this many steps: the
  * first steps' residual is that of a grid barely loaded. */
 #define MPM_CONVERGE_AFTER 10
 
-pm_err mpm_solve(const mpm_model *m, mpm_state *s, mpm_work *w,
+pm_err mpm_solve(mpm_model *m, mpm_state *s, mpm_work *w,
                  const mpm_run_options *opt, mpm_observer observer, void *ctx,
                  mpm_step_info *last) {
   const double t_load = m->opt.t_load;
@@ -23,6 +24,8 @@ pm_err mpm_solve(const mpm_model *m, mpm_state *s, mpm_work *w,
       if (left < s->dt && left > 1e-12 * s->dt) s->dt = left;
     }
     ret = mpm_step(m, s, w);
+    /* Across ranks, the particles that left this rank's cells. */
+    if (!ret && m->par) ret = mpm_par_migrate(m, s, w);
     if (ret) break;
     info = (mpm_step_info){
         .step = s->step,

@@ -34,10 +34,13 @@ typedef pm_err (*mpm_observer)(void *ctx, const mpm_model *m,
 
 /* Step from the state as it is until t_end, max_steps or (quasi-static
  * models) convergence; with a fixed time.dt the last step is cut to end at
- * t_end.  Returns PM_ERR_UNSTABLE on a numerical failure (the observer has
+ * t_end.  Across ranks (m->par) every rank calls it: after each step the
+ * particles that left a rank's cells migrate (which changes m's particle
+ * ranges), and the observer sees the rank's share.  Returns
+ * PM_ERR_UNSTABLE on a numerical failure (the observer has
  * seen every step before it), or the observer's error.  *last (may be
  * NULL) receives the last step's figures.  Allocates nothing. */
-pm_err mpm_solve(const mpm_model *m, mpm_state *s, mpm_work *w,
+pm_err mpm_solve(mpm_model *m, mpm_state *s, mpm_work *w,
                  const mpm_run_options *opt, mpm_observer observer, void *ctx,
                  mpm_step_info *last);
 

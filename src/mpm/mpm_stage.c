@@ -23,11 +23,12 @@ pm_err mpm_stage_status(const mpm_ctx *ctx, const mpm_stage *self) {
   const mpm_state *s = ctx->state;
   long p = w->fail.particle;
   const double *x = s->x + 3 * p, *x0 = m->x0 + 3 * p;
+  const long named = m->gid ? m->gid[p] : p; /* its index on one process */
   return PM_ERROR(PM_ERR_UNSTABLE,
                   "step %ld, t = %.6g s, stage %s: particle %ld at (%g, %g, "
                   "%g), started at (%g, %g, %g): %s",
-                  s->step + 1, s->t + s->dt, self->name, p, x[0], x[1], x[2],
-                  x0[0], x0[1], x0[2], w->fail.cause);
+                  s->step + 1, s->t + s->dt, self->name, named, x[0], x[1],
+                  x[2], x0[0], x0[1], x0[2], w->fail.cause);
 }
 
 void mpm_book_work(mpm_ctx *ctx, const mpm_stage *self, double work) {

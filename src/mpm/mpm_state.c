@@ -2,6 +2,7 @@
 #include "mpm_state.h"
 
 #include "mpm_kind.h"
+#include "mpm_par.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -11,7 +12,7 @@
 pm_err mpm_state_create(const mpm_model *m, mpm_state **out) {
   pm_err ret = PM_SUCCESS;
   mpm_state *s = NULL;
-  const long n = m->n, n3 = 3 * m->grid.n_nodes;
+  const long n = mpm_model_room(m), n3 = 3 * m->grid.n_nodes;
   *out = NULL;
   PM_TRY(PM_ALLOC(s, 1, "MPM state"));
   PM_TRY(PM_ALLOC(s->x, 3 * n, "particle positions"));
@@ -71,7 +72,10 @@ void mpm_state_copy(const mpm_model *m, mpm_state *dst, const mpm_state *src) {
   if (dst->force_prev)
     memcpy(dst->force_prev, src->force_prev, n3 * sizeof(double));
   if (dst->fixed) memcpy(dst->fixed, src->fixed, n3);
-  /* Every other member is a value: take src's, keep dst's storage. */
+  mpm_state_copy_values(dst, src);
+}
+
+void mpm_state_copy_values(mpm_state *dst, const mpm_state *src) {
   mpm_state keep = *dst;
   *dst = *src;
   dst->x = keep.x;
@@ -98,7 +102,7 @@ size_t mpm_state_bytes(const mpm_model *m, const mpm_state *s) {
 pm_err mpm_work_create(const mpm_model *m, mpm_work **out) {
   pm_err ret = PM_SUCCESS;
   mpm_work *w = NULL;
-  const long n = m->n;
+  const long n = mpm_model_room(m);
   *out = NULL;
   PM_TRY(PM_ALLOC(w, 1, "MPM workspace"));
   PM_TRY(mpm_nodes_create(&w->nodes, &m->grid, m->opt.update != MPM_USL,
@@ -129,6 +133,8 @@ pm_err mpm_work_create(const mpm_model *m, mpm_work **out) {
   pm_timers_init(&w->timers);
   for (int k = 0; k < m->pipeline.n; k++)
     w->timer[k] = pm_timers_add(&w->timers, m->pipeline.stage[k].name);
+  w->timer_migrate = -1;
+  if (m->par) mpm_par_work_attach(m, w);
   *out = w;
   w = NULL;
 done:
@@ -162,7 +168,9 @@ size_t mpm_work_bytes(const mpm_model *m, const mpm_work *w) {
   return mpm_nodes_bytes(&w->nodes, &m->grid) +
          mpm_cond_work_bytes(&w->cond, &m->grid) +
          mpm_fbar_work_bytes(&w->fbar) +
-         per_particle * sizeof(double) * (size_t)m->n + scratch;
+         per_particle * sizeof(double) *
+             (size_t)(w->dx ? mpm_model_room(m) : 0) +
+         scratch;
 }
 
 pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck) {

@@ -81,6 +81,7 @@ typedef struct mpm_work {
   mpm_failure fail;
   pm_timers timers;
   int timer[MPM_MAX_STAGES]; /* each stage's timer */
+  int timer_migrate;         /* across ranks: the particles' migration */
 } mpm_work;
 
 /* A state of model m's shape, zeroed (t = 0 and no particle data): what a
@@ -91,6 +92,9 @@ void mpm_state_destroy(mpm_state *s);
 
 /* Copy every value of src into dst (both of model m's shape). */
 void mpm_state_copy(const mpm_model *m, mpm_state *dst, const mpm_state *src);
+/* Copy every member of src that is a value (time, step, energy accounts,
+ * counters...) into dst, keeping dst's arrays (and their lengths). */
+void mpm_state_copy_values(mpm_state *dst, const mpm_state *src);
 
 /* The state's per-particle arrays, named: position, velocity, volume,
  * stress, then each group's own.  Writes at most max into out (the

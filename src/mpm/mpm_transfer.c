@@ -7,6 +7,7 @@
 
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
+#include "mpm_par.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
 
@@ -103,7 +104,7 @@ static void reduce_nodes(mpm_nodes *nd, long nn, int mode, bool imp) {
   }
 }
 
-void mpm_p2g(mpm_ctx *ctx, int mode) {
+pm_err mpm_p2g(mpm_ctx *ctx, int mode) {
   const mpm_model *m = ctx->model;
   const mpm_state *s = ctx->state;
   mpm_work *w = ctx->work;
@@ -132,11 +133,11 @@ void mpm_p2g(mpm_ctx *ctx, int mode) {
     PM_OMP(barrier)
     reduce_nodes(nd, nn, mode, imp);
   }
+  return m->par ? mpm_par_sum_nodes(m, nd, mode, imp) : PM_SUCCESS;
 }
 
 pm_err mpm_stage_p2g(mpm_ctx *ctx, const mpm_stage *self) {
-  mpm_p2g(ctx, self->mode);
-  return PM_SUCCESS;
+  return mpm_p2g(ctx, self->mode);
 }
 
 pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
@@ -178,7 +179,7 @@ pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
 
 pm_err mpm_stage_remap(mpm_ctx *ctx, const mpm_stage *self) {
   (void)self;
-  mpm_p2g(ctx, MPM_P2G_MOM);
+  PM_CALL(mpm_p2g(ctx, MPM_P2G_MOM));
   mpm_grid_velocity(ctx);
   return mpm_conditions_status(ctx);
 }

@@ -54,3 +54,16 @@ set_tests_properties(verification.compare PROPERTIES LABELS verification TIMEOUT
 add_test(NAME verification.bench
   COMMAND bash ${PM_VERIFY_DIR}/bench.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)
+
+# Runs across MPI ranks (mpirun -np 2 and 3) against the same scenes on one
+# process; ranks_migrate checks that migration moves particles and nothing
+# else.
+if(PM_MPI)
+  add_executable(ranks_migrate ${PM_VERIFY_DIR}/ranks_migrate.c)
+  target_link_libraries(ranks_migrate PRIVATE pm_app)
+  add_test(NAME verification.ranks
+    COMMAND bash ${PM_VERIFY_DIR}/ranks.sh $<TARGET_FILE:pointmech>
+      ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_migrate>)
+  set_tests_properties(verification.ranks PROPERTIES LABELS verification
+    TIMEOUT 600 PROCESSORS 2)
+endif()

@@ -109,6 +109,11 @@ typedef struct {
 typedef struct {
   void *ctx;
   pm_err (*step)(void *ctx, const pm_step_report *r, bool frame);
+  /* Whether step, called next with the same report, will read the
+   * simulation (a frame, a history row, a checkpoint, the last frame of a
+   * signal), which it then decides for good: across ranks, the state is
+   * gathered only then.  May be NULL (frame steps only). */
+  bool (*wants)(void *ctx, const pm_step_report *r, bool frame);
 } pm_observer;
 
 /* Columns of a backend's own history (beyond the shared ones). */
@@ -120,6 +125,8 @@ typedef struct pm_backend {
                                 Fragile Points Method" */
   const pm_section *section; /* its scene section, or NULL */
   double dt_safety;          /* its default time.dt_safety */
+  bool ranks;                /* runs across MPI ranks (pm_par.h): the scene
+                                loader refuses it under mpirun otherwise */
   /* Refuse what this method cannot honour in a scene that names it
    * (fluids in FPM, tractions in MPM, ...), naming the key through
    * pm_scene_fail.  Called by the loader. */

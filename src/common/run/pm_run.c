@@ -13,6 +13,7 @@
 #include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_output.h"
+#include "pm_par.h"
 #include "pm_petsc.h"
 
 #define RUN_COLS (32 + PM_HISTORY_MAX + 3 * PM_FIGURES_MAX_BCS)
@@ -59,6 +60,11 @@ typedef struct {
   long resumed_from;     /* the step it was last resumed from (0: none) */
   char ckpt_note[512];   /* why no checkpoint was written, if one failed */
   bool extra_frame;      /* the last frame is a signal's, off the schedule */
+  /* what wants decided for the next step: the signal it ends on (0: none)
+   * and whether a checkpoint is written after it */
+  bool decided;
+  int decided_sig;
+  bool decided_ckpt;
 } run_ctx;
 
 /* ---- errors against the scene's reference field ------------------------- */
@@ -309,11 +315,28 @@ static bool checkpoint_due(const run_ctx *c, const pm_step_report *r) {
          pm_wtime() - c->ckpt_last_wall >= c->ckpt_seconds;
 }
 
+/* After a signal, the state after this step becomes the last frame and a
+ * checkpoint; on the run's last step the run simply ends.  Decided once
+ * per step: by wants when the backend asks first, else by observe. */
+static void decide(run_ctx *c, const pm_step_report *r) {
+  if (c->decided) return;
+  c->decided = true;
+  c->decided_sig = r->last ? 0 : interrupt_signal;
+  c->decided_ckpt =
+      c->results && (checkpoint_due(c, r) || (c->decided_sig && r->step > 0));
+}
+
+static bool wants(void *ctx, const pm_step_report *r, bool frame) {
+  run_ctx *c = ctx;
+  decide(c, r);
+  return frame || c->decided_sig || c->decided_ckpt;
+}
+
 static pm_err observe(void *ctx, const pm_step_report *r, bool frame) {
   run_ctx *c = ctx;
-  /* After a signal, the state after this step becomes the last frame and
-   * a checkpoint; on the run's last step the run simply ends. */
-  const int sig = r->last ? 0 : interrupt_signal;
+  decide(c, r);
+  c->decided = false;
+  const int sig = c->decided_sig;
   if (c->show_progress) {
     char status[96];
     snprintf(status, sizeof status, "t=%.4g s  step %ld  residual %.2e", r->t,
@@ -327,7 +350,7 @@ static pm_err observe(void *ctx, const pm_step_report *r, bool frame) {
     PM_CALL(e);
     c->extra_frame = !frame;
   }
-  if (c->results && (checkpoint_due(c, r) || (sig && r->step > 0))) {
+  if (c->decided_ckpt) {
     pm_err e = write_checkpoint(c, r->step);
     if (e == PM_ERR_ARG && sig) /* the method cannot: say so, go on */
       snprintf(c->ckpt_note, sizeof c->ckpt_note, "no checkpoint: %s",
@@ -631,6 +654,7 @@ static pm_err run_sim(const pm_scene *s, void *sim, const char *out_dir,
   pm_err ret = PM_SUCCESS, run_err = PM_SUCCESS;
   run_ctx *c = NULL;
   const bool quiet = flags & PM_RUN_QUIET;
+  bool agreed = false; /* across ranks: the others heard how setup went */
   void (*old_xfsz)(int) = SIG_ERR;
   memset(o, 0, sizeof *o);
   for (int k = 0; k < 3; k++) o->nrmse[k] = NAN;
@@ -662,11 +686,14 @@ static pm_err run_sim(const pm_scene *s, void *sim, const char *out_dir,
    * killing the process, so that the run can say what happened. */
   old_xfsz = signal(SIGXFSZ, SIG_IGN);
   if (out_dir) PM_TRY(open_outputs(c, out_dir, flags, outdir, rs));
-  pm_observer obs = {.ctx = c, .step = observe};
+  pm_observer obs = {.ctx = c, .step = observe, .wants = wants};
   c->t_start = pm_wtime() - (rs ? rs->h.wall_seconds : 0);
   c->ckpt_last_wall = pm_wtime();
   struct sigaction old_handlers[2];
   catch_interrupts(old_handlers);
+  /* Across ranks, the others wait here for this rank's outputs. */
+  agreed = true;
+  PM_TRY(pm_par_agree(PM_SUCCESS));
   run_err = c->be->run(sim, &obs);
   release_interrupts(old_handlers);
   if (!quiet) pm_progress_finish(&c->progress);
@@ -688,6 +715,7 @@ static pm_err run_sim(const pm_scene *s, void *sim, const char *out_dir,
   else if (o->fig.status == PM_STATUS_NOT_CONVERGED)
     ret = PM_ERROR(PM_ERR_NOT_CONVERGED, "%s", o->message);
 done:
+  if (!agreed) pm_par_agree(ret ? ret : PM_ERR_INTERNAL);
   if (old_xfsz != SIG_ERR) signal(SIGXFSZ, old_xfsz);
   if (c) {
     pm_results_close(c->results, o->fig.status != PM_STATUS_NOT_RUN);
@@ -716,17 +744,42 @@ static pm_err check_not_interrupted(pm_outcome *o) {
                   signal_name(sig));
 }
 
+/* A rank other than 0 of a run across ranks: it steps its share and joins
+ * the collectives of rank 0's observer, which writes everything; a signal
+ * is rank 0's to act on. */
+static pm_err run_worker(const pm_scene *s, void *sim, pm_outcome *o) {
+  struct sigaction ignore, old[2];
+  memset(&ignore, 0, sizeof ignore);
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGINT, &ignore, &old[0]);
+  sigaction(SIGTERM, &ignore, &old[1]);
+  pm_err e = pm_par_agree(PM_SUCCESS); /* rank 0's outputs are open */
+  if (!e) e = s->backend->run(sim, NULL);
+  release_interrupts(old);
+  if (e) snprintf(o->message, sizeof o->message, "%s", pm_error_message());
+  return e;
+}
+
 pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
                     pm_outcome *o) {
   pm_err ret = PM_SUCCESS;
   void *sim = NULL;
   pm_outdir *outdir = NULL;
+  const bool ranks = pm_par_active(), root = pm_par_root();
   PM_CALL(check_not_interrupted(o));
-  PM_CALL(pm_memory_check(s));
-  /* The folder first: a busy or taken one is refused before the setup. */
-  if (out_dir) PM_TRY(pm_outdir_claim(out_dir, outdir_mode(flags), &outdir));
+  PM_CALL(pm_par_agree(pm_memory_check(s)));
+  /* The folder first: a busy or taken one is refused before the setup
+   * (across ranks, rank 0 writes everything). */
+  if (out_dir && root)
+    ret = pm_outdir_claim(out_dir, outdir_mode(flags), &outdir);
+  if (ranks) ret = pm_par_agree(ret);
+  if (ret) goto done;
   PM_TRY(s->backend->create(s, &sim));
-  ret = run_sim(s, sim, out_dir, flags, o, &outdir, NULL);
+  if (root)
+    ret = run_sim(s, sim, out_dir, flags, o, &outdir, NULL);
+  else
+    ret = run_worker(s, sim, o);
 done:
   if (sim) s->backend->destroy(sim);
   pm_outdir_release(outdir);
@@ -755,6 +808,10 @@ pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o) {
   void *sim = NULL;
   char *argv[256];
   PM_CALL(check_not_interrupted(o));
+  PM_CHECK(!pm_par_active(), PM_ERR_UNSUPPORTED,
+           "cannot resume '%s' on %d ranks: resume runs on one process (a "
+           "checkpoint of a run across ranks is that of one process)",
+           out_dir, pm_par_size());
   PM_TRY(pm_outdir_claim(out_dir, PM_OUTDIR_RESUME, &outdir));
   /* A run that ended by itself has nothing to resume; one that was
    * interrupted, killed (still "running") or failed on I/O has. */
@@ -796,7 +853,7 @@ done:
 
 pm_err pm_plan_scene(const pm_scene *s, FILE *out) {
   void *sim = NULL;
-  PM_CALL(pm_memory_check(s));
+  PM_CALL(pm_par_agree(pm_memory_check(s)));
   PM_CALL(s->backend->create(s, &sim));
   pm_err e = s->backend->plan(sim, out);
   if (e == PM_SUCCESS) pm_memory_plan(s, out);

@@ -50,7 +50,9 @@ pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir,
 /* Create the backend's simulation of s, run it as pm_run_sim, destroy it.
  * A scene estimated past the memory available is refused first with
  * PM_ERR_MEMORY (pm_memory_check), before anything is allocated or the
- * output folder is claimed. */
+ * output folder is claimed.  Across MPI ranks (pm_par.h) every rank calls
+ * it: rank 0 claims the folder and writes every output, the others step
+ * their share; all return the same error. */
 pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
                     pm_outcome *o);
 
@@ -60,11 +62,13 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
  * when it is damaged, with the reason), frames and history rows written
  * after the checkpoint are dropped, and the run goes on appending to the
  * same results, history and summary.  On the thread count of the first run
- * it ends bit-identical to an uninterrupted run. */
+ * it ends bit-identical to an uninterrupted run.  One process only
+ * (PM_ERR_UNSUPPORTED across ranks). */
 pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o);
 
 /* Create the simulation and print its plan with the memory estimate (the
- * same refusal first). */
+ * same refusal first).  Across ranks every rank calls it, and rank 0's
+ * out is the one that is read. */
 pm_err pm_plan_scene(const pm_scene *s, FILE *out);
 
 #endif

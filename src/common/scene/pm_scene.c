@@ -12,6 +12,7 @@
 
 #include "pm_backend.h"
 #include "pm_files.h"
+#include "pm_par.h"
 #include "pm_scene_vocab.h"
 
 /* Keep the overrides in the scene, and as comment lines at the end of its
@@ -95,6 +96,11 @@ static pm_err read_scene(pm_scene *s) {
   for (int k = 0; k < st.n; k++)
     if (st.section[k]->check)
       PM_CALL(st.section[k]->check(s, s->section_opts[k]));
+  if (pm_par_active() && !s->backend->ranks)
+    return pm_scene_fail(s, "method", false,
+                         "method %s runs on one process (this run has %d "
+                         "ranks): run it without mpirun, or with -np 1",
+                         s->method, pm_par_size());
   if (s->backend->check) PM_CALL(s->backend->check(s));
   return PM_SUCCESS;
 }

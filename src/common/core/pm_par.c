@@ -1,0 +1,155 @@
+/* pm_par: MPI started only under a launcher; collectives that reduce to the
+ * identity on one process. */
+#include "pm_par.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef PM_HAVE_MPI
+#include <mpi.h>
+#endif
+
+static int par_rank = 0, par_size = 1;
+static double par_sent = 0; /* bytes */
+
+/* An MPI launcher's mark in the environment. */
+static bool launched(void) {
+  return getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMI_SIZE") ||
+         (getenv("PMIX_RANK") && getenv("PMIX_NAMESPACE"));
+}
+
+#ifdef PM_HAVE_MPI
+static void par_finalize(void) {
+  int done = 0;
+  MPI_Finalized(&done);
+  if (!done) MPI_Finalize();
+}
+#endif
+
+pm_err pm_par_init(int *argc, char ***argv) {
+#ifdef PM_HAVE_MPI
+  int ready = 0;
+  MPI_Initialized(&ready);
+  if (!ready) {
+    if (!launched()) return PM_SUCCESS;
+    int provided = 0;
+    PM_CHECK(MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided) ==
+                 MPI_SUCCESS,
+             PM_ERR_INTERNAL, "MPI_Init_thread failed");
+    atexit(par_finalize);
+  }
+  MPI_Comm_rank(MPI_COMM_WORLD, &par_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &par_size);
+  return PM_SUCCESS;
+#else
+  (void)argc;
+  (void)argv;
+  /* Several copies of the whole run would write the same files. */
+  const char *n = getenv("OMPI_COMM_WORLD_SIZE");
+  if (!n) n = getenv("PMI_SIZE");
+  PM_CHECK(!launched() || !n || atoi(n) <= 1, PM_ERR_UNSUPPORTED,
+           "this pointmech was built without MPI (PM_MPI=OFF): mpirun "
+           "started %s copies of one process; run it without mpirun, or "
+           "build with -DPM_MPI=ON",
+           n);
+  return PM_SUCCESS;
+#endif
+}
+
+int pm_par_rank(void) { return par_rank; }
+int pm_par_size(void) { return par_size; }
+
+#ifdef PM_HAVE_MPI
+static void reduce(void *v, int n, MPI_Datatype type, MPI_Op op) {
+  if (par_size == 1 || n <= 0) return;
+  MPI_Allreduce(MPI_IN_PLACE, v, n, type, op, MPI_COMM_WORLD);
+  par_sent += (double)n * (type == MPI_LONG ? sizeof(long) : sizeof(double));
+}
+#endif
+
+void pm_par_sum(double *v, int n) {
+#ifdef PM_HAVE_MPI
+  reduce(v, n, MPI_DOUBLE, MPI_SUM);
+#else
+  (void)v, (void)n;
+#endif
+}
+
+void pm_par_sum_long(long *v, int n) {
+#ifdef PM_HAVE_MPI
+  reduce(v, n, MPI_LONG, MPI_SUM);
+#else
+  (void)v, (void)n;
+#endif
+}
+
+void pm_par_max(double *v, int n) {
+#ifdef PM_HAVE_MPI
+  reduce(v, n, MPI_DOUBLE, MPI_MAX);
+#else
+  (void)v, (void)n;
+#endif
+}
+
+void pm_par_min(double *v, int n) {
+#ifdef PM_HAVE_MPI
+  reduce(v, n, MPI_DOUBLE, MPI_MIN);
+#else
+  (void)v, (void)n;
+#endif
+}
+
+void pm_par_max_long(long *v, int n) {
+#ifdef PM_HAVE_MPI
+  reduce(v, n, MPI_LONG, MPI_MAX);
+#else
+  (void)v, (void)n;
+#endif
+}
+
+void pm_par_bcast(void *p, size_t n) {
+#ifdef PM_HAVE_MPI
+  if (par_size == 1 || n == 0) return;
+  MPI_Bcast(p, (int)n, MPI_BYTE, 0, MPI_COMM_WORLD);
+  if (par_rank == 0) par_sent += (double)n;
+#else
+  (void)p, (void)n;
+#endif
+}
+
+pm_err pm_par_agree(pm_err e) {
+#ifdef PM_HAVE_MPI
+  if (par_size == 1) return e;
+  int first = e != PM_SUCCESS ? par_rank : par_size;
+  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (first == par_size) return PM_SUCCESS;
+  struct {
+    int code;
+    char text[1024];
+  } what = {0};
+  if (par_rank == first) {
+    what.code = (int)e;
+    snprintf(what.text, sizeof what.text, "%s", pm_error_message());
+  }
+  MPI_Bcast(&what, (int)sizeof what, MPI_BYTE, first, MPI_COMM_WORLD);
+  if (par_rank == first) return e;
+  return pm_error_set((pm_err)what.code, __FILE__, __LINE__, __func__, "%s",
+                      what.text);
+#else
+  return e;
+#endif
+}
+
+void pm_par_count_sent(double bytes) { par_sent += bytes; }
+double pm_par_sent(void) { return par_sent; }
+
+void pm_par_abort(int code, const char *msg) {
+  fprintf(stderr, "pointmech: rank %d of %d: %s\n", par_rank, par_size,
+          msg ? msg : "");
+  fflush(stderr);
+#ifdef PM_HAVE_MPI
+  if (par_size > 1) MPI_Abort(MPI_COMM_WORLD, code);
+#endif
+  exit(code);
+}

@@ -1,0 +1,1136 @@
+/* mpm_par: the decomposition, each rank's share of the model, the node sums
+ * on a PETSc DMDA, particle migration and the gather to rank 0. */
+#include "mpm_par.h"
+
+#include <math.h>
+#include <mpi.h>
+#include <petscdmda.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_kind.h"
+#include "mpm_transfer.h"
+#include "pm_omp.h"
+#include "pm_par.h"
+#include "pm_petsc.h"
+#include "pm_progress.h"
+
+/* A particle's record in a migration: its index on one process, its group,
+ * x0 (3), mass, vol0, x (3), v (3), vol, sigma (9), then its group's
+ * arrays in their layout's order. */
+enum {
+  REC_GID = 0,
+  REC_GROUP = 1,
+  REC_X0 = 2,
+  REC_MASS = 5,
+  REC_VOL0 = 6,
+  REC_X = 7,
+  REC_V = 10,
+  REC_VOL = 13,
+  REC_SIGMA = 14,
+  REC_BASE = 23
+};
+
+#define PAR_MAX_DM 4
+
+struct mpm_par {
+  mpm_decomp d;
+  int rank, coord[3];
+  long own_lo[3], own_hi[3]; /* owned nodes (global) per axis */
+  /* the node sums: one DMDA per number of values a transfer moves */
+  int n_dm;
+  struct {
+    int dof;
+    DM da;
+    Vec loc, glob;
+  } dm[PAR_MAX_DM];
+  /* dynamic relaxation's nodal arrays to rank 0: the whole grid in
+   * natural order, and on rank 0 all of it */
+  Vec natural, whole;
+  VecScatter to_root;
+  unsigned char *owned; /* per local node */
+  long n_owned;         /* nodes this rank owns */
+  /* the whole run's ranges, in indices on one process */
+  long n_full;
+  long gbegin[MPM_MAX_GROUPS], gend[MPM_MAX_GROUPS];
+  long *bbegin, *bend; /* per body */
+  /* migration */
+  int rec;   /* doubles per record */
+  int width; /* doubles per particle of the widest array (>= 9) */
+  int *dest; /* per particle (room): its rank after the move */
+  int *scount, *rcount, *sdisp, *rdisp; /* per rank, in doubles */
+  double *sbuf, *rbuf;
+  long sbuf_room, rbuf_room; /* records */
+  long *order;               /* per new particle: old index, or -(k + 1) for
+                                the k-th record received */
+  double *tmp;               /* room x width: one array's new order */
+  /* gather (rank 0 holds the whole run's buffers) */
+  long *ggid;
+  double *gbuf;
+  int *gcount, *gdisp;
+  mpm_par_counts counts;
+};
+
+/* ---- decomposition --------------------------------------------------------
+ */
+
+/* A prescribed value that is 0 wherever and whenever: the wall stays. */
+static bool zero_value(const pm_expr *e) {
+  if (!e) return true;
+  if (pm_expr_uses(e, 'x') || pm_expr_uses(e, 'y') || pm_expr_uses(e, 'z') ||
+      pm_expr_uses(e, 't'))
+    return false;
+  return pm_expr_eval(e, 0, 0, 0, 0) == 0;
+}
+
+/* The condition on axis a whose wall moves (its normal component
+ * prescribed and not 0), or -1. */
+static int moving_wall(const mpm_model *m, int a) {
+  for (int b = 0; b < m->n_bcs; b++) {
+    const mpm_bc *bc = &m->bcs[b];
+    if (bc->axis != a) continue;
+    if ((bc->disp_mask >> a & 1u) && !zero_value(bc->disp[a])) return b;
+    if ((bc->vel_mask >> a & 1u) && !zero_value(bc->velocity[a])) return b;
+  }
+  return -1;
+}
+
+/* The particle's cell along each axis (clamped to the grid). */
+static void cell_of(const mpm_grid *g, const long cells[3], const double x[3],
+                    long c[3]) {
+  for (int a = 0; a < 3; a++) {
+    if (a >= g->dim) {
+      c[a] = 0;
+      continue;
+    }
+    long k = (long)floor((x[a] - g->origin[a]) * g->inv_h);
+    c[a] = k < 0 ? 0 : k >= cells[a] ? cells[a] - 1 : k;
+  }
+}
+
+/* The column along an axis that holds cell c: cut[r] <= c < cut[r + 1]. */
+static int column_of(const long *cut, int n, long c) {
+  int lo = 0, hi = n - 1;
+  while (lo < hi) {
+    int mid = (lo + hi + 1) / 2;
+    if (cut[mid] <= c)
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  return lo;
+}
+
+int mpm_decomp_rank_at(const mpm_decomp *d, const mpm_grid *g,
+                       const double x[3]) {
+  long c[3];
+  cell_of(g, d->cells, x, c);
+  int r[3];
+  for (int a = 0; a < 3; a++) r[a] = column_of(d->cut[a], d->dims[a], c[a]);
+  return r[0] + d->dims[0] * (r[1] + d->dims[1] * r[2]);
+}
+
+void mpm_decomp_destroy(mpm_decomp *d) {
+  for (int a = 0; a < 3; a++) free(d->cut[a]);
+  free(d->count);
+  memset(d, 0, sizeof *d);
+}
+
+/* Cells a rank holds at least along a split axis, and how far a cut stays
+ * from a condition's face plane (its columns' anchors and the ghost layers
+ * then lie on the rank of the face). */
+static int min_cells(const mpm_grid *g) { return g->width; }
+static int face_clearance(const mpm_grid *g) { return g->width + 2; }
+
+static bool cut_allowed(const mpm_model *m, int a, long c) {
+  const mpm_grid *g = &m->grid;
+  for (int b = 0; b < m->n_bcs; b++) {
+    if (m->bcs[b].axis != a) continue;
+    long ia = llround((m->bcs[b].plane - g->origin[a]) * g->inv_h);
+    if (labs(c - ia) < face_clearance(g)) return false;
+  }
+  return true;
+}
+
+/* Cuts along axis a into p shares of the particles (hist: per cell). */
+static pm_err make_cuts(const pm_scene *s, const mpm_model *m, int a, int p,
+                        const long *hist, long total, long *cut) {
+  const long cells = m->grid.nn[a] - 1, w = min_cells(&m->grid);
+  cut[0] = 0;
+  cut[p] = cells;
+  long below = 0, c = 0; /* particles in cells < c */
+  for (int k = 1; k < p; k++) {
+    const double target = (double)total * k / p;
+    while (c < cells && below + hist[c] <= target) below += hist[c++];
+    /* the nearer of the cuts around the target */
+    long best =
+        c < cells && target - below > below + hist[c] - target ? c + 1 : c;
+    long lo = cut[k - 1] + w, hi = cells - (long)(p - k) * w, found = -1;
+    for (long dist = 0; found < 0 && dist <= cells; dist++)
+      for (int sign = -1; sign <= 1 && found < 0; sign += 2) {
+        long q = best + sign * dist;
+        if (q >= lo && q <= hi && cut_allowed(m, a, q)) found = q;
+      }
+    PM_CHECK(found >= 0, PM_ERR_SCENE,
+             "%s: %d ranks along %c cannot share the grid's %ld cells (each "
+             "needs %ld cells, and a cut stays %d cells from a boundary "
+             "face): run on fewer ranks or refine discretization.mesh_size",
+             s->path, p, "xyz"[a], cells, w, face_clearance(&m->grid));
+    cut[k] = found;
+  }
+  return PM_SUCCESS;
+}
+
+pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m,
+                         const mpm_state *st, int size, mpm_decomp *d) {
+  pm_err ret = PM_SUCCESS;
+  const mpm_grid *g = &m->grid;
+  long *hist = NULL;
+  memset(d, 0, sizeof *d);
+  d->size = size;
+  d->ghost = g->width - 1;
+  bool splits[3];
+  size_t used = 0;
+  for (int a = 0; a < 3; a++) {
+    d->cells[a] = a < g->dim ? g->nn[a] - 1 : 1;
+    splits[a] = a < g->dim;
+    int b = a < g->dim ? moving_wall(m, a) : -1;
+    if (b >= 0) {
+      splits[a] = false;
+      used += (size_t)snprintf(d->held + used, sizeof d->held - used,
+                               "%s%c: the wall of boundary.%d "
+                               "(%s) moves",
+                               used ? "; " : "", "xyz"[a], b,
+                               pm_face_name(m->bcs[b].face));
+      if (used >= sizeof d->held) used = sizeof d->held - 1;
+    }
+  }
+  /* The ranks per axis: the least cut area among the factorizations of
+   * size over the axes that may be split. */
+  double best_cost = INFINITY;
+  for (int px = 1; px <= size; px++) {
+    if (size % px) continue;
+    for (int py = 1; py <= size / px; py++) {
+      if ((size / px) % py) continue;
+      const int dims[3] = {px, py, size / px / py};
+      bool ok = true;
+      double cost = 0;
+      for (int a = 0; a < 3 && ok; a++) {
+        if (dims[a] == 1) continue;
+        ok = splits[a] && dims[a] * (long)min_cells(g) <= d->cells[a];
+        double area = 1;
+        for (int b = 0; b < 3; b++)
+          if (b != a) area *= (double)d->cells[b];
+        cost += (dims[a] - 1) * area;
+      }
+      if (ok && cost < best_cost) {
+        best_cost = cost;
+        memcpy(d->dims, dims, sizeof dims);
+      }
+    }
+  }
+  PM_ENSURE(isfinite(best_cost), PM_ERR_SCENE,
+            "%s: %d ranks cannot share the grid (%ld x %ld x %ld cells, at "
+            "least %d cells each along an axis they split%s%s): run on fewer "
+            "ranks or refine discretization.mesh_size",
+            s->path, size, d->cells[0], d->cells[1], d->cells[2], min_cells(g),
+            d->held[0] ? "; unsplit: " : "", d->held);
+  long most = 0;
+  for (int a = 0; a < 3; a++) most = d->cells[a] > most ? d->cells[a] : most;
+  PM_TRY(PM_ALLOC(hist, most, "decomposition histogram"));
+  for (int a = 0; a < 3; a++) {
+    PM_TRY(PM_ALLOC(d->cut[a], d->dims[a] + 1, "decomposition cuts"));
+    d->cut[a][0] = 0;
+    d->cut[a][d->dims[a]] = d->cells[a];
+    if (d->dims[a] == 1) continue;
+    memset(hist, 0, sizeof(long) * (size_t)d->cells[a]);
+    for (long p = 0; p < m->n; p++) {
+      long c[3];
+      cell_of(g, d->cells, st->x + 3 * p, c);
+      hist[c[a]]++;
+    }
+    PM_TRY(make_cuts(s, m, a, d->dims[a], hist, m->n, d->cut[a]));
+  }
+  PM_TRY(PM_ALLOC(d->count, size, "particles per rank"));
+  for (long p = 0; p < m->n; p++)
+    d->count[mpm_decomp_rank_at(d, g, st->x + 3 * p)]++;
+done:
+  free(hist);
+  if (ret) mpm_decomp_destroy(d);
+  return ret;
+}
+
+/* ---- what a run across ranks cannot do yet ---------------------------------
+ */
+
+pm_err mpm_par_check(const pm_scene *s) {
+  char key[64];
+  for (int b = 0; b < s->n_bodies; b++) {
+    if (s->bodies[b].shape == PM_BODY_MEMBRANE)
+      return pm_scene_fail(s, PM_PATH(key, "bodies.%d.membrane", b), true,
+                           "membranes run on one process (this run has %d "
+                           "ranks): run without mpirun, or with -np 1",
+                           pm_par_size());
+    if (s->bodies[b].moving)
+      return pm_scene_fail(s, PM_PATH(key, "bodies.%d.motion", b), true,
+                           "bodies moving as prescribed run on one process "
+                           "(this run has %d ranks): run without mpirun, or "
+                           "with -np 1",
+                           pm_par_size());
+  }
+  if (mpm_scene_settings(s)->fbar == MPM_FBAR_PATCH)
+    return pm_scene_fail(s, "mpm.fbar", false,
+                         "F-bar over node patches runs on one process (this "
+                         "run has %d ranks): take mpm.fbar: cell, or run with "
+                         "-np 1",
+                         pm_par_size());
+  return PM_SUCCESS;
+}
+
+/* ---- each rank's share -----------------------------------------------------
+ */
+
+/* Values a transfer of `mode` moves per node. */
+static int dof_of(int mode, bool imp) {
+  return (mode & MPM_P2G_MASS ? 1 : 0) + (mode & MPM_P2G_MOM ? 3 : 0) +
+         (mode & MPM_P2G_FORCE ? 3 + (imp ? 2 : 0) : 0);
+}
+
+static int dm_index(const struct mpm_par *P, int dof) {
+  for (int k = 0; k < P->n_dm; k++)
+    if (P->dm[k].dof == dof) return k;
+  return -1;
+}
+
+static pm_err make_dm(struct mpm_par *P, const mpm_grid *g, int dof) {
+  pm_err ret = PM_SUCCESS;
+  if (dm_index(P, dof) >= 0) return PM_SUCCESS;
+  PM_CHECK(P->n_dm < PAR_MAX_DM, PM_ERR_INTERNAL, "too many node exchanges");
+  const mpm_decomp *d = &P->d;
+  PetscInt *l[3] = {NULL, NULL, NULL};
+  DM da = NULL;
+  for (int a = 0; a < 3; a++) {
+    PM_TRY(PM_ALLOC(l[a], d->dims[a], "DMDA ownership"));
+    for (int r = 0; r < d->dims[a]; r++)
+      l[a][r] = (PetscInt)(d->cut[a][r + 1] - d->cut[a][r] +
+                           (r == d->dims[a] - 1 && a < g->dim ? 1 : 0));
+  }
+  const DMBoundaryType none = DM_BOUNDARY_NONE;
+  if (g->dim == 3)
+    PM_PETSC(DMDACreate3d(PETSC_COMM_WORLD, none, none, none, DMDA_STENCIL_BOX,
+                          (PetscInt)g->nn[0], (PetscInt)g->nn[1],
+                          (PetscInt)g->nn[2], d->dims[0], d->dims[1],
+                          d->dims[2], dof, d->ghost, l[0], l[1], l[2], &da));
+  else
+    PM_PETSC(DMDACreate2d(PETSC_COMM_WORLD, none, none, DMDA_STENCIL_BOX,
+                          (PetscInt)g->nn[0], (PetscInt)g->nn[1], d->dims[0],
+                          d->dims[1], dof, d->ghost, l[0], l[1], &da));
+  PM_PETSC(DMSetUp(da));
+  /* The DMDA numbers its ranks as the decomposition does: check it. */
+  PetscInt xs[3] = {0, 0, 0}, xm[3] = {1, 1, 1};
+  PM_PETSC(DMDAGetCorners(da, &xs[0], &xs[1], &xs[2], &xm[0], &xm[1], &xm[2]));
+  for (int a = 0; a < g->dim; a++)
+    PM_ENSURE(xs[a] == P->own_lo[a] && xs[a] + xm[a] == P->own_hi[a],
+              PM_ERR_INTERNAL,
+              "rank %d: the DMDA owns nodes [%ld, %ld) along %c, the "
+              "decomposition [%ld, %ld)",
+              P->rank, (long)xs[a], (long)(xs[a] + xm[a]), "xyz"[a],
+              P -> own_lo[a], P -> own_hi[a]);
+  int k = P->n_dm++;
+  P->dm[k].dof = dof;
+  P->dm[k].da = da;
+  da = NULL;
+  PM_PETSC(DMCreateLocalVector(P->dm[k].da, &P->dm[k].loc));
+  PM_PETSC(DMCreateGlobalVector(P->dm[k].da, &P->dm[k].glob));
+done:
+  if (da) DMDestroy(&da);
+  for (int a = 0; a < 3; a++) free(l[a]);
+  return ret;
+}
+
+/* This rank's block of the grid: the DMDA's ghosted corners. */
+static pm_err local_grid(struct mpm_par *P, const mpm_grid *full, mpm_grid *g) {
+  PetscInt gs[3] = {0, 0, 0}, gm[3] = {1, 1, 1};
+  PM_PETSC_CALL(DMDAGetGhostCorners(P->dm[0].da, &gs[0], &gs[1], &gs[2], &gm[0],
+                                    &gm[1], &gm[2]));
+  *g = *full;
+  g->n_nodes = 1;
+  for (int a = 0; a < 3; a++) {
+    g->offset[a] = a < full->dim ? gs[a] : 0;
+    g->nn[a] = a < full->dim ? gm[a] : 1;
+    g->n_nodes *= g->nn[a];
+  }
+  g->stride[0] = 1;
+  g->stride[1] = g->nn[0];
+  g->stride[2] = g->nn[0] * g->nn[1];
+  PM_CALL(PM_ALLOC(P->owned, g->n_nodes, "owned nodes"));
+  P->n_owned = 0;
+  for (long k = 0; k < g->nn[2]; k++)
+    for (long j = 0; j < g->nn[1]; j++)
+      for (long i = 0; i < g->nn[0]; i++) {
+        const long q[3] = {i + g->offset[0], j + g->offset[1],
+                           k + g->offset[2]};
+        bool own = true;
+        for (int a = 0; a < full->dim; a++)
+          own = own && q[a] >= P->own_lo[a] && q[a] < P->own_hi[a];
+        P->owned[i + j * g->stride[1] + k * g->stride[2]] = own;
+        P->n_owned += own;
+      }
+  return PM_SUCCESS;
+}
+
+/* The first local particle whose one-process index is at least q. */
+static long first_at_least(const long *gid, long n, long q) {
+  long lo = 0, hi = n;
+  while (lo < hi) {
+    long mid = lo + (hi - lo) / 2;
+    if (gid[mid] < q)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* Body and group ranges from the particles' indices (after a change). */
+static void set_ranges(mpm_model *m, mpm_state *s) {
+  const struct mpm_par *P = m->par;
+  for (int b = 0; b < m->n_bodies; b++) {
+    m->body_begin[b] = first_at_least(m->gid, m->n, P->bbegin[b]);
+    m->body_end[b] = first_at_least(m->gid, m->n, P->bend[b]);
+  }
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    mpm_group *g = &m->group[gi];
+    g->begin = first_at_least(m->gid, m->n, P->gbegin[gi]);
+    g->end = first_at_least(m->gid, m->n, P->gend[gi]);
+    for (int k = 0; k < g->n_arrays; k++) {
+      g->layout[k].count = g->end - g->begin;
+      if (s) s->group[gi].array[k].count = g->end - g->begin;
+    }
+  }
+}
+
+/* Room for n particles and some to arrive. */
+static long room_for(long n) { return n + n / 4 + 64; }
+
+/* The local model's particles: those of full model m in this rank's cells,
+ * their constants and groups (set up anew from the scene), bodies,
+ * conditions and pipeline. */
+static pm_err local_model(const pm_scene *s, const mpm_model *m,
+                          const mpm_state *st, struct mpm_par *P,
+                          mpm_model **out) {
+  pm_err ret = PM_SUCCESS;
+  mpm_model *lm = NULL;
+  *out = NULL;
+  PM_TRY(PM_ALLOC(lm, 1, "MPM model (this rank's)"));
+  lm->opt = m->opt;
+  lm->dim = m->dim;
+  memcpy(lm->box_min, m->box_min, sizeof lm->box_min);
+  memcpy(lm->box_max, m->box_max, sizeof lm->box_max);
+  lm->layout = m->layout;
+  PM_TRY(local_grid(P, &m->grid, &lm->grid));
+  long n = P->d.count[P->rank];
+  lm->n = n;
+  lm->cap = room_for(n);
+  PM_TRY(PM_ALLOC(lm->x0, 3 * lm->cap, "particle positions"));
+  PM_TRY(PM_ALLOC(lm->mass, lm->cap, "particle masses"));
+  PM_TRY(PM_ALLOC(lm->vol0, lm->cap, "particle volumes"));
+  PM_TRY(PM_ALLOC(lm->gid, lm->cap, "particle indices"));
+  long k = 0;
+  for (long p = 0; p < m->n; p++) {
+    if (mpm_decomp_rank_at(&P->d, &m->grid, st->x + 3 * p) != P->rank) continue;
+    lm->gid[k] = p;
+    for (int c = 0; c < 3; c++) lm->x0[3 * k + c] = m->x0[3 * p + c];
+    lm->mass[k] = m->mass[p];
+    lm->vol0[k] = m->vol0[p];
+    k++;
+  }
+  /* Groups and bodies: ranges of the one-process indices. */
+  lm->n_groups = m->n_groups;
+  lm->kinds = m->kinds;
+  long at = 0;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *fg = &m->group[gi];
+    mpm_group *g = &lm->group[gi];
+    P->gbegin[gi] = fg->begin;
+    P->gend[gi] = fg->end;
+    *g = (mpm_group){.index = fg->index,
+                     .material = fg->material,
+                     .name = fg->name,
+                     .kind = fg->kind,
+                     .c0 = fg->c0,
+                     .c1 = fg->c1};
+    g->begin = at;
+    while (at < n && lm->gid[at] < fg->end) at++;
+    g->end = at;
+    g->cap = room_for(g->end - g->begin);
+    PM_TRY(g->kind->setup(g, &s->materials[g->material], &lm->opt));
+  }
+  lm->n_bodies = m->n_bodies;
+  P->n_full = m->n;
+  PM_TRY(PM_ALLOC(P->bbegin, m->n_bodies + 1, "body ranges"));
+  PM_TRY(PM_ALLOC(P->bend, m->n_bodies + 1, "body ranges"));
+  PM_TRY(PM_ALLOC(lm->body_begin, m->n_bodies + 1, "body ranges"));
+  PM_TRY(PM_ALLOC(lm->body_end, m->n_bodies + 1, "body ranges"));
+  PM_TRY(PM_ALLOC(lm->body_tri_begin, m->n_bodies + 1, "body ranges"));
+  PM_TRY(PM_ALLOC(lm->body_tri_end, m->n_bodies + 1, "body ranges"));
+  PM_TRY(PM_ALLOC(lm->body_links, m->n_bodies + 1, "body links"));
+  PM_TRY(PM_ALLOC(lm->body_normals, m->n_bodies + 1, "body normals"));
+  for (int b = 0; b < m->n_bodies; b++) {
+    P->bbegin[b] = m->body_begin[b];
+    P->bend[b] = m->body_end[b];
+    lm->body_links[b] = m->body_links[b];
+    lm->body_normals[b] = m->body_normals[b];
+  }
+  PM_TRY(mpm_conditions_create(s, &lm->grid, &lm->bcs, &lm->n_bcs));
+  lm->has_absorbing = m->has_absorbing;
+  mpm_pipeline_build(lm);
+  lm->par = P;
+  set_ranges(lm, NULL);
+  *out = lm;
+  lm = NULL;
+done:
+  if (lm) lm->par = NULL; /* P is the caller's until it is attached */
+  mpm_model_destroy(lm);
+  return ret;
+}
+
+/* The local state: the full state's values of this rank's particles and
+ * nodes; the energy accounts on rank 0 (each rank sums its own from
+ * here). */
+static pm_err local_state(const mpm_model *m, const mpm_state *st,
+                          const mpm_model *lm, mpm_state **out) {
+  mpm_state *ls = NULL;
+  PM_CALL(mpm_state_create(lm, &ls));
+  const struct mpm_par *P = lm->par;
+  for (long k = 0; k < lm->n; k++) {
+    const long p = lm->gid[k];
+    memcpy(ls->x + 3 * k, st->x + 3 * p, 3 * sizeof(double));
+    memcpy(ls->v + 3 * k, st->v + 3 * p, 3 * sizeof(double));
+    ls->vol[k] = st->vol[p];
+    memcpy(ls->sigma + 9 * k, st->sigma + 9 * p, 9 * sizeof(double));
+  }
+  for (int gi = 0; gi < lm->n_groups; gi++) {
+    const mpm_group *g = &lm->group[gi];
+    for (int a = 0; a < ls->group[gi].n; a++) {
+      const mpm_array *src = &st->group[gi].array[a];
+      mpm_array *dst = &ls->group[gi].array[a];
+      const int nc = dst->ncomp;
+      for (long k = g->begin; k < g->end; k++)
+        memcpy(dst->data + (k - g->begin) * nc,
+               src->data + (lm->gid[k] - m->group[gi].begin) * nc,
+               nc * sizeof(double));
+    }
+  }
+  /* Scalars: every rank's the same, but the accounts. */
+  mpm_state_copy_values(ls, st);
+  if (P->rank != 0) {
+    memset(ls->energy, 0, sizeof ls->energy);
+    ls->external_work = ls->dissipated = 0;
+  }
+  /* Nodal arrays of dynamic relaxation, from the whole grid's. */
+  const mpm_grid *g = &lm->grid, *fg = &m->grid;
+  for (long i = 0; i < g->n_nodes && ls->force_prev; i++) {
+    long q = 0, r = i;
+    for (int a = 2; a >= 0; a--) {
+      long ia = r / g->stride[a];
+      r -= ia * g->stride[a];
+      q += (ia + g->offset[a]) * fg->stride[a];
+    }
+    memcpy(ls->force_prev + 3 * i, st->force_prev + 3 * q, 3 * sizeof(double));
+    if (ls->fixed) memcpy(ls->fixed + 3 * i, st->fixed + 3 * q, 3);
+  }
+  *out = ls;
+  return PM_SUCCESS;
+}
+
+/* Doubles of a migration record for model m's groups, and of its widest
+ * per-particle array (the stress's 9 at least). */
+static int record_doubles(const mpm_model *m, int *width) {
+  int most = 0;
+  *width = 9;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    int sum = 0;
+    for (int k = 0; k < m->group[gi].n_arrays; k++) {
+      const int nc = m->group[gi].layout[k].ncomp;
+      sum += nc;
+      *width = nc > *width ? nc : *width;
+    }
+    most = sum > most ? sum : most;
+  }
+  return REC_BASE + most;
+}
+
+pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
+                      const mpm_state *st, mpm_model **local,
+                      mpm_state **local_state_out) {
+  pm_err ret = PM_SUCCESS;
+  struct mpm_par *P = NULL;
+  mpm_model *lm = NULL;
+  mpm_state *ls = NULL;
+  const int size = pm_par_size();
+  *local = NULL;
+  *local_state_out = NULL;
+  /* Every rank decomposes alike; a failure of one (memory) stops all
+   * before the collectives that follow. */
+  ret = pm_petsc_init();
+  if (!ret) ret = PM_ALLOC(P, 1, "run across ranks");
+  if (!ret) ret = mpm_decomp_create(s, m, st, size, &P->d);
+  PM_TRY(pm_par_agree(ret));
+  P->rank = pm_par_rank();
+  const mpm_decomp *d = &P->d;
+  P->coord[0] = P->rank % d->dims[0];
+  P->coord[1] = (P->rank / d->dims[0]) % d->dims[1];
+  P->coord[2] = P->rank / (d->dims[0] * d->dims[1]);
+  for (int a = 0; a < 3; a++) {
+    const int r = P->coord[a];
+    P->own_lo[a] = d->cut[a][r];
+    P->own_hi[a] =
+        d->cut[a][r + 1] + (r == d->dims[a] - 1 && a < m->dim ? 1 : 0);
+  }
+  /* The exchanges the pipeline's transfers need. */
+  for (int k = 0; k < m->pipeline.n; k++) {
+    const mpm_stage *stg = &m->pipeline.stage[k];
+    if (stg->run == mpm_stage_p2g)
+      PM_TRY(make_dm(
+          P, &m->grid,
+          dof_of(stg->mode, m->has_absorbing && (stg->mode & MPM_P2G_FORCE))));
+    if (stg->run == mpm_stage_remap)
+      PM_TRY(make_dm(P, &m->grid, dof_of(MPM_P2G_MOM, false)));
+  }
+  PM_TRY(make_dm(P, &m->grid, 3)); /* the gather of nodal vectors */
+  if (m->opt.qs == PM_QS_DYNAMIC_RELAXATION) {
+    PM_PETSC(DMDACreateNaturalVector(P->dm[dm_index(P, 3)].da, &P->natural));
+    PM_PETSC(VecScatterCreateToZero(P->natural, &P->to_root, &P->whole));
+  }
+  ret = local_model(s, m, st, P, &lm);
+  if (!ret) P = NULL; /* lm holds it */
+  if (!ret) ret = local_state(m, st, lm, &ls);
+  PM_TRY(pm_par_agree(ret));
+  struct mpm_par *Q = lm->par;
+  Q->rec = record_doubles(lm, &Q->width);
+  const long room = mpm_model_room(lm);
+  PM_TRY(PM_ALLOC(Q->dest, room, "migration ranks"));
+  PM_TRY(PM_ALLOC(Q->order, room, "migration order"));
+  PM_TRY(PM_ALLOC(Q->tmp, Q->width * room, "migration buffer"));
+  PM_TRY(PM_ALLOC(Q->scount, size, "migration counts"));
+  PM_TRY(PM_ALLOC(Q->rcount, size, "migration counts"));
+  PM_TRY(PM_ALLOC(Q->sdisp, size + 1, "migration offsets"));
+  PM_TRY(PM_ALLOC(Q->rdisp, size + 1, "migration offsets"));
+  PM_TRY(PM_ALLOC(Q->gcount, size, "gather counts"));
+  PM_TRY(PM_ALLOC(Q->gdisp, size + 1, "gather offsets"));
+  Q->sbuf_room = Q->rbuf_room = 64 + room / 8;
+  PM_TRY(PM_ALLOC(Q->sbuf, Q->sbuf_room * Q->rec, "migration buffer"));
+  PM_TRY(PM_ALLOC(Q->rbuf, Q->rbuf_room * Q->rec, "migration buffer"));
+  if (Q->rank == 0) {
+    PM_TRY(PM_ALLOC(Q->ggid, m->n, "gather indices"));
+    PM_TRY(PM_ALLOC(Q->gbuf, Q->width * m->n, "gather buffer"));
+  }
+  *local = lm;
+  *local_state_out = ls;
+  lm = NULL;
+  ls = NULL;
+done:
+  mpm_par_destroy(P);
+  mpm_state_destroy(ls);
+  mpm_model_destroy(lm);
+  return ret;
+}
+
+void mpm_par_destroy(struct mpm_par *P) {
+  if (!P) return;
+  if (P->to_root) VecScatterDestroy(&P->to_root);
+  if (P->whole) VecDestroy(&P->whole);
+  if (P->natural) VecDestroy(&P->natural);
+  for (int k = 0; k < P->n_dm; k++) {
+    VecDestroy(&P->dm[k].loc);
+    VecDestroy(&P->dm[k].glob);
+    DMDestroy(&P->dm[k].da);
+  }
+  mpm_decomp_destroy(&P->d);
+  free(P->owned);
+  free(P->bbegin);
+  free(P->bend);
+  free(P->dest);
+  free(P->scount);
+  free(P->rcount);
+  free(P->sdisp);
+  free(P->rdisp);
+  free(P->sbuf);
+  free(P->rbuf);
+  free(P->order);
+  free(P->tmp);
+  free(P->ggid);
+  free(P->gbuf);
+  free(P->gcount);
+  free(P->gdisp);
+  free(P);
+}
+
+void mpm_par_work_attach(const mpm_model *m, mpm_work *w) {
+  w->nodes.owned = m->par->owned;
+  w->timer_migrate = pm_timers_add(&w->timers, "migrate");
+}
+
+/* ---- node sums -------------------------------------------------------------
+ */
+
+pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
+                         bool imp) {
+  struct mpm_par *P = m->par;
+  const double t0 = pm_wtime();
+  const int dof = dof_of(mode, imp);
+  const int k = dm_index(P, dof);
+  PM_CHECK(k >= 0, PM_ERR_INTERNAL, "no node exchange of %d values", dof);
+  const long nn = m->grid.n_nodes;
+  PetscScalar *a;
+  PM_PETSC_CALL(VecGetArray(P->dm[k].loc, &a));
+  PM_OMP(parallel for schedule(static) default(none) shared(a, nd, nn, dof, mode, imp))
+  for (long i = 0; i < nn; i++) {
+    double *r = a + i * dof;
+    if (mode & MPM_P2G_MASS) *r++ = nd->mass[i];
+    if (mode & MPM_P2G_MOM)
+      for (int c = 0; c < 3; c++) *r++ = nd->mom[3 * i + c];
+    if (mode & MPM_P2G_FORCE) {
+      for (int c = 0; c < 3; c++) *r++ = nd->force[3 * i + c];
+      if (imp)
+        for (int c = 0; c < 2; c++) *r++ = nd->impedance[2 * i + c];
+    }
+  }
+  PM_PETSC_CALL(VecRestoreArray(P->dm[k].loc, &a));
+  PM_PETSC_CALL(VecZeroEntries(P->dm[k].glob));
+  PM_PETSC_CALL(DMLocalToGlobalBegin(P->dm[k].da, P->dm[k].loc, ADD_VALUES,
+                                     P->dm[k].glob));
+  PM_PETSC_CALL(
+      DMLocalToGlobalEnd(P->dm[k].da, P->dm[k].loc, ADD_VALUES, P->dm[k].glob));
+  PM_PETSC_CALL(DMGlobalToLocalBegin(P->dm[k].da, P->dm[k].glob, INSERT_VALUES,
+                                     P->dm[k].loc));
+  PM_PETSC_CALL(DMGlobalToLocalEnd(P->dm[k].da, P->dm[k].glob, INSERT_VALUES,
+                                   P->dm[k].loc));
+  PM_PETSC_CALL(VecGetArray(P->dm[k].loc, &a));
+  PM_OMP(parallel for schedule(static) default(none) shared(a, nd, nn, dof, mode, imp))
+  for (long i = 0; i < nn; i++) {
+    const double *r = a + i * dof;
+    if (mode & MPM_P2G_MASS) nd->mass[i] = *r++;
+    if (mode & MPM_P2G_MOM)
+      for (int c = 0; c < 3; c++) nd->mom[3 * i + c] = *r++;
+    if (mode & MPM_P2G_FORCE) {
+      for (int c = 0; c < 3; c++) nd->force[3 * i + c] = *r++;
+      if (imp)
+        for (int c = 0; c < 2; c++) nd->impedance[2 * i + c] = *r++;
+    }
+  }
+  PM_PETSC_CALL(VecRestoreArray(P->dm[k].loc, &a));
+  /* Each ghost node's values go to its owner and come back. */
+  const double bytes = 2.0 * (double)(nn - P->n_owned) * dof * sizeof(double);
+  P->counts.halo_bytes += bytes;
+  pm_par_count_sent(bytes);
+  P->counts.halo_seconds += pm_wtime() - t0;
+  return PM_SUCCESS;
+}
+
+void mpm_par_step_end(const mpm_model *m, mpm_work *w) {
+  (void)m;
+  double most[3] = {w->max_div, -w->min_jacobian, (double)w->iter_max};
+  pm_par_max(most, 3);
+  w->max_div = most[0];
+  w->min_jacobian = -most[1];
+  w->iter_max = (int)most[2];
+  pm_par_sum_long(&w->iter_capped, 1);
+}
+
+/* ---- migration --------------------------------------------------------------
+ */
+
+/* Grow every per-particle array of m, s and w to room for n particles. */
+static pm_err grow(mpm_model *m, mpm_state *s, mpm_work *w, long n) {
+  struct mpm_par *P = m->par;
+  if (n <= m->cap) return PM_SUCCESS;
+  const long room = room_for(n);
+  PM_CALL(PM_REALLOC(m->x0, 3 * room, "particle positions"));
+  PM_CALL(PM_REALLOC(m->mass, room, "particle masses"));
+  PM_CALL(PM_REALLOC(m->vol0, room, "particle volumes"));
+  PM_CALL(PM_REALLOC(m->gid, room, "particle indices"));
+  PM_CALL(PM_REALLOC(s->x, 3 * room, "particle positions"));
+  PM_CALL(PM_REALLOC(s->v, 3 * room, "particle velocities"));
+  PM_CALL(PM_REALLOC(s->vol, room, "particle volumes"));
+  PM_CALL(PM_REALLOC(s->sigma, 9 * room, "particle stresses"));
+  PM_CALL(PM_REALLOC(w->dx, 3 * room, "particle increments"));
+  PM_CALL(PM_REALLOC(w->cp, room, "particle wave speeds"));
+  if (w->cs) PM_CALL(PM_REALLOC(w->cs, room, "particle wave speeds"));
+  if (w->fbar.jm1) {
+    PM_CALL(PM_REALLOC(w->fbar.jm1, room, "F-bar volume ratios"));
+    w->fbar.n = room;
+  }
+  if (w->fbar.cell) PM_CALL(PM_REALLOC(w->fbar.cell, room, "F-bar cells"));
+  PM_CALL(PM_REALLOC(P->dest, room, "migration ranks"));
+  PM_CALL(PM_REALLOC(P->order, room, "migration order"));
+  PM_CALL(PM_REALLOC(P->tmp, P->width * room, "migration buffer"));
+  m->cap = room;
+  P->counts.grown++;
+  return PM_SUCCESS;
+}
+
+static pm_err grow_group(mpm_group *g, mpm_group_state *gs, long n) {
+  if (n <= g->cap) return PM_SUCCESS;
+  const long room = room_for(n);
+  for (int k = 0; k < gs->n; k++)
+    PM_CALL(PM_REALLOC(gs->array[k].data, gs->array[k].ncomp * room,
+                       gs->array[k].name));
+  g->cap = room;
+  return PM_SUCCESS;
+}
+
+static pm_err grow_buffer(double **buf, long *room, long records, int rec) {
+  if (records <= *room) return PM_SUCCESS;
+  const long r = room_for(records);
+  PM_CALL(PM_REALLOC(*buf, r * rec, "migration buffer"));
+  *room = r;
+  return PM_SUCCESS;
+}
+
+static int by_gid(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* One array's values in the new order: n_new of nc doubles, from the old
+ * array (index order[j] >= 0) or a record (at offset off). */
+static void permute(const struct mpm_par *P, double *data, long n_new, int nc,
+                    long old_base, const double *recs, int off) {
+  double *tmp = P->tmp;
+  const long *order = P->order;
+  const int rec = P->rec;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(tmp, order, data, n_new, nc, old_base, recs, off, rec))
+  for (long j = 0; j < n_new; j++) {
+    const long o = order[j];
+    const double *src =
+        o >= 0 ? data + (o - old_base) * nc : recs + (-o - 1) * rec + off;
+    for (int c = 0; c < nc; c++) tmp[j * nc + c] = src[c];
+  }
+  memcpy(data, tmp, sizeof(double) * (size_t)(n_new * nc));
+}
+
+pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
+  struct mpm_par *P = m->par;
+  const int size = P->d.size, rec = P->rec;
+  const double t0 = pm_wtime();
+  pm_timers_start(&w->timers, w->timer_migrate);
+  /* Where each particle goes. */
+  memset(P->scount, 0, sizeof(int) * (size_t)size);
+  long leaving = 0;
+  for (long p = 0; p < m->n; p++) {
+    int r = mpm_decomp_rank_at(&P->d, &m->grid, s->x + 3 * p);
+    P->dest[p] = r;
+    if (r != P->rank) {
+      P->scount[r]++;
+      leaving++;
+    }
+  }
+  MPI_Alltoall(P->scount, 1, MPI_INT, P->rcount, 1, MPI_INT, MPI_COMM_WORLD);
+  long arriving = 0;
+  for (int r = 0; r < size; r++) arriving += P->rcount[r];
+  long moved[2] = {leaving, arriving};
+  pm_par_sum_long(moved, 1);
+  pm_err ret = PM_SUCCESS;
+  if (moved[0] == 0) goto done; /* nobody moved anywhere */
+  ret = grow_buffer(&P->sbuf, &P->sbuf_room, leaving, rec);
+  if (!ret) ret = grow_buffer(&P->rbuf, &P->rbuf_room, arriving, rec);
+  ret = pm_par_agree(ret);
+  if (ret) goto done;
+  /* Pack the leaving particles, by rank, in their order. */
+  P->sdisp[0] = P->rdisp[0] = 0;
+  for (int r = 0; r < size; r++) {
+    P->sdisp[r + 1] = P->sdisp[r] + P->scount[r];
+    P->rdisp[r + 1] = P->rdisp[r] + P->rcount[r];
+  }
+  for (int r = 0; r < size; r++) P->scount[r] = 0;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    for (long p = g->begin; p < g->end; p++) {
+      const int r = P->dest[p];
+      if (r == P->rank) continue;
+      double *q = P->sbuf + (long)(P->sdisp[r] + P->scount[r]++) * rec;
+      q[REC_GID] = (double)m->gid[p];
+      q[REC_GROUP] = gi;
+      memcpy(q + REC_X0, m->x0 + 3 * p, 3 * sizeof(double));
+      q[REC_MASS] = m->mass[p];
+      q[REC_VOL0] = m->vol0[p];
+      memcpy(q + REC_X, s->x + 3 * p, 3 * sizeof(double));
+      memcpy(q + REC_V, s->v + 3 * p, 3 * sizeof(double));
+      q[REC_VOL] = s->vol[p];
+      memcpy(q + REC_SIGMA, s->sigma + 9 * p, 9 * sizeof(double));
+      int off = REC_BASE;
+      for (int k = 0; k < s->group[gi].n; k++) {
+        const mpm_array *a = &s->group[gi].array[k];
+        memcpy(q + off, a->data + (p - g->begin) * a->ncomp,
+               a->ncomp * sizeof(double));
+        off += a->ncomp;
+      }
+    }
+  }
+  for (int r = 0; r <= size; r++) {
+    P->sdisp[r] *= rec;
+    P->rdisp[r] *= rec;
+  }
+  for (int r = 0; r < size; r++) {
+    P->scount[r] = P->sdisp[r + 1] - P->sdisp[r];
+    P->rcount[r] = P->rdisp[r + 1] - P->rdisp[r];
+  }
+  MPI_Alltoallv(P->sbuf, P->scount, P->sdisp, MPI_DOUBLE, P->rbuf, P->rcount,
+                P->rdisp, MPI_DOUBLE, MPI_COMM_WORLD);
+  P->counts.migrated += leaving;
+  P->counts.migrate_bytes += (double)leaving * rec * sizeof(double);
+  pm_par_count_sent((double)leaving * rec * sizeof(double));
+  if (leaving == 0 && arriving == 0) goto done;
+  /* The new order: those that stay and those that came, by index. */
+  qsort(P->rbuf, (size_t)arriving, (size_t)rec * sizeof(double), by_gid);
+  const long n_new = m->n - leaving + arriving;
+  ret = grow(m, s, w, n_new);
+  long gcount[MPM_MAX_GROUPS] = {0};
+  for (int gi = 0; gi < m->n_groups; gi++)
+    gcount[gi] = m->group[gi].end - m->group[gi].begin;
+  for (long p = 0; p < m->n; p++)
+    if (P->dest[p] != P->rank)
+      for (int gi = 0; gi < m->n_groups; gi++)
+        if (p >= m->group[gi].begin && p < m->group[gi].end) gcount[gi]--;
+  for (long k = 0; k < arriving; k++)
+    gcount[(int)P->rbuf[k * rec + REC_GROUP]]++;
+  for (int gi = 0; !ret && gi < m->n_groups; gi++)
+    ret = grow_group(&m->group[gi], &s->group[gi], gcount[gi]);
+  if (ret) goto done;
+  {
+    long j = 0, p = 0, k = 0;
+    while (p < m->n || k < arriving) {
+      if (p < m->n && P->dest[p] != P->rank) {
+        p++;
+        continue;
+      }
+      bool take_old =
+          k >= arriving ||
+          (p < m->n && (double)m->gid[p] < P->rbuf[k * rec + REC_GID]);
+      P->order[j++] = take_old ? p++ : -(k++ + 1);
+    }
+  }
+  /* The common arrays (old indices from 0), then each group's (old
+   * indices from the group's old start; a particle never changes group). */
+  const double *recs = P->rbuf;
+  long old_begin[MPM_MAX_GROUPS];
+  for (int gi = 0; gi < m->n_groups; gi++) old_begin[gi] = m->group[gi].begin;
+  {
+    /* gid as doubles through the buffer, then back */
+    double *tmp = P->tmp;
+    for (long j = 0; j < n_new; j++) {
+      const long o = P->order[j];
+      tmp[j] = o >= 0 ? (double)m->gid[o] : recs[(-o - 1) * rec + REC_GID];
+    }
+    for (long j = 0; j < n_new; j++) m->gid[j] = (long)tmp[j];
+  }
+  permute(P, m->x0, n_new, 3, 0, recs, REC_X0);
+  permute(P, m->mass, n_new, 1, 0, recs, REC_MASS);
+  permute(P, m->vol0, n_new, 1, 0, recs, REC_VOL0);
+  permute(P, s->x, n_new, 3, 0, recs, REC_X);
+  permute(P, s->v, n_new, 3, 0, recs, REC_V);
+  permute(P, s->vol, n_new, 1, 0, recs, REC_VOL);
+  permute(P, s->sigma, n_new, 9, 0, recs, REC_SIGMA);
+  /* The groups' new ranges are known from the indices now. */
+  const long old_n = m->n;
+  m->n = n_new;
+  set_ranges(m, s);
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    /* This group's slice of the order, with old indices relative to its
+     * old start. */
+    long *order = P->order + g->begin;
+    const long ng = g->end - g->begin;
+    int off = REC_BASE;
+    for (int k = 0; k < s->group[gi].n; k++) {
+      mpm_array *a = &s->group[gi].array[k];
+      const int nc = a->ncomp;
+      for (long j = 0; j < ng; j++) {
+        const long o = order[j];
+        const double *src = o >= 0 ? a->data + (o - old_begin[gi]) * nc
+                                   : recs + (-o - 1) * rec + off;
+        for (int c = 0; c < nc; c++) P->tmp[j * nc + c] = src[c];
+      }
+      memcpy(a->data, P->tmp, sizeof(double) * (size_t)(ng * nc));
+      off += nc;
+    }
+  }
+  (void)old_n;
+done:
+  pm_timers_stop(&w->timers, w->timer_migrate);
+  P->counts.migrate_seconds += pm_wtime() - t0;
+  return pm_par_agree(ret);
+}
+
+/* ---- gather to rank 0 -------------------------------------------------------
+ */
+
+/* Gather n local values of nc doubles each (data) into the whole run's
+ * array on rank 0 (out, indexed by the one-process index less base). */
+static void gather_array(struct mpm_par *P, const double *data, long n, int nc,
+                         const long *gid, long base, double *out) {
+  const int size = P->d.size;
+  int cnt = (int)(n * nc);
+  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (P->rank == 0) {
+    P->gdisp[0] = 0;
+    for (int r = 0; r < size; r++) P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
+  }
+  MPI_Gatherv(data, cnt, MPI_DOUBLE, P->gbuf, P->gcount, P->gdisp, MPI_DOUBLE,
+              0, MPI_COMM_WORLD);
+  if (P->rank != 0) {
+    pm_par_count_sent((double)cnt * sizeof(double));
+    return;
+  }
+  const long total = P->gdisp[size] / (nc ? nc : 1);
+  for (long j = 0; j < total; j++)
+    memcpy(out + (gid[j] - base) * nc, P->gbuf + j * nc, nc * sizeof(double));
+}
+
+pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
+                      const mpm_model *full, mpm_state *fs) {
+  struct mpm_par *P = m->par;
+  const int size = P->d.size;
+  /* The one-process indices, all at once, then per group. */
+  int cnt = (int)m->n;
+  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (P->rank == 0) {
+    P->gdisp[0] = 0;
+    for (int r = 0; r < size; r++) P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
+  }
+  MPI_Gatherv(m->gid, cnt, MPI_LONG, P->ggid, P->gcount, P->gdisp, MPI_LONG, 0,
+              MPI_COMM_WORLD);
+  double *fx = fs ? fs->x : NULL, *fv = fs ? fs->v : NULL,
+         *fvol = fs ? fs->vol : NULL, *fsig = fs ? fs->sigma : NULL;
+  gather_array(P, s->x, m->n, 3, P->ggid, 0, fx);
+  gather_array(P, s->v, m->n, 3, P->ggid, 0, fv);
+  gather_array(P, s->vol, m->n, 1, P->ggid, 0, fvol);
+  gather_array(P, s->sigma, m->n, 9, P->ggid, 0, fsig);
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    const long ng = g->end - g->begin;
+    cnt = (int)ng;
+    MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (P->rank == 0) {
+      P->gdisp[0] = 0;
+      for (int r = 0; r < size; r++)
+        P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
+    }
+    MPI_Gatherv(m->gid + g->begin, cnt, MPI_LONG, P->ggid, P->gcount, P->gdisp,
+                MPI_LONG, 0, MPI_COMM_WORLD);
+    for (int k = 0; k < s->group[gi].n; k++) {
+      const mpm_array *a = &s->group[gi].array[k];
+      gather_array(P, a->data, ng, a->ncomp, P->ggid, P->gbegin[gi],
+                   fs ? fs->group[gi].array[k].data : NULL);
+    }
+  }
+  /* The energy accounts, summed. */
+  enum { n_acc = sizeof(((mpm_state *)0)->energy) / (sizeof(double)) };
+  double acc[n_acc + 2];
+  memcpy(acc, s->energy, sizeof s->energy);
+  acc[n_acc] = s->external_work;
+  acc[n_acc + 1] = s->dissipated;
+  pm_par_sum(acc, n_acc + 2);
+  if (fs) {
+    mpm_state_copy_values(fs, s);
+    memcpy(fs->energy, acc, sizeof fs->energy);
+    fs->external_work = acc[n_acc];
+    fs->dissipated = acc[n_acc + 1];
+  }
+  if (!s->force_prev) return PM_SUCCESS;
+  /* Dynamic relaxation's nodal arrays: owned nodes, in natural order. */
+  const int k = dm_index(P, 3);
+  const mpm_grid *g = &m->grid;
+  Vec nat = P->natural, all = P->whole;
+  VecScatter sc = P->to_root;
+  for (int pass = 0; pass < (s->fixed ? 2 : 1); pass++) {
+    PetscScalar *a;
+    PM_PETSC_CALL(VecGetArray(P->dm[k].loc, &a));
+    for (long i = 0; i < 3 * g->n_nodes; i++)
+      a[i] = pass ? (double)s->fixed[i] : s->force_prev[i];
+    PM_PETSC_CALL(VecRestoreArray(P->dm[k].loc, &a));
+    PM_PETSC_CALL(DMLocalToGlobalBegin(P->dm[k].da, P->dm[k].loc, INSERT_VALUES,
+                                       P->dm[k].glob));
+    PM_PETSC_CALL(DMLocalToGlobalEnd(P->dm[k].da, P->dm[k].loc, INSERT_VALUES,
+                                     P->dm[k].glob));
+    PM_PETSC_CALL(DMDAGlobalToNaturalBegin(P->dm[k].da, P->dm[k].glob,
+                                           INSERT_VALUES, nat));
+    PM_PETSC_CALL(
+        DMDAGlobalToNaturalEnd(P->dm[k].da, P->dm[k].glob, INSERT_VALUES, nat));
+    PM_PETSC_CALL(
+        VecScatterBegin(sc, nat, all, INSERT_VALUES, SCATTER_FORWARD));
+    PM_PETSC_CALL(VecScatterEnd(sc, nat, all, INSERT_VALUES, SCATTER_FORWARD));
+    if (fs) {
+      const PetscScalar *b;
+      PM_PETSC_CALL(VecGetArrayRead(all, &b));
+      const long n3 = 3 * full->grid.n_nodes;
+      for (long i = 0; i < n3; i++) {
+        if (pass)
+          fs->fixed[i] = b[i] != 0;
+        else
+          fs->force_prev[i] = b[i];
+      }
+      PM_PETSC_CALL(VecRestoreArrayRead(all, &b));
+    }
+  }
+  return PM_SUCCESS;
+}
+
+/* ---- plan and counts -------------------------------------------------------
+ */
+
+void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out) {
+  fprintf(out, "ranks        %d: %d x %d x %d boxes of the grid's cells",
+          d->size, d->dims[0], d->dims[1], d->dims[2]);
+  if (m->dim == 2) fprintf(out, " (2-D: z is not split)");
+  fprintf(out, ", %d ghost node layer%s\n", d->ghost, d->ghost == 1 ? "" : "s");
+  for (int a = 0; a < m->dim; a++) {
+    if (d->dims[a] == 1) continue;
+    fprintf(out, "             cuts along %c at cells", "xyz"[a]);
+    for (int r = 1; r < d->dims[a]; r++) fprintf(out, " %ld", d->cut[a][r]);
+    fprintf(out, " of %ld\n", d->cells[a]);
+  }
+  if (d->held[0]) fprintf(out, "             not split: %s\n", d->held);
+  long most = 0, least = -1, total = 0;
+  for (int r = 0; r < d->size; r++) {
+    total += d->count[r];
+    most = d->count[r] > most ? d->count[r] : most;
+    least = least < 0 || d->count[r] < least ? d->count[r] : least;
+  }
+  fprintf(out,
+          "             particles per rank %ld to %ld (imbalance %.3f: the "
+          "most over the mean)\n",
+          least, most, total > 0 ? most * (double)d->size / total : 0.0);
+}
+
+void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
+  const struct mpm_par *P = m->par;
+  const int size = P->d.size;
+  /* Per rank: particles, nodes held, nodes owned, bytes. */
+  double mine[4] = {(double)m->n, (double)m->grid.n_nodes, (double)P->n_owned,
+                    (double)(mpm_model_bytes(m) + mpm_work_bytes(m, w))};
+  double *all = NULL;
+  if (P->rank == 0) all = calloc((size_t)size * 4, sizeof(double));
+  MPI_Gather(mine, 4, MPI_DOUBLE, all, 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (P->rank != 0 || !out || !all) {
+    free(all);
+    return;
+  }
+  mpm_decomp_print(&P->d, m, out);
+  fprintf(out, "             rank  particles  nodes (owned + ghost)  memory\n");
+  for (int r = 0; r < size; r++) {
+    const double *v = all + 4 * r;
+    fprintf(out, "             %4d  %9.0f  %9.0f (%.0f + %.0f)  %.1f MiB\n", r,
+            v[0], v[1], v[2], v[1] - v[2], v[3] / 1048576.0);
+  }
+  free(all);
+}
+
+const mpm_decomp *mpm_par_decomp(const mpm_model *m) { return &m->par->d; }
+
+void mpm_par_get_counts(const mpm_model *m, mpm_par_counts *c) {
+  *c = m->par ? m->par->counts : (mpm_par_counts){0};
+}

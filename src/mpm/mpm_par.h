@@ -1,0 +1,125 @@
+/* mpm_par: explicit MPM across MPI ranks.  The grid is cut into boxes, one
+ * per rank, on a PETSc DMDA; each rank holds the particles of its cells
+ * and its block of the grid with the ghost node layers their stencils
+ * reach.
+ *
+ * A step on a rank is the step of one process on its own particles and
+ * nodes, with three additions:
+ *  - after every particle-to-grid transfer the ranks' contributions to a
+ *    node are summed on its owner and the sums sent back to every rank
+ *    that holds the node as a ghost (DMLocalToGlobal with ADD_VALUES, then
+ *    DMGlobalToLocal), so that each rank holds whole nodal sums on all its
+ *    nodes and updates its ghost nodes as their owner does: the grid's
+ *    velocities need no second exchange;
+ *  - sums over nodes (reactions, residual, damping, energies) count owned
+ *    nodes only and are summed over the ranks; the stable step is their
+ *    minimum; a failure on one rank stops all of them after the same
+ *    stage, with that rank's message (particles named by their index on
+ *    one process);
+ *  - after the move, particles that left the rank's cells go to the rank
+ *    that owns their cell, with every array they carry; a rank's
+ *    particles stay in increasing order of their index on one process, so
+ *    groups and bodies stay contiguous.
+ * Rank 0 also keeps the whole model and gathers the state into it when
+ * the run writes (frames, history, checkpoints): the output of a run
+ * across ranks is that of one process, in the same order.
+ *
+ * The decomposition balances particles, not cells: along each axis it
+ * splits, the cuts divide the particles of the initial state into equal
+ * shares.  It leaves unsplit an axis along which a boundary wall moves (a
+ * face condition's column is walked from the grid's edge to the wall) and
+ * keeps cuts clear of face planes. */
+#ifndef MPM_PAR_H
+#define MPM_PAR_H
+
+#include <stdio.h>
+
+#include "mpm_model.h"
+#include "mpm_state.h"
+
+/* A decomposition of the grid's cells into boxes, one per rank. */
+typedef struct {
+  int size;       /* ranks */
+  int dims[3];    /* ranks per axis (rank = i + dims0 (j + dims1 k)) */
+  long cells[3];  /* cells per axis of the whole grid (1 on z in 2-D) */
+  long *cut[3];   /* dims[a] + 1 cell indices per axis: the column r of
+                     ranks along a owns cells [cut[a][r], cut[a][r + 1]) */
+  long *count;    /* particles per rank in the state decomposed */
+  int ghost;      /* node layers a rank holds beyond its own nodes */
+  char held[256]; /* the axes left unsplit, and why */
+} mpm_decomp;
+
+/* Decompose model m's grid (scene s) for `size` ranks, balancing the
+ * particles of state st.  PM_ERR_SCENE (naming what prevents it) when the
+ * grid cannot be shared by that many ranks.  Release with
+ * mpm_decomp_destroy. */
+pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m,
+                         const mpm_state *st, int size, mpm_decomp *d);
+void mpm_decomp_destroy(mpm_decomp *d);
+/* The rank that owns the cell of position x. */
+int mpm_decomp_rank_at(const mpm_decomp *d, const mpm_grid *g,
+                       const double x[3]);
+
+/* What a run across ranks needs that one process does not: refuse what
+ * it cannot do yet, naming the scene key (PM_ERR_SCENE).  Called by the
+ * scene check when more than one rank runs. */
+pm_err mpm_par_check(const pm_scene *s);
+
+/* This rank's model and state of the run of full model m (scene s) at
+ * state st, which every rank holds: its cells' particles, its block of the
+ * grid, the conditions on it and the exchanges with the other ranks
+ * (collective).  *local owns its arrays; m and st are left as they are. */
+pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
+                      const mpm_state *st, mpm_model **local,
+                      mpm_state **local_state);
+/* Release a model's share of a run across ranks (mpm_model_destroy). */
+void mpm_par_destroy(struct mpm_par *p);
+
+/* Point the workspace of local model m at what its rank shares: the nodes
+ * it owns (mpm_nodes.owned) and the migration's timer. */
+void mpm_par_work_attach(const mpm_model *m, mpm_work *w);
+
+/* Sum the nodal arrays of a particle-to-grid transfer (mode, with the
+ * impedances) over the ranks: owners add their ghosts' contributions and
+ * every rank gets the sums on all its nodes (collective). */
+pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
+                         bool impedances);
+
+/* The figures of a step every rank must share, once it ends: the largest
+ * |tr D|, the smallest J, the iterations (collective). */
+void mpm_par_step_end(const mpm_model *m, mpm_work *w);
+
+/* Send the particles that left this rank's cells to their cells' ranks and
+ * take in those that arrived (collective).  The arrays grow when a rank
+ * holds more than they have room for.  PM_ERR_MEMORY. */
+pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w);
+
+/* Gather the state of every rank into the whole model's state full_state
+ * on rank 0 (NULL on the others), in the order of one process: particles,
+ * the energy accounts, and with dynamic relaxation the nodal arrays it
+ * keeps (collective). */
+pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
+                      const mpm_model *full, mpm_state *full_state);
+
+/* Print the decomposition and every rank's share (particles, nodes, ghost
+ * nodes, memory) to out on rank 0 (collective; out may be NULL on other
+ * ranks). */
+void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out);
+
+/* Print decomposition d of model m for a plan of `size` ranks made on one
+ * process (pointmech plan --ranks N). */
+void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out);
+
+/* Bytes a rank sent per step by exchanges of nodes and particles, and the
+ * seconds they took, over the run so far (summary.json). */
+typedef struct {
+  double halo_bytes, halo_seconds;       /* node sums */
+  double migrate_bytes, migrate_seconds; /* particles */
+  long migrated;                         /* particles sent */
+  long grown;                            /* times the arrays grew */
+} mpm_par_counts;
+void mpm_par_get_counts(const mpm_model *m, mpm_par_counts *c);
+/* The decomposition of local model m. */
+const mpm_decomp *mpm_par_decomp(const mpm_model *m);
+
+#endif

@@ -1,0 +1,159 @@
+#!/usr/bin/env bash
+# Explicit MPM across MPI ranks against the same runs on one process.
+# Usage: ranks.sh POINTMECH SOURCE_DIR RANKS_MIGRATE
+#
+# A run across ranks sums each node's contributions in another order (each
+# rank's share, then the ranks'), so its values differ from one process's
+# by round-off, which the steps carry on: measured 6e-14 (shock tube, 296
+# steps), 3e-14 (disks, 157 steps, 2 to 4 ranks) and 4e-13 (F2, 100
+# steps).  The bound, 1e-10 of each field's largest magnitude, leaves room
+# for other machines and catches any real error (a contribution lost or
+# counted twice is of order 1).  One rank under mpirun is one process, bit
+# for bit.  Each run has one OpenMP thread per rank, and ranks waiting in a
+# collective yield their core (mpi_yield_when_idle): more ranks than cores
+# otherwise spin against each other, 20 times slower.
+set -u
+bin=$1
+src=$2
+migrate=$3
+. "$(dirname "$0")/lib.sh"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+export OMP_NUM_THREADS=1
+py=/usr/bin/python3
+roundoff="$py $src/tests/verification/same_to_roundoff.py"
+tol=1e-10
+mpm=$src/cases/mpm
+
+ranks() { # N, command...
+  local n=$1
+  shift
+  timeout 300 mpirun -np "$n" --bind-to none "$@"
+}
+
+# One process, then N ranks, of SCENE with overrides, compared to
+# round-off; the runs end with exit status $want (default 0).
+across() { # label, scene, ranks, overrides...
+  local label=$1 scene=$2 n=$3 want=${want:-0}
+  shift 3
+  local one=$work/$label-1 many=$work/$label-$n
+  [ -d "$one" ] || "$bin" run "$scene" --out "$one" --quiet "$@" \
+    >/dev/null 2>"$work/err"
+  ranks "$n" "$bin" run "$scene" --out "$many" --quiet "$@" >/dev/null \
+    2>"$work/err"
+  local rc=$?
+  check "$label on $n ranks: exit $want (got $rc)" test $rc -eq "$want"
+  $roundoff "$one" "$many" $tol >"$work/cmp" 2>&1
+  rc=$?
+  sed "s/^/$label, $n ranks against one process: /" "$work/cmp"
+  check "$label on $n ranks: the run of one process to $tol" test $rc -eq 0
+}
+
+# The shock tube (3-D, pressure ratio 1000, split along x between its
+# walls), the disks (2-D: 2 ranks split x, 3 split y, 4 make 2 x 2 boxes of
+# which two start empty) and F2 (3-D, dynamic relaxation with moving and
+# fixed walls: z holds the moving wall and is not split).
+across shock-tube $mpm/m2-shock-tube-reduced.yaml 2
+across disks $mpm/disks-collision.yaml 2
+across disks $mpm/disks-collision.yaml 3
+across disks $mpm/disks-collision.yaml 4
+# (100 steps: not yet quasi-static, exit 3)
+want=3 across f2 $mpm/f2-unconstrained-compression.yaml 2 \
+  --set time.max_steps=100 --set output.every=25
+
+check "shock tube: the decomposition in summary.json" $py -c "
+import json, sys
+r = json.load(open('$work/shock-tube-2/summary.json'))['ranks']
+sys.exit(not (r['count'] == 2 and r['boxes'] == [2, 1, 1] and
+              r['particles_at_start'] == [400, 400] and
+              r['particles_migrated'] > 0 and r['node_bytes_per_step'] > 0))"
+check "disks on 4 ranks: two ranks start empty" $py -c "
+import json, sys
+r = json.load(open('$work/disks-4/summary.json'))['ranks']
+sys.exit(not (sorted(r['particles_at_start']) == [0, 0, 208, 208]))"
+
+# One rank under mpirun is one process.
+ranks 1 "$bin" run "$mpm/disks-collision.yaml" --out "$work/disks-np1" \
+  --quiet >/dev/null 2>"$work/err"
+check "disks on 1 rank: one process, bit for bit" \
+  $py "$src/tests/verification/same_results.py" "$work/disks-1" "$work/disks-np1"
+
+# The plan prints the decomposition and every rank's share.
+ranks 2 "$bin" plan "$mpm/f2-unconstrained-compression.yaml" >"$work/plan" \
+  2>"$work/err"
+check "plan on 2 ranks: exit 0" test $? -eq 0
+check "plan on 2 ranks: the boxes" grep -q '^ranks        2: 1 x 2 x 1 boxes' \
+  "$work/plan"
+check "plan on 2 ranks: z, where a wall moves, not split" \
+  grep -q 'not split: z: the wall of boundary.3 (zmax) moves' "$work/plan"
+check "plan on 2 ranks: a line per rank" \
+  test "$(grep -cE '^ +[01] +[0-9]+ +[0-9]+ \(' "$work/plan")" -eq 2
+
+# Migration moves particles and nothing else.
+for n in 2 3; do
+  ranks $n "$migrate" "$mpm/disks-collision.yaml" 157 >"$work/mig" 2>&1
+  rc=$?
+  tail -1 "$work/mig"
+  check "migration on $n ranks (disks): exit 0 (got $rc)" test $rc -eq 0
+  check "migration on $n ranks (disks): particles moved" \
+    grep -qE 'ranks, [1-9][0-9]* particles migrated, 0 failed' "$work/mig"
+done
+ranks 2 "$migrate" "$mpm/m2-shock-tube-reduced.yaml" 296 >"$work/mig" 2>&1
+rc=$?
+tail -1 "$work/mig"
+check "migration on 2 ranks (shock tube): exit 0 (got $rc)" test $rc -eq 0
+
+# A particle that leaves the grid stops every rank with one process's
+# message (the particle by its index on one process), not a hang.
+fly="--set bodies.1.velocity=[3,3]"
+"$bin" run "$mpm/disks-collision.yaml" --out "$work/fly-1" --quiet $fly \
+  >/dev/null 2>"$work/err1"
+ranks 2 "$bin" run "$mpm/disks-collision.yaml" --out "$work/fly-2" --quiet \
+  $fly >/dev/null 2>"$work/err"
+rc=$?
+check "left the grid on 2 ranks: exit 2 (got $rc)" test $rc -eq 2
+check "left the grid on 2 ranks: one process's message" \
+  grep -qF "$(grep -o 'step [0-9]*, .*left the grid' "$work/err1")" "$work/err"
+check "left the grid on 2 ranks: status unstable" \
+  grep -q '"status": "unstable"' "$work/fly-2/summary.json"
+
+# What runs on one process only is refused, naming the key; nothing written.
+refused "FPM on 2 ranks" "method fpm runs on one process" "$work/fpm-2" \
+  ranks 2 "$bin" run "$src/cases/fpm/f2-unconstrained-compression.yaml" \
+  --out "$work/fpm-2"
+refused "a membrane on 2 ranks" "membrane: membranes run on one process" \
+  "$work/mem-2" ranks 2 "$bin" run "$mpm/m3-gas-box-membrane.yaml" \
+  --out "$work/mem-2"
+refused "convergence on 2 ranks" "convergence runs on one process" \
+  "$work/conv-2" ranks 2 "$bin" convergence "$mpm/disks-collision.yaml" \
+  --set-ladder discretization.mesh_size=0.1,0.05 --out "$work/conv-2"
+
+# Interrupted on 2 ranks (SIGTERM, as a batch system sends it), resumed on
+# one process: the run of one process to round-off (the checkpoint is one
+# process's).
+long="--set time.end=1 --set output.every=50"
+"$bin" run "$mpm/m2-shock-tube-reduced.yaml" --out "$work/long-1" --quiet \
+  $long >/dev/null 2>&1
+timeout 300 mpirun -np 2 --bind-to none "$bin" run \
+  "$mpm/m2-shock-tube-reduced.yaml" --out "$work/long-2" --quiet $long \
+  >/dev/null 2>"$work/err" &
+job=$!
+for _ in $(seq 600); do
+  [ -f "$work/long-2/history.csv" ] &&
+    [ "$(wc -l <"$work/long-2/history.csv")" -ge 4 ] && break
+  sleep 0.05
+done
+kill -TERM $job
+wait $job
+check "interrupted on 2 ranks: status interrupted" \
+  grep -q '"status": "interrupted"' "$work/long-2/summary.json"
+"$bin" resume "$work/long-2" --quiet >/dev/null 2>"$work/err"
+check "resumed on one process: exit 0" test $? -eq 0
+$roundoff "$work/long-1" "$work/long-2" $tol >"$work/cmp" 2>&1
+rc=$?
+sed 's/^/interrupted on 2 ranks, resumed on one process: /' "$work/cmp"
+check "interrupted on 2 ranks, resumed on one: the straight run to $tol" \
+  test $rc -eq 0
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,181 @@
+/* Particle migration across ranks moves particles and nothing else: run
+ * under mpirun (tests/verification/ranks.sh), it steps a scene and checks
+ * after every migration that
+ *  - every particle of the run is on exactly one rank (the one-process
+ *    indices 0..N-1, each once) and sits in a cell of its rank;
+ *  - each particle's constants (mass, reference position and volume) are
+ *    those it had on one process, bit for bit;
+ *  - the state gathered in one-process order (positions, velocities,
+ *    volumes, stresses, each group's arrays) and the total mass and
+ *    momentum summed in that order are the same before and after the
+ *    migration, bit for bit.
+ * Usage: ranks_migrate SCENE STEPS [KEY=VALUE...]; prints a line per check
+ * and exits 0 when all hold. */
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_backend.h"
+#include "mpm_par.h"
+#include "pm_app.h"
+#include "pm_par.h"
+#include "pm_scene.h"
+
+static int failures;
+
+static void expect(bool ok, const char *what, long step) {
+  long bad = !ok;
+  pm_par_sum_long(&bad, 1);
+  if (bad && pm_par_root())
+    printf("FAIL: step %ld: %s (on %ld ranks)\n", step, what, bad);
+  failures += bad != 0;
+}
+
+/* The gathered state's arrays, copied. */
+static double *snapshot(const mpm_model *m, const mpm_state *s, long *len) {
+  mpm_array a[MPM_STATE_MAX_ARRAYS];
+  int na = mpm_state_arrays(m, s, a, MPM_STATE_MAX_ARRAYS);
+  long n = 0;
+  for (int k = 0; k < na; k++) n += a[k].ncomp * a[k].count;
+  double *copy = malloc(sizeof(double) * (size_t)(n + 1));
+  long at = 0;
+  for (int k = 0; k < na; k++) {
+    memcpy(copy + at, a[k].data, sizeof(double) * a[k].ncomp * a[k].count);
+    at += a[k].ncomp * a[k].count;
+  }
+  *len = n;
+  return copy;
+}
+
+/* Total mass and momentum in one-process order. */
+static void totals(const mpm_model *m, const mpm_state *s, double t[4]) {
+  t[0] = t[1] = t[2] = t[3] = 0;
+  for (long p = 0; p < m->n; p++) {
+    t[0] += m->mass[p];
+    for (int c = 0; c < 3; c++) t[1 + c] += m->mass[p] * s->v[3 * p + c];
+  }
+}
+
+int main(int argc, char **argv) {
+  if (argc < 3) {
+    fprintf(stderr, "usage: ranks_migrate SCENE STEPS [KEY=VALUE...]\n");
+    return 2;
+  }
+  if (pm_app_init() || pm_par_init(&argc, &argv)) {
+    fprintf(stderr, "%s\n", pm_error_message());
+    return 2;
+  }
+  const long steps = atol(argv[2]);
+  pm_scene *sc = NULL;
+  mpm_sim *r = NULL;
+  if (pm_scene_load(argv[1], argc - 3, (const char *const *)argv + 3, &sc) ||
+      mpm_sim_create(sc, &r)) {
+    if (pm_par_root()) fprintf(stderr, "%s\n", pm_error_message());
+    return 2;
+  }
+  if (!r->local_model) {
+    fprintf(stderr,
+            "ranks_migrate: run it under mpirun with 2 or more ranks\n");
+    return 2;
+  }
+  /* Every rank's reference: the model as one process has it. */
+  mpm_model *ref = NULL;
+  mpm_state *ref_state = NULL;
+  if (mpm_model_create(sc, &ref, &ref_state)) return 2;
+  mpm_model *m = r->local_model;
+  mpm_state *s = r->local_state;
+  mpm_work *w = r->local_work;
+  const long N = ref->n;
+  long moved = 0;
+  for (long step = 1; step <= steps; step++) {
+    if (mpm_step(m, s, w)) {
+      if (pm_par_root()) fprintf(stderr, "%s\n", pm_error_message());
+      return 2;
+    }
+    long before_len = 0, after_len = 0;
+    double *before = NULL, *after = NULL, tb[4], ta[4];
+    mpm_par_gather(m, s, r->model, r->state);
+    if (r->model) {
+      before = snapshot(r->model, r->state, &before_len);
+      totals(r->model, r->state, tb);
+    }
+    mpm_par_counts c0, c1;
+    mpm_par_get_counts(m, &c0);
+    if (mpm_par_migrate(m, s, w)) return 2;
+    mpm_par_get_counts(m, &c1);
+    moved += c1.migrated - c0.migrated;
+    /* Where every particle is, and what it carries. */
+    long count = m->n;
+    pm_par_sum_long(&count, 1);
+    expect(count == N, "the ranks hold every particle", step);
+    bool own = true, same = true, sorted = true;
+    const mpm_decomp *d = mpm_par_decomp(m);
+    for (long k = 0; k < m->n; k++) {
+      const long p = m->gid[k];
+      own =
+          own && mpm_decomp_rank_at(d, &m->grid, s->x + 3 * k) == pm_par_rank();
+      same = same && p >= 0 && p < N && m->mass[k] == ref->mass[p] &&
+             m->vol0[k] == ref->vol0[p] &&
+             !memcmp(m->x0 + 3 * k, ref->x0 + 3 * p, 3 * sizeof(double));
+      sorted = sorted && (k == 0 || m->gid[k - 1] < p);
+    }
+    expect(own, "each particle on the rank of its cell", step);
+    /* every one-process index once over the ranks */
+    int cnt = (int)m->n, size = pm_par_size(), *counts = NULL, *offs = NULL;
+    long *all = NULL;
+    if (pm_par_root()) {
+      counts = calloc((size_t)size, sizeof *counts);
+      offs = calloc((size_t)size + 1, sizeof *offs);
+      all = calloc((size_t)N + 1, sizeof *all);
+    }
+    MPI_Gather(&cnt, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    bool once = true;
+    if (pm_par_root()) {
+      for (int q = 0; q < size; q++) offs[q + 1] = offs[q] + counts[q];
+      once = offs[size] == N;
+    }
+    pm_par_bcast(&once, sizeof once);
+    if (once) {
+      MPI_Gatherv(m->gid, cnt, MPI_LONG, all, counts, offs, MPI_LONG, 0,
+                  MPI_COMM_WORLD);
+      if (pm_par_root()) {
+        char *seen = calloc((size_t)N, 1);
+        for (long k = 0; k < N && once; k++) {
+          once = all[k] >= 0 && all[k] < N && !seen[all[k]];
+          if (once) seen[all[k]] = 1;
+        }
+        free(seen);
+      }
+    }
+    free(counts);
+    free(offs);
+    free(all);
+    expect(once, "every particle on exactly one rank", step);
+    expect(same, "each particle's mass, x0 and V0 as on one process", step);
+    expect(sorted, "a rank's particles in one-process order", step);
+    mpm_par_gather(m, s, r->model, r->state);
+    if (r->model) {
+      after = snapshot(r->model, r->state, &after_len);
+      totals(r->model, r->state, ta);
+      same = before_len == after_len &&
+             !memcmp(before, after, sizeof(double) * (size_t)before_len);
+      same = same && !memcmp(tb, ta, sizeof tb);
+    }
+    pm_par_bcast(&same, sizeof same);
+    expect(same, "state, mass and momentum gathered unchanged, bit for bit",
+           step);
+    free(before);
+    free(after);
+  }
+  if (pm_par_root())
+    printf("%s: %ld steps on %d ranks, %ld particles migrated, %d failed "
+           "check%s\n",
+           sc->name, steps, pm_par_size(), moved, failures,
+           failures == 1 ? "" : "s");
+  mpm_state_destroy(ref_state);
+  mpm_model_destroy(ref);
+  mpm_sim_destroy(r);
+  pm_scene_destroy(sc);
+  return failures ? 1 : 0;
+}

@@ -1,0 +1,60 @@
+"""Two runs' results and history agree to round-off: the same frames (step
+and time), the same fields, each within TOL of the first run's largest
+magnitude of that field in that frame, and every history column (the wall
+time aside) within TOL of the column's largest magnitude.  Fields and columns
+that are zero to 1e-12 of their scale compare absolutely.  The step size dt
+compares on the scale of the time: the last step is cut to end at
+time.end, dt = t_end - t, so it carries the round-off of t, an absolute
+time error.
+Usage: same_to_roundoff.py OUT_A OUT_B TOL; prints the largest relative
+difference and exits 1 when it exceeds TOL."""
+import csv
+import sys
+
+import h5py
+import numpy as np
+
+a, b, tol = sys.argv[1], sys.argv[2], float(sys.argv[3])
+fa, fb = h5py.File(a + '/results.h5', 'r'), h5py.File(b + '/results.h5', 'r')
+ka, kb = sorted(fa['frames']), sorted(fb['frames'])
+assert ka == kb, (len(ka), len(kb))
+worst, where = 0.0, ''
+for k in ka:
+    ga, gb = fa['frames'][k], fb['frames'][k]
+    assert ga.attrs['step'] == gb.attrs['step'], (k, 'step')
+    assert abs(ga.attrs['time'] - gb.attrs['time']) <= tol * abs(ga.attrs['time']) + 1e-300, (k, 'time')
+    assert sorted(ga) == sorted(gb), (k, sorted(ga), sorted(gb))
+    for f in ga:
+        x, y = ga[f][()], gb[f][()]
+        assert x.shape == y.shape, (k, f, x.shape, y.shape)
+        if not np.array_equal(np.isnan(x), np.isnan(y)):
+            worst, where = float('inf'), 'frame %s %s: NaN in one run' % (k, f)
+            continue
+        x, y = np.nan_to_num(x), np.nan_to_num(y)
+        scale = np.max(np.abs(x)) if x.size else 0.0
+        d = np.max(np.abs(x - y)) if x.size else 0.0
+        rel = d / scale if scale > 1e-12 else d
+        if rel > worst:
+            worst, where = rel, 'frame %s %s' % (k, f)
+ra = list(csv.reader(open(a + '/history.csv')))
+rb = list(csv.reader(open(b + '/history.csv')))
+assert len(ra) == len(rb) and ra[0] == rb[0], (len(ra), len(rb))
+for c, name in enumerate(ra[0]):
+    if name == 'wall_seconds':
+        continue
+    x = np.array([float(r[c]) for r in ra[1:]])
+    y = np.array([float(r[c]) for r in rb[1:]])
+    if not np.array_equal(np.isnan(x), np.isnan(y)):
+        worst, where = float('inf'), 'history %s: NaN in one run' % name
+        continue
+    x, y = x[~np.isnan(x)], y[~np.isnan(y)]
+    scale = np.max(np.abs(x)) if x.size else 0.0
+    if name == 'dt':
+        scale = max(scale, max(abs(float(r[0])) for r in ra[1:]))
+    d = np.max(np.abs(x - y)) if x.size else 0.0
+    rel = d / scale if scale > 1e-12 else d
+    if rel > worst:
+        worst, where = rel, 'history %s' % name
+print('%d frames, %d rows: largest relative difference %.3g (%s)' %
+      (len(ka), len(ra) - 1, worst, where or 'none'))
+sys.exit(0 if worst <= tol else 1)
