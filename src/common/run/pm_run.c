@@ -197,13 +197,17 @@ static const char *signal_name(int sig) {
 }
 
 /* Catch SIGINT and SIGTERM once each (a second one acts as usual, so a
- * run that does not reach the end of its step can still be stopped). */
+ * run that does not reach the end of its step can still be stopped).
+ * Across ranks every one is caught: mpirun forwards the signal it gets,
+ * a batch system or timeout signals every process besides, so rank 0 may
+ * get two at once; mpirun's SIGKILL, after odls_base_sigkill_timeout, is
+ * the hard stop. */
 static void catch_interrupts(struct sigaction old[2]) {
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = on_interrupt;
   sigemptyset(&sa.sa_mask);
-  sa.sa_flags = SA_RESETHAND;
+  sa.sa_flags = pm_par_active() ? 0 : SA_RESETHAND;
   sigaction(SIGINT, &sa, &old[0]);
   sigaction(SIGTERM, &sa, &old[1]);
 }
