@@ -6,32 +6,45 @@
 #     on 2 ranks x 1 thread against the scene on 1 x 1;
 # for the 3-D block (cases/mpm/bench-block.yaml, 110592 particles,
 # quadratic), the shock tube at the paper's size (cases/mpm/m2-shock-tube,
-# 20000 particles, linear) and the disks refined 8 times (2-D, 26624
+# 20000 particles, linear) and the disks refined 8 times (2-D, 25784
 # particles).  Prints seconds per step of the step's stages (rank 0's,
 # which wait for the others in the exchanges), the speed-up and efficiency
-# against 1 x 1 (per core used), and what a rank sends per step: node sums
-# (bytes), particles (bytes), and the exchanges' seconds over the run.
+# against 1 x 1 (per core used), what a rank sends per step (node sums and
+# particles, bytes), the exchanges' seconds over the run, and the ranks'
+# own work (their stages less the exchanges): the busiest rank's over the
+# mean (imbalance) and the share of the step that is not the mean rank's
+# own work (exchanges and waiting).
+# The configurations of a case run in turn, REPEAT times (5): single runs
+# on this machine vary by 10-30%, and taking turns spreads its slow spells
+# over all of them.  Each line gives the median seconds per step (the
+# fastest and slowest beside it) and the other figures of the median run.
 # usage: scripts/bench-ranks.sh [BUILD_DIR]   (STEPS: steps per run, 200)
 bench_name=ranks
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 steps=${STEPS:-200}
+repeat=${REPEAT:-5}
 py=/usr/bin/python3
 
-# fig SUMMARY: "particles steps s/step node-bytes particle-bytes halo-s mig-s"
+# fig SUMMARY: particles, steps, s/step, node bytes, particle bytes (per
+# step), node-sum and migration seconds, imbalance, exchange share
 fig() {
   $py - "$1" <<'EOF'
 import json, sys
 s = json.load(open(sys.argv[1]))
 r = s.get('ranks', {})
-print(s['points'], s['steps'], s['step_seconds'] / max(s['steps'], 1),
+n = max(s['steps'], 1)
+own = r.get('own_work_seconds_mean', s['step_seconds'])
+print(s['points'], s['steps'], s['step_seconds'] / n,
       r.get('node_bytes_per_step', 0), r.get('particle_bytes_per_step', 0),
-      r.get('node_exchange_seconds', 0), r.get('migration_seconds', 0))
+      r.get('node_exchange_seconds', 0), r.get('migration_seconds', 0),
+      r.get('own_work_seconds_max', own) / own if own > 0 else 1,
+      1 - own / s['step_seconds'] if s['step_seconds'] > 0 else 0)
 EOF
 }
 
-# run NAME RANKS THREADS SCENE [--set ...]: the run's figures
-run() {
+# run_once NAME RANKS THREADS SCENE [--set ...]: the run's figures
+run_once() {
   local name=$1 ranks=$2 threads=$3 scene=$4
   shift 4
   local dir="$out/$name-r$ranks-t$threads"
@@ -48,19 +61,33 @@ run() {
   fig "$dir/summary.json"
 }
 
-printf '%-14s %-8s %-9s %6s %10s %8s %10s %12s %14s %8s %8s\n' case kind \
-  "ranks x t" points s/step speed-up efficiency "node B/step" \
-  "particle B/step" halo-s migr-s
-row() { # case kind config cores base figures...
-  local c=$1 k=$2 cfg=$3 cores=$4 base=$5
-  shift 5
-  local n=$1 per=$3 nb=$4 pb=$5 hs=$6 ms=$7
-  $py -c "
-b, p, c = $base, $per, $cores
-print('%-14s %-8s %-9s %6s %10.3e %8.2f %10.2f %12.0f %14.0f %8.2f %8.2f' % (
-  '$c', '$k', '$cfg', $n, p, b / p, b / p / c, $nb, $pb, $hs, $ms))"
+# row CASE KIND CONFIG CORES WORK BASE FILE: the median run of FILE (a
+# run's figures per line) against the median seconds per step BASE of 1 x
+# 1; WORK is the work over that run's (2 for weak scaling)
+row() {
+  $py - "$@" <<'EOF'
+import sys
+c, k, cfg, cores, work, base, path = sys.argv[1:8]
+runs = sorted((list(map(float, l.split())) for l in open(path) if l.strip()),
+              key=lambda r: r[2])
+m = runs[len(runs) // 2]
+per, b = m[2], float(base)
+print('%-11s %-6s %-5s %6d %9.3e %19s %6.2f %6.2f %10.0f %10.0f %6.2f %6.2f %6.3f %5.2f' % (
+    c, k, cfg, m[0], per, '(%.2e - %.2e)' % (runs[0][2], runs[-1][2]),
+    b / per * float(work), b / per * float(work) / float(cores), m[3], m[4],
+    m[5], m[6], m[7], m[8]))
+EOF
 }
 
+median() { # FILE: the median seconds per step
+  $py -c "
+v = sorted(float(l.split()[2]) for l in open('$1') if l.strip())
+print(v[len(v) // 2])"
+}
+
+printf '%-11s %-6s %-5s %6s %9s %19s %6s %6s %10s %10s %6s %6s %6s %5s\n' \
+  case kind rxt points s/step "(range)" speed eff "node B/st" "part. B/st" \
+  halo-s migr-s imbal. comm
 # case, scene, particles per cell doubled along x, an override
 for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
   "shock-tube cases/mpm/m2-shock-tube.yaml 50,1,1" \
@@ -68,14 +95,18 @@ for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
   read -r name scene ppc2 extra <<<"$spec"
   sets=()
   [ -n "${extra:-}" ] && sets=(--set "$extra")
-  one=$(run "$name" 1 1 "$scene" "${sets[@]}")
-  base=$(echo "$one" | cut -d' ' -f3)
-  row "$name" strong 1x1 1 "$base" $one
-  row "$name" strong 1x2 2 "$base" $(run "$name" 1 2 "$scene" "${sets[@]}")
-  row "$name" strong 2x1 2 "$base" $(run "$name" 2 1 "$scene" "${sets[@]}")
-  # weak: twice the particles on twice the ranks, the same time per step
-  # at perfect efficiency
-  w=$(run "$name-weak" 2 1 "$scene" "${sets[@]}" \
-    --set "mpm.particles_per_cell=[$ppc2]")
-  row "$name" weak 2x1 1 "$base" $w
+  rm -f "$out/$name".*.runs
+  for _ in $(seq "$repeat"); do
+    run_once "$name" 1 1 "$scene" "${sets[@]}" >>"$out/$name.1x1.runs"
+    run_once "$name" 1 2 "$scene" "${sets[@]}" >>"$out/$name.1x2.runs"
+    run_once "$name" 2 1 "$scene" "${sets[@]}" >>"$out/$name.2x1.runs"
+    # weak: twice the particles on twice the ranks
+    run_once "$name-weak" 2 1 "$scene" "${sets[@]}" \
+      --set "mpm.particles_per_cell=[$ppc2]" >>"$out/$name.weak.runs"
+  done
+  base=$(median "$out/$name.1x1.runs")
+  row "$name" strong 1x1 1 1 "$base" "$out/$name.1x1.runs"
+  row "$name" strong 1x2 2 1 "$base" "$out/$name.1x2.runs"
+  row "$name" strong 2x1 2 1 "$base" "$out/$name.2x1.runs"
+  row "$name" weak 2x1 2 2 "$base" "$out/$name.weak.runs"
 done

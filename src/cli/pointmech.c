@@ -40,7 +40,8 @@ static void usage(FILE *out) {
           "[--overwrite] [--quiet]\n"
           "                 [--force-memory]\n"
           "       pointmech resume OUT [--quiet]\n"
-          "       pointmech plan SCENE [--set KEY=VALUE]... [--force-memory]\n"
+          "       pointmech plan SCENE [--set KEY=VALUE]... [--force-memory] "
+          "[--ranks N]\n"
           "       pointmech probe OUT --points FILE.csv [--frame N]\n"
           "       pointmech convergence SCENE --set-ladder KEY=V1,V2,... "
           "[--set-ladder ...]\n"
@@ -76,7 +77,12 @@ static void usage(FILE *out) {
           "uninterrupted run\n"
           "  plan   print the pipeline, counts, time step, steps, memory and "
           "an\n"
-          "         estimated run time without running\n"
+          "         estimated run time without running; with --ranks N "
+          "(method mpm),\n"
+          "         also how N MPI ranks would share the run: boxes, "
+          "particles, ghost\n"
+          "         nodes and bytes sent per step (under mpirun, plan prints "
+          "the run's own)\n"
           "  probe  print the displacement of a run's last (or N-th) frame "
           "at the\n"
           "         reference coordinates of FILE.csv (x,y,z per line), by "
@@ -238,7 +244,18 @@ static int parse_args(int argc, char **argv, int first, cli_args *a) {
       a->overwrite = true;
     else if (strcmp(arg, "--force-memory") == 0)
       pm_memory_set_force(true);
-    else if (arg[0] == '-') {
+    else if (strcmp(arg, "--ranks") == 0 && has_next) {
+      char *end;
+      long n = strtol(argv[++k], &end, 10);
+      if (*end || n < 2 || n > 100000) {
+        fprintf(stderr,
+                "pointmech: --ranks expects an integer from 2 to 100000, "
+                "got %s\n",
+                argv[k]);
+        return -1;
+      }
+      pm_par_set_plan_ranks((int)n);
+    } else if (arg[0] == '-') {
       fprintf(stderr, "pointmech: unknown option %s%s\n", arg,
               has_next ? "" : " (or missing value)");
       return -1;
@@ -405,6 +422,13 @@ int main(int argc, char **argv) {
   cli_args a;
   if (parse_args(argc, argv, 2, &a) != 0) {
     usage(stderr);
+    return EXIT_INPUT;
+  }
+  if (pm_par_plan_ranks() > 1 &&
+      (strcmp(cmd, "plan") != 0 || pm_par_active())) {
+    if (pm_par_root())
+      fprintf(stderr, "pointmech: --ranks is for plan on one process (under "
+                      "mpirun, plan prints the decomposition of its ranks)\n");
     return EXIT_INPUT;
   }
   if (strcmp(cmd, "run") == 0 || strcmp(cmd, "plan") == 0) {

@@ -241,13 +241,20 @@ static pm_err run_ranks(mpm_sim *r, const pm_observer *obs) {
   r->obs = NULL;
   mpm_par_counts c;
   mpm_par_get_counts(lm, &c);
-  double sums[4] = {c.halo_bytes, c.migrate_bytes, (double)c.migrated,
-                    (double)c.grown},
-         most[2] = {c.halo_seconds, c.migrate_seconds};
-  pm_par_sum(sums, 4);
-  pm_par_max(most, 2);
-  memcpy(r->ranks_counts, sums, sizeof sums);
-  memcpy(r->ranks_counts + 4, most, sizeof most);
+  /* A rank's own work: its stages' time less the exchanges (in which it
+   * waits for the others). */
+  double own = -c.halo_seconds - c.migrate_seconds;
+  const pm_timers *t = &r->local_work->timers;
+  for (int k = 0; k < t->n; k++) own += t->stage[k].seconds;
+  double sums[5] = {c.halo_bytes, c.migrate_bytes, (double)c.migrated,
+                    (double)c.grown, own},
+         most[3] = {c.halo_seconds, c.migrate_seconds, own};
+  pm_par_sum(sums, 5);
+  pm_par_max(most, 3);
+  memcpy(r->ranks_counts, sums, 4 * sizeof(double));
+  memcpy(r->ranks_counts + 4, most, 2 * sizeof(double));
+  r->ranks_counts[6] = most[2];                 /* the busiest rank's */
+  r->ranks_counts[7] = sums[4] / pm_par_size(); /* the mean */
   return e;
 }
 
@@ -719,12 +726,15 @@ static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
   for (int k = 0; k < d->size; k++)
     PM_CALL(pm_json_integer(j, NULL, d->count[k]));
   PM_CALL(pm_json_end_array(j));
-  PM_CALL(pm_json_number(j, "node_bytes_per_step", c[0] / steps));
-  PM_CALL(pm_json_number(j, "particle_bytes_per_step", c[1] / steps));
+  /* what a rank sent, on average */
+  PM_CALL(pm_json_number(j, "node_bytes_per_step", c[0] / steps / d->size));
+  PM_CALL(pm_json_number(j, "particle_bytes_per_step", c[1] / steps / d->size));
   PM_CALL(pm_json_number(j, "particles_migrated", c[2]));
   PM_CALL(pm_json_number(j, "arrays_grown", c[3]));
   PM_CALL(pm_json_number(j, "node_exchange_seconds", c[4]));
   PM_CALL(pm_json_number(j, "migration_seconds", c[5]));
+  PM_CALL(pm_json_number(j, "own_work_seconds_max", c[6]));
+  PM_CALL(pm_json_number(j, "own_work_seconds_mean", c[7]));
   return pm_json_end_object(j);
 }
 
@@ -914,6 +924,13 @@ static pm_err plan(void *p, FILE *out) {
           mpm_state_bytes(m, st) / 1048576.0,
           mpm_work_bytes(m, r->work) / 1048576.0, r->work->nodes.threads,
           9 * sizeof(double) * (size_t)m->n / 1048576.0);
+  if (pm_par_plan_ranks() > 1) { /* plan --ranks N: the decomposition */
+    mpm_decomp d;
+    PM_CALL(mpm_decomp_create(r->scene, m, st, pm_par_plan_ranks(), &d));
+    mpm_decomp_print(&d, m, out);
+    mpm_decomp_predict(&d, m, out);
+    mpm_decomp_destroy(&d);
+  }
   /* Time a few steps (the state is advanced: a plan is not run after). */
   double t0 = pm_wtime();
   int reps = 0;

@@ -30,8 +30,9 @@ typedef struct {
   mpm_state *local_state;
   mpm_work *local_work;
   /* across ranks, at the end of the run: the exchanges' bytes and
-   * particles summed over the ranks, their seconds the slowest rank's */
-  double ranks_counts[6];
+   * particles summed over the ranks, their seconds the slowest rank's;
+   * the ranks' own work (stages less exchanges), the most and the mean */
+  double ranks_counts[8];
   struct mpm_implicit *imp;   /* method mpm-implicit: its solver (else NULL) */
   int imp_newton, imp_linear; /* the last load step's iterations */
   double setup_wall;          /* s */

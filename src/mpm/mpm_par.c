@@ -1106,6 +1106,58 @@ void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out) {
           least, most, total > 0 ? most * (double)d->size / total : 0.0);
 }
 
+/* Values per node the step's transfers exchange (mass, momentum, forces,
+ * impedances; the MUSL remap's momentum). */
+static int node_values_per_step(const mpm_model *m) {
+  int v = 0;
+  for (int k = 0; k < m->pipeline.n; k++) {
+    const mpm_stage *stg = &m->pipeline.stage[k];
+    if (stg->run == mpm_stage_p2g)
+      v += dof_of(stg->mode, m->has_absorbing && (stg->mode & MPM_P2G_FORCE));
+    if (stg->run == mpm_stage_remap) v += dof_of(MPM_P2G_MOM, false);
+  }
+  return v;
+}
+
+void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out) {
+  const mpm_grid *g = &m->grid;
+  const int values = node_values_per_step(m);
+  double owned_sum = 0, ghost_sum = 0, ghost_max = 0, ratio_max = 0;
+  if (d->size <= 8)
+    fprintf(out, "             rank  particles  nodes (owned + ghost)  "
+                 "node bytes sent per step\n");
+  for (int r = 0; r < d->size; r++) {
+    const int c[3] = {r % d->dims[0], (r / d->dims[0]) % d->dims[1],
+                      r / (d->dims[0] * d->dims[1])};
+    double own = 1, held = 1;
+    for (int a = 0; a < g->dim; a++) {
+      const long lo = d->cut[a][c[a]],
+                 hi = d->cut[a][c[a] + 1] + (c[a] == d->dims[a] - 1 ? 1 : 0);
+      const long glo = lo - d->ghost < 0 ? 0 : lo - d->ghost,
+                 ghi = hi + d->ghost > g->nn[a] ? g->nn[a] : hi + d->ghost;
+      own *= (double)(hi - lo);
+      held *= (double)(ghi - glo);
+    }
+    const double ghost = held - own;
+    owned_sum += own;
+    ghost_sum += ghost;
+    ghost_max = ghost > ghost_max ? ghost : ghost_max;
+    ratio_max = ghost / own > ratio_max ? ghost / own : ratio_max;
+    if (d->size <= 8)
+      fprintf(out, "             %4d  %9ld  %9.0f (%.0f + %.0f)  %.0f\n", r,
+              d->count[r], held, own, ghost,
+              2 * ghost * values * sizeof(double));
+  }
+  fprintf(out,
+          "             ghost nodes per rank %.0f on average, %.0f at most "
+          "(%.3f of its own at most); %d values per node and step, so a "
+          "rank sends %.0f bytes of node sums per step on average, %.0f at "
+          "most\n",
+          ghost_sum / d->size, ghost_max, ratio_max, values,
+          2 * ghost_sum / d->size * values * sizeof(double),
+          2 * ghost_max * values * sizeof(double));
+}
+
 void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
   const struct mpm_par *P = m->par;
   const int size = P->d.size;

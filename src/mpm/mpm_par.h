@@ -106,9 +106,14 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
  * ranks). */
 void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out);
 
-/* Print decomposition d of model m for a plan of `size` ranks made on one
- * process (pointmech plan --ranks N). */
+/* Print decomposition d of model m: its boxes, cuts and balance. */
 void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out);
+/* Print what each rank of decomposition d would hold and send, from the
+ * decomposition alone (pointmech plan --ranks N on one process): its
+ * particles, owned and ghost nodes, and the bytes of node sums it sends
+ * per step (each ghost node's values go to its owner and come back, for
+ * every transfer of the step). */
+void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out);
 
 /* Bytes a rank sent per step by exchanges of nodes and particles, and the
  * seconds they took, over the run so far (summary.json). */

@@ -141,6 +141,10 @@ pm_err pm_par_agree(pm_err e) {
 #endif
 }
 
+static int plan_ranks = 1;
+void pm_par_set_plan_ranks(int n) { plan_ranks = n > 1 ? n : 1; }
+int pm_par_plan_ranks(void) { return plan_ranks; }
+
 void pm_par_count_sent(double bytes) { par_sent += bytes; }
 double pm_par_sent(void) { return par_sent; }
 

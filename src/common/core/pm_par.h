@@ -45,6 +45,11 @@ void pm_par_bcast(void *p, size_t n);
  * message every rank then records as its own (so rank 0 reports it). */
 pm_err pm_par_agree(pm_err e);
 
+/* The ranks a plan made on one process is for (pointmech plan --ranks N;
+ * 1 unless set). */
+void pm_par_set_plan_ranks(int n);
+int pm_par_plan_ranks(void);
+
 /* Bytes moved between ranks by this process so far (sent, by the
  * collectives and exchanges that count them): the scaling model's
  * communication volume. */
