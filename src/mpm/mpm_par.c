@@ -5,6 +5,7 @@
 #include <math.h>
 #include <mpi.h>
 #include <petscdmda.h>
+#include <petscsf.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -31,19 +32,19 @@ enum {
   REC_BASE = 23
 };
 
-#define PAR_MAX_DM 4
-
 struct mpm_par {
   mpm_decomp d;
   int rank, coord[3];
   long own_lo[3], own_hi[3]; /* owned nodes (global) per axis */
-  /* the node sums: one DMDA per number of values a transfer moves */
-  int n_dm;
-  struct {
-    int dof;
-    DM da;
-    Vec loc, glob;
-  } dm[PAR_MAX_DM];
+  /* the node sums: each ghost node (a leaf) is a node of its owner (a
+   * root); the sums go leaves to roots and back, on the ghost nodes and
+   * the owned nodes next to other ranks only */
+  PetscSF ghosts;
+  MPI_Datatype two, three; /* a node's impedances, a node's vector */
+  /* the layout: a DMDA of 3 values per node, which also gathers dynamic
+   * relaxation's nodal vectors */
+  DM da;
+  Vec loc, glob;
   /* dynamic relaxation's nodal arrays to rank 0: the whole grid in
    * natural order, and on rank 0 all of it */
   Vec natural, whole;
@@ -296,16 +297,9 @@ static int dof_of(int mode, bool imp) {
          (mode & MPM_P2G_FORCE ? 3 + (imp ? 2 : 0) : 0);
 }
 
-static int dm_index(const struct mpm_par *P, int dof) {
-  for (int k = 0; k < P->n_dm; k++)
-    if (P->dm[k].dof == dof) return k;
-  return -1;
-}
-
-static pm_err make_dm(struct mpm_par *P, const mpm_grid *g, int dof) {
+static pm_err make_dm(struct mpm_par *P, const mpm_grid *g) {
   pm_err ret = PM_SUCCESS;
-  if (dm_index(P, dof) >= 0) return PM_SUCCESS;
-  PM_CHECK(P->n_dm < PAR_MAX_DM, PM_ERR_INTERNAL, "too many node exchanges");
+  const int dof = 3;
   const mpm_decomp *d = &P->d;
   PetscInt *l[3] = {NULL, NULL, NULL};
   DM da = NULL;
@@ -336,12 +330,10 @@ static pm_err make_dm(struct mpm_par *P, const mpm_grid *g, int dof) {
               "decomposition [%ld, %ld)",
               P->rank, (long)xs[a], (long)(xs[a] + xm[a]), "xyz"[a],
               P -> own_lo[a], P -> own_hi[a]);
-  int k = P->n_dm++;
-  P->dm[k].dof = dof;
-  P->dm[k].da = da;
+  P->da = da;
   da = NULL;
-  PM_PETSC(DMCreateLocalVector(P->dm[k].da, &P->dm[k].loc));
-  PM_PETSC(DMCreateGlobalVector(P->dm[k].da, &P->dm[k].glob));
+  PM_PETSC(DMCreateLocalVector(P->da, &P->loc));
+  PM_PETSC(DMCreateGlobalVector(P->da, &P->glob));
 done:
   if (da) DMDestroy(&da);
   for (int a = 0; a < 3; a++) free(l[a]);
@@ -351,7 +343,7 @@ done:
 /* This rank's block of the grid: the DMDA's ghosted corners. */
 static pm_err local_grid(struct mpm_par *P, const mpm_grid *full, mpm_grid *g) {
   PetscInt gs[3] = {0, 0, 0}, gm[3] = {1, 1, 1};
-  PM_PETSC_CALL(DMDAGetGhostCorners(P->dm[0].da, &gs[0], &gs[1], &gs[2], &gm[0],
+  PM_PETSC_CALL(DMDAGetGhostCorners(P->da, &gs[0], &gs[1], &gs[2], &gm[0],
                                     &gm[1], &gm[2]));
   *g = *full;
   g->n_nodes = 1;
@@ -410,6 +402,61 @@ static void set_ranges(mpm_model *m, mpm_state *s) {
   }
 }
 
+/* The node sums' graph: every node this rank holds but does not own, and
+ * where its owner holds it (the owner's block is computed as this rank's
+ * is: its nodes and the ghost layers, clipped to the grid). */
+static pm_err make_ghosts(struct mpm_par *P, const mpm_grid *full,
+                          const mpm_grid *g) {
+  pm_err ret = PM_SUCCESS;
+  const mpm_decomp *d = &P->d;
+  const long n_ghost = g->n_nodes - P->n_owned;
+  PetscInt *leaf = NULL;
+  PetscSFNode *root = NULL;
+  PM_TRY(PM_ALLOC(leaf, n_ghost + 1, "ghost nodes"));
+  PM_TRY(PM_ALLOC(root, n_ghost + 1, "ghost nodes' owners"));
+  long k = 0;
+  for (long i = 0; i < g->n_nodes; i++) {
+    if (P->owned[i]) continue;
+    long q[3] = {i % g->nn[0], (i / g->nn[0]) % g->nn[1],
+                 i / (g->nn[0] * g->nn[1])};
+    int rank = 0, stride = 1;
+    long at = 0, step = 1;
+    for (int a = 0; a < 3; a++) {
+      q[a] += g->offset[a];
+      const int r = a < full->dim ? column_of(d->cut[a], d->dims[a], q[a]) : 0;
+      const long lo = d->cut[a][r],
+                 hi = d->cut[a][r + 1] +
+                      (r == d->dims[a] - 1 && a < full->dim ? 1 : 0);
+      const long glo = a < full->dim && lo - d->ghost > 0 ? lo - d->ghost : 0;
+      const long ghi = a >= full->dim                ? 1
+                       : hi + d->ghost < full->nn[a] ? hi + d->ghost
+                                                     : full->nn[a];
+      at += (q[a] - glo) * step;
+      step *= ghi - glo;
+      rank += r * stride;
+      stride *= d->dims[a];
+    }
+    leaf[k] = (PetscInt)i;
+    root[k].rank = rank;
+    root[k].index = (PetscInt)at;
+    k++;
+  }
+  PM_PETSC(PetscSFCreate(PETSC_COMM_WORLD, &P->ghosts));
+  PM_PETSC(PetscSFSetGraph(P->ghosts, (PetscInt)g->n_nodes, (PetscInt)k, leaf,
+                           PETSC_OWN_POINTER, root, PETSC_OWN_POINTER));
+  leaf = NULL;
+  root = NULL;
+  PM_PETSC(PetscSFSetUp(P->ghosts));
+  MPI_Type_contiguous(2, MPI_DOUBLE, &P->two);
+  MPI_Type_commit(&P->two);
+  MPI_Type_contiguous(3, MPI_DOUBLE, &P->three);
+  MPI_Type_commit(&P->three);
+done:
+  free(leaf);
+  free(root);
+  return ret;
+}
+
 /* Room for n particles and some to arrive. */
 static long room_for(long n) { return n + n / 4 + 64; }
 
@@ -429,6 +476,7 @@ static pm_err local_model(const pm_scene *s, const mpm_model *m,
   memcpy(lm->box_max, m->box_max, sizeof lm->box_max);
   lm->layout = m->layout;
   PM_TRY(local_grid(P, &m->grid, &lm->grid));
+  PM_TRY(make_ghosts(P, &m->grid, &lm->grid));
   long n = P->d.count[P->rank];
   lm->n = n;
   lm->cap = room_for(n);
@@ -588,19 +636,9 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
     P->own_hi[a] =
         d->cut[a][r + 1] + (r == d->dims[a] - 1 && a < m->dim ? 1 : 0);
   }
-  /* The exchanges the pipeline's transfers need. */
-  for (int k = 0; k < m->pipeline.n; k++) {
-    const mpm_stage *stg = &m->pipeline.stage[k];
-    if (stg->run == mpm_stage_p2g)
-      PM_TRY(make_dm(
-          P, &m->grid,
-          dof_of(stg->mode, m->has_absorbing && (stg->mode & MPM_P2G_FORCE))));
-    if (stg->run == mpm_stage_remap)
-      PM_TRY(make_dm(P, &m->grid, dof_of(MPM_P2G_MOM, false)));
-  }
-  PM_TRY(make_dm(P, &m->grid, 3)); /* the gather of nodal vectors */
+  PM_TRY(make_dm(P, &m->grid));
   if (m->opt.qs == PM_QS_DYNAMIC_RELAXATION) {
-    PM_PETSC(DMDACreateNaturalVector(P->dm[dm_index(P, 3)].da, &P->natural));
+    PM_PETSC(DMDACreateNaturalVector(P->da, &P->natural));
     PM_PETSC(VecScatterCreateToZero(P->natural, &P->to_root, &P->whole));
   }
   ret = local_model(s, m, st, P, &lm);
@@ -639,14 +677,17 @@ done:
 
 void mpm_par_destroy(struct mpm_par *P) {
   if (!P) return;
+  if (P->ghosts) {
+    PetscSFDestroy(&P->ghosts);
+    MPI_Type_free(&P->two);
+    MPI_Type_free(&P->three);
+  }
   if (P->to_root) VecScatterDestroy(&P->to_root);
   if (P->whole) VecDestroy(&P->whole);
   if (P->natural) VecDestroy(&P->natural);
-  for (int k = 0; k < P->n_dm; k++) {
-    VecDestroy(&P->dm[k].loc);
-    VecDestroy(&P->dm[k].glob);
-    DMDestroy(&P->dm[k].da);
-  }
+  if (P->loc) VecDestroy(&P->loc);
+  if (P->glob) VecDestroy(&P->glob);
+  if (P->da) DMDestroy(&P->da);
   mpm_decomp_destroy(&P->d);
   free(P->owned);
   free(P->bbegin);
@@ -679,50 +720,44 @@ pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
                          bool imp) {
   struct mpm_par *P = m->par;
   const double t0 = pm_wtime();
-  const int dof = dof_of(mode, imp);
-  const int k = dm_index(P, dof);
-  PM_CHECK(k >= 0, PM_ERR_INTERNAL, "no node exchange of %d values", dof);
-  const long nn = m->grid.n_nodes;
-  PetscScalar *a;
-  PM_PETSC_CALL(VecGetArray(P->dm[k].loc, &a));
-  PM_OMP(parallel for schedule(static) default(none) shared(a, nd, nn, dof, mode, imp))
-  for (long i = 0; i < nn; i++) {
-    double *r = a + i * dof;
-    if (mode & MPM_P2G_MASS) *r++ = nd->mass[i];
-    if (mode & MPM_P2G_MOM)
-      for (int c = 0; c < 3; c++) *r++ = nd->mom[3 * i + c];
-    if (mode & MPM_P2G_FORCE) {
-      for (int c = 0; c < 3; c++) *r++ = nd->force[3 * i + c];
-      if (imp)
-        for (int c = 0; c < 2; c++) *r++ = nd->impedance[2 * i + c];
+  PetscSF sf = P->ghosts;
+  /* The arrays a transfer of `mode` filled, and their values per node. */
+  double *data[4];
+  MPI_Datatype unit[4];
+  int n = 0, values = 0;
+  if (mode & MPM_P2G_MASS) {
+    data[n] = nd->mass;
+    unit[n++] = MPI_DOUBLE;
+    values += 1;
+  }
+  if (mode & MPM_P2G_MOM) {
+    data[n] = nd->mom;
+    unit[n++] = P->three;
+    values += 3;
+  }
+  if (mode & MPM_P2G_FORCE) {
+    data[n] = nd->force;
+    unit[n++] = P->three;
+    values += 3;
+    if (imp) {
+      data[n] = nd->impedance;
+      unit[n++] = P->two;
+      values += 2;
     }
   }
-  PM_PETSC_CALL(VecRestoreArray(P->dm[k].loc, &a));
-  PM_PETSC_CALL(VecZeroEntries(P->dm[k].glob));
-  PM_PETSC_CALL(DMLocalToGlobalBegin(P->dm[k].da, P->dm[k].loc, ADD_VALUES,
-                                     P->dm[k].glob));
-  PM_PETSC_CALL(
-      DMLocalToGlobalEnd(P->dm[k].da, P->dm[k].loc, ADD_VALUES, P->dm[k].glob));
-  PM_PETSC_CALL(DMGlobalToLocalBegin(P->dm[k].da, P->dm[k].glob, INSERT_VALUES,
-                                     P->dm[k].loc));
-  PM_PETSC_CALL(DMGlobalToLocalEnd(P->dm[k].da, P->dm[k].glob, INSERT_VALUES,
-                                   P->dm[k].loc));
-  PM_PETSC_CALL(VecGetArray(P->dm[k].loc, &a));
-  PM_OMP(parallel for schedule(static) default(none) shared(a, nd, nn, dof, mode, imp))
-  for (long i = 0; i < nn; i++) {
-    const double *r = a + i * dof;
-    if (mode & MPM_P2G_MASS) nd->mass[i] = *r++;
-    if (mode & MPM_P2G_MOM)
-      for (int c = 0; c < 3; c++) nd->mom[3 * i + c] = *r++;
-    if (mode & MPM_P2G_FORCE) {
-      for (int c = 0; c < 3; c++) nd->force[3 * i + c] = *r++;
-      if (imp)
-        for (int c = 0; c < 2; c++) nd->impedance[2 * i + c] = *r++;
-    }
-  }
-  PM_PETSC_CALL(VecRestoreArray(P->dm[k].loc, &a));
+  /* Ghosts' contributions added on their owners, then the sums back. */
+  for (int k = 0; k < n; k++)
+    PM_PETSC_CALL(PetscSFReduceBegin(sf, unit[k], data[k], data[k], MPI_SUM));
+  for (int k = 0; k < n; k++)
+    PM_PETSC_CALL(PetscSFReduceEnd(sf, unit[k], data[k], data[k], MPI_SUM));
+  for (int k = 0; k < n; k++)
+    PM_PETSC_CALL(
+        PetscSFBcastBegin(sf, unit[k], data[k], data[k], MPI_REPLACE));
+  for (int k = 0; k < n; k++)
+    PM_PETSC_CALL(PetscSFBcastEnd(sf, unit[k], data[k], data[k], MPI_REPLACE));
   /* Each ghost node's values go to its owner and come back. */
-  const double bytes = 2.0 * (double)(nn - P->n_owned) * dof * sizeof(double);
+  const double bytes =
+      2.0 * (double)(m->grid.n_nodes - P->n_owned) * values * sizeof(double);
   P->counts.halo_bytes += bytes;
   pm_par_count_sent(bytes);
   P->counts.halo_seconds += pm_wtime() - t0;
@@ -1042,24 +1077,19 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
   }
   if (!s->force_prev) return PM_SUCCESS;
   /* Dynamic relaxation's nodal arrays: owned nodes, in natural order. */
-  const int k = dm_index(P, 3);
   const mpm_grid *g = &m->grid;
   Vec nat = P->natural, all = P->whole;
   VecScatter sc = P->to_root;
   for (int pass = 0; pass < (s->fixed ? 2 : 1); pass++) {
     PetscScalar *a;
-    PM_PETSC_CALL(VecGetArray(P->dm[k].loc, &a));
+    PM_PETSC_CALL(VecGetArray(P->loc, &a));
     for (long i = 0; i < 3 * g->n_nodes; i++)
       a[i] = pass ? (double)s->fixed[i] : s->force_prev[i];
-    PM_PETSC_CALL(VecRestoreArray(P->dm[k].loc, &a));
-    PM_PETSC_CALL(DMLocalToGlobalBegin(P->dm[k].da, P->dm[k].loc, INSERT_VALUES,
-                                       P->dm[k].glob));
-    PM_PETSC_CALL(DMLocalToGlobalEnd(P->dm[k].da, P->dm[k].loc, INSERT_VALUES,
-                                     P->dm[k].glob));
-    PM_PETSC_CALL(DMDAGlobalToNaturalBegin(P->dm[k].da, P->dm[k].glob,
-                                           INSERT_VALUES, nat));
-    PM_PETSC_CALL(
-        DMDAGlobalToNaturalEnd(P->dm[k].da, P->dm[k].glob, INSERT_VALUES, nat));
+    PM_PETSC_CALL(VecRestoreArray(P->loc, &a));
+    PM_PETSC_CALL(DMLocalToGlobalBegin(P->da, P->loc, INSERT_VALUES, P->glob));
+    PM_PETSC_CALL(DMLocalToGlobalEnd(P->da, P->loc, INSERT_VALUES, P->glob));
+    PM_PETSC_CALL(DMDAGlobalToNaturalBegin(P->da, P->glob, INSERT_VALUES, nat));
+    PM_PETSC_CALL(DMDAGlobalToNaturalEnd(P->da, P->glob, INSERT_VALUES, nat));
     PM_PETSC_CALL(
         VecScatterBegin(sc, nat, all, INSERT_VALUES, SCATTER_FORWARD));
     PM_PETSC_CALL(VecScatterEnd(sc, nat, all, INSERT_VALUES, SCATTER_FORWARD));
