@@ -17,8 +17,11 @@
 # The configurations of a case run in turn, REPEAT times (5): single runs
 # on this machine vary by 10-30%, and taking turns spreads its slow spells
 # over all of them.  Each line gives the median seconds per step (the
-# fastest and slowest beside it) and the other figures of the median run.
-# usage: scripts/bench-ranks.sh [BUILD_DIR]   (STEPS: steps per run, 200)
+# fastest and slowest beside it) and the other figures of the median run,
+# and the efficiency of the fastest runs (against the fastest 1 x 1): on a
+# noisy machine the fastest run is the closest to the work itself.
+# usage: scripts/bench-ranks.sh [BUILD_DIR]   (STEPS: steps per run, 200;
+#        TABLE_ONLY=1 tabulates the runs of an earlier call again)
 bench_name=ranks
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -62,32 +65,28 @@ run_once() {
 }
 
 # row CASE KIND CONFIG CORES WORK BASE FILE: the median run of FILE (a
-# run's figures per line) against the median seconds per step BASE of 1 x
-# 1; WORK is the work over that run's (2 for weak scaling)
+# run's figures per line) against BASE, the 1 x 1 runs' file; WORK is the
+# work over that run's (2 for weak scaling)
 row() {
   $py - "$@" <<'EOF'
 import sys
 c, k, cfg, cores, work, base, path = sys.argv[1:8]
-runs = sorted((list(map(float, l.split())) for l in open(path) if l.strip()),
-              key=lambda r: r[2])
-m = runs[len(runs) // 2]
-per, b = m[2], float(base)
-print('%-11s %-6s %-5s %6d %9.3e %19s %6.2f %6.2f %10.0f %10.0f %6.2f %6.2f %6.3f %5.2f' % (
-    c, k, cfg, m[0], per, '(%.2e - %.2e)' % (runs[0][2], runs[-1][2]),
-    b / per * float(work), b / per * float(work) / float(cores), m[3], m[4],
+def runs(f):
+    return sorted((list(map(float, l.split())) for l in open(f) if l.strip()),
+                  key=lambda r: r[2])
+rs, bs = runs(path), runs(base)
+m, b = rs[len(rs) // 2], bs[len(bs) // 2][2]
+per, w, n = m[2], float(work), float(cores)
+print('%-11s %-6s %-5s %6d %9.3e %19s %6.2f %6.2f %9.2f %10.0f %10.0f %6.2f %6.2f %6.3f %5.2f' % (
+    c, k, cfg, m[0], per, '(%.2e - %.2e)' % (rs[0][2], rs[-1][2]),
+    b / per * w, b / per * w / n, bs[0][2] / rs[0][2] * w / n, m[3], m[4],
     m[5], m[6], m[7], m[8]))
 EOF
 }
 
-median() { # FILE: the median seconds per step
-  $py -c "
-v = sorted(float(l.split()[2]) for l in open('$1') if l.strip())
-print(v[len(v) // 2])"
-}
-
-printf '%-11s %-6s %-5s %6s %9s %19s %6s %6s %10s %10s %6s %6s %6s %5s\n' \
-  case kind rxt points s/step "(range)" speed eff "node B/st" "part. B/st" \
-  halo-s migr-s imbal. comm
+printf '%-11s %-6s %-5s %6s %9s %19s %6s %6s %9s %10s %10s %6s %6s %6s %5s\n' \
+  case kind rxt points s/step "(range)" speed eff "eff(fast)" "node B/st" \
+  "part. B/st" halo-s migr-s imbal. comm
 # case, scene, particles per cell doubled along x, an override
 for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
   "shock-tube cases/mpm/m2-shock-tube.yaml 50,1,1" \
@@ -95,8 +94,9 @@ for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
   read -r name scene ppc2 extra <<<"$spec"
   sets=()
   [ -n "${extra:-}" ] && sets=(--set "$extra")
-  rm -f "$out/$name".*.runs
+  [ "${TABLE_ONLY:-0}" = 1 ] || rm -f "$out/$name".*.runs
   for _ in $(seq "$repeat"); do
+    [ "${TABLE_ONLY:-0}" = 1 ] && break
     run_once "$name" 1 1 "$scene" "${sets[@]}" >>"$out/$name.1x1.runs"
     run_once "$name" 1 2 "$scene" "${sets[@]}" >>"$out/$name.1x2.runs"
     run_once "$name" 2 1 "$scene" "${sets[@]}" >>"$out/$name.2x1.runs"
@@ -104,7 +104,7 @@ for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
     run_once "$name-weak" 2 1 "$scene" "${sets[@]}" \
       --set "mpm.particles_per_cell=[$ppc2]" >>"$out/$name.weak.runs"
   done
-  base=$(median "$out/$name.1x1.runs")
+  base="$out/$name.1x1.runs"
   row "$name" strong 1x1 1 1 "$base" "$out/$name.1x1.runs"
   row "$name" strong 1x2 2 1 "$base" "$out/$name.1x2.runs"
   row "$name" strong 2x1 2 1 "$base" "$out/$name.2x1.runs"

@@ -719,8 +719,8 @@ static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
   const double steps = r->state->step > 0 ? (double)r->state->step : 1;
   PM_CALL(pm_json_begin_object(j, "ranks"));
   PM_CALL(pm_json_integer(j, "count", d->size));
-  PM_CALL(pm_json_begin_array(j, "boxes"));
-  for (int a = 0; a < 3; a++) PM_CALL(pm_json_integer(j, NULL, d->dims[a]));
+  PM_CALL(pm_json_begin_array(j, "cuts"));
+  for (int a = 0; a < 3; a++) PM_CALL(pm_json_integer(j, NULL, d->cuts[a]));
   PM_CALL(pm_json_end_array(j));
   PM_CALL(pm_json_begin_array(j, "particles_at_start"));
   for (int k = 0; k < d->size; k++)

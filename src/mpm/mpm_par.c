@@ -4,7 +4,6 @@
 
 #include <math.h>
 #include <mpi.h>
-#include <petscdmda.h>
 #include <petscsf.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,21 +33,16 @@ enum {
 
 struct mpm_par {
   mpm_decomp d;
-  int rank, coord[3];
+  int rank;
   long own_lo[3], own_hi[3]; /* owned nodes (global) per axis */
   /* the node sums: each ghost node (a leaf) is a node of its owner (a
    * root); the sums go leaves to roots and back, on the ghost nodes and
    * the owned nodes next to other ranks only */
   PetscSF ghosts;
   MPI_Datatype two, three; /* a node's impedances, a node's vector */
-  /* the layout: a DMDA of 3 values per node, which also gathers dynamic
-   * relaxation's nodal vectors */
-  DM da;
-  Vec loc, glob;
-  /* dynamic relaxation's nodal arrays to rank 0: the whole grid in
-   * natural order, and on rank 0 all of it */
-  Vec natural, whole;
-  VecScatter to_root;
+  /* dynamic relaxation's nodal arrays to rank 0: a rank's owned nodes'
+   * values, and on rank 0 every rank's */
+  double *nodal, *whole;
   unsigned char *owned; /* per local node */
   long n_owned;         /* nodes this rank owns */
   /* the whole run's ranges, in indices on one process */
@@ -109,37 +103,53 @@ static void cell_of(const mpm_grid *g, const long cells[3], const double x[3],
   }
 }
 
-/* The column along an axis that holds cell c: cut[r] <= c < cut[r + 1]. */
-static int column_of(const long *cut, int n, long c) {
-  int lo = 0, hi = n - 1;
-  while (lo < hi) {
-    int mid = (lo + hi + 1) / 2;
-    if (cut[mid] <= c)
-      lo = mid;
-    else
-      hi = mid - 1;
+/* The rank whose box holds cell (or node) q: down the bisections, the side
+ * of each cut (a node on a cut belongs to the upper box, like its cell). */
+static int rank_of(const mpm_decomp *d, const long q[3]) {
+  if (d->size == 1) return 0;
+  int k = 0;
+  for (;;) {
+    const mpm_decomp_cut *t = &d->tree[k];
+    const int next = t->child[q[t->axis] >= t->at];
+    if (next < 0) return -next - 1;
+    k = next;
   }
-  return lo;
 }
 
 int mpm_decomp_rank_at(const mpm_decomp *d, const mpm_grid *g,
                        const double x[3]) {
   long c[3];
   cell_of(g, d->cells, x, c);
-  int r[3];
-  for (int a = 0; a < 3; a++) r[a] = column_of(d->cut[a], d->dims[a], c[a]);
-  return r[0] + d->dims[0] * (r[1] + d->dims[1] * r[2]);
+  return rank_of(d, c);
+}
+
+void mpm_decomp_nodes(const mpm_decomp *d, int r, long lo[3], long hi[3]) {
+  for (int a = 0; a < 3; a++) {
+    lo[a] = d->box[6 * r + a];
+    hi[a] = d->box[6 * r + 3 + a] + (d->box[6 * r + 3 + a] == d->cells[a]);
+  }
+}
+
+void mpm_decomp_held(const mpm_decomp *d, int r, const mpm_grid *g, long lo[3],
+                     long hi[3]) {
+  mpm_decomp_nodes(d, r, lo, hi);
+  for (int a = 0; a < 3; a++) {
+    if (a >= g->dim) continue;
+    lo[a] = lo[a] - d->ghost > 0 ? lo[a] - d->ghost : 0;
+    hi[a] = hi[a] + d->ghost < g->nn[a] ? hi[a] + d->ghost : g->nn[a];
+  }
 }
 
 void mpm_decomp_destroy(mpm_decomp *d) {
-  for (int a = 0; a < 3; a++) free(d->cut[a]);
+  free(d->box);
+  free(d->tree);
   free(d->count);
   memset(d, 0, sizeof *d);
 }
 
-/* Cells a rank holds at least along a split axis, and how far a cut stays
- * from a condition's face plane (its columns' anchors and the ghost layers
- * then lie on the rank of the face). */
+/* Cells a box keeps at least along an axis it is cut along, and how far a
+ * cut stays from a condition's face plane (its columns' anchors and the
+ * ghost layers then lie in the face's box). */
 static int min_cells(const mpm_grid *g) { return g->width; }
 static int face_clearance(const mpm_grid *g) { return g->width + 2; }
 
@@ -153,32 +163,118 @@ static bool cut_allowed(const mpm_model *m, int a, long c) {
   return true;
 }
 
-/* Cuts along axis a into p shares of the particles (hist: per cell). */
-static pm_err make_cuts(const pm_scene *s, const mpm_model *m, int a, int p,
-                        const long *hist, long total, long *cut) {
-  const long cells = m->grid.nn[a] - 1, w = min_cells(&m->grid);
-  cut[0] = 0;
-  cut[p] = cells;
-  long below = 0, c = 0; /* particles in cells < c */
-  for (int k = 1; k < p; k++) {
-    const double target = (double)total * k / p;
-    while (c < cells && below + hist[c] <= target) below += hist[c++];
-    /* the nearer of the cuts around the target */
-    long best =
-        c < cells && target - below > below + hist[c] - target ? c + 1 : c;
-    long lo = cut[k - 1] + w, hi = cells - (long)(p - k) * w, found = -1;
-    for (long dist = 0; found < 0 && dist <= cells; dist++)
-      for (int sign = -1; sign <= 1 && found < 0; sign += 2) {
-        long q = best + sign * dist;
-        if (q >= lo && q <= hi && cut_allowed(m, a, q)) found = q;
-      }
-    PM_CHECK(found >= 0, PM_ERR_SCENE,
-             "%s: %d ranks along %c cannot share the grid's %ld cells (each "
-             "needs %ld cells, and a cut stays %d cells from a boundary "
-             "face): run on fewer ranks or refine discretization.mesh_size",
-             s->path, p, "xyz"[a], cells, w, face_clearance(&m->grid));
-    cut[k] = found;
+/* What the bisection works on: the model, the axes it may cut, the
+ * particles' cells, a histogram, and the tree it grows. */
+typedef struct {
+  const pm_scene *s;
+  const mpm_model *m;
+  mpm_decomp *d;
+  bool splits[3];
+  long *cell; /* 3 per particle */
+  long *hist;
+  int n_nodes;
+} bisection;
+
+/* Cells of box [lo, hi). */
+static double box_cells(const long lo[3], const long hi[3]) {
+  return (double)(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+}
+
+/* Share n ranks from r0 among the particles idx[0..count) of box [lo, hi):
+ * cut the box's longest axis that may be cut where the particles divide
+ * in the ranks' proportion, and each side likewise.  Returns the tree
+ * node it made, or -(r0 + 1) for a box of one rank. */
+static pm_err bisect(bisection *B, int r0, int n, const long lo[3],
+                     const long hi[3], long *idx, long count, int *node) {
+  mpm_decomp *d = B->d;
+  const long w = min_cells(&B->m->grid);
+  if (n == 1) {
+    for (int a = 0; a < 3; a++) {
+      d->box[6 * r0 + a] = lo[a];
+      d->box[6 * r0 + 3 + a] = hi[a];
+    }
+    d->count[r0] = count;
+    *node = -(r0 + 1);
+    return PM_SUCCESS;
   }
+  const int nl = n / 2, nr = n - nl;
+  /* The longest axis the box may be cut along, with room for both sides. */
+  int axis = -1;
+  for (int a = 0; a < B->m->dim; a++)
+    if (B->splits[a] && hi[a] - lo[a] >= 2 * w &&
+        (axis < 0 || hi[a] - lo[a] > hi[axis] - lo[axis]))
+      axis = a;
+  PM_CHECK(axis >= 0, PM_ERR_SCENE,
+           "%s: %d ranks cannot share the grid (%ld x %ld x %ld cells): a box "
+           "of %ld x %ld x %ld cells for %d ranks cannot be cut along an axis "
+           "that may be cut, keeping %ld cells on each side%s%s; run on fewer "
+           "ranks or refine discretization.mesh_size",
+           B->s->path, d->size, d->cells[0], d->cells[1], d->cells[2],
+           hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], n, w,
+           d->held[0] ? " (not cut: " : "", d->held[0] ? d->held : "");
+  const long len = hi[axis] - lo[axis];
+  memset(B->hist, 0, sizeof(long) * (size_t)len);
+  for (long k = 0; k < count; k++)
+    B->hist[B->cell[3 * idx[k] + axis] - lo[axis]]++;
+  /* The cut nearest to the particles' share, in a whole cell; of the cuts
+   * that share them alike (empty slabs), the middle one. */
+  const double target = (double)count * nl / n;
+  long best = -1, last = -1, below = 0;
+  double best_miss = INFINITY;
+  for (long c = 1; c < len; c++) {
+    below += B->hist[c - 1];
+    const long at = lo[axis] + c;
+    long left[3], right[3];
+    memcpy(left, hi, sizeof left);
+    memcpy(right, lo, sizeof right);
+    left[axis] = right[axis] = at;
+    if (c < w || len - c < w || !cut_allowed(B->m, axis, at) ||
+        box_cells(lo, left) < (double)nl * w ||
+        box_cells(right, hi) < (double)nr * w)
+      continue;
+    const double miss = fabs(below - target);
+    if (miss < best_miss) {
+      best_miss = miss;
+      best = last = c;
+    } else if (miss == best_miss && last == c - 1) {
+      last = c; /* the same empty stretch */
+    }
+  }
+  if (best >= 0) {
+    const long mid = best + (last - best) / 2;
+    if (cut_allowed(B->m, axis, lo[axis] + mid)) best = mid;
+  }
+  PM_CHECK(best >= 0, PM_ERR_SCENE,
+           "%s: %d ranks cannot share the grid: a box of %ld cells along %c "
+           "for %d ranks has no cut %ld cells from its ends and %d cells "
+           "from a boundary face; run on fewer ranks or refine "
+           "discretization.mesh_size",
+           B->s->path, d->size, len, "xyz"[axis], n, w,
+           face_clearance(&B->m->grid));
+  const long at = lo[axis] + best;
+  /* The particles below the cut first. */
+  long split = 0;
+  for (long k = 0; k < count; k++)
+    if (B->cell[3 * idx[k] + axis] < at) {
+      long t = idx[k];
+      idx[k] = idx[split];
+      idx[split++] = t;
+    }
+  const int me = B->n_nodes++;
+  d->tree[me].axis = axis;
+  d->tree[me].at = at;
+  d->cuts[axis]++;
+  long mid_hi[3], mid_lo[3];
+  memcpy(mid_hi, hi, sizeof mid_hi);
+  memcpy(mid_lo, lo, sizeof mid_lo);
+  mid_hi[axis] = mid_lo[axis] = at;
+  int child;
+  PM_CALL(bisect(B, r0, nl, lo, mid_hi, idx, split, &child));
+  d->tree[me].child[0] = child;
+  PM_CALL(
+      bisect(B, r0 + nl, nr, mid_lo, hi, idx + split, count - split, &child));
+  d->tree[me].child[1] = child;
+  *node = me;
   return PM_SUCCESS;
 }
 
@@ -186,77 +282,44 @@ pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m,
                          const mpm_state *st, int size, mpm_decomp *d) {
   pm_err ret = PM_SUCCESS;
   const mpm_grid *g = &m->grid;
-  long *hist = NULL;
+  bisection B = {.s = s, .m = m, .d = d};
+  long *idx = NULL;
   memset(d, 0, sizeof *d);
   d->size = size;
   d->ghost = g->width - 1;
-  bool splits[3];
   size_t used = 0;
+  long most = 1;
   for (int a = 0; a < 3; a++) {
     d->cells[a] = a < g->dim ? g->nn[a] - 1 : 1;
-    splits[a] = a < g->dim;
+    most = d->cells[a] > most ? d->cells[a] : most;
+    B.splits[a] = a < g->dim;
     int b = a < g->dim ? moving_wall(m, a) : -1;
     if (b >= 0) {
-      splits[a] = false;
+      B.splits[a] = false;
       used += (size_t)snprintf(d->held + used, sizeof d->held - used,
-                               "%s%c: the wall of boundary.%d "
-                               "(%s) moves",
+                               "%s%c: the wall of boundary.%d (%s) moves",
                                used ? "; " : "", "xyz"[a], b,
                                pm_face_name(m->bcs[b].face));
       if (used >= sizeof d->held) used = sizeof d->held - 1;
     }
   }
-  /* The ranks per axis: the least cut area among the factorizations of
-   * size over the axes that may be split. */
-  double best_cost = INFINITY;
-  for (int px = 1; px <= size; px++) {
-    if (size % px) continue;
-    for (int py = 1; py <= size / px; py++) {
-      if ((size / px) % py) continue;
-      const int dims[3] = {px, py, size / px / py};
-      bool ok = true;
-      double cost = 0;
-      for (int a = 0; a < 3 && ok; a++) {
-        if (dims[a] == 1) continue;
-        ok = splits[a] && dims[a] * (long)min_cells(g) <= d->cells[a];
-        double area = 1;
-        for (int b = 0; b < 3; b++)
-          if (b != a) area *= (double)d->cells[b];
-        cost += (dims[a] - 1) * area;
-      }
-      if (ok && cost < best_cost) {
-        best_cost = cost;
-        memcpy(d->dims, dims, sizeof dims);
-      }
-    }
-  }
-  PM_ENSURE(isfinite(best_cost), PM_ERR_SCENE,
-            "%s: %d ranks cannot share the grid (%ld x %ld x %ld cells, at "
-            "least %d cells each along an axis they split%s%s): run on fewer "
-            "ranks or refine discretization.mesh_size",
-            s->path, size, d->cells[0], d->cells[1], d->cells[2], min_cells(g),
-            d->held[0] ? "; unsplit: " : "", d->held);
-  long most = 0;
-  for (int a = 0; a < 3; a++) most = d->cells[a] > most ? d->cells[a] : most;
-  PM_TRY(PM_ALLOC(hist, most, "decomposition histogram"));
-  for (int a = 0; a < 3; a++) {
-    PM_TRY(PM_ALLOC(d->cut[a], d->dims[a] + 1, "decomposition cuts"));
-    d->cut[a][0] = 0;
-    d->cut[a][d->dims[a]] = d->cells[a];
-    if (d->dims[a] == 1) continue;
-    memset(hist, 0, sizeof(long) * (size_t)d->cells[a]);
-    for (long p = 0; p < m->n; p++) {
-      long c[3];
-      cell_of(g, d->cells, st->x + 3 * p, c);
-      hist[c[a]]++;
-    }
-    PM_TRY(make_cuts(s, m, a, d->dims[a], hist, m->n, d->cut[a]));
-  }
+  PM_TRY(PM_ALLOC(d->box, 6 * size, "decomposition boxes"));
+  PM_TRY(PM_ALLOC(d->tree, size, "decomposition cuts"));
   PM_TRY(PM_ALLOC(d->count, size, "particles per rank"));
-  for (long p = 0; p < m->n; p++)
-    d->count[mpm_decomp_rank_at(d, g, st->x + 3 * p)]++;
+  PM_TRY(PM_ALLOC(B.cell, 3 * m->n + 1, "particles' cells"));
+  PM_TRY(PM_ALLOC(B.hist, most, "decomposition histogram"));
+  PM_TRY(PM_ALLOC(idx, m->n + 1, "particles' order"));
+  for (long p = 0; p < m->n; p++) {
+    cell_of(g, d->cells, st->x + 3 * p, B.cell + 3 * p);
+    idx[p] = p;
+  }
+  const long lo[3] = {0, 0, 0};
+  int root;
+  PM_TRY(bisect(&B, 0, size, lo, d->cells, idx, m->n, &root));
 done:
-  free(hist);
+  free(idx);
+  free(B.cell);
+  free(B.hist);
   if (ret) mpm_decomp_destroy(d);
   return ret;
 }
@@ -297,59 +360,16 @@ static int dof_of(int mode, bool imp) {
          (mode & MPM_P2G_FORCE ? 3 + (imp ? 2 : 0) : 0);
 }
 
-static pm_err make_dm(struct mpm_par *P, const mpm_grid *g) {
-  pm_err ret = PM_SUCCESS;
-  const int dof = 3;
-  const mpm_decomp *d = &P->d;
-  PetscInt *l[3] = {NULL, NULL, NULL};
-  DM da = NULL;
-  for (int a = 0; a < 3; a++) {
-    PM_TRY(PM_ALLOC(l[a], d->dims[a], "DMDA ownership"));
-    for (int r = 0; r < d->dims[a]; r++)
-      l[a][r] = (PetscInt)(d->cut[a][r + 1] - d->cut[a][r] +
-                           (r == d->dims[a] - 1 && a < g->dim ? 1 : 0));
-  }
-  const DMBoundaryType none = DM_BOUNDARY_NONE;
-  if (g->dim == 3)
-    PM_PETSC(DMDACreate3d(PETSC_COMM_WORLD, none, none, none, DMDA_STENCIL_BOX,
-                          (PetscInt)g->nn[0], (PetscInt)g->nn[1],
-                          (PetscInt)g->nn[2], d->dims[0], d->dims[1],
-                          d->dims[2], dof, d->ghost, l[0], l[1], l[2], &da));
-  else
-    PM_PETSC(DMDACreate2d(PETSC_COMM_WORLD, none, none, DMDA_STENCIL_BOX,
-                          (PetscInt)g->nn[0], (PetscInt)g->nn[1], d->dims[0],
-                          d->dims[1], dof, d->ghost, l[0], l[1], &da));
-  PM_PETSC(DMSetUp(da));
-  /* The DMDA numbers its ranks as the decomposition does: check it. */
-  PetscInt xs[3] = {0, 0, 0}, xm[3] = {1, 1, 1};
-  PM_PETSC(DMDAGetCorners(da, &xs[0], &xs[1], &xs[2], &xm[0], &xm[1], &xm[2]));
-  for (int a = 0; a < g->dim; a++)
-    PM_ENSURE(xs[a] == P->own_lo[a] && xs[a] + xm[a] == P->own_hi[a],
-              PM_ERR_INTERNAL,
-              "rank %d: the DMDA owns nodes [%ld, %ld) along %c, the "
-              "decomposition [%ld, %ld)",
-              P->rank, (long)xs[a], (long)(xs[a] + xm[a]), "xyz"[a],
-              P -> own_lo[a], P -> own_hi[a]);
-  P->da = da;
-  da = NULL;
-  PM_PETSC(DMCreateLocalVector(P->da, &P->loc));
-  PM_PETSC(DMCreateGlobalVector(P->da, &P->glob));
-done:
-  if (da) DMDestroy(&da);
-  for (int a = 0; a < 3; a++) free(l[a]);
-  return ret;
-}
-
-/* This rank's block of the grid: the DMDA's ghosted corners. */
+/* This rank's block of the grid: its box's nodes and the ghost layers. */
 static pm_err local_grid(struct mpm_par *P, const mpm_grid *full, mpm_grid *g) {
-  PetscInt gs[3] = {0, 0, 0}, gm[3] = {1, 1, 1};
-  PM_PETSC_CALL(DMDAGetGhostCorners(P->da, &gs[0], &gs[1], &gs[2], &gm[0],
-                                    &gm[1], &gm[2]));
+  long lo[3], hi[3];
+  mpm_decomp_held(&P->d, P->rank, full, lo, hi);
+  mpm_decomp_nodes(&P->d, P->rank, P->own_lo, P->own_hi);
   *g = *full;
   g->n_nodes = 1;
   for (int a = 0; a < 3; a++) {
-    g->offset[a] = a < full->dim ? gs[a] : 0;
-    g->nn[a] = a < full->dim ? gm[a] : 1;
+    g->offset[a] = a < full->dim ? lo[a] : 0;
+    g->nn[a] = a < full->dim ? hi[a] - lo[a] : 1;
     g->n_nodes *= g->nn[a];
   }
   g->stride[0] = 1;
@@ -417,27 +437,18 @@ static pm_err make_ghosts(struct mpm_par *P, const mpm_grid *full,
   long k = 0;
   for (long i = 0; i < g->n_nodes; i++) {
     if (P->owned[i]) continue;
-    long q[3] = {i % g->nn[0], (i / g->nn[0]) % g->nn[1],
-                 i / (g->nn[0] * g->nn[1])};
-    int rank = 0, stride = 1;
-    long at = 0, step = 1;
+    const long q[3] = {i % g->nn[0] + g->offset[0],
+                       (i / g->nn[0]) % g->nn[1] + g->offset[1],
+                       i / (g->nn[0] * g->nn[1]) + g->offset[2]};
+    const int r = rank_of(d, q);
+    long lo[3], hi[3], at = 0, step = 1;
+    mpm_decomp_held(d, r, full, lo, hi);
     for (int a = 0; a < 3; a++) {
-      q[a] += g->offset[a];
-      const int r = a < full->dim ? column_of(d->cut[a], d->dims[a], q[a]) : 0;
-      const long lo = d->cut[a][r],
-                 hi = d->cut[a][r + 1] +
-                      (r == d->dims[a] - 1 && a < full->dim ? 1 : 0);
-      const long glo = a < full->dim && lo - d->ghost > 0 ? lo - d->ghost : 0;
-      const long ghi = a >= full->dim                ? 1
-                       : hi + d->ghost < full->nn[a] ? hi + d->ghost
-                                                     : full->nn[a];
-      at += (q[a] - glo) * step;
-      step *= ghi - glo;
-      rank += r * stride;
-      stride *= d->dims[a];
+      at += (q[a] - lo[a]) * step;
+      step *= hi[a] - lo[a];
     }
     leaf[k] = (PetscInt)i;
-    root[k].rank = rank;
+    root[k].rank = r;
     root[k].index = (PetscInt)at;
     k++;
   }
@@ -626,21 +637,6 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   if (!ret) ret = mpm_decomp_create(s, m, st, size, &P->d);
   PM_TRY(pm_par_agree(ret));
   P->rank = pm_par_rank();
-  const mpm_decomp *d = &P->d;
-  P->coord[0] = P->rank % d->dims[0];
-  P->coord[1] = (P->rank / d->dims[0]) % d->dims[1];
-  P->coord[2] = P->rank / (d->dims[0] * d->dims[1]);
-  for (int a = 0; a < 3; a++) {
-    const int r = P->coord[a];
-    P->own_lo[a] = d->cut[a][r];
-    P->own_hi[a] =
-        d->cut[a][r + 1] + (r == d->dims[a] - 1 && a < m->dim ? 1 : 0);
-  }
-  PM_TRY(make_dm(P, &m->grid));
-  if (m->opt.qs == PM_QS_DYNAMIC_RELAXATION) {
-    PM_PETSC(DMDACreateNaturalVector(P->da, &P->natural));
-    PM_PETSC(VecScatterCreateToZero(P->natural, &P->to_root, &P->whole));
-  }
   ret = local_model(s, m, st, P, &lm);
   if (!ret) P = NULL; /* lm holds it */
   if (!ret) ret = local_state(m, st, lm, &ls);
@@ -660,6 +656,11 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   Q->sbuf_room = Q->rbuf_room = 64 + room / 8;
   PM_TRY(PM_ALLOC(Q->sbuf, Q->sbuf_room * Q->rec, "migration buffer"));
   PM_TRY(PM_ALLOC(Q->rbuf, Q->rbuf_room * Q->rec, "migration buffer"));
+  if (m->opt.qs == PM_QS_DYNAMIC_RELAXATION) {
+    PM_TRY(PM_ALLOC(Q->nodal, 3 * Q->n_owned + 1, "nodal gather"));
+    if (Q->rank == 0)
+      PM_TRY(PM_ALLOC(Q->whole, 3 * m->grid.n_nodes, "nodal gather"));
+  }
   if (Q->rank == 0) {
     PM_TRY(PM_ALLOC(Q->ggid, m->n, "gather indices"));
     PM_TRY(PM_ALLOC(Q->gbuf, Q->width * m->n, "gather buffer"));
@@ -682,12 +683,8 @@ void mpm_par_destroy(struct mpm_par *P) {
     MPI_Type_free(&P->two);
     MPI_Type_free(&P->three);
   }
-  if (P->to_root) VecScatterDestroy(&P->to_root);
-  if (P->whole) VecDestroy(&P->whole);
-  if (P->natural) VecDestroy(&P->natural);
-  if (P->loc) VecDestroy(&P->loc);
-  if (P->glob) VecDestroy(&P->glob);
-  if (P->da) DMDestroy(&P->da);
+  free(P->nodal);
+  free(P->whole);
   mpm_decomp_destroy(&P->d);
   free(P->owned);
   free(P->bbegin);
@@ -1076,34 +1073,43 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
     fs->dissipated = acc[n_acc + 1];
   }
   if (!s->force_prev) return PM_SUCCESS;
-  /* Dynamic relaxation's nodal arrays: owned nodes, in natural order. */
+  /* Dynamic relaxation's nodal arrays: each rank's owned nodes, placed by
+   * rank 0 in the whole grid from the rank's box. */
   const mpm_grid *g = &m->grid;
-  Vec nat = P->natural, all = P->whole;
-  VecScatter sc = P->to_root;
   for (int pass = 0; pass < (s->fixed ? 2 : 1); pass++) {
-    PetscScalar *a;
-    PM_PETSC_CALL(VecGetArray(P->loc, &a));
-    for (long i = 0; i < 3 * g->n_nodes; i++)
-      a[i] = pass ? (double)s->fixed[i] : s->force_prev[i];
-    PM_PETSC_CALL(VecRestoreArray(P->loc, &a));
-    PM_PETSC_CALL(DMLocalToGlobalBegin(P->da, P->loc, INSERT_VALUES, P->glob));
-    PM_PETSC_CALL(DMLocalToGlobalEnd(P->da, P->loc, INSERT_VALUES, P->glob));
-    PM_PETSC_CALL(DMDAGlobalToNaturalBegin(P->da, P->glob, INSERT_VALUES, nat));
-    PM_PETSC_CALL(DMDAGlobalToNaturalEnd(P->da, P->glob, INSERT_VALUES, nat));
-    PM_PETSC_CALL(
-        VecScatterBegin(sc, nat, all, INSERT_VALUES, SCATTER_FORWARD));
-    PM_PETSC_CALL(VecScatterEnd(sc, nat, all, INSERT_VALUES, SCATTER_FORWARD));
-    if (fs) {
-      const PetscScalar *b;
-      PM_PETSC_CALL(VecGetArrayRead(all, &b));
-      const long n3 = 3 * full->grid.n_nodes;
-      for (long i = 0; i < n3; i++) {
-        if (pass)
-          fs->fixed[i] = b[i] != 0;
-        else
-          fs->force_prev[i] = b[i];
-      }
-      PM_PETSC_CALL(VecRestoreArrayRead(all, &b));
+    long k = 0;
+    for (long i = 0; i < g->n_nodes; i++)
+      if (P->owned[i])
+        for (int c = 0; c < 3; c++, k++)
+          P->nodal[k] =
+              pass ? (double)s->fixed[3 * i + c] : s->force_prev[3 * i + c];
+    int cnt = (int)k;
+    MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (P->rank == 0) {
+      P->gdisp[0] = 0;
+      for (int r = 0; r < size; r++)
+        P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
+    }
+    MPI_Gatherv(P->nodal, cnt, MPI_DOUBLE, P->whole, P->gcount, P->gdisp,
+                MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    if (!fs) continue;
+    const mpm_grid *fg = &full->grid;
+    const double *b = P->whole;
+    for (int r = 0; r < size; r++) {
+      long lo[3], hi[3];
+      mpm_decomp_nodes(&P->d, r, lo, hi);
+      for (int a = fg->dim; a < 3; a++) lo[a] = 0, hi[a] = 1;
+      for (long z = lo[2]; z < hi[2]; z++)
+        for (long y = lo[1]; y < hi[1]; y++)
+          for (long x = lo[0]; x < hi[0]; x++, b += 3) {
+            const long q = x + y * fg->stride[1] + z * fg->stride[2];
+            for (int c = 0; c < 3; c++) {
+              if (pass)
+                fs->fixed[3 * q + c] = b[c] != 0;
+              else
+                fs->force_prev[3 * q + c] = b[c];
+            }
+          }
     }
   }
   return PM_SUCCESS;
@@ -1113,17 +1119,12 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
  */
 
 void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out) {
-  fprintf(out, "ranks        %d: %d x %d x %d boxes of the grid's cells",
-          d->size, d->dims[0], d->dims[1], d->dims[2]);
-  if (m->dim == 2) fprintf(out, " (2-D: z is not split)");
-  fprintf(out, ", %d ghost node layer%s\n", d->ghost, d->ghost == 1 ? "" : "s");
-  for (int a = 0; a < m->dim; a++) {
-    if (d->dims[a] == 1) continue;
-    fprintf(out, "             cuts along %c at cells", "xyz"[a]);
-    for (int r = 1; r < d->dims[a]; r++) fprintf(out, " %ld", d->cut[a][r]);
-    fprintf(out, " of %ld\n", d->cells[a]);
-  }
-  if (d->held[0]) fprintf(out, "             not split: %s\n", d->held);
+  fprintf(out,
+          "ranks        %d: boxes of the grid's cells by recursive bisection "
+          "(cuts along x %d, y %d, z %d), %d ghost node layer%s\n",
+          d->size, d->cuts[0], d->cuts[1], d->cuts[2], d->ghost,
+          d->ghost == 1 ? "" : "s");
+  if (d->held[0]) fprintf(out, "             not cut: %s\n", d->held);
   long most = 0, least = -1, total = 0;
   for (int r = 0; r < d->size; r++) {
     total += d->count[r];
@@ -1134,6 +1135,7 @@ void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out) {
           "             particles per rank %ld to %ld (imbalance %.3f: the "
           "most over the mean)\n",
           least, most, total > 0 ? most * (double)d->size / total : 0.0);
+  (void)m;
 }
 
 /* Values per node the step's transfers exchange (mass, momentum, forces,
@@ -1149,27 +1151,37 @@ static int node_values_per_step(const mpm_model *m) {
   return v;
 }
 
+/* Whether rank r holds a node rank q owns (q is one of r's neighbours). */
+static bool neighbours(const mpm_decomp *d, const mpm_grid *g, int r, int q) {
+  long hl[3], hh[3], ol[3], oh[3];
+  mpm_decomp_held(d, r, g, hl, hh);
+  mpm_decomp_nodes(d, q, ol, oh);
+  for (int a = 0; a < g->dim; a++)
+    if (hh[a] <= ol[a] || oh[a] <= hl[a]) return false;
+  return true;
+}
+
 void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out) {
   const mpm_grid *g = &m->grid;
   const int values = node_values_per_step(m);
-  double owned_sum = 0, ghost_sum = 0, ghost_max = 0, ratio_max = 0;
+  double ghost_sum = 0, ghost_max = 0, ratio_max = 0;
+  int most_nb = 0;
   if (d->size <= 8)
     fprintf(out, "             rank  particles  nodes (owned + ghost)  "
                  "node bytes sent per step\n");
   for (int r = 0; r < d->size; r++) {
-    const int c[3] = {r % d->dims[0], (r / d->dims[0]) % d->dims[1],
-                      r / (d->dims[0] * d->dims[1])};
+    long lo[3], hi[3], hl[3], hh[3];
+    mpm_decomp_nodes(d, r, lo, hi);
+    mpm_decomp_held(d, r, g, hl, hh);
     double own = 1, held = 1;
     for (int a = 0; a < g->dim; a++) {
-      const long lo = d->cut[a][c[a]],
-                 hi = d->cut[a][c[a] + 1] + (c[a] == d->dims[a] - 1 ? 1 : 0);
-      const long glo = lo - d->ghost < 0 ? 0 : lo - d->ghost,
-                 ghi = hi + d->ghost > g->nn[a] ? g->nn[a] : hi + d->ghost;
-      own *= (double)(hi - lo);
-      held *= (double)(ghi - glo);
+      own *= (double)(hi[a] - lo[a]);
+      held *= (double)(hh[a] - hl[a]);
     }
+    int nb = 0;
+    for (int q = 0; q < d->size; q++) nb += q != r && neighbours(d, g, r, q);
+    most_nb = nb > most_nb ? nb : most_nb;
     const double ghost = held - own;
-    owned_sum += own;
     ghost_sum += ghost;
     ghost_max = ghost > ghost_max ? ghost : ghost_max;
     ratio_max = ghost / own > ratio_max ? ghost / own : ratio_max;
@@ -1180,10 +1192,10 @@ void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out) {
   }
   fprintf(out,
           "             ghost nodes per rank %.0f on average, %.0f at most "
-          "(%.3f of its own at most); %d values per node and step, so a "
-          "rank sends %.0f bytes of node sums per step on average, %.0f at "
-          "most\n",
-          ghost_sum / d->size, ghost_max, ratio_max, values,
+          "(%.3f of its own at most), %d neighbour ranks at most; %d values "
+          "per node and step, so a rank sends %.0f bytes of node sums per "
+          "step on average, %.0f at most\n",
+          ghost_sum / d->size, ghost_max, ratio_max, most_nb, values,
           2 * ghost_sum / d->size * values * sizeof(double),
           2 * ghost_max * values * sizeof(double));
 }

@@ -1,5 +1,5 @@
 /* mpm_par: explicit MPM across MPI ranks.  The grid is cut into boxes, one
- * per rank, on a PETSc DMDA; each rank holds the particles of its cells
+ * per rank; each rank holds the particles of its cells
  * and its block of the grid with the ghost node layers their stencils
  * reach.
  *
@@ -7,9 +7,10 @@
  * nodes, with three additions:
  *  - after every particle-to-grid transfer the ranks' contributions to a
  *    node are summed on its owner and the sums sent back to every rank
- *    that holds the node as a ghost (DMLocalToGlobal with ADD_VALUES, then
- *    DMGlobalToLocal), so that each rank holds whole nodal sums on all its
- *    nodes and updates its ghost nodes as their owner does: the grid's
+ *    that holds the node as a ghost (a PETSc star forest whose leaves are
+ *    the ghost nodes and whose roots are their owners' nodes: reduce with
+ *    MPI_SUM, then broadcast), so that each rank holds whole nodal sums on all
+ * its nodes and updates its ghost nodes as their owner does: the grid's
  *    velocities need no second exchange;
  *  - sums over nodes (reactions, residual, damping, energies) count owned
  *    nodes only and are summed over the ranks; the stable step is their
@@ -26,9 +27,11 @@
  *
  * The decomposition balances particles, not cells: along each axis it
  * splits, the cuts divide the particles of the initial state into equal
- * shares.  It leaves unsplit an axis along which a boundary wall moves (a
- * face condition's column is walked from the grid's edge to the wall) and
- * keeps cuts clear of face planes. */
+ * shares (recursive bisection: boxes of any shape, so that particles in a
+ * sphere are shared as well as particles filling the box).  It leaves
+ * uncut an axis along which a boundary wall moves (a face condition's
+ * column is walked from the grid's edge to the wall) and keeps cuts clear
+ * of face planes.  The node sums run on a PetscSF of the ghost nodes. */
 #ifndef MPM_PAR_H
 #define MPM_PAR_H
 
@@ -37,28 +40,45 @@
 #include "mpm_model.h"
 #include "mpm_state.h"
 
-/* A decomposition of the grid's cells into boxes, one per rank. */
+/* A cut of the bisection: cells below `at` along `axis` go to child[0],
+ * the others to child[1]; a child is another cut, or -(rank + 1). */
 typedef struct {
-  int size;       /* ranks */
-  int dims[3];    /* ranks per axis (rank = i + dims0 (j + dims1 k)) */
-  long cells[3];  /* cells per axis of the whole grid (1 on z in 2-D) */
-  long *cut[3];   /* dims[a] + 1 cell indices per axis: the column r of
-                     ranks along a owns cells [cut[a][r], cut[a][r + 1]) */
-  long *count;    /* particles per rank in the state decomposed */
-  int ghost;      /* node layers a rank holds beyond its own nodes */
-  char held[256]; /* the axes left unsplit, and why */
+  int axis;
+  long at;
+  int child[2];
+} mpm_decomp_cut;
+
+/* A decomposition of the grid's cells into boxes, one per rank, by
+ * recursive bisection. */
+typedef struct {
+  int size;             /* ranks */
+  long cells[3];        /* cells per axis of the whole grid (1 on z in 2-D) */
+  long *box;            /* 6 per rank: its cells [lo, hi) along x, y, z */
+  mpm_decomp_cut *tree; /* size - 1 cuts; the first is the root */
+  int cuts[3];          /* cuts along each axis */
+  long *count;          /* particles per rank in the state decomposed */
+  int ghost;            /* node layers a rank holds beyond its own nodes */
+  char held[256];       /* the axes that are not cut, and why */
 } mpm_decomp;
 
 /* Decompose model m's grid (scene s) for `size` ranks, balancing the
- * particles of state st.  PM_ERR_SCENE (naming what prevents it) when the
- * grid cannot be shared by that many ranks.  Release with
- * mpm_decomp_destroy. */
+ * particles of state st: the box of the whole grid is cut along its
+ * longest axis that may be cut, where its particles divide in the
+ * proportion of the ranks on each side, and each side likewise.  PM_ERR_SCENE
+ * (naming what prevents it) when the grid cannot be shared by that many ranks.
+ * Release with mpm_decomp_destroy. */
 pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m,
                          const mpm_state *st, int size, mpm_decomp *d);
 void mpm_decomp_destroy(mpm_decomp *d);
 /* The rank that owns the cell of position x. */
 int mpm_decomp_rank_at(const mpm_decomp *d, const mpm_grid *g,
                        const double x[3]);
+/* The nodes rank r owns, [lo, hi) per axis (a box's cells' lower nodes,
+ * and the grid's last nodes for a box at its upper end), and those it
+ * holds (with the ghost layers, within grid g). */
+void mpm_decomp_nodes(const mpm_decomp *d, int r, long lo[3], long hi[3]);
+void mpm_decomp_held(const mpm_decomp *d, int r, const mpm_grid *g, long lo[3],
+                     long hi[3]);
 
 /* What a run across ranks needs that one process does not: refuse what
  * it cannot do yet, naming the scene key (PM_ERR_SCENE).  Called by the
