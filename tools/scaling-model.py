@@ -16,11 +16,12 @@ Explicit MPM, per step on P ranks:
     + exchanges * 2 * neighbours * alpha                  node sums: messages
     + bytes / beta                                        node sums: volume
     + collectives * alpha * ceil(log2 P)                  agreements, dt, sums
-    + (P - 1) * alpha                                     migration's counts
+    + 2 * neighbours * alpha                              migration (counts,
+                                                          then particles)
 with 2 exchanges a step (MUSL: the transfer, the remap), the busiest rank's
-neighbours as the plan counts them, and 17 collectives (an agreement after each of about 8
-stages, the stable step, the step's figures, the migration's, the
-observer's).
+neighbours as the plan counts them, and 16 collectives (an agreement after each of about 8
+stages, the stable step, the step's figures, the migration's two, the
+observer's two).
 Implicit MPM, per run on P ranks (--implicit):
   T = imbalance * (assembly + residual) / P
     + iterations * (linear / iterations / P
@@ -106,7 +107,7 @@ def main():
         if not a.implicit:
             work = imb * t1 / p
             comm = (2 * 2 * nbr * a.alpha + bmax / a.beta +
-                    17 * a.alpha * lg + (p - 1) * a.alpha)
+                    16 * a.alpha * lg + 2 * nbr * a.alpha)
         else:
             work = imb * (asm + res) / p + lin / p
             comm = its * (8 * (2 * nbr * a.alpha + 24 * gmax / a.beta) +

@@ -49,11 +49,16 @@ struct mpm_par {
   long n_full;
   long gbegin[MPM_MAX_GROUPS], gend[MPM_MAX_GROUPS];
   long *bbegin, *bend; /* per body */
-  /* migration */
-  int rec;   /* doubles per record */
-  int width; /* doubles per particle of the widest array (>= 9) */
-  int *dest; /* per particle (room): its rank after the move */
-  int *scount, *rcount, *sdisp, *rdisp; /* per rank, in doubles */
+  /* migration: to the ranks whose boxes touch this rank's (a particle
+   * moves less than a cell in a step), on a graph communicator */
+  MPI_Comm near;
+  int n_near;   /* such ranks */
+  int *near_of; /* per rank: its place among them, or -1 */
+  int rec;      /* doubles per record */
+  int width;    /* doubles per particle of the widest array (>= 9) */
+  int *dest;    /* per particle (room): where it goes among the near ranks
+                   (-1: it stays) */
+  int *scount, *rcount, *sdisp, *rdisp; /* per near rank, in doubles */
   double *sbuf, *rbuf;
   long sbuf_room, rbuf_room; /* records */
   long *order;               /* per new particle: old index, or -(k + 1) for
@@ -468,6 +473,41 @@ done:
   return ret;
 }
 
+/* The ranks whose boxes touch this rank's, within a cell (those a
+ * particle can move to in a step), and their graph communicator. */
+static pm_err make_near(struct mpm_par *P, const mpm_model *m) {
+  const mpm_decomp *d = &P->d;
+  const long *me = d->box + 6 * P->rank;
+  PM_CALL(PM_ALLOC(P->near_of, d->size, "near ranks"));
+  int *list = NULL, *weight = NULL; /* (all 1: one step's particles) */
+  PM_CALL(PM_ALLOC(list, d->size + 1, "near ranks"));
+  if (PM_ALLOC(weight, d->size + 1, "near ranks")) {
+    free(list);
+    return PM_ERR_MEMORY;
+  }
+  P->n_near = 0;
+  for (int q = 0; q < d->size; q++) {
+    P->near_of[q] = -1;
+    if (q == P->rank) continue;
+    const long *b = d->box + 6 * q;
+    bool touch = true;
+    for (int a = 0; a < m->dim; a++)
+      touch = touch && b[a] <= me[3 + a] && me[a] <= b[3 + a];
+    if (!touch) continue;
+    P->near_of[q] = P->n_near;
+    weight[P->n_near] = 1;
+    list[P->n_near++] = q;
+  }
+  int e = MPI_Dist_graph_create_adjacent(MPI_COMM_WORLD, P->n_near, list,
+                                         weight, P->n_near, list, weight,
+                                         MPI_INFO_NULL, 0, &P->near);
+  free(list);
+  free(weight);
+  PM_CHECK(e == MPI_SUCCESS, PM_ERR_INTERNAL,
+           "MPI_Dist_graph_create_adjacent failed (%d)", e);
+  return PM_SUCCESS;
+}
+
 /* Room for n particles and some to arrive. */
 static long room_for(long n) { return n + n / 4 + 64; }
 
@@ -642,6 +682,7 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   if (!ret) ret = local_state(m, st, lm, &ls);
   PM_TRY(pm_par_agree(ret));
   struct mpm_par *Q = lm->par;
+  PM_TRY(make_near(Q, m));
   Q->rec = record_doubles(lm, &Q->width);
   const long room = mpm_model_room(lm);
   PM_TRY(PM_ALLOC(Q->dest, room, "migration ranks"));
@@ -685,6 +726,8 @@ void mpm_par_destroy(struct mpm_par *P) {
   }
   free(P->nodal);
   free(P->whole);
+  if (P->near_of) MPI_Comm_free(&P->near);
+  free(P->near_of);
   mpm_decomp_destroy(&P->d);
   free(P->owned);
   free(P->bbegin);
@@ -846,43 +889,49 @@ static void permute(const struct mpm_par *P, double *data, long n_new, int nc,
 
 pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   struct mpm_par *P = m->par;
-  const int size = P->d.size, rec = P->rec;
+  const int n_near = P->n_near, rec = P->rec;
   const double t0 = pm_wtime();
+  pm_err ret = PM_SUCCESS;
   pm_timers_start(&w->timers, w->timer_migrate);
   /* Where each particle goes. */
-  memset(P->scount, 0, sizeof(int) * (size_t)size);
-  long leaving = 0;
+  memset(P->scount, 0, sizeof(int) * (size_t)(n_near + 1));
+  long leaving = 0, far = -1;
   for (long p = 0; p < m->n; p++) {
-    int r = mpm_decomp_rank_at(&P->d, &m->grid, s->x + 3 * p);
-    P->dest[p] = r;
-    if (r != P->rank) {
-      P->scount[r]++;
+    const int r = mpm_decomp_rank_at(&P->d, &m->grid, s->x + 3 * p);
+    const int k = r == P->rank ? -1 : P->near_of[r];
+    P->dest[p] = k;
+    if (r != P->rank && k < 0 && far < 0) far = p;
+    if (k >= 0) {
+      P->scount[k]++;
       leaving++;
     }
   }
-  MPI_Alltoall(P->scount, 1, MPI_INT, P->rcount, 1, MPI_INT, MPI_COMM_WORLD);
+  if (far >= 0)
+    ret = PM_ERROR(PM_ERR_UNSTABLE,
+                   "step %ld, t = %.6g s, migration: particle %ld at (%g, %g, "
+                   "%g) moved past the boxes next to its rank's in one step "
+                   "(more than a cell): the step is too large",
+                   s->step, s->t, m->gid[far], s->x[3 * far], s->x[3 * far + 1],
+                   s->x[3 * far + 2]);
+  MPI_Neighbor_alltoall(P->scount, 1, MPI_INT, P->rcount, 1, MPI_INT, P->near);
   long arriving = 0;
-  for (int r = 0; r < size; r++) arriving += P->rcount[r];
-  long moved[2] = {leaving, arriving};
-  pm_par_sum_long(moved, 1);
-  pm_err ret = PM_SUCCESS;
-  if (moved[0] == 0) goto done; /* nobody moved anywhere */
-  ret = grow_buffer(&P->sbuf, &P->sbuf_room, leaving, rec);
+  for (int k = 0; k < n_near; k++) arriving += P->rcount[k];
+  if (!ret) ret = grow_buffer(&P->sbuf, &P->sbuf_room, leaving, rec);
   if (!ret) ret = grow_buffer(&P->rbuf, &P->rbuf_room, arriving, rec);
   ret = pm_par_agree(ret);
   if (ret) goto done;
   /* Pack the leaving particles, by rank, in their order. */
   P->sdisp[0] = P->rdisp[0] = 0;
-  for (int r = 0; r < size; r++) {
-    P->sdisp[r + 1] = P->sdisp[r] + P->scount[r];
-    P->rdisp[r + 1] = P->rdisp[r] + P->rcount[r];
+  for (int k = 0; k < n_near; k++) {
+    P->sdisp[k + 1] = P->sdisp[k] + P->scount[k];
+    P->rdisp[k + 1] = P->rdisp[k] + P->rcount[k];
   }
-  for (int r = 0; r < size; r++) P->scount[r] = 0;
-  for (int gi = 0; gi < m->n_groups; gi++) {
+  for (int k = 0; k < n_near; k++) P->scount[k] = 0;
+  for (int gi = 0; leaving > 0 && gi < m->n_groups; gi++) {
     const mpm_group *g = &m->group[gi];
     for (long p = g->begin; p < g->end; p++) {
       const int r = P->dest[p];
-      if (r == P->rank) continue;
+      if (r < 0) continue;
       double *q = P->sbuf + (long)(P->sdisp[r] + P->scount[r]++) * rec;
       q[REC_GID] = (double)m->gid[p];
       q[REC_GROUP] = gi;
@@ -902,16 +951,16 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
       }
     }
   }
-  for (int r = 0; r <= size; r++) {
-    P->sdisp[r] *= rec;
-    P->rdisp[r] *= rec;
+  for (int k = 0; k <= n_near; k++) {
+    P->sdisp[k] *= rec;
+    P->rdisp[k] *= rec;
   }
-  for (int r = 0; r < size; r++) {
-    P->scount[r] = P->sdisp[r + 1] - P->sdisp[r];
-    P->rcount[r] = P->rdisp[r + 1] - P->rdisp[r];
+  for (int k = 0; k < n_near; k++) {
+    P->scount[k] = P->sdisp[k + 1] - P->sdisp[k];
+    P->rcount[k] = P->rdisp[k + 1] - P->rdisp[k];
   }
-  MPI_Alltoallv(P->sbuf, P->scount, P->sdisp, MPI_DOUBLE, P->rbuf, P->rcount,
-                P->rdisp, MPI_DOUBLE, MPI_COMM_WORLD);
+  MPI_Neighbor_alltoallv(P->sbuf, P->scount, P->sdisp, MPI_DOUBLE, P->rbuf,
+                         P->rcount, P->rdisp, MPI_DOUBLE, P->near);
   P->counts.migrated += leaving;
   P->counts.migrate_bytes += (double)leaving * rec * sizeof(double);
   pm_par_count_sent((double)leaving * rec * sizeof(double));
@@ -924,7 +973,7 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   for (int gi = 0; gi < m->n_groups; gi++)
     gcount[gi] = m->group[gi].end - m->group[gi].begin;
   for (long p = 0; p < m->n; p++)
-    if (P->dest[p] != P->rank)
+    if (P->dest[p] >= 0)
       for (int gi = 0; gi < m->n_groups; gi++)
         if (p >= m->group[gi].begin && p < m->group[gi].end) gcount[gi]--;
   for (long k = 0; k < arriving; k++)
@@ -935,7 +984,7 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   {
     long j = 0, p = 0, k = 0;
     while (p < m->n || k < arriving) {
-      if (p < m->n && P->dest[p] != P->rank) {
+      if (p < m->n && P->dest[p] >= 0) {
         p++;
         continue;
       }
