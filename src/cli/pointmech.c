@@ -411,11 +411,13 @@ int main(int argc, char **argv) {
   /* Across ranks, rank 0 prints; the others' output would repeat it. */
   if (!pm_par_root() && !freopen("/dev/null", "w", stdout))
     pm_par_abort(EXIT_INPUT, "cannot silence the output of this rank");
-  if (pm_par_active() && strcmp(cmd, "run") != 0 && strcmp(cmd, "plan") != 0) {
+  if (pm_par_active() && strcmp(cmd, "run") != 0 && strcmp(cmd, "plan") != 0 &&
+      strcmp(cmd, "resume") != 0) {
     if (pm_par_root())
       fprintf(stderr,
               "pointmech: %s runs on one process (this run has %d ranks): "
-              "start it without mpirun; run and plan go across ranks\n",
+              "start it without mpirun; run, plan and resume go across "
+              "ranks\n",
               cmd, pm_par_size());
     return EXIT_INPUT;
   }
@@ -446,7 +448,8 @@ int main(int argc, char **argv) {
     pm_outcome o;
     pm_err e = pm_resume(a.scene, run_flags(&a), &o);
     int status = e ? report(e) : EXIT_OK;
-    if (access(a.scene, F_OK) == 0) fprintf(stderr, "results in %s\n", a.scene);
+    if (pm_par_root() && access(a.scene, F_OK) == 0)
+      fprintf(stderr, "results in %s\n", a.scene);
     return status;
   }
   if (strcmp(cmd, "keys") == 0) {

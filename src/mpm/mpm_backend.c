@@ -38,19 +38,30 @@ static pm_err figures_work(const mpm_model *m, mpm_work **out) {
   return PM_ALLOC((*out)->cond.reaction, 3 * m->n_bcs + 1, "reactions");
 }
 
-/* Across ranks: this rank's share of the model every rank set up, which
- * rank 0 alone keeps (collective; every rank returns the same error). */
-static pm_err ranks_setup(mpm_sim *r) {
-  const pm_scene *s = r->scene;
-  PM_CALL(pm_par_agree(
-      mpm_par_create(s, r->model, r->state, &r->local_model, &r->local_state)));
-  PM_CALL(pm_par_agree(mpm_work_create(r->local_model, &r->local_work)));
-  if (pm_par_root()) return pm_par_agree(figures_work(r->model, &r->work));
+/* Across ranks: this rank's share of the whole model and state, which
+ * every rank holds (collective; every rank returns the same error), with
+ * the energy accounts of a checkpoint of as many ranks, if given. */
+static pm_err ranks_share(mpm_sim *r, const double *accounts) {
+  PM_CALL(pm_par_agree(mpm_par_create(r->scene, r->model, r->state, accounts,
+                                      &r->local_model, &r->local_state)));
+  return pm_par_agree(mpm_work_create(r->local_model, &r->local_work));
+}
+
+/* Across ranks, once the run starts: the whole model stays on rank 0 as
+ * its view of the run; the other ranks let it go.  Until then every rank
+ * holds it, so that a checkpoint is read into it. */
+static void release_view(mpm_sim *r) {
+  if (pm_par_root() || !r->model) return;
   mpm_state_destroy(r->state);
   mpm_model_destroy(r->model);
   r->state = NULL;
   r->model = NULL;
-  return pm_par_agree(PM_SUCCESS);
+}
+
+static pm_err ranks_setup(mpm_sim *r) {
+  PM_CALL(ranks_share(r, NULL));
+  return pm_par_agree(pm_par_root() ? figures_work(r->model, &r->work)
+                                    : PM_SUCCESS);
 }
 
 /* The simulation of s: explicit (its step's workspace) or implicit (its
@@ -73,7 +84,7 @@ static pm_err sim_create(const pm_scene *s, bool implicit, mpm_sim **out) {
     PM_TRY(mpm_work_create(r->model, &r->work));
   }
   r->setup_wall = pm_wtime() - t0;
-  if (r->model) { /* the outputs' (rank 0's across ranks) */
+  if (pm_par_root()) { /* the outputs' (rank 0's across ranks) */
     PM_TRY(PM_ALLOC(r->scratch, scratch_per_particle(r->model) * r->model->n,
                     "output buffer"));
     PM_TRY(history_setup(r));
@@ -91,6 +102,7 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
 
 void mpm_sim_destroy(mpm_sim *r) {
   if (!r) return;
+  free(r->ckpt_accounts);
   mpm_work_destroy(r->local_work);
   mpm_state_destroy(r->local_state);
   mpm_model_destroy(r->local_model);
@@ -213,8 +225,19 @@ static pm_err observe_ranks(void *ctx, const mpm_model *m, const mpm_state *s,
 /* The time loop across ranks: every rank steps its share; rank 0's view
  * is gathered where the run writes, and at the end. */
 static pm_err run_ranks(mpm_sim *r, const pm_observer *obs) {
-  mpm_model *lm = r->local_model;
   pm_err e = PM_SUCCESS;
+  if (r->resumed) { /* the shares of the state read from the checkpoint */
+    mpm_work_destroy(r->local_work);
+    mpm_state_destroy(r->local_state);
+    mpm_model_destroy(r->local_model);
+    r->local_work = NULL;
+    r->local_state = NULL;
+    r->local_model = NULL;
+    PM_CALL(ranks_share(r, r->ckpt_ranks == pm_par_size() ? r->ckpt_accounts
+                                                          : NULL));
+  }
+  release_view(r);
+  mpm_model *lm = r->local_model;
   r->obs = obs;
   if (!r->resumed) {
     r->run_min_jacobian = INFINITY;
@@ -892,6 +915,7 @@ static void plan_estimate(double per, double steps, long n, double setup,
 /* The plan across ranks (collective): rank 0's view prints the scene's
  * lines, every rank its share, and a few steps of the shares are timed. */
 static pm_err plan_ranks(mpm_sim *r, FILE *out) {
+  release_view(r);
   double steps = r->model ? plan_head(r, out) : 0;
   mpm_par_plan(r->local_model, r->local_work, r->model ? out : NULL);
   double t0 = pm_wtime();
@@ -926,7 +950,7 @@ static pm_err plan(void *p, FILE *out) {
           9 * sizeof(double) * (size_t)m->n / 1048576.0);
   if (pm_par_plan_ranks() > 1) { /* plan --ranks N: the decomposition */
     mpm_decomp d;
-    PM_CALL(mpm_decomp_create(r->scene, m, st, pm_par_plan_ranks(), &d));
+    PM_CALL(mpm_decomp_create(r->scene, m, pm_par_plan_ranks(), &d));
     mpm_decomp_print(&d, m, out);
     mpm_decomp_predict(&d, m, out);
     mpm_decomp_destroy(&d);
@@ -952,6 +976,35 @@ static pm_err create(const pm_scene *s, void **out) {
 
 static void destroy(void *p) { mpm_sim_destroy(p); }
 
+/* The ranks a run had and their energy accounts (one process: its own),
+ * so that a run resumed on as many ranks goes on as it would have. */
+static pm_err ranks_checkpoint(mpm_sim *r, pm_ckpt *ck) {
+  const int n = MPM_PAR_ACCOUNTS;
+  long ranks = pm_par_size();
+  PM_CALL(pm_ckpt_long(ck, "run.ranks", &ranks));
+  PM_CHECK(ranks >= 1 && ranks <= 1000000, PM_ERR_IO,
+           "%s: run.ranks: expected a count of ranks, got %ld",
+           pm_ckpt_path(ck), ranks);
+  if (pm_ckpt_reading(ck)) {
+    free(r->ckpt_accounts);
+    r->ckpt_accounts = NULL;
+    PM_CALL(PM_ALLOC(r->ckpt_accounts, n * ranks, "energy accounts"));
+    r->ckpt_ranks = (int)ranks;
+    return pm_ckpt_doubles(ck, "run.ranks.accounts", n * ranks,
+                           r->ckpt_accounts);
+  }
+  double own[MPM_PAR_ACCOUNTS];
+  const double *rows = own;
+  if (r->local_model) {
+    rows = mpm_par_accounts(r->local_model);
+  } else {
+    memcpy(own, r->state->energy, sizeof r->state->energy);
+    own[n - 2] = r->state->external_work;
+    own[n - 1] = r->state->dissipated;
+  }
+  return pm_ckpt_doubles(ck, "run.ranks.accounts", n * ranks, (double *)rows);
+}
+
 /* The state, and what the run reports over all its steps. */
 static pm_err checkpoint(void *p, pm_ckpt *ck) {
   mpm_sim *r = p;
@@ -963,6 +1016,7 @@ static pm_err checkpoint(void *p, pm_ckpt *ck) {
   PM_CALL(pm_ckpt_long(ck, "run.iter_max_row", &iter_max_row));
   r->iter_max_row = (int)iter_max_row;
   PM_CALL(pm_ckpt_long(ck, "run.iter_capped_prev", &r->iter_capped_prev));
+  PM_CALL(ranks_checkpoint(r, ck));
   if (pm_ckpt_reading(ck)) {
     r->resumed = true;
     r->last.step = r->state->step;

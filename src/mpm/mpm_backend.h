@@ -33,6 +33,10 @@ typedef struct {
    * particles summed over the ranks, their seconds the slowest rank's;
    * the ranks' own work (stages less exchanges), the most and the mean */
   double ranks_counts[8];
+  /* read from a checkpoint: the ranks of the run that wrote it and their
+   * energy accounts (MPM_PAR_ACCOUNTS each) */
+  int ckpt_ranks;
+  double *ckpt_accounts;
   struct mpm_implicit *imp;   /* method mpm-implicit: its solver (else NULL) */
   int imp_newton, imp_linear; /* the last load step's iterations */
   double setup_wall;          /* s */

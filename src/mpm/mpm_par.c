@@ -65,6 +65,7 @@ struct mpm_par {
                                 the k-th record received */
   double *tmp;               /* room x width: one array's new order */
   /* gather (rank 0 holds the whole run's buffers) */
+  double *accounts; /* every rank's energy accounts, on rank 0 */
   long *ggid;
   double *gbuf;
   int *gcount, *gdisp;
@@ -283,8 +284,8 @@ static pm_err bisect(bisection *B, int r0, int n, const long lo[3],
   return PM_SUCCESS;
 }
 
-pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m,
-                         const mpm_state *st, int size, mpm_decomp *d) {
+pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m, int size,
+                         mpm_decomp *d) {
   pm_err ret = PM_SUCCESS;
   const mpm_grid *g = &m->grid;
   bisection B = {.s = s, .m = m, .d = d};
@@ -315,7 +316,7 @@ pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m,
   PM_TRY(PM_ALLOC(B.hist, most, "decomposition histogram"));
   PM_TRY(PM_ALLOC(idx, m->n + 1, "particles' order"));
   for (long p = 0; p < m->n; p++) {
-    cell_of(g, d->cells, st->x + 3 * p, B.cell + 3 * p);
+    cell_of(g, d->cells, m->x0 + 3 * p, B.cell + 3 * p);
     idx[p] = p;
   }
   const long lo[3] = {0, 0, 0};
@@ -528,7 +529,11 @@ static pm_err local_model(const pm_scene *s, const mpm_model *m,
   lm->layout = m->layout;
   PM_TRY(local_grid(P, &m->grid, &lm->grid));
   PM_TRY(make_ghosts(P, &m->grid, &lm->grid));
-  long n = P->d.count[P->rank];
+  /* The particles in this rank's cells now (at the start, or where a
+   * resumed run's checkpoint has them). */
+  long n = 0;
+  for (long p = 0; p < m->n; p++)
+    n += mpm_decomp_rank_at(&P->d, &m->grid, st->x + 3 * p) == P->rank;
   lm->n = n;
   lm->cap = room_for(n);
   PM_TRY(PM_ALLOC(lm->x0, 3 * lm->cap, "particle positions"));
@@ -595,10 +600,11 @@ done:
 }
 
 /* The local state: the full state's values of this rank's particles and
- * nodes; the energy accounts on rank 0 (each rank sums its own from
- * here). */
+ * nodes; the energy accounts this rank's row of `accounts` (each rank sums
+ * its own from there), or without them all on rank 0. */
 static pm_err local_state(const mpm_model *m, const mpm_state *st,
-                          const mpm_model *lm, mpm_state **out) {
+                          const mpm_model *lm, const double *accounts,
+                          mpm_state **out) {
   mpm_state *ls = NULL;
   PM_CALL(mpm_state_create(lm, &ls));
   const struct mpm_par *P = lm->par;
@@ -623,7 +629,12 @@ static pm_err local_state(const mpm_model *m, const mpm_state *st,
   }
   /* Scalars: every rank's the same, but the accounts. */
   mpm_state_copy_values(ls, st);
-  if (P->rank != 0) {
+  if (accounts) {
+    const double *row = accounts + MPM_PAR_ACCOUNTS * P->rank;
+    memcpy(ls->energy, row, sizeof ls->energy);
+    ls->external_work = row[MPM_PAR_ACCOUNTS - 2];
+    ls->dissipated = row[MPM_PAR_ACCOUNTS - 1];
+  } else if (P->rank != 0) {
     memset(ls->energy, 0, sizeof ls->energy);
     ls->external_work = ls->dissipated = 0;
   }
@@ -661,8 +672,8 @@ static int record_doubles(const mpm_model *m, int *width) {
 }
 
 pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
-                      const mpm_state *st, mpm_model **local,
-                      mpm_state **local_state_out) {
+                      const mpm_state *st, const double *accounts,
+                      mpm_model **local, mpm_state **local_state_out) {
   pm_err ret = PM_SUCCESS;
   struct mpm_par *P = NULL;
   mpm_model *lm = NULL;
@@ -674,12 +685,12 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
    * before the collectives that follow. */
   ret = pm_petsc_init();
   if (!ret) ret = PM_ALLOC(P, 1, "run across ranks");
-  if (!ret) ret = mpm_decomp_create(s, m, st, size, &P->d);
+  if (!ret) ret = mpm_decomp_create(s, m, size, &P->d);
   PM_TRY(pm_par_agree(ret));
   P->rank = pm_par_rank();
   ret = local_model(s, m, st, P, &lm);
   if (!ret) P = NULL; /* lm holds it */
-  if (!ret) ret = local_state(m, st, lm, &ls);
+  if (!ret) ret = local_state(m, st, lm, accounts, &ls);
   PM_TRY(pm_par_agree(ret));
   struct mpm_par *Q = lm->par;
   PM_TRY(make_near(Q, m));
@@ -703,6 +714,7 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
       PM_TRY(PM_ALLOC(Q->whole, 3 * m->grid.n_nodes, "nodal gather"));
   }
   if (Q->rank == 0) {
+    PM_TRY(PM_ALLOC(Q->accounts, MPM_PAR_ACCOUNTS * size, "energy accounts"));
     PM_TRY(PM_ALLOC(Q->ggid, m->n, "gather indices"));
     PM_TRY(PM_ALLOC(Q->gbuf, Q->width * m->n, "gather buffer"));
   }
@@ -741,6 +753,7 @@ void mpm_par_destroy(struct mpm_par *P) {
   free(P->rbuf);
   free(P->order);
   free(P->tmp);
+  free(P->accounts);
   free(P->ggid);
   free(P->gbuf);
   free(P->gcount);
@@ -1108,13 +1121,15 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
                    fs ? fs->group[gi].array[k].data : NULL);
     }
   }
-  /* The energy accounts, summed. */
-  enum { n_acc = sizeof(((mpm_state *)0)->energy) / (sizeof(double)) };
-  double acc[n_acc + 2];
+  /* The energy accounts: every rank's (for a checkpoint), and summed. */
+  enum { n_acc = MPM_PAR_ACCOUNTS - 2 };
+  double acc[MPM_PAR_ACCOUNTS];
   memcpy(acc, s->energy, sizeof s->energy);
   acc[n_acc] = s->external_work;
   acc[n_acc + 1] = s->dissipated;
-  pm_par_sum(acc, n_acc + 2);
+  MPI_Gather(acc, MPM_PAR_ACCOUNTS, MPI_DOUBLE, P->accounts, MPM_PAR_ACCOUNTS,
+             MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  pm_par_sum(acc, MPM_PAR_ACCOUNTS);
   if (fs) {
     mpm_state_copy_values(fs, s);
     memcpy(fs->energy, acc, sizeof fs->energy);
@@ -1273,6 +1288,8 @@ void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
 }
 
 const mpm_decomp *mpm_par_decomp(const mpm_model *m) { return &m->par->d; }
+
+const double *mpm_par_accounts(const mpm_model *m) { return m->par->accounts; }
 
 void mpm_par_get_counts(const mpm_model *m, mpm_par_counts *c) {
   *c = m->par ? m->par->counts : (mpm_par_counts){0};

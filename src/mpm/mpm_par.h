@@ -56,19 +56,20 @@ typedef struct {
   long *box;            /* 6 per rank: its cells [lo, hi) along x, y, z */
   mpm_decomp_cut *tree; /* size - 1 cuts; the first is the root */
   int cuts[3];          /* cuts along each axis */
-  long *count;          /* particles per rank in the state decomposed */
+  long *count;          /* particles per rank at the reference positions */
   int ghost;            /* node layers a rank holds beyond its own nodes */
   char held[256];       /* the axes that are not cut, and why */
 } mpm_decomp;
 
-/* Decompose model m's grid (scene s) for `size` ranks, balancing the
- * particles of state st: the box of the whole grid is cut along its
+/* Decompose model m's grid (scene s) for `size` ranks, balancing its
+ * particles at their reference positions (so that a resumed run has the
+ * boxes of its start): the box of the whole grid is cut along its
  * longest axis that may be cut, where its particles divide in the
  * proportion of the ranks on each side, and each side likewise.  PM_ERR_SCENE
  * (naming what prevents it) when the grid cannot be shared by that many ranks.
  * Release with mpm_decomp_destroy. */
-pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m,
-                         const mpm_state *st, int size, mpm_decomp *d);
+pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m, int size,
+                         mpm_decomp *d);
 void mpm_decomp_destroy(mpm_decomp *d);
 /* The rank that owns the cell of position x. */
 int mpm_decomp_rank_at(const mpm_decomp *d, const mpm_grid *g,
@@ -88,10 +89,21 @@ pm_err mpm_par_check(const pm_scene *s);
 /* This rank's model and state of the run of full model m (scene s) at
  * state st, which every rank holds: its cells' particles, its block of the
  * grid, the conditions on it and the exchanges with the other ranks
- * (collective).  *local owns its arrays; m and st are left as they are. */
+ * (collective).  Its energy accounts are its row of `accounts`
+ * (MPM_PAR_ACCOUNTS per rank, as a checkpoint of as many ranks keeps
+ * them), or without them st's on rank 0 and none on the others.  *local
+ * owns its arrays; m and st are left as they are. */
 pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
-                      const mpm_state *st, mpm_model **local,
-                      mpm_state **local_state);
+                      const mpm_state *st, const double *accounts,
+                      mpm_model **local, mpm_state **local_state);
+
+/* A rank's energy accounts: each stage's (work, dissipated), the external
+ * work and the energy dissipated. */
+#define MPM_PAR_ACCOUNTS                                                       \
+  ((int)(sizeof(((mpm_state *)0)->energy) / (sizeof(double))) + 2)
+/* Every rank's accounts as the last gather found them, on rank 0 (NULL on
+ * the others). */
+const double *mpm_par_accounts(const mpm_model *m);
 /* Release a model's share of a run across ranks (mpm_model_destroy). */
 void mpm_par_destroy(struct mpm_par *p);
 

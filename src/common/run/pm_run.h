@@ -62,8 +62,9 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
  * when it is damaged, with the reason), frames and history rows written
  * after the checkpoint are dropped, and the run goes on appending to the
  * same results, history and summary.  On the thread count of the first run
- * it ends bit-identical to an uninterrupted run.  One process only
- * (PM_ERR_UNSUPPORTED across ranks). */
+ * it ends bit-identical to an uninterrupted run.  Across ranks every rank
+ * calls it: rank 0 claims the folder and writes, every rank reads the
+ * checkpoint. */
 pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o);
 
 /* Create the simulation and print its plan with the memory estimate (the
