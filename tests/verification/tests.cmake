@@ -66,4 +66,12 @@ if(PM_MPI)
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_migrate>)
   set_tests_properties(verification.ranks PROPERTIES LABELS verification
     TIMEOUT 600 PROCESSORS 2)
+  # The Newton layer and the implicit MPM across ranks.
+  add_executable(ranks_newton ${PM_VERIFY_DIR}/ranks_newton.c)
+  target_link_libraries(ranks_newton PRIVATE pm_app)
+  add_test(NAME verification.ranks_implicit
+    COMMAND bash ${PM_VERIFY_DIR}/ranks-implicit.sh $<TARGET_FILE:pointmech>
+      ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_newton>)
+  set_tests_properties(verification.ranks_implicit PROPERTIES LABELS
+    verification TIMEOUT 600 PROCESSORS 2)
 endif()

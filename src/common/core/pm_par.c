@@ -108,6 +108,19 @@ void pm_par_max_long(long *v, int n) {
 #endif
 }
 
+long pm_par_offset(long n) {
+#ifdef PM_HAVE_MPI
+  if (par_size == 1) return 0;
+  long before = 0;
+  MPI_Exscan(&n, &before, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  par_sent += sizeof(long);
+  return par_rank == 0 ? 0 : before;
+#else
+  (void)n;
+  return 0;
+#endif
+}
+
 void pm_par_bcast(void *p, size_t n) {
 #ifdef PM_HAVE_MPI
   if (par_size == 1 || n == 0) return;

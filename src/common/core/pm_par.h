@@ -37,6 +37,9 @@ void pm_par_sum_long(long *v, int n);
 void pm_par_max(double *v, int n);
 void pm_par_min(double *v, int n);
 void pm_par_max_long(long *v, int n);
+/* The sum of n over the ranks before this one (0 on rank 0): where this
+ * rank's share starts in a numbering of every rank's in rank order. */
+long pm_par_offset(long n);
 /* Rank 0's n bytes at p on every rank. */
 void pm_par_bcast(void *p, size_t n);
 

@@ -39,9 +39,9 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
   const long n = p->n;
   const double h = 1e-6 * (target - lambda);
   pm_err e = p->set_load(p->ctx, lambda + h);
-  if (e == PM_SUCCESS) e = p->residual(p->ctx, xc, rh);
+  if (e == PM_SUCCESS) e = pm_newton_residual(s, xc, rh);
   if (e == PM_SUCCESS) e = p->set_load(p->ctx, lambda);
-  if (e == PM_SUCCESS) e = p->residual(p->ctx, xc, r);
+  if (e == PM_SUCCESS) e = pm_newton_residual(s, xc, r);
   if (e == PM_SUCCESS) {
     const double f = (target - lambda) / h;
     for (long i = 0; i < n; i++) rh[i] = -(r[i] + f * (rh[i] - r[i]));
@@ -139,9 +139,8 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     if (predicted) {
       /* rtol stays relative to the step's imbalance at the last state:
        * a good prediction must not tighten it to roundoff. */
-      if (p->residual(p->ctx, xc, r) == PM_SUCCESS) {
-        for (long i = 0; i < n; i++) r_ref += r[i] * r[i];
-        r_ref = sqrt(r_ref);
+      if (pm_newton_residual(s, xc, r) == PM_SUCCESS) {
+        r_ref = pm_newton_norm(s, r);
       } else {
         pm_error_clear();
       }

@@ -12,6 +12,7 @@
 
 #include "pm_coloring.h"
 #include "pm_newton_impl.h"
+#include "pm_par.h"
 #include "pm_petsc.h"
 #include "pm_progress.h"
 
@@ -36,6 +37,17 @@ struct pm_newton {
   KSP ksp;
   SNESLineSearch ls;
   PetscOptions opts;
+  /* Across ranks (dist): the ranks' communicator (PETSC_COMM_SELF on one
+   * process), the values a rank holds (owned and ghosts: nloc), the
+   * numbering of its held values over all ranks, and ghosted vectors in
+   * which the callbacks see the ghosts' values (Gx: a residual's state,
+   * Glin: the linearisation point, Gdx: a product's direction) and leave
+   * their contributions (Gr, Gdr). */
+  bool dist;
+  MPI_Comm comm;
+  long nloc;
+  ISLocalToGlobalMapping l2g;
+  Vec Gx, Glin, Gdx, Gr, Gdr;
 
   /* The solve under way. */
   pm_newton_report *rep;
@@ -147,37 +159,139 @@ static pm_err jacobian_values(pm_newton *s, const double *x, double *vals) {
   return PM_SUCCESS;
 }
 
-/* M = vals on the pattern (the matrix's preallocated structure). */
-static pm_err insert_values(Mat M, const pm_pattern *pat, const PetscInt *cols,
-                            const double *vals) {
+/* Rows of the pattern into M: their values (one process), or added to
+ * the rows they are a part of, by local numbers (across ranks). */
+static pm_err set_rows(Mat M, bool dist, const pm_pattern *pat,
+                       const PetscInt *cols, const double *vals) {
   for (long i = 0; i < pat->n; i++) {
     PetscInt row = (PetscInt)i, len = (PetscInt)(pat->ptr[i + 1] - pat->ptr[i]);
-    PM_PETSC_CALL(MatSetValues(M, 1, &row, len, cols + pat->ptr[i],
-                               vals + pat->ptr[i], INSERT_VALUES));
+    if (dist)
+      PM_PETSC_CALL(MatSetValuesLocal(M, 1, &row, len, cols + pat->ptr[i],
+                                      vals + pat->ptr[i], ADD_VALUES));
+    else
+      PM_PETSC_CALL(MatSetValues(M, 1, &row, len, cols + pat->ptr[i],
+                                 vals + pat->ptr[i], INSERT_VALUES));
   }
   PM_PETSC_CALL(MatAssemblyBegin(M, MAT_FINAL_ASSEMBLY));
   PM_PETSC_CALL(MatAssemblyEnd(M, MAT_FINAL_ASSEMBLY));
   return PM_SUCCESS;
 }
 
-/* A sequential AIJ matrix with the pattern's structure (zeros). */
-static pm_err create_matrix(const pm_pattern *pat, PetscInt **cols,
-                            double *zeros, Mat *M) {
+/* M = vals on the pattern (the matrix's preallocated structure). */
+static pm_err insert_values(const pm_newton *s, Mat M, const pm_pattern *pat,
+                            const PetscInt *cols, const double *vals) {
+  if (s->dist) PM_PETSC_CALL(MatZeroEntries(M));
+  return set_rows(M, s->dist, pat, cols, vals);
+}
+
+/* Across ranks: M's structure from every rank's rows, whichever rank owns
+ * them (PETSc's preallocator matrix collects them). */
+static pm_err preallocate_shared(const pm_newton *s, const pm_pattern *pat,
+                                 const PetscInt *cols, const double *zeros,
+                                 Mat M) {
+  pm_err ret = PM_SUCCESS;
+  Mat pre = NULL;
+  PetscInt n = (PetscInt)s->p.n;
+  PM_PETSC(MatCreate(s->comm, &pre));
+  PM_PETSC(MatSetType(pre, MATPREALLOCATOR));
+  PM_PETSC(MatSetSizes(pre, n, n, PETSC_DETERMINE, PETSC_DETERMINE));
+  PM_PETSC(MatSetLocalToGlobalMapping(pre, s->l2g, s->l2g));
+  PM_PETSC(MatSetUp(pre));
+  PM_TRY(set_rows(pre, true, pat, cols, zeros));
+  PM_PETSC(MatPreallocatorPreallocate(pre, PETSC_TRUE, M));
+done:
+  MatDestroy(&pre);
+  return ret;
+}
+
+/* An AIJ matrix with the pattern's structure (zeros): sequential, or over
+ * the ranks with every rank's rows. */
+static pm_err create_matrix(const pm_newton *s, const pm_pattern *pat,
+                            PetscInt **cols, double *zeros, Mat *M) {
   pm_err ret = PM_SUCCESS;
   PetscInt *nnz = NULL;
   long n = pat->n, total = pat->ptr[n];
   PM_TRY(PM_ALLOC(*cols, total > 0 ? total : 1, "matrix columns"));
-  PM_TRY(PM_ALLOC(nnz, n, "matrix row lengths"));
   for (long k = 0; k < total; k++) (*cols)[k] = (PetscInt)pat->idx[k];
-  for (long i = 0; i < n; i++)
-    nnz[i] = (PetscInt)(pat->ptr[i + 1] - pat->ptr[i]);
-  PM_PETSC(
-      MatCreateSeqAIJ(PETSC_COMM_SELF, (PetscInt)n, (PetscInt)n, 0, nnz, M));
+  if (s->dist) {
+    PetscInt own = (PetscInt)s->p.n;
+    PM_PETSC(MatCreate(s->comm, M));
+    PM_PETSC(MatSetType(*M, MATAIJ));
+    PM_PETSC(MatSetSizes(*M, own, own, PETSC_DETERMINE, PETSC_DETERMINE));
+    PM_PETSC(MatSetLocalToGlobalMapping(*M, s->l2g, s->l2g));
+    PM_TRY(preallocate_shared(s, pat, *cols, zeros, *M));
+  } else {
+    PM_TRY(PM_ALLOC(nnz, n, "matrix row lengths"));
+    for (long i = 0; i < n; i++)
+      nnz[i] = (PetscInt)(pat->ptr[i + 1] - pat->ptr[i]);
+    PM_PETSC(
+        MatCreateSeqAIJ(PETSC_COMM_SELF, (PetscInt)n, (PetscInt)n, 0, nnz, M));
+  }
   PM_PETSC(MatSetOption(*M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  PM_TRY(insert_values(*M, pat, *cols, zeros));
+  PM_TRY(insert_values(s, *M, pat, *cols, zeros));
 done:
   free(nnz);
   return ret;
+}
+
+/* ---- Across ranks: the held values ------------------------------------- */
+
+/* The values a callback reads of V: its own array (one process), or the
+ * held values of ghosted G, V's owned values with their ghosts' (across
+ * ranks).  *loc is what to give back to in_done. */
+static PetscErrorCode in_get(const pm_newton *s, Vec V, Vec G, Vec *loc,
+                             const double **a) {
+  PetscFunctionBeginUser;
+  *loc = V;
+  if (s->dist) {
+    PetscCall(VecCopy(V, G));
+    PetscCall(VecGhostUpdateBegin(G, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecGhostUpdateEnd(G, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecGhostGetLocalForm(G, loc));
+  }
+  PetscCall(VecGetArrayRead(*loc, a));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode in_done(const pm_newton *s, Vec G, Vec *loc,
+                              const double **a) {
+  PetscFunctionBeginUser;
+  PetscCall(VecRestoreArrayRead(*loc, a));
+  if (s->dist) PetscCall(VecGhostRestoreLocalForm(G, loc));
+  PetscFunctionReturn(0);
+}
+
+/* Where a callback writes V's values: its array, or ghosted G's held
+ * values (across ranks). */
+static PetscErrorCode out_get(const pm_newton *s, Vec V, Vec G, Vec *loc,
+                              double **a) {
+  PetscFunctionBeginUser;
+  *loc = V;
+  if (s->dist) PetscCall(VecGhostGetLocalForm(G, loc));
+  PetscCall(VecGetArray(*loc, a));
+  PetscFunctionReturn(0);
+}
+
+/* Across ranks, with every rank's callback done (ok on all of them):
+ * the ghosts' contributions added on their owners, into V. */
+static PetscErrorCode out_done(const pm_newton *s, Vec V, Vec G, Vec *loc,
+                               double **a, bool ok) {
+  PetscFunctionBeginUser;
+  PetscCall(VecRestoreArray(*loc, a));
+  if (s->dist) {
+    PetscCall(VecGhostRestoreLocalForm(G, loc));
+    if (ok) {
+      PetscCall(VecGhostUpdateBegin(G, ADD_VALUES, SCATTER_REVERSE));
+      PetscCall(VecGhostUpdateEnd(G, ADD_VALUES, SCATTER_REVERSE));
+      PetscCall(VecCopy(G, V));
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/* A callback's answer, the same on every rank of a shared problem. */
+static pm_err agreed(const pm_newton *s, pm_err e) {
+  return s->dist ? pm_par_agree(e) : e;
 }
 
 /* ---- SNES callbacks ---------------------------------------------------- */
@@ -186,22 +300,23 @@ static PetscErrorCode snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
   pm_newton *s = ctx;
   const double *x;
   double *r;
+  Vec xl, rl;
   PetscFunctionBeginUser;
-  PetscCall(VecGetArrayRead(X, &x));
-  PetscCall(VecGetArray(R, &r));
   double t = pm_wtime();
-  pm_err e = s->p.residual(s->p.ctx, x, r);
+  PetscCall(in_get(s, X, s->Gx, &xl, &x));
+  PetscCall(out_get(s, R, s->Gr, &rl, &r));
+  pm_err e = agreed(s, s->p.residual(s->p.ctx, x, r));
+  PetscCall(out_done(s, R, s->Gr, &rl, &r, e == PM_SUCCESS));
+  PetscCall(in_done(s, s->Gx, &xl, &x));
   if (s->rep) {
     s->rep->time_residual += pm_wtime() - t;
     s->rep->residual_evaluations++;
   }
-  PetscCall(VecRestoreArray(R, &r));
-  PetscCall(VecRestoreArrayRead(X, &x));
   s->domain_last = e != PM_SUCCESS;
   if (e == PM_SUCCESS) PetscFunctionReturn(0);
   if (hard_failure(e)) {
     s->hard = e;
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER, "residual callback failed: %s",
+    SETERRQ(s->comm, PETSC_ERR_USER, "residual callback failed: %s",
             pm_error_message());
   }
   snprintf(s->domain_msg, sizeof s->domain_msg, "%s",
@@ -214,14 +329,15 @@ static PetscErrorCode snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
 static PetscErrorCode snes_jacobian(SNES snes, Vec X, Mat A, Mat B, void *ctx) {
   pm_newton *s = ctx;
   const double *x;
+  Vec xl;
   (void)snes;
   (void)A;
   PetscFunctionBeginUser;
   double t = pm_wtime();
   PetscCall(VecCopy(X, s->Xlin));
-  PetscCall(VecGetArrayRead(X, &x));
+  PetscCall(in_get(s, X, s->Glin, &xl, &x));
   pm_err e = PM_SUCCESS;
-  if (s->p.jacobian_prepare) e = s->p.jacobian_prepare(s->p.ctx, x);
+  if (s->p.jacobian_prepare) e = agreed(s, s->p.jacobian_prepare(s->p.ctx, x));
   /* A preconditioner matrix left unchanged keeps its factorisation: PETSc
    * sets a PC up again only when the matrix's state has changed. */
   bool rebuild =
@@ -230,17 +346,20 @@ static PetscErrorCode snes_jacobian(SNES snes, Vec X, Mat A, Mat B, void *ctx) {
   if (e == PM_SUCCESS && rebuild) {
     if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
       e = color_values(s, s->p.precond_apply, &s->pcol, x, s->pvals);
-      if (e == PM_SUCCESS) e = insert_values(B, &s->ppat, s->pcols, s->pvals);
+      if (e == PM_SUCCESS)
+        e = insert_values(s, B, &s->ppat, s->pcols, s->pvals);
     } else {
-      e = jacobian_values(s, x, s->jvals);
-      if (e == PM_SUCCESS) e = insert_values(B, &s->jpat, s->jcols, s->jvals);
+      e = agreed(s, jacobian_values(s, x, s->jvals));
+      if (e == PM_SUCCESS)
+        e = insert_values(s, B, &s->jpat, s->jcols, s->jvals);
     }
   }
-  PetscCall(VecRestoreArrayRead(X, &x));
+  e = agreed(s, e);
+  PetscCall(in_done(s, s->Glin, &xl, &x));
   if (s->rep) s->rep->time_assembly += pm_wtime() - t;
   if (e != PM_SUCCESS) {
     s->hard = e;
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER, "Jacobian callback failed: %s",
+    SETERRQ(s->comm, PETSC_ERR_USER, "Jacobian callback failed: %s",
             pm_error_message());
   }
   PetscFunctionReturn(0);
@@ -250,19 +369,25 @@ static PetscErrorCode shell_mult(Mat A, Vec in, Vec out) {
   pm_newton *s;
   const double *x, *dx;
   double *dr;
+  Vec xl, dxl, drl;
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(A, &s));
-  PetscCall(VecGetArrayRead(s->Xlin, &x));
-  PetscCall(VecGetArrayRead(in, &dx));
-  PetscCall(VecGetArray(out, &dr));
-  pm_err e = s->p.jacobian_apply(s->p.ctx, x, dx, dr);
+  /* The linearisation point's held values are Glin's since the Jacobian
+   * was made there. */
+  xl = s->Xlin;
+  if (s->dist) PetscCall(VecGhostGetLocalForm(s->Glin, &xl));
+  PetscCall(VecGetArrayRead(xl, &x));
+  PetscCall(in_get(s, in, s->Gdx, &dxl, &dx));
+  PetscCall(out_get(s, out, s->Gdr, &drl, &dr));
+  pm_err e = agreed(s, s->p.jacobian_apply(s->p.ctx, x, dx, dr));
   if (s->rep) s->rep->jacobian_applications++;
-  PetscCall(VecRestoreArray(out, &dr));
-  PetscCall(VecRestoreArrayRead(in, &dx));
-  PetscCall(VecRestoreArrayRead(s->Xlin, &x));
+  PetscCall(out_done(s, out, s->Gdr, &drl, &dr, e == PM_SUCCESS));
+  PetscCall(in_done(s, s->Gdx, &dxl, &dx));
+  PetscCall(VecRestoreArrayRead(xl, &x));
+  if (s->dist) PetscCall(VecGhostRestoreLocalForm(s->Glin, &xl));
   if (e != PM_SUCCESS) {
     s->hard = e;
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER, "jacobian_apply failed: %s",
+    SETERRQ(s->comm, PETSC_ERR_USER, "jacobian_apply failed: %s",
             pm_error_message());
   }
   PetscFunctionReturn(0);
@@ -444,14 +569,26 @@ static pm_err check_problem(const pm_newton_problem *p,
            PM_ERR_ARG,
            "Newton problem: residual, jacobian_apply, pat_ptr and pat_idx "
            "are required");
-  PM_CHECK(p->pat_ptr[p->n] + p->n <= PETSC_MAX_INT, PM_ERR_ARG,
+  const long rows = p->n + (p->shared && pm_par_active() ? p->n_ghost : 0);
+  PM_CHECK(p->pat_ptr[rows] + rows <= PETSC_MAX_INT, PM_ERR_ARG,
            "Newton problem: %ld pattern entries exceed PETSc's indices",
-           p->pat_ptr[p->n]);
+           p->pat_ptr[rows]);
   PM_CHECK(o->op != PM_NEWTON_MATRIX_FREE_CHEAP_PC || p->precond_apply,
            PM_ERR_ARG,
            "Newton problem: the cheap preconditioner needs precond_apply");
   PM_CHECK(!p->pc_pat_ptr == !p->pc_pat_idx, PM_ERR_ARG,
            "Newton problem: give both pc_pat_ptr and pc_pat_idx, or neither");
+  if (!p->shared || !pm_par_active()) return PM_SUCCESS;
+  PM_CHECK(p->n_ghost >= 0 && (p->n_ghost == 0 || p->ghost), PM_ERR_ARG,
+           "Newton problem shared by the ranks: %ld ghost unknowns without "
+           "their numbers",
+           p->n_ghost);
+  PM_CHECK(p->jacobian_values && o->op != PM_NEWTON_MATRIX_FREE_CHEAP_PC,
+           PM_ERR_UNSUPPORTED,
+           "Newton problem shared by %d ranks: the Jacobian must be assembled "
+           "by the caller (jacobian_values), and the cheap preconditioner "
+           "(coloured) runs on one process",
+           pm_par_size());
   return PM_SUCCESS;
 }
 
@@ -462,7 +599,7 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
   bool matrix_free = o->op != PM_NEWTON_ASSEMBLED;
   KSP ksp = NULL;
   PC pc;
-  PM_PETSC(KSPCreate(PETSC_COMM_SELF, &ksp));
+  PM_PETSC(KSPCreate(s->comm, &ksp));
   PM_PETSC(PetscObjectSetOptions((PetscObject)ksp, s->opts));
   PM_PETSC(KSPSetOptionsPrefix(ksp, "pm_"));
   PM_PETSC(KSPGetPC(ksp, &pc));
@@ -486,8 +623,9 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
     PM_PETSC(PCSetType(pc, PCJACOBI));
     break;
   case PM_NEWTON_GMRES_ILU:
+    /* Across ranks ILU(0) in each rank's block (block Jacobi's default). */
     PM_PETSC(KSPSetType(ksp, KSPGMRES));
-    PM_PETSC(PCSetType(pc, PCILU));
+    PM_PETSC(PCSetType(pc, s->dist ? PCBJACOBI : PCILU));
     break;
   case PM_NEWTON_CG_GAMG:
     PM_PETSC(KSPSetType(ksp, KSPCG));
@@ -543,7 +681,7 @@ static pm_err configure_snes(pm_newton *s) {
     PM_CHECK(code == 0, PM_ERR_ARG, "PETSc options \"%s\" not understood",
              s->petsc_options);
   }
-  PM_PETSC_CALL(SNESCreate(PETSC_COMM_SELF, &s->snes));
+  PM_PETSC_CALL(SNESCreate(s->comm, &s->snes));
   PM_PETSC_CALL(PetscObjectSetOptions((PetscObject)s->snes, s->opts));
   PM_PETSC_CALL(SNESGetLineSearch(s->snes, &s->ls));
   PM_PETSC_CALL(PetscObjectSetOptions((PetscObject)s->ls, s->opts));
@@ -605,7 +743,7 @@ static pm_err set_near_null(pm_newton *s, Mat M) {
     PM_PETSC(VecRestoreArray(v[m], &w));
     m++;
   }
-  PM_PETSC(MatNullSpaceCreate(PETSC_COMM_SELF, PETSC_FALSE, m, v, &ns));
+  PM_PETSC(MatNullSpaceCreate(s->comm, PETSC_FALSE, m, v, &ns));
   PM_PETSC(MatSetNearNullSpace(M, ns));
 done:
   MatNullSpaceDestroy(&ns);
@@ -613,18 +751,50 @@ done:
   return ret;
 }
 
+/* Across ranks: the numbering of the held values over all ranks (owned
+ * ones from this rank's offset, then the ghosts') and the ghosted vectors
+ * of the callbacks. */
+static pm_err create_shared(pm_newton *s) {
+  pm_err ret = PM_SUCCESS;
+  const long n = s->p.n, ng = s->p.n_ghost;
+  PetscInt *global = NULL, *ghost = NULL;
+  PM_TRY(PM_ALLOC(global, s->nloc, "global numbers"));
+  PM_TRY(PM_ALLOC(ghost, ng + 1, "ghost numbers"));
+  const long offset = pm_par_offset(n);
+  for (long i = 0; i < n; i++) global[i] = (PetscInt)(offset + i);
+  for (long k = 0; k < ng; k++)
+    global[n + k] = ghost[k] = (PetscInt)s->p.ghost[k];
+  PM_PETSC(ISLocalToGlobalMappingCreate(s->comm, 1, (PetscInt)s->nloc, global,
+                                        PETSC_COPY_VALUES, &s->l2g));
+  PM_PETSC(VecCreateGhost(s->comm, (PetscInt)n, PETSC_DETERMINE, (PetscInt)ng,
+                          ghost, &s->Gx));
+  PM_PETSC(VecDuplicate(s->Gx, &s->Glin));
+  PM_PETSC(VecDuplicate(s->Gx, &s->Gdx));
+  PM_PETSC(VecDuplicate(s->Gx, &s->Gr));
+  PM_PETSC(VecDuplicate(s->Gx, &s->Gdr));
+done:
+  free(global);
+  free(ghost);
+  return ret;
+}
+
 static pm_err create_petsc_objects(pm_newton *s) {
   PetscInt n = (PetscInt)s->p.n;
-  PM_PETSC_CALL(VecCreateSeq(PETSC_COMM_SELF, n, &s->X));
+  if (s->dist) {
+    PM_CALL(create_shared(s));
+    PM_PETSC_CALL(VecCreateMPI(s->comm, n, PETSC_DETERMINE, &s->X));
+  } else {
+    PM_PETSC_CALL(VecCreateSeq(PETSC_COMM_SELF, n, &s->X));
+  }
   PM_PETSC_CALL(VecDuplicate(s->X, &s->R));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Xstart));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Xlin));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Xacc));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Work));
   if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
-    PM_CALL(create_matrix(&s->ppat, &s->pcols, s->pvals, &s->P));
+    PM_CALL(create_matrix(s, &s->ppat, &s->pcols, s->pvals, &s->P));
   } else {
-    PM_CALL(create_matrix(&s->jpat, &s->jcols, s->jvals, &s->J));
+    PM_CALL(create_matrix(s, &s->jpat, &s->jcols, s->jvals, &s->J));
   }
   if (s->p.near_null_count > 0) {
     Mat A, B;
@@ -632,7 +802,8 @@ static pm_err create_petsc_objects(pm_newton *s) {
     PM_CALL(set_near_null(s, B));
   }
   if (s->o.op != PM_NEWTON_ASSEMBLED) {
-    PM_PETSC_CALL(MatCreateShell(PETSC_COMM_SELF, n, n, n, n, s, &s->Shell));
+    PM_PETSC_CALL(MatCreateShell(s->comm, n, n, PETSC_DETERMINE,
+                                 PETSC_DETERMINE, s, &s->Shell));
     PM_PETSC_CALL(
         MatShellSetOperation(s->Shell, MATOP_MULT, (void (*)(void))shell_mult));
   }
@@ -653,6 +824,10 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
   s->p = *problem;
   s->o = *options;
   s->p.pat_ptr = s->p.pat_idx = s->p.pc_pat_ptr = s->p.pc_pat_idx = NULL;
+  s->dist = problem->shared && pm_par_active();
+  s->comm = s->dist ? PETSC_COMM_WORLD : PETSC_COMM_SELF;
+  s->nloc = problem->n + (s->dist ? problem->n_ghost : 0);
+  s->p.ghost = NULL; /* the caller's: read once, below */
   if (options->petsc_options) {
     s->petsc_options = strdup(options->petsc_options);
     PM_ENSURE(s->petsc_options, PM_ERR_MEMORY, "out of memory (PETSc options)");
@@ -661,7 +836,7 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
   if (!(s->o.min_dlambda > 0))
     s->o.min_dlambda = ldexp(1.0 / s->o.load_steps, -s->o.max_cuts);
 
-  long n = problem->n;
+  long n = s->nloc;
   PM_TRY(
       pm_pattern_build(n, problem->pat_ptr, problem->pat_idx, true, &s->jpat));
   if (problem->jacobian_values)
@@ -681,7 +856,11 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
   }
   PM_TRY(PM_ALLOC(s->seed, n, "colour seed"));
   PM_TRY(PM_ALLOC(s->dr, n, "colour image"));
-  PM_TRY(create_petsc_objects(s));
+  s->p.ghost = problem->ghost;
+  ret = create_petsc_objects(s);
+  if (s->dist) ret = pm_par_agree(ret);
+  s->p.ghost = NULL;
+  PM_TRY(ret);
   s->p.near_null = NULL; /* the caller's: read once, above */
   *out = s;
   s = NULL;
@@ -704,6 +883,12 @@ void pm_newton_destroy(pm_newton **sp) {
   VecDestroy(&s->Xlin);
   VecDestroy(&s->Xacc);
   VecDestroy(&s->Work);
+  VecDestroy(&s->Gx);
+  VecDestroy(&s->Glin);
+  VecDestroy(&s->Gdx);
+  VecDestroy(&s->Gr);
+  VecDestroy(&s->Gdr);
+  ISLocalToGlobalMappingDestroy(&s->l2g);
   PetscOptionsDestroy(&s->opts);
   pm_pattern_free(&s->jpat);
   pm_pattern_free(&s->ppat);
@@ -925,6 +1110,29 @@ done:
   return ret;
 }
 
+pm_err pm_newton_residual(pm_newton *s, const double *x, double *r) {
+  if (!s->dist) return s->p.residual(s->p.ctx, x, r);
+  pm_err e = PM_SUCCESS;
+  const double *xh;
+  double *rh;
+  Vec xl, rl;
+  PM_CALL(copy_in(s->Work, x, s->p.n));
+  PM_PETSC_CALL(in_get(s, s->Work, s->Gx, &xl, &xh));
+  PM_PETSC_CALL(out_get(s, s->R, s->Gr, &rl, &rh));
+  e = agreed(s, s->p.residual(s->p.ctx, xh, rh));
+  PM_PETSC_CALL(out_done(s, s->R, s->Gr, &rl, &rh, e == PM_SUCCESS));
+  PM_PETSC_CALL(in_done(s, s->Gx, &xl, &xh));
+  if (e == PM_SUCCESS) PM_CALL(copy_out(s->R, r, s->p.n));
+  return e;
+}
+
+double pm_newton_norm(const pm_newton *s, const double *v) {
+  double sum = 0;
+  for (long i = 0; i < s->p.n; i++) sum += v[i] * v[i];
+  if (s->dist) pm_par_sum(&sum, 1);
+  return sqrt(sum);
+}
+
 pm_err pm_newton_solve(pm_newton *s, double *x, pm_newton_report *report) {
   pm_newton_report local;
   PM_CHECK(s && x, PM_ERR_ARG, "pm_newton_solve: solver and x are required");
@@ -936,6 +1144,8 @@ pm_err pm_newton_solve(pm_newton *s, double *x, pm_newton_report *report) {
 pm_err pm_newton_jacobian_values(pm_newton *s, const double *x, double *val) {
   PM_CHECK(s && x && val, PM_ERR_ARG,
            "pm_newton_jacobian_values: solver, x and val are required");
+  PM_CHECK(!s->dist, PM_ERR_UNSUPPORTED,
+           "pm_newton_jacobian_values: one process's problems only");
   if (s->p.jacobian_prepare) PM_CALL(s->p.jacobian_prepare(s->p.ctx, x));
   PM_CALL(jacobian_values(s, x, s->jvals));
   for (long k = 0; k < s->jpat.nsrc; k++) val[k] = s->jvals[s->jpat.src[k]];
@@ -950,6 +1160,8 @@ pm_err pm_newton_check_jacobian(pm_newton *s, const double *x, double h,
            "pm_newton_check_jacobian: solver, x, max_error and h > 0 are "
            "required (h %g)",
            h);
+  PM_CHECK(!s->dist, PM_ERR_UNSUPPORTED,
+           "pm_newton_check_jacobian: one process's problems only");
   long n = s->p.n;
   /* The pattern by columns (a caller-assembled Jacobian has no colouring
    * yet). */

@@ -44,12 +44,39 @@
  * [0, 1]; residual and the Jacobian are those at the last lambda set.  The
  * state passed to pm_load_steps is taken as converged at lambda = 0.
  *
+ * Across ranks (pm_newton_problem.shared, in a run of more than one
+ * rank), every rank creates the solver with its share of the unknowns and
+ * calls each of the solver's functions together with the others (they are
+ * collective).  A rank owns its unknowns 0 .. n-1, numbered offset ..
+ * offset + n - 1 over all ranks (offset = pm_par_offset(n): the ranks'
+ * shares follow one another in rank order), and holds n_ghost unknowns
+ * more that other ranks own: local numbers n .. n + n_ghost - 1, global
+ * numbers ghost[0 .. n_ghost-1].  Then
+ *  - x, dx given to callbacks have n + n_ghost values (a ghost's is its
+ *    owner's);
+ *  - residual and jacobian_apply write n + n_ghost values: a ghost's is
+ *    this rank's part of its owner's entry, added there (an assembly: each
+ *    rank adds what its own elements or particles give);
+ *  - the pattern has n + n_ghost rows over local column numbers, and the
+ *    values of jacobian_values are added likewise (a ghost row's to its
+ *    owner's row);
+ *  - an inadmissible state on one rank is inadmissible on all (the lowest
+ *    failing rank's message is every rank's);
+ *  - the arrays the solver's own functions take (x of pm_newton_solve and
+ *    pm_load_steps, the load state, near_null) have the n owned values.
+ * Colouring would need the whole pattern: a shared problem gives
+ * jacobian_values, with the operator PM_NEWTON_ASSEMBLED or
+ * PM_NEWTON_MATRIX_FREE.  Norms, reasons and iteration counts are over all
+ * ranks (every rank sees the same); times are the rank's own.  ILU is
+ * block Jacobi with ILU(0) in each rank's block.
+ *
  * PETSc is initialised on first use (without command-line arguments; a
  * program started without mpirun runs as one MPI process) and finalised
- * by pm_solve_finalize or at exit.  All objects are sequential (one
- * process); PETSc's own options, prefixed "pm_" ("-pm_snes_monitor",
- * "-pm_ksp_view", "-pm_pc_type ilu"), may be given per solver in
- * pm_newton_options.petsc_options and override the options struct. */
+ * by pm_solve_finalize or at exit.  Objects are sequential (one process),
+ * or on every rank for a shared problem; PETSc's own options, prefixed
+ * "pm_" ("-pm_snes_monitor", "-pm_ksp_view", "-pm_pc_type ilu"), may be
+ * given per solver in pm_newton_options.petsc_options and override the
+ * options struct. */
 #ifndef PM_NEWTON_H
 #define PM_NEWTON_H
 
@@ -102,6 +129,14 @@ typedef struct {
    * Read by pm_newton_create, not kept (at most 16).  Optional (0, NULL). */
   int near_null_count;
   const double *near_null;
+
+  /* Across ranks (see above): the problem is shared by the ranks when
+   * this is set and more than one rank runs; ghost lists the global
+   * numbers of the n_ghost unknowns held beyond the owned.  false, 0,
+   * NULL: one process's problem. */
+  bool shared;
+  long n_ghost;
+  const long *ghost;
 
   /* Load stepping only (pm_load_steps); NULL otherwise. */
   pm_err (*set_load)(void *ctx, double lambda);

@@ -21,4 +21,12 @@ pm_err pm_newton_solve_from(pm_newton *s, double *x, const double *x_start,
 pm_err pm_newton_tangent_solve(pm_newton *s, const double *x, const double *b,
                                double *dx, pm_newton_report *rep);
 
+/* r = the residual at x (both of the n owned values): the problem's
+ * callback, through the held values of a shared problem (collective then,
+ * with the ranks' agreed answer). */
+pm_err pm_newton_residual(pm_newton *s, const double *x, double *r);
+
+/* The Euclidean norm of v (the n owned values) over all ranks. */
+double pm_newton_norm(const pm_newton *s, const double *v);
+
 #endif
