@@ -74,7 +74,16 @@ static pm_err sim_create(const pm_scene *s, bool implicit, mpm_sim **out) {
   r->scene = s;
   double t0 = pm_wtime();
   PM_TRY(pm_par_agree(mpm_model_create(s, &r->model, &r->state)));
-  if (implicit) {
+  if (implicit && pm_par_active()) {
+    /* Each rank's share: the particles of its cells by their reference
+     * positions (the grid moves with them: none migrates). */
+    PM_TRY(figures_work(r->model, &r->work));
+    PM_TRY(pm_par_agree(mpm_par_create(s, r->model, r->state, NULL,
+                                       &r->local_model, &r->local_state)));
+    PM_TRY(pm_par_agree(
+        mpm_implicit_create(s, r->local_model, r->local_state, &r->imp)));
+    r->run_min_jacobian = 1;
+  } else if (implicit) {
     PM_TRY(figures_work(r->model, &r->work));
     PM_TRY(mpm_implicit_create(s, r->model, r->state, &r->imp));
     r->run_min_jacobian = 1;
@@ -124,10 +133,11 @@ static size_t sim_bytes(const mpm_sim *r) {
       mpm_model_bytes(r->model) + mpm_state_bytes(r->model, r->state) +
       mpm_work_bytes(r->model, r->work) +
       scratch_per_particle(r->model) * sizeof(double) * (size_t)r->model->n;
-  if (r->local_model)
-    bytes += mpm_model_bytes(r->local_model) +
-             mpm_state_bytes(r->local_model, r->local_state) +
-             mpm_work_bytes(r->local_model, r->local_work);
+  if (r->local_model) /* (the implicit solver has no step workspace) */
+    bytes +=
+        mpm_model_bytes(r->local_model) +
+        mpm_state_bytes(r->local_model, r->local_state) +
+        (r->local_work ? mpm_work_bytes(r->local_model, r->local_work) : 0);
   return bytes;
 }
 
@@ -935,6 +945,17 @@ static pm_err plan_ranks(mpm_sim *r, FILE *out) {
   return PM_SUCCESS;
 }
 
+/* plan --ranks N on one process: how N ranks would share the run. */
+static pm_err plan_decomposition(const mpm_sim *r, FILE *out) {
+  if (pm_par_plan_ranks() <= 1) return PM_SUCCESS;
+  mpm_decomp d;
+  PM_CALL(mpm_decomp_create(r->scene, r->model, pm_par_plan_ranks(), &d));
+  mpm_decomp_print(&d, r->model, out);
+  mpm_decomp_predict(&d, r->model, out);
+  mpm_decomp_destroy(&d);
+  return PM_SUCCESS;
+}
+
 static pm_err plan(void *p, FILE *out) {
   mpm_sim *r = p;
   if (r->local_model) return plan_ranks(r, out);
@@ -948,13 +969,7 @@ static pm_err plan(void *p, FILE *out) {
           mpm_state_bytes(m, st) / 1048576.0,
           mpm_work_bytes(m, r->work) / 1048576.0, r->work->nodes.threads,
           9 * sizeof(double) * (size_t)m->n / 1048576.0);
-  if (pm_par_plan_ranks() > 1) { /* plan --ranks N: the decomposition */
-    mpm_decomp d;
-    PM_CALL(mpm_decomp_create(r->scene, m, pm_par_plan_ranks(), &d));
-    mpm_decomp_print(&d, m, out);
-    mpm_decomp_predict(&d, m, out);
-    mpm_decomp_destroy(&d);
-  }
+  PM_CALL(plan_decomposition(r, out));
   /* Time a few steps (the state is advanced: a plan is not run after). */
   double t0 = pm_wtime();
   int reps = 0;
@@ -1058,11 +1073,31 @@ static pm_err implicit_create(const pm_scene *s, void **out) {
   return PM_SUCCESS;
 }
 
+/* Across ranks, a converged load step (collective): rank 0 decides
+ * whether its observer will read the state; if so every rank sends its
+ * particles and load stepping's states; rank 0 reports, and every rank
+ * returns its observer's answer. */
+static pm_err implicit_share(mpm_sim *r, const pm_step_report *rep,
+                             bool frame) {
+  int want = frame;
+  if (pm_par_root() && r->obs && r->obs->wants)
+    want = want || r->obs->wants(r->obs->ctx, rep, frame);
+  pm_par_bcast(&want, sizeof want);
+  if (want) {
+    PM_CALL(pm_par_agree(
+        mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
+    PM_CALL(mpm_implicit_gather(r->imp, r->model));
+  }
+  pm_err e = PM_SUCCESS;
+  if (pm_par_root() && r->obs) e = r->obs->step(r->obs->ctx, rep, frame);
+  return pm_par_agree(e);
+}
+
 /* Each converged load step is a step of the run: t = lambda t_load. */
 static pm_err implicit_observe(void *ctx, const mpm_implicit_step *step) {
   mpm_sim *r = ctx;
-  const mpm_model *m = r->model;
-  mpm_state *st = r->state;
+  const mpm_model *m = r->local_model ? r->local_model : r->model;
+  mpm_state *st = r->local_model ? r->local_state : r->state;
   st->step = step->step;
   st->t = step->lambda * m->opt.t_load;
   r->imp_newton = step->newton;
@@ -1081,21 +1116,31 @@ static pm_err implicit_observe(void *ctx, const mpm_implicit_step *step) {
                         .t = st->t,
                         .residual = step->residual,
                         .progress = step->lambda};
-  return r->obs ? r->obs->step(r->obs->ctx, &rep,
-                               last || (every > 0 && st->step % every == 0))
-                : PM_SUCCESS;
+  const bool frame = last || (every > 0 && st->step % every == 0);
+  if (r->local_model) return implicit_share(r, &rep, frame);
+  return r->obs ? r->obs->step(r->obs->ctx, &rep, frame) : PM_SUCCESS;
 }
 
 static pm_err implicit_run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
   pm_err e = PM_SUCCESS;
   r->obs = obs;
+  if (r->local_model) release_view(r);
   if (!r->resumed) {
     r->energy0 = 0;
     r->run_min_jacobian_step = 0;
-    e = report(r, true, false);
+    /* the initial state: rank 0's view holds it across ranks */
+    if (pm_par_root()) e = report(r, true, false);
+    if (r->local_model) e = pm_par_agree(e);
   }
   if (!e) e = mpm_implicit_run(r->imp, implicit_observe, r);
+  /* Across ranks, the state the run ended in, for the figures (a
+   * failure's too). */
+  if (r->local_model) {
+    pm_err g = pm_par_agree(
+        mpm_par_gather(r->local_model, r->local_state, r->model, r->state));
+    if (!e) e = g;
+  }
   r->obs = NULL;
   /* the solver's time, as stages */
   const pm_load_report *lr = mpm_implicit_report(r->imp);
@@ -1156,6 +1201,10 @@ static pm_err implicit_plan(void *p, FILE *out) {
   plan_groups(m, out);
   plan_bodies(r, out);
   mpm_implicit_plan(r->imp, out);
+  if (r->local_model) /* across ranks: the decomposition, each rank's share */
+    mpm_par_plan(r->local_model, NULL, out);
+  else
+    PM_CALL(plan_decomposition(r, out));
   fprintf(out,
           "memory       %.1f MiB (model %.1f, state %.1f, output %.1f; "
           "PETSc's matrix and solver besides)\n",
@@ -1168,7 +1217,12 @@ static pm_err implicit_plan(void *p, FILE *out) {
 static pm_err implicit_checkpoint(void *p, pm_ckpt *ck) {
   mpm_sim *r = p;
   PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
-  PM_CALL(mpm_implicit_checkpoint(r->imp, ck));
+  /* A resumed run across ranks: each rank's particles take the state read
+   * (they are those of its cells by their reference positions, as at the
+   * start). */
+  if (r->local_model && pm_ckpt_reading(ck))
+    mpm_par_take_state(r->model, r->state, r->local_model, r->local_state);
+  PM_CALL(mpm_implicit_checkpoint(r->imp, r->model, ck));
   PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &r->run_min_jacobian));
   PM_CALL(pm_ckpt_long(ck, "run.min_jacobian_step", &r->run_min_jacobian_step));
   if (pm_ckpt_reading(ck)) {
@@ -1186,6 +1240,7 @@ const pm_backend mpm_implicit_backend = {
     .section = NULL,
     .dt_safety = 0.5,
     .check = mpm_implicit_check_scene,
+    .ranks = true,
     .create = implicit_create,
     .estimate_bytes = mpm_estimate_bytes,
     .destroy = destroy,

@@ -8,7 +8,9 @@
 #include <string.h>
 
 #include "mpm_kind.h"
+#include "mpm_par.h"
 #include "pm_omp.h"
+#include "pm_par.h"
 #include "pm_progress.h"
 #include "pm_tensor.h"
 
@@ -37,6 +39,17 @@ struct mpm_implicit {
   unsigned char *active;
   long *dof, *unk_dof;
   long nunk, npre, pre_cap;
+  /* Across ranks (the model a rank's share: m->par): the unknowns are the
+   * owned nodes' (nunk), then the ghost nodes' that other ranks own
+   * (nghost, global numbers ghost); nheld = nunk + nghost (nunk on one
+   * process).  Sums over nodes add the ranks' parts first. */
+  bool ranks;
+  long nghost, nheld;
+  long *ghost, *gnum; /* gnum: 3 per node, a dof's global number or -1 */
+  long nunk_all, entries_all; /* over all ranks */
+  double *whole;   /* load stepping's two states on the whole grid (for
+                      checkpoints: rank 0's across ranks) */
+  long active_all; /* active nodes over all ranks */
   long *pre_dof;
   double *pre_val; /* increment at local load 1 */
   int *pre_bc;
@@ -48,7 +61,8 @@ struct mpm_implicit {
   long *face_ptr, *face;
   /* nodal work, 3 per node */
   double *u, *du, *f, *df, *diag;
-  double *x_unk; /* unknowns */
+  double *x_unk;  /* unknowns */
+  double *x_held; /* across ranks: the owned unknowns and the ghosts' */
   /* load: the base's global load, the step's end, the local load */
   double lam0, lam1, lam_local;
   pm_newton_options opt;
@@ -139,8 +153,8 @@ static void note_failure(mpm_implicit *im, long p, const char *what, double J) {
       im->fail_p = p;
       const double *x = im->xb + 3 * p;
       snprintf(im->fail_msg, sizeof im->fail_msg,
-               "particle %ld at (%.6g, %.6g, %.6g): %s (J = %.4g)", p, x[0],
-               x[1], x[2], what, J);
+               "particle %ld at (%.6g, %.6g, %.6g): %s (J = %.4g)",
+               im->m->gid ? im->m->gid[p] : p, x[0], x[1], x[2], what, J);
     }
   }
 }
@@ -396,7 +410,7 @@ static bool nodal_force(mpm_implicit *im, const double *u, double *f) {
 /* u from the unknowns x and the prescribed values at the local load. */
 static void fill_u(mpm_implicit *im, const double *x) {
   memset(im->u, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
-  for (long k = 0; k < im->nunk; k++) im->u[im->unk_dof[k]] = x[k];
+  for (long k = 0; k < im->nheld; k++) im->u[im->unk_dof[k]] = x[k];
   for (long k = 0; k < im->npre; k++)
     im->u[im->pre_dof[k]] = im->lam_local * im->pre_val[k];
 }
@@ -408,7 +422,7 @@ static pm_err cb_residual(void *ctx, const double *x, double *r) {
   fill_u(im, x);
   if (!nodal_force(im, im->u, im->f))
     return PM_ERROR(PM_ERR_UNSTABLE, "%s", im->fail_msg);
-  for (long k = 0; k < im->nunk; k++) r[k] = im->f[im->unk_dof[k]];
+  for (long k = 0; k < im->nheld; k++) r[k] = im->f[im->unk_dof[k]];
   return PM_SUCCESS;
 }
 
@@ -424,11 +438,11 @@ static pm_err cb_apply(void *ctx, const double *x, const double *dx,
   const mpm_model *m = im->m;
   fill_u(im, x);
   memset(im->du, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
-  for (long k = 0; k < im->nunk; k++) im->du[im->unk_dof[k]] = dx[k];
+  for (long k = 0; k < im->nheld; k++) im->du[im->unk_dof[k]] = dx[k];
   if (im->fbar) {
     if (!fbar_force(im, im->u, im->du, im->df))
       return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
-    for (long k = 0; k < im->nunk; k++) dr[k] = im->df[im->unk_dof[k]];
+    for (long k = 0; k < im->nheld; k++) dr[k] = im->df[im->unk_dof[k]];
     return PM_SUCCESS;
   }
   memset(im->df, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
@@ -456,7 +470,7 @@ static pm_err cb_apply(void *ctx, const double *x, const double *dx,
     }
   })
   if (im->fail_p >= 0) return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
-  for (long k = 0; k < im->nunk; k++) dr[k] = df[im->unk_dof[k]];
+  for (long k = 0; k < im->nheld; k++) dr[k] = df[im->unk_dof[k]];
   return PM_SUCCESS;
 }
 
@@ -509,7 +523,7 @@ static pm_err cb_values(void *ctx, const double *x, double *val) {
   mpm_implicit *im = ctx;
   const mpm_model *m = im->m;
   fill_u(im, x);
-  memset(val, 0, sizeof(double) * (size_t)im->pat_ptr[im->nunk]);
+  memset(val, 0, sizeof(double) * (size_t)im->pat_ptr[im->nheld]);
   im->fail_p = -1;
   const long *dof = im->dof;
   FOR_PARTICLES(im, {
@@ -605,6 +619,7 @@ static long stencil_base(const mpm_grid *g, const double x[3], long ijk[3]) {
     double w[3], dw[3];
     mpm_shape_1d(g->shape, (x[c] - g->origin[c]) * g->inv_h, g->inv_h, &ijk[c],
                  w, dw);
+    ijk[c] -= g->offset[c]; /* in the rank's block (0 on one process) */
     base += ijk[c] * g->stride[c];
   }
   return base;
@@ -691,7 +706,8 @@ static pm_err prescribe(mpm_implicit *im, long node, int c, int b, double v) {
 static void node_position(const mpm_grid *g, long k, double x[3]) {
   long ijk[3] = {k % g->nn[0], (k / g->nn[0]) % g->nn[1], k / g->stride[2]};
   for (int c = 0; c < 3; c++)
-    x[c] = c < g->dim ? g->origin[c] + (double)ijk[c] * g->h : 0;
+    x[c] =
+        c < g->dim ? g->origin[c] + (double)(ijk[c] + g->offset[c]) * g->h : 0;
 }
 
 /* Prescribed dofs of the conditions for the step from lam0 to lam1. */
@@ -708,7 +724,7 @@ static pm_err make_prescribed(mpm_implicit *im) {
       long ia = (long)llround((bc->plane - g->origin[a]) * g->inv_h);
       for (long k = 0; k < g->n_nodes; k++) {
         if (!im->active[k]) continue;
-        long idx = (k / g->stride[a]) % g->nn[a];
+        long idx = (k / g->stride[a]) % g->nn[a] + g->offset[a];
         if (bc->outward > 0 ? idx < ia : idx > ia) continue;
         double x[3];
         node_position(g, k, x);
@@ -732,9 +748,49 @@ static pm_err make_prescribed(mpm_implicit *im) {
   return PM_SUCCESS;
 }
 
+/* Across ranks: the global numbers of the unknowns (each rank's owned
+ * ones after the ranks' before it), the owners' numbers at the ghost
+ * nodes, and the ghost nodes' unknowns numbered after the owned. */
+static pm_err number_ghosts(mpm_implicit *im) {
+  const long nn = im->g.n_nodes;
+  const unsigned char *own = mpm_par_owned(im->m);
+  const long first = pm_par_offset(im->nunk);
+  for (long d = 0; d < 3 * nn; d++)
+    im->gnum[d] = im->dof[d] >= 0 ? first + im->dof[d] : -1;
+  MPI_Datatype three;
+  MPI_Type_contiguous(3, MPI_LONG, &three);
+  MPI_Type_commit(&three);
+  pm_err e = mpm_par_nodes_bcast(im->m, im->gnum, three);
+  MPI_Type_free(&three);
+  PM_CALL(e);
+  long count = 0;
+  for (long k = 0; k < nn; k++)
+    for (int c = 0; !own[k] && c < 3; c++) count += im->gnum[3 * k + c] >= 0;
+  PM_CALL(PM_REALLOC(im->ghost, count + 1, "ghost unknowns"));
+  im->nghost = 0;
+  for (long k = 0; k < nn; k++)
+    for (int c = 0; !own[k] && c < 3; c++) {
+      const long d = 3 * k + c;
+      if (im->gnum[d] < 0) continue;
+      /* Active nodes and prescribed dofs are the same on every rank that
+       * holds the node. */
+      PM_CHECK(im->dof[d] == -1, PM_ERR_INTERNAL,
+               "implicit MPM across ranks: dof %ld of a ghost node is %ld "
+               "here and an unknown on its owner",
+               d, im->dof[d]);
+      im->ghost[im->nghost] = im->gnum[d];
+      im->dof[d] = im->nunk + im->nghost++;
+    }
+  im->nheld = im->nunk + im->nghost;
+  return PM_SUCCESS;
+}
+
 /* Active nodes, prescribed and unknown dofs, and the Jacobian's pattern:
  * every row of a node lists the unknowns of the nodes within a stencil's
- * reach in neighbour order, each neighbour's components in order. */
+ * reach in neighbour order, each neighbour's components in order.  Across
+ * ranks a node is active where any rank's particles reach it, a rank
+ * numbers its own nodes' unknowns, and the rows of ghost nodes hold what
+ * its particles add to them. */
 static pm_err make_dofs(mpm_implicit *im) {
   const mpm_grid *g = &im->g;
   const long nn = g->n_nodes;
@@ -744,28 +800,42 @@ static pm_err make_dofs(mpm_implicit *im) {
     mpm_stencil_at(g, im->xb + 3 * p, MPM_STENCIL_W, &st);
     for (int k = 0; k < st.n; k++) im->active[st.node[k]] = 1;
   }
+  const unsigned char *own = im->ranks ? mpm_par_owned(im->m) : NULL;
+  if (im->ranks)
+    PM_CALL(
+        mpm_par_nodes_reduce(im->m, im->active, MPI_UNSIGNED_CHAR, MPI_MAX));
   for (long d = 0; d < 3 * nn; d++) im->dof[d] = -1;
   PM_CALL(make_prescribed(im));
   im->nunk = 0;
+  im->active_all = 0;
   for (long k = 0; k < nn; k++) {
-    if (!im->active[k]) continue;
+    if (!im->active[k] || (own && !own[k])) continue;
+    im->active_all++;
     for (int c = 0; c < im->dim; c++)
       if (im->dof[3 * k + c] == -1) im->dof[3 * k + c] = im->nunk++;
   }
-  PM_CHECK(im->nunk > 0, PM_ERR_SCENE,
+  im->nheld = im->nunk;
+  if (im->ranks) PM_CALL(number_ghosts(im));
+  long counts[2] = {im->nunk, im->active_all};
+  pm_par_sum_long(counts, 2);
+  im->nunk_all = counts[0];
+  im->active_all = counts[1];
+  PM_CHECK(im->nunk_all > 0, PM_ERR_SCENE,
            "%s: every grid displacement is prescribed: nothing to solve",
            im->s->path);
-  PM_CALL(PM_REALLOC(im->unk_dof, im->nunk, "unknowns"));
-  PM_CALL(PM_REALLOC(im->x_unk, im->nunk, "unknowns"));
-  PM_CALL(PM_REALLOC(im->diag, im->nunk, "tangent diagonal"));
-  PM_CALL(PM_REALLOC(im->pat_ptr, im->nunk + 1, "Jacobian pattern"));
-  PM_CALL(PM_REALLOC(im->pc_ptr, im->nunk + 1, "diagonal pattern"));
-  PM_CALL(PM_REALLOC(im->pc_idx, im->nunk, "diagonal pattern"));
+  const long nh = im->nheld;
+  PM_CALL(PM_REALLOC(im->unk_dof, nh + 1, "unknowns"));
+  PM_CALL(PM_REALLOC(im->x_unk, im->nunk + 1, "unknowns"));
+  if (im->ranks) PM_CALL(PM_REALLOC(im->x_held, nh + 1, "held unknowns"));
+  PM_CALL(PM_REALLOC(im->diag, nh + 1, "tangent diagonal"));
+  PM_CALL(PM_REALLOC(im->pat_ptr, nh + 1, "Jacobian pattern"));
+  PM_CALL(PM_REALLOC(im->pc_ptr, nh + 1, "diagonal pattern"));
+  PM_CALL(PM_REALLOC(im->pc_idx, nh + 1, "diagonal pattern"));
   memset(im->x_unk, 0, sizeof(double) * (size_t)im->nunk);
   for (long d = 0; d < 3 * nn; d++)
     if (im->dof[d] >= 0) im->unk_dof[im->dof[d]] = d;
-  for (long k = 0; k <= im->nunk; k++) im->pc_ptr[k] = k;
-  for (long k = 0; k < im->nunk; k++) im->pc_idx[k] = k;
+  for (long k = 0; k <= nh; k++) im->pc_ptr[k] = k;
+  for (long k = 0; k < nh; k++) im->pc_idx[k] = k;
   /* neighbour offsets and the row lengths */
   const int span = im->w - 1;
   long total = 0;
@@ -806,7 +876,9 @@ static pm_err make_dofs(mpm_implicit *im) {
       im->pat_ptr[row + 1] = cnt; /* lengths first */
     }
   }
-  for (long r = 0; r < im->nunk; r++) im->pat_ptr[r + 1] += im->pat_ptr[r];
+  for (long r = 0; r < nh; r++) im->pat_ptr[r + 1] += im->pat_ptr[r];
+  im->entries_all = total;
+  pm_par_sum_long(&im->entries_all, 1);
   if (total > im->pat_cap) {
     PM_CALL(PM_REALLOC(im->pat_idx, total, "Jacobian pattern"));
     im->pat_cap = total;
@@ -885,6 +957,9 @@ static pm_err make_solver(mpm_implicit *im) {
       .pc_pat_idx = im->matrix_free ? im->pc_idx : NULL,
       .near_null_count = nnull,
       .near_null = amg ? im->near_null : NULL,
+      .shared = im->ranks,
+      .n_ghost = im->nghost,
+      .ghost = im->ghost,
       .set_load = cb_set_load,
   };
   pb.on_step = on_step;
@@ -905,18 +980,39 @@ static pm_err rebuild(mpm_implicit *im) {
 static pm_err commit(mpm_implicit *im, const double *x) {
   const mpm_model *m = im->m;
   mpm_state *st = im->st;
+  if (im->ranks) { /* the ghost nodes' unknowns too */
+    PM_CALL(pm_newton_held_values(im->solver, x, im->x_held));
+    x = im->x_held;
+  }
   fill_u(im, x);
   if (!nodal_force(im, im->u, im->f))
     return PM_ERROR(PM_ERR_UNSTABLE, "%s", im->fail_msg);
+  /* Across ranks: whole nodal sums, counted at the nodes a rank owns. */
+  const unsigned char *own = im->ranks ? mpm_par_owned(m) : NULL;
+  if (im->ranks) {
+    MPI_Datatype three;
+    MPI_Type_contiguous(3, MPI_DOUBLE, &three);
+    MPI_Type_commit(&three);
+    pm_err e = mpm_par_nodes_reduce(m, im->f, three, MPI_SUM);
+    MPI_Type_free(&three);
+    PM_CALL(e);
+  }
   for (int b = 0; b < 3 * m->n_bcs; b++) im->reaction[b] = 0;
-  double rr = 0, rf = 0;
+  double sums[2] = {0, 0}; /* |r|^2, |reactions|^2 */
   for (long k = 0; k < im->npre; k++) {
+    if (own && !own[im->pre_dof[k] / 3]) continue;
     const double fk = im->f[im->pre_dof[k]];
     im->reaction[3 * im->pre_bc[k] + im->pre_dof[k] % 3] += fk;
-    rf += fk * fk;
+    sums[1] += fk * fk;
   }
   for (long k = 0; k < im->nunk; k++)
-    rr += im->f[im->unk_dof[k]] * im->f[im->unk_dof[k]];
+    sums[0] += im->f[im->unk_dof[k]] * im->f[im->unk_dof[k]];
+  if (im->ranks) {
+    pm_par_sum(im->reaction, 3 * m->n_bcs);
+    pm_par_sum(sums, 2);
+    pm_par_min(&im->min_jacobian, 1);
+  }
+  const double rr = sums[0], rf = sums[1];
   im->residual = rf > 0 ? sqrt(rr / rf) : sqrt(rr);
   if (im->fbar) /* the stress from Fbar, before F_b changes */
     FOR_BUCKETS(im, {
@@ -975,7 +1071,8 @@ static pm_err commit(mpm_implicit *im, const double *x) {
     }
   }
   PM_CHECK(bad < 0, PM_ERR_UNSTABLE,
-           "particle %ld: no stress at the converged state", bad);
+           "particle %ld: no stress at the converged state",
+           m->gid ? m->gid[bad] : bad);
   return PM_SUCCESS;
 }
 
@@ -1001,7 +1098,8 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
   (void)step;
   mpm_implicit *im = ctx;
   if (im->mode == MPM_GRID_RESET && lambda < 1) return PM_SUCCESS;
-  PM_CALL(commit(im, x));
+  pm_err e = commit(im, x);
+  PM_CALL(im->ranks ? pm_par_agree(e) : e);
   im->lambda = im->lam0 + lambda * (im->lam1 - im->lam0);
   return report_step(im, report);
 }
@@ -1124,6 +1222,7 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   im->m = m;
   im->st = st;
   im->n = m->n;
+  im->ranks = m->par != NULL;
   im->dim = m->dim;
   im->mode = (mpm_grid_mode)ms->implicit.grid;
   im->matrix_free = ms->implicit.op == MPM_OP_MATRIX_FREE;
@@ -1178,6 +1277,7 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   PM_TRY(PM_ALLOC(im->cbuck, nn, "bucket colours"));
   PM_TRY(PM_ALLOC(im->active, nn, "active nodes"));
   PM_TRY(PM_ALLOC(im->dof, 3 * nn, "grid dofs"));
+  if (im->ranks) PM_TRY(PM_ALLOC(im->gnum, 3 * nn, "global dofs"));
   PM_TRY(PM_ALLOC(im->nb_off, nn * im->nnb, "neighbour offsets"));
   PM_TRY(PM_ALLOC(im->u, 3 * nn, "nodal displacements"));
   PM_TRY(PM_ALLOC(im->du, 3 * nn, "nodal directions"));
@@ -1235,7 +1335,7 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   for (int gi = 0; gi < m->n_groups; gi++)
     M = fmax(M, im->view[gi].mat->wave_modulus);
   o->atol = 100 * DBL_EPSILON * M * pow(m->grid.h, im->dim - 1) *
-            sqrt((double)im->nunk);
+            sqrt((double)im->nunk_all);
   PM_TRY(make_solver(im));
   im->built_for = 0;
   if (im->mode == MPM_GRID_KEPT) PM_TRY(pm_load_state_init(&im->ls, im->nunk));
@@ -1259,6 +1359,8 @@ void mpm_implicit_destroy(mpm_implicit *im) {
   free(im->cbuck);
   free(im->active);
   free(im->dof);
+  free(im->gnum);
+  free(im->ghost);
   free(im->unk_dof);
   free(im->pre_dof);
   free(im->pre_val);
@@ -1277,6 +1379,8 @@ void mpm_implicit_destroy(mpm_implicit *im) {
   free(im->df);
   free(im->diag);
   free(im->x_unk);
+  free(im->x_held);
+  free(im->whole);
   free(im->reaction);
   free(im);
 }
@@ -1290,8 +1394,8 @@ const pm_load_report *mpm_implicit_report(const mpm_implicit *im) {
   return &im->rep;
 }
 void mpm_implicit_size(const mpm_implicit *im, long *unknowns, long *entries) {
-  *unknowns = im->nunk;
-  *entries = im->pat_ptr ? im->pat_ptr[im->nunk] : 0;
+  *unknowns = im->nunk_all;
+  *entries = im->entries_all;
 }
 
 static const char *linear_name(pm_newton_linear l) {
@@ -1307,22 +1411,22 @@ static const char *linear_name(pm_newton_linear l) {
 
 void mpm_implicit_plan(const mpm_implicit *im, FILE *out) {
   const mpm_grid *g = &im->g;
-  long active = 0;
-  for (long k = 0; k < g->n_nodes; k++) active += im->active[k];
+  const long active = im->active_all;
   fprintf(out, "algorithm    %s\n",
           im->mode == MPM_GRID_KEPT
               ? "grid kept with the particles (the modified algorithm: "
                 "total Lagrangian on the grid)"
               : "grid reset after each load step (the standard algorithm)");
   fprintf(out,
-          "solver grid  %ld x %ld x %ld nodes (%ld active), cell %g m, "
+          "solver grid  %ld x %ld x %ld nodes%s (%ld active), cell %g m, "
           "%d colours of cells\n",
-          g->nn[0], g->nn[1], g->nn[2], active, g->h, im->sn);
+          g->nn[0], g->nn[1], g->nn[2], im->ranks ? " on rank 0" : "", active,
+          g->h, im->sn);
   fprintf(out,
           "unknowns     %ld (%ld prescribed), Jacobian %ld entries "
           "(%.1f MiB)%s\n",
-          im->nunk, im->npre, im->pat_ptr[im->nunk],
-          im->pat_ptr[im->nunk] * 12.0 / 1048576.0,
+          im->nunk_all, im->npre, im->entries_all,
+          im->entries_all * 12.0 / 1048576.0,
           im->mode == MPM_GRID_RESET ? ", first load step" : "");
   fprintf(out, "newton       %d load steps, at most %d iterations each, ",
           im->opt_steps, im->opt.max_iter);
@@ -1337,7 +1441,63 @@ void mpm_implicit_plan(const mpm_implicit *im, FILE *out) {
                           : "assembled tangent");
 }
 
-pm_err mpm_implicit_checkpoint(mpm_implicit *im, pm_ckpt *ck) {
+/* Node i of the solver's grid g as a node of the whole grid fg. */
+static long whole_node(const mpm_grid *g, const mpm_grid *fg, long i) {
+  const long ijk[3] = {i % g->nn[0], (i / g->nn[0]) % g->nn[1],
+                       i / g->stride[2]};
+  long q = 0;
+  for (int a = 0; a < 3; a++) q += (ijk[a] + g->offset[a]) * fg->stride[a];
+  return q;
+}
+
+/* The owned unknowns x (nunk) as nodal displacements u of the solver's
+ * grid (0 at the other dofs), and back. */
+static void unknowns_to_nodes(const mpm_implicit *im, const double *x,
+                              double *u) {
+  memset(u, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
+  for (long k = 0; k < im->nunk; k++) u[im->unk_dof[k]] = x[k];
+}
+
+pm_err mpm_implicit_gather(mpm_implicit *im, const mpm_model *full) {
+  if (im->mode != MPM_GRID_KEPT) return PM_SUCCESS;
+  pm_err e = PM_SUCCESS;
+  if (full && !im->whole)
+    e = PM_ALLOC(im->whole, 6 * full->grid.n_nodes, "nodal gather");
+  PM_CALL(pm_par_agree(e));
+  const long nf = full ? 3 * full->grid.n_nodes : 0;
+  for (int s = 0; s < 2; s++) {
+    unknowns_to_nodes(im, s ? im->ls.xprev : im->ls.xc, im->du);
+    PM_CALL(mpm_par_gather_nodes(im->m, full, im->du,
+                                 full ? im->whole + s * nf : NULL));
+  }
+  return PM_SUCCESS;
+}
+
+/* With the grid kept: load stepping's two states as nodal displacements of
+ * the whole grid (full's), written from the solver's unknowns (or, across
+ * ranks, from what mpm_implicit_gather gathered) or read into them. */
+static pm_err checkpoint_states(mpm_implicit *im, const mpm_model *full,
+                                pm_ckpt *ck) {
+  const mpm_grid *fg = &full->grid;
+  const long nf = 3 * fg->n_nodes;
+  const bool reading = pm_ckpt_reading(ck);
+  if (!im->whole) PM_CALL(PM_ALLOC(im->whole, 2 * nf, "nodal states"));
+  for (int s = 0; s < 2; s++) {
+    double *x = s ? im->ls.xprev : im->ls.xc, *u = im->whole + s * nf;
+    if (!reading && !im->ranks) unknowns_to_nodes(im, x, u);
+    PM_CALL(pm_ckpt_doubles(ck, s ? "implicit.load.u_prev" : "implicit.load.u",
+                            nf, u));
+    if (!reading) continue;
+    for (long k = 0; k < im->nunk; k++) {
+      const long d = im->unk_dof[k];
+      x[k] = u[3 * whole_node(&im->g, fg, d / 3) + d % 3];
+    }
+  }
+  return PM_SUCCESS;
+}
+
+pm_err mpm_implicit_checkpoint(mpm_implicit *im, const mpm_model *full,
+                               pm_ckpt *ck) {
   long step = im->step;
   PM_CALL(pm_ckpt_double(ck, "implicit.lambda", &im->lambda));
   PM_CALL(pm_ckpt_long(ck, "implicit.step", &step));
@@ -1345,11 +1505,12 @@ pm_err mpm_implicit_checkpoint(mpm_implicit *im, pm_ckpt *ck) {
   PM_CALL(
       pm_ckpt_doubles(ck, "implicit.reaction", 3 * im->m->n_bcs, im->reaction));
   PM_CALL(pm_ckpt_double(ck, "implicit.residual", &im->residual));
-  if (im->mode == MPM_GRID_KEPT)
-    PM_CALL(
-        pm_load_checkpoint(ck, "implicit.load", im->nunk, &im->ls, &im->rep));
-  else
+  if (im->mode == MPM_GRID_KEPT) {
+    PM_CALL(pm_load_checkpoint(ck, "implicit.load", 0, &im->ls, &im->rep));
+    PM_CALL(checkpoint_states(im, full, ck));
+  } else {
     PM_CALL(pm_load_checkpoint(ck, "implicit.load", 0, NULL, &im->rep));
+  }
   if (pm_ckpt_reading(ck) && im->mode == MPM_GRID_RESET) im->built_for = -1;
   return PM_SUCCESS;
 }

@@ -103,8 +103,19 @@ void mpm_implicit_size(const mpm_implicit *im, long *unknowns, long *entries);
 void mpm_implicit_plan(const mpm_implicit *im, FILE *out);
 
 /* The solver's part of a checkpoint (load stepping, counters), between
- * load steps; the particles' state is the model state's. */
-pm_err mpm_implicit_checkpoint(mpm_implicit *im, pm_ckpt *ck);
+ * load steps; the particles' state is the model state's.  With the grid
+ * kept, load stepping's last two converged states are written as the
+ * nodal displacements of the whole grid (full: the whole model, whose grid
+ * is the solver's on one process), so that a run resumes on any number of
+ * ranks.  Across ranks rank 0 writes what mpm_implicit_gather gathered,
+ * and every rank reads. */
+pm_err mpm_implicit_checkpoint(mpm_implicit *im, const mpm_model *full,
+                               pm_ckpt *ck);
+
+/* Across ranks: load stepping's last two converged states, as nodal
+ * displacements of the whole grid, to rank 0 for its checkpoint (full:
+ * the whole model there, NULL on the other ranks; collective). */
+pm_err mpm_implicit_gather(mpm_implicit *im, const mpm_model *full);
 
 /* Tests: the largest |J - J_fd| over the largest |J_fd| of the Jacobian
  * against central differences of the residual at a smooth field of size

@@ -289,6 +289,7 @@ pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m, int size,
   pm_err ret = PM_SUCCESS;
   const mpm_grid *g = &m->grid;
   bisection B = {.s = s, .m = m, .d = d};
+  const bool implicit = strcmp(s->method, "mpm-implicit") == 0;
   long *idx = NULL;
   memset(d, 0, sizeof *d);
   d->size = size;
@@ -299,7 +300,9 @@ pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m, int size,
     d->cells[a] = a < g->dim ? g->nn[a] - 1 : 1;
     most = d->cells[a] > most ? d->cells[a] : most;
     B.splits[a] = a < g->dim;
-    int b = a < g->dim ? moving_wall(m, a) : -1;
+    /* (The implicit solver prescribes the nodes at and beyond a face by
+     * their place alone: no column to walk.) */
+    int b = a < g->dim && !implicit ? moving_wall(m, a) : -1;
     if (b >= 0) {
       B.splits[a] = false;
       used += (size_t)snprintf(d->held + used, sizeof d->held - used,
@@ -608,6 +611,22 @@ static pm_err local_state(const mpm_model *m, const mpm_state *st,
   mpm_state *ls = NULL;
   PM_CALL(mpm_state_create(lm, &ls));
   const struct mpm_par *P = lm->par;
+  mpm_par_take_state(m, st, lm, ls);
+  if (accounts) {
+    const double *row = accounts + MPM_PAR_ACCOUNTS * P->rank;
+    memcpy(ls->energy, row, sizeof ls->energy);
+    ls->external_work = row[MPM_PAR_ACCOUNTS - 2];
+    ls->dissipated = row[MPM_PAR_ACCOUNTS - 1];
+  } else if (P->rank != 0) {
+    memset(ls->energy, 0, sizeof ls->energy);
+    ls->external_work = ls->dissipated = 0;
+  }
+  *out = ls;
+  return PM_SUCCESS;
+}
+
+void mpm_par_take_state(const mpm_model *m, const mpm_state *st,
+                        const mpm_model *lm, mpm_state *ls) {
   for (long k = 0; k < lm->n; k++) {
     const long p = lm->gid[k];
     memcpy(ls->x + 3 * k, st->x + 3 * p, 3 * sizeof(double));
@@ -627,17 +646,9 @@ static pm_err local_state(const mpm_model *m, const mpm_state *st,
                nc * sizeof(double));
     }
   }
-  /* Scalars: every rank's the same, but the accounts. */
+  /* Scalars: every rank's the same (the energy accounts are set by the
+   * caller). */
   mpm_state_copy_values(ls, st);
-  if (accounts) {
-    const double *row = accounts + MPM_PAR_ACCOUNTS * P->rank;
-    memcpy(ls->energy, row, sizeof ls->energy);
-    ls->external_work = row[MPM_PAR_ACCOUNTS - 2];
-    ls->dissipated = row[MPM_PAR_ACCOUNTS - 1];
-  } else if (P->rank != 0) {
-    memset(ls->energy, 0, sizeof ls->energy);
-    ls->external_work = ls->dissipated = 0;
-  }
   /* Nodal arrays of dynamic relaxation, from the whole grid's. */
   const mpm_grid *g = &lm->grid, *fg = &m->grid;
   for (long i = 0; i < g->n_nodes && ls->force_prev; i++) {
@@ -650,8 +661,6 @@ static pm_err local_state(const mpm_model *m, const mpm_state *st,
     memcpy(ls->force_prev + 3 * i, st->force_prev + 3 * q, 3 * sizeof(double));
     if (ls->fixed) memcpy(ls->fixed + 3 * i, st->fixed + 3 * q, 3);
   }
-  *out = ls;
-  return PM_SUCCESS;
 }
 
 /* Doubles of a migration record for model m's groups, and of its widest
@@ -816,6 +825,35 @@ pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
   P->counts.halo_seconds += pm_wtime() - t0;
   return PM_SUCCESS;
 }
+
+/* One pass of a nodal array's ghost values (`unit` per node) between the
+ * ranks, counted. */
+static void count_ghosts(const mpm_model *m, MPI_Datatype unit) {
+  int size = 0;
+  MPI_Type_size(unit, &size);
+  const double bytes = (double)(m->grid.n_nodes - m->par->n_owned) * size;
+  m->par->counts.halo_bytes += bytes;
+  pm_par_count_sent(bytes);
+}
+
+pm_err mpm_par_nodes_reduce(const mpm_model *m, void *a, MPI_Datatype unit,
+                            MPI_Op op) {
+  PetscSF sf = m->par->ghosts;
+  count_ghosts(m, unit);
+  PM_PETSC_CALL(PetscSFReduceBegin(sf, unit, a, a, op));
+  PM_PETSC_CALL(PetscSFReduceEnd(sf, unit, a, a, op));
+  return mpm_par_nodes_bcast(m, a, unit);
+}
+
+pm_err mpm_par_nodes_bcast(const mpm_model *m, void *a, MPI_Datatype unit) {
+  PetscSF sf = m->par->ghosts;
+  count_ghosts(m, unit);
+  PM_PETSC_CALL(PetscSFBcastBegin(sf, unit, a, a, MPI_REPLACE));
+  PM_PETSC_CALL(PetscSFBcastEnd(sf, unit, a, a, MPI_REPLACE));
+  return PM_SUCCESS;
+}
+
+const unsigned char *mpm_par_owned(const mpm_model *m) { return m->par->owned; }
 
 void mpm_par_step_end(const mpm_model *m, mpm_work *w) {
   (void)m;
@@ -1084,6 +1122,55 @@ static void gather_array(struct mpm_par *P, const double *data, long n, int nc,
     memcpy(out + (gid[j] - base) * nc, P->gbuf + j * nc, nc * sizeof(double));
 }
 
+/* Three values per node of this rank's owned nodes (of src, or the flags
+ * srcf) into the whole grid's array on rank 0 (dst, or the flags dstf;
+ * fg the whole grid there, NULL on the other ranks): each rank's owned
+ * nodes in its box's order, placed by rank 0 (collective). */
+static pm_err gather_owned(const mpm_model *m, const mpm_grid *fg,
+                           const double *src, const unsigned char *srcf,
+                           double *dst, unsigned char *dstf) {
+  struct mpm_par *P = m->par;
+  const mpm_grid *g = &m->grid;
+  const int size = P->d.size;
+  pm_err e = PM_SUCCESS;
+  if (!P->nodal) e = PM_ALLOC(P->nodal, 3 * P->n_owned + 1, "nodal gather");
+  if (!e && fg && !P->whole)
+    e = PM_ALLOC(P->whole, 3 * fg->n_nodes, "nodal gather");
+  PM_CALL(pm_par_agree(e));
+  long k = 0;
+  for (long i = 0; i < g->n_nodes; i++)
+    if (P->owned[i])
+      for (int c = 0; c < 3; c++, k++)
+        P->nodal[k] = src ? src[3 * i + c] : (double)srcf[3 * i + c];
+  int cnt = (int)k;
+  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (P->rank == 0) {
+    P->gdisp[0] = 0;
+    for (int r = 0; r < size; r++) P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
+  }
+  MPI_Gatherv(P->nodal, cnt, MPI_DOUBLE, P->whole, P->gcount, P->gdisp,
+              MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (!fg) return PM_SUCCESS;
+  const double *b = P->whole;
+  for (int r = 0; r < size; r++) {
+    long lo[3], hi[3];
+    mpm_decomp_nodes(&P->d, r, lo, hi);
+    for (int a = fg->dim; a < 3; a++) lo[a] = 0, hi[a] = 1;
+    for (long z = lo[2]; z < hi[2]; z++)
+      for (long y = lo[1]; y < hi[1]; y++)
+        for (long x = lo[0]; x < hi[0]; x++, b += 3) {
+          const long q = x + y * fg->stride[1] + z * fg->stride[2];
+          for (int c = 0; c < 3; c++) {
+            if (dst)
+              dst[3 * q + c] = b[c];
+            else
+              dstf[3 * q + c] = b[c] != 0;
+          }
+        }
+  }
+  return PM_SUCCESS;
+}
+
 pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
                       const mpm_model *full, mpm_state *fs) {
   struct mpm_par *P = m->par;
@@ -1137,46 +1224,18 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
     fs->dissipated = acc[n_acc + 1];
   }
   if (!s->force_prev) return PM_SUCCESS;
-  /* Dynamic relaxation's nodal arrays: each rank's owned nodes, placed by
-   * rank 0 in the whole grid from the rank's box. */
-  const mpm_grid *g = &m->grid;
-  for (int pass = 0; pass < (s->fixed ? 2 : 1); pass++) {
-    long k = 0;
-    for (long i = 0; i < g->n_nodes; i++)
-      if (P->owned[i])
-        for (int c = 0; c < 3; c++, k++)
-          P->nodal[k] =
-              pass ? (double)s->fixed[3 * i + c] : s->force_prev[3 * i + c];
-    int cnt = (int)k;
-    MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
-    if (P->rank == 0) {
-      P->gdisp[0] = 0;
-      for (int r = 0; r < size; r++)
-        P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
-    }
-    MPI_Gatherv(P->nodal, cnt, MPI_DOUBLE, P->whole, P->gcount, P->gdisp,
-                MPI_DOUBLE, 0, MPI_COMM_WORLD);
-    if (!fs) continue;
-    const mpm_grid *fg = &full->grid;
-    const double *b = P->whole;
-    for (int r = 0; r < size; r++) {
-      long lo[3], hi[3];
-      mpm_decomp_nodes(&P->d, r, lo, hi);
-      for (int a = fg->dim; a < 3; a++) lo[a] = 0, hi[a] = 1;
-      for (long z = lo[2]; z < hi[2]; z++)
-        for (long y = lo[1]; y < hi[1]; y++)
-          for (long x = lo[0]; x < hi[0]; x++, b += 3) {
-            const long q = x + y * fg->stride[1] + z * fg->stride[2];
-            for (int c = 0; c < 3; c++) {
-              if (pass)
-                fs->fixed[3 * q + c] = b[c] != 0;
-              else
-                fs->force_prev[3 * q + c] = b[c];
-            }
-          }
-    }
-  }
+  /* Dynamic relaxation's nodal arrays. */
+  const mpm_grid *fg = fs ? &full->grid : NULL;
+  PM_CALL(gather_owned(m, fg, s->force_prev, NULL, fs ? fs->force_prev : NULL,
+                       NULL));
+  if (s->fixed)
+    PM_CALL(gather_owned(m, fg, NULL, s->fixed, NULL, fs ? fs->fixed : NULL));
   return PM_SUCCESS;
+}
+
+pm_err mpm_par_gather_nodes(const mpm_model *m, const mpm_model *full,
+                            const double *local, double *whole) {
+  return gather_owned(m, full ? &full->grid : NULL, local, NULL, whole, NULL);
 }
 
 /* ---- plan and counts -------------------------------------------------------
@@ -1268,8 +1327,9 @@ void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
   const struct mpm_par *P = m->par;
   const int size = P->d.size;
   /* Per rank: particles, nodes held, nodes owned, bytes. */
-  double mine[4] = {(double)m->n, (double)m->grid.n_nodes, (double)P->n_owned,
-                    (double)(mpm_model_bytes(m) + mpm_work_bytes(m, w))};
+  double mine[4] = {
+      (double)m->n, (double)m->grid.n_nodes, (double)P->n_owned,
+      (double)(mpm_model_bytes(m) + (w ? mpm_work_bytes(m, w) : 0))};
   double *all = NULL;
   if (P->rank == 0) all = calloc((size_t)size * 4, sizeof(double));
   MPI_Gather(mine, 4, MPI_DOUBLE, all, 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);

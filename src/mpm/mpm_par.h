@@ -35,6 +35,7 @@
 #ifndef MPM_PAR_H
 #define MPM_PAR_H
 
+#include <mpi.h>
 #include <stdio.h>
 
 #include "mpm_model.h"
@@ -97,6 +98,13 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
                       const mpm_state *st, const double *accounts,
                       mpm_model **local, mpm_state **local_state);
 
+/* The values of full state st (of full model m) of local model lm's
+ * particles and nodes into local state ls, whose arrays have room for
+ * them: particles, their groups' arrays, the scalars (but the energy
+ * accounts) and dynamic relaxation's nodal arrays. */
+void mpm_par_take_state(const mpm_model *m, const mpm_state *st,
+                        const mpm_model *lm, mpm_state *ls);
+
 /* A rank's energy accounts: each stage's (work, dissipated), the external
  * work and the energy dissipated. */
 #define MPM_PAR_ACCOUNTS                                                       \
@@ -117,6 +125,17 @@ void mpm_par_work_attach(const mpm_model *m, mpm_work *w);
 pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
                          bool impedances);
 
+/* Reduce a nodal array of local model m (one `unit` per node of its block)
+ * onto the nodes' owners with op, then give the owners' values back to
+ * every rank that holds the node (collective).  For sums over the ranks'
+ * particles (op MPI_SUM) and flags (MPI_MAX). */
+pm_err mpm_par_nodes_reduce(const mpm_model *m, void *a, MPI_Datatype unit,
+                            MPI_Op op);
+/* The owners' values of a nodal array at the ghost nodes (collective). */
+pm_err mpm_par_nodes_bcast(const mpm_model *m, void *a, MPI_Datatype unit);
+/* Per node of local model m's block: 1 where its rank owns it. */
+const unsigned char *mpm_par_owned(const mpm_model *m);
+
 /* The figures of a step every rank must share, once it ends: the largest
  * |tr D|, the smallest J, the iterations (collective). */
 void mpm_par_step_end(const mpm_model *m, mpm_work *w);
@@ -133,9 +152,16 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w);
 pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
                       const mpm_model *full, mpm_state *full_state);
 
+/* Three values per node of the whole grid (`whole`, on rank 0; NULL on the
+ * others) from each rank's owned nodes of its block (`local`, three per
+ * node of local model m's block); full is the whole model on rank 0
+ * (collective). */
+pm_err mpm_par_gather_nodes(const mpm_model *m, const mpm_model *full,
+                            const double *local, double *whole);
+
 /* Print the decomposition and every rank's share (particles, nodes, ghost
- * nodes, memory) to out on rank 0 (collective; out may be NULL on other
- * ranks). */
+ * nodes, memory of the model and of the workspace w, which may be NULL) to
+ * out on rank 0 (collective; out may be NULL on other ranks). */
 void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out);
 
 /* Print decomposition d of model m: its boxes, cuts and balance. */

@@ -215,8 +215,10 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
     PM_CALL(pm_ckpt_double(ck, NAME("dl"), &st->dl));
     PM_CALL(pm_ckpt_long(ck, NAME("good"), &st->good));
     PM_CALL(pm_ckpt_long(ck, NAME("have_prev"), &st->have_prev));
-    PM_CALL(pm_ckpt_doubles(ck, NAME("xc"), n, st->xc));
-    PM_CALL(pm_ckpt_doubles(ck, NAME("xprev"), n, st->xprev));
+    if (n > 0) {
+      PM_CALL(pm_ckpt_doubles(ck, NAME("xc"), n, st->xc));
+      PM_CALL(pm_ckpt_doubles(ck, NAME("xprev"), n, st->xprev));
+    }
   }
   long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,
        linear = rep->linear_iterations;

@@ -1126,6 +1126,20 @@ pm_err pm_newton_residual(pm_newton *s, const double *x, double *r) {
   return e;
 }
 
+pm_err pm_newton_held_values(pm_newton *s, const double *x, double *held) {
+  if (!s->dist) {
+    memcpy(held, x, (size_t)s->p.n * sizeof *held);
+    return PM_SUCCESS;
+  }
+  const double *h;
+  Vec hl;
+  PM_CALL(copy_in(s->Work, x, s->p.n));
+  PM_PETSC_CALL(in_get(s, s->Work, s->Gx, &hl, &h));
+  memcpy(held, h, (size_t)s->nloc * sizeof *held);
+  PM_PETSC_CALL(in_done(s, s->Gx, &hl, &h));
+  return PM_SUCCESS;
+}
+
 double pm_newton_norm(const pm_newton *s, const double *v) {
   double sum = 0;
   for (long i = 0; i < s->p.n; i++) sum += v[i] * v[i];

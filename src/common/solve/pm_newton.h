@@ -335,6 +335,11 @@ int pm_newton_pc_colors(const pm_newton *s);
  * callback's hard failure or a PETSc failure as it is. */
 pm_err pm_newton_solve(pm_newton *s, double *x, pm_newton_report *report);
 
+/* held (n + n_ghost values) = the owned values x (n) with their ghosts'
+ * values from their owners: what the callbacks see of x (a copy on one
+ * process; collective for a shared problem). */
+pm_err pm_newton_held_values(pm_newton *s, const double *x, double *held);
+
 /* Loads from lambda = 0 (x converged there) to 1 in options.load_steps
  * steps: each sets the load, solves by Newton from the last converged
  * state (or the predictor), and calls on_step.  A step that fails (any
@@ -376,9 +381,11 @@ void pm_load_state_free(pm_load_state *state);
 pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *state,
                           pm_load_report *report);
 
-/* Write or read load stepping's state (st, over n unknowns; NULL: none)
- * and the counters of rep, as checkpoint items named PREFIX.lambda, ...
- * (pm_checkpoint.h: the same calls write and read). */
+/* Write or read load stepping's state (st, over n unknowns; NULL: none;
+ * n = 0: its figures without the states xc and xprev, which the caller
+ * keeps in a form of its own) and the counters of rep, as checkpoint items
+ * named PREFIX.lambda, ... (pm_checkpoint.h: the same calls write and
+ * read). */
 pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
                           pm_load_state *st, pm_load_report *rep);
 
