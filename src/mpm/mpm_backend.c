@@ -198,20 +198,18 @@ static pm_err gather(mpm_sim *r) {
   return PM_SUCCESS;
 }
 
-/* A step of a run across ranks (collective): rank 0 decides whether its
- * observer will read the state; if so every rank sends its particles; rank
- * 0 reports, and every rank returns its observer's answer. */
+static pm_err gather_view(void *r) { return gather(r); }
+
+/* A step of a run across ranks (collective): rank 0 reports it, with the
+ * particles gathered where its observer reads them. */
 static pm_err share(mpm_sim *r, bool frame, bool last) {
-  int want = frame;
+  pm_step_report rep = {0};
   if (r->model) {
     view_figures(r);
-    pm_step_report rep = step_report(r, last);
-    if (r->obs && r->obs->wants)
-      want = want || r->obs->wants(r->obs->ctx, &rep, frame);
+    rep = step_report(r, last);
   }
-  pm_par_bcast(&want, sizeof want);
-  if (want) PM_CALL(gather(r));
-  return pm_par_agree(r->model ? report(r, frame, last) : PM_SUCCESS);
+  return pm_observer_share(r->model ? r->obs : NULL, &rep, frame, gather_view,
+                           r);
 }
 
 static pm_err observe_ranks(void *ctx, const mpm_model *m, const mpm_state *s,
