@@ -161,17 +161,6 @@ static pm_step_report note_step(fpm_sim *sim, const fpm_step_info *info) {
                           .progress = frac};
 }
 
-static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
-                      const fpm_step_info *info, bool frame) {
-  fpm_sim *sim = ctx;
-  (void)m;
-  (void)st;
-  pm_step_report r = note_step(sim, info);
-  return sim->obs ? sim->obs->step(sim->obs->ctx, &r, frame) : PM_SUCCESS;
-}
-
-/* ---- across ranks ---- */
-
 /* Every rank's share of the state into rank 0's view (collective). */
 static pm_err gather(void *ctx) {
   fpm_sim *sim = ctx;
@@ -179,14 +168,20 @@ static pm_err gather(void *ctx) {
                                      pm_par_root() ? sim->state : NULL));
 }
 
-static pm_err observe_ranks(void *ctx, const fpm_model *m, const fpm_state *st,
-                            const fpm_step_info *info, bool frame) {
+/* Across ranks rank 0 reports, with the state gathered where its observer
+ * reads it (collective). */
+static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
+                      const fpm_step_info *info, bool frame) {
   fpm_sim *sim = ctx;
   (void)m;
   (void)st;
   pm_step_report r = note_step(sim, info);
-  return pm_observer_share(sim->obs, &r, frame, gather, sim);
+  if (sim->local_model)
+    return pm_observer_share(sim->obs, &r, frame, gather, sim);
+  return sim->obs ? sim->obs->step(sim->obs->ctx, &r, frame) : PM_SUCCESS;
 }
+
+/* ---- across ranks ---- */
 
 /* Across ranks, once the run starts: the whole model stays on rank 0 as
  * its view of the run; the other ranks let it go. */
@@ -274,8 +269,7 @@ static pm_err run(void *p, const pm_observer *obs) {
     return e;
   }
   sim->first_step = st->step;
-  e = fpm_run(lm, st, &opt, sim->local_model ? observe_ranks : observe, sim,
-              &sim->last, stage);
+  e = fpm_run(lm, st, &opt, observe, sim, &sim->last, stage);
   if (sim->local_model) { /* the state the run ended in, for the figures */
     pm_err g = gather(sim);
     if (!e) e = g;
@@ -552,9 +546,11 @@ static pm_err create(const pm_scene *s, void **out) {
   fpm_sim *sim = NULL;
   pm_err e = pm_par_agree(fpm_sim_create(s, &sim));
   if (!e && pm_par_active()) {
+    const double t0 = pm_wtime();
     e = fpm_par_create(sim->model, &sim->local_model);
     if (!e)
       e = pm_par_agree(fpm_state_create(sim->local_model, &sim->local_state));
+    sim->setup_wall += pm_wtime() - t0;
   }
   if (e) {
     fpm_sim_destroy(sim);

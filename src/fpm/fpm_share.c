@@ -77,8 +77,9 @@ long fpm_partition_edge_cut(const fpm_model *m, const int *owner) {
  * stress or displacement it reads; NONE for the others. */
 enum { OWN = 0, FLUX = 1, STRESS = 2, DISPLACEMENT = 3, NONE = 4 };
 
-/* Mark the points that `from`'s points read at `level` (those of a lower
- * level, marked before, are the readers). */
+/* Mark `to` on the points not yet held that the points of level `from` or
+ * lower read: their supports, and for displacement ghosts also the points
+ * of their fits. */
 static void mark_support(const fpm_model *m, signed char *level, int from,
                          int to) {
   for (long i = 0; i < m->n; i++) {
@@ -110,9 +111,9 @@ static void share_levels(const fpm_model *m, const int *owner, int r,
   mark_support(m, level, STRESS, DISPLACEMENT);
 }
 
-/* The rows (CSR) of the share's points that have one (those whose stress
- * it computes), entries copied in their order, neighbours as local
- * indices; -1 where a neighbour is not held (none is, by the levels). */
+/* The rows (CSR) of the share's first n_rows points (those whose stress
+ * it computes), entries in their order, neighbours as indices in the share
+ * (the levels hold every one). */
 static pm_err copy_rows(const long *ptr, const int *nbr, long n_rows,
                         const long *gid, const int *local_of, long *lptr,
                         int **lnbr) {
