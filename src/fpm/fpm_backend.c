@@ -9,15 +9,19 @@
 
 #include "fpm_estimate.h"
 #include "fpm_gfd.h"
+#include "fpm_par.h"
 #include "fpm_scene.h"
 #include "gm_cells.h"
 #include "pm_files.h"
 #include "pm_metrics.h"
 #include "pm_omp.h"
+#include "pm_par.h"
 #include "pm_tensor.h"
 
 void fpm_sim_destroy(fpm_sim *sim) {
   if (!sim) return;
+  fpm_state_destroy(sim->local_state);
+  fpm_model_destroy(sim->local_model);
   fpm_static_state_free(&sim->static_state);
   fpm_state_destroy(sim->state);
   fpm_model_destroy(sim->model);
@@ -129,12 +133,8 @@ long fpm_sim_conditioning(const fpm_sim *sim, double *worst,
 /* Each step of fpm_run: the run's figures, and the report to the run's
  * observer with a progress fraction (time, or the residual's way to its
  * tolerance once the loads are on). */
-static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
-                      const fpm_step_info *info, bool frame) {
-  fpm_sim *sim = ctx;
+static pm_step_report note_step(fpm_sim *sim, const fpm_step_info *info) {
   const pm_scene *s = sim->scene;
-  (void)m;
-  (void)st;
   sim->last = *info;
   if (info->min_jacobian < sim->run_min_jacobian) {
     sim->run_min_jacobian = info->min_jacobian;
@@ -154,12 +154,62 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
   } else if (info->step > 0 && info->t >= load_end && sim->res0 == 0) {
     sim->res0 = info->residual;
   }
-  pm_step_report r = {.last = info->last,
-                      .step = info->step,
-                      .t = info->t,
-                      .residual = info->residual,
-                      .progress = frac};
+  return (pm_step_report){.last = info->last,
+                          .step = info->step,
+                          .t = info->t,
+                          .residual = info->residual,
+                          .progress = frac};
+}
+
+/* Every rank's share of the state into rank 0's view (collective). */
+static pm_err gather(void *ctx) {
+  fpm_sim *sim = ctx;
+  return pm_par_agree(fpm_par_gather(sim->local_model, sim->local_state,
+                                     pm_par_root() ? sim->state : NULL));
+}
+
+/* Across ranks rank 0 reports, with the state gathered where its observer
+ * reads it (collective). */
+static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
+                      const fpm_step_info *info, bool frame) {
+  fpm_sim *sim = ctx;
+  (void)m;
+  (void)st;
+  pm_step_report r = note_step(sim, info);
+  if (sim->local_model)
+    return pm_observer_share(sim->obs, &r, frame, gather, sim);
   return sim->obs ? sim->obs->step(sim->obs->ctx, &r, frame) : PM_SUCCESS;
+}
+
+/* ---- across ranks ---- */
+
+/* Across ranks, once the run starts: the whole model stays on rank 0 as
+ * its view of the run; the other ranks let it go. */
+static void release_view(fpm_sim *sim) {
+  if (pm_par_root()) return;
+  fpm_state_destroy(sim->state);
+  fpm_model_destroy(sim->model);
+  gm_dual_destroy(sim->dual);
+  gm_mesh_destroy(sim->mesh);
+  free(sim->scratch);
+  sim->state = NULL;
+  sim->model = NULL;
+  sim->dual = NULL;
+  sim->mesh = NULL;
+  sim->scratch = NULL;
+}
+
+/* What the exchanges cost over the run, summed over the ranks (the
+ * seconds of the slowest rank), for the summary. */
+static void ranks_costs(fpm_sim *sim) {
+  fpm_par_costs c;
+  fpm_par_get_costs(sim->local_model, &c);
+  double sums[2] = {c.ghost_bytes, (double)c.exchanges},
+         most[2] = {c.exchange_seconds, c.gather_seconds};
+  pm_par_sum(sums, 2);
+  pm_par_max(most, 2);
+  memcpy(sim->ranks_costs, sums, sizeof sums);
+  memcpy(sim->ranks_costs + 2, most, sizeof most);
 }
 
 static pm_err run(void *p, const pm_observer *obs) {
@@ -177,10 +227,18 @@ static pm_err run(void *p, const pm_observer *obs) {
       .min_jacobian = s->stability.min_jacobian,
       .max_energy_error = s->stability.max_energy_error,
   };
+  /* Across ranks, this rank's share: from the checkpoint every rank read
+   * into the whole state, when resumed. */
+  fpm_model *lm = sim->local_model ? sim->local_model : m;
+  fpm_state *st = sim->local_model ? sim->local_state : sim->state;
+  if (sim->local_model) {
+    if (sim->resumed) fpm_par_scatter(lm, sim->state, st);
+    release_view(sim);
+  }
   if (!sim->resumed) { /* a resumed run has these from its checkpoint */
-    memset(sim->state->u, 0, 3 * m->n * sizeof(double));
-    memset(sim->state->v, 0, 3 * m->n * sizeof(double));
-    sim->state->step = 0;
+    memset(st->u, 0, 3 * lm->n * sizeof(double));
+    memset(st->v, 0, 3 * lm->n * sizeof(double));
+    st->step = 0;
     sim->run_min_jacobian = INFINITY;
     sim->run_min_jacobian_step = 0;
     sim->run_max_energy_error = 0;
@@ -210,8 +268,13 @@ static pm_err run(void *p, const pm_observer *obs) {
     sim->status = pm_static_status(e);
     return e;
   }
-  sim->first_step = sim->state->step;
-  e = fpm_run(m, sim->state, &opt, observe, sim, &sim->last, stage);
+  sim->first_step = st->step;
+  e = fpm_run(lm, st, &opt, observe, sim, &sim->last, stage);
+  if (sim->local_model) { /* the state the run ended in, for the figures */
+    pm_err g = gather(sim);
+    if (!e) e = g;
+    ranks_costs(sim);
+  }
   sim->obs = NULL;
   sim->timers.stage[sim->tm_force].seconds += stage[0];
   sim->timers.stage[sim->tm_force].calls += sim->last.step + 1;
@@ -328,6 +391,9 @@ static void figures(void *p, pm_figures *f, bool with_fields) {
   f->step_seconds = pm_timers_seconds(&sim->timers, sim->tm_force) +
                     pm_timers_seconds(&sim->timers, sim->tm_update);
   f->memory_bytes = fpm_model_bytes(m) + fpm_state_bytes(m);
+  if (sim->local_model)
+    f->memory_bytes +=
+        fpm_model_bytes(sim->local_model) + fpm_state_bytes(sim->local_model);
   if (with_fields) field_figures(sim, f);
 }
 
@@ -344,6 +410,32 @@ static void history_values(void *p, double *v) {
   fpm_sim *sim = p;
   v[0] = sim->last.damping;
   v[1] = (double)fpm_sim_conditioning(sim, NULL, NULL);
+}
+
+/* The partition and what the exchanges cost (bytes a rank received per
+ * step on average; seconds of the slowest rank). */
+static pm_err summary_ranks(pm_json *j, const fpm_sim *sim) {
+  const fpm_model *lm = sim->local_model;
+  const fpm_share_counts *c = fpm_par_counts(lm);
+  const double *k = sim->ranks_costs;
+  const int size = pm_par_size();
+  PM_CALL(pm_json_begin_object(j, "ranks"));
+  PM_CALL(pm_json_integer(j, "count", size));
+  PM_CALL(pm_json_integer(
+      j, "edge_cut", fpm_partition_edge_cut(sim->model, fpm_par_owner(lm))));
+  PM_CALL(pm_json_begin_array(j, "points"));
+  for (int r = 0; r < size; r++) PM_CALL(pm_json_integer(j, NULL, c[r].own));
+  PM_CALL(pm_json_end_array(j));
+  PM_CALL(pm_json_begin_array(j, "ghost_points"));
+  for (int r = 0; r < size; r++)
+    PM_CALL(pm_json_integer(
+        j, NULL, c[r].flux_ghosts + c[r].stress_ghosts + c[r].u_ghosts));
+  PM_CALL(pm_json_end_array(j));
+  PM_CALL(
+      pm_json_number(j, "ghost_bytes_per_step", k[1] > 0 ? k[0] / k[1] : 0));
+  PM_CALL(pm_json_number(j, "exchange_seconds", k[2]));
+  PM_CALL(pm_json_number(j, "gather_seconds", k[3]));
+  return pm_json_end_object(j);
 }
 
 static pm_err summary(void *p, pm_json *j) {
@@ -372,6 +464,7 @@ static pm_err summary(void *p, pm_json *j) {
   PM_CALL(pm_json_integer(j, "dt_critical_point", sim->dt_point));
   PM_CALL(pm_json_integer(j, "ill_conditioned_points", ill));
   PM_CALL(pm_json_string(j, "jump", m->q ? "quadratic" : "linear"));
+  if (sim->local_model) PM_CALL(summary_ranks(j, sim));
   if (m->q) {
     PM_CALL(pm_json_integer(j, "fit_points_two_rings", m->n_qwide));
     PM_CALL(pm_json_integer(j, "fit_points_linear", m->n_qlinear));
@@ -447,9 +540,22 @@ static pm_err checkpoint(void *p, pm_ckpt *ck) {
   return PM_SUCCESS;
 }
 
+/* Across ranks every rank sets up the whole model (the same on every
+ * rank), then takes its share (collective). */
 static pm_err create(const pm_scene *s, void **out) {
   fpm_sim *sim = NULL;
-  PM_CALL(fpm_sim_create(s, &sim));
+  pm_err e = pm_par_agree(fpm_sim_create(s, &sim));
+  if (!e && pm_par_active()) {
+    const double t0 = pm_wtime();
+    e = fpm_par_create(sim->model, &sim->local_model);
+    if (!e)
+      e = pm_par_agree(fpm_state_create(sim->local_model, &sim->local_state));
+    sim->setup_wall += pm_wtime() - t0;
+  }
+  if (e) {
+    fpm_sim_destroy(sim);
+    return e;
+  }
   *out = sim;
   return PM_SUCCESS;
 }
@@ -463,6 +569,7 @@ const pm_backend fpm_backend = {
     .description = "explicit total-Lagrangian Fragile Points Method",
     .section = &fpm_section,
     .dt_safety = 0.9,
+    .ranks = true,
     .check = fpm_check_scene,
     .create = create,
     .estimate_bytes = fpm_estimate_bytes,
@@ -482,21 +589,39 @@ const pm_backend fpm_backend = {
 
 /* ---- plan --------------------------------------------------------------- */
 
-static pm_err plan(void *p, FILE *out) {
-  fpm_sim *sim = p;
-  const pm_scene *s = sim->scene;
-  fpm_model *m = sim->model;
-  fpm_state *st = sim->state;
-  /* Time a few force evaluations at a small deformation. */
+/* Seconds of one force evaluation at a small deformation of model m (u:
+ * its state's; across ranks every rank times its share together,
+ * collective). */
+static double time_force(const fpm_model *m, fpm_state *st) {
   for (long i = 0; i < 3 * m->n; i++) st->u[i] = 1e-9 * m->x[i];
   double t0 = pm_wtime();
-  int reps = 0;
-  do {
+  int reps = 0, more = 1;
+  for (;;) {
+    more = pm_wtime() - t0 < 0.2 && reps < 1000;
+    if (m->par) pm_par_bcast(&more, sizeof more);
+    if (!more) break;
+    fpm_par_exchange(m, st->u);
     fpm_force(m, st);
     reps++;
-  } while (pm_wtime() - t0 < 0.2 && reps < 1000);
-  double per_step = 1.1 * (pm_wtime() - t0) / reps;
+  }
   memset(st->u, 0, 3 * m->n * sizeof(double));
+  return 1.1 * (pm_wtime() - t0) / (reps > 0 ? reps : 1);
+}
+
+static void plan_estimate(const fpm_sim *sim, double per_step, double steps,
+                          FILE *out) {
+  fprintf(out,
+          "estimate     %.3g s per step, %.3g s for %.0f steps on %d "
+          "threads%s (setup took %.3g s)\n",
+          per_step, per_step * steps, steps, pm_omp_threads(),
+          pm_par_active() ? " per rank" : "", sim->setup_wall);
+}
+
+/* The plan's lines from the scene to the memory; the steps (0 for a static
+ * solve, whose lines end there). */
+static double plan_head(fpm_sim *sim, FILE *out) {
+  const pm_scene *s = sim->scene;
+  fpm_model *m = sim->model;
   double steps = ceil(s->time.end / sim->dt);
   if (s->time.max_steps > 0 && steps > s->time.max_steps)
     steps = (double)s->time.max_steps;
@@ -563,7 +688,7 @@ static pm_err plan(void *p, FILE *out) {
             "memory       %.1f MiB (operators and state; the tangent "
             "and its factors come on top)\n",
             (bytes + fpm_linear_bytes(m)) / 1048576.0);
-    return PM_SUCCESS;
+    return 0;
   }
   fprintf(out, "             %d. central difference%s, %ld prescribed dofs\n",
           stage++,
@@ -588,9 +713,39 @@ static pm_err plan(void *p, FILE *out) {
           s->time.qs != PM_QS_NONE ? " (at most: stops when converged)" : "");
   fprintf(out, "memory       %.1f MiB (operators and state)\n",
           bytes / 1048576.0);
-  fprintf(out,
-          "estimate     %.3g s per step, %.3g s for %.0f steps on %d "
-          "threads (setup took %.3g s)\n",
-          per_step, per_step * steps, steps, pm_omp_threads(), sim->setup_wall);
+  return steps;
+}
+
+/* The plan across ranks (collective): rank 0's view prints the scene's
+ * lines and every rank's share, and the shares' forces are timed. */
+static pm_err plan_ranks(fpm_sim *sim, FILE *out) {
+  const fpm_model *lm = sim->local_model;
+  double steps = 0;
+  if (pm_par_root()) {
+    steps = plan_head(sim, out);
+    fpm_share_print(sim->model, fpm_par_owner(lm), pm_par_size(),
+                    fpm_par_counts(lm), out);
+  }
+  double per_step = time_force(lm, sim->local_state);
+  if (pm_par_root()) plan_estimate(sim, per_step, steps, out);
+  return PM_SUCCESS;
+}
+
+static pm_err plan(void *p, FILE *out) {
+  fpm_sim *sim = p;
+  if (sim->local_model) return plan_ranks(sim, out);
+  const int ranks = pm_par_plan_ranks();
+  double per_step = time_force(sim->model, sim->state);
+  double steps = plan_head(sim, out);
+  if (sim->scene->time.qs == PM_QS_STATIC) {
+    if (ranks > 1)
+      fprintf(out,
+              "ranks        %d: not across ranks: the static solver "
+              "(time.quasi_static.method: static) runs on one process\n",
+              ranks);
+    return PM_SUCCESS;
+  }
+  if (ranks > 1) PM_CALL(fpm_share_predict(sim->model, ranks, out));
+  plan_estimate(sim, per_step, steps, out);
   return PM_SUCCESS;
 }

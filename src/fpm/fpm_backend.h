@@ -51,6 +51,16 @@ typedef struct {
   fpm_static_state static_state;   /* its load stepping (a checkpoint's) */
   bool resumed;                    /* the state came from a checkpoint */
   long first_step;                 /* the step this run started from */
+  /* Across MPI ranks (fpm_par.h): this rank's share of the model and its
+   * state, which it steps.  Rank 0 keeps the whole model and state above
+   * as the run's view, gathered into where the run writes; the other ranks
+   * let them go when the run starts (until then they hold them, so that a
+   * checkpoint is read into them). */
+  fpm_model *local_model;
+  fpm_state *local_state;
+  double ranks_costs[4]; /* summed over the ranks at the end: ghost bytes,
+                            exchanges; the slowest's exchange and gather
+                            seconds */
 } fpm_sim;
 
 /* Mesh the scene's domain, build subdomains, operators and state, and pick

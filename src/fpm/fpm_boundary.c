@@ -173,6 +173,7 @@ double fpm_prescribed(const fpm_model *m, long k, double t) {
 
 long fpm_update_tractions(const fpm_model *m, fpm_state *st, double t) {
   double norm2 = 0;
+  const long n_own = m->n_own;
   long bad = -1;
   for (long k = 0; k < m->n_tfacets; k++) {
     const pm_scene_bc *bc = &m->scene->bcs[m->tf_bc[k]];
@@ -188,9 +189,11 @@ long fpm_update_tractions(const fpm_model *m, fpm_state *st, double t) {
         v = r * m->tf_base[3 * k + a];
       if (!isfinite(v) && bad < 0) bad = 3 * k + a;
       st->tf_value[3 * k + a] = v;
-      norm2 += v * v * m->tf_area[k] * m->tf_area[k];
+      if (m->tf_point[k] < n_own)
+        norm2 += v * v * m->tf_area[k] * m->tf_area[k];
     }
   }
+  st->fext_sq = norm2;
   st->fext_norm = sqrt(norm2);
   return bad;
 }
@@ -202,11 +205,12 @@ pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
     const pm_expr *e = bc->traction[k % 3];
     const double *c = m->tf_centroid + 3 * (k / 3);
     return pm_expr_fail_value(e, pm_expr_eval(e, c[0], c[1], c[2], t), step, t,
-                              "facet of point", m->tf_point[k / 3], c);
+                              "facet of point",
+                              fpm_point_id(m, m->tf_point[k / 3]), c);
   }
   const pm_scene_bc *bc = &m->scene->bcs[m->cd_bc[k]];
   const pm_expr *e = bc->disp[m->cd_comp[k]];
   const double *x = m->x + 3 * m->cd_point[k];
   return pm_expr_fail_value(e, pm_expr_eval(e, x[0], x[1], x[2], t), step, t,
-                            "point", m->cd_point[k], x);
+                            "point", fpm_point_id(m, m->cd_point[k]), x);
 }

@@ -25,9 +25,10 @@ typedef struct {
 } fields;
 
 /* Pass 1: F_i = I + sum_k (u_k - u_i) (x) g_ik, then P_i, W_i, J_i.
- * Returns the smallest inadmissible point id or -1. */
+ * Returns the smallest inadmissible point of the model's own, or -1 (a
+ * ghost's is its owner's to find). */
 static long stress_pass(const fpm_model *m, fpm_state *st) {
-  const long n = m->n;
+  const long n = m->n_stress, n_own = m->n_own;
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr;
   const double *restrict g = m->g, *restrict u = st->u;
@@ -37,9 +38,9 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
   const pm_material *mats = m->mats;
   const double *ms = m->mstate;
   const long mss = m->mstate_stride;
-  long bad = n;
+  long bad = n_own;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(n, ptr, nbr, g, u, H, P, W, J, mat, mats, ms, mss)
+         shared(n, n_own, ptr, nbr, g, u, H, P, W, J, mat, mats, ms, mss)
          reduction(min : bad))
   for (long i = 0; i < n; i++) {
     double h[9] = {0};
@@ -72,14 +73,14 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
         i < bad)
       bad = i;
   }
-  return bad < n ? bad : -1;
+  return bad < n_own ? bad : -1;
 }
 
 /* With fpm.jump: quadratic, the fit of each point:
  * theta_i = sum_m (u_m - u_i) (x) q_im (3 x FPM_QFIT). */
 static void fit_pass(const fpm_model *m, const double *restrict u,
                      double *restrict th) {
-  const long n = m->n;
+  const long n = m->n_stress;
   const long *restrict ptr = m->qs_ptr;
   const int *restrict nbr = m->qs_nbr;
   const double *restrict q = m->q;
@@ -120,9 +121,10 @@ static inline double fit_at(const double *theta, int c, const double *phi) {
  * With fpm.jump: quadratic the penalty measures the jump of the fits,
  * [[u]]_q = u_i + theta_i phi(d_i) - u_k - theta_k phi(d_k), and its force
  * leaves through zq_i = sum_e b and Zq_i = sum_e b (x) phi(d_i) (gathered
- * by the fit weights in pass 3) instead of r and Q. */
+ * by the fit weights in pass 3) instead of r and Q.  The energy counts the
+ * model's own points. */
 static double flux_pass(const fpm_model *m, const fields *fl) {
-  const long n = m->n;
+  const long n = m->n_flux, n_own = m->n_own;
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr;
   const double *restrict erec = m->erec, *restrict pa = m->p_area,
@@ -142,9 +144,10 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   const bool quad = th != NULL;
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
-         shared(n, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat, mats, ms,
-                mss, sym, th, zq, Zq, quad, base, bu, bH))
+         shared(n, n_own, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat,
+                mats, ms, mss, sym, th, zq, Zq, quad, base, bu, bH))
   for (long i = 0; i < n; i++) {
+    const bool counted = i < n_own;
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
     double Q[9] = {0}, ri[3] = {0}, B[9] = {0}, z[3] = {0}, Z[27] = {0};
     double B0[9] = {0}; /* linearisation, SIPG: sum_e K_e at the base */
@@ -178,7 +181,8 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
           for (int q = 0; q < FPM_QFIT; q++)
             Z[FPM_QFIT * c + q] += b * phi_i[q];
         }
-        epen += 0.25 * be * pjump * pjump; /* each interface is seen twice */
+        /* each interface is seen twice */
+        if (counted) epen += 0.25 * be * pjump * pjump;
         if (sym) {
           /* K_e = int_e [[u]] (x) n = [[u]](c_e) (x) a + (H_i - H_k) Mc^T */
           const double h0 = Hi[3 * c] - Hk[3 * c],
@@ -189,7 +193,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
                              h2 * Mc[3 * q + 2];
             B[3 * c + q] += K;
             /* -{P} : K_e, each interface seen twice */
-            epen -= 0.25 * (Pi[3 * c + q] + Pk[3 * c + q]) * K;
+            if (counted) epen -= 0.25 * (Pi[3 * c + q] + Pk[3 * c + q]) * K;
           }
           if (base) {
             const double *bHi = bH + 9 * i, *bHk = bH + 9 * k;
@@ -266,16 +270,17 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
 /* Boundary terms: the consistency flux on facets with displacement
  * conditions, projected on the prescribed components
  * (r_i -= Pi P_i a_f, T_i -= Pi P_i (M_f - a_f (x) X_i)), and prescribed
- * tractions (r_i -= t |f|, T_i -= t (x) |f| (c_f - X_i)). */
+ * tractions (r_i -= t |f|, T_i -= t (x) |f| (c_f - X_i)).  The flux's norm
+ * counts the model's own points. */
 static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
-  const long nd = m->n_dpts;
+  const long nd = m->n_dpts, n_own = m->n_own;
   const long *restrict dp = m->dpt_point;
   const double *restrict da = m->dpt_area, *restrict dm = m->dpt_mrel;
   const double *restrict P = fl->P;
   double *restrict T = fl->T, *restrict r = fl->r, *restrict bf = fl->bflux;
   double norm2 = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : norm2)
-         shared(nd, dp, da, dm, P, T, r, bf))
+         shared(nd, n_own, dp, da, dm, P, T, r, bf))
   for (long p = 0; p < nd; p++) {
     const long i = dp[p];
     const double *Pi = P + 9 * i;
@@ -285,13 +290,14 @@ static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
           Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] + Pi[3 * c + 2] * A[2];
       r[3 * i + c] -= flux;
       if (bf) bf[3 * p + c] = flux;
-      norm2 += flux * flux;
+      if (i < n_own) norm2 += flux * flux;
       for (int q = 0; q < 3; q++)
         T[9 * i + 3 * c + q] -= Pi[3 * c] * B[q] + Pi[3 * c + 1] * B[3 + q] +
                                 Pi[3 * c + 2] * B[6 + q];
     }
   }
   if (!st) return; /* the linearisation: tractions do not depend on u */
+  st->bflux_sq = norm2;
   st->bflux_norm = sqrt(norm2);
   /* Several facets share a point: serial (boundary only). */
   for (long k = 0; k < m->n_tfacets; k++) {
@@ -306,7 +312,7 @@ static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
 
 /* Pass 3: f_k = sum_{i in S(k)} T_i g_ik - T_k sum_j g_kj + r_k. */
 static void gather_pass(const fpm_model *m, const fields *fl) {
-  const long n = m->n;
+  const long n = m->n_own;
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr, *restrict mir = m->mirror;
   const double *restrict g = m->g, *restrict gs = m->gsum, *restrict T = fl->T,
@@ -335,7 +341,7 @@ static void gather_pass(const fpm_model *m, const fields *fl) {
 /* With fpm.jump: quadratic, the penalty force through the fits:
  * f_k += zq_k - Zq_k qsum_k + sum over the fits holding k of Zq_i q_ik. */
 static void fit_gather_pass(const fpm_model *m, const fields *fl) {
-  const long n = m->n;
+  const long n = m->n_own;
   const long *restrict tp = m->qt_ptr;
   const int *restrict te = m->qt_entry, *restrict own = m->qs_own;
   const double *restrict q = m->q, *restrict qs = m->qsum,

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fpm_gfd.h"
+#include "fpm_par.h"
 #include "gm_shape.h"
 #include "pm_omp.h"
 
@@ -49,6 +50,10 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->qt_entry);
   free(m->q);
   free(m->qsum);
+  free(m->gid);
+  free(m->tf_gid);
+  gm_dual_destroy(m->own_dual);
+  fpm_par_destroy(m->par);
   free(m);
 }
 
@@ -322,6 +327,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   m->penalty = o->penalty;
   m->flux = (fpm_flux)o->flux;
   m->jump = (fpm_jump)o->jump;
+  m->n_own = m->n_flux = m->n_stress = m->n;
   long n = m->n, nnz = m->nnz;
   PM_TRY(PM_ALLOC(m->g, 3 * nnz, "GFD weights"));
   PM_TRY(PM_ALLOC(m->gsum, 3 * n, "GFD weight sums"));

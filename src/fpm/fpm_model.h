@@ -90,26 +90,45 @@ typedef struct {
   long *bcf_ptr;          /* n_bcs + 1: the facets of condition b are */
   long *bcf_facet;        /* bcf_facet[bcf_ptr[b] .. bcf_ptr[b + 1]) */
   const pm_scene *scene;  /* borrowed: boundary expressions and ramps */
+  /* Across MPI ranks (fpm_par.h) a rank's model is its share: its own
+   * points first, in one-process order, then the ghost points their force
+   * reads, and each pass runs over the points that need it: the force is
+   * gathered on [0, n_own), the flux of [0, n_flux), the stress (and the
+   * quadratic fit) of [0, n_stress), and u is held on all n.  Only its own
+   * points count in sums, and its conditions' dofs are its own points'.
+   * On one process all are n, gid and par NULL. */
+  long n_own, n_flux, n_stress;
+  long *gid;           /* n: each point's index on one process, or NULL */
+  long *tf_gid;        /* n_tfacets: each traction facet's, or NULL */
+  gm_dual *own_dual;   /* a share's points, volumes and rows (dual is it) */
+  struct fpm_par *par; /* the exchanges of a share across ranks, or NULL */
 } fpm_model;
+
+/* Point i's index on one process (for messages). */
+static inline long fpm_point_id(const fpm_model *m, long i) {
+  return m->gid ? m->gid[i] : i;
+}
 
 /* Fields that change every step.  All allocated by fpm_state_create. */
 typedef struct {
-  double *u, *v;         /* 3 n displacement, velocity (half step) */
-  double *f;             /* 3 n net force f_int - f_ext */
-  double *H;             /* 9 n: F - I per point */
-  double *P;             /* 9 n: first Piola-Kirchhoff stress */
-  double *T;             /* 9 n: V P - Q, the gathered flux tensor */
-  double *r;             /* 3 n: interface and boundary force terms */
-  double *W;             /* n: strain energy density */
-  double *J;             /* n: det F */
-  double *tf_value;      /* 3 n_tfacets: traction at the current time */
-  double fext_norm;      /* |f_ext| of the current tractions */
-  double bflux_norm;     /* |consistency flux on prescribed faces| */
-  double penalty_energy; /* interface energy, J: 1/2 sum_e beta |e| [[u]]^2,
-                            and with SIPG also - sum_e {P} : K_e */
-  double *theta;         /* 27 n: the quadratic fit (fpm.jump: quadratic) */
-  double *zq;            /* 3 n: sum_e b_e, the penalty force through u_i */
-  double *Zq;            /* 27 n: sum_e b_e (x) phi(d_i), through theta_i */
+  double *u, *v;            /* 3 n displacement, velocity (half step) */
+  double *f;                /* 3 n net force f_int - f_ext */
+  double *H;                /* 9 n: F - I per point */
+  double *P;                /* 9 n: first Piola-Kirchhoff stress */
+  double *T;                /* 9 n: V P - Q, the gathered flux tensor */
+  double *r;                /* 3 n: interface and boundary force terms */
+  double *W;                /* n: strain energy density */
+  double *J;                /* n: det F */
+  double *tf_value;         /* 3 n_tfacets: traction at the current time */
+  double fext_norm;         /* |f_ext| of the current tractions */
+  double bflux_norm;        /* |consistency flux on prescribed faces| */
+  double fext_sq, bflux_sq; /* their squares over the model's own points
+                               (a share's part of the whole run's) */
+  double penalty_energy;    /* interface energy, J: 1/2 sum_e beta |e| [[u]]^2,
+                               and with SIPG also - sum_e {P} : K_e */
+  double *theta;            /* 27 n: the quadratic fit (fpm.jump: quadratic) */
+  double *zq;               /* 3 n: sum_e b_e, the penalty force through u_i */
+  double *Zq;               /* 27 n: sum_e b_e (x) phi(d_i), through theta_i */
   double *bflux;        /* 3 n_dpts: that flux per point: the supports' force on
                            the body, with f on the prescribed dofs */
   double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "fpm_par.h"
 #include "pm_backend.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
@@ -88,15 +89,17 @@ double fpm_support_work(const fpm_model *m, fpm_state *st, const double *du,
     work += 0.5 * (prev[k] + st->f[dof]) * du[dof] * scale;
     prev[k] = st->f[dof];
   }
+  /* A share's ghosts' flux and tractions are their owners' work. */
   for (long p = 0; p < m->n_dpts; p++)
     for (int a = 0; a < 3; a++) {
       const double fb = st->bflux[3 * p + a];
-      work +=
-          0.5 * (prev_b[3 * p + a] + fb) * du[3 * m->dpt_point[p] + a] * scale;
+      if (m->dpt_point[p] < m->n_own)
+        work += 0.5 * (prev_b[3 * p + a] + fb) * du[3 * m->dpt_point[p] + a] *
+                scale;
       prev_b[3 * p + a] = fb;
     }
   for (long k = 0; k < m->n_tfacets; k++)
-    for (int a = 0; a < 3; a++)
+    for (int a = 0; a < 3 && m->tf_point[k] < m->n_own; a++)
       work += st->tf_value[3 * k + a] * m->tf_area[k] *
               du[3 * m->tf_point[k] + a] * scale;
   if (rr) *rr = r2;
@@ -126,17 +129,6 @@ static long apply_prescribed(const fpm_model *m, fpm_state *st, double t,
   return bad;
 }
 
-/* The prescribed dofs and tractions at time t; PM_ERR_UNSTABLE naming the
- * condition when a value is not finite. */
-static pm_err apply_loads(const fpm_model *m, fpm_state *st, long step,
-                          double t, double dt) {
-  long bad = apply_prescribed(m, st, t, dt);
-  if (bad >= 0) return fpm_condition_failure(m, false, bad, step, t);
-  bad = fpm_update_tractions(m, st, t);
-  if (bad >= 0) return fpm_condition_failure(m, true, bad, step, t);
-  return PM_SUCCESS;
-}
-
 static pm_err unstable(const fpm_model *m, const fpm_state *st, long step,
                        double t, double dt, long p, double min_jacobian) {
   const double *x = m->x + 3 * p;
@@ -155,21 +147,93 @@ static pm_err unstable(const fpm_model *m, const fpm_state *st, long step,
   return PM_ERROR(PM_ERR_UNSTABLE,
                   "step %ld, t = %.6g s: point %ld at (%g, %g, %g): %s "
                   "(J = %g); dt = %.4g s",
-                  step, t, p, x[0], x[1], x[2], cause, J, dt);
+                  step, t, fpm_point_id(m, p), x[0], x[1], x[2], cause, J, dt);
 }
 
-/* The point of smallest J (serial; only on the way out). */
-static long argmin_jacobian(const fpm_model *m, const fpm_state *st) {
-  long best = 0;
-  for (long i = 1; i < m->n; i++)
-    if (st->J[i] < st->J[best]) best = i;
-  return best;
+/* Where a failure comes in one process's order (fpm_par_agree): the
+ * prescribed dofs (by dof), then the tractions (by facet entry), then the
+ * points' stresses (by point), each stage after the one before. */
+#define KEY_STAGE (1L << 40)
+
+/* The supports at time t (move_dt < 0: where they are, a resumed state's;
+ * 0: at rest; > 0: moved over a step of move_dt) and the tractions, the
+ * ghosts' displacements from their owners, and the force (its seconds
+ * added to *seconds): PM_ERR_UNSTABLE naming the condition or the point of
+ * the first failure, the same on every rank. */
+static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
+                       double dt, double move_dt, double *seconds) {
+  pm_err e = PM_SUCCESS;
+  long key = 0;
+  long bad = move_dt >= 0 ? apply_prescribed(m, st, t, move_dt) : -1;
+  if (bad >= 0) {
+    e = fpm_condition_failure(m, false, bad, step, t);
+    key = 3 * fpm_point_id(m, m->cd_point[bad]) + m->cd_comp[bad];
+  } else if ((bad = fpm_update_tractions(m, st, t)) >= 0) {
+    e = fpm_condition_failure(m, true, bad, step, t);
+    key = KEY_STAGE + 3 * (m->tf_gid ? m->tf_gid[bad / 3] : bad / 3) + bad % 3;
+  }
+  fpm_par_exchange(m, st->u);
+  if (e == PM_SUCCESS) {
+    const double w = pm_wtime();
+    bad = fpm_force(m, st);
+    *seconds += pm_wtime() - w;
+    if (bad >= 0) {
+      e = unstable(m, st, step, t, dt, bad, 0);
+      key = 2 * KEY_STAGE + fpm_point_id(m, bad);
+    }
+  }
+  return fpm_par_agree(m, e, key);
+}
+
+/* The point of smallest J among the model's own (the first of them), as
+ * the failure of stability.min_jacobian, the same on every rank (serial;
+ * only on the way out). */
+static pm_err below_min_jacobian(const fpm_model *m, const fpm_state *st,
+                                 long step, double t, double dt, double jmin,
+                                 double min_jacobian) {
+  long best = -1;
+  for (long i = 0; i < m->n_own && best < 0; i++)
+    if (st->J[i] == jmin) best = i;
+  pm_err e =
+      best >= 0 ? unstable(m, st, step, t, dt, best, min_jacobian) : PM_SUCCESS;
+  return fpm_par_agree(m, e, best >= 0 ? fpm_point_id(m, best) : 0);
+}
+
+/* The sums a step's figures come from, over the model's own points and
+ * summed over the ranks. */
+enum {
+  SUM_S1, /* du . f before the update (the Rayleigh quotient) */
+  SUM_S2, /* m du^2 */
+  SUM_SD, /* m v_mid^2 (the damping's work) */
+  SUM_S3, /* dt v . f after it */
+  SUM_RF, /* |f|^2 on free dofs */
+  SUM_KIN,
+  SUM_STRAIN,
+  SUM_WORK, /* of the supports and tractions over the step */
+  SUM_RR,   /* |f|^2 on prescribed dofs */
+  SUM_BFLUX,
+  SUM_FEXT,
+  SUM_PENALTY,
+  SUMS
+};
+
+/* Stop the loop at step, time t: the last figures and the stages'
+ * seconds to the caller, and e. */
+static pm_err stop_at(pm_err e, fpm_step_info *si, long step, double t,
+                      fpm_step_info *info, double stage_seconds[2],
+                      const double seconds[2]) {
+  si->step = step;
+  si->t = t;
+  si->converged = false;
+  if (info) *info = *si;
+  if (stage_seconds) memcpy(stage_seconds, seconds, 2 * sizeof(double));
+  return e;
 }
 
 pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
                fpm_observer observer, void *ctx, fpm_step_info *info,
                double stage_seconds[2]) {
-  const long n = m->n;
+  const long n = m->n_own;
   const double dt = opt->dt;
   const double load_end = pm_scene_load_end(m->scene);
   const bool resumed = st->step > 0;
@@ -179,20 +243,12 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
                                         : 0;
   double ext_work = resumed ? st->external_work : 0;
   double dissipated = resumed ? st->dissipated : 0;
-  double t_force = 0, t_update = 0;
+  double seconds[2] = {0, 0}; /* force, the rest of the step */
   PM_CHECK(dt > 0 && isfinite(dt), PM_ERR_ARG, "time step must be > 0 (got %g)",
            dt);
   /* A resumed state has its supports in place: only the tractions and the
    * force (functions of u and t) are computed again. */
-  if (!resumed) {
-    PM_CALL(apply_loads(m, st, 0, 0, 0));
-  } else {
-    long bad_traction = fpm_update_tractions(m, st, t);
-    if (bad_traction >= 0)
-      return fpm_condition_failure(m, true, bad_traction, st->step, t);
-  }
-  long bad = fpm_force(m, st);
-  if (bad >= 0) return unstable(m, st, st->step, t, dt, bad, 0);
+  PM_CALL(force_at(m, st, st->step, t, dt, resumed ? -1 : 0, seconds));
   fpm_support_start(m, st);
 
   fpm_step_info si = {0};
@@ -201,6 +257,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   si.min_jacobian = INFINITY;
   for (long i = 0; i < n; i++)
     si.min_jacobian = fmin(si.min_jacobian, st->J[i]);
+  fpm_par_min(m, &si.min_jacobian, 1);
   /* The initial state, as a frame. */
   if (observer && !resumed) {
     pm_err e = observer(ctx, m, st, &si, true);
@@ -213,6 +270,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   const unsigned char *restrict fixed = m->fixed;
   for (long step = st->step + 1;; step++) {
     double w0 = pm_wtime();
+    double sum[SUMS] = {0};
     double s1 = 0, s2 = 0, sd = 0;
     const double cd2 = 0.5 * c * dt;
     const double damp_old = (1 - cd2) / (1 + cd2), damp_new = dt / (1 + cd2);
@@ -237,22 +295,12 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
       }
     }
     t += dt;
-    pm_err stop = apply_loads(m, st, step, t, dt);
-    double w1 = pm_wtime();
-    bad = stop == PM_SUCCESS ? fpm_force(m, st) : -1;
-    double w2 = pm_wtime();
-    t_force += w2 - w1;
-    if (bad >= 0) stop = unstable(m, st, step, t, dt, bad, 0);
+    const double force_before = seconds[0];
+    pm_err stop = force_at(m, st, step, t, dt, dt, seconds);
+    seconds[1] -= seconds[0] - force_before;
     if (stop != PM_SUCCESS) {
-      if (stage_seconds) {
-        stage_seconds[0] = t_force;
-        stage_seconds[1] = t_update;
-      }
-      si.step = step;
-      si.t = t;
-      si.converged = false;
-      if (info) *info = si;
-      return stop;
+      seconds[1] += pm_wtime() - w0;
+      return stop_at(stop, &si, step, t, info, stage_seconds, seconds);
     }
     double s3 = 0, rf = 0, kin = 0, se = 0, jmin = INFINITY;
     const double *restrict W = st->W, *restrict vol = m->dual->volume,
@@ -276,17 +324,34 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     /* The supports' force on the body is the boundary consistency flux
      * plus the force left on prescribed dofs; its work (trapezoidal rule
      * over the step), and that of the tractions, give the external work. */
-    double rr;
-    ext_work += fpm_support_work(m, st, st->v, dt, &rr);
+    sum[SUM_WORK] = fpm_support_work(m, st, st->v, dt, &sum[SUM_RR]);
+    sum[SUM_S1] = s1;
+    sum[SUM_S2] = s2;
+    sum[SUM_SD] = sd;
+    sum[SUM_S3] = s3;
+    sum[SUM_RF] = rf;
+    sum[SUM_KIN] = kin;
+    sum[SUM_STRAIN] = se;
+    sum[SUM_BFLUX] = st->bflux_sq;
+    sum[SUM_FEXT] = st->fext_sq;
+    sum[SUM_PENALTY] = st->penalty_energy;
+    fpm_par_sum(m, sum, SUMS);
+    fpm_par_min(m, &jmin, 1);
+    st->bflux_norm = sqrt(sum[SUM_BFLUX]);
+    st->fext_norm = sqrt(sum[SUM_FEXT]);
+    st->penalty_energy = sum[SUM_PENALTY];
+    kin = sum[SUM_KIN];
+    se = sum[SUM_STRAIN];
+    ext_work += sum[SUM_WORK];
     /* The damping force c m (v_old + v_new) / 2 does work c m v_mid^2 dt
      * (exactly what the update takes from the kinetic energy). */
-    dissipated += c * sd * dt;
-    if (opt->qs == PM_QS_DYNAMIC_RELAXATION && s2 > 0) {
-      double w2r = (s3 - s1) / s2;
+    dissipated += c * sum[SUM_SD] * dt;
+    if (opt->qs == PM_QS_DYNAMIC_RELAXATION && sum[SUM_S2] > 0) {
+      double w2r = (sum[SUM_S3] - sum[SUM_S1]) / sum[SUM_S2];
       if (w2r > 0 && isfinite(w2r)) c = 2 * sqrt(w2r);
       if (c * dt > 1.9) c = 1.9 / dt;
     }
-    double ref = sqrt(rr) + st->bflux_norm + st->fext_norm;
+    double ref = sqrt(sum[SUM_RR]) + st->bflux_norm + st->fext_norm;
     si.step = step;
     si.t = t;
     si.kinetic = kin;
@@ -294,7 +359,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     si.penalty = st->penalty_energy;
     si.external_work = ext_work;
     si.dissipated = dissipated;
-    si.residual = ref > 0 ? sqrt(rf) / ref : sqrt(rf);
+    si.residual = ref > 0 ? sqrt(sum[SUM_RF]) / ref : sqrt(sum[SUM_RF]);
     si.damping = c;
     si.min_jacobian = jmin;
     si.energy_error = fpm_energy_error(&si);
@@ -303,6 +368,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
      * relative order dt / t, dominates. */
     si.energy_checked =
         step >= FPM_ENERGY_CHECK_AFTER && t >= 0.1 * load_end && ext_work > 0;
+    seconds[1] += pm_wtime() - w0;
     if (opt->max_energy_error > 0 && si.energy_checked &&
         fabs(si.energy_error) > opt->max_energy_error) {
       si.converged = false;
@@ -319,8 +385,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     if (jmin <= opt->min_jacobian) {
       si.converged = false;
       if (info) *info = si;
-      return unstable(m, st, step, t, dt, argmin_jacobian(m, st),
-                      opt->min_jacobian);
+      return below_min_jacobian(m, st, step, t, dt, jmin, opt->min_jacobian);
     }
     si.converged = opt->qs != PM_QS_NONE && t >= load_end &&
                    si.residual < opt->qs_tolerance;
@@ -333,7 +398,6 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     st->damping = c;
     st->external_work = ext_work;
     st->dissipated = dissipated;
-    t_update += (w1 - w0) + (pm_wtime() - w2);
     if (observer) {
       pm_err e = observer(ctx, m, st, &si, frame);
       if (e != PM_SUCCESS) {
@@ -344,9 +408,6 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     if (last) break;
   }
   if (info) *info = si;
-  if (stage_seconds) {
-    stage_seconds[0] = t_force;
-    stage_seconds[1] = t_update;
-  }
+  if (stage_seconds) memcpy(stage_seconds, seconds, sizeof seconds);
   return PM_SUCCESS;
 }

@@ -208,20 +208,18 @@ static pm_err gather(mpm_sim *r) {
   return PM_SUCCESS;
 }
 
-/* A step of a run across ranks (collective): rank 0 decides whether its
- * observer will read the state; if so every rank sends its particles; rank
- * 0 reports, and every rank returns its observer's answer. */
+static pm_err gather_view(void *r) { return gather(r); }
+
+/* A step of a run across ranks (collective): rank 0 reports it, with the
+ * particles gathered where its observer reads them. */
 static pm_err share(mpm_sim *r, bool frame, bool last) {
-  int want = frame;
+  pm_step_report rep = {0};
   if (r->model) {
     view_figures(r);
-    pm_step_report rep = step_report(r, last);
-    if (r->obs && r->obs->wants)
-      want = want || r->obs->wants(r->obs->ctx, &rep, frame);
+    rep = step_report(r, last);
   }
-  pm_par_bcast(&want, sizeof want);
-  if (want) PM_CALL(gather(r));
-  return pm_par_agree(r->model ? report(r, frame, last) : PM_SUCCESS);
+  return pm_observer_share(r->model ? r->obs : NULL, &rep, frame, gather_view,
+                           r);
 }
 
 static pm_err observe_ranks(void *ctx, const mpm_model *m, const mpm_state *s,
@@ -1073,24 +1071,13 @@ static pm_err implicit_create(const pm_scene *s, void **out) {
   return PM_SUCCESS;
 }
 
-/* Across ranks, a converged load step (collective): rank 0 decides
- * whether its observer will read the state; if so every rank sends its
- * particles and load stepping's states; rank 0 reports, and every rank
- * returns its observer's answer. */
-static pm_err implicit_share(mpm_sim *r, const pm_step_report *rep,
-                             bool frame) {
-  int want = frame;
-  if (pm_par_root() && r->obs && r->obs->wants)
-    want = want || r->obs->wants(r->obs->ctx, rep, frame);
-  pm_par_bcast(&want, sizeof want);
-  if (want) {
-    PM_CALL(pm_par_agree(
-        mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
-    PM_CALL(mpm_implicit_gather(r->imp, r->model));
-  }
-  pm_err e = PM_SUCCESS;
-  if (pm_par_root() && r->obs) e = r->obs->step(r->obs->ctx, rep, frame);
-  return pm_par_agree(e);
+/* Across ranks, what rank 0's observer reads of a converged load step:
+ * every rank's particles and load stepping's states (collective). */
+static pm_err implicit_gather(void *ctx) {
+  mpm_sim *r = ctx;
+  PM_CALL(pm_par_agree(
+      mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
+  return mpm_implicit_gather(r->imp, r->model);
 }
 
 /* Each converged load step is a step of the run: t = lambda t_load. */
@@ -1117,7 +1104,9 @@ static pm_err implicit_observe(void *ctx, const mpm_implicit_step *step) {
                         .residual = step->residual,
                         .progress = step->lambda};
   const bool frame = last || (every > 0 && st->step % every == 0);
-  if (r->local_model) return implicit_share(r, &rep, frame);
+  if (r->local_model)
+    return pm_observer_share(pm_par_root() ? r->obs : NULL, &rep, frame,
+                             implicit_gather, r);
   return r->obs ? r->obs->step(r->obs->ctx, &rep, frame) : PM_SUCCESS;
 }
 

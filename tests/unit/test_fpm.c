@@ -13,6 +13,7 @@
 
 #include "fpm_gfd.h"
 #include "fpm_model.h"
+#include "fpm_share.h"
 #include "fpm_solver.h"
 #include "fpm_static.h"
 #include "gm_cells.h"
@@ -492,6 +493,90 @@ static void test_gfd_ill_conditioned(void **state) {
 
 /* gmsh sets the OpenMP thread count process-wide; meshing must leave the
  * caller's setting as it was (it once silently serialized every run). */
+/* A rank's share computes the force on its own points as the whole model
+ * does, bit for bit, from the displacements of the points it holds (those
+ * the exchange brings); every point is owned by exactly one rank, a share's
+ * own points come first in one-process order, and an inadmissible point
+ * is reported by its owner alone.  Linear and quadratic jumps, IIPG and
+ * SIPG, on 2 and 3 ranks. */
+static void test_shares(void **state) {
+  (void)state;
+  const int flux[3] = {FPM_FLUX_IIPG, FPM_FLUX_SIPG, FPM_FLUX_IIPG};
+  const int jump[3] = {FPM_JUMP_LINEAR, FPM_JUMP_LINEAR, FPM_JUMP_QUADRATIC};
+  for (int k = 0; k < 3; k++) {
+    fixture *fx = fixture_new(3, 0.02, 20, true);
+    fx->opt.flux = flux[k];
+    fx->opt.jump = jump[k];
+    fpm_model *m;
+    fpm_state *st;
+    fixture_model(fx, &m, &st);
+    smooth_plus_rough(m, 7 + k, 0.05, 1e-4, st->u, NULL);
+    double *moved = malloc(sizeof(double) * 3 * m->n);
+    memcpy(moved, st->u, sizeof(double) * 3 * m->n);
+    for (int a = 0; a < 3; a++) st->u[3 * (m->n / 2) + a] += 0.05;
+    const long inverted = fpm_force(m, st);
+    assert_true(inverted >= 0);
+    memcpy(st->u, moved, sizeof(double) * 3 * m->n);
+    free(moved);
+    assert_int_equal(fpm_force(m, st), -1);
+    int *owner = malloc(sizeof(int) * m->n), *owned = calloc(m->n, sizeof(int));
+    for (int parts = 2; parts <= 3; parts++) {
+      assert_int_equal(fpm_partition(m, parts, owner), PM_SUCCESS);
+      memset(owned, 0, sizeof(int) * m->n);
+      long ghosts = 0, first = m->n;
+      for (int r = 0; r < parts; r++) {
+        fpm_model *s;
+        fpm_state *ss;
+        assert_int_equal(fpm_share_create(m, owner, r, &s), PM_SUCCESS);
+        assert_int_equal(fpm_state_create(s, &ss), PM_SUCCESS);
+        assert_true(s->n_own > 0 && s->n_own <= s->n_flux &&
+                    s->n_flux <= s->n_stress && s->n_stress <= s->n);
+        for (long i = 0; i < s->n; i++) {
+          const long g = s->gid[i];
+          assert_int_equal(owner[g] == r, i < s->n_own);
+          if (i < s->n_own) owned[g]++;
+          if (i > 0 && i != s->n_own && i != s->n_flux && i != s->n_stress)
+            assert_true(s->gid[i - 1] < g);
+          memcpy(ss->u + 3 * i, st->u + 3 * g, 3 * sizeof(double));
+        }
+        ghosts += s->n - s->n_own;
+        assert_int_equal(fpm_force(s, ss), -1);
+        for (long i = 0; i < s->n_own; i++) {
+          const long g = s->gid[i];
+          assert_memory_equal(ss->f + 3 * i, st->f + 3 * g, 3 * sizeof(double));
+          assert_memory_equal(ss->P + 9 * i, st->P + 9 * g, 9 * sizeof(double));
+          assert_memory_equal(ss->J + i, st->J + g, sizeof(double));
+        }
+        /* A point moved far: the points it turns inside out are named by
+         * their owners alone, by their indices on one process, and the
+         * smallest is the one the whole model names. */
+        for (long i = 0; i < s->n; i++)
+          if (s->gid[i] == m->n / 2)
+            for (int a = 0; a < 3; a++) ss->u[3 * i + a] += 0.05;
+        const long found = fpm_force(s, ss);
+        if (found >= 0) {
+          assert_true(found < s->n_own && ss->J[found] <= 0);
+          first = s->gid[found] < first ? s->gid[found] : first;
+        }
+        fpm_state_destroy(ss);
+        fpm_model_destroy(s);
+      }
+      for (long i = 0; i < m->n; i++) assert_int_equal(owned[i], 1);
+      assert_int_equal(first, inverted);
+      print_message("%s %s, %d ranks: %ld points, %ld ghosts, %ld pairs "
+                    "cut: forces on own points as one process's\n",
+                    flux[k] == FPM_FLUX_SIPG ? "SIPG" : "IIPG",
+                    jump[k] == FPM_JUMP_QUADRATIC ? "quadratic" : "linear",
+                    parts, m->n, ghosts, fpm_partition_edge_cut(m, owner));
+    }
+    free(owner);
+    free(owned);
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+}
+
 static void test_meshing_keeps_threads(void **state) {
   (void)state;
   pm_omp_set_threads(2);
@@ -513,6 +598,7 @@ int main(void) {
       cmocka_unit_test(test_force_linearisation),
       cmocka_unit_test(test_static_tangent),
       cmocka_unit_test(test_deformed_condition),
+      cmocka_unit_test(test_shares),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

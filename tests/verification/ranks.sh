@@ -18,37 +18,8 @@ bin=$1
 src=$2
 migrate=$3
 . "$(dirname "$0")/lib.sh"
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-export OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
-export OMP_NUM_THREADS=1
-py=/usr/bin/python3
-roundoff="$py $src/tests/verification/same_to_roundoff.py"
-tol=1e-10
+. "$(dirname "$0")/ranks-lib.sh"
 mpm=$src/cases/mpm
-
-ranks() { # N, command...
-  local n=$1
-  shift
-  timeout 300 mpirun -np "$n" --bind-to none "$@"
-}
-
-# One process, then N ranks, of SCENE with overrides, compared to
-# round-off; the runs end with exit status $want (default 0).
-across() { # label, scene, ranks, overrides...
-  local label=$1 scene=$2 n=$3 want=${want:-0}
-  shift 3
-  local one=$work/$label-1 many=$work/$label-$n
-  [ -d "$one" ] || "$bin" run "$scene" --out "$one" --quiet "$@" \
-    >/dev/null 2>"$work/err"
-  ranks "$n" "$bin" run "$scene" --out "$many" --quiet "$@" >/dev/null \
-    2>"$work/err"
-  local rc=$?
-  check "$label on $n ranks: exit $want (got $rc)" test $rc -eq "$want"
-  $roundoff "$one" "$many" $tol >"$work/cmp" 2>&1
-  rc=$?
-  sed "s/^/$label, $n ranks against one process: /" "$work/cmp"
-  check "$label on $n ranks: the run of one process to $tol" test $rc -eq 0
-}
 
 # The shock tube (3-D, pressure ratio 1000, cut along x between its
 # walls), the disks (2-D: 2, 3 and 4 boxes, each disk's particles shared
@@ -78,7 +49,7 @@ sys.exit(not (sum(r['particles_at_start']) == 416 and
 ranks 1 "$bin" run "$mpm/disks-collision.yaml" --out "$work/disks-np1" \
   --quiet >/dev/null 2>"$work/err"
 check "disks on 1 rank: one process, bit for bit" \
-  $py "$src/tests/verification/same_results.py" "$work/disks-1" "$work/disks-np1"
+  $same "$work/disks-1" "$work/disks-np1"
 
 # The plan prints the decomposition and every rank's share.
 ranks 2 "$bin" plan "$mpm/f2-unconstrained-compression.yaml" >"$work/plan" \
@@ -107,22 +78,10 @@ check "migration on 2 ranks (shock tube): exit 0 (got $rc)" test $rc -eq 0
 
 # A particle that leaves the grid stops every rank with one process's
 # message (the particle by its index on one process), not a hang.
-fly="--set bodies.1.velocity=[3,3]"
-"$bin" run "$mpm/disks-collision.yaml" --out "$work/fly-1" --quiet $fly \
-  >/dev/null 2>"$work/err1"
-ranks 2 "$bin" run "$mpm/disks-collision.yaml" --out "$work/fly-2" --quiet \
-  $fly >/dev/null 2>"$work/err"
-rc=$?
-check "left the grid on 2 ranks: exit 2 (got $rc)" test $rc -eq 2
-check "left the grid on 2 ranks: one process's message" \
-  grep -qF "$(grep -o 'step [0-9]*, .*left the grid' "$work/err1")" "$work/err"
-check "left the grid on 2 ranks: status unstable" \
-  grep -q '"status": "unstable"' "$work/fly-2/summary.json"
+fails_alike left-the-grid 2 'step [0-9]*, .*left the grid' \
+  "$mpm/disks-collision.yaml" --set "bodies.1.velocity=[3,3]"
 
 # What runs on one process only is refused, naming the key; nothing written.
-refused "FPM on 2 ranks" "method fpm runs on one process" "$work/fpm-2" \
-  ranks 2 "$bin" run "$src/cases/fpm/f2-unconstrained-compression.yaml" \
-  --out "$work/fpm-2"
 refused "a membrane on 2 ranks" "membrane: membranes run on one process" \
   "$work/mem-2" ranks 2 "$bin" run "$mpm/m3-gas-box-membrane.yaml" \
   --out "$work/mem-2"
@@ -133,46 +92,17 @@ refused "convergence on 2 ranks" "convergence runs on one process" \
 # Interrupted on 2 ranks and resumed: on 2 ranks bit for bit the run that
 # was not interrupted (the boxes come from the reference positions, each
 # rank's energy accounts from the checkpoint), on 3 ranks and on one
-# process to round-off (a checkpoint is one process's).  The signal goes
-# to rank 0 (its pid is in summary.json), which stops every rank after the
-# step; mpirun forwards a signal of its own about 2 s late, or not before
-# it gives up on its ranks (README, "Across MPI ranks").
+# process to round-off (a checkpoint is one process's).
 tube=$mpm/m2-shock-tube-reduced.yaml
 long="--set time.end=2 --set output.every=100"
 "$bin" run "$tube" --out "$work/long-1" --quiet $long >/dev/null 2>&1
 ranks 2 "$bin" run "$tube" --out "$work/long-2" --quiet $long >/dev/null 2>&1
-timeout 300 mpirun -np 2 --bind-to none "$bin" run "$tube" \
-  --out "$work/cut" --quiet $long >/dev/null 2>"$work/err" &
-job=$!
-for _ in $(seq 600); do
-  [ -f "$work/cut/history.csv" ] &&
-    [ "$(wc -l <"$work/cut/history.csv")" -ge 4 ] && break
-  sleep 0.05
-done
-pid=$(sed -n 's/^ *"pid": \([0-9]*\).*/\1/p' "$work/cut/summary.json")
-kill -TERM "$pid"
-wait $job
-check "interrupted on 2 ranks: status interrupted" \
-  grep -q '"status": "interrupted"' "$work/cut/summary.json"
-for n in 1 2 3; do
-  cp -r "$work/cut" "$work/cut-$n"
-  if [ $n -eq 1 ]; then
-    "$bin" resume "$work/cut-$n" --quiet >/dev/null 2>"$work/err"
-  else
-    ranks $n "$bin" resume "$work/cut-$n" --quiet >/dev/null 2>"$work/err"
-  fi
-  check "interrupted on 2 ranks, resumed on $n: exit 0" test $? -eq 0
-done
+interrupt 2 "$work/cut" "$tube" $long
+resume_on "$work/cut" 1 2 3
 check "interrupted on 2 ranks, resumed on 2: the run of 2 ranks, bit for bit" \
-  $py "$src/tests/verification/same_results.py" "$work/long-2" "$work/cut-2"
-for pair in "long-2 cut-3 3" "long-1 cut-1 1"; do
-  read -r straight resumed n <<<"$pair"
-  $roundoff "$work/$straight" "$work/$resumed" $tol >"$work/cmp" 2>&1
-  rc=$?
-  sed "s/^/interrupted on 2 ranks, resumed on $n: /" "$work/cmp"
-  check "interrupted on 2 ranks, resumed on $n: the straight run to $tol" \
-    test $rc -eq 0
-done
+  $same "$work/long-2" "$work/cut-2"
+roundoff "interrupted on 2 ranks, resumed on 3" "$work/long-2" "$work/cut-3"
+roundoff "interrupted on 2 ranks, resumed on 1" "$work/long-1" "$work/cut-1"
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -56,8 +56,8 @@ add_test(NAME verification.bench
 set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)
 
 # Runs across MPI ranks (mpirun -np 2 and 3) against the same scenes on one
-# process; ranks_migrate checks that migration moves particles and nothing
-# else.
+# process, explicit MPM (ranks.sh) and FPM (ranks-fpm.sh); ranks_migrate
+# checks that migration moves particles and nothing else.
 if(PM_MPI)
   add_executable(ranks_migrate ${PM_VERIFY_DIR}/ranks_migrate.c)
   target_link_libraries(ranks_migrate PRIVATE pm_app)
@@ -74,4 +74,9 @@ if(PM_MPI)
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_newton>)
   set_tests_properties(verification.ranks_implicit PROPERTIES LABELS
     verification TIMEOUT 600 PROCESSORS 2)
+  add_test(NAME verification.ranks_fpm
+    COMMAND bash ${PM_VERIFY_DIR}/ranks-fpm.sh $<TARGET_FILE:pointmech>
+      ${PROJECT_SOURCE_DIR})
+  set_tests_properties(verification.ranks_fpm PROPERTIES LABELS verification
+    TIMEOUT 600 PROCESSORS 2)
 endif()

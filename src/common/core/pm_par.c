@@ -2,6 +2,7 @@
  * identity on one process. */
 #include "pm_par.h"
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -131,25 +132,34 @@ void pm_par_bcast(void *p, size_t n) {
 #endif
 }
 
-pm_err pm_par_agree(pm_err e) {
+pm_err pm_par_agree(pm_err e) { return pm_par_agree_first(e, 0); }
+
+pm_err pm_par_agree_first(pm_err e, long key) {
 #ifdef PM_HAVE_MPI
   if (par_size == 1) return e;
-  int first = e != PM_SUCCESS ? par_rank : par_size;
-  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  if (first == par_size) return PM_SUCCESS;
+  struct {
+    long key;
+    int rank;
+  } first = {e != PM_SUCCESS ? key : LONG_MAX, par_rank};
+  if (e != PM_SUCCESS && key == LONG_MAX) /* the successes' mark */
+    first.key = LONG_MAX - 1;
+  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_LONG_INT, MPI_MINLOC,
+                MPI_COMM_WORLD);
+  if (first.key == LONG_MAX) return PM_SUCCESS;
   struct {
     int code;
     char text[1024];
   } what = {0};
-  if (par_rank == first) {
+  if (par_rank == first.rank) {
     what.code = (int)e;
     snprintf(what.text, sizeof what.text, "%s", pm_error_message());
   }
-  MPI_Bcast(&what, (int)sizeof what, MPI_BYTE, first, MPI_COMM_WORLD);
-  if (par_rank == first) return e;
+  MPI_Bcast(&what, (int)sizeof what, MPI_BYTE, first.rank, MPI_COMM_WORLD);
+  if (par_rank == first.rank) return e;
   return pm_error_set((pm_err)what.code, __FILE__, __LINE__, __func__, "%s",
                       what.text);
 #else
+  (void)key;
   return e;
 #endif
 }

@@ -47,6 +47,12 @@ void pm_par_bcast(void *p, size_t n);
  * rank has it; else the failure of the lowest rank that failed, whose
  * message every rank then records as its own (so rank 0 reports it). */
 pm_err pm_par_agree(pm_err e);
+/* The same with an order among the failures: key places this rank's
+ * failure in the order one process would meet it (the failing point's
+ * index on one process, say); the failure of smallest key wins (the lowest
+ * rank's among equal keys), so that every rank reports what one process
+ * would have.  key is ignored where e is PM_SUCCESS. */
+pm_err pm_par_agree_first(pm_err e, long key);
 
 /* The ranks a plan made on one process is for (pointmech plan --ranks N;
  * 1 unless set). */

@@ -6,6 +6,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "pm_par.h"
+
 static const pm_backend *registry[PM_BACKENDS_MAX];
 static int n_registered;
 
@@ -64,4 +66,14 @@ void pm_backend_names(char *buf, size_t size) {
   for (int k = 0; k < n_registered && used < size; k++)
     used += (size_t)snprintf(buf + used, size - used, "%s%s", k ? ", " : "",
                              registry[k]->method);
+}
+
+pm_err pm_observer_share(const pm_observer *obs, const pm_step_report *r,
+                         bool frame, pm_err (*gather)(void *ctx), void *ctx) {
+  const bool view = pm_par_root() && obs;
+  int want = frame;
+  if (view && obs->wants) want = want || obs->wants(obs->ctx, r, frame);
+  pm_par_bcast(&want, sizeof want);
+  if (want) PM_CALL(gather(ctx));
+  return pm_par_agree(view ? obs->step(obs->ctx, r, frame) : PM_SUCCESS);
 }

@@ -116,6 +116,16 @@ typedef struct {
   bool (*wants)(void *ctx, const pm_step_report *r, bool frame);
 } pm_observer;
 
+/* A step of a run across MPI ranks (pm_par.h; collective): rank 0, which
+ * holds the run's observer obs (NULL on the others, or none) and the
+ * step's report r, asks the observer whether it will read the simulation;
+ * if so every rank calls gather(ctx), which brings the state rank 0 reads
+ * into its view; then rank 0 reports.  Every rank returns the observer's
+ * answer, or gather's failure (which gather agrees on).  On one process:
+ * gather where the observer wants it, then the report. */
+pm_err pm_observer_share(const pm_observer *obs, const pm_step_report *r,
+                         bool frame, pm_err (*gather)(void *ctx), void *ctx);
+
 /* Columns of a backend's own history (beyond the shared ones). */
 #define PM_HISTORY_MAX 128
 

@@ -1,0 +1,244 @@
+/* fpm_par: the shares of a run across ranks, the ghosts' displacements on
+ * a star forest, the step's sums and failures, and the gather to rank 0. */
+#include "fpm_par.h"
+
+#include <mpi.h>
+#include <petscsf.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_par.h"
+#include "pm_petsc.h"
+#include "pm_progress.h"
+
+struct fpm_par {
+  int rank, size;
+  int *owner;               /* every point's rank (the partition) */
+  fpm_share_counts *counts; /* every rank's share, on rank 0 */
+  /* the ghosts' displacements: each ghost (a leaf) is a point its owner
+   * holds among its own (a root) */
+  PetscSF ghosts;
+  /* the gather: each own point (a leaf) is a point of rank 0's whole
+   * arrays (a root; none on the other ranks) */
+  PetscSF to_root;
+  MPI_Datatype three, nine;
+  double none[9]; /* the roots of the gather on the other ranks */
+  fpm_par_costs costs;
+};
+
+void fpm_par_destroy(struct fpm_par *P) {
+  if (!P) return;
+  if (P->ghosts) PetscSFDestroy(&P->ghosts);
+  if (P->to_root) PetscSFDestroy(&P->to_root);
+  if (P->three) MPI_Type_free(&P->three);
+  if (P->nine) MPI_Type_free(&P->nine);
+  free(P->owner);
+  free(P->counts);
+  free(P);
+}
+
+/* A digest of the support graph and the positions (FNV-1a). */
+static uint64_t graph_digest(const fpm_model *m) {
+  uint64_t h = 1469598103934665603ull;
+  const unsigned char *parts[3] = {(const unsigned char *)m->nbr_ptr,
+                                   (const unsigned char *)m->nbr,
+                                   (const unsigned char *)m->x};
+  const size_t bytes[3] = {sizeof(long) * (size_t)(m->n + 1),
+                           sizeof(int) * (size_t)m->nnz,
+                           sizeof(double) * 3 * (size_t)m->n};
+  for (int k = 0; k < 3; k++)
+    for (size_t b = 0; b < bytes[k]; b++) {
+      h ^= parts[k][b];
+      h *= 1099511628211ull;
+    }
+  return h;
+}
+
+/* The partition, made on rank 0 and sent to every rank, which must hold the
+ * same graph (each meshed the domain itself). */
+static pm_err partition(struct fpm_par *P, const fpm_model *m) {
+  uint64_t mine = graph_digest(m), first = mine;
+  pm_par_bcast(&first, sizeof first);
+  PM_CALL(pm_par_agree(
+      first == mine
+          ? PM_SUCCESS
+          : PM_ERROR(PM_ERR_INTERNAL,
+                     "rank %d meshed the domain into another graph of "
+                     "points than rank 0 (%ld points): the ranks cannot "
+                     "share it",
+                     P->rank, m->n)));
+  PM_CALL(PM_ALLOC(P->owner, m->n + 1, "partition"));
+  PM_CALL(pm_par_agree(P->rank == 0 ? fpm_partition(m, P->size, P->owner)
+                                    : PM_SUCCESS));
+  pm_par_bcast(P->owner, sizeof(int) * (size_t)m->n);
+  return PM_SUCCESS;
+}
+
+/* The star forests: ghosts to their owners' own points (each rank's own
+ * points are in one-process order, so an owner's index of a point is the
+ * count of its points before it), own points to rank 0's whole arrays. */
+static pm_err make_forests(struct fpm_par *P, const fpm_model *full,
+                           const fpm_model *s) {
+  pm_err ret = PM_SUCCESS;
+  const long n_ghost = s->n - s->n_own;
+  long *index = NULL, *seen = NULL;
+  PetscInt *leaf = NULL;
+  PetscSFNode *root = NULL;
+  PM_TRY(PM_ALLOC(index, full->n + 1, "owners' indices"));
+  PM_TRY(PM_ALLOC(seen, P->size, "owners' indices"));
+  for (long i = 0; i < full->n; i++) index[i] = seen[P->owner[i]]++;
+  PM_TRY(PM_ALLOC(leaf, n_ghost + 1, "ghost points"));
+  PM_TRY(PM_ALLOC(root, (n_ghost > s->n_own ? n_ghost : s->n_own) + 1,
+                  "ghost points' owners"));
+  for (long k = 0; k < n_ghost; k++) {
+    const long g = s->gid[s->n_own + k];
+    leaf[k] = (PetscInt)(s->n_own + k);
+    root[k].rank = P->owner[g];
+    root[k].index = (PetscInt)index[g];
+  }
+  PM_PETSC(PetscSFCreate(PETSC_COMM_WORLD, &P->ghosts));
+  PM_PETSC(PetscSFSetGraph(P->ghosts, (PetscInt)s->n_own, (PetscInt)n_ghost,
+                           leaf, PETSC_COPY_VALUES, root, PETSC_COPY_VALUES));
+  PM_PETSC(PetscSFSetUp(P->ghosts));
+  for (long k = 0; k < s->n_own; k++) {
+    root[k].rank = 0;
+    root[k].index = (PetscInt)s->gid[k];
+  }
+  PM_PETSC(PetscSFCreate(PETSC_COMM_WORLD, &P->to_root));
+  PM_PETSC(PetscSFSetGraph(P->to_root, P->rank == 0 ? (PetscInt)full->n : 0,
+                           (PetscInt)s->n_own, NULL, PETSC_COPY_VALUES, root,
+                           PETSC_COPY_VALUES));
+  PM_PETSC(PetscSFSetUp(P->to_root));
+  MPI_Type_contiguous(3, MPI_DOUBLE, &P->three);
+  MPI_Type_commit(&P->three);
+  MPI_Type_contiguous(9, MPI_DOUBLE, &P->nine);
+  MPI_Type_commit(&P->nine);
+done:
+  free(index);
+  free(seen);
+  free(leaf);
+  free(root);
+  return ret;
+}
+
+/* Every rank's share counted on rank 0, and every point owned once. */
+static pm_err count_shares(struct fpm_par *P, const fpm_model *full,
+                           const fpm_model *s) {
+  fpm_share_counts mine;
+  fpm_share_count(s, &mine);
+  PM_CALL(pm_par_agree(P->rank == 0 ? PM_ALLOC(P->counts, P->size, "shares")
+                                    : PM_SUCCESS));
+  MPI_Gather(&mine, (int)sizeof mine, MPI_BYTE, P->counts, (int)sizeof mine,
+             MPI_BYTE, 0, MPI_COMM_WORLD);
+  long own = s->n_own;
+  pm_par_sum_long(&own, 1);
+  PM_CHECK(own == full->n, PM_ERR_INTERNAL,
+           "the ranks' shares own %ld points of %ld", own, full->n);
+  return PM_SUCCESS;
+}
+
+pm_err fpm_par_create(const fpm_model *m, fpm_model **local) {
+  pm_err ret = PM_SUCCESS;
+  struct fpm_par *P = NULL;
+  fpm_model *s = NULL;
+  *local = NULL;
+  PM_TRY(pm_par_agree(PM_ALLOC(P, 1, "FPM ranks")));
+  P->rank = pm_par_rank();
+  P->size = pm_par_size();
+  PM_TRY(pm_par_agree(pm_petsc_init()));
+  PM_TRY(partition(P, m));
+  PM_TRY(pm_par_agree(fpm_share_create(m, P->owner, P->rank, &s)));
+  PM_TRY(pm_par_agree(make_forests(P, m, s)));
+  PM_TRY(pm_par_agree(count_shares(P, m, s)));
+  s->par = P;
+  P = NULL;
+  *local = s;
+  s = NULL;
+done:
+  fpm_par_destroy(P);
+  fpm_model_destroy(s);
+  return ret;
+}
+
+void fpm_par_exchange(const fpm_model *m, double *u) {
+  struct fpm_par *P = m->par;
+  if (!P) return;
+  const double t0 = pm_wtime();
+  /* Nothing to report: a star forest set up once fails only on MPI's own
+   * failures, which stop every rank (MPI_ERRORS_ARE_FATAL). */
+  PetscSFBcastBegin(P->ghosts, P->three, u, u, MPI_REPLACE);
+  PetscSFBcastEnd(P->ghosts, P->three, u, u, MPI_REPLACE);
+  P->costs.ghost_bytes += 3.0 * sizeof(double) * (double)(m->n - m->n_own);
+  pm_par_count_sent(3.0 * sizeof(double) * (double)(m->n - m->n_own));
+  P->costs.exchanges++;
+  P->costs.exchange_seconds += pm_wtime() - t0;
+}
+
+void fpm_par_sum(const fpm_model *m, double *v, int n) {
+  if (m->par) pm_par_sum(v, n);
+}
+
+void fpm_par_min(const fpm_model *m, double *v, int n) {
+  if (m->par) pm_par_min(v, n);
+}
+
+pm_err fpm_par_agree(const fpm_model *m, pm_err e, long key) {
+  return m->par ? pm_par_agree_first(e, key) : e;
+}
+
+/* What the time loop carries from step to step. */
+static void copy_carried(fpm_state *to, const fpm_state *from) {
+  to->step = from->step;
+  to->t = from->t;
+  to->damping = from->damping;
+  to->external_work = from->external_work;
+  to->dissipated = from->dissipated;
+}
+
+void fpm_par_scatter(const fpm_model *m, const fpm_state *whole,
+                     fpm_state *st) {
+  for (long i = 0; i < m->n; i++) {
+    const long g = m->gid[i];
+    memcpy(st->u + 3 * i, whole->u + 3 * g, 3 * sizeof(double));
+    memcpy(st->v + 3 * i, whole->v + 3 * g, 3 * sizeof(double));
+  }
+  copy_carried(st, whole);
+}
+
+pm_err fpm_par_gather(const fpm_model *m, const fpm_state *st,
+                      fpm_state *whole) {
+  struct fpm_par *P = m->par;
+  const double t0 = pm_wtime();
+  const double *from[7] = {st->u, st->v, st->f, st->H, st->P, st->W, st->J};
+  double *none = P->none;
+  double *to[7] = {none, none, none, none, none, none, none};
+  if (whole) {
+    double *w[7] = {whole->u, whole->v, whole->f, whole->H,
+                    whole->P, whole->W, whole->J};
+    memcpy(to, w, sizeof to);
+    copy_carried(whole, st);
+    whole->penalty_energy = st->penalty_energy;
+  }
+  const MPI_Datatype unit[7] = {P->three, P->three,   P->three,  P->nine,
+                                P->nine,  MPI_DOUBLE, MPI_DOUBLE};
+  for (int k = 0; k < 7; k++)
+    PM_PETSC_CALL(
+        PetscSFReduceBegin(P->to_root, unit[k], from[k], to[k], MPI_REPLACE));
+  for (int k = 0; k < 7; k++)
+    PM_PETSC_CALL(
+        PetscSFReduceEnd(P->to_root, unit[k], from[k], to[k], MPI_REPLACE));
+  pm_par_count_sent(29.0 * sizeof(double) * (double)m->n_own);
+  P->costs.gather_seconds += pm_wtime() - t0;
+  return PM_SUCCESS;
+}
+
+const int *fpm_par_owner(const fpm_model *m) { return m->par->owner; }
+
+const fpm_share_counts *fpm_par_counts(const fpm_model *m) {
+  return m->par->counts;
+}
+
+void fpm_par_get_costs(const fpm_model *m, fpm_par_costs *c) {
+  *c = m->par ? m->par->costs : (fpm_par_costs){0};
+}

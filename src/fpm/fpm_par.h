@@ -1,0 +1,75 @@
+/* fpm_par: explicit FPM across MPI ranks.  The points are partitioned by
+ * PT-Scotch on the support graph (fpm_share.h); each rank steps its share,
+ * its own points and the ghosts whose values their force reads, so that
+ * its force on its own points is the force one process computes, the same
+ * operations in the same order.  A step on a rank is the step of one
+ * process on its share, with:
+ *  - one exchange: once the rank's own displacements are updated and the
+ *    supports moved, the ghosts' displacements come from their owners (a
+ *    PETSc star forest whose leaves are the ghosts and whose roots their
+ *    owners' points);
+ *  - sums over the own points (energies, the residual, the supports' work,
+ *    dynamic relaxation's Rayleigh quotient) summed over the ranks, and
+ *    the smallest J; every rank then holds the same figures, damping and
+ *    energy accounts;
+ *  - a failure (a condition's value not finite, J <= 0, a stress not
+ *    finite) agreed by every rank: the one one process meets first wins,
+ *    and every rank stops with its message, which names the point by its
+ *    index on one process.
+ * Rank 0 keeps the whole model and gathers the state into it where the run
+ * writes (another star forest, its own points to rank 0's whole arrays):
+ * frames, history and checkpoints are those of one process.  Every function
+ * here is the identity on a model that is not a share (m->par NULL). */
+#ifndef FPM_PAR_H
+#define FPM_PAR_H
+
+#include <stdio.h>
+
+#include "fpm_model.h"
+#include "fpm_share.h"
+
+/* This rank's share of model m, which every rank holds whole (collective;
+ * every rank returns the same error): rank 0 partitions the points
+ * (fpm_partition) after checking that every rank meshed the same graph,
+ * every rank takes its share and the exchanges are set up.  *local owns
+ * its arrays and the exchanges (fpm_model_destroy). */
+pm_err fpm_par_create(const fpm_model *m, fpm_model **local);
+void fpm_par_destroy(struct fpm_par *p);
+
+/* The ghosts' displacements u (3 per point) from their owners
+ * (collective). */
+void fpm_par_exchange(const fpm_model *m, double *u);
+
+/* Sums and minima of n values over the ranks, in place (collective). */
+void fpm_par_sum(const fpm_model *m, double *v, int n);
+void fpm_par_min(const fpm_model *m, double *v, int n);
+
+/* Every rank's failure e, placed by key in one process's order
+ * (pm_par_agree_first; collective). */
+pm_err fpm_par_agree(const fpm_model *m, pm_err e, long key);
+
+/* A share's state from the whole run's, which every rank holds (a
+ * checkpoint read by every rank): displacements and velocities of every
+ * point it holds, and what the time loop carries. */
+void fpm_par_scatter(const fpm_model *m, const fpm_state *whole, fpm_state *st);
+
+/* Gather the state of every rank's share into the whole run's state on
+ * rank 0 (whole; NULL on the other ranks), in one process's order: u, v,
+ * f, F - I, P, W, J and what the time loop carries (collective). */
+pm_err fpm_par_gather(const fpm_model *m, const fpm_state *st,
+                      fpm_state *whole);
+
+/* The partition (every rank's owner, on every rank) and every rank's
+ * counts (on rank 0; NULL on the others) of a share. */
+const int *fpm_par_owner(const fpm_model *m);
+const fpm_share_counts *fpm_par_counts(const fpm_model *m);
+
+/* What the exchanges cost this rank so far: bytes it received of ghost
+ * displacements, and the seconds of the exchanges and the gathers. */
+typedef struct {
+  double ghost_bytes, exchange_seconds, gather_seconds;
+  long exchanges;
+} fpm_par_costs;
+void fpm_par_get_costs(const fpm_model *m, fpm_par_costs *c);
+
+#endif

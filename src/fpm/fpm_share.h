@@ -1,0 +1,71 @@
+/* fpm_share: the partition of an FPM model's points among ranks, by a
+ * graph partitioner on the supports, and a rank's share of the model: its
+ * own points and the ghost points whose values their force reads, with
+ * what every pass reads of them, copied from the whole model.  Nothing
+ * here communicates: every rank makes its own share from the whole model
+ * it holds at setup, and pointmech plan --ranks N makes every rank's on one
+ * process (fpm_par.h runs the shares across ranks).
+ *
+ * The ghosts are those that make a rank's force on its own points the
+ * force one process computes, the same operations in the same order, with
+ * the displacements as the only values taken from other ranks:
+ *  - the gather of f_k reads T_i and r_i of k's support (and, with the
+ *    quadratic jump, Zq_i of every fit that holds k): the flux is computed
+ *    on those points (flux ghosts);
+ *  - the flux of a point reads u, F, P (and the fit theta) of its
+ *    support: the stress and the fit are computed on those (stress ghosts);
+ *  - the stress reads u over the support, the fit over the fit's points
+ *    (the support, or two rings): displacements only (displacement
+ *    ghosts).
+ * With the linear jump that is three rings of support around a rank's
+ * points, with the quadratic up to five; the interfaces, boundary facets
+ * and conditions of every point held come with it from the whole model,
+ * computed once at setup. */
+#ifndef FPM_SHARE_H
+#define FPM_SHARE_H
+
+#include <stdio.h>
+
+#include "fpm_model.h"
+
+/* Partition the points of model m among `parts` ranks into owner (m->n
+ * ranks): PETSc's MatPartitioning (PT-Scotch) on the support graph, each
+ * point weighted by its support and fit entries (its work in the passes).
+ * On one process and one thread of the partitioner, so that the partition
+ * is the same wherever it is made (plan --ranks N on one process predicts
+ * the run of N ranks, and a resumed run has the partition of the run it
+ * continues).  parts 1: every point on rank 0, without PETSc.
+ * PM_ERR_LINALG naming PETSc's failure. */
+pm_err fpm_partition(const fpm_model *m, int parts, int *owner);
+
+/* Rank r's share of model m (held whole) under partition owner: a model
+ * whose points are r's own, in one-process order, then its flux, stress
+ * and displacement ghosts, each in one-process order (fpm_model: n_own,
+ * n_flux, n_stress, n, gid), with their operators, interfaces, masses,
+ * materials, boundary facets (of the points whose flux it computes) and
+ * prescribed dofs (of its own points).  Reactions are not computed on a
+ * share (no facet lists).  *out owns its arrays; m is left as it is. */
+pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
+                        fpm_model **out);
+
+/* What a share holds, for the plan and the summary. */
+typedef struct {
+  long own, flux_ghosts, stress_ghosts, u_ghosts;
+  double bytes; /* its model and state */
+} fpm_share_counts;
+void fpm_share_count(const fpm_model *share, fpm_share_counts *c);
+
+/* Support pairs (interfaces) whose points are on different ranks. */
+long fpm_partition_edge_cut(const fpm_model *m, const int *owner);
+
+/* Print the shares of `parts` ranks (counts[parts]) of model m under
+ * partition owner: points and ghosts per rank, memory, the displacements
+ * a rank receives per step, the balance and the edge cut. */
+void fpm_share_print(const fpm_model *m, const int *owner, int parts,
+                     const fpm_share_counts *counts, FILE *out);
+
+/* The shares of `parts` ranks made on one process (plan --ranks N): the
+ * partition and what each rank would hold, printed as fpm_share_print. */
+pm_err fpm_share_predict(const fpm_model *m, int parts, FILE *out);
+
+#endif

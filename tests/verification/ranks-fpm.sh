@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# Explicit FPM across MPI ranks against the same runs on one process.
+# Usage: ranks-fpm.sh POINTMECH SOURCE_DIR
+#
+# A rank's force on its own points is one process's, the same operations in
+# the same order (its ghosts carry what the force reads), so the fields are
+# one process's bit for bit for as long as the step's sums do not feed back
+# into it: until dynamic relaxation's damping starts (F2 here: step 800 of
+# 1000), and with the quadratic jump.  From then on, the damping
+# coefficient 2 sqrt((s3 - s1) / s2) takes the sums, summed over the ranks
+# in another order than one process's, into the steps: measured 1e-11 (the
+# fields, every history column) after 200 steps of relaxation, as between
+# one and two OpenMP threads of one process (2e-11).  The coefficient itself
+# is a difference of two sums that nearly cancel when the relaxation starts:
+# its round-off on one process, 1 against 2 threads, is 7e-10, and so is
+# that of the energy it dissipates; those two history columns are held to
+# 1e-8, every other column and every field to 1e-10 of its largest
+# magnitude, the bound of the MPM runs across ranks (verification.ranks).
+# Each rank has one OpenMP thread (ranks-lib.sh).
+set -u
+bin=$1
+src=$2
+. "$(dirname "$0")/lib.sh"
+. "$(dirname "$0")/ranks-lib.sh"
+bounds="damping=1e-8 dissipated=1e-8"
+fpm=$src/cases/fpm
+f2=$fpm/f2-unconstrained-compression.yaml
+f4=$fpm/f4-compression-60-h1.09e-2.yaml
+
+# F2 (3-D, 459 points, rollers and a moving face, dynamic relaxation from
+# step 800) on 2 and 3 ranks; 1000 steps, not yet quasi-static (exit 3).
+f2set="--set discretization.mesh_size=0.015 --set time.max_steps=1000
+  --set output.every=100"
+want=3 across f2 "$f2" 2 $f2set
+want=3 across f2 "$f2" 3 $f2set
+check "f2 on 3 ranks: the partition in summary.json" $py -c "
+import json, sys
+s = json.load(open('$work/f2-3/summary.json'))
+r = s['ranks']
+print('f2 on 3 ranks: points per rank %s, ghost points %s, %d pairs cut, '
+      '%.0f bytes of ghost displacements a rank receives per step'
+      % (r['points'], r['ghost_points'], r['edge_cut'],
+         r['ghost_bytes_per_step']))
+sys.exit(not (r['count'] == 3 and sum(r['points']) == s['points'] and
+              min(r['ghost_points']) > 0 and r['edge_cut'] > 0))"
+
+# One rank under mpirun is one process.
+ranks 1 "$bin" run "$f2" --out "$work/f2-np1" --quiet $f2set >/dev/null \
+  2>"$work/err"
+rc=$?
+check "f2 on 1 rank: exit 3 (got $rc)" test $rc -eq 3
+check "f2 on 1 rank: one process, bit for bit" \
+  $same "$work/f2-1" "$work/f2-np1"
+
+# The quadratic jump (F4 at 60%, coarsest h; its ghosts reach over the fits'
+# two rings), 200 steps.
+want=3 across f4-quadratic "$f4" 2 --set time.max_steps=200 \
+  --set output.every=50
+
+# plan on 2 ranks prints every rank's share; plan --ranks 2 on one
+# process predicts the same.
+ranks 2 "$bin" plan "$f2" >"$work/plan-2" 2>"$work/err"
+check "plan on 2 ranks: exit 0" test $? -eq 0
+"$bin" plan "$f2" --ranks 2 >"$work/plan-p" 2>"$work/err"
+check "plan --ranks 2: exit 0" test $? -eq 0
+sed -n '/^ranks /,/ghost points per rank/p' "$work/plan-2" >"$work/share-2"
+sed -n '/^ranks /,/ghost points per rank/p' "$work/plan-p" >"$work/share-p"
+check "plan on 2 ranks: a line per rank" \
+  test "$(grep -cE '^ +[01] +[0-9]+ +[0-9]+ \(' "$work/share-2")" -eq 2
+check "plan --ranks 2 predicts the shares of 2 ranks" \
+  cmp -s "$work/share-2" "$work/share-p"
+
+# A point turned inside out stops every rank with one process's message
+# (the point by its index on one process).
+fails_alike inverted 3 'step [0-9]*, .*(J = [^)]*)' "$f2" \
+  --set time.dt=1e-3 --set output.every=5
+
+# The static solver runs on one process: refused at its key, nothing
+# written.
+refused "static on 2 ranks" \
+  "the static solver (Newton's method) runs on one process" \
+  "$work/static-2" ranks 2 "$bin" run "$f2" --out "$work/static-2" \
+  --set time.quasi_static.method=static
+
+# Interrupted on 2 ranks and resumed: on 2 ranks bit for bit the run that
+# was not interrupted (the partition is the same), on one process to
+# round-off (a checkpoint is one process's).
+interrupt 2 "$work/cut" "$f2" $f2set
+want=3 resume_on "$work/cut" 1 2
+check "interrupted on 2 ranks, resumed on 2: the run of 2 ranks, bit for bit" \
+  $same "$work/f2-2" "$work/cut-2"
+roundoff "interrupted on 2 ranks, resumed on 1" "$work/f2-1" "$work/cut-1"
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,104 @@
+# Shared by the verification tests across MPI ranks (ranks.sh, ranks-fpm.sh,
+# ranks-implicit.sh),
+# sourced after lib.sh with $bin and $src set: runs on N ranks, each with one
+# OpenMP thread, ranks waiting in a collective yielding their core
+# (mpi_yield_when_idle: more ranks than cores otherwise spin against each
+# other, 20 times slower), and their comparisons with one process.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+export OMP_NUM_THREADS=1
+py=/usr/bin/python3
+same="$py $src/tests/verification/same_results.py"
+tol=1e-10
+
+ranks() { # N, command...
+  local n=$1
+  shift
+  timeout 300 mpirun -np "$n" --bind-to none "$@"
+}
+
+# Two runs' results and history to round-off: $tol, and the history
+# columns named in $bounds (COLUMN=BOUND ...) to their own; the largest
+# differences printed after LABEL.
+roundoff() { # label, run, run
+  $py "$src/tests/verification/same_to_roundoff.py" "$2" "$3" $tol \
+    ${bounds:-} >"$work/cmp" 2>&1
+  local rc=$?
+  sed "s/^/$1: /" "$work/cmp"
+  check "$1: to $tol" test $rc -eq 0
+}
+
+# One process (once), then N ranks, of SCENE with overrides, compared to
+# round-off; the runs end with exit status $want (default 0).
+across() { # label, scene, ranks, overrides...
+  local label=$1 scene=$2 n=$3 want=${want:-0}
+  shift 3
+  local one=$work/$label-1 many=$work/$label-$n
+  [ -d "$one" ] || "$bin" run "$scene" --out "$one" --quiet "$@" \
+    >/dev/null 2>"$work/err"
+  ranks "$n" "$bin" run "$scene" --out "$many" --quiet "$@" >/dev/null \
+    2>"$work/err"
+  local rc=$?
+  check "$label on $n ranks: exit $want (got $rc)" test $rc -eq "$want"
+  roundoff "$label, $n ranks against one process" "$one" "$many"
+}
+
+# Run SCENE with overrides on N ranks into OUT and send SIGTERM to rank 0
+# (its pid is in summary.json) once history.csv has 3 rows, which stops
+# every rank after the step with a checkpoint; mpirun forwards a signal of
+# its own about 2 s late, or not before it gives up on its ranks (README,
+# "Across MPI ranks").
+interrupt() { # ranks, out, scene, overrides...
+  local n=$1 out=$2 scene=$3 job pid
+  shift 3
+  ranks "$n" "$bin" run "$scene" --out "$out" --quiet "$@" >/dev/null \
+    2>"$work/err" &
+  job=$!
+  for _ in $(seq 600); do
+    [ -f "$out/history.csv" ] &&
+      [ "$(wc -l <"$out/history.csv")" -ge 4 ] && break
+    sleep 0.05
+  done
+  pid=$(sed -n 's/^ *"pid": \([0-9]*\).*/\1/p' "$out/summary.json")
+  kill -TERM "$pid"
+  wait $job
+  check "interrupted on $n ranks: status interrupted" \
+    grep -q '"status": "interrupted"' "$out/summary.json"
+}
+
+# Resume copies of the interrupted run OUT on each count of ranks (1: one
+# process, without mpirun) into OUT-N; they end with exit status $want
+# (default 0).
+resume_on() { # out, counts...
+  local out=$1 want=${want:-0} n rc
+  shift
+  for n in "$@"; do
+    cp -r "$out" "$out-$n"
+    if [ "$n" -eq 1 ]; then
+      "$bin" resume "$out-$n" --quiet >/dev/null 2>"$work/err"
+    else
+      ranks "$n" "$bin" resume "$out-$n" --quiet >/dev/null 2>"$work/err"
+    fi
+    rc=$?
+    check "interrupted, resumed on $n: exit $want (got $rc)" \
+      test $rc -eq "$want"
+  done
+}
+
+# A run of SCENE with overrides that fails: on N ranks it stops every rank
+# with one process's message (what PATTERN matches of it: the step, the
+# point or particle by its index on one process), exit 2, status unstable.
+fails_alike() { # label, ranks, pattern, scene, overrides...
+  local label=$1 n=$2 pattern=$3 scene=$4 rc
+  shift 4
+  "$bin" run "$scene" --out "$work/$label-1" --quiet "$@" >/dev/null \
+    2>"$work/err1"
+  ranks "$n" "$bin" run "$scene" --out "$work/$label-$n" --quiet "$@" \
+    >/dev/null 2>"$work/err"
+  rc=$?
+  check "$label on $n ranks: exit 2 (got $rc)" test $rc -eq 2
+  check "$label on $n ranks: one process's message" \
+    grep -qF "$(grep -o "$pattern" "$work/err1")" "$work/err"
+  check "$label on $n ranks: status unstable" \
+    grep -q '"status": "unstable"' "$work/$label-$n/summary.json"
+}
