@@ -23,6 +23,9 @@ void fpm_sim_destroy(fpm_sim *sim) {
   fpm_state_destroy(sim->local_state);
   fpm_model_destroy(sim->local_model);
   fpm_static_state_free(&sim->static_state);
+  fpm_static_state_free(&sim->local_static);
+  free(sim->static_local);
+  free(sim->static_whole);
   fpm_state_destroy(sim->state);
   fpm_model_destroy(sim->model);
   gm_dual_destroy(sim->dual);
@@ -161,11 +164,62 @@ static pm_step_report note_step(fpm_sim *sim, const fpm_step_info *info) {
                           .progress = frac};
 }
 
+/* A static solve across ranks: the shares' load stepping into rank 0's
+ * whole one, in one process's order (its two states through the points'
+ * displacements), for a checkpoint (collective). */
+static pm_err gather_static(fpm_sim *sim) {
+  const fpm_model *lm = sim->local_model, *m = sim->model;
+  const fpm_static_state *ls = &sim->local_static;
+  fpm_static_state *ws = &sim->static_state;
+  for (int k = 0; k < 2; k++) {
+    fpm_static_nodal(lm, k ? ls->load.xprev : ls->load.xc, sim->static_local);
+    PM_CALL(fpm_par_gather_points(lm, sim->static_local,
+                                  pm_par_root() ? sim->static_whole : NULL));
+    if (pm_par_root())
+      fpm_static_unknowns(m, sim->static_whole,
+                          k ? ws->load.xprev : ws->load.xc);
+  }
+  if (!pm_par_root()) return PM_SUCCESS;
+  ws->load.lambda = ls->load.lambda;
+  ws->load.lambda_prev = ls->load.lambda_prev;
+  ws->load.dl = ls->load.dl;
+  ws->load.good = ls->load.good;
+  ws->load.have_prev = ls->load.have_prev;
+  ws->external_work = ls->external_work;
+  return PM_SUCCESS;
+}
+
+/* A static solve resumed across ranks: the share's load stepping and
+ * displacements (of every point it holds) from the whole run's, which
+ * every rank read from the checkpoint. */
+static void scatter_static(fpm_sim *sim) {
+  const fpm_model *lm = sim->local_model, *m = sim->model;
+  const fpm_static_state *ws = &sim->static_state;
+  fpm_static_state *ls = &sim->local_static;
+  double *held = sim->local_state->u; /* 3 per point held */
+  for (int k = 1; k >= 0; k--) {      /* xc last: its displacements stay */
+    fpm_static_nodal(m, k ? ws->load.xprev : ws->load.xc, sim->static_whole);
+    for (long i = 0; i < lm->n; i++)
+      memcpy(held + 3 * i, sim->static_whole + 3 * lm->gid[i],
+             3 * sizeof(double));
+    fpm_static_unknowns(lm, held, k ? ls->load.xprev : ls->load.xc);
+  }
+  ls->load.lambda = ws->load.lambda;
+  ls->load.lambda_prev = ws->load.lambda_prev;
+  ls->load.dl = ws->load.dl;
+  ls->load.good = ws->load.good;
+  ls->load.have_prev = ws->load.have_prev;
+  ls->external_work = ws->external_work;
+}
+
 /* Every rank's share of the state into rank 0's view (collective). */
 static pm_err gather(void *ctx) {
   fpm_sim *sim = ctx;
-  return pm_par_agree(fpm_par_gather(sim->local_model, sim->local_state,
-                                     pm_par_root() ? sim->state : NULL));
+  PM_CALL(pm_par_agree(fpm_par_gather(sim->local_model, sim->local_state,
+                                      pm_par_root() ? sim->state : NULL)));
+  if (sim->scene->time.qs == PM_QS_STATIC)
+    PM_CALL(pm_par_agree(gather_static(sim)));
+  return PM_SUCCESS;
 }
 
 /* Across ranks rank 0 reports, with the state gathered where its observer
@@ -231,12 +285,17 @@ static pm_err run(void *p, const pm_observer *obs) {
    * into the whole state, when resumed. */
   fpm_model *lm = sim->local_model ? sim->local_model : m;
   fpm_state *st = sim->local_model ? sim->local_state : sim->state;
+  const bool is_static = s->time.qs == PM_QS_STATIC;
   if (sim->local_model) {
-    if (sim->resumed) fpm_par_scatter(lm, sim->state, st);
+    if (sim->resumed && is_static)
+      scatter_static(sim);
+    else if (sim->resumed)
+      fpm_par_scatter(lm, sim->state, st);
     release_view(sim);
   }
   if (!sim->resumed) { /* a resumed run has these from its checkpoint */
-    memset(st->u, 0, 3 * lm->n * sizeof(double));
+    if (!is_static || !sim->local_model)
+      memset(st->u, 0, 3 * lm->n * sizeof(double));
     memset(st->v, 0, 3 * lm->n * sizeof(double));
     st->step = 0;
     sim->run_min_jacobian = INFINITY;
@@ -248,12 +307,18 @@ static pm_err run(void *p, const pm_observer *obs) {
   sim->obs = obs;
   double stage[2] = {0, 0};
   pm_err e;
-  if (s->time.qs == PM_QS_STATIC) {
+  if (is_static) {
     fpm_static_report *r = &sim->static_report;
     double w0 = pm_wtime();
-    e = fpm_static_run_from(m, sim->state, &sim->static_state, observe, sim,
-                            &sim->last, r);
+    e = fpm_static_run_from(
+        lm, st, sim->local_model ? &sim->local_static : &sim->static_state,
+        observe, sim, &sim->last, r);
     double wall = pm_wtime() - w0;
+    if (sim->local_model) { /* the state the run ended in, for the figures */
+      pm_err g = gather(sim);
+      if (!e) e = g;
+      ranks_costs(sim);
+    }
     sim->obs = NULL;
     pm_stage *tm = sim->timers.stage;
     tm[sim->tm_force].seconds += r->load.time_residual;
@@ -550,6 +615,14 @@ static pm_err create(const pm_scene *s, void **out) {
     e = fpm_par_create(sim->model, &sim->local_model);
     if (!e)
       e = pm_par_agree(fpm_state_create(sim->local_model, &sim->local_state));
+    if (!e && s->time.qs == PM_QS_STATIC) { /* its load stepping's share */
+      const fpm_model *lm = sim->local_model;
+      e = fpm_static_state_init(&sim->local_static, lm);
+      if (!e) e = PM_ALLOC(sim->static_local, 3 * lm->n + 1, "nodal gather");
+      if (!e)
+        e = PM_ALLOC(sim->static_whole, 3 * sim->model->n, "nodal gather");
+      e = pm_par_agree(e);
+    }
     sim->setup_wall += pm_wtime() - t0;
   }
   if (e) {
@@ -737,15 +810,8 @@ static pm_err plan(void *p, FILE *out) {
   const int ranks = pm_par_plan_ranks();
   double per_step = time_force(sim->model, sim->state);
   double steps = plan_head(sim, out);
-  if (sim->scene->time.qs == PM_QS_STATIC) {
-    if (ranks > 1)
-      fprintf(out,
-              "ranks        %d: not across ranks: the static solver "
-              "(time.quasi_static.method: static) runs on one process\n",
-              ranks);
-    return PM_SUCCESS;
-  }
   if (ranks > 1) PM_CALL(fpm_share_predict(sim->model, ranks, out));
+  if (sim->scene->time.qs == PM_QS_STATIC) return PM_SUCCESS;
   plan_estimate(sim, per_step, steps, out);
   return PM_SUCCESS;
 }

@@ -61,6 +61,12 @@ typedef struct {
   double ranks_costs[4]; /* summed over the ranks at the end: ghost bytes,
                             exchanges; the slowest's exchange and gather
                             seconds */
+  /* A static solve across ranks: the share's load stepping (over its own
+   * points' free dofs), which static_state above (the whole run's, in one
+   * process's order) mirrors where the run writes, and the buffers of
+   * that: 3 per own point, and on rank 0 3 per point of the whole model */
+  fpm_static_state local_static;
+  double *static_local, *static_whole;
 } fpm_sim;
 
 /* Mesh the scene's domain, build subdomains, operators and state, and pick

@@ -437,7 +437,7 @@ size_t fpm_linear_bytes(const fpm_model *m) {
 
 void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
                         fpm_linear *l) {
-  const long n = m->n;
+  const long n = m->n, ns = m->n_stress; /* (the stress's points) */
   const double *restrict H = st->H;
   double *restrict D = l->D;
   const int *restrict mat = m->mat;
@@ -447,8 +447,8 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
   memcpy(l->bu, st->u, 3 * n * sizeof(double));
   memcpy(l->bH, st->H, 9 * n * sizeof(double));
   PM_OMP(parallel for schedule(static) default(none)
-         shared(n, H, D, mat, mats, ms, mss))
-  for (long i = 0; i < n; i++) {
+         shared(ns, H, D, mat, mats, ms, mss))
+  for (long i = 0; i < ns; i++) {
     double F[9], E[9] = {0}, dP[9];
     for (int k = 0; k < 9; k++) F[k] = H[9 * i + k];
     F[0] += 1;
@@ -465,7 +465,7 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
 
 void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
                       double *df) {
-  const long n = m->n;
+  const long n = m->n_stress; /* the stress's points (all on one process) */
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr;
   const double *restrict g = m->g, *restrict D = l->D;

@@ -233,6 +233,19 @@ pm_err fpm_par_gather(const fpm_model *m, const fpm_state *st,
   return PM_SUCCESS;
 }
 
+pm_err fpm_par_gather_points(const fpm_model *m, const double *local,
+                             double *whole) {
+  struct fpm_par *P = m->par;
+  const double t0 = pm_wtime();
+  double *to = whole ? whole : P->none;
+  PM_PETSC_CALL(
+      PetscSFReduceBegin(P->to_root, P->three, local, to, MPI_REPLACE));
+  PM_PETSC_CALL(PetscSFReduceEnd(P->to_root, P->three, local, to, MPI_REPLACE));
+  pm_par_count_sent(3.0 * sizeof(double) * (double)m->n_own);
+  P->costs.gather_seconds += pm_wtime() - t0;
+  return PM_SUCCESS;
+}
+
 const int *fpm_par_owner(const fpm_model *m) { return m->par->owner; }
 
 const fpm_share_counts *fpm_par_counts(const fpm_model *m) {

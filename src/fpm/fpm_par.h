@@ -59,6 +59,12 @@ void fpm_par_scatter(const fpm_model *m, const fpm_state *whole, fpm_state *st);
 pm_err fpm_par_gather(const fpm_model *m, const fpm_state *st,
                       fpm_state *whole);
 
+/* Three values per own point of every rank's share (local) into rank 0's
+ * array over the whole model's points (whole; NULL on the other ranks)
+ * (collective). */
+pm_err fpm_par_gather_points(const fpm_model *m, const double *local,
+                             double *whole);
+
 /* The partition (every rank's owner, on every rank) and every rank's
  * counts (on rank 0; NULL on the others) of a share. */
 const int *fpm_par_owner(const fpm_model *m);

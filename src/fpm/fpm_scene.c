@@ -143,12 +143,5 @@ pm_err fpm_check_scene(const pm_scene *s) {
   if (pm_scene_has(s, "gravity"))
     return pm_scene_fail(s, "gravity", true,
                          "expected no gravity for method fpm, got gravity");
-  if (pm_par_active() && s->time.qs == PM_QS_STATIC)
-    return pm_scene_fail(s, "time.quasi_static.method", false,
-                         "the static solver (Newton's method) runs on one "
-                         "process (this run has %d ranks): run it without "
-                         "mpirun, or with -np 1; explicit FPM (dynamic-"
-                         "relaxation, damping, none) runs across ranks",
-                         pm_par_size());
   return PM_SUCCESS;
 }

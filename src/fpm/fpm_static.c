@@ -10,7 +10,9 @@
 #include <string.h>
 
 #include "fpm_gfd.h"
+#include "fpm_par.h"
 #include "pm_omp.h"
+#include "pm_par.h"
 #include "pm_progress.h"
 
 /* The tangent assembled directly: K = E D Gamma + S, where
@@ -43,8 +45,14 @@ typedef struct {
   const long *pat_ptr;
   const long *free_of;
   fpm_linear *lin;
-  long nf;       /* free dofs */
-  long *dof;     /* nf: their dof index */
+  /* The unknowns: the free dofs of the model's own points (nf; all its
+   * points on one process), then across ranks those of its ghosts (nheld
+   * in all), which the solver gives their owners' values. */
+  long nf, nheld;
+  long *dof;   /* nheld: their dof index */
+  long *ghost; /* nheld - nf: the ghosts' unknowns' numbers over the ranks */
+  pm_newton *solver;
+  double *held;  /* nheld: the unknowns held, for a converged state */
   double *du;    /* 3 n work */
   double *df;    /* 3 n work */
   double *u_old; /* 3 n: the last converged displacement */
@@ -58,17 +66,25 @@ typedef struct {
 /* The state at the free values x (prescribed dofs as set by set_load). */
 static long evaluate(static_ctx *c, const double *x) {
   if (x)
-    for (long j = 0; j < c->nf; j++) c->st->u[c->dof[j]] = x[j];
+    for (long j = 0; j < c->nheld; j++) c->st->u[c->dof[j]] = x[j];
   return fpm_force(c->m, c->st);
 }
 
 static pm_err inadmissible(const static_ctx *c, long p) {
   const double *x = c->m->x + 3 * p;
   return PM_ERROR(PM_ERR_UNSTABLE,
-                  "point %ld at (%g, %g, %g): volume ratio J = %g%s", p, x[0],
-                  x[1], x[2], c->st->J[p],
+                  "point %ld at (%g, %g, %g): volume ratio J = %g%s",
+                  fpm_point_id(c->m, p), x[0], x[1], x[2], c->st->J[p],
                   isfinite(c->st->J[p]) ? " (inverted subdomain)"
                                         : " (deformation not finite)");
+}
+
+/* The state just evaluated (bad: its first inadmissible point, or -1),
+ * admissible on every rank or on none (the failure one process meets
+ * first). */
+static pm_err admissible(const static_ctx *c, long bad) {
+  pm_err e = bad >= 0 ? inadmissible(c, bad) : PM_SUCCESS;
+  return fpm_par_agree(c->m, e, bad >= 0 ? fpm_point_id(c->m, bad) : 0);
 }
 
 static pm_err residual(void *ctx, const double *x, double *r) {
@@ -77,6 +93,8 @@ static pm_err residual(void *ctx, const double *x, double *r) {
   if (bad >= 0) return inadmissible(c, bad);
   const double *f = c->st->f;
   for (long j = 0; j < c->nf; j++) r[j] = f[c->dof[j]];
+  /* (a rank's force on its own points is whole: nothing for the ghosts') */
+  for (long j = c->nf; j < c->nheld; j++) r[j] = 0;
   return PM_SUCCESS;
 }
 
@@ -92,9 +110,37 @@ static pm_err apply(void *ctx, const double *x, const double *dx, double *dr) {
   static_ctx *c = ctx;
   (void)x;
   memset(c->du, 0, 3 * c->m->n * sizeof(double));
-  for (long j = 0; j < c->nf; j++) c->du[c->dof[j]] = dx[j];
+  for (long j = 0; j < c->nheld; j++) c->du[c->dof[j]] = dx[j];
   fpm_force_linear(c->m, c->lin, c->du, c->df);
   for (long j = 0; j < c->nf; j++) dr[j] = c->df[c->dof[j]];
+  for (long j = c->nf; j < c->nheld; j++) dr[j] = 0;
+  return PM_SUCCESS;
+}
+
+/* The loads at lambda on the model's own points (a condition's value not
+ * finite: the failure, naming its point). */
+static pm_err own_loads(static_ctx *c, double lambda, long *key) {
+  const fpm_model *m = c->m;
+  /* Proportional loading: the loads at the end of the ramps times lambda
+   * (the path of a rate-independent solid does not depend on the ramps'
+   * shape, and a proportional path is what the predictor extrapolates). */
+  for (long k = 0; k < m->n_cdofs; k++) {
+    double u = fpm_prescribed(m, k, c->load_end);
+    if (!isfinite(u)) {
+      *key = fpm_point_id(m, m->cd_point[k]);
+      return fpm_condition_failure(m, false, k, -1, c->load_end);
+    }
+    c->st->u[3 * m->cd_point[k] + m->cd_comp[k]] = lambda * u;
+  }
+  if (m->n_tfacets > 0) {
+    long bad = fpm_update_tractions(m, c->st, c->load_end);
+    if (bad >= 0) {
+      *key = fpm_point_id(m, m->tf_point[bad / 3]);
+      return fpm_condition_failure(m, true, bad, -1, c->load_end);
+    }
+    for (long k = 0; k < 3 * m->n_tfacets; k++) c->st->tf_value[k] *= lambda;
+    c->st->fext_norm *= lambda;
+  }
   return PM_SUCCESS;
 }
 
@@ -102,22 +148,19 @@ static pm_err set_load(void *ctx, double lambda) {
   static_ctx *c = ctx;
   const fpm_model *m = c->m;
   c->t = lambda * c->load_end;
-  /* Proportional loading: the loads at the end of the ramps times lambda
-   * (the path of a rate-independent solid does not depend on the ramps'
-   * shape, and a proportional path is what the predictor extrapolates). */
-  for (long k = 0; k < m->n_cdofs; k++) {
-    double u = fpm_prescribed(m, k, c->load_end);
-    if (!isfinite(u))
-      return fpm_condition_failure(m, false, k, -1, c->load_end);
-    c->st->u[3 * m->cd_point[k] + m->cd_comp[k]] = lambda * u;
+  long key = 0;
+  pm_err e = own_loads(c, lambda, &key);
+  if (m->par) {
+    /* A rank's failure is every rank's (the one one process meets first);
+     * the ghosts' prescribed values (and, until the solver sets them,
+     * their unknowns') come from their owners. */
+    PM_CALL(fpm_par_agree(m, e, key));
+    fpm_par_exchange(m, c->st->u);
+    double sq = c->st->fext_sq; /* the tractions of every rank's points */
+    fpm_par_sum(m, &sq, 1);
+    c->st->fext_norm = lambda * sqrt(sq);
   }
-  if (m->n_tfacets > 0) {
-    long bad = fpm_update_tractions(m, c->st, c->load_end);
-    if (bad >= 0) return fpm_condition_failure(m, true, bad, -1, c->load_end);
-    for (long k = 0; k < 3 * m->n_tfacets; k++) c->st->tf_value[k] *= lambda;
-    c->st->fext_norm *= lambda;
-  }
-  return PM_SUCCESS;
+  return e;
 }
 
 /* The figures of the state in c->st (its force just computed): energies,
@@ -126,9 +169,9 @@ static pm_err set_load(void *ctx, double lambda) {
 static void figures(static_ctx *c, long step) {
   const fpm_model *m = c->m;
   fpm_state *st = c->st;
-  const long n = m->n;
+  const long n = m->n, n_own = m->n_own;
   double se = 0, rf = 0, jmin = INFINITY;
-  for (long i = 0; i < n; i++) {
+  for (long i = 0; i < n_own; i++) {
     se += m->dual->volume[i] * st->W[i];
     jmin = fmin(jmin, st->J[i]);
     for (int a = 0; a < 3; a++)
@@ -136,15 +179,24 @@ static void figures(static_ctx *c, long step) {
   }
   for (long d = 0; d < 3 * n; d++) c->du[d] = st->u[d] - c->u_old[d];
   double rr;
-  *c->ext_work += fpm_support_work(m, st, c->du, 1, &rr);
+  const double work = fpm_support_work(m, st, c->du, 1, &rr);
   memcpy(c->u_old, st->u, 3 * n * sizeof(double));
-  double ref = sqrt(rr) + st->bflux_norm + st->fext_norm;
+  double bflux = st->bflux_norm, penalty = st->penalty_energy;
+  double sums[6] = {se, rf, rr, work, st->bflux_sq, penalty};
+  if (m->par) { /* over every rank's own points */
+    fpm_par_sum(m, sums, 6);
+    fpm_par_min(m, &jmin, 1);
+    se = sums[0], rf = sums[1], rr = sums[2], bflux = sqrt(sums[4]);
+    penalty = sums[5];
+  }
+  *c->ext_work += sums[3];
+  double ref = sqrt(rr) + bflux + st->fext_norm;
   fpm_step_info *si = &c->si;
   si->step = step;
   si->t = c->t;
   si->kinetic = 0;
   si->strain = se;
-  si->penalty = st->penalty_energy;
+  si->penalty = penalty;
   si->external_work = *c->ext_work;
   si->dissipated = 0;
   si->residual = ref > 0 ? sqrt(rf) / ref : sqrt(rf);
@@ -160,8 +212,11 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
   static_ctx *c = ctx;
   (void)report;
   c->t = lambda * c->load_end;
-  long bad = evaluate(c, x);
-  if (bad >= 0) return inadmissible(c, bad);
+  if (c->m->par) { /* x: the own unknowns; the ghosts' from their owners */
+    PM_CALL(pm_newton_held_values(c->solver, x, c->held));
+    x = c->held;
+  }
+  PM_CALL(admissible(c, evaluate(c, x)));
   figures(c, step);
   c->si.converged = lambda >= 1;
   c->si.last = c->si.converged;
@@ -242,7 +297,7 @@ static void flux_geometry(const fpm_model *m, const long *dpt_of, long i,
  * E^c_kj[s] = sum_i C^c_ij[s] . gamma_ik + c^c_kj[s]. */
 static pm_err build_E(const fpm_model *m, tangent *t) {
   pm_err ret = PM_SUCCESS;
-  const long n = m->n;
+  const long n = m->n, rows = m->n_own; /* (rows: the own points') */
   long *mark = NULL, *list = NULL, *dpt_of = NULL;
   PM_TRY(PM_ALLOC(mark, n, "tangent marks"));
   PM_TRY(PM_ALLOC(list, n, "tangent lists"));
@@ -251,7 +306,7 @@ static pm_err build_E(const fpm_model *m, tangent *t) {
   for (long i = 0; i < n; i++) mark[i] = dpt_of[i] = -1;
   for (long p = 0; p < m->n_dpts; p++) dpt_of[m->dpt_point[p]] = p;
   for (int pass = 0; pass < 2; pass++) {
-    for (long k = 0; k < n; k++) {
+    for (long k = 0; k < rows; k++) {
       long cnt = 0;
       /* i over k's closed support: gamma_ik is the weight of u_k in H_i */
       for (long ri = 0; ri < closed_size(m, k); ri++) {
@@ -308,9 +363,9 @@ static pm_err build_E(const fpm_model *m, tangent *t) {
       for (long a = 0; a < cnt; a++) mark[list[a]] = -1;
     }
     if (pass == 0) {
-      for (long k = 0; k < n; k++) t->E_ptr[k + 1] += t->E_ptr[k];
-      PM_TRY(PM_ALLOC(t->E_j, t->E_ptr[n], "tangent geometry"));
-      PM_TRY(PM_ALLOC(t->E, 9 * t->E_ptr[n], "tangent geometry"));
+      for (long k = 0; k < rows; k++) t->E_ptr[k + 1] += t->E_ptr[k];
+      PM_TRY(PM_ALLOC(t->E_j, t->E_ptr[rows] + 1, "tangent geometry"));
+      PM_TRY(PM_ALLOC(t->E, 9 * t->E_ptr[rows] + 1, "tangent geometry"));
     }
   }
 done:
@@ -358,7 +413,7 @@ static long recon_size(const fpm_model *m, long i) {
  * through point i's side only (the force of the side's own field). */
 static pm_err build_S(const fpm_model *m, tangent *t) {
   pm_err ret = PM_SUCCESS;
-  const long n = m->n;
+  const long n = m->n, rows = m->n_own;
   long *mark = NULL, *list = NULL;
   double *acc = NULL;
   PM_TRY(PM_ALLOC(mark, n, "penalty marks"));
@@ -367,7 +422,7 @@ static pm_err build_S(const fpm_model *m, tangent *t) {
   PM_TRY(PM_ALLOC(t->S_ptr, n + 1, "penalty matrix"));
   for (long i = 0; i < n; i++) mark[i] = -1;
   for (int pass = 0; pass < 2; pass++) {
-    for (long k = 0; k < n; k++) {
+    for (long k = 0; k < rows; k++) {
       long cnt = 0;
       /* the points i whose own field at their interfaces moves with u_k:
        * k itself and those whose reconstruction holds k */
@@ -421,11 +476,11 @@ static pm_err build_S(const fpm_model *m, tangent *t) {
       for (long a = 0; a < cnt; a++) mark[list[a]] = -1;
     }
     if (pass == 0) {
-      for (long k = 0; k < n; k++) t->S_ptr[k + 1] += t->S_ptr[k];
-      PM_TRY(PM_ALLOC(t->S_m, t->S_ptr[n] > 0 ? t->S_ptr[n] : 1,
+      for (long k = 0; k < rows; k++) t->S_ptr[k + 1] += t->S_ptr[k];
+      PM_TRY(PM_ALLOC(t->S_m, t->S_ptr[rows] > 0 ? t->S_ptr[rows] : 1,
                       "penalty matrix"));
-      PM_TRY(
-          PM_ALLOC(t->S, t->S_ptr[n] > 0 ? t->S_ptr[n] : 1, "penalty matrix"));
+      PM_TRY(PM_ALLOC(t->S, t->S_ptr[rows] > 0 ? t->S_ptr[rows] : 1,
+                      "penalty matrix"));
     }
   }
 done:
@@ -435,16 +490,18 @@ done:
   return ret;
 }
 
+/* Rows are the own points' (a share's; all on one process), the products
+ * D gamma those of the points whose stress they read. */
 static pm_err tangent_build(const fpm_model *m, tangent *t) {
-  const long n = m->n;
+  const long n = m->n, ns = m->n_stress;
   PM_CALL(build_E(m, t));
   PM_CALL(build_S(m, t));
-  PM_CALL(PM_ALLOC(t->Dg_ptr, n + 1, "tangent products"));
-  for (long j = 0; j < n; j++)
+  PM_CALL(PM_ALLOC(t->Dg_ptr, ns + 1, "tangent products"));
+  for (long j = 0; j < ns; j++)
     t->Dg_ptr[j + 1] = t->Dg_ptr[j] + closed_size(m, j);
-  PM_CALL(PM_ALLOC(t->Dg, 27 * t->Dg_ptr[n], "tangent products"));
+  PM_CALL(PM_ALLOC(t->Dg, 27 * t->Dg_ptr[ns], "tangent products"));
   t->max_reach = 0;
-  for (long k = 0; k < n; k++)
+  for (long k = 0; k < m->n_own; k++)
     if (t->R_ptr[k + 1] - t->R_ptr[k] > t->max_reach)
       t->max_reach = t->R_ptr[k + 1] - t->R_ptr[k];
   t->threads = pm_omp_threads();
@@ -460,11 +517,12 @@ static pm_err tangent_values(void *ctx, const double *x, double *val) {
   (void)x;
   const fpm_model *m = c->m;
   tangent *t = &c->tg;
-  const long n = m->n;
+  const long n = m->n, ns = m->n_stress, rows = m->n_own;
   const double *D = fpm_linear_tangent(c->lin);
-  /* D_j gamma_jm for every j and member m of its closed support */
-  PM_OMP(parallel for schedule(static) default(none) shared(n, m, t, D))
-  for (long j = 0; j < n; j++) {
+  /* D_j gamma_jm for every j (whose stress the rows read) and member m of
+   * its closed support */
+  PM_OMP(parallel for schedule(static) default(none) shared(ns, m, t, D))
+  for (long j = 0; j < ns; j++) {
     const double *Dj = D + 81 * j;
     for (long r = 0; r < closed_size(m, j); r++) {
       const double *w;
@@ -480,7 +538,7 @@ static pm_err tangent_values(void *ctx, const double *x, double *val) {
     }
   }
   const long *free_of = c->free_of, *pat = c->pat_ptr;
-  PM_OMP(parallel default(none) shared(n, m, t, free_of, pat, val)) {
+  PM_OMP(parallel default(none) shared(n, rows, m, t, free_of, pat, val)) {
     int th = 0;
 #ifdef _OPENMP
     th = omp_get_thread_num();
@@ -488,7 +546,7 @@ static pm_err tangent_values(void *ctx, const double *x, double *val) {
     long *mark = t->mark + (size_t)th * n;
     double *blk = t->work + (size_t)th * 9 * t->max_reach;
     PM_OMP(for schedule(dynamic, 16))
-    for (long k = 0; k < n; k++) {
+    for (long k = 0; k < rows; k++) {
       const long r0 = t->R_ptr[k], nr = t->R_ptr[k + 1] - r0;
       for (long a = 0; a < nr; a++) mark[t->R_list[r0 + a]] = a;
       for (long a = 0; a < 9 * nr; a++) blk[a] = 0;
@@ -581,11 +639,12 @@ static long reach(const fpm_model *m, long k, long *reach_list, long *a_list,
   return nr;
 }
 
-/* The Jacobian's pattern over the free dofs (free_of: dof -> unknown). */
+/* The Jacobian's pattern over the nf unknowns (free_of: dof -> unknown):
+ * the rows of the own points' (a share's ghosts' rows are empty). */
 static pm_err build_pattern(const fpm_model *m, const long *free_of, long nf,
                             tangent *tg, long **ptr_out, long **idx_out) {
   pm_err ret = PM_SUCCESS;
-  const long n = m->n;
+  const long n = m->n, rows = m->n_own;
   long *mark_a = NULL, *mark_r = NULL, *a_list = NULL, *r_list = NULL,
        *ptr = NULL, *idx = NULL;
   PM_TRY(PM_ALLOC(mark_a, n, "pattern marks"));
@@ -597,7 +656,7 @@ static pm_err build_pattern(const fpm_model *m, const long *free_of, long nf,
   for (long i = 0; i < n; i++) mark_a[i] = mark_r[i] = -1;
   /* Count, then fill. */
   for (int pass = 0; pass < 2; pass++) {
-    for (long k = 0; k < n; k++) {
+    for (long k = 0; k < rows; k++) {
       long nr = reach(m, k, r_list, a_list, mark_a, mark_r, pass * n + k);
       if (pass == 0)
         tg->R_ptr[k + 1] = nr;
@@ -622,8 +681,8 @@ static pm_err build_pattern(const fpm_model *m, const long *free_of, long nf,
       }
     }
     if (pass == 0) {
-      for (long k = 0; k < n; k++) tg->R_ptr[k + 1] += tg->R_ptr[k];
-      PM_TRY(PM_ALLOC(tg->R_list, tg->R_ptr[n], "Jacobian reach"));
+      for (long k = 0; k < rows; k++) tg->R_ptr[k + 1] += tg->R_ptr[k];
+      PM_TRY(PM_ALLOC(tg->R_list, tg->R_ptr[rows] + 1, "Jacobian reach"));
       for (long r = 0; r < nf; r++) ptr[r + 1] += ptr[r];
       PM_TRY(PM_ALLOC(idx, ptr[nf] > 0 ? ptr[nf] : 1, "Jacobian pattern"));
     }
@@ -657,6 +716,8 @@ static void solve_free(solve_t *v) {
   fpm_linear_destroy(v->c.lin);
   tangent_free(&v->c.tg);
   free(v->c.dof);
+  free(v->c.ghost);
+  free(v->c.held);
   free(v->c.du);
   free(v->c.df);
   free(v->c.u_old);
@@ -673,8 +734,16 @@ static void solve_free(solve_t *v) {
 static int rigid_modes(const fpm_model *m, const long *dof, long nf,
                        double *rigid) {
   double c[3] = {0, 0, 0};
-  for (long i = 0; i < m->n; i++)
-    for (int a = 0; a < 3; a++) c[a] += m->x[3 * i + a] / (double)m->n;
+  if (m->par) { /* the body's centroid: every rank's own points */
+    double sum[4] = {0, 0, 0, (double)m->n_own};
+    for (long i = 0; i < m->n_own; i++)
+      for (int a = 0; a < 3; a++) sum[a] += m->x[3 * i + a];
+    fpm_par_sum(m, sum, 4);
+    for (int a = 0; a < 3; a++) c[a] = sum[a] / sum[3];
+  } else {
+    for (long i = 0; i < m->n; i++)
+      for (int a = 0; a < 3; a++) c[a] += m->x[3 * i + a] / (double)m->n;
+  }
   /* rotation about axis r: u = e_r x (x - c) */
   const int rots3[3] = {0, 1, 2}, rots2[1] = {2};
   const int nt = m->dim, nr = m->dim == 3 ? 3 : 1;
@@ -696,6 +765,29 @@ static int rigid_modes(const fpm_model *m, const long *dof, long nf,
   return nt + nr;
 }
 
+/* Across ranks: the unknowns of the ghosts, numbered after the own ones,
+ * and their numbers over all ranks (each rank's own unknowns follow the
+ * ranks' before it; a ghost's are its owner's, by the exchange of the
+ * displacements).  A ghost's dof is an unknown where its owner's is. */
+static pm_err number_ghosts(const fpm_model *m, long *free_of, static_ctx *c) {
+  const long n = m->n;
+  double *g = c->du; /* 3 n: the numbers, exact in doubles */
+  const long first = pm_par_offset(c->nf);
+  for (long d = 0; d < 3 * n; d++)
+    g[d] = free_of[d] >= 0 ? (double)(first + free_of[d]) : -1;
+  fpm_par_exchange(m, g);
+  long count = 0;
+  for (long d = 3 * m->n_own; d < 3 * n; d++) count += g[d] >= 0;
+  PM_CALL(PM_ALLOC(c->ghost, count + 1, "ghost unknowns"));
+  for (long d = 3 * m->n_own; d < 3 * n; d++) {
+    if (g[d] < 0) continue;
+    c->ghost[c->nheld - c->nf] = (long)g[d];
+    free_of[d] = c->nheld;
+    c->dof[c->nheld++] = d;
+  }
+  return PM_SUCCESS;
+}
+
 static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
   const long n = m->n;
   static_ctx *c = &v->c;
@@ -710,15 +802,20 @@ static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
   PM_CALL(PM_ALLOC(c->u_old, 3 * n, "converged displacement"));
   for (long d = 0; d < 3 * n; d++) {
     v->free_of[d] = -1;
-    if (!m->fixed[d]) {
+    if (d < 3 * m->n_own && !m->fixed[d]) {
       v->free_of[d] = c->nf;
       c->dof[c->nf++] = d;
     }
   }
-  PM_CHECK(c->nf > 0, PM_ERR_SCENE, "%s: every displacement is prescribed",
+  c->nheld = c->nf;
+  if (m->par) PM_CALL(number_ghosts(m, v->free_of, c));
+  long all = c->nf;
+  if (m->par) pm_par_sum_long(&all, 1);
+  PM_CHECK(all > 0, PM_ERR_SCENE, "%s: every displacement is prescribed",
            m->scene->path);
-  PM_CALL(PM_ALLOC(v->x, c->nf, "free displacements"));
-  PM_CALL(build_pattern(m, v->free_of, c->nf, &c->tg, &v->ptr, &v->idx));
+  PM_CALL(PM_ALLOC(v->x, c->nf + 1, "free displacements"));
+  PM_CALL(PM_ALLOC(c->held, c->nheld + 1, "held displacements"));
+  PM_CALL(build_pattern(m, v->free_of, c->nheld, &c->tg, &v->ptr, &v->idx));
   c->pat_ptr = v->ptr;
   c->free_of = v->free_of;
   PM_CALL(tangent_build(m, &c->tg));
@@ -734,6 +831,9 @@ static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
                                 .pat_idx = v->idx,
                                 .near_null_count = n_rigid,
                                 .near_null = v->rigid,
+                                .shared = m->par != NULL,
+                                .n_ghost = c->nheld - c->nf,
+                                .ghost = c->ghost,
                                 .set_load = set_load,
                                 .on_step = on_step};
   return PM_SUCCESS;
@@ -746,19 +846,36 @@ static double force_floor(const fpm_model *m) {
          hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int k = 0; k < m->n_mats; k++)
     emax = fmax(emax, m->mats[k].youngs_modulus);
-  for (long i = 0; i < m->n; i++)
+  for (long i = 0; i < m->n_own; i++)
     for (int a = 0; a < 3; a++) {
       lo[a] = fmin(lo[a], m->x[3 * i + a]);
       hi[a] = fmax(hi[a], m->x[3 * i + a]);
     }
+  if (m->par) { /* the body's box: every rank's points (the same floor) */
+    fpm_par_min(m, lo, 3);
+    for (int a = 0; a < 3; a++) hi[a] = -hi[a];
+    fpm_par_min(m, hi, 3);
+    for (int a = 0; a < 3; a++) hi[a] = -hi[a];
+  }
   double diag2 = 0;
   for (int a = 0; a < 3; a++) diag2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
   return 1e-12 * emax * diag2;
 }
 
+void fpm_static_nodal(const fpm_model *m, const double *x, double *u) {
+  long j = 0;
+  for (long d = 0; d < 3 * m->n_own; d++) u[d] = m->fixed[d] ? 0 : x[j++];
+}
+
+void fpm_static_unknowns(const fpm_model *m, const double *u, double *x) {
+  long j = 0;
+  for (long d = 0; d < 3 * m->n_own; d++)
+    if (!m->fixed[d]) x[j++] = u[d];
+}
+
 pm_err fpm_static_state_init(fpm_static_state *s, const fpm_model *m) {
   memset(s, 0, sizeof *s);
-  for (long d = 0; d < 3 * m->n; d++) s->free_dofs += !m->fixed[d];
+  for (long d = 0; d < 3 * m->n_own; d++) s->free_dofs += !m->fixed[d];
   return pm_load_state_init(&s->load, s->free_dofs > 0 ? s->free_dofs : 1);
 }
 
@@ -791,8 +908,10 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   c->ext_work = &ss->external_work;
   double w0 = pm_wtime();
   PM_TRY(solve_setup(m, st, &v));
-  rep->unknowns = c->nf;
-  rep->pattern_entries = v.ptr[c->nf];
+  long sizes[2] = {c->nf, v.ptr[c->nheld]};
+  if (m->par) pm_par_sum_long(sizes, 2);
+  rep->unknowns = sizes[0];
+  rep->pattern_entries = sizes[1];
   PM_ENSURE(c->nf == ss->free_dofs, PM_ERR_ARG,
             "static state of %ld free dofs for a model of %ld", ss->free_dofs,
             c->nf);
@@ -809,11 +928,9 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
     c->t = ss->load.lambda * c->load_end;
     memcpy(v.x, ss->load.xc, (size_t)c->nf * sizeof *v.x);
   }
-  long bad = evaluate(c, resumed ? v.x : NULL);
-  if (bad >= 0) {
-    ret = inadmissible(c, bad);
-    goto done;
-  }
+  /* (across ranks the state holds a resumed run's displacements on every
+   * point, its ghosts' too) */
+  PM_TRY(admissible(c, evaluate(c, resumed && !m->par ? v.x : NULL)));
   fpm_support_start(m, st);
   memcpy(c->u_old, st->u, 3 * m->n * sizeof(double));
   /* The figures of the state (a resumed one's too, for a run that fails
@@ -836,6 +953,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
    * preconditions the exact tangent applied matrix-free. */
   if (m->flux == FPM_FLUX_SIPG) no.op = PM_NEWTON_MATRIX_FREE;
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
+  c->solver = solver;
   rep->setup_seconds = pm_wtime() - w0;
   ret = pm_load_steps_from(solver, v.x, &ss->load, &rep->load);
 done:

@@ -39,6 +39,13 @@ typedef struct {
   double external_work;
 } fpm_static_state;
 
+/* The unknowns of model m (its own points' free dofs: all its points' on
+ * one process) as displacements u (3 per own point, 0 at the prescribed
+ * dofs), and back: how load stepping's states cross between a share and
+ * the whole model. */
+void fpm_static_nodal(const fpm_model *m, const double *x, double *u);
+void fpm_static_unknowns(const fpm_model *m, const double *u, double *x);
+
 /* A state for model m (from rest).  PM_ERR_MEMORY. */
 pm_err fpm_static_state_init(fpm_static_state *s, const fpm_model *m);
 void fpm_static_state_free(fpm_static_state *s);

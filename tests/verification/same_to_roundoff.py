@@ -5,7 +5,9 @@ time aside) within TOL of the column's largest magnitude.  Fields and columns
 that are zero to 1e-12 of their scale compare absolutely.  The step size dt
 compares on the scale of the time: the last step is cut to end at
 time.end, dt = t_end - t, so it carries the round-off of t, an absolute
-time error.
+time error.  Reactions compare on the scale of the run's largest reaction:
+one whose exact value is 0 (a roller's along a free direction) carries the
+round-off of the load.
 Usage: same_to_roundoff.py OUT_A OUT_B TOL [COLUMN=BOUND ...]; prints the
 largest relative difference and exits 1 when it exceeds TOL.  A history
 column named with its own BOUND is held to that instead (one whose round-off
@@ -44,6 +46,9 @@ for k in ka:
             worst, where = rel, 'frame %s %s' % (k, f)
 ra = list(csv.reader(open(a + '/history.csv')))
 rb = list(csv.reader(open(b + '/history.csv')))
+reaction = max([abs(float(r[c])) for r in ra[1:]
+                for c, name in enumerate(ra[0])
+                if name.startswith('reaction_') and r[c] != 'nan'] + [0.0])
 assert len(ra) == len(rb) and ra[0] == rb[0], (len(ra), len(rb))
 for c, name in enumerate(ra[0]):
     if name == 'wall_seconds':
@@ -57,6 +62,8 @@ for c, name in enumerate(ra[0]):
     scale = np.max(np.abs(x)) if x.size else 0.0
     if name == 'dt':
         scale = max(scale, max(abs(float(r[0])) for r in ra[1:]))
+    if name.startswith('reaction_'):
+        scale = max(scale, reaction)
     d = np.max(np.abs(x - y)) if x.size else 0.0
     rel = d / scale if scale > 1e-12 else d
     if name in own:
