@@ -41,6 +41,7 @@
 #include "gm_trisurf.h"
 #include "mpm_isonormal.h"
 #include "mpm_kind.h"
+#include "mpm_par.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
 
@@ -55,11 +56,28 @@ typedef struct {
   double c0, c1;  /* eq. 39 */
   double limit;   /* S_L, eq. 40 */
   double failure; /* eps_max at failure */
-  /* point -> triangles, both counted within the group (gm_trisurf's
-   * incidence of the group's surface) */
-  long *inc_start, *inc_tri;
-  /* the group's bodies: points [begin, end) counted within the group,
-   * their links (MPM_LINKS_*) and normal method (pm_normals_method) */
+  /* The links the normal stage reads among the group's points (counted
+   * from the group's start): triangles of 3 corners, each point's
+   * triangles (gm_trisurf's incidence, in triangle order) and, along a
+   * curve, each point's neighbours (2 per point: before and after it, as
+   * gm_curve_neighbours gives them).  Across ranks a corner or neighbour
+   * np + j (np the rank's points of the group) is the j-th ghost: a point
+   * of another rank, at mpm_par_ghost_x.  The rooms are the arrays'
+   * (across ranks they grow: tri 3 per triangle, inc_start and link 1 and
+   * 2 per point). */
+  long n_tris, *tri, *inc_start, *inc_tri, *link;
+  long tri_room, inc_room, point_room;
+  /* Across ranks: the whole group's links on one process (its points
+   * counted from `first`, the group's start there), from which a rank's
+   * are made whenever points move between ranks; each of the rank's
+   * triangles' index among the whole's (increasing). */
+  struct {
+    long first, n_points, n_tris, *tri, *inc_start, *inc_tri;
+  } whole;
+  long *tri_whole;
+  /* the group's bodies: points [begin, end) counted within the group on
+   * one process (the whole group's, across ranks), their links
+   * (MPM_LINKS_*) and normal method (pm_normals_method) */
   int n_bodies;
   struct membrane_body {
     int body;
@@ -98,8 +116,14 @@ static pm_err membrane_setup(mpm_group *g, const pm_scene_material *sm,
 static void membrane_release(mpm_group *g) {
   membrane_params *mp = g->params;
   if (!mp) return;
+  free(mp->tri);
   free(mp->inc_start);
   free(mp->inc_tri);
+  free(mp->link);
+  free(mp->whole.tri);
+  free(mp->whole.inc_start);
+  free(mp->whole.inc_tri);
+  free(mp->tri_whole);
   free(mp->bodies);
 }
 
@@ -186,21 +210,30 @@ double mpm_membrane_max_strain(const double e[3]) { return eps_max(e); }
 
 /* ---- normals and frames ------------------------------------------------- */
 
-/* Unit normals of triangles [t0, t1) from positions x into tn (3 each,
- * indexed t - t0); zero for a degenerate triangle. */
-static void triangle_normals(const mpm_model *m, const double *x, long t0,
-                             long t1, double *tn) {
-  const long *tri = m->tri;
+/* The position of link point c: the group's point c (positions xo, np of
+ * them) or ghost c - np (positions xg). */
+static inline const double *link_x(const double *xo, const double *xg, long np,
+                                   long c) {
+  return c < np ? xo + 3 * c : xg + 3 * (c - np);
+}
+
+/* Unit normals of the links' triangles into tn (3 each) from the
+ * positions of the group's np points xo and of the ghosts xg; zero for a
+ * degenerate triangle. */
+static void triangle_normals(const membrane_params *mp, const double *xo,
+                             const double *xg, long np, double *tn) {
+  const long *tri = mp->tri, nt = mp->n_tris;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(tri, x, t0, t1, tn))
-  for (long t = t0; t < t1; t++) {
-    const double *a = x + 3 * tri[3 * t], *b = x + 3 * tri[3 * t + 1],
-                 *c = x + 3 * tri[3 * t + 2];
+         shared(tri, nt, xo, xg, np, tn))
+  for (long t = 0; t < nt; t++) {
+    const double *a = link_x(xo, xg, np, tri[3 * t]),
+                 *b = link_x(xo, xg, np, tri[3 * t + 1]),
+                 *c = link_x(xo, xg, np, tri[3 * t + 2]);
     double u[3], v[3], n[3];
     for (int i = 0; i < 3; i++) u[i] = b[i] - a[i], v[i] = c[i] - a[i];
     pm_v_cross(u, v, n);
     double len = pm_v_norm(n);
-    for (int i = 0; i < 3; i++) tn[3 * (t - t0) + i] = len > 0 ? n[i] / len : 0;
+    for (int i = 0; i < 3; i++) tn[3 * t + i] = len > 0 ? n[i] / len : 0;
   }
 }
 
@@ -593,25 +626,27 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
 
 /* Each point's new unit normal into nn (3 per point of the group, holding
  * the previous normals n0 on entry; a point without one keeps n0), by its
- * body's method.  tn: 3 per triangle of the group. */
+ * body's method.  tn: 3 per triangle of the links.  The bodies' points are
+ * the model's (across ranks, the rank's), their neighbours on other ranks
+ * the ghosts. */
 static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
                             const double *x, long step, iso_work *iw,
                             double *tn, double *nn, iso_stats *st) {
   const membrane_params *mp = gr->params;
-  const long t0 = m->tri_begin[gr->index], t1 = m->tri_end[gr->index];
-  if (t1 > t0) triangle_normals(m, x, t0, t1, tn);
+  const long np = gr->end - gr->begin;
+  const double *xo = x + 3 * gr->begin, *xg = mpm_par_ghost_x(m, gr->index);
+  if (mp->n_tris > 0) triangle_normals(mp, xo, xg, np, tn);
   for (int bi = 0; bi < mp->n_bodies; bi++) {
     const struct membrane_body *b = &mp->bodies[bi];
-    const long n = b->end - b->begin;
-    const double *xb = x + 3 * (gr->begin + b->begin);
-    double *nb = nn + 3 * b->begin;
+    const long b0 = m->body_begin[b->body] - gr->begin,
+               b1 = m->body_end[b->body] - gr->begin;
     if (b->method != PM_NORMALS_CONNECTIVITY) {
-      PM_CALL(
-          iso_normals(&m->grid, iw, b->body, b->method, n, xb, step, nb, st));
+      PM_CALL(iso_normals(&m->grid, iw, b->body, b->method, b1 - b0,
+                          xo + 3 * b0, step, nn + 3 * b0, st));
       continue;
     }
     if (b->links == MPM_LINKS_TRIANGLES) {
-      for (long k = b->begin; k < b->end; k++) {
+      for (long k = b0; k < b1; k++) {
         double n1[3];
         if (point_normal(mp, k, tn, n1)) memcpy(nn + 3 * k, n1, sizeof n1);
       }
@@ -619,7 +654,10 @@ static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
     }
     /* A curve: perpendicular to the chord of the neighbours (a point whose
      * chord vanishes gets 0, and the stress stage keeps its normal). */
-    gm_curve_normals(n, xb, b->links == MPM_LINKS_LOOP, nb);
+    const long *link = mp->link;
+    for (long k = b0; k < b1; k++)
+      gm_curve_normal(link_x(xo, xg, np, link[2 * k]),
+                      link_x(xo, xg, np, link[2 * k + 1]), nn + 3 * k);
   }
   return PM_SUCCESS;
 }
@@ -693,16 +731,29 @@ static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
     if (mb->method != PM_NORMALS_CONNECTIVITY) mp->iso = true;
     if (mb->end - mb->begin > mp->max_body) mp->max_body = mb->end - mb->begin;
   }
-  /* Incidence: each point's triangles, of the group's surface. */
-  long *local = NULL;
-  PM_TRY(mpm_triangles_local(m, t0, t1, g->begin, &local));
+  /* The links: the group's triangles, each point's (the surface's
+   * incidence), and along curves each point's neighbours. */
+  PM_TRY(mpm_triangles_local(m, t0, t1, g->begin, &mp->tri));
+  mp->n_tris = mp->tri_room = t1 - t0;
+  mp->point_room = np;
   gm_trisurf sf = {.n_points = np,
                    .x = s->x + 3 * g->begin,
                    .n_tris = t1 - t0,
-                   .tri = local};
-  ret = gm_trisurf_incidence(&sf, &mp->inc_start, &mp->inc_tri);
-  free(local);
-  if (ret) goto done;
+                   .tri = mp->tri};
+  PM_TRY(gm_trisurf_incidence(&sf, &mp->inc_start, &mp->inc_tri));
+  mp->inc_room = mp->inc_start[np];
+  PM_TRY(PM_ALLOC(mp->link, 2 * np + 1, "membrane curves"));
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    if (b->links != MPM_LINKS_CHAIN && b->links != MPM_LINKS_LOOP) continue;
+    for (long k = b->begin; k < b->end; k++) {
+      long prev, next;
+      gm_curve_neighbours(k - b->begin, b->end - b->begin,
+                          b->links == MPM_LINKS_LOOP, &prev, &next);
+      mp->link[2 * k] = b->begin + prev;
+      mp->link[2 * k + 1] = b->begin + next;
+    }
+  }
   PM_TRY(PM_ALLOC(tn, 3 * (t1 - t0) + 3, "triangle normals"));
   PM_TRY(PM_ALLOC(nn, 3 * np, "membrane normals"));
   PM_TRY(iso_work_create(m, g, &iw, &iw_bytes));
@@ -710,18 +761,18 @@ static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
    * normals where the body has connectivity, else away from its centre;
    * they are also the fit's previous normals. */
   PM_TRY(PM_ALLOC(ref, 3 * np, "membrane normals"));
-  const double *xg = s->x + 3 * g->begin;
-  if (t1 > t0) triangle_normals(m, s->x, t0, t1, tn);
+  const double *xo = s->x + 3 * g->begin;
+  if (t1 > t0) triangle_normals(mp, xo, NULL, np, tn);
   for (int bi = 0; bi < mp->n_bodies; bi++) {
     const struct membrane_body *b = &mp->bodies[bi];
     if (b->links == MPM_LINKS_CHAIN || b->links == MPM_LINKS_LOOP)
-      gm_curve_normals(b->end - b->begin, xg + 3 * b->begin,
+      gm_curve_normals(b->end - b->begin, xo + 3 * b->begin,
                        b->links == MPM_LINKS_LOOP, ref + 3 * b->begin);
     double c[3];
-    body_centre(xg, b, c);
+    body_centre(xo, b, c);
     for (long k = b->begin; k < b->end; k++) {
       if (b->links == MPM_LINKS_TRIANGLES) point_normal(mp, k, tn, ref + 3 * k);
-      if (!(pm_v_norm(ref + 3 * k) > 0.5)) away_from(xg, c, k, ref + 3 * k);
+      if (!(pm_v_norm(ref + 3 * k) > 0.5)) away_from(xo, c, k, ref + 3 * k);
     }
   }
   memcpy(nn, ref, sizeof(double) * 3 * (size_t)np);
@@ -756,10 +807,163 @@ done:
   return ret;
 }
 
-/* Doubles of step workspace: each point's new normal, each triangle's. */
+/* Doubles of step workspace: each point's new normal, each triangle's
+ * (across ranks, room for as many as the arrays have). */
 static long membrane_scratch(const mpm_model *m, const mpm_group *g) {
-  return 3 * (g->end - g->begin) +
-         3 * (m->tri_end[g->index] - m->tri_begin[g->index]);
+  (void)m;
+  const membrane_params *mp = g->params;
+  const long np = g->end - g->begin;
+  return 3 * (g->cap > np ? g->cap : np) + 3 * mp->tri_room;
+}
+
+/* ---- across ranks ---------------------------------------------------------
+ * A rank's points of the group read their neighbours' positions: the
+ * points of its triangles, and along a curve the points before and after
+ * them.  Those on other ranks are ghosts (mpm_par.h sends their positions
+ * after every step's migration); the links are made anew from the whole
+ * group's whenever points move between ranks. */
+
+/* Room for n longs in *a (room *room), kept when it suffices. */
+static pm_err room_for_longs(long **a, long *room, long n, const char *what) {
+  if (n <= *room && *a) return PM_SUCCESS;
+  const long r = n + n / 4 + 16;
+  PM_CALL(PM_REALLOC(*a, r, what));
+  *room = r;
+  return PM_SUCCESS;
+}
+
+static int long_cmp(const void *a, const void *b) {
+  const long x = *(const long *)a, y = *(const long *)b;
+  return (x > y) - (x < y);
+}
+
+/* Sort n longs and drop repeats; returns how many are left. */
+static long sort_unique(long *a, long n) {
+  if (n == 0) return 0;
+  qsort(a, (size_t)n, sizeof *a, long_cmp);
+  long k = 1;
+  for (long i = 1; i < n; i++)
+    if (a[i] != a[k - 1]) a[k++] = a[i];
+  return k;
+}
+
+/* The place of v in the sorted a[0, n), or -1. */
+static long find_long(const long *a, long n, long v) {
+  const long *f = bsearch(&v, a, (size_t)n, sizeof *a, long_cmp);
+  return f ? f - a : -1;
+}
+
+static pm_err membrane_ranks_share(const mpm_group *whole, mpm_group *g) {
+  const membrane_params *wp = whole->params;
+  membrane_params *mp = g->params;
+  const long np = whole->end - whole->begin;
+  PM_CALL(PM_ALLOC(mp->bodies, wp->n_bodies + 1, "membrane bodies"));
+  memcpy(mp->bodies, wp->bodies, sizeof *wp->bodies * (size_t)wp->n_bodies);
+  mp->n_bodies = wp->n_bodies;
+  mp->iso = wp->iso;
+  mp->max_body = wp->max_body;
+  mp->whole.first = whole->begin;
+  mp->whole.n_points = np;
+  mp->whole.n_tris = wp->n_tris;
+  PM_CALL(PM_ALLOC(mp->whole.tri, 3 * wp->n_tris + 1, "membrane triangles"));
+  PM_CALL(PM_ALLOC(mp->whole.inc_start, np + 1, "membrane incidence"));
+  PM_CALL(
+      PM_ALLOC(mp->whole.inc_tri, wp->inc_start[np] + 1, "membrane incidence"));
+  memcpy(mp->whole.tri, wp->tri, sizeof(long) * 3 * (size_t)wp->n_tris);
+  memcpy(mp->whole.inc_start, wp->inc_start, sizeof(long) * (size_t)(np + 1));
+  memcpy(mp->whole.inc_tri, wp->inc_tri,
+         sizeof(long) * (size_t)wp->inc_start[np]);
+  return PM_SUCCESS;
+}
+
+/* The link point of the whole group's point q: the rank's point (from the
+ * group's start; its points' one-process indices own[0, np), increasing)
+ * or np + its place among the ghosts want[0, nw). */
+static long link_of(const long *own, long np, const long *want, long nw,
+                    long q) {
+  long k = find_long(own, np, q);
+  return k >= 0 ? k : np + find_long(want, nw, q);
+}
+
+static pm_err membrane_ranks_link(const mpm_model *m, mpm_group *g, long **want,
+                                  long *room, long *n_want) {
+  membrane_params *mp = g->params;
+  const long np = g->end - g->begin, first = mp->whole.first;
+  const long *own = m->gid + g->begin, *ws = mp->whole.inc_start,
+             *wi = mp->whole.inc_tri, *wt = mp->whole.tri;
+  /* The triangles of the rank's points, by their index in the whole. */
+  long nt = 0;
+  for (long k = 0; k < np; k++)
+    nt += ws[own[k] - first + 1] - ws[own[k] - first];
+  const long ni = nt; /* the incidence's entries */
+  const long tri_room = mp->tri_room;
+  PM_CALL(
+      room_for_longs(&mp->tri_whole, &mp->tri_room, nt, "membrane triangles"));
+  if (mp->tri_room != tri_room || !mp->tri)
+    PM_CALL(PM_REALLOC(mp->tri, 3 * mp->tri_room, "membrane triangles"));
+  if (np > mp->point_room || !mp->link) {
+    const long r = np + np / 4 + 16;
+    PM_CALL(PM_REALLOC(mp->link, 2 * r, "membrane curves"));
+    PM_CALL(PM_REALLOC(mp->inc_start, r + 1, "membrane incidence"));
+    mp->point_room = r;
+  }
+  PM_CALL(
+      room_for_longs(&mp->inc_tri, &mp->inc_room, ni, "membrane incidence"));
+  nt = 0;
+  for (long k = 0; k < np; k++)
+    for (long j = ws[own[k] - first]; j < ws[own[k] - first + 1]; j++)
+      mp->tri_whole[nt++] = wi[j];
+  nt = sort_unique(mp->tri_whole, nt);
+  /* The ghosts: their corners and the curves' neighbours that are not the
+   * rank's, by one-process index. */
+  PM_CALL(room_for_longs(want, room, 3 * nt + 2 * np, "membrane ghosts"));
+  long nw = 0;
+  for (long t = 0; t < nt; t++)
+    for (int c = 0; c < 3; c++) {
+      const long q = first + wt[3 * mp->tri_whole[t] + c];
+      if (find_long(own, np, q) < 0) (*want)[nw++] = q;
+    }
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    if (b->links != MPM_LINKS_CHAIN && b->links != MPM_LINKS_LOOP) continue;
+    const long b0 = m->body_begin[b->body] - g->begin,
+               b1 = m->body_end[b->body] - g->begin;
+    for (long k = b0; k < b1; k++) {
+      long prev, next;
+      gm_curve_neighbours(own[k] - first - b->begin, b->end - b->begin,
+                          b->links == MPM_LINKS_LOOP, &prev, &next);
+      mp->link[2 * k] = first + b->begin + prev; /* one-process, for now */
+      mp->link[2 * k + 1] = first + b->begin + next;
+      for (int e = 0; e < 2; e++)
+        if (find_long(own, np, mp->link[2 * k + e]) < 0)
+          (*want)[nw++] = mp->link[2 * k + e];
+    }
+  }
+  nw = sort_unique(*want, nw);
+  *n_want = nw;
+  /* The triangles' corners, the incidence and the curves' neighbours as
+   * link points. */
+  for (long t = 0; t < nt; t++)
+    for (int c = 0; c < 3; c++)
+      mp->tri[3 * t + c] =
+          link_of(own, np, *want, nw, first + wt[3 * mp->tri_whole[t] + c]);
+  mp->n_tris = nt;
+  long at = 0;
+  for (long k = 0; k < np; k++) {
+    mp->inc_start[k] = at;
+    for (long j = ws[own[k] - first]; j < ws[own[k] - first + 1]; j++)
+      mp->inc_tri[at++] = find_long(mp->tri_whole, nt, wi[j]);
+  }
+  mp->inc_start[np] = at;
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    if (b->links != MPM_LINKS_CHAIN && b->links != MPM_LINKS_LOOP) continue;
+    for (long k = m->body_begin[b->body] - g->begin;
+         k < m->body_end[b->body] - g->begin; k++)
+      for (int e = 0; e < 2; e++)
+        mp->link[2 * k + e] = link_of(own, np, *want, nw, mp->link[2 * k + e]);
+  }
+  return PM_SUCCESS;
 }
 
 /* The normal stage: each point's new normal into the group's workspace. */
@@ -945,6 +1149,8 @@ const mpm_kind mpm_kind_membrane = {
     .seed = membrane_seed,
     .finish = membrane_finish,
     .scratch = membrane_scratch,
+    .ranks_share = membrane_ranks_share,
+    .ranks_link = membrane_ranks_link,
     .work_create = iso_work_create,
     .work_free = iso_work_free,
     .pre_stress = membrane_normals,

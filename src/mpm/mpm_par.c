@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "mpm_kind.h"
+#include "mpm_par_ghosts.h"
 #include "mpm_transfer.h"
 #include "pm_omp.h"
 #include "pm_par.h"
@@ -64,6 +65,12 @@ struct mpm_par {
   long *order;               /* per new particle: old index, or -(k + 1) for
                                 the k-th record received */
   double *tmp;               /* room x width: one array's new order */
+  /* the ghosts of linked points (membranes' neighbours on other ranks),
+   * and what the last migration did to them: linked points that left
+   * this rank, and whether its particles changed */
+  mpm_ghosts *gh;
+  long linked_left;
+  bool reordered;
   /* gather (rank 0 holds the whole run's buffers) */
   double *accounts; /* every rank's energy accounts, on rank 0 */
   long *ggid;
@@ -336,17 +343,21 @@ done:
 pm_err mpm_par_check(const pm_scene *s) {
   char key[64];
   for (int b = 0; b < s->n_bodies; b++) {
-    if (s->bodies[b].shape == PM_BODY_MEMBRANE)
-      return pm_scene_fail(s, PM_PATH(key, "bodies.%d.membrane", b), true,
-                           "membranes run on one process (this run has %d "
-                           "ranks): run without mpirun, or with -np 1",
-                           pm_par_size());
-    if (s->bodies[b].moving)
-      return pm_scene_fail(s, PM_PATH(key, "bodies.%d.motion", b), true,
-                           "bodies moving as prescribed run on one process "
-                           "(this run has %d ranks): run without mpirun, or "
-                           "with -np 1",
-                           pm_par_size());
+    const pm_scene_body *body = &s->bodies[b];
+    if (body->shape != PM_BODY_MEMBRANE ||
+        body->membrane.normals == PM_NORMALS_CONNECTIVITY)
+      continue;
+    /* A fit reads the points of the cells around its cell, up to a block
+     * of 8 cells a side: ghosts that far are not kept. */
+    PM_PATH(key, "bodies.%d.membrane.normals", b);
+    if (!pm_scene_has(s, key)) PM_PATH(key, "bodies.%d.membrane", b);
+    return pm_scene_fail(
+        s, key, true,
+        "membrane normals by isosurface least squares (normals: %s) run on "
+        "one process (this run has %d ranks): a fit reads the points of the "
+        "cells around its own; take normals: connectivity, or run with -np 1",
+        pm_key_name_of(pm_normals_names, body->membrane.normals),
+        pm_par_size());
   }
   if (mpm_scene_settings(s)->fbar == MPM_FBAR_PATCH)
     return pm_scene_fail(s, "mpm.fbar", false,
@@ -416,6 +427,10 @@ static void set_ranges(mpm_model *m, mpm_state *s) {
   for (int b = 0; b < m->n_bodies; b++) {
     m->body_begin[b] = first_at_least(m->gid, m->n, P->bbegin[b]);
     m->body_end[b] = first_at_least(m->gid, m->n, P->bend[b]);
+  }
+  for (int k = 0; k < m->n_moving; k++) {
+    m->moving[k].begin = m->body_begin[m->moving[k].body];
+    m->moving[k].end = m->body_end[m->moving[k].body];
   }
   for (int gi = 0; gi < m->n_groups; gi++) {
     mpm_group *g = &m->group[gi];
@@ -569,6 +584,7 @@ static pm_err local_model(const pm_scene *s, const mpm_model *m,
     g->end = at;
     g->cap = room_for(g->end - g->begin);
     PM_TRY(g->kind->setup(g, &s->materials[g->material], &lm->opt));
+    if (g->kind->ranks_share) PM_TRY(g->kind->ranks_share(fg, g));
   }
   lm->n_bodies = m->n_bodies;
   P->n_full = m->n;
@@ -588,6 +604,12 @@ static pm_err local_model(const pm_scene *s, const mpm_model *m,
   }
   PM_TRY(mpm_conditions_create(s, &lm->grid, &lm->bcs, &lm->n_bcs));
   lm->has_absorbing = m->has_absorbing;
+  /* Bodies moving as prescribed: their ranges are set with the bodies'. */
+  if (m->n_moving > 0) {
+    PM_TRY(PM_ALLOC(lm->moving, m->n_moving, "moving bodies"));
+    memcpy(lm->moving, m->moving, sizeof *m->moving * (size_t)m->n_moving);
+    lm->n_moving = m->n_moving;
+  }
   mpm_pipeline_build(lm);
   lm->par = P;
   set_ranges(lm, NULL);
@@ -694,6 +716,7 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   PM_TRY(pm_par_agree(ret));
   struct mpm_par *Q = lm->par;
   PM_TRY(make_near(Q, m));
+  PM_TRY(mpm_ghosts_create(lm, ls, Q->near, Q->n_near, &Q->gh));
   Q->rec = record_doubles(lm, &Q->width);
   const long room = mpm_model_room(lm);
   PM_TRY(PM_ALLOC(Q->dest, room, "migration ranks"));
@@ -738,6 +761,7 @@ void mpm_par_destroy(struct mpm_par *P) {
   }
   free(P->nodal);
   free(P->whole);
+  mpm_ghosts_destroy(P->gh);
   if (P->near_of) MPI_Comm_free(&P->near);
   free(P->near_of);
   mpm_decomp_destroy(&P->d);
@@ -811,6 +835,21 @@ pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
   /* Each ghost node's values go to its owner and come back. */
   const double bytes =
       2.0 * (double)(m->grid.n_nodes - P->n_owned) * values * sizeof(double);
+  P->counts.halo_bytes += bytes;
+  pm_par_count_sent(bytes);
+  P->counts.halo_seconds += pm_wtime() - t0;
+  return PM_SUCCESS;
+}
+
+pm_err mpm_par_sum_node_values(const mpm_model *m, double *v) {
+  struct mpm_par *P = m->par;
+  const double t0 = pm_wtime();
+  PM_PETSC_CALL(PetscSFReduceBegin(P->ghosts, MPI_DOUBLE, v, v, MPI_SUM));
+  PM_PETSC_CALL(PetscSFReduceEnd(P->ghosts, MPI_DOUBLE, v, v, MPI_SUM));
+  PM_PETSC_CALL(PetscSFBcastBegin(P->ghosts, MPI_DOUBLE, v, v, MPI_REPLACE));
+  PM_PETSC_CALL(PetscSFBcastEnd(P->ghosts, MPI_DOUBLE, v, v, MPI_REPLACE));
+  const double bytes =
+      2.0 * (double)(m->grid.n_nodes - P->n_owned) * sizeof(double);
   P->counts.halo_bytes += bytes;
   pm_par_count_sent(bytes);
   P->counts.halo_seconds += pm_wtime() - t0;
@@ -900,11 +939,15 @@ static void permute(const struct mpm_par *P, double *data, long n_new, int nc,
   memcpy(data, tmp, sizeof(double) * (size_t)(n_new * nc));
 }
 
-pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
+/* The particles' move between ranks (collective; every rank returns the
+ * same). */
+static pm_err move_particles(mpm_model *m, mpm_state *s, mpm_work *w) {
   struct mpm_par *P = m->par;
   const int n_near = P->n_near, rec = P->rec;
   const double t0 = pm_wtime();
   pm_err ret = PM_SUCCESS;
+  P->linked_left = 0;
+  P->reordered = false;
   pm_timers_start(&w->timers, w->timer_migrate);
   /* Where each particle goes. */
   memset(P->scount, 0, sizeof(int) * (size_t)(n_near + 1));
@@ -942,9 +985,11 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   for (int k = 0; k < n_near; k++) P->scount[k] = 0;
   for (int gi = 0; leaving > 0 && gi < m->n_groups; gi++) {
     const mpm_group *g = &m->group[gi];
+    const bool linked = g->kind->ranks_link != NULL;
     for (long p = g->begin; p < g->end; p++) {
       const int r = P->dest[p];
       if (r < 0) continue;
+      P->linked_left += linked;
       double *q = P->sbuf + (long)(P->sdisp[r] + P->scount[r]++) * rec;
       q[REC_GID] = (double)m->gid[p];
       q[REC_GROUP] = gi;
@@ -978,6 +1023,7 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   P->counts.migrate_bytes += (double)leaving * rec * sizeof(double);
   pm_par_count_sent((double)leaving * rec * sizeof(double));
   if (leaving == 0 && arriving == 0) goto done;
+  P->reordered = true;
   /* The new order: those that stay and those that came, by index. */
   qsort(P->rbuf, (size_t)arriving, (size_t)rec * sizeof(double), by_gid);
   const long n_new = m->n - leaving + arriving;
@@ -1057,6 +1103,48 @@ done:
   pm_timers_stop(&w->timers, w->timer_migrate);
   P->counts.migrate_seconds += pm_wtime() - t0;
   return pm_par_agree(ret);
+}
+
+/* Room in each group's step workspace for what its kind needs now (its
+ * particles, a membrane's triangles). */
+static pm_err grow_scratch(const mpm_model *m, mpm_work *w) {
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    const long need = g->kind->scratch ? g->kind->scratch(m, g) : 0;
+    if (need <= w->n_scratch[gi]) continue;
+    PM_CALL(PM_REALLOC(w->scratch[gi], need, "kind workspace"));
+    w->n_scratch[gi] = need;
+  }
+  return PM_SUCCESS;
+}
+
+pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
+  struct mpm_par *P = m->par;
+  PM_CALL(move_particles(m, s, w));
+  if (!P->gh) return PM_SUCCESS;
+  /* The ghosts: their links anew when a linked point moved between any
+   * two ranks, and their positions after this step's move. */
+  const double t0 = pm_wtime();
+  pm_timers_start(&w->timers, w->timer_migrate);
+  long moved = P->linked_left;
+  pm_par_sum_long(&moved, 1);
+  const double sent = mpm_ghosts_bytes(P->gh);
+  pm_err e = mpm_ghosts_update(P->gh, m, s, moved > 0, P->reordered);
+  if (!e) e = pm_par_agree(grow_scratch(m, w));
+  P->counts.ghost_bytes += mpm_ghosts_bytes(P->gh) - sent;
+  pm_par_count_sent(mpm_ghosts_bytes(P->gh) - sent);
+  pm_timers_stop(&w->timers, w->timer_migrate);
+  P->counts.migrate_seconds += pm_wtime() - t0;
+  return e;
+}
+
+const double *mpm_par_ghost_x(const mpm_model *m, int gi) {
+  return m->par ? mpm_ghosts_x(m->par->gh, gi) : NULL;
+}
+
+const long *mpm_par_ghost_ids(const mpm_model *m, int gi, long *n) {
+  *n = m->par ? mpm_ghosts_count(m->par->gh, gi) : 0;
+  return m->par ? mpm_ghosts_ids(m->par->gh, gi) : NULL;
 }
 
 /* ---- gather to rank 0 -------------------------------------------------------

@@ -117,14 +117,29 @@ void mpm_par_work_attach(const mpm_model *m, mpm_work *w);
 pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
                          bool impedances);
 
+/* Sum one value per node (v, on this rank's nodes) over the ranks, as
+ * mpm_par_sum_nodes does a transfer's (collective). */
+pm_err mpm_par_sum_node_values(const mpm_model *m, double *v);
+
 /* The figures of a step every rank must share, once it ends: the largest
  * |tr D|, the smallest J, the iterations (collective). */
 void mpm_par_step_end(const mpm_model *m, mpm_work *w);
 
 /* Send the particles that left this rank's cells to their cells' ranks and
- * take in those that arrived (collective).  The arrays grow when a rank
- * holds more than they have room for.  PM_ERR_MEMORY. */
+ * take in those that arrived, then bring the ghosts of linked points (a
+ * membrane's neighbours on other ranks: mpm_par_ghosts.h) up to date
+ * (collective).  The arrays grow when a rank holds more than they have
+ * room for.  PM_ERR_MEMORY; PM_ERR_UNSTABLE when a particle moved farther
+ * than the next boxes, or a linked point's neighbour is on a rank farther
+ * than those. */
 pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w);
+
+/* The positions of group gi's ghosts (3 each; NULL on one process and for
+ * a group without them): the points of other ranks that this rank's points
+ * of the group are linked to, in the order the kind's ranks_link gave. */
+const double *mpm_par_ghost_x(const mpm_model *m, int gi);
+/* Their one-process indices (increasing), n of them (NULL and 0 without). */
+const long *mpm_par_ghost_ids(const mpm_model *m, int gi, long *n);
 
 /* Gather the state of every rank into the whole model's state full_state
  * on rank 0 (NULL on the others), in the order of one process: particles,
@@ -151,7 +166,8 @@ void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out);
  * seconds they took, over the run so far (summary.json). */
 typedef struct {
   double halo_bytes, halo_seconds;       /* node sums */
-  double migrate_bytes, migrate_seconds; /* particles */
+  double migrate_bytes, migrate_seconds; /* particles (and ghosts' seconds) */
+  double ghost_bytes;                    /* linked points' ghosts */
   long migrated;                         /* particles sent */
   long grown;                            /* times the arrays grew */
 } mpm_par_counts;
