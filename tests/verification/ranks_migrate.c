@@ -14,7 +14,8 @@
  *    every triangle it has a corner of, the neighbours along a curve),
  *    each held by one other rank, at that rank's position bit for bit:
  *    every triangle's three points found.  It prints how many triangles
- *    span two ranks or more and how many membrane points moved.
+ *    (or a curve's segments) span two ranks or more and how many membrane
+ *    points moved.
  * Usage: ranks_migrate SCENE STEPS [KEY=VALUE...]; prints a line per check
  * and exits 0 when all hold. */
 #include <mpi.h>
@@ -253,6 +254,14 @@ int main(int argc, char **argv) {
           const long *c = ref->tri + 3 * t;
           span += owner[c[0]] != owner[c[1]] || owner[c[0]] != owner[c[2]];
         }
+        for (int b = 0; b < ref->n_bodies; b++) {
+          const long b0 = ref->body_begin[b], nb = ref->body_end[b] - b0;
+          const int links = ref->body_links[b];
+          for (long k = 0; k + 1 < nb && (links == MPM_LINKS_CHAIN ||
+                                          links == MPM_LINKS_LOOP);
+               k++)
+            span += owner[b0 + k] != owner[b0 + k + 1];
+        }
         spanning = span > spanning ? span : spanning;
         for (int gi = 0; owner_prev && gi < ref->n_groups; gi++)
           if (ref->group[gi].kind->ranks_link)
@@ -263,9 +272,11 @@ int main(int argc, char **argv) {
     free(before);
     free(after);
   }
+  pm_par_sum_long(&moved, 1); /* each rank counted those it sent */
   if (pm_par_root() && linked)
-    printf("%s: membrane points moved between ranks %ld, triangles spanning "
-           "two ranks or more %ld (most at one step)\n",
+    printf("%s: membrane points moved between ranks %ld, links spanning two "
+           "ranks or more (triangles, a curve's segments) %ld (most at one "
+           "step)\n",
            sc->name, linked_moved, spanning);
   if (pm_par_root())
     printf("%s: %ld steps on %d ranks, %ld particles migrated, %d failed "
