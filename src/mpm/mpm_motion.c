@@ -12,15 +12,18 @@ void mpm_motion_velocity(const mpm_motion *mv, double t, double v[3]) {
     v[c] = mv->v[c] ? pm_expr_eval(mv->v[c], 0, 0, 0, t) : 0.0;
 }
 
-/* The body's velocity, or a failure at its first particle. */
+/* The body's velocity, or a failure at its first particle (recorded by
+ * the rank that holds it: every rank stops, with one process's message). */
 static bool velocity_at(const mpm_ctx *ctx, const mpm_motion *mv, double t,
                         double v[3]) {
   mpm_motion_velocity(mv, t, v);
   if (isfinite(v[0] + v[1] + v[2])) return true;
-  mpm_fail(ctx->work, mv->begin,
-           "the prescribed velocity of its body (motion.velocity) is not "
-           "finite at t = %g s (|v|^2 = %g)",
-           t, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  const long *gid = ctx->model->gid;
+  if (mv->end > mv->begin && (!gid || gid[mv->begin] == mv->first))
+    mpm_fail(ctx->work, mv->begin,
+             "the prescribed velocity of its body (motion.velocity) is not "
+             "finite at t = %g s (|v|^2 = %g)",
+             t, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   return false;
 }
 

@@ -1,5 +1,6 @@
 /* mpm_par: the decomposition, each rank's share of the model, the node sums
- * on a PETSc DMDA, particle migration and the gather to rank 0. */
+ * on a PETSc star forest, particle migration (and the ghosts of linked
+ * points after it) and the gather to rank 0. */
 #include "mpm_par.h"
 
 #include <math.h>
@@ -8,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpm_grid_stages.h"
 #include "mpm_kind.h"
 #include "mpm_par_ghosts.h"
 #include "mpm_transfer.h"
@@ -1299,6 +1301,11 @@ static int node_values_per_step(const mpm_model *m) {
     if (stg->run == mpm_stage_p2g)
       v += dof_of(stg->mode, m->has_absorbing && (stg->mode & MPM_P2G_FORCE));
     if (stg->run == mpm_stage_remap) v += dof_of(MPM_P2G_MOM, false);
+    /* each moving body's mass at the nodes, in the update (and before
+     * the stress with USF) */
+    if (stg->run == mpm_stage_grid_update ||
+        stg->run == mpm_stage_grid_velocity)
+      v += m->n_moving;
   }
   return v;
 }
@@ -1355,22 +1362,31 @@ void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out) {
 void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
   const struct mpm_par *P = m->par;
   const int size = P->d.size;
-  /* Per rank: particles, nodes held, nodes owned, bytes. */
-  double mine[4] = {(double)m->n, (double)m->grid.n_nodes, (double)P->n_owned,
-                    (double)(mpm_model_bytes(m) + mpm_work_bytes(m, w))};
+  /* Per rank: particles, nodes held, nodes owned, bytes, ghost points. */
+  double ghosts = 0;
+  for (int gi = 0; gi < m->n_groups; gi++)
+    ghosts += (double)mpm_ghosts_count(P->gh, gi);
+  double mine[5] = {(double)m->n, (double)m->grid.n_nodes, (double)P->n_owned,
+                    (double)(mpm_model_bytes(m) + mpm_work_bytes(m, w)),
+                    ghosts};
   double *all = NULL;
-  if (P->rank == 0) all = calloc((size_t)size * 4, sizeof(double));
-  MPI_Gather(mine, 4, MPI_DOUBLE, all, 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (P->rank == 0) all = calloc((size_t)size * 5, sizeof(double));
+  MPI_Gather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (P->rank != 0 || !out || !all) {
     free(all);
     return;
   }
   mpm_decomp_print(&P->d, m, out);
-  fprintf(out, "             rank  particles  nodes (owned + ghost)  memory\n");
+  const bool linked = P->gh != NULL;
+  fprintf(out,
+          "             rank  particles  nodes (owned + ghost)  memory%s\n",
+          linked ? "  ghost points (of membranes)" : "");
   for (int r = 0; r < size; r++) {
-    const double *v = all + 4 * r;
-    fprintf(out, "             %4d  %9.0f  %9.0f (%.0f + %.0f)  %.1f MiB\n", r,
+    const double *v = all + 5 * r;
+    fprintf(out, "             %4d  %9.0f  %9.0f (%.0f + %.0f)  %.1f MiB", r,
             v[0], v[1], v[2], v[1] - v[2], v[3] / 1048576.0);
+    if (linked) fprintf(out, "  %.0f", v[4]);
+    fprintf(out, "\n");
   }
   free(all);
 }

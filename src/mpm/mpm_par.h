@@ -20,7 +20,13 @@
  *  - after the move, particles that left the rank's cells go to the rank
  *    that owns their cell, with every array they carry; a rank's
  *    particles stay in increasing order of their index on one process, so
- *    groups and bodies stay contiguous.
+ *    groups and bodies stay contiguous;
+ *  - particles that read others of their group (a membrane point's normal
+ *    reads its neighbours') get the positions of those on other ranks,
+ *    the ghosts, once a step after the migration (mpm_par_ghosts.h); the
+ *    links among them are made anew when a linked point changed rank;
+ *  - a body moving as prescribed sums its mass at the nodes over the
+ *    ranks before it sets their velocities.
  * Rank 0 also keeps the whole model and gathers the state into it when
  * the run writes (frames, history, checkpoints): the output of a run
  * across ranks is that of one process, in the same order.

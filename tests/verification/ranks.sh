@@ -18,37 +18,8 @@ bin=$1
 src=$2
 migrate=$3
 . "$(dirname "$0")/lib.sh"
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-export OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
-export OMP_NUM_THREADS=1
-py=/usr/bin/python3
-roundoff="$py $src/tests/verification/same_to_roundoff.py"
-tol=1e-10
-mpm=$src/cases/mpm
-
-ranks() { # N, command...
-  local n=$1
-  shift
-  timeout 300 mpirun -np "$n" --bind-to none "$@"
-}
-
-# One process, then N ranks, of SCENE with overrides, compared to
-# round-off; the runs end with exit status $want (default 0).
-across() { # label, scene, ranks, overrides...
-  local label=$1 scene=$2 n=$3 want=${want:-0}
-  shift 3
-  local one=$work/$label-1 many=$work/$label-$n
-  [ -d "$one" ] || "$bin" run "$scene" --out "$one" --quiet "$@" \
-    >/dev/null 2>"$work/err"
-  ranks "$n" "$bin" run "$scene" --out "$many" --quiet "$@" >/dev/null \
-    2>"$work/err"
-  local rc=$?
-  check "$label on $n ranks: exit $want (got $rc)" test $rc -eq "$want"
-  $roundoff "$one" "$many" $tol >"$work/cmp" 2>&1
-  rc=$?
-  sed "s/^/$label, $n ranks against one process: /" "$work/cmp"
-  check "$label on $n ranks: the run of one process to $tol" test $rc -eq 0
-}
+# shellcheck source=ranks-lib.sh
+. "$(dirname "$0")/ranks-lib.sh"
 
 # The shock tube (3-D, pressure ratio 1000, cut along x between its
 # walls), the disks (2-D: 2, 3 and 4 boxes, each disk's particles shared
@@ -138,41 +109,7 @@ refused "convergence on 2 ranks" "convergence runs on one process" \
 # step; mpirun forwards a signal of its own about 2 s late, or not before
 # it gives up on its ranks (README, "Across MPI ranks").
 tube=$mpm/m2-shock-tube-reduced.yaml
-long="--set time.end=2 --set output.every=100"
-"$bin" run "$tube" --out "$work/long-1" --quiet $long >/dev/null 2>&1
-ranks 2 "$bin" run "$tube" --out "$work/long-2" --quiet $long >/dev/null 2>&1
-timeout 300 mpirun -np 2 --bind-to none "$bin" run "$tube" \
-  --out "$work/cut" --quiet $long >/dev/null 2>"$work/err" &
-job=$!
-for _ in $(seq 600); do
-  [ -f "$work/cut/history.csv" ] &&
-    [ "$(wc -l <"$work/cut/history.csv")" -ge 4 ] && break
-  sleep 0.05
-done
-pid=$(sed -n 's/^ *"pid": \([0-9]*\).*/\1/p' "$work/cut/summary.json")
-kill -TERM "$pid"
-wait $job
-check "interrupted on 2 ranks: status interrupted" \
-  grep -q '"status": "interrupted"' "$work/cut/summary.json"
-for n in 1 2 3; do
-  cp -r "$work/cut" "$work/cut-$n"
-  if [ $n -eq 1 ]; then
-    "$bin" resume "$work/cut-$n" --quiet >/dev/null 2>"$work/err"
-  else
-    ranks $n "$bin" resume "$work/cut-$n" --quiet >/dev/null 2>"$work/err"
-  fi
-  check "interrupted on 2 ranks, resumed on $n: exit 0" test $? -eq 0
-done
-check "interrupted on 2 ranks, resumed on 2: the run of 2 ranks, bit for bit" \
-  $py "$src/tests/verification/same_results.py" "$work/long-2" "$work/cut-2"
-for pair in "long-2 cut-3 3" "long-1 cut-1 1"; do
-  read -r straight resumed n <<<"$pair"
-  $roundoff "$work/$straight" "$work/$resumed" $tol >"$work/cmp" 2>&1
-  rc=$?
-  sed "s/^/interrupted on 2 ranks, resumed on $n: /" "$work/cmp"
-  check "interrupted on 2 ranks, resumed on $n: the straight run to $tol" \
-    test $rc -eq 0
-done
+resumed tube 4 "1 2 3" "$tube" --set time.end=2 --set output.every=100
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
