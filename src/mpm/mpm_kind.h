@@ -78,6 +78,11 @@ typedef struct mpm_kind {
   pm_err (*ranks_share)(const mpm_group *whole, mpm_group *g);
   pm_err (*ranks_link)(const struct mpm_model *m, mpm_group *g, long **want,
                        long *room, long *n);
+  /* Optional, across ranks: how many cells around a rank's cells hold
+   * points of group g that its points read each step (a membrane's normals
+   * fitted per cell read the points of the blocks of cells around it), 0
+   * when none; mpm_par_nearby gives those of other ranks. */
+  int (*ranks_reach)(const mpm_group *g);
 
   /* Optional: a stage run just before the constitutive stage (membranes:
    * their normals), named pre_stage_name, described by describe_pre. */

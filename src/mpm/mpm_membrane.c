@@ -44,6 +44,7 @@
 #include "mpm_par.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
+#include "pm_par.h"
 
 /* State array slots. */
 enum { MEM_FRAME = 0, MEM_STRAIN = 1, MEM_OMEGA = 2, MEM_FAILED = 3 };
@@ -348,7 +349,20 @@ typedef struct {
   cell_point *cp; /* per point of a body */
   long *order;    /* the points in cell order */
   long *run;      /* start of each cell's points in order, and the end */
+  /* across ranks: a body's points with the nearby points of other ranks,
+   * in one-process order (3 each), their normals, and where each of the
+   * rank's points is among them */
+  double *xe, *ne;
+  long *at;
 } iso_work;
+
+/* Where a body's fits are made: the whole grid's nodes per axis (the
+ * cells' keys, which seed the fits' draws, count on the whole grid) and
+ * the cells whose points' normals are wanted, [lo, hi) per axis (a rank's
+ * own; the points in the cells around them serve the merged blocks). */
+typedef struct {
+  long nn[3], lo[3], hi[3];
+} iso_cells;
 
 static void iso_work_free(void *p) {
   iso_work *w = p;
@@ -363,6 +377,9 @@ static void iso_work_free(void *p) {
   free(w->cp);
   free(w->order);
   free(w->run);
+  free(w->xe);
+  free(w->ne);
+  free(w->at);
   free(w);
 }
 
@@ -382,6 +399,12 @@ static pm_err iso_work_create(const mpm_model *m, const mpm_group *g,
   PM_TRY(PM_ALLOC(w->order, n, "membrane points by cell"));
   PM_TRY(PM_ALLOC(w->run, n + 1, "membrane cells"));
   *bytes = sizeof *w + (size_t)n * (sizeof(cell_point) + 2 * sizeof(long));
+  if (m->par) {
+    PM_TRY(PM_ALLOC(w->xe, 3 * n, "membrane points with nearby ones"));
+    PM_TRY(PM_ALLOC(w->ne, 3 * n, "membrane points with nearby ones"));
+    PM_TRY(PM_ALLOC(w->at, n, "membrane points with nearby ones"));
+    *bytes += (size_t)n * (6 * sizeof(double) + sizeof(long));
+  }
   for (int t = 0; t < w->threads; t++) {
     for (int o = 0; o < 2; o++) {
       mpm_iso_config c = mpm_iso_config_default(m->dim, o + 1);
@@ -405,12 +428,14 @@ static int cell_point_cmp(const void *a, const void *b) {
   return (p->k > q->k) - (p->k < q->k);
 }
 
-/* The cell of x (indices of its lower node), its key. */
-static inline long cell_of(const mpm_grid *g, const double x[3], long c[3]) {
+/* The cell of x (indices of its lower node), its key on the whole grid
+ * of nn nodes per axis. */
+static inline long cell_of(const mpm_grid *g, const long nn[3],
+                           const double x[3], long c[3]) {
   c[2] = 0;
   for (int d = 0; d < g->dim; d++)
     c[d] = (long)floor((x[d] - g->origin[d]) * g->inv_h);
-  return c[0] + g->nn[0] * (c[1] + g->nn[1] * c[2]);
+  return c[0] + nn[0] * (c[1] + nn[1] * c[2]);
 }
 
 /* The points of the cell at key in cell order [*lo, *hi), found by
@@ -486,14 +511,17 @@ static void stats_add(iso_stats *a, const mpm_iso_report *r, long points) {
 }
 
 /* Normals nn (3 per point of the body, holding its previous normals on
- * entry) of the body's n points at x (3 each), by method, at step `step`. */
-static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
-                          long n, const double *x, long step, double *nn,
+ * entry) of the body's n points at x (3 each), by method, at step `step`,
+ * for the points in the cells [cells->lo, cells->hi). */
+static pm_err iso_normals(const mpm_grid *g, const iso_cells *cells,
+                          iso_work *w, int body, int method, long n,
+                          const double *x, long step, double *nn,
                           iso_stats *st) {
   const int dim = g->dim;
+  const long *gn = cells->nn;
   for (long k = 0; k < n; k++) {
     long c[3];
-    w->cp[k].key = cell_of(g, x + 3 * k, c);
+    w->cp[k].key = cell_of(g, gn, x + 3 * k, c);
     w->cp[k].k = k;
   }
   qsort(w->cp, (size_t)n, sizeof *w->cp, cell_point_cmp);
@@ -505,8 +533,8 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
   w->run[n_cells] = n;
   pm_err err = PM_SUCCESS;
   iso_stats sum = {0};
-  PM_OMP(parallel default(none) shared(g, w, body, method, n, x, step, nn,
-                                       n_cells, dim, err, sum)) {
+  PM_OMP(parallel default(none) shared(g, cells, gn, w, body, method, n, x,
+                                       step, nn, n_cells, dim, err, sum)) {
     iso_stats my = {0};
     iso_thread *th = &w->t[pm_omp_thread()];
     PM_OMP(for schedule(dynamic, 8))
@@ -514,7 +542,11 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
       const long r0 = w->run[ci], r1 = w->run[ci + 1], cnt = r1 - r0;
       const long key = w->cp[r0].key;
       long cell[3];
-      cell_of(g, x + 3 * w->order[r0], cell);
+      cell_of(g, gn, x + 3 * w->order[r0], cell);
+      bool wanted = true;
+      for (int d = 0; d < dim; d++)
+        wanted = wanted && cell[d] >= cells->lo[d] && cell[d] < cells->hi[d];
+      if (!wanted) continue; /* another rank's */
       int order = method == PM_NORMALS_ISO_LINEAR ? 1
                   : method == PM_NORMALS_ISO_QUADRATIC
                       ? 2
@@ -579,10 +611,10 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
               long q[3] = {first[0] + c0, first[1] + c1, first[2] + c2}, a, z;
               bool in = true;
               for (int d = 0; d < dim; d++)
-                if (q[d] < 0 || q[d] >= g->nn[d] - 1) in = false;
-              if (!in || !cell_range(w, n_cells,
-                                     q[0] + g->nn[0] * (q[1] + g->nn[1] * q[2]),
-                                     &a, &z))
+                if (q[d] < 0 || q[d] >= gn[d] - 1) in = false;
+              if (!in ||
+                  !cell_range(w, n_cells, q[0] + gn[0] * (q[1] + gn[1] * q[2]),
+                              &a, &z))
                 continue;
               for (long r = a; r < z; r++) th->gather[m++] = w->order[r];
             }
@@ -624,6 +656,55 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
 
 /* ---- normals of every body of the group ---------------------------------- */
 
+/* The first of the n increasing a[] that is at least v. */
+static long lower_bound(const long *a, long n, long v) {
+  long lo = 0, hi = n;
+  while (lo < hi) {
+    const long mid = lo + (hi - lo) / 2;
+    if (a[mid] < v)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* Across ranks, the fitted normals nn of body b's points of the rank
+ * (group points [b0, b1), positions x from the group's start): fitted with
+ * the nearby points of other ranks (those within the merged blocks' reach
+ * of the rank's cells), all in one-process order, so that each cell of
+ * the rank is fitted to the points, in the order, one process fits it
+ * to. */
+static pm_err iso_normals_ranks(const mpm_model *m, const mpm_group *gr,
+                                const struct membrane_body *b,
+                                const iso_cells *cells, iso_work *w, long b0,
+                                long b1, const double *x, long step, double *nn,
+                                iso_stats *st) {
+  const membrane_params *mp = gr->params;
+  const long *own = m->gid + gr->begin, *ids;
+  long n_near;
+  const double *xn = mpm_par_nearby(m, gr->index, &n_near, &ids);
+  const long j0 = lower_bound(ids, n_near, mp->whole.first + b->begin),
+             j1 = lower_bound(ids, n_near, mp->whole.first + b->end);
+  long e = 0;
+  for (long k = b0, j = j0; k < b1 || j < j1; e++) {
+    const bool mine = j >= j1 || (k < b1 && own[k] < ids[j]);
+    if (mine) {
+      memcpy(w->xe + 3 * e, x + 3 * k, 3 * sizeof(double));
+      memcpy(w->ne + 3 * e, nn + 3 * k, 3 * sizeof(double));
+      w->at[k++ - b0] = e;
+    } else {
+      memcpy(w->xe + 3 * e, xn + 3 * j++, 3 * sizeof(double));
+      memset(w->ne + 3 * e, 0, 3 * sizeof(double)); /* not read */
+    }
+  }
+  PM_CALL(iso_normals(&m->grid, cells, w, b->body, b->method, e, w->xe, step,
+                      w->ne, st));
+  for (long k = b0; k < b1; k++)
+    memcpy(nn + 3 * k, w->ne + 3 * w->at[k - b0], 3 * sizeof(double));
+  return PM_SUCCESS;
+}
+
 /* Each point's new unit normal into nn (3 per point of the group, holding
  * the previous normals n0 on entry; a point without one keeps n0), by its
  * body's method.  tn: 3 per triangle of the links.  The bodies' points are
@@ -641,8 +722,14 @@ static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
     const long b0 = m->body_begin[b->body] - gr->begin,
                b1 = m->body_end[b->body] - gr->begin;
     if (b->method != PM_NORMALS_CONNECTIVITY) {
-      PM_CALL(iso_normals(&m->grid, iw, b->body, b->method, b1 - b0,
-                          xo + 3 * b0, step, nn + 3 * b0, st));
+      iso_cells cells;
+      mpm_par_cells(m, cells.nn, cells.lo, cells.hi);
+      if (m->par)
+        PM_CALL(
+            iso_normals_ranks(m, gr, b, &cells, iw, b0, b1, xo, step, nn, st));
+      else
+        PM_CALL(iso_normals(&m->grid, &cells, iw, b->body, b->method, b1 - b0,
+                            xo + 3 * b0, step, nn + 3 * b0, st));
       continue;
     }
     if (b->links == MPM_LINKS_TRIANGLES) {
@@ -980,13 +1067,31 @@ static pm_err membrane_normals(mpm_ctx *ctx, const mpm_stage *self) {
     for (int d = 0; d < 3; d++) nn[3 * k + d] = frame[9 * k + 6 + d];
   iso_stats st = {0};
   pm_err e = group_normals(m, gr, s->x, s->step, w->kind_work[gi], tn, nn, &st);
+  /* Across ranks each cell is fitted by one rank: the fits' figures are
+   * the ranks' summed (every rank then keeps the run's, as one process). */
+  double v[8] = {(double)st.cells[0], (double)st.cells[1],
+                 (double)st.cells[2], (double)st.cells[3],
+                 (double)st.points,   (double)st.degenerate,
+                 (double)st.draws,    st.max_condition};
+  if (m->par && ((const membrane_params *)gr->params)->iso) {
+    pm_par_sum(v, 7);
+    pm_par_max(v + 7, 1);
+  }
   if (e) return e;
-  for (int i = 0; i < 4; i++) s->iso.cells[i] += (double)st.cells[i];
-  s->iso.points += (double)st.points;
-  s->iso.degenerate += (double)st.degenerate;
-  s->iso.draws += (double)st.draws;
-  s->iso.max_condition = st.max_condition;
+  for (int i = 0; i < 4; i++) s->iso.cells[i] += v[i];
+  s->iso.points += v[4];
+  s->iso.degenerate += v[5];
+  s->iso.draws += v[6];
+  s->iso.max_condition = v[7];
   return PM_SUCCESS;
+}
+
+/* Across ranks, the cells around a rank's whose points its fits read: a
+ * merged block of up to 2^ISO_MERGE_LEVELS cells a side reaches that many
+ * less one beyond the cell it fits. */
+static int membrane_ranks_reach(const mpm_group *g) {
+  const membrane_params *mp = g->params;
+  return mp->iso ? (1 << ISO_MERGE_LEVELS) - 1 : 0;
 }
 
 /* ---- the stage ---------------------------------------------------------- */
@@ -1151,6 +1256,7 @@ const mpm_kind mpm_kind_membrane = {
     .scratch = membrane_scratch,
     .ranks_share = membrane_ranks_share,
     .ranks_link = membrane_ranks_link,
+    .ranks_reach = membrane_ranks_reach,
     .work_create = iso_work_create,
     .work_free = iso_work_free,
     .pre_stress = membrane_normals,

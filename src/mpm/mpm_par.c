@@ -343,24 +343,6 @@ done:
  */
 
 pm_err mpm_par_check(const pm_scene *s) {
-  char key[64];
-  for (int b = 0; b < s->n_bodies; b++) {
-    const pm_scene_body *body = &s->bodies[b];
-    if (body->shape != PM_BODY_MEMBRANE ||
-        body->membrane.normals == PM_NORMALS_CONNECTIVITY)
-      continue;
-    /* A fit reads the points of the cells around its cell, up to a block
-     * of 8 cells a side: ghosts that far are not kept. */
-    PM_PATH(key, "bodies.%d.membrane.normals", b);
-    if (!pm_scene_has(s, key)) PM_PATH(key, "bodies.%d.membrane", b);
-    return pm_scene_fail(
-        s, key, true,
-        "membrane normals by isosurface least squares (normals: %s) run on "
-        "one process (this run has %d ranks): a fit reads the points of the "
-        "cells around its own; take normals: connectivity, or run with -np 1",
-        pm_key_name_of(pm_normals_names, body->membrane.normals),
-        pm_par_size());
-  }
   if (mpm_scene_settings(s)->fbar == MPM_FBAR_PATCH)
     return pm_scene_fail(s, "mpm.fbar", false,
                          "F-bar over node patches runs on one process (this "
@@ -718,7 +700,8 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   PM_TRY(pm_par_agree(ret));
   struct mpm_par *Q = lm->par;
   PM_TRY(make_near(Q, m));
-  PM_TRY(mpm_ghosts_create(lm, ls, Q->near, Q->n_near, &Q->gh));
+  PM_TRY(mpm_ghosts_create(lm, ls, &Q->d, Q->gbegin, Q->gend, Q->near,
+                           Q->n_near, &Q->gh));
   Q->rec = record_doubles(lm, &Q->width);
   const long room = mpm_model_room(lm);
   PM_TRY(PM_ALLOC(Q->dest, room, "migration ranks"));
@@ -1144,6 +1127,29 @@ const double *mpm_par_ghost_x(const mpm_model *m, int gi) {
   return m->par ? mpm_ghosts_x(m->par->gh, gi) : NULL;
 }
 
+const double *mpm_par_nearby(const mpm_model *m, int gi, long *n,
+                             const long **ids) {
+  if (m->par) return mpm_ghosts_nearby(m->par->gh, gi, n, ids);
+  *n = 0;
+  *ids = NULL;
+  return NULL;
+}
+
+void mpm_par_cells(const mpm_model *m, long nn[3], long lo[3], long hi[3]) {
+  for (int a = 0; a < 3; a++) {
+    if (m->par) {
+      const mpm_decomp *d = &m->par->d;
+      nn[a] = a < m->dim ? d->cells[a] + 1 : 1;
+      lo[a] = d->box[6 * m->par->rank + a];
+      hi[a] = d->box[6 * m->par->rank + 3 + a];
+    } else {
+      nn[a] = m->grid.nn[a];
+      lo[a] = 0;
+      hi[a] = a < m->dim ? m->grid.nn[a] - 1 : 1;
+    }
+  }
+}
+
 const long *mpm_par_ghost_ids(const mpm_model *m, int gi, long *n) {
   *n = m->par ? mpm_ghosts_count(m->par->gh, gi) : 0;
   return m->par ? mpm_ghosts_ids(m->par->gh, gi) : NULL;
@@ -1364,8 +1370,12 @@ void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
   const int size = P->d.size;
   /* Per rank: particles, nodes held, nodes owned, bytes, ghost points. */
   double ghosts = 0;
-  for (int gi = 0; gi < m->n_groups; gi++)
-    ghosts += (double)mpm_ghosts_count(P->gh, gi);
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    long nearby;
+    const long *ids;
+    mpm_ghosts_nearby(P->gh, gi, &nearby, &ids);
+    ghosts += (double)(mpm_ghosts_count(P->gh, gi) + nearby);
+  }
   double mine[5] = {(double)m->n, (double)m->grid.n_nodes, (double)P->n_owned,
                     (double)(mpm_model_bytes(m) + mpm_work_bytes(m, w)),
                     ghosts};

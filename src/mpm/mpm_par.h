@@ -22,9 +22,11 @@
  *    particles stay in increasing order of their index on one process, so
  *    groups and bodies stay contiguous;
  *  - particles that read others of their group (a membrane point's normal
- *    reads its neighbours') get the positions of those on other ranks,
- *    the ghosts, once a step after the migration (mpm_par_ghosts.h); the
- *    links among them are made anew when a linked point changed rank;
+ *    reads its neighbours', or the points of the cells around its own
+ *    when it is fitted per cell) get the positions of those on other
+ *    ranks, the ghosts, once a step after the migration
+ *    (mpm_par_ghosts.h); the links among them are made anew when a linked
+ *    point changed rank;
  *  - a body moving as prescribed sums its mass at the nodes over the
  *    ranks before it sets their velocities.
  * Rank 0 also keeps the whole model and gathers the state into it when
@@ -146,6 +148,16 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w);
 const double *mpm_par_ghost_x(const mpm_model *m, int gi);
 /* Their one-process indices (increasing), n of them (NULL and 0 without). */
 const long *mpm_par_ghost_ids(const mpm_model *m, int gi, long *n);
+/* Group gi's nearby points of other ranks (those within its kind's reach,
+ * mpm_kind.ranks_reach, of this rank's cells): positions (3 each), their
+ * one-process indices (increasing) in *ids, *n of them (NULL and 0 on one
+ * process and for a group without a reach). */
+const double *mpm_par_nearby(const mpm_model *m, int gi, long *n,
+                             const long **ids);
+/* The whole grid's nodes per axis nn (1 along z in 2-D), and the cells
+ * whose particles this rank holds, [lo, hi) per axis (on one process the
+ * whole grid's). */
+void mpm_par_cells(const mpm_model *m, long nn[3], long lo[3], long hi[3]);
 
 /* Gather the state of every rank into the whole model's state full_state
  * on rank 0 (NULL on the others), in the order of one process: particles,

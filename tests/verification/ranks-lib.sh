@@ -18,7 +18,8 @@ ranks() { # N, command...
 }
 
 # One process, then N ranks, of SCENE with overrides, compared to
-# round-off; the runs end with exit status $want (default 0).
+# round-off (less the history columns $skip, comma-separated); the runs
+# end with exit status $want (default 0).
 across() { # label, scene, ranks, overrides...
   local label=$1 scene=$2 n=$3 want=${want:-0}
   shift 3
@@ -29,7 +30,7 @@ across() { # label, scene, ranks, overrides...
     2>"$work/err"
   local rc=$?
   check "$label on $n ranks: exit $want (got $rc)" test $rc -eq "$want"
-  $roundoff "$one" "$many" $tol >"$work/cmp" 2>&1
+  $roundoff "$one" "$many" $tol ${skip:-} >"$work/cmp" 2>&1
   rc=$?
   sed "s/^/$label, $n ranks against one process: /" "$work/cmp"
   check "$label on $n ranks: the run of one process to $tol" test $rc -eq 0

@@ -94,9 +94,10 @@ check "left the grid on 2 ranks: status unstable" \
 refused "FPM on 2 ranks" "method fpm runs on one process" "$work/fpm-2" \
   ranks 2 "$bin" run "$src/cases/fpm/f2-unconstrained-compression.yaml" \
   --out "$work/fpm-2"
-refused "normals by isosurface fits on 2 ranks" \
-  "bodies.0.membrane.normals: membrane normals by isosurface least squares (normals: hybrid) run on one process" \
-  "$work/iso-2" ranks 2 "$bin" run "$mpm/m5-gas-circle.yaml" --out "$work/iso-2"
+refused "F-bar over node patches on 2 ranks" \
+  "mpm.fbar: F-bar over node patches runs on one process" \
+  "$work/patch-2" ranks 2 "$bin" run "$mpm/locking-beam.yaml" \
+  --out "$work/patch-2"
 refused "convergence on 2 ranks" "convergence runs on one process" \
   "$work/conv-2" ranks 2 "$bin" convergence "$mpm/disks-collision.yaml" \
   --set-ladder discretization.mesh_size=0.1,0.05 --out "$work/conv-2"

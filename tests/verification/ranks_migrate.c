@@ -13,11 +13,13 @@
  *    ranks that its membrane points are linked to (the other corners of
  *    every triangle it has a corner of, the neighbours along a curve),
  *    each held by one other rank, at that rank's position bit for bit:
- *    every triangle's three points found.  It prints how many triangles
- *    (or a curve's segments) span two ranks or more and how many membrane
- *    points moved.
- * Usage: ranks_migrate SCENE STEPS [KEY=VALUE...]; prints a line per check
- * and exits 0 when all hold. */
+ *    every triangle's three points found; and where a membrane's normals
+ *    are fitted per cell, its nearby points are exactly the points of
+ *    other ranks in the cells within the fits' reach of the rank's box.  It
+ * prints how many triangles (or a curve's segments) span two ranks or more and
+ * how many membrane points moved. Usage: ranks_migrate SCENE STEPS
+ * [KEY=VALUE...]; prints a line per check and exits 0 when all hold. */
+#include <math.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -109,6 +111,39 @@ static bool ghosts_right(const mpm_model *m, const mpm_model *ref,
   return ok;
 }
 
+/* Whether this rank's nearby points of every group whose kind reads the
+ * cells around its own are the points of other ranks in those cells
+ * (within the kind's reach of the rank's box), at positions x. */
+static bool nearby_right(const mpm_model *m, const mpm_model *ref,
+                         const char *mine, const double *x) {
+  const mpm_decomp *d = mpm_par_decomp(m);
+  const long *box = d->box + 6 * pm_par_rank();
+  const mpm_grid *g = &ref->grid;
+  bool ok = true;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_kind *k = m->group[gi].kind;
+    const int reach = k->ranks_reach ? k->ranks_reach(&m->group[gi]) : 0;
+    if (!reach) continue;
+    long n, at = 0;
+    const long *ids;
+    const double *nx = mpm_par_nearby(m, gi, &n, &ids);
+    for (long p = ref->group[gi].begin; ok && p < ref->group[gi].end; p++) {
+      bool in = !mine[p];
+      for (int a = 0; a < g->dim; a++) {
+        long c = (long)floor((x[3 * p + a] - g->origin[a]) * g->inv_h);
+        c = c < 0 ? 0 : c >= d->cells[a] ? d->cells[a] - 1 : c;
+        in = in && c >= box[a] - reach && c < box[3 + a] + reach;
+      }
+      if (!in) continue;
+      ok = at < n && ids[at] == p &&
+           !memcmp(nx + 3 * at, x + 3 * p, 3 * sizeof(double));
+      at++;
+    }
+    ok = ok && at == n;
+  }
+  return ok;
+}
+
 /* Total mass and momentum in one-process order. */
 static void totals(const mpm_model *m, const mpm_state *s, double t[4]) {
   t[0] = t[1] = t[2] = t[3] = 0;
@@ -154,7 +189,8 @@ int main(int argc, char **argv) {
   double *whole_x = malloc(sizeof(double) * 3 * (size_t)(N + 1));
   bool linked = false;
   for (int gi = 0; gi < m->n_groups; gi++)
-    linked = linked || m->group[gi].kind->ranks_link;
+    linked = linked || m->group[gi].kind->ranks_link ||
+             m->group[gi].kind->ranks_reach;
   for (long step = 1; step <= steps; step++) {
     if (mpm_step(m, s, w)) {
       if (pm_par_root()) fprintf(stderr, "%s\n", pm_error_message());
@@ -247,6 +283,10 @@ int main(int argc, char **argv) {
       for (long k = 0; k < m->n; k++) mine[m->gid[k]] = 1;
       expect(ghosts_right(m, ref, mine, whole_x),
              "ghosts: the points linked to this rank's, at their positions",
+             step);
+      expect(nearby_right(m, ref, mine, whole_x),
+             "nearby points: those of other ranks within reach, at their "
+             "positions",
              step);
       if (pm_par_root()) {
         long span = 0;
