@@ -67,6 +67,12 @@ across circle "$circle" 2 --set "$links" --set time.max_steps=400 \
 skip=normals_max_condition across circle-fitted "$circle" 2 \
   --set time.max_steps=100 --set output.every=25
 
+# The dogbone (M5): its curve crosses the cut with many points on either
+# side (the circle's cut, 5 cells from the symmetry planes, leaves one
+# rank a single particle), its normals fitted per cell, 200 steps.
+skip=normals_max_condition across dogbone-fitted "$mpm/m5-gas-dogbone.yaml" 2 \
+  --set time.max_steps=200 --set output.every=50
+
 # The sphere's normals fitted per cell in 3-D (hybrid-quadratic: blocks of
 # up to 8 cells a side, reaching 7 cells beyond a rank's box): the first
 # step's normals, from the positions every run starts from, are one
