@@ -194,30 +194,37 @@ void gm_curve_point_lengths(const gm_curve *c, double *len) {
   }
 }
 
+void gm_curve_neighbours(long k, long n, bool closed, long *prev, long *next) {
+  if (closed) {
+    *prev = (k + n - 1) % n;
+    *next = (k + 1) % n;
+  } else {
+    *prev = k - 1 < 0 ? 0 : k - 1;
+    *next = k + 1 > n - 1 ? n - 1 : k + 1;
+  }
+}
+
+bool gm_curve_normal(const double prev[3], const double next[3], double n[3]) {
+  const double tx = next[0] - prev[0];
+  const double ty = next[1] - prev[1];
+  const double len = hypot(tx, ty);
+  /* Not (len > 0) also catches a NaN from a point that went bad. */
+  if (!(len > 0.0)) {
+    n[0] = n[1] = n[2] = 0.0;
+    return false;
+  }
+  n[0] = ty / len;
+  n[1] = -tx / len;
+  n[2] = 0.0;
+  return true;
+}
+
 long gm_curve_normals(long n, const double *x, bool closed, double *normal) {
   long vanished = 0;
   for (long k = 0; k < n; k++) {
-    long prev = k - 1, next = k + 1;
-    if (closed) {
-      prev = (k + n - 1) % n;
-      next = (k + 1) % n;
-    } else {
-      prev = prev < 0 ? 0 : prev;
-      next = next > n - 1 ? n - 1 : next;
-    }
-    const double tx = x[3 * next] - x[3 * prev];
-    const double ty = x[3 * next + 1] - x[3 * prev + 1];
-    const double len = hypot(tx, ty);
-    double *nk = normal + 3 * k;
-    /* Not (len > 0) also catches a NaN from a point that went bad. */
-    if (!(len > 0.0)) {
-      nk[0] = nk[1] = nk[2] = 0.0;
-      vanished++;
-      continue;
-    }
-    nk[0] = ty / len;
-    nk[1] = -tx / len;
-    nk[2] = 0.0;
+    long prev, next;
+    gm_curve_neighbours(k, n, closed, &prev, &next);
+    vanished += !gm_curve_normal(x + 3 * prev, x + 3 * next, normal + 3 * k);
   }
   return vanished;
 }

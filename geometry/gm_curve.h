@@ -54,6 +54,14 @@ void gm_curve_point_lengths(const gm_curve *c, double *len);
  * (0, 0, 0) and the function returns how many did.  Allocates nothing
  * (it runs every step). */
 long gm_curve_normals(long n, const double *x, bool closed, double *normal);
+/* The neighbours in the list of point k of n (prev and next, as
+ * gm_curve_normals takes them: around a closed curve, the point itself at
+ * an open curve's ends). */
+void gm_curve_neighbours(long k, long n, bool closed, long *prev, long *next);
+/* The unit normal of a point whose neighbours are at prev and next (as
+ * gm_curve_normals gives it); false, with n = 0, when their chord
+ * vanishes (or is not finite). */
+bool gm_curve_normal(const double prev[3], const double next[3], double n[3]);
 
 /* The region a 2-D membrane encloses, for `inside` and `outside` bodies:
  * the polygon of the points x (n, in order), closed

@@ -189,8 +189,9 @@ static void view_figures(mpm_sim *r) {
   w->min_jacobian = lw->min_jacobian;
   w->iter_max = lw->iter_max;
   w->iter_capped = lw->iter_capped;
-  memcpy(w->cond.reaction, lw->cond.reaction,
-         3 * sizeof(double) * (size_t)r->model->n_bcs);
+  if (r->model->n_bcs > 0) /* (a scene without conditions has no array) */
+    memcpy(w->cond.reaction, lw->cond.reaction,
+           3 * sizeof(double) * (size_t)r->model->n_bcs);
   w->timers = lw->timers;
   mpm_state *v = r->state;
   const mpm_state *ls = r->local_state;
@@ -277,15 +278,20 @@ static pm_err run_ranks(mpm_sim *r, const pm_observer *obs) {
   double own = -c.halo_seconds - c.migrate_seconds;
   const pm_timers *t = &r->local_work->timers;
   for (int k = 0; k < t->n; k++) own += t->stage[k].seconds;
-  double sums[5] = {c.halo_bytes, c.migrate_bytes, (double)c.migrated,
-                    (double)c.grown, own},
+  double sums[6] = {c.halo_bytes,
+                    c.migrate_bytes,
+                    (double)c.migrated,
+                    (double)c.grown,
+                    own,
+                    c.ghost_bytes},
          most[3] = {c.halo_seconds, c.migrate_seconds, own};
-  pm_par_sum(sums, 5);
+  pm_par_sum(sums, 6);
   pm_par_max(most, 3);
   memcpy(r->ranks_counts, sums, 4 * sizeof(double));
   memcpy(r->ranks_counts + 4, most, 2 * sizeof(double));
   r->ranks_counts[6] = most[2];                 /* the busiest rank's */
   r->ranks_counts[7] = sums[4] / pm_par_size(); /* the mean */
+  r->ranks_counts[8] = sums[5];
   return e;
 }
 
@@ -760,6 +766,8 @@ static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
   /* what a rank sent, on average */
   PM_CALL(pm_json_number(j, "node_bytes_per_step", c[0] / steps / d->size));
   PM_CALL(pm_json_number(j, "particle_bytes_per_step", c[1] / steps / d->size));
+  /* the ghosts of linked points (membranes' neighbours) */
+  PM_CALL(pm_json_number(j, "ghost_bytes_per_step", c[8] / steps / d->size));
   PM_CALL(pm_json_number(j, "particles_migrated", c[2]));
   PM_CALL(pm_json_number(j, "arrays_grown", c[3]));
   PM_CALL(pm_json_number(j, "node_exchange_seconds", c[4]));

@@ -31,8 +31,9 @@ typedef struct {
   mpm_work *local_work;
   /* across ranks, at the end of the run: the exchanges' bytes and
    * particles summed over the ranks, their seconds the slowest rank's;
-   * the ranks' own work (stages less exchanges), the most and the mean */
-  double ranks_counts[8];
+   * the ranks' own work (stages less exchanges), the most and the mean;
+   * the bytes of linked points' ghosts, summed */
+  double ranks_counts[9];
   /* read from a checkpoint: the ranks of the run that wrote it and their
    * energy accounts (MPM_PAR_ACCOUNTS each) */
   int ckpt_ranks;

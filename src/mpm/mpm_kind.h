@@ -64,6 +64,26 @@ typedef struct mpm_kind {
                         void **out, size_t *bytes);
   void (*work_free)(void *w);
 
+  /* Optional, across ranks (mpm_par.h), for a group whose points read
+   * other points of the group each step (a membrane point's normal reads
+   * its neighbours' positions).  ranks_share: at setup, a rank's group g
+   * takes from the whole model's group what its links are made from (a
+   * surface's triangles in one-process order).  ranks_link: whenever
+   * points moved between ranks, the one-process indices of the points of
+   * other ranks that the rank's points of g read (the ghosts: sorted,
+   * without repeats) into *want (room *room, grown as needed), *n of them,
+   * and g's links among its points and those anew (ghost j is point
+   * (g->end - g->begin) + j; mpm_par_ghost_x gives their positions).
+   * PM_ERR_MEMORY. */
+  pm_err (*ranks_share)(const mpm_group *whole, mpm_group *g);
+  pm_err (*ranks_link)(const struct mpm_model *m, mpm_group *g, long **want,
+                       long *room, long *n);
+  /* Optional, across ranks: how many cells around a rank's cells hold
+   * points of group g that its points read each step (a membrane's normals
+   * fitted per cell read the points of the blocks of cells around it), 0
+   * when none; mpm_par_nearby gives those of other ranks. */
+  int (*ranks_reach)(const mpm_group *g);
+
   /* Optional: a stage run just before the constitutive stage (membranes:
    * their normals), named pre_stage_name, described by describe_pre. */
   mpm_stage_fn pre_stress;

@@ -41,8 +41,10 @@
 #include "gm_trisurf.h"
 #include "mpm_isonormal.h"
 #include "mpm_kind.h"
+#include "mpm_par.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
+#include "pm_par.h"
 
 /* State array slots. */
 enum { MEM_FRAME = 0, MEM_STRAIN = 1, MEM_OMEGA = 2, MEM_FAILED = 3 };
@@ -55,11 +57,28 @@ typedef struct {
   double c0, c1;  /* eq. 39 */
   double limit;   /* S_L, eq. 40 */
   double failure; /* eps_max at failure */
-  /* point -> triangles, both counted within the group (gm_trisurf's
-   * incidence of the group's surface) */
-  long *inc_start, *inc_tri;
-  /* the group's bodies: points [begin, end) counted within the group,
-   * their links (MPM_LINKS_*) and normal method (pm_normals_method) */
+  /* The links the normal stage reads among the group's points (counted
+   * from the group's start): triangles of 3 corners, each point's
+   * triangles (gm_trisurf's incidence, in triangle order) and, along a
+   * curve, each point's neighbours (2 per point: before and after it, as
+   * gm_curve_neighbours gives them).  Across ranks a corner or neighbour
+   * np + j (np the rank's points of the group) is the j-th ghost: a point
+   * of another rank, at mpm_par_ghost_x.  The rooms are the arrays'
+   * (across ranks they grow: tri 3 per triangle, inc_start and link 1 and
+   * 2 per point). */
+  long n_tris, *tri, *inc_start, *inc_tri, *link;
+  long tri_room, inc_room, point_room;
+  /* Across ranks: the whole group's links on one process (its points
+   * counted from `first`, the group's start there), from which a rank's
+   * are made whenever points move between ranks; each of the rank's
+   * triangles' index among the whole's (increasing). */
+  struct {
+    long first, n_points, n_tris, *tri, *inc_start, *inc_tri;
+  } whole;
+  long *tri_whole;
+  /* the group's bodies: points [begin, end) counted within the group on
+   * one process (the whole group's, across ranks), their links
+   * (MPM_LINKS_*) and normal method (pm_normals_method) */
   int n_bodies;
   struct membrane_body {
     int body;
@@ -98,8 +117,14 @@ static pm_err membrane_setup(mpm_group *g, const pm_scene_material *sm,
 static void membrane_release(mpm_group *g) {
   membrane_params *mp = g->params;
   if (!mp) return;
+  free(mp->tri);
   free(mp->inc_start);
   free(mp->inc_tri);
+  free(mp->link);
+  free(mp->whole.tri);
+  free(mp->whole.inc_start);
+  free(mp->whole.inc_tri);
+  free(mp->tri_whole);
   free(mp->bodies);
 }
 
@@ -186,21 +211,30 @@ double mpm_membrane_max_strain(const double e[3]) { return eps_max(e); }
 
 /* ---- normals and frames ------------------------------------------------- */
 
-/* Unit normals of triangles [t0, t1) from positions x into tn (3 each,
- * indexed t - t0); zero for a degenerate triangle. */
-static void triangle_normals(const mpm_model *m, const double *x, long t0,
-                             long t1, double *tn) {
-  const long *tri = m->tri;
+/* The position of link point c: the group's point c (positions xo, np of
+ * them) or ghost c - np (positions xg). */
+static inline const double *link_x(const double *xo, const double *xg, long np,
+                                   long c) {
+  return c < np ? xo + 3 * c : xg + 3 * (c - np);
+}
+
+/* Unit normals of the links' triangles into tn (3 each) from the
+ * positions of the group's np points xo and of the ghosts xg; zero for a
+ * degenerate triangle. */
+static void triangle_normals(const membrane_params *mp, const double *xo,
+                             const double *xg, long np, double *tn) {
+  const long *tri = mp->tri, nt = mp->n_tris;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(tri, x, t0, t1, tn))
-  for (long t = t0; t < t1; t++) {
-    const double *a = x + 3 * tri[3 * t], *b = x + 3 * tri[3 * t + 1],
-                 *c = x + 3 * tri[3 * t + 2];
+         shared(tri, nt, xo, xg, np, tn))
+  for (long t = 0; t < nt; t++) {
+    const double *a = link_x(xo, xg, np, tri[3 * t]),
+                 *b = link_x(xo, xg, np, tri[3 * t + 1]),
+                 *c = link_x(xo, xg, np, tri[3 * t + 2]);
     double u[3], v[3], n[3];
     for (int i = 0; i < 3; i++) u[i] = b[i] - a[i], v[i] = c[i] - a[i];
     pm_v_cross(u, v, n);
     double len = pm_v_norm(n);
-    for (int i = 0; i < 3; i++) tn[3 * (t - t0) + i] = len > 0 ? n[i] / len : 0;
+    for (int i = 0; i < 3; i++) tn[3 * t + i] = len > 0 ? n[i] / len : 0;
   }
 }
 
@@ -315,7 +349,20 @@ typedef struct {
   cell_point *cp; /* per point of a body */
   long *order;    /* the points in cell order */
   long *run;      /* start of each cell's points in order, and the end */
+  /* across ranks: a body's points with the nearby points of other ranks,
+   * in one-process order (3 each), their normals, and where each of the
+   * rank's points is among them */
+  double *xe, *ne;
+  long *at;
 } iso_work;
+
+/* Where a body's fits are made: the whole grid's nodes per axis (the
+ * cells' keys, which seed the fits' draws, count on the whole grid) and
+ * the cells whose points' normals are wanted, [lo, hi) per axis (a rank's
+ * own; the points in the cells around them serve the merged blocks). */
+typedef struct {
+  long nn[3], lo[3], hi[3];
+} iso_cells;
 
 static void iso_work_free(void *p) {
   iso_work *w = p;
@@ -330,6 +377,9 @@ static void iso_work_free(void *p) {
   free(w->cp);
   free(w->order);
   free(w->run);
+  free(w->xe);
+  free(w->ne);
+  free(w->at);
   free(w);
 }
 
@@ -349,6 +399,12 @@ static pm_err iso_work_create(const mpm_model *m, const mpm_group *g,
   PM_TRY(PM_ALLOC(w->order, n, "membrane points by cell"));
   PM_TRY(PM_ALLOC(w->run, n + 1, "membrane cells"));
   *bytes = sizeof *w + (size_t)n * (sizeof(cell_point) + 2 * sizeof(long));
+  if (m->par) {
+    PM_TRY(PM_ALLOC(w->xe, 3 * n, "membrane points with nearby ones"));
+    PM_TRY(PM_ALLOC(w->ne, 3 * n, "membrane points with nearby ones"));
+    PM_TRY(PM_ALLOC(w->at, n, "membrane points with nearby ones"));
+    *bytes += (size_t)n * (6 * sizeof(double) + sizeof(long));
+  }
   for (int t = 0; t < w->threads; t++) {
     for (int o = 0; o < 2; o++) {
       mpm_iso_config c = mpm_iso_config_default(m->dim, o + 1);
@@ -372,12 +428,14 @@ static int cell_point_cmp(const void *a, const void *b) {
   return (p->k > q->k) - (p->k < q->k);
 }
 
-/* The cell of x (indices of its lower node), its key. */
-static inline long cell_of(const mpm_grid *g, const double x[3], long c[3]) {
+/* The cell of x (indices of its lower node), its key on the whole grid
+ * of nn nodes per axis. */
+static inline long cell_of(const mpm_grid *g, const long nn[3],
+                           const double x[3], long c[3]) {
   c[2] = 0;
   for (int d = 0; d < g->dim; d++)
     c[d] = (long)floor((x[d] - g->origin[d]) * g->inv_h);
-  return c[0] + g->nn[0] * (c[1] + g->nn[1] * c[2]);
+  return c[0] + nn[0] * (c[1] + nn[1] * c[2]);
 }
 
 /* The points of the cell at key in cell order [*lo, *hi), found by
@@ -453,14 +511,17 @@ static void stats_add(iso_stats *a, const mpm_iso_report *r, long points) {
 }
 
 /* Normals nn (3 per point of the body, holding its previous normals on
- * entry) of the body's n points at x (3 each), by method, at step `step`. */
-static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
-                          long n, const double *x, long step, double *nn,
+ * entry) of the body's n points at x (3 each), by method, at step `step`,
+ * for the points in the cells [cells->lo, cells->hi). */
+static pm_err iso_normals(const mpm_grid *g, const iso_cells *cells,
+                          iso_work *w, int body, int method, long n,
+                          const double *x, long step, double *nn,
                           iso_stats *st) {
   const int dim = g->dim;
+  const long *gn = cells->nn;
   for (long k = 0; k < n; k++) {
     long c[3];
-    w->cp[k].key = cell_of(g, x + 3 * k, c);
+    w->cp[k].key = cell_of(g, gn, x + 3 * k, c);
     w->cp[k].k = k;
   }
   qsort(w->cp, (size_t)n, sizeof *w->cp, cell_point_cmp);
@@ -472,8 +533,8 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
   w->run[n_cells] = n;
   pm_err err = PM_SUCCESS;
   iso_stats sum = {0};
-  PM_OMP(parallel default(none) shared(g, w, body, method, n, x, step, nn,
-                                       n_cells, dim, err, sum)) {
+  PM_OMP(parallel default(none) shared(g, cells, gn, w, body, method, n, x,
+                                       step, nn, n_cells, dim, err, sum)) {
     iso_stats my = {0};
     iso_thread *th = &w->t[pm_omp_thread()];
     PM_OMP(for schedule(dynamic, 8))
@@ -481,7 +542,11 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
       const long r0 = w->run[ci], r1 = w->run[ci + 1], cnt = r1 - r0;
       const long key = w->cp[r0].key;
       long cell[3];
-      cell_of(g, x + 3 * w->order[r0], cell);
+      cell_of(g, gn, x + 3 * w->order[r0], cell);
+      bool wanted = true;
+      for (int d = 0; d < dim; d++)
+        wanted = wanted && cell[d] >= cells->lo[d] && cell[d] < cells->hi[d];
+      if (!wanted) continue; /* another rank's */
       int order = method == PM_NORMALS_ISO_LINEAR ? 1
                   : method == PM_NORMALS_ISO_QUADRATIC
                       ? 2
@@ -546,10 +611,10 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
               long q[3] = {first[0] + c0, first[1] + c1, first[2] + c2}, a, z;
               bool in = true;
               for (int d = 0; d < dim; d++)
-                if (q[d] < 0 || q[d] >= g->nn[d] - 1) in = false;
-              if (!in || !cell_range(w, n_cells,
-                                     q[0] + g->nn[0] * (q[1] + g->nn[1] * q[2]),
-                                     &a, &z))
+                if (q[d] < 0 || q[d] >= gn[d] - 1) in = false;
+              if (!in ||
+                  !cell_range(w, n_cells, q[0] + gn[0] * (q[1] + gn[1] * q[2]),
+                              &a, &z))
                 continue;
               for (long r = a; r < z; r++) th->gather[m++] = w->order[r];
             }
@@ -591,27 +656,84 @@ static pm_err iso_normals(const mpm_grid *g, iso_work *w, int body, int method,
 
 /* ---- normals of every body of the group ---------------------------------- */
 
+/* The first of the n increasing a[] that is at least v. */
+static long lower_bound(const long *a, long n, long v) {
+  long lo = 0, hi = n;
+  while (lo < hi) {
+    const long mid = lo + (hi - lo) / 2;
+    if (a[mid] < v)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* Across ranks, the fitted normals nn of body b's points of the rank
+ * (group points [b0, b1), positions x from the group's start): fitted with
+ * the nearby points of other ranks (those within the merged blocks' reach
+ * of the rank's cells), all in one-process order, so that each cell of
+ * the rank is fitted to the points, in the order, one process fits it
+ * to. */
+static pm_err iso_normals_ranks(const mpm_model *m, const mpm_group *gr,
+                                const struct membrane_body *b,
+                                const iso_cells *cells, iso_work *w, long b0,
+                                long b1, const double *x, long step, double *nn,
+                                iso_stats *st) {
+  const membrane_params *mp = gr->params;
+  const long *own = m->gid + gr->begin, *ids;
+  long n_near;
+  const double *xn = mpm_par_nearby(m, gr->index, &n_near, &ids);
+  const long j0 = lower_bound(ids, n_near, mp->whole.first + b->begin),
+             j1 = lower_bound(ids, n_near, mp->whole.first + b->end);
+  long e = 0;
+  for (long k = b0, j = j0; k < b1 || j < j1; e++) {
+    const bool mine = j >= j1 || (k < b1 && own[k] < ids[j]);
+    if (mine) {
+      memcpy(w->xe + 3 * e, x + 3 * k, 3 * sizeof(double));
+      memcpy(w->ne + 3 * e, nn + 3 * k, 3 * sizeof(double));
+      w->at[k++ - b0] = e;
+    } else {
+      memcpy(w->xe + 3 * e, xn + 3 * j++, 3 * sizeof(double));
+      memset(w->ne + 3 * e, 0, 3 * sizeof(double)); /* not read */
+    }
+  }
+  PM_CALL(iso_normals(&m->grid, cells, w, b->body, b->method, e, w->xe, step,
+                      w->ne, st));
+  for (long k = b0; k < b1; k++)
+    memcpy(nn + 3 * k, w->ne + 3 * w->at[k - b0], 3 * sizeof(double));
+  return PM_SUCCESS;
+}
+
 /* Each point's new unit normal into nn (3 per point of the group, holding
  * the previous normals n0 on entry; a point without one keeps n0), by its
- * body's method.  tn: 3 per triangle of the group. */
+ * body's method.  tn: 3 per triangle of the links.  The bodies' points are
+ * the model's (across ranks, the rank's), their neighbours on other ranks
+ * the ghosts. */
 static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
                             const double *x, long step, iso_work *iw,
                             double *tn, double *nn, iso_stats *st) {
   const membrane_params *mp = gr->params;
-  const long t0 = m->tri_begin[gr->index], t1 = m->tri_end[gr->index];
-  if (t1 > t0) triangle_normals(m, x, t0, t1, tn);
+  const long np = gr->end - gr->begin;
+  const double *xo = x + 3 * gr->begin, *xg = mpm_par_ghost_x(m, gr->index);
+  if (mp->n_tris > 0) triangle_normals(mp, xo, xg, np, tn);
   for (int bi = 0; bi < mp->n_bodies; bi++) {
     const struct membrane_body *b = &mp->bodies[bi];
-    const long n = b->end - b->begin;
-    const double *xb = x + 3 * (gr->begin + b->begin);
-    double *nb = nn + 3 * b->begin;
+    const long b0 = m->body_begin[b->body] - gr->begin,
+               b1 = m->body_end[b->body] - gr->begin;
     if (b->method != PM_NORMALS_CONNECTIVITY) {
-      PM_CALL(
-          iso_normals(&m->grid, iw, b->body, b->method, n, xb, step, nb, st));
+      iso_cells cells;
+      mpm_par_cells(m, cells.nn, cells.lo, cells.hi);
+      if (m->par)
+        PM_CALL(
+            iso_normals_ranks(m, gr, b, &cells, iw, b0, b1, xo, step, nn, st));
+      else
+        PM_CALL(iso_normals(&m->grid, &cells, iw, b->body, b->method, b1 - b0,
+                            xo + 3 * b0, step, nn + 3 * b0, st));
       continue;
     }
     if (b->links == MPM_LINKS_TRIANGLES) {
-      for (long k = b->begin; k < b->end; k++) {
+      for (long k = b0; k < b1; k++) {
         double n1[3];
         if (point_normal(mp, k, tn, n1)) memcpy(nn + 3 * k, n1, sizeof n1);
       }
@@ -619,7 +741,10 @@ static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
     }
     /* A curve: perpendicular to the chord of the neighbours (a point whose
      * chord vanishes gets 0, and the stress stage keeps its normal). */
-    gm_curve_normals(n, xb, b->links == MPM_LINKS_LOOP, nb);
+    const long *link = mp->link;
+    for (long k = b0; k < b1; k++)
+      gm_curve_normal(link_x(xo, xg, np, link[2 * k]),
+                      link_x(xo, xg, np, link[2 * k + 1]), nn + 3 * k);
   }
   return PM_SUCCESS;
 }
@@ -693,16 +818,29 @@ static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
     if (mb->method != PM_NORMALS_CONNECTIVITY) mp->iso = true;
     if (mb->end - mb->begin > mp->max_body) mp->max_body = mb->end - mb->begin;
   }
-  /* Incidence: each point's triangles, of the group's surface. */
-  long *local = NULL;
-  PM_TRY(mpm_triangles_local(m, t0, t1, g->begin, &local));
+  /* The links: the group's triangles, each point's (the surface's
+   * incidence), and along curves each point's neighbours. */
+  PM_TRY(mpm_triangles_local(m, t0, t1, g->begin, &mp->tri));
+  mp->n_tris = mp->tri_room = t1 - t0;
+  mp->point_room = np;
   gm_trisurf sf = {.n_points = np,
                    .x = s->x + 3 * g->begin,
                    .n_tris = t1 - t0,
-                   .tri = local};
-  ret = gm_trisurf_incidence(&sf, &mp->inc_start, &mp->inc_tri);
-  free(local);
-  if (ret) goto done;
+                   .tri = mp->tri};
+  PM_TRY(gm_trisurf_incidence(&sf, &mp->inc_start, &mp->inc_tri));
+  mp->inc_room = mp->inc_start[np];
+  PM_TRY(PM_ALLOC(mp->link, 2 * np + 1, "membrane curves"));
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    if (b->links != MPM_LINKS_CHAIN && b->links != MPM_LINKS_LOOP) continue;
+    for (long k = b->begin; k < b->end; k++) {
+      long prev, next;
+      gm_curve_neighbours(k - b->begin, b->end - b->begin,
+                          b->links == MPM_LINKS_LOOP, &prev, &next);
+      mp->link[2 * k] = b->begin + prev;
+      mp->link[2 * k + 1] = b->begin + next;
+    }
+  }
   PM_TRY(PM_ALLOC(tn, 3 * (t1 - t0) + 3, "triangle normals"));
   PM_TRY(PM_ALLOC(nn, 3 * np, "membrane normals"));
   PM_TRY(iso_work_create(m, g, &iw, &iw_bytes));
@@ -710,18 +848,18 @@ static pm_err membrane_finish(const mpm_model *m, mpm_group *g, mpm_state *s) {
    * normals where the body has connectivity, else away from its centre;
    * they are also the fit's previous normals. */
   PM_TRY(PM_ALLOC(ref, 3 * np, "membrane normals"));
-  const double *xg = s->x + 3 * g->begin;
-  if (t1 > t0) triangle_normals(m, s->x, t0, t1, tn);
+  const double *xo = s->x + 3 * g->begin;
+  if (t1 > t0) triangle_normals(mp, xo, NULL, np, tn);
   for (int bi = 0; bi < mp->n_bodies; bi++) {
     const struct membrane_body *b = &mp->bodies[bi];
     if (b->links == MPM_LINKS_CHAIN || b->links == MPM_LINKS_LOOP)
-      gm_curve_normals(b->end - b->begin, xg + 3 * b->begin,
+      gm_curve_normals(b->end - b->begin, xo + 3 * b->begin,
                        b->links == MPM_LINKS_LOOP, ref + 3 * b->begin);
     double c[3];
-    body_centre(xg, b, c);
+    body_centre(xo, b, c);
     for (long k = b->begin; k < b->end; k++) {
       if (b->links == MPM_LINKS_TRIANGLES) point_normal(mp, k, tn, ref + 3 * k);
-      if (!(pm_v_norm(ref + 3 * k) > 0.5)) away_from(xg, c, k, ref + 3 * k);
+      if (!(pm_v_norm(ref + 3 * k) > 0.5)) away_from(xo, c, k, ref + 3 * k);
     }
   }
   memcpy(nn, ref, sizeof(double) * 3 * (size_t)np);
@@ -756,10 +894,163 @@ done:
   return ret;
 }
 
-/* Doubles of step workspace: each point's new normal, each triangle's. */
+/* Doubles of step workspace: each point's new normal, each triangle's
+ * (across ranks, room for as many as the arrays have). */
 static long membrane_scratch(const mpm_model *m, const mpm_group *g) {
-  return 3 * (g->end - g->begin) +
-         3 * (m->tri_end[g->index] - m->tri_begin[g->index]);
+  (void)m;
+  const membrane_params *mp = g->params;
+  const long np = g->end - g->begin;
+  return 3 * (g->cap > np ? g->cap : np) + 3 * mp->tri_room;
+}
+
+/* ---- across ranks ---------------------------------------------------------
+ * A rank's points of the group read their neighbours' positions: the
+ * points of its triangles, and along a curve the points before and after
+ * them.  Those on other ranks are ghosts (mpm_par.h sends their positions
+ * after every step's migration); the links are made anew from the whole
+ * group's whenever points move between ranks. */
+
+/* Room for n longs in *a (room *room), kept when it suffices. */
+static pm_err room_for_longs(long **a, long *room, long n, const char *what) {
+  if (n <= *room && *a) return PM_SUCCESS;
+  const long r = n + n / 4 + 16;
+  PM_CALL(PM_REALLOC(*a, r, what));
+  *room = r;
+  return PM_SUCCESS;
+}
+
+static int long_cmp(const void *a, const void *b) {
+  const long x = *(const long *)a, y = *(const long *)b;
+  return (x > y) - (x < y);
+}
+
+/* Sort n longs and drop repeats; returns how many are left. */
+static long sort_unique(long *a, long n) {
+  if (n == 0) return 0;
+  qsort(a, (size_t)n, sizeof *a, long_cmp);
+  long k = 1;
+  for (long i = 1; i < n; i++)
+    if (a[i] != a[k - 1]) a[k++] = a[i];
+  return k;
+}
+
+/* The place of v in the sorted a[0, n), or -1. */
+static long find_long(const long *a, long n, long v) {
+  const long *f = bsearch(&v, a, (size_t)n, sizeof *a, long_cmp);
+  return f ? f - a : -1;
+}
+
+static pm_err membrane_ranks_share(const mpm_group *whole, mpm_group *g) {
+  const membrane_params *wp = whole->params;
+  membrane_params *mp = g->params;
+  const long np = whole->end - whole->begin;
+  PM_CALL(PM_ALLOC(mp->bodies, wp->n_bodies + 1, "membrane bodies"));
+  memcpy(mp->bodies, wp->bodies, sizeof *wp->bodies * (size_t)wp->n_bodies);
+  mp->n_bodies = wp->n_bodies;
+  mp->iso = wp->iso;
+  mp->max_body = wp->max_body;
+  mp->whole.first = whole->begin;
+  mp->whole.n_points = np;
+  mp->whole.n_tris = wp->n_tris;
+  PM_CALL(PM_ALLOC(mp->whole.tri, 3 * wp->n_tris + 1, "membrane triangles"));
+  PM_CALL(PM_ALLOC(mp->whole.inc_start, np + 1, "membrane incidence"));
+  PM_CALL(
+      PM_ALLOC(mp->whole.inc_tri, wp->inc_start[np] + 1, "membrane incidence"));
+  memcpy(mp->whole.tri, wp->tri, sizeof(long) * 3 * (size_t)wp->n_tris);
+  memcpy(mp->whole.inc_start, wp->inc_start, sizeof(long) * (size_t)(np + 1));
+  memcpy(mp->whole.inc_tri, wp->inc_tri,
+         sizeof(long) * (size_t)wp->inc_start[np]);
+  return PM_SUCCESS;
+}
+
+/* The link point of the whole group's point q: the rank's point (from the
+ * group's start; its points' one-process indices own[0, np), increasing)
+ * or np + its place among the ghosts want[0, nw). */
+static long link_of(const long *own, long np, const long *want, long nw,
+                    long q) {
+  long k = find_long(own, np, q);
+  return k >= 0 ? k : np + find_long(want, nw, q);
+}
+
+static pm_err membrane_ranks_link(const mpm_model *m, mpm_group *g, long **want,
+                                  long *room, long *n_want) {
+  membrane_params *mp = g->params;
+  const long np = g->end - g->begin, first = mp->whole.first;
+  const long *own = m->gid + g->begin, *ws = mp->whole.inc_start,
+             *wi = mp->whole.inc_tri, *wt = mp->whole.tri;
+  /* The triangles of the rank's points, by their index in the whole. */
+  long nt = 0;
+  for (long k = 0; k < np; k++)
+    nt += ws[own[k] - first + 1] - ws[own[k] - first];
+  const long ni = nt; /* the incidence's entries */
+  const long tri_room = mp->tri_room;
+  PM_CALL(
+      room_for_longs(&mp->tri_whole, &mp->tri_room, nt, "membrane triangles"));
+  if (mp->tri_room != tri_room || !mp->tri)
+    PM_CALL(PM_REALLOC(mp->tri, 3 * mp->tri_room, "membrane triangles"));
+  if (np > mp->point_room || !mp->link) {
+    const long r = np + np / 4 + 16;
+    PM_CALL(PM_REALLOC(mp->link, 2 * r, "membrane curves"));
+    PM_CALL(PM_REALLOC(mp->inc_start, r + 1, "membrane incidence"));
+    mp->point_room = r;
+  }
+  PM_CALL(
+      room_for_longs(&mp->inc_tri, &mp->inc_room, ni, "membrane incidence"));
+  nt = 0;
+  for (long k = 0; k < np; k++)
+    for (long j = ws[own[k] - first]; j < ws[own[k] - first + 1]; j++)
+      mp->tri_whole[nt++] = wi[j];
+  nt = sort_unique(mp->tri_whole, nt);
+  /* The ghosts: their corners and the curves' neighbours that are not the
+   * rank's, by one-process index. */
+  PM_CALL(room_for_longs(want, room, 3 * nt + 2 * np, "membrane ghosts"));
+  long nw = 0;
+  for (long t = 0; t < nt; t++)
+    for (int c = 0; c < 3; c++) {
+      const long q = first + wt[3 * mp->tri_whole[t] + c];
+      if (find_long(own, np, q) < 0) (*want)[nw++] = q;
+    }
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    if (b->links != MPM_LINKS_CHAIN && b->links != MPM_LINKS_LOOP) continue;
+    const long b0 = m->body_begin[b->body] - g->begin,
+               b1 = m->body_end[b->body] - g->begin;
+    for (long k = b0; k < b1; k++) {
+      long prev, next;
+      gm_curve_neighbours(own[k] - first - b->begin, b->end - b->begin,
+                          b->links == MPM_LINKS_LOOP, &prev, &next);
+      mp->link[2 * k] = first + b->begin + prev; /* one-process, for now */
+      mp->link[2 * k + 1] = first + b->begin + next;
+      for (int e = 0; e < 2; e++)
+        if (find_long(own, np, mp->link[2 * k + e]) < 0)
+          (*want)[nw++] = mp->link[2 * k + e];
+    }
+  }
+  nw = sort_unique(*want, nw);
+  *n_want = nw;
+  /* The triangles' corners, the incidence and the curves' neighbours as
+   * link points. */
+  for (long t = 0; t < nt; t++)
+    for (int c = 0; c < 3; c++)
+      mp->tri[3 * t + c] =
+          link_of(own, np, *want, nw, first + wt[3 * mp->tri_whole[t] + c]);
+  mp->n_tris = nt;
+  long at = 0;
+  for (long k = 0; k < np; k++) {
+    mp->inc_start[k] = at;
+    for (long j = ws[own[k] - first]; j < ws[own[k] - first + 1]; j++)
+      mp->inc_tri[at++] = find_long(mp->tri_whole, nt, wi[j]);
+  }
+  mp->inc_start[np] = at;
+  for (int bi = 0; bi < mp->n_bodies; bi++) {
+    const struct membrane_body *b = &mp->bodies[bi];
+    if (b->links != MPM_LINKS_CHAIN && b->links != MPM_LINKS_LOOP) continue;
+    for (long k = m->body_begin[b->body] - g->begin;
+         k < m->body_end[b->body] - g->begin; k++)
+      for (int e = 0; e < 2; e++)
+        mp->link[2 * k + e] = link_of(own, np, *want, nw, mp->link[2 * k + e]);
+  }
+  return PM_SUCCESS;
 }
 
 /* The normal stage: each point's new normal into the group's workspace. */
@@ -776,13 +1067,31 @@ static pm_err membrane_normals(mpm_ctx *ctx, const mpm_stage *self) {
     for (int d = 0; d < 3; d++) nn[3 * k + d] = frame[9 * k + 6 + d];
   iso_stats st = {0};
   pm_err e = group_normals(m, gr, s->x, s->step, w->kind_work[gi], tn, nn, &st);
+  /* Across ranks each cell is fitted by one rank: the fits' figures are
+   * the ranks' summed (every rank then keeps the run's, as one process). */
+  double v[8] = {(double)st.cells[0], (double)st.cells[1],
+                 (double)st.cells[2], (double)st.cells[3],
+                 (double)st.points,   (double)st.degenerate,
+                 (double)st.draws,    st.max_condition};
+  if (m->par && ((const membrane_params *)gr->params)->iso) {
+    pm_par_sum(v, 7);
+    pm_par_max(v + 7, 1);
+  }
   if (e) return e;
-  for (int i = 0; i < 4; i++) s->iso.cells[i] += (double)st.cells[i];
-  s->iso.points += (double)st.points;
-  s->iso.degenerate += (double)st.degenerate;
-  s->iso.draws += (double)st.draws;
-  s->iso.max_condition = st.max_condition;
+  for (int i = 0; i < 4; i++) s->iso.cells[i] += v[i];
+  s->iso.points += v[4];
+  s->iso.degenerate += v[5];
+  s->iso.draws += v[6];
+  s->iso.max_condition = v[7];
   return PM_SUCCESS;
+}
+
+/* Across ranks, the cells around a rank's whose points its fits read: a
+ * merged block of up to 2^ISO_MERGE_LEVELS cells a side reaches that many
+ * less one beyond the cell it fits. */
+static int membrane_ranks_reach(const mpm_group *g) {
+  const membrane_params *mp = g->params;
+  return mp->iso ? (1 << ISO_MERGE_LEVELS) - 1 : 0;
 }
 
 /* ---- the stage ---------------------------------------------------------- */
@@ -945,6 +1254,9 @@ const mpm_kind mpm_kind_membrane = {
     .seed = membrane_seed,
     .finish = membrane_finish,
     .scratch = membrane_scratch,
+    .ranks_share = membrane_ranks_share,
+    .ranks_link = membrane_ranks_link,
+    .ranks_reach = membrane_ranks_reach,
     .work_create = iso_work_create,
     .work_free = iso_work_free,
     .pre_stress = membrane_normals,

@@ -15,6 +15,8 @@
 typedef struct {
   int body; /* scene body */
   long begin, end;
+  long first; /* its first particle's index on one process (across ranks,
+                 the particles [begin, end) are the rank's share) */
   const pm_expr *v[3];
 } mpm_motion;
 

@@ -1,5 +1,6 @@
 /* mpm_par: the decomposition, each rank's share of the model, the node sums
- * on a PETSc DMDA, particle migration and the gather to rank 0. */
+ * on a PETSc star forest, particle migration (and the ghosts of linked
+ * points after it) and the gather to rank 0. */
 #include "mpm_par.h"
 
 #include <math.h>
@@ -8,7 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpm_grid_stages.h"
 #include "mpm_kind.h"
+#include "mpm_par_ghosts.h"
 #include "mpm_transfer.h"
 #include "pm_omp.h"
 #include "pm_par.h"
@@ -64,6 +67,12 @@ struct mpm_par {
   long *order;               /* per new particle: old index, or -(k + 1) for
                                 the k-th record received */
   double *tmp;               /* room x width: one array's new order */
+  /* the ghosts of linked points (membranes' neighbours on other ranks),
+   * and what the last migration did to them: linked points that left
+   * this rank, and whether its particles changed */
+  mpm_ghosts *gh;
+  long linked_left;
+  bool reordered;
   /* gather (rank 0 holds the whole run's buffers) */
   double *accounts; /* every rank's energy accounts, on rank 0 */
   long *ggid;
@@ -337,20 +346,6 @@ done:
  */
 
 pm_err mpm_par_check(const pm_scene *s) {
-  char key[64];
-  for (int b = 0; b < s->n_bodies; b++) {
-    if (s->bodies[b].shape == PM_BODY_MEMBRANE)
-      return pm_scene_fail(s, PM_PATH(key, "bodies.%d.membrane", b), true,
-                           "membranes run on one process (this run has %d "
-                           "ranks): run without mpirun, or with -np 1",
-                           pm_par_size());
-    if (s->bodies[b].moving)
-      return pm_scene_fail(s, PM_PATH(key, "bodies.%d.motion", b), true,
-                           "bodies moving as prescribed run on one process "
-                           "(this run has %d ranks): run without mpirun, or "
-                           "with -np 1",
-                           pm_par_size());
-  }
   if (mpm_scene_settings(s)->fbar == MPM_FBAR_PATCH)
     return pm_scene_fail(s, "mpm.fbar", false,
                          "F-bar over node patches runs on one process (this "
@@ -419,6 +414,10 @@ static void set_ranges(mpm_model *m, mpm_state *s) {
   for (int b = 0; b < m->n_bodies; b++) {
     m->body_begin[b] = first_at_least(m->gid, m->n, P->bbegin[b]);
     m->body_end[b] = first_at_least(m->gid, m->n, P->bend[b]);
+  }
+  for (int k = 0; k < m->n_moving; k++) {
+    m->moving[k].begin = m->body_begin[m->moving[k].body];
+    m->moving[k].end = m->body_end[m->moving[k].body];
   }
   for (int gi = 0; gi < m->n_groups; gi++) {
     mpm_group *g = &m->group[gi];
@@ -572,6 +571,7 @@ static pm_err local_model(const pm_scene *s, const mpm_model *m,
     g->end = at;
     g->cap = room_for(g->end - g->begin);
     PM_TRY(g->kind->setup(g, &s->materials[g->material], &lm->opt));
+    if (g->kind->ranks_share) PM_TRY(g->kind->ranks_share(fg, g));
   }
   lm->n_bodies = m->n_bodies;
   P->n_full = m->n;
@@ -591,6 +591,12 @@ static pm_err local_model(const pm_scene *s, const mpm_model *m,
   }
   PM_TRY(mpm_conditions_create(s, &lm->grid, &lm->bcs, &lm->n_bcs));
   lm->has_absorbing = m->has_absorbing;
+  /* Bodies moving as prescribed: their ranges are set with the bodies'. */
+  if (m->n_moving > 0) {
+    PM_TRY(PM_ALLOC(lm->moving, m->n_moving, "moving bodies"));
+    memcpy(lm->moving, m->moving, sizeof *m->moving * (size_t)m->n_moving);
+    lm->n_moving = m->n_moving;
+  }
   mpm_pipeline_build(lm);
   lm->par = P;
   set_ranges(lm, NULL);
@@ -703,6 +709,8 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   PM_TRY(pm_par_agree(ret));
   struct mpm_par *Q = lm->par;
   PM_TRY(make_near(Q, m));
+  PM_TRY(mpm_ghosts_create(lm, ls, &Q->d, Q->gbegin, Q->gend, Q->near,
+                           Q->n_near, &Q->gh));
   Q->rec = record_doubles(lm, &Q->width);
   const long room = mpm_model_room(lm);
   PM_TRY(PM_ALLOC(Q->dest, room, "migration ranks"));
@@ -747,6 +755,7 @@ void mpm_par_destroy(struct mpm_par *P) {
   }
   free(P->nodal);
   free(P->whole);
+  mpm_ghosts_destroy(P->gh);
   if (P->near_of) MPI_Comm_free(&P->near);
   free(P->near_of);
   mpm_decomp_destroy(&P->d);
@@ -839,10 +848,13 @@ static void count_ghosts(const mpm_model *m, MPI_Datatype unit) {
 pm_err mpm_par_nodes_reduce(const mpm_model *m, void *a, MPI_Datatype unit,
                             MPI_Op op) {
   PetscSF sf = m->par->ghosts;
+  const double t0 = pm_wtime();
   count_ghosts(m, unit);
   PM_PETSC_CALL(PetscSFReduceBegin(sf, unit, a, a, op));
   PM_PETSC_CALL(PetscSFReduceEnd(sf, unit, a, a, op));
-  return mpm_par_nodes_bcast(m, a, unit);
+  pm_err e = mpm_par_nodes_bcast(m, a, unit);
+  m->par->counts.halo_seconds += pm_wtime() - t0;
+  return e;
 }
 
 pm_err mpm_par_nodes_bcast(const mpm_model *m, void *a, MPI_Datatype unit) {
@@ -938,11 +950,15 @@ static void permute(const struct mpm_par *P, double *data, long n_new, int nc,
   memcpy(data, tmp, sizeof(double) * (size_t)(n_new * nc));
 }
 
-pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
+/* The particles' move between ranks (collective; every rank returns the
+ * same). */
+static pm_err move_particles(mpm_model *m, mpm_state *s, mpm_work *w) {
   struct mpm_par *P = m->par;
   const int n_near = P->n_near, rec = P->rec;
   const double t0 = pm_wtime();
   pm_err ret = PM_SUCCESS;
+  P->linked_left = 0;
+  P->reordered = false;
   pm_timers_start(&w->timers, w->timer_migrate);
   /* Where each particle goes. */
   memset(P->scount, 0, sizeof(int) * (size_t)(n_near + 1));
@@ -980,9 +996,11 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   for (int k = 0; k < n_near; k++) P->scount[k] = 0;
   for (int gi = 0; leaving > 0 && gi < m->n_groups; gi++) {
     const mpm_group *g = &m->group[gi];
+    const bool linked = g->kind->ranks_link != NULL;
     for (long p = g->begin; p < g->end; p++) {
       const int r = P->dest[p];
       if (r < 0) continue;
+      P->linked_left += linked;
       double *q = P->sbuf + (long)(P->sdisp[r] + P->scount[r]++) * rec;
       q[REC_GID] = (double)m->gid[p];
       q[REC_GROUP] = gi;
@@ -1016,6 +1034,7 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   P->counts.migrate_bytes += (double)leaving * rec * sizeof(double);
   pm_par_count_sent((double)leaving * rec * sizeof(double));
   if (leaving == 0 && arriving == 0) goto done;
+  P->reordered = true;
   /* The new order: those that stay and those that came, by index. */
   qsort(P->rbuf, (size_t)arriving, (size_t)rec * sizeof(double), by_gid);
   const long n_new = m->n - leaving + arriving;
@@ -1095,6 +1114,71 @@ done:
   pm_timers_stop(&w->timers, w->timer_migrate);
   P->counts.migrate_seconds += pm_wtime() - t0;
   return pm_par_agree(ret);
+}
+
+/* Room in each group's step workspace for what its kind needs now (its
+ * particles, a membrane's triangles). */
+static pm_err grow_scratch(const mpm_model *m, mpm_work *w) {
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    const long need = g->kind->scratch ? g->kind->scratch(m, g) : 0;
+    if (need <= w->n_scratch[gi]) continue;
+    PM_CALL(PM_REALLOC(w->scratch[gi], need, "kind workspace"));
+    w->n_scratch[gi] = need;
+  }
+  return PM_SUCCESS;
+}
+
+pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
+  struct mpm_par *P = m->par;
+  PM_CALL(move_particles(m, s, w));
+  if (!P->gh) return PM_SUCCESS;
+  /* The ghosts: their links anew when a linked point moved between any
+   * two ranks, and their positions after this step's move. */
+  const double t0 = pm_wtime();
+  pm_timers_start(&w->timers, w->timer_migrate);
+  long moved = P->linked_left;
+  pm_par_sum_long(&moved, 1);
+  const double sent = mpm_ghosts_bytes(P->gh);
+  pm_err e = mpm_ghosts_update(P->gh, m, s, moved > 0, P->reordered);
+  if (!e) e = pm_par_agree(grow_scratch(m, w));
+  P->counts.ghost_bytes += mpm_ghosts_bytes(P->gh) - sent;
+  pm_par_count_sent(mpm_ghosts_bytes(P->gh) - sent);
+  pm_timers_stop(&w->timers, w->timer_migrate);
+  P->counts.migrate_seconds += pm_wtime() - t0;
+  return e;
+}
+
+const double *mpm_par_ghost_x(const mpm_model *m, int gi) {
+  return m->par ? mpm_ghosts_x(m->par->gh, gi) : NULL;
+}
+
+const double *mpm_par_nearby(const mpm_model *m, int gi, long *n,
+                             const long **ids) {
+  if (m->par) return mpm_ghosts_nearby(m->par->gh, gi, n, ids);
+  *n = 0;
+  *ids = NULL;
+  return NULL;
+}
+
+void mpm_par_cells(const mpm_model *m, long nn[3], long lo[3], long hi[3]) {
+  for (int a = 0; a < 3; a++) {
+    if (m->par) {
+      const mpm_decomp *d = &m->par->d;
+      nn[a] = a < m->dim ? d->cells[a] + 1 : 1;
+      lo[a] = d->box[6 * m->par->rank + a];
+      hi[a] = d->box[6 * m->par->rank + 3 + a];
+    } else {
+      nn[a] = m->grid.nn[a];
+      lo[a] = 0;
+      hi[a] = a < m->dim ? m->grid.nn[a] - 1 : 1;
+    }
+  }
+}
+
+const long *mpm_par_ghost_ids(const mpm_model *m, int gi, long *n) {
+  *n = m->par ? mpm_ghosts_count(m->par->gh, gi) : 0;
+  return m->par ? mpm_ghosts_ids(m->par->gh, gi) : NULL;
 }
 
 /* ---- gather to rank 0 -------------------------------------------------------
@@ -1270,6 +1354,11 @@ static int node_values_per_step(const mpm_model *m) {
     if (stg->run == mpm_stage_p2g)
       v += dof_of(stg->mode, m->has_absorbing && (stg->mode & MPM_P2G_FORCE));
     if (stg->run == mpm_stage_remap) v += dof_of(MPM_P2G_MOM, false);
+    /* each moving body's mass at the nodes, in the update (and before
+     * the stress with USF) */
+    if (stg->run == mpm_stage_grid_update ||
+        stg->run == mpm_stage_grid_velocity)
+      v += m->n_moving;
   }
   return v;
 }
@@ -1326,23 +1415,35 @@ void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out) {
 void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
   const struct mpm_par *P = m->par;
   const int size = P->d.size;
-  /* Per rank: particles, nodes held, nodes owned, bytes. */
-  double mine[4] = {
+  /* Per rank: particles, nodes held, nodes owned, bytes, ghost points. */
+  double ghosts = 0;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    long nearby;
+    const long *ids;
+    mpm_ghosts_nearby(P->gh, gi, &nearby, &ids);
+    ghosts += (double)(mpm_ghosts_count(P->gh, gi) + nearby);
+  }
+  double mine[5] = {
       (double)m->n, (double)m->grid.n_nodes, (double)P->n_owned,
-      (double)(mpm_model_bytes(m) + (w ? mpm_work_bytes(m, w) : 0))};
+      (double)(mpm_model_bytes(m) + (w ? mpm_work_bytes(m, w) : 0)), ghosts};
   double *all = NULL;
-  if (P->rank == 0) all = calloc((size_t)size * 4, sizeof(double));
-  MPI_Gather(mine, 4, MPI_DOUBLE, all, 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (P->rank == 0) all = calloc((size_t)size * 5, sizeof(double));
+  MPI_Gather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (P->rank != 0 || !out || !all) {
     free(all);
     return;
   }
   mpm_decomp_print(&P->d, m, out);
-  fprintf(out, "             rank  particles  nodes (owned + ghost)  memory\n");
+  const bool linked = P->gh != NULL;
+  fprintf(out,
+          "             rank  particles  nodes (owned + ghost)  memory%s\n",
+          linked ? "  ghost points (of membranes)" : "");
   for (int r = 0; r < size; r++) {
-    const double *v = all + 4 * r;
-    fprintf(out, "             %4d  %9.0f  %9.0f (%.0f + %.0f)  %.1f MiB\n", r,
+    const double *v = all + 5 * r;
+    fprintf(out, "             %4d  %9.0f  %9.0f (%.0f + %.0f)  %.1f MiB", r,
             v[0], v[1], v[2], v[1] - v[2], v[3] / 1048576.0);
+    if (linked) fprintf(out, "  %.0f", v[4]);
+    fprintf(out, "\n");
   }
   free(all);
 }

@@ -20,7 +20,15 @@
  *  - after the move, particles that left the rank's cells go to the rank
  *    that owns their cell, with every array they carry; a rank's
  *    particles stay in increasing order of their index on one process, so
- *    groups and bodies stay contiguous.
+ *    groups and bodies stay contiguous;
+ *  - particles that read others of their group (a membrane point's normal
+ *    reads its neighbours', or the points of the cells around its own
+ *    when it is fitted per cell) get the positions of those on other
+ *    ranks, the ghosts, once a step after the migration
+ *    (mpm_par_ghosts.h); the links among them are made anew when a linked
+ *    point changed rank;
+ *  - a body moving as prescribed sums its mass at the nodes over the
+ *    ranks before it sets their velocities.
  * Rank 0 also keeps the whole model and gathers the state into it when
  * the run writes (frames, history, checkpoints): the output of a run
  * across ranks is that of one process, in the same order.
@@ -141,9 +149,30 @@ const unsigned char *mpm_par_owned(const mpm_model *m);
 void mpm_par_step_end(const mpm_model *m, mpm_work *w);
 
 /* Send the particles that left this rank's cells to their cells' ranks and
- * take in those that arrived (collective).  The arrays grow when a rank
- * holds more than they have room for.  PM_ERR_MEMORY. */
+ * take in those that arrived, then bring the ghosts of linked points (a
+ * membrane's neighbours on other ranks: mpm_par_ghosts.h) up to date
+ * (collective).  The arrays grow when a rank holds more than they have
+ * room for.  PM_ERR_MEMORY; PM_ERR_UNSTABLE when a particle moved farther
+ * than the next boxes, or a linked point's neighbour is on a rank farther
+ * than those. */
 pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w);
+
+/* The positions of group gi's ghosts (3 each; NULL on one process and for
+ * a group without them): the points of other ranks that this rank's points
+ * of the group are linked to, in the order the kind's ranks_link gave. */
+const double *mpm_par_ghost_x(const mpm_model *m, int gi);
+/* Their one-process indices (increasing), n of them (NULL and 0 without). */
+const long *mpm_par_ghost_ids(const mpm_model *m, int gi, long *n);
+/* Group gi's nearby points of other ranks (those within its kind's reach,
+ * mpm_kind.ranks_reach, of this rank's cells): positions (3 each), their
+ * one-process indices (increasing) in *ids, *n of them (NULL and 0 on one
+ * process and for a group without a reach). */
+const double *mpm_par_nearby(const mpm_model *m, int gi, long *n,
+                             const long **ids);
+/* The whole grid's nodes per axis nn (1 along z in 2-D), and the cells
+ * whose particles this rank holds, [lo, hi) per axis (on one process the
+ * whole grid's). */
+void mpm_par_cells(const mpm_model *m, long nn[3], long lo[3], long hi[3]);
 
 /* Gather the state of every rank into the whole model's state full_state
  * on rank 0 (NULL on the others), in the order of one process: particles,
@@ -177,7 +206,8 @@ void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out);
  * seconds they took, over the run so far (summary.json). */
 typedef struct {
   double halo_bytes, halo_seconds;       /* node sums */
-  double migrate_bytes, migrate_seconds; /* particles */
+  double migrate_bytes, migrate_seconds; /* particles (and ghosts' seconds) */
+  double ghost_bytes;                    /* linked points' ghosts */
   long migrated;                         /* particles sent */
   long grown;                            /* times the arrays grew */
 } mpm_par_counts;

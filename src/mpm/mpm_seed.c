@@ -455,7 +455,7 @@ static pm_err make_lists(seed_ctx *c) {
     if (!body->moving || c->count[b] == 0) continue;
     mpm_motion *mv = &m->moving[k++];
     mv->body = b;
-    mv->begin = m->body_begin[b];
+    mv->begin = mv->first = m->body_begin[b];
     mv->end = m->body_end[b];
     for (int d = 0; d < 3; d++) mv->v[d] = body->motion[d];
   }

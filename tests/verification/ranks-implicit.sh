@@ -41,8 +41,11 @@ echo "I2 interrupted on 2 ranks after $(($(wc -l <"$work/cut/history.csv") - 1))
 resume_on "$work/cut" 1 2 3
 check "I2 interrupted on 2 ranks, resumed on 2: the run of 2 ranks, bit for bit" \
   $same "$work/j-2" "$work/cut-2"
+# (CG on other ranks may take an iteration more or less: a count, held to
+# no bound)
 for n in 1 3; do
-  roundoff "I2 interrupted on 2 ranks, resumed on $n" "$work/j-1" "$work/cut-$n"
+  bounds="linear_iterations=inf" roundoff \
+    "I2 interrupted on 2 ranks, resumed on $n" "$work/j-1" "$work/cut-$n"
 done
 
 # What runs on one process only is refused, naming the key, before

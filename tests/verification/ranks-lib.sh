@@ -1,5 +1,5 @@
 # Shared by the verification tests across MPI ranks (ranks.sh, ranks-fpm.sh,
-# ranks-implicit.sh),
+# ranks-implicit.sh, ranks-membranes.sh),
 # sourced after lib.sh with $bin and $src set: runs on N ranks, each with one
 # OpenMP thread, ranks waiting in a collective yielding their core
 # (mpi_yield_when_idle: more ranks than cores otherwise spin against each
@@ -10,6 +10,7 @@ export OMP_NUM_THREADS=1
 py=/usr/bin/python3
 same="$py $src/tests/verification/same_results.py"
 tol=1e-10
+mpm=$src/cases/mpm
 
 ranks() { # N, command...
   local n=$1

@@ -19,7 +19,6 @@ src=$2
 migrate=$3
 . "$(dirname "$0")/lib.sh"
 . "$(dirname "$0")/ranks-lib.sh"
-mpm=$src/cases/mpm
 
 # The shock tube (3-D, pressure ratio 1000, cut along x between its
 # walls), the disks (2-D: 2, 3 and 4 boxes, each disk's particles shared
@@ -82,9 +81,10 @@ fails_alike left-the-grid 2 'step [0-9]*, .*left the grid' \
   "$mpm/disks-collision.yaml" --set "bodies.1.velocity=[3,3]"
 
 # What runs on one process only is refused, naming the key; nothing written.
-refused "a membrane on 2 ranks" "membrane: membranes run on one process" \
-  "$work/mem-2" ranks 2 "$bin" run "$mpm/m3-gas-box-membrane.yaml" \
-  --out "$work/mem-2"
+refused "F-bar over node patches on 2 ranks" \
+  "mpm.fbar: F-bar over node patches runs on one process" \
+  "$work/patch-2" ranks 2 "$bin" run "$mpm/locking-beam.yaml" \
+  --out "$work/patch-2"
 refused "convergence on 2 ranks" "convergence runs on one process" \
   "$work/conv-2" ranks 2 "$bin" convergence "$mpm/disks-collision.yaml" \
   --set-ladder discretization.mesh_size=0.1,0.05 --out "$work/conv-2"

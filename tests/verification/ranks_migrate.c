@@ -8,15 +8,26 @@
  *  - the state gathered in one-process order (positions, velocities,
  *    volumes, stresses, each group's arrays) and the total mass and
  *    momentum summed in that order are the same before and after the
- *    migration, bit for bit.
- * Usage: ranks_migrate SCENE STEPS [KEY=VALUE...]; prints a line per check
- * and exits 0 when all hold. */
+ *    migration, bit for bit;
+ *  - with membranes, every rank's ghosts are exactly the points of other
+ *    ranks that its membrane points are linked to (the other corners of
+ *    every triangle it has a corner of, the neighbours along a curve),
+ *    each held by one other rank, at that rank's position bit for bit:
+ *    every triangle's three points found; and where a membrane's normals
+ *    are fitted per cell, its nearby points are exactly the points of
+ *    other ranks in the cells within the fits' reach of the rank's box.  It
+ * prints how many triangles (or a curve's segments) span two ranks or more and
+ * how many membrane points moved. Usage: ranks_migrate SCENE STEPS
+ * [KEY=VALUE...]; prints a line per check and exits 0 when all hold. */
+#include <math.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "gm_curve.h"
 #include "mpm_backend.h"
+#include "mpm_kind.h"
 #include "mpm_par.h"
 #include "pm_app.h"
 #include "pm_par.h"
@@ -46,6 +57,91 @@ static double *snapshot(const mpm_model *m, const mpm_state *s, long *len) {
   }
   *len = n;
   return copy;
+}
+
+static int long_cmp(const void *a, const void *b) {
+  const long x = *(const long *)a, y = *(const long *)b;
+  return (x > y) - (x < y);
+}
+
+/* Whether this rank's ghosts of every linked group are the points of other
+ * ranks its points are linked to in the one-process model ref (mine: 1
+ * where this rank holds the particle), at positions x (the whole run's,
+ * in one-process order). */
+static bool ghosts_right(const mpm_model *m, const mpm_model *ref,
+                         const char *mine, const double *x) {
+  bool ok = true;
+  long *need =
+      malloc(sizeof(long) * (size_t)(6 * ref->n_tris + 2 * ref->n + 1));
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    if (!m->group[gi].kind->ranks_link) continue;
+    long n_need = 0, n;
+    for (long t = ref->tri_begin[gi]; t < ref->tri_end[gi]; t++) {
+      const long *c = ref->tri + 3 * t;
+      if (!mine[c[0]] && !mine[c[1]] && !mine[c[2]]) continue;
+      for (int k = 0; k < 3; k++)
+        if (!mine[c[k]]) need[n_need++] = c[k];
+    }
+    for (int b = 0; b < ref->n_bodies; b++) {
+      const long b0 = ref->body_begin[b], nb = ref->body_end[b] - b0;
+      const int links = ref->body_links[b];
+      if (b0 < ref->group[gi].begin || b0 >= ref->group[gi].end ||
+          (links != MPM_LINKS_CHAIN && links != MPM_LINKS_LOOP))
+        continue;
+      for (long k = 0; k < nb; k++) {
+        long prev, next;
+        gm_curve_neighbours(k, nb, links == MPM_LINKS_LOOP, &prev, &next);
+        if (!mine[b0 + k]) continue;
+        if (!mine[b0 + prev]) need[n_need++] = b0 + prev;
+        if (!mine[b0 + next]) need[n_need++] = b0 + next;
+      }
+    }
+    qsort(need, (size_t)n_need, sizeof *need, long_cmp);
+    long u = 0;
+    for (long k = 0; k < n_need; k++)
+      if (u == 0 || need[k] != need[u - 1]) need[u++] = need[k];
+    const long *ids = mpm_par_ghost_ids(m, gi, &n);
+    const double *gx = mpm_par_ghost_x(m, gi);
+    ok = ok && n == u &&
+         (n == 0 || !memcmp(ids, need, sizeof(long) * (size_t)n));
+    for (long j = 0; ok && j < n; j++)
+      ok = !memcmp(gx + 3 * j, x + 3 * ids[j], 3 * sizeof(double));
+  }
+  free(need);
+  return ok;
+}
+
+/* Whether this rank's nearby points of every group whose kind reads the
+ * cells around its own are the points of other ranks in those cells
+ * (within the kind's reach of the rank's box), at positions x. */
+static bool nearby_right(const mpm_model *m, const mpm_model *ref,
+                         const char *mine, const double *x) {
+  const mpm_decomp *d = mpm_par_decomp(m);
+  const long *box = d->box + 6 * pm_par_rank();
+  const mpm_grid *g = &ref->grid;
+  bool ok = true;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_kind *k = m->group[gi].kind;
+    const int reach = k->ranks_reach ? k->ranks_reach(&m->group[gi]) : 0;
+    if (!reach) continue;
+    long n, at = 0;
+    const long *ids;
+    const double *nx = mpm_par_nearby(m, gi, &n, &ids);
+    for (long p = ref->group[gi].begin; ok && p < ref->group[gi].end; p++) {
+      bool in = !mine[p];
+      for (int a = 0; a < g->dim; a++) {
+        long c = (long)floor((x[3 * p + a] - g->origin[a]) * g->inv_h);
+        c = c < 0 ? 0 : c >= d->cells[a] ? d->cells[a] - 1 : c;
+        in = in && c >= box[a] - reach && c < box[3 + a] + reach;
+      }
+      if (!in) continue;
+      ok = at < n && ids[at] == p &&
+           !memcmp(nx + 3 * at, x + 3 * p, 3 * sizeof(double));
+      at++;
+    }
+    ok = ok && at == n;
+  }
+  return ok;
 }
 
 /* Total mass and momentum in one-process order. */
@@ -87,7 +183,14 @@ int main(int argc, char **argv) {
   mpm_state *s = r->local_state;
   mpm_work *w = r->local_work;
   const long N = ref->n;
-  long moved = 0;
+  long moved = 0, linked_moved = 0, spanning = 0;
+  int *owner = NULL, *owner_prev = NULL; /* rank 0's */
+  char *mine = calloc((size_t)N + 1, 1);
+  double *whole_x = malloc(sizeof(double) * 3 * (size_t)(N + 1));
+  bool linked = false;
+  for (int gi = 0; gi < m->n_groups; gi++)
+    linked = linked || m->group[gi].kind->ranks_link ||
+             m->group[gi].kind->ranks_reach;
   for (long step = 1; step <= steps; step++) {
     if (mpm_step(m, s, w)) {
       if (pm_par_root()) fprintf(stderr, "%s\n", pm_error_message());
@@ -140,6 +243,12 @@ int main(int argc, char **argv) {
       MPI_Gatherv(m->gid, cnt, MPI_LONG, all, counts, offs, MPI_LONG, 0,
                   MPI_COMM_WORLD);
       if (pm_par_root()) {
+        free(owner_prev);
+        owner_prev = owner;
+        owner = calloc((size_t)N + 1, sizeof *owner);
+        for (int q = 0; q < size; q++)
+          for (int k = offs[q]; k < offs[q + 1]; k++)
+            if (all[k] >= 0 && all[k] < N) owner[all[k]] = q;
         char *seen = calloc((size_t)N, 1);
         for (long k = 0; k < N && once; k++) {
           once = all[k] >= 0 && all[k] < N && !seen[all[k]];
@@ -165,14 +274,59 @@ int main(int argc, char **argv) {
     pm_par_bcast(&same, sizeof same);
     expect(same, "state, mass and momentum gathered unchanged, bit for bit",
            step);
+    if (linked && once) {
+      /* The ghosts against the whole run's positions. */
+      if (r->model)
+        memcpy(whole_x, r->state->x, sizeof(double) * 3 * (size_t)N);
+      MPI_Bcast(whole_x, (int)(3 * N), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+      memset(mine, 0, (size_t)N);
+      for (long k = 0; k < m->n; k++) mine[m->gid[k]] = 1;
+      expect(ghosts_right(m, ref, mine, whole_x),
+             "ghosts: the points linked to this rank's, at their positions",
+             step);
+      expect(nearby_right(m, ref, mine, whole_x),
+             "nearby points: those of other ranks within reach, at their "
+             "positions",
+             step);
+      if (pm_par_root()) {
+        long span = 0;
+        for (long t = 0; t < ref->n_tris; t++) {
+          const long *c = ref->tri + 3 * t;
+          span += owner[c[0]] != owner[c[1]] || owner[c[0]] != owner[c[2]];
+        }
+        for (int b = 0; b < ref->n_bodies; b++) {
+          const long b0 = ref->body_begin[b], nb = ref->body_end[b] - b0;
+          const int links = ref->body_links[b];
+          for (long k = 0; k + 1 < nb && (links == MPM_LINKS_CHAIN ||
+                                          links == MPM_LINKS_LOOP);
+               k++)
+            span += owner[b0 + k] != owner[b0 + k + 1];
+        }
+        spanning = span > spanning ? span : spanning;
+        for (int gi = 0; owner_prev && gi < ref->n_groups; gi++)
+          if (ref->group[gi].kind->ranks_link)
+            for (long p = ref->group[gi].begin; p < ref->group[gi].end; p++)
+              linked_moved += owner[p] != owner_prev[p];
+      }
+    }
     free(before);
     free(after);
   }
+  pm_par_sum_long(&moved, 1); /* each rank counted those it sent */
+  if (pm_par_root() && linked)
+    printf("%s: membrane points moved between ranks %ld, links spanning two "
+           "ranks or more (triangles, a curve's segments) %ld (most at one "
+           "step)\n",
+           sc->name, linked_moved, spanning);
   if (pm_par_root())
     printf("%s: %ld steps on %d ranks, %ld particles migrated, %d failed "
            "check%s\n",
            sc->name, steps, pm_par_size(), moved, failures,
            failures == 1 ? "" : "s");
+  free(owner);
+  free(owner_prev);
+  free(mine);
+  free(whole_x);
   mpm_state_destroy(ref_state);
   mpm_model_destroy(ref);
   mpm_sim_destroy(r);

@@ -1,7 +1,10 @@
 """Two runs' results and history agree to round-off: the same frames (step
 and time), the same fields, each within TOL of the first run's largest
 magnitude of that field in that frame, and every history column (the wall
-time aside) within TOL of the column's largest magnitude.  Fields and columns
+time aside) within TOL of the column's largest magnitude, where values one
+unit of their 10th significant digit apart count as equal (history.csv
+prints 10 digits: a difference of 1e-16 that straddles a rounding shows
+as one unit, up to 1e-9 of the value).  Fields and columns
 that are zero to 1e-12 of their scale compare absolutely.  The step size dt
 compares on the scale of the time: the last step is cut to end at
 time.end, dt = t_end - t, so it carries the round-off of t, an absolute
@@ -64,7 +67,14 @@ for c, name in enumerate(ra[0]):
         scale = max(scale, max(abs(float(r[0])) for r in ra[1:]))
     if name.startswith('reaction_'):
         scale = max(scale, reaction)
-    d = np.max(np.abs(x - y)) if x.size else 0.0
+    # history.csv prints 10 significant digits: values that differ by one
+    # unit of the last (a real difference of any size that straddles a
+    # rounding) cannot be told apart, and count as equal.
+    dd = np.abs(x - y)
+    big = np.maximum(np.abs(x), np.abs(y))
+    unit = np.where(big > 0, 10.0 ** (np.floor(np.log10(np.where(big > 0, big, 1))) - 9), 0)
+    dd = np.where(dd <= unit * (1 + 1e-6), 0.0, dd)
+    d = np.max(dd) if x.size else 0.0
     rel = d / scale if scale > 1e-12 else d
     if name in own:
         apart[name] = rel

@@ -79,4 +79,11 @@ if(PM_MPI)
       ${PROJECT_SOURCE_DIR})
   set_tests_properties(verification.ranks_fpm PROPERTIES LABELS verification
     TIMEOUT 600 PROCESSORS 2)
+  # Membranes (their neighbours on other ranks) and bodies moving as
+  # prescribed across ranks.
+  add_test(NAME verification.ranks_membranes
+    COMMAND bash ${PM_VERIFY_DIR}/ranks-membranes.sh $<TARGET_FILE:pointmech>
+      ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_migrate>)
+  set_tests_properties(verification.ranks_membranes PROPERTIES LABELS
+    verification TIMEOUT 600 PROCESSORS 2)
 endif()
