@@ -112,6 +112,7 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
 void mpm_sim_destroy(mpm_sim *r) {
   if (!r) return;
   free(r->ckpt_accounts);
+  free(r->imp_ranks);
   mpm_work_destroy(r->local_work);
   mpm_state_destroy(r->local_state);
   mpm_model_destroy(r->local_model);
@@ -1132,8 +1133,19 @@ static pm_err implicit_run(void *p, const pm_observer *obs) {
   }
   if (!e) e = mpm_implicit_run(r->imp, implicit_observe, r);
   /* Across ranks, the state the run ended in, for the figures (a
-   * failure's too). */
+   * failure's too), and each rank's share of the unknowns. */
   if (r->local_model) {
+    const int size = pm_par_size(), me = pm_par_rank();
+    pm_err a = PM_SUCCESS;
+    if (!r->imp_ranks) a = PM_ALLOC(r->imp_ranks, 3 * size, "ranks' unknowns");
+    if (!(a = pm_par_agree(a))) {
+      memset(r->imp_ranks, 0, 3 * (size_t)size * sizeof(long));
+      r->imp_ranks[3 * me] = r->local_model->n;
+      mpm_implicit_held(r->imp, &r->imp_ranks[3 * me + 1],
+                        &r->imp_ranks[3 * me + 2]);
+      pm_par_sum_long(r->imp_ranks, 3 * size);
+    }
+    if (!e) e = a;
     pm_err g = pm_par_agree(
         mpm_par_gather(r->local_model, r->local_state, r->model, r->state));
     if (!e) e = g;
@@ -1151,6 +1163,33 @@ static pm_err implicit_run(void *p, const pm_observer *obs) {
                   lr->time_linear);
   r->status = pm_static_status(e);
   return e;
+}
+
+/* The decomposition of an implicit run across ranks: per rank its
+ * particles, own unknowns and ghost unknowns, and the bytes a rank
+ * receives, on average, in a product with the tangent (its ghosts'
+ * values; a residual's or the tangent's assembly sends as many back). */
+static pm_err implicit_summary_ranks(pm_json *j, const mpm_sim *r) {
+  const mpm_decomp *d = mpm_par_decomp(r->local_model);
+  const int size = pm_par_size();
+  static const char *const names[3] = {"particles", "unknowns",
+                                       "ghost_unknowns"};
+  double ghosts = 0;
+  PM_CALL(pm_json_begin_object(j, "ranks"));
+  PM_CALL(pm_json_integer(j, "count", size));
+  PM_CALL(pm_json_begin_array(j, "cuts"));
+  for (int a = 0; a < 3; a++) PM_CALL(pm_json_integer(j, NULL, d->cuts[a]));
+  PM_CALL(pm_json_end_array(j));
+  for (int k = 0; k < 3; k++) {
+    PM_CALL(pm_json_begin_array(j, names[k]));
+    for (int q = 0; q < size; q++)
+      PM_CALL(pm_json_integer(j, NULL, r->imp_ranks[3 * q + k]));
+    PM_CALL(pm_json_end_array(j));
+  }
+  for (int q = 0; q < size; q++) ghosts += (double)r->imp_ranks[3 * q + 2];
+  PM_CALL(pm_json_number(j, "halo_bytes_per_product",
+                         ghosts * sizeof(double) / size));
+  return pm_json_end_object(j);
 }
 
 static pm_err implicit_summary(void *p, pm_json *j) {
@@ -1180,6 +1219,7 @@ static pm_err implicit_summary(void *p, pm_json *j) {
   PM_CALL(pm_json_number(j, "residual_seconds", lr->time_residual));
   PM_CALL(pm_json_number(j, "tangent_seconds", lr->time_assembly));
   PM_CALL(pm_json_number(j, "linear_seconds", lr->time_linear));
+  if (r->imp_ranks) PM_CALL(implicit_summary_ranks(j, r));
   return PM_SUCCESS;
 }
 

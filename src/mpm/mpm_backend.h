@@ -40,8 +40,11 @@ typedef struct {
   double *ckpt_accounts;
   struct mpm_implicit *imp;   /* method mpm-implicit: its solver (else NULL) */
   int imp_newton, imp_linear; /* the last load step's iterations */
-  double setup_wall;          /* s */
-  double *scratch;            /* output buffer (scratch_per_particle) */
+  /* across ranks, at the end of an implicit run: per rank its particles,
+   * own unknowns and ghost unknowns (3 each) */
+  long *imp_ranks;
+  double setup_wall; /* s */
+  double *scratch;   /* output buffer (scratch_per_particle) */
   /* history columns of its own: names (and their storage) */
   const char *hist_names[PM_HISTORY_MAX];
   char hist_store[PM_HISTORY_MAX][48];

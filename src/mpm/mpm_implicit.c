@@ -1398,6 +1398,11 @@ void mpm_implicit_size(const mpm_implicit *im, long *unknowns, long *entries) {
   *entries = im->entries_all;
 }
 
+void mpm_implicit_held(const mpm_implicit *im, long *own, long *ghost) {
+  *own = im->nunk;
+  *ghost = im->ranks ? im->nghost : 0;
+}
+
 static const char *linear_name(pm_newton_linear l) {
   switch (l) {
   case PM_NEWTON_DIRECT: return "direct (LU)";

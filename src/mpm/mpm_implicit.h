@@ -98,6 +98,10 @@ double mpm_implicit_lambda(const mpm_implicit *im);
 const pm_load_report *mpm_implicit_report(const mpm_implicit *im);
 /* Unknowns and stored Jacobian entries of the current (last) problem. */
 void mpm_implicit_size(const mpm_implicit *im, long *unknowns, long *entries);
+/* Across ranks: this rank's own unknowns and its ghost nodes' unknowns
+ * (the values a product with the tangent or a residual's assembly
+ * exchanges); on one process all unknowns and 0. */
+void mpm_implicit_held(const mpm_implicit *im, long *own, long *ghost);
 
 /* Print the plan's lines: algorithm, grid, unknowns, solver. */
 void mpm_implicit_plan(const mpm_implicit *im, FILE *out);

@@ -26,6 +26,18 @@ done
 # ranks_newton and ranks_fpm.)
 i2=$src/cases/mpm/i2-vessel-slice.yaml
 bounds="linear_iterations=inf" across i2-gamg "$i2" 2
+# summary.json's shares: every particle and every unknown on exactly one
+# rank, the ghosts those of the one face the ranks share (65 nodes of the
+# cut's x, 2 unknowns each, less the prescribed ones at the grips)
+check "I2 on 2 ranks: the ranks' particles and unknowns add up" $py -c "
+import json, sys
+s = json.load(open(sys.argv[1]))
+r = s['ranks']
+assert r['count'] == 2 and sum(r['particles']) == s['points'], r
+assert sum(r['unknowns']) == s['unknowns'], (r, s['unknowns'])
+assert all(0 < g <= 2 * 65 for g in r['ghost_unknowns']), r
+assert r['halo_bytes_per_product'] == 8 * sum(r['ghost_unknowns']) / 2, r
+" "$work/i2-gamg-2/summary.json"
 
 # Interrupted on 2 ranks and resumed (I2 at 32^2 cells, CG + Jacobi, whose
 # iterates repeat bit for bit across ranks: LU (MUMPS) and GAMG across
