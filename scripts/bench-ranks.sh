@@ -24,7 +24,7 @@
 #        TABLE_ONLY=1 tabulates the runs of an earlier call again)
 bench_name=ranks
 source "$(dirname "$0")/bench-lib.sh"
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+bind=core
 steps=${STEPS:-200}
 repeat=${REPEAT:-5}
 py=/usr/bin/python3
@@ -46,67 +46,29 @@ print(s['points'], s['steps'], s['step_seconds'] / n,
 EOF
 }
 
-# run_once NAME RANKS THREADS SCENE [--set ...]: the run's figures
-run_once() {
-  local name=$1 ranks=$2 threads=$3 scene=$4
-  shift 4
-  local dir="$out/$name-r$ranks-t$threads"
-  if [ "$ranks" -eq 1 ]; then
-    OMP_NUM_THREADS=$threads "$bin" run --overwrite "$scene" --out "$dir" \
-      --quiet --set time.max_steps="$steps" --set output.every=1000000 "$@" \
-      2>/dev/null || true
-  else
-    OMP_NUM_THREADS=$threads mpirun -np "$ranks" --bind-to core "$bin" run \
-      --overwrite "$scene" --out "$dir" --quiet \
-      --set time.max_steps="$steps" --set output.every=1000000 "$@" \
-      2>/dev/null || true
-  fi
-  fig "$dir/summary.json"
-}
-
-# row CASE KIND CONFIG CORES WORK BASE FILE: the median run of FILE (a
-# run's figures per line) against BASE, the 1 x 1 runs' file; WORK is the
-# work over that run's (2 for weak scaling)
-row() {
-  $py - "$@" <<'EOF'
-import sys
-c, k, cfg, cores, work, base, path = sys.argv[1:8]
-def runs(f):
-    return sorted((list(map(float, l.split())) for l in open(f) if l.strip()),
-                  key=lambda r: r[2])
-rs, bs = runs(path), runs(base)
-m, b = rs[len(rs) // 2], bs[len(bs) // 2][2]
-per, w, n = m[2], float(work), float(cores)
-print('%-11s %-6s %-5s %6d %9.3e %19s %6.2f %6.2f %9.2f %10.0f %10.0f %6.2f %6.2f %6.3f %5.2f' % (
-    c, k, cfg, m[0], per, '(%.2e - %.2e)' % (rs[0][2], rs[-1][2]),
-    b / per * w, b / per * w / n, bs[0][2] / rs[0][2] * w / n, m[3], m[4],
-    m[5], m[6], m[7], m[8]))
-EOF
-}
-
-printf '%-11s %-6s %-5s %6s %9s %19s %6s %6s %9s %10s %10s %6s %6s %6s %5s\n' \
-  case kind rxt points s/step "(range)" speed eff "eff(fast)" "node B/st" \
-  "part. B/st" halo-s migr-s imbal. comm
+printf '%-20s %7s %10s %21s %6s %6s %9s %10s %10s %10s %10s %10s %10s\n' \
+  "case kind config" points s/step "(range)" speed eff "eff(fast)" \
+  "node B/st" "part. B/st" halo-s migr-s imbal. comm
 # case, scene, particles per cell doubled along x, an override
 for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
   "shock-tube cases/mpm/m2-shock-tube.yaml 50,1,1" \
   "disks cases/mpm/disks-collision.yaml 4,2 discretization.mesh_size=6.25e-3"; do
   read -r name scene ppc2 extra <<<"$spec"
-  sets=()
-  [ -n "${extra:-}" ] && sets=(--set "$extra")
+  sets=(--set time.max_steps="$steps")
+  [ -n "${extra:-}" ] && sets+=(--set "$extra")
   [ "${TABLE_ONLY:-0}" = 1 ] || rm -f "$out/$name".*.runs
   for _ in $(seq "$repeat"); do
     [ "${TABLE_ONLY:-0}" = 1 ] && break
-    run_once "$name" 1 1 "$scene" "${sets[@]}" >>"$out/$name.1x1.runs"
-    run_once "$name" 1 2 "$scene" "${sets[@]}" >>"$out/$name.1x2.runs"
-    run_once "$name" 2 1 "$scene" "${sets[@]}" >>"$out/$name.2x1.runs"
+    ranks_run "$name" 1 1 "$scene" "${sets[@]}" >>"$out/$name.1x1.runs"
+    ranks_run "$name" 1 2 "$scene" "${sets[@]}" >>"$out/$name.1x2.runs"
+    ranks_run "$name" 2 1 "$scene" "${sets[@]}" >>"$out/$name.2x1.runs"
     # weak: twice the particles on twice the ranks
-    run_once "$name-weak" 2 1 "$scene" "${sets[@]}" \
+    ranks_run "$name-weak" 2 1 "$scene" "${sets[@]}" \
       --set "mpm.particles_per_cell=[$ppc2]" >>"$out/$name.weak.runs"
   done
   base="$out/$name.1x1.runs"
-  row "$name" strong 1x1 1 1 "$base" "$out/$name.1x1.runs"
-  row "$name" strong 1x2 2 1 "$base" "$out/$name.1x2.runs"
-  row "$name" strong 2x1 2 1 "$base" "$out/$name.2x1.runs"
-  row "$name" weak 2x1 2 2 "$base" "$out/$name.weak.runs"
+  ranks_row "$name strong 1x1" 1 1 "$base" "$out/$name.1x1.runs"
+  ranks_row "$name strong 1x2" 2 1 "$base" "$out/$name.1x2.runs"
+  ranks_row "$name strong 2x1" 2 1 "$base" "$out/$name.2x1.runs"
+  ranks_row "$name weak 2x1" 2 2 "$base" "$out/$name.weak.runs"
 done
