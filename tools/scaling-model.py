@@ -27,14 +27,18 @@ Implicit MPM, per run on P ranks (--implicit):
     + iterations * (linear / iterations / P
                     + halos * (2 * neighbours * alpha + 24 * ghosts / beta)
                     + reductions * alpha * ceil(log2 P))
-with 8 halo exchanges and 3 reductions per linear iteration (a Krylov step
-and a multigrid cycle of a few levels); the coarse grids' solve is left
-out (it does not shrink with P).
+with, per linear iteration, 8 halo exchanges and 3 reductions for GMRES +
+GAMG (a Krylov step and a multigrid cycle of a few levels; the coarse
+grids' solve is left out: it does not shrink with P), or 1 and 3 for CG +
+Jacobi (one product with the tangent; PETSc's CG reduces (p, Ap),
+(z, r) and the norm of z): --per-iteration HALOS,REDUCTIONS.
 
 Usage:
   /usr/bin/python3 tools/scaling-model.py POINTMECH SCENE --ranks 20,60,120,200
       [--set KEY=VALUE]... [--alpha 1.5e-6] [--beta 1e10]
       [--implicit ASSEMBLY,RESIDUAL,LINEAR,ITERATIONS]
+      [--per-iteration HALOS,REDUCTIONS]   (8,3: GMRES + GAMG; 1,3: CG +
+                                            Jacobi)
 """
 import argparse
 import math
@@ -73,8 +77,10 @@ def main():
     ap.add_argument('--alpha', type=float, default=1.5e-6)
     ap.add_argument('--beta', type=float, default=1e10)
     ap.add_argument('--implicit', default=None)
+    ap.add_argument('--per-iteration', default='8,3')
     a = ap.parse_args()
     ranks = [int(r) for r in a.ranks.split(',')]
+    halos, reductions = [int(x) for x in a.per_iteration.split(',')]
     one = plan(a.pointmech, a.scene, a.set)
     n, = number(r'particles +(\d+)', one, 'the particles')
     if not a.implicit:
@@ -85,8 +91,9 @@ def main():
     else:
         asm, res, lin, its = [float(x) for x in a.implicit.split(',')]
         print('one process: %d particles; assembly %.3g s, residuals %.3g s, '
-              'linear solves %.3g s over %d iterations' % (n, asm, res, lin,
-                                                          its))
+              'linear solves %.3g s over %d iterations (%d halo exchanges '
+              'and %d reductions each)' % (n, asm, res, lin, its, halos,
+                                           reductions))
     print('network (assumed): alpha %.2g s, beta %.2g bytes/s' %
           (a.alpha, a.beta))
     rows = []
@@ -110,8 +117,8 @@ def main():
                     16 * a.alpha * lg + 2 * nbr * a.alpha)
         else:
             work = imb * (asm + res) / p + lin / p
-            comm = its * (8 * (2 * nbr * a.alpha + 24 * gmax / a.beta) +
-                          3 * a.alpha * lg)
+            comm = its * (halos * (2 * nbr * a.alpha + 24 * gmax / a.beta) +
+                          reductions * a.alpha * lg)
         rows.append((p, cuts, imb, gmax, ratio, nbr, bmax, work, comm))
     base = rows[0][0] * (rows[0][7] + rows[0][8])
     unit = 's per step' if not a.implicit else 's'
