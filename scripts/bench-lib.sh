@@ -53,3 +53,29 @@ print('%-20s %7d %10.3e %21s %6.2f %6.2f %9.2f' % (
     ''.join(' %10.4g' % v for v in m[3:]))
 PY
 }
+
+# ranks_case NAME SCENE PPC2 [ARGS...]: REPEAT turns of SCENE on 1 rank x 1
+# thread, 1 x 2 threads and 2 ranks x 1 (and, unless PPC2 is -, twice the
+# particles, particles_per_cell PPC2, on 2 ranks: weak scaling), their fig
+# lines in $out/NAME.CONFIG.runs (TABLE_ONLY=1: the earlier call's), then
+# a ranks_row of each configuration.
+ranks_case() {
+  local name=$1 scene=$2 ppc2=$3
+  shift 3
+  [ "${TABLE_ONLY:-0}" = 1 ] || rm -f "$out/$name".*.runs
+  for _ in $(seq "${repeat:-3}"); do
+    [ "${TABLE_ONLY:-0}" = 1 ] && break
+    ranks_run "$name" 1 1 "$scene" "$@" >>"$out/$name.1x1.runs"
+    ranks_run "$name" 1 2 "$scene" "$@" >>"$out/$name.1x2.runs"
+    ranks_run "$name" 2 1 "$scene" "$@" >>"$out/$name.2x1.runs"
+    [ "$ppc2" = - ] && continue
+    ranks_run "$name-weak" 2 1 "$scene" "$@" \
+      --set "mpm.particles_per_cell=[$ppc2]" >>"$out/$name.weak.runs"
+  done
+  local base="$out/$name.1x1.runs"
+  ranks_row "$name 1x1" 1 1 "$base" "$out/$name.1x1.runs"
+  ranks_row "$name 1x2thr" 2 1 "$base" "$out/$name.1x2.runs"
+  ranks_row "$name 2x1" 2 1 "$base" "$out/$name.2x1.runs"
+  [ "$ppc2" = - ] ||
+    ranks_row "$name weak2x1" 2 2 "$base" "$out/$name.weak.runs"
+}

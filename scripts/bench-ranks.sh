@@ -47,7 +47,7 @@ EOF
 }
 
 printf '%-20s %7s %10s %21s %6s %6s %9s %10s %10s %10s %10s %10s %10s\n' \
-  "case kind config" points s/step "(range)" speed eff "eff(fast)" \
+  "case config" points s/step "(range)" speed eff "eff(fast)" \
   "node B/st" "part. B/st" halo-s migr-s imbal. comm
 # case, scene, particles per cell doubled along x, an override
 for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
@@ -56,19 +56,5 @@ for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
   read -r name scene ppc2 extra <<<"$spec"
   sets=(--set time.max_steps="$steps")
   [ -n "${extra:-}" ] && sets+=(--set "$extra")
-  [ "${TABLE_ONLY:-0}" = 1 ] || rm -f "$out/$name".*.runs
-  for _ in $(seq "$repeat"); do
-    [ "${TABLE_ONLY:-0}" = 1 ] && break
-    ranks_run "$name" 1 1 "$scene" "${sets[@]}" >>"$out/$name.1x1.runs"
-    ranks_run "$name" 1 2 "$scene" "${sets[@]}" >>"$out/$name.1x2.runs"
-    ranks_run "$name" 2 1 "$scene" "${sets[@]}" >>"$out/$name.2x1.runs"
-    # weak: twice the particles on twice the ranks
-    ranks_run "$name-weak" 2 1 "$scene" "${sets[@]}" \
-      --set "mpm.particles_per_cell=[$ppc2]" >>"$out/$name.weak.runs"
-  done
-  base="$out/$name.1x1.runs"
-  ranks_row "$name strong 1x1" 1 1 "$base" "$out/$name.1x1.runs"
-  ranks_row "$name strong 1x2" 2 1 "$base" "$out/$name.1x2.runs"
-  ranks_row "$name strong 2x1" 2 1 "$base" "$out/$name.2x1.runs"
-  ranks_row "$name weak 2x1" 2 2 "$base" "$out/$name.weak.runs"
+  ranks_case "$name" "$scene" "$ppc2" "${sets[@]}"
 done

@@ -49,21 +49,5 @@ for spec in "shock-tube cases/mpm/m2-shock-tube.yaml 50,1,1 time.max_steps=$((2 
   "f3-fpm cases/fpm/f3-extension-60-h5.19e-3.yaml - time.max_steps=$steps"; do
   read -r name scene ppc2 extra <<<"$spec"
   case " ${CASES:-$name} " in *" $name "*) ;; *) continue ;; esac
-  sets=(--set "$extra")
-  [ "${TABLE_ONLY:-0}" = 1 ] || rm -f "$out/$name".*.runs
-  for _ in $(seq "$repeat"); do
-    [ "${TABLE_ONLY:-0}" = 1 ] && break
-    ranks_run "$name" 1 1 "$scene" "${sets[@]}" >>"$out/$name.1x1.runs"
-    ranks_run "$name" 1 2 "$scene" "${sets[@]}" >>"$out/$name.1x2.runs"
-    ranks_run "$name" 2 1 "$scene" "${sets[@]}" >>"$out/$name.2x1.runs"
-    [ "$ppc2" = - ] && continue
-    ranks_run "$name-weak" 2 1 "$scene" "${sets[@]}" \
-      --set "mpm.particles_per_cell=[$ppc2]" >>"$out/$name.weak.runs"
-  done
-  base="$out/$name.1x1.runs"
-  ranks_row "$name 1x1" 1 1 "$base" "$out/$name.1x1.runs"
-  ranks_row "$name 1x2thr" 2 1 "$base" "$out/$name.1x2.runs"
-  ranks_row "$name 2x1" 2 1 "$base" "$out/$name.2x1.runs"
-  [ "$ppc2" = - ] ||
-    ranks_row "$name weak2x1" 2 2 "$base" "$out/$name.weak.runs"
+  ranks_case "$name" "$scene" "$ppc2" --set "$extra"
 done

@@ -164,6 +164,17 @@ static pm_step_report note_step(fpm_sim *sim, const fpm_step_info *info) {
                           .progress = frac};
 }
 
+/* Load stepping's scalars (where it stands, its last step, the work
+ * done) from one static state to another; the displacements apart. */
+static void load_scalars(fpm_static_state *to, const fpm_static_state *from) {
+  to->load.lambda = from->load.lambda;
+  to->load.lambda_prev = from->load.lambda_prev;
+  to->load.dl = from->load.dl;
+  to->load.good = from->load.good;
+  to->load.have_prev = from->load.have_prev;
+  to->external_work = from->external_work;
+}
+
 /* A static solve across ranks: the shares' load stepping into rank 0's
  * whole one, in one process's order (its two states through the points'
  * displacements), for a checkpoint (collective). */
@@ -180,12 +191,7 @@ static pm_err gather_static(fpm_sim *sim) {
                           k ? ws->load.xprev : ws->load.xc);
   }
   if (!pm_par_root()) return PM_SUCCESS;
-  ws->load.lambda = ls->load.lambda;
-  ws->load.lambda_prev = ls->load.lambda_prev;
-  ws->load.dl = ls->load.dl;
-  ws->load.good = ls->load.good;
-  ws->load.have_prev = ls->load.have_prev;
-  ws->external_work = ls->external_work;
+  load_scalars(ws, ls);
   return PM_SUCCESS;
 }
 
@@ -204,12 +210,7 @@ static void scatter_static(fpm_sim *sim) {
              3 * sizeof(double));
     fpm_static_unknowns(lm, held, k ? ls->load.xprev : ls->load.xc);
   }
-  ls->load.lambda = ws->load.lambda;
-  ls->load.lambda_prev = ws->load.lambda_prev;
-  ls->load.dl = ws->load.dl;
-  ls->load.good = ws->load.good;
-  ls->load.have_prev = ws->load.have_prev;
-  ls->external_work = ws->external_work;
+  load_scalars(ls, ws);
 }
 
 /* Every rank's share of the state into rank 0's view (collective). */
