@@ -17,6 +17,7 @@
 #include "pm_error.h"
 #include "pm_memory.h"
 #include "pm_par.h"
+#include "pm_par_mpi.h"
 #include "pm_probe.h"
 #include "pm_bench.h"
 #include "pm_run.h"
@@ -408,6 +409,7 @@ int main(int argc, char **argv) {
     pm_wait_policy_apply(argv);
   pm_err init = pm_app_init();
   if (!init) init = pm_par_init(&argc, &argv);
+  if (!init) init = pm_par_attach(MPI_COMM_WORLD); /* the program's ranks */
   if (init) return report(init);
   /* Across ranks, rank 0 prints; the others' output would repeat it. */
   if (!pm_par_root() && !freopen("/dev/null", "w", stdout))

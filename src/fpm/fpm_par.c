@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "pm_par.h"
+#include "pm_par_mpi.h"
 #include "pm_petsc.h"
 #include "pm_progress.h"
 
@@ -130,7 +131,7 @@ static pm_err count_shares(struct fpm_par *P, const fpm_model *full,
   PM_CALL(pm_par_agree(P->rank == 0 ? PM_ALLOC(P->counts, P->size, "shares")
                                     : PM_SUCCESS));
   MPI_Gather(&mine, (int)sizeof mine, MPI_BYTE, P->counts, (int)sizeof mine,
-             MPI_BYTE, 0, MPI_COMM_WORLD);
+             MPI_BYTE, 0, pm_par_comm());
   long own = s->n_own;
   pm_par_sum_long(&own, 1);
   PM_CHECK(own == full->n, PM_ERR_INTERNAL,

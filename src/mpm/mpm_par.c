@@ -15,6 +15,7 @@
 #include "mpm_transfer.h"
 #include "pm_omp.h"
 #include "pm_par.h"
+#include "pm_par_mpi.h"
 #include "pm_petsc.h"
 #include "pm_progress.h"
 
@@ -501,9 +502,9 @@ static pm_err make_near(struct mpm_par *P, const mpm_model *m) {
     weight[P->n_near] = 1;
     list[P->n_near++] = q;
   }
-  int e = MPI_Dist_graph_create_adjacent(MPI_COMM_WORLD, P->n_near, list,
-                                         weight, P->n_near, list, weight,
-                                         MPI_INFO_NULL, 0, &P->near);
+  int e = MPI_Dist_graph_create_adjacent(pm_par_comm(), P->n_near, list, weight,
+                                         P->n_near, list, weight, MPI_INFO_NULL,
+                                         0, &P->near);
   free(list);
   free(weight);
   PM_CHECK(e == MPI_SUCCESS, PM_ERR_INTERNAL,
@@ -1190,13 +1191,13 @@ static void gather_array(struct mpm_par *P, const double *data, long n, int nc,
                          const long *gid, long base, double *out) {
   const int size = P->d.size;
   int cnt = (int)(n * nc);
-  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, pm_par_comm());
   if (P->rank == 0) {
     P->gdisp[0] = 0;
     for (int r = 0; r < size; r++) P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
   }
   MPI_Gatherv(data, cnt, MPI_DOUBLE, P->gbuf, P->gcount, P->gdisp, MPI_DOUBLE,
-              0, MPI_COMM_WORLD);
+              0, pm_par_comm());
   if (P->rank != 0) {
     pm_par_count_sent((double)cnt * sizeof(double));
     return;
@@ -1227,13 +1228,13 @@ static pm_err gather_owned(const mpm_model *m, const mpm_grid *fg,
       for (int c = 0; c < 3; c++, k++)
         P->nodal[k] = src ? src[3 * i + c] : (double)srcf[3 * i + c];
   int cnt = (int)k;
-  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, pm_par_comm());
   if (P->rank == 0) {
     P->gdisp[0] = 0;
     for (int r = 0; r < size; r++) P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
   }
   MPI_Gatherv(P->nodal, cnt, MPI_DOUBLE, P->whole, P->gcount, P->gdisp,
-              MPI_DOUBLE, 0, MPI_COMM_WORLD);
+              MPI_DOUBLE, 0, pm_par_comm());
   if (!fg) return PM_SUCCESS;
   const double *b = P->whole;
   for (int r = 0; r < size; r++) {
@@ -1261,13 +1262,13 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
   const int size = P->d.size;
   /* The one-process indices, all at once, then per group. */
   int cnt = (int)m->n;
-  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, pm_par_comm());
   if (P->rank == 0) {
     P->gdisp[0] = 0;
     for (int r = 0; r < size; r++) P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
   }
   MPI_Gatherv(m->gid, cnt, MPI_LONG, P->ggid, P->gcount, P->gdisp, MPI_LONG, 0,
-              MPI_COMM_WORLD);
+              pm_par_comm());
   double *fx = fs ? fs->x : NULL, *fv = fs ? fs->v : NULL,
          *fvol = fs ? fs->vol : NULL, *fsig = fs ? fs->sigma : NULL;
   gather_array(P, s->x, m->n, 3, P->ggid, 0, fx);
@@ -1278,14 +1279,14 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
     const mpm_group *g = &m->group[gi];
     const long ng = g->end - g->begin;
     cnt = (int)ng;
-    MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    MPI_Gather(&cnt, 1, MPI_INT, P->gcount, 1, MPI_INT, 0, pm_par_comm());
     if (P->rank == 0) {
       P->gdisp[0] = 0;
       for (int r = 0; r < size; r++)
         P->gdisp[r + 1] = P->gdisp[r] + P->gcount[r];
     }
     MPI_Gatherv(m->gid + g->begin, cnt, MPI_LONG, P->ggid, P->gcount, P->gdisp,
-                MPI_LONG, 0, MPI_COMM_WORLD);
+                MPI_LONG, 0, pm_par_comm());
     for (int k = 0; k < s->group[gi].n; k++) {
       const mpm_array *a = &s->group[gi].array[k];
       gather_array(P, a->data, ng, a->ncomp, P->ggid, P->gbegin[gi],
@@ -1299,7 +1300,7 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
   acc[n_acc] = s->external_work;
   acc[n_acc + 1] = s->dissipated;
   MPI_Gather(acc, MPM_PAR_ACCOUNTS, MPI_DOUBLE, P->accounts, MPM_PAR_ACCOUNTS,
-             MPI_DOUBLE, 0, MPI_COMM_WORLD);
+             MPI_DOUBLE, 0, pm_par_comm());
   pm_par_sum(acc, MPM_PAR_ACCOUNTS);
   if (fs) {
     mpm_state_copy_values(fs, s);
@@ -1428,7 +1429,7 @@ void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
       (double)(mpm_model_bytes(m) + (w ? mpm_work_bytes(m, w) : 0)), ghosts};
   double *all = NULL;
   if (P->rank == 0) all = calloc((size_t)size * 5, sizeof(double));
-  MPI_Gather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Gather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, 0, pm_par_comm());
   if (P->rank != 0 || !out || !all) {
     free(all);
     return;

@@ -10,6 +10,7 @@
 
 #include "mpm_kind.h"
 #include "pm_par.h"
+#include "pm_par_mpi.h"
 
 struct mpm_ghosts {
   MPI_Comm near; /* the ranks whose boxes touch this one's (borrowed) */
@@ -238,9 +239,9 @@ static pm_err make_far(mpm_ghosts *gh, const mpm_decomp *d, int rank, int dim) {
     weight[gh->n_far] = 1;
     list[gh->n_far++] = q;
   }
-  int e = MPI_Dist_graph_create_adjacent(MPI_COMM_WORLD, gh->n_far, list,
-                                         weight, gh->n_far, list, weight,
-                                         MPI_INFO_NULL, 0, &gh->far);
+  int e = MPI_Dist_graph_create_adjacent(pm_par_comm(), gh->n_far, list, weight,
+                                         gh->n_far, list, weight, MPI_INFO_NULL,
+                                         0, &gh->far);
   PM_ENSURE(e == MPI_SUCCESS, PM_ERR_INTERNAL,
             "MPI_Dist_graph_create_adjacent failed (%d)", e);
 done:

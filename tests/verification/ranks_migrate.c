@@ -31,6 +31,7 @@
 #include "mpm_par.h"
 #include "pm_app.h"
 #include "pm_par.h"
+#include "pm_par_mpi.h"
 #include "pm_scene.h"
 
 static int failures;
@@ -158,7 +159,8 @@ int main(int argc, char **argv) {
     fprintf(stderr, "usage: ranks_migrate SCENE STEPS [KEY=VALUE...]\n");
     return 2;
   }
-  if (pm_app_init() || pm_par_init(&argc, &argv)) {
+  if (pm_app_init() || pm_par_init(&argc, &argv) ||
+      pm_par_attach(MPI_COMM_WORLD)) {
     fprintf(stderr, "%s\n", pm_error_message());
     return 2;
   }

@@ -19,6 +19,7 @@
 
 #include "pm_newton.h"
 #include "pm_par.h"
+#include "pm_par_mpi.h"
 #include "pm_petsc.h"
 
 #define N 400     /* unknowns: nodes 1..N; node 0 is fixed */
@@ -188,7 +189,9 @@ static pm_err solve(chain *c, pm_newton_linear lin, pm_newton_operator op,
 int main(int argc, char **argv) {
   setvbuf(stdout, NULL, _IOLBF, 0);
   /* PETSc starts on every rank together (its start is collective). */
-  if (pm_par_init(&argc, &argv) || pm_petsc_init()) return 2;
+  if (pm_par_init(&argc, &argv) || pm_par_attach(MPI_COMM_WORLD) ||
+      pm_petsc_init())
+    return 2;
   const int rank = pm_par_rank(), size = pm_par_size();
   static chain c, one;
   static double x[N], x1[N];

@@ -7,11 +7,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef PM_HAVE_MPI
-#include <mpi.h>
-#endif
+#include "pm_par_mpi.h"
 
 static int par_rank = 0, par_size = 1;
+#ifdef PM_HAVE_MPI
+static MPI_Comm par_comm = MPI_COMM_NULL; /* NULL until pm_par_attach */
+#endif
 static double par_sent = 0; /* bytes */
 
 /* An MPI launcher's mark in the environment. */
@@ -40,8 +41,6 @@ pm_err pm_par_init(int *argc, char ***argv) {
              PM_ERR_INTERNAL, "MPI_Init_thread failed");
     atexit(par_finalize);
   }
-  MPI_Comm_rank(MPI_COMM_WORLD, &par_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &par_size);
   return PM_SUCCESS;
 #else
   (void)argc;
@@ -58,13 +57,38 @@ pm_err pm_par_init(int *argc, char ***argv) {
 #endif
 }
 
+pm_err pm_par_attach(MPI_Comm comm) {
+#ifndef PM_HAVE_MPI
+  (void)comm; /* a build without MPI is one process */
+  return PM_SUCCESS;
+#else
+  int ready = 0;
+  MPI_Initialized(&ready);
+  if (!ready) return PM_SUCCESS; /* no launcher: one process */
+  PM_CHECK(comm != MPI_COMM_NULL, PM_ERR_INTERNAL,
+           "pm_par_attach: the communicator is MPI_COMM_NULL");
+  par_comm = comm;
+  MPI_Comm_rank(comm, &par_rank);
+  MPI_Comm_size(comm, &par_size);
+  return PM_SUCCESS;
+#endif
+}
+
+MPI_Comm pm_par_comm(void) {
+#ifdef PM_HAVE_MPI
+  return par_comm;
+#else
+  return MPI_COMM_NULL;
+#endif
+}
+
 int pm_par_rank(void) { return par_rank; }
 int pm_par_size(void) { return par_size; }
 
 #ifdef PM_HAVE_MPI
 static void reduce(void *v, int n, MPI_Datatype type, MPI_Op op) {
   if (par_size == 1 || n <= 0) return;
-  MPI_Allreduce(MPI_IN_PLACE, v, n, type, op, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, v, n, type, op, par_comm);
   par_sent += (double)n * (type == MPI_LONG ? sizeof(long) : sizeof(double));
 }
 #endif
@@ -113,7 +137,7 @@ long pm_par_offset(long n) {
 #ifdef PM_HAVE_MPI
   if (par_size == 1) return 0;
   long before = 0;
-  MPI_Exscan(&n, &before, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Exscan(&n, &before, 1, MPI_LONG, MPI_SUM, par_comm);
   par_sent += sizeof(long);
   return par_rank == 0 ? 0 : before;
 #else
@@ -125,7 +149,7 @@ long pm_par_offset(long n) {
 void pm_par_bcast(void *p, size_t n) {
 #ifdef PM_HAVE_MPI
   if (par_size == 1 || n == 0) return;
-  MPI_Bcast(p, (int)n, MPI_BYTE, 0, MPI_COMM_WORLD);
+  MPI_Bcast(p, (int)n, MPI_BYTE, 0, par_comm);
   if (par_rank == 0) par_sent += (double)n;
 #else
   (void)p, (void)n;
@@ -143,8 +167,7 @@ pm_err pm_par_agree_first(pm_err e, long key) {
   } first = {e != PM_SUCCESS ? key : LONG_MAX, par_rank};
   if (e != PM_SUCCESS && key == LONG_MAX) /* the successes' mark */
     first.key = LONG_MAX - 1;
-  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_LONG_INT, MPI_MINLOC,
-                MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_LONG_INT, MPI_MINLOC, par_comm);
   if (first.key == LONG_MAX) return PM_SUCCESS;
   struct {
     int code;
@@ -154,7 +177,7 @@ pm_err pm_par_agree_first(pm_err e, long key) {
     what.code = (int)e;
     snprintf(what.text, sizeof what.text, "%s", pm_error_message());
   }
-  MPI_Bcast(&what, (int)sizeof what, MPI_BYTE, first.rank, MPI_COMM_WORLD);
+  MPI_Bcast(&what, (int)sizeof what, MPI_BYTE, first.rank, par_comm);
   if (par_rank == first.rank) return e;
   return pm_error_set((pm_err)what.code, __FILE__, __LINE__, __func__, "%s",
                       what.text);
@@ -176,7 +199,7 @@ void pm_par_abort(int code, const char *msg) {
           msg ? msg : "");
   fflush(stderr);
 #ifdef PM_HAVE_MPI
-  if (par_size > 1) MPI_Abort(MPI_COMM_WORLD, code);
+  if (par_size > 1) MPI_Abort(par_comm, code);
 #endif
   exit(code);
 }

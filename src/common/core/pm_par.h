@@ -20,7 +20,9 @@
  * says so: OMPI_COMM_WORLD_SIZE, PMI_SIZE or PMIX_RANK with a size), with
  * threads funnelled to the main one; registers MPI_Finalize at exit.
  * Without a launcher, or in a build without MPI, nothing is started.
- * Idempotent.  PM_ERR_INTERNAL when MPI cannot start. */
+ * The run stays one process until the program attaches its communicator
+ * (pm_par_attach, pm_par_mpi.h).  Idempotent.  PM_ERR_INTERNAL when MPI
+ * cannot start. */
 pm_err pm_par_init(int *argc, char ***argv);
 
 /* This process's rank and the number of ranks (0 and 1 without MPI). */

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "pm_newton.h"
+#include "pm_par_mpi.h"
 
 static bool started;  /* this module called PetscInitialize */
 static bool finished; /* PETSc was finalised: it cannot start again */
@@ -37,6 +38,9 @@ pm_err pm_petsc_init(void) {
            "PETSc was finalised (pm_solve_finalize) and cannot start again");
   PM_PETSC_CALL(PetscInitialized(&ready));
   if (ready) return PM_SUCCESS;
+  /* PETSc's objects live on the run's ranks (PETSc's own world where the
+   * program attached none: it starts MPI itself then). */
+  if (pm_par_comm() != MPI_COMM_NULL) PETSC_COMM_WORLD = pm_par_comm();
   PetscErrorCode code = PetscInitializeNoArguments();
   PM_CHECK(code == 0, PM_ERR_LINALG, "PetscInitializeNoArguments failed (%d)",
            (int)code);
