@@ -1,6 +1,6 @@
 /* pm_compare: the methods' runs of one scene, their fields on one lattice
  * (moving least squares) and their errors against each other and the
- * references. */
+ * references: the options, each method's run, and the comparison. */
 #include "pm_compare.h"
 
 #include <math.h>
@@ -13,17 +13,6 @@
 #include "pm_mls.h"
 #include "pm_probe.h"
 
-/* How far a lattice point's fit may reach, in mean point spacings, and
- * how far its nearest point may be, in mean nearest-neighbour distances: a
- * point farther than that (off the method's body) is flagged rather than
- * extrapolated to.  A corner of a body whose points are inset by half their
- * spacing (MPM particles) is 0.87 of it from its nearest point; a point on
- * a face of a mesh, at most 0.58 of an edge. */
-#define CMP_REACH 5.0
-#define CMP_GAP 1.5
-/* Regular lattice: points along a long axis at most this many times the
- * shortest axis's intervals. */
-#define CMP_ASPECT_MAX 8
 #define CMP_SETS_MAX 66 /* method=M and the --set overrides */
 #define CMP_FIELDS_MAX 16
 
@@ -120,166 +109,6 @@ static pm_err load_scene(const pm_compare_options *o, const char *label,
   return pm_scene_load(o->scene, n, sets, s);
 }
 
-/* ---- the lattice -------------------------------------------------------- */
-
-static void grow(double lo[3], double hi[3], const double *p, double r) {
-  for (int k = 0; k < 3; k++) {
-    lo[k] = fmin(lo[k], p[k] - r);
-    hi[k] = fmax(hi[k], p[k] + r);
-  }
-}
-
-/* The reference box of the scene's bodies: their shapes' bounds, the
- * domain box for shapes given by a region, a mesh, an image or a
- * membrane (where the lattice points off the body are then flagged). */
-static void bodies_box(const pm_scene *s, double lo[3], double hi[3]) {
-  for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
-  for (int b = 0; b < s->n_bodies; b++) {
-    const pm_scene_body *B = &s->bodies[b];
-    double top[3];
-    switch (B->shape) {
-    case PM_BODY_BOX:
-      grow(lo, hi, B->a, 0);
-      grow(lo, hi, B->b, 0);
-      break;
-    case PM_BODY_SPHERE: grow(lo, hi, B->a, B->radius); break;
-    case PM_BODY_CYLINDER:
-      for (int k = 0; k < 3; k++) top[k] = B->a[k] + B->b[k];
-      grow(lo, hi, B->a, B->radius);
-      grow(lo, hi, top, B->radius);
-      break;
-    default:
-      grow(lo, hi, s->box_min, 0);
-      grow(lo, hi, s->box_max, 0);
-      break;
-    }
-  }
-  for (int k = 0; k < 3; k++) {
-    if (!(lo[k] <= hi[k])) lo[k] = s->box_min[k], hi[k] = s->box_max[k];
-    /* Within the domain: a shape cannot reach past it. */
-    lo[k] = fmax(lo[k], s->box_min[k]);
-    hi[k] = fmin(hi[k], s->box_max[k]);
-  }
-  if (s->dimension == 2) lo[2] = hi[2] = 0;
-}
-
-/* n points along the shortest axis of the bodies' box, the other axes at
- * about the same spacing, x outermost and z innermost. */
-static pm_err regular_lattice(cmp_study *c, long n) {
-  pm_err ret = PM_SUCCESS;
-  double lo[3], hi[3], shortest = INFINITY;
-  bodies_box(c->base, lo, hi);
-  for (int k = 0; k < c->dim; k++) {
-    PM_CHECK(hi[k] > lo[k], PM_ERR_SCENE,
-             "%s: the bodies' box is flat along %c ([%g, %g] m): no lattice",
-             c->base->path, "xyz"[k], lo[k], hi[k]);
-    shortest = fmin(shortest, hi[k] - lo[k]);
-  }
-  const double spacing = shortest / (double)(n - 1);
-  c->m = 1;
-  for (int k = 0; k < 3; k++) {
-    c->side[k] = 1;
-    if (k < c->dim) {
-      double cells = ceil((hi[k] - lo[k]) / spacing - 1e-9);
-      c->side[k] = 1 + (long)fmin(cells, CMP_ASPECT_MAX * (double)(n - 1));
-    }
-    c->m *= c->side[k];
-    c->centre[k] = 0.5 * (lo[k] + hi[k]);
-  }
-  PM_TRY(PM_ALLOC(c->x, 3 * c->m, "lattice"));
-  long i = 0;
-  for (long a = 0; a < c->side[0]; a++)
-    for (long b = 0; b < c->side[1]; b++)
-      for (long d = 0; d < c->side[2]; d++, i++) {
-        const long idx[3] = {a, b, d};
-        for (int k = 0; k < 3; k++)
-          c->x[3 * i + k] = c->side[k] > 1
-                                ? lo[k] + (hi[k] - lo[k]) * (double)idx[k] /
-                                              (double)(c->side[k] - 1)
-                                : lo[k];
-      }
-  int len = snprintf(c->lattice_label, sizeof c->lattice_label,
-                     "a regular lattice of %ld", c->side[0]);
-  for (int k = 1; k < c->dim; k++)
-    len += snprintf(c->lattice_label + len, sizeof c->lattice_label - len,
-                    " x %ld", c->side[k]);
-  len += snprintf(c->lattice_label + len, sizeof c->lattice_label - len,
-                  " points over the bodies' box [%g, %g]", lo[0], hi[0]);
-  for (int k = 1; k < c->dim; k++)
-    len += snprintf(c->lattice_label + len, sizeof c->lattice_label - len,
-                    " x [%g, %g]", lo[k], hi[k]);
-  snprintf(c->lattice_label + len, sizeof c->lattice_label - len, " m");
-done:
-  return ret;
-}
-
-/* The FE referee's lattice points, and its centre. */
-static pm_err fe_lattice(cmp_study *c) {
-  pm_err ret = PM_SUCCESS;
-  const pm_fe_reference *fe = c->fe;
-  c->m = fe->n;
-  c->dim = fe->dim == 2 ? 2 : 3;
-  PM_TRY(PM_ALLOC(c->x, 3 * c->m, "lattice"));
-  memcpy(c->x, fe->x, sizeof *c->x * 3 * (size_t)c->m);
-  memcpy(c->centre, fe->centre, sizeof c->centre);
-  snprintf(c->lattice_label, sizeof c->lattice_label,
-           "the FE referee's lattice (%s/lattice.csv, %ld points)", fe->dir,
-           fe->n);
-done:
-  return ret;
-}
-
-/* The field u of the cloud mls at every lattice point into out ([m][3]),
- * NaN where flagged; returns the flagged count. */
-/* The field f (ncomp components) at q into v when q lies on the cloud
- * and a regular fit reaches it; false (v NaN) when q is flagged. */
-static bool fit_on_cloud(pm_mls *mls, const double *q, int ncomp,
-                         const double *f, double *v) {
-  if (pm_mls_nearest(mls, q) <= CMP_GAP * pm_mls_gap(mls) &&
-      pm_mls_fit(mls, q, ncomp, f, CMP_REACH, v) > 0)
-    return true;
-  for (int k = 0; k < ncomp; k++) v[k] = NAN;
-  return false;
-}
-
-static long map_lattice(const cmp_study *c, pm_mls *mls, const double *u,
-                        double *out) {
-  long flagged = 0;
-  for (long i = 0; i < c->m; i++)
-    flagged += !fit_on_cloud(mls, c->x + 3 * i, 3, u, out + 3 * i);
-  return flagged;
-}
-
-/* The last frame of the reference run, on the lattice. */
-static pm_err map_run(cmp_study *c) {
-  pm_err ret = PM_SUCCESS;
-  long n = 0;
-  double *x = NULL, *u = NULL;
-  pm_mls *mls = NULL;
-  char what[PM_PATH_MAX + 64];
-  PM_TRY(pm_results_read(c->run_dir, -1, &n, &x, &u));
-  snprintf(what, sizeof what, "the reference run %s", c->run_dir);
-  PM_TRY(pm_mls_create(n, x, what, &mls));
-  PM_TRY(PM_ALLOC(c->run_u, 3 * c->m, "reference at the lattice"));
-  map_lattice(c, mls, u, c->run_u);
-done:
-  pm_mls_free(mls);
-  free(x);
-  free(u);
-  return ret;
-}
-
-void cmp_analytic(const cmp_study *c, double t, double *ref) {
-  const pm_scene *s = c->base;
-  for (long i = 0; i < c->m; i++) {
-    const double *X = c->x + 3 * i;
-    for (int k = 0; k < 3; k++)
-      ref[3 * i + k] = s->reference_mask >> k & 1u
-                           ? pm_expr_eval(s->reference[k], X[0], X[1], X[2], t)
-                           : 0.0;
-  }
-}
-
 /* ---- one method --------------------------------------------------------- */
 
 /* Record why method M stopped: its error, a status, the message. */
@@ -328,10 +157,10 @@ static pm_err map_method(cmp_study *c, cmp_method *M, const pm_backend *be,
   snprintf(what, sizeof what, "the points of %s", M->name);
   PM_TRY(pm_mls_create(p.n, p.x, what, &mls));
   PM_TRY(PM_ALLOC(M->u, 3 * c->m, "displacement at the lattice"));
-  M->flagged = map_lattice(c, mls, be->displacement(sim), M->u);
+  M->flagged = cmp_map_lattice(c, mls, be->displacement(sim), M->u);
   M->mapped = true;
   PM_TRY(von_mises_of(be, sim, p.n, &own, &vm));
-  if (vm) fit_on_cloud(mls, c->centre, 1, vm, &M->von_mises_centre);
+  if (vm) cmp_fit_on_cloud(mls, c->centre, 1, vm, &M->von_mises_centre);
 done:
   pm_mls_free(mls);
   free(own);
@@ -380,147 +209,6 @@ done:
   if (sim) s->backend->destroy(sim);
   pm_scene_destroy(s);
   return e;
-}
-
-/* ---- errors ------------------------------------------------------------- */
-
-/* The rows of a ([m][3]) at the valid lattice points into b. */
-static void compact(const cmp_study *c, const double *a, double *b) {
-  long j = 0;
-  for (long i = 0; i < c->m; i++)
-    if (c->valid[i]) {
-      memcpy(b + 3 * j, a + 3 * i, 3 * sizeof *a);
-      j++;
-    }
-}
-
-static double largest(long n, unsigned mask, const double *u) {
-  double big = 0;
-  for (long j = 0; j < n; j++) {
-    double r2 = 0;
-    for (int k = 0; k < 3; k++)
-      if (mask >> k & 1u) r2 += u[3 * j + k] * u[3 * j + k];
-    big = fmax(big, sqrt(r2));
-  }
-  return big;
-}
-
-/* Root mean square of |a - b| over n points, over scale. */
-static double rms_over(long n, unsigned mask, const double *a, const double *b,
-                       double scale) {
-  double sum = 0;
-  for (long j = 0; j < n; j++)
-    for (int k = 0; k < 3; k++)
-      if (mask >> k & 1u) {
-        double d = a[3 * j + k] - b[3 * j + k];
-        sum += d * d;
-      }
-  return n > 0 && scale > 0 ? sqrt(sum / (double)n) / scale : NAN;
-}
-
-/* The NRMSE against the analytic field as a run reports it (pm_run): a
- * single component's own (over its range), several as a vector. */
-static double analytic_nrmse(long n, unsigned mask, const double *u,
-                             const double *ref) {
-  int count = 0, last = 0;
-  for (int k = 0; k < 3; k++)
-    if (mask >> k & 1u) count++, last = k;
-  if (count == 1) return pm_nrmse(n, 3, u + last, ref + last);
-  return pm_nrmse_vector(n, mask, u, ref);
-}
-
-/* The lattice points every mapped method and the reference run fit. */
-static void find_valid(cmp_study *c) {
-  c->n_valid = 0;
-  for (long i = 0; i < c->m; i++) {
-    bool ok = true;
-    for (int k = 0; k < c->n && ok; k++)
-      if (c->meth[k].mapped) ok = isfinite(c->meth[k].u[3 * i]);
-    if (c->run_u) ok = ok && isfinite(c->run_u[3 * i]);
-    c->valid[i] = ok;
-    c->n_valid += ok;
-  }
-}
-
-/* Every method against the references, the pairs against each other. */
-static pm_err compute_errors(cmp_study *c) {
-  pm_err ret = PM_SUCCESS;
-  double *full = NULL, *a = NULL, *b = NULL, *r = NULL, *xv = NULL, *fu = NULL;
-  const unsigned mask = cmp_mask(c);
-  PM_TRY(PM_ALLOC(c->valid, c->m, "lattice flags"));
-  find_valid(c);
-  const long nv = c->n_valid;
-  PM_TRY(PM_ALLOC(full, 3 * c->m, "analytic field"));
-  PM_TRY(PM_ALLOC(a, 3 * c->m + 3, "lattice values"));
-  PM_TRY(PM_ALLOC(b, 3 * c->m + 3, "lattice values"));
-  PM_TRY(PM_ALLOC(r, 3 * c->m + 3, "lattice values"));
-  pm_fe_reference view = {.n = 0};
-  if (c->fe) {
-    PM_TRY(PM_ALLOC(xv, 3 * c->m + 3, "lattice points"));
-    PM_TRY(PM_ALLOC(fu, 3 * c->m + 3, "FE values"));
-    compact(c, c->fe->x, xv);
-    compact(c, c->fe->u, fu);
-    view = *c->fe;
-    view.n = nv;
-    view.x = xv;
-    view.u = fu;
-  }
-  /* One scale for the pairs: the reference's largest |u|, else the
-   * methods'. */
-  c->scale = 0;
-  if (c->fe) {
-    c->scale = largest(nv, mask, fu);
-    snprintf(c->scale_label, sizeof c->scale_label, "the FE referee's");
-  } else if (c->run_u) {
-    compact(c, c->run_u, r);
-    c->scale = largest(nv, mask, r);
-    snprintf(c->scale_label, sizeof c->scale_label, "the reference run's");
-  } else {
-    for (int k = 0; k < c->n; k++)
-      if (c->meth[k].mapped) {
-        compact(c, c->meth[k].u, a);
-        c->scale = fmax(c->scale, largest(nv, mask, a));
-      }
-    snprintf(c->scale_label, sizeof c->scale_label, "the methods' own");
-  }
-  for (int k = 0; k < c->n; k++) {
-    cmp_method *M = &c->meth[k];
-    M->e_analytic = M->e_fe = M->e_fe_interior = NAN;
-    M->reaction_fe = M->sed_fe = M->e_run = NAN;
-    for (int l = 0; l < c->n; l++) c->pair[k][l] = NAN;
-    if (!M->mapped || nv == 0) continue;
-    compact(c, M->u, a);
-    if (c->analytic) {
-      cmp_analytic(c, M->out.fig.time, full);
-      compact(c, full, r);
-      M->e_analytic = analytic_nrmse(nv, c->base->reference_mask, a, r);
-    }
-    if (c->fe) {
-      pm_fe_errors e;
-      pm_fe_errors_of(&view, a, &M->out, &e);
-      M->e_fe = e.nrmse;
-      M->e_fe_interior = e.nrmse_interior;
-      M->reaction_fe = e.reaction_error;
-      M->sed_fe = e.sed_error;
-    }
-    if (c->run_u) {
-      compact(c, c->run_u, r);
-      M->e_run = pm_nrmse_vector(nv, mask, a, r);
-    }
-    for (int l = 0; l < k; l++)
-      if (c->meth[l].mapped) {
-        compact(c, c->meth[l].u, b);
-        c->pair[k][l] = c->pair[l][k] = rms_over(nv, mask, a, b, c->scale);
-      }
-  }
-done:
-  free(full);
-  free(a);
-  free(b);
-  free(r);
-  free(xv);
-  free(fu);
-  return ret;
 }
 
 /* ---- the comparison ----------------------------------------------------- */
@@ -618,10 +306,10 @@ pm_err pm_compare_run(const pm_compare_options *o, FILE *out, char *dir,
   if (dir && size) snprintf(dir, size, "%s", c->out_dir);
   PM_TRY(choose_references(c, &fe));
   if (c->fe)
-    PM_TRY(fe_lattice(c));
+    PM_TRY(cmp_fe_lattice(c));
   else
-    PM_TRY(regular_lattice(c, n_lattice));
-  if (c->run_dir[0]) PM_TRY(map_run(c));
+    PM_TRY(cmp_regular_lattice(c, n_lattice));
+  if (c->run_dir[0]) PM_TRY(cmp_map_run(c));
   PM_TRY(pm_mkdir_p(c->out_dir));
   for (int k = 0; k < c->n; k++)
     PM_TRY(pm_path_join(c->meth[k].dir, sizeof c->meth[k].dir, c->out_dir,
@@ -641,7 +329,7 @@ pm_err pm_compare_run(const pm_compare_options *o, FILE *out, char *dir,
       break;
     }
   }
-  PM_TRY(compute_errors(c));
+  PM_TRY(cmp_compute_errors(c));
   PM_TRY(cmp_write_report(c, out));
   if (o->rows) fill_rows(c, o->rows, o->n_rows);
   if (out) fprintf(out, "tables in %s/compare.{md,csv}\n", c->out_dir);

@@ -1,5 +1,6 @@
 /* pm_compare_impl: what a comparison holds once its methods ran, shared by
- * the driver (pm_compare.c) and its tables (pm_compare_report.c). */
+ * the driver (pm_compare.c), its lattice (pm_compare_lattice.c), its errors
+ * (pm_compare_errors.c) and its tables (pm_compare_report.c). */
 #ifndef PM_COMPARE_IMPL_H
 #define PM_COMPARE_IMPL_H
 
@@ -9,6 +10,7 @@
 #include "pm_compare.h"
 #include "pm_fe.h"
 #include "pm_files.h"
+#include "pm_mls.h"
 #include "pm_run.h"
 #include "pm_scene.h"
 
@@ -65,6 +67,31 @@ typedef struct {
 static inline unsigned cmp_mask(const cmp_study *c) {
   return c->dim == 2 ? 3u : 7u;
 }
+
+/* c's lattice: n points along the shortest axis of the bodies' box, the
+ * other axes at about the same spacing (regular), or the FE referee's
+ * points (fe).  PM_ERR_MEMORY, or PM_ERR_SCENE for a degenerate box. */
+pm_err cmp_regular_lattice(cmp_study *c, long n);
+pm_err cmp_fe_lattice(cmp_study *c);
+
+/* The field f (ncomp components) of the cloud mls at q into v when q lies
+ * on the cloud and a regular fit reaches it; false (v NaN) when q is
+ * flagged. */
+bool cmp_fit_on_cloud(pm_mls *mls, const double *q, int ncomp, const double *f,
+                      double *v);
+
+/* The field u of the cloud mls at every lattice point into out ([m][3]),
+ * NaN where flagged; returns the flagged count. */
+long cmp_map_lattice(const cmp_study *c, pm_mls *mls, const double *u,
+                     double *out);
+
+/* The last frame of the reference run c->run_dir, on the lattice
+ * (c->run_u). */
+pm_err cmp_map_run(cmp_study *c);
+
+/* Every method against the references and the pairs against each other,
+ * over the lattice points every mapped field fits (c->valid). */
+pm_err cmp_compute_errors(cmp_study *c);
 
 /* The analytic field at the lattice at time t into ref ([m][3], 0 where
  * the scene gives no component). */

@@ -26,14 +26,6 @@ static const char *cnum(char b[NUM_MAX], double v) {
   return pm_table_number(b, v, 10);
 }
 
-/* The label of condition b, as history.csv and summary.json name it. */
-static void bc_label(const pm_scene *s, int b, char *buf, size_t size) {
-  if (s->bcs[b].on == PM_ON_REGION)
-    snprintf(buf, size, "boundary.%d", b);
-  else
-    snprintf(buf, size, "%s", s->bcs[b].surface);
-}
-
 /* The components of condition b that a reaction is reported for. */
 static unsigned bc_mask(const pm_scene *s, int b) {
   return s->bcs[b].disp_mask | s->bcs[b].velocity_mask;
@@ -173,7 +165,7 @@ static void md_reactions(const cmp_study *c, FILE *m) {
   for (int bc = 0; bc < s->n_bcs; bc++)
     for (int k = 0; k < 3; k++)
       if (bc_mask(s, bc) >> k & 1u) {
-        bc_label(s, bc, label, sizeof label);
+        pm_run_bc_label(s, bc, label, sizeof label);
         fprintf(m, " %s %c |", label, "xyz"[k]);
         cols++;
       }
@@ -276,7 +268,7 @@ static void csv_header(const cmp_study *c, FILE *f) {
   for (int b = 0; b < s->n_bcs; b++)
     for (int k = 0; k < 3; k++)
       if (bc_mask(s, b) >> k & 1u) {
-        bc_label(s, b, label, sizeof label);
+        pm_run_bc_label(s, b, label, sizeof label);
         fprintf(f, ",reaction_%s_%c", label, "xyz"[k]);
       }
   fprintf(f, ",message\n");

@@ -72,4 +72,9 @@ pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o);
  * out is the one that is read. */
 pm_err pm_plan_scene(const pm_scene *s, FILE *out);
 
+/* The label of boundary condition b of s, as history.csv (reaction
+ * columns) and summary.json (reactions) name it: its surface, or
+ * "boundary.B" for a region; into buf (size bytes, truncated). */
+void pm_run_bc_label(const pm_scene *s, int b, char *buf, size_t size);
+
 #endif

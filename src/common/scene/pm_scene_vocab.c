@@ -1,7 +1,7 @@
 /* pm_scene_vocab: the shared scene vocabulary as key tables (each key once,
- * with its default, range, unit and meaning), the readers of the keys a
- * table cannot describe alone (materials, whose keys depend on their
- * model; fibres), and the checks across keys. */
+ * with its default, range, unit and meaning).  The readers of the keys a
+ * table cannot describe alone are in pm_scene_readers.c, the materials in
+ * pm_scene_materials.c, the checks across keys in pm_scene_check.c. */
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -40,73 +40,6 @@ static const pm_name field_names[] = {
 #define S(field) offsetof(pm_scene, field)
 #define B(field) offsetof(pm_scene_body, field)
 #define C(field) offsetof(pm_scene_bc, field)
-
-/* ---- custom readers ----------------------------------------------------- */
-
-static pm_err read_dimension(pm_reader *r, int id, const char *path,
-                             const pm_key *k, void *dst) {
-  (void)k;
-  const char *v = pm_sdoc_scalar(r->doc, id);
-  if (!v || (strcmp(v, "2") && strcmp(v, "3")))
-    return pm_reader_expected(r, path, "2 or 3");
-  *(int *)dst = v[0] - '0';
-  r->dimension = *(int *)dst;
-  return PM_SUCCESS;
-}
-
-/* fibres: [[ax, ay, az], ...]: 1 to PM_FIBRES_MAX non-zero directions,
- * normalized. */
-static pm_err read_fibres(pm_reader *r, int id, const char *path,
-                          const pm_key *k, void *dst) {
-  (void)k;
-  typedef struct {
-    double v[3];
-    int n;
-  } dir3;
-  static const pm_key dir = {.name = "fibre",
-                             .type = PM_KEY_NUMBERS,
-                             .count_offset = offsetof(dir3, n),
-                             .min_count = 3,
-                             .max_count = 3};
-  pm_material_point *pt = dst;
-  char sub[PM_SDOC_PATH];
-  int n = pm_sdoc_count(r->doc, id);
-  if (pm_sdoc_kind_of(r->doc, id) != PM_SDOC_LIST || n < 1 || n > PM_FIBRES_MAX)
-    return pm_reader_expected(r, path,
-                              "a list of 1 or 2 directions [ax, ay, az]");
-  pt->n_fibres = n;
-  for (int f = 0; f < n; f++) {
-    dir3 d;
-    snprintf(sub, sizeof sub, "%s.%d", path, f);
-    PM_CALL(pm_reader_value(r, pm_sdoc_item(r->doc, id, f), sub, &dir, &d));
-    double len = pm_v_norm(d.v);
-    if (!(len > 0)) return pm_reader_expected(r, sub, "a non-zero direction");
-    for (int c = 0; c < 3; c++) pt->fibres[f][c] = d.v[c] / len;
-  }
-  return PM_SUCCESS;
-}
-
-/* region: an expression in x, y, z (inside where > 0), or the word
- * domain. */
-static pm_err read_region(pm_reader *r, int id, const char *path,
-                          const pm_key *k, void *dst) {
-  (void)k;
-  pm_scene_body *b = (pm_scene_body *)((char *)dst - B(region));
-  const char *text = pm_sdoc_scalar(r->doc, id);
-  if (!text || !text[0])
-    return pm_reader_expected(r, path, "an expression in x, y, z, or domain");
-  if (strcmp(text, "domain") == 0) {
-    b->shape = PM_BODY_DOMAIN;
-    return PM_SUCCESS;
-  }
-  b->shape = PM_BODY_REGION;
-  return pm_reader_expr(r, path, text, "xyz", &b->region);
-}
-
-static void release_expr(void *dst) {
-  pm_expr_destroy(*(pm_expr **)dst);
-  *(pm_expr **)dst = NULL;
-}
 
 /* ---- tables ------------------------------------------------------------- */
 
@@ -486,9 +419,9 @@ static const pm_key body_keys[] = {
     {.name = "region",
      .type = PM_KEY_CUSTOM,
      .offset = B(region),
-     .read = read_region,
+     .read = pm_scene_read_region,
      .what = "an expression in x, y, z, or domain",
-     .release = release_expr,
+     .release = pm_scene_release_expr,
      .doc = "inside where f(x, y, z) > 0 (or: domain)"},
     {.name = "box",
      .type = PM_KEY_MAPPING,
@@ -564,7 +497,7 @@ static const pm_key body_keys[] = {
     {.name = "fibres",
      .type = PM_KEY_CUSTOM,
      .offset = B(point),
-     .read = read_fibres,
+     .read = pm_scene_read_fibres,
      .what = "a list of 1 or 2 directions [ax, ay, az]",
      .doc = "fibre directions [[ax, ay, az], ...] (anisotropic models)"},
     {0}};
@@ -804,7 +737,7 @@ const pm_key pm_scene_keys[] = {
      .type = PM_KEY_CUSTOM,
      .offset = S(dimension),
      .flags = PM_KEY_REQUIRED,
-     .read = read_dimension,
+     .read = pm_scene_read_dimension,
      .what = "2 or 3",
      .doc = "3, or 2 for plane strain"},
     {.name = "domain",

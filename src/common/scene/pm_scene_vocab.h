@@ -20,6 +20,20 @@ extern const pm_key pm_scene_material_keys[PM_MATERIAL_KEYS];
 pm_err pm_scene_read_materials(pm_reader *r, int id, const char *path,
                                const pm_key *k, void *dst);
 
+/* CUSTOM readers of pm_scene_keys (pm_scene_readers.c), each failing at
+ * the key at fault: the dimension (2 or 3, also into r->dimension), a
+ * material point's fibres (1 to PM_FIBRES_MAX non-zero directions,
+ * normalized), a body's region (an expression in x, y, z, or domain). */
+pm_err pm_scene_read_dimension(pm_reader *r, int id, const char *path,
+                               const pm_key *k, void *dst);
+pm_err pm_scene_read_fibres(pm_reader *r, int id, const char *path,
+                            const pm_key *k, void *dst);
+pm_err pm_scene_read_region(pm_reader *r, int id, const char *path,
+                            const pm_key *k, void *dst);
+
+/* Release of an expression key (dst: a pm_expr *, set to NULL). */
+void pm_scene_release_expr(void *dst);
+
 /* After reading: defaults that depend on other keys, names resolved to
  * indices, and the checks across keys, each failing at the key at fault. */
 pm_err pm_scene_finish(pm_reader *r, pm_scene *s);

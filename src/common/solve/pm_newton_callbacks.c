@@ -1,0 +1,147 @@
+/* pm_newton_callbacks: what SNES calls of the problem: the residual (with
+ * inadmissible states as domain errors), the Jacobian (assembled or as a
+ * shell), the line search's precheck and the linear solver's timing. */
+#include <math.h>
+#include <stdio.h>
+
+#include <petscsnes.h>
+
+#include "pm_newton_solver_impl.h"
+#include "pm_progress.h"
+
+PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
+  pm_newton *s = ctx;
+  const double *x;
+  double *r;
+  Vec xl, rl;
+  PetscFunctionBeginUser;
+  double t = pm_wtime();
+  PetscCall(pm_newton_in_get(s, X, s->Gx, &xl, &x));
+  PetscCall(pm_newton_out_get(s, R, s->Gr, &rl, &r));
+  pm_err e = pm_newton_agreed(s, s->p.residual(s->p.ctx, x, r));
+  PetscCall(pm_newton_out_done(s, R, s->Gr, &rl, &r, e == PM_SUCCESS));
+  PetscCall(pm_newton_in_done(s, s->Gx, &xl, &x));
+  if (s->rep) {
+    s->rep->time_residual += pm_wtime() - t;
+    s->rep->residual_evaluations++;
+  }
+  s->domain_last = e != PM_SUCCESS;
+  if (e == PM_SUCCESS) PetscFunctionReturn(0);
+  if (pm_newton_hard_failure(e)) {
+    s->hard = e;
+    SETERRQ(s->comm, PETSC_ERR_USER, "residual callback failed: %s",
+            pm_error_message());
+  }
+  snprintf(s->domain_msg, sizeof s->domain_msg, "%s",
+           pm_error_code() == e ? pm_error_message() : pm_err_string(e));
+  pm_error_clear();
+  PetscCall(SNESSetFunctionDomainError(snes));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
+                                       void *ctx) {
+  pm_newton *s = ctx;
+  const double *x;
+  Vec xl;
+  (void)snes;
+  (void)A;
+  PetscFunctionBeginUser;
+  double t = pm_wtime();
+  PetscCall(VecCopy(X, s->Xlin));
+  PetscCall(pm_newton_in_get(s, X, s->Glin, &xl, &x));
+  pm_err e = PM_SUCCESS;
+  if (s->p.jacobian_prepare)
+    e = pm_newton_agreed(s, s->p.jacobian_prepare(s->p.ctx, x));
+  /* A preconditioner matrix left unchanged keeps its factorisation: PETSc
+   * sets a PC up again only when the matrix's state has changed. */
+  bool rebuild =
+      s->o.op == PM_NEWTON_ASSEMBLED || s->jacobians % s->o.pc_lag == 0;
+  s->jacobians++;
+  if (e == PM_SUCCESS && rebuild) {
+    if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
+      e = pm_newton_color_values(s, s->p.precond_apply, &s->pcol, x, s->pvals);
+      if (e == PM_SUCCESS)
+        e = pm_newton_insert_values(s, B, &s->ppat, s->pcols, s->pvals);
+    } else {
+      e = pm_newton_agreed(s, pm_newton_values_at(s, x, s->jvals));
+      if (e == PM_SUCCESS)
+        e = pm_newton_insert_values(s, B, &s->jpat, s->jcols, s->jvals);
+    }
+  }
+  e = pm_newton_agreed(s, e);
+  PetscCall(pm_newton_in_done(s, s->Glin, &xl, &x));
+  if (s->rep) s->rep->time_assembly += pm_wtime() - t;
+  if (e != PM_SUCCESS) {
+    s->hard = e;
+    SETERRQ(s->comm, PETSC_ERR_USER, "Jacobian callback failed: %s",
+            pm_error_message());
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode pm_newton_shell_mult(Mat A, Vec in, Vec out) {
+  pm_newton *s;
+  const double *x, *dx;
+  double *dr;
+  Vec xl, dxl, drl;
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &s));
+  /* The linearisation point's held values are Glin's since the Jacobian
+   * was made there. */
+  xl = s->Xlin;
+  if (s->dist) PetscCall(VecGhostGetLocalForm(s->Glin, &xl));
+  PetscCall(VecGetArrayRead(xl, &x));
+  PetscCall(pm_newton_in_get(s, in, s->Gdx, &dxl, &dx));
+  PetscCall(pm_newton_out_get(s, out, s->Gdr, &drl, &dr));
+  pm_err e = pm_newton_agreed(s, s->p.jacobian_apply(s->p.ctx, x, dx, dr));
+  if (s->rep) s->rep->jacobian_applications++;
+  PetscCall(pm_newton_out_done(s, out, s->Gdr, &drl, &dr, e == PM_SUCCESS));
+  PetscCall(pm_newton_in_done(s, s->Gdx, &dxl, &dx));
+  PetscCall(VecRestoreArrayRead(xl, &x));
+  if (s->dist) PetscCall(VecGhostRestoreLocalForm(s->Glin, &xl));
+  if (e != PM_SUCCESS) {
+    s->hard = e;
+    SETERRQ(s->comm, PETSC_ERR_USER, "jacobian_apply failed: %s",
+            pm_error_message());
+  }
+  PetscFunctionReturn(0);
+}
+
+/* The Newton direction before the line search scales it: SNES's Y solves
+ * J Y = r, so dx = -Y. */
+PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
+                                  PetscBool *changed, void *ctx) {
+  pm_newton *s = ctx;
+  Vec F;
+  PetscReal dot;
+  (void)ls;
+  (void)X;
+  PetscFunctionBeginUser;
+  *changed = PETSC_FALSE;
+  PetscCall(SNESGetFunction(s->snes, &F, NULL, NULL));
+  PetscCall(VecNorm(Y, NORM_2, &s->incr));
+  PetscCall(VecDot(Y, F, &dot));
+  s->energy = fabs(dot);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
+  pm_newton *s = ctx;
+  (void)ksp;
+  (void)b;
+  (void)x;
+  s->linear_started = pm_wtime();
+  s->in_linear = true;
+  return 0;
+}
+
+PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx) {
+  pm_newton *s = ctx;
+  (void)ksp;
+  (void)b;
+  (void)x;
+  if (s->rep) s->rep->time_linear += pm_wtime() - s->linear_started;
+  s->in_linear = false;
+  return 0;
+}

@@ -1,0 +1,150 @@
+/* pm_newton_solver_impl: the Newton solver's state and the functions its
+ * files share (assembly, held values across ranks, SNES callbacks, linear
+ * solver); not for callers of pm_newton.h. */
+#ifndef PM_NEWTON_SOLVER_IMPL_H
+#define PM_NEWTON_SOLVER_IMPL_H
+
+#include <stdbool.h>
+
+#include <petscsnes.h>
+
+#include "pm_coloring.h"
+#include "pm_newton.h"
+#include "pm_par.h"
+
+typedef pm_err (*apply_fn)(void *ctx, const double *x, const double *dx,
+                           double *dr);
+
+struct pm_newton {
+  pm_newton_problem p; /* the caller's, with pattern pointers cleared */
+  pm_newton_options o;
+  char *petsc_options;     /* copy of o.petsc_options */
+  pm_pattern jpat, ppat;   /* Jacobian's and cheap operator's */
+  pm_coloring jcol, pcol;  /* their colourings (pcol: cheap only) */
+  PetscInt *jcols, *pcols; /* pattern columns as PETSc indices */
+  double *jvals, *pvals;   /* values in pattern order */
+  double *seed, *dr;       /* colour seed and its image */
+  double *srcvals;         /* jacobian_values: values in the caller's order */
+  Vec X, R, Xstart, Xlin, Xacc, Work;
+  Mat J;     /* assembled Jacobian (not in the cheap mode) */
+  Mat P;     /* assembled cheap operator (cheap mode only) */
+  Mat Shell; /* matrix-free Jacobian (matrix-free modes only) */
+  SNES snes;
+  KSP ksp;
+  SNESLineSearch ls;
+  PetscOptions opts;
+  /* Across ranks (dist): the ranks' communicator (PETSC_COMM_SELF on one
+   * process), the values a rank holds (owned and ghosts: nloc), the
+   * numbering of its held values over all ranks, and ghosted vectors in
+   * which the callbacks see the ghosts' values (Gx: a residual's state,
+   * Glin: the linearisation point, Gdx: a product's direction) and leave
+   * their contributions (Gr, Gdr). */
+  bool dist;
+  MPI_Comm comm;
+  long nloc;
+  ISLocalToGlobalMapping l2g;
+  Vec Gx, Glin, Gdx, Gr, Gdr;
+
+  /* The solve under way. */
+  pm_newton_report *rep;
+  pm_newton_reason reason;
+  pm_err hard;      /* a callback's failure that aborts the solve */
+  bool domain_last; /* the last residual call was inadmissible */
+  char domain_msg[256];
+  double r0, e0;       /* reference residual for rtol, |dx_0 . r(x_0)| */
+  double r_ref;        /* a reference residual larger than |r(x_0)| (0: none) */
+  double incr, energy; /* |dx_k|, |dx_k . r(x_k)| of the current step */
+  long jacobians;      /* Jacobian callbacks in this solve (for pc_lag) */
+  double linear_started;
+  bool in_linear; /* between the linear solver's pre- and postsolve */
+  bool started;   /* the initial state was admissible */
+};
+
+/* A callback's failure that aborts the solve (not an inadmissible state). */
+static inline bool pm_newton_hard_failure(pm_err e) {
+  return e == PM_ERR_MEMORY || e == PM_ERR_IO || e == PM_ERR_INTERNAL;
+}
+
+/* A callback's answer, the same on every rank of a shared problem. */
+static inline pm_err pm_newton_agreed(const pm_newton *s, pm_err e) {
+  return s->dist ? pm_par_agree(e) : e;
+}
+
+/* ---- pm_newton_assembly.c ---- */
+
+/* v's n values = x (copy_in), or x = v's (copy_out). */
+pm_err pm_newton_copy_in(Vec v, const double *x, long n);
+pm_err pm_newton_copy_out(Vec v, double *x, long n);
+
+/* vals (pattern order) = J(x) by one application of f per colour of col;
+ * a failing application is returned with its colour. */
+pm_err pm_newton_color_values(pm_newton *s, apply_fn f, const pm_coloring *col,
+                              const double *x, double *vals);
+
+/* The Jacobian's values at x in pattern order: the caller's assembly when
+ * it gives one, else colouring. */
+pm_err pm_newton_values_at(pm_newton *s, const double *x, double *vals);
+
+/* M = vals on the pattern (the matrix's preallocated structure). */
+pm_err pm_newton_insert_values(const pm_newton *s, Mat M, const pm_pattern *pat,
+                               const PetscInt *cols, const double *vals);
+
+/* *M: an AIJ matrix with pat's structure, set to zeros (n values, the
+ * caller's); *cols (allocated, the caller frees) the pattern's columns as
+ * PETSc indices.  Sequential, or over the ranks with every rank's rows. */
+pm_err pm_newton_create_matrix(const pm_newton *s, const pm_pattern *pat,
+                               PetscInt **cols, double *zeros, Mat *M);
+
+/* The problem's near-null vectors, orthonormalised, as M's near null space
+ * (at most 16 of them, else PM_ERR_ARG). */
+pm_err pm_newton_set_near_null(pm_newton *s, Mat M);
+
+/* ---- pm_newton_shared.c ---- */
+
+/* The values a callback reads of V (in_get .. in_done) and where it writes
+ * them (out_get .. out_done): V's own array on one process, ghosted G's held
+ * values across ranks; out_done with ok adds the ghosts' contributions on
+ * their owners, into V. */
+PetscErrorCode pm_newton_in_get(const pm_newton *s, Vec V, Vec G, Vec *loc,
+                                const double **a);
+PetscErrorCode pm_newton_in_done(const pm_newton *s, Vec G, Vec *loc,
+                                 const double **a);
+PetscErrorCode pm_newton_out_get(const pm_newton *s, Vec V, Vec G, Vec *loc,
+                                 double **a);
+PetscErrorCode pm_newton_out_done(const pm_newton *s, Vec V, Vec G, Vec *loc,
+                                  double **a, bool ok);
+
+/* Across ranks: the numbering of the held values over all ranks (s->l2g)
+ * and the ghosted vectors of the callbacks. */
+pm_err pm_newton_create_shared(pm_newton *s);
+
+/* ---- pm_newton_callbacks.c: what SNES (and KSP) call, ctx = the solver. */
+
+PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx);
+PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
+                                       void *ctx);
+PetscErrorCode pm_newton_shell_mult(Mat A, Vec in, Vec out);
+PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
+                                  PetscBool *changed, void *ctx);
+PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx);
+PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx);
+
+/* ---- pm_newton_convergence.c ---- */
+
+/* SNES's convergence test: sets s->reason and *reason after `it`
+ * iterations. */
+PetscErrorCode pm_newton_converged_test(SNES snes, PetscInt it, PetscReal xnorm,
+                                        PetscReal snorm, PetscReal fnorm,
+                                        SNESConvergedReason *reason, void *ctx);
+
+/* ---- pm_newton_linear.c ---- */
+
+/* Gives SNES a new linear solver (in place of one left inconsistent by a
+ * failure inside it); s->ksp is it. */
+pm_err pm_newton_replace_linear(pm_newton *s);
+
+/* What the linear solver multiplies by (A) and builds its preconditioner
+ * from (B). */
+void pm_newton_operators(const pm_newton *s, Mat *A, Mat *B);
+
+#endif
