@@ -30,6 +30,20 @@ static long scratch_per_particle(const mpm_model *m) {
 
 static pm_err history_setup(mpm_sim *r);
 
+/* The scene checks: the method's own, then what a run across ranks cannot
+ * do yet (mpm_par_check), then for the implicit MPM its own. */
+static pm_err check_explicit(const pm_scene *s) {
+  PM_CALL(mpm_check_scene(s));
+  if (pm_par_active()) PM_CALL(mpm_par_check(s));
+  return PM_SUCCESS;
+}
+
+static pm_err check_implicit(const pm_scene *s) {
+  PM_CALL(check_explicit(s));
+  if (pm_par_active()) PM_CALL(mpm_par_check_implicit(s));
+  return mpm_implicit_check_scene(s);
+}
+
 /* A workspace that holds only the figures of a step (reactions, residual)
  * and the timers: the implicit solver's, and rank 0's view of a run
  * across ranks. */
@@ -942,7 +956,7 @@ static pm_err plan_ranks(mpm_sim *r, FILE *out) {
     pm_par_bcast(&more, sizeof more);
     if (!more) break;
     pm_err e = mpm_step(r->local_model, r->local_state, r->local_work);
-    if (!e) e = mpm_par_migrate(r->local_model, r->local_state, r->local_work);
+    if (!e) e = mpm_xc_migrate(r->local_model, r->local_state, r->local_work);
     if (e) break; /* agreed by every rank */
     reps++;
   }
@@ -1054,7 +1068,7 @@ const pm_backend mpm_backend = {
     .section = &mpm_section,
     .dt_safety = 0.5,
     .ranks = true,
-    .check = mpm_check_scene,
+    .check = check_explicit,
     .create = create,
     .estimate_bytes = mpm_estimate_bytes,
     .destroy = destroy,
@@ -1276,7 +1290,7 @@ const pm_backend mpm_implicit_backend = {
                    "the grid, PETSc)",
     .section = NULL,
     .dt_safety = 0.5,
-    .check = mpm_implicit_check_scene,
+    .check = check_implicit,
     .ranks = true,
     .create = implicit_create,
     .estimate_bytes = mpm_estimate_bytes,

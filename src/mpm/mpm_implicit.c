@@ -8,9 +8,8 @@
 #include <string.h>
 
 #include "mpm_kind.h"
-#include "mpm_par.h"
+#include "mpm_exchange.h"
 #include "pm_omp.h"
-#include "pm_par.h"
 #include "pm_progress.h"
 #include "pm_tensor.h"
 
@@ -39,7 +38,7 @@ struct mpm_implicit {
   unsigned char *active;
   long *dof, *unk_dof;
   long nunk, npre, pre_cap;
-  /* Across ranks (the model a rank's share: m->par): the unknowns are the
+  /* Across ranks (the model a rank's share: m->xc): the unknowns are the
    * owned nodes' (nunk), then the ghost nodes' that other ranks own
    * (nghost, global numbers ghost); nheld = nunk + nghost (nunk on one
    * process).  Sums over nodes add the ranks' parts first. */
@@ -748,43 +747,6 @@ static pm_err make_prescribed(mpm_implicit *im) {
   return PM_SUCCESS;
 }
 
-/* Across ranks: the global numbers of the unknowns (each rank's owned
- * ones after the ranks' before it), the owners' numbers at the ghost
- * nodes, and the ghost nodes' unknowns numbered after the owned. */
-static pm_err number_ghosts(mpm_implicit *im) {
-  const long nn = im->g.n_nodes;
-  const unsigned char *own = mpm_par_owned(im->m);
-  const long first = pm_par_offset(im->nunk);
-  for (long d = 0; d < 3 * nn; d++)
-    im->gnum[d] = im->dof[d] >= 0 ? first + im->dof[d] : -1;
-  MPI_Datatype three;
-  MPI_Type_contiguous(3, MPI_LONG, &three);
-  MPI_Type_commit(&three);
-  pm_err e = mpm_par_nodes_bcast(im->m, im->gnum, three);
-  MPI_Type_free(&three);
-  PM_CALL(e);
-  long count = 0;
-  for (long k = 0; k < nn; k++)
-    for (int c = 0; !own[k] && c < 3; c++) count += im->gnum[3 * k + c] >= 0;
-  PM_CALL(PM_REALLOC(im->ghost, count + 1, "ghost unknowns"));
-  im->nghost = 0;
-  for (long k = 0; k < nn; k++)
-    for (int c = 0; !own[k] && c < 3; c++) {
-      const long d = 3 * k + c;
-      if (im->gnum[d] < 0) continue;
-      /* Active nodes and prescribed dofs are the same on every rank that
-       * holds the node. */
-      PM_CHECK(im->dof[d] == -1, PM_ERR_INTERNAL,
-               "implicit MPM across ranks: dof %ld of a ghost node is %ld "
-               "here and an unknown on its owner",
-               d, im->dof[d]);
-      im->ghost[im->nghost] = im->gnum[d];
-      im->dof[d] = im->nunk + im->nghost++;
-    }
-  im->nheld = im->nunk + im->nghost;
-  return PM_SUCCESS;
-}
-
 /* Active nodes, prescribed and unknown dofs, and the Jacobian's pattern:
  * every row of a node lists the unknowns of the nodes within a stencil's
  * reach in neighbour order, each neighbour's components in order.  Across
@@ -800,10 +762,9 @@ static pm_err make_dofs(mpm_implicit *im) {
     mpm_stencil_at(g, im->xb + 3 * p, MPM_STENCIL_W, &st);
     for (int k = 0; k < st.n; k++) im->active[st.node[k]] = 1;
   }
-  const unsigned char *own = im->ranks ? mpm_par_owned(im->m) : NULL;
+  const unsigned char *own = im->ranks ? mpm_xc_owned(im->m) : NULL;
   if (im->ranks)
-    PM_CALL(
-        mpm_par_nodes_reduce(im->m, im->active, MPI_UNSIGNED_CHAR, MPI_MAX));
+    PM_CALL(mpm_xc_nodes_reduce(im->m, im->active, MPM_XC_BYTE, MPM_XC_MAX));
   for (long d = 0; d < 3 * nn; d++) im->dof[d] = -1;
   PM_CALL(make_prescribed(im));
   im->nunk = 0;
@@ -815,9 +776,15 @@ static pm_err make_dofs(mpm_implicit *im) {
       if (im->dof[3 * k + c] == -1) im->dof[3 * k + c] = im->nunk++;
   }
   im->nheld = im->nunk;
-  if (im->ranks) PM_CALL(number_ghosts(im));
+  /* Across ranks: the global numbers of the unknowns, the owners' numbers
+   * at the ghost nodes, and the ghost nodes' unknowns after the owned. */
+  if (im->ranks) {
+    PM_CALL(mpm_xc_number_unknowns(im->m, im->nunk, im->dof, im->gnum,
+                                   &im->ghost, &im->nghost));
+    im->nheld = im->nunk + im->nghost;
+  }
   long counts[2] = {im->nunk, im->active_all};
-  pm_par_sum_long(counts, 2);
+  mpm_xc_sum_long(im->m, counts, 2);
   im->nunk_all = counts[0];
   im->active_all = counts[1];
   PM_CHECK(im->nunk_all > 0, PM_ERR_SCENE,
@@ -878,7 +845,7 @@ static pm_err make_dofs(mpm_implicit *im) {
   }
   for (long r = 0; r < nh; r++) im->pat_ptr[r + 1] += im->pat_ptr[r];
   im->entries_all = total;
-  pm_par_sum_long(&im->entries_all, 1);
+  mpm_xc_sum_long(im->m, &im->entries_all, 1);
   if (total > im->pat_cap) {
     PM_CALL(PM_REALLOC(im->pat_idx, total, "Jacobian pattern"));
     im->pat_cap = total;
@@ -988,15 +955,9 @@ static pm_err commit(mpm_implicit *im, const double *x) {
   if (!nodal_force(im, im->u, im->f))
     return PM_ERROR(PM_ERR_UNSTABLE, "%s", im->fail_msg);
   /* Across ranks: whole nodal sums, counted at the nodes a rank owns. */
-  const unsigned char *own = im->ranks ? mpm_par_owned(m) : NULL;
-  if (im->ranks) {
-    MPI_Datatype three;
-    MPI_Type_contiguous(3, MPI_DOUBLE, &three);
-    MPI_Type_commit(&three);
-    pm_err e = mpm_par_nodes_reduce(m, im->f, three, MPI_SUM);
-    MPI_Type_free(&three);
-    PM_CALL(e);
-  }
+  const unsigned char *own = im->ranks ? mpm_xc_owned(m) : NULL;
+  if (im->ranks)
+    PM_CALL(mpm_xc_nodes_reduce(m, im->f, MPM_XC_DOUBLE3, MPM_XC_SUM));
   for (int b = 0; b < 3 * m->n_bcs; b++) im->reaction[b] = 0;
   double sums[2] = {0, 0}; /* |r|^2, |reactions|^2 */
   for (long k = 0; k < im->npre; k++) {
@@ -1008,9 +969,9 @@ static pm_err commit(mpm_implicit *im, const double *x) {
   for (long k = 0; k < im->nunk; k++)
     sums[0] += im->f[im->unk_dof[k]] * im->f[im->unk_dof[k]];
   if (im->ranks) {
-    pm_par_sum(im->reaction, 3 * m->n_bcs);
-    pm_par_sum(sums, 2);
-    pm_par_min(&im->min_jacobian, 1);
+    mpm_xc_sum(m, im->reaction, 3 * m->n_bcs);
+    mpm_xc_sum(m, sums, 2);
+    mpm_xc_min(m, &im->min_jacobian, 1);
   }
   const double rr = sums[0], rf = sums[1];
   im->residual = rf > 0 ? sqrt(rr / rf) : sqrt(rr);
@@ -1099,7 +1060,7 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
   mpm_implicit *im = ctx;
   if (im->mode == MPM_GRID_RESET && lambda < 1) return PM_SUCCESS;
   pm_err e = commit(im, x);
-  PM_CALL(im->ranks ? pm_par_agree(e) : e);
+  PM_CALL(im->ranks ? mpm_xc_agree(im->m, e) : e);
   im->lambda = im->lam0 + lambda * (im->lam1 - im->lam0);
   return report_step(im, report);
 }
@@ -1222,7 +1183,7 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   im->m = m;
   im->st = st;
   im->n = m->n;
-  im->ranks = m->par != NULL;
+  im->ranks = mpm_xc_shared(m);
   im->dim = m->dim;
   im->mode = (mpm_grid_mode)ms->implicit.grid;
   im->matrix_free = ms->implicit.op == MPM_OP_MATRIX_FREE;
@@ -1468,12 +1429,12 @@ pm_err mpm_implicit_gather(mpm_implicit *im, const mpm_model *full) {
   pm_err e = PM_SUCCESS;
   if (full && !im->whole)
     e = PM_ALLOC(im->whole, 6 * full->grid.n_nodes, "nodal gather");
-  PM_CALL(pm_par_agree(e));
+  PM_CALL(mpm_xc_agree(im->m, e));
   const long nf = full ? 3 * full->grid.n_nodes : 0;
   for (int s = 0; s < 2; s++) {
     unknowns_to_nodes(im, s ? im->ls.xprev : im->ls.xc, im->du);
-    PM_CALL(mpm_par_gather_nodes(im->m, full, im->du,
-                                 full ? im->whole + s * nf : NULL));
+    PM_CALL(mpm_xc_gather_nodes(im->m, full, im->du,
+                                full ? im->whole + s * nf : NULL));
   }
   return PM_SUCCESS;
 }

@@ -36,6 +36,7 @@ enum {
 };
 
 struct mpm_par {
+  mpm_exchange xc; /* the core's view of this share (ctx: this) */
   mpm_decomp d;
   int rank;
   long own_lo[3], own_hi[3]; /* owned nodes (global) per axis */
@@ -81,6 +82,12 @@ struct mpm_par {
   int *gcount, *gdisp;
   mpm_par_counts counts;
 };
+
+static void fill_exchange(struct mpm_par *P);
+static void par_free(struct mpm_par *P);
+
+/* The share of local model m. */
+static inline struct mpm_par *par_of(const mpm_model *m) { return m->xc->ctx; }
 
 /* ---- decomposition --------------------------------------------------------
  */
@@ -356,6 +363,28 @@ pm_err mpm_par_check(const pm_scene *s) {
   return PM_SUCCESS;
 }
 
+pm_err mpm_par_check_implicit(const pm_scene *s) {
+  const mpm_settings *ms = mpm_scene_settings(s);
+  if (ms->implicit.grid == MPM_GRID_RESET)
+    return pm_scene_fail(s, "mpm.implicit.grid", false,
+                         "the grid reset after each load step runs on one "
+                         "process (this run has %d ranks): take kept, or run "
+                         "with -np 1",
+                         pm_par_size());
+  if (ms->implicit.op == MPM_OP_MATRIX_FREE)
+    return pm_scene_fail(s, "mpm.implicit.operator", false,
+                         "the matrix-free operator runs on one process (this "
+                         "run has %d ranks): take assembled, or run with -np "
+                         "1",
+                         pm_par_size());
+  if (ms->fbar == MPM_FBAR_CELL)
+    return pm_scene_fail(s, "mpm.fbar", false,
+                         "the implicit F-bar runs on one process (this run "
+                         "has %d ranks): run with -np 1",
+                         pm_par_size());
+  return PM_SUCCESS;
+}
+
 /* ---- each rank's share -----------------------------------------------------
  */
 
@@ -411,7 +440,7 @@ static long first_at_least(const long *gid, long n, long q) {
 
 /* Body and group ranges from the particles' indices (after a change). */
 static void set_ranges(mpm_model *m, mpm_state *s) {
-  const struct mpm_par *P = m->par;
+  const struct mpm_par *P = par_of(m);
   for (int b = 0; b < m->n_bodies; b++) {
     m->body_begin[b] = first_at_least(m->gid, m->n, P->bbegin[b]);
     m->body_end[b] = first_at_least(m->gid, m->n, P->bend[b]);
@@ -599,12 +628,12 @@ static pm_err local_model(const pm_scene *s, const mpm_model *m,
     lm->n_moving = m->n_moving;
   }
   mpm_pipeline_build(lm);
-  lm->par = P;
+  lm->xc = &P->xc;
   set_ranges(lm, NULL);
   *out = lm;
   lm = NULL;
 done:
-  if (lm) lm->par = NULL; /* P is the caller's until it is attached */
+  if (lm) lm->xc = NULL; /* P is the caller's until it is attached */
   mpm_model_destroy(lm);
   return ret;
 }
@@ -617,7 +646,7 @@ static pm_err local_state(const mpm_model *m, const mpm_state *st,
                           mpm_state **out) {
   mpm_state *ls = NULL;
   PM_CALL(mpm_state_create(lm, &ls));
-  const struct mpm_par *P = lm->par;
+  const struct mpm_par *P = par_of(lm);
   mpm_par_take_state(m, st, lm, ls);
   if (accounts) {
     const double *row = accounts + MPM_PAR_ACCOUNTS * P->rank;
@@ -704,11 +733,12 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   if (!ret) ret = mpm_decomp_create(s, m, size, &P->d);
   PM_TRY(pm_par_agree(ret));
   P->rank = pm_par_rank();
+  fill_exchange(P);
   ret = local_model(s, m, st, P, &lm);
   if (!ret) P = NULL; /* lm holds it */
   if (!ret) ret = local_state(m, st, lm, accounts, &ls);
   PM_TRY(pm_par_agree(ret));
-  struct mpm_par *Q = lm->par;
+  struct mpm_par *Q = par_of(lm);
   PM_TRY(make_near(Q, m));
   PM_TRY(mpm_ghosts_create(lm, ls, &Q->d, Q->gbegin, Q->gend, Q->near,
                            Q->n_near, &Q->gh));
@@ -741,13 +771,13 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   lm = NULL;
   ls = NULL;
 done:
-  mpm_par_destroy(P);
+  par_free(P);
   mpm_state_destroy(ls);
   mpm_model_destroy(lm);
   return ret;
 }
 
-void mpm_par_destroy(struct mpm_par *P) {
+static void par_free(struct mpm_par *P) {
   if (!P) return;
   if (P->ghosts) {
     PetscSFDestroy(&P->ghosts);
@@ -780,17 +810,17 @@ void mpm_par_destroy(struct mpm_par *P) {
   free(P);
 }
 
-void mpm_par_work_attach(const mpm_model *m, mpm_work *w) {
-  w->nodes.owned = m->par->owned;
+static void par_work_attach(const mpm_model *m, mpm_work *w) {
+  w->nodes.owned = par_of(m)->owned;
   w->timer_migrate = pm_timers_add(&w->timers, "migrate");
 }
 
 /* ---- node sums -------------------------------------------------------------
  */
 
-pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
-                         bool imp) {
-  struct mpm_par *P = m->par;
+static pm_err par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
+                            bool imp) {
+  struct mpm_par *P = par_of(m);
   const double t0 = pm_wtime();
   PetscSF sf = P->ghosts;
   /* The arrays a transfer of `mode` filled, and their values per node. */
@@ -841,34 +871,93 @@ pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
 static void count_ghosts(const mpm_model *m, MPI_Datatype unit) {
   int size = 0;
   MPI_Type_size(unit, &size);
-  const double bytes = (double)(m->grid.n_nodes - m->par->n_owned) * size;
-  m->par->counts.halo_bytes += bytes;
+  const double bytes = (double)(m->grid.n_nodes - par_of(m)->n_owned) * size;
+  par_of(m)->counts.halo_bytes += bytes;
   pm_par_count_sent(bytes);
 }
 
-pm_err mpm_par_nodes_reduce(const mpm_model *m, void *a, MPI_Datatype unit,
-                            MPI_Op op) {
-  PetscSF sf = m->par->ghosts;
-  const double t0 = pm_wtime();
-  count_ghosts(m, unit);
-  PM_PETSC_CALL(PetscSFReduceBegin(sf, unit, a, a, op));
-  PM_PETSC_CALL(PetscSFReduceEnd(sf, unit, a, a, op));
-  pm_err e = mpm_par_nodes_bcast(m, a, unit);
-  m->par->counts.halo_seconds += pm_wtime() - t0;
-  return e;
-}
-
-pm_err mpm_par_nodes_bcast(const mpm_model *m, void *a, MPI_Datatype unit) {
-  PetscSF sf = m->par->ghosts;
+static pm_err bcast_nodes(const mpm_model *m, void *a, MPI_Datatype unit) {
+  PetscSF sf = par_of(m)->ghosts;
   count_ghosts(m, unit);
   PM_PETSC_CALL(PetscSFBcastBegin(sf, unit, a, a, MPI_REPLACE));
   PM_PETSC_CALL(PetscSFBcastEnd(sf, unit, a, a, MPI_REPLACE));
   return PM_SUCCESS;
 }
 
-const unsigned char *mpm_par_owned(const mpm_model *m) { return m->par->owned; }
+static pm_err reduce_nodes(const mpm_model *m, void *a, MPI_Datatype unit,
+                           MPI_Op op) {
+  PetscSF sf = par_of(m)->ghosts;
+  const double t0 = pm_wtime();
+  count_ghosts(m, unit);
+  PM_PETSC_CALL(PetscSFReduceBegin(sf, unit, a, a, op));
+  PM_PETSC_CALL(PetscSFReduceEnd(sf, unit, a, a, op));
+  pm_err e = bcast_nodes(m, a, unit);
+  par_of(m)->counts.halo_seconds += pm_wtime() - t0;
+  return e;
+}
 
-void mpm_par_step_end(const mpm_model *m, mpm_work *w) {
+/* The MPI type of a node's unit; *made when it was made here (to free). */
+static MPI_Datatype unit_type(mpm_xc_unit u, bool *made) {
+  *made = false;
+  if (u == MPM_XC_DOUBLE) return MPI_DOUBLE;
+  if (u == MPM_XC_BYTE) return MPI_UNSIGNED_CHAR;
+  MPI_Datatype t;
+  MPI_Type_contiguous(3, u == MPM_XC_LONG3 ? MPI_LONG : MPI_DOUBLE, &t);
+  MPI_Type_commit(&t);
+  *made = true;
+  return t;
+}
+
+static pm_err par_nodes_reduce(const mpm_model *m, void *a, mpm_xc_unit unit,
+                               mpm_xc_op op) {
+  bool made;
+  MPI_Datatype t = unit_type(unit, &made);
+  pm_err e = reduce_nodes(m, a, t, op == MPM_XC_MAX ? MPI_MAX : MPI_SUM);
+  if (made) MPI_Type_free(&t);
+  return e;
+}
+
+static pm_err par_nodes_bcast(const mpm_model *m, void *a, mpm_xc_unit unit) {
+  bool made;
+  MPI_Datatype t = unit_type(unit, &made);
+  pm_err e = bcast_nodes(m, a, t);
+  if (made) MPI_Type_free(&t);
+  return e;
+}
+
+static const unsigned char *par_owned(const mpm_model *m) {
+  return par_of(m)->owned;
+}
+
+static pm_err par_number_unknowns(const mpm_model *m, long nunk, long *dof,
+                                  long *gnum, long **ghost, long *nghost) {
+  const long nn = m->grid.n_nodes;
+  const unsigned char *own = par_of(m)->owned;
+  const long first = pm_par_offset(nunk);
+  for (long d = 0; d < 3 * nn; d++) gnum[d] = dof[d] >= 0 ? first + dof[d] : -1;
+  PM_CALL(par_nodes_bcast(m, gnum, MPM_XC_LONG3));
+  long count = 0;
+  for (long k = 0; k < nn; k++)
+    for (int c = 0; !own[k] && c < 3; c++) count += gnum[3 * k + c] >= 0;
+  PM_CALL(PM_REALLOC(*ghost, count + 1, "ghost unknowns"));
+  *nghost = 0;
+  for (long k = 0; k < nn; k++)
+    for (int c = 0; !own[k] && c < 3; c++) {
+      const long d = 3 * k + c;
+      if (gnum[d] < 0) continue;
+      /* Active nodes and prescribed dofs are the same on every rank that
+       * holds the node. */
+      PM_CHECK(dof[d] == -1, PM_ERR_INTERNAL,
+               "implicit MPM across ranks: dof %ld of a ghost node is %ld "
+               "here and an unknown on its owner",
+               d, dof[d]);
+      (*ghost)[*nghost] = gnum[d];
+      dof[d] = nunk + (*nghost)++;
+    }
+  return PM_SUCCESS;
+}
+
+static void par_step_end(const mpm_model *m, mpm_work *w) {
   (void)m;
   double most[3] = {w->max_div, -w->min_jacobian, (double)w->iter_max};
   pm_par_max(most, 3);
@@ -883,7 +972,7 @@ void mpm_par_step_end(const mpm_model *m, mpm_work *w) {
 
 /* Grow every per-particle array of m, s and w to room for n particles. */
 static pm_err grow(mpm_model *m, mpm_state *s, mpm_work *w, long n) {
-  struct mpm_par *P = m->par;
+  struct mpm_par *P = par_of(m);
   if (n <= m->cap) return PM_SUCCESS;
   const long room = room_for(n);
   PM_CALL(PM_REALLOC(m->x0, 3 * room, "particle positions"));
@@ -954,7 +1043,7 @@ static void permute(const struct mpm_par *P, double *data, long n_new, int nc,
 /* The particles' move between ranks (collective; every rank returns the
  * same). */
 static pm_err move_particles(mpm_model *m, mpm_state *s, mpm_work *w) {
-  struct mpm_par *P = m->par;
+  struct mpm_par *P = par_of(m);
   const int n_near = P->n_near, rec = P->rec;
   const double t0 = pm_wtime();
   pm_err ret = PM_SUCCESS;
@@ -1130,8 +1219,8 @@ static pm_err grow_scratch(const mpm_model *m, mpm_work *w) {
   return PM_SUCCESS;
 }
 
-pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
-  struct mpm_par *P = m->par;
+static pm_err par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
+  struct mpm_par *P = par_of(m);
   PM_CALL(move_particles(m, s, w));
   if (!P->gh) return PM_SUCCESS;
   /* The ghosts: their links anew when a linked point moved between any
@@ -1150,36 +1239,27 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   return e;
 }
 
-const double *mpm_par_ghost_x(const mpm_model *m, int gi) {
-  return m->par ? mpm_ghosts_x(m->par->gh, gi) : NULL;
+static const double *par_ghost_x(const mpm_model *m, int gi) {
+  return mpm_ghosts_x(par_of(m)->gh, gi);
 }
 
-const double *mpm_par_nearby(const mpm_model *m, int gi, long *n,
-                             const long **ids) {
-  if (m->par) return mpm_ghosts_nearby(m->par->gh, gi, n, ids);
-  *n = 0;
-  *ids = NULL;
-  return NULL;
+static const double *par_nearby(const mpm_model *m, int gi, long *n,
+                                const long **ids) {
+  return mpm_ghosts_nearby(par_of(m)->gh, gi, n, ids);
 }
 
-void mpm_par_cells(const mpm_model *m, long nn[3], long lo[3], long hi[3]) {
+static void par_cells(const mpm_model *m, long nn[3], long lo[3], long hi[3]) {
+  const struct mpm_par *P = par_of(m);
   for (int a = 0; a < 3; a++) {
-    if (m->par) {
-      const mpm_decomp *d = &m->par->d;
-      nn[a] = a < m->dim ? d->cells[a] + 1 : 1;
-      lo[a] = d->box[6 * m->par->rank + a];
-      hi[a] = d->box[6 * m->par->rank + 3 + a];
-    } else {
-      nn[a] = m->grid.nn[a];
-      lo[a] = 0;
-      hi[a] = a < m->dim ? m->grid.nn[a] - 1 : 1;
-    }
+    nn[a] = a < m->dim ? P->d.cells[a] + 1 : 1;
+    lo[a] = P->d.box[6 * P->rank + a];
+    hi[a] = P->d.box[6 * P->rank + 3 + a];
   }
 }
 
-const long *mpm_par_ghost_ids(const mpm_model *m, int gi, long *n) {
-  *n = m->par ? mpm_ghosts_count(m->par->gh, gi) : 0;
-  return m->par ? mpm_ghosts_ids(m->par->gh, gi) : NULL;
+static const long *par_ghost_ids(const mpm_model *m, int gi, long *n) {
+  *n = mpm_ghosts_count(par_of(m)->gh, gi);
+  return mpm_ghosts_ids(par_of(m)->gh, gi);
 }
 
 /* ---- gather to rank 0 -------------------------------------------------------
@@ -1214,7 +1294,7 @@ static void gather_array(struct mpm_par *P, const double *data, long n, int nc,
 static pm_err gather_owned(const mpm_model *m, const mpm_grid *fg,
                            const double *src, const unsigned char *srcf,
                            double *dst, unsigned char *dstf) {
-  struct mpm_par *P = m->par;
+  struct mpm_par *P = par_of(m);
   const mpm_grid *g = &m->grid;
   const int size = P->d.size;
   pm_err e = PM_SUCCESS;
@@ -1258,7 +1338,7 @@ static pm_err gather_owned(const mpm_model *m, const mpm_grid *fg,
 
 pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
                       const mpm_model *full, mpm_state *fs) {
-  struct mpm_par *P = m->par;
+  struct mpm_par *P = par_of(m);
   const int size = P->d.size;
   /* The one-process indices, all at once, then per group. */
   int cnt = (int)m->n;
@@ -1318,8 +1398,8 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
   return PM_SUCCESS;
 }
 
-pm_err mpm_par_gather_nodes(const mpm_model *m, const mpm_model *full,
-                            const double *local, double *whole) {
+static pm_err par_gather_nodes(const mpm_model *m, const mpm_model *full,
+                               const double *local, double *whole) {
   return gather_owned(m, full ? &full->grid : NULL, local, NULL, whole, NULL);
 }
 
@@ -1414,7 +1494,7 @@ void mpm_decomp_predict(const mpm_decomp *d, const mpm_model *m, FILE *out) {
 }
 
 void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
-  const struct mpm_par *P = m->par;
+  const struct mpm_par *P = par_of(m);
   const int size = P->d.size;
   /* Per rank: particles, nodes held, nodes owned, bytes, ghost points. */
   double ghosts = 0;
@@ -1449,10 +1529,64 @@ void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
   free(all);
 }
 
-const mpm_decomp *mpm_par_decomp(const mpm_model *m) { return &m->par->d; }
+const mpm_decomp *mpm_par_decomp(const mpm_model *m) { return &par_of(m)->d; }
 
-const double *mpm_par_accounts(const mpm_model *m) { return m->par->accounts; }
+const double *mpm_par_accounts(const mpm_model *m) {
+  return par_of(m)->accounts;
+}
 
 void mpm_par_get_counts(const mpm_model *m, mpm_par_counts *c) {
-  *c = m->par ? m->par->counts : (mpm_par_counts){0};
+  *c = m->xc ? par_of(m)->counts : (mpm_par_counts){0};
+}
+
+/* The core's reductions over the ranks (mpm_exchange.h). */
+static void xc_sum(void *ctx, double *v, int n) {
+  (void)ctx;
+  pm_par_sum(v, n);
+}
+static void xc_max(void *ctx, double *v, int n) {
+  (void)ctx;
+  pm_par_max(v, n);
+}
+static void xc_min(void *ctx, double *v, int n) {
+  (void)ctx;
+  pm_par_min(v, n);
+}
+static void xc_sum_long(void *ctx, long *v, int n) {
+  (void)ctx;
+  pm_par_sum_long(v, n);
+}
+static pm_err xc_agree(void *ctx, pm_err e) {
+  (void)ctx;
+  return pm_par_agree(e);
+}
+static long xc_offset(void *ctx, long n) {
+  (void)ctx;
+  return pm_par_offset(n);
+}
+static void xc_release(mpm_exchange *xc) { par_free(xc->ctx); }
+
+/* The exchange that a local model holds: this share's operations. */
+static void fill_exchange(struct mpm_par *P) {
+  P->xc = (mpm_exchange){.ctx = P,
+                         .sum = xc_sum,
+                         .max = xc_max,
+                         .min = xc_min,
+                         .sum_long = xc_sum_long,
+                         .agree = xc_agree,
+                         .offset = xc_offset,
+                         .sum_nodes = par_sum_nodes,
+                         .nodes_reduce = par_nodes_reduce,
+                         .nodes_bcast = par_nodes_bcast,
+                         .owned = par_owned,
+                         .work_attach = par_work_attach,
+                         .step_end = par_step_end,
+                         .migrate = par_migrate,
+                         .ghost_x = par_ghost_x,
+                         .ghost_ids = par_ghost_ids,
+                         .nearby = par_nearby,
+                         .cells = par_cells,
+                         .number_unknowns = par_number_unknowns,
+                         .gather_nodes = par_gather_nodes,
+                         .release = xc_release};
 }
