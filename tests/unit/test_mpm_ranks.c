@@ -1,7 +1,6 @@
 /* test_mpm_ranks: MPM's ranks layer in one process: the decomposition's
- * boxes, owned and held nodes, and the core stepping through the exchange
- * interface (mpm_exchange.h) with a fake share of one rank, which must give
- * one process's state bit for bit. */
+ * boxes and nodes, and the core stepping through the exchange interface with
+ * a fake share of one rank, which must give one process's state bit for bit. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

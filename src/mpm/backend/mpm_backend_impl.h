@@ -1,7 +1,6 @@
-/* mpm_backend_impl: what the pieces of MPM's two backends share: the
- * simulation's setup and reports, rank 0's view of a run across ranks, and
- * the entries of the backend table both methods use.  Internal to
- * backend/. */
+/* mpm_backend_impl: what the pieces of MPM's two backends share (internal
+ * to backend/): the simulation's setup and reports, rank 0's view of a run
+ * across ranks, and the backend table's entries both methods use. */
 #ifndef MPM_BACKEND_IMPL_H
 #define MPM_BACKEND_IMPL_H
 

@@ -1,7 +1,6 @@
-/* mpm_exchange: how the core of MPM reaches the other ranks of a run.  The
- * ranks layer (src/mpm/ranks) fills a table of its operations into a rank's
- * model; on one process the model has none and every accessor here does
- * what one process does, so the core never asks whether ranks run. */
+/* mpm_exchange: how MPM's core reaches other ranks: a table the ranks layer
+ * fills into a rank's model (NULL on one process), and accessors that do
+ * what one process does without it, so the core never asks about ranks. */
 #ifndef MPM_EXCHANGE_H
 #define MPM_EXCHANGE_H
 
