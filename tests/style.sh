@@ -3,7 +3,7 @@
 # repository's .clang-format.
 set -u
 cd "$1"
-files=$(ls src/*/*.[ch] src/common/*/*.[ch] geometry/*.[ch] geometry/cgal/*.cpp \
+files=$(ls src/*/*.[ch] src/*/*/*.[ch] src/*/*/*/*.[ch] geometry/*.[ch] geometry/cgal/*.cpp \
   tests/*/*.[ch] 2>/dev/null)
 bad=0
 for f in $files; do

@@ -41,10 +41,9 @@
 #include "gm_trisurf.h"
 #include "mpm_isonormal.h"
 #include "mpm_kind.h"
-#include "mpm_par.h"
+#include "mpm_exchange.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
-#include "pm_par.h"
 
 /* State array slots. */
 enum { MEM_FRAME = 0, MEM_STRAIN = 1, MEM_OMEGA = 2, MEM_FAILED = 3 };
@@ -399,7 +398,7 @@ static pm_err iso_work_create(const mpm_model *m, const mpm_group *g,
   PM_TRY(PM_ALLOC(w->order, n, "membrane points by cell"));
   PM_TRY(PM_ALLOC(w->run, n + 1, "membrane cells"));
   *bytes = sizeof *w + (size_t)n * (sizeof(cell_point) + 2 * sizeof(long));
-  if (m->par) {
+  if (m->xc) {
     PM_TRY(PM_ALLOC(w->xe, 3 * n, "membrane points with nearby ones"));
     PM_TRY(PM_ALLOC(w->ne, 3 * n, "membrane points with nearby ones"));
     PM_TRY(PM_ALLOC(w->at, n, "membrane points with nearby ones"));
@@ -683,7 +682,7 @@ static pm_err iso_normals_ranks(const mpm_model *m, const mpm_group *gr,
   const membrane_params *mp = gr->params;
   const long *own = m->gid + gr->begin, *ids;
   long n_near;
-  const double *xn = mpm_par_nearby(m, gr->index, &n_near, &ids);
+  const double *xn = mpm_xc_nearby(m, gr->index, &n_near, &ids);
   const long j0 = lower_bound(ids, n_near, mp->whole.first + b->begin),
              j1 = lower_bound(ids, n_near, mp->whole.first + b->end);
   long e = 0;
@@ -715,7 +714,7 @@ static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
                             double *tn, double *nn, iso_stats *st) {
   const membrane_params *mp = gr->params;
   const long np = gr->end - gr->begin;
-  const double *xo = x + 3 * gr->begin, *xg = mpm_par_ghost_x(m, gr->index);
+  const double *xo = x + 3 * gr->begin, *xg = mpm_xc_ghost_x(m, gr->index);
   if (mp->n_tris > 0) triangle_normals(mp, xo, xg, np, tn);
   for (int bi = 0; bi < mp->n_bodies; bi++) {
     const struct membrane_body *b = &mp->bodies[bi];
@@ -723,8 +722,8 @@ static pm_err group_normals(const mpm_model *m, const mpm_group *gr,
                b1 = m->body_end[b->body] - gr->begin;
     if (b->method != PM_NORMALS_CONNECTIVITY) {
       iso_cells cells;
-      mpm_par_cells(m, cells.nn, cells.lo, cells.hi);
-      if (m->par)
+      mpm_xc_cells(m, cells.nn, cells.lo, cells.hi);
+      if (m->xc)
         PM_CALL(
             iso_normals_ranks(m, gr, b, &cells, iw, b0, b1, xo, step, nn, st));
       else
@@ -1073,9 +1072,9 @@ static pm_err membrane_normals(mpm_ctx *ctx, const mpm_stage *self) {
                  (double)st.cells[2], (double)st.cells[3],
                  (double)st.points,   (double)st.degenerate,
                  (double)st.draws,    st.max_condition};
-  if (m->par && ((const membrane_params *)gr->params)->iso) {
-    pm_par_sum(v, 7);
-    pm_par_max(v + 7, 1);
+  if (m->xc && ((const membrane_params *)gr->params)->iso) {
+    mpm_xc_sum(m, v, 7);
+    mpm_xc_max(m, v + 7, 1);
   }
   if (e) return e;
   for (int i = 0; i < 4; i++) s->iso.cells[i] += v[i];

@@ -101,8 +101,8 @@ static bool ghosts_right(const mpm_model *m, const mpm_model *ref,
     long u = 0;
     for (long k = 0; k < n_need; k++)
       if (u == 0 || need[k] != need[u - 1]) need[u++] = need[k];
-    const long *ids = mpm_par_ghost_ids(m, gi, &n);
-    const double *gx = mpm_par_ghost_x(m, gi);
+    const long *ids = mpm_xc_ghost_ids(m, gi, &n);
+    const double *gx = mpm_xc_ghost_x(m, gi);
     ok = ok && n == u &&
          (n == 0 || !memcmp(ids, need, sizeof(long) * (size_t)n));
     for (long j = 0; ok && j < n; j++)
@@ -127,7 +127,7 @@ static bool nearby_right(const mpm_model *m, const mpm_model *ref,
     if (!reach) continue;
     long n, at = 0;
     const long *ids;
-    const double *nx = mpm_par_nearby(m, gi, &n, &ids);
+    const double *nx = mpm_xc_nearby(m, gi, &n, &ids);
     for (long p = ref->group[gi].begin; ok && p < ref->group[gi].end; p++) {
       bool in = !mine[p];
       for (int a = 0; a < g->dim; a++) {
@@ -207,7 +207,7 @@ int main(int argc, char **argv) {
     }
     mpm_par_counts c0, c1;
     mpm_par_get_counts(m, &c0);
-    if (mpm_par_migrate(m, s, w)) return 2;
+    if (mpm_xc_migrate(m, s, w)) return 2;
     mpm_par_get_counts(m, &c1);
     moved += c1.migrated - c0.migrated;
     /* Where every particle is, and what it carries. */

@@ -7,7 +7,7 @@
 
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
-#include "mpm_par.h"
+#include "mpm_exchange.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
 
@@ -133,7 +133,7 @@ pm_err mpm_p2g(mpm_ctx *ctx, int mode) {
     PM_OMP(barrier)
     reduce_nodes(nd, nn, mode, imp);
   }
-  return m->par ? mpm_par_sum_nodes(m, nd, mode, imp) : PM_SUCCESS;
+  return mpm_xc_sum_nodes(m, nd, mode, imp);
 }
 
 pm_err mpm_stage_p2g(mpm_ctx *ctx, const mpm_stage *self) {

@@ -14,7 +14,7 @@
 
 /* Geometry of a uniform Cartesian grid over the domain box, with `ghost`
  * node layers outside it.  Part of the model: nothing here changes.  On a
- * rank of a run across ranks (mpm_par.h) it is the rank's block of the
+ * rank of a run across ranks (src/mpm/ranks) it is the rank's block of the
  * whole grid: nn nodes per axis from global node `offset`, with the whole
  * grid's origin and reach, so that a node's position and a particle's
  * weights are computed exactly as on one process. */
@@ -56,7 +56,7 @@ typedef struct {
                         faces only) */
   /* Across ranks: 1 where this rank owns the node, 0 at a ghost node whose
    * values it computes too but whose sums belong to another rank (NULL on
-   * one process).  Borrowed from the model's mpm_par. */
+   * one process).  Borrowed from the model's share (mpm_xc_work_attach). */
   const unsigned char *owned;
 } mpm_nodes;
 

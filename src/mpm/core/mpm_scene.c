@@ -7,8 +7,6 @@
 #include <string.h>
 
 #include "mpm_kind.h"
-#include "mpm_par.h"
-#include "pm_par.h"
 
 static const pm_name shape_names[] = {
     {"linear", MPM_BASIS_LINEAR}, {"quadratic", MPM_BASIS_QUADRATIC}, {0}};
@@ -302,38 +300,11 @@ pm_err mpm_check_scene(const pm_scene *s) {
     return pm_scene_expected(s, "time.dt_rule",
                              "paper for method mpm (its stable step is the "
                              "CFL bound of every step)");
-  if (pm_par_active()) PM_CALL(mpm_par_check(s));
-  return PM_SUCCESS;
-}
-
-/* What the implicit MPM cannot do across ranks yet (PM_ERR_SCENE naming
- * the key). */
-static pm_err implicit_ranks_check(const pm_scene *s) {
-  const mpm_settings *ms = mpm_scene_settings(s);
-  if (ms->implicit.grid == MPM_GRID_RESET)
-    return pm_scene_fail(s, "mpm.implicit.grid", false,
-                         "the grid reset after each load step runs on one "
-                         "process (this run has %d ranks): take kept, or run "
-                         "with -np 1",
-                         pm_par_size());
-  if (ms->implicit.op == MPM_OP_MATRIX_FREE)
-    return pm_scene_fail(s, "mpm.implicit.operator", false,
-                         "the matrix-free operator runs on one process (this "
-                         "run has %d ranks): take assembled, or run with -np "
-                         "1",
-                         pm_par_size());
-  if (ms->fbar == MPM_FBAR_CELL)
-    return pm_scene_fail(s, "mpm.fbar", false,
-                         "the implicit F-bar runs on one process (this run "
-                         "has %d ranks): run with -np 1",
-                         pm_par_size());
   return PM_SUCCESS;
 }
 
 pm_err mpm_implicit_check_scene(const pm_scene *s) {
   char p[PM_SDOC_PATH];
-  PM_CALL(mpm_check_scene(s));
-  if (pm_par_active()) PM_CALL(implicit_ranks_check(s));
   if (mpm_scene_settings(s)->fbar == MPM_FBAR_PATCH)
     return pm_scene_expected(s, "mpm.fbar",
                              "none or cell for method mpm-implicit (a node's "

@@ -14,7 +14,7 @@ enum { MPM_P2G_MASS = 1, MPM_P2G_MOM = 2, MPM_P2G_FORCE = 4 };
  * momentum, and the internal force -V sigma grad S (with the impedances
  * sum S m rho c when the grid has them).  Per-thread accumulators, reduced
  * in thread order: no atomics.  Across ranks, then summed over the ranks
- * (mpm_par_sum_nodes; a PETSc failure is PM_ERR_LINALG). */
+ * (mpm_xc_sum_nodes; a PETSc failure is PM_ERR_LINALG). */
 pm_err mpm_p2g(mpm_ctx *ctx, int mode);
 
 /* Stages: p2g of self->mode; g2p (FLIP/PIC velocities and the position

@@ -7,7 +7,7 @@
 
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
-#include "mpm_par.h"
+#include "mpm_exchange.h"
 #include "mpm_seed.h"
 #include "mpm_state.h"
 
@@ -116,7 +116,7 @@ void mpm_model_destroy(mpm_model *m) {
   free(m->mass);
   free(m->vol0);
   free(m->gid);
-  mpm_par_destroy(m->par);
+  mpm_xc_release(m);
   free(m);
 }
 

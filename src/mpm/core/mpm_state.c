@@ -2,7 +2,7 @@
 #include "mpm_state.h"
 
 #include "mpm_kind.h"
-#include "mpm_par.h"
+#include "mpm_exchange.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -134,7 +134,7 @@ pm_err mpm_work_create(const mpm_model *m, mpm_work **out) {
   for (int k = 0; k < m->pipeline.n; k++)
     w->timer[k] = pm_timers_add(&w->timers, m->pipeline.stage[k].name);
   w->timer_migrate = -1;
-  if (m->par) mpm_par_work_attach(m, w);
+  mpm_xc_work_attach(m, w);
   *out = w;
   w = NULL;
 done:

@@ -34,7 +34,7 @@ typedef pm_err (*mpm_observer)(void *ctx, const mpm_model *m,
 
 /* Step from the state as it is until t_end, max_steps or (quasi-static
  * models) convergence; with a fixed time.dt the last step is cut to end at
- * t_end.  Across ranks (m->par) every rank calls it: after each step the
+ * t_end.  Across ranks (m->xc) every rank calls it: after each step the
  * particles that left a rank's cells migrate (which changes m's particle
  * ranges), and the observer sees the rank's share.  Returns
  * PM_ERR_UNSTABLE on a numerical failure (the observer has

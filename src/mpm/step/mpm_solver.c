@@ -1,7 +1,7 @@
 /* mpm_solver: the explicit time loop. */
 #include "mpm_solver.h"
 
-#include "mpm_par.h"
+#include "mpm_exchange.h"
 #include "mpm_pipeline.h"
 
 /* Quasi-static convergence is tested only after this many steps: the
@@ -25,7 +25,7 @@ pm_err mpm_solve(mpm_model *m, mpm_state *s, mpm_work *w,
     }
     ret = mpm_step(m, s, w);
     /* Across ranks, the particles that left this rank's cells. */
-    if (!ret && m->par) ret = mpm_par_migrate(m, s, w);
+    if (!ret) ret = mpm_xc_migrate(m, s, w);
     if (ret) break;
     info = (mpm_step_info){
         .step = s->step,

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "mpm_par.h"
+#include "mpm_exchange.h"
 #include "mpm_state.h"
 
 void mpm_motion_velocity(const mpm_motion *mv, double t, double v[3]) {
@@ -77,7 +77,7 @@ double mpm_motion_apply(const mpm_ctx *ctx, double *vel, bool book) {
     /* Each node once (its share then marked as done): the velocity blended
      * towards the body's by the body's share of the node's mass, so that a
      * node the body starts to touch takes its velocity gradually. */
-    if (!m->par) {
+    if (!mpm_xc_shared(m)) {
       body_mass(m, x, mv, rm, false);
       for (long p = mv->begin; p < mv->end; p++) {
         mpm_stencil st;
@@ -91,7 +91,7 @@ double mpm_motion_apply(const mpm_ctx *ctx, double *vel, bool book) {
      * its mass is summed over them, and every node that has some is
      * blended (the ghosts as their owners do; the owners book the work). */
     body_mass(m, x, mv, rm, true);
-    if (mpm_par_nodes_reduce(m, rm, MPI_DOUBLE, MPI_SUM)) return work;
+    if (mpm_xc_nodes_reduce(m, rm, MPM_XC_DOUBLE, MPM_XC_SUM)) return work;
     for (long i = 0; i < m->grid.n_nodes; i++) {
       const double wi = blend(nd, vel, rm, i, v, dim, book);
       if (mpm_node_owned(nd, i)) work += wi;

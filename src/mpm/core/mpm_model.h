@@ -16,7 +16,7 @@
 #include "pm_scene.h"
 
 struct mpm_state;
-struct mpm_par;
+struct mpm_exchange;
 
 /* What the model takes from the scene, copied at creation so that nothing
  * after it reads the scene's mpm, time or stability sections. */
@@ -54,11 +54,11 @@ typedef struct mpm_model {
   double *x0;   /* reference position */
   double *mass; /* mass, kg */
   double *vol0; /* initial volume */
-  /* Across ranks (mpm_par.h): this rank's share of the run, the particles
-   * it holds (their arrays have room for cap), each one's index on one
-   * process (gid, increasing), and the exchanges with the other ranks.
-   * On one process par and gid are NULL and cap is n. */
-  struct mpm_par *par;
+  /* Across ranks: the exchange with the other ranks (mpm_exchange.h, filled
+   * in by the ranks layer; owned), the particles this rank holds (their
+   * arrays have room for cap) and each one's index on one process (gid,
+   * increasing).  On one process xc and gid are NULL and cap is n. */
+  struct mpm_exchange *xc;
   long *gid;
   long cap;
   mpm_group group[MPM_MAX_GROUPS];

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "mpm_state.h"
-#include "pm_par.h"
+#include "mpm_exchange.h"
 
 pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
                              int *n_bcs) {
@@ -308,6 +308,6 @@ double mpm_conditions_apply(const mpm_ctx *ctx, double *vel, bool reactions) {
     work += R * 0.5 * (nd->vel0[i] + vel[i]) * dt;
   }
   /* Every rank's share of the reactions: the residual's scale. */
-  if (m->par) pm_par_sum(cw->reaction, 3 * m->n_bcs);
+  mpm_xc_sum(m, cw->reaction, 3 * m->n_bcs);
   return work;
 }

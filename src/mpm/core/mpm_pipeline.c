@@ -8,10 +8,9 @@
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
 #include "mpm_motion.h"
-#include "mpm_par.h"
+#include "mpm_exchange.h"
 #include "mpm_state.h"
 #include "mpm_transfer.h"
-#include "pm_par.h"
 
 static mpm_stage *add(mpm_pipeline *pl, const char *name, mpm_stage_fn fn) {
   PM_ASSERT(pl->n < MPM_MAX_STAGES);
@@ -149,10 +148,10 @@ pm_err mpm_step(const mpm_model *m, mpm_state *s, mpm_work *w) {
         e = pl->stage[j].after_update(&ctx, &pl->stage[j]);
     pm_timers_stop(&w->timers, w->timer[k]);
     /* Across ranks, every rank stops after the stage if one failed. */
-    if (m->par) e = pm_par_agree(e);
+    e = mpm_xc_agree(m, e);
     if (e) return e;
   }
-  if (m->par) mpm_par_step_end(m, w);
+  mpm_xc_step_end(m, w);
   s->t += s->dt;
   s->step++;
   s->max_div_prev = w->max_div;

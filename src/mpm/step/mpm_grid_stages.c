@@ -9,7 +9,7 @@
 #include "mpm_kind.h"
 #include "mpm_state.h"
 #include "pm_omp.h"
-#include "pm_par.h"
+#include "mpm_exchange.h"
 
 /* ---- stable step -------------------------------------------------------- */
 
@@ -38,7 +38,7 @@ double mpm_stable_dt(const mpm_model *m, const mpm_state *s, double *cp) {
     }
     worst = fmax(worst, w);
   }
-  if (m->par) pm_par_max(&worst, 1);
+  mpm_xc_max(m, &worst, 1);
   return worst > 0 ? m->opt.dt_safety * h / worst : INFINITY;
 }
 
@@ -171,7 +171,7 @@ pm_err mpm_stage_damping(mpm_ctx *ctx, const mpm_stage *self) {
     }
     sums[0] = num;
     sums[1] = den;
-    if (ctx->model->par) pm_par_sum(sums, 2);
+    mpm_xc_sum(ctx->model, sums, 2);
     num = sums[0];
     den = sums[1];
     if (den > 0 && s->step > 0) {
@@ -240,9 +240,9 @@ static double residual(const mpm_ctx *ctx) {
       if (!owner || !owner[3 * i + k]) r2 += f * f;
     }
   }
-  if (m->par) {
+  if (mpm_xc_shared(m)) {
     double sums[2] = {r2, f2};
-    pm_par_sum(sums, 2);
+    mpm_xc_sum(m, sums, 2);
     r2 = sums[0];
     f2 = sums[1];
   }

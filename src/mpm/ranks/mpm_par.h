@@ -43,9 +43,9 @@
 #ifndef MPM_PAR_H
 #define MPM_PAR_H
 
-#include <mpi.h>
 #include <stdio.h>
 
+#include "mpm_exchange.h"
 #include "mpm_model.h"
 #include "mpm_state.h"
 
@@ -91,9 +91,12 @@ void mpm_decomp_held(const mpm_decomp *d, int r, const mpm_grid *g, long lo[3],
                      long hi[3]);
 
 /* What a run across ranks needs that one process does not: refuse what
- * it cannot do yet, naming the scene key (PM_ERR_SCENE).  Called by the
- * scene check when more than one rank runs. */
+ * it cannot do yet, naming the scene key (PM_ERR_SCENE).  The backends'
+ * scene checks call it when more than one rank runs, after the method's
+ * own checks (mpm_check_scene); mpm_par_check_implicit then adds what the
+ * implicit MPM cannot do across ranks yet, before its own checks. */
 pm_err mpm_par_check(const pm_scene *s);
+pm_err mpm_par_check_implicit(const pm_scene *s);
 
 /* This rank's model and state of the run of full model m (scene s) at
  * state st, which every rank holds: its cells' particles, its block of the
@@ -101,7 +104,8 @@ pm_err mpm_par_check(const pm_scene *s);
  * (collective).  Its energy accounts are its row of `accounts`
  * (MPM_PAR_ACCOUNTS per rank, as a checkpoint of as many ranks keeps
  * them), or without them st's on rank 0 and none on the others.  *local
- * owns its arrays; m and st are left as they are. */
+ * owns its arrays and holds the exchange its core calls (mpm_exchange.h:
+ * this share, released with it); m and st are left as they are. */
 pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
                       const mpm_state *st, const double *accounts,
                       mpm_model **local, mpm_state **local_state);
@@ -120,73 +124,12 @@ void mpm_par_take_state(const mpm_model *m, const mpm_state *st,
 /* Every rank's accounts as the last gather found them, on rank 0 (NULL on
  * the others). */
 const double *mpm_par_accounts(const mpm_model *m);
-/* Release a model's share of a run across ranks (mpm_model_destroy). */
-void mpm_par_destroy(struct mpm_par *p);
-
-/* Point the workspace of local model m at what its rank shares: the nodes
- * it owns (mpm_nodes.owned) and the migration's timer. */
-void mpm_par_work_attach(const mpm_model *m, mpm_work *w);
-
-/* Sum the nodal arrays of a particle-to-grid transfer (mode, with the
- * impedances) over the ranks: owners add their ghosts' contributions and
- * every rank gets the sums on all its nodes (collective). */
-pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
-                         bool impedances);
-
-/* Reduce a nodal array of local model m (one `unit` per node of its block)
- * onto the nodes' owners with op, then give the owners' values back to
- * every rank that holds the node (collective).  For sums over the ranks'
- * particles (op MPI_SUM) and flags (MPI_MAX). */
-pm_err mpm_par_nodes_reduce(const mpm_model *m, void *a, MPI_Datatype unit,
-                            MPI_Op op);
-/* The owners' values of a nodal array at the ghost nodes (collective). */
-pm_err mpm_par_nodes_bcast(const mpm_model *m, void *a, MPI_Datatype unit);
-/* Per node of local model m's block: 1 where its rank owns it. */
-const unsigned char *mpm_par_owned(const mpm_model *m);
-
-/* The figures of a step every rank must share, once it ends: the largest
- * |tr D|, the smallest J, the iterations (collective). */
-void mpm_par_step_end(const mpm_model *m, mpm_work *w);
-
-/* Send the particles that left this rank's cells to their cells' ranks and
- * take in those that arrived, then bring the ghosts of linked points (a
- * membrane's neighbours on other ranks: mpm_par_ghosts.h) up to date
- * (collective).  The arrays grow when a rank holds more than they have
- * room for.  PM_ERR_MEMORY; PM_ERR_UNSTABLE when a particle moved farther
- * than the next boxes, or a linked point's neighbour is on a rank farther
- * than those. */
-pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w);
-
-/* The positions of group gi's ghosts (3 each; NULL on one process and for
- * a group without them): the points of other ranks that this rank's points
- * of the group are linked to, in the order the kind's ranks_link gave. */
-const double *mpm_par_ghost_x(const mpm_model *m, int gi);
-/* Their one-process indices (increasing), n of them (NULL and 0 without). */
-const long *mpm_par_ghost_ids(const mpm_model *m, int gi, long *n);
-/* Group gi's nearby points of other ranks (those within its kind's reach,
- * mpm_kind.ranks_reach, of this rank's cells): positions (3 each), their
- * one-process indices (increasing) in *ids, *n of them (NULL and 0 on one
- * process and for a group without a reach). */
-const double *mpm_par_nearby(const mpm_model *m, int gi, long *n,
-                             const long **ids);
-/* The whole grid's nodes per axis nn (1 along z in 2-D), and the cells
- * whose particles this rank holds, [lo, hi) per axis (on one process the
- * whole grid's). */
-void mpm_par_cells(const mpm_model *m, long nn[3], long lo[3], long hi[3]);
-
 /* Gather the state of every rank into the whole model's state full_state
  * on rank 0 (NULL on the others), in the order of one process: particles,
  * the energy accounts, and with dynamic relaxation the nodal arrays it
  * keeps (collective). */
 pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
                       const mpm_model *full, mpm_state *full_state);
-
-/* Three values per node of the whole grid (`whole`, on rank 0; NULL on the
- * others) from each rank's owned nodes of its block (`local`, three per
- * node of local model m's block); full is the whole model on rank 0
- * (collective). */
-pm_err mpm_par_gather_nodes(const mpm_model *m, const mpm_model *full,
-                            const double *local, double *whole);
 
 /* Print the decomposition and every rank's share (particles, nodes, ghost
  * nodes, memory of the model and of the workspace w, which may be NULL) to

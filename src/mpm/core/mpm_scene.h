@@ -95,9 +95,9 @@ double mpm_bc_largest_displacement(const pm_scene *s, int b, int comp,
 /* The layout of scene s; false when no cell divides the box. */
 bool mpm_grid_layout(const pm_scene *s, mpm_layout *lay);
 
-/* What method mpm-implicit cannot honour besides: fluids, membranes,
- * moving bodies, velocity and absorbing conditions, models without a
- * tangent. */
+/* What method mpm-implicit cannot honour beyond mpm_check_scene's (which
+ * its backend runs first): fluids, membranes, moving bodies, velocity and
+ * absorbing conditions, models without a tangent. */
 pm_err mpm_implicit_check_scene(const pm_scene *s);
 
 #endif

@@ -1,0 +1,81 @@
+/* mpm_backend_impl: what the pieces of MPM's two backends share (internal
+ * to backend/): the simulation's setup and reports, rank 0's view of a run
+ * across ranks, and the backend table's entries both methods use. */
+#ifndef MPM_BACKEND_IMPL_H
+#define MPM_BACKEND_IMPL_H
+
+#include <stdio.h>
+
+#include "mpm_backend.h"
+#include "mpm_implicit.h"
+#include "mpm_kind.h"
+#include "mpm_pipeline.h"
+
+/* ---- the simulation (mpm_backend.c) ---- */
+
+/* Doubles per particle of the output buffer (mpm_sim.scratch). */
+long mpm_sim_scratch_per_particle(const mpm_model *m);
+/* The simulation of s: explicit (its step's workspace) or implicit (its
+ * solver; the workspace holds only the reactions and the timers).
+ * Failures as mpm_model_create; *out NULL then. */
+pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out);
+/* A workspace that holds only the figures of a step (reactions, residual)
+ * and the timers (*out, released with mpm_work_destroy).  PM_ERR_MEMORY. */
+pm_err mpm_sim_figures_work(const mpm_model *m, mpm_work **out);
+/* Bytes the simulation holds (across ranks rank 0's: share and view). */
+size_t mpm_sim_bytes(const mpm_sim *r);
+/* The report of the step the state is at, and that report to the run's
+ * observer (with a frame when asked). */
+pm_step_report mpm_sim_step_report(const mpm_sim *r, bool last);
+pm_err mpm_sim_report(mpm_sim *r, bool frame, bool last);
+/* What the run keeps of a step's figures over all its steps. */
+void mpm_sim_note_step(mpm_sim *r, const mpm_state *s, const mpm_work *w,
+                       const mpm_step_info *info);
+/* The scene check of method mpm (with what a run across ranks cannot do). */
+pm_err mpm_sim_check_scene(const pm_scene *s);
+/* The backend table's destroy: mpm_sim_destroy. */
+void mpm_sim_destroy_any(void *p);
+
+/* ---- rank 0's view of a run across ranks (mpm_view.c) ---- */
+
+/* This rank's share of the whole model and state, which every rank holds,
+ * with the energy accounts of a checkpoint of as many ranks, if given
+ * (collective; every rank returns the same error). */
+pm_err mpm_view_share(mpm_sim *r, const double *accounts);
+/* Once the run starts the whole model stays on rank 0 as its view of the
+ * run; the other ranks let it go. */
+void mpm_view_release(mpm_sim *r);
+/* The share and rank 0's figures workspace (collective). */
+pm_err mpm_view_setup(mpm_sim *r);
+/* The time loop across ranks (collective): every rank steps its share;
+ * rank 0's view is gathered where the run writes, and at the end. */
+pm_err mpm_view_run(mpm_sim *r, const pm_observer *obs);
+/* What rank 0's observer reads of a converged implicit load step: every
+ * rank's particles and load stepping's states (collective). */
+pm_err mpm_view_implicit_gather(void *ctx);
+
+/* ---- what the run driver reads (mpm_fields.c, mpm_history.c) ---- */
+
+void mpm_sim_points(void *p, pm_points *pts);
+const double *mpm_sim_displacement(void *p);
+int mpm_sim_fields(void *p, unsigned want, pm_field *f, int max);
+void mpm_sim_figures(void *p, pm_figures *f, bool with_fields);
+/* The history columns of its own (mpm_sim.hist_names), on rank 0.
+ * PM_ERR_MEMORY. */
+pm_err mpm_sim_history_setup(mpm_sim *r);
+int mpm_sim_history_names(void *p, const char **names, int max);
+void mpm_sim_history_values(void *p, double *v);
+
+/* ---- summary and plan (mpm_summary.c, mpm_plan.c) ---- */
+
+/* The names of a basis and of a particle update (upper: as the plan
+ * prints it). */
+const char *mpm_sim_basis_name(mpm_basis b);
+const char *mpm_sim_update_name(mpm_update u, bool upper);
+pm_err mpm_sim_summary(void *p, pm_json *j);
+pm_err mpm_sim_implicit_summary(void *p, pm_json *j);
+const pm_timers *mpm_sim_timers(void *p);
+pm_err mpm_sim_plan(void *p, FILE *out);
+pm_err mpm_sim_implicit_plan(void *p, FILE *out);
+
+#endif

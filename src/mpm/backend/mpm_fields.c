@@ -1,0 +1,178 @@
+/* mpm_fields: what the run driver reads of an MPM simulation: its points,
+ * displacement, fields and figures. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_backend_impl.h"
+#include "pm_metrics.h"
+#include "pm_omp.h"
+#include "pm_tensor.h"
+
+void mpm_sim_points(void *p, pm_points *pts) {
+  const mpm_sim *r = p;
+  *pts = (pm_points){.n = r->model->n,
+                     .x = r->model->x0,
+                     .nodes_per_cell = 1,
+                     .n_surface = r->model->n_tris,
+                     .surface = r->model->tri};
+}
+
+/* u = x - x0 into the buffer's last 3 n. */
+const double *mpm_sim_displacement(void *p) {
+  mpm_sim *r = p;
+  const long n3 = 3 * r->model->n;
+  const double *x = r->state->x, *x0 = r->model->x0;
+  double *u = r->scratch + 6 * r->model->n;
+  PM_OMP(parallel for schedule(static) default(none) shared(n3, x, x0, u))
+  for (long i = 0; i < n3; i++) u[i] = x[i] - x0[i];
+  return u;
+}
+
+/* Per particle into the buffer: strain energy density, J, density,
+ * pressure, internal energy (n each, in that order). */
+static void particle_fields(mpm_sim *r) {
+  const mpm_model *m = r->model;
+  const mpm_state *s = r->state;
+  const long n = m->n;
+  double *sed = r->scratch, *jac = sed + n, *rho = sed + 2 * n,
+         *pres = sed + 3 * n, *ener = sed + 4 * n;
+  for (long p = 0; p < n; p++) {
+    jac[p] = s->vol[p] / m->vol0[p];
+    rho[p] = m->mass[p] / s->vol[p];
+  }
+  for (int gi = 0; gi < m->n_groups; gi++)
+    m->group[gi].kind->fields(m, s, &m->group[gi], sed, pres, ener);
+}
+
+int mpm_sim_fields(void *p, unsigned want, pm_field *f, int max) {
+  mpm_sim *r = p;
+  const mpm_state *s = r->state;
+  const long n = r->model->n;
+  const mpm_model *m = r->model;
+  int nf = 0;
+  if (max < 15) return 0;
+  double *sed = r->scratch, *jac = sed + n, *rho = sed + 2 * n,
+         *pres = sed + 3 * n, *ener = sed + 4 * n, *mat = sed + 11 * n;
+  particle_fields(r);
+  /* Each particle's material (the scene's index), to colour by. */
+  for (int gi = 0; gi < m->n_groups; gi++)
+    for (long p = m->group[gi].begin; p < m->group[gi].end; p++)
+      mat[p] = m->group[gi].material;
+  f[nf++] = (pm_field){"material", 1, mat};
+  if (m->kinds & MPM_KIND_MEMBRANE) {
+    double *normal = sed + 12 * n, *damage = sed + 15 * n,
+           *failed = sed + 16 * n;
+    memset(normal, 0, 5 * sizeof(double) * (size_t)n);
+    for (int gi = 0; gi < m->n_groups; gi++)
+      if (m->group[gi].kind->surface_fields)
+        m->group[gi].kind->surface_fields(m, s, &m->group[gi], normal, damage,
+                                          failed);
+    f[nf++] = (pm_field){"normal", 3, normal};
+    f[nf++] = (pm_field){"damage", 1, damage};
+    f[nf++] = (pm_field){"failed", 1, failed};
+  }
+  /* The particles' current positions are each frame's geometry. */
+  f[nf++] = (pm_field){"position", 3, s->x};
+  if (want & PM_FIELD_DISPLACEMENT)
+    f[nf++] = (pm_field){"displacement", 3, mpm_sim_displacement(r)};
+  if (want & PM_FIELD_VELOCITY) f[nf++] = (pm_field){"velocity", 3, s->v};
+  if (want & PM_FIELD_STRESS) {
+    const bool has_pressure = r->model->kinds & MPM_KIND_INTERNAL_ENERGY;
+    double *vm = sed + 9 * n, *mean = has_pressure ? NULL : sed + 10 * n;
+    pm_stress_invariants(n, s->sigma, vm, mean);
+    f[nf++] = (pm_field){"stress", 9, s->sigma};
+    f[nf++] = (pm_field){"von_mises", 1, vm};
+    if (mean) f[nf++] = (pm_field){"pressure", 1, mean};
+  }
+  if (want & PM_FIELD_STRAIN_ENERGY_DENSITY)
+    f[nf++] = (pm_field){"strain_energy_density", 1, sed};
+  if (want & PM_FIELD_JACOBIAN) f[nf++] = (pm_field){"jacobian", 1, jac};
+  if (r->model->kinds & MPM_KIND_INTERNAL_ENERGY) {
+    f[nf++] = (pm_field){"density", 1, rho};
+    f[nf++] = (pm_field){"pressure", 1, pres};
+    f[nf++] = (pm_field){"internal_energy", 1, ener};
+  }
+  return nf;
+}
+
+/* Mean strain energy density of the particles that store it, largest von
+ * Mises stress and smallest J, with where they are now. */
+static void field_figures(mpm_sim *r, pm_figures *f) {
+  const mpm_model *m = r->model;
+  const mpm_state *s = r->state;
+  const double *sed = r->scratch;
+  double w = 0, v0 = 0;
+  long vm_at = 0, j_at = 0;
+  particle_fields(r);
+  f->max_von_mises = 0;
+  f->end_min_jacobian = INFINITY;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    const mpm_group *g = &m->group[gi];
+    const bool elastic = g->kind->flags & MPM_KIND_STRAIN_ENERGY;
+    for (long p = g->begin; p < g->end; p++) {
+      double vm = pm_t_von_mises(s->sigma + 9 * p);
+      if (vm > f->max_von_mises) {
+        f->max_von_mises = vm;
+        vm_at = p;
+      }
+      double J = s->vol[p] / m->vol0[p];
+      if (J < f->end_min_jacobian) {
+        f->end_min_jacobian = J;
+        j_at = p;
+      }
+      if (elastic) {
+        w += m->vol0[p] * sed[p];
+        v0 += m->vol0[p];
+      }
+    }
+  }
+  f->mean_sed = v0 > 0 ? w / v0 : NAN;
+  for (int a = 0; a < 3; a++) {
+    f->max_von_mises_at[a] = s->x[3 * vm_at + a];
+    f->end_min_jacobian_at[a] = s->x[3 * j_at + a];
+  }
+}
+
+void mpm_sim_figures(void *p, pm_figures *f, bool with_fields) {
+  mpm_sim *r = p;
+  const mpm_model *m = r->model;
+  const mpm_state *s = r->state;
+  const pm_timers *t = &r->work->timers;
+  f->status = r->status;
+  f->dim = m->dim;
+  f->points = m->n;
+  f->steps = s->step;
+  f->time = s->t;
+  f->h = m->grid.h;
+  f->dt = s->dt;
+  f->dt_stable = s->dt_stable / m->opt.dt_safety;
+  f->residual = r->work->residual;
+  mpm_energies(m, s, &f->kinetic, &f->strain, &f->internal);
+  f->interface = 0;
+  f->external_work = s->external_work;
+  f->dissipated = s->dissipated;
+  f->energy0 = r->energy0;
+  f->energy_error =
+      pm_energy_error(r->energy0, f->kinetic + f->strain + f->internal,
+                      s->dissipated, s->external_work);
+  f->max_energy_error = NAN; /* reported, not bounded */
+  f->min_jacobian = r->run_min_jacobian;
+  f->min_jacobian_step = r->run_min_jacobian_step;
+  for (int b = 0; b < m->n_bcs && b < PM_FIGURES_MAX_BCS; b++)
+    for (int c = 0; c < 3; c++)
+      f->reaction[b][c] = r->work->cond.reaction[3 * b + c];
+  f->setup_seconds = r->setup_wall;
+  f->step_seconds = 0;
+  for (int k = 0; k < t->n; k++) f->step_seconds += t->stage[k].seconds;
+  f->memory_bytes = mpm_sim_bytes(r);
+  if (r->imp) { /* no time steps, no energy balance: load steps */
+    f->dt = f->dt_stable = 0;
+    f->energy_error = NAN;
+    f->residual = mpm_implicit_residual(r->imp);
+    const pm_load_report *lr = mpm_implicit_report(r->imp);
+    f->step_seconds = lr->time_total;
+  }
+  if (with_fields) field_figures(r, f);
+}

@@ -1,0 +1,161 @@
+/* mpm_view: rank 0's view of an MPM run across ranks: each rank's share
+ * made from the whole model, the time loop of the shares, and the whole
+ * run gathered into the view where the run writes. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_backend_impl.h"
+#include "mpm_par.h"
+#include "pm_par.h"
+
+/* Across ranks: this rank's share of the whole model and state, which
+ * every rank holds (collective; every rank returns the same error), with
+ * the energy accounts of a checkpoint of as many ranks, if given. */
+pm_err mpm_view_share(mpm_sim *r, const double *accounts) {
+  PM_CALL(pm_par_agree(mpm_par_create(r->scene, r->model, r->state, accounts,
+                                      &r->local_model, &r->local_state)));
+  return pm_par_agree(mpm_work_create(r->local_model, &r->local_work));
+}
+
+/* Across ranks, once the run starts: the whole model stays on rank 0 as
+ * its view of the run; the other ranks let it go.  Until then every rank
+ * holds it, so that a checkpoint is read into it. */
+void mpm_view_release(mpm_sim *r) {
+  if (pm_par_root() || !r->model) return;
+  mpm_state_destroy(r->state);
+  mpm_model_destroy(r->model);
+  r->state = NULL;
+  r->model = NULL;
+}
+
+pm_err mpm_view_setup(mpm_sim *r) {
+  PM_CALL(mpm_view_share(r, NULL));
+  return pm_par_agree(pm_par_root() ? mpm_sim_figures_work(r->model, &r->work)
+                                    : PM_SUCCESS);
+}
+
+/* Rank 0's view of the last step: the figures every rank shares (the
+ * residual, the reactions, the smallest J) and its own timers. */
+static void view_figures(mpm_sim *r) {
+  const mpm_work *lw = r->local_work;
+  mpm_work *w = r->work;
+  w->residual = lw->residual;
+  w->min_jacobian = lw->min_jacobian;
+  w->iter_max = lw->iter_max;
+  w->iter_capped = lw->iter_capped;
+  if (r->model->n_bcs > 0) /* (a scene without conditions has no array) */
+    memcpy(w->cond.reaction, lw->cond.reaction,
+           3 * sizeof(double) * (size_t)r->model->n_bcs);
+  w->timers = lw->timers;
+  mpm_state *v = r->state;
+  const mpm_state *ls = r->local_state;
+  v->t = ls->t;
+  v->step = ls->step;
+  v->dt = ls->dt;
+  v->dt_stable = ls->dt_stable;
+}
+
+/* Every rank's particles into rank 0's view (collective). */
+static pm_err gather(mpm_sim *r) {
+  PM_CALL(pm_par_agree(
+      mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
+  if (r->model) view_figures(r);
+  return PM_SUCCESS;
+}
+
+static pm_err gather_view(void *r) { return gather(r); }
+
+/* A step of a run across ranks (collective): rank 0 reports it, with the
+ * particles gathered where its observer reads them. */
+static pm_err share(mpm_sim *r, bool frame, bool last) {
+  pm_step_report rep = {0};
+  if (r->model) {
+    view_figures(r);
+    rep = mpm_sim_step_report(r, last);
+  }
+  return pm_observer_share(r->model ? r->obs : NULL, &rep, frame, gather_view,
+                           r);
+}
+
+static pm_err observe_ranks(void *ctx, const mpm_model *m, const mpm_state *s,
+                            const mpm_work *w, const mpm_step_info *info,
+                            bool frame) {
+  (void)m;
+  mpm_sim_note_step(ctx, s, w, info);
+  return share(ctx, frame, info->last);
+}
+
+/* The time loop across ranks: every rank steps its share; rank 0's view
+ * is gathered where the run writes, and at the end. */
+pm_err mpm_view_run(mpm_sim *r, const pm_observer *obs) {
+  pm_err e = PM_SUCCESS;
+  if (r->resumed) { /* the shares of the state read from the checkpoint */
+    mpm_work_destroy(r->local_work);
+    mpm_state_destroy(r->local_state);
+    mpm_model_destroy(r->local_model);
+    r->local_work = NULL;
+    r->local_state = NULL;
+    r->local_model = NULL;
+    PM_CALL(mpm_view_share(r, r->ckpt_ranks == pm_par_size() ? r->ckpt_accounts
+                                                             : NULL));
+  }
+  mpm_view_release(r);
+  mpm_model *lm = r->local_model;
+  r->obs = obs;
+  if (!r->resumed) {
+    r->run_min_jacobian = INFINITY;
+    r->run_min_jacobian_step = 0;
+    if (r->model) { /* the initial state, which rank 0's view holds */
+      double kin, strain, internal;
+      mpm_energies(r->model, r->state, &kin, &strain, &internal);
+      r->energy0 = kin + strain + internal;
+      for (long q = 0; q < r->model->n; q++)
+        r->run_min_jacobian =
+            fmin(r->run_min_jacobian, r->state->vol[q] / r->model->vol0[q]);
+    }
+    e = share(r, true, false);
+  }
+  mpm_run_options opt = {.t_end = lm->opt.t_end,
+                         .max_steps = lm->opt.max_steps,
+                         .frame_every = r->scene->output.every};
+  if (!e)
+    e = mpm_solve(lm, r->local_state, r->local_work, &opt, observe_ranks, r,
+                  &r->last);
+  /* The state the run ended in, for the figures (a failure's too). */
+  pm_err g = gather(r);
+  if (!e) e = g;
+  r->obs = NULL;
+  mpm_par_counts c;
+  mpm_par_get_counts(lm, &c);
+  /* A rank's own work: its stages' time less the exchanges (in which it
+   * waits for the others). */
+  double own = -c.halo_seconds - c.migrate_seconds;
+  const pm_timers *t = &r->local_work->timers;
+  for (int k = 0; k < t->n; k++) own += t->stage[k].seconds;
+  double sums[6] = {c.halo_bytes,
+                    c.migrate_bytes,
+                    (double)c.migrated,
+                    (double)c.grown,
+                    own,
+                    c.ghost_bytes},
+         most[3] = {c.halo_seconds, c.migrate_seconds, own};
+  pm_par_sum(sums, 6);
+  pm_par_max(most, 3);
+  memcpy(r->ranks_counts, sums, 4 * sizeof(double));
+  memcpy(r->ranks_counts + 4, most, 2 * sizeof(double));
+  r->ranks_counts[6] = most[2];                 /* the busiest rank's */
+  r->ranks_counts[7] = sums[4] / pm_par_size(); /* the mean */
+  r->ranks_counts[8] = sums[5];
+  return e;
+}
+
+/* Across ranks, what rank 0's observer reads of a converged load step:
+ * every rank's particles and load stepping's states (collective). */
+pm_err mpm_view_implicit_gather(void *ctx) {
+  mpm_sim *r = ctx;
+  PM_CALL(pm_par_agree(
+      mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
+  return mpm_implicit_gather(r->imp, r->model);
+}

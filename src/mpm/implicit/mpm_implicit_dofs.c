@@ -1,0 +1,348 @@
+/* mpm_implicit_dofs: the implicit MPM's structure: particles in coloured
+ * buckets, prescribed and unknown dofs, the Jacobian's pattern, the
+ * near-null space and the Newton solver over them. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_exchange.h"
+#include "mpm_implicit_impl.h"
+#include "mpm_kind.h"
+#include "pm_omp.h"
+#include "pm_progress.h"
+#include "pm_tensor.h"
+
+/* ---- structure: buckets, dofs, pattern ---------------------------------- */
+
+/* The first node of particle p's stencil (its cell's for linear shapes). */
+static long stencil_base(const mpm_grid *g, const double x[3], long ijk[3]) {
+  long base = 0;
+  for (int c = 0; c < 3; c++) {
+    ijk[c] = 0;
+    if (c >= g->dim) continue;
+    double w[3], dw[3];
+    mpm_shape_1d(g->shape, (x[c] - g->origin[c]) * g->inv_h, g->inv_h, &ijk[c],
+                 w, dw);
+    ijk[c] -= g->offset[c]; /* in the rank's block (0 on one process) */
+    base += ijk[c] * g->stride[c];
+  }
+  return base;
+}
+
+/* Particles sorted into buckets by their stencil's first node, and the
+ * non-empty buckets listed by colour (sum_c (ijk_c mod w) w^c). */
+void mpm_implicit_make_buckets(mpm_implicit *im) {
+  const mpm_grid *g = &im->g;
+  const long nn = g->n_nodes;
+  long *cnt = im->bucket; /* nn + 1 */
+  memset(cnt, 0, sizeof(long) * (size_t)(nn + 1));
+  for (long p = 0; p < im->n; p++) {
+    long ijk[3];
+    cnt[stencil_base(g, im->xb + 3 * p, ijk) + 1]++;
+  }
+  for (long k = 0; k < nn; k++) cnt[k + 1] += cnt[k];
+  /* fill: order by bucket (cnt[k] moves to the bucket's end, then back) */
+  for (long p = 0; p < im->n; p++) {
+    long ijk[3];
+    long b = stencil_base(g, im->xb + 3 * p, ijk);
+    im->order[cnt[b]++] = p;
+  }
+  for (long k = nn; k > 0; k--) cnt[k] = cnt[k - 1];
+  cnt[0] = 0;
+  /* colours */
+  long ccount[MPM_STENCIL_MAX + 1] = {0};
+  for (long k = 0; k < nn; k++) {
+    if (cnt[k + 1] == cnt[k]) continue;
+    long i = k % g->nn[0], j = (k / g->nn[0]) % g->nn[1], l = k / g->stride[2];
+    int col = (int)(i % im->w) +
+              im->w * ((int)(j % im->w) + im->w * (int)(l % im->w));
+    ccount[col + 1]++;
+  }
+  im->ncol = im->sn;
+  for (int c = 0; c < im->ncol; c++) ccount[c + 1] += ccount[c];
+  memcpy(im->cptr, ccount, sizeof(long) * (size_t)(im->ncol + 1));
+  for (long k = 0; k < nn; k++) {
+    if (cnt[k + 1] == cnt[k]) continue;
+    long i = k % g->nn[0], j = (k / g->nn[0]) % g->nn[1], l = k / g->stride[2];
+    int col = (int)(i % im->w) +
+              im->w * ((int)(j % im->w) + im->w * (int)(l % im->w));
+    im->cbuck[ccount[col]++] = k;
+  }
+}
+
+/* The full-load value of condition b's component c at x (face plane on its
+ * axis). */
+static double bc_value(const mpm_implicit *im, int b, int c,
+                       const double x[3]) {
+  const mpm_bc *bc = &im->m->bcs[b];
+  double y[3] = {x[0], x[1], x[2]};
+  y[bc->axis] = bc->plane;
+  double T = im->m->opt.t_load;
+  return pm_ramp_factor(bc->ramp, bc->ramp_time, T) *
+         pm_expr_eval(bc->disp[c], y[0], y[1], y[2], T);
+}
+
+/* Prescribe component c of node k by condition b with increment v at
+ * local load 1 (a later condition overrides an earlier one). */
+static pm_err prescribe(mpm_implicit *im, long node, int c, int b, double v) {
+  long d = 3 * node + c;
+  if (im->dof[d] <= -2) {
+    long k = -2 - im->dof[d];
+    im->pre_val[k] = v;
+    im->pre_bc[k] = b;
+    return PM_SUCCESS;
+  }
+  if (im->npre == im->pre_cap) {
+    long cap = im->pre_cap ? 2 * im->pre_cap : 1024;
+    PM_CALL(PM_REALLOC(im->pre_dof, cap, "prescribed dofs"));
+    PM_CALL(PM_REALLOC(im->pre_val, cap, "prescribed values"));
+    PM_CALL(PM_REALLOC(im->pre_bc, cap, "prescribed dofs"));
+    im->pre_cap = cap;
+  }
+  im->pre_dof[im->npre] = d;
+  im->pre_val[im->npre] = v;
+  im->pre_bc[im->npre] = b;
+  im->dof[d] = -2 - im->npre++;
+  return PM_SUCCESS;
+}
+
+/* Node k's position on the solver's grid. */
+void mpm_implicit_node_position(const mpm_grid *g, long k, double x[3]) {
+  long ijk[3] = {k % g->nn[0], (k / g->nn[0]) % g->nn[1], k / g->stride[2]};
+  for (int c = 0; c < 3; c++)
+    x[c] =
+        c < g->dim ? g->origin[c] + (double)(ijk[c] + g->offset[c]) * g->h : 0;
+}
+
+/* Prescribed dofs of the conditions for the step from lam0 to lam1. */
+static pm_err make_prescribed(mpm_implicit *im) {
+  const mpm_model *m = im->m;
+  const mpm_grid *g = &im->g;
+  const double scale = im->lam1 - im->lam0;
+  im->npre = 0;
+  for (int b = 0; b < m->n_bcs; b++) {
+    const mpm_bc *bc = &m->bcs[b];
+    if (!bc->disp_mask) continue;
+    const int a = bc->axis;
+    if (im->mode == MPM_GRID_KEPT) {
+      long ia = (long)llround((bc->plane - g->origin[a]) * g->inv_h);
+      for (long k = 0; k < g->n_nodes; k++) {
+        if (!im->active[k]) continue;
+        long idx = (k / g->stride[a]) % g->nn[a] + g->offset[a];
+        if (bc->outward > 0 ? idx < ia : idx > ia) continue;
+        double x[3];
+        mpm_implicit_node_position(g, k, x);
+        for (int c = 0; c < im->dim; c++)
+          if (bc->disp_mask & (1u << c))
+            PM_CALL(prescribe(im, k, c, b, scale * bc_value(im, b, c, x)));
+      }
+    } else {
+      for (long q = im->face_ptr[b]; q < im->face_ptr[b + 1]; q++) {
+        long p = im->face[q];
+        mpm_stencil st;
+        mpm_stencil_at(g, im->xb + 3 * p, MPM_STENCIL_W, &st);
+        for (int k = 0; k < st.n; k++)
+          for (int c = 0; c < im->dim; c++)
+            if (bc->disp_mask & (1u << c))
+              PM_CALL(prescribe(im, st.node[k], c, b,
+                                scale * bc_value(im, b, c, m->x0 + 3 * p)));
+      }
+    }
+  }
+  return PM_SUCCESS;
+}
+
+/* Active nodes, prescribed and unknown dofs, and the Jacobian's pattern:
+ * every row of a node lists the unknowns of the nodes within a stencil's
+ * reach in neighbour order, each neighbour's components in order.  Across
+ * ranks a node is active where any rank's particles reach it, a rank
+ * numbers its own nodes' unknowns, and the rows of ghost nodes hold what
+ * its particles add to them. */
+pm_err mpm_implicit_make_dofs(mpm_implicit *im) {
+  const mpm_grid *g = &im->g;
+  const long nn = g->n_nodes;
+  memset(im->active, 0, (size_t)nn);
+  for (long p = 0; p < im->n; p++) {
+    mpm_stencil st;
+    mpm_stencil_at(g, im->xb + 3 * p, MPM_STENCIL_W, &st);
+    for (int k = 0; k < st.n; k++) im->active[st.node[k]] = 1;
+  }
+  const unsigned char *own = im->ranks ? mpm_xc_owned(im->m) : NULL;
+  if (im->ranks)
+    PM_CALL(mpm_xc_nodes_reduce(im->m, im->active, MPM_XC_BYTE, MPM_XC_MAX));
+  for (long d = 0; d < 3 * nn; d++) im->dof[d] = -1;
+  PM_CALL(make_prescribed(im));
+  im->nunk = 0;
+  im->active_all = 0;
+  for (long k = 0; k < nn; k++) {
+    if (!im->active[k] || (own && !own[k])) continue;
+    im->active_all++;
+    for (int c = 0; c < im->dim; c++)
+      if (im->dof[3 * k + c] == -1) im->dof[3 * k + c] = im->nunk++;
+  }
+  im->nheld = im->nunk;
+  /* Across ranks: the global numbers of the unknowns, the owners' numbers
+   * at the ghost nodes, and the ghost nodes' unknowns after the owned. */
+  if (im->ranks) {
+    PM_CALL(mpm_xc_number_unknowns(im->m, im->nunk, im->dof, im->gnum,
+                                   &im->ghost, &im->nghost));
+    im->nheld = im->nunk + im->nghost;
+  }
+  long counts[2] = {im->nunk, im->active_all};
+  mpm_xc_sum_long(im->m, counts, 2);
+  im->nunk_all = counts[0];
+  im->active_all = counts[1];
+  PM_CHECK(im->nunk_all > 0, PM_ERR_SCENE,
+           "%s: every grid displacement is prescribed: nothing to solve",
+           im->s->path);
+  const long nh = im->nheld;
+  PM_CALL(PM_REALLOC(im->unk_dof, nh + 1, "unknowns"));
+  PM_CALL(PM_REALLOC(im->x_unk, im->nunk + 1, "unknowns"));
+  if (im->ranks) PM_CALL(PM_REALLOC(im->x_held, nh + 1, "held unknowns"));
+  PM_CALL(PM_REALLOC(im->diag, nh + 1, "tangent diagonal"));
+  PM_CALL(PM_REALLOC(im->pat_ptr, nh + 1, "Jacobian pattern"));
+  PM_CALL(PM_REALLOC(im->pc_ptr, nh + 1, "diagonal pattern"));
+  PM_CALL(PM_REALLOC(im->pc_idx, nh + 1, "diagonal pattern"));
+  memset(im->x_unk, 0, sizeof(double) * (size_t)im->nunk);
+  for (long d = 0; d < 3 * nn; d++)
+    if (im->dof[d] >= 0) im->unk_dof[im->dof[d]] = d;
+  for (long k = 0; k <= nh; k++) im->pc_ptr[k] = k;
+  for (long k = 0; k < nh; k++) im->pc_idx[k] = k;
+  /* neighbour offsets and the row lengths */
+  const int span = im->w - 1;
+  long total = 0;
+  im->pat_ptr[0] = 0;
+  for (long k = 0; k < nn; k++) {
+    int *off = im->nb_off + k * im->nnb;
+    int cnt = 0, own = 0;
+    for (int c = 0; c < 3; c++) own += im->dof[3 * k + c] >= 0;
+    long ijk[3] = {k % g->nn[0], (k / g->nn[0]) % g->nn[1], k / g->stride[2]};
+    for (int s = 0; s < im->nnb; s++) {
+      off[s] = -1;
+      if (!own) continue;
+      int d[3] = {0, 0, 0};
+      for (int c = 0, q = s; c < im->dim; c++, q /= im->nb)
+        d[c] = q % im->nb - span;
+      long nb = 0;
+      bool in = true;
+      for (int c = 0; c < 3; c++) {
+        if (c >= im->dim) {
+          if (d[c] != 0) in = false;
+          continue;
+        }
+        long i = ijk[c] + d[c];
+        if (i < 0 || i >= g->nn[c]) in = false;
+        nb += i * g->stride[c];
+      }
+      if (!in) continue;
+      int r = 0;
+      for (int c = 0; c < 3; c++) r += im->dof[3 * nb + c] >= 0;
+      if (!r) continue;
+      off[s] = cnt;
+      cnt += r;
+    }
+    for (int c = 0; c < 3; c++) {
+      long row = im->dof[3 * k + c];
+      if (row < 0) continue;
+      total += cnt;
+      im->pat_ptr[row + 1] = cnt; /* lengths first */
+    }
+  }
+  for (long r = 0; r < nh; r++) im->pat_ptr[r + 1] += im->pat_ptr[r];
+  im->entries_all = total;
+  mpm_xc_sum_long(im->m, &im->entries_all, 1);
+  if (total > im->pat_cap) {
+    PM_CALL(PM_REALLOC(im->pat_idx, total, "Jacobian pattern"));
+    im->pat_cap = total;
+  }
+  for (long k = 0; k < nn; k++) {
+    const int *off = im->nb_off + k * im->nnb;
+    long ijk[3] = {k % g->nn[0], (k / g->nn[0]) % g->nn[1], k / g->stride[2]};
+    for (int c = 0; c < 3; c++) {
+      long row = im->dof[3 * k + c];
+      if (row < 0) continue;
+      long pos = im->pat_ptr[row];
+      for (int s = 0; s < im->nnb; s++) {
+        if (off[s] < 0) continue;
+        long nb = 0;
+        for (int e = 0; e < im->dim; e++) {
+          int d = (e == 0   ? s % im->nb
+                   : e == 1 ? (s / im->nb) % im->nb
+                            : s / (im->nb * im->nb)) -
+                  span;
+          nb += (ijk[e] + d) * g->stride[e];
+        }
+        for (int e = 0; e < 3; e++)
+          if (im->dof[3 * nb + e] >= 0)
+            im->pat_idx[pos++] = im->dof[3 * nb + e];
+      }
+    }
+  }
+  return PM_SUCCESS;
+}
+
+/* Rigid motions over the unknowns, at the nodes' base positions (the
+ * grid's for reset; the reference for kept), for algebraic multigrid. */
+static pm_err make_near_null(mpm_implicit *im, int *count) {
+  const int nr = im->dim == 3 ? 6 : 3;
+  PM_CALL(PM_REALLOC(im->near_null, (long)nr * im->nunk, "rigid motions"));
+  double *z = im->near_null;
+  for (long k = 0; k < im->nunk; k++) {
+    long d = im->unk_dof[k], node = d / 3;
+    int c = (int)(d % 3);
+    double x[3];
+    mpm_implicit_node_position(&im->g, node, x);
+    for (int r = 0; r < nr; r++) z[(long)r * im->nunk + k] = 0;
+    z[(long)c * im->nunk + k] = 1; /* translations */
+    if (im->dim == 2) {
+      /* rotation about z: (-y, x) */
+      z[2L * im->nunk + k] = c == 0 ? -x[1] : x[0];
+    } else {
+      /* rotations about x, y, z: e_r x x */
+      const double rx[3][3] = {
+          {0, -x[2], x[1]}, {x[2], 0, -x[0]}, {-x[1], x[0], 0}};
+      for (int r = 0; r < 3; r++) z[(long)(3 + r) * im->nunk + k] = rx[r][c];
+    }
+  }
+  *count = nr;
+  return PM_SUCCESS;
+}
+
+/* The solver for the current structure. */
+pm_err mpm_implicit_make_solver(mpm_implicit *im) {
+  pm_newton_destroy(&im->solver);
+  int nnull = 0;
+  const bool amg = im->opt.linear == PM_NEWTON_GMRES_GAMG ||
+                   im->opt.linear == PM_NEWTON_CG_GAMG;
+  if (amg) PM_CALL(make_near_null(im, &nnull));
+  pm_newton_problem pb = {
+      .n = im->nunk,
+      .ctx = im,
+      .residual = mpm_implicit_cb_residual,
+      .jacobian_apply = mpm_implicit_cb_apply,
+      .jacobian_prepare = mpm_implicit_cb_prepare,
+      .jacobian_values =
+          im->matrix_free || im->fbar ? NULL : mpm_implicit_cb_values,
+      .pat_ptr = im->pat_ptr,
+      .pat_idx = im->pat_idx,
+      .precond_apply = im->matrix_free ? mpm_implicit_cb_precond : NULL,
+      .pc_pat_ptr = im->matrix_free ? im->pc_ptr : NULL,
+      .pc_pat_idx = im->matrix_free ? im->pc_idx : NULL,
+      .near_null_count = nnull,
+      .near_null = amg ? im->near_null : NULL,
+      .shared = im->ranks,
+      .n_ghost = im->nghost,
+      .ghost = im->ghost,
+      .set_load = mpm_implicit_cb_set_load,
+  };
+  pb.on_step = mpm_implicit_on_step;
+  return pm_newton_create(&pb, &im->opt, &im->solver);
+}
+
+/* Build buckets, dofs and the solver for the base as it is. */
+pm_err mpm_implicit_rebuild(mpm_implicit *im) {
+  mpm_implicit_make_buckets(im);
+  PM_CALL(mpm_implicit_make_dofs(im));
+  return mpm_implicit_make_solver(im);
+}

@@ -1,0 +1,216 @@
+/* mpm_implicit_tangent: the implicit MPM's tangent: its assembled values,
+ * the diagonal preconditioner, and the check against differences. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_exchange.h"
+#include "mpm_implicit_impl.h"
+#include "mpm_kind.h"
+#include "pm_omp.h"
+#include "pm_progress.h"
+#include "pm_tensor.h"
+
+/* A_n[iJkM] = sum_KL A[iKkL] Fb[JK] Fb[ML] (A when F_b = I), with
+ * A[iKkL] = dP_iK / dF_kL from nine tangent calls. */
+static bool particle_tangent(const mpm_implicit *im, long p, const double F[9],
+                             double An[81]) {
+  const mpm_solid_view *v = &im->view[im->grp[p]];
+  const double *ms = model_state(im, p);
+  double A[81];
+  for (int kl = 0; kl < 9; kl++) {
+    double dF[9] = {0}, dP[9];
+    dF[kl] = 1;
+    if (!pm_material_tangent(v->mat, F, ms, dF, dP)) return false;
+    for (int iK = 0; iK < 9; iK++) A[9 * iK + kl] = dP[iK];
+  }
+  const double *Fb = base_F(im, p);
+  if (!Fb) {
+    memcpy(An, A, sizeof A);
+    return true;
+  }
+  double T[81]; /* T[iJkL] = sum_K A[iKkL] Fb[JK] */
+  for (int i = 0; i < 3; i++)
+    for (int J = 0; J < 3; J++)
+      for (int kl = 0; kl < 9; kl++) {
+        double s = 0;
+        for (int K = 0; K < 3; K++)
+          s += A[9 * (3 * i + K) + kl] * Fb[3 * J + K];
+        T[9 * (3 * i + J) + kl] = s;
+      }
+  for (int iJ = 0; iJ < 9; iJ++)
+    for (int k = 0; k < 3; k++)
+      for (int M = 0; M < 3; M++) {
+        double s = 0;
+        for (int L = 0; L < 3; L++) s += T[9 * iJ + 3 * k + L] * Fb[3 * M + L];
+        An[9 * iJ + 3 * k + M] = s;
+      }
+  return true;
+}
+
+/* Unknown components of node b before component c. */
+static inline int rank_of(const long *dof, long b, int c) {
+  int r = 0;
+  for (int j = 0; j < c; j++) r += dof[3 * b + j] >= 0;
+  return r;
+}
+
+/* The assembled tangent in the pattern's order. */
+pm_err mpm_implicit_cb_values(void *ctx, const double *x, double *val) {
+  mpm_implicit *im = ctx;
+  const mpm_model *m = im->m;
+  mpm_implicit_fill_u(im, x);
+  memset(val, 0, sizeof(double) * (size_t)im->pat_ptr[im->nheld]);
+  im->fail_p = -1;
+  const long *dof = im->dof;
+  FOR_PARTICLES(im, {
+    double F[9], An[81], G[MPM_STENCIL_MAX][27];
+    particle_F(im, p, &st, im->u, F);
+    if (!particle_tangent(im, p, F, An)) {
+      note_failure(im, p, "no tangent: J <= 0", pm_t_det(F));
+      continue;
+    }
+    const double V0 = m->vol0[p];
+    /* G_b[iJk] = V0 sum_M An[iJkM] g_b[M] */
+    for (int b = 0; b < st.n; b++)
+      for (int iJk = 0; iJk < 27; iJk++)
+        G[b][iJk] = V0 * (An[3 * iJk] * st.grad[b][0] +
+                          An[3 * iJk + 1] * st.grad[b][1] +
+                          An[3 * iJk + 2] * st.grad[b][2]);
+    for (int a = 0; a < st.n; a++) {
+      const long na = st.node[a];
+      for (int i = 0; i < 3; i++) {
+        const long row = dof[3 * na + i];
+        if (row < 0) continue;
+        for (int b = 0; b < st.n; b++) {
+          const long nbn = st.node[b];
+          const int off = im->nb_off[na * im->nnb + im->soff[a][b]];
+          if (off < 0) continue;
+          long pos = im->pat_ptr[row] + off;
+          for (int k = 0; k < 3; k++) {
+            if (dof[3 * nbn + k] < 0) continue;
+            double s = 0;
+            for (int J = 0; J < 3; J++)
+              s += st.grad[a][J] * G[b][9 * i + 3 * J + k];
+            val[pos++] += s;
+          }
+        }
+      }
+    }
+  })
+  if (im->fail_p >= 0) return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
+  return PM_SUCCESS;
+}
+
+/* The tangent's diagonal, for the matrix-free operator's Jacobi
+ * preconditioner: P dx = diag(K) dx (assembled by colouring from the
+ * diagonal pattern: one product with dx = 1). */
+pm_err mpm_implicit_cb_prepare(void *ctx, const double *x) {
+  mpm_implicit *im = ctx;
+  if (!im->matrix_free) return PM_SUCCESS;
+  const mpm_model *m = im->m;
+  mpm_implicit_fill_u(im, x);
+  double *dg = im->df;
+  memset(dg, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
+  im->fail_p = -1;
+  FOR_PARTICLES(im, {
+    double F[9], An[81];
+    particle_F(im, p, &st, im->u, F);
+    if (!particle_tangent(im, p, F, An)) {
+      note_failure(im, p, "no tangent: J <= 0", pm_t_det(F));
+      continue;
+    }
+    for (int a = 0; a < st.n; a++) {
+      const double *ga = st.grad[a];
+      double *d = dg + 3 * st.node[a];
+      for (int i = 0; i < 3; i++) {
+        double s = 0;
+        for (int J = 0; J < 3; J++)
+          for (int M = 0; M < 3; M++)
+            s += ga[J] * An[9 * (3 * i + J) + 3 * i + M] * ga[M];
+        d[i] += m->vol0[p] * s;
+      }
+    }
+  })
+  if (im->fail_p >= 0) return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
+  for (long k = 0; k < im->nunk; k++) im->diag[k] = dg[im->unk_dof[k]];
+  return PM_SUCCESS;
+}
+
+pm_err mpm_implicit_cb_precond(void *ctx, const double *x, const double *dx,
+                               double *dr) {
+  (void)x;
+  mpm_implicit *im = ctx;
+  for (long k = 0; k < im->nunk; k++) dr[k] = im->diag[k] * dx[k];
+  return PM_SUCCESS;
+}
+
+/* A smooth field over the unknowns, for the tangent check. */
+static void smooth_field(const mpm_implicit *im, double amp, double *x) {
+  for (long k = 0; k < im->nunk; k++) {
+    double y[3];
+    long d = im->unk_dof[k];
+    mpm_implicit_node_position(&im->g, d / 3, y);
+    double h = im->g.h * 10;
+    x[k] = amp * sin(y[0] / h + 0.3 * (double)(d % 3)) * cos(y[1] / h) *
+           (1 + 0.2 * sin(y[2] / h));
+  }
+}
+
+pm_err mpm_implicit_check_tangent(mpm_implicit *im, double lambda, double amp,
+                                  double *assembled_error,
+                                  double *matrix_free_error) {
+  pm_err ret = PM_SUCCESS;
+  if (im->mode == MPM_GRID_RESET) PM_CALL(mpm_implicit_rebuild(im));
+  const long n = im->nunk;
+  const long nz = im->pat_ptr[n];
+  double *x = NULL, *val = NULL, *xp = NULL, *r1 = NULL, *r2 = NULL, *e = NULL,
+         *ke = NULL;
+  PM_TRY(PM_ALLOC(x, n, "check"));
+  PM_TRY(PM_ALLOC(xp, n, "check"));
+  PM_TRY(PM_ALLOC(r1, n, "check"));
+  PM_TRY(PM_ALLOC(r2, n, "check"));
+  PM_TRY(PM_ALLOC(e, n, "check"));
+  PM_TRY(PM_ALLOC(ke, n, "check"));
+  PM_TRY(PM_ALLOC(val, nz, "check"));
+  im->lam_local = lambda;
+  smooth_field(im, amp, x);
+  /* the values the solver assembles (directly, or coloured from the
+   * product with F-bar) */
+  PM_TRY(pm_newton_jacobian_values(im->solver, x, val));
+  /* central differences, column by column */
+  double dmax = 0, err_a = 0, err_m = 0;
+  for (long j = 0; j < n; j++) {
+    const double h = 1e-6 * (fabs(x[j]) + amp + 1e-30);
+    memcpy(xp, x, sizeof(double) * (size_t)n);
+    xp[j] = x[j] + h;
+    PM_TRY(mpm_implicit_cb_residual(im, xp, r1));
+    xp[j] = x[j] - h;
+    PM_TRY(mpm_implicit_cb_residual(im, xp, r2));
+    memset(e, 0, sizeof(double) * (size_t)n);
+    e[j] = 1;
+    PM_TRY(mpm_implicit_cb_apply(im, x, e, ke));
+    for (long i = 0; i < n; i++) {
+      double d = (r1[i] - r2[i]) / (2 * h);
+      dmax = fmax(dmax, fabs(d));
+      err_m = fmax(err_m, fabs(ke[i] - d));
+      /* the assembled value of (i, j), 0 outside the pattern */
+      double a = 0;
+      for (long q = im->pat_ptr[i]; q < im->pat_ptr[i + 1]; q++)
+        if (im->pat_idx[q] == j) a += val[q];
+      err_a = fmax(err_a, fabs(a - d));
+    }
+  }
+  *assembled_error = dmax > 0 ? err_a / dmax : err_a;
+  *matrix_free_error = dmax > 0 ? err_m / dmax : err_m;
+done:
+  free(x);
+  free(xp);
+  free(r1);
+  free(r2);
+  free(e);
+  free(ke);
+  free(val);
+  return ret;
+}

@@ -1,0 +1,47 @@
+/* mpm_par_check: what a run of MPM across ranks cannot do yet, refused at
+ * the scene check. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_kind.h"
+#include "mpm_par_impl.h"
+#include "pm_par.h"
+#include "pm_par_mpi.h"
+#include "pm_petsc.h"
+#include "pm_progress.h"
+
+/* ---- what a run across ranks cannot do yet ---------------------------------
+ */
+
+pm_err mpm_par_check(const pm_scene *s) {
+  if (mpm_scene_settings(s)->fbar == MPM_FBAR_PATCH)
+    return pm_scene_fail(s, "mpm.fbar", false,
+                         "F-bar over node patches runs on one process (this "
+                         "run has %d ranks): take mpm.fbar: cell, or run with "
+                         "-np 1",
+                         pm_par_size());
+  return PM_SUCCESS;
+}
+
+pm_err mpm_par_check_implicit(const pm_scene *s) {
+  const mpm_settings *ms = mpm_scene_settings(s);
+  if (ms->implicit.grid == MPM_GRID_RESET)
+    return pm_scene_fail(s, "mpm.implicit.grid", false,
+                         "the grid reset after each load step runs on one "
+                         "process (this run has %d ranks): take kept, or run "
+                         "with -np 1",
+                         pm_par_size());
+  if (ms->implicit.op == MPM_OP_MATRIX_FREE)
+    return pm_scene_fail(s, "mpm.implicit.operator", false,
+                         "the matrix-free operator runs on one process (this "
+                         "run has %d ranks): take assembled, or run with -np "
+                         "1",
+                         pm_par_size());
+  if (ms->fbar == MPM_FBAR_CELL)
+    return pm_scene_fail(s, "mpm.fbar", false,
+                         "the implicit F-bar runs on one process (this run "
+                         "has %d ranks): run with -np 1",
+                         pm_par_size());
+  return PM_SUCCESS;
+}
