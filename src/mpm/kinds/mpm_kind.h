@@ -1,5 +1,5 @@
-/* mpm_kind: particle kinds (solid, fluid, membrane, rigid; the table of
- * them in mpm_kind.c, each in its folder under kinds/).  A kind brings
+/* mpm_kind: particle kinds (solid, fluid, membrane, rigid: each a file or
+ * a folder under kinds/, and a row of the table in mpm_kind.c).  A kind brings
  * its constants, its per-particle state arrays, its constitutive stage and
  * what the rest of the step needs to know of it (wave speeds, energies,
  * output fields), so that nothing outside a kind's file branches on what a
