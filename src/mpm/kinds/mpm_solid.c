@@ -384,10 +384,23 @@ static void solid_fields(const mpm_model *m, const mpm_state *s,
   }
 }
 
+/* Every volume body's material that is not a fluid. */
+static bool solid_takes(const pm_scene_material *sm, mpm_body_role role) {
+  return role == MPM_BODY_VOLUME && !pm_material_is_fluid(&sm->mat);
+}
+
+/* F, q and its model's state, and with F-bar its Jbar - 1 and the
+ * workspace's J - 1 and cell or patch average. */
+static double solid_doubles(const pm_scene_material *sm, bool fbar) {
+  return 9 + 1 + sm->mat.state_size + (fbar ? 3 : 0);
+}
+
 const mpm_kind mpm_kind_solid = {
     .name = "solid",
     .stage_name = "stress: solid",
     .flags = MPM_KIND_STRAIN_ENERGY,
+    .takes = solid_takes,
+    .estimate_doubles = solid_doubles,
     .setup = solid_setup,
     .seed = solid_seed,
     .stress = solid_stress,

@@ -102,19 +102,11 @@ static double image_particles(const pm_scene *s, int b, double box) {
   return (known ? fmin(voxels, fit) : fit) * fmax(0, n - prev);
 }
 
-/* Doubles per particle of the kind of body b's particles, as its setup
- * lays them out: a fluid's density, energy, pressure and q; a solid's F, q
- * and its model's state, and with F-bar its Jbar - 1 and the workspace's
- * J - 1 and cell or patch average; a membrane's frame, strain, damage and
- * failed, and its triangles (two per point) with their incidence and
- * normals. */
+/* Doubles per particle of the kind of body b's particles (the kind's
+ * estimate_doubles). */
 static double kind_doubles(const pm_scene_material *sm, const pm_scene_body *b,
                            bool fbar) {
-  const mpm_kind *k = mpm_kind_of(sm, mpm_body_role_of(b));
-  if (k == &mpm_kind_fluid) return 4;
-  if (k == &mpm_kind_rigid) return 0;
-  if (k == &mpm_kind_membrane) return 9 + 3 + 2 + 2 * (3 + 6);
-  return 9 + 1 + sm->mat.state_size + (fbar ? 3 : 0);
+  return mpm_kind_of(sm, mpm_body_role_of(b))->estimate_doubles(sm, fbar);
 }
 
 size_t mpm_estimate_bytes(const pm_scene *s, long *points) {

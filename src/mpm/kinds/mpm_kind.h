@@ -1,4 +1,5 @@
-/* mpm_kind: particle kinds (solid, fluid; membranes next).  A kind brings
+/* mpm_kind: particle kinds (solid, fluid, membrane, rigid: each a file or
+ * a folder under kinds/, and a row of the table in mpm_kind.c).  A kind brings
  * its constants, its per-particle state arrays, its constitutive stage and
  * what the rest of the step needs to know of it (wave speeds, energies,
  * output fields), so that nothing outside a kind's file branches on what a
@@ -28,10 +29,26 @@ enum {
   MPM_KIND_RIGID = 16u           /* moves as prescribed: no stress */
 };
 
+/* What a body makes of its material's particles. */
+typedef enum {
+  MPM_BODY_VOLUME = 0, /* seeded in cells: the material's kind */
+  MPM_BODY_MEMBRANE,   /* the vertices of a surface */
+  MPM_BODY_RIGID       /* moves as prescribed */
+} mpm_body_role;
+
 typedef struct mpm_kind {
   const char *name;       /* "solid", "fluid" */
   const char *stage_name; /* its constitutive stage's ("stress: solid") */
   unsigned flags;         /* MPM_KIND_* */
+
+  /* Whether the kind takes the particles of scene material sm whose bodies
+   * have the role given (mpm_kind_of asks the kinds in the table's
+   * order). */
+  bool (*takes)(const pm_scene_material *sm, mpm_body_role role);
+  /* Doubles per particle of the kind's own arrays and workspace, as setup
+   * lays them out, for mpm_estimate_bytes: of material sm, with F-bar
+   * (fbar) or without. */
+  double (*estimate_doubles)(const pm_scene_material *sm, bool fbar);
 
   /* Fill group g (material, c0, c1 and the particle range already set) from
    * its scene material: the kind's constants into g->params (owned by g,
@@ -64,7 +81,7 @@ typedef struct mpm_kind {
                         void **out, size_t *bytes);
   void (*work_free)(void *w);
 
-  /* Optional, across ranks (mpm_par.h), for a group whose points read
+  /* Optional, across ranks (mpm_exchange.h), for a group whose points read
    * other points of the group each step (a membrane point's normal reads
    * its neighbours' positions).  ranks_share: at setup, a rank's group g
    * takes from the whole model's group what its links are made from (a
@@ -73,7 +90,7 @@ typedef struct mpm_kind {
    * other ranks that the rank's points of g read (the ghosts: sorted,
    * without repeats) into *want (room *room, grown as needed), *n of them,
    * and g's links among its points and those anew (ghost j is point
-   * (g->end - g->begin) + j; mpm_par_ghost_x gives their positions).
+   * (g->end - g->begin) + j; mpm_xc_ghost_x gives their positions).
    * PM_ERR_MEMORY. */
   pm_err (*ranks_share)(const mpm_group *whole, mpm_group *g);
   pm_err (*ranks_link)(const struct mpm_model *m, mpm_group *g, long **want,
@@ -81,7 +98,7 @@ typedef struct mpm_kind {
   /* Optional, across ranks: how many cells around a rank's cells hold
    * points of group g that its points read each step (a membrane's normals
    * fitted per cell read the points of the blocks of cells around it), 0
-   * when none; mpm_par_nearby gives those of other ranks. */
+   * when none; mpm_xc_nearby gives those of other ranks. */
   int (*ranks_reach)(const mpm_group *g);
 
   /* Optional: a stage run just before the constitutive stage (membranes:
@@ -130,18 +147,13 @@ extern const mpm_kind mpm_kind_fluid;
 extern const mpm_kind mpm_kind_membrane;
 extern const mpm_kind mpm_kind_rigid;
 
-/* What a body makes of its material's particles. */
-typedef enum {
-  MPM_BODY_VOLUME = 0, /* seeded in cells: the material's kind */
-  MPM_BODY_MEMBRANE,   /* the vertices of a surface */
-  MPM_BODY_RIGID       /* moves as prescribed */
-} mpm_body_role;
-
 /* The role of body b in scene s. */
 mpm_body_role mpm_body_role_of(const pm_scene_body *b);
 
 /* The kind of the particles of a scene material whose bodies have the role
- * given (mpm_check_scene sees that they share it). */
+ * given (mpm_check_scene sees that they share it): the first kind of the
+ * table (mpm_kind.c) that takes them; NULL when none does (every role has
+ * a kind today). */
 const mpm_kind *mpm_kind_of(const pm_scene_material *sm, mpm_body_role role);
 
 /* Membrane law, for tests: the largest principal strain of the in-plane

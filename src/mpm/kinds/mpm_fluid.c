@@ -226,10 +226,23 @@ static void fluid_fields(const mpm_model *m, const mpm_state *s,
   }
 }
 
+/* A volume body's fluid material. */
+static bool fluid_takes(const pm_scene_material *sm, mpm_body_role role) {
+  return role == MPM_BODY_VOLUME && pm_material_is_fluid(&sm->mat);
+}
+
+/* Density, energy, pressure and q. */
+static double fluid_doubles(const pm_scene_material *sm, bool fbar) {
+  (void)sm, (void)fbar;
+  return 4;
+}
+
 const mpm_kind mpm_kind_fluid = {
     .name = "fluid",
     .stage_name = "stress: fluid",
     .flags = MPM_KIND_INTERNAL_ENERGY | MPM_KIND_ITERATES,
+    .takes = fluid_takes,
+    .estimate_doubles = fluid_doubles,
     .setup = fluid_setup,
     .seed = fluid_seed,
     .stress = fluid_stress,

@@ -46,10 +46,24 @@ static void rigid_fields(const mpm_model *m, const mpm_state *s,
   for (long p = g->begin; p < g->end; p++) sed[p] = pressure[p] = energy[p] = 0;
 }
 
+/* A body with motion, whatever its material. */
+static bool rigid_takes(const pm_scene_material *sm, mpm_body_role role) {
+  (void)sm;
+  return role == MPM_BODY_RIGID;
+}
+
+/* No state. */
+static double rigid_doubles(const pm_scene_material *sm, bool fbar) {
+  (void)sm, (void)fbar;
+  return 0;
+}
+
 const mpm_kind mpm_kind_rigid = {
     .name = "rigid",
     .stage_name = NULL,
     .flags = MPM_KIND_RIGID,
+    .takes = rigid_takes,
+    .estimate_doubles = rigid_doubles,
     .setup = rigid_setup,
     .seed = rigid_seed,
     .stress = NULL,
