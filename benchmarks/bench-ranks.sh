@@ -20,7 +20,7 @@
 # fastest and slowest beside it) and the other figures of the median run,
 # and the efficiency of the fastest runs (against the fastest 1 x 1): on a
 # noisy machine the fastest run is the closest to the work itself.
-# usage: scripts/bench-ranks.sh [BUILD_DIR]   (STEPS: steps per run, 200;
+# usage: benchmarks/bench-ranks.sh [BUILD_DIR]   (STEPS: steps per run, 200;
 #        TABLE_ONLY=1 tabulates the runs of an earlier call again)
 bench_name=ranks
 source "$(dirname "$0")/bench-lib.sh"

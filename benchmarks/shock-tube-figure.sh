@@ -3,7 +3,7 @@
 # and the non-iterative energy update: runs a scene through
 # verify_shock_tube --profiles and draws density, velocity, pressure and
 # internal energy with tools/plot-shock-tube.py.
-# usage: scripts/shock-tube-figure.sh BUILD [SCENE] [OUT_DIR]
+# usage: benchmarks/shock-tube-figure.sh BUILD [SCENE] [OUT_DIR]
 #   default SCENE cases/mpm/m2-shock-tube.yaml (the paper's size, ~30 s),
 #   default OUT_DIR out/shock-tube; writes OUT_DIR/profiles.png and the CSVs.
 set -euo pipefail

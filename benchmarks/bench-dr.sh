@@ -5,7 +5,7 @@
 # steps and wall time to the same relative residual, same step, for F2
 # and F3 60% at h = 1.09e-2.  The fixed rates bracket the critical damping
 # 2 omega_1 that the adaptive run settles on.
-#   scripts/bench-dr.sh [BUILD_DIR]      FLUX=iipg|sipg  PENALTY=p
+#   benchmarks/bench-dr.sh [BUILD_DIR]      FLUX=iipg|sipg  PENALTY=p
 bench_name=dr
 # shellcheck source=bench-lib.sh
 . "$(dirname "$0")/bench-lib.sh"

@@ -8,7 +8,7 @@
 # on 1 and 2 ranks, each synced to disk and renamed as pointmech's frames
 # are.  The ways take turns, REPS times (5); each line gives the median
 # and the fastest seconds of a frame.
-# usage: scripts/bench-parallel-output.sh [BUILD_DIR]
+# usage: benchmarks/bench-parallel-output.sh [BUILD_DIR]
 bench_name=parallel-output
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1

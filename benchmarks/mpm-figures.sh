@@ -5,14 +5,14 @@
 #                                   energy update against the exact solution
 #   OUT/m2-sod/profiles.png         the same tube at the Sod ratio
 #   OUT/disks-energy.png            the colliding disks' energy, FLIP and PIC
-# usage: scripts/mpm-figures.sh [BUILD_DIR] [OUT]  (defaults build, out/mpm-figures)
+# usage: benchmarks/mpm-figures.sh [BUILD_DIR] [OUT]  (defaults build, out/mpm-figures)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
 out=${2:-out/mpm-figures}
 mkdir -p "$out"
-scripts/shock-tube-figure.sh "$build" cases/mpm/m2-shock-tube.yaml "$out/m2-shock-tube"
-scripts/shock-tube-figure.sh "$build" cases/mpm/m2-sod.yaml "$out/m2-sod"
+benchmarks/shock-tube-figure.sh "$build" cases/mpm/m2-shock-tube.yaml "$out/m2-shock-tube"
+benchmarks/shock-tube-figure.sh "$build" cases/mpm/m2-sod.yaml "$out/m2-sod"
 for blend in 1 0; do
   "$build/pointmech" run --overwrite cases/mpm/disks-collision.yaml --quiet \
     --out "$out/disks-flip$blend" --set mpm.flip=$blend --set output.every=2

@@ -6,7 +6,7 @@
 # table: the top reaction's error against FE, the displacement NRMSE at the
 # FE lattice and the wall time per run; the runs are in
 # out/study-flux/FORM-nuNU/convergence.{md,csv}.
-#   scripts/study-flux.sh [BUILD_DIR] [FORM ...]
+#   benchmarks/study-flux.sh [BUILD_DIR] [FORM ...]
 #   FORM: paper     IIPG, linear jump, p = 20 (the FPM paper)
 #         p0        IIPG, linear jump, p = 0 (no penalty: inconsistent)
 #         sipg      SIPG, linear jump, p = 100

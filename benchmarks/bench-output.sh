@@ -6,7 +6,7 @@
 # every core, as seconds per frame and per checkpoint beside the seconds per
 # step, and as the fraction of step time at the scene's own output.every
 # and at a checkpoint every 1000 steps.
-# usage: scripts/bench-output.sh [BUILD_DIR]   (STEPS: steps per run, 2000;
+# usage: benchmarks/bench-output.sh [BUILD_DIR]   (STEPS: steps per run, 2000;
 #        EVERY: frames and checkpoints every EVERY steps in the run, 100)
 bench_name=output
 source "$(dirname "$0")/bench-lib.sh"

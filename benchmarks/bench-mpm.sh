@@ -10,7 +10,7 @@
 #     particles) and the reduced oocyte (cases/mpm/m4-oocyte-reduced.yaml:
 #     a zona with elastodamage, two stiffened-gas fluids, two moving
 #     bodies, absorbing faces; 8967 particles).
-# usage: scripts/bench-mpm.sh [BUILD_DIR]   (STEPS: steps per run, 100)
+# usage: benchmarks/bench-mpm.sh [BUILD_DIR]   (STEPS: steps per run, 100)
 bench_name=mpm
 source "$(dirname "$0")/bench-lib.sh"
 steps=${STEPS:-100}

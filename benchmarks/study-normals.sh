@@ -17,7 +17,7 @@
 #                           sphere and the reduced oocyte in 3-D, the
 #                           oocyte's angles split between points next to a
 #                           failed one and the others
-# usage: scripts/study-normals.sh [BUILD_DIR] [OUT]
+# usage: benchmarks/study-normals.sh [BUILD_DIR] [OUT]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}

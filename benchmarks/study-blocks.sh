@@ -6,7 +6,7 @@
 # resolutions with the case's finite-element referee (cases/fe/CASE)
 # instead, without the dense run, and adds the reaction and strain energy
 # errors.  Writes out/study-CASE-TAG/convergence.{md,csv}.
-#   scripts/study-blocks.sh [BUILD_DIR] [CASE ...]
+#   benchmarks/study-blocks.sh [BUILD_DIR] [CASE ...]
 #   CASE: f3-extension-60 f3-extension-100 f3-extension-200
 #         f4-compression-20 f4-compression-40 f4-compression-60
 # FORMULATION chooses the flux, jump and penalty (TAG is its name):

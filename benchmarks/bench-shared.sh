@@ -4,7 +4,7 @@
 # OpenMP wait policy of the measured run and of the competing one.  Run it
 # on an otherwise idle machine.
 #
-# usage: scripts/bench-shared.sh BUILD [STEPS] [POLICY...]
+# usage: benchmarks/bench-shared.sh BUILD [STEPS] [POLICY...]
 #   POLICY: default (OMP_WAIT_POLICY and GOMP_SPINCOUNT unset), passive,
 #   active, or spin=N (GOMP_SPINCOUNT=N)
 set -euo pipefail

@@ -5,10 +5,10 @@
 # (IIPG, linear jump, p = 20) and the symmetric flux (SIPG, p = 100) -- at
 # the resolutions of SIZES (default: the paper's three coarsest), against
 # the case's finite-element referee, with the referee's own meshes and
-# times on the reaction panel.  Runs scripts/study-blocks.sh (REFERENCE=fe)
+# times on the reaction panel.  Runs benchmarks/study-blocks.sh (REFERENCE=fe)
 # once per setting, then tools/plot-convergence.py;
 # writes out/study-CASE-*/ and out/cost-CASE-cost.png.
-#   scripts/study-cost.sh [BUILD_DIR] [CASE ...]
+#   benchmarks/study-cost.sh [BUILD_DIR] [CASE ...]
 # Time it on an otherwise idle machine: the wall times are the figure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,10 +19,10 @@ cases=("$@")
 export REFERENCE=fe SIZES=${SIZES:-8.72e-3,6.42e-3,4.15e-3}
 o=${STUDY_OUT:-out}
 for c in "${cases[@]}"; do
-  FORMULATION=scene scripts/study-blocks.sh "$build" "$c"
-  FORMULATION=scene QS=static scripts/study-blocks.sh "$build" "$c"
-  FORMULATION=paper scripts/study-blocks.sh "$build" "$c"
-  FORMULATION=sipg scripts/study-blocks.sh "$build" "$c"
+  FORMULATION=scene benchmarks/study-blocks.sh "$build" "$c"
+  FORMULATION=scene QS=static benchmarks/study-blocks.sh "$build" "$c"
+  FORMULATION=paper benchmarks/study-blocks.sh "$build" "$c"
+  FORMULATION=sipg benchmarks/study-blocks.sh "$build" "$c"
   /usr/bin/python3 tools/plot-convergence.py \
     "$o/study-$c-scene/convergence.csv" \
     "$o/study-$c-scene-static/convergence.csv" \

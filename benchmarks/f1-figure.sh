@@ -3,7 +3,7 @@
 # with p = 0 and p = 20, each point's subdomain drawn moved by its own
 # linear field, so that the gaps and overlaps of the inconsistent p = 0
 # solution show (jumps magnified 5 times in the second figure).
-#   scripts/f1-figure.sh [BUILD_DIR]    -> out/f1-figure/*.png
+#   benchmarks/f1-figure.sh [BUILD_DIR]    -> out/f1-figure/*.png
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build}/pointmech

@@ -15,7 +15,7 @@
 # efficiency per core against 1 x 1 (of the medians and of the fastest
 # runs), and what a rank sends per step (node sums, particles, membrane
 # ghosts, FPM's ghost displacements).
-# usage: scripts/bench-scaling.sh [BUILD_DIR]   (STEPS: 200, the explicit
+# usage: benchmarks/bench-scaling.sh [BUILD_DIR]   (STEPS: 200, the explicit
 #        runs' steps: F3 STEPS, the shock tube 2 STEPS, the oocyte 10 STEPS;
 #        TABLE_ONLY=1 tabulates an earlier call's runs again; CASES="f3-fpm
 #        i2" runs those cases only, of shock-tube oocyte i2 f3-fpm)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Case I2, the paper's 2-D slice (figs. 7 and 8): 64^2, 128^2 and 256^2
 # cells, grid kept and grid reset, then the figure and the table.
-#   scripts/study-i2.sh [BUILD_DIR] [OUT_DIR]
+#   benchmarks/study-i2.sh [BUILD_DIR] [OUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}

@@ -15,7 +15,7 @@
 #                           membrane's current surface at the end (0.3 s)
 #                           against the start, by cell size over point
 #                           spacing
-# usage: scripts/study-membranes.sh [BUILD_DIR] [OUT] [m1|m3|leak|all]
+# usage: benchmarks/study-membranes.sh [BUILD_DIR] [OUT] [m1|m3|leak|all]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}

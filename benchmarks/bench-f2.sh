@@ -3,7 +3,7 @@
 # resolutions (or those given as arguments), each run from rest to its
 # quasi-static state; prints points, NRMSE of u_z, steps, wall time, time
 # per point-step and point-steps per second per core.
-#   scripts/bench-f2.sh [BUILD_DIR] [h ...]   (h among the case files)
+#   benchmarks/bench-f2.sh [BUILD_DIR] [h ...]   (h among the case files)
 # BENCH_RULE=spectral uses the measured stable step instead of eqs. 24-26.
 set -euo pipefail
 cd "$(dirname "$0")/.."

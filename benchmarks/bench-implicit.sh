@@ -3,7 +3,7 @@
 # (64^2 and 128^2 cells, grid kept) and on F2 (the neo-Hookean cube, 40%
 # compression, 8000 particles), one run at a time; and F2 by implicit
 # against explicit MPM, error and time.
-#   scripts/bench-implicit.sh [BUILD_DIR] [OUT_DIR]
+#   benchmarks/bench-implicit.sh [BUILD_DIR] [OUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}

@@ -6,7 +6,7 @@
 # shock tube's) and 88 000 (the full oocyte's), 0 to 10 000 of them leaving
 # a step; each line the median and fastest seconds of a step over STEPS
 # steps (200).
-# usage: scripts/bench-migration.sh [BUILD_DIR]
+# usage: benchmarks/bench-migration.sh [BUILD_DIR]
 bench_name=migration
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1

@@ -8,7 +8,7 @@
 # QS=none runs plain dynamics (no damping) to END seconds (default 2)
 # instead of dynamic relaxation; only the symmetric flux conserves energy
 # there.
-#   scripts/bench-dt.sh [BUILD_DIR]   FLUX=iipg|sipg  PENALTY=p  QS=...  END=s
+#   benchmarks/bench-dt.sh [BUILD_DIR]   FLUX=iipg|sipg  PENALTY=p  QS=...  END=s
 bench_name=dt
 # shellcheck source=bench-lib.sh
 . "$(dirname "$0")/bench-lib.sh"
