@@ -1,12 +1,14 @@
-/* pm_testing: helpers shared by the unit tests (include after cmocka.h):
- * a success check that prints the error message, a failure check on the
- * code and the message, and a temporary directory per test (cmocka
- * setup/teardown) removed with everything in it. */
+/* pm_testing: helpers shared by the unit and verification tests (include
+ * after cmocka.h): a success check that prints the error message, a
+ * failure check on the code and the message, a temporary directory per
+ * test (cmocka setup/teardown) removed with everything in it, a file's
+ * text and a folder's entries, and reproducible uniform numbers. */
 #ifndef PM_TESTING_H
 #define PM_TESTING_H
 
 #include <dirent.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -88,6 +90,55 @@ static inline void pm_test_write_file(const char *dir, const char *name,
   assert_non_null(f);
   assert_true(fputs(text, f) >= 0);
   assert_int_equal(fclose(f), 0);
+}
+
+/* The whole file at path, NUL-terminated, in a new buffer (the caller
+ * frees it); fails the test when it cannot be read. */
+static inline char *pm_test_slurp(const char *path) {
+  FILE *fp = fopen(path, "r");
+  char *buf;
+  long n;
+  assert_non_null(fp);
+  fseek(fp, 0, SEEK_END);
+  n = ftell(fp);
+  rewind(fp);
+  buf = calloc((size_t)n + 1, 1);
+  assert_int_equal(fread(buf, 1, (size_t)n, fp), (size_t)n);
+  fclose(fp);
+  return buf;
+}
+
+/* The file at path holds exactly text. */
+static inline void pm_test_assert_file(const char *path, const char *text) {
+  char *s = pm_test_slurp(path);
+  assert_string_equal(s, text);
+  free(s);
+}
+
+/* Number of entries of folder dir (not . and ..); *tmp, unless tmp is
+ * NULL, counts those whose name holds ".tmp.". */
+static inline int pm_test_count_entries(const char *dir, int *tmp) {
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  int n = 0;
+  assert_non_null(d);
+  if (tmp) *tmp = 0;
+  while ((e = readdir(d))) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+    n++;
+    if (tmp && strstr(e->d_name, ".tmp.")) (*tmp)++;
+  }
+  closedir(d);
+  return n;
+}
+
+/* Deterministic uniform numbers in [0, 1) (xorshift64*): the next of the
+ * stream whose state *s is (seeded nonzero). */
+static inline double pm_test_uniform(uint64_t *s) {
+  *s ^= *s >> 12;
+  *s ^= *s << 25;
+  *s ^= *s >> 27;
+  return (double)((*s * 0x2545F4914F6CDD1Dull) >> 11) * 0x1.0p-53;
 }
 
 /* "path:line:col" of the first occurrence of needle in text (where a

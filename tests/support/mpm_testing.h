@@ -15,6 +15,7 @@
 #include "mpm_shape.h"
 #include "mpm_solver.h"
 #include "mpm_state.h"
+#include "mpm_test_arrays.h"
 #include "mpm_transfer.h"
 #include "pm_app.h"
 #include "pm_run.h"
@@ -34,14 +35,9 @@ static inline void check_near(double a, double b, double tol, const char *what,
              what, a, b, tol, fabs(a - b));
 }
 
-/* Deterministic uniform numbers in [0, 1) (xorshift64*). */
+/* The MPM tests' one stream of uniform numbers in [0, 1). */
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
-static inline double uniform(void) {
-  rng ^= rng >> 12;
-  rng ^= rng << 25;
-  rng ^= rng >> 27;
-  return (double)((rng * 0x2545F4914F6CDD1Dull) >> 11) * 0x1.0p-53;
-}
+static inline double uniform(void) { return pm_test_uniform(&rng); }
 
 /* A scene's model, state and workspace. */
 typedef struct {
@@ -69,13 +65,6 @@ static inline void drop_model(model *m) {
 
 static inline void step(model *m) {
   assert_ok(mpm_step(m->model, m->state, m->work));
-}
-
-/* Group gi's state array called name, or NULL. */
-static inline const double *group_array(const model *m, int gi,
-                                        const char *name) {
-  const mpm_array *a = mpm_group_state_find(&m->state->group[gi], name);
-  return a ? a->data : NULL;
 }
 
 /* Coordinates of grid node `node`. */

@@ -10,6 +10,7 @@
 
 #include "mpm_backend.h"
 #include "mpm_state.h"
+#include "mpm_test_arrays.h"
 #include "pm_app.h"
 #include "pm_run.h"
 #include "pm_scene.h"
@@ -32,14 +33,6 @@ static inline bool state_finite(const mpm_model *m, const mpm_state *s) {
   for (long i = 0; i < 9 * m->n; i++)
     if (!isfinite(s->sigma[i])) return false;
   return true;
-}
-
-/* Group gi's state array called name, or fail the test. */
-static inline const double *group_array(const mpm_state *s, int gi,
-                                        const char *name) {
-  const mpm_array *a = mpm_group_state_find(&s->group[gi], name);
-  if (!a) fail_msg("group %d has no array %s", gi, name);
-  return a->data;
 }
 
 /* A simulation and the outcome of its run through the run driver. */
