@@ -3,26 +3,18 @@
 # resolutions (or those given as arguments), each run from rest to its
 # quasi-static state; prints points, NRMSE of u_z, steps, wall time, time
 # per point-step and point-steps per second per core.
-#   benchmarks/bench-f2.sh [BUILD_DIR] [h ...]   (h among the case files)
+#   benchmarks/bench-f2.sh [BUILD_DIR] [h ...]
+#   (h: average nodal spacings of the paper's ladder, 1.09e-2 8.02e-3
+#   5.19e-3 3.73e-3, run as the scene with discretization.mesh_size set)
 # BENCH_RULE=spectral uses the measured stable step instead of eqs. 24-26.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-build=${1:-build}
+rule=${BENCH_RULE:-paper}
+bench_name=f2-$rule bench_env=BENCH_RULE
+# shellcheck source=bench-lib.sh
+. "$(dirname "$0")/bench-lib.sh"
 shift || true
 sizes=("$@")
 [ ${#sizes[@]} -gt 0 ] || sizes=(1.09e-2 8.02e-3 5.19e-3 3.73e-3)
-bin=$build/pointmech
-scene_of() { # the case file of resolution h
-  if [ "$1" = 1.09e-2 ]; then echo cases/fpm/f2-unconstrained-compression.yaml
-  else echo "cases/fpm/f2-unconstrained-compression-h$1.yaml"; fi
-}
-rule=${BENCH_RULE:-paper}
-out=${BENCH_OUT:-out/bench-f2-$rule}
-mkdir -p "$out"
-
-get() { # key file: a number or string value from our summary.json
-  sed -n "s/^  \"$1\": \"\{0,1\}\([^\",]*\)\"\{0,1\},\{0,1\}$/\1/p" "$2" | head -1
-}
+scene=cases/fpm/f2-unconstrained-compression.yaml
 nrmse_z() { sed -n 's/^    "u_z": \([^,]*\),\{0,1\}$/\1/p' "$1" | head -1; }
 
 echo "case F2, dt rule: $rule"
@@ -30,8 +22,9 @@ printf '%-9s %10s %7s %8s %12s %7s %9s %10s %14s %8s\n' h mean_edge points \
   threads NRMSE_u_z steps wall_s setup_s "s/point-step" "Mps/s/c"
 for h in "${sizes[@]}"; do
   dir=$out/h$h
-  "$bin" run --overwrite "$(scene_of "$h")" --set time.dt_rule="$rule" --out "$dir" --quiet \
-    2>"$dir.log" || { echo "h=$h failed: see $dir.log"; continue; }
+  size=$(paper_mesh_size "$h") || continue
+  bench_run "$dir" "$scene" --set discretization.mesh_size="$size" \
+    --set time.dt_rule="$rule" || { echo "h=$h failed: see $dir.log"; continue; }
   s=$dir/summary.json
   printf '%-9s %10.4g %7s %8s %12s %7s %9.2f %10.2f %14.3e %8.2f\n' "$h" \
     "$(get mean_edge_length "$s")" "$(get points "$s")" "$(get threads "$s")" "$(nrmse_z "$s")" \

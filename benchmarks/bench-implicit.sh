@@ -4,13 +4,11 @@
 # compression, 8000 particles), one run at a time; and F2 by implicit
 # against explicit MPM, error and time.
 #   benchmarks/bench-implicit.sh [BUILD_DIR] [OUT_DIR]
-set -euo pipefail
-cd "$(dirname "$0")/.."
-build=${1:-build}
-out=${2:-out/bench-implicit}
-mkdir -p "$out"
+bench_name=implicit bench_out=${2:-}
+# shellcheck source=bench-lib.sh
+. "$(dirname "$0")/bench-lib.sh"
 row() { # name, run dir
-  /usr/bin/python3 - "$1" "$2" <<'PY'
+  $py - "$1" "$2" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[2] + "/summary.json"))
 nr = d.get("nrmse", {})
@@ -30,37 +28,31 @@ for cells in 64 128; do
   h=$(awk -v c="$cells" 'BEGIN { printf "%.10g", 537.6e-6 / c }')
   for ls in cg-gamg gmres-gamg cg-jacobi direct; do
     run="$out/i2-$cells-$ls"
-    "$build/pointmech" run $i2 --out "$run" --overwrite --quiet \
-      --set discretization.mesh_size="$h" \
-      --set time.quasi_static.linear_solver=$ls --set output.every=100 \
-      >/dev/null 2>&1 || true
+    bench_run "$run" $i2 --set discretization.mesh_size="$h" \
+      --set time.quasi_static.linear_solver=$ls --set output.every=100 || true
     row "I2 $cells^2 kept, $ls, assembled" "$run"
   done
   run="$out/i2-$cells-mf"
-  "$build/pointmech" run $i2 --out "$run" --overwrite --quiet \
-    --set discretization.mesh_size="$h" --set mpm.implicit.operator=matrix-free \
-    --set output.every=100 >/dev/null 2>&1 || true
+  bench_run "$run" $i2 --set discretization.mesh_size="$h" \
+    --set mpm.implicit.operator=matrix-free --set output.every=100 || true
   row "I2 $cells^2 kept, cg-jacobi, matrix-free" "$run"
 done
 f2=cases/mpm/f2-unconstrained-compression.yaml
 for ls in cg-gamg direct cg-jacobi; do
   run="$out/f2-implicit-$ls"
-  "$build/pointmech" run $f2 --out "$run" --overwrite --quiet \
-    --set method=mpm-implicit --set mpm.shape=linear \
+  bench_run "$run" $f2 --set method=mpm-implicit --set mpm.shape=linear \
     --set time.quasi_static.linear_solver=$ls \
-    --set time.quasi_static.tolerance=1e-10 >/dev/null 2>&1 || true
+    --set time.quasi_static.tolerance=1e-10 || true
   row "F2 implicit (linear), $ls" "$run"
 done
 run="$out/f2-implicit-mf"
-"$build/pointmech" run $f2 --out "$run" --overwrite --quiet \
-  --set method=mpm-implicit --set mpm.shape=linear \
+bench_run "$run" $f2 --set method=mpm-implicit --set mpm.shape=linear \
   --set mpm.implicit.operator=matrix-free \
-  --set time.quasi_static.tolerance=1e-10 >/dev/null 2>&1 || true
+  --set time.quasi_static.tolerance=1e-10 || true
 row "F2 implicit (linear), cg-jacobi, matrix-free" "$run"
 run="$out/f2-explicit"
-"$build/pointmech" run $f2 --out "$run" --overwrite --quiet >/dev/null 2>&1 || true
+bench_run "$run" $f2 || true
 row "F2 explicit (quadratic, MUSL, dyn. relaxation 1e-4)" "$run"
 run="$out/f2-explicit-linear"
-"$build/pointmech" run $f2 --out "$run" --overwrite --quiet \
-  --set mpm.shape=linear >/dev/null 2>&1 || true
+bench_run "$run" $f2 --set mpm.shape=linear || true
 row "F2 explicit (linear, MUSL, dyn. relaxation 1e-4)" "$run"

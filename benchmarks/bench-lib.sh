@@ -1,15 +1,76 @@
-# Shared by the bench scripts (sourced): strict mode, the repository root,
-# the program (BUILD_DIR/pointmech, BUILD_DIR from $1, default build), the
-# flux and penalty (FLUX, PENALTY), the output folder (BENCH_OUT, default
-# out/bench-NAME) and get KEY FILE for a top-level summary.json value.
+# shellcheck shell=bash
+# Shared by the bench and study scripts (sourced after setting bench_name,
+# and optionally bench_out, a default output folder, and bench_env, the
+# names of the environment settings the script reads): strict mode, the
+# repository root, the program (BUILD_DIR/pointmech, BUILD_DIR from $1,
+# default build; $build is BUILD_DIR), the flux and penalty (FLUX,
+# PENALTY), the output folder (BENCH_OUT, else bench_out, else
+# out/bench-NAME), and the stamp line every table starts with (bench_stamp).
 set -euo pipefail
+bench_cmd=("$0" "$@")
 cd "$(dirname "$0")/.."
-bin=${1:-build}/pointmech
+build=${1:-build}
+bin=$build/pointmech
 flux=${FLUX:-iipg}
 penalty=${PENALTY:-20}
-out=${BENCH_OUT:-out/bench-$bench_name}
+out=${BENCH_OUT:-${bench_out:-out/bench-$bench_name}}
+py=/usr/bin/python3
 mkdir -p "$out"
+
+# get KEY FILE: a top-level number or string value of a summary.json.
 get() { sed -n "s/^  \"$1\": \"\{0,1\}\([^\",]*\)\"\{0,1\},\{0,1\}$/\1/p" "$2" | head -1; }
+
+# json FILE KEY...: a value of a summary.json (or any JSON) down the path
+# of keys, "" where it has none.
+json() {
+  $py - "$@" <<'PY'
+import json, sys
+v = json.load(open(sys.argv[1]))
+for k in sys.argv[2:]:
+    v = v.get(k, "") if isinstance(v, dict) else ""
+print(v)
+PY
+}
+
+# The line a table starts with: when it was measured (UTC), on which
+# commit (-dirty: with changes not committed), on how many cores, and the
+# command that made it, with the environment settings it read.
+bench_stamp() {
+  local commit env="" v
+  commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+  git diff --quiet HEAD -- 2>/dev/null || commit=$commit-dirty
+  for v in ${bench_env:-}; do
+    [ -n "${!v+x}" ] && env+="$v=${!v} "
+  done
+  echo "measured $(date -u '+%Y-%m-%d %H:%M UTC'), commit $commit," \
+    "$(nproc) cores: $env${bench_cmd[*]}"
+}
+bench_stamp
+
+# The gmsh element size of the FPM papers' average nodal spacing h (the
+# block scenes' ladder: 0.8 h, 0.77 h for the dense reference).
+paper_mesh_size() {
+  case $1 in
+  1.09e-2) echo 8.72e-3 ;;
+  8.02e-3) echo 6.42e-3 ;;
+  5.19e-3) echo 4.15e-3 ;;
+  3.73e-3) echo 2.98e-3 ;;
+  2.79e-3) echo 2.15e-3 ;;
+  *)
+    echo "h = $1: expected one of 1.09e-2 8.02e-3 5.19e-3 3.73e-3 2.79e-3" >&2
+    return 1
+    ;;
+  esac
+}
+
+# bench_run DIR SCENE [ARGS...]: one quiet run of SCENE into DIR (replaced)
+# with ARGS (--set ...), its messages in DIR.log; returns its exit status.
+bench_run() {
+  local dir=$1 scene=$2
+  shift 2
+  mkdir -p "$(dirname "$dir")"
+  "$bin" run --overwrite "$scene" --out "$dir" --quiet "$@" >"$dir.log" 2>&1
+}
 
 # Runs across MPI ranks (bench-ranks.sh, bench-scaling.sh), each script
 # defining fig SUMMARY (a line of the run's figures: points, steps,
@@ -38,7 +99,7 @@ ranks_run() {
 # of the medians, that of the fastest runs, then the median run's own
 # figures.  WORK is the work over 1 x 1's (2: weak scaling).
 ranks_row() {
-  /usr/bin/python3 - "$@" <<'PY'
+  $py - "$@" <<'PY'
 import sys
 label, cores, work, base, path = sys.argv[1:6]
 def runs(f):
@@ -54,11 +115,13 @@ print('%-20s %7d %10.3e %21s %6.2f %6.2f %9.2f' % (
 PY
 }
 
-# ranks_case NAME SCENE PPC2 [ARGS...]: REPEAT turns of SCENE on 1 rank x 1
-# thread, 1 x 2 threads and 2 ranks x 1 (and, unless PPC2 is -, twice the
-# particles, particles_per_cell PPC2, on 2 ranks: weak scaling), their fig
-# lines in $out/NAME.CONFIG.runs (TABLE_ONLY=1: the earlier call's), then
-# a ranks_row of each configuration.
+# ranks_case NAME SCENE PPC2 [ARGS...]: the runs of a case side by side:
+# REPEAT turns of SCENE on 1 rank x 1 thread, 1 x 2 threads and 2 ranks x
+# 1 (and, unless PPC2 is -, twice the particles, particles_per_cell PPC2,
+# on 2 ranks: weak scaling), taking turns so that the machine's slow spells
+# fall on all of them; their fig lines in $out/NAME.CONFIG.runs
+# (TABLE_ONLY=1: the earlier call's), then a ranks_row of each
+# configuration.
 ranks_case() {
   local name=$1 scene=$2 ppc2=$3
   shift 3
@@ -78,4 +141,18 @@ ranks_case() {
   ranks_row "$name 2x1" 2 1 "$base" "$out/$name.2x1.runs"
   [ "$ppc2" = - ] ||
     ranks_row "$name weak2x1" 2 2 "$base" "$out/$name.weak.runs"
+}
+
+# ranks_specs SPEC...: ranks_case over cases given as "NAME SCENE PPC2
+# [KEY=VALUE ...]" (each KEY=VALUE an override); with CASES set, only the
+# cases it names.
+ranks_specs() {
+  local spec name scene ppc2 extra sets kv
+  for spec in "$@"; do
+    read -r name scene ppc2 extra <<<"$spec"
+    case " ${CASES:-$name} " in *" $name "*) ;; *) continue ;; esac
+    sets=()
+    for kv in ${extra:-}; do sets+=(--set "$kv"); done
+    ranks_case "$name" "$scene" "$ppc2" "${sets[@]}"
+  done
 }

@@ -7,7 +7,7 @@
 # a step; each line the median and fastest seconds of a step over STEPS
 # steps (200).
 # usage: benchmarks/bench-migration.sh [BUILD_DIR]
-bench_name=migration
+bench_name=migration bench_env=STEPS
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 tool=$(dirname "$bin")/bench-migration

@@ -11,7 +11,7 @@
 #     a zona with elastodamage, two stiffened-gas fluids, two moving
 #     bodies, absorbing faces; 8967 particles).
 # usage: benchmarks/bench-mpm.sh [BUILD_DIR]   (STEPS: steps per run, 100)
-bench_name=mpm
+bench_name=mpm bench_env=STEPS
 source "$(dirname "$0")/bench-lib.sh"
 steps=${STEPS:-100}
 cores=$(nproc)
@@ -22,8 +22,8 @@ for scene in cases/mpm/bench-block.yaml cases/mpm/m2-shock-tube.yaml \
   name=$(basename "$scene" .yaml)
   for threads in 1 "$cores"; do
     dir="$out/$name-t$threads"
-    OMP_NUM_THREADS=$threads "$bin" run --overwrite "$scene" --out "$dir" --quiet \
-      --set time.max_steps="$steps" --set output.every=1000000 2>/dev/null
+    OMP_NUM_THREADS=$threads bench_run "$dir" "$scene" \
+      --set time.max_steps="$steps" --set output.every=1000000
     s="$dir/summary.json"
     printf '%-28s %8s %7s %8s %14.3e %14.3e\n' "$name" "$(get particles "$s")" \
       "$threads" "$(get steps "$s")" "$(get point_steps_per_second "$s")" \

@@ -8,27 +8,22 @@
 # and at a checkpoint every 1000 steps.
 # usage: benchmarks/bench-output.sh [BUILD_DIR]   (STEPS: steps per run, 2000;
 #        EVERY: frames and checkpoints every EVERY steps in the run, 100)
-bench_name=output
+bench_name=output bench_env="STEPS EVERY"
 source "$(dirname "$0")/bench-lib.sh"
 steps=${STEPS:-2000}
 every=${EVERY:-100}
-stage() { # summary.json, stage name: its seconds
-  /usr/bin/python3 -c 'import json, sys
-print(json.load(open(sys.argv[1]))["stage_seconds"][sys.argv[2]])' "$1" "$2"
-}
 printf '%-32s %9s %6s %6s %6s %11s %11s %11s %12s %12s\n' case points steps \
   frames ckpts "s/step" "s/frame" "s/ckpt" "frames(%)" "ckpt/1000(%)"
 for scene in cases/fpm/f2-unconstrained-compression.yaml \
   cases/mpm/m2-shock-tube.yaml; do
   name=$(basename "$(dirname "$scene")")-$(basename "$scene" .yaml)
   dir="$out/$name"
-  "$bin" run --overwrite "$scene" --out "$dir" --quiet \
-    --set time.max_steps="$steps" --set output.every="$every" \
-    --set output.checkpoint.every="$every" 2>/dev/null || true
+  bench_run "$dir" "$scene" --set time.max_steps="$steps" \
+    --set output.every="$every" --set output.checkpoint.every="$every" || true
   s="$dir/summary.json"
   scene_every=$(sed -n 's/^output: {every: \([0-9]*\).*/\1/p' "$scene")
-  /usr/bin/python3 - "$s" "$name" "$(stage "$s" output)" \
-    "$(stage "$s" checkpoint)" "${scene_every:-100}" <<'EOF'
+  $py - "$s" "$name" "$(json "$s" stage_seconds output)" \
+    "$(json "$s" stage_seconds checkpoint)" "${scene_every:-100}" <<'EOF'
 import json, sys
 s = json.load(open(sys.argv[1]))
 name, out_s, ck_s, scene_every = sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), int(sys.argv[5])

@@ -9,7 +9,7 @@
 # are.  The ways take turns, REPS times (5); each line gives the median
 # and the fastest seconds of a frame.
 # usage: benchmarks/bench-parallel-output.sh [BUILD_DIR]
-bench_name=parallel-output
+bench_name=parallel-output bench_env=REPS
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 tool=$(dirname "$bin")/bench-parallel-output

@@ -21,13 +21,13 @@
 # and the efficiency of the fastest runs (against the fastest 1 x 1): on a
 # noisy machine the fastest run is the closest to the work itself.
 # usage: benchmarks/bench-ranks.sh [BUILD_DIR]   (STEPS: steps per run, 200;
-#        TABLE_ONLY=1 tabulates the runs of an earlier call again)
-bench_name=ranks
+#        TABLE_ONLY=1 tabulates the runs of an earlier call again; CASES="block
+#        disks" runs those cases only, of block shock-tube disks)
+bench_name=ranks bench_env="STEPS REPEAT TABLE_ONLY CASES"
 source "$(dirname "$0")/bench-lib.sh"
 bind=core
 steps=${STEPS:-200}
 repeat=${REPEAT:-5}
-py=/usr/bin/python3
 
 # fig SUMMARY: particles, steps, s/step, node bytes, particle bytes (per
 # step), node-sum and migration seconds, imbalance, exchange share
@@ -49,12 +49,7 @@ EOF
 printf '%-20s %7s %10s %21s %6s %6s %9s %10s %10s %10s %10s %10s %10s\n' \
   "case config" points s/step "(range)" speed eff "eff(fast)" \
   "node B/st" "part. B/st" halo-s migr-s imbal. comm
-# case, scene, particles per cell doubled along x, an override
-for spec in "block cases/mpm/bench-block.yaml 4,2,2" \
-  "shock-tube cases/mpm/m2-shock-tube.yaml 50,1,1" \
-  "disks cases/mpm/disks-collision.yaml 4,2 discretization.mesh_size=6.25e-3"; do
-  read -r name scene ppc2 extra <<<"$spec"
-  sets=(--set time.max_steps="$steps")
-  [ -n "${extra:-}" ] && sets+=(--set "$extra")
-  ranks_case "$name" "$scene" "$ppc2" "${sets[@]}"
-done
+# case, scene, particles per cell doubled along x, overrides
+ranks_specs "block cases/mpm/bench-block.yaml 4,2,2 time.max_steps=$steps" \
+  "shock-tube cases/mpm/m2-shock-tube.yaml 50,1,1 time.max_steps=$steps" \
+  "disks cases/mpm/disks-collision.yaml 4,2 time.max_steps=$steps discretization.mesh_size=6.25e-3"

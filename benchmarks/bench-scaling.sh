@@ -19,12 +19,11 @@
 #        runs' steps: F3 STEPS, the shock tube 2 STEPS, the oocyte 10 STEPS;
 #        TABLE_ONLY=1 tabulates an earlier call's runs again; CASES="f3-fpm
 #        i2" runs those cases only, of shock-tube oocyte i2 f3-fpm)
-bench_name=scaling
+bench_name=scaling bench_env="STEPS BIND REPEAT TABLE_ONLY CASES"
 source "$(dirname "$0")/bench-lib.sh"
 steps=${STEPS:-200}
 bind=${BIND:-none}
 repeat=${REPEAT:-3}
-py=/usr/bin/python3
 
 # fig SUMMARY: points, steps, s/step, bytes a rank sends per step
 fig() {
@@ -43,11 +42,7 @@ EOF
 printf '%-20s %7s %10s %21s %6s %6s %9s %10s\n' "case config" points \
   s/step "(range)" speed eff "eff(fast)" "B/step/rank"
 # case, scene, weak scaling's particles per cell (or -), overrides
-for spec in "shock-tube cases/mpm/m2-shock-tube.yaml 50,1,1 time.max_steps=$((2 * steps))" \
+ranks_specs "shock-tube cases/mpm/m2-shock-tube.yaml 50,1,1 time.max_steps=$((2 * steps))" \
   "oocyte cases/mpm/m4-oocyte-reduced.yaml - time.max_steps=$((10 * steps))" \
   "i2 cases/mpm/i2-vessel-slice.yaml - time.end=1" \
-  "f3-fpm cases/fpm/f3-extension-60-h5.19e-3.yaml - time.max_steps=$steps"; do
-  read -r name scene ppc2 extra <<<"$spec"
-  case " ${CASES:-$name} " in *" $name "*) ;; *) continue ;; esac
-  ranks_case "$name" "$scene" "$ppc2" --set "$extra"
-done
+  "f3-fpm cases/fpm/f3-extension-60.yaml - discretization.mesh_size=$(paper_mesh_size 5.19e-3) time.max_steps=$steps"

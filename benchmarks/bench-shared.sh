@@ -7,15 +7,15 @@
 # usage: benchmarks/bench-shared.sh BUILD [STEPS] [POLICY...]
 #   POLICY: default (OMP_WAIT_POLICY and GOMP_SPINCOUNT unset), passive,
 #   active, or spin=N (GOMP_SPINCOUNT=N)
-set -euo pipefail
-build=${1:?usage: bench-shared.sh BUILD [STEPS] [POLICY...]}
+[ $# -ge 1 ] || { echo "usage: bench-shared.sh BUILD [STEPS] [POLICY...]" >&2; exit 1; }
+bench_name=shared
+# shellcheck source=bench-lib.sh
+. "$(dirname "$0")/bench-lib.sh"
 steps=${2:-4000}
 shift $(($# >= 2 ? 2 : 1))
 policies=("$@")
 [ ${#policies[@]} -gt 0 ] || policies=(default passive)
-root=$(cd "$(dirname "$0")/.." && pwd)
-bin=$build/pointmech
-scene=$root/cases/fpm/f2-unconstrained-compression.yaml
+scene=cases/fpm/f2-unconstrained-compression.yaml
 work=$(mktemp -d)
 competitor=
 cleanup() {

@@ -10,20 +10,20 @@
 # writes out/study-CASE-*/ and out/cost-CASE-cost.png.
 #   benchmarks/study-cost.sh [BUILD_DIR] [CASE ...]
 # Time it on an otherwise idle machine: the wall times are the figure.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-build=${1:-build}
+bench_name=study-cost bench_out=${STUDY_OUT:-out} bench_env="SIZES STUDY_OUT"
+# shellcheck source=bench-lib.sh
+. "$(dirname "$0")/bench-lib.sh"
 shift || true
 cases=("$@")
 [ ${#cases[@]} -gt 0 ] || cases=(f3-extension-60)
 export REFERENCE=fe SIZES=${SIZES:-8.72e-3,6.42e-3,4.15e-3}
-o=${STUDY_OUT:-out}
+o=$out
 for c in "${cases[@]}"; do
   FORMULATION=scene benchmarks/study-blocks.sh "$build" "$c"
   FORMULATION=scene QS=static benchmarks/study-blocks.sh "$build" "$c"
   FORMULATION=paper benchmarks/study-blocks.sh "$build" "$c"
   FORMULATION=sipg benchmarks/study-blocks.sh "$build" "$c"
-  /usr/bin/python3 tools/plot-convergence.py \
+  $py tools/plot-convergence.py \
     "$o/study-$c-scene/convergence.csv" \
     "$o/study-$c-scene-static/convergence.csv" \
     "$o/study-$c-paper/convergence.csv" "$o/study-$c-sipg/convergence.csv" \

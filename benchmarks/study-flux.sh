@@ -14,17 +14,18 @@
 #                   flux needs this penalty for coercivity: p = 10 diverges
 #                   in undamped dynamics)
 #         quadratic IIPG, quadratic jump, p = 0.05 (the block scenes')
-set -euo pipefail
-cd "$(dirname "$0")/.."
-build=${1:-build}
+bench_name=study-flux bench_out=${STUDY_OUT:-out}/study-flux
+bench_env="SIZES STUDY_OUT"
+# shellcheck source=bench-lib.sh
+. "$(dirname "$0")/bench-lib.sh"
 shift || true
 forms=("$@")
 [ ${#forms[@]} -gt 0 ] || forms=(paper p0 sipg sipg-quadratic quadratic)
 sizes=${SIZES:-8.72e-3,6.42e-3,4.15e-3}
-out=${STUDY_OUT:-out}/study-flux
-mkdir -p "$out"
 table=$out/study-flux.md
 {
+  bench_stamp
+  echo
   echo "| formulation | nu | points | reaction error | NRMSE | wall (s) |"
   echo "|---|---|---|---|---|---|"
 } >"$table"
@@ -50,7 +51,7 @@ for form in "${forms[@]}"; do
     fe=cases/fe/f3-extension-60
     [ "$nu" = 0.495 ] || fe=$fe-nu$nu
     dir=$out/$form-nu$nu
-    "$build/pointmech" convergence --overwrite cases/fpm/f3-extension-60-h1.09e-2.yaml \
+    "$bin" convergence --overwrite cases/fpm/f3-extension-60.yaml \
       --quiet "${set_form[@]}" --set materials.0.poisson_ratio="$nu" \
       --set output.every=1000000 --reference "fe:$fe" \
       --set-ladder discretization.mesh_size="$sizes" --out "$dir" \

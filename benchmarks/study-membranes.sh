@@ -16,15 +16,14 @@
 #                           against the start, by cell size over point
 #                           spacing
 # usage: benchmarks/study-membranes.sh [BUILD_DIR] [OUT] [m1|m3|leak|all]
-set -euo pipefail
-cd "$(dirname "$0")/.."
-build=${1:-build}
-out=${2:-out/membranes}
+bench_name=membranes bench_out=${2:-out/membranes}
+# shellcheck source=bench-lib.sh
+. "$(dirname "$0")/bench-lib.sh"
 which=${3:-all}
-mkdir -p "$out"
+stamp=$(bench_stamp)
 
 run() { # case, cell, dir
-  "$build/pointmech" run --overwrite "cases/mpm/$1.yaml" --quiet \
+  "$bin" run --overwrite "cases/mpm/$1.yaml" --quiet \
     --set discretization.mesh_size="$2" --set output.every=20 --out "$3"
 }
 
@@ -36,7 +35,7 @@ study() { # name, scene, column, png, title, cells...
     run "$scene" "$h" "$out/$name/h$h"
     args+=("cell $h m=$out/$name/h$h")
   done
-  /usr/bin/python3 tools/plot-history.py --columns "$col" --title "$title" \
+  $py tools/plot-history.py --columns "$col" --title "$title" \
     --out "$out/$name/$png" "${args[@]}"
 }
 
@@ -50,15 +49,15 @@ if [ "$which" = all ] || [ "$which" = m3 ]; then
 fi
 if [ "$which" = all ] || [ "$which" = leak ]; then
   for r in 1 2 3 4; do
-    "$build/pointmech" run --overwrite cases/mpm/membrane-sphere-gas.yaml \
+    "$bin" run --overwrite cases/mpm/membrane-sphere-gas.yaml \
       --quiet --set time.end=0.3 --set output.every=100 \
       --set bodies.0.membrane.sphere.refinement=$r --out "$out/leak/r$r" ||
       echo "refinement $r: the run stopped (see $out/leak/r$r/summary.json)"
   done
-  /usr/bin/python3 - "$out" <<'PY'
+  $py - "$out" "$stamp" <<'PY'
 import csv, math, os, sys
 out = sys.argv[1]
-lines = ["# Gas inside a closed membrane (sphere R = 0.5 m, cell 0.1 m, 0.3 s)", "",
+lines = [sys.argv[2], "", "# Gas inside a closed membrane (sphere R = 0.5 m, cell 0.1 m, 0.3 s)", "",
          "| refinement | membrane points | edge (m) | cell / edge | gas mass inside at 0 | at the end | end (s) | lost |",
          "|---|---|---|---|---|---|---|---|"]
 for r in (1, 2, 3, 4):
@@ -75,12 +74,12 @@ open(os.path.join(out, "leak.md"), "w").write("\n".join(lines) + "\n")
 print("\n".join(lines))
 PY
 fi
-/usr/bin/python3 - "$out" <<'PY'
+$py - "$out" "$stamp" <<'PY'
 import csv, json, os, sys
 out = sys.argv[1]
 cases = [("m1", "cuboid_uz", [0.05, 0.1, 0.15, 0.2], ["0.05", "0.025", "0.02"]),
          ("m3", "cube_uz", [0.01, 0.02, 0.03], ["0.04", "0.02", "0.01"])]
-lines = ["# M1 and M3 at three cell sizes", ""]
+lines = [sys.argv[2], "", "# M1 and M3 at three cell sizes", ""]
 for name, col, times, cells in cases:
     runs = [os.path.join(out, name, "h" + h) for h in cells]
     if not all(os.path.exists(os.path.join(r, "history.csv")) for r in runs):

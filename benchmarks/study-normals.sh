@@ -18,19 +18,20 @@
 #                           oocyte's angles split between points next to a
 #                           failed one and the others
 # usage: benchmarks/study-normals.sh [BUILD_DIR] [OUT]
-set -euo pipefail
-cd "$(dirname "$0")/.."
-build=${1:-build}
-out=${2:-out/normals}
-mkdir -p "$out"
-py=/usr/bin/python3
+bench_name=normals bench_out=${2:-out/normals}
+# shellcheck source=bench-lib.sh
+. "$(dirname "$0")/bench-lib.sh"
 
-"$build/pointmech" normals >"$out/tables.md"
+{
+  bench_stamp
+  echo
+  "$bin" normals
+} >"$out/tables.md"
 
 run() { # scene, method, dir, extra --set...
   local scene=$1 method=$2 dir=$3
   shift 3
-  "$build/pointmech" run --overwrite "cases/mpm/$scene.yaml" --quiet \
+  "$bin" run --overwrite "cases/mpm/$scene.yaml" --quiet \
     --set bodies.0.membrane.normals="$method" "$@" --out "$dir"
 }
 for m in hybrid hybrid-quadratic connectivity; do
@@ -61,10 +62,11 @@ for c in circle dogbone; do
     "connectivity=$out/$c-connectivity"
 done
 
-$py - "$out" <<'PY'
+$py - "$out" "$(bench_stamp)" <<'PY'
 import csv, json, subprocess, sys
 out = sys.argv[1]
-rows = ["| run | method | steps | wall (s) | normal stage per point-step (us) "
+rows = [sys.argv[2], "",
+        "| run | method | steps | wall (s) | normal stage per point-step (us) "
         "| pressure at the end | angle rms (deg) | largest | point-frames > 10 deg |",
         "|---|---|---|---|---|---|---|---|---|"]
 for case, npts in (("circle", 91), ("dogbone", 100), ("sphere", 2562),
