@@ -63,6 +63,33 @@ paper_mesh_size() {
   esac
 }
 
+# fpm_form NAME: the array form set to the overrides of an FPM
+# formulation:
+#   scene, quadratic  the block scenes' own: IIPG, quadratic jump, p = 0.05
+#   paper             the FPM paper's: IIPG, linear jump, p = 20
+#   p0                IIPG, linear jump, p = 0 (no penalty: inconsistent)
+#   sipg              SIPG, linear jump, p = 100
+#   sipg-quadratic    SIPG, quadratic jump, p = 100 (the symmetric flux
+#                     needs this penalty for coercivity: p = 10 diverges in
+#                     undamped dynamics)
+# (SIPG with the measured stable step x 0.5).
+fpm_form() {
+  local sipg=(--set fpm.flux=sipg --set fpm.penalty=100
+    --set time.dt_rule=spectral --set time.dt_safety=0.5)
+  case $1 in
+  scene | quadratic) form=() ;;
+  paper) form=(--set fpm.jump=linear --set fpm.penalty=20) ;;
+  p0) form=(--set fpm.jump=linear --set fpm.penalty=0) ;;
+  sipg) form=("${sipg[@]}" --set fpm.jump=linear) ;;
+  sipg-quadratic) form=("${sipg[@]}") ;;
+  *)
+    echo "unknown FPM formulation $1: expected scene, paper, p0, sipg," \
+      "sipg-quadratic or quadratic" >&2
+    return 1
+    ;;
+  esac
+}
+
 # bench_run DIR SCENE [ARGS...]: one quiet run of SCENE into DIR (replaced)
 # with ARGS (--set ...), its messages in DIR.log; returns its exit status.
 bench_run() {

@@ -27,18 +27,7 @@ cases=("$@")
 [ ${#cases[@]} -gt 0 ] || cases=(f3-extension-60 f3-extension-100
   f3-extension-200 f4-compression-20 f4-compression-40 f4-compression-60)
 tag=${FORMULATION:-scene}
-case $tag in
-scene) form=() ;;
-paper) form=(--set fpm.jump=linear --set fpm.penalty=20) ;;
-sipg)
-  form=(--set fpm.flux=sipg --set fpm.jump=linear --set fpm.penalty=100
-    --set time.dt_rule=spectral --set time.dt_safety=0.5)
-  ;;
-*)
-  echo "FORMULATION: expected scene, paper or sipg, got $tag" >&2
-  exit 1
-  ;;
-esac
+fpm_form "$tag"
 if [ "${QS:-}" = static ]; then
   form+=(--set time.quasi_static.method=static)
   tag=$tag-static

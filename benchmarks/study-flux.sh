@@ -29,34 +29,18 @@ table=$out/study-flux.md
   echo "| formulation | nu | points | reaction error | NRMSE | wall (s) |"
   echo "|---|---|---|---|---|---|"
 } >"$table"
-for form in "${forms[@]}"; do
-  case $form in
-  paper) set_form=(--set fpm.jump=linear --set fpm.penalty=20) ;;
-  p0) set_form=(--set fpm.jump=linear --set fpm.penalty=0) ;;
-  sipg)
-    set_form=(--set fpm.flux=sipg --set fpm.jump=linear --set fpm.penalty=100
-      --set time.dt_rule=spectral --set time.dt_safety=0.5)
-    ;;
-  sipg-quadratic)
-    set_form=(--set fpm.flux=sipg --set fpm.penalty=100
-      --set time.dt_rule=spectral --set time.dt_safety=0.5)
-    ;;
-  quadratic) set_form=() ;;
-  *)
-    echo "study-flux: unknown formulation $form" >&2
-    exit 1
-    ;;
-  esac
+for name in "${forms[@]}"; do
+  fpm_form "$name"
   for nu in 0.3 0.45 0.495; do
     fe=cases/fe/f3-extension-60
     [ "$nu" = 0.495 ] || fe=$fe-nu$nu
-    dir=$out/$form-nu$nu
+    dir=$out/$name-nu$nu
     "$bin" convergence --overwrite cases/fpm/f3-extension-60.yaml \
-      --quiet "${set_form[@]}" --set materials.0.poisson_ratio="$nu" \
+      --quiet "${form[@]}" --set materials.0.poisson_ratio="$nu" \
       --set output.every=1000000 --reference "fe:$fe" \
       --set-ladder discretization.mesh_size="$sizes" --out "$dir" \
       >"$dir.log" 2>&1 || true
-    awk -F, -v f="$form" -v nu="$nu" '
+    awk -F, -v f="$name" -v nu="$nu" '
       NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
       { printf "| %s | %s | %s | %s | %s | %s |\n", f, nu, $c["points"],
           ($c["status"] == "converged" ? sprintf("%+.2f%%", 100 * $c["reaction_error"]) : $c["status"]),
