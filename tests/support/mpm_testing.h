@@ -26,15 +26,6 @@
 #define EPS DBL_EPSILON
 #define MINIMAL PM_TEST_DATA "/scenes/minimal-2d.yaml"
 
-/* |a - b| <= tol with both values in the message (NaN fails). */
-#define assert_near(a, b, tol) check_near((a), (b), (tol), #a, __LINE__)
-static inline void check_near(double a, double b, double tol, const char *what,
-                              int line) {
-  if (!(fabs(a - b) <= tol))
-    fail_msg("line %d: %s = %.17g, expected %.17g (tol %g, off by %g)", line,
-             what, a, b, tol, fabs(a - b));
-}
-
 /* The MPM tests' one stream of uniform numbers in [0, 1). */
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
 static inline double uniform(void) { return pm_test_uniform(&rng); }

@@ -25,6 +25,15 @@
       fail_msg("%s = %.17g, expected %.17g (%s)", #a, a_, b_, #b);             \
   } while (0)
 
+/* |a - b| <= tol with both values in the message (NaN fails). */
+#define assert_near(a, b, tol) pm_test_near((a), (b), (tol), #a, __LINE__)
+static inline void pm_test_near(double a, double b, double tol,
+                                const char *what, int line) {
+  if (!(fabs(a - b) <= tol))
+    fail_msg("line %d: %s = %.17g, expected %.17g (tol %g, off by %g)", line,
+             what, a, b, tol, fabs(a - b));
+}
+
 /* Expect success; on failure show the recorded message. */
 #define assert_ok(expr)                                                        \
   do {                                                                         \
