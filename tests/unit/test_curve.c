@@ -21,14 +21,6 @@
 
 #define PI 3.14159265358979323846
 
-/* Deterministic uniform numbers in [0, 1) (xorshift64*). */
-static double uniform(uint64_t *s) {
-  *s ^= *s >> 12;
-  *s ^= *s << 25;
-  *s ^= *s >> 27;
-  return (double)((*s * 0x2545F4914F6CDD1Dull) >> 11) * 0x1.0p-53;
-}
-
 /* The curve (xs(t), ys(t)) for t in [t0, t1], n points. */
 static gm_curve parametric(const char *xs, const char *ys, double t0, double t1,
                            long n, bool closed) {
@@ -451,7 +443,7 @@ static void test_contains_tiling(void **state) {
     }
   uint64_t seed = 12345;
   for (int k = 0; k < 20000; k++) {
-    double x[3] = {2 * uniform(&seed), 2 * uniform(&seed), 0};
+    double x[3] = {2 * pm_test_uniform(&seed), 2 * pm_test_uniform(&seed), 0};
     if (k % 4 == 1) x[1] = x[0];     /* on the diagonal y = x */
     if (k % 4 == 2) x[1] = 2 - x[0]; /* on the diagonal x + y = 2 */
     if (k % 4 == 3) {                /* on the grid's lines and vertices */

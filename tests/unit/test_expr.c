@@ -10,15 +10,7 @@
 #include <string.h>
 
 #include "pm_expr.h"
-
-/* |a - b| <= tol with both values in the message (NaN fails). */
-#define assert_near(a, b, tol) check_near((a), (b), (tol), #a, __LINE__)
-static void check_near(double a, double b, double tol, const char *what,
-                       int line) {
-  if (!(fabs(a - b) <= tol))
-    fail_msg("line %d: %s = %.17g, expected %.17g (tol %g)", line, what, a, b,
-             tol);
-}
+#include "pm_testing.h"
 
 static double eval_text(const char *text, double x, double y, double z,
                         double t) {

@@ -22,30 +22,6 @@
 
 /* ---- Helpers ----------------------------------------------------------- */
 
-/* Number of directory entries (not . and ..). */
-static int count_entries(const char *dir) {
-  DIR *d = opendir(dir);
-  struct dirent *e;
-  int n = 0;
-  assert_non_null(d);
-  while ((e = readdir(d)))
-    if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) n++;
-  closedir(d);
-  return n;
-}
-
-/* Whole file into a static buffer. */
-static const char *slurp(const char *path) {
-  static char buf[8192];
-  FILE *fp = fopen(path, "r");
-  size_t n;
-  assert_non_null(fp);
-  n = fread(buf, 1, sizeof buf - 1, fp);
-  buf[n] = '\0';
-  fclose(fp);
-  return buf;
-}
-
 static bool exists(const char *path) {
   struct stat st;
   return stat(path, &st) == 0;
@@ -81,25 +57,25 @@ static void test_afile_commit_abort(void **state) {
   assert_int_equal(pm_afile_open(path, &f), PM_SUCCESS);
   fprintf(pm_afile_stream(f), "hello\n");
   assert_false(exists(path)); /* not visible before commit */
-  assert_int_equal(count_entries(dir), 1);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 1);
   assert_string_equal(pm_afile_path(f), path);
   assert_int_equal(pm_afile_commit(f), PM_SUCCESS);
-  assert_string_equal(slurp(path), "hello\n");
-  assert_int_equal(count_entries(dir), 1);
+  pm_test_assert_file(path, "hello\n");
+  assert_int_equal(pm_test_count_entries(dir, NULL), 1);
 
   /* Abort: the old file stays, no temporary file remains. */
   assert_int_equal(pm_afile_open(path, &f), PM_SUCCESS);
   fprintf(pm_afile_stream(f), "partial");
   pm_afile_abort(f);
-  assert_string_equal(slurp(path), "hello\n");
-  assert_int_equal(count_entries(dir), 1);
+  pm_test_assert_file(path, "hello\n");
+  assert_int_equal(pm_test_count_entries(dir, NULL), 1);
 
   /* Abort of a new file leaves nothing at all. */
   snprintf(path, sizeof path, "%s/new.txt", dir);
   assert_int_equal(pm_afile_open(path, &f), PM_SUCCESS);
   pm_afile_abort(f);
   assert_false(exists(path));
-  assert_int_equal(count_entries(dir), 1);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 1);
   pm_afile_abort(NULL);
   assert_int_equal(pm_afile_commit(NULL), PM_SUCCESS);
 }
@@ -155,36 +131,36 @@ static void test_history(void **state) {
   }
   /* Synced rows are on disk while the run goes on. */
   assert_int_equal(pm_history_sync(h), PM_SUCCESS);
-  assert_string_equal(slurp(path), "time,kinetic,\"reaction, x\"\n"
-                                   "0,0.3333333333,-0\n"
-                                   "0.5,0.3333333333,-2e-12\n"
-                                   "1,0.3333333333,-4e-12\n");
+  pm_test_assert_file(path, "time,kinetic,\"reaction, x\"\n"
+                            "0,0.3333333333,-0\n"
+                            "0.5,0.3333333333,-2e-12\n"
+                            "1,0.3333333333,-4e-12\n");
   double bad[3] = {NAN, INFINITY, 1e300};
   assert_int_equal(pm_history_row(h, bad), PM_SUCCESS);
   assert_int_equal(pm_history_close(h), PM_SUCCESS);
-  assert_string_equal(slurp(path), "time,kinetic,\"reaction, x\"\n"
-                                   "0,0.3333333333,-0\n"
-                                   "0.5,0.3333333333,-2e-12\n"
-                                   "1,0.3333333333,-4e-12\n"
-                                   "nan,inf,1e+300\n");
-  assert_int_equal(count_entries(dir), 1);
+  pm_test_assert_file(path, "time,kinetic,\"reaction, x\"\n"
+                            "0,0.3333333333,-0\n"
+                            "0.5,0.3333333333,-2e-12\n"
+                            "1,0.3333333333,-4e-12\n"
+                            "nan,inf,1e+300\n");
+  assert_int_equal(pm_test_count_entries(dir, NULL), 1);
 
   /* Resuming keeps the first rows and appends after them. */
   assert_int_equal(pm_history_open(dir, 3, names, 2, &h), PM_SUCCESS);
   double next[3] = {2, 0, 0};
   assert_int_equal(pm_history_row(h, next), PM_SUCCESS);
   assert_int_equal(pm_history_close(h), PM_SUCCESS);
-  assert_string_equal(slurp(path), "time,kinetic,\"reaction, x\"\n"
-                                   "0,0.3333333333,-0\n"
-                                   "0.5,0.3333333333,-2e-12\n"
-                                   "2,0,0\n");
-  assert_int_equal(count_entries(dir), 1);
+  pm_test_assert_file(path, "time,kinetic,\"reaction, x\"\n"
+                            "0,0.3333333333,-0\n"
+                            "0.5,0.3333333333,-2e-12\n"
+                            "2,0,0\n");
+  assert_int_equal(pm_test_count_entries(dir, NULL), 1);
   /* ... but not another table's, nor more rows than it has. */
   assert_int_equal(pm_history_open(dir, 1, names, 1, &h), PM_ERR_IO);
   assert_non_null(strstr(pm_error_message(), "columns"));
   assert_int_equal(pm_history_open(dir, 3, names, 9, &h), PM_ERR_IO);
   assert_non_null(strstr(pm_error_message(), "holds 3 rows"));
-  assert_int_equal(count_entries(dir), 1);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 1);
 
   assert_int_equal(pm_history_open(dir, 0, names, -1, &h), PM_ERR_ARG);
   assert_int_equal(pm_history_close(NULL), PM_SUCCESS);
@@ -292,26 +268,26 @@ static void test_json(void **state) {
   assert_int_equal(pm_json_end_object(j), PM_SUCCESS);
   assert_false(exists(path));
   assert_int_equal(pm_json_close(j, true), PM_SUCCESS);
-  assert_string_equal(
-      slurp(path), "{\n"
-                   "  \"name\": \"a \\\"q\\\" \\\\ b\\n\\t\\u0001 \xc3\xa9\",\n"
-                   "  \"steps\": 123456789012,\n"
-                   "  \"dt\": 0.25,\n"
-                   "  \"nan\": null,\n"
-                   "  \"ok\": true,\n"
-                   "  \"nested\": [\n"
-                   "    -1.5e-300,\n"
-                   "    null,\n"
-                   "    [\n"
-                   "      {\n"
-                   "        \"deep\": []\n"
-                   "      }\n"
-                   "    ]\n"
-                   "  ],\n"
-                   "  \"empty\": {},\n"
-                   "  \"null\": null\n"
-                   "}\n");
-  assert_int_equal(count_entries(dir), 1);
+  pm_test_assert_file(
+      path, "{\n"
+            "  \"name\": \"a \\\"q\\\" \\\\ b\\n\\t\\u0001 \xc3\xa9\",\n"
+            "  \"steps\": 123456789012,\n"
+            "  \"dt\": 0.25,\n"
+            "  \"nan\": null,\n"
+            "  \"ok\": true,\n"
+            "  \"nested\": [\n"
+            "    -1.5e-300,\n"
+            "    null,\n"
+            "    [\n"
+            "      {\n"
+            "        \"deep\": []\n"
+            "      }\n"
+            "    ]\n"
+            "  ],\n"
+            "  \"empty\": {},\n"
+            "  \"null\": null\n"
+            "}\n");
+  assert_int_equal(pm_test_count_entries(dir, NULL), 1);
   python_json_check(path);
 }
 
@@ -357,13 +333,13 @@ static void test_json_misuse(void **state) {
   assert_int_equal(pm_json_integer(j, NULL, 2), PM_ERR_ARG);
   assert_int_equal(pm_json_close(j, false), PM_SUCCESS);
   assert_false(exists(path));
-  assert_int_equal(count_entries(dir), 0);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 0);
 
   /* A bare top-level scalar is a valid document. */
   assert_int_equal(pm_json_open(path, &j), PM_SUCCESS);
   assert_int_equal(pm_json_number(j, NULL, 2.5), PM_SUCCESS);
   assert_int_equal(pm_json_close(j, true), PM_SUCCESS);
-  assert_string_equal(slurp(path), "2.5\n");
+  pm_test_assert_file(path, "2.5\n");
   pm_error_clear();
 }
 

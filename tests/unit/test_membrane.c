@@ -69,7 +69,7 @@ static void test_seeding(void **state) {
   assert_near(mass, 500 * vol, 1e-12 * mass);
   /* Frames: orthonormal, the normal outward (n . x > 0 on a sphere about
    * the origin) and along x within the icosphere's facets. */
-  const double *frame = group_array(&m, 0, "frame");
+  const double *frame = group_array(m.state, 0, "frame");
   assert_non_null(frame);
   double worst = 0, worst_dir = 0;
   for (long k = 0; k < me - mb; k++) {
@@ -122,8 +122,8 @@ static void test_steps(void **state) {
   assert_near(m.state->v[3 * rb + 1], 0.1 * cos(10 * t), 1e-15);
   for (long i = 0; i < 3 * md->n; i++) assert_true(isfinite(m.state->x[i]));
   for (long i = 0; i < 9 * md->n; i++) assert_true(isfinite(m.state->sigma[i]));
-  assert_non_null(group_array(&m, 0, "membrane_strain"));
-  assert_non_null(group_array(&m, 0, "failed"));
+  assert_non_null(group_array(m.state, 0, "membrane_strain"));
+  assert_non_null(group_array(m.state, 0, "failed"));
   drop_model(&m);
 }
 

@@ -341,11 +341,11 @@ static void test_solid_state_and_stages(void **state) {
   assert_int_equal(g->n_arrays, 1);
   assert_string_equal(g->layout[0].name, "F");
   assert_int_equal(m.state->group[0].n, 1);
-  assert_non_null(group_array(&m, 0, "F"));
-  assert_null(group_array(&m, 0, "density"));
-  assert_null(group_array(&m, 0, "energy"));
-  assert_null(group_array(&m, 0, "pressure"));
-  assert_null(group_array(&m, 0, "q"));
+  assert_non_null(group_array(m.state, 0, "F"));
+  assert_null(group_array(m.state, 0, "density"));
+  assert_null(group_array(m.state, 0, "energy"));
+  assert_null(group_array(m.state, 0, "pressure"));
+  assert_null(group_array(m.state, 0, "q"));
   assert_null(m.work->nodes.impedance);
   assert_null(m.work->cs);
   assert_null(m.state->force_prev);
@@ -368,9 +368,9 @@ static void test_solid_state_and_stages(void **state) {
   const char *av = "materials.0.artificial_viscosity.c1=0.5";
   m = make_model(MINIMAL, 1, &av);
   g = &m.model->group[0];
-  assert_non_null(group_array(&m, 0, "F"));
-  assert_non_null(group_array(&m, 0, "q"));
-  assert_null(group_array(&m, 0, "density"));
+  assert_non_null(group_array(m.state, 0, "F"));
+  assert_non_null(group_array(m.state, 0, "q"));
+  assert_null(group_array(m.state, 0, "density"));
   assert_int_equal(mpm_group_bytes_per_particle(g), 80);
   drop_model(&m);
 
@@ -441,13 +441,13 @@ static void test_fluid_state_and_stages(void **state) {
   const mpm_group *g = &md->group[0];
   assert_ptr_equal(g->kind, &mpm_kind_fluid);
   /* No F: density, energy, pressure and q. */
-  assert_null(group_array(&m, 0, "F"));
-  const double *rho = group_array(&m, 0, "density");
-  const double *pressure = group_array(&m, 0, "pressure");
+  assert_null(group_array(m.state, 0, "F"));
+  const double *rho = group_array(m.state, 0, "density");
+  const double *pressure = group_array(m.state, 0, "pressure");
   assert_non_null(rho);
-  assert_non_null(group_array(&m, 0, "energy"));
+  assert_non_null(group_array(m.state, 0, "energy"));
   assert_non_null(pressure);
-  assert_non_null(group_array(&m, 0, "q"));
+  assert_non_null(group_array(m.state, 0, "q"));
   assert_int_equal(m.state->group[0].n, 4);
   assert_int_equal(mpm_group_bytes_per_particle(g), 32);
   assert_true(has_stage(&m, "stress: fluid"));
@@ -484,7 +484,7 @@ static void test_fluid_state_and_stages(void **state) {
 static void test_fbar(void **state) {
   (void)state;
   model m = make_model(MINIMAL, 0, NULL);
-  assert_null(group_array(&m, 0, "Jbar_minus_1"));
+  assert_null(group_array(m.state, 0, "Jbar_minus_1"));
   assert_null(m.work->fbar.partial);
   assert_null(m.work->fbar.jm1);
   assert_int_equal(mpm_fbar_work_bytes(&m.work->fbar), 0);
@@ -493,7 +493,7 @@ static void test_fbar(void **state) {
 
   const char *cell = "mpm.fbar=cell", *patch = "mpm.fbar=patch";
   m = make_model(MINIMAL, 1, &cell);
-  assert_non_null(group_array(&m, 0, "Jbar_minus_1"));
+  assert_non_null(group_array(m.state, 0, "Jbar_minus_1"));
   assert_non_null(m.work->fbar.cell);
   assert_null(m.work->fbar.qbar);
   assert_contains(find_stage(m.model, "stress: solid")->detail,

@@ -20,36 +20,6 @@
 
 /* ---- Helpers ----------------------------------------------------------- */
 
-/* Number of directory entries; *tmp counts names containing ".tmp.". */
-static int count_entries(const char *dir, int *tmp) {
-  DIR *d = opendir(dir);
-  struct dirent *e;
-  int n = 0;
-  assert_non_null(d);
-  if (tmp) *tmp = 0;
-  while ((e = readdir(d))) {
-    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-    n++;
-    if (tmp && strstr(e->d_name, ".tmp.")) (*tmp)++;
-  }
-  closedir(d);
-  return n;
-}
-
-static char *slurp(const char *path) {
-  FILE *fp = fopen(path, "r");
-  char *buf;
-  long n;
-  assert_non_null(fp);
-  fseek(fp, 0, SEEK_END);
-  n = ftell(fp);
-  rewind(fp);
-  buf = calloc((size_t)n + 1, 1);
-  assert_int_equal(fread(buf, 1, (size_t)n, fp), (size_t)n);
-  fclose(fp);
-  return buf;
-}
-
 /* Two tetrahedra sharing a face. */
 #define NP 5
 #define NC 2
@@ -115,13 +85,14 @@ static void test_write_read(void **state) {
   assert_int_equal(pm_results_frames(r), 2);
   /* While the run goes on, every frame is on disk under its final name:
    * the index, the XDMF and the results folder, no temporary file. */
-  assert_int_equal(count_entries(dir, &tmp), 3);
+  assert_int_equal(pm_test_count_entries(dir, &tmp), 3);
   assert_int_equal(tmp, 0);
   snprintf(path, sizeof path, "%s/results", dir);
-  assert_int_equal(count_entries(path, &tmp), 3); /* mesh and two frames */
+  assert_int_equal(pm_test_count_entries(path, &tmp),
+                   3); /* mesh and two frames */
   assert_int_equal(tmp, 0);
   pm_results_close(r, true);
-  assert_int_equal(count_entries(dir, &tmp), 3);
+  assert_int_equal(pm_test_count_entries(dir, &tmp), 3);
 
   /* Read back with the HDF5 API. */
   snprintf(path, sizeof path, "%s/results.h5", dir);
@@ -180,7 +151,7 @@ static void test_write_read(void **state) {
 
   /* XDMF: both frames, their times and datasets. */
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
-  char *x = slurp(path);
+  char *x = pm_test_slurp(path);
   assert_non_null(strstr(x, "<Xdmf Version=\"3.0\">"));
   assert_null(strstr(x, "position"));
   assert_non_null(strstr(x, "CollectionType=\"Temporal\""));
@@ -213,19 +184,19 @@ static void test_abort_and_point_cloud(void **state) {
   assert_ok(
       pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "0.1.0", &r));
   pm_results_close(r, false);
-  assert_int_equal(count_entries(dir, NULL), 0);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 0);
   /* ... but a frame written is never taken back. */
   assert_ok(
       pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "0.1.0", &r));
   assert_ok(pm_results_write_frame(r, 0, 0.0, 1, &f));
   pm_results_close(r, false);
-  assert_int_equal(count_entries(dir, NULL), 3);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 3);
 
   /* Point cloud without cells and without frames: bare mesh XDMF. */
   assert_ok(pm_results_create(dir, 2, NP, coords, 0, 1, NULL, NULL, NULL, &r));
   pm_results_close(r, true);
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
-  char *x = slurp(path);
+  char *x = pm_test_slurp(path);
   assert_non_null(strstr(x, "TopologyType=\"Polyvertex\" "
                             "NumberOfElements=\"5\" NodesPerElement=\"1\""));
   assert_null(strstr(x, "Temporal"));
@@ -250,7 +221,7 @@ static void test_moving_and_reopen(void **state) {
   }
   pm_results_close(r, true);
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
-  char *x = slurp(path);
+  char *x = pm_test_slurp(path);
   assert_non_null(strstr(x, "results/frame_000002.h5:/position</DataItem>\n"
                             "        </Geometry>"));
   assert_null(strstr(x, "Attribute Name=\"position\""));
@@ -266,10 +237,10 @@ static void test_moving_and_reopen(void **state) {
   assert_ok(pm_results_write_frame(r, 25, 2.5, 2, f));
   pm_results_close(r, true);
   snprintf(path, sizeof path, "%s/results", dir);
-  assert_int_equal(count_entries(path, &tmp), 4);
+  assert_int_equal(pm_test_count_entries(path, &tmp), 4);
   assert_int_equal(tmp, 0);
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
-  x = slurp(path);
+  x = pm_test_slurp(path);
   assert_non_null(strstr(x, "<Time Value=\"1\"/>"));
   assert_non_null(strstr(x, "<Time Value=\"2.5\"/>"));
   assert_null(strstr(x, "<Time Value=\"2\"/>"));
@@ -301,7 +272,7 @@ static void test_bad_arguments(void **state) {
   assert_int_equal(
       pm_results_create(dir, 1, NP, coords, NC, 4, tets, scene, "v", &r),
       PM_ERR_ARG);
-  assert_int_equal(count_entries(dir, NULL), 0);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 0);
 
   assert_ok(pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "v", &r));
   pm_field two = {"u", 2, v};
@@ -314,7 +285,7 @@ static void test_bad_arguments(void **state) {
   assert_int_equal(pm_results_write_frame(r, 0, 0.0, 1, &nodata), PM_ERR_ARG);
   assert_int_equal(pm_results_frames(r), 0);
   pm_results_close(r, false);
-  assert_int_equal(count_entries(dir, NULL), 0);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 0);
   pm_error_clear();
 }
 
@@ -418,7 +389,7 @@ static void test_surface(void **state) {
   /* Before the first frame: the bare mesh, both grids on the reference
    * coordinates. */
   assert_ok(pm_results_create_ex(dir, 3, &surface_points, scene, "v", &r));
-  char *x = slurp(path);
+  char *x = pm_test_slurp(path);
   assert_non_null(strstr(x, "<Grid Name=\"mesh\" GridType=\"Collection\" "
                             "CollectionType=\"Spatial\">"));
   assert_int_equal(count_in(x, x + strlen(x), "<Grid Name=\"points\""), 1);
@@ -432,10 +403,10 @@ static void test_surface(void **state) {
     pos[3 * 4 + 2] = 1 + k; /* the apex rises */
     damage[4] = 0.5 * k;
     assert_ok(pm_results_write_frame(r, 10 * k, 1e-6 * k, 2, f));
-    if (k == 1) two = slurp(path);
+    if (k == 1) two = pm_test_slurp(path);
   }
   pm_results_close(r, true);
-  x = slurp(path);
+  x = pm_test_slurp(path);
   for (long k = 0; k < 3; k++) check_surface_frame(x, k);
   assert_int_equal(count_in(x, x + strlen(x), "<Time "), 3);
   free(x);
@@ -475,14 +446,14 @@ static void test_surface(void **state) {
    * for byte from mesh.h5 and the frames, then goes on with both grids. */
   assert_ok(pm_results_reopen(dir, NP, 2, &r));
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
-  x = slurp(path);
+  x = pm_test_slurp(path);
   assert_string_equal(x, two);
   free(x);
   free(two);
   pos[3 * 4 + 2] = 7;
   assert_ok(pm_results_write_frame(r, 25, 2.5e-6, 2, f));
   pm_results_close(r, true);
-  x = slurp(path);
+  x = pm_test_slurp(path);
   for (long k = 0; k < 3; k++) check_surface_frame(x, k);
   assert_non_null(strstr(x, "<Time Value=\"2.5e-06\"/>"));
   free(x);
@@ -516,7 +487,7 @@ static void test_surface_bad(void **state) {
   }
   assert_int_equal(pm_results_create_ex(dir, 3, NULL, scene, "v", &r),
                    PM_ERR_ARG);
-  assert_int_equal(count_entries(dir, NULL), 0);
+  assert_int_equal(pm_test_count_entries(dir, NULL), 0);
 
   /* n_surface 0: no surface, whatever the pointer (points-only results). */
   pm_points p = surface_points;
@@ -525,7 +496,7 @@ static void test_surface_bad(void **state) {
   pm_results_close(r, true);
   char path[512];
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
-  char *x = slurp(path);
+  char *x = pm_test_slurp(path);
   assert_null(strstr(x, "membrane"));
   assert_non_null(strstr(x, "<Grid Name=\"mesh\" GridType=\"Uniform\">"));
   free(x);

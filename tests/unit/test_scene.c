@@ -13,15 +13,7 @@
 #include "fpm_scene.h"
 #include "pm_app.h"
 #include "pm_scene.h"
-
-/* |a - b| <= tol with both values in the message (NaN fails). */
-#define assert_near(a, b, tol) check_near((a), (b), (tol), #a, __LINE__)
-static void check_near(double a, double b, double tol, const char *what,
-                       int line) {
-  if (!(fabs(a - b) <= tol))
-    fail_msg("line %d: %s = %.17g, expected %.17g (tol %g)", line, what, a, b,
-             tol);
-}
+#include "pm_testing.h"
 
 #define SCENES PM_TEST_DATA "/scenes/"
 #define F2 SCENES "f2-unconstrained-compression.yaml"

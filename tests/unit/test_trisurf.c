@@ -32,14 +32,6 @@ static double now(void) {
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* Deterministic uniform numbers in [0, 1) (xorshift64*). */
-static double uniform(uint64_t *s) {
-  *s ^= *s >> 12;
-  *s ^= *s << 25;
-  *s ^= *s >> 27;
-  return (double)((*s * 0x2545F4914F6CDD1Dull) >> 11) * 0x1.0p-53;
-}
-
 /* Twice the area vector of triangle t. */
 static void area_vector(const gm_trisurf *s, long t, double n[3]) {
   const long *v = s->tri + 3 * t;
@@ -428,8 +420,8 @@ static void test_inside_sphere(void **state) {
   assert_true(gm_inside_contains(in, c));
   uint64_t seed = 3;
   for (int i = 0; i < 200; i++) {
-    double u[3] = {uniform(&seed) - 0.5, uniform(&seed) - 0.5,
-                   uniform(&seed) - 0.5};
+    double u[3] = {pm_test_uniform(&seed) - 0.5, pm_test_uniform(&seed) - 0.5,
+                   pm_test_uniform(&seed) - 0.5};
     const double n = pm_v_norm(u);
     double a[3], b[3];
     for (int k = 0; k < 3; k++) {
@@ -449,7 +441,7 @@ static void test_inside_sphere(void **state) {
   double *x = malloc(sizeof *x * 3 * (size_t)n);
   char *serial = malloc((size_t)n), *threaded = malloc((size_t)n);
   assert_true(x && serial && threaded);
-  for (long i = 0; i < 3 * n; i++) x[i] = 2.4 * uniform(&seed) - 1.2;
+  for (long i = 0; i < 3 * n; i++) x[i] = 2.4 * pm_test_uniform(&seed) - 1.2;
   for (long i = 0; i < n; i++) serial[i] = gm_inside_contains(in, x + 3 * i);
   PM_OMP(parallel for num_threads(4) schedule(dynamic, 256) default(none)
              shared(in, x, threaded, n))
@@ -498,8 +490,9 @@ static void test_inside_rate(void **state) {
   long hits = 0;
   t0 = now();
   for (long i = 0; i < n; i++) {
-    const double x[3] = {2.4 * uniform(&seed) - 1.2, 2.4 * uniform(&seed) - 1.2,
-                         2.4 * uniform(&seed) - 1.2};
+    const double x[3] = {2.4 * pm_test_uniform(&seed) - 1.2,
+                         2.4 * pm_test_uniform(&seed) - 1.2,
+                         2.4 * pm_test_uniform(&seed) - 1.2};
     hits += gm_inside_contains(in, x);
   }
   const double query = now() - t0;

@@ -24,14 +24,6 @@
 
 #define PI 3.14159265358979323846
 
-/* Deterministic uniform numbers in [0, 1) (xorshift64*). */
-static double uniform(uint64_t *s) {
-  *s ^= *s >> 12;
-  *s ^= *s << 25;
-  *s ^= *s >> 27;
-  return (double)((*s * 0x2545F4914F6CDD1Dull) >> 11) * 0x1.0p-53;
-}
-
 /* Fraction of n uniform points of [lo, hi] that the volume contains, the
  * points drawn up front and queried in a parallel loop (the queries are
  * read-only). */
@@ -40,7 +32,7 @@ static double hit_fraction(const gm_volume *v, const double lo[3],
   double *x = malloc(sizeof *x * 3 * (size_t)n);
   assert_non_null(x);
   for (long i = 0; i < 3 * n; i++)
-    x[i] = lo[i % 3] + (hi[i % 3] - lo[i % 3]) * uniform(&seed);
+    x[i] = lo[i % 3] + (hi[i % 3] - lo[i % 3]) * pm_test_uniform(&seed);
   long hits = 0;
   PM_OMP(parallel for default(none) shared(v, x, n) reduction(+ : hits))
   for (long i = 0; i < n; i++) hits += gm_volume_contains(v, x + 3 * i);
@@ -109,7 +101,7 @@ static void test_sphere(void **state) {
   for (int i = 0; i < 20000; i++) {
     double x[3], d = 0.0;
     for (int k = 0; k < 3; k++) {
-      x[k] = 0.6 * (2.0 * uniform(&seed) - 1.0);
+      x[k] = 0.6 * (2.0 * pm_test_uniform(&seed) - 1.0);
       d += x[k] * x[k];
     }
     d = sqrt(d);

@@ -107,7 +107,7 @@ resume_case fpm "$fpm" 5 --set discretization.mesh_size=0.02 \
 # A static solve: the load stepping's state (load factor, step size, the
 # last two converged states) is what resumes.
 ckpt_every=3
-resume_case fpm-static "$src/cases/fpm/f3-extension-60-h1.09e-2.yaml" 5 \
+resume_case fpm-static "$src/cases/fpm/f3-extension-60.yaml" 5 \
   --set discretization.mesh_size=0.02 --set time.quasi_static.method=static
 mpm=$src/cases/mpm/m2-shock-tube-reduced.yaml
 # The scene ends at step 296, which left one row between the SIGKILL and

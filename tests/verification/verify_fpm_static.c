@@ -81,8 +81,8 @@ static void test_f3_static_against_relaxation(void **state) {
   const char *st_sets[] = {"discretization.mesh_size=0.0145",
                            "time.quasi_static.method=static"};
   run_t dr = {0}, st = {0};
-  run(CASES "f3-extension-60-h1.09e-2.yaml", 1, dr_sets, &dr);
-  run(CASES "f3-extension-60-h1.09e-2.yaml", 2, st_sets, &st);
+  run(CASES "f3-extension-60.yaml", 1, dr_sets, &dr);
+  run(CASES "f3-extension-60.yaml", 2, st_sets, &st);
   double Rd = dr.out.loaded_reaction, Rs = st.out.loaded_reaction;
   double Ed = dr.out.fig.mean_sed, Es = st.out.fig.mean_sed;
   print_message("F3 60%%, %ld points: top reaction %.10g N by relaxation "

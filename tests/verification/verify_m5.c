@@ -78,6 +78,7 @@ typedef struct {
 
 static double gas_pressure(const mpm_model *m, const mpm_state *st) {
   const double *pg = group_array(st, 1, "pressure");
+  assert_non_null(pg);
   const long gb = m->group[1].begin, ge = m->group[1].end;
   double pv = 0, v = 0;
   for (long q = gb; q < ge; q++) {
@@ -116,6 +117,7 @@ static m5_run run_case(const char *file, const char *method, double t_end) {
     if (st->t < 0.8 * t_end) continue;
     /* The carried normals against the neighbours' (signs ignored). */
     const double *frame = group_array(st, 0, "frame");
+    assert_non_null(frame);
     gm_curve_normals(me - mb, st->x + 3 * mb, false, nc);
     for (long q = 0; q < me - mb; q++) {
       double c =
@@ -274,6 +276,7 @@ static void test_sphere_normals(void **state) {
       mpm_state *st = NULL;
       assert_int_equal(mpm_model_create(s, &m, &st), PM_SUCCESS);
       const double *frame = group_array(st, 0, "frame");
+      assert_non_null(frame);
       double sum = 0, big = 0;
       long over = 0, n = m->body_end[0] - m->body_begin[0];
       for (long q = 0; q < n; q++) {

@@ -81,7 +81,9 @@ static void frame_rotation(const char *normals) {
   const mpm_stage *normal = stage_named(m, "normals: membrane");
   const mpm_stage *stage = stage_named(m, "stress: membrane");
   double *eps = (double *)group_array(st, 0, "membrane_strain");
+  assert_non_null(eps);
   const double *frame = group_array(st, 0, "frame");
+  assert_non_null(frame);
   const long n = m->n;
   for (long k = 0; k < n; k++) {
     eps[3 * k] = 2e-3;
@@ -225,6 +227,7 @@ static void test_tension_wave(void **state) {
   const mpm_model *m = r->sim->model;
   mpm_state *st = r->sim->state;
   double *eps = (double *)group_array(st, 0, "membrane_strain");
+  assert_non_null(eps);
   const double E = 1e6, nu = 0.3, rho = 1000, t = 0.01, e0 = 0.01, V = 0.01;
   long centre = -1;
   for (long p = 0; p < m->n; p++) {
@@ -350,6 +353,7 @@ static void test_strip_failure(void **state) {
   const mpm_model *m = r->sim->model;
   mpm_state *st = r->sim->state;
   const double *failed = group_array(st, 0, "failed");
+  assert_non_null(failed);
   const double c = sqrt(1e6 / 1000.0), V = 1.138, tau = 0.002;
   const double t_reflect = 1.0 / c - tau * log(1 - 0.03 * c / V);
   double t_first = -1, x_first = -1;
@@ -412,7 +416,9 @@ static void test_gas_sphere(void **state) {
   const double R0 = 0.5, t = 0.1, E = 1e6, nu = 0.3;
   const double Req = sphere_equilibrium(R0, t, E, nu, 1.4, 1000);
   const double *eps = group_array(st, 0, "membrane_strain");
+  assert_non_null(eps);
   const double *pg = group_array(st, 1, "pressure");
+  assert_non_null(pg);
   /* Over the last fifth of the run: the mean radius of the membrane's
    * points, its mean in-plane strain (e11 + e22) / 2, and the gas's mean
    * pressure. */

@@ -344,6 +344,7 @@ static void test_water_pulse(void **state) {
     fail_msg("%s", pm_error_message());
   const mpm_group *g = &md->group[0];
   const double *pressure = group_array(st, 0, "pressure");
+  assert_non_null(pressure);
   const pm_fluid *fl = &s->materials[g->material].mat.fluid;
   const double x0 = s->bodies[0].b[0], rho0 = s->bodies[1].density;
   const double pL = s->bodies[0].pressure, pR = s->bodies[1].pressure;
