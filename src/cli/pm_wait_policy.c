@@ -3,7 +3,7 @@
  * explicit FPM run of F2 on two threads beside another such run took 5-20
  * times its time alone; with a spin of 3000 before sleeping, 2.6-3 times,
  * at no measurable cost alone; passive waiting shares best (1.0-1.7 times)
- * but costs 1.5-1.7 times alone (README, "A shared machine, measured"). */
+ * but costs 1.5-1.7 times alone (docs/validation.md, "A shared machine"). */
 #include "pm_wait_policy.h"
 
 #include <stdlib.h>

@@ -47,7 +47,7 @@ across() { # label, scene, ranks, overrides...
 # Run SCENE with overrides on N ranks into OUT and send SIGTERM to rank 0
 # (its pid is in summary.json) once history.csv has 3 rows, which stops
 # every rank after the step with a checkpoint; mpirun forwards a signal of
-# its own about 2 s late, or not before it gives up on its ranks (README,
+# its own about 2 s late, or not before it gives up on its ranks (docs/user-guide.md,
 # "Across MPI ranks").
 interrupt() { # ranks, out, scene, overrides...
   local n=$1 out=$2 scene=$3 job pid

@@ -13,7 +13,7 @@
  *     - {label: mpm, method: mpm, set: [mpm.fbar=cell]}
  *   cases:
  *     - name: f3-60
- *       scene: ../fpm/f3-extension-60-h1.09e-2.yaml
+ *       scene: ../fpm/f3-extension-60.yaml
  *       methods: [fpm-paper, mpm]     # default: every method of the suite
  *       resolutions: [2e-2, 1e-2]     # discretization.mesh_size; default
  *                                     # the scene's own
