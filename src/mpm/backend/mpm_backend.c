@@ -65,6 +65,7 @@ pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out) {
   } else {
     PM_TRY(mpm_work_create(r->model, &r->work));
   }
+  mpm_view_init(r, implicit);
   r->setup_wall = pm_wtime() - t0;
   if (pm_par_root()) { /* the outputs' (rank 0's across ranks) */
     PM_TRY(PM_ALLOC(r->scratch,
@@ -129,10 +130,11 @@ pm_step_report mpm_sim_step_report(const mpm_sim *r, bool last) {
                           .progress = s->t / r->model->opt.t_end};
 }
 
-/* Report a step to the run's observer. */
+/* Report a step to the run's observer (rank 0's alone, across ranks). */
 pm_err mpm_sim_report(mpm_sim *r, bool frame, bool last) {
   pm_step_report rep = mpm_sim_step_report(r, last);
-  return r->obs ? r->obs->step(r->obs->ctx, &rep, frame) : PM_SUCCESS;
+  const pm_observer *obs = r->view.obs;
+  return obs ? obs->step(obs->ctx, &rep, frame) : PM_SUCCESS;
 }
 
 /* What the run keeps of a step's figures over all its steps. */
@@ -151,10 +153,8 @@ static pm_err observe(void *ctx, const mpm_model *m, const mpm_state *s,
                       bool frame) {
   (void)m;
   mpm_sim_note_step(ctx, s, w, info);
-  return mpm_sim_report(ctx, frame, info->last);
+  return mpm_view_report(ctx, frame, info->last);
 }
-
-/* ---- across ranks ---- */
 
 /* The run's status from the loop's error. */
 static void conclude(mpm_sim *r, const mpm_model *m, pm_err e) {
@@ -169,33 +169,38 @@ static void conclude(mpm_sim *r, const mpm_model *m, pm_err e) {
         r->last.converged ? PM_STATUS_CONVERGED : PM_STATUS_NOT_CONVERGED;
 }
 
+/* The time loop: on one process the run's; across ranks every rank
+ * steps its share and rank 0's view is gathered where the run writes, and
+ * at the end (pm_view). */
 static pm_err run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
-  if (r->local_model) {
-    pm_err e = mpm_view_run(r, obs);
-    conclude(r, r->local_model, e);
-    return e;
-  }
-  mpm_model *m = r->model;
   pm_err e = PM_SUCCESS;
-  r->obs = obs;
+  if (r->view.ranks && r->resumed) /* the shares of the checkpoint's state */
+    PM_CALL(mpm_view_reshare(r));
+  pm_view_start(&r->view, obs);
+  mpm_model *lm = r->view.ranks ? r->local_model : r->model;
+  mpm_state *ls = r->view.ranks ? r->local_state : r->state;
+  mpm_work *lw = r->view.ranks ? r->local_work : r->work;
   if (!r->resumed) { /* a resumed run has these from its checkpoint */
-    double kin, strain, internal;
-    mpm_energies(m, r->state, &kin, &strain, &internal);
-    r->energy0 = kin + strain + internal;
     r->run_min_jacobian = INFINITY;
     r->run_min_jacobian_step = 0;
-    for (long q = 0; q < m->n; q++)
-      r->run_min_jacobian =
-          fmin(r->run_min_jacobian, r->state->vol[q] / m->vol0[q]);
-    e = mpm_sim_report(r, true, false);
+    if (r->model) { /* the initial state: across ranks rank 0's view's */
+      double kin, strain, internal;
+      mpm_energies(r->model, r->state, &kin, &strain, &internal);
+      r->energy0 = kin + strain + internal;
+      for (long q = 0; q < r->model->n; q++)
+        r->run_min_jacobian =
+            fmin(r->run_min_jacobian, r->state->vol[q] / r->model->vol0[q]);
+    }
+    e = mpm_view_report(r, true, false);
   }
-  mpm_run_options opt = {.t_end = m->opt.t_end,
-                         .max_steps = m->opt.max_steps,
+  mpm_run_options opt = {.t_end = lm->opt.t_end,
+                         .max_steps = lm->opt.max_steps,
                          .frame_every = r->scene->output.every};
-  if (!e) e = mpm_solve(m, r->state, r->work, &opt, observe, r, &r->last);
-  r->obs = NULL;
-  conclude(r, m, e);
+  if (!e) e = mpm_solve(lm, ls, lw, &opt, observe, r, &r->last);
+  e = pm_view_end(&r->view, e); /* the state it ended in, for the figures */
+  if (r->view.ranks) mpm_view_counts(r);
+  conclude(r, lm, e);
   return e;
 }
 

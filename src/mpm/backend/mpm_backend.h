@@ -7,6 +7,7 @@
 #include "mpm_solver.h"
 #include "mpm_state.h"
 #include "pm_backend.h"
+#include "pm_view.h"
 #include "pm_scene.h"
 
 extern const pm_backend mpm_backend;
@@ -59,9 +60,9 @@ typedef struct {
   long run_min_jacobian_step;
   int iter_max_row; /* most iterations since the last history row */
   long iter_capped_prev;
-  mpm_step_info last;     /* the last step's figures */
-  bool resumed;           /* the state came from a checkpoint */
-  const pm_observer *obs; /* during a run */
+  mpm_step_info last; /* the last step's figures */
+  bool resumed;       /* the state came from a checkpoint */
+  pm_view view;       /* the run's observer, and rank 0's view across ranks */
 } mpm_sim;
 
 /* Model, initial state, workspace and output buffer of scene s.  Failures

@@ -47,9 +47,19 @@ pm_err mpm_view_share(mpm_sim *r, const double *accounts);
 void mpm_view_release(mpm_sim *r);
 /* The share and rank 0's figures workspace (collective). */
 pm_err mpm_view_setup(mpm_sim *r);
-/* The time loop across ranks (collective): every rank steps its share;
- * rank 0's view is gathered where the run writes, and at the end. */
-pm_err mpm_view_run(mpm_sim *r, const pm_observer *obs);
+/* The run's view (pm_view): across ranks when r has a share, with the
+ * explicit or the implicit gather. */
+void mpm_view_init(mpm_sim *r, bool implicit);
+/* Report the step the state is at to the run's observer (across ranks,
+ * collective: rank 0 reports, the shares gathered into its view where the
+ * observer reads them). */
+pm_err mpm_view_report(mpm_sim *r, bool frame, bool last);
+/* A resumed run across ranks: each rank's share anew from the whole state
+ * read from the checkpoint (collective). */
+pm_err mpm_view_reshare(mpm_sim *r);
+/* What the exchanges cost over the run, summed over the ranks (the
+ * busiest rank's seconds), into r->ranks_counts (collective). */
+void mpm_view_counts(mpm_sim *r);
 /* What rank 0's observer reads of a converged implicit load step: every
  * rank's particles and load stepping's states (collective). */
 pm_err mpm_view_implicit_gather(void *ctx);

@@ -49,17 +49,13 @@ static pm_err implicit_observe(void *ctx, const mpm_implicit_step *step) {
                         .residual = step->residual,
                         .progress = step->lambda};
   const bool frame = last || (every > 0 && st->step % every == 0);
-  if (r->local_model)
-    return pm_observer_share(pm_par_root() ? r->obs : NULL, &rep, frame,
-                             mpm_view_implicit_gather, r);
-  return r->obs ? r->obs->step(r->obs->ctx, &rep, frame) : PM_SUCCESS;
+  return pm_view_step(&r->view, &rep, frame);
 }
 
 static pm_err implicit_run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
   pm_err e = PM_SUCCESS;
-  r->obs = obs;
-  if (r->local_model) mpm_view_release(r);
+  pm_view_start(&r->view, obs);
   if (!r->resumed) {
     r->energy0 = 0;
     r->run_min_jacobian_step = 0;
@@ -82,11 +78,8 @@ static pm_err implicit_run(void *p, const pm_observer *obs) {
       pm_par_sum_long(r->imp_ranks, 3 * size);
     }
     if (!e) e = a;
-    pm_err g = pm_par_agree(
-        mpm_par_gather(r->local_model, r->local_state, r->model, r->state));
-    if (!e) e = g;
   }
-  r->obs = NULL;
+  e = pm_view_end(&r->view, e);
   /* the solver's time, as stages */
   const pm_load_report *lr = mpm_implicit_report(r->imp);
   pm_timers *t = &r->work->timers;

@@ -140,7 +140,7 @@ static void plan_estimate(double per, double steps, long n, double setup,
 /* The plan across ranks (collective): rank 0's view prints the scene's
  * lines, every rank its share, and a few steps of the shares are timed. */
 static pm_err plan_ranks(mpm_sim *r, FILE *out) {
-  mpm_view_release(r);
+  pm_view_release(&r->view);
   double steps = r->model ? plan_head(r, out) : 0;
   mpm_par_plan(r->local_model, r->local_work, r->model ? out : NULL);
   double t0 = pm_wtime();

@@ -58,77 +58,46 @@ static void view_figures(mpm_sim *r) {
 }
 
 /* Every rank's particles into rank 0's view (collective). */
-static pm_err gather(mpm_sim *r) {
+static pm_err gather(void *ctx) {
+  mpm_sim *r = ctx;
   PM_CALL(pm_par_agree(
       mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
   if (r->model) view_figures(r);
   return PM_SUCCESS;
 }
 
-static pm_err gather_view(void *r) { return gather(r); }
+static void release(void *ctx) { mpm_view_release(ctx); }
 
-/* A step of a run across ranks (collective): rank 0 reports it, with the
- * particles gathered where its observer reads them. */
-static pm_err share(mpm_sim *r, bool frame, bool last) {
+void mpm_view_init(mpm_sim *r, bool implicit) {
+  r->view = (pm_view){.ranks = r->local_model != NULL,
+                      .ctx = r,
+                      .gather = implicit ? mpm_view_implicit_gather : gather,
+                      .release = release};
+}
+
+pm_err mpm_view_report(mpm_sim *r, bool frame, bool last) {
   pm_step_report rep = {0};
-  if (r->model) {
-    view_figures(r);
+  if (r->model) { /* one process, or rank 0 */
+    if (r->view.ranks) view_figures(r);
     rep = mpm_sim_step_report(r, last);
   }
-  return pm_observer_share(r->model ? r->obs : NULL, &rep, frame, gather_view,
-                           r);
+  return pm_view_step(&r->view, &rep, frame);
 }
 
-static pm_err observe_ranks(void *ctx, const mpm_model *m, const mpm_state *s,
-                            const mpm_work *w, const mpm_step_info *info,
-                            bool frame) {
-  (void)m;
-  mpm_sim_note_step(ctx, s, w, info);
-  return share(ctx, frame, info->last);
+pm_err mpm_view_reshare(mpm_sim *r) {
+  mpm_work_destroy(r->local_work);
+  mpm_state_destroy(r->local_state);
+  mpm_model_destroy(r->local_model);
+  r->local_work = NULL;
+  r->local_state = NULL;
+  r->local_model = NULL;
+  return mpm_view_share(r, r->ckpt_ranks == pm_par_size() ? r->ckpt_accounts
+                                                          : NULL);
 }
 
-/* The time loop across ranks: every rank steps its share; rank 0's view
- * is gathered where the run writes, and at the end. */
-pm_err mpm_view_run(mpm_sim *r, const pm_observer *obs) {
-  pm_err e = PM_SUCCESS;
-  if (r->resumed) { /* the shares of the state read from the checkpoint */
-    mpm_work_destroy(r->local_work);
-    mpm_state_destroy(r->local_state);
-    mpm_model_destroy(r->local_model);
-    r->local_work = NULL;
-    r->local_state = NULL;
-    r->local_model = NULL;
-    PM_CALL(mpm_view_share(r, r->ckpt_ranks == pm_par_size() ? r->ckpt_accounts
-                                                             : NULL));
-  }
-  mpm_view_release(r);
-  mpm_model *lm = r->local_model;
-  r->obs = obs;
-  if (!r->resumed) {
-    r->run_min_jacobian = INFINITY;
-    r->run_min_jacobian_step = 0;
-    if (r->model) { /* the initial state, which rank 0's view holds */
-      double kin, strain, internal;
-      mpm_energies(r->model, r->state, &kin, &strain, &internal);
-      r->energy0 = kin + strain + internal;
-      for (long q = 0; q < r->model->n; q++)
-        r->run_min_jacobian =
-            fmin(r->run_min_jacobian, r->state->vol[q] / r->model->vol0[q]);
-    }
-    e = share(r, true, false);
-  }
-  mpm_run_options opt = {.t_end = lm->opt.t_end,
-                         .max_steps = lm->opt.max_steps,
-                         .frame_every = r->scene->output.every};
-  if (!e)
-    e = mpm_solve(lm, r->local_state, r->local_work, &opt, observe_ranks, r,
-                  &r->last);
-  /* The state the run ended in, for the figures (a failure's too). */
-  pm_err g = gather(r);
-  if (!e) e = g;
-  r->obs = NULL;
+void mpm_view_counts(mpm_sim *r) {
   mpm_par_counts c;
-  mpm_par_get_counts(lm, &c);
+  mpm_par_get_counts(r->local_model, &c);
   /* A rank's own work: its stages' time less the exchanges (in which it
    * waits for the others). */
   double own = -c.halo_seconds - c.migrate_seconds;
@@ -148,7 +117,6 @@ pm_err mpm_view_run(mpm_sim *r, const pm_observer *obs) {
   r->ranks_counts[6] = most[2];                 /* the busiest rank's */
   r->ranks_counts[7] = sums[4] / pm_par_size(); /* the mean */
   r->ranks_counts[8] = sums[5];
-  return e;
 }
 
 /* Across ranks, what rank 0's observer reads of a converged load step:

@@ -1,0 +1,45 @@
+/* pm_view: rank 0's view of a run shared among MPI ranks, one for every
+ * backend.  Each rank steps its share of the run; rank 0 also keeps the
+ * whole model and state (its view), into which the shares are gathered
+ * where the run writes (frames, history, checkpoints) and where it ends,
+ * so that a run across ranks writes what one process writes.  On one
+ * process the run is its own view and every call is the plain one. */
+#ifndef PM_VIEW_H
+#define PM_VIEW_H
+
+#include <stdbool.h>
+
+#include "pm_backend.h"
+#include "pm_error.h"
+
+typedef struct {
+  bool ranks; /* the run is shared among ranks */
+  void *ctx;  /* the backend's simulation, passed to the callbacks */
+  /* The shares' state into rank 0's view, with the figures every rank
+   * shares (collective; called on every rank). */
+  pm_err (*gather)(void *ctx);
+  /* On a rank other than 0: let the whole model and state go (the share
+   * is all that rank runs). */
+  void (*release)(void *ctx);
+  const pm_observer *obs; /* the run's, while it runs (rank 0 reports) */
+} pm_view;
+
+/* The run starts with observer obs (which may be NULL): across ranks, the
+ * ranks other than 0 release their view. */
+void pm_view_start(pm_view *v, const pm_observer *obs);
+
+/* Across ranks, the ranks other than 0 let their view go (a plan, or the
+ * start of a run).  Nothing on one process or on rank 0. */
+void pm_view_release(pm_view *v);
+
+/* Report step r: on one process to the observer; across ranks rank 0
+ * reports, with the shares gathered into its view where the observer asks
+ * for them (pm_observer_share; collective).  The observer's failure. */
+pm_err pm_view_step(pm_view *v, const pm_step_report *r, bool frame);
+
+/* The run ended with e: across ranks, the state it ended in (a failure's
+ * too) gathered into rank 0's view for the figures (collective).  e, or the
+ * gather's failure where e is PM_SUCCESS.  The observer is let go. */
+pm_err pm_view_end(pm_view *v, pm_err e);
+
+#endif
