@@ -10,9 +10,7 @@
 #include <string.h>
 
 #include "fpm_gfd.h"
-#include "fpm_par.h"
 #include "pm_omp.h"
-#include "pm_par.h"
 #include "pm_progress.h"
 
 /* The tangent assembled directly: K = E D Gamma + S, where
@@ -84,7 +82,8 @@ static pm_err inadmissible(const static_ctx *c, long p) {
  * first). */
 static pm_err admissible(const static_ctx *c, long bad) {
   pm_err e = bad >= 0 ? inadmissible(c, bad) : PM_SUCCESS;
-  return fpm_par_agree(c->m, e, bad >= 0 ? fpm_point_id(c->m, bad) : 0);
+  return fpm_exchange_agree(c->m->xc, e,
+                            bad >= 0 ? fpm_point_id(c->m, bad) : 0);
 }
 
 static pm_err residual(void *ctx, const double *x, double *r) {
@@ -150,14 +149,14 @@ static pm_err set_load(void *ctx, double lambda) {
   c->t = lambda * c->load_end;
   long key = 0;
   pm_err e = own_loads(c, lambda, &key);
-  if (m->par) {
+  if (m->xc) {
     /* A rank's failure is every rank's (the one one process meets first);
      * the ghosts' prescribed values (and, until the solver sets them,
      * their unknowns') come from their owners. */
-    PM_CALL(fpm_par_agree(m, e, key));
-    fpm_par_exchange(m, c->st->u);
+    PM_CALL(fpm_exchange_agree(m->xc, e, key));
+    fpm_exchange_ghosts(m->xc, c->st->u);
     double sq = c->st->fext_sq; /* the tractions of every rank's points */
-    fpm_par_sum(m, &sq, 1);
+    fpm_exchange_sum(m->xc, &sq, 1);
     c->st->fext_norm = lambda * sqrt(sq);
   }
   return e;
@@ -183,9 +182,9 @@ static void figures(static_ctx *c, long step) {
   memcpy(c->u_old, st->u, 3 * n * sizeof(double));
   double bflux = st->bflux_norm, penalty = st->penalty_energy;
   double sums[6] = {se, rf, rr, work, st->bflux_sq, penalty};
-  if (m->par) { /* over every rank's own points */
-    fpm_par_sum(m, sums, 6);
-    fpm_par_min(m, &jmin, 1);
+  if (m->xc) { /* over every rank's own points */
+    fpm_exchange_sum(m->xc, sums, 6);
+    fpm_exchange_min(m->xc, &jmin, 1);
     se = sums[0], rf = sums[1], rr = sums[2], bflux = sqrt(sums[4]);
     penalty = sums[5];
   }
@@ -212,7 +211,7 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
   static_ctx *c = ctx;
   (void)report;
   c->t = lambda * c->load_end;
-  if (c->m->par) { /* x: the own unknowns; the ghosts' from their owners */
+  if (c->m->xc) { /* x: the own unknowns; the ghosts' from their owners */
     PM_CALL(pm_newton_held_values(c->solver, x, c->held));
     x = c->held;
   }
@@ -734,11 +733,11 @@ static void solve_free(solve_t *v) {
 static int rigid_modes(const fpm_model *m, const long *dof, long nf,
                        double *rigid) {
   double c[3] = {0, 0, 0};
-  if (m->par) { /* the body's centroid: every rank's own points */
+  if (m->xc) { /* the body's centroid: every rank's own points */
     double sum[4] = {0, 0, 0, (double)m->n_own};
     for (long i = 0; i < m->n_own; i++)
       for (int a = 0; a < 3; a++) sum[a] += m->x[3 * i + a];
-    fpm_par_sum(m, sum, 4);
+    fpm_exchange_sum(m->xc, sum, 4);
     for (int a = 0; a < 3; a++) c[a] = sum[a] / sum[3];
   } else {
     for (long i = 0; i < m->n; i++)
@@ -772,10 +771,10 @@ static int rigid_modes(const fpm_model *m, const long *dof, long nf,
 static pm_err number_ghosts(const fpm_model *m, long *free_of, static_ctx *c) {
   const long n = m->n;
   double *g = c->du; /* 3 n: the numbers, exact in doubles */
-  const long first = pm_par_offset(c->nf);
+  const long first = fpm_exchange_offset(m->xc, c->nf);
   for (long d = 0; d < 3 * n; d++)
     g[d] = free_of[d] >= 0 ? (double)(first + free_of[d]) : -1;
-  fpm_par_exchange(m, g);
+  fpm_exchange_ghosts(m->xc, g);
   long count = 0;
   for (long d = 3 * m->n_own; d < 3 * n; d++) count += g[d] >= 0;
   PM_CALL(PM_ALLOC(c->ghost, count + 1, "ghost unknowns"));
@@ -808,9 +807,9 @@ static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
     }
   }
   c->nheld = c->nf;
-  if (m->par) PM_CALL(number_ghosts(m, v->free_of, c));
+  if (m->xc) PM_CALL(number_ghosts(m, v->free_of, c));
   long all = c->nf;
-  if (m->par) pm_par_sum_long(&all, 1);
+  if (m->xc) fpm_exchange_sum_long(m->xc, &all, 1);
   PM_CHECK(all > 0, PM_ERR_SCENE, "%s: every displacement is prescribed",
            m->scene->path);
   PM_CALL(PM_ALLOC(v->x, c->nf + 1, "free displacements"));
@@ -831,7 +830,7 @@ static pm_err solve_setup(const fpm_model *m, fpm_state *st, solve_t *v) {
                                 .pat_idx = v->idx,
                                 .near_null_count = n_rigid,
                                 .near_null = v->rigid,
-                                .shared = m->par != NULL,
+                                .shared = m->xc != NULL,
                                 .n_ghost = c->nheld - c->nf,
                                 .ghost = c->ghost,
                                 .set_load = set_load,
@@ -851,10 +850,10 @@ static double force_floor(const fpm_model *m) {
       lo[a] = fmin(lo[a], m->x[3 * i + a]);
       hi[a] = fmax(hi[a], m->x[3 * i + a]);
     }
-  if (m->par) { /* the body's box: every rank's points (the same floor) */
-    fpm_par_min(m, lo, 3);
+  if (m->xc) { /* the body's box: every rank's points (the same floor) */
+    fpm_exchange_min(m->xc, lo, 3);
     for (int a = 0; a < 3; a++) hi[a] = -hi[a];
-    fpm_par_min(m, hi, 3);
+    fpm_exchange_min(m->xc, hi, 3);
     for (int a = 0; a < 3; a++) hi[a] = -hi[a];
   }
   double diag2 = 0;
@@ -909,7 +908,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   double w0 = pm_wtime();
   PM_TRY(solve_setup(m, st, &v));
   long sizes[2] = {c->nf, v.ptr[c->nheld]};
-  if (m->par) pm_par_sum_long(sizes, 2);
+  if (m->xc) fpm_exchange_sum_long(m->xc, sizes, 2);
   rep->unknowns = sizes[0];
   rep->pattern_entries = sizes[1];
   PM_ENSURE(c->nf == ss->free_dofs, PM_ERR_ARG,
@@ -930,7 +929,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   }
   /* (across ranks the state holds a resumed run's displacements on every
    * point, its ghosts' too) */
-  PM_TRY(admissible(c, evaluate(c, resumed && !m->par ? v.x : NULL)));
+  PM_TRY(admissible(c, evaluate(c, resumed && !m->xc ? v.x : NULL)));
   fpm_support_start(m, st);
   memcpy(c->u_old, st->u, 3 * m->n * sizeof(double));
   /* The figures of the state (a resumed one's too, for a run that fails

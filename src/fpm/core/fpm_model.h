@@ -7,9 +7,10 @@
 #include <stdbool.h>
 
 #include "gm_dual.h"
+#include "fpm_exchange.h"
+#include "fpm_scene.h"
 #include "pm_error.h"
 #include "pm_material.h"
-#include "fpm_scene.h"
 #include "pm_scene.h"
 
 #define FPM_MAX_MATERIALS 16
@@ -90,18 +91,19 @@ typedef struct {
   long *bcf_ptr;          /* n_bcs + 1: the facets of condition b are */
   long *bcf_facet;        /* bcf_facet[bcf_ptr[b] .. bcf_ptr[b + 1]) */
   const pm_scene *scene;  /* borrowed: boundary expressions and ramps */
-  /* Across MPI ranks (fpm_par.h) a rank's model is its share: its own
+  /* Across ranks (src/fpm/ranks) a rank's model is its share: its own
    * points first, in one-process order, then the ghost points their force
    * reads, and each pass runs over the points that need it: the force is
    * gathered on [0, n_own), the flux of [0, n_flux), the stress (and the
    * quadratic fit) of [0, n_stress), and u is held on all n.  Only its own
    * points count in sums, and its conditions' dofs are its own points'.
-   * On one process all are n, gid and par NULL. */
+   * On one process all are n, gid and xc NULL. */
   long n_own, n_flux, n_stress;
-  long *gid;           /* n: each point's index on one process, or NULL */
-  long *tf_gid;        /* n_tfacets: each traction facet's, or NULL */
-  gm_dual *own_dual;   /* a share's points, volumes and rows (dual is it) */
-  struct fpm_par *par; /* the exchanges of a share across ranks, or NULL */
+  long *gid;         /* n: each point's index on one process, or NULL */
+  long *tf_gid;      /* n_tfacets: each traction facet's, or NULL */
+  gm_dual *own_dual; /* a share's points, volumes and rows (dual is it) */
+  fpm_exchange *xc;  /* a share's exchanges with the other ranks (released
+                        with the model), or NULL */
 } fpm_model;
 
 /* Point i's index on one process (for messages). */
