@@ -152,6 +152,25 @@ typedef struct {
 pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
                         const gm_mesh *mesh, const gm_dual *d, fpm_model **out);
 
+/* The points a model holds of a whole model's (a rank's share): its own
+ * points [0, n_own), then the ghosts whose flux [n_own, n_flux), stress
+ * [n_flux, n_stress) and displacement [n_stress, n) its passes read (see
+ * fpm_model.n_own), each group in one-process order. */
+typedef struct {
+  long n_own, n_flux, n_stress, n;
+  const long *gid; /* n: each point's index in the whole model */
+} fpm_points;
+
+/* The model of the points pts of model m (m held whole; pts borrowed): a
+ * model whose point i is m's pts->gid[i], with their operators,
+ * interfaces, masses, materials, boundary facets (of the points whose flux
+ * it computes) and prescribed dofs (of its own points), in one process's
+ * order; rows, fits and mirror entries of the points whose stress it
+ * computes.  Reactions are not computed on it (no facet lists).  *out owns
+ * its arrays (fpm_model_destroy); m is left as it is.  PM_ERR_MEMORY. */
+pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
+                        fpm_model **out);
+
 /* The body FPM meshes as its domain: the scene's only body when it is a
  * gmsh volume (bodies: [{mesh: FILE}]), whose physical surfaces then name
  * boundary conditions; -1 when FPM meshes domain.box. */

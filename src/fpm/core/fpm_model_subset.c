@@ -1,0 +1,237 @@
+/* fpm_model_subset: the model of some of a whole model's points (a rank's
+ * share): their rows, operators, interfaces, fits, masses, materials and
+ * boundary, taken from the whole model in one process's order. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_gfd.h"
+#include "fpm_model.h"
+
+/* The rows (CSR) of the share's first n_rows points (those whose stress
+ * it computes), entries in their order, neighbours as indices in the share
+ * (the levels hold every one). */
+static pm_err copy_rows(const long *ptr, const int *nbr, long n_rows,
+                        const long *gid, const int *local_of, long *lptr,
+                        int **lnbr) {
+  long nnz = 0;
+  lptr[0] = 0;
+  for (long li = 0; li < n_rows; li++) {
+    nnz += ptr[gid[li] + 1] - ptr[gid[li]];
+    lptr[li + 1] = nnz;
+  }
+  PM_CALL(PM_ALLOC(*lnbr, nnz + 1, "share's rows"));
+  for (long li = 0; li < n_rows; li++)
+    for (long e = ptr[gid[li]], f = lptr[li]; e < ptr[gid[li] + 1]; e++, f++)
+      (*lnbr)[f] = local_of[nbr[e]];
+  return PM_SUCCESS;
+}
+
+/* Copy `width` values per item of the listed items (idx[0..count)). */
+static void copy_items(double *to, const double *from, const long *idx,
+                       long count, int width) {
+  for (long k = 0; k < count; k++)
+    memcpy(to + width * k, from + width * idx[k], sizeof(double) * width);
+}
+
+/* The points' own arrays: positions, volumes, rows of the support, GFD
+ * weights, interface records, sums, materials, masses and the mask. */
+static pm_err subset_points(const fpm_model *m, fpm_model *s, const int *lof) {
+  const long n = s->n, ns = s->n_stress;
+  gm_dual *d = s->own_dual;
+  PM_CALL(PM_ALLOC(d->x, 3 * n, "share's positions"));
+  PM_CALL(PM_ALLOC(d->volume, n, "share's volumes"));
+  PM_CALL(PM_ALLOC(d->nbr_ptr, n + 1, "share's supports"));
+  copy_items(d->x, m->x, s->gid, n, 3);
+  for (long li = 0; li < n; li++) d->volume[li] = m->dual->volume[s->gid[li]];
+  PM_CALL(copy_rows(m->nbr_ptr, m->nbr, ns, s->gid, lof, d->nbr_ptr, &s->nbr));
+  for (long li = ns; li < n; li++) d->nbr_ptr[li + 1] = d->nbr_ptr[ns];
+  s->x = d->x;
+  s->nbr_ptr = d->nbr_ptr;
+  s->nnz = d->nbr_ptr[n];
+  const long nnz = s->nnz;
+  PM_CALL(PM_ALLOC(s->g, 3 * nnz + 1, "share's GFD weights"));
+  PM_CALL(PM_ALLOC(s->erec, FPM_EREC * nnz + 1, "share's interfaces"));
+  PM_CALL(PM_ALLOC(s->mirror, nnz + 1, "share's mirror entries"));
+  for (long li = 0; li < ns; li++) {
+    const long gi = s->gid[li], e0 = m->nbr_ptr[gi], f0 = s->nbr_ptr[li];
+    const long cnt = m->nbr_ptr[gi + 1] - e0;
+    memcpy(s->g + 3 * f0, m->g + 3 * e0, sizeof(double) * 3 * cnt);
+    memcpy(s->erec + FPM_EREC * f0, m->erec + FPM_EREC * e0,
+           sizeof(double) * FPM_EREC * cnt);
+    /* Entry (k, i) of entry (i, k), where k's row is held. */
+    for (long f = f0; f < f0 + cnt; f++) {
+      const long lk = s->nbr[f];
+      const long gk = m->nbr[e0 + f - f0];
+      s->mirror[f] =
+          lk >= 0 && lk < ns
+              ? (int)(s->nbr_ptr[lk] + m->mirror[e0 + f - f0] - m->nbr_ptr[gk])
+              : -1;
+    }
+  }
+  PM_CALL(PM_ALLOC(s->gsum, 3 * n, "share's GFD sums"));
+  PM_CALL(PM_ALLOC(s->cond, n, "share's conditions"));
+  PM_CALL(PM_ALLOC(s->p_area, 3 * n, "share's area sums"));
+  PM_CALL(PM_ALLOC(s->p_mrel, 9 * n, "share's moment sums"));
+  PM_CALL(PM_ALLOC(s->mat, n, "share's materials"));
+  PM_CALL(PM_ALLOC(s->mass, n, "share's masses"));
+  PM_CALL(PM_ALLOC(s->fixed, 3 * n, "share's constraint mask"));
+  copy_items(s->gsum, m->gsum, s->gid, n, 3);
+  copy_items(s->cond, m->cond, s->gid, n, 1);
+  copy_items(s->p_area, m->p_area, s->gid, n, 3);
+  copy_items(s->p_mrel, m->p_mrel, s->gid, n, 9);
+  copy_items(s->mass, m->mass, s->gid, n, 1);
+  for (long li = 0; li < n; li++) {
+    s->mat[li] = m->mat[s->gid[li]];
+    memcpy(s->fixed + 3 * li, m->fixed + 3 * s->gid[li], 3);
+  }
+  s->mstate_stride = m->mstate_stride;
+  if (m->mstate) {
+    PM_CALL(PM_ALLOC(s->mstate, (size_t)m->mstate_stride * n,
+                     "share's material state"));
+    copy_items(s->mstate, m->mstate, s->gid, n, m->mstate_stride);
+  }
+  return PM_SUCCESS;
+}
+
+/* The quadratic fits of the points whose stress the share computes, and
+ * for its own points the fits that hold them, in one process's order
+ * (the order of their entries). */
+static pm_err subset_fits(const fpm_model *m, fpm_model *s, const int *lof) {
+  const long n = s->n, ns = s->n_stress, no = s->n_own;
+  PM_CALL(PM_ALLOC(s->qs_ptr, n + 1, "share's fits"));
+  PM_CALL(
+      copy_rows(m->qs_ptr, m->qs_nbr, ns, s->gid, lof, s->qs_ptr, &s->qs_nbr));
+  for (long li = ns; li < n; li++) s->qs_ptr[li + 1] = s->qs_ptr[ns];
+  const long nq = s->qs_ptr[n];
+  PM_CALL(PM_ALLOC(s->qs_own, nq + 1, "share's fit owners"));
+  PM_CALL(PM_ALLOC(s->q, FPM_QFIT * nq + 1, "share's fit weights"));
+  PM_CALL(PM_ALLOC(s->qsum, FPM_QFIT * n, "share's fit sums"));
+  copy_items(s->qsum, m->qsum, s->gid, n, FPM_QFIT);
+  for (long li = 0; li < ns; li++) {
+    const long e0 = m->qs_ptr[s->gid[li]], f0 = s->qs_ptr[li];
+    memcpy(s->q + FPM_QFIT * f0, m->q + FPM_QFIT * e0,
+           sizeof(double) * FPM_QFIT * (s->qs_ptr[li + 1] - f0));
+    for (long f = f0; f < s->qs_ptr[li + 1]; f++) s->qs_own[f] = (int)li;
+  }
+  PM_CALL(PM_ALLOC(s->qt_ptr, n + 1, "share's fit transpose"));
+  long nt = 0;
+  for (long li = 0; li < no; li++) {
+    const long gk = s->gid[li];
+    nt += m->qt_ptr[gk + 1] - m->qt_ptr[gk];
+  }
+  PM_CALL(PM_ALLOC(s->qt_entry, nt + 1, "share's fit transpose"));
+  nt = 0;
+  for (long li = 0; li < n; li++) {
+    s->qt_ptr[li] = nt;
+    if (li >= no) continue;
+    const long gk = s->gid[li];
+    for (long t = m->qt_ptr[gk]; t < m->qt_ptr[gk + 1]; t++) {
+      const long ge = m->qt_entry[t], gi = m->qs_own[ge], i = lof[gi];
+      s->qt_entry[nt++] = (int)(s->qs_ptr[i] + ge - m->qs_ptr[gi]);
+    }
+  }
+  s->qt_ptr[n] = nt;
+  s->n_qwide = m->n_qwide;
+  s->n_qlinear = m->n_qlinear;
+  return PM_SUCCESS;
+}
+
+/* The boundary: the consistency flux and the tractions of the points whose
+ * flux the share computes (in one process's order: facets that share a
+ * point add up in it), the prescribed dofs of its own points. */
+static pm_err subset_boundary(const fpm_model *m, fpm_model *s,
+                              const int *lof) {
+  const long nf = s->n_flux, no = s->n_own;
+  long *idx = NULL;
+  pm_err ret = PM_SUCCESS;
+  const long most = m->n_dpts > m->n_tfacets ? m->n_dpts : m->n_tfacets;
+  PM_TRY(PM_ALLOC(idx, (most > m->n_cdofs ? most : m->n_cdofs) + 1,
+                  "share's boundary"));
+  long c = 0;
+  for (long p = 0; p < m->n_dpts; p++)
+    if (lof[m->dpt_point[p]] >= 0 && lof[m->dpt_point[p]] < nf) idx[c++] = p;
+  s->n_dpts = c;
+  PM_TRY(PM_ALLOC(s->dpt_point, c + 1, "share's flux points"));
+  PM_TRY(PM_ALLOC(s->dpt_area, 9 * c + 1, "share's flux areas"));
+  PM_TRY(PM_ALLOC(s->dpt_mrel, 27 * c + 1, "share's flux moments"));
+  for (long k = 0; k < c; k++) s->dpt_point[k] = lof[m->dpt_point[idx[k]]];
+  copy_items(s->dpt_area, m->dpt_area, idx, c, 9);
+  copy_items(s->dpt_mrel, m->dpt_mrel, idx, c, 27);
+  c = 0;
+  for (long k = 0; k < m->n_tfacets; k++)
+    if (lof[m->tf_point[k]] >= 0 && lof[m->tf_point[k]] < nf) idx[c++] = k;
+  s->n_tfacets = c;
+  PM_TRY(PM_ALLOC(s->tf_point, c + 1, "share's traction facets"));
+  PM_TRY(PM_ALLOC(s->tf_gid, c + 1, "share's traction facets"));
+  PM_TRY(PM_ALLOC(s->tf_bc, c + 1, "share's traction facets"));
+  PM_TRY(PM_ALLOC(s->tf_area, c + 1, "share's traction facets"));
+  PM_TRY(PM_ALLOC(s->tf_rel, 3 * c + 1, "share's traction facets"));
+  PM_TRY(PM_ALLOC(s->tf_centroid, 3 * c + 1, "share's traction facets"));
+  PM_TRY(PM_ALLOC(s->tf_base, 3 * c + 1, "share's traction facets"));
+  for (long k = 0; k < c; k++) {
+    s->tf_point[k] = lof[m->tf_point[idx[k]]];
+    s->tf_gid[k] = idx[k];
+    s->tf_bc[k] = m->tf_bc[idx[k]];
+  }
+  copy_items(s->tf_area, m->tf_area, idx, c, 1);
+  copy_items(s->tf_rel, m->tf_rel, idx, c, 3);
+  copy_items(s->tf_centroid, m->tf_centroid, idx, c, 3);
+  copy_items(s->tf_base, m->tf_base, idx, c, 3);
+  s->tf_time_dependent = m->tf_time_dependent;
+  c = 0;
+  for (long k = 0; k < m->n_cdofs; k++)
+    if (lof[m->cd_point[k]] >= 0 && lof[m->cd_point[k]] < no) idx[c++] = k;
+  s->n_cdofs = c;
+  PM_TRY(PM_ALLOC(s->cd_point, c + 1, "share's prescribed dofs"));
+  PM_TRY(PM_ALLOC(s->cd_comp, c + 1, "share's prescribed dofs"));
+  PM_TRY(PM_ALLOC(s->cd_bc, c + 1, "share's prescribed dofs"));
+  PM_TRY(PM_ALLOC(s->cd_base, c + 1, "share's prescribed dofs"));
+  for (long k = 0; k < c; k++) {
+    s->cd_point[k] = lof[m->cd_point[idx[k]]];
+    s->cd_comp[k] = m->cd_comp[idx[k]];
+    s->cd_bc[k] = m->cd_bc[idx[k]];
+  }
+  copy_items(s->cd_base, m->cd_base, idx, c, 1);
+  s->cd_time_dependent = m->cd_time_dependent;
+done:
+  free(idx);
+  return ret;
+}
+
+pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
+                        fpm_model **out) {
+  pm_err ret = PM_SUCCESS;
+  fpm_model *s = NULL;
+  int *lof = NULL; /* each point's index in the subset, or -1 */
+  *out = NULL;
+  PM_TRY(PM_ALLOC(lof, m->n + 1, "share's points"));
+  PM_TRY(PM_ALLOC(s, 1, "FPM model (a rank's share)"));
+  PM_TRY(PM_ALLOC(s->own_dual, 1, "share's points"));
+  s->n_own = pts->n_own;
+  s->n_flux = pts->n_flux;
+  s->n_stress = pts->n_stress;
+  s->n = pts->n;
+  PM_TRY(PM_ALLOC(s->gid, s->n + 1, "share's point indices"));
+  memcpy(s->gid, pts->gid, sizeof(long) * (size_t)s->n);
+  for (long i = 0; i < m->n; i++) lof[i] = -1;
+  for (long li = 0; li < s->n; li++) lof[s->gid[li]] = (int)li;
+  s->dim = m->dim;
+  s->own_dual->dim = m->dim;
+  s->own_dual->n_points = s->n;
+  s->dual = s->own_dual;
+  s->scene = m->scene;
+  s->penalty = m->penalty;
+  s->flux = m->flux;
+  s->jump = m->jump;
+  s->n_mats = m->n_mats;
+  memcpy(s->mats, m->mats, sizeof s->mats);
+  PM_TRY(subset_points(m, s, lof));
+  if (m->qs_ptr) PM_TRY(subset_fits(m, s, lof));
+  PM_TRY(subset_boundary(m, s, lof));
+  *out = s;
+  s = NULL;
+done:
+  fpm_model_destroy(s);
+  free(lof);
+  return ret;
+}
