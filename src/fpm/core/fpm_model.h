@@ -7,9 +7,10 @@
 #include <stdbool.h>
 
 #include "gm_dual.h"
+#include "fpm_exchange.h"
+#include "fpm_scene.h"
 #include "pm_error.h"
 #include "pm_material.h"
-#include "fpm_scene.h"
 #include "pm_scene.h"
 
 #define FPM_MAX_MATERIALS 16
@@ -90,18 +91,19 @@ typedef struct {
   long *bcf_ptr;          /* n_bcs + 1: the facets of condition b are */
   long *bcf_facet;        /* bcf_facet[bcf_ptr[b] .. bcf_ptr[b + 1]) */
   const pm_scene *scene;  /* borrowed: boundary expressions and ramps */
-  /* Across MPI ranks (fpm_par.h) a rank's model is its share: its own
+  /* Across ranks (src/fpm/ranks) a rank's model is its share: its own
    * points first, in one-process order, then the ghost points their force
    * reads, and each pass runs over the points that need it: the force is
    * gathered on [0, n_own), the flux of [0, n_flux), the stress (and the
    * quadratic fit) of [0, n_stress), and u is held on all n.  Only its own
    * points count in sums, and its conditions' dofs are its own points'.
-   * On one process all are n, gid and par NULL. */
+   * On one process all are n, gid and xc NULL. */
   long n_own, n_flux, n_stress;
-  long *gid;           /* n: each point's index on one process, or NULL */
-  long *tf_gid;        /* n_tfacets: each traction facet's, or NULL */
-  gm_dual *own_dual;   /* a share's points, volumes and rows (dual is it) */
-  struct fpm_par *par; /* the exchanges of a share across ranks, or NULL */
+  long *gid;         /* n: each point's index on one process, or NULL */
+  long *tf_gid;      /* n_tfacets: each traction facet's, or NULL */
+  gm_dual *own_dual; /* a share's points, volumes and rows (dual is it) */
+  fpm_exchange *xc;  /* a share's exchanges with the other ranks (released
+                        with the model), or NULL */
 } fpm_model;
 
 /* Point i's index on one process (for messages). */
@@ -149,6 +151,25 @@ typedef struct {
  * geometry, masses and boundary conditions. */
 pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
                         const gm_mesh *mesh, const gm_dual *d, fpm_model **out);
+
+/* The points a model holds of a whole model's (a rank's share): its own
+ * points [0, n_own), then the ghosts whose flux [n_own, n_flux), stress
+ * [n_flux, n_stress) and displacement [n_stress, n) its passes read (see
+ * fpm_model.n_own), each group in one-process order. */
+typedef struct {
+  long n_own, n_flux, n_stress, n;
+  const long *gid; /* n: each point's index in the whole model */
+} fpm_points;
+
+/* The model of the points pts of model m (m held whole; pts borrowed): a
+ * model whose point i is m's pts->gid[i], with their operators,
+ * interfaces, masses, materials, boundary facets (of the points whose flux
+ * it computes) and prescribed dofs (of its own points), in one process's
+ * order; rows, fits and mirror entries of the points whose stress it
+ * computes.  Reactions are not computed on it (no facet lists).  *out owns
+ * its arrays (fpm_model_destroy); m is left as it is.  PM_ERR_MEMORY. */
+pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
+                        fpm_model **out);
 
 /* The body FPM meshes as its domain: the scene's only body when it is a
  * gmsh volume (bodies: [{mesh: FILE}]), whose physical surfaces then name

@@ -6,7 +6,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "fpm_par.h"
 #include "pm_backend.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
@@ -150,7 +149,7 @@ static pm_err unstable(const fpm_model *m, const fpm_state *st, long step,
                   step, t, fpm_point_id(m, p), x[0], x[1], x[2], cause, J, dt);
 }
 
-/* Where a failure comes in one process's order (fpm_par_agree): the
+/* Where a failure comes in one process's order (fpm_exchange_agree): the
  * prescribed dofs (by dof), then the tractions (by facet entry), then the
  * points' stresses (by point), each stage after the one before. */
 #define KEY_STAGE (1L << 40)
@@ -172,7 +171,7 @@ static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
     e = fpm_condition_failure(m, true, bad, step, t);
     key = KEY_STAGE + 3 * (m->tf_gid ? m->tf_gid[bad / 3] : bad / 3) + bad % 3;
   }
-  fpm_par_exchange(m, st->u);
+  fpm_exchange_ghosts(m->xc, st->u);
   if (e == PM_SUCCESS) {
     const double w = pm_wtime();
     bad = fpm_force(m, st);
@@ -182,7 +181,7 @@ static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
       key = 2 * KEY_STAGE + fpm_point_id(m, bad);
     }
   }
-  return fpm_par_agree(m, e, key);
+  return fpm_exchange_agree(m->xc, e, key);
 }
 
 /* The point of smallest J among the model's own (the first of them), as
@@ -196,7 +195,7 @@ static pm_err below_min_jacobian(const fpm_model *m, const fpm_state *st,
     if (st->J[i] == jmin) best = i;
   pm_err e =
       best >= 0 ? unstable(m, st, step, t, dt, best, min_jacobian) : PM_SUCCESS;
-  return fpm_par_agree(m, e, best >= 0 ? fpm_point_id(m, best) : 0);
+  return fpm_exchange_agree(m->xc, e, best >= 0 ? fpm_point_id(m, best) : 0);
 }
 
 /* The sums a step's figures come from, over the model's own points and
@@ -257,7 +256,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
   si.min_jacobian = INFINITY;
   for (long i = 0; i < n; i++)
     si.min_jacobian = fmin(si.min_jacobian, st->J[i]);
-  fpm_par_min(m, &si.min_jacobian, 1);
+  fpm_exchange_min(m->xc, &si.min_jacobian, 1);
   /* The initial state, as a frame. */
   if (observer && !resumed) {
     pm_err e = observer(ctx, m, st, &si, true);
@@ -335,8 +334,8 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     sum[SUM_BFLUX] = st->bflux_sq;
     sum[SUM_FEXT] = st->fext_sq;
     sum[SUM_PENALTY] = st->penalty_energy;
-    fpm_par_sum(m, sum, SUMS);
-    fpm_par_min(m, &jmin, 1);
+    fpm_exchange_sum(m->xc, sum, SUMS);
+    fpm_exchange_min(m->xc, &jmin, 1);
     st->bflux_norm = sqrt(sum[SUM_BFLUX]);
     st->fext_norm = sqrt(sum[SUM_FEXT]);
     st->penalty_energy = sum[SUM_PENALTY];

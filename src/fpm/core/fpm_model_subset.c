@@ -1,115 +1,11 @@
-/* fpm_share: the partition of the points (MatPartitioning) and a rank's
- * share of an FPM model, its own points and ghosts in pass order. */
-#include "fpm_share.h"
-
-#include <petscmat.h>
+/* fpm_model_subset: the model of some of a whole model's points (a rank's
+ * share): their rows, operators, interfaces, fits, masses, materials and
+ * boundary, taken from the whole model in one process's order. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "fpm_gfd.h"
-#include "pm_petsc.h"
-
-/* ---- partition ------------------------------------------------------------
- */
-
-pm_err fpm_partition(const fpm_model *m, int parts, int *owner) {
-  pm_err ret = PM_SUCCESS;
-  const long n = m->n, nnz = m->nbr_ptr[m->n];
-  Mat adj = NULL;
-  MatPartitioning part = NULL;
-  IS is = NULL;
-  PetscInt *ia = NULL, *ja = NULL, *w = NULL;
-  memset(owner, 0, sizeof(int) * (size_t)n);
-  if (parts <= 1) return PM_SUCCESS;
-  PM_CALL(pm_petsc_init());
-  /* PT-Scotch's threads take turns in an order that varies from run to
-   * run, and so did its partitions (3 different ones in 6 runs of the
-   * same graph); on one thread it gives the same partition every time. */
-  setenv("SCOTCH_PTHREAD_NUMBER", "1", 1);
-  PM_PETSC(PetscMalloc1(n + 1, &ia));
-  PM_PETSC(PetscMalloc1(nnz + 1, &ja));
-  PM_PETSC(PetscMalloc1(n + 1, &w));
-  for (long i = 0; i <= n; i++) ia[i] = (PetscInt)m->nbr_ptr[i];
-  for (long e = 0; e < nnz; e++) ja[e] = (PetscInt)m->nbr[e];
-  for (long i = 0; i < n; i++)
-    w[i] = (PetscInt)(1 + m->nbr_ptr[i + 1] - m->nbr_ptr[i] +
-                      (m->qs_ptr ? m->qs_ptr[i + 1] - m->qs_ptr[i] : 0));
-  /* The adjacency and the weights are PETSc's from here. */
-  PetscInt *a = ia, *b = ja;
-  ia = ja = NULL;
-  PM_PETSC(MatCreateMPIAdj(PETSC_COMM_SELF, (PetscInt)n, (PetscInt)n, a, b,
-                           NULL, &adj));
-  PM_PETSC(MatPartitioningCreate(PETSC_COMM_SELF, &part));
-  PM_PETSC(MatPartitioningSetAdjacency(part, adj));
-  PM_PETSC(MatPartitioningSetType(part, MATPARTITIONINGPTSCOTCH));
-  PM_PETSC(MatPartitioningSetNParts(part, (PetscInt)parts));
-  PetscInt *weights = w;
-  w = NULL;
-  PM_PETSC(MatPartitioningSetVertexWeights(part, weights));
-  PM_PETSC(MatPartitioningSetFromOptions(part));
-  PM_PETSC(MatPartitioningApply(part, &is));
-  const PetscInt *to;
-  PM_PETSC(ISGetIndices(is, &to));
-  for (long i = 0; i < n; i++) owner[i] = (int)to[i];
-  PM_PETSC(ISRestoreIndices(is, &to));
-done:
-  ISDestroy(&is);
-  MatPartitioningDestroy(&part);
-  MatDestroy(&adj);
-  PetscFree(ia);
-  PetscFree(ja);
-  PetscFree(w);
-  return ret;
-}
-
-long fpm_partition_edge_cut(const fpm_model *m, const int *owner) {
-  long cut = 0;
-  for (long i = 0; i < m->n; i++)
-    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
-      cut += m->nbr[e] > i && owner[m->nbr[e]] != owner[i];
-  return cut;
-}
-
-/* ---- a rank's share ---------------------------------------------------------
- */
-
-/* Levels of the points a share holds: its own, and the ghosts whose flux,
- * stress or displacement it reads; NONE for the others. */
-enum { OWN = 0, FLUX = 1, STRESS = 2, DISPLACEMENT = 3, NONE = 4 };
-
-/* Mark `to` on the points not yet held that the points of level `from` or
- * lower read: their supports, and for displacement ghosts also the points
- * of their fits. */
-static void mark_support(const fpm_model *m, signed char *level, int from,
-                         int to) {
-  for (long i = 0; i < m->n; i++) {
-    if (level[i] > from) continue;
-    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
-      if (level[m->nbr[e]] == NONE) level[m->nbr[e]] = (signed char)to;
-    if (to != DISPLACEMENT || !m->qs_ptr) continue;
-    for (long e = m->qs_ptr[i]; e < m->qs_ptr[i + 1]; e++)
-      if (level[m->qs_nbr[e]] == NONE) level[m->qs_nbr[e]] = DISPLACEMENT;
-  }
-}
-
-/* Each point's level in rank r's share. */
-static void share_levels(const fpm_model *m, const int *owner, int r,
-                         signed char *level) {
-  for (long i = 0; i < m->n; i++) level[i] = owner[i] == r ? OWN : NONE;
-  /* The gather of an own point reads its support's flux, and with the
-   * quadratic jump that of every fit holding it. */
-  mark_support(m, level, OWN, FLUX);
-  if (m->qs_ptr)
-    for (long k = 0; k < m->n; k++) {
-      if (level[k] != OWN) continue;
-      for (long t = m->qt_ptr[k]; t < m->qt_ptr[k + 1]; t++) {
-        const long i = m->qs_own[m->qt_entry[t]];
-        if (level[i] == NONE) level[i] = FLUX;
-      }
-    }
-  mark_support(m, level, FLUX, STRESS);
-  mark_support(m, level, STRESS, DISPLACEMENT);
-}
+#include "fpm_model.h"
 
 /* The rows (CSR) of the share's first n_rows points (those whose stress
  * it computes), entries in their order, neighbours as indices in the share
@@ -139,7 +35,7 @@ static void copy_items(double *to, const double *from, const long *idx,
 
 /* The points' own arrays: positions, volumes, rows of the support, GFD
  * weights, interface records, sums, materials, masses and the mask. */
-static pm_err share_points(const fpm_model *m, fpm_model *s, const int *lof) {
+static pm_err subset_points(const fpm_model *m, fpm_model *s, const int *lof) {
   const long n = s->n, ns = s->n_stress;
   gm_dual *d = s->own_dual;
   PM_CALL(PM_ALLOC(d->x, 3 * n, "share's positions"));
@@ -200,7 +96,7 @@ static pm_err share_points(const fpm_model *m, fpm_model *s, const int *lof) {
 /* The quadratic fits of the points whose stress the share computes, and
  * for its own points the fits that hold them, in one process's order
  * (the order of their entries). */
-static pm_err share_fits(const fpm_model *m, fpm_model *s, const int *lof) {
+static pm_err subset_fits(const fpm_model *m, fpm_model *s, const int *lof) {
   const long n = s->n, ns = s->n_stress, no = s->n_own;
   PM_CALL(PM_ALLOC(s->qs_ptr, n + 1, "share's fits"));
   PM_CALL(
@@ -243,7 +139,8 @@ static pm_err share_fits(const fpm_model *m, fpm_model *s, const int *lof) {
 /* The boundary: the consistency flux and the tractions of the points whose
  * flux the share computes (in one process's order: facets that share a
  * point add up in it), the prescribed dofs of its own points. */
-static pm_err share_boundary(const fpm_model *m, fpm_model *s, const int *lof) {
+static pm_err subset_boundary(const fpm_model *m, fpm_model *s,
+                              const int *lof) {
   const long nf = s->n_flux, no = s->n_own;
   long *idx = NULL;
   pm_err ret = PM_SUCCESS;
@@ -301,29 +198,21 @@ done:
   return ret;
 }
 
-pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
+pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
                         fpm_model **out) {
   pm_err ret = PM_SUCCESS;
   fpm_model *s = NULL;
-  signed char *level = NULL;
-  int *lof = NULL; /* each point's index in the share, or -1 */
+  int *lof = NULL; /* each point's index in the subset, or -1 */
   *out = NULL;
-  PM_TRY(PM_ALLOC(level, m->n + 1, "share's points"));
   PM_TRY(PM_ALLOC(lof, m->n + 1, "share's points"));
-  share_levels(m, owner, r, level);
   PM_TRY(PM_ALLOC(s, 1, "FPM model (a rank's share)"));
   PM_TRY(PM_ALLOC(s->own_dual, 1, "share's points"));
-  long count[NONE + 1] = {0};
-  for (long i = 0; i < m->n; i++) count[level[i]]++;
-  s->n_own = count[OWN];
-  s->n_flux = s->n_own + count[FLUX];
-  s->n_stress = s->n_flux + count[STRESS];
-  s->n = s->n_stress + count[DISPLACEMENT];
+  s->n_own = pts->n_own;
+  s->n_flux = pts->n_flux;
+  s->n_stress = pts->n_stress;
+  s->n = pts->n;
   PM_TRY(PM_ALLOC(s->gid, s->n + 1, "share's point indices"));
-  long at = 0;
-  for (int lv = OWN; lv < NONE; lv++)
-    for (long i = 0; i < m->n; i++)
-      if (level[i] == lv) s->gid[at++] = i;
+  memcpy(s->gid, pts->gid, sizeof(long) * (size_t)s->n);
   for (long i = 0; i < m->n; i++) lof[i] = -1;
   for (long li = 0; li < s->n; li++) lof[s->gid[li]] = (int)li;
   s->dim = m->dim;
@@ -336,86 +225,13 @@ pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
   s->jump = m->jump;
   s->n_mats = m->n_mats;
   memcpy(s->mats, m->mats, sizeof s->mats);
-  PM_TRY(share_points(m, s, lof));
-  if (m->qs_ptr) PM_TRY(share_fits(m, s, lof));
-  PM_TRY(share_boundary(m, s, lof));
+  PM_TRY(subset_points(m, s, lof));
+  if (m->qs_ptr) PM_TRY(subset_fits(m, s, lof));
+  PM_TRY(subset_boundary(m, s, lof));
   *out = s;
   s = NULL;
 done:
   fpm_model_destroy(s);
-  free(level);
   free(lof);
-  return ret;
-}
-
-void fpm_share_count(const fpm_model *s, fpm_share_counts *c) {
-  c->own = s->n_own;
-  c->flux_ghosts = s->n_flux - s->n_own;
-  c->stress_ghosts = s->n_stress - s->n_flux;
-  c->u_ghosts = s->n - s->n_stress;
-  c->bytes = (double)(fpm_model_bytes(s) + fpm_state_bytes(s));
-}
-
-/* ---- plan ------------------------------------------------------------------
- */
-
-void fpm_share_print(const fpm_model *m, const int *owner, int parts,
-                     const fpm_share_counts *c, FILE *out) {
-  long most = 0, ghosts = 0, most_ghosts = 0;
-  for (int r = 0; r < parts; r++) {
-    const long g = c[r].flux_ghosts + c[r].stress_ghosts + c[r].u_ghosts;
-    most = c[r].own > most ? c[r].own : most;
-    most_ghosts = g > most_ghosts ? g : most_ghosts;
-    ghosts += g;
-  }
-  fprintf(out,
-          "ranks        %d: points by PT-Scotch on the support graph "
-          "(MatPartitioning), %s\n"
-          "             %ld support pairs cut of %ld; points per rank %ld at "
-          "most (imbalance %.3f: the most over the mean)\n",
-          parts,
-          m->qs_ptr ? "ghosts to 3 rings of support, 5 where the quadratic "
-                      "fits take two"
-                    : "ghosts to 3 rings of support",
-          fpm_partition_edge_cut(m, owner), m->nbr_ptr[m->n] / 2, most,
-          m->n > 0 ? most * (double)parts / m->n : 0.0);
-  if (parts <= 16) {
-    fprintf(out, "             rank  points  ghosts (flux + stress + "
-                 "displacement)  memory\n");
-    for (int r = 0; r < parts; r++)
-      fprintf(out, "             %4d  %6ld  %6ld (%ld + %ld + %ld)  %.1f MiB\n",
-              r, c[r].own,
-              c[r].flux_ghosts + c[r].stress_ghosts + c[r].u_ghosts,
-              c[r].flux_ghosts, c[r].stress_ghosts, c[r].u_ghosts,
-              c[r].bytes / 1048576.0);
-  }
-  fprintf(out,
-          "             ghost points per rank %.0f on average, %ld at most: a "
-          "rank receives their displacements, %.0f bytes per step on "
-          "average, %.0f at most\n",
-          (double)ghosts / parts, most_ghosts,
-          3.0 * sizeof(double) * ghosts / parts,
-          3.0 * sizeof(double) * most_ghosts);
-}
-
-pm_err fpm_share_predict(const fpm_model *m, int parts, FILE *out) {
-  pm_err ret = PM_SUCCESS;
-  int *owner = NULL;
-  fpm_share_counts *c = NULL;
-  fpm_model *s = NULL;
-  PM_TRY(PM_ALLOC(owner, m->n + 1, "partition"));
-  PM_TRY(PM_ALLOC(c, parts, "shares"));
-  PM_TRY(fpm_partition(m, parts, owner));
-  for (int r = 0; r < parts; r++) {
-    PM_TRY(fpm_share_create(m, owner, r, &s));
-    fpm_share_count(s, &c[r]);
-    fpm_model_destroy(s);
-    s = NULL;
-  }
-  fpm_share_print(m, owner, parts, c, out);
-done:
-  fpm_model_destroy(s);
-  free(owner);
-  free(c);
   return ret;
 }

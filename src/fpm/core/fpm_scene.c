@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "gm_cells.h"
-#include "pm_par.h"
 
 static const pm_name flux_names[] = {
     {"iipg", FPM_FLUX_IIPG}, {"sipg", FPM_FLUX_SIPG}, {NULL, 0}};

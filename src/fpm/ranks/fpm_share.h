@@ -1,7 +1,7 @@
 /* fpm_share: the partition of an FPM model's points among ranks, by a
  * graph partitioner on the supports, and a rank's share of the model: its
  * own points and the ghost points whose values their force reads, with
- * what every pass reads of them, copied from the whole model.  Nothing
+ * what every pass reads of them (fpm_model_subset).  Nothing
  * here communicates: every rank makes its own share from the whole model
  * it holds at setup, and pointmech plan --ranks N makes every rank's on one
  * process (fpm_par.h runs the shares across ranks).
@@ -38,13 +38,11 @@
  * PM_ERR_LINALG naming PETSc's failure. */
 pm_err fpm_partition(const fpm_model *m, int parts, int *owner);
 
-/* Rank r's share of model m (held whole) under partition owner: a model
- * whose points are r's own, in one-process order, then its flux, stress
- * and displacement ghosts, each in one-process order (fpm_model: n_own,
- * n_flux, n_stress, n, gid), with their operators, interfaces, masses,
- * materials, boundary facets (of the points whose flux it computes) and
- * prescribed dofs (of its own points).  Reactions are not computed on a
- * share (no facet lists).  *out owns its arrays; m is left as it is. */
+/* Rank r's share of model m (held whole) under partition owner: its
+ * points are r's own, in one-process order, then its flux, stress and
+ * displacement ghosts, each in one-process order (fpm_points), and its
+ * model is fpm_model_subset's of them.  *out owns its arrays; m is left as
+ * it is. */
 pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
                         fpm_model **out);
 

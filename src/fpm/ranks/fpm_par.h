@@ -18,8 +18,9 @@
  *    index on one process.
  * Rank 0 keeps the whole model and gathers the state into it where the run
  * writes (another star forest, its own points to rank 0's whole arrays):
- * frames, history and checkpoints are those of one process.  Every function
- * here is the identity on a model that is not a share (m->par NULL). */
+ * frames, history and checkpoints are those of one process.  The
+ * functions below take a share (m->xc set by fpm_par_create); only
+ * fpm_par_get_costs also takes a model on one process (all zero). */
 #ifndef FPM_PAR_H
 #define FPM_PAR_H
 
@@ -31,23 +32,11 @@
 /* This rank's share of model m, which every rank holds whole (collective;
  * every rank returns the same error): rank 0 partitions the points
  * (fpm_partition) after checking that every rank meshed the same graph,
- * every rank takes its share and the exchanges are set up.  *local owns
- * its arrays and the exchanges (fpm_model_destroy). */
+ * every rank takes its share and the exchanges are set up: the share's
+ * exchange (fpm_exchange.h: the ghosts' displacements, the sums and
+ * minima, the failures agreed) is this rank's.  *local owns its arrays and
+ * the exchanges (fpm_model_destroy). */
 pm_err fpm_par_create(const fpm_model *m, fpm_model **local);
-void fpm_par_destroy(struct fpm_par *p);
-
-/* The ghosts' displacements u (3 per point) from their owners
- * (collective). */
-void fpm_par_exchange(const fpm_model *m, double *u);
-
-/* Sums and minima of n values over the ranks, in place (collective). */
-void fpm_par_sum(const fpm_model *m, double *v, int n);
-void fpm_par_min(const fpm_model *m, double *v, int n);
-
-/* Every rank's failure e, placed by key in one process's order
- * (pm_par_agree_first; collective). */
-pm_err fpm_par_agree(const fpm_model *m, pm_err e, long key);
-
 /* A share's state from the whole run's, which every rank holds (a
  * checkpoint read by every rank): displacements and velocities of every
  * point it holds, and what the time loop carries. */

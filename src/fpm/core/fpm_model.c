@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "fpm_gfd.h"
-#include "fpm_par.h"
 #include "gm_shape.h"
 #include "pm_omp.h"
 
@@ -53,7 +52,7 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->gid);
   free(m->tf_gid);
   gm_dual_destroy(m->own_dual);
-  fpm_par_destroy(m->par);
+  if (m->xc) m->xc->release(m->xc->ctx);
   free(m);
 }
 

@@ -14,6 +14,7 @@
 #include "pm_progress.h"
 
 struct fpm_par {
+  fpm_exchange xc; /* what the core calls (ctx: this) */
   int rank, size;
   int *owner;               /* every point's rank (the partition) */
   fpm_share_counts *counts; /* every rank's share, on rank 0 */
@@ -25,10 +26,12 @@ struct fpm_par {
   PetscSF to_root;
   MPI_Datatype three, nine;
   double none[9]; /* the roots of the gather on the other ranks */
+  long n_ghost;   /* the share's ghost points */
   fpm_par_costs costs;
 };
 
-void fpm_par_destroy(struct fpm_par *P) {
+static void par_destroy(void *ctx) {
+  struct fpm_par *P = ctx;
   if (!P) return;
   if (P->ghosts) PetscSFDestroy(&P->ghosts);
   if (P->to_root) PetscSFDestroy(&P->to_root);
@@ -139,6 +142,45 @@ static pm_err count_shares(struct fpm_par *P, const fpm_model *full,
   return PM_SUCCESS;
 }
 
+/* The exchange's operations (fpm_exchange.h) on a share's ranks. */
+static void exchange_ghosts(void *ctx, double *u) {
+  struct fpm_par *P = ctx;
+  const double t0 = pm_wtime();
+  /* Nothing to report: a star forest set up once fails only on MPI's own
+   * failures, which stop every rank (MPI_ERRORS_ARE_FATAL). */
+  PetscSFBcastBegin(P->ghosts, P->three, u, u, MPI_REPLACE);
+  PetscSFBcastEnd(P->ghosts, P->three, u, u, MPI_REPLACE);
+  P->costs.ghost_bytes += 3.0 * sizeof(double) * (double)P->n_ghost;
+  pm_par_count_sent(3.0 * sizeof(double) * (double)P->n_ghost);
+  P->costs.exchanges++;
+  P->costs.exchange_seconds += pm_wtime() - t0;
+}
+
+static pm_err agree(void *ctx, pm_err e, long key) {
+  (void)ctx;
+  return pm_par_agree_first(e, key);
+}
+
+static void sum(void *ctx, double *v, int n) {
+  (void)ctx;
+  pm_par_sum(v, n);
+}
+
+static void min(void *ctx, double *v, int n) {
+  (void)ctx;
+  pm_par_min(v, n);
+}
+
+static void sum_long(void *ctx, long *v, int n) {
+  (void)ctx;
+  pm_par_sum_long(v, n);
+}
+
+static long offset(void *ctx, long count) {
+  (void)ctx;
+  return pm_par_offset(count);
+}
+
 pm_err fpm_par_create(const fpm_model *m, fpm_model **local) {
   pm_err ret = PM_SUCCESS;
   struct fpm_par *P = NULL;
@@ -152,40 +194,23 @@ pm_err fpm_par_create(const fpm_model *m, fpm_model **local) {
   PM_TRY(pm_par_agree(fpm_share_create(m, P->owner, P->rank, &s)));
   PM_TRY(pm_par_agree(make_forests(P, m, s)));
   PM_TRY(pm_par_agree(count_shares(P, m, s)));
-  s->par = P;
+  P->n_ghost = s->n - s->n_own;
+  P->xc = (fpm_exchange){.ctx = P,
+                         .ghosts = exchange_ghosts,
+                         .agree = agree,
+                         .sum = sum,
+                         .min = min,
+                         .sum_long = sum_long,
+                         .offset = offset,
+                         .release = par_destroy};
+  s->xc = &P->xc;
   P = NULL;
   *local = s;
   s = NULL;
 done:
-  fpm_par_destroy(P);
+  par_destroy(P);
   fpm_model_destroy(s);
   return ret;
-}
-
-void fpm_par_exchange(const fpm_model *m, double *u) {
-  struct fpm_par *P = m->par;
-  if (!P) return;
-  const double t0 = pm_wtime();
-  /* Nothing to report: a star forest set up once fails only on MPI's own
-   * failures, which stop every rank (MPI_ERRORS_ARE_FATAL). */
-  PetscSFBcastBegin(P->ghosts, P->three, u, u, MPI_REPLACE);
-  PetscSFBcastEnd(P->ghosts, P->three, u, u, MPI_REPLACE);
-  P->costs.ghost_bytes += 3.0 * sizeof(double) * (double)(m->n - m->n_own);
-  pm_par_count_sent(3.0 * sizeof(double) * (double)(m->n - m->n_own));
-  P->costs.exchanges++;
-  P->costs.exchange_seconds += pm_wtime() - t0;
-}
-
-void fpm_par_sum(const fpm_model *m, double *v, int n) {
-  if (m->par) pm_par_sum(v, n);
-}
-
-void fpm_par_min(const fpm_model *m, double *v, int n) {
-  if (m->par) pm_par_min(v, n);
-}
-
-pm_err fpm_par_agree(const fpm_model *m, pm_err e, long key) {
-  return m->par ? pm_par_agree_first(e, key) : e;
 }
 
 /* What the time loop carries from step to step. */
@@ -209,7 +234,7 @@ void fpm_par_scatter(const fpm_model *m, const fpm_state *whole,
 
 pm_err fpm_par_gather(const fpm_model *m, const fpm_state *st,
                       fpm_state *whole) {
-  struct fpm_par *P = m->par;
+  struct fpm_par *P = m->xc->ctx;
   const double t0 = pm_wtime();
   const double *from[7] = {st->u, st->v, st->f, st->H, st->P, st->W, st->J};
   double *none = P->none;
@@ -236,7 +261,7 @@ pm_err fpm_par_gather(const fpm_model *m, const fpm_state *st,
 
 pm_err fpm_par_gather_points(const fpm_model *m, const double *local,
                              double *whole) {
-  struct fpm_par *P = m->par;
+  struct fpm_par *P = m->xc->ctx;
   const double t0 = pm_wtime();
   double *to = whole ? whole : P->none;
   PM_PETSC_CALL(
@@ -247,12 +272,17 @@ pm_err fpm_par_gather_points(const fpm_model *m, const double *local,
   return PM_SUCCESS;
 }
 
-const int *fpm_par_owner(const fpm_model *m) { return m->par->owner; }
+/* The ranks of a share (its exchange's context). */
+static const struct fpm_par *par_of(const fpm_model *m) {
+  return m->xc ? m->xc->ctx : NULL;
+}
+
+const int *fpm_par_owner(const fpm_model *m) { return par_of(m)->owner; }
 
 const fpm_share_counts *fpm_par_counts(const fpm_model *m) {
-  return m->par->counts;
+  return par_of(m)->counts;
 }
 
 void fpm_par_get_costs(const fpm_model *m, fpm_par_costs *c) {
-  *c = m->par ? m->par->costs : (fpm_par_costs){0};
+  *c = m->xc ? par_of(m)->costs : (fpm_par_costs){0};
 }

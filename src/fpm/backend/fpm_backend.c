@@ -1,0 +1,222 @@
+/* fpm_backend: FPM's entry of the backend table: the simulation of a scene
+ * set up (on one process, or every rank's share), its checkpoint, and the
+ * table naming the run (fpm_backend_run.c), what the run driver reads
+ * (fpm_backend_figures.c) and the plan (fpm_backend_plan.c). */
+#include "fpm_backend.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_backend_impl.h"
+#include "fpm_estimate.h"
+#include "fpm_gfd.h"
+#include "fpm_par.h"
+#include "fpm_scene.h"
+#include "gm_cells.h"
+#include "pm_par.h"
+
+void fpm_sim_destroy(fpm_sim *sim) {
+  if (!sim) return;
+  fpm_state_destroy(sim->local_state);
+  fpm_model_destroy(sim->local_model);
+  fpm_static_state_free(&sim->static_state);
+  fpm_static_state_free(&sim->local_static);
+  free(sim->static_local);
+  free(sim->static_whole);
+  fpm_state_destroy(sim->state);
+  fpm_model_destroy(sim->model);
+  gm_dual_destroy(sim->dual);
+  gm_mesh_destroy(sim->mesh);
+  free(sim->scratch);
+  free(sim);
+}
+
+pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
+  pm_err ret = PM_SUCCESS;
+  fpm_sim *sim = NULL;
+  *out = NULL;
+  PM_ENSURE(s->method && strcmp(s->method, "fpm") == 0, PM_ERR_ARG,
+            "fpm_sim_create: scene %s has method %s", s->path,
+            s->method ? s->method : "(none)");
+  PM_TRY(PM_ALLOC(sim, 1, "FPM simulation"));
+  sim->scene = s;
+  pm_timers_init(&sim->timers);
+  sim->tm_mesh = pm_timers_add(&sim->timers, "mesh (gmsh)");
+  sim->tm_dual = pm_timers_add(&sim->timers, "subdomains");
+  sim->tm_operators = pm_timers_add(&sim->timers, "GFD operators and BCs");
+  sim->tm_force = pm_timers_add(&sim->timers, "internal force");
+  sim->tm_assembly = sim->tm_linear = -1;
+  if (s->time.qs == PM_QS_STATIC) {
+    sim->tm_update = pm_timers_add(&sim->timers, "load steps and output");
+    sim->tm_assembly = pm_timers_add(&sim->timers, "tangent (colouring)");
+    sim->tm_linear = pm_timers_add(&sim->timers, "linear solves");
+  } else {
+    sim->tm_update = pm_timers_add(&sim->timers, "time integration");
+  }
+  double t0 = pm_wtime();
+  pm_timers_start(&sim->timers, sim->tm_mesh);
+  /* The domain: the box, or the scene's one gmsh volume. */
+  int domain = fpm_domain_body(s);
+  if (domain >= 0)
+    PM_TRY(gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
+                        &sim->mesh));
+  else
+    PM_TRY(gm_mesh_box(s->dimension, s->box_min, s->box_max, s->mesh_size,
+                       &sim->mesh));
+  pm_timers_stop(&sim->timers, sim->tm_mesh);
+  sim->mean_edge = gm_mesh_mean_edge(sim->mesh);
+  pm_timers_start(&sim->timers, sim->tm_dual);
+  const fpm_options *o = fpm_scene_options(s);
+  sim->cells = gm_cells_find(o->cells);
+  PM_TRY(sim->cells->build(sim->mesh, &sim->dual));
+  pm_timers_stop(&sim->timers, sim->tm_dual);
+  pm_timers_start(&sim->timers, sim->tm_operators);
+  PM_TRY(fpm_model_create(s, o, sim->mesh, sim->dual, &sim->model));
+  PM_TRY(fpm_state_create(sim->model, &sim->state));
+  if (s->time.qs == PM_QS_STATIC)
+    PM_TRY(fpm_static_state_init(&sim->static_state, sim->model));
+  PM_TRY(PM_ALLOC(sim->scratch, 11 * sim->model->n, "output buffer"));
+  sim->dt_paper = fpm_stable_dt(sim->model, &sim->dt_point);
+  sim->dt_stable = sim->dt_paper;
+  if (s->time.dt_rule == PM_DT_SPECTRAL) {
+    fpm_sim_measure_spectrum(sim);
+    sim->dt_stable = sim->dt_spectral;
+  }
+  sim->dt = s->time.dt > 0 ? s->time.dt : s->time.dt_safety * sim->dt_stable;
+  pm_timers_stop(&sim->timers, sim->tm_operators);
+  sim->setup_wall = pm_wtime() - t0;
+  *out = sim;
+  sim = NULL;
+done:
+  fpm_sim_destroy(sim);
+  return ret;
+}
+
+/* Power iterations for the spectral radius: the Rayleigh quotient
+ * approaches it from below, to within a percent on the meshes tried. */
+#define FPM_SPECTRAL_ITERATIONS 100
+
+void fpm_sim_measure_spectrum(fpm_sim *sim) {
+  if (sim->dt_spectral > 0) return;
+  double lambda;
+  sim->dt_spectral = fpm_spectral_dt(
+      sim->model, sim->state, FPM_SPECTRAL_ITERATIONS, sim->scratch, &lambda);
+}
+
+long fpm_sim_conditioning(const fpm_sim *sim, double *worst,
+                          long *worst_point) {
+  const fpm_model *m = sim->model;
+  return fpm_gfd_deformed_condition(m->dim, m->n, m->x, sim->state->u,
+                                    m->nbr_ptr, sim->dual->nbr, FPM_COND_MAX,
+                                    worst, worst_point);
+}
+
+static const pm_timers *timers(void *p) { return &((fpm_sim *)p)->timers; }
+
+/* The time loop's state (fpm_state: u, v and what the loop carries) and
+ * what the run reports over all its steps. */
+/* A static solve's load stepping: where it is, its last two converged
+ * states over the free dofs, and its counters. */
+static pm_err checkpoint_static(fpm_sim *sim, pm_ckpt *ck) {
+  fpm_static_state *ss = &sim->static_state;
+  PM_CALL(pm_load_checkpoint(ck, "static", ss->free_dofs, &ss->load,
+                             &sim->static_report.load));
+  return pm_ckpt_double(ck, "static.external_work", &ss->external_work);
+}
+
+/* The time loop's state (fpm_state: u, v and what the loop carries; or a
+ * static solve's load stepping) and what the run reports over all its
+ * steps. */
+static pm_err checkpoint(void *p, pm_ckpt *ck) {
+  fpm_sim *sim = p;
+  fpm_state *st = sim->state;
+  const long n3 = 3 * sim->model->n;
+  const bool is_static = sim->scene->time.qs == PM_QS_STATIC;
+  if (is_static) {
+    PM_CALL(checkpoint_static(sim, ck));
+  } else {
+    PM_CALL(pm_ckpt_doubles(ck, "fpm.u", n3, st->u));
+    PM_CALL(pm_ckpt_doubles(ck, "fpm.v", n3, st->v));
+    PM_CALL(pm_ckpt_long(ck, "fpm.step", &st->step));
+    PM_CALL(pm_ckpt_double(ck, "fpm.t", &st->t));
+    PM_CALL(pm_ckpt_double(ck, "fpm.damping", &st->damping));
+    PM_CALL(pm_ckpt_double(ck, "fpm.external_work", &st->external_work));
+    PM_CALL(pm_ckpt_double(ck, "fpm.dissipated", &st->dissipated));
+  }
+  PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &sim->run_min_jacobian));
+  PM_CALL(
+      pm_ckpt_long(ck, "run.min_jacobian_step", &sim->run_min_jacobian_step));
+  PM_CALL(
+      pm_ckpt_double(ck, "run.max_energy_error", &sim->run_max_energy_error));
+  PM_CALL(pm_ckpt_double(ck, "run.residual0", &sim->res0));
+  if (pm_ckpt_reading(ck)) {
+    sim->resumed = true;
+    if (is_static) {
+      sim->last.step = sim->static_report.load.steps;
+      sim->last.t =
+          sim->static_state.load.lambda * pm_scene_load_end(sim->scene);
+      sim->last.external_work = sim->static_state.external_work;
+    } else {
+      sim->last.step = st->step;
+      sim->last.t = st->t;
+      sim->last.damping = st->damping;
+      sim->last.external_work = st->external_work;
+      sim->last.dissipated = st->dissipated;
+    }
+  }
+  return PM_SUCCESS;
+}
+
+/* Across ranks every rank sets up the whole model (the same on every
+ * rank), then takes its share (collective). */
+static pm_err create(const pm_scene *s, void **out) {
+  fpm_sim *sim = NULL;
+  pm_err e = pm_par_agree(fpm_sim_create(s, &sim));
+  if (!e && pm_par_active()) {
+    const double t0 = pm_wtime();
+    e = fpm_par_create(sim->model, &sim->local_model);
+    if (!e)
+      e = pm_par_agree(fpm_state_create(sim->local_model, &sim->local_state));
+    if (!e && s->time.qs == PM_QS_STATIC) { /* its load stepping's share */
+      const fpm_model *lm = sim->local_model;
+      e = fpm_static_state_init(&sim->local_static, lm);
+      if (!e) e = PM_ALLOC(sim->static_local, 3 * lm->n + 1, "nodal gather");
+      if (!e)
+        e = PM_ALLOC(sim->static_whole, 3 * sim->model->n, "nodal gather");
+      e = pm_par_agree(e);
+    }
+    sim->setup_wall += pm_wtime() - t0;
+  }
+  if (e) {
+    fpm_sim_destroy(sim);
+    return e;
+  }
+  *out = sim;
+  return PM_SUCCESS;
+}
+
+static void destroy(void *sim) { fpm_sim_destroy(sim); }
+
+const pm_backend fpm_backend = {
+    .method = "fpm",
+    .description = "explicit total-Lagrangian Fragile Points Method",
+    .section = &fpm_section,
+    .dt_safety = 0.9,
+    .ranks = true,
+    .check = fpm_check_scene,
+    .create = create,
+    .estimate_bytes = fpm_estimate_bytes,
+    .destroy = destroy,
+    .plan = fpm_backend_plan,
+    .run = fpm_backend_run,
+    .points = fpm_backend_points,
+    .fields = fpm_backend_fields,
+    .displacement = fpm_backend_displacement,
+    .figures = fpm_backend_figures,
+    .history_names = fpm_backend_history_names,
+    .history_values = fpm_backend_history_values,
+    .summary = fpm_backend_summary,
+    .timers = timers,
+    .checkpoint = checkpoint,
+};

@@ -1,0 +1,223 @@
+/* fpm_backend_figures: what the run driver reads of an FPM simulation:
+ * its points and fields, the figures, the history's columns and the
+ * summary. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_backend_impl.h"
+#include "fpm_gfd.h"
+#include "fpm_par.h"
+#include "pm_metrics.h"
+#include "pm_omp.h"
+#include "pm_par.h"
+#include "pm_tensor.h"
+
+/* Cauchy stress sigma = P F^T / J per point into scratch. */
+static void cauchy_stress(const fpm_model *m, const fpm_state *st,
+                          double *sig) {
+  const long n = m->n;
+  PM_OMP(parallel for schedule(static) default(none) shared(n, st, sig))
+  for (long i = 0; i < n; i++) {
+    double F[9], FT[9];
+    for (int a = 0; a < 9; a++) F[a] = st->H[9 * i + a];
+    F[0] += 1;
+    F[4] += 1;
+    F[8] += 1;
+    pm_t_transpose(F, FT);
+    pm_t_mul(st->P + 9 * i, FT, sig + 9 * i);
+    for (int a = 0; a < 9; a++) sig[9 * i + a] /= st->J[i];
+  }
+}
+
+void fpm_backend_points(void *p, pm_points *pts) {
+  const fpm_sim *sim = p;
+  *pts = (pm_points){.n = sim->model->n,
+                     .x = sim->model->x,
+                     .n_cells = sim->mesh->n_cells,
+                     .nodes_per_cell = sim->mesh->nodes_per_cell,
+                     .cells = sim->mesh->cells};
+}
+
+const double *fpm_backend_displacement(void *p) {
+  return ((fpm_sim *)p)->state->u;
+}
+
+int fpm_backend_fields(void *p, unsigned want, pm_field *out, int max) {
+  fpm_sim *sim = p;
+  const fpm_state *st = sim->state;
+  int nf = 0;
+  if (max < 8) return 0;
+  if (want & PM_FIELD_DISPLACEMENT)
+    out[nf++] = (pm_field){"displacement", 3, st->u};
+  if (want & PM_FIELD_VELOCITY) out[nf++] = (pm_field){"velocity", 3, st->v};
+  if (want & PM_FIELD_STRESS) {
+    const long n = sim->model->n;
+    double *vm = sim->scratch + 9 * n, *p_mean = vm + n;
+    cauchy_stress(sim->model, st, sim->scratch);
+    pm_stress_invariants(n, sim->scratch, vm, p_mean);
+    out[nf++] = (pm_field){"stress", 9, sim->scratch};
+    out[nf++] = (pm_field){"von_mises", 1, vm};
+    out[nf++] = (pm_field){"pressure", 1, p_mean};
+  }
+  if (want & PM_FIELD_STRAIN_ENERGY_DENSITY)
+    out[nf++] = (pm_field){"strain_energy_density", 1, st->W};
+  if (want & PM_FIELD_JACOBIAN) out[nf++] = (pm_field){"jacobian", 1, st->J};
+  if (want & PM_FIELD_FORCE) out[nf++] = (pm_field){"force", 3, st->f};
+  return nf;
+}
+
+/* Mean strain energy density, largest von Mises stress and smallest J of
+ * the current fields, with their points. */
+static void field_figures(fpm_sim *sim, pm_figures *f) {
+  const fpm_model *m = sim->model;
+  const fpm_state *st = sim->state;
+  const double *vol = sim->dual->volume, *sig = sim->scratch;
+  cauchy_stress(m, st, sim->scratch);
+  double vsum = 0, wsum = 0;
+  long vm_at = 0, j_at = 0;
+  f->max_von_mises = -1;
+  f->end_min_jacobian = INFINITY;
+  for (long i = 0; i < m->n; i++) {
+    vsum += vol[i];
+    wsum += vol[i] * st->W[i];
+    double vm = pm_t_von_mises(sig + 9 * i);
+    if (vm > f->max_von_mises) {
+      f->max_von_mises = vm;
+      vm_at = i;
+    }
+    if (st->J[i] < f->end_min_jacobian) {
+      f->end_min_jacobian = st->J[i];
+      j_at = i;
+    }
+  }
+  f->mean_sed = vsum > 0 ? wsum / vsum : 0;
+  for (int a = 0; a < 3; a++) {
+    f->max_von_mises_at[a] = m->x[3 * vm_at + a];
+    f->end_min_jacobian_at[a] = m->x[3 * j_at + a];
+  }
+}
+
+void fpm_backend_figures(void *p, pm_figures *f, bool with_fields) {
+  fpm_sim *sim = p;
+  const fpm_model *m = sim->model;
+  const pm_scene *s = sim->scene;
+  const fpm_step_info *l = &sim->last;
+  f->status = sim->status;
+  f->dim = m->dim;
+  f->points = m->n;
+  f->steps = l->step;
+  f->time = l->t;
+  f->h = sim->mean_edge;
+  f->dt = sim->dt;
+  f->dt_stable = sim->dt_stable;
+  f->residual = l->residual;
+  f->kinetic = l->kinetic;
+  f->strain = l->strain;
+  f->internal = 0;
+  f->interface = l->penalty;
+  f->external_work = l->external_work;
+  f->dissipated = l->dissipated;
+  f->energy0 = 0;
+  f->energy_error = fpm_energy_error(l);
+  f->max_energy_error = sim->run_max_energy_error;
+  f->min_jacobian = sim->run_min_jacobian;
+  f->min_jacobian_step = sim->run_min_jacobian_step;
+  for (int b = 0; b < s->n_bcs && b < PM_FIGURES_MAX_BCS; b++)
+    fpm_reaction(m, sim->state, b, f->reaction[b]);
+  f->setup_seconds = sim->setup_wall;
+  f->step_seconds = pm_timers_seconds(&sim->timers, sim->tm_force) +
+                    pm_timers_seconds(&sim->timers, sim->tm_update);
+  f->memory_bytes = fpm_model_bytes(m) + fpm_state_bytes(m);
+  if (sim->local_model)
+    f->memory_bytes +=
+        fpm_model_bytes(sim->local_model) + fpm_state_bytes(sim->local_model);
+  if (with_fields) field_figures(sim, f);
+}
+
+static const char *const own_cols[] = {"damping", "ill_conditioned"};
+
+int fpm_backend_history_names(void *p, const char **names, int max) {
+  (void)p;
+  int n = 0;
+  for (; n < 2 && n < max; n++) names[n] = own_cols[n];
+  return n;
+}
+
+void fpm_backend_history_values(void *p, double *v) {
+  fpm_sim *sim = p;
+  v[0] = sim->last.damping;
+  v[1] = (double)fpm_sim_conditioning(sim, NULL, NULL);
+}
+
+/* The partition and what the exchanges cost (bytes a rank received per
+ * step on average; seconds of the slowest rank). */
+static pm_err summary_ranks(pm_json *j, const fpm_sim *sim) {
+  const fpm_model *lm = sim->local_model;
+  const fpm_share_counts *c = fpm_par_counts(lm);
+  const double *k = sim->ranks_costs;
+  const int size = pm_par_size();
+  PM_CALL(pm_json_begin_object(j, "ranks"));
+  PM_CALL(pm_json_integer(j, "count", size));
+  PM_CALL(pm_json_integer(
+      j, "edge_cut", fpm_partition_edge_cut(sim->model, fpm_par_owner(lm))));
+  PM_CALL(pm_json_begin_array(j, "points"));
+  for (int r = 0; r < size; r++) PM_CALL(pm_json_integer(j, NULL, c[r].own));
+  PM_CALL(pm_json_end_array(j));
+  PM_CALL(pm_json_begin_array(j, "ghost_points"));
+  for (int r = 0; r < size; r++)
+    PM_CALL(pm_json_integer(
+        j, NULL, c[r].flux_ghosts + c[r].stress_ghosts + c[r].u_ghosts));
+  PM_CALL(pm_json_end_array(j));
+  PM_CALL(
+      pm_json_number(j, "ghost_bytes_per_step", k[1] > 0 ? k[0] / k[1] : 0));
+  PM_CALL(pm_json_number(j, "exchange_seconds", k[2]));
+  PM_CALL(pm_json_number(j, "gather_seconds", k[3]));
+  return pm_json_end_object(j);
+}
+
+pm_err fpm_backend_summary(void *p, pm_json *j) {
+  fpm_sim *sim = p;
+  const fpm_model *m = sim->model;
+  const pm_scene *s = sim->scene;
+  double worst;
+  long worst_point;
+  long ill = fpm_sim_conditioning(sim, &worst, &worst_point);
+  PM_CALL(pm_json_integer(j, "cells", sim->mesh->n_cells));
+  PM_CALL(pm_json_integer(j, "interfaces", sim->dual->n_ifaces));
+  PM_CALL(pm_json_integer(j, "boundary_facets", sim->dual->n_facets));
+  PM_CALL(pm_json_integer(j, "prescribed_dofs", m->n_cdofs));
+  PM_CALL(pm_json_number(j, "mesh_size", s->mesh_size));
+  PM_CALL(pm_json_number(j, "mean_edge_length", sim->mean_edge));
+  PM_CALL(pm_json_number(j, "penalty", m->penalty));
+  PM_CALL(
+      pm_json_string(j, "flux", m->flux == FPM_FLUX_SIPG ? "sipg" : "iipg"));
+  PM_CALL(pm_json_string(j, "dt_rule",
+                         s->time.dt > 0                      ? "time.dt"
+                         : s->time.dt_rule == PM_DT_SPECTRAL ? "spectral"
+                                                             : "paper"));
+  PM_CALL(pm_json_number(j, "dt_paper", sim->dt_paper));
+  if (sim->dt_spectral > 0)
+    PM_CALL(pm_json_number(j, "dt_spectral", sim->dt_spectral));
+  PM_CALL(pm_json_integer(j, "dt_critical_point", sim->dt_point));
+  PM_CALL(pm_json_integer(j, "ill_conditioned_points", ill));
+  PM_CALL(pm_json_string(j, "jump", m->q ? "quadratic" : "linear"));
+  if (sim->local_model) PM_CALL(summary_ranks(j, sim));
+  if (m->q) {
+    PM_CALL(pm_json_integer(j, "fit_points_two_rings", m->n_qwide));
+    PM_CALL(pm_json_integer(j, "fit_points_linear", m->n_qlinear));
+  }
+  if (s->time.qs == PM_QS_STATIC) {
+    const fpm_static_report *r = &sim->static_report;
+    PM_CALL(pm_json_integer(j, "static_unknowns", r->unknowns));
+    PM_CALL(pm_json_integer(j, "static_jacobian_entries", r->pattern_entries));
+    PM_CALL(pm_json_integer(j, "static_load_steps", r->load.steps));
+    PM_CALL(pm_json_integer(j, "static_cuts", r->load.cuts));
+    PM_CALL(pm_json_integer(j, "static_newton_iterations",
+                            r->load.newton_iterations));
+    PM_CALL(pm_json_integer(j, "static_linear_iterations",
+                            r->load.linear_iterations));
+    PM_CALL(pm_json_number(j, "static_setup_seconds", r->setup_seconds));
+  }
+  return pm_json_number(j, "max_support_condition", worst);
+}

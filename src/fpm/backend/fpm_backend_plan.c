@@ -1,0 +1,165 @@
+/* fpm_backend_plan: pointmech plan for FPM: the scene's discretization,
+ * pipeline, step and memory, the shares across ranks and a timed estimate
+ * of the run. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_backend_impl.h"
+#include "fpm_par.h"
+#include "pm_omp.h"
+#include "pm_par.h"
+
+/* Seconds of one force evaluation at a small deformation of model m (u:
+ * its state's; across ranks every rank times its share together,
+ * collective). */
+static double time_force(const fpm_model *m, fpm_state *st) {
+  for (long i = 0; i < 3 * m->n; i++) st->u[i] = 1e-9 * m->x[i];
+  double t0 = pm_wtime();
+  int reps = 0, more = 1;
+  for (;;) {
+    more = pm_wtime() - t0 < 0.2 && reps < 1000;
+    if (m->xc) pm_par_bcast(&more, sizeof more);
+    if (!more) break;
+    fpm_exchange_ghosts(m->xc, st->u);
+    fpm_force(m, st);
+    reps++;
+  }
+  memset(st->u, 0, 3 * m->n * sizeof(double));
+  return 1.1 * (pm_wtime() - t0) / (reps > 0 ? reps : 1);
+}
+
+static void plan_estimate(const fpm_sim *sim, double per_step, double steps,
+                          FILE *out) {
+  fprintf(out,
+          "estimate     %.3g s per step, %.3g s for %.0f steps on %d "
+          "threads%s (setup took %.3g s)\n",
+          per_step, per_step * steps, steps, pm_omp_threads(),
+          pm_par_active() ? " per rank" : "", sim->setup_wall);
+}
+
+/* The plan's lines from the scene to the memory; the steps (0 for a static
+ * solve, whose lines end there). */
+static double plan_head(fpm_sim *sim, FILE *out) {
+  const pm_scene *s = sim->scene;
+  fpm_model *m = sim->model;
+  double steps = ceil(s->time.end / sim->dt);
+  if (s->time.max_steps > 0 && steps > s->time.max_steps)
+    steps = (double)s->time.max_steps;
+  size_t bytes = fpm_model_bytes(m) + fpm_state_bytes(m);
+  const double *xc = m->x + 3 * sim->dt_point;
+  fprintf(out, "scene        %s (%s)\n", s->name, s->path);
+  fprintf(out, "method       fpm, %dD, %s\n", m->dim,
+          m->dim == 2 ? "plane strain" : "solid");
+  fprintf(out, "points       %ld (mesh size %g m, mean edge %.4g m)\n", m->n,
+          s->mesh_size, sim->mean_edge);
+  const gm_dual *d = sim->dual;
+  fprintf(out,
+          "cells        %s, one per node of %ld simplices: %ld interfaces, %ld "
+          "facets\n",
+          sim->cells->name, sim->mesh->n_cells, d->n_ifaces, d->n_facets);
+  if (d->min_quality_point >= 0)
+    fprintf(out,
+            "             %ld faces of round-off size dropped, %ld slivers; "
+            "lowest quality %.3g (1 for a cube) at point %ld\n",
+            d->n_dropped_faces, d->n_slivers, d->min_quality,
+            d->min_quality_point);
+  fprintf(out, "pipeline     1. stress per point (");
+  for (int k = 0; k < m->n_mats; k++)
+    fprintf(out, "%s%s", k ? ", " : "", m->mats[k].model->name);
+  fprintf(out, ")\n");
+  if (m->q)
+    fprintf(out,
+            "             2. quadratic fit per point, %ld entries (%ld "
+            "points over two rings, %ld linear)\n",
+            m->qs_ptr[m->n], m->n_qwide, m->n_qlinear);
+  fprintf(out,
+          "             %d. interface flux (%s, penalty %g on the %s "
+          "jump), %ld support entries\n",
+          m->q ? 3 : 2,
+          m->flux == FPM_FLUX_SIPG ? "SIPG: with the adjoint term, tangent "
+                                     "per point"
+                                   : "IIPG",
+          m->penalty, m->q ? "quadratic" : "linear", m->nnz);
+  int stage = m->q ? 4 : 3;
+  if (m->n_dpts > 0)
+    fprintf(out,
+            "             %d. consistency flux on prescribed faces, %ld "
+            "points\n",
+            stage++, m->n_dpts);
+  if (m->n_tfacets > 0)
+    fprintf(out, "             %d. tractions, %ld facets%s\n", stage++,
+            m->n_tfacets, m->tf_time_dependent ? " (time-dependent)" : "");
+  fprintf(out, "             %d. gather forces\n", stage++);
+  if (s->time.qs == PM_QS_STATIC) {
+    static const char *const linear[] = {"direct (LU)", "GMRES + GAMG",
+                                         "CG + Jacobi", "GMRES + ILU(0)"};
+    fprintf(out,
+            "             %d. Newton's method in %ld proportional load steps "
+            "(at most %ld iterations each), %ld prescribed dofs\n"
+            "             tangent assembled directly (%s), linear solver "
+            "%s\n",
+            stage++, s->time.qs_load_steps, s->time.qs_max_iterations,
+            m->n_cdofs,
+            m->flux == FPM_FLUX_SIPG
+                ? "preconditioning the exact tangent applied matrix-free"
+                : "exact",
+            linear[s->time.qs_linear]);
+    fprintf(out,
+            "memory       %.1f MiB (operators and state; the tangent "
+            "and its factors come on top)\n",
+            (bytes + fpm_linear_bytes(m)) / 1048576.0);
+    return 0;
+  }
+  fprintf(out, "             %d. central difference%s, %ld prescribed dofs\n",
+          stage++,
+          s->time.qs == PM_QS_DYNAMIC_RELAXATION ? " with dynamic relaxation"
+          : s->time.qs == PM_QS_DAMPING          ? " with damping"
+                                                 : "",
+          m->n_cdofs);
+  fpm_sim_measure_spectrum(sim);
+  fprintf(out, "dt           %.4g s (%s)\n", sim->dt,
+          s->time.dt > 0                      ? "time.dt"
+          : s->time.dt_rule == PM_DT_SPECTRAL ? "dt_safety x spectral"
+                                              : "dt_safety x paper bound");
+  fprintf(out,
+          "             bound of eqs. 24-26: %.4g s, set by point %ld at "
+          "(%g, %g, %g)\n",
+          sim->dt_paper, sim->dt_point, xc[0], xc[1], xc[2]);
+  fprintf(out,
+          "             spectral (power iteration): %.4g s = %.2f x the "
+          "bound\n",
+          sim->dt_spectral, sim->dt_spectral / sim->dt_paper);
+  fprintf(out, "steps        %.0f to t = %g s%s\n", steps, s->time.end,
+          s->time.qs != PM_QS_NONE ? " (at most: stops when converged)" : "");
+  fprintf(out, "memory       %.1f MiB (operators and state)\n",
+          bytes / 1048576.0);
+  return steps;
+}
+
+/* The plan across ranks (collective): rank 0's view prints the scene's
+ * lines and every rank's share, and the shares' forces are timed. */
+static pm_err plan_ranks(fpm_sim *sim, FILE *out) {
+  const fpm_model *lm = sim->local_model;
+  double steps = 0;
+  if (pm_par_root()) {
+    steps = plan_head(sim, out);
+    fpm_share_print(sim->model, fpm_par_owner(lm), pm_par_size(),
+                    fpm_par_counts(lm), out);
+  }
+  double per_step = time_force(lm, sim->local_state);
+  if (pm_par_root()) plan_estimate(sim, per_step, steps, out);
+  return PM_SUCCESS;
+}
+
+pm_err fpm_backend_plan(void *p, FILE *out) {
+  fpm_sim *sim = p;
+  if (sim->local_model) return plan_ranks(sim, out);
+  const int ranks = pm_par_plan_ranks();
+  double per_step = time_force(sim->model, sim->state);
+  double steps = plan_head(sim, out);
+  if (ranks > 1) PM_CALL(fpm_share_predict(sim->model, ranks, out));
+  if (sim->scene->time.qs == PM_QS_STATIC) return PM_SUCCESS;
+  plan_estimate(sim, per_step, steps, out);
+  return PM_SUCCESS;
+}

@@ -1,0 +1,156 @@
+/* fpm_static: Newton's method in load steps on the free dofs of an FPM
+ * model.  Unknowns are the free displacement components; the prescribed
+ * ones follow the load factor.  This file runs the load stepping (and the
+ * tangent's check); the problem, the tangent, its pattern and the unknowns
+ * are in fpm_static_problem.c, _tangent.c, _pattern.c and _unknowns.c. */
+#include "fpm_static.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_static_impl.h"
+#include "pm_progress.h"
+
+/* A force floor far below any load but above the force's round-off: the
+ * stiffest modulus times the squared size of the body, times 1e-12. */
+static double force_floor(const fpm_model *m) {
+  double emax = 0, lo[3] = {INFINITY, INFINITY, INFINITY},
+         hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int k = 0; k < m->n_mats; k++)
+    emax = fmax(emax, m->mats[k].youngs_modulus);
+  for (long i = 0; i < m->n_own; i++)
+    for (int a = 0; a < 3; a++) {
+      lo[a] = fmin(lo[a], m->x[3 * i + a]);
+      hi[a] = fmax(hi[a], m->x[3 * i + a]);
+    }
+  if (m->xc) { /* the body's box: every rank's points (the same floor) */
+    fpm_exchange_min(m->xc, lo, 3);
+    for (int a = 0; a < 3; a++) hi[a] = -hi[a];
+    fpm_exchange_min(m->xc, hi, 3);
+    for (int a = 0; a < 3; a++) hi[a] = -hi[a];
+  }
+  double diag2 = 0;
+  for (int a = 0; a < 3; a++) diag2 += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+  return 1e-12 * emax * diag2;
+}
+
+pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
+                      void *ctx, fpm_step_info *info, fpm_static_report *rep) {
+  fpm_static_state ss;
+  PM_CALL(fpm_static_state_init(&ss, m));
+  pm_err e = fpm_static_run_from(m, st, &ss, observer, ctx, info, rep);
+  fpm_static_state_free(&ss);
+  return e;
+}
+
+pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
+                           fpm_static_state *ss, fpm_observer observer,
+                           void *ctx, fpm_step_info *info,
+                           fpm_static_report *rep) {
+  pm_err ret = PM_SUCCESS;
+  fpm_static_solve v = {.c = {.observer = observer, .octx = ctx}};
+  const pm_scene *s = m->scene;
+  fpm_static_ctx *c = &v.c;
+  pm_newton *solver = NULL;
+  const bool resumed = ss->load.lambda > 0;
+  const pm_load_report done_before = rep->load;
+  memset(rep, 0, sizeof *rep);
+  if (resumed) rep->load = done_before;
+  c->ext_work = &ss->external_work;
+  double w0 = pm_wtime();
+  PM_TRY(fpm_static_setup(m, st, &v));
+  long sizes[2] = {c->nf, v.ptr[c->nheld]};
+  fpm_exchange_sum_long(m->xc, sizes, 2);
+  rep->unknowns = sizes[0];
+  rep->pattern_entries = sizes[1];
+  PM_ENSURE(c->nf == ss->free_dofs, PM_ERR_ARG,
+            "static state of %ld free dofs for a model of %ld", ss->free_dofs,
+            c->nf);
+
+  if (!resumed) {
+    /* The initial state, as a frame. */
+    memset(st->u, 0, 3 * m->n * sizeof(double));
+    ss->external_work = 0;
+    PM_TRY(fpm_static_set_load(c, 0));
+  } else {
+    /* The last converged state: its force gives the supports' forces the
+     * work of the next step starts from, as in the first run. */
+    PM_TRY(fpm_static_set_load(c, ss->load.lambda));
+    c->t = ss->load.lambda * c->load_end;
+    memcpy(v.x, ss->load.xc, (size_t)c->nf * sizeof *v.x);
+  }
+  /* (across ranks the state holds a resumed run's displacements on every
+   * point, its ghosts' too) */
+  PM_TRY(fpm_static_admissible(
+      c, fpm_static_evaluate(c, resumed && !m->xc ? v.x : NULL)));
+  fpm_support_start(m, st);
+  memcpy(c->u_old, st->u, 3 * m->n * sizeof(double));
+  /* The figures of the state (a resumed one's too, for a run that fails
+   * before its next step); only the initial state is a frame. */
+  fpm_static_figures(c, rep->load.steps);
+  if (!resumed && observer) PM_TRY(observer(ctx, m, st, &c->si, true));
+
+  pm_newton_options no = pm_newton_options_default();
+  no.rtol = s->time.qs_tolerance;
+  no.atol = force_floor(m);
+  no.max_iter = (int)s->time.qs_max_iterations;
+  /* A step Newton creeps through (short line-search steps from a state
+   * outside its basin) is cut sooner than at max_iter. */
+  no.stall_after = 6;
+  no.linear = pm_newton_linear_of(s->time.qs_linear);
+  no.load_steps = (int)s->time.qs_load_steps;
+  no.predictor = true;
+  no.petsc_options = s->time.qs_solver_options;
+  /* SIPG: the assembled tangent lacks the adjoint term's derivative; it
+   * preconditions the exact tangent applied matrix-free. */
+  if (m->flux == FPM_FLUX_SIPG) no.op = PM_NEWTON_MATRIX_FREE;
+  PM_TRY(pm_newton_create(&v.prob, &no, &solver));
+  c->solver = solver;
+  rep->setup_seconds = pm_wtime() - w0;
+  ret = pm_load_steps_from(solver, v.x, &ss->load, &rep->load);
+done:
+  if (info) *info = c->si;
+  pm_newton_destroy(&solver);
+  fpm_static_solve_free(&v);
+  return ret;
+}
+
+pm_err fpm_static_check_tangent(const fpm_model *m, fpm_state *st,
+                                const double *u, double *assembled_error,
+                                double *difference_error) {
+  pm_err ret = PM_SUCCESS;
+  fpm_static_solve v = {0};
+  double *v1 = NULL, *v2 = NULL;
+  pm_newton *direct = NULL, *colored = NULL;
+  PM_TRY(fpm_static_setup(m, st, &v));
+  memcpy(st->u, u, 3 * m->n * sizeof(double));
+  for (long j = 0; j < v.c.nf; j++) v.x[j] = u[v.c.dof[j]];
+  pm_newton_options no = pm_newton_options_default();
+  PM_TRY(pm_newton_create(&v.prob, &no, &direct));
+  v.prob.jacobian_values = NULL;
+  PM_TRY(pm_newton_create(&v.prob, &no, &colored));
+  const long nv = v.ptr[v.c.nf];
+  PM_TRY(PM_ALLOC(v1, nv, "tangent values"));
+  PM_TRY(PM_ALLOC(v2, nv, "tangent values"));
+  PM_TRY(pm_newton_jacobian_values(direct, v.x, v1));
+  PM_TRY(pm_newton_jacobian_values(colored, v.x, v2));
+  double dmax = 0, big = 0;
+  for (long k = 0; k < nv; k++) {
+    dmax = fmax(dmax, fabs(v1[k] - v2[k]));
+    big = fmax(big, fabs(v2[k]));
+  }
+  *assembled_error = big > 0 ? dmax / big : dmax;
+  if (difference_error) {
+    long row, col;
+    PM_TRY(pm_newton_check_jacobian(direct, v.x, 1e-7, difference_error, &row,
+                                    &col));
+  }
+done:
+  pm_newton_destroy(&direct);
+  pm_newton_destroy(&colored);
+  fpm_static_solve_free(&v);
+  free(v1);
+  free(v2);
+  return ret;
+}

@@ -1,0 +1,114 @@
+/* fpm_static_impl: what the files of FPM's static solve share: the
+ * directly assembled tangent's parts, the context pm_newton's callbacks
+ * work on, and the solve's set-up. */
+#ifndef FPM_STATIC_IMPL_H
+#define FPM_STATIC_IMPL_H
+
+#include "fpm_static.h"
+
+/* The tangent assembled directly: K = E D Gamma + S, where
+ *   H_j = sum_m u_m (x) gamma_jm        (gamma: GFD weights, self -gsum)
+ *   f_k[c] = sum_j sum_s P_j[c][s] E^c_kj[s] + (penalty, linear in u)
+ * E (constant: the interface and boundary geometry gathered by the GFD
+ * weights) is built once per run, and so is the penalty's scalar matrix S
+ * (the same for every component).  Per Newton iteration only the products
+ * with the tangent moduli D are formed.  Exact for IIPG; with SIPG the
+ * adjoint term's derivative is left out (the solve then multiplies by the
+ * exact tangent matrix-free and preconditions with this one). */
+typedef struct {
+  long *R_ptr, *R_list; /* per point k: the points its force reaches */
+  long *E_ptr, *E_j;    /* per point k: the points j whose stress reaches */
+  double *E;            /* 9 per (k, j): E^c_kj[s] at 3 c + s */
+  long *S_ptr, *S_m;    /* per point k: the penalty matrix's columns */
+  double *S;
+  double *Dg;   /* 27 per (j, m in S(j) and j): D_j gamma_jm */
+  long *Dg_ptr; /* n + 1: point j's records start at Dg_ptr[j] */
+  long max_reach;
+  int threads;
+  long *mark;   /* threads x n: a row's points */
+  double *work; /* threads x 9 max_reach: a row's blocks */
+} fpm_static_tangent;
+
+typedef struct {
+  const fpm_model *m;
+  fpm_state *st;
+  fpm_static_tangent tg;
+  const long *pat_ptr;
+  const long *free_of;
+  fpm_linear *lin;
+  /* The unknowns: the free dofs of the model's own points (nf; all its
+   * points on one process), then across ranks those of its ghosts (nheld
+   * in all), which the solver gives their owners' values. */
+  long nf, nheld;
+  long *dof;   /* nheld: their dof index */
+  long *ghost; /* nheld - nf: the ghosts' unknowns' numbers over the ranks */
+  pm_newton *solver;
+  double *held;  /* nheld: the unknowns held, for a converged state */
+  double *du;    /* 3 n work */
+  double *df;    /* 3 n work */
+  double *u_old; /* 3 n: the last converged displacement */
+  double load_end, t;
+  fpm_observer observer;
+  void *octx;
+  fpm_step_info si;
+  double *ext_work; /* fpm_static_state.external_work */
+} fpm_static_ctx;
+
+/* Everything a solve needs of the model: the free dofs, the Jacobian's
+ * pattern, the directly assembled tangent's constant parts, the
+ * linearisation's work space, and the problem for pm_newton.  Released by
+ * fpm_static_solve_free (also after a failure in fpm_static_setup). */
+typedef struct {
+  fpm_static_ctx c;
+  long *free_of, *ptr, *idx;
+  double *x;
+  double *rigid; /* the rigid motions on the free dofs (for multigrid) */
+  pm_newton_problem prob;
+} fpm_static_solve;
+
+/* fpm_static_problem.c: the problem pm_newton solves. */
+
+/* The state at the free values x (NULL: the unknowns as they are; the
+ * prescribed dofs as set by fpm_static_set_load): its force; returns -1 or
+ * the first inadmissible point. */
+long fpm_static_evaluate(fpm_static_ctx *c, const double *x);
+/* The state just evaluated (bad: its first inadmissible point, or -1),
+ * admissible on every rank or on none (the failure one process meets
+ * first): PM_ERR_UNSTABLE naming the point. */
+pm_err fpm_static_admissible(const fpm_static_ctx *c, long bad);
+/* The loads at load factor lambda (pm_newton_problem.set_load; ctx is the
+ * fpm_static_ctx). */
+pm_err fpm_static_set_load(void *ctx, double lambda);
+/* The figures of the state in c->st into c->si (collective). */
+void fpm_static_figures(fpm_static_ctx *c, long step);
+/* Everything a solve needs of model m with state st into *v (zeroed but
+ * for the observer); release with fpm_static_solve_free, also after a
+ * failure.  PM_ERR_MEMORY; PM_ERR_SCENE when every dof is prescribed. */
+pm_err fpm_static_setup(const fpm_model *m, fpm_state *st, fpm_static_solve *v);
+void fpm_static_solve_free(fpm_static_solve *v);
+
+/* fpm_static_tangent.c: the tangent's constant parts for the rows of the
+ * own points (after fpm_static_pattern, whose reach it reads), its values
+ * in the pattern's order (pm_newton_problem.jacobian_values; ctx is the
+ * fpm_static_ctx), and their release. */
+pm_err fpm_static_tangent_build(const fpm_model *m, fpm_static_tangent *t);
+pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val);
+void fpm_static_tangent_free(fpm_static_tangent *t);
+
+/* fpm_static_pattern.c: the Jacobian's pattern over the nf unknowns
+ * (free_of: dof -> unknown, -1 for none) into *ptr_out, *idx_out (CSR,
+ * the caller's), and each own point's reach into tg.  PM_ERR_MEMORY. */
+pm_err fpm_static_pattern(const fpm_model *m, const long *free_of, long nf,
+                          fpm_static_tangent *tg, long **ptr_out,
+                          long **idx_out);
+
+/* fpm_static_unknowns.c: across ranks (m->xc), the ghosts' unknowns
+ * numbered after the own ones into free_of and c (dof, ghost, nheld); and
+ * the rigid motions of the body on the nf free dofs dof into rigid
+ * (count x nf; returns count). */
+pm_err fpm_static_number_ghosts(const fpm_model *m, long *free_of,
+                                fpm_static_ctx *c);
+int fpm_static_rigid_modes(const fpm_model *m, const long *dof, long nf,
+                           double *rigid);
+
+#endif

@@ -1,0 +1,123 @@
+/* fpm_static_pattern: the pattern of the Jacobian of FPM's static solve:
+ * each own point's force is reached by the supports of the supports of its
+ * supports (and, with the quadratic jump, the fits of those). */
+#include <stdlib.h>
+
+#include "fpm_static_impl.h"
+
+/* Marks the points of S(i) and i into list (marker: stamp). */
+static long add_support(const fpm_model *m, long i, long *list, long cnt,
+                        long *mark, long stamp) {
+  if (mark[i] != stamp) {
+    mark[i] = stamp;
+    list[cnt++] = i;
+  }
+  for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+    long k = m->nbr[e];
+    if (mark[k] != stamp) {
+      mark[k] = stamp;
+      list[cnt++] = k;
+    }
+  }
+  return cnt;
+}
+
+static long add_fit(const fpm_model *m, long j, long *list, long cnt,
+                    long *mark, long stamp) {
+  if (!m->q) return cnt;
+  for (long e = m->qs_ptr[j]; e < m->qs_ptr[j + 1]; e++) {
+    long k = m->qs_nbr[e];
+    if (mark[k] != stamp) {
+      mark[k] = stamp;
+      list[cnt++] = k;
+    }
+  }
+  return cnt;
+}
+
+/* The points whose displacement reaches the force on point k, into reach
+ * (returns the count). */
+static long reach(const fpm_model *m, long k, long *reach_list, long *a_list,
+                  long *mark_a, long *mark_r, long stamp) {
+  long na = add_support(m, k, a_list, 0, mark_a, stamp);
+  if (m->q)
+    for (long t = m->qt_ptr[k]; t < m->qt_ptr[k + 1]; t++) {
+      long i = m->qs_own[m->qt_entry[t]];
+      if (mark_a[i] != stamp) {
+        mark_a[i] = stamp;
+        a_list[na++] = i;
+      }
+    }
+  long nr = 0;
+  for (long ia = 0; ia < na; ia++) {
+    long i = a_list[ia];
+    for (long e = m->nbr_ptr[i] - 1; e < m->nbr_ptr[i + 1]; e++) {
+      long j = e < m->nbr_ptr[i] ? i : m->nbr[e];
+      nr = add_support(m, j, reach_list, nr, mark_r, stamp);
+      nr = add_fit(m, j, reach_list, nr, mark_r, stamp);
+    }
+  }
+  return nr;
+}
+
+/* The Jacobian's pattern over the nf unknowns (free_of: dof -> unknown):
+ * the rows of the own points' (a share's ghosts' rows are empty). */
+pm_err fpm_static_pattern(const fpm_model *m, const long *free_of, long nf,
+                          fpm_static_tangent *tg, long **ptr_out,
+                          long **idx_out) {
+  pm_err ret = PM_SUCCESS;
+  const long n = m->n, rows = m->n_own;
+  long *mark_a = NULL, *mark_r = NULL, *a_list = NULL, *r_list = NULL,
+       *ptr = NULL, *idx = NULL;
+  PM_TRY(PM_ALLOC(mark_a, n, "pattern marks"));
+  PM_TRY(PM_ALLOC(mark_r, n, "pattern marks"));
+  PM_TRY(PM_ALLOC(a_list, n, "pattern lists"));
+  PM_TRY(PM_ALLOC(r_list, n, "pattern lists"));
+  PM_TRY(PM_ALLOC(ptr, nf + 1, "Jacobian pattern"));
+  PM_TRY(PM_ALLOC(tg->R_ptr, n + 1, "Jacobian reach"));
+  for (long i = 0; i < n; i++) mark_a[i] = mark_r[i] = -1;
+  /* Count, then fill. */
+  for (int pass = 0; pass < 2; pass++) {
+    for (long k = 0; k < rows; k++) {
+      long nr = reach(m, k, r_list, a_list, mark_a, mark_r, pass * n + k);
+      if (pass == 0)
+        tg->R_ptr[k + 1] = nr;
+      else
+        for (long t = 0; t < nr; t++) tg->R_list[tg->R_ptr[k] + t] = r_list[t];
+      long cols = 0;
+      for (long t = 0; t < nr; t++)
+        for (int a = 0; a < 3; a++) cols += free_of[3 * r_list[t] + a] >= 0;
+      for (int c = 0; c < 3; c++) {
+        long row = free_of[3 * k + c];
+        if (row < 0) continue;
+        if (pass == 0) {
+          ptr[row + 1] = cols;
+          continue;
+        }
+        long w = ptr[row];
+        for (long t = 0; t < nr; t++)
+          for (int a = 0; a < 3; a++) {
+            long col = free_of[3 * r_list[t] + a];
+            if (col >= 0) idx[w++] = col;
+          }
+      }
+    }
+    if (pass == 0) {
+      for (long k = 0; k < rows; k++) tg->R_ptr[k + 1] += tg->R_ptr[k];
+      PM_TRY(PM_ALLOC(tg->R_list, tg->R_ptr[rows] + 1, "Jacobian reach"));
+      for (long r = 0; r < nf; r++) ptr[r + 1] += ptr[r];
+      PM_TRY(PM_ALLOC(idx, ptr[nf] > 0 ? ptr[nf] : 1, "Jacobian pattern"));
+    }
+  }
+  *ptr_out = ptr;
+  *idx_out = idx;
+  ptr = idx = NULL;
+done:
+  free(mark_a);
+  free(mark_r);
+  free(a_list);
+  free(r_list);
+  free(ptr);
+  free(idx);
+  return ret;
+}

@@ -1,0 +1,246 @@
+/* fpm_static_problem: the problem FPM's static solve gives pm_newton: the
+ * residual, the tangent's application and preparation, the loads at a load
+ * factor, the figures and report of each converged load step, and the
+ * set-up of it all over the free dofs. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_static_impl.h"
+
+/* The state at the free values x (prescribed dofs as set by set_load). */
+long fpm_static_evaluate(fpm_static_ctx *c, const double *x) {
+  if (x)
+    for (long j = 0; j < c->nheld; j++) c->st->u[c->dof[j]] = x[j];
+  return fpm_force(c->m, c->st);
+}
+
+static pm_err inadmissible(const fpm_static_ctx *c, long p) {
+  const double *x = c->m->x + 3 * p;
+  return PM_ERROR(PM_ERR_UNSTABLE,
+                  "point %ld at (%g, %g, %g): volume ratio J = %g%s",
+                  fpm_point_id(c->m, p), x[0], x[1], x[2], c->st->J[p],
+                  isfinite(c->st->J[p]) ? " (inverted subdomain)"
+                                        : " (deformation not finite)");
+}
+
+/* The state just evaluated (bad: its first inadmissible point, or -1),
+ * admissible on every rank or on none (the failure one process meets
+ * first). */
+pm_err fpm_static_admissible(const fpm_static_ctx *c, long bad) {
+  pm_err e = bad >= 0 ? inadmissible(c, bad) : PM_SUCCESS;
+  return fpm_exchange_agree(c->m->xc, e,
+                            bad >= 0 ? fpm_point_id(c->m, bad) : 0);
+}
+
+static pm_err residual(void *ctx, const double *x, double *r) {
+  fpm_static_ctx *c = ctx;
+  long bad = fpm_static_evaluate(c, x);
+  if (bad >= 0) return inadmissible(c, bad);
+  const double *f = c->st->f;
+  for (long j = 0; j < c->nf; j++) r[j] = f[c->dof[j]];
+  /* (a rank's force on its own points is whole: nothing for the ghosts') */
+  for (long j = c->nf; j < c->nheld; j++) r[j] = 0;
+  return PM_SUCCESS;
+}
+
+static pm_err prepare(void *ctx, const double *x) {
+  fpm_static_ctx *c = ctx;
+  long bad = fpm_static_evaluate(c, x);
+  if (bad >= 0) return inadmissible(c, bad);
+  fpm_linear_prepare(c->m, c->st, c->lin);
+  return PM_SUCCESS;
+}
+
+static pm_err apply(void *ctx, const double *x, const double *dx, double *dr) {
+  fpm_static_ctx *c = ctx;
+  (void)x;
+  memset(c->du, 0, 3 * c->m->n * sizeof(double));
+  for (long j = 0; j < c->nheld; j++) c->du[c->dof[j]] = dx[j];
+  fpm_force_linear(c->m, c->lin, c->du, c->df);
+  for (long j = 0; j < c->nf; j++) dr[j] = c->df[c->dof[j]];
+  for (long j = c->nf; j < c->nheld; j++) dr[j] = 0;
+  return PM_SUCCESS;
+}
+
+/* The loads at lambda on the model's own points (a condition's value not
+ * finite: the failure, naming its point). */
+static pm_err own_loads(fpm_static_ctx *c, double lambda, long *key) {
+  const fpm_model *m = c->m;
+  /* Proportional loading: the loads at the end of the ramps times lambda
+   * (the path of a rate-independent solid does not depend on the ramps'
+   * shape, and a proportional path is what the predictor extrapolates). */
+  for (long k = 0; k < m->n_cdofs; k++) {
+    double u = fpm_prescribed(m, k, c->load_end);
+    if (!isfinite(u)) {
+      *key = fpm_point_id(m, m->cd_point[k]);
+      return fpm_condition_failure(m, false, k, -1, c->load_end);
+    }
+    c->st->u[3 * m->cd_point[k] + m->cd_comp[k]] = lambda * u;
+  }
+  if (m->n_tfacets > 0) {
+    long bad = fpm_update_tractions(m, c->st, c->load_end);
+    if (bad >= 0) {
+      *key = fpm_point_id(m, m->tf_point[bad / 3]);
+      return fpm_condition_failure(m, true, bad, -1, c->load_end);
+    }
+    for (long k = 0; k < 3 * m->n_tfacets; k++) c->st->tf_value[k] *= lambda;
+    c->st->fext_norm *= lambda;
+  }
+  return PM_SUCCESS;
+}
+
+pm_err fpm_static_set_load(void *ctx, double lambda) {
+  fpm_static_ctx *c = ctx;
+  const fpm_model *m = c->m;
+  c->t = lambda * c->load_end;
+  long key = 0;
+  pm_err e = own_loads(c, lambda, &key);
+  if (m->xc) {
+    /* A rank's failure is every rank's (the one one process meets first);
+     * the ghosts' prescribed values (and, until the solver sets them,
+     * their unknowns') come from their owners. */
+    PM_CALL(fpm_exchange_agree(m->xc, e, key));
+    fpm_exchange_ghosts(m->xc, c->st->u);
+    double sq = c->st->fext_sq; /* the tractions of every rank's points */
+    fpm_exchange_sum(m->xc, &sq, 1);
+    c->st->fext_norm = lambda * sqrt(sq);
+  }
+  return e;
+}
+
+/* The figures of the state in c->st (its force just computed): energies,
+ * the residual over the supports' forces, smallest J; the external work
+ * by the trapezoidal rule from the last converged state. */
+void fpm_static_figures(fpm_static_ctx *c, long step) {
+  const fpm_model *m = c->m;
+  fpm_state *st = c->st;
+  const long n = m->n, n_own = m->n_own;
+  double se = 0, rf = 0, jmin = INFINITY;
+  for (long i = 0; i < n_own; i++) {
+    se += m->dual->volume[i] * st->W[i];
+    jmin = fmin(jmin, st->J[i]);
+    for (int a = 0; a < 3; a++)
+      if (!m->fixed[3 * i + a]) rf += st->f[3 * i + a] * st->f[3 * i + a];
+  }
+  for (long d = 0; d < 3 * n; d++) c->du[d] = st->u[d] - c->u_old[d];
+  double rr;
+  const double work = fpm_support_work(m, st, c->du, 1, &rr);
+  memcpy(c->u_old, st->u, 3 * n * sizeof(double));
+  double bflux = st->bflux_norm, penalty = st->penalty_energy;
+  double sums[6] = {se, rf, rr, work, st->bflux_sq, penalty};
+  if (m->xc) { /* over every rank's own points */
+    fpm_exchange_sum(m->xc, sums, 6);
+    fpm_exchange_min(m->xc, &jmin, 1);
+    se = sums[0], rf = sums[1], rr = sums[2], bflux = sqrt(sums[4]);
+    penalty = sums[5];
+  }
+  *c->ext_work += sums[3];
+  double ref = sqrt(rr) + bflux + st->fext_norm;
+  fpm_step_info *si = &c->si;
+  si->step = step;
+  si->t = c->t;
+  si->kinetic = 0;
+  si->strain = se;
+  si->penalty = penalty;
+  si->external_work = *c->ext_work;
+  si->dissipated = 0;
+  si->residual = ref > 0 ? sqrt(rf) / ref : sqrt(rf);
+  si->damping = 0;
+  si->min_jacobian = jmin;
+  si->energy_error = fpm_energy_error(si);
+  si->energy_checked = false; /* the load path's quadrature, not a check */
+  si->converged = false;
+}
+
+static pm_err on_step(void *ctx, int step, double lambda, const double *x,
+                      const pm_newton_report *report) {
+  fpm_static_ctx *c = ctx;
+  (void)report;
+  c->t = lambda * c->load_end;
+  if (c->m->xc) { /* x: the own unknowns; the ghosts' from their owners */
+    PM_CALL(pm_newton_held_values(c->solver, x, c->held));
+    x = c->held;
+  }
+  PM_CALL(fpm_static_admissible(c, fpm_static_evaluate(c, x)));
+  fpm_static_figures(c, step);
+  c->si.converged = lambda >= 1;
+  c->si.last = c->si.converged;
+  const double jlim = c->m->scene->stability.min_jacobian;
+  if (c->si.min_jacobian <= jlim)
+    return PM_ERROR(PM_ERR_UNSTABLE,
+                    "load step %d (lambda %.6g): smallest volume ratio J = "
+                    "%g <= stability.min_jacobian = %g",
+                    step, lambda, c->si.min_jacobian, jlim);
+  return c->observer ? c->observer(c->octx, c->m, c->st, &c->si, true)
+                     : PM_SUCCESS;
+}
+
+void fpm_static_solve_free(fpm_static_solve *v) {
+  fpm_linear_destroy(v->c.lin);
+  fpm_static_tangent_free(&v->c.tg);
+  free(v->c.dof);
+  free(v->c.ghost);
+  free(v->c.held);
+  free(v->c.du);
+  free(v->c.df);
+  free(v->c.u_old);
+  free(v->free_of);
+  free(v->ptr);
+  free(v->idx);
+  free(v->x);
+  free(v->rigid);
+}
+
+pm_err fpm_static_setup(const fpm_model *m, fpm_state *st,
+                        fpm_static_solve *v) {
+  const long n = m->n;
+  fpm_static_ctx *c = &v->c;
+  c->m = m;
+  c->st = st;
+  c->load_end = pm_scene_load_end(m->scene);
+  PM_CALL(fpm_linear_create(m, &c->lin));
+  PM_CALL(PM_ALLOC(v->free_of, 3 * n, "free dofs"));
+  PM_CALL(PM_ALLOC(c->dof, 3 * n, "free dofs"));
+  PM_CALL(PM_ALLOC(c->du, 3 * n, "displacement increment"));
+  PM_CALL(PM_ALLOC(c->df, 3 * n, "force increment"));
+  PM_CALL(PM_ALLOC(c->u_old, 3 * n, "converged displacement"));
+  for (long d = 0; d < 3 * n; d++) {
+    v->free_of[d] = -1;
+    if (d < 3 * m->n_own && !m->fixed[d]) {
+      v->free_of[d] = c->nf;
+      c->dof[c->nf++] = d;
+    }
+  }
+  c->nheld = c->nf;
+  if (m->xc) PM_CALL(fpm_static_number_ghosts(m, v->free_of, c));
+  long all = c->nf;
+  fpm_exchange_sum_long(m->xc, &all, 1);
+  PM_CHECK(all > 0, PM_ERR_SCENE, "%s: every displacement is prescribed",
+           m->scene->path);
+  PM_CALL(PM_ALLOC(v->x, c->nf + 1, "free displacements"));
+  PM_CALL(PM_ALLOC(c->held, c->nheld + 1, "held displacements"));
+  PM_CALL(
+      fpm_static_pattern(m, v->free_of, c->nheld, &c->tg, &v->ptr, &v->idx));
+  c->pat_ptr = v->ptr;
+  c->free_of = v->free_of;
+  PM_CALL(fpm_static_tangent_build(m, &c->tg));
+  PM_CALL(PM_ALLOC(v->rigid, 6 * c->nf, "rigid motions"));
+  const int n_rigid = fpm_static_rigid_modes(m, c->dof, c->nf, v->rigid);
+  v->prob = (pm_newton_problem){.n = c->nf,
+                                .ctx = c,
+                                .residual = residual,
+                                .jacobian_apply = apply,
+                                .jacobian_prepare = prepare,
+                                .jacobian_values = fpm_static_tangent_values,
+                                .pat_ptr = v->ptr,
+                                .pat_idx = v->idx,
+                                .near_null_count = n_rigid,
+                                .near_null = v->rigid,
+                                .shared = m->xc != NULL,
+                                .n_ghost = c->nheld - c->nf,
+                                .ghost = c->ghost,
+                                .set_load = fpm_static_set_load,
+                                .on_step = on_step};
+  return PM_SUCCESS;
+}

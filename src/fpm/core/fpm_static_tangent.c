@@ -1,0 +1,363 @@
+/* fpm_static_tangent: the tangent of FPM's static solve assembled
+ * directly: its constant parts (the interface and boundary geometry E
+ * gathered by the GFD weights, the penalty's matrix S) built once, and its
+ * values in the Jacobian's pattern at each Newton iteration. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fpm_gfd.h"
+#include "fpm_static_impl.h"
+#include "pm_omp.h"
+
+/* The weight of u_m in H_j for the r-th member of j's closed support
+ * (r = 0: j itself, -gsum_j; else its (r-1)-th neighbour), and that point. */
+static inline long closed_member(const fpm_model *m, long j, long r,
+                                 const double **w) {
+  if (r == 0) {
+    *w = m->gsum + 3 * j;
+    return j;
+  }
+  long e = m->nbr_ptr[j] + r - 1;
+  *w = m->g + 3 * e;
+  return m->nbr[e];
+}
+
+static inline long closed_size(const fpm_model *m, long j) {
+  return m->nbr_ptr[j + 1] - m->nbr_ptr[j] + 1;
+}
+
+void fpm_static_tangent_free(fpm_static_tangent *t) {
+  free(t->R_ptr);
+  free(t->R_list);
+  free(t->E_ptr);
+  free(t->E_j);
+  free(t->E);
+  free(t->S_ptr);
+  free(t->S_m);
+  free(t->S);
+  free(t->Dg);
+  free(t->Dg_ptr);
+  free(t->work);
+  free(t->mark);
+}
+
+/* Adds the 3 x 3 geometry C^c_ij (rows s, columns q) of T_i = sum_j P_j C_ij
+ * for component row c: member r of i's closed support. */
+static void flux_geometry(const fpm_model *m, const long *dpt_of, long i,
+                          long r, int c, double C[9], double cv[3]) {
+  if (r == 0) {
+    const double *Bm = m->p_mrel + 9 * i, *A = m->p_area + 3 * i;
+    for (int a = 0; a < 9; a++) C[a] = -0.5 * Bm[a];
+    for (int a = 0; a < 3; a++) {
+      C[4 * a] += m->dual->volume[i];
+      cv[a] = -0.5 * A[a];
+    }
+    long p = dpt_of[i];
+    if (p >= 0) {
+      const double *Ac = m->dpt_area + 9 * p + 3 * c,
+                   *Bc = m->dpt_mrel + 27 * p + 9 * c;
+      for (int a = 0; a < 9; a++) C[a] -= Bc[a];
+      for (int a = 0; a < 3; a++) cv[a] -= Ac[a];
+    }
+    return;
+  }
+  const double *rec = m->erec + FPM_EREC * (m->nbr_ptr[i] + r - 1);
+  const double *a = rec, *Mc = rec + 3, *di = rec + 12;
+  for (int s = 0; s < 3; s++) {
+    cv[s] = -0.5 * a[s];
+    for (int q = 0; q < 3; q++)
+      C[3 * s + q] = -0.5 * (Mc[3 * s + q] + a[s] * di[q]);
+  }
+}
+
+/* E: per point k, the points j whose stress reaches f_k, with
+ * E^c_kj[s] = sum_i C^c_ij[s] . gamma_ik + c^c_kj[s]. */
+static pm_err build_E(const fpm_model *m, fpm_static_tangent *t) {
+  pm_err ret = PM_SUCCESS;
+  const long n = m->n, rows = m->n_own; /* (rows: the own points') */
+  long *mark = NULL, *list = NULL, *dpt_of = NULL;
+  PM_TRY(PM_ALLOC(mark, n, "tangent marks"));
+  PM_TRY(PM_ALLOC(list, n, "tangent lists"));
+  PM_TRY(PM_ALLOC(dpt_of, n, "prescribed-face points"));
+  PM_TRY(PM_ALLOC(t->E_ptr, n + 1, "tangent geometry"));
+  for (long i = 0; i < n; i++) mark[i] = dpt_of[i] = -1;
+  for (long p = 0; p < m->n_dpts; p++) dpt_of[m->dpt_point[p]] = p;
+  for (int pass = 0; pass < 2; pass++) {
+    for (long k = 0; k < rows; k++) {
+      long cnt = 0;
+      /* i over k's closed support: gamma_ik is the weight of u_k in H_i */
+      for (long ri = 0; ri < closed_size(m, k); ri++) {
+        const double *dummy;
+        long i = closed_member(m, k, ri, &dummy);
+        for (long rj = 0; rj < closed_size(m, i); rj++) {
+          long j = closed_member(m, i, rj, &dummy);
+          if (mark[j] < 0) {
+            mark[j] = cnt;
+            list[cnt++] = j;
+          }
+        }
+      }
+      if (pass == 1) {
+        double *E = t->E + 9 * t->E_ptr[k];
+        for (long a = 0; a < cnt; a++) t->E_j[t->E_ptr[k] + a] = list[a];
+        for (long ri = 0; ri < closed_size(m, k); ri++) {
+          const double *w;
+          long i = closed_member(m, k, ri, &w);
+          double gik[3];
+          if (ri == 0)
+            for (int a = 0; a < 3; a++) gik[a] = -w[a];
+          else {
+            const double *g = m->g + 3 * m->mirror[m->nbr_ptr[k] + ri - 1];
+            for (int a = 0; a < 3; a++) gik[a] = g[a];
+          }
+          for (long rj = 0; rj < closed_size(m, i); rj++) {
+            const double *dummy;
+            long j = closed_member(m, i, rj, &dummy);
+            double *Ekj = E + 9 * mark[j];
+            for (int c = 0; c < 3; c++) {
+              double C[9], cv[3];
+              flux_geometry(m, dpt_of, i, rj, c, C, cv);
+              for (int s2 = 0; s2 < 3; s2++)
+                Ekj[3 * c + s2] += C[3 * s2] * gik[0] + C[3 * s2 + 1] * gik[1] +
+                                   C[3 * s2 + 2] * gik[2];
+            }
+          }
+        }
+        /* r_k = sum_j P_j c_kj over k's closed support */
+        for (long rj = 0; rj < closed_size(m, k); rj++) {
+          const double *dummy;
+          long j = closed_member(m, k, rj, &dummy);
+          for (int c = 0; c < 3; c++) {
+            double C[9], cv[3];
+            flux_geometry(m, dpt_of, k, rj, c, C, cv);
+            for (int s2 = 0; s2 < 3; s2++)
+              E[9 * mark[j] + 3 * c + s2] += cv[s2];
+          }
+        }
+      } else {
+        t->E_ptr[k + 1] = cnt;
+      }
+      for (long a = 0; a < cnt; a++) mark[list[a]] = -1;
+    }
+    if (pass == 0) {
+      for (long k = 0; k < rows; k++) t->E_ptr[k + 1] += t->E_ptr[k];
+      PM_TRY(PM_ALLOC(t->E_j, t->E_ptr[rows] + 1, "tangent geometry"));
+      PM_TRY(PM_ALLOC(t->E, 9 * t->E_ptr[rows] + 1, "tangent geometry"));
+    }
+  }
+done:
+  free(mark);
+  free(list);
+  free(dpt_of);
+  return ret;
+}
+
+/* The penalty's reconstruction weight of u_x in point i's field at offset
+ * d (linear: H_i d; quadratic: theta_i phi(d)), for the r-th member of
+ * i's reconstruction support; returns the member's point. */
+static long recon_member(const fpm_model *m, long i, long r, const double d[3],
+                         double *w) {
+  if (m->q) {
+    double phi[FPM_QFIT];
+    fpm_gfd_phi(d, phi);
+    const double *q;
+    long x;
+    if (r == 0) {
+      q = m->qsum + FPM_QFIT * i;
+      x = i;
+    } else {
+      q = m->q + FPM_QFIT * (m->qs_ptr[i] + r - 1);
+      x = m->qs_nbr[m->qs_ptr[i] + r - 1];
+    }
+    double v = 0;
+    for (int a = 0; a < FPM_QFIT; a++) v += q[a] * phi[a];
+    *w = r == 0 ? -v : v;
+    return x;
+  }
+  const double *g;
+  long x = closed_member(m, i, r, &g);
+  double v = g[0] * d[0] + g[1] * d[1] + g[2] * d[2];
+  *w = r == 0 ? -v : v;
+  return x;
+}
+
+static long recon_size(const fpm_model *m, long i) {
+  return m->q ? m->qs_ptr[i + 1] - m->qs_ptr[i] + 1 : closed_size(m, i);
+}
+
+/* S: the penalty's scalar matrix, S_km = sum_i sum_(e of i) beta_e
+ * t_ek J_em with [[u]]_e = sum_m J_em u_m and t_ek = d[[u]]_e / d u_k
+ * through point i's side only (the force of the side's own field). */
+static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
+  pm_err ret = PM_SUCCESS;
+  const long n = m->n, rows = m->n_own;
+  long *mark = NULL, *list = NULL;
+  double *acc = NULL;
+  PM_TRY(PM_ALLOC(mark, n, "penalty marks"));
+  PM_TRY(PM_ALLOC(list, n, "penalty lists"));
+  PM_TRY(PM_ALLOC(acc, n, "penalty row"));
+  PM_TRY(PM_ALLOC(t->S_ptr, n + 1, "penalty matrix"));
+  for (long i = 0; i < n; i++) mark[i] = -1;
+  for (int pass = 0; pass < 2; pass++) {
+    for (long k = 0; k < rows; k++) {
+      long cnt = 0;
+      /* the points i whose own field at their interfaces moves with u_k:
+       * k itself and those whose reconstruction holds k */
+      long ni = m->q ? 1 + m->qt_ptr[k + 1] - m->qt_ptr[k] : closed_size(m, k);
+      for (long ii = 0; ii < ni; ii++) {
+        long i;
+        if (ii == 0)
+          i = k;
+        else if (m->q)
+          i = m->qs_own[m->qt_entry[m->qt_ptr[k] + ii - 1]];
+        else
+          i = m->nbr[m->nbr_ptr[k] + ii - 1];
+        for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+          const double *rec = m->erec + FPM_EREC * e;
+          const double *di = rec + 12, *dk = rec + 15, be = rec[18];
+          const long kk = m->nbr[e];
+          /* t_ek: k's weight in u_i + recon_i(d_i) */
+          double tk = 0;
+          for (long r = 0; r < recon_size(m, i); r++) {
+            double w;
+            if (recon_member(m, i, r, di, &w) == k) tk += w;
+          }
+          if (k == i) tk += 1;
+          if (tk == 0 || be == 0) continue;
+          /* J_em over both sides */
+          for (int side = 0; side < 2; side++) {
+            long p = side ? kk : i;
+            double sign = side ? -1 : 1;
+            const double *d = side ? dk : di;
+            for (long r = 0; r < recon_size(m, p); r++) {
+              double w;
+              long x = recon_member(m, p, r, d, &w);
+              if (r == 0) w += 1;
+              if (mark[x] < 0) {
+                mark[x] = cnt;
+                list[cnt++] = x;
+                acc[mark[x]] = 0;
+              }
+              acc[mark[x]] += be * tk * sign * w;
+            }
+          }
+        }
+      }
+      if (pass == 0)
+        t->S_ptr[k + 1] = cnt;
+      else
+        for (long a = 0; a < cnt; a++) {
+          t->S_m[t->S_ptr[k] + a] = list[a];
+          t->S[t->S_ptr[k] + a] = acc[a];
+        }
+      for (long a = 0; a < cnt; a++) mark[list[a]] = -1;
+    }
+    if (pass == 0) {
+      for (long k = 0; k < rows; k++) t->S_ptr[k + 1] += t->S_ptr[k];
+      PM_TRY(PM_ALLOC(t->S_m, t->S_ptr[rows] > 0 ? t->S_ptr[rows] : 1,
+                      "penalty matrix"));
+      PM_TRY(PM_ALLOC(t->S, t->S_ptr[rows] > 0 ? t->S_ptr[rows] : 1,
+                      "penalty matrix"));
+    }
+  }
+done:
+  free(mark);
+  free(list);
+  free(acc);
+  return ret;
+}
+
+/* Rows are the own points' (a share's; all on one process), the products
+ * D gamma those of the points whose stress they read. */
+pm_err fpm_static_tangent_build(const fpm_model *m, fpm_static_tangent *t) {
+  const long n = m->n, ns = m->n_stress;
+  PM_CALL(build_E(m, t));
+  PM_CALL(build_S(m, t));
+  PM_CALL(PM_ALLOC(t->Dg_ptr, ns + 1, "tangent products"));
+  for (long j = 0; j < ns; j++)
+    t->Dg_ptr[j + 1] = t->Dg_ptr[j] + closed_size(m, j);
+  PM_CALL(PM_ALLOC(t->Dg, 27 * t->Dg_ptr[ns], "tangent products"));
+  t->max_reach = 0;
+  for (long k = 0; k < m->n_own; k++)
+    if (t->R_ptr[k + 1] - t->R_ptr[k] > t->max_reach)
+      t->max_reach = t->R_ptr[k + 1] - t->R_ptr[k];
+  t->threads = pm_omp_threads();
+  PM_CALL(PM_ALLOC(t->mark, (size_t)t->threads * n, "tangent marks"));
+  for (long a = 0; a < (long)t->threads * n; a++) t->mark[a] = -1;
+  PM_CALL(PM_ALLOC(t->work, (size_t)t->threads * 9 * t->max_reach,
+                   "tangent blocks"));
+  return PM_SUCCESS;
+}
+
+pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
+  fpm_static_ctx *c = ctx;
+  (void)x;
+  const fpm_model *m = c->m;
+  fpm_static_tangent *t = &c->tg;
+  const long n = m->n, ns = m->n_stress, rows = m->n_own;
+  const double *D = fpm_linear_tangent(c->lin);
+  /* D_j gamma_jm for every j (whose stress the rows read) and member m of
+   * its closed support */
+  PM_OMP(parallel for schedule(static) default(none) shared(ns, m, t, D))
+  for (long j = 0; j < ns; j++) {
+    const double *Dj = D + 81 * j;
+    for (long r = 0; r < closed_size(m, j); r++) {
+      const double *w;
+      closed_member(m, j, r, &w);
+      double g[3] = {w[0], w[1], w[2]};
+      if (r == 0) g[0] = -g[0], g[1] = -g[1], g[2] = -g[2];
+      double *out = t->Dg + 27 * (t->Dg_ptr[j] + r);
+      for (int row = 0; row < 9; row++)
+        for (int a = 0; a < 3; a++)
+          out[3 * row + a] = Dj[9 * row + 3 * a] * g[0] +
+                             Dj[9 * row + 3 * a + 1] * g[1] +
+                             Dj[9 * row + 3 * a + 2] * g[2];
+    }
+  }
+  const long *free_of = c->free_of, *pat = c->pat_ptr;
+  PM_OMP(parallel default(none) shared(n, rows, m, t, free_of, pat, val)) {
+    int th = 0;
+#ifdef _OPENMP
+    th = omp_get_thread_num();
+#endif
+    long *mark = t->mark + (size_t)th * n;
+    double *blk = t->work + (size_t)th * 9 * t->max_reach;
+    PM_OMP(for schedule(dynamic, 16))
+    for (long k = 0; k < rows; k++) {
+      const long r0 = t->R_ptr[k], nr = t->R_ptr[k + 1] - r0;
+      for (long a = 0; a < nr; a++) mark[t->R_list[r0 + a]] = a;
+      for (long a = 0; a < 9 * nr; a++) blk[a] = 0;
+      for (long q = t->E_ptr[k]; q < t->E_ptr[k + 1]; q++) {
+        const long j = t->E_j[q];
+        const double *E = t->E + 9 * q;
+        for (long r = 0; r < closed_size(m, j); r++) {
+          const double *w;
+          long mm = closed_member(m, j, r, &w);
+          const double *Dg = t->Dg + 27 * (t->Dg_ptr[j] + r);
+          double *b = blk + 9 * mark[mm];
+          for (int cc = 0; cc < 3; cc++)
+            for (int a = 0; a < 3; a++)
+              b[3 * cc + a] += E[3 * cc] * Dg[3 * (3 * cc) + a] +
+                               E[3 * cc + 1] * Dg[3 * (3 * cc + 1) + a] +
+                               E[3 * cc + 2] * Dg[3 * (3 * cc + 2) + a];
+        }
+      }
+      for (long q = t->S_ptr[k]; q < t->S_ptr[k + 1]; q++) {
+        double *b = blk + 9 * mark[t->S_m[q]];
+        for (int cc = 0; cc < 3; cc++) b[4 * cc] += t->S[q];
+      }
+      for (int cc = 0; cc < 3; cc++) {
+        long row = free_of[3 * k + cc];
+        if (row < 0) continue;
+        long w = pat[row];
+        for (long a = 0; a < nr; a++)
+          for (int b = 0; b < 3; b++)
+            if (free_of[3 * t->R_list[r0 + a] + b] >= 0)
+              val[w++] = blk[9 * a + 3 * cc + b];
+      }
+      for (long a = 0; a < nr; a++) mark[t->R_list[r0 + a]] = -1;
+    }
+  }
+  return PM_SUCCESS;
+}

@@ -1,0 +1,211 @@
+/* fpm_share: the partition of the points (MatPartitioning) and the choice
+ * of a rank's share of an FPM model, its own points and ghosts in pass
+ * order (the model of them is fpm_model_subset's). */
+#include "fpm_share.h"
+
+#include <petscmat.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_petsc.h"
+
+/* ---- partition ------------------------------------------------------------
+ */
+
+pm_err fpm_partition(const fpm_model *m, int parts, int *owner) {
+  pm_err ret = PM_SUCCESS;
+  const long n = m->n, nnz = m->nbr_ptr[m->n];
+  Mat adj = NULL;
+  MatPartitioning part = NULL;
+  IS is = NULL;
+  PetscInt *ia = NULL, *ja = NULL, *w = NULL;
+  memset(owner, 0, sizeof(int) * (size_t)n);
+  if (parts <= 1) return PM_SUCCESS;
+  PM_CALL(pm_petsc_init());
+  /* PT-Scotch's threads take turns in an order that varies from run to
+   * run, and so did its partitions (3 different ones in 6 runs of the
+   * same graph); on one thread it gives the same partition every time. */
+  setenv("SCOTCH_PTHREAD_NUMBER", "1", 1);
+  PM_PETSC(PetscMalloc1(n + 1, &ia));
+  PM_PETSC(PetscMalloc1(nnz + 1, &ja));
+  PM_PETSC(PetscMalloc1(n + 1, &w));
+  for (long i = 0; i <= n; i++) ia[i] = (PetscInt)m->nbr_ptr[i];
+  for (long e = 0; e < nnz; e++) ja[e] = (PetscInt)m->nbr[e];
+  for (long i = 0; i < n; i++)
+    w[i] = (PetscInt)(1 + m->nbr_ptr[i + 1] - m->nbr_ptr[i] +
+                      (m->qs_ptr ? m->qs_ptr[i + 1] - m->qs_ptr[i] : 0));
+  /* The adjacency and the weights are PETSc's from here. */
+  PetscInt *a = ia, *b = ja;
+  ia = ja = NULL;
+  PM_PETSC(MatCreateMPIAdj(PETSC_COMM_SELF, (PetscInt)n, (PetscInt)n, a, b,
+                           NULL, &adj));
+  PM_PETSC(MatPartitioningCreate(PETSC_COMM_SELF, &part));
+  PM_PETSC(MatPartitioningSetAdjacency(part, adj));
+  PM_PETSC(MatPartitioningSetType(part, MATPARTITIONINGPTSCOTCH));
+  PM_PETSC(MatPartitioningSetNParts(part, (PetscInt)parts));
+  PetscInt *weights = w;
+  w = NULL;
+  PM_PETSC(MatPartitioningSetVertexWeights(part, weights));
+  PM_PETSC(MatPartitioningSetFromOptions(part));
+  PM_PETSC(MatPartitioningApply(part, &is));
+  const PetscInt *to;
+  PM_PETSC(ISGetIndices(is, &to));
+  for (long i = 0; i < n; i++) owner[i] = (int)to[i];
+  PM_PETSC(ISRestoreIndices(is, &to));
+done:
+  ISDestroy(&is);
+  MatPartitioningDestroy(&part);
+  MatDestroy(&adj);
+  PetscFree(ia);
+  PetscFree(ja);
+  PetscFree(w);
+  return ret;
+}
+
+long fpm_partition_edge_cut(const fpm_model *m, const int *owner) {
+  long cut = 0;
+  for (long i = 0; i < m->n; i++)
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
+      cut += m->nbr[e] > i && owner[m->nbr[e]] != owner[i];
+  return cut;
+}
+
+/* ---- a rank's share ---------------------------------------------------------
+ */
+
+/* Levels of the points a share holds: its own, and the ghosts whose flux,
+ * stress or displacement it reads; NONE for the others. */
+enum { OWN = 0, FLUX = 1, STRESS = 2, DISPLACEMENT = 3, NONE = 4 };
+
+/* Mark `to` on the points not yet held that the points of level `from` or
+ * lower read: their supports, and for displacement ghosts also the points
+ * of their fits. */
+static void mark_support(const fpm_model *m, signed char *level, int from,
+                         int to) {
+  for (long i = 0; i < m->n; i++) {
+    if (level[i] > from) continue;
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
+      if (level[m->nbr[e]] == NONE) level[m->nbr[e]] = (signed char)to;
+    if (to != DISPLACEMENT || !m->qs_ptr) continue;
+    for (long e = m->qs_ptr[i]; e < m->qs_ptr[i + 1]; e++)
+      if (level[m->qs_nbr[e]] == NONE) level[m->qs_nbr[e]] = DISPLACEMENT;
+  }
+}
+
+/* Each point's level in rank r's share. */
+static void share_levels(const fpm_model *m, const int *owner, int r,
+                         signed char *level) {
+  for (long i = 0; i < m->n; i++) level[i] = owner[i] == r ? OWN : NONE;
+  /* The gather of an own point reads its support's flux, and with the
+   * quadratic jump that of every fit holding it. */
+  mark_support(m, level, OWN, FLUX);
+  if (m->qs_ptr)
+    for (long k = 0; k < m->n; k++) {
+      if (level[k] != OWN) continue;
+      for (long t = m->qt_ptr[k]; t < m->qt_ptr[k + 1]; t++) {
+        const long i = m->qs_own[m->qt_entry[t]];
+        if (level[i] == NONE) level[i] = FLUX;
+      }
+    }
+  mark_support(m, level, FLUX, STRESS);
+  mark_support(m, level, STRESS, DISPLACEMENT);
+}
+
+pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
+                        fpm_model **out) {
+  pm_err ret = PM_SUCCESS;
+  signed char *level = NULL;
+  long *gid = NULL;
+  *out = NULL;
+  PM_TRY(PM_ALLOC(level, m->n + 1, "share's points"));
+  share_levels(m, owner, r, level);
+  long count[NONE + 1] = {0};
+  for (long i = 0; i < m->n; i++) count[level[i]]++;
+  fpm_points pts = {.n_own = count[OWN]};
+  pts.n_flux = pts.n_own + count[FLUX];
+  pts.n_stress = pts.n_flux + count[STRESS];
+  pts.n = pts.n_stress + count[DISPLACEMENT];
+  PM_TRY(PM_ALLOC(gid, pts.n + 1, "share's point indices"));
+  long at = 0;
+  for (int lv = OWN; lv < NONE; lv++)
+    for (long i = 0; i < m->n; i++)
+      if (level[i] == lv) gid[at++] = i;
+  pts.gid = gid;
+  PM_TRY(fpm_model_subset(m, &pts, out));
+done:
+  free(level);
+  free(gid);
+  return ret;
+}
+
+void fpm_share_count(const fpm_model *s, fpm_share_counts *c) {
+  c->own = s->n_own;
+  c->flux_ghosts = s->n_flux - s->n_own;
+  c->stress_ghosts = s->n_stress - s->n_flux;
+  c->u_ghosts = s->n - s->n_stress;
+  c->bytes = (double)(fpm_model_bytes(s) + fpm_state_bytes(s));
+}
+
+/* ---- plan ------------------------------------------------------------------
+ */
+
+void fpm_share_print(const fpm_model *m, const int *owner, int parts,
+                     const fpm_share_counts *c, FILE *out) {
+  long most = 0, ghosts = 0, most_ghosts = 0;
+  for (int r = 0; r < parts; r++) {
+    const long g = c[r].flux_ghosts + c[r].stress_ghosts + c[r].u_ghosts;
+    most = c[r].own > most ? c[r].own : most;
+    most_ghosts = g > most_ghosts ? g : most_ghosts;
+    ghosts += g;
+  }
+  fprintf(out,
+          "ranks        %d: points by PT-Scotch on the support graph "
+          "(MatPartitioning), %s\n"
+          "             %ld support pairs cut of %ld; points per rank %ld at "
+          "most (imbalance %.3f: the most over the mean)\n",
+          parts,
+          m->qs_ptr ? "ghosts to 3 rings of support, 5 where the quadratic "
+                      "fits take two"
+                    : "ghosts to 3 rings of support",
+          fpm_partition_edge_cut(m, owner), m->nbr_ptr[m->n] / 2, most,
+          m->n > 0 ? most * (double)parts / m->n : 0.0);
+  if (parts <= 16) {
+    fprintf(out, "             rank  points  ghosts (flux + stress + "
+                 "displacement)  memory\n");
+    for (int r = 0; r < parts; r++)
+      fprintf(out, "             %4d  %6ld  %6ld (%ld + %ld + %ld)  %.1f MiB\n",
+              r, c[r].own,
+              c[r].flux_ghosts + c[r].stress_ghosts + c[r].u_ghosts,
+              c[r].flux_ghosts, c[r].stress_ghosts, c[r].u_ghosts,
+              c[r].bytes / 1048576.0);
+  }
+  fprintf(out,
+          "             ghost points per rank %.0f on average, %ld at most: a "
+          "rank receives their displacements, %.0f bytes per step on "
+          "average, %.0f at most\n",
+          (double)ghosts / parts, most_ghosts,
+          3.0 * sizeof(double) * ghosts / parts,
+          3.0 * sizeof(double) * most_ghosts);
+}
+
+pm_err fpm_share_predict(const fpm_model *m, int parts, FILE *out) {
+  pm_err ret = PM_SUCCESS;
+  int *owner = NULL;
+  fpm_share_counts *c = NULL;
+  fpm_model *s = NULL;
+  PM_TRY(PM_ALLOC(owner, m->n + 1, "partition"));
+  PM_TRY(PM_ALLOC(c, parts, "shares"));
+  PM_TRY(fpm_partition(m, parts, owner));
+  for (int r = 0; r < parts; r++) {
+    PM_TRY(fpm_share_create(m, owner, r, &s));
+    fpm_share_count(s, &c[r]);
+    fpm_model_destroy(s);
+    s = NULL;
+  }
+  fpm_share_print(m, owner, parts, c, out);
+done:
+  fpm_model_destroy(s);
+  free(owner);
+  free(c);
+  return ret;
+}
