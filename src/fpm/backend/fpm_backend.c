@@ -192,6 +192,7 @@ static pm_err create(const pm_scene *s, void **out) {
     fpm_sim_destroy(sim);
     return e;
   }
+  fpm_backend_view_init(sim);
   *out = sim;
   return PM_SUCCESS;
 }

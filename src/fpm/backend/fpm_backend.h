@@ -12,6 +12,7 @@
 #include "gm_cells.h"
 #include "gm_dual.h"
 #include "pm_backend.h"
+#include "pm_view.h"
 #include "pm_progress.h"
 #include "pm_scene.h"
 
@@ -42,11 +43,11 @@ typedef struct {
   fpm_step_info last;      /* the last step's figures */
   double run_min_jacobian; /* smallest J seen at any step of the run */
   long run_min_jacobian_step;
-  double run_max_energy_error;     /* largest |energy-balance error| over the
-                                      steps where it is checked */
-  const pm_observer *obs;          /* during a run */
-  double res0;                     /* first residual after the ramps */
-  double load_end;                 /* when every ramp has ended, s */
+  double run_max_energy_error; /* largest |energy-balance error| over the
+                                  steps where it is checked */
+  pm_view view;    /* the run's observer, and rank 0's view across ranks */
+  double res0;     /* first residual after the ramps */
+  double load_end; /* when every ramp has ended, s */
   fpm_static_report static_report; /* time.quasi_static.method: static */
   fpm_static_state static_state;   /* its load stepping (a checkpoint's) */
   bool resumed;                    /* the state came from a checkpoint */

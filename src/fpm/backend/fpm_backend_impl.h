@@ -11,8 +11,10 @@
 #include "pm_backend.h"
 #include "pm_files.h"
 
-/* fpm_backend_run.c: the time loop or static solve (pm_backend.run). */
+/* fpm_backend_run.c: the time loop or static solve (pm_backend.run), and
+ * the run's view (pm_view; across ranks when sim has a share). */
 pm_err fpm_backend_run(void *p, const pm_observer *obs);
+void fpm_backend_view_init(fpm_sim *sim);
 
 /* fpm_backend_figures.c: the points, fields, figures, history columns and
  * summary of the run (pm_backend's entries of those names). */

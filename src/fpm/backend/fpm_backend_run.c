@@ -107,17 +107,15 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
   (void)m;
   (void)st;
   pm_step_report r = note_step(sim, info);
-  if (sim->local_model)
-    return pm_observer_share(sim->obs, &r, frame, gather, sim);
-  return sim->obs ? sim->obs->step(sim->obs->ctx, &r, frame) : PM_SUCCESS;
+  return pm_view_step(&sim->view, &r, frame);
 }
 
 /* ---- across ranks ---- */
 
 /* Across ranks, once the run starts: the whole model stays on rank 0 as
- * its view of the run; the other ranks let it go. */
-static void release_view(fpm_sim *sim) {
-  if (pm_par_root()) return;
+ * its view of the run; the other ranks let it go (pm_view.release). */
+static void release_view(void *ctx) {
+  fpm_sim *sim = ctx;
   fpm_state_destroy(sim->state);
   fpm_model_destroy(sim->model);
   gm_dual_destroy(sim->dual);
@@ -143,6 +141,13 @@ static void ranks_costs(fpm_sim *sim) {
   memcpy(sim->ranks_costs + 2, most, sizeof most);
 }
 
+void fpm_backend_view_init(fpm_sim *sim) {
+  sim->view = (pm_view){.ranks = sim->local_model != NULL,
+                        .ctx = sim,
+                        .gather = gather,
+                        .release = release_view};
+}
+
 pm_err fpm_backend_run(void *p, const pm_observer *obs) {
   fpm_sim *sim = p;
   const pm_scene *s = sim->scene;
@@ -163,13 +168,13 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
   fpm_model *lm = sim->local_model ? sim->local_model : m;
   fpm_state *st = sim->local_model ? sim->local_state : sim->state;
   const bool is_static = s->time.qs == PM_QS_STATIC;
-  if (sim->local_model) {
-    if (sim->resumed && is_static)
+  if (sim->local_model && sim->resumed) {
+    if (is_static)
       scatter_static(sim);
-    else if (sim->resumed)
+    else
       fpm_par_scatter(lm, sim->state, st);
-    release_view(sim);
   }
+  pm_view_start(&sim->view, obs);
   if (!sim->resumed) { /* a resumed run has these from its checkpoint */
     if (!is_static || !sim->local_model)
       memset(st->u, 0, 3 * lm->n * sizeof(double));
@@ -181,7 +186,6 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
     sim->res0 = 0;
   }
   sim->load_end = pm_scene_load_end(s);
-  sim->obs = obs;
   double stage[2] = {0, 0};
   pm_err e;
   if (is_static) {
@@ -191,12 +195,8 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
         lm, st, sim->local_model ? &sim->local_static : &sim->static_state,
         observe, sim, &sim->last, r);
     double wall = pm_wtime() - w0;
-    if (sim->local_model) { /* the state the run ended in, for the figures */
-      pm_err g = gather(sim);
-      if (!e) e = g;
-      ranks_costs(sim);
-    }
-    sim->obs = NULL;
+    e = pm_view_end(&sim->view, e); /* the state it ended in, for figures */
+    if (sim->local_model) ranks_costs(sim);
     pm_stage *tm = sim->timers.stage;
     tm[sim->tm_force].seconds += r->load.time_residual;
     tm[sim->tm_force].calls += r->load.newton_iterations;
@@ -212,12 +212,8 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
   }
   sim->first_step = st->step;
   e = fpm_run(lm, st, &opt, observe, sim, &sim->last, stage);
-  if (sim->local_model) { /* the state the run ended in, for the figures */
-    pm_err g = gather(sim);
-    if (!e) e = g;
-    ranks_costs(sim);
-  }
-  sim->obs = NULL;
+  e = pm_view_end(&sim->view, e); /* the state it ended in, for figures */
+  if (sim->local_model) ranks_costs(sim);
   sim->timers.stage[sim->tm_force].seconds += stage[0];
   sim->timers.stage[sim->tm_force].calls += sim->last.step + 1;
   sim->timers.stage[sim->tm_update].seconds += stage[1];
