@@ -115,6 +115,18 @@ pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
 /* Release a model (NULL accepted); its states and workspaces first. */
 void mpm_model_destroy(mpm_model *m);
 
+/* The model of whole model m's particles sel[0..n) (one-process indices,
+ * increasing), on grid block `grid` (a copy of m's grid's geometry shifted
+ * to a block of it), for scene s: their constants, with room for room(n)
+ * particles and each group room(its count); every group set up by its
+ * kind; the bodies, the conditions on the block, the moving bodies and the
+ * pipeline.  The body ranges (which follow the particles) and the exchange
+ * are the caller's to set (a rank's share, src/mpm/ranks).  PM_ERR_MEMORY,
+ * or a kind's or the conditions' failure; *out NULL then. */
+pm_err mpm_model_subset(const pm_scene *s, const mpm_model *m,
+                        const mpm_grid *grid, const long *sel, long n,
+                        long (*room)(long), mpm_model **out);
+
 /* Triangles [t0, t1) of m with their corners counted from particle
  * `first` (a group's or a body's surface as gm_trisurf wants it): a new
  * array of 3 (t1 - t0) indices the caller frees.  PM_ERR_MEMORY. */

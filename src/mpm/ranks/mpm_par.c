@@ -175,87 +175,42 @@ static pm_err local_model(const pm_scene *s, const mpm_model *m,
                           mpm_model **out) {
   pm_err ret = PM_SUCCESS;
   mpm_model *lm = NULL;
+  long *sel = NULL;
   *out = NULL;
-  PM_TRY(PM_ALLOC(lm, 1, "MPM model (this rank's)"));
-  lm->opt = m->opt;
-  lm->dim = m->dim;
-  memcpy(lm->box_min, m->box_min, sizeof lm->box_min);
-  memcpy(lm->box_max, m->box_max, sizeof lm->box_max);
-  lm->layout = m->layout;
-  PM_TRY(local_grid(P, &m->grid, &lm->grid));
-  PM_TRY(make_ghosts(P, &m->grid, &lm->grid));
+  mpm_grid grid;
+  PM_TRY(local_grid(P, &m->grid, &grid));
+  PM_TRY(make_ghosts(P, &m->grid, &grid));
   /* The particles in this rank's cells now (at the start, or where a
    * resumed run's checkpoint has them). */
   long n = 0;
   for (long p = 0; p < m->n; p++)
     n += mpm_decomp_rank_at(&P->d, &m->grid, st->x + 3 * p) == P->rank;
-  lm->n = n;
-  lm->cap = mpm_par_room_for(n);
-  PM_TRY(PM_ALLOC(lm->x0, 3 * lm->cap, "particle positions"));
-  PM_TRY(PM_ALLOC(lm->mass, lm->cap, "particle masses"));
-  PM_TRY(PM_ALLOC(lm->vol0, lm->cap, "particle volumes"));
-  PM_TRY(PM_ALLOC(lm->gid, lm->cap, "particle indices"));
-  long k = 0;
-  for (long p = 0; p < m->n; p++) {
-    if (mpm_decomp_rank_at(&P->d, &m->grid, st->x + 3 * p) != P->rank) continue;
-    lm->gid[k] = p;
-    for (int c = 0; c < 3; c++) lm->x0[3 * k + c] = m->x0[3 * p + c];
-    lm->mass[k] = m->mass[p];
-    lm->vol0[k] = m->vol0[p];
-    k++;
-  }
-  /* Groups and bodies: ranges of the one-process indices. */
-  lm->n_groups = m->n_groups;
-  lm->kinds = m->kinds;
-  long at = 0;
+  PM_TRY(PM_ALLOC(sel, n + 1, "this rank's particles"));
+  for (long p = 0, k = 0; p < m->n; p++)
+    if (mpm_decomp_rank_at(&P->d, &m->grid, st->x + 3 * p) == P->rank)
+      sel[k++] = p;
+  PM_TRY(mpm_model_subset(s, m, &grid, sel, n, mpm_par_room_for, &lm));
+  /* The whole model's group and body ranges, which migration keeps. */
   for (int gi = 0; gi < m->n_groups; gi++) {
     const mpm_group *fg = &m->group[gi];
-    mpm_group *g = &lm->group[gi];
     P->gbegin[gi] = fg->begin;
     P->gend[gi] = fg->end;
-    *g = (mpm_group){.index = fg->index,
-                     .material = fg->material,
-                     .name = fg->name,
-                     .kind = fg->kind,
-                     .c0 = fg->c0,
-                     .c1 = fg->c1};
-    g->begin = at;
-    while (at < n && lm->gid[at] < fg->end) at++;
-    g->end = at;
-    g->cap = mpm_par_room_for(g->end - g->begin);
-    PM_TRY(g->kind->setup(g, &s->materials[g->material], &lm->opt));
-    if (g->kind->ranks_share) PM_TRY(g->kind->ranks_share(fg, g));
+    if (fg->kind->ranks_share)
+      PM_TRY(fg->kind->ranks_share(fg, &lm->group[gi]));
   }
-  lm->n_bodies = m->n_bodies;
   P->n_full = m->n;
   PM_TRY(PM_ALLOC(P->bbegin, m->n_bodies + 1, "body ranges"));
   PM_TRY(PM_ALLOC(P->bend, m->n_bodies + 1, "body ranges"));
-  PM_TRY(PM_ALLOC(lm->body_begin, m->n_bodies + 1, "body ranges"));
-  PM_TRY(PM_ALLOC(lm->body_end, m->n_bodies + 1, "body ranges"));
-  PM_TRY(PM_ALLOC(lm->body_tri_begin, m->n_bodies + 1, "body ranges"));
-  PM_TRY(PM_ALLOC(lm->body_tri_end, m->n_bodies + 1, "body ranges"));
-  PM_TRY(PM_ALLOC(lm->body_links, m->n_bodies + 1, "body links"));
-  PM_TRY(PM_ALLOC(lm->body_normals, m->n_bodies + 1, "body normals"));
   for (int b = 0; b < m->n_bodies; b++) {
     P->bbegin[b] = m->body_begin[b];
     P->bend[b] = m->body_end[b];
-    lm->body_links[b] = m->body_links[b];
-    lm->body_normals[b] = m->body_normals[b];
   }
-  PM_TRY(mpm_conditions_create(s, &lm->grid, &lm->bcs, &lm->n_bcs));
-  lm->has_absorbing = m->has_absorbing;
-  /* Bodies moving as prescribed: their ranges are set with the bodies'. */
-  if (m->n_moving > 0) {
-    PM_TRY(PM_ALLOC(lm->moving, m->n_moving, "moving bodies"));
-    memcpy(lm->moving, m->moving, sizeof *m->moving * (size_t)m->n_moving);
-    lm->n_moving = m->n_moving;
-  }
-  mpm_pipeline_build(lm);
   lm->xc = &P->xc;
   mpm_par_set_ranges(lm, NULL);
   *out = lm;
   lm = NULL;
 done:
+  free(sel);
   if (lm) lm->xc = NULL; /* P is the caller's until it is attached */
   mpm_model_destroy(lm);
   return ret;
