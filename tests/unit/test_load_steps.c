@@ -1,0 +1,205 @@
+/* Unit tests of load stepping on the shared Newton solver: steps cut and
+ * grown (a run that completes), the iterations' bound, and a load that no
+ * step can carry, named with its cause. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_coloring.h"
+#include "pm_newton.h"
+#include "pm_testing.h"
+#include "newton_chain.h"
+
+/* ---- Load stepping ----------------------------------------------------- */
+
+/* Steps of 1/4 with an inadmissible jump above 0.1: the first is cut to
+ * 1/16 (two cuts), steps grow by half after two converged ones and are cut
+ * again past the limit, and the run reaches lambda = 1 on u*; on_step sees
+ * each converged step. */
+static void test_load_steps_cut(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 60, 2, 2);
+  ch.jump_limit = 0.1;
+  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_options opt = pm_newton_options_default();
+  opt.load_steps = 4;
+  opt.rtol = 1e-10;
+  pm_load_report rep;
+  assert_ok(chain_load_steps(&ch, &prob, &opt, &rep));
+  print_message("jump limit 0.1, steps of 0.25: %d steps, %d cuts, smallest "
+                "dlambda %g, %d Newton iterations, %.1f ms\n",
+                rep.steps, rep.cuts, rep.dlambda_min, rep.newton_iterations,
+                1e3 * rep.time_total);
+  assert_true(rep.cuts >= 2);
+  assert_true(rep.lambda == 1.0);
+  assert_true(ch.lambda_done == 1.0);
+  /* Every step at or below the limit, none below a cut of the largest
+   * admissible one (0.1 / 2). */
+  assert_true(rep.dlambda_min >= 0.05 && rep.dlambda_min <= 0.0625);
+  assert_true(rep.steps >= 10 && rep.steps <= 20);
+  assert_true(chain_error(&ch, ch.x, 1.0) < 1e-9);
+
+  /* Without cutting room the same run fails at the first step. */
+  opt.max_cuts = 1;
+  assert_int_equal(chain_load_steps(&ch, &prob, &opt, &rep), PM_ERR_UNSTABLE);
+  const char *msg = pm_error_message();
+  print_message("%s\n", msg);
+  assert_non_null(strstr(msg, "load step 1 (lambda 0 -> 0.125)"));
+  assert_non_null(strstr(msg, "load jump 0.125 above 0.1"));
+  assert_non_null(strstr(msg, "cut 1 times to dlambda 0.125: giving up"));
+  assert_int_equal(rep.steps, 0);
+  assert_true(ch.lambda == 0.0); /* the load of the state returned */
+  pm_error_clear();
+  chain_free(&ch);
+}
+
+/* Too few Newton iterations for the whole load at once: without the
+ * predictor the step is cut until it converges; with it, the first step
+ * starts from the tangent predictor (the linear response to the load
+ * increment), which leaves Newton only the nonlinear remainder: no cut
+ * and fewer iterations. */
+static void test_load_steps_iterations(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 60, 2, 2);
+  ch.amp *= 2;
+  pm_newton_problem prob = chain_problem(&ch);
+  int iterations[2];
+  for (int predictor = 0; predictor < 2; predictor++) {
+    pm_newton_options opt = pm_newton_options_default();
+    opt.load_steps = 1;
+    opt.max_iter = 4;
+    opt.rtol = 1e-9;
+    opt.predictor = predictor;
+    pm_load_report rep;
+    assert_ok(chain_load_steps(&ch, &prob, &opt, &rep));
+    print_message("max_iter 4, %s: %d steps, %d cuts, %d Newton iterations\n",
+                  predictor ? "predictor" : "no predictor", rep.steps, rep.cuts,
+                  rep.newton_iterations);
+    assert_true(predictor ? rep.cuts == 0 : rep.cuts >= 1);
+    assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+    iterations[predictor] = rep.newton_iterations;
+  }
+  assert_true(iterations[1] < iterations[0]);
+  chain_free(&ch);
+}
+
+/* A bar of saturating springs, T(s) = Tmax tanh(s / s0), fixed at one end
+ * and pulled by lambda P = lambda 2.2 Tmax at the other, has no state beyond
+ * lambda = 1/2.2: the stepping creeps up to it and gives up with a message
+ * naming the step and the loads. */
+typedef struct {
+  long n;
+  double tmax, s0, load;
+  double ratio; /* P / Tmax */
+} bar;
+
+static pm_err bar_set_load(void *ctx, double lambda) {
+  bar *b = ctx;
+  b->load = lambda * b->ratio * b->tmax;
+  return PM_SUCCESS;
+}
+
+static pm_err bar_residual(void *ctx, const double *x, double *r) {
+  const bar *b = ctx;
+  for (long i = 0; i < b->n; i++) {
+    double left = b->tmax * tanh((x[i] - (i ? x[i - 1] : 0)) / b->s0);
+    double right =
+        i + 1 < b->n ? b->tmax * tanh((x[i + 1] - x[i]) / b->s0) : b->load;
+    r[i] = left - right;
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err bar_apply(void *ctx, const double *x, const double *dx,
+                        double *dr) {
+  const bar *b = ctx;
+  for (long i = 0; i < b->n; i++) {
+    double sl = x[i] - (i ? x[i - 1] : 0), dsl = dx[i] - (i ? dx[i - 1] : 0);
+    double tl = tanh(sl / b->s0);
+    dr[i] = b->tmax / b->s0 * (1 - tl * tl) * dsl;
+    if (i + 1 < b->n) {
+      double tr = tanh((x[i + 1] - x[i]) / b->s0);
+      dr[i] -= b->tmax / b->s0 * (1 - tr * tr) * (dx[i + 1] - dx[i]);
+    }
+  }
+  return PM_SUCCESS;
+}
+
+static void test_load_steps_impossible(void **state) {
+  (void)state;
+  enum { N = 10 };
+  bar b = {N, 1.0, 0.01, 0, 2.2};
+  long *ptr, *idx;
+  band_pattern(N, 1, &ptr, &idx);
+  pm_newton_problem prob = {.n = N,
+                            .ctx = &b,
+                            .residual = bar_residual,
+                            .jacobian_apply = bar_apply,
+                            .pat_ptr = ptr,
+                            .pat_idx = idx,
+                            .set_load = bar_set_load};
+  pm_newton_options opt = pm_newton_options_default();
+  opt.load_steps = 4;
+  opt.max_cuts = 6;
+  opt.atol = 1e-12;
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  double x[N] = {0};
+  pm_load_report rep;
+  pm_err e = pm_load_steps(s, x, &rep);
+  assert_true(e == PM_ERR_NOT_CONVERGED || e == PM_ERR_UNSTABLE);
+  const char *msg = pm_error_message();
+  print_message("%s\n", msg);
+  char want[96];
+  snprintf(want, sizeof want, "load step %d (lambda %.6g -> ", rep.steps + 1,
+           rep.lambda);
+  assert_non_null(strstr(msg, want));
+  assert_non_null(strstr(msg, "Newton"));
+  assert_non_null(strstr(msg, "times to dlambda 0.00391: giving up"));
+  assert_true(rep.lambda < 1 / 2.2 && rep.lambda > 0.4);
+  /* The state returned is the converged one at rep.lambda: each spring
+   * carries the load. */
+  double s_exact = b.s0 * atanh(rep.lambda * 2.2);
+  for (long i = 0; i < N; i++)
+    assert_close(x[i], s_exact * (double)(i + 1), 1e-8, 1e-14);
+  assert_close(b.load, rep.lambda * 2.2, 1e-15, 0);
+  pm_error_clear();
+  pm_newton_destroy(&s);
+
+  /* P = 2 Tmax: at lambda = 1/2 tanh saturates in floating point and J is
+   * singular; MUMPS told to stop at a singular matrix fails inside the
+   * linear solver with an error: a linear solver failure, after which a
+   * new linear solver carries on. */
+  b.ratio = 2;
+  for (int icntl = 0; icntl < 2; icntl++) {
+    opt.petsc_options =
+        icntl ? "-pm_mat_mumps_icntl_24 1" : "-pm_mat_mumps_icntl_24 0";
+    assert_ok(pm_newton_create(&prob, &opt, &s));
+    memset(x, 0, sizeof x);
+    e = pm_load_steps(s, x, &rep);
+    print_message("%s: %s\n", pm_err_name(e), pm_error_message());
+    assert_true(e == PM_ERR_NOT_CONVERGED || e == PM_ERR_UNSTABLE);
+    pm_error_clear();
+    pm_newton_destroy(&s);
+  }
+  free(ptr);
+  free(idx);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_load_steps_cut),
+      cmocka_unit_test(test_load_steps_iterations),
+      cmocka_unit_test(test_load_steps_impossible),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
