@@ -42,9 +42,6 @@ void mpm_sim_destroy_any(void *p);
  * with the energy accounts of a checkpoint of as many ranks, if given
  * (collective; every rank returns the same error). */
 pm_err mpm_view_share(mpm_sim *r, const double *accounts);
-/* Once the run starts the whole model stays on rank 0 as its view of the
- * run; the other ranks let it go. */
-void mpm_view_release(mpm_sim *r);
 /* The share and rank 0's figures workspace (collective). */
 pm_err mpm_view_setup(mpm_sim *r);
 /* The run's view (pm_view): across ranks when r has a share, with the

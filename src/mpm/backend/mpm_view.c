@@ -20,10 +20,12 @@ pm_err mpm_view_share(mpm_sim *r, const double *accounts) {
 }
 
 /* Across ranks, once the run starts: the whole model stays on rank 0 as
- * its view of the run; the other ranks let it go.  Until then every rank
- * holds it, so that a checkpoint is read into it. */
-void mpm_view_release(mpm_sim *r) {
-  if (pm_par_root() || !r->model) return;
+ * its view of the run; the other ranks let it go (pm_view.release, called
+ * on them alone).  Until then every rank holds it, so that a checkpoint is
+ * read into it. */
+static void release(void *ctx) {
+  mpm_sim *r = ctx;
+  if (!r->model) return;
   mpm_state_destroy(r->state);
   mpm_model_destroy(r->model);
   r->state = NULL;
@@ -65,8 +67,6 @@ static pm_err gather(void *ctx) {
   if (r->model) view_figures(r);
   return PM_SUCCESS;
 }
-
-static void release(void *ctx) { mpm_view_release(ctx); }
 
 void mpm_view_init(mpm_sim *r, bool implicit) {
   r->view = (pm_view){.ranks = r->local_model != NULL,

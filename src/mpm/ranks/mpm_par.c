@@ -1,18 +1,13 @@
 /* mpm_par: each rank's share of the model and state of an MPM run, and
  * the exchange table (mpm_exchange.h) that its core calls. */
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "mpm_grid_stages.h"
 #include "mpm_kind.h"
 #include "mpm_par_impl.h"
-#include "mpm_transfer.h"
-#include "pm_omp.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
 #include "pm_petsc.h"
-#include "pm_progress.h"
 
 static void fill_exchange(struct mpm_par *P);
 static void par_free(struct mpm_par *P);
