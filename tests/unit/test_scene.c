@@ -134,7 +134,10 @@ static void test_defaults(void **state) {
   assert_int_equal(s->bodies[0].material, 0);
   assert_null(s->bodies[0].region);
   assert_int_equal(s->n_bcs, 0);
-  assert_near(fpm_scene_options(s)->penalty, 20, 0);
+  /* the default formulation: quadratic jump, small penalty */
+  assert_int_equal(fpm_scene_options(s)->formulation, FPM_FORMULATION_DEFAULT);
+  assert_int_equal(fpm_scene_options(s)->jump, FPM_JUMP_QUADRATIC);
+  assert_near(fpm_scene_options(s)->penalty, 0.05, 0);
   assert_near(s->time.dt, 0, 0);
   assert_near(s->time.dt_safety, 0.5, 0); /* the default of method mpm */
   assert_near(s->time.ramp, 0.5, 0);
@@ -376,9 +379,14 @@ static void test_vocabulary(void **state) {
   assert_near(eval(s->bcs[1].region, 0, 0, 0, 0), 0.001, 1e-18);
   assert_int_equal(s->bcs[0].on, PM_ON_FACE);
   assert_int_equal(s->bcs[0].face, PM_FACE_XMIN);
-  assert_true(pm_scene_has(s, "fpm.penalty"));
+  assert_true(pm_scene_has(s, "fpm.formulation"));
+  assert_false(pm_scene_has(s, "fpm.penalty"));
   assert_false(pm_scene_has(s, "fpm.flux"));
   const fpm_options *o = fpm_scene_options(s);
+  /* formulation: paper sets the keys the scene does not give */
+  assert_int_equal(o->formulation, FPM_FORMULATION_PAPER);
+  assert_int_equal(o->jump, FPM_JUMP_LINEAR);
+  assert_near(o->penalty, 20, 0);
   assert_int_equal(o->flux, FPM_FLUX_IIPG);
   assert_string_equal(o->cells, "median-dual");
   pm_scene_destroy(s);

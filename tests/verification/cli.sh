@@ -31,8 +31,8 @@ outputs_complete() { # name, output folder
 
 line_of() { grep -n -- "$1" "$scene" | head -1 | cut -d: -f1; }
 
-bad_scene unknown-key 's/fpm: {penalty: 20}/fpm: {penalty: 20, penalti: 3}/' \
-  "$(line_of 'fpm: {penalty')" penalti
+bad_scene unknown-key 's/fpm: {formulation: paper}/fpm: {formulation: paper, penalti: 3}/' \
+  "$(line_of 'fpm: {formulation')" penalti
 bad_scene wrong-type 's/mesh_size: 8.72e-3/mesh_size: fine/' \
   "$(line_of 'mesh_size:')" mesh_size
 bad_scene negative-size 's/mesh_size: 8.72e-3/mesh_size: -0.01/' \

@@ -30,11 +30,10 @@
 #define CASES PM_SOURCE_DIR "/cases/fpm/"
 
 /* Every case at the coarsest level of the paper's ladder (h = 1.09e-2 m)
- * with the quadratic jump at p = 0.05 (F3 200%'s scene keeps the paper's
- * formulation for its finer levels). */
+ * with the default formulation (F3 200%'s scene keeps the paper's for its
+ * finer levels). */
 static const char *const COARSEST[] = {"discretization.mesh_size=8.72e-3",
-                                       "fpm.jump=quadratic",
-                                       "fpm.penalty=0.05"};
+                                       "fpm.formulation=default"};
 
 /* Remove the run's files and its folder. */
 static void remove_run(const char *dir) {
@@ -63,7 +62,7 @@ static void check_case(const fe_case *c) {
   char dir[] = "/tmp/verify_fe_blocks.XXXXXX", path[512];
   if (!mkdtemp(dir)) fail_msg("cannot create a temporary folder");
   snprintf(path, sizeof path, CASES "%s", c->scene);
-  if (pm_scene_load(path, 3, COARSEST, &s) != PM_SUCCESS)
+  if (pm_scene_load(path, 2, COARSEST, &s) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
   assert_non_null(s->reference_fe);
   if (pm_fe_load(s->reference_fe, &fe) != PM_SUCCESS)

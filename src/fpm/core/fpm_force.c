@@ -121,7 +121,9 @@ static inline double fit_at(const double *theta, int c, const double *phi) {
  * With fpm.jump: quadratic the penalty measures the jump of the fits,
  * [[u]]_q = u_i + theta_i phi(d_i) - u_k - theta_k phi(d_k), and its force
  * leaves through zq_i = sum_e b and Zq_i = sum_e b (x) phi(d_i) (gathered
- * by the fit weights in pass 3) instead of r and Q.  The energy counts the
+ * by the fit weights in pass 3) instead of r and Q; the boundary
+ * interfaces' linear-jump penalty (beta_b |e| = rec[19], zero elsewhere)
+ * leaves through r and Q as the linear jump's does.  The energy counts the
  * model's own points. */
 static double flux_pass(const fpm_model *m, const fields *fl) {
   const long n = m->n_flux, n_own = m->n_own;
@@ -155,7 +157,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
       const long k = nbr[e];
       const double *rec = erec + FPM_EREC * e;
       const double *a = rec, *Mc = rec + 3, *di = rec + 12, *dk = rec + 15;
-      const double be = rec[18];
+      const double be = rec[18], bl = rec[19];
       const double *Pk = P + 9 * k, *Hk = H + 9 * k, *uk = u + 3 * k;
       double w[3], phi_i[FPM_QFIT], phi_k[FPM_QFIT];
       if (quad) {
@@ -174,7 +176,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
         const double b = be * pjump;
         w[c] = 0.5 * (Pk[3 * c] * a[0] + Pk[3 * c + 1] * a[1] +
                       Pk[3 * c + 2] * a[2]) -
-               (quad ? 0 : b);
+               (quad ? bl * jump : b);
         ri[c] -= w[c];
         if (quad) {
           z[c] += b;
@@ -182,7 +184,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
             Z[FPM_QFIT * c + q] += b * phi_i[q];
         }
         /* each interface is seen twice */
-        if (counted) epen += 0.25 * be * pjump * pjump;
+        if (counted) epen += 0.25 * (be * pjump * pjump + bl * jump * jump);
         if (sym) {
           /* K_e = int_e [[u]] (x) n = [[u]](c_e) (x) a + (H_i - H_k) Mc^T */
           const double h0 = Hi[3 * c] - Hk[3 * c],

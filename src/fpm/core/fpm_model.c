@@ -147,6 +147,18 @@ done:
   return ret;
 }
 
+/* beta |e| / p = E / h |e| of interface f between points i and k (E the
+ * mean of their Young's moduli, h their distance). */
+static double unit_beta(const fpm_model *m, long i, long k, long f) {
+  const double *xi = m->x + 3 * i, *xk = m->x + 3 * k;
+  const double h = sqrt((xk[0] - xi[0]) * (xk[0] - xi[0]) +
+                        (xk[1] - xi[1]) * (xk[1] - xi[1]) +
+                        (xk[2] - xi[2]) * (xk[2] - xi[2]));
+  const double E = 0.5 * (m->mats[m->mat[i]].youngs_modulus +
+                          m->mats[m->mat[k]].youngs_modulus);
+  return E / h * m->dual->if_area[f];
+}
+
 /* Interface records per support entry and the per-point sums of the
  * consistency geometry (oriented outward from each point). */
 static void build_interfaces(fpm_model *m) {
@@ -172,15 +184,31 @@ static void build_interfaces(fpm_model *m) {
         for (int q = 0; q < 3; q++)
           pm[3 * p + q] += r[3 + 3 * p + q] + r[p] * r[12 + q];
       }
-      double h = sqrt((xk[0] - xi[0]) * (xk[0] - xi[0]) +
-                      (xk[1] - xi[1]) * (xk[1] - xi[1]) +
-                      (xk[2] - xi[2]) * (xk[2] - xi[2]));
-      double E = 0.5 * (m->mats[m->mat[i]].youngs_modulus +
-                        m->mats[m->mat[k]].youngs_modulus);
-      r[18] = m->penalty * E / h * d->if_area[f];
+      r[18] = m->penalty * unit_beta(m, i, k, f);
       r[19] = 0;
     }
   }
+}
+
+/* With the quadratic jump, the linear-jump penalty beta_b |e| = p_b E /
+ * h_e |e| (record slot 19) on every interface of a point that has a
+ * boundary facet (where the quadratic fits are one-sided). */
+static pm_err boundary_penalty(fpm_model *m) {
+  pm_err ret = PM_SUCCESS;
+  const gm_dual *d = m->dual;
+  unsigned char *on = NULL;
+  PM_TRY(PM_ALLOC(on, m->n, "boundary points"));
+  for (long f = 0; f < d->n_facets; f++) on[d->facet_point[f]] = 1;
+  for (long i = 0; i < m->n; i++)
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+      const long k = m->nbr[e];
+      if (!on[i] && !on[k]) continue;
+      m->erec[FPM_EREC * e + 19] =
+          m->boundary_penalty * unit_beta(m, i, k, d->nbr_iface[e]);
+    }
+done:
+  free(on);
+  return ret;
 }
 
 /* A support with fewer points than this, or a fit worse conditioned than
@@ -324,6 +352,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   m->nnz = d->nbr_ptr[d->n_points];
   m->scene = s;
   m->penalty = o->penalty;
+  m->boundary_penalty = o->boundary_penalty;
   m->flux = (fpm_flux)o->flux;
   m->jump = (fpm_jump)o->jump;
   m->n_own = m->n_flux = m->n_stress = m->n;
@@ -350,6 +379,8 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   PM_TRY(build_mirror(m));
   PM_TRY(assign_materials(m, s, fpm_domain_body(s)));
   build_interfaces(m);
+  if (m->jump == FPM_JUMP_QUADRATIC && m->boundary_penalty > 0)
+    PM_TRY(boundary_penalty(m));
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
   PM_TRY(fpm_build_boundary(m, s, mesh));
   *out = m;
@@ -436,5 +467,6 @@ double fpm_stable_dt(const fpm_model *m, long *critical_point) {
   }
   if (critical_point) *critical_point = crit;
   double p = m->penalty > 1 ? m->penalty : 1;
+  if (m->q && m->boundary_penalty > p) p = m->boundary_penalty;
   return 2.0 / sqrt(lam_max) / sqrt(p);
 }

@@ -13,14 +13,43 @@ static const pm_name flux_names[] = {
 static const pm_name jump_names[] = {
     {"linear", FPM_JUMP_LINEAR}, {"quadratic", FPM_JUMP_QUADRATIC}, {NULL, 0}};
 
+static const pm_name formulation_names[] = {
+    {"default", FPM_FORMULATION_DEFAULT},
+    {"paper", FPM_FORMULATION_PAPER},
+    {NULL, 0}};
+
+/* The paper's formulation: the defaults of the keys it sets. */
+#define PAPER_PENALTY 20.0
+
 static const pm_key fpm_keys[] = {
+    {.name = "formulation",
+     .type = PM_KEY_ENUM,
+     .offset = offsetof(fpm_options, formulation),
+     .def = "default",
+     .names = formulation_names,
+     .doc = "default (IIPG flux, quadratic jump, penalty 0.05: within 1-2% "
+            "of converged FE on near-incompressible blocks) or paper (the "
+            "FPM paper's flux: linear jump, penalty 20; 18-28% stiff at nu "
+            "= 0.495, but it holds at the largest strains); fpm keys given "
+            "beside it override its values"},
     {.name = "penalty",
      .type = PM_KEY_NUMBER,
      .offset = offsetof(fpm_options, penalty),
-     .def = "20",
+     .def = "0.05",
      .range = PM_RANGE_GE,
      .unit = "",
-     .doc = "interior penalty p: beta = p E / h per interface"},
+     .doc = "interior penalty p: beta = p E / h per interface (20 with "
+            "formulation: paper)"},
+    {.name = "boundary_penalty",
+     .type = PM_KEY_NUMBER,
+     .offset = offsetof(fpm_options, boundary_penalty),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .unit = "",
+     .doc = "with the quadratic jump, a second penalty p_b (beta = p_b E / "
+            "h) on the jump of the points' linear fields across every "
+            "interface of a point on the body's boundary, where the "
+            "quadratic fits are one-sided (ignored with the linear jump)"},
     {.name = "flux",
      .type = PM_KEY_ENUM,
      .offset = offsetof(fpm_options, flux),
@@ -31,12 +60,12 @@ static const pm_key fpm_keys[] = {
     {.name = "jump",
      .type = PM_KEY_ENUM,
      .offset = offsetof(fpm_options, jump),
-     .def = "linear",
+     .def = "quadratic",
      .names = jump_names,
      .doc = "the reconstruction whose interface jump the penalty measures: "
             "linear (each point's linear field, the paper) or quadratic (a "
-            "least-squares quadratic fit about each point: the penalty then "
-            "vanishes on quadratic fields and does not stiffen "
+            "least-squares quadratic fit about each point, the default: the "
+            "penalty then vanishes on quadratic fields and does not stiffen "
             "near-incompressible solids)"},
     {.name = "cells",
      .type = PM_KEY_STRING,
@@ -48,8 +77,12 @@ static const pm_key fpm_keys[] = {
     {0}};
 
 static pm_err check_section(const pm_scene *s, void *opts) {
-  const fpm_options *o = opts;
+  fpm_options *o = opts;
   char what[256];
+  if (o->formulation == FPM_FORMULATION_PAPER) {
+    if (!pm_scene_has(s, "fpm.jump")) o->jump = FPM_JUMP_LINEAR;
+    if (!pm_scene_has(s, "fpm.penalty")) o->penalty = PAPER_PENALTY;
+  }
   if (gm_cells_find(o->cells)) return PM_SUCCESS;
   size_t used = (size_t)snprintf(what, sizeof what, "one of");
   for (int k = 0; k < gm_cells_count() && used < sizeof what; k++)

@@ -18,12 +18,22 @@ typedef enum {
   FPM_JUMP_QUADRATIC   /* a least-squares quadratic fit about each point */
 } fpm_jump;
 
+/* A named set of defaults for the flux keys. */
+typedef enum {
+  FPM_FORMULATION_DEFAULT = 0, /* accurate and stable: quadratic jump, small
+                                  p, linear jump on boundary interfaces */
+  FPM_FORMULATION_PAPER        /* the FPM paper's: linear jump, p = 20 */
+} fpm_formulation;
+
 /* Options of the fpm section. */
 typedef struct {
-  double penalty; /* fpm.penalty p >= 0 (beta = p E / h) */
-  int flux;       /* fpm_flux */
-  int jump;       /* fpm_jump */
-  char *cells;    /* fpm.cells: the partition into subdomains */
+  int formulation;         /* fpm_formulation */
+  double penalty;          /* fpm.penalty p >= 0 (beta = p E / h) */
+  double boundary_penalty; /* fpm.boundary_penalty p_b >= 0: linear-jump
+                              penalty on boundary interfaces (quadratic jump) */
+  int flux;                /* fpm_flux */
+  int jump;                /* fpm_jump */
+  char *cells;             /* fpm.cells: the partition into subdomains */
 } fpm_options;
 
 extern const pm_section fpm_section;

@@ -156,9 +156,9 @@ done:
 /* The penalty's reconstruction weight of u_x in point i's field at offset
  * d (linear: H_i d; quadratic: theta_i phi(d)), for the r-th member of
  * i's reconstruction support; returns the member's point. */
-static long recon_member(const fpm_model *m, long i, long r, const double d[3],
-                         double *w) {
-  if (m->q) {
+static long recon_member(const fpm_model *m, bool quad, long i, long r,
+                         const double d[3], double *w) {
+  if (quad) {
     double phi[FPM_QFIT];
     fpm_gfd_phi(d, phi);
     const double *q;
@@ -182,76 +182,96 @@ static long recon_member(const fpm_model *m, long i, long r, const double d[3],
   return x;
 }
 
-static long recon_size(const fpm_model *m, long i) {
-  return m->q ? m->qs_ptr[i + 1] - m->qs_ptr[i] + 1 : closed_size(m, i);
+static long recon_size(const fpm_model *m, bool quad, long i) {
+  return quad ? m->qs_ptr[i + 1] - m->qs_ptr[i] + 1 : closed_size(m, i);
+}
+
+/* The row scratch of build_S: mark[x] is x's slot in list/acc, or -1. */
+typedef struct {
+  long *mark, *list, cnt;
+  double *acc;
+} srow;
+
+/* Adds to row k of S the penalty of one reconstruction (quad: the fits'
+ * jump with beta = rec[18]; else the linear fields' jump with beta =
+ * rec[18], or rec[19] beside the quadratic jump). */
+static void add_S_row(const fpm_model *m, bool quad, long k, srow *w) {
+  const int slot = quad || !m->q ? 18 : 19;
+  /* the points i whose own field at their interfaces moves with u_k:
+   * k itself and those whose reconstruction holds k */
+  long ni = quad ? 1 + m->qt_ptr[k + 1] - m->qt_ptr[k] : closed_size(m, k);
+  for (long ii = 0; ii < ni; ii++) {
+    long i;
+    if (ii == 0)
+      i = k;
+    else if (quad)
+      i = m->qs_own[m->qt_entry[m->qt_ptr[k] + ii - 1]];
+    else
+      i = m->nbr[m->nbr_ptr[k] + ii - 1];
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+      const double *rec = m->erec + FPM_EREC * e;
+      const double *di = rec + 12, *dk = rec + 15, be = rec[slot];
+      const long kk = m->nbr[e];
+      if (be == 0) continue;
+      /* t_ek: k's weight in u_i + recon_i(d_i) */
+      double tk = 0;
+      for (long r = 0; r < recon_size(m, quad, i); r++) {
+        double wt;
+        if (recon_member(m, quad, i, r, di, &wt) == k) tk += wt;
+      }
+      if (k == i) tk += 1;
+      if (tk == 0) continue;
+      /* J_em over both sides */
+      for (int side = 0; side < 2; side++) {
+        long p = side ? kk : i;
+        double sign = side ? -1 : 1;
+        const double *d = side ? dk : di;
+        for (long r = 0; r < recon_size(m, quad, p); r++) {
+          double wt;
+          long x = recon_member(m, quad, p, r, d, &wt);
+          if (r == 0) wt += 1;
+          if (w->mark[x] < 0) {
+            w->mark[x] = w->cnt;
+            w->list[w->cnt++] = x;
+            w->acc[w->mark[x]] = 0;
+          }
+          w->acc[w->mark[x]] += be * tk * sign * wt;
+        }
+      }
+    }
+  }
 }
 
 /* S: the penalty's scalar matrix, S_km = sum_i sum_(e of i) beta_e
  * t_ek J_em with [[u]]_e = sum_m J_em u_m and t_ek = d[[u]]_e / d u_k
- * through point i's side only (the force of the side's own field). */
+ * through point i's side only (the force of the side's own field); with
+ * the quadratic jump, plus the boundary interfaces' linear-jump term. */
 static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
   pm_err ret = PM_SUCCESS;
   const long n = m->n, rows = m->n_own;
-  long *mark = NULL, *list = NULL;
-  double *acc = NULL;
-  PM_TRY(PM_ALLOC(mark, n, "penalty marks"));
-  PM_TRY(PM_ALLOC(list, n, "penalty lists"));
-  PM_TRY(PM_ALLOC(acc, n, "penalty row"));
+  srow w = {0};
+  bool lin_too = false;
+  if (m->q)
+    for (long e = 0; e < m->nnz && !lin_too; e++)
+      lin_too = m->erec[FPM_EREC * e + 19] != 0;
+  PM_TRY(PM_ALLOC(w.mark, n, "penalty marks"));
+  PM_TRY(PM_ALLOC(w.list, n, "penalty lists"));
+  PM_TRY(PM_ALLOC(w.acc, n, "penalty row"));
   PM_TRY(PM_ALLOC(t->S_ptr, n + 1, "penalty matrix"));
-  for (long i = 0; i < n; i++) mark[i] = -1;
+  for (long i = 0; i < n; i++) w.mark[i] = -1;
   for (int pass = 0; pass < 2; pass++) {
     for (long k = 0; k < rows; k++) {
-      long cnt = 0;
-      /* the points i whose own field at their interfaces moves with u_k:
-       * k itself and those whose reconstruction holds k */
-      long ni = m->q ? 1 + m->qt_ptr[k + 1] - m->qt_ptr[k] : closed_size(m, k);
-      for (long ii = 0; ii < ni; ii++) {
-        long i;
-        if (ii == 0)
-          i = k;
-        else if (m->q)
-          i = m->qs_own[m->qt_entry[m->qt_ptr[k] + ii - 1]];
-        else
-          i = m->nbr[m->nbr_ptr[k] + ii - 1];
-        for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
-          const double *rec = m->erec + FPM_EREC * e;
-          const double *di = rec + 12, *dk = rec + 15, be = rec[18];
-          const long kk = m->nbr[e];
-          /* t_ek: k's weight in u_i + recon_i(d_i) */
-          double tk = 0;
-          for (long r = 0; r < recon_size(m, i); r++) {
-            double w;
-            if (recon_member(m, i, r, di, &w) == k) tk += w;
-          }
-          if (k == i) tk += 1;
-          if (tk == 0 || be == 0) continue;
-          /* J_em over both sides */
-          for (int side = 0; side < 2; side++) {
-            long p = side ? kk : i;
-            double sign = side ? -1 : 1;
-            const double *d = side ? dk : di;
-            for (long r = 0; r < recon_size(m, p); r++) {
-              double w;
-              long x = recon_member(m, p, r, d, &w);
-              if (r == 0) w += 1;
-              if (mark[x] < 0) {
-                mark[x] = cnt;
-                list[cnt++] = x;
-                acc[mark[x]] = 0;
-              }
-              acc[mark[x]] += be * tk * sign * w;
-            }
-          }
-        }
-      }
+      w.cnt = 0;
+      add_S_row(m, m->q != NULL, k, &w);
+      if (lin_too) add_S_row(m, false, k, &w);
       if (pass == 0)
-        t->S_ptr[k + 1] = cnt;
+        t->S_ptr[k + 1] = w.cnt;
       else
-        for (long a = 0; a < cnt; a++) {
-          t->S_m[t->S_ptr[k] + a] = list[a];
-          t->S[t->S_ptr[k] + a] = acc[a];
+        for (long a = 0; a < w.cnt; a++) {
+          t->S_m[t->S_ptr[k] + a] = w.list[a];
+          t->S[t->S_ptr[k] + a] = w.acc[a];
         }
-      for (long a = 0; a < cnt; a++) mark[list[a]] = -1;
+      for (long a = 0; a < w.cnt; a++) w.mark[w.list[a]] = -1;
     }
     if (pass == 0) {
       for (long k = 0; k < rows; k++) t->S_ptr[k + 1] += t->S_ptr[k];
@@ -262,9 +282,9 @@ static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
     }
   }
 done:
-  free(mark);
-  free(list);
-  free(acc);
+  free(w.mark);
+  free(w.list);
+  free(w.acc);
   return ret;
 }
 
