@@ -605,8 +605,8 @@ static const pm_key bc_keys[] = {
      .def = "100",
      .range = PM_RANGE_GT,
      .doc = "plate, sphere: contact stiffness factor kappa, the stiffness "
-            "of a point kappa E A / h (A its boundary area facing the "
-            "body, h discretization.mesh_size)"},
+            "of a point kappa E A / h (A its boundary facet area, "
+            "h discretization.mesh_size)"},
     {.name = "name",
      .type = PM_KEY_STRING,
      .offset = C(name),
