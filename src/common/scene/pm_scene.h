@@ -203,8 +203,19 @@ typedef enum {
   PM_ON_FACE = 0, /* a face of domain.box (on: xmin ... zmax) */
   PM_ON_SURFACE,  /* a named surface of the domain's mesh (on: NAME, a gmsh
                      physical group) */
-  PM_ON_REGION    /* the boundary where region(x, y, z) > 0 */
+  PM_ON_REGION,   /* the boundary where region(x, y, z) > 0 */
+  PM_ON_PLATE,    /* a rigid plane pushing where it touches (contact) */
+  PM_ON_SPHERE    /* a rigid sphere pushing where it touches (contact) */
 } pm_on;
+
+/* How a rigid body holds what touches it. */
+typedef enum {
+  PM_CONTACT_FRICTIONLESS = 0, /* normal force only */
+  PM_CONTACT_STICKING          /* held tangentially where it touched */
+} pm_contact;
+
+/* Whether a condition is a rigid body in contact (plate or sphere). */
+#define PM_BC_RIGID(bc) ((bc)->on == PM_ON_PLATE || (bc)->on == PM_ON_SPHERE)
 
 /* A boundary condition.  Displacement components are prescribed values at
  * full load (expressions in x, y, z and t, in m); traction components are
@@ -224,6 +235,16 @@ typedef struct {
   bool absorbing; /* viscous (absorbing) boundary */
   pm_ramp ramp;
   double ramp_time; /* s; time.ramp when not given */
+  /* A rigid body (PM_ON_PLATE, PM_ON_SPHERE): its reference geometry,
+   * moved rigidly by ramp(t) * displacement(t) (every component prescribed:
+   * those not given are 0); surface holds its name (default plate.<i> or
+   * sphere.<i>), the label of its reactions. */
+  double rigid_point[3];  /* plate: a point of the plane; sphere: centre */
+  double rigid_normal[3]; /* plate: unit normal, toward the body */
+  double rigid_radius;    /* sphere: m */
+  pm_contact contact;     /* frictionless (default) or sticking */
+  double contact_penalty; /* kappa: FPM contact stiffness kappa E A / h */
+  char *name;             /* name: as given, or NULL */
   pm_scene_mark mark;
 } pm_scene_bc;
 

@@ -321,9 +321,80 @@ static pm_err finish_time(pm_reader *r, pm_scene *s) {
   return PM_SUCCESS;
 }
 
+/* A rigid body of boundary i (plate or sphere, given as key): neither on
+ * nor region, nor tractions, velocities or absorbing; its normal made
+ * unit; its motion a function of t alone, the components not given 0; its
+ * name (default KEY.<i>) as the label of its reactions. */
+static pm_err finish_rigid(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc,
+                           const char *key) {
+  char p[PM_SDOC_PATH];
+  (void)s;
+  if (bc->surface || bc->region)
+    return pm_reader_fail(
+        r, PM_PATH(p, "boundary.%d.%s", i, bc->surface ? "on" : "region"), true,
+        "expected no %s with %s (a rigid body acts where it touches), "
+        "got %s",
+        bc->surface ? "on" : "region", key, bc->surface ? "on" : "region");
+  static const char *const other[] = {"traction", "velocity", "absorbing"};
+  const bool has[] = {bc->traction_mask != 0, bc->velocity_mask != 0,
+                      bc->absorbing};
+  for (int k = 0; k < 3; k++)
+    if (has[k])
+      return pm_reader_fail(r, PM_PATH(p, "boundary.%d.%s", i, other[k]), true,
+                            "expected displacement only with %s (its rigid "
+                            "motion, f(t)), got %s",
+                            key, other[k]);
+  if (bc->on == PM_ON_PLATE) {
+    double len = pm_v_norm(bc->rigid_normal);
+    if (!(len > 0) || !isfinite(len))
+      return pm_reader_expected(r, PM_PATH(p, "boundary.%d.plate.normal", i),
+                                "a direction of non-zero length");
+    for (int a = 0; a < 3; a++) bc->rigid_normal[a] /= len;
+  }
+  for (int c = 0; c < 3; c++) {
+    PM_PATH(p, "boundary.%d.displacement.%c", i, "xyz"[c]);
+    if (!bc->disp[c]) {
+      PM_CALL(pm_reader_expr(r, p, "0", "t", &bc->disp[c]));
+      continue;
+    }
+    for (int v = 0; v < 3; v++)
+      if (pm_expr_uses(bc->disp[c], "xyz"[v]))
+        return pm_reader_fail(r, p, false,
+                              "expected a function of t only (a rigid "
+                              "body's motion), got %s, which uses %c",
+                              pm_expr_text(bc->disp[c]), "xyz"[v]);
+  }
+  bc->disp_mask = r->dimension == 2 ? 3u : 7u;
+  if (bc->name) {
+    bc->surface = strdup(bc->name);
+  } else {
+    char label[32];
+    snprintf(label, sizeof label, "%s.%d", key, i);
+    bc->surface = strdup(label);
+  }
+  if (!bc->surface) return PM_ERROR(PM_ERR_MEMORY, "out of memory");
+  return PM_SUCCESS;
+}
+
 /* Where the condition acts: on a face or a named surface, or a region. */
 static pm_err finish_on(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc) {
   char p[PM_SDOC_PATH];
+  const bool plate = pm_reader_has(r, PM_PATH(p, "boundary.%d.plate", i)),
+             sphere = pm_reader_has(r, PM_PATH(p, "boundary.%d.sphere", i));
+  if (plate && sphere)
+    return pm_reader_fail(r, PM_PATH(p, "boundary.%d.sphere", i), true,
+                          "expected plate or sphere, got both");
+  if (plate || sphere) {
+    bc->on = plate ? PM_ON_PLATE : PM_ON_SPHERE;
+    return finish_rigid(r, s, i, bc, plate ? "plate" : "sphere");
+  }
+  static const char *const rigid_only[] = {"contact", "penalty", "name"};
+  for (int k = 0; k < 3; k++)
+    if (pm_reader_has(r, PM_PATH(p, "boundary.%d.%s", i, rigid_only[k])))
+      return pm_reader_fail(r, p, true,
+                            "expected %s only with a plate or a sphere, got "
+                            "it with %s",
+                            rigid_only[k], bc->region ? "region" : "on");
   bool has_on = bc->surface != NULL, has_region = bc->region != NULL;
   if (has_on == has_region) {
     if (has_on)

@@ -16,6 +16,10 @@ static const pm_name ramp_names[] = {{"smooth", PM_RAMP_SMOOTH},
                                      {"linear", PM_RAMP_LINEAR},
                                      {"none", PM_RAMP_NONE},
                                      {NULL, 0}};
+static const pm_name contact_names[] = {
+    {"frictionless", PM_CONTACT_FRICTIONLESS},
+    {"sticking", PM_CONTACT_STICKING},
+    {NULL, 0}};
 static const pm_name qs_names[] = {
     {"none", PM_QS_NONE},
     {"dynamic-relaxation", PM_QS_DYNAMIC_RELAXATION},
@@ -502,6 +506,36 @@ static const pm_key body_keys[] = {
      .doc = "fibre directions [[ax, ay, az], ...] (anisotropic models)"},
     {0}};
 
+/* The rigid bodies of boundary: (contact). */
+static const pm_key plate_keys[] = {
+    {.name = "point",
+     .type = PM_KEY_POINT,
+     .offset = C(rigid_point),
+     .flags = PM_KEY_REQUIRED,
+     .unit = "m",
+     .doc = "a point of the plane at t = 0"},
+    {.name = "normal",
+     .type = PM_KEY_POINT,
+     .offset = C(rigid_normal),
+     .flags = PM_KEY_REQUIRED,
+     .doc = "its normal, pointing to the body's side (any length > 0)"},
+    {0}};
+
+static const pm_key sphere_bc_keys[] = {{.name = "center",
+                                         .type = PM_KEY_POINT,
+                                         .offset = C(rigid_point),
+                                         .flags = PM_KEY_REQUIRED,
+                                         .unit = "m",
+                                         .doc = "its centre at t = 0"},
+                                        {.name = "radius",
+                                         .type = PM_KEY_NUMBER,
+                                         .offset = C(rigid_radius),
+                                         .flags = PM_KEY_REQUIRED,
+                                         .range = PM_RANGE_GT,
+                                         .unit = "m",
+                                         .doc = "its radius"},
+                                        {0}};
+
 static const pm_key bc_keys[] = {
     {.name = "on",
      .type = PM_KEY_STRING,
@@ -548,6 +582,36 @@ static const pm_key bc_keys[] = {
      .range = PM_RANGE_GT,
      .unit = "s",
      .doc = "ramp duration (default: time.ramp)"},
+    {.name = "plate",
+     .type = PM_KEY_MAPPING,
+     .keys = plate_keys,
+     .doc = "{point, normal}: a rigid plane (instead of on) that pushes the "
+            "body where it touches, moved by displacement f(t) (FPM "
+            "dynamic relaxation or explicit)"},
+    {.name = "sphere",
+     .type = PM_KEY_MAPPING,
+     .keys = sphere_bc_keys,
+     .doc = "{center, radius}: a rigid sphere (instead of on), likewise"},
+    {.name = "contact",
+     .type = PM_KEY_ENUM,
+     .offset = C(contact),
+     .def = "frictionless",
+     .names = contact_names,
+     .doc = "plate, sphere: frictionless (normal force only) or sticking "
+            "(a point that touches is held where it touched)"},
+    {.name = "penalty",
+     .type = PM_KEY_NUMBER,
+     .offset = C(contact_penalty),
+     .def = "100",
+     .range = PM_RANGE_GT,
+     .doc = "plate, sphere: contact stiffness factor kappa, the stiffness "
+            "of a point kappa E A / h (A its boundary facet area, "
+            "h discretization.mesh_size)"},
+    {.name = "name",
+     .type = PM_KEY_STRING,
+     .offset = C(name),
+     .doc = "plate, sphere: the label of its reaction columns (default "
+            "plate.<index>, sphere.<index>)"},
     {0}};
 
 static const pm_key quasi_static_keys[] = {
@@ -776,7 +840,8 @@ const pm_key pm_scene_keys[] = {
      .count_offset = S(n_bcs),
      .elem_size = sizeof(pm_scene_bc),
      .keys = bc_keys,
-     .doc = "[{on, displacement | traction | ...}]"},
+     .doc = "[{on | region | plate | sphere, displacement | traction | "
+            "...}]"},
     {.name = "gravity",
      .type = PM_KEY_POINT,
      .offset = S(gravity),

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "fpm_backend_impl.h"
+#include "fpm_contact.h"
 #include "fpm_estimate.h"
 #include "fpm_gfd.h"
 #include "fpm_par.h"
@@ -100,8 +101,10 @@ done:
 void fpm_sim_measure_spectrum(fpm_sim *sim) {
   if (sim->dt_spectral > 0) return;
   double lambda;
-  sim->dt_spectral = fpm_spectral_dt(
-      sim->model, sim->state, FPM_SPECTRAL_ITERATIONS, sim->scratch, &lambda);
+  sim->dt_spectral = fpm_contact_stable_dt(
+      sim->model->contact,
+      fpm_spectral_dt(sim->model, sim->state, FPM_SPECTRAL_ITERATIONS,
+                      sim->scratch, &lambda));
 }
 
 long fpm_sim_conditioning(const fpm_sim *sim, double *worst,
@@ -143,6 +146,10 @@ static pm_err checkpoint(void *p, pm_ckpt *ck) {
     PM_CALL(pm_ckpt_double(ck, "fpm.damping", &st->damping));
     PM_CALL(pm_ckpt_double(ck, "fpm.external_work", &st->external_work));
     PM_CALL(pm_ckpt_double(ck, "fpm.dissipated", &st->dissipated));
+    if (st->contact)
+      PM_CALL(pm_ckpt_doubles(ck, "fpm.contact",
+                              fpm_contact_state_size(sim->model->contact),
+                              st->contact));
   }
   PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &sim->run_min_jacobian));
   PM_CALL(
@@ -173,6 +180,8 @@ static pm_err checkpoint(void *p, pm_ckpt *ck) {
 static pm_err create(const pm_scene *s, void **out) {
   fpm_sim *sim = NULL;
   pm_err e = pm_par_agree(fpm_sim_create(s, &sim));
+  if (!e && pm_par_active() && sim->model->contact)
+    e = fpm_contact_refuse_ranks(s);
   if (!e && pm_par_active()) {
     const double t0 = pm_wtime();
     e = fpm_par_create(sim->model, &sim->local_model);

@@ -23,6 +23,8 @@ static pm_err select_facets(fpm_model *m, const pm_scene *s,
     for (int b = 0; b < s->n_bcs; b++) {
       const pm_scene_bc *bc = &s->bcs[b];
       int surf = -1;
+      m->bcf_ptr[b] = n;
+      if (PM_BC_RIGID(bc)) continue; /* in contact: fpm_contact */
       if (bc->on != PM_ON_REGION) {
         surf = gm_mesh_surface_find(mesh, bc->surface);
         if (surf < 0) {

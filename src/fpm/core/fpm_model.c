@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_contact.h"
 #include "fpm_gfd.h"
 #include "gm_shape.h"
 #include "pm_omp.h"
@@ -15,6 +16,7 @@
 
 void fpm_model_destroy(fpm_model *m) {
   if (!m) return;
+  fpm_contact_destroy(m->contact);
   free(m->g);
   free(m->gsum);
   free(m->mirror);
@@ -383,6 +385,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
     PM_TRY(boundary_penalty(m));
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
   PM_TRY(fpm_build_boundary(m, s, mesh));
+  PM_TRY(fpm_contact_create(m, s, &m->contact));
   *out = m;
   m = NULL;
 done:
@@ -414,6 +417,7 @@ pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
   PM_TRY(PM_ALLOC(st->bflux, 3 * m->n_dpts, "boundary flux"));
   PM_TRY(
       PM_ALLOC(st->support_prev, m->n_cdofs + 3 * m->n_dpts, "support forces"));
+  if (m->contact) PM_TRY(fpm_contact_state_init(m->contact, &st->contact));
   *out = st;
   st = NULL;
 done:
@@ -438,6 +442,7 @@ void fpm_state_destroy(fpm_state *st) {
   free(st->tf_value);
   free(st->bflux);
   free(st->support_prev);
+  free(st->contact);
   free(st);
 }
 
@@ -445,6 +450,7 @@ size_t fpm_state_bytes(const fpm_model *m) {
   return (size_t)m->n * (3 * 4 + 9 * 3 + 2) * sizeof(double) +
          (size_t)(m->n_tfacets + 2 * m->n_dpts) * 3 * sizeof(double) +
          (size_t)m->n_cdofs * sizeof(double) +
+         (size_t)fpm_contact_state_size(m->contact) * sizeof(double) +
          (m->q ? (size_t)m->n * 57 * sizeof(double) : 0);
 }
 
@@ -468,5 +474,5 @@ double fpm_stable_dt(const fpm_model *m, long *critical_point) {
   if (critical_point) *critical_point = crit;
   double p = m->penalty > 1 ? m->penalty : 1;
   if (m->q && m->boundary_penalty > p) p = m->boundary_penalty;
-  return 2.0 / sqrt(lam_max) / sqrt(p);
+  return fpm_contact_stable_dt(m->contact, 2.0 / sqrt(lam_max) / sqrt(p));
 }

@@ -14,6 +14,8 @@
 #include "pm_scene.h"
 
 #define FPM_MAX_MATERIALS 16
+
+struct fpm_contact;
 #define FPM_EREC 20 /* doubles per support-entry record */
 
 /* Everything that does not change during a run.  Arrays are per point
@@ -87,13 +89,15 @@ typedef struct {
   long n_cdofs;
   long *cd_point;
   int *cd_comp;
-  int *cd_bc;             /* scene boundary condition */
-  double *cd_base;        /* value at full load (t-independent part) */
-  bool cd_time_dependent; /* some displacement expression uses t */
-  unsigned char *fixed;   /* 3 n: 1 where the component is prescribed */
-  long *bcf_ptr;          /* n_bcs + 1: the facets of condition b are */
-  long *bcf_facet;        /* bcf_facet[bcf_ptr[b] .. bcf_ptr[b + 1]) */
-  const pm_scene *scene;  /* borrowed: boundary expressions and ramps */
+  int *cd_bc;                  /* scene boundary condition */
+  double *cd_base;             /* value at full load (t-independent part) */
+  bool cd_time_dependent;      /* some displacement expression uses t */
+  unsigned char *fixed;        /* 3 n: 1 where the component is prescribed */
+  long *bcf_ptr;               /* n_bcs + 1: the facets of condition b are */
+  long *bcf_facet;             /* bcf_facet[bcf_ptr[b] .. bcf_ptr[b + 1]) */
+  const pm_scene *scene;       /* borrowed: boundary expressions and ramps */
+  struct fpm_contact *contact; /* rigid bodies in contact (fpm_contact.h),
+                                  or NULL when the scene has none */
   /* Across ranks (src/fpm/ranks) a rank's model is its share: its own
    * points first, in one-process order, then the ghost points their force
    * reads, and each pass runs over the points that need it: the force is
@@ -138,6 +142,8 @@ typedef struct {
                            the body, with f on the prescribed dofs */
   double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous
                            step (trapezoidal work of the supports) */
+  double *contact;      /* the rigid bodies' contact state
+                           (fpm_contact_state_size), or NULL */
   /* What the time loop carries from step to step (fpm_run continues from
    * it: step 0 is the initial state). */
   long step;

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "fpm_contact.h"
 #include "pm_backend.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
@@ -28,6 +29,7 @@ void fpm_reaction(const fpm_model *m, const fpm_state *st, int b, double R[3]) {
   for (long k = 0; k < m->n_cdofs; k++)
     if (m->cd_bc[k] == b)
       R[m->cd_comp[k]] += st->f[3 * m->cd_point[k] + m->cd_comp[k]];
+  fpm_contact_reaction(m, st, b, R);
 }
 
 double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
@@ -175,6 +177,7 @@ static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
   if (e == PM_SUCCESS) {
     const double w = pm_wtime();
     bad = fpm_force(m, st);
+    if (bad < 0) fpm_contact_force(m, st, t);
     *seconds += pm_wtime() - w;
     if (bad >= 0) {
       e = unstable(m, st, step, t, dt, bad, 0);
@@ -249,6 +252,7 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
    * force (functions of u and t) are computed again. */
   PM_CALL(force_at(m, st, st->step, t, dt, resumed ? -1 : 0, seconds));
   fpm_support_start(m, st);
+  fpm_contact_start(m, st, t);
 
   fpm_step_info si = {0};
   si.step = st->step;
@@ -323,7 +327,8 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     /* The supports' force on the body is the boundary consistency flux
      * plus the force left on prescribed dofs; its work (trapezoidal rule
      * over the step), and that of the tractions, give the external work. */
-    sum[SUM_WORK] = fpm_support_work(m, st, st->v, dt, &sum[SUM_RR]);
+    sum[SUM_WORK] = fpm_support_work(m, st, st->v, dt, &sum[SUM_RR]) +
+                    fpm_contact_work(m, st, t);
     sum[SUM_S1] = s1;
     sum[SUM_S2] = s2;
     sum[SUM_SD] = sd;

@@ -281,6 +281,15 @@ pm_err mpm_check_scene(const pm_scene *s) {
       return pm_scene_fail(s, PM_PATH(p, "boundary.%d.traction", i), true,
                            "expected displacement, velocity or absorbing "
                            "(method mpm), got traction");
+    if (PM_BC_RIGID(bc))
+      return pm_scene_fail(
+          s,
+          PM_PATH(p, "boundary.%d.%s", i,
+                  bc->on == PM_ON_PLATE ? "plate" : "sphere"),
+          true,
+          "contact needs method fpm for now (MPM's rigid bodies are "
+          "bodies: with motion), got a rigid %s in boundary",
+          bc->on == PM_ON_PLATE ? "plate" : "sphere");
     if (bc->on != PM_ON_FACE)
       return pm_scene_fail(
           s,

@@ -1,0 +1,273 @@
+/* fpm_contact: penalty contact of rigid plates and spheres on the boundary
+ * points of an FPM body: candidates, forces, tangent, reactions and work. */
+#include "fpm_contact.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm_omp.h"
+
+/* Layout of the state: anchors (3 per pair), then per body the reaction,
+ * the previous reaction and the previous displacement (9 per body), then
+ * the contact energy. */
+#define ST_BODY(c, b) (3 * (c)->pair_ptr[(c)->n_bodies] + 9 * (b))
+
+long fpm_contact_state_size(const fpm_contact *c) {
+  return c ? 3 * c->pair_ptr[c->n_bodies] + 9 * c->n_bodies + 1 : 0;
+}
+
+pm_err fpm_contact_state_init(const fpm_contact *c, double **out) {
+  const long n = fpm_contact_state_size(c);
+  PM_CALL(PM_ALLOC(*out, n, "contact state"));
+  for (long k = 0; k < 3 * c->pair_ptr[c->n_bodies]; k++) (*out)[k] = NAN;
+  return PM_SUCCESS;
+}
+
+/* Signed distance of x from the body displaced by d, and the unit normal
+ * there (out of the rigid body, toward the deformable one). */
+static double gap(const pm_scene_bc *bc, const double d[3], const double x[3],
+                  double n[3]) {
+  double r[3];
+  for (int a = 0; a < 3; a++) r[a] = x[a] - d[a] - bc->rigid_point[a];
+  if (bc->on == PM_ON_PLATE) {
+    memcpy(n, bc->rigid_normal, 3 * sizeof(double));
+    return r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
+  }
+  double len = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+  for (int a = 0; a < 3; a++) n[a] = len > 0 ? r[a] / len : (a == 2);
+  return len - bc->rigid_radius;
+}
+
+bool fpm_contact_point(const pm_scene_bc *bc, double k, const double d[3],
+                       const double x[3], double anchor[3], double F[3],
+                       double *energy) {
+  double n[3];
+  const double g = gap(bc, d, x, n);
+  *energy = 0;
+  if (!(g < 0)) {
+    F[0] = F[1] = F[2] = 0;
+    anchor[0] = anchor[1] = anchor[2] = NAN;
+    return false;
+  }
+  if (bc->contact == PM_CONTACT_FRICTIONLESS) {
+    for (int a = 0; a < 3; a++) F[a] = -k * g * n[a];
+    *energy = 0.5 * k * g * g;
+    return true;
+  }
+  if (isnan(anchor[0]))
+    for (int a = 0; a < 3; a++) anchor[a] = x[a] - d[a] - g * n[a];
+  double e = 0;
+  for (int a = 0; a < 3; a++) {
+    const double s = x[a] - d[a] - anchor[a];
+    F[a] = -k * s;
+    e += s * s;
+  }
+  *energy = 0.5 * k * e;
+  return true;
+}
+
+void fpm_contact_tangent(const pm_scene_bc *bc, double k, const double d[3],
+                         const double x[3], const double anchor[3],
+                         double K[9]) {
+  double n[3];
+  const double g = gap(bc, d, x, n);
+  memset(K, 0, 9 * sizeof(double));
+  if (!(g < 0)) return;
+  if (bc->contact == PM_CONTACT_STICKING) {
+    (void)anchor;
+    K[0] = K[4] = K[8] = k;
+    return;
+  }
+  /* F = -k g n: on a sphere n turns with x, dn/dx = (I - n n) / r. */
+  double q = 0;
+  if (bc->on == PM_ON_SPHERE) q = g / (g + bc->rigid_radius);
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++)
+      K[3 * a + b] = k * (n[a] * n[b] + q * ((a == b) - n[a] * n[b]));
+}
+
+/* The rigid body's displacement at time t: ramp(t) d(t). */
+static void body_displacement(const pm_scene_bc *bc, double t, double d[3]) {
+  const double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
+  for (int a = 0; a < 3; a++)
+    d[a] = bc->disp[a] ? r * pm_expr_eval(bc->disp[a], 0, 0, 0, t) : 0;
+}
+
+/* Each point's boundary area (sum of its facets' areas) into area (n). */
+static void boundary_areas(const gm_dual *d, double *area) {
+  for (long f = 0; f < d->n_facets; f++)
+    area[d->facet_point[f]] += d->facet_area[f];
+}
+
+/* A body that starts inside the deformable body: the first point deeper
+ * than the tolerance, at the body's key. */
+static pm_err check_start(const fpm_model *m, const fpm_contact *c, int b) {
+  const pm_scene *s = m->scene;
+  const pm_scene_bc *bc = &s->bcs[c->bc[b]];
+  const double zero[3] = {0, 0, 0}, tol = 1e-3 * s->mesh_size;
+  char p[64];
+  for (long q = c->pair_ptr[b]; q < c->pair_ptr[b + 1]; q++) {
+    const long i = c->pair_point[q];
+    const double *x = m->x + 3 * i;
+    double n[3], g = gap(bc, zero, x, n);
+    if (g < -tol)
+      return pm_scene_fail(
+          s,
+          PM_PATH(p, "boundary.%d.%s", c->bc[b],
+                  bc->on == PM_ON_PLATE ? "plate" : "sphere"),
+          false,
+          "expected a rigid body outside the body at t = 0, got point %ld at "
+          "(%g, %g, %g) %g m inside it (the tolerance is 1e-3 mesh_size)",
+          fpm_point_id(m, i), x[0], x[1], x[2], -g);
+  }
+  return PM_SUCCESS;
+}
+
+pm_err fpm_contact_create(const fpm_model *m, const pm_scene *s,
+                          fpm_contact **out) {
+  pm_err ret = PM_SUCCESS;
+  fpm_contact *c = NULL;
+  double *area = NULL;
+  *out = NULL;
+  int nb = 0;
+  for (int b = 0; b < s->n_bcs; b++) nb += PM_BC_RIGID(&s->bcs[b]);
+  if (nb == 0) return PM_SUCCESS;
+  const gm_dual *d = m->dual;
+  PM_TRY(PM_ALLOC(c, 1, "contact"));
+  PM_TRY(PM_ALLOC(area, m->n, "contact areas"));
+  boundary_areas(d, area);
+  long nbp = 0;
+  for (long i = 0; i < m->n_own; i++) nbp += area[i] > 0;
+  c->n_bodies = nb;
+  PM_TRY(PM_ALLOC(c->bc, nb, "contact bodies"));
+  PM_TRY(PM_ALLOC(c->pair_ptr, nb + 1, "contact pairs"));
+  PM_TRY(PM_ALLOC(c->pair_point, nb * nbp, "contact pairs"));
+  PM_TRY(PM_ALLOC(c->pair_k, nb * nbp, "contact pairs"));
+  long q = 0;
+  for (int b = 0, k = 0; b < s->n_bcs; b++) {
+    const pm_scene_bc *bc = &s->bcs[b];
+    if (!PM_BC_RIGID(bc)) continue;
+    c->bc[k] = b;
+    c->pair_ptr[k] = q;
+    for (long i = 0; i < m->n_own; i++) {
+      if (!(area[i] > 0)) continue;
+      const double E = m->mats[m->mat[i]].youngs_modulus;
+      c->pair_point[q] = i;
+      c->pair_k[q] = bc->contact_penalty * E * area[i] / s->mesh_size;
+      c->max_k_over_m = fmax(c->max_k_over_m, c->pair_k[q] / m->mass[i]);
+      q++;
+    }
+    c->pair_ptr[++k] = q;
+  }
+  for (int b = 0; b < nb; b++) PM_TRY(check_start(m, c, b));
+  *out = c;
+  c = NULL;
+done:
+  free(area);
+  fpm_contact_destroy(c);
+  return ret;
+}
+
+pm_err fpm_contact_refuse_ranks(const pm_scene *s) {
+  char p[64];
+  for (int b = 0; b < s->n_bcs; b++)
+    if (PM_BC_RIGID(&s->bcs[b]))
+      return pm_scene_fail(
+          s,
+          PM_PATH(p, "boundary.%d.%s", b,
+                  s->bcs[b].on == PM_ON_PLATE ? "plate" : "sphere"),
+          true, "contact needs one process for now, got a run across ranks");
+  return PM_SUCCESS;
+}
+
+void fpm_contact_destroy(fpm_contact *c) {
+  if (!c) return;
+  free(c->bc);
+  free(c->pair_ptr);
+  free(c->pair_point);
+  free(c->pair_k);
+  free(c);
+}
+
+void fpm_contact_force(const fpm_model *m, fpm_state *st, double t) {
+  const fpm_contact *c = m->contact;
+  if (!c) return;
+  double *restrict S = st->contact, *restrict f = st->f;
+  const double *restrict u = st->u, *restrict x = m->x;
+  double energy = 0, fsq = 0;
+  for (int b = 0; b < c->n_bodies; b++) {
+    const pm_scene_bc *bc = &m->scene->bcs[c->bc[b]];
+    const long *restrict pt = c->pair_point;
+    const double *restrict kq = c->pair_k;
+    const long q0 = c->pair_ptr[b], q1 = c->pair_ptr[b + 1];
+    double d[3], rx = 0, ry = 0, rz = 0, e = 0, s2 = 0;
+    body_displacement(bc, t, d);
+    PM_OMP(parallel for schedule(static) default(none)
+           reduction(+ : rx, ry, rz, e, s2)
+           shared(q0, q1, pt, kq, S, f, u, x, bc, d))
+    for (long q = q0; q < q1; q++) {
+      const long i = pt[q];
+      double xi[3], F[3], ei;
+      for (int a = 0; a < 3; a++) xi[a] = x[3 * i + a] + u[3 * i + a];
+      if (!fpm_contact_point(bc, kq[q], d, xi, S + 3 * q, F, &ei)) continue;
+      for (int a = 0; a < 3; a++) f[3 * i + a] -= F[a];
+      rx += F[0];
+      ry += F[1];
+      rz += F[2];
+      e += ei;
+      s2 += F[0] * F[0] + F[1] * F[1] + F[2] * F[2];
+    }
+    double *R = S + ST_BODY(c, b);
+    R[0] = rx;
+    R[1] = ry;
+    R[2] = rz;
+    energy += e;
+    fsq += s2;
+  }
+  S[ST_BODY(c, c->n_bodies)] = energy;
+  st->penalty_energy += energy;
+  st->fext_sq += fsq;
+  st->fext_norm = sqrt(st->fext_sq);
+}
+
+void fpm_contact_start(const fpm_model *m, fpm_state *st, double t) {
+  const fpm_contact *c = m->contact;
+  if (!c) return;
+  for (int b = 0; b < c->n_bodies; b++) {
+    double *B = st->contact + ST_BODY(c, b);
+    memcpy(B + 3, B, 3 * sizeof(double));
+    body_displacement(&m->scene->bcs[c->bc[b]], t, B + 6);
+  }
+}
+
+double fpm_contact_work(const fpm_model *m, fpm_state *st, double t) {
+  const fpm_contact *c = m->contact;
+  if (!c) return 0;
+  double work = 0;
+  for (int b = 0; b < c->n_bodies; b++) {
+    double *B = st->contact + ST_BODY(c, b), d[3];
+    body_displacement(&m->scene->bcs[c->bc[b]], t, d);
+    for (int a = 0; a < 3; a++) {
+      work += 0.5 * (B[3 + a] + B[a]) * (d[a] - B[6 + a]);
+      B[3 + a] = B[a];
+      B[6 + a] = d[a];
+    }
+  }
+  return work;
+}
+
+void fpm_contact_reaction(const fpm_model *m, const fpm_state *st, int b,
+                          double R[3]) {
+  const fpm_contact *c = m->contact;
+  if (!c) return;
+  for (int k = 0; k < c->n_bodies; k++)
+    if (c->bc[k] == b)
+      for (int a = 0; a < 3; a++) R[a] += st->contact[ST_BODY(c, k) + a];
+}
+
+double fpm_contact_stable_dt(const fpm_contact *c, double dt) {
+  if (!c || !(c->max_k_over_m > 0)) return dt;
+  return 2 / sqrt(4 / (dt * dt) + c->max_k_over_m);
+}

@@ -1,0 +1,79 @@
+/* fpm_contact: rigid plates and spheres (boundary: plate / sphere) pushing
+ * an FPM body by penalty contact on its boundary points, with the reaction
+ * and the work of each rigid body. */
+#ifndef FPM_CONTACT_H
+#define FPM_CONTACT_H
+
+#include "fpm_model.h"
+
+/* The contact candidates of a model: for each rigid body, every point
+ * that has boundary facets, with its penalty stiffness. */
+typedef struct fpm_contact {
+  int n_bodies;
+  int *bc;          /* n_bodies: the scene's condition of each */
+  long *pair_ptr;   /* n_bodies + 1: body b's pairs are pair_ptr[b] .. [b+1] */
+  long *pair_point; /* the point of each pair */
+  double *pair_k;   /* its penalty stiffness kappa E A / h, N/m */
+  double max_k_over_m; /* the largest k / m of a pair, 1/s^2 */
+} fpm_contact;
+
+/* Doubles of state a contact holds (fpm_state.contact): per pair the
+ * sticking anchor (3, NaN while apart), per body the reaction, the
+ * previous reaction and the previous displacement (3 each), and the
+ * contact energy (1). */
+long fpm_contact_state_size(const fpm_contact *c);
+/* Make that state (*out, the caller's to free): at rest, apart. */
+pm_err fpm_contact_state_init(const fpm_contact *c, double **out);
+
+/* Penalty contact of one point at position x (3) against one rigid body
+ * displaced by d (3), with gap g (the signed distance, < 0 inside): the
+ * force on the point F (3) and its energy.  Frictionless: F = -k g n.
+ * Sticking: F = -k (x - d - anchor), anchor (3, in the body's frame) the
+ * surface point where it touched, set on touching and NaN while apart.
+ * Returns whether the point touches (g < 0). */
+bool fpm_contact_point(const pm_scene_bc *bc, double k, const double d[3],
+                       const double x[3], double anchor[3], double F[3],
+                       double *energy);
+
+/* The tangent of fpm_contact_point at x (after the call that set the
+ * anchor): dF = -K dx, K (9, row-major) symmetric; 0 while apart. */
+void fpm_contact_tangent(const pm_scene_bc *bc, double k, const double d[3],
+                         const double x[3], const double anchor[3],
+                         double K[9]);
+
+/* The contact of the scene's rigid bodies on model m (m's points,
+ * boundary facets, masses and materials made): *out NULL when the scene
+ * has none.  A body that starts inside the body (a point penetrating by
+ * more than 1e-3 mesh_size at t = 0) fails at its key (PM_ERR_SCENE)
+ * naming the point. */
+pm_err fpm_contact_create(const fpm_model *m, const pm_scene *s,
+                          fpm_contact **out);
+void fpm_contact_destroy(fpm_contact *c);
+
+/* PM_ERR_SCENE at the first rigid body of s: contact runs on one process
+ * for now (a share's model holds no contact). */
+pm_err fpm_contact_refuse_ranks(const pm_scene *s);
+
+/* The rigid bodies' forces at time t added to st->f (f_int - f_ext),
+ * their energy to st->penalty_energy, |F|^2 to st->fext_sq (and
+ * fext_norm) and the reactions kept in st->contact.  Serial over bodies,
+ * parallel over points; allocates nothing. */
+void fpm_contact_force(const fpm_model *m, fpm_state *st, double t);
+
+/* Start of the work: remember the reactions and displacements. */
+void fpm_contact_start(const fpm_model *m, fpm_state *st, double t);
+
+/* Work of the rigid bodies on the body since the last call (trapezoid rule:
+ * mean reaction times the displacement increment), remembered next. */
+double fpm_contact_work(const fpm_model *m, fpm_state *st, double t);
+
+/* Add the reaction of condition b (the force of the rigid body on the body)
+ * to R; nothing when b is no rigid body. */
+void fpm_contact_reaction(const fpm_model *m, const fpm_state *st, int b,
+                          double R[3]);
+
+/* The stable step dt of the model, lowered for the contact stiffness:
+ * 2 / sqrt((2 / dt)^2 + max k / m). */
+double fpm_contact_stable_dt(const fpm_contact *c, double dt);
+
+#endif

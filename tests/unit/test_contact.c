@@ -1,0 +1,232 @@
+/* test_contact: rigid plates and spheres in contact with FPM points: the
+ * penalty force and its tangent on a few points, the scene keys, and bad
+ * input refused at its key (file:line:col). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "fpm_backend.h"
+#include "fpm_contact.h"
+#include "pm_app.h"
+#include "pm_scene.h"
+#include "pm_testing.h"
+
+/* A rigid body as the scene loader leaves it. */
+static pm_scene_bc rigid(pm_on on, pm_contact contact, const double p[3],
+                         const double n[3], double radius) {
+  pm_scene_bc bc = {0};
+  bc.on = on;
+  bc.contact = contact;
+  memcpy(bc.rigid_point, p, sizeof bc.rigid_point);
+  if (n) memcpy(bc.rigid_normal, n, sizeof bc.rigid_normal);
+  bc.rigid_radius = radius;
+  return bc;
+}
+
+/* The tangent against central differences of the force (a fresh anchor
+ * copy for each evaluation, as set by the first call). */
+static void check_tangent(const pm_scene_bc *bc, double k, const double d[3],
+                          const double x[3], const double anchor[3]) {
+  double K[9], h = 1e-7;
+  fpm_contact_tangent(bc, k, d, x, anchor, K);
+  for (int b = 0; b < 3; b++) {
+    double xp[3], xm[3], Fp[3], Fm[3], e, ap[3], am[3];
+    memcpy(xp, x, sizeof xp);
+    memcpy(xm, x, sizeof xm);
+    memcpy(ap, anchor, sizeof ap);
+    memcpy(am, anchor, sizeof am);
+    xp[b] += h;
+    xm[b] -= h;
+    fpm_contact_point(bc, k, d, xp, ap, Fp, &e);
+    fpm_contact_point(bc, k, d, xm, am, Fm, &e);
+    for (int a = 0; a < 3; a++)
+      assert_near(-(Fp[a] - Fm[a]) / (2 * h), K[3 * a + b], 1e-6 * k);
+  }
+}
+
+/* A plate z = 0.1 facing down, moved down by 0.01: a point at z = 0.095
+ * penetrates 0.005 and is pushed down by k 0.005; one below is free. */
+static void test_plate_frictionless(void **state) {
+  (void)state;
+  const double p[3] = {0, 0, 0.1}, n[3] = {0, 0, -1}, d[3] = {0, 0, -0.01};
+  pm_scene_bc bc = rigid(PM_ON_PLATE, PM_CONTACT_FRICTIONLESS, p, n, 0);
+  const double k = 2e4;
+  double x[3] = {0.03, 0.07, 0.095}, a[3] = {NAN, NAN, NAN}, F[3], e;
+  assert_true(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  assert_near(F[0], 0, 0);
+  assert_near(F[1], 0, 0);
+  assert_near(F[2], -k * 0.005, 1e-12);
+  assert_near(e, 0.5 * k * 0.005 * 0.005, 1e-15);
+  check_tangent(&bc, k, d, x, a);
+  double y[3] = {0.03, 0.07, 0.0899};
+  assert_false(fpm_contact_point(&bc, k, d, y, a, F, &e));
+  assert_near(F[2], 0, 0);
+  assert_near(e, 0, 0);
+}
+
+/* Sticking: the point is held where it touched; moving it sideways while
+ * in contact pulls it back by k times the slip, and leaving frees it. */
+static void test_plate_sticking(void **state) {
+  (void)state;
+  const double p[3] = {0, 0, 0}, n[3] = {0, 0, 1}, d[3] = {0, 0, 0};
+  pm_scene_bc bc = rigid(PM_ON_PLATE, PM_CONTACT_STICKING, p, n, 0);
+  const double k = 10;
+  double x[3] = {0.2, 0.1, -0.01}, a[3] = {NAN, NAN, NAN}, F[3], e;
+  assert_true(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  assert_near(a[0], 0.2, 1e-15);
+  assert_near(a[1], 0.1, 1e-15);
+  assert_near(a[2], 0, 1e-15);
+  assert_near(F[2], 0.1, 1e-14);
+  x[0] += 0.03; /* slides 0.03 along x */
+  assert_true(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  assert_near(F[0], -0.3, 1e-14);
+  assert_near(F[2], 0.1, 1e-14);
+  assert_near(e, 0.5 * k * (0.03 * 0.03 + 0.01 * 0.01), 1e-15);
+  check_tangent(&bc, k, d, x, a);
+  x[2] = 0.001; /* leaves */
+  assert_false(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  assert_true(isnan(a[0]));
+}
+
+/* A sphere of radius 0.02 moved by (0, 0, -0.01): the force is along the
+ * radius through the point, k times the depth, and the tangent holds the
+ * turning of the normal. */
+static void test_sphere(void **state) {
+  (void)state;
+  const double c[3] = {0.05, 0.05, 0.12}, d[3] = {0, 0, -0.01};
+  pm_scene_bc bc = rigid(PM_ON_SPHERE, PM_CONTACT_FRICTIONLESS, c, NULL, 0.02);
+  const double k = 3e3;
+  double x[3] = {0.06, 0.05, 0.095}, a[3] = {NAN, NAN, NAN}, F[3], e;
+  const double r[3] = {0.01, 0, -0.015},
+               len = sqrt(0.01 * 0.01 + 0.015 * 0.015);
+  assert_true(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  for (int i = 0; i < 3; i++)
+    assert_near(F[i], k * (0.02 - len) * r[i] / len, 1e-12);
+  check_tangent(&bc, k, d, x, a);
+  bc.contact = PM_CONTACT_STICKING;
+  a[0] = a[1] = a[2] = NAN;
+  assert_true(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  for (int i = 0; i < 3; i++)
+    assert_near(F[i], k * (0.02 - len) * r[i] / len, 1e-12);
+  check_tangent(&bc, k, d, x, a);
+}
+
+/* A scene text with the plate entry given, loaded as NAME. */
+static pm_err load(const char *plate, const char *method, const char *qs,
+                   pm_scene **s) {
+  char text[2048];
+  snprintf(text, sizeof text,
+           "name: contact\n"
+           "method: %s\n"
+           "dimension: 3\n"
+           "domain: {box: {min: [0, 0, 0], max: [0.1, 0.1, 0.1]}}\n"
+           "discretization: {mesh_size: 0.04}\n"
+           "materials:\n"
+           "  - {name: gel, model: neo-hookean, density: 1000, "
+           "youngs_modulus: 3000, poisson_ratio: 0.3}\n"
+           "bodies: [{material: gel, region: domain}]\n"
+           "boundary:\n"
+           "  - {on: zmin, displacement: {x: 0, y: 0, z: 0}}\n"
+           "  - %s\n"
+           "time: {end: 1, quasi_static: {method: %s}}\n",
+           method, plate, qs);
+  return pm_scene_load_text(text, strlen(text), "contact.yaml", 0, NULL, s);
+}
+
+/* Loading fails with a message holding frag1 and frag2. */
+static void load_fails(const char *plate, const char *method, const char *qs,
+                       const char *frag1, const char *frag2) {
+  pm_scene *s = NULL;
+  pm_error_clear();
+  assert_int_equal(load(plate, method, qs, &s), PM_ERR_SCENE);
+  assert_null(s);
+  const char *msg = pm_error_message();
+  if (!strstr(msg, frag1) || (frag2 && !strstr(msg, frag2)))
+    fail_msg("message \"%s\" lacks \"%s\" or \"%s\"", msg, frag1,
+             frag2 ? frag2 : "");
+}
+
+static void test_keys(void **state) {
+  (void)state;
+  pm_scene *s = NULL;
+  assert_ok(load("{plate: {point: [0, 0, 0.1], normal: [0, 0, -2]}, "
+                 "displacement: {z: -0.01*t}, contact: sticking}",
+                 "fpm", "dynamic-relaxation", &s));
+  const pm_scene_bc *bc = &s->bcs[1];
+  assert_int_equal(bc->on, PM_ON_PLATE);
+  assert_int_equal(bc->contact, PM_CONTACT_STICKING);
+  assert_near(bc->rigid_normal[2], -1, 0);
+  assert_int_equal(bc->disp_mask, 7);
+  assert_string_equal(bc->surface, "plate.1");
+  assert_near(pm_expr_eval(bc->disp[0], 0, 0, 0, 1), 0, 0);
+  assert_near(pm_expr_eval(bc->disp[2], 0, 0, 0, 2), -0.02, 1e-15);
+  assert_near(bc->contact_penalty, 100, 0);
+  pm_scene_destroy(s);
+  assert_ok(load("{sphere: {center: [0.05, 0.05, 0.13], radius: 0.02}, "
+                 "displacement: {z: -0.01}, name: ball}",
+                 "fpm", "dynamic-relaxation", &s));
+  assert_int_equal(s->bcs[1].on, PM_ON_SPHERE);
+  assert_int_equal(s->bcs[1].contact, PM_CONTACT_FRICTIONLESS);
+  assert_string_equal(s->bcs[1].surface, "ball");
+  pm_scene_destroy(s);
+}
+
+static void test_bad_keys(void **state) {
+  (void)state;
+  const char *dr = "dynamic-relaxation";
+  load_fails("{plate: {point: [0, 0, 0.1], normal: [0, 0, 0]}, "
+             "displacement: {z: -0.01}}",
+             "fpm", dr, "contact.yaml:11:", "non-zero length");
+  load_fails("{on: zmax, plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
+             "displacement: {z: -0.01}}",
+             "fpm", dr, "contact.yaml:11:", "expected no on with plate");
+  load_fails("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
+             "displacement: {z: -0.01*x}}",
+             "fpm", dr, "contact.yaml:11:", "a function of t only");
+  load_fails("{on: zmax, displacement: {z: -0.01}, contact: sticking}", "fpm",
+             dr, "contact.yaml:11:", "only with a plate or a sphere");
+  load_fails("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
+             "displacement: {z: -0.01}}",
+             "fpm", "static", "contact.yaml:11:",
+             "contact needs time.quasi_static.method dynamic-relaxation");
+  load_fails("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
+             "displacement: {z: -0.01}}",
+             "mpm", "none", "contact.yaml:11:", "contact needs method fpm");
+}
+
+/* A plate that starts 5 mm inside the block is refused when the points
+ * are made, at its key, naming a point. */
+static void test_plate_inside(void **state) {
+  (void)state;
+  pm_scene *s = NULL;
+  fpm_sim *sim = NULL;
+  assert_ok(load("{plate: {point: [0, 0, 0.095], normal: [0, 0, -1]}, "
+                 "displacement: {z: -0.01}}",
+                 "fpm", "dynamic-relaxation", &s));
+  pm_error_clear();
+  assert_int_equal(fpm_sim_create(s, &sim), PM_ERR_SCENE);
+  const char *msg = pm_error_message();
+  if (!strstr(msg, "contact.yaml:11:") || !strstr(msg, "inside"))
+    fail_msg("message \"%s\"", msg);
+  fpm_sim_destroy(sim);
+  pm_scene_destroy(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_plate_frictionless),
+      cmocka_unit_test(test_plate_sticking),
+      cmocka_unit_test(test_sphere),
+      cmocka_unit_test(test_keys),
+      cmocka_unit_test(test_bad_keys),
+      cmocka_unit_test(test_plate_inside),
+  };
+  if (pm_app_init() != PM_SUCCESS) return 1;
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

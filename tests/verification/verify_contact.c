@@ -1,0 +1,87 @@
+/* Verification of rigid plates in contact (FPM): the F2 cube on rollers
+ * compressed 40% by a frictionless plate must reach the exact homogeneous
+ * solution (u_z = -0.4 z, free lateral expansion) and its reaction. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "fpm_backend.h"
+#include "pm_app.h"
+#include "pm_metrics.h"
+#include "pm_run.h"
+#include "pm_scene.h"
+#include "pm_testing.h"
+
+#define CASES PM_SOURCE_DIR "/cases/fpm/"
+
+/* The plate's reaction against the exact one, P_zz of uniaxial stress at
+ * axial stretch 0.6 times the face's 0.01 m^2, and the displacement NRMSE
+ * against the exact field, on 145 points (mesh_size 0.025): the penalty's
+ * penetration, about p h / (kappa E) (1.8e-4 m of the 0.04 m at kappa
+ * 100), is most of both errors, which fall as 1 / kappa.  The energy
+ * balance, the plate's work booked, within 1%. */
+static void run_plate(const char *penalty, double tol_reaction, double tol_u) {
+  char set_penalty[64];
+  snprintf(set_penalty, sizeof set_penalty, "boundary.3.penalty=%s", penalty);
+  const char *sets[] = {set_penalty, "discretization.mesh_size=0.025",
+                        "time.dt_rule=spectral",
+                        "time.quasi_static.tolerance=1e-7"};
+  pm_scene *s = NULL;
+  assert_ok(pm_scene_load(CASES "f2-plates.yaml", 4, sets, &s));
+  fpm_sim *sim = NULL;
+  assert_ok(fpm_sim_create(s, &sim));
+  pm_outcome o;
+  assert_ok(pm_run_sim(s, sim, NULL, true, &o));
+  assert_int_equal(sim->status, PM_STATUS_CONVERGED);
+  const fpm_model *m = sim->model;
+  double lat[2], P[9], W, J;
+  assert_ok(pm_material_uniaxial(&m->mats[0], NULL, 0.6, lat));
+  const double F[9] = {lat[0], 0, 0, 0, lat[0], 0, 0, 0, 0.6};
+  assert_true(pm_material_stress(&m->mats[0], F, NULL, P, &W, &J));
+  const double exact = P[8] * 0.01;
+  double *ref = malloc(3 * m->n * sizeof *ref), e[3];
+  for (long i = 0; i < 3 * m->n; i++)
+    ref[i] = (i % 3 == 2 ? -0.4 : lat[0] - 1) * m->x[i];
+  for (int a = 0; a < 3; a++)
+    e[a] = pm_nrmse(m->n, 3, sim->state->u + a, ref + a);
+  const double R = o.fig.reaction[3][2], balance = fpm_energy_error(&sim->last);
+  print_message("F2 under a frictionless plate, kappa %s: %ld points, %ld "
+                "steps, dt %.3g s; reaction %.5g N (exact %.5g N, %+.3f%%), "
+                "lateral %.2g %.2g N; NRMSE u_x %.2e u_y %.2e u_z %.2e; "
+                "energy balance %.2e\n",
+                penalty, m->n, sim->last.step, sim->dt, R, exact,
+                100 * (R / exact - 1), o.fig.reaction[3][0],
+                o.fig.reaction[3][1], e[0], e[1], e[2], balance);
+  assert_true(fabs(R / exact - 1) <= tol_reaction);
+  for (int a = 0; a < 3; a++) assert_true(e[a] <= tol_u);
+  assert_true(fabs(balance) <= 0.01);
+  free(ref);
+  fpm_sim_destroy(sim);
+  pm_scene_destroy(s);
+}
+
+/* The default kappa 100: -0.71%, NRMSE u_x 3.6e-3, u_z 2.2e-3 measured. */
+static void test_plate_default(void **state) {
+  (void)state;
+  run_plate("100", 0.01, 5e-3);
+}
+
+/* kappa 1000: -0.073%, NRMSE u_x 4.8e-4, u_z 3.9e-4 measured. */
+static void test_plate_stiff(void **state) {
+  (void)state;
+  run_plate("1000", 0.002, 1e-3);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_plate_default),
+      cmocka_unit_test(test_plate_stiff),
+  };
+  if (pm_app_init() != PM_SUCCESS) return 1;
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
