@@ -21,6 +21,14 @@ pm_err mpm_par_check(const pm_scene *s) {
                          "run has %d ranks): take mpm.fbar: cell, or run with "
                          "-np 1",
                          pm_par_size());
+  for (int i = 0; i < s->n_bcs; i++)
+    if (s->bcs[i].on == PM_ON_REGION) {
+      char p[64];
+      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.region", i), true,
+                           "grips on regions of particles run on one process "
+                           "(this run has %d ranks): run with -np 1",
+                           pm_par_size());
+    }
   return PM_SUCCESS;
 }
 
