@@ -25,7 +25,8 @@ int mpm_grips_count(const mpm_bc *bcs, int n);
 
 /* Move the velocity of the nodes the held particles touch towards the
  * grip's velocity over the step, prescribed component by component, by
- * the grip's share of each node's mass (all the way from half of it on).  With
+ * the grip's share of each node's mass (all the way from a quarter of it
+ * on).  With
  * reactions: add the force this applies to the grid to the conditions'
  * reactions, mark the nodes it holds wholly as set (so the quasi-static
  * residual leaves them out) and return its work over the step (J); else 0. Call
