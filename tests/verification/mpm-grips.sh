@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # MPM conditions on regions of particles (grips) and tractions on faces,
 # against the analytic 1-D bar (linear elastic, nu = 0, plane), at two
-# cells: a grip's reaction and an end traction's displacement, and bad
-# input refused with file:line:col.  The grips hold the particle layers
+# cells: a grip's reaction and an end traction's displacement (explicit
+# MPM; the traction by the implicit MPM too), and bad input refused with
+# file:line:col.  The grips hold the particle layers
 # themselves, so the bar between the held layers is the analytic gauge;
 # the grid adds about half a cell of compliance at each grip (first order
 # in h: -5.4% at h = 0.02 m, -2.7% at 0.01 m on this bar).
@@ -70,6 +71,18 @@ check "traction bar h 0.01: completes" test $? -eq 0
 u1=$(top_u "$work/t1" 0.39) # layers at 0.3925 and 0.3975: mean 0.395
 check "traction bar h 0.01: u $u1 within 2% of 3.925e-4" within "$u1" 3.925e-4 0.02
 
+# The traction by the implicit MPM (a face holds the bottom, y = 0; linear
+# B-splines hold the linear field exactly): u = (t / E) y at the top layer.
+sed 's/method: mpm$/method: mpm-implicit/
+     s/region: "0.01 - y", displacement: {y: 0}/on: ymin, displacement: {y: 0}/
+     s/min: \[-0.02, -0.02\]/min: [-0.02, 0]/
+     s/quasi_static: {.*}/quasi_static: {method: static, load_steps: 4}/' \
+  "$trac" >"$work/implicit.yaml"
+"$bin" run "$work/implicit.yaml" --out "$work/ti" --quiet 2>"$work/err"
+check "implicit traction bar: completes" test $? -eq 0
+ui=$(top_u "$work/ti" 0.39)
+check "implicit traction bar: u $ui within 1e-6 of 3.95e-4" within "$ui" 3.95e-4 1e-6
+
 # Bad input.
 bad_scene grip-grips-nothing "$grip" 's/region: "y - 0.39"/region: "y - 0.5"/' \
   'y - 0.5' 'boundary.1.region: expected a region that holds particles'
@@ -79,9 +92,9 @@ bad_scene grip-on-absorbing "$grip" \
 bad_scene traction-on-region "$trac" \
   's/on: ymax, traction/region: "y - 0.39", traction/' 'region: "y - 0.39"' \
   'boundary.1.traction: expected displacement or velocity on a region'
-bad_scene traction-implicit "$trac" \
-  's/method: mpm$/method: mpm-implicit/; s/region: "0.01 - y", displacement/on: ymin, displacement/' \
-  'traction: {y: 10}' \
+bad_scene traction-on-region-implicit "$trac" \
+  's/method: mpm$/method: mpm-implicit/; s/on: ymax, traction/region: "y - 0.39", traction/' \
+  'region: "y - 0.39"' \
   'boundary.1.traction: expected displacement (method mpm-implicit), got traction'
 bad_scene grip-implicit "$grip" 's/method: mpm$/method: mpm-implicit/' \
   'region: "0.01 - y"' \

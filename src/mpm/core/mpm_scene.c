@@ -278,7 +278,7 @@ pm_err mpm_check_scene(const pm_scene *s) {
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
     const bool implicit = strcmp(s->method, "mpm-implicit") == 0;
-    if (bc->traction_mask && (implicit || bc->on != PM_ON_FACE))
+    if (bc->traction_mask && bc->on != PM_ON_FACE)
       return pm_scene_fail(s, PM_PATH(p, "boundary.%d.traction", i), true,
                            "expected %s (method %s), got traction",
                            implicit ? "displacement"

@@ -154,3 +154,22 @@ pm_err mpm_book_tractions(mpm_ctx *ctx, const mpm_stage *self) {
   mpm_book_work(ctx, self, work * ctx->state->dt);
   return PM_SUCCESS;
 }
+
+void mpm_tractions_nodal(const mpm_model *m, const mpm_grid *g,
+                         const double *xb, double lam, double *f) {
+  const double T = m->opt.t_load;
+  for (int b = 0; b < m->n_bcs; b++) {
+    const mpm_bc *bc = &m->bcs[b];
+    if (!bc->traction_mask) continue;
+    for (long k = 0; k < bc->n_held; k++) {
+      double ft[3], xs[3];
+      particle_force(m, bc, k, T, ft);
+      face_point(m, bc, k, xb, xs);
+      mpm_stencil st;
+      mpm_stencil_at(g, xs, MPM_STENCIL_W, &st);
+      for (int j = 0; j < st.n; j++)
+        for (int c = 0; c < 3; c++)
+          f[3 * st.node[j] + c] -= lam * st.w[j] * ft[c];
+    }
+  }
+}

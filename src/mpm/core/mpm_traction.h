@@ -30,4 +30,10 @@ pm_err mpm_stage_tractions(mpm_ctx *ctx, const mpm_stage *self);
  * its work over the step with the nodes' mean velocity. */
 pm_err mpm_book_tractions(mpm_ctx *ctx, const mpm_stage *self);
 
+/* The implicit MPM's external force: f -= lam t(X, t_load) A at the face
+ * points over the particles at base positions xb (3 per particle), on grid
+ * g (3 per node), lam the load factor: dead loads, no tangent. */
+void mpm_tractions_nodal(const struct mpm_model *m, const mpm_grid *g,
+                         const double *xb, double lam, double *f);
+
 #endif
