@@ -39,9 +39,10 @@ check "sphere-outside-grid: says 'outside the grid'" \
   grep -qF 'outside the grid' "$work/err"
 bad_scene fluid-without-pressure "$tube" 's/, pressure: 0.001//' \
   'density: 0.125' 'bodies.1: missing required key pressure'
-bad_scene traction-in-mpm "$tube" \
-  's/{on: xmax, velocity: {x: 0}/{on: xmax, traction: {x: 0}/' 'on: xmax' \
-  'boundary.1.traction: expected displacement, velocity or absorbing (method mpm), got traction'
+bad_scene traction-on-region-in-mpm "$tube" \
+  's/{on: xmax, velocity: {x: 0}/{region: "x - 0.9", traction: {x: 0}/' \
+  'region: "x - 0.9"' \
+  'boundary.1.traction: expected displacement or velocity on a region (a grip; tractions act on a face) (method mpm), got traction'
 bad_scene flip-2 "$tube" 's/flip: 1.0/flip: 2/' 'flip:' \
   'mpm.flip: expected a number in [0, 1], got 2'
 bad_scene unknown-mpm-key "$tube" 's/^  update: musl$/  update: musl\n  updat: usf/' \

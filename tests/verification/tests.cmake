@@ -88,3 +88,9 @@ if(PM_MPI)
   set_tests_properties(verification.ranks_membranes PROPERTIES LABELS
     verification TIMEOUT 600 PROCESSORS 2)
 endif()
+
+# Grips on regions of particles and tractions on faces (explicit MPM):
+# reactions and displacements of a bar against the analytic 1-D answer.
+add_test(NAME verification.mpm_grips
+  COMMAND bash ${PM_VERIFY_DIR}/mpm-grips.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.mpm_grips PROPERTIES LABELS verification TIMEOUT 300)

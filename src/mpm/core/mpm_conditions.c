@@ -17,24 +17,30 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
   for (int b = 0; b < s->n_bcs; b++) {
     const pm_scene_bc *sb = &s->bcs[b];
     mpm_bc *bc = &(*bcs)[b];
-    bc->face = sb->face;
-    bc->axis = pm_face_axis(sb->face);
-    bc->plane = pm_face_plane(sb->face, s->box_min, s->box_max);
-    bool is_max = sb->face == PM_FACE_XMAX || sb->face == PM_FACE_YMAX ||
-                  sb->face == PM_FACE_ZMAX;
-    bc->outward = is_max ? 1.0 : -1.0;
     bc->disp_mask = sb->disp_mask;
     bc->vel_mask = sb->velocity_mask;
+    bc->traction_mask = sb->traction_mask;
     bc->ramp = sb->ramp;
     bc->ramp_time = sb->ramp_time;
     bc->absorbing = sb->absorbing;
     for (int c = 0; c < 3; c++) {
       bc->disp[c] = sb->disp[c];
       bc->velocity[c] = sb->velocity[c];
+      bc->traction[c] = sb->traction[c];
       const pm_expr *e = sb->disp[c] ? sb->disp[c] : sb->velocity[c];
       bc->constant[c] = !e || (!pm_expr_uses(e, 'x') && !pm_expr_uses(e, 'y') &&
                                !pm_expr_uses(e, 'z'));
     }
+    /* A grip has no columns: its held particles act. */
+    bc->grip = sb->on != PM_ON_FACE;
+    bc->region = sb->region;
+    if (bc->grip) continue;
+    bc->face = sb->face;
+    bc->axis = pm_face_axis(sb->face);
+    bc->plane = pm_face_plane(sb->face, s->box_min, s->box_max);
+    bool is_max = sb->face == PM_FACE_XMAX || sb->face == PM_FACE_YMAX ||
+                  sb->face == PM_FACE_ZMAX;
+    bc->outward = is_max ? 1.0 : -1.0;
     /* Columns: every node of the face plane. */
     int a = bc->axis, t1 = (a + 1) % 3, t2 = (a + 2) % 3;
     long n1 = g->nn[t1], n2 = g->nn[t2];
@@ -55,13 +61,25 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
 }
 
 void mpm_conditions_destroy(mpm_bc *bcs, int n_bcs) {
-  for (int b = 0; b < n_bcs; b++) free(bcs[b].col);
+  for (int b = 0; b < n_bcs; b++) {
+    free(bcs[b].col);
+    free(bcs[b].held);
+    free(bcs[b].area);
+    free(bcs[b].reach);
+  }
   free(bcs);
 }
 
-pm_err mpm_cond_work_create(mpm_cond_work *cw, const mpm_grid *g, int n_bcs) {
+pm_err mpm_cond_work_create(mpm_cond_work *cw, const mpm_grid *g,
+                            const mpm_bc *bcs, int n_bcs) {
   if (n_bcs == 0) return PM_SUCCESS;
   const long n3 = 3 * g->n_nodes;
+  bool grips = false;
+  for (int b = 0; b < n_bcs; b++) grips = grips || bcs[b].grip;
+  if (grips) {
+    PM_CALL(PM_ALLOC(cw->grip_mass, g->n_nodes, "grip masses"));
+    PM_CALL(PM_ALLOC(cw->grip_mom, n3, "grip momenta"));
+  }
   PM_CALL(PM_ALLOC(cw->owner, n3, "constrained dof owners"));
   PM_CALL(PM_ALLOC(cw->fold, n3, "folded condition forces"));
   PM_CALL(PM_ALLOC(cw->fold_out, n3, "folded condition forces"));
@@ -74,18 +92,19 @@ void mpm_cond_work_destroy(mpm_cond_work *cw) {
   free(cw->fold);
   free(cw->fold_out);
   free(cw->reaction);
+  free(cw->grip_mass);
+  free(cw->grip_mom);
   memset(cw, 0, sizeof *cw);
 }
 
 size_t mpm_cond_work_bytes(const mpm_cond_work *cw, const mpm_grid *g) {
   if (!cw->owner) return 0;
-  return (3 * sizeof(short) + 6 * sizeof(double)) * (size_t)g->n_nodes;
+  return (3 * sizeof(short) + (cw->grip_mass ? 10 : 6) * sizeof(double)) *
+         (size_t)g->n_nodes;
 }
 
-/* Velocity the condition prescribes on component c at face position x over
- * the step from t to t + dt. */
-static double bc_velocity(const mpm_bc *bc, int c, const double x[3], double t,
-                          double dt) {
+double mpm_bc_velocity(const mpm_bc *bc, int c, const double x[3], double t,
+                       double dt) {
   double T = bc->ramp_time;
   if (bc->disp[c]) {
     double u1 = pm_ramp_factor(bc->ramp, T, t + dt) *
@@ -163,7 +182,7 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
     int b = fold ? m->n_bcs - 1 - bb : bb;
     const mpm_bc *bc = &m->bcs[b];
     unsigned mask = bc->disp_mask | bc->vel_mask;
-    if (!mask) continue;
+    if (!mask || bc->grip) continue;
     int a = bc->axis;
     double vconst[3] = {0, 0, 0}, wall_const = bc->plane;
     double xc[3];
@@ -171,7 +190,7 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
     xc[a] = bc->plane;
     for (int c = 0; c < 3; c++)
       if ((mask >> c & 1u) && bc->constant[c])
-        vconst[c] = bc_velocity(bc, c, xc, t, dt);
+        vconst[c] = mpm_bc_velocity(bc, c, xc, t, dt);
     if (bc->constant[a]) wall_const = bc_wall(bc, xc, t);
     long step_a = g->stride[a];
     for (long k = 0; k < bc->n_cols; k++) {
@@ -189,7 +208,7 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
       if (!fold)
         for (int c = 0; c < 3; c++) {
           if (!(mask >> c & 1u)) continue;
-          v[c] = bc->constant[c] ? vconst[c] : bc_velocity(bc, c, x, t, dt);
+          v[c] = bc->constant[c] ? vconst[c] : mpm_bc_velocity(bc, c, x, t, dt);
           if (!isfinite(v[c]))
             note_not_finite(cw, bc->disp[c] ? bc->disp[c] : bc->velocity[c],
                             col, x, t, dt);

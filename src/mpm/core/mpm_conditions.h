@@ -1,7 +1,9 @@
 /* mpm_conditions: boundary conditions on the grid.  A face condition sets
  * the nodes at and beyond its (moving) wall from an anchor inside it, moves
  * their forces onto the anchors, and counts its reaction and work; null
- * directions zero components everywhere (in the grid update). */
+ * directions zero components everywhere (in the grid update).  A condition
+ * on a region holds particles instead (a grip: mpm_grip.h); a traction
+ * acts through the particles at a face (mpm_traction.h). */
 #ifndef MPM_CONDITIONS_H
 #define MPM_CONDITIONS_H
 
@@ -26,16 +28,31 @@ typedef struct {
   double ramp_time;
   bool absorbing;
   bool constant[3]; /* expression uses none of x, y, z */
+  /* A grip (a condition on a region): the particles it holds (indices,
+   * owned; found by mpm_grips_create), and no columns. */
+  bool grip;
+  const pm_expr *region;
+  long n_held;
+  long *held;
+  /* A traction (nominal, Pa, at full load; NULL where not given): the
+   * particles that carry it are held[0..n_held), with their areas and
+   * their reference distances to the face (owned; found by
+   * mpm_tractions_create). */
+  unsigned traction_mask;
+  const pm_expr *traction[3];
+  double *area, *reach;
 } mpm_bc;
 
 /* What the conditions keep during a step: workspace. */
 typedef struct {
-  short *owner;     /* 3 per node: the condition that set the dof this step,
-                       -(b + 1) prescribed, b + 1 reflected, 0 free */
-  double *fold;     /* 3 per node: forces of the conditions' dependent dofs
-                       moved onto the dofs they follow (their anchors) */
-  double *fold_out; /* 3 per node: the force a dependent dof moved out */
-  double *reaction; /* 3 per condition: its force on the body, N */
+  short *owner;      /* 3 per node: the condition that set the dof this step,
+                        -(b + 1) prescribed, b + 1 reflected, 0 free */
+  double *fold;      /* 3 per node: forces of the conditions' dependent dofs
+                        moved onto the dofs they follow (their anchors) */
+  double *fold_out;  /* 3 per node: the force a dependent dof moved out */
+  double *reaction;  /* 3 per condition: its force on the body, N */
+  double *grip_mass; /* per node: a grip's mass there (grips only) */
+  double *grip_mom;  /* 3 per node: its prescribed momentum (grips only) */
   /* The first prescribed value that was not finite: its expression (NULL
    * while none), the node of its column, the face position and the time
    * it was evaluated at. */
@@ -52,13 +69,20 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
 /* Release conditions made by mpm_conditions_create (NULL accepted). */
 void mpm_conditions_destroy(mpm_bc *bcs, int n_bcs);
 
-/* Allocate the conditions' workspace for n_bcs conditions on grid g (none
- * when n_bcs is 0). */
-pm_err mpm_cond_work_create(mpm_cond_work *cw, const mpm_grid *g, int n_bcs);
+/* Allocate the conditions' workspace for conditions bcs[0..n_bcs) on grid
+ * g (none when n_bcs is 0; with grips their nodal sums too). */
+pm_err mpm_cond_work_create(mpm_cond_work *cw, const mpm_grid *g,
+                            const mpm_bc *bcs, int n_bcs);
 /* Release the conditions' workspace (and zero it). */
 void mpm_cond_work_destroy(mpm_cond_work *cw);
 /* Bytes the conditions' workspace takes. */
 size_t mpm_cond_work_bytes(const mpm_cond_work *cw, const mpm_grid *g);
+
+/* Velocity condition bc prescribes on component c at reference position x
+ * over the step from t to t + dt (the mean over the step of a prescribed
+ * displacement's rate). */
+double mpm_bc_velocity(const mpm_bc *bc, int c, const double x[3], double t,
+                       double dt);
 
 /* Move the forces of the dependent dofs onto their anchors (into the
  * work's fold), from the nodal forces of this step. */

@@ -1,6 +1,9 @@
 /* mpm_model: creation of the model and its initial state from a scene. */
 #include "mpm_model.h"
 
+#include "mpm_grip.h"
+#include "mpm_traction.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,6 +11,7 @@
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
 #include "mpm_exchange.h"
+#include "mpm_grip.h"
 #include "mpm_seed.h"
 #include "mpm_state.h"
 
@@ -83,6 +87,8 @@ pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
     if (m->bcs[b].absorbing) m->has_absorbing = true;
   /* The state's arrays follow the groups and the conditions. */
   PM_TRY(mpm_seed(s, m, &st));
+  PM_TRY(mpm_grips_create(s, m));
+  PM_TRY(mpm_tractions_create(s, m));
   mpm_pipeline_build(m);
   st->damping = m->opt.qs == PM_QS_DAMPING ? m->opt.qs_damping : 0;
   PM_TRY(initial_step(s, m, st));

@@ -7,6 +7,8 @@
 
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
+#include "mpm_grip.h"
+#include "mpm_traction.h"
 #include "mpm_motion.h"
 #include "mpm_exchange.h"
 #include "mpm_state.h"
@@ -51,6 +53,16 @@ static void add_grid_forces(mpm_model *m) {
     snprintf(st->detail, sizeof st->detail,
              "m g on the nodes, g = (%g, %g, %g); its work after the update",
              o->gravity[0], o->gravity[1], o->gravity[2]);
+  }
+  const int n_tractions = mpm_tractions_count(m->bcs, m->n_bcs);
+  if (n_tractions > 0) {
+    st = add(&m->pipeline, "tractions", mpm_stage_tractions);
+    st->after_update = mpm_book_tractions;
+    st->books = MPM_BOOKS_WORK;
+    snprintf(st->detail, sizeof st->detail,
+             "%d traction%s: t A on the face's particles, to the nodes "
+             "through the shape functions; its work after the update",
+             n_tractions, n_tractions == 1 ? "" : "s");
   }
   if (m->has_absorbing) {
     st = add(&m->pipeline, "absorbing boundaries", mpm_stage_absorbing);
@@ -119,6 +131,15 @@ void mpm_pipeline_build(mpm_model *m) {
              "%d bod%s moving as prescribed: velocity and position of the "
              "expressions of t",
              m->n_moving, m->n_moving == 1 ? "y" : "ies");
+  }
+  const int n_grips = mpm_grips_count(m->bcs, m->n_bcs);
+  if (n_grips > 0) {
+    st = add(pl, "grips", mpm_stage_grips);
+    st->books = MPM_BOOKS_WORK;
+    snprintf(st->detail, sizeof st->detail,
+             "%d grip%s: held particles at their prescribed motion, the "
+             "nodes they touch with them",
+             n_grips, n_grips == 1 ? "" : "s");
   }
   if (o->update == MPM_MUSL) {
     st = add(pl, "remap", mpm_stage_remap);

@@ -277,10 +277,7 @@ pm_err mpm_check_scene(const pm_scene *s) {
   }
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
-    if (bc->traction_mask)
-      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.traction", i), true,
-                           "expected displacement, velocity or absorbing "
-                           "(method mpm), got traction");
+    const bool implicit = strcmp(s->method, "mpm-implicit") == 0;
     if (PM_BC_RIGID(bc))
       return pm_scene_fail(
           s,
@@ -290,15 +287,28 @@ pm_err mpm_check_scene(const pm_scene *s) {
           "contact needs method fpm for now (MPM's rigid bodies are "
           "bodies: with motion), got a rigid %s in boundary",
           bc->on == PM_ON_PLATE ? "plate" : "sphere");
-    if (bc->on != PM_ON_FACE)
+    if (bc->traction_mask && bc->on != PM_ON_FACE)
+      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.traction", i), true,
+                           "expected %s (method %s), got traction",
+                           implicit ? "displacement"
+                                    : "displacement or velocity on a region "
+                                      "(a grip; tractions act on a face)",
+                           s->method);
+    if (bc->on == PM_ON_SURFACE)
       return pm_scene_fail(
-          s,
-          PM_PATH(p, "boundary.%d.%s", i,
-                  bc->on == PM_ON_REGION ? "region" : "on"),
-          bc->on == PM_ON_REGION,
+          s, PM_PATH(p, "boundary.%d.on", i), false,
           "expected on: a face of domain.box (xmin, xmax, ymin, ymax, zmin, "
-          "zmax) for method mpm (its conditions act on grid planes), got %s",
-          bc->on == PM_ON_REGION ? "region" : bc->surface);
+          "zmax)%s for method %s, got %s",
+          implicit ? "" : " or region: (a grip on the particles in it)",
+          s->method, bc->surface);
+    if (bc->on == PM_ON_REGION && bc->absorbing)
+      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.absorbing", i), true,
+                           "expected displacement or velocity on a region "
+                           "(a grip), got absorbing");
+    if (bc->on == PM_ON_REGION && !(bc->disp_mask | bc->velocity_mask))
+      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.region", i), true,
+                           "expected displacement or velocity with a region "
+                           "(a grip), got neither");
   }
   if (pm_scene_has(s, "stability.max_energy_error"))
     return pm_scene_fail(s, "stability.max_energy_error", true,
@@ -339,6 +349,11 @@ pm_err mpm_implicit_check_scene(const pm_scene *s) {
   }
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
+    if (bc->on == PM_ON_REGION)
+      return pm_scene_fail(
+          s, PM_PATH(p, "boundary.%d.region", i), true,
+          "expected on: a face of domain.box for method mpm-implicit (grips "
+          "on regions of particles run by method mpm), got region");
     if (bc->velocity_mask || bc->absorbing)
       return pm_scene_fail(
           s,

@@ -107,7 +107,7 @@ pm_err mpm_work_create(const mpm_model *m, mpm_work **out) {
   PM_TRY(PM_ALLOC(w, 1, "MPM workspace"));
   PM_TRY(mpm_nodes_create(&w->nodes, &m->grid, m->opt.update != MPM_USL,
                           m->has_absorbing, pm_omp_threads()));
-  PM_TRY(mpm_cond_work_create(&w->cond, &m->grid, m->n_bcs));
+  PM_TRY(mpm_cond_work_create(&w->cond, &m->grid, m->bcs, m->n_bcs));
   PM_TRY(PM_ALLOC(w->dx, 3 * n, "particle increments"));
   PM_TRY(PM_ALLOC(w->cp, n, "particle wave speeds"));
   if (m->has_absorbing) PM_TRY(PM_ALLOC(w->cs, n, "particle wave speeds"));

@@ -9,6 +9,7 @@
 #include "mpm_exchange.h"
 #include "mpm_implicit_impl.h"
 #include "mpm_kind.h"
+#include "mpm_traction.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
 #include "pm_tensor.h"
@@ -126,9 +127,13 @@ static bool fbar_force(mpm_implicit *im, const double *u, const double *du,
 /* Nodal force f = f_int - lambda f_gravity from the nodal values u.
  * Returns false when a particle's stress fails (im->fail_msg). */
 bool mpm_implicit_nodal_force(mpm_implicit *im, const double *u, double *f) {
-  if (im->fbar) return fbar_force(im, u, NULL, f);
   const mpm_model *m = im->m;
   const double lam = im->lam0 + im->lam_local * (im->lam1 - im->lam0);
+  if (im->fbar) {
+    const bool ok = fbar_force(im, u, NULL, f);
+    mpm_tractions_nodal(m, &im->g, im->xb, lam, f);
+    return ok;
+  }
   memset(f, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
   im->fail_p = -1;
   for (int t = 0; t < im->threads; t++) im->tmin[t] = INFINITY;
@@ -161,6 +166,7 @@ bool mpm_implicit_nodal_force(mpm_implicit *im, const double *u, double *f) {
   im->min_jacobian = INFINITY;
   for (int t = 0; t < im->threads; t++)
     im->min_jacobian = fmin(im->min_jacobian, im->tmin[t]);
+  mpm_tractions_nodal(m, &im->g, im->xb, lam, f);
   return im->fail_p < 0;
 }
 

@@ -21,6 +21,16 @@ pm_err mpm_par_check(const pm_scene *s) {
                          "run has %d ranks): take mpm.fbar: cell, or run with "
                          "-np 1",
                          pm_par_size());
+  for (int i = 0; i < s->n_bcs; i++)
+    if (s->bcs[i].on == PM_ON_REGION || s->bcs[i].traction_mask) {
+      const bool grip = s->bcs[i].on == PM_ON_REGION;
+      char p[64];
+      return pm_scene_fail(
+          s, PM_PATH(p, "boundary.%d.%s", i, grip ? "region" : "traction"),
+          true, "%s run on one process (this run has %d ranks): run with -np 1",
+          grip ? "grips on regions of particles" : "tractions on particles",
+          pm_par_size());
+    }
   return PM_SUCCESS;
 }
 
