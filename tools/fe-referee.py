@@ -797,12 +797,15 @@ def summary(folder, names):
             continue
         spec = CASES[name]
         comp = "reaction_" + "xyz"[spec["load"][1]]
+        figure = "reaction (N%s)" % ("/m" if spec["dim"] == 2 else "")
+        if spec["traction"]:  # its reaction is the load: the tip instead
+            comp, figure = "tip_u", "tip u_%s (m)" % "xyz"[spec["traction"][1]]
         rows = read_csv(path)
         out.append("**%s** (%s, %s model)\n" % (
             name, rows[-1]["element"], rows[-1]["model"]))
-        out.append("| N | nodes | reaction (N%s) | mean SED (J/m^3) | von "
+        out.append("| N | nodes | %s | mean SED (J/m^3) | von "
                    "Mises at centre (Pa) | increments | wall (s) | CPU (s) "
-                   "| status |" % ("/m" if spec["dim"] == 2 else ""))
+                   "| status |" % figure)
         out.append("|---|---|---|---|---|---|---|---|---|")
         for r in rows:
             status = r["status"] if r["status"] == "converged" else \
