@@ -49,15 +49,18 @@ def moduli(nu):
 
 
 def case(dim, faces, load, ladder, nu=0.495, about="", increment=(0.05, 0.1),
-         mirrors=()):
+         mirrors=(), traction=None):
     """A case: dimension, the prescribed components per face of the part
     solved (face -> {component: value}), the loaded face and component, the
     mesh ladder, Poisson's ratio, a description, the first and largest load
     increments of the static step, and the planes of symmetry (axis, plane)
     the part solved is mirrored about to give the whole block: the part is
-    the block's side of each plane at higher coordinates."""
+    the block's side of each plane at higher coordinates.  A traction case
+    (traction = (face, component, nominal traction in Pa)) loads that face
+    instead; its figure is the tip displacement (see TRACTION below)."""
     return dict(dim=dim, faces=faces, load=load, ladder=ladder, nu=nu,
-                about=about, increment=increment, mirrors=mirrors)
+                about=about, increment=increment, mirrors=mirrors,
+                traction=traction)
 
 
 LADDER_3D = [2, 4, 8, 12, 16, 20]
@@ -120,6 +123,45 @@ CASES = {
     "f3-extension-60-nu0.45": constrained(
         0.06, "F3 60% with nu = 0.45", nu=0.45),
 }
+
+# ---- traction cases: the near-incompressible panel ---------------------------
+# A dead (fixed-direction, nominal) traction on a free face, written as
+# CLOADs: the consistent nodal forces of the quadratic edges.  Their
+# figure is the tip displacement: the mean of u along the loaded component
+# over the lattice points on the loaded face (tip_u, beside tip_face and
+# tip_axis in the ladder), the reaction on the clamped face being the
+# applied load.  Both integrations are run (--element full): nu = 0.499
+# locks the fully integrated CPE8 on coarse meshes.
+CASES["panel-near-incompressible"] = case(
+    2, {"xmin": {0: 0.0, 1: 0.0}}, ("xmin", 1), LADDER_2D, nu=0.499,
+    about="10 x 4 m plane-strain panel, nu = 0.499, u = 0 on x = 0, "
+    "nominal shear traction t_y = 20 Pa on x = 10 (dead load)",
+    traction=("xmax", 1, 20.0))
+TIP_COLUMNS = ["tip_face", "tip_axis", "tip_u"]
+
+
+def traction_loads(mesh, spec):
+    """*CLOAD lines of a traction case: uniform nominal traction q on the
+    face, per element edge h the quadratic edge's consistent forces q h/6,
+    2 q h/3, q h/6 (1 m deep)."""
+    face, comp, q = spec["traction"]
+    k = 1 - AXIS[face[0]]  # the face's tangential axis (2-D)
+    text = "*CLOAD\n"
+    for nid in mesh.face(face):
+        j, last = mesh.index[nid - 1][k], 2 * mesh.ne[k]
+        w = 2.0 / 3.0 if j % 2 else (1.0 / 6.0 if j in (0, last) else 1.0 / 3.0)
+        text += "%d,%d,%s\n" % (nid, comp + 1, number(q * w * mesh.h))
+    return text
+
+
+def tip_displacement(spec, lattice):
+    """The traction case's tip figures: the loaded face, its component, and
+    the mean displacement along it over the lattice points on the face."""
+    face, comp, _ = spec["traction"]
+    k = AXIS[face[0]]
+    plane = 0.0 if face.endswith("min") else BOX[spec["dim"]][k]
+    on = np.abs(lattice[:, k] - plane) < 1e-9
+    return face, "xyz"[comp], float(np.mean(lattice[on, 3 + comp]))
 
 # Block sizes: the 3-D cube and the 2-D plane-strain block.
 BOX = {3: (0.1, 0.1, 0.1), 2: (10.0, 4.0)}
@@ -330,6 +372,8 @@ def write_deck(path, name, spec, n, mesh, reduced):
     for face, comps in spec["faces"].items():
         for c, v in sorted(comps.items()):
             lines += "N%s,%d,%d,%s\n" % (face.upper(), c + 1, c + 1, number(v))
+    if spec["traction"]:
+        lines += traction_loads(mesh, spec)
     load = "N" + spec["load"][0].upper()
     # CalculiX uses one output frequency for every request of a step; the
     # default (every increment) keeps the last converged increment of a
@@ -544,7 +588,7 @@ def run_case(name, spec, n, reduced, work, threads):
     face, axis = spec["load"]
     history = [b for b in blocks
                if b[0].startswith("total force") and b[1] == load_set]
-    if history:
+    if history and not spec["traction"]:  # a traction's work: not here
         t = np.array([0.0] + [b[2] for b in history])
         f = np.array([0.0] + [b[3][0][axis] for b in history])
         row["work_density"] = (np.trapz(f, t) * spec["faces"][face][axis]
@@ -572,6 +616,11 @@ def run_case(name, spec, n, reduced, work, threads):
         pts = lattice_points(dim)
         lattice = np.array([mesh.displacement(p, u) for p in pts])
         lattice = np.hstack([np.pad(pts, ((0, 0), (0, 3 - dim))), lattice])
+    if spec["traction"]:
+        face, comp = spec["traction"][0], "xyz"[spec["traction"][1]]
+        row.update(tip_face=face, tip_axis=comp, tip_u=math.nan)
+        if lattice is not None:
+            row["tip_u"] = tip_displacement(spec, lattice)[2]
     return row, lattice
 
 
@@ -617,15 +666,20 @@ def describe(name, spec):
              "displacement (trapezoids over the increments) / volume; "
              "load_fraction: share of the prescribed displacement reached\n"
              % (dim, spec["load"][0], str(CENTRE[dim])))
+    if spec["traction"]:
+        text += ("# traction case: work_density not computed; tip_u: mean "
+                 "displacement along tip_axis (m) over the lattice points on "
+                 "tip_face, the case's figure (tolerance.csv: tip)\n")
     return text
 
 
 def write_ladder(path, header, rows):
+    columns = COLUMNS + (TIP_COLUMNS if "tip_u" in rows[0] else [])
     with open(path + ".tmp", "w") as f:
         f.write(header)
-        f.write(",".join(COLUMNS) + "\n")
+        f.write(",".join(columns) + "\n")
         for r in rows:
-            f.write(",".join(cell(r[c]) for c in COLUMNS) + "\n")
+            f.write(",".join(cell(r[c]) for c in columns) + "\n")
     os.replace(path + ".tmp", path)
 
 
@@ -690,14 +744,15 @@ def write_tolerance(path, header, spec, rows, lattices):
     n = [r["N"] for r in done]
     fine = done[-1]
     result = []
-    for q in ("reaction", "mean_sed", "von_mises_centre", "lattice_nrmse"):
+    first = "tip" if spec["traction"] else "reaction"
+    for q in (first, "mean_sed", "von_mises_centre", "lattice_nrmse"):
         if q == "lattice_nrmse":
             lat = [lattices[k][:, 3:] for k in n]
             # Signed changes are not defined for a field: the NRMSE of each
             # mesh against the next stands for their size.
             d = [nrmse_vector(lat[i], lat[i + 1]) for i in range(len(n) - 1)]
         else:
-            key = comp if q == "reaction" else q
+            key = {"reaction": comp, "tip": "tip_u"}.get(q, q)
             v = [r[key] for r in done]
             d = [(v[i + 1] - v[i]) / abs(fine[key]) for i in range(len(n) - 1)]
         change = abs(d[-1])
@@ -742,12 +797,15 @@ def summary(folder, names):
             continue
         spec = CASES[name]
         comp = "reaction_" + "xyz"[spec["load"][1]]
+        figure = "reaction (N%s)" % ("/m" if spec["dim"] == 2 else "")
+        if spec["traction"]:  # its reaction is the load: the tip instead
+            comp, figure = "tip_u", "tip u_%s (m)" % "xyz"[spec["traction"][1]]
         rows = read_csv(path)
         out.append("**%s** (%s, %s model)\n" % (
             name, rows[-1]["element"], rows[-1]["model"]))
-        out.append("| N | nodes | reaction (N%s) | mean SED (J/m^3) | von "
+        out.append("| N | nodes | %s | mean SED (J/m^3) | von "
                    "Mises at centre (Pa) | increments | wall (s) | CPU (s) "
-                   "| status |" % ("/m" if spec["dim"] == 2 else ""))
+                   "| status |" % figure)
         out.append("|---|---|---|---|---|---|---|---|---|")
         for r in rows:
             status = r["status"] if r["status"] == "converged" else \
@@ -848,6 +906,10 @@ def main():
                       row["work_density"], row["increments"],
                       row["wall_seconds"], row["status"],
                       row["load_fraction"]), flush=True)
+            if "tip_u" in row:
+                print("%-30s N %3d tip u_%s on %s: %.7g m" % (
+                    name, n, row["tip_axis"], row["tip_face"], row["tip_u"]),
+                    flush=True)
             write_ladder(os.path.join(folder, "ladder.csv"), header, rows)
             if not a.keep:
                 shutil.rmtree(os.path.join(a.work, "%s-N%d-%s" % (

@@ -42,9 +42,14 @@ static void check_case(const char *dir) {
   assert_true(isfinite(r->reaction[axis]) && r->reaction[axis] != 0);
   assert_true(r->mean_sed > 0 && r->von_mises_centre > 0);
   const pm_fe_tolerance *t = &r->tolerance;
-  assert_true(t->reaction > 0 && t->mean_sed > 0 && t->lattice_nrmse > 0 &&
+  /* A traction case claims its tip displacement, its reaction being the
+   * applied load. */
+  const bool tip = r->tip_face >= 0;
+  const double claim = tip ? t->tip : t->reaction;
+  assert_true(claim > 0 && t->mean_sed > 0 && t->lattice_nrmse > 0 &&
               t->von_mises_centre > 0);
-  double dr = rel_change(f->reaction[axis], p->reaction[axis]);
+  double dr = tip ? rel_change(f->tip_u, p->tip_u)
+                  : rel_change(f->reaction[axis], p->reaction[axis]);
   double ds = rel_change(f->mean_sed, p->mean_sed);
   double dv = rel_change(f->von_mises_centre, p->von_mises_centre);
   /* The previous mesh's lattice, at the same points. */
@@ -55,13 +60,15 @@ static void check_case(const char *dir) {
   assert_int_equal(n, r->n);
   for (long i = 0; i < 3 * n; i++) assert_true(fabs(x[i] - r->x[i]) < 1e-12);
   double dl = pm_nrmse_vector(n, r->dim == 2 ? 3u : 7u, u, r->u);
-  print_message("%-30s N %d -> %d (%s): reaction %.7g N, change %.2e (tol "
+  print_message("%-30s N %d -> %d (%s): %s %.7g, change %.2e (tol "
                 "%g); mean SED %.7g J/m^3, %.2e (%g); von Mises %.6g Pa, "
                 "%.2e (%g); lattice NRMSE %.2e (%g)\n",
-                r->name, p->n, f->n, f->element, r->reaction[axis], dr,
-                t->reaction, r->mean_sed, ds, t->mean_sed, r->von_mises_centre,
-                dv, t->von_mises_centre, dl, t->lattice_nrmse);
-  assert_true(dr <= t->reaction);
+                r->name, p->n, f->n, f->element,
+                tip ? "tip (m)" : "reaction (N)",
+                tip ? r->tip_u : r->reaction[axis], dr, claim, r->mean_sed, ds,
+                t->mean_sed, r->von_mises_centre, dv, t->von_mises_centre, dl,
+                t->lattice_nrmse);
+  assert_true(dr <= claim);
   assert_true(ds <= t->mean_sed);
   assert_true(dv <= t->von_mises_centre);
   assert_true(dl <= t->lattice_nrmse);
@@ -198,6 +205,43 @@ static void test_good(void **state) {
   pm_fe_free(r);
 }
 
+/* A traction case: the tip columns name the loaded face and component,
+ * and pm_fe_tip averages that component over the lattice points on the
+ * face (here x = 0.1: two of the three points). */
+static void test_tip(void **state) {
+  const char *dir = *state;
+  pm_fe_reference *r = NULL;
+  const char *ladder =
+      "N,nodes,dofs,element,h,reaction_x,reaction_y,reaction_z,mean_sed,"
+      "von_mises_centre,increments,wall_seconds,ccx_version,load_fraction,"
+      "status,tip_face,tip_axis,tip_u\n"
+      "2,81,243,C3D20R,0.05,0,-8,0,1.3,52,12,1.4,2.20,1,converged,xmax,y,0.5\n"
+      "4,425,1275,C3D20R,0.025,0,-8,0,1.4,52,12,4.2,2.20,1,converged,xmax,y,"
+      "0.6\n";
+  write_reference(dir, ladder,
+                  "x,y,z,u_x,u_y,u_z\n0,0,0,0,0,0\n0.1,0,0,0,0.5,0\n"
+                  "0.1,0.1,0,0,0.7,0\n",
+                  "quantity,tolerance\ntip,1e-2\n");
+  assert_ok(pm_fe_load(dir, &r));
+  assert_int_equal(r->tip_face, 1);
+  assert_int_equal(r->tip_axis, 1);
+  assert_true(r->tip_u == 0.6 && r->tolerance.tip == 1e-2);
+  assert_true(isnan(r->tolerance.reaction));
+  double mapped[9] = {0, 0, 0, 0, 0.45, 0, 0, 0.69, 0};
+  assert_close(pm_fe_tip(r, mapped), 0.57, 1e-15, 0);
+  pm_fe_errors e;
+  pm_outcome o = {.loaded_axis = -1, .fig = {.mean_sed = 1.4}};
+  pm_fe_errors_of(r, mapped, &o, &e);
+  assert_close(e.tip_error, -0.05, 1e-14, 0);
+  assert_true(isnan(e.reaction_error));
+  pm_fe_free(r);
+  /* Without tip columns there is no tip. */
+  write_reference(dir, LADDER_HEAD LADDER_ROWS, LATTICE, NULL);
+  assert_ok(pm_fe_load(dir, &r));
+  assert_true(r->tip_face == -1 && isnan(pm_fe_tip(r, mapped)));
+  pm_fe_free(r);
+}
+
 /* The interior NRMSE sees only the lattice points off the bounding faces
  * and keeps the whole lattice's normaliser: on a 3 x 3 x 3 lattice an error
  * at a face point leaves it zero, and one at the centre (the one interior
@@ -260,6 +304,12 @@ static const bad_case BAD[] = {
     {LADDER_HEAD LADDER_ROWS, LATTICE,
      "quantity,tolerance\nreaction,1e-3\nstress,1e-3\n", "tolerance.csv", 3,
      "column quantity: expected reaction, mean_sed"},
+    {"N,nodes,dofs,element,h,reaction_x,reaction_y,reaction_z,mean_sed,"
+     "von_mises_centre,increments,wall_seconds,ccx_version,tip_face,tip_axis,"
+     "tip_u\n2,81,243,C3D20R,0.05,0,-8,0,1,1,12,1,2.20,top,y,0.5\n",
+     LATTICE, NULL, "ladder.csv", 2,
+     "column tip_face: expected xmin, xmax, ymin, ymax, zmin or zmax, got "
+     "'top'"},
 };
 
 static void test_malformed(void **state) {
@@ -307,6 +357,8 @@ static void test_names(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_committed_cases),
+      cmocka_unit_test_setup_teardown(test_tip, pm_test_make_dir,
+                                      pm_test_drop_dir),
       cmocka_unit_test(test_f2_exact),
       cmocka_unit_test(test_interior_nrmse),
       cmocka_unit_test_setup_teardown(test_good, pm_test_make_dir,

@@ -4,6 +4,9 @@
 #    the implicit MPM) writes its report, every method within its own
 #    tolerance of the exact field (FPM and implicit MPM 1e-6, explicit MPM
 #    5e-3, the bound of verify_mpm_f2) and of the FE referee's reaction;
+#  - the hard cases, coarse (cases/bench/hard-tiny.yaml): every outcome,
+#    a refused run among them, in one table, the panel against its FE
+#    referee's tip displacement;
 #  - a two-case suite whose second case goes unstable: the failure is
 #    listed with its diagnosis, the first case still reported, exit 2;
 #  - variants of one method under labels, with their own overrides;
@@ -80,6 +83,47 @@ fi
 refused "tiny again: refused without --overwrite" \
   'already holds a bench' "$out/none" \
   "$bin" bench "$src/cases/bench/tiny.yaml" --out "$out" --quiet
+
+# ---- the hard cases, coarse ----------------------------------------------
+# hard-tiny.yaml: the near-incompressible panel at 157 points, F3 200% and
+# F4 60% at 237, F4 between plates, the reduced shock tube.  The static
+# solve refuses contact: its run on the plates is refused, listed with the
+# reason in the one table, and the suite goes on (exit 1, a refused scene).
+out=$work/hard-tiny
+"$bin" bench "$src/cases/bench/hard-tiny.yaml" --out "$out" --quiet \
+  >"$out.log" 2>"$work/err"
+rc=$?
+cat "$out.log"
+check "hard-tiny: exit 1, a refused run (got $rc)" test $rc -eq 1
+csv=$out/bench.csv
+md=$out/bench.md
+s=$(field "$csv" f4-plates-40 fpm-static status)
+check "hard-tiny: the plates by a static solve refused ($s)" test "$s" = refused
+check "hard-tiny: its reason in the table's diagnosis column" grep -Eq \
+  '^\| f4-plates-40 \| 0.02 \| fpm-static \| refused \|.*contact.* \|$' "$md"
+for m in fpm-static fpm-paper; do
+  s=$(field "$csv" panel $m status)
+  check "hard-tiny: panel by $m converged ($s)" test "$s" = converged
+  t=$(field "$csv" panel $m tip_error_fe)
+  check "hard-tiny: panel by $m: tip error $t tabulated" \
+    awk -v t="$t" 'BEGIN { exit !(t != "" && t + 0 > -1 && t + 0 < 1) }'
+done
+# The default formulation (the quadratic jump, p = 0.05) at 157 points
+# against the referee's tip displacement (1.3935 m, CPE8R N = 16):
+# measured -4.3%.
+t=$(field "$csv" panel fpm-static tip_error_fe)
+check "hard-tiny: panel by the default within 5% of FE ($t)" \
+  awk -v t="$t" 'BEGIN { exit !(t != "" && t * t <= 0.05 * 0.05) }'
+check "hard-tiny: the referee's tip ladder tabulated" \
+  grep -q '^fe,panel,,fe,CalculiX CPE8R,converged,.*,[-0-9.e]*,$' "$csv"
+for c in f3-200 f4-60; do
+  s=$(field "$csv" $c fpm-static status)
+  check "hard-tiny: $c's outcome recorded ($s)" test -n "$s"
+  check "hard-tiny: $c in the table" grep -Eq "^\| $c \| 0.02 \| fpm-static \| $s \|" "$md"
+done
+s=$(field "$csv" m2-shock-tube mpm status)
+check "hard-tiny: the shock tube completed after the refusal ($s)" \
+  test "$s" = completed
 
 # ---- a failing case does not stop the suite ------------------------------
 # The second case runs the explicit MPM at 25 times its stable step.

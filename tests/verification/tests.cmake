@@ -54,7 +54,7 @@ set_tests_properties(verification.compare PROPERTIES LABELS verification TIMEOUT
 
 add_test(NAME verification.bench
   COMMAND bash ${PM_VERIFY_DIR}/bench.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
-set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)
+set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 450 PROCESSORS 2)
 
 # Runs across MPI ranks (mpirun -np 2 and 3) against the same scenes on one
 # process, explicit MPM (ranks.sh) and FPM (ranks-fpm.sh); ranks_migrate

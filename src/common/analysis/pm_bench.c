@@ -91,6 +91,10 @@ static void print_row(FILE *out, const pm_compare_row *r) {
     fprintf(out, "%sreaction %+.2f%% of FE", sep, 100 * r->reaction_fe);
     sep = ", ";
   }
+  if (isfinite(r->tip_fe)) {
+    fprintf(out, "%stip %+.2f%% of FE", sep, 100 * r->tip_fe);
+    sep = ", ";
+  }
   if (r->ran)
     fprintf(out, "%s%.2f s, %.0f MiB", sep, r->wall_seconds,
             (double)r->memory_bytes / MIB);
@@ -147,6 +151,11 @@ static void case_fe(const pm_bench_suite *S, const pm_bench_case *C,
       if (fabs(r->reaction[k]) > fabs(r->reaction[F->axis])) F->axis = k;
     F->reaction = r->reaction[F->axis];
     F->tol = r->tolerance.reaction;
+    F->tip = r->tip_face >= 0;
+    if (F->tip) {
+      F->reaction = r->tip_u;
+      F->tol = r->tolerance.tip;
+    }
     F->n = r->n_rows < BENCH_FE_ROWS ? r->n_rows : BENCH_FE_ROWS;
     for (int k = 0; k < F->n; k++) F->rows[k] = r->rows[k];
   }

@@ -57,10 +57,16 @@ typedef struct {
   char dir[PM_PATH_MAX + 1];
   int n;
   pm_fe_row rows[BENCH_FE_ROWS];
-  double reaction; /* the referee's loaded reaction, N */
-  double tol;      /* its relative reaction tolerance (NaN: none) */
+  double reaction; /* the referee's loaded reaction, N; a traction case's
+                      (tip): its tip displacement, m (pm_fe_tip) */
+  double tol;      /* its relative tolerance on that (NaN: none) */
   int axis;
+  bool tip; /* a traction case: judged by the tip displacement */
 } pm_bench_fe;
+
+/* A run's error against the FE referee's figure (relative): the loaded
+ * reaction's, or a traction case's tip displacement's. */
+double pm_bench_fe_error(const pm_compare_row *r);
 
 typedef struct {
   pm_sdoc doc;

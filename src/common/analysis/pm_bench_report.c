@@ -17,6 +17,10 @@ double pm_bench_judged(const pm_compare_row *r, const char **against) {
   return NAN;
 }
 
+double pm_bench_fe_error(const pm_compare_row *r) {
+  return isfinite(r->reaction_fe) ? r->reaction_fe : r->tip_fe;
+}
+
 void pm_bench_res_text(char *b, size_t size, double res) {
   if (isfinite(res))
     snprintf(b, size, "%g", res);
@@ -49,7 +53,7 @@ static void md_verdict(const pm_bench_suite *S, const pm_bench_comparison *runs,
       for (int i = 0; i < n_runs; i++) {
         if (runs[i].c != c || k >= runs[i].n_rows) continue;
         const pm_compare_row *r = &runs[i].rows[k];
-        if (!reached(r) || !isfinite(r->reaction_fe)) continue;
+        if (!reached(r) || !isfinite(pm_bench_fe_error(r))) continue;
         if (!fine || r->points > fine->points) {
           coarse = fine;
           fine = r;
@@ -60,12 +64,14 @@ static void md_verdict(const pm_bench_suite *S, const pm_bench_comparison *runs,
       if (!coarse) continue;
       if (!header) {
         fprintf(m, "\n## Convergence toward the referee\n\n| case | "
-                   "method | points | reaction error (%%) | change by the "
+                   "method | points | reaction (tip) error (%%) | change "
+                   "by the "
                    "last refinement (%%) | NRMSE | verdict |\n"
                    "|---|---|---|---|---|---|---|\n");
         header = true;
       }
-      const double e = fine->reaction_fe, d = coarse->reaction_fe - e;
+      const double e = pm_bench_fe_error(fine);
+      const double d = pm_bench_fe_error(coarse) - e;
       const double tol = fe[c].tol;
       const char *verdict =
           isfinite(tol) && fabs(e) <= tol
@@ -106,30 +112,51 @@ static void each_fe_level(const pm_bench_suite *S, const pm_bench_fe *fe,
     for (int k = 0; k < F->n; k++) {
       const pm_fe_row *r = &F->rows[k];
       if (!r->converged) continue;
-      double err = (r->reaction[F->axis] - F->reaction) / F->reaction;
-      fn(f, S->c[c].name, r, F->axis, err);
+      double v = F->tip ? r->tip_u : r->reaction[F->axis];
+      fn(f, S->c[c].name, r, F->tip ? -1 : F->axis,
+         (v - F->reaction) / F->reaction);
     }
   }
 }
 
-/* A row of bench.md's table of the referee's ladder. */
+/* A row of bench.md's table of the referee's ladder (axis -1: a traction
+ * case's tip displacement). */
 static void md_fe_level(FILE *m, const char *name, const pm_fe_row *r, int axis,
                         double err) {
   char b[3][PM_TABLE_NUMBER];
   fprintf(m, "| %s | %d | %ld | %s | %s | %s | %.3g |\n", name, r->n, r->nodes,
           pm_table_number(b[0], r->h, 4),
-          pm_table_number(b[1], r->reaction[axis], 6),
+          pm_table_number(b[1], axis >= 0 ? r->reaction[axis] : r->tip_u, 6),
           pm_table_number(b[2], 100 * err, 3), r->wall_seconds);
 }
 
-/* A row "fe" of bench.csv. */
+/* A row "fe" of bench.csv: err under reaction_error_fe, or under
+ * tip_error_fe for a traction case (axis -1). */
 static void csv_fe_level(FILE *f, const char *name, const pm_fe_row *r,
                          int axis, double err) {
   char b[2][PM_TABLE_NUMBER];
-  (void)axis;
-  fprintf(f, "fe,%s,,fe,CalculiX %s,converged,%ld,%s,%ld,,,,,%s,,,%.6g,,,\n",
+  pm_table_number(b[1], err, 10);
+  fprintf(f, "fe,%s,,fe,CalculiX %s,converged,%ld,%s,%ld,,,,,%s,,,%.6g,,,%s,\n",
           name, r->element, r->nodes, pm_table_number(b[0], r->h, 10),
-          r->increments, pm_table_number(b[1], err, 10), r->wall_seconds);
+          r->increments, axis >= 0 ? b[1] : "", r->wall_seconds,
+          axis >= 0 ? "" : b[1]);
+}
+
+/* The first sentence (up to '.', ';' or a line's end; at most 200
+ * characters) of a run's message as a table cell's text, and the row's
+ * end. */
+static void md_first_line(FILE *m, const char *msg) {
+  char cell[204];
+  size_t n = 0;
+  while (msg[n] && n < sizeof cell - 4 && msg[n] != '\n' && msg[n] != ';' &&
+         !(msg[n] == '.' && (msg[n + 1] == ' ' || !msg[n + 1])))
+    n++;
+  memcpy(cell, msg, n);
+  if (msg[n] && msg[n] != '.' && msg[n] != ';' && msg[n] != '\n')
+    memcpy(cell + n, "...", 3), n += 3;
+  cell[n] = 0;
+  pm_md_text(m, cell);
+  fprintf(m, " |\n");
 }
 
 static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
@@ -142,15 +169,16 @@ static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
           "%.1f s in all.\n\n## Accuracy and cost\n\n",
           S->name, S->path, S->n_cases, n_runs, seconds);
   fprintf(m, "| case | resolution (m) | method | status | points | h (m) | "
-             "steps | NRMSE | against | reaction error (FE) | wall (s) | "
-             "memory (MiB) |\n|---|---|---|---|---|---|---|---|---|---|---|"
-             "---|\n");
+             "steps | NRMSE | against | reaction (tip) error (FE) | wall (s) "
+             "| memory (MiB) | diagnosis |\n|---|---|---|---|---|---|---|---|"
+             "---|---|---|---|---|\n");
   for (int i = 0; i < n_runs; i++) {
     const pm_bench_comparison *R = &runs[i];
     pm_bench_res_text(res, sizeof res, R->res);
     if (R->n_rows == 0) {
-      fprintf(m, "| %s | %s | | failed | | | | | | | | |\n", S->c[R->c].name,
+      fprintf(m, "| %s | %s | | failed | | | | | | | | | ", S->c[R->c].name,
               res);
+      md_first_line(m, R->message);
       n_fail++;
     }
     for (int k = 0; k < R->n_rows; k++) {
@@ -166,20 +194,26 @@ static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
       else
         fprintf(m, " | | |");
       fprintf(m, " %s | %s | %s |", pm_table_number(b[1], e, 3), against,
-              pm_table_number(b[2], 100 * r->reaction_fe, 3));
+              pm_table_number(b[2], 100 * pm_bench_fe_error(r), 3));
       if (r->ran)
-        fprintf(m, " %.3g | %.1f |\n", r->wall_seconds,
+        fprintf(m, " %.3g | %.1f | ", r->wall_seconds,
                 (double)r->memory_bytes / MIB);
       else
-        fprintf(m, " | |\n");
+        fprintf(m, " | | ");
+      md_first_line(m, r->message);
     }
   }
-  fprintf(m, "\nReaction error in %% of the FE referee's loaded reaction.\n");
+  fprintf(m, "\nReaction error in %% of the FE referee's loaded reaction; "
+             "for a case loaded by a traction (its reaction is the load), "
+             "the tip displacement's error (the mean displacement on the "
+             "loaded face, negative when the run is stiffer).  Diagnosis: "
+             "the first sentence of why a run stopped (all of it under "
+             "Failures).\n");
   bool any_fe = false;
   for (int c = 0; c < S->n_cases; c++) any_fe = any_fe || fe[c].have;
   if (any_fe) {
     fprintf(m, "\n## The FE referee's ladder\n\n| case | N | nodes | h (m) | "
-               "reaction (N) | reaction error (%%) | wall (s) |\n"
+               "reaction (N) or tip (m) | error (%%) | wall (s) |\n"
                "|---|---|---|---|---|---|---|\n");
     each_fe_level(S, fe, m, md_fe_level);
     fprintf(m, "\nErrors against the referee's finest converged level, "
@@ -224,13 +258,13 @@ static void write_csv(const pm_bench_suite *S, const pm_bench_comparison *runs,
   fprintf(f, "kind,case,resolution,label,method,status,points,h,steps,"
              "nrmse,against,nrmse_analytic,nrmse_fe,reaction_error_fe,"
              "sed_error_fe,min_jacobian,wall_seconds,setup_seconds,"
-             "memory_bytes,message\n");
+             "memory_bytes,tip_error_fe,message\n");
   for (int i = 0; i < n_runs; i++) {
     const pm_bench_comparison *R = &runs[i];
     const char *cname = S->c[R->c].name;
     pm_table_number(b[0], R->res, 10);
     if (R->n_rows == 0) {
-      fprintf(f, "method,%s,%s,,,failed,,,,,,,,,,,,,,", cname, b[0]);
+      fprintf(f, "method,%s,%s,,,failed,,,,,,,,,,,,,,,", cname, b[0]);
       pm_csv_text(f, R->message);
       fputc('\n', f);
     }
@@ -256,6 +290,7 @@ static void write_csv(const pm_bench_suite *S, const pm_bench_comparison *runs,
                 r->memory_bytes);
       else
         fprintf(f, ",,,");
+      fprintf(f, "%s,", pm_table_number(b[8], r->tip_fe, 10));
       pm_csv_text(f, r->message);
       fputc('\n', f);
     }

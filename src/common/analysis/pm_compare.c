@@ -264,6 +264,7 @@ static void fill_rows(const cmp_study *c, pm_compare_row *rows, int *n) {
     r->e_run = M->e_run;
     r->reaction_fe = M->reaction_fe;
     r->sed_fe = M->sed_fe;
+    r->tip_fe = M->tip_fe;
     r->loaded_reaction = r->ran ? M->out.loaded_reaction : NAN;
     r->min_jacobian = r->ran ? g->min_jacobian : NAN;
   }

@@ -27,8 +27,9 @@ typedef struct {
   double h, wall_seconds, setup_seconds;
   size_t memory_bytes;
   /* NRMSE against the analytic field, the FE lattice, a reference run;
-   * the loaded face's reaction and the mean SED against FE's (relative). */
-  double e_analytic, e_fe, e_run, reaction_fe, sed_fe;
+   * the loaded face's reaction and the mean SED against FE's (relative);
+   * a traction case's tip displacement against FE's (pm_fe_tip). */
+  double e_analytic, e_fe, e_run, reaction_fe, sed_fe, tip_fe;
   double loaded_reaction, min_jacobian;
 } pm_compare_row;
 

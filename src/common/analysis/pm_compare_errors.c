@@ -110,7 +110,7 @@ pm_err cmp_compute_errors(cmp_study *c) {
   for (int k = 0; k < c->n; k++) {
     cmp_method *M = &c->meth[k];
     M->e_analytic = M->e_fe = M->e_fe_interior = NAN;
-    M->reaction_fe = M->sed_fe = M->e_run = NAN;
+    M->reaction_fe = M->sed_fe = M->e_run = M->tip_fe = NAN;
     for (int l = 0; l < c->n; l++) c->pair[k][l] = NAN;
     if (!M->mapped || nv == 0) continue;
     compact(c, M->u, a);
@@ -126,6 +126,7 @@ pm_err cmp_compute_errors(cmp_study *c) {
       M->e_fe_interior = e.nrmse_interior;
       M->reaction_fe = e.reaction_error;
       M->sed_fe = e.sed_error;
+      M->tip_fe = e.tip_error;
     }
     if (c->run_u) {
       compact(c, c->run_u, r);

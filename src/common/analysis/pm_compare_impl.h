@@ -36,6 +36,7 @@ typedef struct {
    * with the reaction and mean SED errors), against a reference run; NaN
    * where there is no such reference. */
   double e_analytic, e_fe, e_fe_interior, reaction_fe, sed_fe, e_run;
+  double tip_fe; /* a traction case's tip error against FE (pm_fe_errors) */
 } cmp_method;
 
 typedef struct {

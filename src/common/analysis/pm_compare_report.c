@@ -56,6 +56,7 @@ void pm_md_text(FILE *f, const char *s) {
 static void md_accuracy(const cmp_study *c, FILE *m) {
   char b[8][NUM_MAX];
   const bool fe = c->fe != NULL, run = c->run_u != NULL;
+  const bool tip = fe && c->fe->tip_face >= 0;
   fprintf(m, "## Accuracy\n\n| method | status | points | h (m) | steps |");
   int cols = 6;
   if (c->analytic) {
@@ -66,6 +67,10 @@ static void md_accuracy(const cmp_study *c, FILE *m) {
     fprintf(m, " NRMSE FE | NRMSE FE (interior) | reaction error (FE) | SED "
                "error (FE) |");
     cols += 4;
+  }
+  if (tip) {
+    fprintf(m, " tip error (FE) |");
+    cols++;
   }
   if (run) {
     fprintf(m, " NRMSE reference run |");
@@ -90,6 +95,7 @@ static void md_accuracy(const cmp_study *c, FILE *m) {
       fprintf(m, " %s | %s | %s | %s |", num(b[2], M->e_fe),
               num(b[3], M->e_fe_interior), num(b[4], M->reaction_fe),
               num(b[5], M->sed_fe));
+    if (tip) fprintf(m, " %s |", num(b[7], M->tip_fe));
     if (run) fprintf(m, " %s |", num(b[6], M->e_run));
     if (M->mapped)
       fprintf(m, " %ld |\n", M->flagged);
@@ -264,7 +270,7 @@ static void csv_header(const cmp_study *c, FILE *f) {
              "reaction_error_fe,sed_error_fe,nrmse_reference_run,nrmse_pair,"
              "flagged_points,mean_strain_energy_density,von_mises_centre,"
              "min_jacobian,end_min_jacobian,loaded_reaction,wall_seconds,"
-             "setup_seconds,memory_bytes");
+             "setup_seconds,memory_bytes,tip_error_fe");
   for (int b = 0; b < s->n_bcs; b++)
     for (int k = 0; k < 3; k++)
       if (bc_mask(s, b) >> k & 1u) {
@@ -298,6 +304,7 @@ static void csv_method(const cmp_study *c, const cmp_method *M, FILE *f) {
             g->setup_seconds, g->memory_bytes);
   else
     fprintf(f, ",,,,,,,,");
+  fprintf(f, ",%s", cnum(b[13], M->tip_fe));
   for (int bc = 0; bc < s->n_bcs; bc++)
     for (int k = 0; k < 3; k++)
       if (bc_mask(s, bc) >> k & 1u)
@@ -319,8 +326,9 @@ static void write_csv(const cmp_study *c, FILE *f) {
     for (int l = k + 1; l < c->n; l++) {
       fprintf(f, "pair,%s,%s,,,,,,,,,,,,%s", c->meth[k].name, c->meth[l].name,
               cnum(b, c->pair[k][l]));
-      /* flagged .. setup, memory, the reactions and the message: empty. */
-      for (int e = 0; e < 10 + n_react; e++) fputc(',', f);
+      /* flagged .. setup, memory, tip, the reactions and the message:
+       * empty. */
+      for (int e = 0; e < 11 + n_react; e++) fputc(',', f);
       fputc('\n', f);
     }
 }

@@ -124,6 +124,9 @@ enum {
   C_REQUIRED, /* the columns above are required, those below optional */
   C_FRACTION = C_REQUIRED,
   C_STATUS,
+  C_TIP_FACE,
+  C_TIP_AXIS,
+  C_TIP_U,
   C_COUNT
 };
 static const char *const ladder_columns[C_COUNT] = {
@@ -134,7 +137,36 @@ static const char *const ladder_columns[C_COUNT] = {
     "mean_sed",    "von_mises_centre",
     "increments",  "wall_seconds",
     "ccx_version", "load_fraction",
-    "status"};
+    "status",      "tip_face",
+    "tip_axis",    "tip_u"};
+
+/* A traction case's tip columns: face name and component into indices
+ * (-1 when the ladder has none). */
+static pm_err tip_columns(const table *t, const int *col, int *face,
+                          int *axis) {
+  static const char *const faces[] = {"xmin", "xmax", "ymin",
+                                      "ymax", "zmin", "zmax"};
+  *face = *axis = -1;
+  if (col[C_TIP_FACE] < 0 && col[C_TIP_AXIS] < 0 && col[C_TIP_U] < 0)
+    return PM_SUCCESS;
+  PM_CHECK(col[C_TIP_FACE] >= 0 && col[C_TIP_AXIS] >= 0 && col[C_TIP_U] >= 0,
+           PM_ERR_ARG,
+           "%s:%ld: expected the columns tip_face, tip_axis and tip_u "
+           "together",
+           t->in.path, t->in.line);
+  const char *f = t->f[col[C_TIP_FACE]], *a = t->f[col[C_TIP_AXIS]];
+  for (int k = 0; k < 6; k++)
+    if (strcmp(f, faces[k]) == 0) *face = k;
+  PM_CHECK(*face >= 0, PM_ERR_ARG,
+           "%s:%ld: column tip_face: expected xmin, xmax, ymin, ymax, zmin "
+           "or zmax, got '%.*s'",
+           t->in.path, t->in.line, SHOW_MAX, f);
+  PM_CHECK(strlen(a) == 1 && a[0] >= 'x' && a[0] <= 'z', PM_ERR_ARG,
+           "%s:%ld: column tip_axis: expected x, y or z, got '%.*s'",
+           t->in.path, t->in.line, SHOW_MAX, a);
+  *axis = a[0] - 'x';
+  return PM_SUCCESS;
+}
 
 static pm_err ladder_row(const table *t, const int *col, pm_fe_row *r) {
   long v;
@@ -167,6 +199,9 @@ static pm_err ladder_row(const table *t, const int *col, pm_fe_row *r) {
     PM_CALL(table_number(t, col[C_RX + k], nan_ok, &r->reaction[k]));
   PM_CALL(table_number(t, col[C_SED], nan_ok, &r->mean_sed));
   PM_CALL(table_number(t, col[C_VM], nan_ok, &r->von_mises_centre));
+  r->tip_u = NAN;
+  if (col[C_TIP_U] >= 0)
+    PM_CALL(table_number(t, col[C_TIP_U], nan_ok, &r->tip_u));
   PM_CHECK(r->h > 0, PM_ERR_ARG,
            "%s:%ld: column h: expected a size > 0, got %g", t->in.path,
            t->in.line, r->h);
@@ -195,6 +230,7 @@ static pm_err read_ladder(const char *path, pm_fe_reference *r) {
     pm_fe_row *row = &r->rows[r->n_rows];
     memset(row, 0, sizeof *row);
     PM_TRY(ladder_row(&t, col, row));
+    PM_TRY(tip_columns(&t, col, &r->tip_face, &r->tip_axis));
     PM_ENSURE(r->n_rows == 0 || row->h < r->rows[r->n_rows - 1].h, PM_ERR_ARG,
               "%s:%ld: expected the meshes from coarsest to finest (h %g after "
               "%g)",
@@ -261,10 +297,10 @@ done:
  */
 
 static pm_err read_tolerance(const char *path, pm_fe_tolerance *tol) {
-  static const char *const names[] = {"reaction", "mean_sed",
-                                      "von_mises_centre", "lattice_nrmse"};
+  static const char *const names[] = {
+      "reaction", "mean_sed", "von_mises_centre", "lattice_nrmse", "tip"};
   double *dst[] = {&tol->reaction, &tol->mean_sed, &tol->von_mises_centre,
-                   &tol->lattice_nrmse};
+                   &tol->lattice_nrmse, &tol->tip};
   pm_err ret = PM_SUCCESS;
   table t = {.ncol = 0};
   int cq, ct;
@@ -276,10 +312,10 @@ static pm_err read_tolerance(const char *path, pm_fe_tolerance *tol) {
     PM_TRY(table_next(&t, &more));
     if (!more) break;
     int k = 0;
-    while (k < 4 && strcmp(t.f[cq], names[k])) k++;
-    PM_ENSURE(k < 4, PM_ERR_ARG,
+    while (k < 5 && strcmp(t.f[cq], names[k])) k++;
+    PM_ENSURE(k < 5, PM_ERR_ARG,
               "%s:%ld: column quantity: expected reaction, mean_sed, "
-              "von_mises_centre or lattice_nrmse, got '%.*s'",
+              "von_mises_centre, lattice_nrmse or tip, got '%.*s'",
               path, t.in.line, SHOW_MAX, t.f[cq]);
     PM_TRY(table_number(&t, ct, false, dst[k]));
     PM_ENSURE(*dst[k] > 0, PM_ERR_ARG,
@@ -305,7 +341,7 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
   char path[PM_PATH_MAX + 1];
   *out = NULL;
   PM_TRY(PM_ALLOC(r, 1, "FE reference"));
-  r->tolerance = (pm_fe_tolerance){NAN, NAN, NAN, NAN};
+  r->tolerance = (pm_fe_tolerance){NAN, NAN, NAN, NAN, NAN};
   size_t len = strlen(dir);
   while (len > 1 && dir[len - 1] == '/') len--;
   PM_ENSURE(len <= PM_PATH_MAX, PM_ERR_ARG,
@@ -317,6 +353,7 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
             "FE folder name '%s' is longer than %zu characters", base,
             sizeof r->name - 1);
   memcpy(r->name, base, strlen(base) + 1);
+  r->tip_face = r->tip_axis = -1;
   PM_TRY(pm_path_join(path, sizeof path, r->dir, "ladder.csv"));
   PM_TRY(read_ladder(path, r));
   PM_TRY(pm_path_join(path, sizeof path, r->dir, "lattice.csv"));
@@ -327,6 +364,10 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
   memcpy(r->reaction, f->reaction, sizeof r->reaction);
   r->mean_sed = f->mean_sed;
   r->von_mises_centre = f->von_mises_centre;
+  r->tip_u = f->tip_u;
+  PM_ENSURE(r->tip_face < 0 || isfinite(r->tip_u), PM_ERR_ARG,
+            "%s/ladder.csv: the finest converged mesh (N = %d) has no tip_u",
+            r->dir, f->n);
   double lo[3], hi[3];
   for (int c = 0; c < 3; c++) lo[c] = hi[c] = r->x[c];
   for (long i = 1; i < r->n; i++)
@@ -397,16 +438,35 @@ double pm_fe_nrmse_interior(const pm_fe_reference *r, const double *mapped) {
   return sqrt(sum / (double)m) / big;
 }
 
+double pm_fe_tip(const pm_fe_reference *r, const double *mapped) {
+  if (r->tip_face < 0 || r->tip_axis < 0 || r->n < 1) return NAN;
+  int a = r->tip_face / 2;
+  double plane = r->x[a];
+  for (long j = 1; j < r->n; j++)
+    plane = r->tip_face % 2 ? fmax(plane, r->x[3 * j + a])
+                            : fmin(plane, r->x[3 * j + a]);
+  double sum = 0, tol = 1e-9 * fmax(1.0, fabs(plane));
+  long m = 0;
+  for (long j = 0; j < r->n; j++)
+    if (fabs(r->x[3 * j + a] - plane) <= tol) {
+      sum += mapped[3 * j + r->tip_axis];
+      m++;
+    }
+  return sum / (double)m;
+}
+
 void pm_fe_errors_of(const pm_fe_reference *r, const double *mapped,
                      const pm_outcome *o, pm_fe_errors *e) {
   e->nrmse = pm_nrmse_vector(r->n, r->dim == 2 ? 3u : 7u, mapped, r->u);
   e->nrmse_interior = pm_fe_nrmse_interior(r, mapped);
   e->reaction_error = NAN;
-  int axis = o->loaded_axis;
+  /* A traction case's reaction is the applied load: no check. */
+  int axis = r->tip_face < 0 ? o->loaded_axis : -1;
   if (axis >= 0 && axis < 3)
     e->reaction_error =
         (o->loaded_reaction - r->reaction[axis]) / r->reaction[axis];
   e->sed_error = (o->fig.mean_sed - r->mean_sed) / r->mean_sed;
+  e->tip_error = (pm_fe_tip(r, mapped) - r->tip_u) / r->tip_u;
 }
 
 pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
@@ -414,6 +474,7 @@ pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
   pm_err ret = PM_SUCCESS;
   double *mapped = NULL;
   e->nrmse = e->nrmse_interior = e->reaction_error = e->sed_error = NAN;
+  e->tip_error = NAN;
   PM_TRY(PM_ALLOC(mapped, 3 * r->n, "displacement at the FE lattice"));
   PM_TRY(pm_probe_map(out_dir, -1, r->n, r->x, mapped));
   pm_fe_errors_of(r, mapped, o, e);

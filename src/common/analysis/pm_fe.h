@@ -27,12 +27,15 @@ typedef struct {
   char ccx_version[PM_FE_TEXT_MAX];
   double load_fraction; /* share of the prescribed displacement reached */
   bool converged;       /* reached the full load */
+  double tip_u;         /* a traction case's tip displacement (m): the mean of u
+                           along the reference's tip_axis over the lattice points
+                           on its tip_face; NaN when the ladder has none */
 } pm_fe_row;
 
 /* The relative tolerances the case is claimed converged to (tolerance.csv:
  * the change between the two finest converged meshes, rounded up). */
 typedef struct {
-  double reaction, mean_sed, von_mises_centre, lattice_nrmse;
+  double reaction, mean_sed, von_mises_centre, lattice_nrmse, tip;
 } pm_fe_tolerance;
 
 typedef struct {
@@ -50,6 +53,12 @@ typedef struct {
   /* The finest converged row's figures. */
   double reaction[3], mean_sed, von_mises_centre;
   pm_fe_tolerance tolerance; /* NaN where tolerance.csv gives none */
+  /* A traction-loaded case (ladder columns tip_face, tip_axis, tip_u): its
+   * figure is the tip displacement, the reaction being the applied load.
+   * tip_face: the lattice's bounding face (0..5: xmin, xmax, ..., zmax),
+   * tip_axis: the component (0..2); both -1 and tip_u NaN otherwise. */
+  int tip_face, tip_axis;
+  double tip_u;
 } pm_fe_reference;
 
 /* Read DIR/ladder.csv, DIR/lattice.csv and (when present)
@@ -78,7 +87,15 @@ typedef struct {
                             the loaded component: > 0 when the run's
                             reaction is the larger (the run is stiffer) */
   double sed_error;      /* (mean SED - FE) / FE */
+  double tip_error;      /* a traction case's (tip - FE) / FE, the tip
+                            displacement as pm_fe_tip (< 0 when the run is
+                            stiffer); NaN for other cases */
 } pm_fe_errors;
+
+/* A traction case's tip displacement of mapped (displacements at the
+ * lattice, [r->n][3]): the mean of its tip_axis component over the lattice
+ * points on tip_face.  NaN when r is not a traction case. */
+double pm_fe_tip(const pm_fe_reference *r, const double *mapped);
 
 /* The NRMSE of mapped (a run's displacement at the lattice, [n][3])
  * against the reference over the lattice points off the lattice's

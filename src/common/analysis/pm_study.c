@@ -28,8 +28,10 @@ typedef struct {
   double rate;  /* against the previous level; NaN when none */
   /* Against a finite-element reference (NaN otherwise): the relative
    * errors of the reaction on the loaded face and of the mean strain
-   * energy density, and the reaction error's rate. */
-  double reaction_error, reaction_rate, sed_error;
+   * energy density, and the reaction error's rate; a traction case's
+   * tip displacement error (pm_fe_errors), whose rate reaction_rate then
+   * holds. */
+  double reaction_error, reaction_rate, sed_error, tip_error;
   double error_interior; /* NRMSE off the lattice's faces (FE only) */
   char dir[PM_PATH_MAX + 1];
 } level;
@@ -119,6 +121,7 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
   pm_afile *csv = NULL, *md = NULL;
   char path[PM_PATH_MAX + 1];
   bool fe = cmp->fe != NULL;
+  bool tip = fe && cmp->fe->tip_face >= 0;
   PM_TRY(pm_path_join(path, sizeof path, out_dir, "convergence.csv"));
   PM_TRY(pm_afile_open(path, &csv));
   PM_TRY(pm_path_join(path, sizeof path, out_dir, "convergence.md"));
@@ -133,14 +136,15 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
   fprintf(c, ",h,points,steps,status,error,rate,wall_seconds,setup_seconds,"
              "mean_strain_energy_density,max_von_mises,reaction,min_jacobian,"
              "energy_balance_error,reaction_error,reaction_rate,sed_error,"
-             "error_interior\n");
+             "error_interior,tip_error\n");
   fprintf(m,
           " h (m) | points | steps | NRMSE | q |%s wall (s) | mean SED "
           "(J/m^3) | max von Mises (Pa) | reaction (N) | min J | energy "
           "error | status |\n|",
-          fe ? " NRMSE (interior) | reaction error | q (reaction) | SED "
-               "error |"
-             : "");
+          !fe   ? ""
+          : tip ? " NRMSE (interior) | tip error | q (tip) | SED error |"
+                : " NRMSE (interior) | reaction error | q (reaction) | SED "
+                  "error |");
   for (int k = 0; k < n_keys + 13 + (fe ? 4 : 0); k++) fprintf(m, "---|");
   fprintf(m, "\n");
   int total = n_levels + (ref ? 1 : 0);
@@ -148,7 +152,7 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
     const level *L = r < n_levels ? &lv[r] : ref;
     const pm_figures *f = &L->out.fig;
     char e[32], q[32], w[32], sed[32], vm[32], re[32], mj[32], ee[32];
-    char rerr[32], rq[32], serr[32], ei[32];
+    char rerr[32], rq[32], serr[32], ei[32], terr[32];
     fmt_num(e, sizeof e, L->error);
     fmt_num(q, sizeof q, L->rate);
     snprintf(w, sizeof w, "%.3f", f->wall_seconds);
@@ -161,6 +165,7 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
     fmt_num(rq, sizeof rq, L->reaction_rate);
     fmt_num(serr, sizeof serr, L->sed_error);
     fmt_num(ei, sizeof ei, L->error_interior);
+    fmt_num(terr, sizeof terr, L->tip_error);
     const char *status = r < n_levels ? pm_status_name(f->status) : "reference";
     if (r < n_levels) {
       fprintf(c, "%d", r + 1);
@@ -174,12 +179,12 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
       fprintf(c, ",%s", keys[k].value[idx]);
       fprintf(m, " %s |", keys[k].value[idx]);
     }
-    fprintf(c, ",%.6g,%ld,%ld,%s,%s,%s,%s,%.4g,%s,%s,%s,%s,%s,%s,%s,%s,%s\n",
+    fprintf(c, ",%.6g,%ld,%ld,%s,%s,%s,%s,%.4g,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s\n",
             f->h, f->points, f->steps, status, e, q, w, f->setup_seconds, sed,
-            vm, re, mj, ee, rerr, rq, serr, ei);
+            vm, re, mj, ee, rerr, rq, serr, ei, terr);
     fprintf(m, " %.4g | %ld | %ld | %s | %s |", f->h, f->points, f->steps, e,
             q);
-    if (fe) fprintf(m, " %s | %s | %s | %s |", ei, rerr, rq, serr);
+    if (fe) fprintf(m, " %s | %s | %s | %s |", ei, tip ? terr : rerr, rq, serr);
     fprintf(m, " %s | %s | %s | %s | %s | %s | %s |\n", w, sed, vm, re, mj, ee,
             status);
   }
@@ -204,15 +209,24 @@ static pm_err write_tables(const char *out_dir, const ladder_key *keys,
             "whole lattice's largest displacement.\n",
             r->reaction[0], r->reaction[1], r->reaction[2], r->mean_sed,
             r->centre[0], r->centre[1], r->centre[2], r->von_mises_centre);
+    if (tip)
+      fprintf(m,
+              "A traction case: its reaction is the applied load; the tip "
+              "error is (u - u_FE) / u_FE of the mean u_%c over the "
+              "lattice's points on its face %c%s (FE: %.7g m; < 0: the run "
+              "is stiffer), tolerance %g.\n",
+              "xyz"[r->tip_axis], "xyz"[r->tip_face / 2],
+              r -> tip_face % 2 ? "max" : "min", r->tip_u, r->tolerance.tip);
     const pm_fe_tolerance *t = &r->tolerance;
     fprintf(m,
             "The referee claims (relative, between its two finest meshes and "
-            "their trend): reaction %g, mean SED %g, von Mises %g, lattice "
+            "their trend): %s %g, mean SED %g, von Mises %g, lattice "
             "NRMSE %g; differences below these are not resolved.\n",
-            t->reaction, t->mean_sed, t->von_mises_centre, t->lattice_nrmse);
+            tip ? "tip" : "reaction", tip ? t->tip : t->reaction, t->mean_sed,
+            t->von_mises_centre, t->lattice_nrmse);
     if (isfinite(cmp->q_reaction))
-      fprintf(m, "Observed rate of the reaction error: q = %.3f.\n",
-              cmp->q_reaction);
+      fprintf(m, "Observed rate of the %s error: q = %.3f.\n",
+              tip ? "tip" : "reaction", cmp->q_reaction);
   }
   PM_TRY(pm_afile_commit(csv));
   csv = NULL;
@@ -330,6 +344,7 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
     ref.err = pm_run_scene(s, ref.dir, run_flags(o), &ref.out);
     ref.error = ref.rate = NAN;
     ref.reaction_error = ref.reaction_rate = ref.sed_error = NAN;
+    ref.tip_error = NAN;
     ref.error_interior = NAN;
     pm_scene_destroy(s);
     s = NULL;
@@ -372,6 +387,7 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
     s = NULL;
     L->error = L->rate = NAN;
     L->reaction_error = L->reaction_rate = L->sed_error = NAN;
+    L->tip_error = NAN;
     L->error_interior = NAN;
     if (L->err != PM_SUCCESS) {
       if (out) fprintf(out, "  %s\n", pm_error_message());
@@ -387,6 +403,7 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
       L->error_interior = e.nrmse_interior;
       L->reaction_error = e.reaction_error;
       L->sed_error = e.sed_error;
+      L->tip_error = e.tip_error;
     } else {
       PM_TRY(
           error_against(L->dir, L->out.fig.dim, rn, rx, ru, work, &L->error));
@@ -402,7 +419,7 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
   for (int l = 0; l < n_levels; l++) {
     xs[l] = by_h ? lv[l].out.fig.h : strtod(keys[0].value[l], NULL);
     es[l] = lv[l].error;
-    rs[l] = lv[l].reaction_error;
+    rs[l] = fe && fe->tip_face >= 0 ? lv[l].tip_error : lv[l].reaction_error;
   }
   double q_fit = rates(n_levels, xs, es, rate);
   for (int l = 0; l < n_levels; l++) lv[l].rate = rate[l];
