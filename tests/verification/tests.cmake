@@ -88,3 +88,7 @@ if(PM_MPI)
   set_tests_properties(verification.ranks_membranes PROPERTIES LABELS
     verification TIMEOUT 600 PROCESSORS 2)
 endif()
+
+add_test(NAME verification.implicit_stop
+  COMMAND bash ${PM_VERIFY_DIR}/implicit-stop.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.implicit_stop PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)
