@@ -63,9 +63,11 @@ struct pm_newton {
   bool started; /* the initial state was admissible */
 };
 
-/* A callback's failure that aborts the solve (not an inadmissible state). */
+/* A callback's failure that aborts the solve (not an inadmissible state);
+ * a signal's (a callback that polls it) among them. */
 static inline bool pm_newton_hard_failure(pm_err e) {
-  return e == PM_ERR_MEMORY || e == PM_ERR_IO || e == PM_ERR_INTERNAL;
+  return e == PM_ERR_MEMORY || e == PM_ERR_IO || e == PM_ERR_INTERNAL ||
+         e == PM_ERR_INTERRUPTED;
 }
 
 /* A callback's answer, the same on every rank of a shared problem. */
