@@ -21,6 +21,20 @@ check() { # name, condition-command...
   fi
 }
 
+# Rows in OUT/history.csv (0 while it does not exist).
+rows() { if [ -f "$1/history.csv" ]; then wc -l <"$1/history.csv"; else echo 0; fi; }
+
+# Wait while process PID runs and OUT/history.csv holds fewer than N lines
+# (at most about a minute).
+wait_rows() { # pid, out, lines
+  local waited=0
+  while [ "$(rows "$2")" -lt "$3" ] && kill -0 "$1" 2>/dev/null &&
+    [ $waited -lt 6000 ]; do
+    sleep 0.01
+    waited=$((waited + 1))
+  done
+}
+
 # Column NAME of the row whose first field is LEVEL in a convergence.csv.
 col() { # csv, level, name
   awk -F, -v lv="$2" -v name="$3" '

@@ -25,7 +25,9 @@ done
 # held to no bound).  (3 ranks: the resumed runs below; LU across ranks:
 # ranks_newton and ranks_fpm.)
 i2=$src/cases/mpm/i2-vessel-slice.yaml
-bounds="linear_iterations=inf" across i2-gamg "$i2" 2
+bounds="linear_iterations=inf" across i2-gamg "$i2" 2 \
+  --set time.quasi_static.linear_solver=gmres-gamg \
+  --set 'time.quasi_static.solver_options=-pm_ksp_rtol 1e-10'
 # summary.json's shares: every particle and every unknown on exactly one
 # rank, the ghosts those of the one face the ranks share (65 nodes of the
 # cut's x, 2 unknowns each, less the prescribed ones at the grips)

@@ -14,21 +14,14 @@ py=/usr/bin/python3
 . "$here/lib.sh"
 export OMP_NUM_THREADS=2
 
-# Rows in OUT/history.csv (0 while it does not exist).
-rows() { if [ -f "$1/history.csv" ]; then wc -l <"$1/history.csv"; else echo 0; fi; }
-
 # Start a run (arguments after the output folder), wait until its history
 # holds at least N lines, then send SIGNAL; sets rc to its exit status.
 run_until() { # signal, lines, out, scene, args...
   local sig=$1 n=$2 out=$3 scene=$4
   shift 4
   "$bin" run "$scene" --out "$out" --quiet "$@" >/dev/null 2>"$work/err" &
-  local pid=$! waited=0
-  while [ "$(rows "$out")" -lt "$n" ] && kill -0 $pid 2>/dev/null &&
-    [ $waited -lt 6000 ]; do
-    sleep 0.01
-    waited=$((waited + 1))
-  done
+  local pid=$!
+  wait_rows $pid "$out" "$n"
   kill -"$sig" $pid 2>/dev/null
   wait $pid
   rc=$?

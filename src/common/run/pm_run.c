@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pm_interrupt.h"
 #include "pm_memory.h"
 #include "pm_omp.h"
 #include "pm_output.h"
@@ -67,6 +68,7 @@ pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
   c->tm_output = pm_timers_add(&c->out_timer, "output");
   c->tm_checkpoint = pm_timers_add(&c->out_timer, "checkpoint");
   c->ckpt_step = -1;
+  c->last_step = -1;
   c->ckpt_every = s->output.checkpoint.every;
   c->ckpt_seconds = 60 * s->output.checkpoint.minutes;
   c->be->points(sim, &c->pts);
@@ -92,7 +94,7 @@ pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
   /* Across ranks, the others wait here for this rank's outputs. */
   agreed = true;
   PM_TRY(pm_par_agree(PM_SUCCESS));
-  run_err = c->be->run(sim, &obs);
+  run_err = pm_run_interrupted_inside(c, c->be->run(sim, &obs));
   pm_run_release_interrupts(old_handlers);
   if (!quiet) pm_progress_finish(&c->progress);
   c->be->figures(sim, &o->fig, true);
@@ -161,7 +163,19 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
     ret = pm_outdir_claim(out_dir, outdir_mode(flags), &outdir);
   if (ranks) ret = pm_par_agree(ret);
   if (ret) goto done;
-  PM_TRY(s->backend->create(s, &sim));
+  /* A signal during the setup (one process): the setup's polls stop it
+   * (pm_interrupt_check), else it stops once the setup is done. */
+  if (!ranks) {
+    struct sigaction old[2];
+    pm_interrupt_catch(old, 0);
+    ret = s->backend->create(s, &sim);
+    pm_interrupt_release(old);
+    if (!ret) ret = pm_interrupt_check("during the setup (nothing written)");
+    if (ret == PM_ERR_INTERRUPTED) o->fig.status = PM_STATUS_INTERRUPTED;
+    if (ret) goto done;
+  } else {
+    PM_TRY(s->backend->create(s, &sim));
+  }
   if (root)
     ret = pm_run_root(s, sim, out_dir, flags, o, &outdir, NULL);
   else

@@ -46,6 +46,7 @@ typedef struct {
   long resumed_from;     /* the step it was last resumed from (0: none) */
   char ckpt_note[512];   /* why no checkpoint was written, if one failed */
   bool extra_frame;      /* the last frame is a signal's, off the schedule */
+  long last_step;        /* the last step observed (-1: none yet) */
   /* what wants decided for the next step: the signal it ends on (0: none)
    * and whether a checkpoint is written after it */
   bool decided;
@@ -99,6 +100,12 @@ void pm_run_release_interrupts(const struct sigaction old[2]);
  * frame, checkpoint; PM_ERR_INTERRUPTED after a signal). */
 bool pm_run_wants(void *ctx, const pm_step_report *r, bool frame);
 pm_err pm_run_observe(void *ctx, const pm_step_report *r, bool frame);
+
+/* After the backend's loop ended with run_err: when a signal stopped it
+ * inside a step (a linear solve, a Newton iteration), the checkpoint of the
+ * last step observed (the last converged state, which the backend holds)
+ * and the message saying so; returns run_err. */
+pm_err pm_run_interrupted_inside(pm_run_ctx *c, pm_err run_err);
 
 /* PM_ERR_INTERRUPTED (o's status so) once a run of this process was
  * interrupted; o is cleared (status failed) either way. */

@@ -4,19 +4,14 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "pm_interrupt.h"
 #include "pm_par.h"
 #include "pm_run_impl.h"
 
-/* SIGINT or SIGTERM received during a run (0: none).  Sticky for the
- * process: once a run is interrupted, pm_run_scene starts no other (a
- * study's remaining levels are refused without being set up). */
-static volatile sig_atomic_t interrupt_signal;
-
-static void on_interrupt(int sig) { interrupt_signal = sig; }
-
-static const char *signal_name(int sig) {
-  return sig == SIGINT ? "SIGINT" : "SIGTERM";
-}
+/* The signal flag is the process's (pm_interrupt): sticky, so that once
+ * a run is interrupted, pm_run_scene starts no other (a study's remaining
+ * levels are refused without being set up). */
+static const char *signal_name(int sig) { return pm_interrupt_name(sig); }
 
 /* Catch SIGINT and SIGTERM once each (a second one acts as usual, so a
  * run that does not reach the end of its step can still be stopped).
@@ -25,18 +20,11 @@ static const char *signal_name(int sig) {
  * get two at once; mpirun's SIGKILL, after odls_base_sigkill_timeout, is
  * the hard stop. */
 void pm_run_catch_interrupts(struct sigaction old[2]) {
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_interrupt;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = pm_par_active() ? 0 : SA_RESETHAND;
-  sigaction(SIGINT, &sa, &old[0]);
-  sigaction(SIGTERM, &sa, &old[1]);
+  pm_interrupt_catch(old, !pm_par_active());
 }
 
 void pm_run_release_interrupts(const struct sigaction old[2]) {
-  sigaction(SIGINT, &old[0], NULL);
-  sigaction(SIGTERM, &old[1], NULL);
+  pm_interrupt_release(old);
 }
 
 /* After a signal, the state after this step becomes the last frame and a
@@ -45,7 +33,7 @@ void pm_run_release_interrupts(const struct sigaction old[2]) {
 static void decide(pm_run_ctx *c, const pm_step_report *r) {
   if (c->decided) return;
   c->decided = true;
-  c->decided_sig = r->last ? 0 : interrupt_signal;
+  c->decided_sig = r->last ? 0 : pm_interrupt_signal();
   c->decided_ckpt = c->results && (pm_run_checkpoint_due(c, r) ||
                                    (c->decided_sig && r->step > 0));
 }
@@ -60,6 +48,7 @@ pm_err pm_run_observe(void *ctx, const pm_step_report *r, bool frame) {
   pm_run_ctx *c = ctx;
   decide(c, r);
   c->decided = false;
+  c->last_step = r->step;
   const int sig = c->decided_sig;
   if (c->show_progress) {
     char status[96];
@@ -96,11 +85,43 @@ pm_err pm_run_observe(void *ctx, const pm_step_report *r, bool frame) {
                   c->ckpt_note);
 }
 
+pm_err pm_run_interrupted_inside(pm_run_ctx *c, pm_err run_err) {
+  if (run_err != PM_ERR_INTERRUPTED) return run_err;
+  if (c->decided_sig) return run_err; /* the observer's own, after a step */
+  char why[1024], note[600] = "";
+  snprintf(why, sizeof why, "%s", pm_error_message());
+  const long step = c->last_step;
+  if (c->ckpt_step == step && step > 0) {
+    snprintf(note, sizeof note,
+             "; `pointmech resume %s` continues from its "
+             "checkpoint of step %ld",
+             c->out_dir, step);
+  } else if (!c->results || step <= 0) {
+    snprintf(note, sizeof note, "; no checkpoint: %s",
+             step <= 0 ? "no step had converged" : "no output folder");
+  } else if (pm_par_active()) {
+    snprintf(note, sizeof note,
+             "; no checkpoint: a signal inside a solve "
+             "across ranks leaves the last one written");
+  } else {
+    pm_err e = pm_run_write_checkpoint(c, step);
+    if (e == PM_SUCCESS)
+      snprintf(note, sizeof note,
+               "; `pointmech resume %s` continues from "
+               "its checkpoint of step %ld, the last converged",
+               c->out_dir, step);
+    else
+      snprintf(note, sizeof note, "; no checkpoint: %s", pm_error_message());
+  }
+  return PM_ERROR(PM_ERR_INTERRUPTED, "%s (results up to step %ld kept%s)", why,
+                  step > 0 ? step : 0, note);
+}
+
 /* Refuse to start once a run of this process was interrupted. */
 pm_err pm_run_check_not_interrupted(pm_outcome *o) {
   memset(o, 0, sizeof *o);
   o->fig.status = PM_STATUS_FAILED;
-  const int sig = interrupt_signal;
+  const int sig = pm_interrupt_signal();
   if (!sig) return PM_SUCCESS;
   o->fig.status = PM_STATUS_INTERRUPTED;
   return PM_ERROR(PM_ERR_INTERRUPTED,

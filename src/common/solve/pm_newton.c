@@ -112,9 +112,10 @@ static pm_err classify(pm_newton *s, pm_newton_report *rep) {
     PM_PETSC_CALL(KSPGetIterationNumber(s->ksp, &kits));
     rep->reason = PM_NEWTON_DIVERGED_LINEAR;
     snprintf(rep->message, cap,
-             "Newton: the linear solver failed in iteration %d (%s after %d "
-             "linear iterations; %s)",
-             it + 1, KSPConvergedReasons[kr], (int)kits, figures);
+             "Newton: the linear solver failed in iteration %d: %s (%s) "
+             "after %d linear iterations, linear residual %.2e from %.2e; %s",
+             it + 1, pm_newton_linear_reason_words(kr), KSPConvergedReasons[kr],
+             (int)kits, s->lin_r, s->lin_r0, figures);
     /* A failed factorisation is not redone by PETSc 3.18 (MUMPS keeps its
      * error): the next solve gets a new linear solver. */
     if (kr == KSP_DIVERGED_PC_FAILED) PM_CALL(pm_newton_replace_linear(s));

@@ -115,7 +115,7 @@ static pm_err configure_snes(pm_newton *s) {
   pm_newton_operators(s, &A, &B);
   PM_PETSC_CALL(SNESSetJacobian(s->snes, A, B, pm_newton_snes_jacobian, s));
   PM_PETSC_CALL(
-      SNESSetConvergenceTest(s->snes, pm_newton_converged_test, s, NULL));
+      SNESSetConvergenceTest(s->snes, pm_newton_converged_or_stopped, s, NULL));
   /* The step-size test (stol) is off: a short step is no convergence. */
   PM_PETSC_CALL(SNESSetTolerances(s->snes, 0, 0, 0, o->max_iter, 1000000000));
   PM_PETSC_CALL(SNESLineSearchSetType(s->ls, types[o->line_search]));

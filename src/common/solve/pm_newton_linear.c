@@ -1,9 +1,120 @@
 /* pm_newton_linear: the linear solver of each Newton step, configured from
- * the options and then PETSc's, and what it multiplies by. */
+ * the options and then PETSc's, what it multiplies by, and the tests that
+ * stop it (and Newton) on a signal. */
+#include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
+
 #include <petscsnes.h>
 
+#include "pm_interrupt.h"
 #include "pm_newton_solver_impl.h"
 #include "pm_petsc.h"
+
+int pm_newton_stop_signal(const pm_newton *s) {
+  int sig = pm_interrupt_signal();
+  if (s->dist) {
+    int any = sig;
+    MPI_Allreduce(&sig, &any, 1, MPI_INT, MPI_MAX, s->comm);
+    sig = any;
+  }
+  return sig;
+}
+
+const char *pm_newton_linear_reason_words(KSPConvergedReason r) {
+  switch (r) {
+  case KSP_DIVERGED_ITS: return "the iteration limit was reached";
+  case KSP_DIVERGED_DTOL: return "the residual grew past the divergence limit";
+  case KSP_DIVERGED_BREAKDOWN:
+  case KSP_DIVERGED_BREAKDOWN_BICG: return "the Krylov method broke down";
+  case KSP_DIVERGED_INDEFINITE_PC: return "the preconditioner is indefinite";
+  case KSP_DIVERGED_INDEFINITE_MAT: return "the matrix is indefinite";
+  case KSP_DIVERGED_NANORINF: return "a residual was not finite";
+  case KSP_DIVERGED_PC_FAILED:
+    return "the preconditioner failed (a zero pivot or a singular matrix)";
+  case KSP_DIVERGED_NULL: return "a null vector appeared";
+  case KSP_DIVERGED_NONSYMMETRIC: return "the matrix is not symmetric";
+  default: break;
+  }
+  return r > 0 ? "converged" : "diverged";
+}
+
+/* A signal asks the solve to stop: s->hard = PM_ERR_INTERRUPTED with
+ * where it was (`where` iteration it, residual r from r0); true then. */
+static bool stopped(pm_newton *s, const char *where, int it, double r,
+                    double r0) {
+  const int sig = pm_newton_stop_signal(s);
+  if (!sig) return false;
+  s->hard = PM_ERROR(PM_ERR_INTERRUPTED,
+                     "interrupted by %s in %s %d (residual %.3e from %.3e)",
+                     pm_interrupt_name(sig), where, it, r, r0);
+  return true;
+}
+
+/* The linear solver's convergence test: PETSc's default, the residual
+ * norms recorded, and a stop on a signal (checked at every iteration). */
+typedef struct {
+  pm_newton *s;
+  void *dflt; /* the default test's context */
+} linear_test_ctx;
+
+static PetscErrorCode linear_test(KSP ksp, PetscInt it, PetscReal rnorm,
+                                  KSPConvergedReason *reason, void *ctx) {
+  linear_test_ctx *t = ctx;
+  pm_newton *s = t->s;
+  PetscCall(KSPConvergedDefault(ksp, it, rnorm, reason, t->dflt));
+  if (it == 0) s->lin_r0 = rnorm;
+  s->lin_r = rnorm;
+  if (*reason == KSP_CONVERGED_ITERATING &&
+      stopped(s, "a linear solve, linear iteration", (int)it, rnorm, s->lin_r0))
+    *reason = KSP_DIVERGED_ITS;
+  return 0;
+}
+
+static PetscErrorCode linear_test_destroy(void *ctx) {
+  linear_test_ctx *t = ctx;
+  PetscCall(KSPConvergedDefaultDestroy(t->dflt));
+  free(t);
+  return 0;
+}
+
+/* Before each linear solve: its residual norms unknown (a direct solve
+ * records none), then the Newton solver's presolve. */
+static PetscErrorCode linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
+  pm_newton *s = ctx;
+  s->lin_r0 = s->lin_r = NAN;
+  return pm_newton_linear_presolve(ksp, b, x, ctx);
+}
+
+/* ksp's convergence test: linear_test (after KSPSetFromOptions, which would
+ * set PETSc's default in its place). */
+static pm_err set_linear_test(pm_newton *s, KSP ksp) {
+  pm_err ret = PM_SUCCESS;
+  linear_test_ctx *t = calloc(1, sizeof *t);
+  PM_CHECK(t, PM_ERR_MEMORY, "out of memory (linear solver test)");
+  t->s = s;
+  PM_PETSC(KSPConvergedDefaultCreate(&t->dflt));
+  PM_PETSC(KSPSetConvergenceTest(ksp, linear_test, t, linear_test_destroy));
+  return PM_SUCCESS;
+done:
+  if (t->dflt) KSPConvergedDefaultDestroy(t->dflt);
+  free(t);
+  return ret;
+}
+
+PetscErrorCode pm_newton_converged_or_stopped(SNES snes, PetscInt it,
+                                              PetscReal xnorm, PetscReal snorm,
+                                              PetscReal fnorm,
+                                              SNESConvergedReason *reason,
+                                              void *ctx) {
+  pm_newton *s = ctx;
+  PetscCall(
+      pm_newton_converged_test(snes, it, xnorm, snorm, fnorm, reason, ctx));
+  if (*reason == SNES_CONVERGED_ITERATING &&
+      stopped(s, "Newton iteration", (int)it + 1, fnorm, s->r0))
+    *reason = SNES_DIVERGED_FUNCTION_DOMAIN;
+  return 0;
+}
 
 /* The linear solver, configured from the options and then PETSc's. */
 static pm_err create_linear(pm_newton *s, KSP *out) {
@@ -47,12 +158,13 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
   }
   PM_PETSC(KSPSetTolerances(ksp, o->linear_rtol, PETSC_DEFAULT, PETSC_DEFAULT,
                             o->linear_max_iter));
-  PM_PETSC(KSPSetPreSolve(ksp, pm_newton_linear_presolve, s));
+  PM_PETSC(KSPSetPreSolve(ksp, linear_presolve, s));
   PM_PETSC(KSPSetPostSolve(ksp, pm_newton_linear_postsolve, s));
   PM_PETSC(PetscOptionsPush(s->opts));
   PetscErrorCode code = KSPSetFromOptions(ksp);
   PetscOptionsPop();
   PM_PETSC(code);
+  PM_TRY(set_linear_test(s, ksp));
   *out = ksp;
   ksp = NULL;
 done:

@@ -57,12 +57,17 @@ struct pm_newton {
   long jacobians;      /* Jacobian callbacks in this solve (for pc_lag) */
   double linear_started;
   bool in_linear; /* between the linear solver's pre- and postsolve */
-  bool started;   /* the initial state was admissible */
+  /* The last linear solve's residual norms: first and last (the linear
+   * solver's convergence test records them). */
+  double lin_r0, lin_r;
+  bool started; /* the initial state was admissible */
 };
 
-/* A callback's failure that aborts the solve (not an inadmissible state). */
+/* A callback's failure that aborts the solve (not an inadmissible state);
+ * a signal's (a callback that polls it) among them. */
 static inline bool pm_newton_hard_failure(pm_err e) {
-  return e == PM_ERR_MEMORY || e == PM_ERR_IO || e == PM_ERR_INTERNAL;
+  return e == PM_ERR_MEMORY || e == PM_ERR_IO || e == PM_ERR_INTERNAL ||
+         e == PM_ERR_INTERRUPTED;
 }
 
 /* A callback's answer, the same on every rank of a shared problem. */
@@ -146,5 +151,20 @@ pm_err pm_newton_replace_linear(pm_newton *s);
 /* What the linear solver multiplies by (A) and builds its preconditioner
  * from (B). */
 void pm_newton_operators(const pm_newton *s, Mat *A, Mat *B);
+
+/* The signal (SIGINT, SIGTERM) that asks the solve to stop, 0 if none:
+ * the process's, across ranks any rank's (collective then). */
+int pm_newton_stop_signal(const pm_newton *s);
+
+/* SNES's convergence test (pm_newton_converged_test) that also stops the
+ * solve on a signal: s->hard = PM_ERR_INTERRUPTED, with the message. */
+PetscErrorCode pm_newton_converged_or_stopped(SNES snes, PetscInt it,
+                                              PetscReal xnorm, PetscReal snorm,
+                                              PetscReal fnorm,
+                                              SNESConvergedReason *reason,
+                                              void *ctx);
+
+/* A linear solver's reason in words ("the iteration limit was reached"). */
+const char *pm_newton_linear_reason_words(KSPConvergedReason r);
 
 #endif

@@ -2,12 +2,14 @@
  * (see mpm_implicit.h for the formulation): setup, queries and plan. */
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "mpm_exchange.h"
 #include "mpm_implicit_impl.h"
 #include "mpm_kind.h"
+#include "pm_interrupt.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
 #include "pm_tensor.h"
@@ -64,6 +66,65 @@ static pm_err reset_grid(mpm_implicit *im, const pm_scene *s) {
     hi[c] = m->box_max[c] + (c < im->dim ? room : 0);
   }
   return mpm_grid_init(&im->g, im->dim, m->grid.shape, h, lo, hi, s->path);
+}
+
+/* Poisson's ratio from which a material is near-incompressible. */
+#define MPM_IMPLICIT_NEAR_INCOMPRESSIBLE_NU 0.45
+
+/* Unknowns up to which the default linear solver is direct (MUMPS LU),
+ * by dimension: above, GMRES with algebraic multigrid (GAMG with the
+ * rigid-body near-null space).  On this project's cases the Krylov solver
+ * stalls where the factorisation is cheap (docs/validation.md,
+ * "Implicit MPM that never hangs"). */
+#define MPM_IMPLICIT_DIRECT_MAX_2D 100000L
+#define MPM_IMPLICIT_DIRECT_MAX_3D 30000L
+
+/* The linear solver: the scene's, else direct below the size above and
+ * GMRES + GAMG beyond; a multigrid solve is bounded (relative residual
+ * 1e-6 of the preconditioned one, 1000 iterations: a failure then cuts the
+ * load step with its reason instead of iterating for minutes; Jacobi and
+ * ILU keep 1e-10 and 20 000, the paper's CG + Jacobi needing thousands). */
+static void choose_linear(mpm_implicit *im, bool given) {
+  pm_newton_options *o = &im->opt;
+  const long cap =
+      im->dim == 3 ? MPM_IMPLICIT_DIRECT_MAX_3D : MPM_IMPLICIT_DIRECT_MAX_2D;
+  if (given) {
+    snprintf(im->why_linear, sizeof im->why_linear,
+             "time.quasi_static.linear_solver");
+  } else {
+    o->linear = im->nunk_all <= cap ? PM_NEWTON_DIRECT : PM_NEWTON_GMRES_GAMG;
+    snprintf(im->why_linear, sizeof im->why_linear,
+             "default: %ld unknowns %s %ld, where the factorisation %s",
+             im->nunk_all, im->nunk_all <= cap ? "<=" : ">", cap,
+             im->nunk_all <= cap ? "is faster and never stalls"
+                                 : "costs too much memory and time");
+  }
+  if (o->linear == PM_NEWTON_GMRES_GAMG || o->linear == PM_NEWTON_CG_GAMG) {
+    o->linear_rtol = 1e-6;
+    o->linear_max_iter = 1000;
+  }
+}
+
+/* Why F-bar is on or off, for plan: the largest Poisson ratio against
+ * the near-incompressible threshold. */
+static void note_fbar(mpm_implicit *im, const pm_scene *s) {
+  double nu = 0;
+  for (int gi = 0; gi < im->m->n_groups; gi++)
+    nu = fmax(nu, im->view[gi].mat->poisson_ratio);
+  const bool given = pm_scene_has(s, "mpm.fbar");
+  if (given)
+    snprintf(im->why_fbar, sizeof im->why_fbar, "mpm.fbar: %s",
+             im->fbar ? "cell" : "none");
+  else if (nu >= MPM_IMPLICIT_NEAR_INCOMPRESSIBLE_NU)
+    snprintf(im->why_fbar, sizeof im->why_fbar,
+             "off: nu = %.4g is near-incompressible (>= %.2f), but F-bar's "
+             "tangent is coloured, tens of times slower; set mpm.fbar: cell "
+             "against locking in bending",
+             nu, MPM_IMPLICIT_NEAR_INCOMPRESSIBLE_NU);
+  else
+    snprintf(im->why_fbar, sizeof im->why_fbar,
+             "off: nu = %.4g < %.2f, no volumetric locking to cure", nu,
+             MPM_IMPLICIT_NEAR_INCOMPRESSIBLE_NU);
 }
 
 pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
@@ -153,10 +214,9 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   } else {
     o->rtol = s->time.qs_tolerance;
   }
-  o->linear = pm_scene_has(s, "time.quasi_static.linear_solver")
-                  ? pm_newton_linear_of(s->time.qs_linear)
-                  : PM_NEWTON_GMRES_GAMG; /* measured fastest from
-                                             I2 at 128^2 cells up */
+  const bool linear_given = pm_scene_has(s, "time.quasi_static.linear_solver");
+  o->linear = linear_given ? pm_newton_linear_of(s->time.qs_linear)
+                           : PM_NEWTON_DIRECT; /* chosen by size below */
   if (im->matrix_free) {
     if (pm_scene_has(s, "time.quasi_static.linear_solver") &&
         o->linear != PM_NEWTON_CG_JACOBI) {
@@ -181,6 +241,9 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   if (im->mode == MPM_GRID_RESET) im->lam1 = 1.0 / im->opt_steps;
   mpm_implicit_make_buckets(im);
   PM_TRY(mpm_implicit_make_dofs(im));
+  PM_TRY(pm_interrupt_check("while setting up the implicit MPM's grid"));
+  if (!im->matrix_free) choose_linear(im, linear_given);
+  note_fbar(im, s);
   /* An absolute floor on the residual: a hundred times its roundoff, eps
    * times the stiffest material's P-wave modulus times a node's share of
    * a face (h^(d-1)), over the unknowns.  Below it the relative test
@@ -296,7 +359,9 @@ void mpm_implicit_plan(const mpm_implicit *im, FILE *out) {
     fprintf(out,
             "eq. 9: displacement below %g and energy below %g of the first\n",
             im->opt.dtol, im->opt.etol);
-  fprintf(out, "linear       %s, %s\n", linear_name(im->opt.linear),
+  fprintf(out, "linear       %s, %s (%s)\n", linear_name(im->opt.linear),
           im->matrix_free ? "matrix-free (diagonal preconditioner)"
-                          : "assembled tangent");
+                          : "assembled tangent",
+          im->matrix_free ? "mpm.implicit.operator" : im->why_linear);
+  fprintf(out, "F-bar        %s\n", im->why_fbar);
 }

@@ -8,6 +8,7 @@
 
 #include "mpm_exchange.h"
 #include "mpm_implicit_impl.h"
+#include "pm_interrupt.h"
 #include "mpm_kind.h"
 #include "mpm_traction.h"
 #include "pm_omp.h"
@@ -182,6 +183,8 @@ void mpm_implicit_fill_u(mpm_implicit *im, const double *x) {
 
 pm_err mpm_implicit_cb_residual(void *ctx, const double *x, double *r) {
   mpm_implicit *im = ctx;
+  /* a signal stops the solve here too (Newton's tests poll it between) */
+  PM_CALL(pm_interrupt_check("in a residual evaluation"));
   mpm_implicit_fill_u(im, x);
   if (!mpm_implicit_nodal_force(im, im->u, im->f))
     return PM_ERROR(PM_ERR_UNSTABLE, "%s", im->fail_msg);

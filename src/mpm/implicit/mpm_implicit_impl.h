@@ -74,6 +74,8 @@ struct mpm_implicit {
   double jmin; /* stability.min_jacobian */
   bool matrix_free;
   bool fbar; /* mpm.fbar: cell (the stress from the bucket's Jbar) */
+  /* why the linear solver and F-bar are what they are (for plan) */
+  char why_linear[192], why_fbar[256];
   int threads;
   double *tmin;        /* per thread: smallest J of a force evaluation */
   double min_jacobian; /* of the last force evaluation */

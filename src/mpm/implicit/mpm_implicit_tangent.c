@@ -7,6 +7,7 @@
 
 #include "mpm_exchange.h"
 #include "mpm_implicit_impl.h"
+#include "pm_interrupt.h"
 #include "mpm_kind.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
@@ -108,6 +109,7 @@ pm_err mpm_implicit_cb_values(void *ctx, const double *x, double *val) {
  * diagonal pattern: one product with dx = 1). */
 pm_err mpm_implicit_cb_prepare(void *ctx, const double *x) {
   mpm_implicit *im = ctx;
+  PM_CALL(pm_interrupt_check("before the tangent's assembly"));
   if (!im->matrix_free) return PM_SUCCESS;
   const mpm_model *m = im->m;
   mpm_implicit_fill_u(im, x);
