@@ -8,6 +8,7 @@
 
 #include "pm_newton_impl.h"
 #include "pm_newton_solver_impl.h"
+#include "pm_omp.h"
 #include "pm_progress.h"
 
 /* A mass raised this many times over (by inadmissible increments or a
@@ -99,6 +100,7 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
     it++;
     /* v at the half step, damped by c (central difference, unit step) */
     const double keep = (1 - 0.5 * c) / (1 + 0.5 * c), push = 1 / (1 + 0.5 * c);
+    PM_OMP(parallel for schedule(static))
     for (long i = 0; i < n; i++) {
       v[i] = keep * v[i] - push * r[i] / (scale * m[i]);
       xt[i] = x[i] + v[i];
@@ -125,6 +127,7 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
      * r(x + v) - r(x): the lowest mode's damping, and a mass raised where
      * the response is stiffer than the masses allow. */
     double num = 0, den = 0;
+    PM_OMP(parallel for schedule(static) reduction(+ : num, den))
     for (long i = 0; i < n; i++) {
       num += v[i] * (rt[i] - r[i]);
       den += scale * m[i] * v[i] * v[i];

@@ -194,12 +194,12 @@ static pm_err diagnose(void *ctx, const double *x, char *buf, long cap) {
     return PM_SUCCESS;
   }
   long pf = 0, pj = 0;
-  double fmax_ = -1, jmin = INFINITY;
+  double f2max = -1, jmin = INFINITY;
   for (long i = 0; i < m->n_own; i++) {
     double f2 = 0;
     for (int a = 0; a < 3; a++)
       if (!m->fixed[3 * i + a]) f2 += c->st->f[3 * i + a] * c->st->f[3 * i + a];
-    if (f2 > fmax_) fmax_ = f2, pf = i;
+    if (f2 > f2max) f2max = f2, pf = i;
     if (c->st->J[i] < jmin) jmin = c->st->J[i], pj = i;
   }
   const double *xf = m->x + 3 * pf, *xj = m->x + 3 * pj;
@@ -207,7 +207,7 @@ static pm_err diagnose(void *ctx, const double *x, char *buf, long cap) {
            "largest out-of-balance force %.3g N at point %ld (%g, %g, %g), "
            "J = %.4g there; smallest volume ratio J = %.4g at point %ld (%g, "
            "%g, %g)",
-           sqrt(fmax_), fpm_point_id(m, pf), xf[0], xf[1], xf[2], c->st->J[pf],
+           sqrt(f2max), fpm_point_id(m, pf), xf[0], xf[1], xf[2], c->st->J[pf],
            jmin, fpm_point_id(m, pj), xj[0], xj[1], xj[2]);
   return PM_SUCCESS;
 }
