@@ -1,6 +1,7 @@
 /* Unit tests of load stepping on the shared Newton solver: steps cut and
- * grown (a run that completes), the iterations' bound, and a load that no
- * step can carry, named with its cause. */
+ * grown (a run that completes), the iterations' bound, a load that no
+ * step can carry, named with its cause, and the relaxation fallback
+ * through a limit point where Newton stalls. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -195,11 +196,110 @@ static void test_load_steps_impossible(void **state) {
   free(idx);
 }
 
+/* ---- Snap-through: r(x) = x^3 - 3 x + q lambda, x = sqrt(3) at rest --------
+ * The energy x^4/4 - 3 x^2/2 + q lambda x has its right well until q lambda
+ * = 2 (a limit point at x = 1, lambda = 2/q); past it the only equilibrium
+ * is in the left well, which Newton cannot reach from the right (the
+ * residual's norm has its minimum at the limit point) but relaxation,
+ * going downhill, does. */
+typedef struct {
+  double q, lambda;
+} snap;
+
+static pm_err snap_residual(void *ctx, const double *x, double *r) {
+  const snap *sn = ctx;
+  r[0] = x[0] * x[0] * x[0] - 3 * x[0] + sn->q * sn->lambda;
+  return PM_SUCCESS;
+}
+
+static pm_err snap_apply(void *ctx, const double *x, const double *dx,
+                         double *dr) {
+  (void)ctx;
+  dr[0] = (3 * x[0] * x[0] - 3) * dx[0];
+  return PM_SUCCESS;
+}
+
+static pm_err snap_set_load(void *ctx, double lambda) {
+  ((snap *)ctx)->lambda = lambda;
+  return PM_SUCCESS;
+}
+
+static pm_err snap_diagnose(void *ctx, const double *x, char *buf, long cap) {
+  (void)ctx;
+  snprintf(buf, (size_t)cap, "x = %.4f", x[0]);
+  return PM_SUCCESS;
+}
+
+/* The real root of x^3 - 3 x + c (c > 2: one real root), by Cardano. */
+static double snap_root(double c) {
+  double d = sqrt(c * c / 4 - 1);
+  return cbrt(-c / 2 + d) + cbrt(-c / 2 - d);
+}
+
+static void test_relaxation_fallback(void **state) {
+  (void)state;
+  snap sn = {3.6, 0};
+  long ptr[2] = {0, 1}, idx[1] = {0};
+  pm_newton_problem prob = {.n = 1,
+                            .ctx = &sn,
+                            .residual = snap_residual,
+                            .jacobian_apply = snap_apply,
+                            .pat_ptr = ptr,
+                            .pat_idx = idx,
+                            .set_load = snap_set_load,
+                            .diagnose = snap_diagnose};
+  pm_newton_options opt = pm_newton_options_default();
+  opt.rtol = 1e-10;
+  opt.stall_after = 6;
+  opt.max_cuts = 6;
+  pm_newton *s = NULL;
+  pm_load_report rep;
+
+  /* Plain Newton: stuck at the limit point, lambda 2/q = 0.5556. */
+  opt.relax_after = 0;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  double x = sqrt(3);
+  pm_err e = pm_load_steps(s, &x, &rep);
+  print_message("without relaxation: %s\n", pm_error_message());
+  assert_true(e == PM_ERR_NOT_CONVERGED || e == PM_ERR_UNSTABLE);
+  assert_true(rep.lambda < 2 / 3.6 && rep.lambda > 0.5);
+  assert_non_null(strstr(pm_error_message(), "giving up; at the last state "
+                                             "tried: x = "));
+  assert_int_equal(rep.relaxations, 0);
+  pm_error_clear();
+  pm_newton_destroy(&s);
+
+  /* With relaxation: through to lambda = 1, on the left root. */
+  opt.relax_after = 2;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  x = sqrt(3);
+  assert_ok(pm_load_steps(s, &x, &rep));
+  print_message("with relaxation: %d steps, %d cuts, %d relaxations (%ld "
+                "iterations), %d steps converged by it, x = %.15f against "
+                "%.15f\n",
+                rep.steps, rep.cuts, rep.relaxations, rep.relax_iterations,
+                rep.relaxed_steps, x, snap_root(3.6));
+  assert_close(rep.lambda, 1, 0, 0);
+  assert_close(x, snap_root(3.6), 1e-9, 0);
+  assert_true(rep.relaxed_steps >= 1);
+  pm_newton_destroy(&s);
+
+  /* Bad options are named. */
+  opt.relax_rtol = 2;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  x = sqrt(3);
+  assert_int_equal(pm_load_steps(s, &x, &rep), PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "relax_rtol"));
+  pm_error_clear();
+  pm_newton_destroy(&s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_load_steps_cut),
       cmocka_unit_test(test_load_steps_iterations),
       cmocka_unit_test(test_load_steps_impossible),
+      cmocka_unit_test(test_relaxation_fallback),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -464,9 +464,11 @@ static void test_failures(void **state) {
   assert_true(x[5] == -1.0);
 
   memset(x, 0, sizeof x);
+  /* A residual not finite is an inadmissible state. */
   ch.nan_residual = true;
   assert_int_equal(pm_newton_solve(s, x, &rep), PM_ERR_UNSTABLE);
-  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_NAN);
+  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_DOMAIN);
+  assert_non_null(strstr(rep.message, "residual not finite at unknown"));
   ch.nan_residual = false;
 
   ch.hard_failure = true;

@@ -280,6 +280,7 @@ typedef struct pm_scene {
     double qs_damping;      /* time.quasi_static.damping: 1/s for damping */
     long qs_load_steps;     /* time.quasi_static.load_steps (static) */
     long qs_max_iterations; /* ...max_iterations per load step */
+    long qs_relax_after;    /* ...relax_after: cuts before relaxation */
     pm_linear_solver qs_linear; /* ...linear_solver */
     char *qs_solver_options;    /* ...solver_options: PETSc options */
     long max_steps;             /* time.max_steps; 0: no limit */

@@ -647,6 +647,16 @@ static const pm_key quasi_static_keys[] = {
      .unit = "",
      .doc = "method static: load steps along the scene's ramps (a step that "
             "fails is halved and retried)"},
+    {.name = "relax_after",
+     .type = PM_KEY_INTEGER,
+     .offset = S(time.qs_relax_after),
+     .def = "2",
+     .range = PM_RANGE_GE,
+     .lo = 0,
+     .unit = "",
+     .doc = "method static (FPM, one process): after this many halvings of "
+            "a load step in a row, and at the smallest step, dynamic "
+            "relaxation within the step, then Newton again; 0: never"},
     {.name = "max_iterations",
      .type = PM_KEY_INTEGER,
      .offset = S(time.qs_max_iterations),

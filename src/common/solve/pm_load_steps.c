@@ -1,5 +1,6 @@
 /* pm_load_steps: the load factor from 0 to 1 in steps, each solved by
- * Newton from the last converged state; a failed step is halved. */
+ * Newton from the last converged state; a failed step is relaxed
+ * (pm_load_relax.c) or halved, and steps grow after easy ones. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,6 +59,44 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
   return e != PM_SUCCESS ? e : e2;
 }
 
+/* The fallback of a step Newton could not finish, at the step's load (set):
+ * relaxation from the last converged state xc to relax_rtol of its
+ * imbalance, Newton from there, and if Newton fails again relaxation on
+ * from its last iterate to Newton's own tolerance.  x receives the state
+ * (converged on success, else the last admissible one); what happened goes
+ * to msg (cap bytes). */
+static pm_err relax_step(pm_newton *s, double *x, const double *xc,
+                         pm_relax_work *w, pm_load_report *rep, char *msg,
+                         size_t cap) {
+  const pm_newton_options *o = pm_newton_options_of(s);
+  const long n = pm_newton_problem_of(s)->n;
+  char part[256];
+  double r0 = 0, r1 = 0;
+  memcpy(x, xc, (size_t)n * sizeof *x);
+  pm_err e = pm_load_relax(s, x, o->relax_rtol, o->atol, w, rep, &r0, part,
+                           sizeof part);
+  snprintf(msg, cap, "%s", part);
+  if (e != PM_SUCCESS && e != PM_ERR_NOT_CONVERGED) return e;
+  pm_error_clear();
+  e = pm_newton_solve_from(s, x, xc, r0, &rep->last);
+  add_solve(rep, &rep->last);
+  if (e == PM_SUCCESS || !recoverable(e)) return e;
+  pm_error_clear();
+  const size_t used = strlen(msg);
+  snprintf(msg + used, cap - used, "; then %s", rep->last.message);
+  e = pm_load_relax(s, x, 0, fmax(o->rtol * r0, o->atol), w, rep, &r1, part,
+                    sizeof part);
+  const size_t used2 = strlen(msg);
+  snprintf(msg + used2, cap - used2, "; on from there: %s", part);
+  if (e == PM_SUCCESS) {
+    /* Converged by the residual criterion, by relaxation alone. */
+    rep->last.reason = PM_NEWTON_CONVERGED_RESIDUAL;
+    rep->last.status = PM_SUCCESS;
+    rep->last.message[0] = '\0';
+  }
+  return e;
+}
+
 pm_err pm_load_state_init(pm_load_state *state, long n) {
   memset(state, 0, sizeof *state);
   pm_err ret = PM_SUCCESS;
@@ -88,6 +127,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
   pm_err ret = PM_SUCCESS;
   pm_load_report local;
   pm_load_report *rep = report ? report : &local;
+  pm_relax_work rw = {0};
   double *r = NULL, *rh = NULL;
   double t0 = pm_wtime();
   const bool resumed = st && st->lambda > 0;
@@ -100,11 +140,29 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
   double *xc = st->xc, *xprev = st->xprev;
   PM_CHECK(p->set_load, PM_ERR_ARG,
            "pm_load_steps: the problem has no set_load");
+  PM_CHECK(o->easy_iterations >= 0 && o->max_dlambda >= 0 &&
+               o->max_dlambda <= 1,
+           PM_ERR_ARG,
+           "pm_load_steps: easy_iterations must be >= 0 and max_dlambda in "
+           "[0, 1] (got %d, %g)",
+           o->easy_iterations, o->max_dlambda);
+  PM_CHECK(
+      o->relax_after >= 0 &&
+          (o->relax_after == 0 ||
+           (o->relax_max_iter > 0 && o->relax_rtol > 0 && o->relax_rtol < 1)),
+      PM_ERR_ARG,
+      "pm_load_steps: relax_after must be >= 0, and with it relax_max_iter "
+      "> 0 and relax_rtol in (0, 1) (got %d, %d, %g)",
+      o->relax_after, o->relax_max_iter, o->relax_rtol);
+  const bool relaxing = pm_load_relax_available(s);
+  if (relaxing) PM_TRY(pm_relax_work_init(&rw, n));
   if (o->predictor) {
     PM_TRY(PM_ALLOC(r, n, "residual"));
     PM_TRY(PM_ALLOC(rh, n, "residual"));
   }
   const double nominal = 1.0 / o->load_steps;
+  const double largest = o->max_dlambda > 0 ? o->max_dlambda : nominal;
+  double relaxed_dl = -1; /* the step size relaxation was last tried at */
   if (!resumed) {
     memcpy(xc, x, (size_t)n * sizeof *xc);
     st->lambda = st->lambda_prev = 0;
@@ -154,6 +212,19 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       e = pm_newton_solve_from(s, x, xc, r_ref, &rep->last);
       add_solve(rep, &rep->last);
     }
+    char relaxed[768] = "", failed[sizeof rep->last.message] = "";
+    if (e != PM_SUCCESS && recoverable(e) && relaxing && st->dl != relaxed_dl &&
+        (cuts == o->relax_after || cuts >= o->max_cuts ||
+         st->dl / 2 < o->min_dlambda * (1 - 1e-12))) {
+      /* Newton cannot finish this step, cut relax_after times or at its
+       * floor: relaxation within the step. */
+      pm_error_clear();
+      relaxed_dl = st->dl;
+      snprintf(failed, sizeof failed, "%s", rep->last.message);
+      e = relax_step(s, x, xc, &rw, rep, relaxed, sizeof relaxed);
+      if (e == PM_SUCCESS) rep->relaxed_steps++;
+      if (e == PM_ERR_UNSUPPORTED) e = PM_ERR_NOT_CONVERGED;
+    }
     if (e == PM_SUCCESS) {
       memcpy(xprev, xc, (size_t)n * sizeof *xc);
       memcpy(xc, x, (size_t)n * sizeof *xc);
@@ -162,13 +233,19 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       st->have_prev = 1;
       rep->steps++;
       rep->lambda = target;
+      relaxed_dl = -1;
       if (target - lambda < rep->dlambda_min)
         rep->dlambda_min = target - lambda;
       cuts = 0;
       /* The next step's size, before on_step: the state it sees is the
        * one the next step starts from. */
-      if (st->dl < nominal && o->grow_after > 0 &&
-          ++st->good >= o->grow_after) {
+      const bool easy =
+          o->easy_iterations > 0 && rep->last.iterations <= o->easy_iterations;
+      if (easy && st->dl < largest) {
+        st->dl = fmin(1.5 * st->dl, largest);
+        st->good = 0;
+      } else if (st->dl < nominal && o->grow_after > 0 &&
+                 ++st->good >= o->grow_after) {
         st->dl = fmin(1.5 * st->dl, nominal);
         st->good = 0;
       }
@@ -184,11 +261,20 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     pm_error_clear();
     st->good = 0;
     if (cuts >= o->max_cuts || st->dl / 2 < o->min_dlambda * (1 - 1e-12)) {
+      /* Where the last state tried stands, in the problem's words. */
+      char where[512] = "";
+      if (p->diagnose &&
+          p->diagnose(p->ctx, x, where, sizeof where) != PM_SUCCESS) {
+        where[0] = '\0';
+        pm_error_clear();
+      }
       ret = PM_ERROR(e,
-                     "load step %d (lambda %.6g -> %.6g): %s; cut %d times to "
-                     "dlambda %.3g: giving up",
-                     rep->steps + 1, lambda, target, rep->last.message, cuts,
-                     target - lambda);
+                     "load step %d (lambda %.6g -> %.6g): %s%s%s; cut %d times "
+                     "to dlambda %.3g: giving up%s%s",
+                     rep->steps + 1, lambda, target,
+                     failed[0] ? failed : rep->last.message,
+                     relaxed[0] ? "; " : "", relaxed, cuts, target - lambda,
+                     where[0] ? "; at the last state tried: " : "", where);
       goto done;
     }
     cuts++;
@@ -202,6 +288,7 @@ done:
   rep->time_total += pm_wtime() - t0;
   free(r);
   free(rh);
+  pm_relax_work_free(&rw);
   return ret;
 }
 

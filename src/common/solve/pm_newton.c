@@ -27,7 +27,9 @@ pm_newton_options pm_newton_options_default(void) {
                              .line_search = PM_LINE_SEARCH_BT,
                              .load_steps = 10,
                              .max_cuts = 10,
-                             .grow_after = 2};
+                             .grow_after = 2,
+                             .relax_max_iter = 20000,
+                             .relax_rtol = 1e-3};
 }
 
 const char *pm_newton_reason_name(pm_newton_reason r) {

@@ -12,8 +12,9 @@
  *   says that x is inadmissible (J <= 0, a point inverted, a model outside
  *   its range): the line search shortens the step, and load stepping cuts
  *   the load step; the callback's message (PM_ERROR) is kept for the
- *   report.  Only PM_ERR_MEMORY, PM_ERR_IO and PM_ERR_INTERNAL abort the
- *   solve at once and are returned as they are.
+ *   report.  A residual with an entry not finite is inadmissible too.  Only
+ * PM_ERR_MEMORY, PM_ERR_IO and PM_ERR_INTERNAL abort the solve at once and are
+ * returned as they are.
  * - jacobian_prepare(ctx, x), if given, is called once at each new
  *   linearisation point x (an accepted Newton iterate, where residual
  *   succeeded) before any jacobian_apply there; it may compute and cache
@@ -145,6 +146,13 @@ typedef struct {
    * A failure stops the stepping and is returned.  Optional. */
   pm_err (*on_step)(void *ctx, int step, double lambda, const double *x,
                     const struct pm_newton_report *report);
+  /* Where a state that load stepping gives up at stands (x: the owned
+   * values of the last state tried, at the load of the failing step): one
+   * line into buf (cap bytes) naming, say, the point of largest
+   * out-of-balance force and of smallest volume ratio, with their
+   * positions; appended to the failure's message.  A failure of its own
+   * is ignored.  Optional. */
+  pm_err (*diagnose)(void *ctx, const double *x, char *buf, long cap);
 } pm_newton_problem;
 
 /* The linear solver of each Newton iteration.  With a matrix-free operator
@@ -224,6 +232,25 @@ typedef struct {
   int grow_after;     /* after this many converged steps in a row at a cut
                          step, grow it by half (up to the nominal); 0
                          never: 2 */
+  /* After an easy step (converged in at most easy_iterations Newton
+   * iterations) the next grows by half, up to max_dlambda (0: the nominal
+   * 1/load_steps); 0: growth only back to the nominal after cuts. */
+  int easy_iterations; /* 0 */
+  double max_dlambda;  /* 0 */
+  /* The fallback of a step Newton cannot finish: dynamic relaxation within
+   * the step (pm_load_relax.c) from the last converged state under the
+   * step's load, with a mass per unknown from the tangent's row sums there
+   * (raised where the response turns out stiffer) and damping from the
+   * Rayleigh quotient of each increment, until the residual has fallen by
+   * relax_rtol; then Newton again from there, and if that fails too,
+   * relaxation on from Newton's last iterate to Newton's own tolerance.
+   * Tried once a step has been cut relax_after times in a row, and again
+   * before giving up at the smallest step; relax_max_iter iterations (one
+   * residual each) per relaxation.  0: never.  One process's problems
+   * only. */
+  int relax_after;    /* 2 */
+  int relax_max_iter; /* 20000 */
+  double relax_rtol;  /* 1e-3 */
   bool predictor;     /* start each step from the linear extrapolation of
                          the last two converged states, or where there are
                          not two (the first step) from the tangent
@@ -303,6 +330,11 @@ typedef struct {
   double time_residual, time_assembly, time_linear, time_total;
   pm_newton_report last; /* the last Newton solve (the failing one on
                             failure) */
+  /* The relaxation fallback: relaxations run, steps they let converge,
+   * their iterations (one residual each) and wall seconds. */
+  int relaxations, relaxed_steps;
+  long relax_iterations;
+  double time_relax;
 } pm_load_report;
 
 /* A solver for one problem: the colouring, PETSc's matrix, vectors, SNES
@@ -345,13 +377,16 @@ pm_err pm_newton_held_values(pm_newton *s, const double *x, double *held);
  * state (or the predictor), and calls on_step.  A step that fails (any
  * reason of pm_newton_solve but a hard failure) is halved and retried from
  * the last converged state, up to max_cuts halvings in a row and no
- * smaller than min_dlambda.  x receives the last converged state, and the
- * load is left set to its lambda.  report (may be NULL) is filled in
- * either case.  On failure returns PM_ERR_NOT_CONVERGED or PM_ERR_UNSTABLE
- * with a message naming the step, the loads and the cause, e.g. "load step
- * 7 (lambda 0.4375 -> 0.46875): Newton did not converge in 25 iterations
- * (residual 3.2e-04 from 1.1e+00); cut 6 times to dlambda 1e-04: giving
- * up". */
+ * smaller than min_dlambda; after relax_after cuts in a row, and at the
+ * smallest step, dynamic relaxation within the step is tried first (see
+ * relax_after).  x receives the last converged state, and the load is left
+ * set to its lambda.  report (may be NULL) is filled in either case.  On
+ * failure returns PM_ERR_NOT_CONVERGED or PM_ERR_UNSTABLE with a message
+ * naming the step, the loads and the cause, and the problem's diagnose
+ * line of the last state tried, e.g. "load step 7 (lambda 0.4375 ->
+ * 0.46875): Newton did not converge in 25 iterations (residual 3.2e-04
+ * from 1.1e+00); relaxation: ...; cut 6 times to dlambda 1e-04: giving up;
+ * at the last state tried: ...". */
 pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report);
 
 /* What load stepping carries from one step to the next: the load factor

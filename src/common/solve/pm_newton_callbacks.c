@@ -1,6 +1,7 @@
 /* pm_newton_callbacks: what SNES calls of the problem: the residual (with
- * inadmissible states as domain errors), the Jacobian (assembled or as a
- * shell), the line search's precheck and the linear solver's timing. */
+ * inadmissible states and residuals not finite as domain errors), the Jacobian
+ * (assembled or as a shell), the line search's precheck and the linear solver's
+ * timing. */
 #include <math.h>
 #include <stdio.h>
 
@@ -18,7 +19,15 @@ PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
   double t = pm_wtime();
   PetscCall(pm_newton_in_get(s, X, s->Gx, &xl, &x));
   PetscCall(pm_newton_out_get(s, R, s->Gr, &rl, &r));
-  pm_err e = pm_newton_agreed(s, s->p.residual(s->p.ctx, x, r));
+  pm_err e = s->p.residual(s->p.ctx, x, r);
+  /* A residual that is not finite (a stress the model cannot evaluate) is
+   * an inadmissible state like an inverted point: the line search
+   * shortens the step. */
+  const long held = s->dist ? s->nloc : s->p.n;
+  for (long i = 0; i < held && e == PM_SUCCESS; i++)
+    if (!isfinite(r[i]))
+      e = PM_ERROR(PM_ERR_UNSTABLE, "residual not finite at unknown %ld", i);
+  e = pm_newton_agreed(s, e);
   PetscCall(pm_newton_out_done(s, R, s->Gr, &rl, &r, e == PM_SUCCESS));
   PetscCall(pm_newton_in_done(s, s->Gx, &xl, &x));
   if (s->rep) {

@@ -29,4 +29,28 @@ pm_err pm_newton_residual(pm_newton *s, const double *x, double *r);
 /* The Euclidean norm of v (the n owned values) over all ranks. */
 double pm_newton_norm(const pm_newton *s, const double *v);
 
+/* ---- pm_load_relax.c: dynamic relaxation within a load step ---- */
+
+/* Its work space: n values each. */
+typedef struct {
+  double *mass, *v, *r, *rt, *xt;
+} pm_relax_work;
+pm_err pm_relax_work_init(pm_relax_work *w, long n);
+void pm_relax_work_free(pm_relax_work *w);
+
+/* Dynamic relaxation at the load set, from x (in/out: the last admissible
+ * state reached) until |r| <= max(rel |r(x start)|, goal) (the start's
+ * residual into *r_start) or options.relax_max_iter iterations,
+ * with masses from the tangent at the start.  Counts and times go to rep;
+ * msg (cap bytes) gets one line of what it did.  PM_SUCCESS at the goal;
+ * PM_ERR_NOT_CONVERGED short of it; PM_ERR_UNSTABLE for an inadmissible
+ * start or no admissible increment; PM_ERR_UNSUPPORTED across ranks; a
+ * hard failure of a callback as it is. */
+pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
+                     pm_relax_work *w, pm_load_report *rep, double *r_start,
+                     char *msg, long cap);
+
+/* Whether s can relax (options.relax_after > 0, one process's problem). */
+bool pm_load_relax_available(const pm_newton *s);
+
 #endif

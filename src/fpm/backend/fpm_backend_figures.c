@@ -218,6 +218,11 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(pm_json_integer(j, "static_linear_iterations",
                             r->load.linear_iterations));
     PM_CALL(pm_json_number(j, "static_setup_seconds", r->setup_seconds));
+    PM_CALL(pm_json_integer(j, "static_relaxations", r->load.relaxations));
+    PM_CALL(pm_json_integer(j, "static_relaxed_steps", r->load.relaxed_steps));
+    PM_CALL(pm_json_integer(j, "static_relax_iterations",
+                            r->load.relax_iterations));
+    PM_CALL(pm_json_number(j, "static_relax_seconds", r->load.time_relax));
   }
   return pm_json_number(j, "max_support_condition", worst);
 }

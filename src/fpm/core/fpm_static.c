@@ -101,6 +101,10 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   no.linear = pm_newton_linear_of(s->time.qs_linear);
   no.load_steps = (int)s->time.qs_load_steps;
   no.predictor = true;
+  /* Steps Newton cannot finish get dynamic relaxation within the step;
+   * steps grow back after cuts at once when Newton found them easy. */
+  no.relax_after = (int)s->time.qs_relax_after;
+  no.easy_iterations = 3;
   no.petsc_options = s->time.qs_solver_options;
   /* SIPG: the assembled tangent lacks the adjoint term's derivative; it
    * preconditions the exact tangent applied matrix-free. */

@@ -3,6 +3,7 @@
  * factor, the figures and report of each converged load step, and the
  * set-up of it all over the free dofs. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -176,6 +177,41 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
                      : PM_SUCCESS;
 }
 
+/* Where the state x stands (pm_newton_problem.diagnose): the point of
+ * largest out-of-balance force and the point of smallest J, with their
+ * positions.  One process's models only (PM_ERR_UNSUPPORTED across
+ * ranks, on every rank). */
+static pm_err diagnose(void *ctx, const double *x, char *buf, long cap) {
+  fpm_static_ctx *c = ctx;
+  const fpm_model *m = c->m;
+  PM_CHECK(!m->xc, PM_ERR_UNSUPPORTED, "diagnosis: one process only");
+  long bad = fpm_static_evaluate(c, x);
+  if (bad >= 0) {
+    pm_err e = inadmissible(c, bad);
+    snprintf(buf, (size_t)cap, "%s", pm_error_message());
+    pm_error_clear();
+    (void)e;
+    return PM_SUCCESS;
+  }
+  long pf = 0, pj = 0;
+  double f2max = -1, jmin = INFINITY;
+  for (long i = 0; i < m->n_own; i++) {
+    double f2 = 0;
+    for (int a = 0; a < 3; a++)
+      if (!m->fixed[3 * i + a]) f2 += c->st->f[3 * i + a] * c->st->f[3 * i + a];
+    if (f2 > f2max) f2max = f2, pf = i;
+    if (c->st->J[i] < jmin) jmin = c->st->J[i], pj = i;
+  }
+  const double *xf = m->x + 3 * pf, *xj = m->x + 3 * pj;
+  snprintf(buf, (size_t)cap,
+           "largest out-of-balance force %.3g N at point %ld (%g, %g, %g), "
+           "J = %.4g there; smallest volume ratio J = %.4g at point %ld (%g, "
+           "%g, %g)",
+           sqrt(f2max), fpm_point_id(m, pf), xf[0], xf[1], xf[2], c->st->J[pf],
+           jmin, fpm_point_id(m, pj), xj[0], xj[1], xj[2]);
+  return PM_SUCCESS;
+}
+
 void fpm_static_solve_free(fpm_static_solve *v) {
   fpm_linear_destroy(v->c.lin);
   fpm_static_tangent_free(&v->c.tg);
@@ -241,6 +277,7 @@ pm_err fpm_static_setup(const fpm_model *m, fpm_state *st,
                                 .n_ghost = c->nheld - c->nf,
                                 .ghost = c->ghost,
                                 .set_load = fpm_static_set_load,
-                                .on_step = on_step};
+                                .on_step = on_step,
+                                .diagnose = diagnose};
   return PM_SUCCESS;
 }

@@ -1,0 +1,82 @@
+/* Unit tests of the Newton line search against inadmissible trial states:
+ * a trial whose residual is refused (an inverted point) or not finite (a
+ * stress the model cannot evaluate) is shortened, not accepted. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "pm_newton.h"
+#include "pm_testing.h"
+
+/* r(x) = x^3 - 1 (root 1), with every x > 1.5 inadmissible: refused when
+ * nan is false, a residual of NaN when true.  From x = 0.2 the full Newton
+ * step goes to 8.47. */
+typedef struct {
+  bool nan;
+  long refused;
+} cubic;
+
+static pm_err cubic_residual(void *ctx, const double *x, double *r) {
+  cubic *c = ctx;
+  if (x[0] > 1.5) {
+    c->refused++;
+    if (!c->nan)
+      return PM_ERROR(PM_ERR_UNSTABLE, "x = %g past the limit", x[0]);
+    r[0] = NAN;
+    return PM_SUCCESS;
+  }
+  r[0] = x[0] * x[0] * x[0] - 1;
+  return PM_SUCCESS;
+}
+
+static pm_err cubic_apply(void *ctx, const double *x, const double *dx,
+                          double *dr) {
+  (void)ctx;
+  dr[0] = 3 * x[0] * x[0] * dx[0];
+  return PM_SUCCESS;
+}
+
+static void test_inadmissible_trials(void **state) {
+  (void)state;
+  long ptr[2] = {0, 1}, idx[1] = {0};
+  for (int nan = 0; nan < 2; nan++) {
+    cubic c = {nan != 0, 0};
+    pm_newton_problem prob = {.n = 1,
+                              .ctx = &c,
+                              .residual = cubic_residual,
+                              .jacobian_apply = cubic_apply,
+                              .pat_ptr = ptr,
+                              .pat_idx = idx};
+    pm_newton_options opt = pm_newton_options_default();
+    opt.rtol = 1e-14;
+    pm_newton *s = NULL;
+    assert_ok(pm_newton_create(&prob, &opt, &s));
+    double x = 0.2;
+    pm_newton_report rep;
+    assert_ok(pm_newton_solve(s, &x, &rep));
+    print_message("%s trials: %s in %d iterations, %ld residuals (%ld "
+                  "refused), first step length %.3g, x - 1 = %.1e\n",
+                  nan ? "NaN" : "refused", pm_newton_reason_name(rep.reason),
+                  rep.iterations, rep.residual_evaluations, c.refused,
+                  rep.step_length[1], x - 1);
+    assert_close(x, 1, 1e-13, 0);
+    assert_true(c.refused >= 1);
+    assert_true(rep.step_length[1] < 1);
+    assert_true(rep.reason == PM_NEWTON_CONVERGED_RESIDUAL ||
+                rep.reason == PM_NEWTON_CONVERGED_ABSOLUTE);
+    pm_newton_destroy(&s);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_inadmissible_trials),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
