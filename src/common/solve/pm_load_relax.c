@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pm_interrupt.h"
 #include "pm_newton_impl.h"
 #include "pm_newton_solver_impl.h"
 #include "pm_omp.h"
@@ -98,6 +99,9 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
   memset(v, 0, (size_t)n * sizeof *v);
   while (rn > goal && it < max_iter) {
     it++;
+    if ((e = pm_interrupt_check("in the relaxation of a load step")) !=
+        PM_SUCCESS)
+      goto out;
     /* v at the half step, damped by c (central difference, unit step) */
     const double keep = (1 - 0.5 * c) / (1 + 0.5 * c), push = 1 / (1 + 0.5 * c);
     PM_OMP(parallel for schedule(static))
