@@ -87,6 +87,97 @@ def constrained(uz, about, **options):
 
 SLOW = dict(increment=(0.02, 0.05))  # smaller load steps for large strains
 
+
+# ---- F4 between rigid plates (contact) ----------------------------------------
+# The faces on the plates stick from the start and are pressed throughout:
+# they are held as the plates move (the clamped conditions).  The lateral
+# faces meet the plates as they roll over: node-to-surface contact with
+# each plate's face, a stiff linear pressure-overclosure law and friction
+# that sticks.  Each plate is a rigid slab of one linear brick over the
+# quarter's side, larger than the barrelled block, every node moved as
+# the plate.  The reaction is the top face's plus the top plate's.
+PLATE_REACH = 0.2  # m: the plates' extent along x and y (the block: 0.1)
+PLATE_THICKNESS = 0.01  # m
+# Contact: normal slope (Pa/m) and the tension at large clearance (Pa),
+# Coulomb coefficient and stick slope (Pa/m).
+CONTACT = dict(slope=3.0e8, tension=1.0e-3, friction=5.0, stick=3.0e8)
+
+
+def between_plates(uz, about, **options):
+    """F4 between plates: as constrained(uz), with the lateral faces in
+    sticking contact with the two rigid plates."""
+    spec = constrained(uz, about, **options)
+    spec["plates"] = True
+    return spec
+
+
+def plate_blocks(spec, mesh):
+    """The deck's additions for the plates (spec["plates"]): their nodes and
+    elements, the sets, surfaces, contact pairs and interaction, the
+    plates' motion and the top plate's force output, as a dict of text."""
+    top = spec["faces"]["zmax"][2]
+    n0, e0 = mesh.n_nodes, len(mesh.conn)
+    lo, hi = mesh.lo, mesh.hi
+    corners = [(lo[0], lo[1]), (PLATE_REACH, lo[1]), (PLATE_REACH, PLATE_REACH),
+               (lo[0], PLATE_REACH)]
+    nodes, elems = [], []
+    for k, (z0, z1) in enumerate(((-PLATE_THICKNESS, 0.0),
+                                  (hi[2], hi[2] + PLATE_THICKNESS))):
+        first = n0 + 8 * k + 1
+        for z in (z0, z1):
+            for x, y in corners:
+                nodes.append("%d,%s,%s,%s" % (n0 + len(nodes) + 1, number(x),
+                                              number(y), number(z)))
+        elems.append("%d,%s" % (e0 + k + 1, ",".join(
+            str(first + j) for j in range(8))))
+    text = dict(mesh="\n".join(nodes) + "\n*ELEMENT,TYPE=C3D8,ELSET=EPLATES\n"
+                + "\n".join(elems) + "\n")
+    # The lateral faces x = 0.1 (face S4 of C3D20) and y = 0.1 (S5) of the
+    # quarter are the slave surface; each plate's face towards the block
+    # (bottom plate: S2, top plate: S1) a master.
+    index = np.indices(mesh.ne).reshape(3, -1).T
+    faces = ["%d,S4" % (e + 1) for e in np.nonzero(
+        index[:, 0] == mesh.ne[0] - 1)[0]]
+    faces += ["%d,S5" % (e + 1) for e in np.nonzero(
+        index[:, 1] == mesh.ne[1] - 1)[0]]
+    c = CONTACT
+    text["model"] = (
+        "*NSET,NSET=NPBOT\n" + id_lines(range(n0 + 1, n0 + 9))
+        + "*NSET,NSET=NPTOP\n" + id_lines(range(n0 + 9, n0 + 17))
+        + "*SURFACE,NAME=SLATERAL\n" + "\n".join(faces) + "\n"
+        + "*SURFACE,NAME=SPBOT\n%d,S2\n" % (e0 + 1)
+        + "*SURFACE,NAME=SPTOP\n%d,S1\n" % (e0 + 2)
+        + "*MATERIAL,NAME=PLATE\n*ELASTIC\n1e9,0.3\n"
+        + "*SOLID SECTION,ELSET=EPLATES,MATERIAL=PLATE\n"
+        + "*SURFACE INTERACTION,NAME=STICK\n"
+        + "*SURFACE BEHAVIOR,PRESSURE-OVERCLOSURE=LINEAR\n%g,%g\n"
+        % (c["slope"], c["tension"])
+        + "*FRICTION\n%g,%g\n" % (c["friction"], c["stick"])
+        + "".join("*CONTACT PAIR,INTERACTION=STICK,TYPE=NODE TO SURFACE\n"
+                  "SLATERAL,%s\n" % m for m in ("SPBOT", "SPTOP")))
+    text["boundary"] = ("NPBOT,1,3,0.\nNPTOP,1,2,0.\nNPTOP,3,3,%s\n"
+                        % number(top))
+    text["output"] = "*NODE PRINT,NSET=NPTOP,TOTALS=ONLY\nRF\n"
+    return text
+
+
+def plate_force(blocks, load_set):
+    """The top plate's force on the block, increment by increment: the
+    totals of the face held (load_set) plus those of the plate's nodes
+    (NPTOP), written as the load set's blocks.  Returns the last such
+    block and the blocks with the load set's replaced by the sums."""
+    plate = {b[2]: b[3][0] for b in blocks
+             if b[0].startswith("total force") and b[1] == "NPTOP"}
+    out = []
+    for b in blocks:
+        if b[0].startswith("total force") and b[1] == "NPTOP":
+            continue
+        if b[0].startswith("total force") and b[1] == load_set:
+            p = plate.get(b[2], [0.0, 0.0, 0.0])
+            b = (b[0], b[1], b[2], [[a + c for a, c in zip(b[3][0], p)]])
+        out.append(b)
+    return last_block(out, "total force", load_set), out
+
 CASES = {
     "f1-extension": case(
         2, {"xmin": {0: 0.0, 1: 0.0}, "xmax": {0: 2.0}}, ("xmax", 0),
@@ -118,6 +209,13 @@ CASES = {
         -0.04, "F4: as F3 with u_z = -0.04 m", **SLOW),
     "f4-compression-60": constrained(
         -0.06, "F4: as F3 with u_z = -0.06 m", **SLOW),
+    "f4-plates-20": between_plates(
+        -0.02, "F4 between plates: the cube squeezed by 0.02 m between two "
+        "sticking rigid plates"),
+    "f4-plates-40": between_plates(
+        -0.04, "F4 between plates: as f4-plates-20 with 0.04 m", **SLOW),
+    "f4-plates-60": between_plates(
+        -0.06, "F4 between plates: as f4-plates-20 with 0.06 m", **SLOW),
     "f3-extension-60-nu0.3": constrained(
         0.06, "F3 60% with nu = 0.3", nu=0.3),
     "f3-extension-60-nu0.45": constrained(
@@ -347,6 +445,11 @@ def write_deck(path, name, spec, n, mesh, reduced):
         if len(ids) > 16:
             out.append(",".join(str(v) for v in ids[16:]))
     lines = "\n".join(out) + "\n"
+    plates = plate_blocks(spec, mesh) if spec.get("plates") else None
+    if plates:  # the plates' nodes, then their elements
+        head, _, tail = lines.partition("*ELEMENT")
+        lines = head + plates["mesh"].split("*ELEMENT")[0] + "*ELEMENT" + tail
+        lines += "*ELEMENT" + plates["mesh"].split("*ELEMENT")[1]
     sets = {}
     for face in spec["faces"]:
         sets["N" + face.upper()] = mesh.face(face)
@@ -358,6 +461,8 @@ def write_deck(path, name, spec, n, mesh, reduced):
     # CalculiX: U = C10 (Ibar1 - 3) + (J - 1)^2 / D1.
     lines += "%s,%s\n" % (number(mu / 2.0), number(2.0 / kappa))
     lines += "*SOLID SECTION,ELSET=EALL,MATERIAL=GEL\n"
+    if plates:
+        lines += plates["model"]
     if dim == 2:
         lines += "1.\n"  # thickness, m: results per metre of depth
     first, largest = spec["increment"]
@@ -374,6 +479,8 @@ def write_deck(path, name, spec, n, mesh, reduced):
             lines += "N%s,%d,%d,%s\n" % (face.upper(), c + 1, c + 1, number(v))
     if spec["traction"]:
         lines += traction_loads(mesh, spec)
+    if plates:
+        lines += plates["boundary"]
     load = "N" + spec["load"][0].upper()
     # CalculiX uses one output frequency for every request of a step; the
     # default (every increment) keeps the last converged increment of a
@@ -382,6 +489,8 @@ def write_deck(path, name, spec, n, mesh, reduced):
     lines += "*EL FILE,NSET=NCENTRE\nS\n"
     lines += "*NODE PRINT,NSET=NALL\nU\n"
     lines += "*NODE PRINT,NSET=%s,TOTALS=ONLY\nRF\n" % load
+    if plates:
+        lines += plates["output"]
     lines += "*END STEP\n"
     with open(path, "w") as f:
         f.write(lines)
@@ -579,6 +688,8 @@ def run_case(name, spec, n, reduced, work, threads):
     disp = last_block(blocks, "displacements", "NALL")
     load_set = "N" + spec["load"][0].upper()
     force = last_block(blocks, "total force", load_set)
+    if spec.get("plates"):  # the face held plus the top plate's contact
+        force, blocks = plate_force(blocks, load_set)
     # The part's reactions and energy stand for the whole block's: forces
     # scale with the block's cross-section over the part's, and components
     # normal to a plane of symmetry cancel with their mirror images.
