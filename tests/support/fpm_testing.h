@@ -136,6 +136,7 @@ static inline void fixture_defaults(fixture *fx) {
     if (!strcmp(k->name, "penalty")) fx->opt.penalty = atof(k->def);
     if (!strcmp(k->name, "boundary_penalty"))
       fx->opt.boundary_penalty = atof(k->def);
+    if (!strcmp(k->name, "stiffening")) fx->opt.stiffening = atof(k->def);
     if (!strcmp(k->name, "jump"))
       fx->opt.jump =
           strcmp(k->def, "quadratic") ? FPM_JUMP_LINEAR : FPM_JUMP_QUADRATIC;

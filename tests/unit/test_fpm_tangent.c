@@ -26,13 +26,16 @@ static double stored_energy(const fpm_model *m, fpm_state *st) {
 /* With the symmetric flux the force is the gradient of the stored energy
  * sum V W - sum_e {P} : K_e + 1/2 sum_e beta |e| [[u]]^2: its derivative
  * along a random direction, by central differences, equals f . d (relative
- * 1e-6).  The incomplete flux is not a gradient: its mismatch is printed. */
+ * 1e-6).  The incomplete flux is not a gradient: its mismatch is printed.
+ * k = 3: SIPG with fpm.stiffening (p_s = 1e6, so that its quartic energy
+ * is a sizeable part of the interfaces' at this small rough field). */
 static void test_sipg_is_gradient(void **state) {
   (void)state;
-  for (int k = 0; k < 3; k++) {
+  for (int k = 0; k < 4; k++) {
     fixture *fx = fixture_new(3, 0.03, 100, false);
     fx->opt.flux = k == 1 ? FPM_FLUX_IIPG : FPM_FLUX_SIPG;
     fx->opt.jump = k == 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
+    if (k == 3) fx->opt.stiffening = 1e6;
     fpm_model *m;
     fpm_state *st;
     fixture_model(fx, &m, &st);
@@ -53,7 +56,8 @@ static void test_sipg_is_gradient(void **state) {
     print_message("%s: dE/de = %.10g, f . d = %.10g, relative mismatch %.3g\n",
                   k == 0   ? "SIPG"
                   : k == 1 ? "IIPG"
-                           : "SIPG, quadratic jump",
+                  : k == 2 ? "SIPG, quadratic jump"
+                           : "SIPG, stiffening",
                   dE, fd, rel);
     if (k != 1) assert_true(rel <= 1e-6);
     free(u0);
@@ -66,29 +70,32 @@ static void test_sipg_is_gradient(void **state) {
 
 /* The F2 cube at mesh size h, p = 20, with the flux and jump of variant k
  * (bit 0: SIPG, bit 1: quadratic jump), or for k = 4 the default
- * formulation (with its boundary penalty): its model and state. */
+ * formulation (with its boundary penalty), for k = 5 the default with
+ * fpm.stiffening p_s = 1e5: its model and state. */
 static fixture *variant(double h, int k, fpm_model **m, fpm_state **st) {
   fixture *fx = fixture_new(3, h, 20, true);
   fx->opt.flux = k & 1 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
   fx->opt.jump = k & 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
-  if (k == 4) fixture_defaults(fx);
+  if (k >= 4) fixture_defaults(fx);
+  if (k == 5) fx->opt.stiffening = 1e5;
   fixture_model(fx, m, st);
   return fx;
 }
 
 static const char *variant_name(int k) {
   static const char *const names[] = {
-      "IIPG, linear jump", "SIPG, linear jump", "IIPG, quadratic jump",
-      "SIPG, quadratic jump", "the default formulation"};
+      "IIPG, linear jump",       "SIPG, linear jump",
+      "IIPG, quadratic jump",    "SIPG, quadratic jump",
+      "the default formulation", "the default formulation with stiffening"};
   return names[k];
 }
 
 /* fpm_force_linear is the derivative of fpm_force: K d against central
  * differences of f along a random d at a finite deformation, for both
- * fluxes and both jumps (relative 1e-6 of |K d|). */
+ * fluxes and both jumps and the stiffening (relative 1e-6 of |K d|). */
 static void test_force_linearisation(void **state) {
   (void)state;
-  for (int k = 0; k < 5; k++) {
+  for (int k = 0; k < 6; k++) {
     fpm_model *m;
     fpm_state *st;
     fpm_linear *lin;

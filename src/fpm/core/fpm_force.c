@@ -108,6 +108,21 @@ static inline double fit_at(const double *theta, int c, const double *phi) {
   return v;
 }
 
+/* The jump of the linear fields at an interface: u_i + H_i d_i - u_k -
+ * H_k d_k. */
+static inline void linear_jump(const double *ui, const double *uk,
+                               const double *Hi, const double *Hk,
+                               const double *di, const double *dk, double *j) {
+  for (int c = 0; c < 3; c++)
+    j[c] = ui[c] - uk[c] + Hi[3 * c] * di[0] + Hi[3 * c + 1] * di[1] +
+           Hi[3 * c + 2] * di[2] - Hk[3 * c] * dk[0] - Hk[3 * c + 1] * dk[1] -
+           Hk[3 * c + 2] * dk[2];
+}
+
+static inline double dot3(const double *a, const double *b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
 /* Pass 2: per point i, over its interfaces e with outward area vector a,
  * d_i = x_e - X_i, d_k = x_e - X_k:
  *   [[u]] = u_i + H_i d_i - u_k - H_k d_k,  b = beta |e| [[u]],
@@ -123,8 +138,10 @@ static inline double fit_at(const double *theta, int c, const double *phi) {
  * leaves through zq_i = sum_e b and Zq_i = sum_e b (x) phi(d_i) (gathered
  * by the fit weights in pass 3) instead of r and Q; the boundary
  * interfaces' linear-jump penalty (beta_b |e| = rec[19], zero elsewhere)
- * leaves through r and Q as the linear jump's does.  The energy counts the
- * model's own points. */
+ * leaves through r and Q as the linear jump's does.  The stiffening
+ * (fpm.stiffening, c_e |e| = rec[20]) adds s = c_e |e| |j|^2 j to the
+ * linear jump's force, the gradient of c_e |e| |j|^4 / 4.  The energy
+ * counts the model's own points. */
 static double flux_pass(const fpm_model *m, const fields *fl) {
   const long n = m->n_flux, n_own = m->n_own;
   const long *restrict ptr = m->nbr_ptr;
@@ -157,18 +174,32 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
       const long k = nbr[e];
       const double *rec = erec + FPM_EREC * e;
       const double *a = rec, *Mc = rec + 3, *di = rec + 12, *dk = rec + 15;
-      const double be = rec[18], bl = rec[19];
+      const double be = rec[18], bl = rec[19], cs = rec[20];
       const double *Pk = P + 9 * k, *Hk = H + 9 * k, *uk = u + 3 * k;
-      double w[3], phi_i[FPM_QFIT], phi_k[FPM_QFIT];
+      double w[3], phi_i[FPM_QFIT], phi_k[FPM_QFIT], jv[3], sv[3] = {0};
       if (quad) {
         fpm_gfd_phi(di, phi_i);
         fpm_gfd_phi(dk, phi_k);
       }
+      linear_jump(ui, uk, Hi, Hk, di, dk, jv);
+      if (cs != 0) {
+        /* the stiffening: s = c |j|^2 j, linearised c (|j0|^2 dj + 2 (j0 .
+         * dj) j0) about the base's jump j0 */
+        if (base) {
+          double j0[3];
+          linear_jump(bu + 3 * i, bu + 3 * k, bH + 9 * i, bH + 9 * k, di, dk,
+                      j0);
+          const double jj = dot3(j0, j0), jd = dot3(j0, jv);
+          for (int c = 0; c < 3; c++)
+            sv[c] = cs * (jj * jv[c] + 2 * jd * j0[c]);
+        } else {
+          const double jj = dot3(jv, jv);
+          for (int c = 0; c < 3; c++) sv[c] = cs * jj * jv[c];
+          if (counted) epen += 0.125 * cs * jj * jj;
+        }
+      }
       for (int c = 0; c < 3; c++) {
-        const double jump = ui[c] - uk[c] + Hi[3 * c] * di[0] +
-                            Hi[3 * c + 1] * di[1] + Hi[3 * c + 2] * di[2] -
-                            Hk[3 * c] * dk[0] - Hk[3 * c + 1] * dk[1] -
-                            Hk[3 * c + 2] * dk[2];
+        const double jump = jv[c];
         const double pjump = quad ? ui[c] - uk[c] +
                                         fit_at(th + 27 * i, c, phi_i) -
                                         fit_at(th + 27 * k, c, phi_k)
@@ -176,7 +207,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
         const double b = be * pjump;
         w[c] = 0.5 * (Pk[3 * c] * a[0] + Pk[3 * c + 1] * a[1] +
                       Pk[3 * c + 2] * a[2]) -
-               (quad ? bl * jump : b);
+               (quad ? bl * jump : b) - sv[c];
         ri[c] -= w[c];
         if (quad) {
           z[c] += b;

@@ -188,6 +188,12 @@ static void build_interfaces(fpm_model *m) {
       }
       r[18] = m->penalty * unit_beta(m, i, k, f);
       r[19] = 0;
+      {
+        const double h2 = (xk[0] - xi[0]) * (xk[0] - xi[0]) +
+                          (xk[1] - xi[1]) * (xk[1] - xi[1]) +
+                          (xk[2] - xi[2]) * (xk[2] - xi[2]);
+        r[20] = m->stiffening * unit_beta(m, i, k, f) / h2;
+      }
     }
   }
 }
@@ -355,6 +361,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   m->scene = s;
   m->penalty = o->penalty;
   m->boundary_penalty = o->boundary_penalty;
+  m->stiffening = o->stiffening;
   m->flux = (fpm_flux)o->flux;
   m->jump = (fpm_jump)o->jump;
   m->n_own = m->n_flux = m->n_stress = m->n;
@@ -474,5 +481,7 @@ double fpm_stable_dt(const fpm_model *m, long *critical_point) {
   if (critical_point) *critical_point = crit;
   double p = m->penalty > 1 ? m->penalty : 1;
   if (m->q && m->boundary_penalty > p) p = m->boundary_penalty;
+  /* the stiffening's penalty 3 p_s (|j| / h)^2, taken at |j| <= h / 4 */
+  if (0.1875 * m->stiffening > p) p = 0.1875 * m->stiffening;
   return fpm_contact_stable_dt(m->contact, 2.0 / sqrt(lam_max) / sqrt(p));
 }

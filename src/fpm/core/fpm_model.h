@@ -16,7 +16,7 @@
 #define FPM_MAX_MATERIALS 16
 
 struct fpm_contact;
-#define FPM_EREC 20 /* doubles per support-entry record */
+#define FPM_EREC 21 /* doubles per support-entry record */
 
 /* Everything that does not change during a run.  Arrays are per point
  * (n), per support entry (nnz, in the CSR order of the dual's adjacency) or
@@ -39,7 +39,8 @@ typedef struct {
    * (3), first moment about the interface centroid Mc = M - a (x) x_e (9),
    * d_i = x_e - X_i (3), d_k = x_e - X_k (3), beta |e| = p E / h_e |e| (1),
    * and with the quadratic jump the linear jump's beta_b |e| = p_b E / h_e
-   * |e| on the interfaces of boundary points, else 0 (1).
+   * |e| on the interfaces of boundary points, else 0 (1), and the
+   * stiffening penalty's c_e |e| = p_s E / h_e^3 |e| (1, 0 without it).
    * Entries stream in order in the flux pass; moments about the centroid
    * keep M - a (x) X_i = Mc + a (x) d_i free of cancellation. */
   double *erec;   /* FPM_EREC nnz */
@@ -55,6 +56,7 @@ typedef struct {
   double *mass;            /* n: lumped mass rho V */
   double penalty;          /* p */
   double boundary_penalty; /* p_b (quadratic jump only) */
+  double stiffening;       /* p_s: the linear jump's quartic penalty */
   fpm_flux flux;           /* IIPG or SIPG */
   /* The quadratic reconstruction of fpm.jump: quadratic (all NULL with the
    * linear jump).  Point i's fit uses the points qs_nbr[qs_ptr[i] ..

@@ -222,6 +222,7 @@ pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
   s->scene = m->scene;
   s->penalty = m->penalty;
   s->boundary_penalty = m->boundary_penalty;
+  s->stiffening = m->stiffening;
   s->flux = m->flux;
   s->jump = m->jump;
   s->n_mats = m->n_mats;

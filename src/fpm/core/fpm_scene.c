@@ -50,6 +50,16 @@ static const pm_key fpm_keys[] = {
             "h) on the jump of the points' linear fields across every "
             "interface of a point on the body's boundary, where the "
             "quadratic fits are one-sided (ignored with the linear jump)"},
+    {.name = "stiffening",
+     .type = PM_KEY_NUMBER,
+     .offset = offsetof(fpm_options, stiffening),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .unit = "",
+     .doc = "a penalty that stiffens with the jump: the energy p_s E / h^3 "
+            "|e| |[[u]]|^4 / 4 on the jump of the points' linear fields "
+            "across every interface, negligible where the field is smooth "
+            "(jump O(h^2)) and strong where the fits part (jump O(h))"},
     {.name = "flux",
      .type = PM_KEY_ENUM,
      .offset = offsetof(fpm_options, flux),

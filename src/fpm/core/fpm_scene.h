@@ -31,6 +31,8 @@ typedef struct {
   double penalty;          /* fpm.penalty p >= 0 (beta = p E / h) */
   double boundary_penalty; /* fpm.boundary_penalty p_b >= 0: linear-jump
                               penalty on boundary interfaces (quadratic jump) */
+  double stiffening;       /* fpm.stiffening p_s >= 0: quartic penalty on
+                              the linear jump, |e| p_s E/h^3 |[[u]]|^4 / 4 */
   int flux;                /* fpm_flux */
   int jump;                /* fpm_jump */
   char *cells;             /* fpm.cells: the partition into subdomains */
