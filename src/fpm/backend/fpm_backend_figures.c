@@ -202,6 +202,10 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
   PM_CALL(pm_json_integer(j, "dt_critical_point", sim->dt_point));
   PM_CALL(pm_json_integer(j, "ill_conditioned_points", ill));
   PM_CALL(pm_json_string(j, "jump", m->q ? "quadratic" : "linear"));
+  if (m->boundary_penalty > 0)
+    PM_CALL(pm_json_number(j, "boundary_penalty", m->boundary_penalty));
+  if (m->stiffening > 0)
+    PM_CALL(pm_json_number(j, "stiffening", m->stiffening));
   if (sim->local_model) PM_CALL(summary_ranks(j, sim));
   if (m->q) {
     PM_CALL(pm_json_integer(j, "fit_points_two_rings", m->n_qwide));

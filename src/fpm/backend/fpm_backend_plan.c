@@ -73,14 +73,19 @@ static double plan_head(fpm_sim *sim, FILE *out) {
             "             2. quadratic fit per point, %ld entries (%ld "
             "points over two rings, %ld linear)\n",
             m->qs_ptr[m->n], m->n_qwide, m->n_qlinear);
+  char extra[96] = "";
+  if (m->boundary_penalty > 0 || m->stiffening > 0)
+    snprintf(extra, sizeof extra,
+             "; boundary penalty %g, stiffening %g on the linear jump",
+             m->boundary_penalty, m->stiffening);
   fprintf(out,
           "             %d. interface flux (%s, penalty %g on the %s "
-          "jump), %ld support entries\n",
+          "jump%s), %ld support entries\n",
           m->q ? 3 : 2,
           m->flux == FPM_FLUX_SIPG ? "SIPG: with the adjoint term, tangent "
                                      "per point"
                                    : "IIPG",
-          m->penalty, m->q ? "quadratic" : "linear", m->nnz);
+          m->penalty, m->q ? "quadratic" : "linear", extra, m->nnz);
   int stage = m->q ? 4 : 3;
   if (m->n_dpts > 0)
     fprintf(out,
