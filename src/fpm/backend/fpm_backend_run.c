@@ -2,6 +2,7 @@
  * time loop or the static solve, on one process or on this rank's share
  * with rank 0's view of the whole run gathered where the run writes. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -110,6 +111,27 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
   return pm_view_step(&sim->view, &r, frame);
 }
 
+/* A signal stopped a load step inside its solve on every rank (e:
+ * PM_ERR_INTERRUPTED): across ranks the last converged step goes to the
+ * observer once more, which (seeing the signal) writes its frame (dropped
+ * on resume) and its checkpoint, collectively, and ends the run; the
+ * message says where the solve was stopped.  On one process the run
+ * driver writes that checkpoint itself. */
+static pm_err stopped_inside(fpm_sim *sim, pm_err e) {
+  if (e != PM_ERR_INTERRUPTED || !sim->local_model || sim->last.step <= 0)
+    return e;
+  char where[512];
+  snprintf(where, sizeof where, "%s", pm_error_message());
+  fpm_step_info last = sim->last;
+  last.last = false;
+  pm_step_report rep = note_step(sim, &last);
+  pm_err o = pm_view_step(&sim->view, &rep, false);
+  if (o != PM_ERR_INTERRUPTED) return o ? o : e;
+  char after[1024];
+  snprintf(after, sizeof after, "%s", pm_error_message());
+  return PM_ERROR(PM_ERR_INTERRUPTED, "%s; %s", where, after);
+}
+
 /* ---- across ranks ---- */
 
 /* Across ranks, once the run starts: the whole model stays on rank 0 as
@@ -194,6 +216,7 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
     e = fpm_static_run_from(
         lm, st, sim->local_model ? &sim->local_static : &sim->static_state,
         observe, sim, &sim->last, r);
+    e = stopped_inside(sim, e);
     double wall = pm_wtime() - w0;
     e = pm_view_end(&sim->view, e); /* the state it ended in, for figures */
     if (sim->local_model) ranks_costs(sim);
