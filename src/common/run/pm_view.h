@@ -37,6 +37,14 @@ void pm_view_release(pm_view *v);
  * for them (pm_observer_share; collective).  The observer's failure. */
 pm_err pm_view_step(pm_view *v, const pm_step_report *r, bool frame);
 
+/* A signal stopped a load step inside its solve (e: PM_ERR_INTERRUPTED,
+ * on every rank): the last converged step r, which the state still holds,
+ * goes to the observer once more, which (seeing the signal) writes its
+ * frame, dropped on resume, and its checkpoint, collectively, and ends the
+ * run; the message then says where the solve was stopped.  Any other e
+ * comes back as it is. */
+pm_err pm_view_stopped_inside(pm_view *v, const pm_step_report *r, pm_err e);
+
 /* The run ended with e: across ranks, the state it ended in (a failure's
  * too) gathered into rank 0's view for the figures (collective).  e, or the
  * gather's failure where e is PM_SUCCESS.  The observer is let go. */

@@ -111,25 +111,16 @@ static pm_err observe(void *ctx, const fpm_model *m, const fpm_state *st,
   return pm_view_step(&sim->view, &r, frame);
 }
 
-/* A signal stopped a load step inside its solve on every rank (e:
- * PM_ERR_INTERRUPTED): across ranks the last converged step goes to the
- * observer once more, which (seeing the signal) writes its frame (dropped
- * on resume) and its checkpoint, collectively, and ends the run; the
- * message says where the solve was stopped.  On one process the run
- * driver writes that checkpoint itself. */
+/* A signal stopped a load step inside its solve across ranks: the last
+ * converged step to the observer once more (pm_view_stopped_inside).  On
+ * one process the run driver writes that checkpoint itself. */
 static pm_err stopped_inside(fpm_sim *sim, pm_err e) {
   if (e != PM_ERR_INTERRUPTED || !sim->local_model || sim->last.step <= 0)
     return e;
-  char where[512];
-  snprintf(where, sizeof where, "%s", pm_error_message());
   fpm_step_info last = sim->last;
   last.last = false;
   pm_step_report rep = note_step(sim, &last);
-  pm_err o = pm_view_step(&sim->view, &rep, false);
-  if (o != PM_ERR_INTERRUPTED) return o ? o : e;
-  char after[1024];
-  snprintf(after, sizeof after, "%s", pm_error_message());
-  return PM_ERROR(PM_ERR_INTERRUPTED, "%s; %s", where, after);
+  return pm_view_stopped_inside(&sim->view, &rep, e);
 }
 
 /* ---- across ranks ---- */

@@ -52,28 +52,20 @@ static pm_err implicit_observe(void *ctx, const mpm_implicit_step *step) {
   return pm_view_step(&r->view, &rep, frame);
 }
 
-/* A signal stopped a load step inside its solve (e: PM_ERR_INTERRUPTED,
- * on every rank): the last converged step, which the state still holds,
- * goes to the observer once more, which (seeing the signal) writes its
- * frame and checkpoint and ends the run; the message says where the solve
- * was stopped.  Nothing to resume before the first converged step. */
+/* A signal stopped a load step inside its solve: the last converged step,
+ * which the state still holds, to the observer once more
+ * (pm_view_stopped_inside).  Nothing to resume before the first one. */
 static pm_err stopped_inside(mpm_sim *r, pm_err e) {
   const mpm_model *m = r->local_model ? r->local_model : r->model;
   const mpm_state *st = r->local_model ? r->local_state : r->state;
   if (e != PM_ERR_INTERRUPTED || st->step <= 0) return e;
-  char where[512];
-  snprintf(where, sizeof where, "%s", pm_error_message());
   pm_step_report rep = {.last = false,
                         .step = st->step,
                         .t = st->t,
                         .residual = r->work->residual,
                         .progress =
                             m->opt.t_load > 0 ? st->t / m->opt.t_load : 0};
-  pm_err o = pm_view_step(&r->view, &rep, false);
-  if (o != PM_ERR_INTERRUPTED) return o ? o : e;
-  char after[1024];
-  snprintf(after, sizeof after, "%s", pm_error_message());
-  return PM_ERROR(PM_ERR_INTERRUPTED, "%s; %s", where, after);
+  return pm_view_stopped_inside(&r->view, &rep, e);
 }
 
 static pm_err implicit_run(void *p, const pm_observer *obs) {
