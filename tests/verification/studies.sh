@@ -10,14 +10,24 @@
 #  - the same ladders with the scenes' own formulation against the
 #    finite-element referee: displacement and reaction error rates (see
 #    below);
+#  - the finest level of those ladders, F3 60% and F4 20% at the paper's
+#    coarsest resolution (h = 1.09e-2 m, 1851 points), against FE: converged,
+#    top reaction within 2% (F3) and 5% (F4), displacement NRMSE at the FE
+#    lattice at or below the paper's figure (F3);
 #  - F3 200% and F4 60% at the coarsest paper resolution: converged, J > 0
 #    throughout, energy balance within 1% of the external work.
 # The self-convergence and extreme checks use the symmetric flux
 # (fpm.flux: sipg, linear jump, p = 100), the one whose force derives from
 # an energy.
+#
+# One OpenMP thread unless the caller sets OMP_NUM_THREADS: the scenes have
+# 157 to 1851 points, where a step is mostly fork/join, and two threads on
+# cores shared with another job spin against each other (the F1 ladder took
+# about ten times the CPU seconds of one thread on a loaded machine).
 set -u
 bin=$1
 src=$2
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 VERBOSE_CHECKS=1
 # shellcheck source=lib.sh
 . "$(dirname "$0")/lib.sh"
@@ -30,6 +40,7 @@ rate() { sed -n 's/^Observed rate (.*q = \([-0-9.]*\)\..*/\1/p' "$1"; }
 rate_reaction() {
   sed -n 's/^Observed rate of the reaction error: q = \([-0-9.]*\)\..*/\1/p' "$1"
 }
+absle() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && (a < 0 ? -a : a) <= b + 0) }'; }
 
 # ---- F1 penalty study ------------------------------------------------------
 for kind in extension compression-guided; do
@@ -91,6 +102,28 @@ for c in f3-extension-60 f4-compression-20; do
   else
     check "$c against FE: displacement rate q = $q >= 1.6" ge "$q" 1.6
     echo "  $c against FE: reaction error rate q = $qr (not asserted)"
+  fi
+  # The finest level (mesh size 8.72e-3 m, h = 1.09e-2 m, 1851 points) is
+  # the block scene as committed at the paper's coarsest resolution, the run
+  # verify_fe_blocks made for these two cases before it was asked here: the
+  # top reaction within 2% of FE for F3 and 5% for F4 20% (whose FE force is
+  # itself uncertain by about 4%), and F3's displacement NRMSE at the FE
+  # lattice at or below the FPM paper's figure for this h, 1.11e-2 (F4 20%'s
+  # is printed beside the paper's 8.59e-3).
+  csv=$out/convergence.csv
+  st=$(col "$csv" 5 status)
+  re=$(col "$csv" 5 reaction_error)
+  e=$(col "$csv" 5 error)
+  check "$c at 1851 points against FE: converged ($st)" test "$st" = converged
+  if [ "$c" = f3-extension-60 ]; then
+    check "$c at 1851 points against FE: reaction error $re within 2%" \
+      absle "$re" 0.02
+    check "$c at 1851 points against FE: NRMSE $e <= 1.11e-2 (paper)" \
+      le "$e" 1.11e-2
+  else
+    check "$c at 1851 points against FE: reaction error $re within 5%" \
+      absle "$re" 0.05
+    echo "  $c at 1851 points against FE: NRMSE $e (paper 8.59e-3, not asserted)"
   fi
 done
 
