@@ -1,10 +1,13 @@
 # Verification tests: whole runs against analytic solutions, and the
 # command line's handling of bad input and numerical failure.
-# Each verification test runs its own OpenMP threads on every core, so
+# Each verification program runs its own OpenMP threads on every core, so
 # ctest gives it the machine (PROCESSORS 2): oversubscribed OpenMP threads
-# spin against each other and run several times slower.  For a machine
-# shared with other jobs, tests/CMakeLists.txt also sets a short spin
-# (GOMP_SPINCOUNT=3000) for every test, these included.
+# spin against each other and run several times slower.  The scripts whose
+# scenes are small run one thread (they export OMP_NUM_THREADS=1 unless the
+# caller set it) and take one core (PROCESSORS 1), so ctest -j2 runs another
+# test beside them.  For a machine shared with other jobs,
+# tests/CMakeLists.txt also sets a short spin (GOMP_SPINCOUNT=3000) for
+# every test, these included.
 set(PM_VERIFY_DIR ${CMAKE_CURRENT_LIST_DIR})
 file(GLOB PM_VERIFY_TESTS CONFIGURE_DEPENDS ${PM_VERIFY_DIR}/verify_*.c)
 foreach(src ${PM_VERIFY_TESTS})
@@ -19,11 +22,11 @@ endforeach()
 
 add_test(NAME verification.cli
   COMMAND bash ${PM_VERIFY_DIR}/cli.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
-set_tests_properties(verification.cli PROPERTIES LABELS verification TIMEOUT 600 PROCESSORS 2)
+set_tests_properties(verification.cli PROPERTIES LABELS verification TIMEOUT 600 PROCESSORS 1)
 
 add_test(NAME verification.cli_mpm
   COMMAND bash ${PM_VERIFY_DIR}/cli-mpm.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
-set_tests_properties(verification.cli_mpm PROPERTIES LABELS verification TIMEOUT 600 PROCESSORS 2)
+set_tests_properties(verification.cli_mpm PROPERTIES LABELS verification TIMEOUT 600 PROCESSORS 1)
 
 add_test(NAME verification.cli_not_finite
   COMMAND bash ${PM_VERIFY_DIR}/cli-not-finite.sh $<TARGET_FILE:pointmech>)
@@ -31,7 +34,7 @@ set_tests_properties(verification.cli_not_finite PROPERTIES LABELS verification 
 
 add_test(NAME verification.studies
   COMMAND bash ${PM_VERIFY_DIR}/studies.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
-set_tests_properties(verification.studies PROPERTIES LABELS verification TIMEOUT 900 PROCESSORS 2)
+set_tests_properties(verification.studies PROPERTIES LABELS verification TIMEOUT 900 PROCESSORS 1)
 
 add_test(NAME verification.restart
   COMMAND bash ${PM_VERIFY_DIR}/restart.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
@@ -50,11 +53,11 @@ set_tests_properties(verification.membranes PROPERTIES LABELS verification TIMEO
 
 add_test(NAME verification.compare
   COMMAND bash ${PM_VERIFY_DIR}/compare.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
-set_tests_properties(verification.compare PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)
+set_tests_properties(verification.compare PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 1)
 
 add_test(NAME verification.bench
   COMMAND bash ${PM_VERIFY_DIR}/bench.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
-set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 450 PROCESSORS 2)
+set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 450 PROCESSORS 1)
 
 # Runs across MPI ranks (mpirun -np 2 and 3) against the same scenes on one
 # process, explicit MPM (ranks.sh) and FPM (ranks-fpm.sh); ranks_migrate
