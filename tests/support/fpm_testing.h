@@ -145,4 +145,39 @@ static inline void fixture_defaults(fixture *fx) {
   }
 }
 
+/* |K d - (f(u0 + eps d) - f(u0 - eps d)) / 2 eps| / |K d| at the state
+ * u0 = smooth_plus_rough(seed, smooth 0.2, rough 1e-3), d its rough part,
+ * eps = 1e-6: how far fpm_force_linear is from the force's derivative. */
+static inline double linearisation_error(const fpm_model *m, fpm_state *st,
+                                         unsigned long long seed) {
+  fpm_linear *lin;
+  assert_int_equal(fpm_linear_create(m, &lin), PM_SUCCESS);
+  const long nd = 3 * m->n;
+  double *u0 = calloc(nd, sizeof *u0), *d = calloc(nd, sizeof *d),
+         *kd = calloc(nd, sizeof *kd), *fp = calloc(nd, sizeof *fp);
+  smooth_plus_rough(m, seed, 0.2, 1e-3, u0, d);
+  memcpy(st->u, u0, nd * sizeof *u0);
+  assert_int_equal(fpm_force(m, st), -1);
+  fpm_linear_prepare(m, st, lin);
+  fpm_force_linear(m, lin, d, kd);
+  const double eps = 1e-6;
+  for (long i = 0; i < nd; i++) st->u[i] = u0[i] + eps * d[i];
+  assert_int_equal(fpm_force(m, st), -1);
+  memcpy(fp, st->f, nd * sizeof *fp);
+  for (long i = 0; i < nd; i++) st->u[i] = u0[i] - eps * d[i];
+  assert_int_equal(fpm_force(m, st), -1);
+  double err = 0, norm = 0;
+  for (long i = 0; i < nd; i++) {
+    const double c = (fp[i] - st->f[i]) / (2 * eps);
+    err += (c - kd[i]) * (c - kd[i]);
+    norm += kd[i] * kd[i];
+  }
+  free(u0);
+  free(d);
+  free(kd);
+  free(fp);
+  fpm_linear_destroy(lin);
+  return sqrt(err / norm);
+}
+
 #endif

@@ -220,6 +220,21 @@ static inline pm_hyper_vol pm_hyper_vol_log(const pm_hyper_kin *k, double K) {
                         K * (1 - k->lnJ) / (k->J * k->J)};
 }
 
+/* The same two energies as functions of J alone (pm_model.volumetric):
+ * U, U', U'' into u[0..2]. */
+static inline void pm_hyper_u_quadratic(double K, double J, double u[3]) {
+  u[0] = 0.5 * K * (J - 1) * (J - 1);
+  u[1] = K * (J - 1);
+  u[2] = K;
+}
+
+static inline void pm_hyper_u_log(double K, double J, double u[3]) {
+  const double l = log(J);
+  u[0] = 0.5 * K * l * l;
+  u[1] = K * l / J;
+  u[2] = K * (1 - l) / (J * J);
+}
+
 /* P += U' cof F. */
 static inline void pm_hyper_vol_stress(const pm_hyper_kin *k, pm_hyper_vol v,
                                        double P[9]) {

@@ -81,6 +81,10 @@ struct pm_model {
   /* dP = A : dF, A = d2W/dF dF (major symmetry).  False when J <= 0. */
   bool (*tangent)(const pm_material *m, const double F[9], const double *state,
                   const double dF[9], double dP[9]);
+  /* Optional, for models split as W = W_iso(J^-1/3 F) + U(J): U(J), U'(J)
+   * and U''(J) into U[0..2] (J > 0).  NULL: the model has no such split
+   * (averaged-volume treatments refuse it). */
+  void (*volumetric)(const pm_material *m, double J, double U[3]);
   /* Optional rate form for updated-Lagrangian backends: the Cauchy stress
    * advanced over dt by the rate of deformation D and the spin W
    * (objective, Jaumann).  NULL: the backend uses P(F). */
@@ -133,6 +137,17 @@ static inline bool pm_material_tangent(const pm_material *m, const double F[9],
                                        const double *state, const double dF[9],
                                        double dP[9]) {
   return m->model->tangent(m, F, state, dF, dP);
+}
+
+/* Whether the model splits off a volumetric energy U(J) (pm_model.volumetric),
+ * and U, U', U'' at J > 0 (only for a model that has it). */
+static inline bool pm_material_has_volumetric(const pm_material *m) {
+  return m->model->volumetric != NULL;
+}
+
+static inline void pm_material_volumetric(const pm_material *m, double J,
+                                          double U[3]) {
+  m->model->volumetric(m, J, U);
 }
 
 /* W(F) alone; NaN when J <= 0. */

@@ -163,6 +163,11 @@ static bool tangent(const pm_material *m, const double F[9], const double *st,
   return true;
 }
 
+/* U(J) of the split W = W_iso + U(J). */
+static void volumetric(const pm_material *m, double J, double U[3]) {
+  pm_hyper_u_quadratic(m->c[HGO_K], J, U);
+}
+
 const pm_model pm_model_holzapfel_gasser_ogden = {
     .name = "holzapfel-gasser-ogden",
     .formula = "W = mu/2 (Ibar1 - 3) + k1/(2 k2) sum_f (exp(k2 <E_f>^2) - 1) "
@@ -177,5 +182,6 @@ const pm_model pm_model_holzapfel_gasser_ogden = {
     .init = init,
     .stress = stress,
     .tangent = tangent,
+    .volumetric = volumetric,
     .state_init = state_init,
 };

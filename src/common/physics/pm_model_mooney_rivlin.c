@@ -75,6 +75,11 @@ static bool tangent(const pm_material *m, const double F[9], const double *st,
   return true;
 }
 
+/* U(J) of the split W = W_iso + U(J). */
+static void volumetric(const pm_material *m, double J, double U[3]) {
+  pm_hyper_u_quadratic(m->c[MR_K], J, U);
+}
+
 const pm_model pm_model_mooney_rivlin = {
     .name = "mooney-rivlin",
     .formula = "W = c10 (Ibar1 - 3) + c01 (Ibar2 - 3) + K/2 (J - 1)^2, "
@@ -84,4 +89,5 @@ const pm_model pm_model_mooney_rivlin = {
     .init = init,
     .stress = stress,
     .tangent = tangent,
+    .volumetric = volumetric,
 };

@@ -37,6 +37,11 @@ static bool tangent(const pm_material *m, const double F[9], const double *st,
   return true;
 }
 
+/* U(J) of the split W = W_iso + U(J). */
+static void volumetric(const pm_material *m, double J, double U[3]) {
+  pm_hyper_u_log(m->c[PM_EL_K], J, U);
+}
+
 const pm_model pm_model_neo_hookean_log = {
     .name = "neo-hookean-log",
     .formula = "W = mu/2 (J^-2/3 tr C - 3) + K/2 (ln J)^2 (Simo-Hughes)",
@@ -46,4 +51,5 @@ const pm_model pm_model_neo_hookean_log = {
     .init = pm_elastic_init,
     .stress = stress,
     .tangent = tangent,
+    .volumetric = volumetric,
 };

@@ -219,6 +219,11 @@ static bool tangent(const pm_material *m, const double F[9], const double *st,
   return true;
 }
 
+/* U(J) of the split W = W_iso + U(J). */
+static void volumetric(const pm_material *m, double J, double U[3]) {
+  pm_hyper_u_quadratic(m->c[OG_K], J, U);
+}
+
 const pm_model pm_model_ogden = {
     .name = "ogden",
     .formula = "W = sum_p mu_p/alpha_p (lb1^a_p + lb2^a_p + lb3^a_p - 3) + "
@@ -230,4 +235,5 @@ const pm_model pm_model_ogden = {
     .init = init,
     .stress = stress,
     .tangent = tangent,
+    .volumetric = volumetric,
 };

@@ -68,6 +68,9 @@ static double plan_head(fpm_sim *sim, FILE *out) {
   for (int k = 0; k < m->n_mats; k++)
     fprintf(out, "%s%s", k ? ", " : "", m->mats[k].model->name);
   fprintf(out, ")\n");
+  if (m->vavg)
+    fprintf(out, "             averaged volume: Jbar = A J and the pressure A "
+                 "U'(Jbar) over each closed support (fpm.volumetric)\n");
   if (m->q)
     fprintf(out,
             "             2. quadratic fit per point, %ld entries (%ld "

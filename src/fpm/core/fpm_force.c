@@ -9,6 +9,7 @@
 
 #include "fpm_gfd.h"
 #include "fpm_model.h"
+#include "fpm_volumetric.h"
 #include "pm_material.h"
 #include "pm_omp.h"
 #include "pm_tensor.h"
@@ -398,6 +399,7 @@ static void fit_gather_pass(const fpm_model *m, const fields *fl) {
 long fpm_force(const fpm_model *m, fpm_state *st) {
   long bad = stress_pass(m, st);
   if (bad >= 0) return bad;
+  if (m->vavg) fpm_volumetric_stress(m, st);
   const fields fl = {.u = st->u,
                      .H = st->H,
                      .P = st->P,
@@ -421,6 +423,7 @@ struct fpm_linear {
   double *dH, *dP, *theta; /* 9 n, 9 n, 27 n (NULL with the linear jump) */
   double *T, *r, *zq, *Zq; /* 9 n, 3 n, 3 n, 27 n */
   double *bu, *bH;         /* 3 n, 9 n: the state linearised about */
+  fpm_volumetric_lin vol;  /* fpm.volumetric: averaged (else NULLs) */
 };
 
 pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
@@ -441,6 +444,7 @@ pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
     PM_TRY(PM_ALLOC(l->zq, 3 * n, "penalty force increments"));
     PM_TRY(PM_ALLOC(l->Zq, 27 * n, "penalty fit force increments"));
   }
+  if (m->vavg) PM_TRY(fpm_volumetric_lin_create(m, &l->vol));
   *out = l;
   l = NULL;
 done:
@@ -460,12 +464,14 @@ void fpm_linear_destroy(fpm_linear *l) {
   free(l->Zq);
   free(l->bu);
   free(l->bH);
+  fpm_volumetric_lin_free(&l->vol);
   free(l);
 }
 
 size_t fpm_linear_bytes(const fpm_model *m) {
   return (size_t)m->n * (81 + 9 + 9 + 9 + 3 + 12 + (m->q ? 57 : 0)) *
-         sizeof(double);
+             sizeof(double) +
+         fpm_volumetric_lin_bytes(m);
 }
 
 void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
@@ -494,6 +500,7 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
       for (int a = 0; a < 9; a++) D[81 * i + 9 * a + b] = dP[a];
     }
   }
+  if (m->vavg) fpm_volumetric_prepare(m, st, &l->vol, D);
 }
 
 void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
@@ -521,6 +528,7 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
       dP[9 * i + a] = s;
     }
   }
+  if (m->vavg) fpm_volumetric_apply(m, &l->vol, dH, dP);
   const fields fl = {.u = du,
                      .H = dH,
                      .P = dP,

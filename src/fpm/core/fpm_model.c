@@ -8,6 +8,7 @@
 
 #include "fpm_contact.h"
 #include "fpm_gfd.h"
+#include "fpm_volumetric.h"
 #include "gm_shape.h"
 #include "pm_omp.h"
 
@@ -51,6 +52,8 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->qt_entry);
   free(m->q);
   free(m->qsum);
+  free(m->vavg);
+  free(m->vself);
   free(m->gid);
   free(m->tf_gid);
   gm_dual_destroy(m->own_dual);
@@ -67,7 +70,8 @@ size_t fpm_model_bytes(const fpm_model *m) {
          m->n_cdofs * (d + sizeof(long) + 2 * sizeof(int)) +
          (m->q ? (size_t)m->qs_ptr[m->n] * (FPM_QFIT * d + 3 * sizeof(int)) +
                      (size_t)m->n * (FPM_QFIT * d + 2 * sizeof(long))
-               : 0);
+               : 0) +
+         (m->vavg ? (size_t)(m->nnz + m->n) * d : 0);
 }
 
 /* Entry (k, i) for every entry (i, k): supports are symmetric (mesh
@@ -391,6 +395,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   if (m->jump == FPM_JUMP_QUADRATIC && m->boundary_penalty > 0)
     PM_TRY(boundary_penalty(m));
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
+  if (o->volumetric == FPM_VOLUMETRIC_AVERAGED) PM_TRY(fpm_volumetric_build(m));
   PM_TRY(fpm_build_boundary(m, s, mesh));
   PM_TRY(fpm_contact_create(m, s, &m->contact));
   *out = m;
@@ -420,6 +425,10 @@ pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
     PM_TRY(PM_ALLOC(st->zq, 3 * n, "penalty forces"));
     PM_TRY(PM_ALLOC(st->Zq, 27 * n, "penalty fit forces"));
   }
+  if (m->vavg) {
+    PM_TRY(PM_ALLOC(st->Jbar, n, "averaged volume ratio"));
+    PM_TRY(PM_ALLOC(st->dUbar, n, "averaged pressure"));
+  }
   PM_TRY(PM_ALLOC(st->tf_value, 3 * m->n_tfacets, "tractions"));
   PM_TRY(PM_ALLOC(st->bflux, 3 * m->n_dpts, "boundary flux"));
   PM_TRY(
@@ -446,6 +455,8 @@ void fpm_state_destroy(fpm_state *st) {
   free(st->theta);
   free(st->zq);
   free(st->Zq);
+  free(st->Jbar);
+  free(st->dUbar);
   free(st->tf_value);
   free(st->bflux);
   free(st->support_prev);
@@ -458,7 +469,8 @@ size_t fpm_state_bytes(const fpm_model *m) {
          (size_t)(m->n_tfacets + 2 * m->n_dpts) * 3 * sizeof(double) +
          (size_t)m->n_cdofs * sizeof(double) +
          (size_t)fpm_contact_state_size(m->contact) * sizeof(double) +
-         (m->q ? (size_t)m->n * 57 * sizeof(double) : 0);
+         (m->q ? (size_t)m->n * 57 * sizeof(double) : 0) +
+         (m->vavg ? (size_t)m->n * 2 * sizeof(double) : 0);
 }
 
 double fpm_stable_dt(const fpm_model *m, long *critical_point) {

@@ -58,6 +58,10 @@ typedef struct {
   double boundary_penalty; /* p_b (quadratic jump only) */
   double stiffening;       /* p_s: the linear jump's quartic penalty */
   fpm_flux flux;           /* IIPG or SIPG */
+  /* fpm.volumetric: averaged (fpm_volumetric.h): the weights a_ik of each
+   * support entry and a_ii of each point (both NULL with standard). */
+  double *vavg;  /* nnz */
+  double *vself; /* n */
   /* The quadratic reconstruction of fpm.jump: quadratic (all NULL with the
    * linear jump).  Point i's fit uses the points qs_nbr[qs_ptr[i] ..
    * qs_ptr[i+1]) (its support, or its two rings where the support cannot
@@ -140,6 +144,8 @@ typedef struct {
   double *theta;            /* 27 n: the quadratic fit (fpm.jump: quadratic) */
   double *zq;               /* 3 n: sum_e b_e, the penalty force through u_i */
   double *Zq;               /* 27 n: sum_e b_e (x) phi(d_i), through theta_i */
+  double *Jbar, *dUbar;     /* n each: averaged J and U'(Jbar) (fpm.volumetric:
+                               averaged; else NULL) */
   double *bflux;        /* 3 n_dpts: that flux per point: the supports' force on
                            the body, with f on the prescribed dofs */
   double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous

@@ -13,6 +13,11 @@ static const pm_name flux_names[] = {
 static const pm_name jump_names[] = {
     {"linear", FPM_JUMP_LINEAR}, {"quadratic", FPM_JUMP_QUADRATIC}, {NULL, 0}};
 
+static const pm_name volumetric_names[] = {
+    {"standard", FPM_VOLUMETRIC_STANDARD},
+    {"averaged", FPM_VOLUMETRIC_AVERAGED},
+    {NULL, 0}};
+
 static const pm_name formulation_names[] = {
     {"default", FPM_FORMULATION_DEFAULT},
     {"paper", FPM_FORMULATION_PAPER},
@@ -77,6 +82,16 @@ static const pm_key fpm_keys[] = {
             "least-squares quadratic fit about each point, the default: the "
             "penalty then vanishes on quadratic fields and does not stiffen "
             "near-incompressible solids)"},
+    {.name = "volumetric",
+     .type = PM_KEY_ENUM,
+     .offset = offsetof(fpm_options, volumetric),
+     .def = "standard",
+     .names = volumetric_names,
+     .doc = "the volumetric stress: standard (U'(J) of each point's own J) "
+            "or averaged (an F-bar kind: each point's J averaged over its "
+            "support, the exact gradient of sum V U(Jbar); for models split "
+            "as W_iso + U(J): neo-hookean, neo-hookean-log, mooney-rivlin, "
+            "ogden, holzapfel-gasser-ogden; IIPG flux, one process)"},
     {.name = "cells",
      .type = PM_KEY_STRING,
      .offset = offsetof(fpm_options, cells),
@@ -187,8 +202,29 @@ static pm_err check_boundary(const pm_scene *s) {
   return PM_SUCCESS;
 }
 
+/* fpm.volumetric: averaged needs the volumetric split of every material
+ * and the IIPG flux (the SIPG adjoint term would couple the averages). */
+static pm_err check_volumetric(const pm_scene *s) {
+  const fpm_options *o = fpm_scene_options(s);
+  if (!o || o->volumetric != FPM_VOLUMETRIC_AVERAGED) return PM_SUCCESS;
+  for (int i = 0; i < s->n_materials; i++)
+    if (!pm_material_has_volumetric(&s->materials[i].mat))
+      return pm_scene_fail(
+          s, "fpm.volumetric", true,
+          "expected standard for material %s (%s): averaged needs a model "
+          "split as W_iso + U(J) (neo-hookean, neo-hookean-log, "
+          "mooney-rivlin, ogden, holzapfel-gasser-ogden), got averaged",
+          s->materials[i].name, s->materials[i].mat.model->name);
+  if (o->flux == FPM_FLUX_SIPG)
+    return pm_scene_fail(s, "fpm.volumetric", true,
+                         "expected standard with fpm.flux sipg (averaged "
+                         "needs the IIPG flux), got averaged");
+  return PM_SUCCESS;
+}
+
 pm_err fpm_check_scene(const pm_scene *s) {
   PM_CALL(check_materials(s));
+  PM_CALL(check_volumetric(s));
   PM_CALL(check_bodies(s));
   PM_CALL(check_boundary(s));
   if (pm_scene_has(s, "gravity"))

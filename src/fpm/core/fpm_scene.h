@@ -18,6 +18,13 @@ typedef enum {
   FPM_JUMP_QUADRATIC   /* a least-squares quadratic fit about each point */
 } fpm_jump;
 
+/* The volumetric part of the stress. */
+typedef enum {
+  FPM_VOLUMETRIC_STANDARD = 0, /* U'(J_i) of each point's own J */
+  FPM_VOLUMETRIC_AVERAGED      /* J averaged over each point's support (F-bar
+                                  kind; fpm_volumetric.h) */
+} fpm_volumetric;
+
 /* A named set of defaults for the flux keys. */
 typedef enum {
   FPM_FORMULATION_DEFAULT = 0, /* accurate and stable: quadratic jump, small
@@ -35,6 +42,7 @@ typedef struct {
                               the linear jump, |e| p_s E/h^3 |[[u]]|^4 / 4 */
   int flux;                /* fpm_flux */
   int jump;                /* fpm_jump */
+  int volumetric;          /* fpm_volumetric */
   char *cells;             /* fpm.cells: the partition into subdomains */
 } fpm_options;
 

@@ -109,6 +109,10 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   /* SIPG: the assembled tangent lacks the adjoint term's derivative; it
    * preconditions the exact tangent applied matrix-free. */
   if (m->flux == FPM_FLUX_SIPG) no.op = PM_NEWTON_MATRIX_FREE;
+  /* fpm.volumetric averaged: the assembled tangent lacks the averages'
+   * coupling (it keeps each point's own volumetric stiffness); it
+   * preconditions the exact tangent applied matrix-free. */
+  if (m->vavg) no.op = PM_NEWTON_MATRIX_FREE;
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
   c->solver = solver;
   rep->setup_seconds = pm_wtime() - w0;
