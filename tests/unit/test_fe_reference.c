@@ -213,21 +213,26 @@ static void test_good(void **state) {
 }
 
 /* Richardson limits in tolerance.csv (column extrapolated) stand for the
- * referee's figures; the finest row keeps the mesh's own, and an empty
- * field leaves the finest mesh's figure. */
+ * referee's figures where their uncertainty is below the finest mesh's
+ * estimated error; the finest row keeps the mesh's own, and an empty field or a
+ * limit less sure than the finest mesh (von Mises here) leaves the finest
+ * mesh's figure. */
 static void test_extrapolated(void **state) {
   const char *dir = *state;
   pm_fe_reference *r = NULL;
   write_reference(dir, LADDER_HEAD LADDER_ROWS, LATTICE,
-                  "quantity,tolerance,extrapolated,extrapolation_uncertainty\n"
-                  "reaction,1e-2,-21.5,2e-3\nmean_sed,1e-2,340,1e-3\n"
-                  "von_mises_centre,1e-2,,\nlattice_nrmse,1e-2,,\n");
+                  "quantity,tolerance,estimated_error,extrapolated,"
+                  "extrapolation_uncertainty\n"
+                  "reaction,1e-2,8e-3,-21.5,2e-3\nmean_sed,1e-2,8e-3,340,1e-3\n"
+                  "von_mises_centre,1e-2,8e-3,1300,1e-2\n"
+                  "lattice_nrmse,1e-2,,,\n");
   assert_ok(pm_fe_load(dir, &r));
   assert_true(r->reaction[2] == -21.5 && r->reaction[0] == 0);
   assert_true(r->rows[r->finest].reaction[2] == -21.79);
   assert_true(r->mean_sed == 340 && r->von_mises_centre == 1313.2);
   assert_true(r->extrapolation_uncertainty.reaction == 2e-3);
-  assert_true(isnan(r->extrapolated.von_mises_centre));
+  assert_true(r->extrapolated.von_mises_centre == 1300);
+  assert_true(isnan(r->extrapolated.lattice_nrmse));
   pm_fe_free(r);
 }
 

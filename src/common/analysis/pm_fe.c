@@ -323,6 +323,7 @@ static pm_err read_tolerance(const char *path, pm_fe_reference *r) {
   PM_TRY(table_require(&t, "tolerance", &ct));
   const int ce = table_column(&t, "extrapolated");
   const int cu = table_column(&t, "extrapolation_uncertainty");
+  const int cs = table_column(&t, "estimated_error");
   for (;;) {
     PM_TRY(table_next(&t, &more));
     if (!more) break;
@@ -339,6 +340,7 @@ static pm_err read_tolerance(const char *path, pm_fe_reference *r) {
               t.in.line, *dst);
     PM_TRY(table_optional(&t, ce, quantity(&r->extrapolated, k)));
     PM_TRY(table_optional(&t, cu, quantity(&r->extrapolation_uncertainty, k)));
+    PM_TRY(table_optional(&t, cs, quantity(&r->estimated_error, k)));
   }
 done:
   pm_lines_close(&t.in);
@@ -361,6 +363,7 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
   PM_TRY(PM_ALLOC(r, 1, "FE reference"));
   r->tolerance = (pm_fe_tolerance){NAN, NAN, NAN, NAN, NAN};
   r->extrapolated = r->extrapolation_uncertainty = r->tolerance;
+  r->estimated_error = r->tolerance;
   size_t len = strlen(dir);
   while (len > 1 && dir[len - 1] == '/') len--;
   PM_ENSURE(len <= PM_PATH_MAX, PM_ERR_ARG,
@@ -384,17 +387,21 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
   r->mean_sed = f->mean_sed;
   r->von_mises_centre = f->von_mises_centre;
   r->tip_u = f->tip_u;
-  /* The Richardson limits, where the ladder gives them, stand for the
-   * solution: the reaction along the loaded (largest) component. */
-  const pm_fe_tolerance *ex = &r->extrapolated;
+  /* A Richardson limit stands for the solution where it is surer than the
+   * finest mesh: its uncertainty below the finest mesh's estimated error
+   * (with three meshes only it never is).  The reaction along the loaded
+   * (largest) component. */
   int axis = 0;
   for (int c = 1; c < 3; c++)
     if (fabs(f->reaction[c]) > fabs(f->reaction[axis])) axis = c;
-  if (isfinite(ex->reaction)) r->reaction[axis] = ex->reaction;
-  if (isfinite(ex->mean_sed)) r->mean_sed = ex->mean_sed;
-  if (isfinite(ex->von_mises_centre))
-    r->von_mises_centre = ex->von_mises_centre;
-  if (isfinite(ex->tip)) r->tip_u = ex->tip;
+  double *fig[] = {&r->reaction[axis], &r->mean_sed, &r->von_mises_centre, NULL,
+                   &r->tip_u};
+  for (int k = 0; k < 5; k++) {
+    const double lim = *quantity(&r->extrapolated, k);
+    const double unc = *quantity(&r->extrapolation_uncertainty, k);
+    if (fig[k] && isfinite(lim) && unc < *quantity(&r->estimated_error, k))
+      *fig[k] = lim;
+  }
   PM_ENSURE(r->tip_face < 0 || isfinite(r->tip_u), PM_ERR_ARG,
             "%s/ladder.csv: the finest converged mesh (N = %d) has no tip_u",
             r->dir, f->n);
