@@ -49,7 +49,8 @@ def moduli(nu):
 
 
 def case(dim, faces, load, ladder, nu=0.495, about="", increment=(0.05, 0.1),
-         mirrors=(), traction=None):
+         mirrors=(), traction=None, singular=(), grading=1.0,
+         element="reduced"):
     """A case: dimension, the prescribed components per face of the part
     solved (face -> {component: value}), the loaded face and component, the
     mesh ladder, Poisson's ratio, a description, the first and largest load
@@ -57,10 +58,15 @@ def case(dim, faces, load, ladder, nu=0.495, about="", increment=(0.05, 0.1),
     the part solved is mirrored about to give the whole block: the part is
     the block's side of each plane at higher coordinates.  A traction case
     (traction = (face, component, nominal traction in Pa)) loads that face
-    instead; its figure is the tip displacement (see TRACTION below)."""
+    instead; its figure is the tip displacement (see TRACTION below).
+    singular: the planes (axis, coordinate) whose edges with the free
+    faces are singular lines, which a mesh graded with exponent grading
+    (> 1; 1: uniform) refines towards (see graded_edges).  element:
+    "reduced" (C3D20R/CPE8R) or "full" integration (C3D20/CPE8)."""
     return dict(dim=dim, faces=faces, load=load, ladder=ladder, nu=nu,
                 about=about, increment=increment, mirrors=mirrors,
-                traction=traction)
+                traction=traction, singular=singular, grading=grading,
+                element=element)
 
 
 LADDER_3D = [2, 4, 8, 12, 16, 20]
@@ -73,19 +79,28 @@ LADDER_F2 = [2, 4, 8]
 # F3 and F4 are symmetric about x = 0.05 and y = 0.05: the quarter
 # x, y >= 0.05 is solved, with u_x = 0 and u_y = 0 on those planes.
 QUARTER = ((0, 0.05), (1, 0.05))
+# Their singular lines: the edges of the clamped faces z = 0 and z = 0.1
+# with the free lateral faces x, y = 0 and 0.1.
+CUBE_FACES = tuple((a, c) for a in range(3) for c in (0.0, 0.1))
 
 
-def constrained(uz, about, **options):
+def constrained(uz, about, ladder=LADDER_3D, **options):
     """F3/F4: the cube with its bottom fixed and its top held laterally and
     moved by uz (m), solved on the quarter."""
     faces = {"zmin": {0: 0.0, 1: 0.0, 2: 0.0},
              "zmax": {0: 0.0, 1: 0.0, 2: uz},
              "xmin": {0: 0.0}, "ymin": {1: 0.0}}
-    return case(3, faces, ("zmax", 2), LADDER_3D, about=about,
-                mirrors=QUARTER, **options)
+    return case(3, faces, ("zmax", 2), ladder, about=about,
+                mirrors=QUARTER, singular=CUBE_FACES, **options)
 
 
 SLOW = dict(increment=(0.02, 0.05))  # smaller load steps for large strains
+# The clamped F4: the free faces fold over the clamped edges, where the
+# uniform meshes converge at order 0.7 and the reduced C3D20R's smallest
+# elements invert once graded: meshes graded towards the clamped edges
+# (q = 2) of the fully integrated C3D20 (see cases/fe/README.md).
+LADDER_F4 = [4, 8, 12, 16]
+F4_MESH = dict(grading=2.0, element="full", ladder=LADDER_F4)
 
 
 # ---- F4 between rigid plates (contact) ----------------------------------------
@@ -204,11 +219,11 @@ CASES = {
     "f3-extension-200": constrained(
         0.20, "F3: as f3-extension-60 with u_z = +0.20 m", **SLOW),
     "f4-compression-20": constrained(
-        -0.02, "F4: as F3 with u_z = -0.02 m"),
+        -0.02, "F4: as F3 with u_z = -0.02 m", **F4_MESH),
     "f4-compression-40": constrained(
-        -0.04, "F4: as F3 with u_z = -0.04 m", **SLOW),
+        -0.04, "F4: as F3 with u_z = -0.04 m", **SLOW, **F4_MESH),
     "f4-compression-60": constrained(
-        -0.06, "F4: as F3 with u_z = -0.06 m", **SLOW),
+        -0.06, "F4: as F3 with u_z = -0.06 m", **SLOW, **F4_MESH),
     "f4-plates-20": between_plates(
         -0.02, "F4 between plates: the cube squeezed by 0.02 m between two "
         "sticking rigid plates"),
@@ -295,17 +310,31 @@ class Mesh:
     of each plane of symmetry.  Nodes lie on the half-element grid where at
     most one index is odd (corners and mid-edge nodes)."""
 
-    def __init__(self, dim, n, mirrors=()):
+    def __init__(self, dim, n, mirrors=(), grading=1.0, singular=()):
         self.dim = dim
         self.lo = [0.0] * dim
         self.hi = list(BOX[dim])
         ne = list(SHAPE[dim](n))
-        self.h = self.hi[0] / ne[0]
+        self.h = self.hi[0] / ne[0]  # the uniform mesh's edge
         for axis, plane in mirrors:
             self.lo[axis] = plane
             ne[axis] = int(round((self.hi[axis] - plane) / self.h))
         self.ne = tuple(ne)
         self.mirrors = mirrors
+        self.grading = grading
+        # Element boundaries along each axis, graded towards the singular
+        # planes at the part's ends (see graded_edges).
+        self.edges = [graded_edges(self.lo[k], self.hi[k], self.ne[k],
+                                   [pl for a, pl in singular if a == k],
+                                   grading) for k in range(dim)]
+        # Node coordinates along each axis on the half-element grid: the
+        # boundaries and the midpoints between them (straight edges).
+        self.grid = []
+        for e in self.edges:
+            g = np.empty(2 * len(e) - 1)
+            g[0::2], g[1::2] = e, 0.5 * (e[:-1] + e[1:])
+            self.grid.append(g)
+        self.h_min = min(float(np.min(np.diff(e))) for e in self.edges)
         self.local = C3D20_LOCAL if dim == 3 else CPE8_LOCAL
         grid = [2 * e + 1 for e in self.ne]
         self.id = -np.ones(grid, dtype=np.int64)
@@ -314,12 +343,16 @@ class Mesh:
         idx = idx[keep]
         self.id[tuple(idx.T)] = np.arange(1, len(idx) + 1)
         self.index = idx  # grid index of node id - 1
-        self.x = np.array(self.lo) + idx * (self.h / 2.0)
+        self.x = np.stack([self.grid[k][idx[:, k]] for k in range(dim)],
+                          axis=1)
         elems = np.indices(self.ne).reshape(dim, -1).T
         centre = 2 * elems + 1  # grid index of each element's centre
         self.conn = np.stack(
             [self.id[tuple((centre + np.array(o)).T)] for o in self.local],
             axis=1)
+        # Each element's edge along each axis ([elements][dim]).
+        self.size = np.stack([np.diff(self.edges[k])[elems[:, k]]
+                              for k in range(dim)], axis=1)
 
     @property
     def n_nodes(self):
@@ -338,12 +371,12 @@ class Mesh:
 
     def node_at(self, p):
         """Id of the node at point p, or None when p is not a node."""
-        g = [(p[k] - self.lo[k]) / (self.h / 2.0) for k in range(self.dim)]
-        gi = [int(round(v)) for v in g]
-        if any(abs(v - r) > 1e-9 for v, r in zip(g, gi)):
-            return None
-        if any(r < 0 or r > 2 * e for r, e in zip(gi, self.ne)):
-            return None
+        gi = []
+        for k in range(self.dim):
+            hit = np.nonzero(np.abs(self.grid[k] - p[k]) < 1e-12)[0]
+            if len(hit) == 0:
+                return None
+            gi.append(int(hit[0]))
         nid = int(self.id[tuple(gi)])
         return nid if nid > 0 else None
 
@@ -363,16 +396,40 @@ class Mesh:
         ([nodes][c]) by the shape functions of the element holding p."""
         e, xi = [], []
         for k in range(self.dim):
-            t = (p[k] - self.lo[k]) / self.h
-            ek = min(max(int(math.floor(t)), 0), self.ne[k] - 1)
+            b = self.edges[k]
+            ek = int(np.searchsorted(b, p[k], side="right")) - 1
+            ek = min(max(ek, 0), self.ne[k] - 1)
             e.append(ek)
-            xi.append(2.0 * (t - ek) - 1.0)
+            xi.append(2.0 * (p[k] - b[ek]) / (b[ek + 1] - b[ek]) - 1.0)
         centre = np.array([2 * v + 1 for v in e])
         value = 0.0
         for off in self.local:
             nid = self.id[tuple(centre + np.array(off))]
             value = value + serendipity(off, xi) * u[nid - 1]
         return value
+
+
+def graded_edges(lo, hi, ne, planes, q):
+    """The ne + 1 element boundaries of [lo, hi], graded towards those of
+    planes (coordinates) that are ends of the interval: with t uniform on
+    [0, 1], towards hi x = 1 - (1 - t)^q, towards lo x = t^q, towards both
+    each half so (the middle boundary stays at the midpoint); q = 1 is the
+    uniform mesh.  An element at a graded end is about q times smaller than
+    the uniform one's, and its neighbours grow by (k + 1)^q - k^q."""
+    t = np.linspace(0.0, 1.0, ne + 1)
+    at_lo = any(abs(p - lo) < 1e-12 for p in planes)
+    at_hi = any(abs(p - hi) < 1e-12 for p in planes)
+    if q == 1.0 or not (at_lo or at_hi):
+        x = t
+    elif at_lo and at_hi:
+        s = 2.0 * t - 1.0
+        x = 0.5 * (1.0 + np.sign(s) * (1.0 - (1.0 - np.abs(s)) ** q))
+    elif at_hi:
+        x = 1.0 - (1.0 - t) ** q
+    else:
+        x = t ** q
+    x[0], x[-1] = 0.0, 1.0
+    return lo + (hi - lo) * x
 
 
 def serendipity(off, xi):
@@ -549,19 +606,19 @@ def strain_energy(mesh, u, nu, reduced):
     weights = np.prod(np.array(np.meshgrid(*[ws] * dim, indexing="ij"))
                       .reshape(dim, -1), axis=0)
     ue = u[mesh.conn - 1][:, :, :dim]  # [elements][local nodes][dim]
-    jac = (mesh.h / 2.0) ** dim  # reference volume per unit natural volume
+    # Reference volume per unit natural volume, per element (boxes).
+    jac = np.prod(mesh.size / 2.0, axis=1)
+    scale = 2.0 / mesh.size  # dN/dX_k = dN/dxi_k * 2 / h_k in a box
     total = 0.0
     for xi, w in zip(points, weights):
-        # dN/dX = dN/dxi * 2 / h on the undistorted structured mesh.
         g = np.array([serendipity_gradient(o, xi) for o in mesh.local])
-        g *= 2.0 / mesh.h
         F = np.tile(np.eye(3), (len(ue), 1, 1))
-        F[:, :dim, :dim] += np.einsum("eai,aj->eij", ue, g)
+        F[:, :dim, :dim] += np.einsum("eai,aj,ej->eij", ue, g, scale)
         J = np.linalg.det(F)
         I1 = np.einsum("eij,eij->e", F, F)
         W = 0.5 * mu * (J ** (-2.0 / 3.0) * I1 - 3.0) \
             + 0.5 * kappa * (J - 1.0) ** 2
-        total += w * jac * W.sum()
+        total += w * np.dot(jac, W)
     return total
 
 
@@ -644,6 +701,18 @@ def lattice_points(dim):
     return grid
 
 
+def make_mesh(spec, n):
+    """The mesh of ladder value n of a case, graded as the case says."""
+    return Mesh(spec["dim"], n, spec["mirrors"], spec["grading"],
+                spec["singular"])
+
+
+def job_name(name, spec, n, reduced):
+    g = spec["grading"]
+    return "%s-N%d-%s%s" % (name, n, element_type(spec["dim"], reduced),
+                            "" if g == 1.0 else "-q%g" % g)
+
+
 def run_case(name, spec, n, reduced, work, threads):
     """Write and run the deck of case name on mesh n; return the row of the
     ladder and the lattice displacements (None when the run reached no
@@ -652,8 +721,8 @@ def run_case(name, spec, n, reduced, work, threads):
     if dim == 3 and n % 2:
         raise SystemExit("%s: N = %d: the centre is a node only for even N"
                          % (name, n))
-    mesh = Mesh(dim, n, spec["mirrors"])
-    job = "%s-N%d-%s" % (name, n, element_type(dim, reduced))
+    mesh = make_mesh(spec, n)
+    job = job_name(name, spec, n, reduced)
     rundir = os.path.join(work, job)
     shutil.rmtree(rundir, ignore_errors=True)
     os.makedirs(rundir)
@@ -676,7 +745,8 @@ def run_case(name, spec, n, reduced, work, threads):
     converged = abs(reached - 1.0) < 1e-9
     row = dict(N=n, nodes=mesh.n_nodes, dofs=dim * mesh.n_nodes,
                element=element_type(dim, reduced), h=mesh.h,
-               model=model_name(mesh),
+               model=model_name(mesh), grading=mesh.grading,
+               h_min=mesh.h_min,
                reaction_x=math.nan, reaction_y=math.nan, reaction_z=math.nan,
                mean_sed=math.nan, von_mises_centre=math.nan,
                increments=increments, iterations=iterations, wall_seconds=wall,
@@ -740,7 +810,8 @@ def run_case(name, spec, n, reduced, work, threads):
 COLUMNS = ["N", "nodes", "dofs", "element", "h", "reaction_x", "reaction_y",
            "reaction_z", "mean_sed", "von_mises_centre", "increments",
            "wall_seconds", "ccx_version", "model", "iterations",
-           "cpu_seconds", "work_density", "load_fraction", "status"]
+           "cpu_seconds", "work_density", "load_fraction", "status",
+           "grading", "h_min"]
 
 
 def cell(v):
@@ -777,6 +848,12 @@ def describe(name, spec):
              "displacement (trapezoids over the increments) / volume; "
              "load_fraction: share of the prescribed displacement reached\n"
              % (dim, spec["load"][0], str(CENTRE[dim])))
+    if spec["grading"] != 1.0:
+        text += ("# %s elements on meshes graded towards the clamped edges "
+                 "(x = 1 - (1 - t)^grading towards each singular face, "
+                 "cases/fe/README.md); h: the uniform mesh's edge 0.1/N; "
+                 "h_min: the smallest element edge (m)\n"
+                 % element_type(dim, spec["element"] == "reduced"))
     if spec["traction"]:
         text += ("# traction case: work_density not computed; tip_u: mean "
                  "displacement along tip_axis (m) over the lattice points on "
@@ -845,18 +922,47 @@ def observed_order(n, d1, d2):
     return 0.5 * (lo + hi)
 
 
+def richardson(n, v):
+    """Richardson extrapolation of the values v on the meshes n (the last
+    three): the limit v3 + (v3 - v2) / ((n3/n2)^p - 1) with the order p
+    they show, or None when they show none."""
+    d1, d2 = v[-2] - v[-3], v[-1] - v[-2]
+    p = observed_order(n[-3:], d1, d2)
+    if not p:
+        return None
+    return v[-1] + d2 / ((n[-1] / n[-2]) ** p - 1.0)
+
+
+def extrapolate(n, v):
+    """The Richardson limit of v over the three finest meshes n and its
+    uncertainty, relative to the limit: the change of the limit when the
+    finest mesh is added (the limit of the three meshes before it), or,
+    with three meshes only, 1.25 times the distance of the finest from the
+    limit (Roache's grid convergence index).  (nan, nan) without one."""
+    limit = richardson(n, v) if len(n) >= 3 else None
+    if limit is None:
+        return math.nan, math.nan
+    before = richardson(n[:-1], v[:-1]) if len(n) >= 4 else None
+    if before is None:
+        return limit, 1.25 * abs(v[-1] - limit) / abs(limit)
+    return limit, abs(limit - before) / abs(limit)
+
+
 def write_tolerance(path, header, spec, rows, lattices):
     """The change of each quantity between the two finest converged meshes,
     the error of the finest estimated from the last three (Richardson: the
-    observed order p, then change / ((N3/N2)^p - 1)), and the tolerance
-    claimed: the next value of 1, 2, 5 x 10^k above both."""
+    observed order p, then change / ((N3/N2)^p - 1)), the tolerance
+    claimed: the next value of 1, 2, 5 x 10^k above both, and for single
+    numbers the Richardson limit with its uncertainty (extrapolate)."""
     comp = "reaction_" + "xyz"[spec["load"][1]]
-    done = [r for r in rows if r["status"] == "converged"][-3:]
+    converged = [r for r in rows if r["status"] == "converged"]
+    done = converged[-3:]
     n = [r["N"] for r in done]
     fine = done[-1]
     result = []
     first = "tip" if spec["traction"] else "reaction"
     for q in (first, "mean_sed", "von_mises_centre", "lattice_nrmse"):
+        limit, spread = math.nan, math.nan
         if q == "lattice_nrmse":
             lat = [lattices[k][:, 3:] for k in n]
             # Signed changes are not defined for a field: the NRMSE of each
@@ -866,11 +972,14 @@ def write_tolerance(path, header, spec, rows, lattices):
             key = {"reaction": comp, "tip": "tip_u"}.get(q, q)
             v = [r[key] for r in done]
             d = [(v[i + 1] - v[i]) / abs(fine[key]) for i in range(len(n) - 1)]
+            limit, spread = extrapolate([r["N"] for r in converged[-4:]],
+                                        [r[key] for r in converged[-4:]])
         change = abs(d[-1])
         p = observed_order(n, d[0], d[1]) if len(d) == 2 else None
         estimate = change / ((n[-1] / n[-2]) ** p - 1.0) if p else math.nan
         worst = change if math.isnan(estimate) else max(change, estimate)
-        result.append((q, n[-1], n[-2], change, p, estimate, claim(worst)))
+        result.append((q, n[-1], n[-2], change, p, estimate, claim(worst),
+                       limit, spread))
     with open(path + ".tmp", "w") as f:
         f.write(header)
         f.write("# relative_change: between the meshes N = %d and N = %d "
@@ -878,14 +987,22 @@ def write_tolerance(path, header, spec, rows, lattices):
                 "observed over N = %s (empty when the changes do not shrink "
                 "monotonically); estimated_error: of the finest mesh, "
                 "change / ((N_finest / N_previous)^order - 1); tolerance: "
-                "the next value of 1, 2, 5 x 10^k above both\n"
+                "the next value of 1, 2, 5 x 10^k above both; "
+                "extrapolated: the Richardson limit over the three finest "
+                "(same units as the ladder); extrapolation_uncertainty: "
+                "relative, the change of that limit when the finest mesh "
+                "is added (1.25 x the finest's distance from it with three "
+                "meshes only)\n"
                 % (n[-2], n[-1], ", ".join(str(k) for k in n)))
         f.write("quantity,finest_N,previous_N,relative_change,order,"
-                "estimated_error,tolerance\n")
-        for q, nf, np_, c, p, e, t in result:
-            f.write("%s,%d,%d,%.4e,%s,%s,%g\n" % (
+                "estimated_error,tolerance,extrapolated,"
+                "extrapolation_uncertainty\n")
+        for q, nf, np_, c, p, e, t, lim, spr in result:
+            f.write("%s,%d,%d,%.4e,%s,%s,%g,%s,%s\n" % (
                 q, nf, np_, c, "%.3f" % p if p else "",
-                "%.4e" % e if not math.isnan(e) else "", t))
+                "%.4e" % e if not math.isnan(e) else "", t,
+                "%.7g" % lim if not math.isnan(lim) else "",
+                "%.2e" % spr if not math.isnan(spr) else ""))
     os.replace(path + ".tmp", path)
     return result
 
@@ -912,8 +1029,10 @@ def summary(folder, names):
         if spec["traction"]:  # its reaction is the load: the tip instead
             comp, figure = "tip_u", "tip u_%s (m)" % "xyz"[spec["traction"][1]]
         rows = read_csv(path)
-        out.append("**%s** (%s, %s model)\n" % (
-            name, rows[-1]["element"], rows[-1]["model"]))
+        graded = float(rows[-1].get("grading") or 1.0)
+        out.append("**%s** (%s, %s model%s)\n" % (
+            name, rows[-1]["element"], rows[-1]["model"],
+            ", graded q = %g" % graded if graded != 1.0 else ""))
         out.append("| N | nodes | %s | mean SED (J/m^3) | von "
                    "Mises at centre (Pa) | increments | wall (s) | CPU (s) "
                    "| status |" % figure)
@@ -936,8 +1055,26 @@ def summary(folder, names):
                            q["quantity"], float(q["relative_change"]),
                            q["order"] or "-", q["estimated_error"] or "-",
                            q["tolerance"]) for q in t) + ".")
+            limits = ["%s %.7g (+- %.1e)" % (
+                q["quantity"], float(q["extrapolated"]),
+                float(q["extrapolation_uncertainty"]))
+                for q in t if q.get("extrapolated")]
+            if limits:
+                out.append("Richardson limits (relative uncertainty): "
+                           + ", ".join(limits) + ".")
         out.append("")
     return "\n".join(out)
+
+
+def with_options(spec, a):
+    """The case with the grading and element asked for on the command
+    line, if any."""
+    spec = dict(spec)
+    if a.grading is not None:
+        spec["grading"] = a.grading
+    if a.element is not None:
+        spec["element"] = a.element
+    return spec
 
 
 def main():
@@ -954,8 +1091,11 @@ def main():
     ap.add_argument("--ladder", help="mesh values, e.g. 2,4,8 (default: the "
                     "case's ladder)")
     ap.add_argument("--element", choices=["reduced", "full"],
-                    default="reduced", help="C3D20R/CPE8R (reduced, default) "
+                    help="C3D20R/CPE8R (reduced; the default but for F4) "
                     "or C3D20/CPE8 (full integration)")
+    ap.add_argument("--grading", type=float,
+                    help="exponent of the mesh grading towards the singular "
+                    "lines (1: uniform; default: the case's)")
     ap.add_argument("--out", default=OUT_ROOT,
                     help="results folder (default cases/fe)")
     ap.add_argument("--work", default=os.path.join("/tmp", "fe-referee"),
@@ -976,19 +1116,17 @@ def main():
     unknown = [n for n in names if n not in CASES]
     if unknown or not names:
         ap.error("name cases (or --all): %s" % ", ".join(CASES))
-    reduced = a.element == "reduced"
     os.makedirs(a.work, exist_ok=True)
     if not a.run:
         for name in names:
-            spec = CASES[name]
+            spec = with_options(CASES[name], a)
+            reduced = spec["element"] == "reduced"
             ladder = [int(v) for v in a.ladder.split(",")] if a.ladder \
                 else spec["ladder"]
             for n in ladder:
-                job = "%s-N%d-%s" % (name, n, element_type(spec["dim"],
-                                                           reduced))
+                job = job_name(name, spec, n, reduced)
                 path = os.path.join(a.work, job + ".inp")
-                write_deck(path, name, spec, n,
-                           Mesh(spec["dim"], n, spec["mirrors"]), reduced)
+                write_deck(path, name, spec, n, make_mesh(spec, n), reduced)
                 print(path)
         return 0
     if shutil.which("ccx") is None:
@@ -996,7 +1134,8 @@ def main():
     version = ccx_version()
     status = 0
     for name in names:
-        spec = CASES[name]
+        spec = with_options(CASES[name], a)
+        reduced = spec["element"] == "reduced"
         ladder = [int(v) for v in a.ladder.split(",")] if a.ladder \
             else spec["ladder"]
         folder = os.path.join(a.out, name)
@@ -1023,8 +1162,8 @@ def main():
                     flush=True)
             write_ladder(os.path.join(folder, "ladder.csv"), header, rows)
             if not a.keep:
-                shutil.rmtree(os.path.join(a.work, "%s-N%d-%s" % (
-                    name, n, row["element"])), ignore_errors=True)
+                shutil.rmtree(os.path.join(a.work, job_name(
+                    name, spec, n, reduced)), ignore_errors=True)
         done = [r for r in rows if r["status"] == "converged"]
         for old in os.listdir(folder):
             if old.startswith("lattice") or old == "tolerance.csv":
@@ -1044,10 +1183,11 @@ def main():
                           % (row["N"], row["element"]), lattices[row["N"]])
         result = write_tolerance(os.path.join(folder, "tolerance.csv"), header,
                                  spec, rows, lattices)
-        for q, nf, np_, c, p, e, t in result:
+        for q, nf, np_, c, p, e, t, lim, spr in result:
             print("%-30s %-18s change N %d -> %d: %.3e, order %s, estimated "
-                  "error %.3e (tolerance %g)"
-                  % (name, q, np_, nf, c, "%.2f" % p if p else "-", e, t))
+                  "error %.3e (tolerance %g), extrapolated %.7g +- %.2e"
+                  % (name, q, np_, nf, c, "%.2f" % p if p else "-", e, t,
+                     lim, spr))
     return status
 
 

@@ -68,6 +68,13 @@ static void check_case(const char *dir) {
                 tip ? r->tip_u : r->reaction[axis], dr, claim, r->mean_sed, ds,
                 t->mean_sed, r->von_mises_centre, dv, t->von_mises_centre, dl,
                 t->lattice_nrmse);
+  /* A Richardson limit lies within the claim of the finest mesh. */
+  if (!tip && isfinite(r->extrapolated.reaction))
+    assert_true(rel_change(f->reaction[axis], r->extrapolated.reaction) <=
+                claim);
+  if (isfinite(r->extrapolated.mean_sed))
+    assert_true(rel_change(f->mean_sed, r->extrapolated.mean_sed) <=
+                t->mean_sed);
   assert_true(dr <= claim);
   assert_true(ds <= t->mean_sed);
   assert_true(dv <= t->von_mises_centre);
@@ -205,6 +212,30 @@ static void test_good(void **state) {
   pm_fe_free(r);
 }
 
+/* Richardson limits in tolerance.csv (column extrapolated) stand for the
+ * referee's figures where their uncertainty is below the finest mesh's
+ * estimated error; the finest row keeps the mesh's own, and an empty field or a
+ * limit less sure than the finest mesh (von Mises here) leaves the finest
+ * mesh's figure. */
+static void test_extrapolated(void **state) {
+  const char *dir = *state;
+  pm_fe_reference *r = NULL;
+  write_reference(dir, LADDER_HEAD LADDER_ROWS, LATTICE,
+                  "quantity,tolerance,estimated_error,extrapolated,"
+                  "extrapolation_uncertainty\n"
+                  "reaction,1e-2,8e-3,-21.5,2e-3\nmean_sed,1e-2,8e-3,340,1e-3\n"
+                  "von_mises_centre,1e-2,8e-3,1300,1e-2\n"
+                  "lattice_nrmse,1e-2,,,\n");
+  assert_ok(pm_fe_load(dir, &r));
+  assert_true(r->reaction[2] == -21.5 && r->reaction[0] == 0);
+  assert_true(r->rows[r->finest].reaction[2] == -21.79);
+  assert_true(r->mean_sed == 340 && r->von_mises_centre == 1313.2);
+  assert_true(r->extrapolation_uncertainty.reaction == 2e-3);
+  assert_true(r->extrapolated.von_mises_centre == 1300);
+  assert_true(isnan(r->extrapolated.lattice_nrmse));
+  pm_fe_free(r);
+}
+
 /* A traction case: the tip columns name the loaded face and component,
  * and pm_fe_tip averages that component over the lattice points on the
  * face (here x = 0.1: two of the three points). */
@@ -304,6 +335,9 @@ static const bad_case BAD[] = {
     {LADDER_HEAD LADDER_ROWS, LATTICE,
      "quantity,tolerance\nreaction,1e-3\nstress,1e-3\n", "tolerance.csv", 3,
      "column quantity: expected reaction, mean_sed"},
+    {LADDER_HEAD LADDER_ROWS, LATTICE,
+     "quantity,tolerance,extrapolated\nreaction,1e-3,abc\n", "tolerance.csv", 2,
+     "column extrapolated: expected a finite number, got 'abc'"},
     {"N,nodes,dofs,element,h,reaction_x,reaction_y,reaction_z,mean_sed,"
      "von_mises_centre,increments,wall_seconds,ccx_version,tip_face,tip_axis,"
      "tip_u\n2,81,243,C3D20R,0.05,0,-8,0,1,1,12,1,2.20,top,y,0.5\n",
@@ -362,6 +396,8 @@ int main(void) {
       cmocka_unit_test(test_f2_exact),
       cmocka_unit_test(test_interior_nrmse),
       cmocka_unit_test_setup_teardown(test_good, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_extrapolated, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_malformed, pm_test_make_dir,
                                       pm_test_drop_dir),

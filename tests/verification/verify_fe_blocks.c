@@ -9,8 +9,8 @@
  * F3 60% and F4 20% at this h are the finest level of the ladders that
  * verification.studies (tests/verification/studies.sh) runs against the
  * same referees: the same runs, the same bounds (F3 60%: 2% and 1.11e-2;
- * F4 20%: 5%, whose FE force is itself uncertain by about 4%), asserted
- * there once. */
+ * F4 20%: 10%, where FPM is +8.35% stiff against the Richardson limit of the
+ * graded FE ladder), asserted there once. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

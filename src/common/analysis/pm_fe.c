@@ -296,11 +296,24 @@ done:
 /* ---- tolerance.csv ---------------------------------------------------------
  */
 
-static pm_err read_tolerance(const char *path, pm_fe_tolerance *tol) {
+/* The k-th quantity of a pm_fe_tolerance (reaction, mean_sed,
+ * von_mises_centre, lattice_nrmse, tip). */
+static double *quantity(pm_fe_tolerance *q, int k) {
+  double *v[] = {&q->reaction, &q->mean_sed, &q->von_mises_centre,
+                 &q->lattice_nrmse, &q->tip};
+  return v[k];
+}
+
+/* An optional numeric field (col < 0 or empty: NaN). */
+static pm_err table_optional(const table *t, int col, double *v) {
+  *v = NAN;
+  if (col < 0 || !t->f[col][0]) return PM_SUCCESS;
+  return table_number(t, col, false, v);
+}
+
+static pm_err read_tolerance(const char *path, pm_fe_reference *r) {
   static const char *const names[] = {
       "reaction", "mean_sed", "von_mises_centre", "lattice_nrmse", "tip"};
-  double *dst[] = {&tol->reaction, &tol->mean_sed, &tol->von_mises_centre,
-                   &tol->lattice_nrmse, &tol->tip};
   pm_err ret = PM_SUCCESS;
   table t = {.ncol = 0};
   int cq, ct;
@@ -308,6 +321,9 @@ static pm_err read_tolerance(const char *path, pm_fe_tolerance *tol) {
   PM_TRY(table_open(&t, path, "FE tolerance"));
   PM_TRY(table_require(&t, "quantity", &cq));
   PM_TRY(table_require(&t, "tolerance", &ct));
+  const int ce = table_column(&t, "extrapolated");
+  const int cu = table_column(&t, "extrapolation_uncertainty");
+  const int cs = table_column(&t, "estimated_error");
   for (;;) {
     PM_TRY(table_next(&t, &more));
     if (!more) break;
@@ -317,10 +333,14 @@ static pm_err read_tolerance(const char *path, pm_fe_tolerance *tol) {
               "%s:%ld: column quantity: expected reaction, mean_sed, "
               "von_mises_centre, lattice_nrmse or tip, got '%.*s'",
               path, t.in.line, SHOW_MAX, t.f[cq]);
-    PM_TRY(table_number(&t, ct, false, dst[k]));
-    PM_ENSURE(*dst[k] > 0, PM_ERR_ARG,
+    double *dst = quantity(&r->tolerance, k);
+    PM_TRY(table_number(&t, ct, false, dst));
+    PM_ENSURE(*dst > 0, PM_ERR_ARG,
               "%s:%ld: column tolerance: expected a number > 0, got %g", path,
-              t.in.line, *dst[k]);
+              t.in.line, *dst);
+    PM_TRY(table_optional(&t, ce, quantity(&r->extrapolated, k)));
+    PM_TRY(table_optional(&t, cu, quantity(&r->extrapolation_uncertainty, k)));
+    PM_TRY(table_optional(&t, cs, quantity(&r->estimated_error, k)));
   }
 done:
   pm_lines_close(&t.in);
@@ -342,6 +362,8 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
   *out = NULL;
   PM_TRY(PM_ALLOC(r, 1, "FE reference"));
   r->tolerance = (pm_fe_tolerance){NAN, NAN, NAN, NAN, NAN};
+  r->extrapolated = r->extrapolation_uncertainty = r->tolerance;
+  r->estimated_error = r->tolerance;
   size_t len = strlen(dir);
   while (len > 1 && dir[len - 1] == '/') len--;
   PM_ENSURE(len <= PM_PATH_MAX, PM_ERR_ARG,
@@ -359,12 +381,27 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
   PM_TRY(pm_path_join(path, sizeof path, r->dir, "lattice.csv"));
   PM_TRY(pm_fe_read_lattice(path, &r->n, &r->x, &r->u));
   PM_TRY(pm_path_join(path, sizeof path, r->dir, "tolerance.csv"));
-  if (is_file(path)) PM_TRY(read_tolerance(path, &r->tolerance));
+  if (is_file(path)) PM_TRY(read_tolerance(path, r));
   const pm_fe_row *f = &r->rows[r->finest];
   memcpy(r->reaction, f->reaction, sizeof r->reaction);
   r->mean_sed = f->mean_sed;
   r->von_mises_centre = f->von_mises_centre;
   r->tip_u = f->tip_u;
+  /* A Richardson limit stands for the solution where it is surer than the
+   * finest mesh: its uncertainty below the finest mesh's estimated error
+   * (with three meshes only it never is).  The reaction along the loaded
+   * (largest) component. */
+  int axis = 0;
+  for (int c = 1; c < 3; c++)
+    if (fabs(f->reaction[c]) > fabs(f->reaction[axis])) axis = c;
+  double *fig[] = {&r->reaction[axis], &r->mean_sed, &r->von_mises_centre, NULL,
+                   &r->tip_u};
+  for (int k = 0; k < 5; k++) {
+    const double lim = *quantity(&r->extrapolated, k);
+    const double unc = *quantity(&r->extrapolation_uncertainty, k);
+    if (fig[k] && isfinite(lim) && unc < *quantity(&r->estimated_error, k))
+      *fig[k] = lim;
+  }
   PM_ENSURE(r->tip_face < 0 || isfinite(r->tip_u), PM_ERR_ARG,
             "%s/ladder.csv: the finest converged mesh (N = %d) has no tip_u",
             r->dir, f->n);

@@ -50,9 +50,19 @@ typedef struct {
                        the finest converged mesh (lattice.csv) */
   int dim;          /* 2 when the lattice lies in z = 0, else 3 */
   double centre[3]; /* the lattice's centre: where von_mises_centre is */
-  /* The finest converged row's figures. */
+  /* The referee's figures: the finest converged row's, or the Richardson
+   * limits of the ladder where tolerance.csv gives them (extrapolated)
+   * with an uncertainty below the finest mesh's estimated error (the
+   * reaction along its largest component).  rows[finest] keeps the mesh's
+   * own. */
   double reaction[3], mean_sed, von_mises_centre;
   pm_fe_tolerance tolerance; /* NaN where tolerance.csv gives none */
+  /* tolerance.csv's columns extrapolated (the Richardson limit, in the
+   * quantity's units) and extrapolation_uncertainty (relative); NaN where
+   * it gives none. */
+  pm_fe_tolerance extrapolated, extrapolation_uncertainty;
+  /* Its column estimated_error: the finest mesh's error (relative). */
+  pm_fe_tolerance estimated_error;
   /* A traction-loaded case (ladder columns tip_face, tip_axis, tip_u): its
    * figure is the tip displacement, the reaction being the applied load.
    * tip_face: the lattice's bounding face (0..5: xmin, xmax, ..., zmax),
