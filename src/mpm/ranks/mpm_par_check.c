@@ -22,6 +22,19 @@ pm_err mpm_par_check(const pm_scene *s) {
                          "-np 1",
                          pm_par_size());
   for (int i = 0; i < s->n_bcs; i++)
+    if (PM_BC_RIGID(&s->bcs[i])) {
+      char p[64];
+      return pm_scene_fail(
+          s,
+          PM_PATH(p, "boundary.%d.%s", i,
+                  s->bcs[i].on == PM_ON_PLATE ? "plate" : "sphere"),
+          true,
+          "contact runs on one process (this run has %d ranks: a node's "
+          "contact reads the particles of other ranks' blocks): run with "
+          "-np 1",
+          pm_par_size());
+    }
+  for (int i = 0; i < s->n_bcs; i++)
     if (s->bcs[i].on == PM_ON_REGION || s->bcs[i].traction_mask) {
       const bool grip = s->bcs[i].on == PM_ON_REGION;
       char p[64];
