@@ -27,21 +27,25 @@ static bool in_contact(const mpm_model *m, int gi) {
 
 pm_err mpm_contacts_check(const pm_scene *s, const mpm_model *m) {
   const double zero[3] = {0, 0, 0};
-  for (int b = 0; b < m->n_bcs; b++) {
+  for (int b = 0, k = 0; b < m->n_bcs; b++) {
     const pm_scene_bc *bc = m->bcs[b].rigid;
     if (!bc) continue;
+    char key[64];
+    PM_PATH(key, "boundary.%d.%s", b,
+            bc->on == PM_ON_PLATE ? "plate" : "sphere");
+    if (++k > MPM_CONTACT_MAX)
+      return pm_scene_fail(s, key, true,
+                           "expected at most %d rigid bodies for method mpm "
+                           "(a bit of a node's flag each), got more",
+                           MPM_CONTACT_MAX);
     for (int gi = 0; gi < m->n_groups; gi++) {
       if (!in_contact(m, gi)) continue;
       for (long p = m->group[gi].begin; p < m->group[gi].end; p++) {
         const double *x = m->x0 + 3 * p;
         double n[3], g = pm_rigid_gap(bc, zero, x, n);
         if (!(g < 0)) continue;
-        char key[64];
         return pm_scene_fail(
-            s,
-            PM_PATH(key, "boundary.%d.%s", b,
-                    bc->on == PM_ON_PLATE ? "plate" : "sphere"),
-            false,
+            s, key, false,
             "expected a rigid body outside the bodies at t = 0, got "
             "particle %ld (material %s) at (%g, %g, %g) %g m inside it",
             p, m->group[gi].name, x[0], x[1], x[2], -g);
@@ -59,7 +63,7 @@ static void mark_touched(const mpm_model *m, const mpm_state *s,
                          unsigned char *touched) {
   const mpm_grid *g = &m->grid;
   const double tol = 1e-6 * g->h, inv_dim = 1.0 / m->dim;
-  memset(touched, 0, (size_t)g->n_nodes);
+  for (long i = 0; i < g->n_nodes; i++) touched[i] &= (unsigned char)~1u;
   /* Serial: the particles near the body share nodes; the test is a dot
    * product a particle. */
   for (int gi = 0; gi < m->n_groups; gi++) {
@@ -71,7 +75,7 @@ static void mark_touched(const mpm_model *m, const mpm_state *s,
       mpm_stencil st;
       mpm_stencil_at(g, s->x + 3 * p, MPM_STENCIL_W, &st);
       for (int j = 0; j < st.n; j++)
-        if (st.w[j] > 0) touched[st.node[j]] = 1;
+        if (st.w[j] > 0) touched[st.node[j]] |= 1u;
     }
   }
 }
@@ -102,6 +106,7 @@ typedef struct {
   double dm[3], V[3], reach;
   int axis;
   bool stick;
+  unsigned char bit; /* its bit in touched: the nodes in contact */
 } body_step;
 
 /* The anchor of node i (gap `gap`, normal n along axis a) in its column:
@@ -132,7 +137,7 @@ static bool node_contact(const mpm_grid *g, const mpm_nodes *nd,
   double x[3];
   *j = -1;
   *T = 0;
-  if (!touched[i] || !(nd->mass[i] > 0)) return false;
+  if (!(touched[i] & 1u) || !(nd->mass[i] > 0)) return false;
   node_position(g, i, x);
   const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
   if (!(gap < b->reach)) return false;
@@ -172,7 +177,7 @@ static void gather_fold(const mpm_ctx *ctx, const body_step *b, long j,
     const long ia = ja - (long)sign * k;
     if (ia < 0 || ia >= g->nn[a]) break;
     const long i = j + (ia - ja) * g->stride[a];
-    if (touched[i] != 2) continue;
+    if (!(touched[i] & b->bit)) continue;
     double x[3], n[3];
     long ki;
     node_position(g, i, x);
@@ -184,11 +189,14 @@ static void gather_fold(const mpm_ctx *ctx, const body_step *b, long j,
   }
 }
 
-/* One rigid body's contact on vel: the nodes in contact (touched 2), the
- * anchors' folded forces (with reactions), then the nodes' velocities.
- * Adds its force on the body to R (3) and returns its work. */
+/* One rigid body's contact on vel: the nodes in contact (found with
+ * reactions, in the grid update, and marked by the body's bit in touched;
+ * the remap of MUSL later in the step keeps them), the anchors' folded
+ * forces (with reactions), then the nodes' velocities.  Adds its force on
+ * the body to R (3) and returns its work. */
 static double body_contact(const mpm_ctx *ctx, const body_step *b, int bi,
-                           double *vel, bool reactions, double R[3]) {
+                           double *vel, bool reactions, bool find,
+                           double R[3]) {
   const mpm_grid *g = &ctx->model->grid;
   const mpm_nodes *nd = &ctx->work->nodes;
   mpm_cond_work *cw = &ctx->work->cond;
@@ -201,19 +209,22 @@ static double body_contact(const mpm_ctx *ctx, const body_step *b, int bi,
   const short mark = (short)-(bi + 1);
   const bool fold = reactions && b->axis >= 0 && cf;
   double rx = 0, ry = 0, rz = 0, work = 0;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(g, nd, touched, vel, b, nn))
-  for (long i = 0; i < nn; i++) {
-    double vc[3], n[3], T;
-    long j;
-    if (node_contact(g, nd, touched, vel, b, i, vc, n, &j, &T)) touched[i] = 2;
+  if (find) {
+    PM_OMP(parallel for schedule(static) default(none)
+           shared(g, nd, touched, vel, b, nn))
+    for (long i = 0; i < nn; i++) {
+      double vc[3], n[3], T;
+      long j;
+      if (node_contact(g, nd, touched, vel, b, i, vc, n, &j, &T))
+        touched[i] |= b->bit;
+    }
   }
   if (fold) {
     PM_OMP(parallel for schedule(static) default(none)
            shared(ctx, b, nd, touched, vel, vel0, mass, cf, nn, dt, dim)
            reduction(+ : rx, ry, rz, work))
     for (long j = 0; j < nn; j++) {
-      if (touched[j] == 2 || !(mass[j] > 0)) continue;
+      if ((touched[j] & b->bit) || !(mass[j] > 0)) continue;
       double f[3];
       gather_fold(ctx, b, j, f);
       for (int c = 0; c < dim; c++) {
@@ -231,7 +242,7 @@ static double body_contact(const mpm_ctx *ctx, const body_step *b, int bi,
          shared(g, nd, touched, owner, vel, vel0, mass, b, nn, dt, dim, mark,
                 reactions) reduction(+ : rx, ry, rz, work))
   for (long i = 0; i < nn; i++) {
-    if (touched[i] != 2) continue;
+    if (!(touched[i] & b->bit) || !(mass[i] > 0)) continue;
     double x[3], n[3], vc[3], dv[3] = {0, 0, 0};
     long k;
     node_position(g, i, x);
@@ -269,12 +280,19 @@ double mpm_contacts_apply(const mpm_ctx *ctx, double *vel, bool reactions) {
   const double t = ctx->state->t, dt = ctx->state->dt;
   double work = 0;
   if (!cw->touched) return 0;
-  for (int b = 0; b < m->n_bcs; b++) {
+  /* The update finds the nodes in contact; MUSL's remap, after it in the
+   * same step, keeps them, so that the velocities of the stress and of the
+   * positions agree (USF's grid velocity, before the update, finds its
+   * own). */
+  const bool find = reactions || m->opt.update != MPM_MUSL;
+  if (find) memset(cw->touched, 0, (size_t)m->grid.n_nodes);
+  for (int b = 0, k = 0; b < m->n_bcs; b++) {
     const pm_scene_bc *bc = m->bcs[b].rigid;
     if (!bc) continue;
     body_step bs = {.bc = bc,
                     .axis = plate_axis(bc),
-                    .stick = bc->contact == PM_CONTACT_STICKING};
+                    .stick = bc->contact == PM_CONTACT_STICKING,
+                    .bit = (unsigned char)(2u << k++)};
     bs.reach = bs.axis >= 0 ? (0.5 - 1e-6) * m->grid.h : 0.0;
     double d0[3], d1[3];
     pm_rigid_displacement(bc, t, d0);
@@ -283,9 +301,9 @@ double mpm_contacts_apply(const mpm_ctx *ctx, double *vel, bool reactions) {
       bs.V[c] = (d1[c] - d0[c]) / dt;
       bs.dm[c] = 0.5 * (d0[c] + d1[c]);
     }
-    mark_touched(m, ctx->state, bc, d1, cw->touched);
+    if (find) mark_touched(m, ctx->state, bc, d1, cw->touched);
     double R[3] = {0, 0, 0};
-    work += body_contact(ctx, &bs, b, vel, reactions, R);
+    work += body_contact(ctx, &bs, b, vel, reactions, find, R);
     if (!reactions) continue;
     for (int c = 0; c < 3; c++) cw->reaction[3 * b + c] += R[c];
   }

@@ -12,12 +12,16 @@
 
 struct mpm_model;
 
+/* The most rigid bodies a scene of method mpm may have. */
+#define MPM_CONTACT_MAX 7
+
 /* How many of the conditions bcs[0..n) are rigid bodies. */
 int mpm_contacts_count(const mpm_bc *bcs, int n);
 
 /* Check the rigid bodies of model m (scene s, particles seeded): one that
- * starts inside a body (a particle's centre past its surface at t = 0)
- * fails with PM_ERR_SCENE at its key (file:line:col) naming the particle.
+ * starts inside a body (a particle's centre past its surface at t = 0), or
+ * more than MPM_CONTACT_MAX of them, fail with PM_ERR_SCENE at the key
+ * (file:line:col), naming the particle.
  * Nothing to do without rigid bodies. */
 pm_err mpm_contacts_check(const pm_scene *s, const struct mpm_model *m);
 
@@ -31,7 +35,9 @@ pm_err mpm_contacts_check(const pm_scene *s, const struct mpm_model *m);
  * least h/2 inside (the extension a face condition makes), so that a
  * linear field stays linear through the plate.  Frictionless: the normal
  * component; sticking: all of them; either only where that pushes the
- * body away (no pull).  With reactions: add the force this applies to the
+ * body away (no pull).  With reactions (the grid update) the nodes in
+ * contact are found; without, MUSL's remap keeps the update's.  With
+ * reactions: add the force this applies to the
  * conditions' reactions, mark the dofs it sets (owner) and return its
  * work over the step (J); else 0.  Parallel over nodes; allocates
  * nothing. */
