@@ -2,6 +2,7 @@
 #include "pm_rigid.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "pm_expr.h"
@@ -23,4 +24,13 @@ void pm_rigid_displacement(const pm_scene_bc *bc, double t, double d[3]) {
   const double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
   for (int a = 0; a < 3; a++)
     d[a] = bc->disp[a] ? r * pm_expr_eval(bc->disp[a], 0, 0, 0, t) : 0;
+}
+
+pm_err pm_rigid_refuse(const pm_scene *s, int i, const char *needs,
+                       const char *got) {
+  const char *kind = s->bcs[i].on == PM_ON_PLATE ? "plate" : "sphere";
+  char p[64];
+  snprintf(p, sizeof p, "boundary.%d.%s", i, kind);
+  return pm_scene_fail(s, p, true, "contact needs %s, got a rigid %s with %s",
+                       needs, kind, got);
 }

@@ -17,4 +17,10 @@ double pm_rigid_gap(const pm_scene_bc *bc, const double d[3], const double x[3],
  * d (3; components not given are 0). */
 void pm_rigid_displacement(const pm_scene_bc *bc, double t, double d[3]);
 
+/* Fail (PM_ERR_SCENE) at the key of rigid body i of s
+ * (boundary.<i>.plate or .sphere, file:line:col) with "contact needs
+ * <needs>, got a rigid plate|sphere with <got>". */
+pm_err pm_rigid_refuse(const pm_scene *s, int i, const char *needs,
+                       const char *got);
+
 #endif

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mpm_kind.h"
+#include "pm_rigid.h"
 
 static const pm_name shape_names[] = {
     {"linear", MPM_BASIS_LINEAR}, {"quadratic", MPM_BASIS_QUADRATIC}, {0}};
@@ -350,15 +351,10 @@ pm_err mpm_implicit_check_scene(const pm_scene *s) {
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
     if (PM_BC_RIGID(bc))
-      return pm_scene_fail(
-          s,
-          PM_PATH(p, "boundary.%d.%s", i,
-                  bc->on == PM_ON_PLATE ? "plate" : "sphere"),
-          true,
-          "contact needs method mpm or fpm for now (the implicit MPM's "
-          "tangent has no contact terms), got a rigid %s with method "
-          "mpm-implicit",
-          bc->on == PM_ON_PLATE ? "plate" : "sphere");
+      return pm_rigid_refuse(s, i,
+                             "method mpm or fpm for now (the implicit MPM's "
+                             "tangent has no contact terms)",
+                             "method mpm-implicit");
     if (bc->on == PM_ON_REGION)
       return pm_scene_fail(
           s, PM_PATH(p, "boundary.%d.region", i), true,
