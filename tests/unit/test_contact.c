@@ -197,7 +197,8 @@ static void test_bad_keys(void **state) {
              "contact needs time.quasi_static.method dynamic-relaxation");
   load_fails("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
              "displacement: {z: -0.01}}",
-             "mpm", "none", "contact.yaml:11:", "contact needs method fpm");
+             "mpm-implicit", "static",
+             "contact.yaml:11:", "contact needs method mpm or fpm");
 }
 
 /* A plate that starts 5 mm inside the block is refused when the points

@@ -97,6 +97,9 @@ endif()
 add_test(NAME verification.mpm_grips
   COMMAND bash ${PM_VERIFY_DIR}/mpm-grips.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.mpm_grips PROPERTIES LABELS verification TIMEOUT 300)
+add_test(NAME verification.mpm_contact
+  COMMAND bash ${PM_VERIFY_DIR}/mpm-contact.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.mpm_contact PROPERTIES LABELS verification TIMEOUT 300)
 add_test(NAME verification.implicit_stop
   COMMAND bash ${PM_VERIFY_DIR}/implicit-stop.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.implicit_stop PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)

@@ -589,7 +589,8 @@ static const pm_key bc_keys[] = {
      .keys = plate_keys,
      .doc = "{point, normal}: a rigid plane (instead of on) that pushes the "
             "body where it touches, moved by displacement f(t) (FPM "
-            "dynamic relaxation or explicit)"},
+            "dynamic relaxation or explicit; method mpm: in the grid's "
+            "contact)"},
     {.name = "sphere",
      .type = PM_KEY_MAPPING,
      .keys = sphere_bc_keys,
@@ -608,7 +609,8 @@ static const pm_key bc_keys[] = {
      .range = PM_RANGE_GT,
      .doc = "plate, sphere: contact stiffness factor kappa, the stiffness "
             "of a point kappa E A / h (A its boundary facet area, "
-            "h discretization.mesh_size)"},
+            "h discretization.mesh_size; FPM only: the MPM's grid contact "
+            "has no penalty)"},
     {.name = "name",
      .type = PM_KEY_STRING,
      .offset = C(name),

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "pm_omp.h"
+#include "pm_rigid.h"
 
 /* Layout of the state: anchors (3 per pair), then per body the reaction,
  * the previous reaction and the previous displacement (9 per body), then
@@ -25,26 +26,11 @@ pm_err fpm_contact_state_init(const fpm_contact *c, double **out) {
   return PM_SUCCESS;
 }
 
-/* Signed distance of x from the body displaced by d, and the unit normal
- * there (out of the rigid body, toward the deformable one). */
-static double gap(const pm_scene_bc *bc, const double d[3], const double x[3],
-                  double n[3]) {
-  double r[3];
-  for (int a = 0; a < 3; a++) r[a] = x[a] - d[a] - bc->rigid_point[a];
-  if (bc->on == PM_ON_PLATE) {
-    memcpy(n, bc->rigid_normal, 3 * sizeof(double));
-    return r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
-  }
-  double len = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-  for (int a = 0; a < 3; a++) n[a] = len > 0 ? r[a] / len : (a == 2);
-  return len - bc->rigid_radius;
-}
-
 bool fpm_contact_point(const pm_scene_bc *bc, double k, const double d[3],
                        const double x[3], double anchor[3], double F[3],
                        double *energy) {
   double n[3];
-  const double g = gap(bc, d, x, n);
+  const double g = pm_rigid_gap(bc, d, x, n);
   *energy = 0;
   if (!(g < 0)) {
     F[0] = F[1] = F[2] = 0;
@@ -72,7 +58,7 @@ void fpm_contact_tangent(const pm_scene_bc *bc, double k, const double d[3],
                          const double x[3], const double anchor[3],
                          double K[9]) {
   double n[3];
-  const double g = gap(bc, d, x, n);
+  const double g = pm_rigid_gap(bc, d, x, n);
   memset(K, 0, 9 * sizeof(double));
   if (!(g < 0)) return;
   if (bc->contact == PM_CONTACT_STICKING) {
@@ -86,13 +72,6 @@ void fpm_contact_tangent(const pm_scene_bc *bc, double k, const double d[3],
   for (int a = 0; a < 3; a++)
     for (int b = 0; b < 3; b++)
       K[3 * a + b] = k * (n[a] * n[b] + q * ((a == b) - n[a] * n[b]));
-}
-
-/* The rigid body's displacement at time t: ramp(t) d(t). */
-static void body_displacement(const pm_scene_bc *bc, double t, double d[3]) {
-  const double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
-  for (int a = 0; a < 3; a++)
-    d[a] = bc->disp[a] ? r * pm_expr_eval(bc->disp[a], 0, 0, 0, t) : 0;
 }
 
 /* Each point's boundary area (sum of its facets' areas) into area (n). */
@@ -111,7 +90,7 @@ static pm_err check_start(const fpm_model *m, const fpm_contact *c, int b) {
   for (long q = c->pair_ptr[b]; q < c->pair_ptr[b + 1]; q++) {
     const long i = c->pair_point[q];
     const double *x = m->x + 3 * i;
-    double n[3], g = gap(bc, zero, x, n);
+    double n[3], g = pm_rigid_gap(bc, zero, x, n);
     if (g < -tol)
       return pm_scene_fail(
           s,
@@ -203,7 +182,7 @@ void fpm_contact_force(const fpm_model *m, fpm_state *st, double t) {
     const double *restrict kq = c->pair_k;
     const long q0 = c->pair_ptr[b], q1 = c->pair_ptr[b + 1];
     double d[3], rx = 0, ry = 0, rz = 0, e = 0, s2 = 0;
-    body_displacement(bc, t, d);
+    pm_rigid_displacement(bc, t, d);
     PM_OMP(parallel for schedule(static) default(none)
            reduction(+ : rx, ry, rz, e, s2)
            shared(q0, q1, pt, kq, S, f, u, x, bc, d))
@@ -238,7 +217,7 @@ void fpm_contact_start(const fpm_model *m, fpm_state *st, double t) {
   for (int b = 0; b < c->n_bodies; b++) {
     double *B = st->contact + ST_BODY(c, b);
     memcpy(B + 3, B, 3 * sizeof(double));
-    body_displacement(&m->scene->bcs[c->bc[b]], t, B + 6);
+    pm_rigid_displacement(&m->scene->bcs[c->bc[b]], t, B + 6);
   }
 }
 
@@ -248,7 +227,7 @@ double fpm_contact_work(const fpm_model *m, fpm_state *st, double t) {
   double work = 0;
   for (int b = 0; b < c->n_bodies; b++) {
     double *B = st->contact + ST_BODY(c, b), d[3];
-    body_displacement(&m->scene->bcs[c->bc[b]], t, d);
+    pm_rigid_displacement(&m->scene->bcs[c->bc[b]], t, d);
     for (int a = 0; a < 3; a++) {
       work += 0.5 * (B[3 + a] + B[a]) * (d[a] - B[6 + a]);
       B[3 + a] = B[a];

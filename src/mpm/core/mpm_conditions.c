@@ -31,6 +31,11 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
       bc->constant[c] = !e || (!pm_expr_uses(e, 'x') && !pm_expr_uses(e, 'y') &&
                                !pm_expr_uses(e, 'z'));
     }
+    /* A rigid body has no columns: the contact finds its nodes. */
+    if (PM_BC_RIGID(sb)) {
+      bc->rigid = sb;
+      continue;
+    }
     /* A grip has no columns: its held particles act. */
     bc->grip = sb->on != PM_ON_FACE;
     bc->region = sb->region;
@@ -74,12 +79,16 @@ pm_err mpm_cond_work_create(mpm_cond_work *cw, const mpm_grid *g,
                             const mpm_bc *bcs, int n_bcs) {
   if (n_bcs == 0) return PM_SUCCESS;
   const long n3 = 3 * g->n_nodes;
-  bool grips = false;
-  for (int b = 0; b < n_bcs; b++) grips = grips || bcs[b].grip;
+  bool grips = false, rigid = false;
+  for (int b = 0; b < n_bcs; b++) {
+    grips = grips || bcs[b].grip;
+    rigid = rigid || bcs[b].rigid;
+  }
   if (grips) {
     PM_CALL(PM_ALLOC(cw->grip_mass, g->n_nodes, "grip masses"));
     PM_CALL(PM_ALLOC(cw->grip_mom, n3, "grip momenta"));
   }
+  if (rigid) PM_CALL(PM_ALLOC(cw->touched, g->n_nodes, "contact nodes"));
   PM_CALL(PM_ALLOC(cw->owner, n3, "constrained dof owners"));
   PM_CALL(PM_ALLOC(cw->fold, n3, "folded condition forces"));
   PM_CALL(PM_ALLOC(cw->fold_out, n3, "folded condition forces"));
@@ -94,12 +103,14 @@ void mpm_cond_work_destroy(mpm_cond_work *cw) {
   free(cw->reaction);
   free(cw->grip_mass);
   free(cw->grip_mom);
+  free(cw->touched);
   memset(cw, 0, sizeof *cw);
 }
 
 size_t mpm_cond_work_bytes(const mpm_cond_work *cw, const mpm_grid *g) {
   if (!cw->owner) return 0;
-  return (3 * sizeof(short) + (cw->grip_mass ? 10 : 6) * sizeof(double)) *
+  return (3 * sizeof(short) + (cw->touched ? 1 : 0) +
+          (cw->grip_mass ? 10 : 6) * sizeof(double)) *
          (size_t)g->n_nodes;
 }
 
@@ -182,7 +193,7 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
     int b = fold ? m->n_bcs - 1 - bb : bb;
     const mpm_bc *bc = &m->bcs[b];
     unsigned mask = bc->disp_mask | bc->vel_mask;
-    if (!mask || bc->grip) continue;
+    if (!mask || bc->grip || bc->rigid) continue;
     int a = bc->axis;
     double vconst[3] = {0, 0, 0}, wall_const = bc->plane;
     double xc[3];

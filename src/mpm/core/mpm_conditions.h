@@ -3,7 +3,8 @@
  * their forces onto the anchors, and counts its reaction and work; null
  * directions zero components everywhere (in the grid update).  A condition
  * on a region holds particles instead (a grip: mpm_grip.h); a traction
- * acts through the particles at a face (mpm_traction.h). */
+ * acts through the particles at a face (mpm_traction.h); a rigid plate or
+ * sphere acts in the grid's contact (mpm_contact.h). */
 #ifndef MPM_CONDITIONS_H
 #define MPM_CONDITIONS_H
 
@@ -41,6 +42,10 @@ typedef struct {
   unsigned traction_mask;
   const pm_expr *traction[3];
   double *area, *reach;
+  /* A rigid plate or sphere in the grid's contact (mpm_contact.h): the
+   * scene's condition (borrowed; NULL for other conditions), and no
+   * columns. */
+  const pm_scene_bc *rigid;
 } mpm_bc;
 
 /* What the conditions keep during a step: workspace. */
@@ -53,6 +58,8 @@ typedef struct {
   double *reaction;  /* 3 per condition: its force on the body, N */
   double *grip_mass; /* per node: a grip's mass there (grips only) */
   double *grip_mom;  /* 3 per node: its prescribed momentum (grips only) */
+  unsigned char *touched; /* per node: a rigid body's particles reach it
+                             there (rigid bodies only) */
   /* The first prescribed value that was not finite: its expression (NULL
    * while none), the node of its column, the face position and the time
    * it was evaluated at. */

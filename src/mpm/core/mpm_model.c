@@ -3,6 +3,7 @@
 
 #include "mpm_grip.h"
 #include "mpm_traction.h"
+#include "mpm_contact.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -89,6 +90,7 @@ pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
   PM_TRY(mpm_seed(s, m, &st));
   PM_TRY(mpm_grips_create(s, m));
   PM_TRY(mpm_tractions_create(s, m));
+  PM_TRY(mpm_contacts_check(s, m));
   mpm_pipeline_build(m);
   st->damping = m->opt.qs == PM_QS_DAMPING ? m->opt.qs_damping : 0;
   PM_TRY(initial_step(s, m, st));

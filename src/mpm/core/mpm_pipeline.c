@@ -5,6 +5,7 @@
 
 #include <stdio.h>
 
+#include "mpm_contact.h"
 #include "mpm_grid_stages.h"
 #include "mpm_kind.h"
 #include "mpm_grip.h"
@@ -116,11 +117,13 @@ void mpm_pipeline_build(mpm_model *m) {
   /* The conditions belong to the update: it books their work. */
   st->books = m->n_bcs > 0 || m->n_moving > 0 ? MPM_BOOKS_WORK : 0;
   pl->update = st->index;
+  const int n_rigid = mpm_contacts_count(m->bcs, m->n_bcs);
   snprintf(st->detail, sizeof st->detail,
-           "v^L = v + dt f / m, %d boundary condition%s%s%s", m->n_bcs,
+           "v^L = v + dt f / m, %d boundary condition%s%s%s%s", m->n_bcs,
            m->n_bcs == 1 ? "" : "s",
            o->null_velocity ? ", null directions" : "",
-           m->n_moving ? ", nodes of moving bodies at their velocity" : "");
+           m->n_moving ? ", nodes of moving bodies at their velocity" : "",
+           n_rigid ? ", rigid bodies in the grid's contact" : "");
   st = add(pl, "g2p", mpm_stage_g2p);
   snprintf(st->detail, sizeof st->detail,
            "particle velocities (FLIP %g / PIC %g)", o->flip, 1 - o->flip);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mpm_kind.h"
+#include "pm_rigid.h"
 
 static const pm_name shape_names[] = {
     {"linear", MPM_BASIS_LINEAR}, {"quadratic", MPM_BASIS_QUADRATIC}, {0}};
@@ -278,15 +279,15 @@ pm_err mpm_check_scene(const pm_scene *s) {
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
     const bool implicit = strcmp(s->method, "mpm-implicit") == 0;
-    if (PM_BC_RIGID(bc))
-      return pm_scene_fail(
-          s,
-          PM_PATH(p, "boundary.%d.%s", i,
-                  bc->on == PM_ON_PLATE ? "plate" : "sphere"),
-          true,
-          "contact needs method fpm for now (MPM's rigid bodies are "
-          "bodies: with motion), got a rigid %s in boundary",
-          bc->on == PM_ON_PLATE ? "plate" : "sphere");
+    if (PM_BC_RIGID(bc)) { /* contact: mpm_contact */
+      if (pm_scene_has(s, PM_PATH(p, "boundary.%d.penalty", i)))
+        return pm_scene_fail(s, p, true,
+                             "expected no penalty for method %s (the grid's "
+                             "contact sets nodal velocities: it has no "
+                             "stiffness), got penalty",
+                             s->method);
+      continue;
+    }
     if (bc->traction_mask && bc->on != PM_ON_FACE)
       return pm_scene_fail(s, PM_PATH(p, "boundary.%d.traction", i), true,
                            "expected %s (method %s), got traction",
@@ -349,6 +350,11 @@ pm_err mpm_implicit_check_scene(const pm_scene *s) {
   }
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
+    if (PM_BC_RIGID(bc))
+      return pm_rigid_refuse(s, i,
+                             "method mpm or fpm for now (the implicit MPM's "
+                             "tangent has no contact terms)",
+                             "method mpm-implicit");
     if (bc->on == PM_ON_REGION)
       return pm_scene_fail(
           s, PM_PATH(p, "boundary.%d.region", i), true,

@@ -1,6 +1,7 @@
 /* mpm_par_check: what a run of MPM across ranks cannot do yet, refused at
  * the scene check. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -10,6 +11,7 @@
 #include "pm_par_mpi.h"
 #include "pm_petsc.h"
 #include "pm_progress.h"
+#include "pm_rigid.h"
 
 /* ---- what a run across ranks cannot do yet ---------------------------------
  */
@@ -21,6 +23,16 @@ pm_err mpm_par_check(const pm_scene *s) {
                          "run has %d ranks): take mpm.fbar: cell, or run with "
                          "-np 1",
                          pm_par_size());
+  for (int i = 0; i < s->n_bcs; i++)
+    if (PM_BC_RIGID(&s->bcs[i])) {
+      char got[64];
+      snprintf(got, sizeof got, "a run across %d ranks", pm_par_size());
+      return pm_rigid_refuse(s, i,
+                             "one process (a node's contact reads the "
+                             "particles of other ranks' blocks): run with "
+                             "-np 1",
+                             got);
+    }
   for (int i = 0; i < s->n_bcs; i++)
     if (s->bcs[i].on == PM_ON_REGION || s->bcs[i].traction_mask) {
       const bool grip = s->bcs[i].on == PM_ON_REGION;

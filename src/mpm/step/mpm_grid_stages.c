@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "mpm_conditions.h"
+#include "mpm_contact.h"
 #include "mpm_grip.h"
 #include "mpm_kind.h"
 #include "mpm_state.h"
@@ -283,6 +284,7 @@ pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
   double work = mpm_conditions_apply(ctx, nd->vel_new, true);
   work += mpm_grips_apply(ctx, nd->vel_new, true);
   if (m->n_moving > 0) work += mpm_motion_apply(ctx, nd->vel_new, true);
+  work += mpm_contacts_apply(ctx, nd->vel_new, true);
   if (m->n_bcs > 0 || m->n_moving > 0) mpm_book_work(ctx, self, work);
   if (m->opt.qs != PM_QS_NONE) ctx->work->residual = residual(ctx);
   PM_CALL(mpm_stage_status(ctx, self));
@@ -305,6 +307,7 @@ void mpm_grid_velocity(mpm_ctx *ctx) {
   mpm_conditions_apply(ctx, nd->vel, false);
   mpm_grips_apply(ctx, nd->vel, false);
   if (ctx->model->n_moving > 0) mpm_motion_apply(ctx, nd->vel, false);
+  mpm_contacts_apply(ctx, nd->vel, false);
 }
 
 pm_err mpm_stage_grid_velocity(mpm_ctx *ctx, const mpm_stage *self) {
