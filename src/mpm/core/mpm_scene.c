@@ -147,7 +147,9 @@ static const pm_key mpm_keys[] = {
      .names = fbar_names,
      .doc = "F-bar for solids against volumetric locking: the stress sees "
             "J averaged over the particles of each cell (cell) or over the "
-            "nodes' patches (patch); none: each particle's own"},
+            "nodes' patches (patch); none: each particle's own.  Method "
+            "mpm-implicit without the key: cell when a material's Poisson "
+            "ratio is 0.45 or more, else none"},
     {.name = "fluid",
      .type = PM_KEY_MAPPING,
      .keys = fluid_keys,

@@ -105,21 +105,27 @@ static void choose_linear(mpm_implicit *im, bool given) {
   }
 }
 
-/* Why F-bar is on or off, for plan: the largest Poisson ratio against
- * the near-incompressible threshold. */
-static void note_fbar(mpm_implicit *im, const pm_scene *s) {
+/* F-bar by default: on for a near-incompressible material (the largest
+ * Poisson ratio at or above the threshold), where the particles' own J
+ * locks (the implicit MPM's locking beam: 52% too stiff without it, +2.9%
+ * with it, docs/validation.md); mpm.fbar given decides.  Its tangent is
+ * assembled (mpm_implicit_fbar_tangent.c), as cheap as the plain one.
+ * Records why in why_fbar, for plan. */
+static void choose_fbar(mpm_implicit *im, const pm_scene *s) {
   double nu = 0;
   for (int gi = 0; gi < im->m->n_groups; gi++)
     nu = fmax(nu, im->view[gi].mat->poisson_ratio);
-  const bool given = pm_scene_has(s, "mpm.fbar");
-  if (given)
+  if (pm_scene_has(s, "mpm.fbar")) {
+    im->fbar = mpm_scene_settings(s)->fbar == MPM_FBAR_CELL;
     snprintf(im->why_fbar, sizeof im->why_fbar, "mpm.fbar: %s",
              im->fbar ? "cell" : "none");
-  else if (nu >= MPM_IMPLICIT_NEAR_INCOMPRESSIBLE_NU)
+    return;
+  }
+  im->fbar = nu >= MPM_IMPLICIT_NEAR_INCOMPRESSIBLE_NU;
+  if (im->fbar)
     snprintf(im->why_fbar, sizeof im->why_fbar,
-             "off: nu = %.4g is near-incompressible (>= %.2f), but F-bar's "
-             "tangent is coloured, tens of times slower; set mpm.fbar: cell "
-             "against locking in bending",
+             "cell (default): nu = %.4g is near-incompressible (>= %.2f), "
+             "where the particles' own J locks; mpm.fbar: none turns it off",
              nu, MPM_IMPLICIT_NEAR_INCOMPRESSIBLE_NU);
   else
     snprintf(im->why_fbar, sizeof im->why_fbar,
@@ -142,7 +148,6 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   im->dim = m->dim;
   im->mode = (mpm_grid_mode)ms->implicit.grid;
   im->matrix_free = ms->implicit.op == MPM_OP_MATRIX_FREE;
-  im->fbar = ms->fbar == MPM_FBAR_CELL;
   im->jmin = s->stability.min_jacobian;
   im->has_gravity = m->opt.has_gravity;
   for (int c = 0; c < 3; c++) im->gravity[c] = m->opt.gravity[c];
@@ -163,6 +168,7 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
     im->group_begin[gi] = g->begin;
     for (long p = g->begin; p < g->end; p++) im->grp[p] = (unsigned char)gi;
   }
+  choose_fbar(im, s);
   im->threads = pm_omp_threads();
   PM_TRY(PM_ALLOC(im->tmin, im->threads, "thread minima"));
   if (im->mode == MPM_GRID_KEPT) {
@@ -243,7 +249,6 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   PM_TRY(mpm_implicit_make_dofs(im));
   PM_TRY(pm_interrupt_check("while setting up the implicit MPM's grid"));
   if (!im->matrix_free) choose_linear(im, linear_given);
-  note_fbar(im, s);
   /* An absolute floor on the residual: a hundred times its roundoff, eps
    * times the stiffest material's P-wave modulus times a node's share of
    * a face (h^(d-1)), over the unknowns.  Below it the relative test
@@ -283,6 +288,8 @@ void mpm_implicit_destroy(mpm_implicit *im) {
   free(im->pre_dof);
   free(im->pre_val);
   free(im->pre_bc);
+  free(im->pre_anchor);
+  free(im->pre_t);
   free(im->nb_off);
   free(im->pat_ptr);
   free(im->pat_idx);
@@ -345,12 +352,13 @@ void mpm_implicit_plan(const mpm_implicit *im, FILE *out) {
           "%d colours of cells\n",
           g->nn[0], g->nn[1], g->nn[2], im->ranks ? " on rank 0" : "", active,
           g->h, im->sn);
-  fprintf(out,
-          "unknowns     %ld (%ld prescribed), Jacobian %ld entries "
-          "(%.1f MiB)%s\n",
-          im->nunk_all, im->npre, im->entries_all,
-          im->entries_all * 12.0 / 1048576.0,
-          im->mode == MPM_GRID_RESET ? ", first load step" : "");
+  fprintf(
+      out,
+      "unknowns     %ld (%ld prescribed or following), Jacobian %ld entries "
+      "(%.1f MiB)%s\n",
+      im->nunk_all, im->npre, im->entries_all,
+      im->entries_all * 12.0 / 1048576.0,
+      im->mode == MPM_GRID_RESET ? ", first load step" : "");
   fprintf(out, "newton       %d load steps, at most %d iterations each, ",
           im->opt_steps, im->opt.max_iter);
   if (im->opt.rtol > 0)

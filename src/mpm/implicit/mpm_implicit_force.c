@@ -18,10 +18,11 @@
 /* T_q of particle p (with dT when du: then dS and dJbar are the bucket's
  * sums' derivatives), from the bucket's Jbar, S and sum V0.  Also s_q (and
  * ds_q) for the sums' pass.  False when the stress or tangent fails. */
-static bool fbar_particle(const mpm_implicit *im, long p, const fbar_point *fp,
-                          double Jbar, double S, double V, double dJbar,
-                          double dS, bool with_d, double T[9], double dT[9],
-                          double *s_out, double *ds_out) {
+bool mpm_implicit_fbar_particle(const mpm_implicit *im, long p,
+                                const fbar_point *fp, double Jbar, double S,
+                                double V, double dJbar, double dS, bool with_d,
+                                double T[9], double dT[9], double *s_out,
+                                double *ds_out) {
   const int d = im->dim;
   const mpm_solid_view *v = &im->view[im->grp[p]];
   const double *ms = model_state(im, p);
@@ -84,8 +85,9 @@ static bool fbar_force(mpm_implicit *im, const double *u, const double *du,
       fbar_point fp;
       fbar_point_at(im, p, &st, u, du, &fp);
       double s, ds = 0;
-      ok = fbar_particle(im, p, &fp, Jbar, 0, V, dJbar, 0, du != NULL, NULL,
-                         NULL, &s, du ? &ds : NULL);
+      ok = mpm_implicit_fbar_particle(im, p, &fp, Jbar, 0, V, dJbar, 0,
+                                      du != NULL, NULL, NULL, &s,
+                                      du ? &ds : NULL);
       S += s;
       dS += ds;
     }
@@ -104,8 +106,8 @@ static bool fbar_force(mpm_implicit *im, const double *u, const double *du,
       fbar_point fp;
       fbar_point_at(im, p, &st, u, du, &fp);
       double T[9], dT[9], Q[9];
-      fbar_particle(im, p, &fp, Jbar, S, V, dJbar, dS, du != NULL,
-                    du ? NULL : T, du ? dT : NULL, NULL, NULL);
+      mpm_implicit_fbar_particle(im, p, &fp, Jbar, S, V, dJbar, dS, du != NULL,
+                                 du ? NULL : T, du ? dT : NULL, NULL, NULL);
       to_base(base_F(im, p), du ? dT : T, Q);
       const double mg = lam * m->mass[p];
       for (int k = 0; k < st.n; k++) {
@@ -175,8 +177,26 @@ bool mpm_implicit_nodal_force(mpm_implicit *im, const double *u, double *f) {
 void mpm_implicit_fill_u(mpm_implicit *im, const double *x) {
   memset(im->u, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
   for (long k = 0; k < im->nheld; k++) im->u[im->unk_dof[k]] = x[k];
+  for (long k = 0; k < im->npre; k++) {
+    const long an = im->pre_anchor[k];
+    im->u[im->pre_dof[k]] = im->lam_local * im->pre_val[k] +
+                            (an >= 0 ? im->pre_t[k] * im->u[an] : 0.0);
+  }
+}
+
+void mpm_implicit_fill_du(mpm_implicit *im, const double *dx) {
+  memset(im->du, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
+  for (long k = 0; k < im->nheld; k++) im->du[im->unk_dof[k]] = dx[k];
   for (long k = 0; k < im->npre; k++)
-    im->u[im->pre_dof[k]] = im->lam_local * im->pre_val[k];
+    if (im->pre_anchor[k] >= 0)
+      im->du[im->pre_dof[k]] = im->pre_t[k] * im->du[im->pre_anchor[k]];
+}
+
+void mpm_implicit_fold(const mpm_implicit *im, const double *f, double *r) {
+  for (long k = 0; k < im->nheld; k++) r[k] = f[im->unk_dof[k]];
+  for (long k = 0; k < im->npre; k++)
+    if (im->pre_anchor[k] >= 0)
+      r[im->dof[im->pre_anchor[k]]] += im->pre_t[k] * f[im->pre_dof[k]];
 }
 
 /* ---- the problem's callbacks --------------------------------------------- */
@@ -188,7 +208,7 @@ pm_err mpm_implicit_cb_residual(void *ctx, const double *x, double *r) {
   mpm_implicit_fill_u(im, x);
   if (!mpm_implicit_nodal_force(im, im->u, im->f))
     return PM_ERROR(PM_ERR_UNSTABLE, "%s", im->fail_msg);
-  for (long k = 0; k < im->nheld; k++) r[k] = im->f[im->unk_dof[k]];
+  mpm_implicit_fold(im, im->f, r);
   return PM_SUCCESS;
 }
 
@@ -203,12 +223,11 @@ pm_err mpm_implicit_cb_apply(void *ctx, const double *x, const double *dx,
   mpm_implicit *im = ctx;
   const mpm_model *m = im->m;
   mpm_implicit_fill_u(im, x);
-  memset(im->du, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
-  for (long k = 0; k < im->nheld; k++) im->du[im->unk_dof[k]] = dx[k];
+  mpm_implicit_fill_du(im, dx);
   if (im->fbar) {
     if (!fbar_force(im, im->u, im->du, im->df))
       return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
-    for (long k = 0; k < im->nheld; k++) dr[k] = im->df[im->unk_dof[k]];
+    mpm_implicit_fold(im, im->df, dr);
     return PM_SUCCESS;
   }
   memset(im->df, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
@@ -236,6 +255,6 @@ pm_err mpm_implicit_cb_apply(void *ctx, const double *x, const double *dx,
     }
   })
   if (im->fail_p >= 0) return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
-  for (long k = 0; k < im->nheld; k++) dr[k] = df[im->unk_dof[k]];
+  mpm_implicit_fold(im, df, dr);
   return PM_SUCCESS;
 }

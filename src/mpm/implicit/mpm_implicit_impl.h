@@ -51,6 +51,11 @@ struct mpm_implicit {
   long *pre_dof;
   double *pre_val; /* increment at local load 1 */
   int *pre_bc;
+  /* A prescribed dof may follow an unknown (its anchor, a grid dof,
+   * -1 none): u = lam_local pre_val + pre_t u[anchor], the odd or even
+   * extension of the field beyond a condition's face (grid kept). */
+  long *pre_anchor;
+  double *pre_t;
   int *nb_off; /* nnb per node: offset of a neighbour's columns in a row */
   long *pat_ptr, *pat_idx, pat_cap;
   long *pc_ptr, *pc_idx; /* diagonal pattern (matrix-free Jacobi) */
@@ -159,6 +164,22 @@ static inline void note_failure(mpm_implicit *im, long p, const char *what,
   }
 }
 
+/* The unknown dof d follows and its factor: dof d itself (factor 1), or
+ * a prescribed dof's anchor; false when d follows none. */
+static inline bool follows(const mpm_implicit *im, long d, long *unk,
+                           double *t) {
+  const long k = im->dof[d];
+  if (k >= 0) {
+    *unk = k;
+    *t = 1;
+    return true;
+  }
+  if (k > -2 || im->pre_anchor[-2 - k] < 0) return false;
+  *unk = im->dof[im->pre_anchor[-2 - k]];
+  *t = im->pre_t[-2 - k];
+  return true;
+}
+
 /* ---- the colour loop ---------------------------------------------------- */
 
 /* Visit every particle, colour by colour, buckets of a colour in parallel:
@@ -256,6 +277,16 @@ static inline void fbar_bucket_J(const mpm_implicit *im, long q0, long q1,
   if (dJbar) *dJbar = sd / sv;
 }
 
+/* T_q of particle p at fp (the bucket's Jbar, S and sum V0 given), and
+ * with with_d its derivative dT along fp's dF, dJ and the bucket's dJbar,
+ * dS; s_q and ds_q for the bucket's sums (each output may be NULL).
+ * False when the stress or tangent fails (mpm_implicit_force.c). */
+bool mpm_implicit_fbar_particle(const mpm_implicit *im, long p,
+                                const fbar_point *fp, double Jbar, double S,
+                                double V, double dJbar, double dS, bool with_d,
+                                double T[9], double dT[9], double *s_out,
+                                double *ds_out);
+
 /* ---- between the pieces -------------------------------------------------- */
 
 /* Forces (mpm_implicit_force.c): the nodal forces f at displacements u,
@@ -264,6 +295,11 @@ static inline void fbar_bucket_J(const mpm_implicit *im, long q0, long q1,
  * load and the tangent's product. */
 bool mpm_implicit_nodal_force(mpm_implicit *im, const double *u, double *f);
 void mpm_implicit_fill_u(mpm_implicit *im, const double *x);
+/* du from the directions dx of the unknowns (the prescribed dofs follow
+ * their anchors); the nodal forces f folded onto the unknowns into r (a
+ * dof that follows an anchor adds its force times its factor there). */
+void mpm_implicit_fill_du(mpm_implicit *im, const double *dx);
+void mpm_implicit_fold(const mpm_implicit *im, const double *f, double *r);
 pm_err mpm_implicit_cb_residual(void *ctx, const double *x, double *r);
 pm_err mpm_implicit_cb_set_load(void *ctx, double lambda);
 pm_err mpm_implicit_cb_apply(void *ctx, const double *x, const double *dx,
@@ -281,6 +317,27 @@ pm_err mpm_implicit_make_dofs(mpm_implicit *im);
 pm_err mpm_implicit_make_solver(mpm_implicit *im);
 pm_err mpm_implicit_rebuild(mpm_implicit *im);
 void mpm_implicit_node_position(const mpm_grid *g, long k, double x[3]);
+/* Add v to the tangent's entry (row unknown of node rn, column dof cd) in
+ * the pattern's order (val); false when the entry is outside the
+ * pattern. */
+bool mpm_implicit_add_entry(const mpm_implicit *im, long row, long rn, long cd,
+                            double v, double *val);
+/* The particle's (or bucket's) tangent block K (3 st->n square, rows and
+ * columns node by node, component by component) added to the assembled
+ * values val, folded through the conditions' extensions; *outside set
+ * when an entry falls outside the pattern. */
+void mpm_implicit_scatter_block(const mpm_implicit *im, const mpm_stencil *st,
+                                const double *K, double *val, bool *outside);
+/* After an assembly: PM_ERR_INTERNAL with the failed particle
+ * (im->fail_msg) or when an entry fell outside the pattern, else
+ * PM_SUCCESS. */
+pm_err mpm_implicit_values_status(const mpm_implicit *im, bool outside);
+/* An[iJkM] = sum_KL A[iKkL] Fb[JK] Fb[ML] for particle p (A when F_b =
+ * I), A[9 iK + kL] = dP_iK / dF_kL. */
+void mpm_implicit_tangent_to_base(const mpm_implicit *im, long p,
+                                  const double A[81], double An[81]);
+/* F-bar's assembled tangent (mpm_implicit_fbar_tangent.c). */
+pm_err mpm_implicit_fbar_values(mpm_implicit *im, double *val);
 /* Converged steps (mpm_implicit_steps.c): Newton's step callback. */
 pm_err mpm_implicit_on_step(void *ctx, int step, double lambda, const double *x,
                             const pm_newton_report *report);

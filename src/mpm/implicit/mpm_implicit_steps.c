@@ -32,14 +32,16 @@ static pm_err commit(mpm_implicit *im, const double *x) {
     PM_CALL(mpm_xc_nodes_reduce(m, im->f, MPM_XC_DOUBLE3, MPM_XC_SUM));
   for (int b = 0; b < 3 * m->n_bcs; b++) im->reaction[b] = 0;
   double sums[2] = {0, 0}; /* |r|^2, |reactions|^2 */
+  /* A dof that follows an anchor moved t f onto it: (1 - t) f is the
+   * condition's. */
   for (long k = 0; k < im->npre; k++) {
     if (own && !own[im->pre_dof[k] / 3]) continue;
-    const double fk = im->f[im->pre_dof[k]];
+    const double fk = (1 - im->pre_t[k]) * im->f[im->pre_dof[k]];
     im->reaction[3 * im->pre_bc[k] + im->pre_dof[k] % 3] += fk;
     sums[1] += fk * fk;
   }
-  for (long k = 0; k < im->nunk; k++)
-    sums[0] += im->f[im->unk_dof[k]] * im->f[im->unk_dof[k]];
+  mpm_implicit_fold(im, im->f, im->df); /* the residual of the unknowns */
+  for (long k = 0; k < im->nunk; k++) sums[0] += im->df[k] * im->df[k];
   if (im->ranks) {
     mpm_xc_sum(m, im->reaction, 3 * m->n_bcs);
     mpm_xc_sum(m, sums, 2);

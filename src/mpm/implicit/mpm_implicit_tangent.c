@@ -26,10 +26,16 @@ static bool particle_tangent(const mpm_implicit *im, long p, const double F[9],
     if (!pm_material_tangent(v->mat, F, ms, dF, dP)) return false;
     for (int iK = 0; iK < 9; iK++) A[9 * iK + kl] = dP[iK];
   }
+  mpm_implicit_tangent_to_base(im, p, A, An);
+  return true;
+}
+
+void mpm_implicit_tangent_to_base(const mpm_implicit *im, long p,
+                                  const double A[81], double An[81]) {
   const double *Fb = base_F(im, p);
   if (!Fb) {
-    memcpy(An, A, sizeof A);
-    return true;
+    memcpy(An, A, 81 * sizeof(double));
+    return;
   }
   double T[81]; /* T[iJkL] = sum_K A[iKkL] Fb[JK] */
   for (int i = 0; i < 3; i++)
@@ -47,7 +53,6 @@ static bool particle_tangent(const mpm_implicit *im, long p, const double F[9],
         for (int L = 0; L < 3; L++) s += T[9 * iJ + 3 * k + L] * Fb[3 * M + L];
         An[9 * iJ + 3 * k + M] = s;
       }
-  return true;
 }
 
 /* Unknown components of node b before component c. */
@@ -57,16 +62,95 @@ static inline int rank_of(const long *dof, long b, int c) {
   return r;
 }
 
+bool mpm_implicit_add_entry(const mpm_implicit *im, long row, long rn, long cd,
+                            double v, double *val) {
+  const mpm_grid *g = &im->g;
+  const long cn = cd / 3;
+  int s = 0;
+  for (int c = im->dim - 1; c >= 0; c--) {
+    const long dc =
+        (cn / g->stride[c]) % g->nn[c] - (rn / g->stride[c]) % g->nn[c];
+    if (dc < 1 - im->w || dc > im->w - 1) return false;
+    s = s * im->nb + (int)dc + im->w - 1;
+  }
+  const int off = im->nb_off[rn * im->nnb + s];
+  if (off < 0) return false;
+  /* Rows an extension folds onto lie in the particle's own stencil (the
+   * mirror of a node beyond a face is in every stencil that reaches it),
+   * so the colours keep threads apart; atomic all the same. */
+  double *e =
+      val + im->pat_ptr[row] + off + rank_of(im->dof, cn, (int)(cd % 3));
+  PM_OMP(atomic)
+  *e += v;
+  return true;
+}
+
+pm_err mpm_implicit_values_status(const mpm_implicit *im, bool outside) {
+  if (im->fail_p >= 0) return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
+  PM_CHECK(!outside, PM_ERR_INTERNAL,
+           "a condition's extension couples unknowns outside the tangent's "
+           "pattern");
+  return PM_SUCCESS;
+}
+
+/* Add v to the entry (row unknown of node rn, column grid dof cd) through
+ * the unknown cd follows (none: nothing). */
+static inline void add_followed(const mpm_implicit *im, long row, long rn,
+                                long cd, double v, double *val, bool *outside) {
+  long cu;
+  double ct;
+  if (!follows(im, cd, &cu, &ct)) return;
+  if (!mpm_implicit_add_entry(im, row, rn, im->unk_dof[cu], ct * v, val))
+    *outside = true;
+}
+
+void mpm_implicit_scatter_block(const mpm_implicit *im, const mpm_stencil *st,
+                                const double *K, double *val, bool *outside) {
+  const long *dof = im->dof;
+  const int n3 = 3 * st->n;
+  for (int a = 0; a < st->n; a++) {
+    const long na = st->node[a];
+    for (int i = 0; i < 3; i++) {
+      const double *Ka = K + (long)(3 * a + i) * n3;
+      const long row = dof[3 * na + i];
+      if (row >= 0) { /* an unknown: its stencil's unknowns in order */
+        for (int b = 0; b < st->n; b++) {
+          const long nbn = st->node[b];
+          const int off = im->nb_off[na * im->nnb + im->soff[a][b]];
+          long pos = off < 0 ? -1 : im->pat_ptr[row] + off;
+          for (int k = 0; k < 3; k++)
+            if (dof[3 * nbn + k] >= 0)
+              val[pos++] += Ka[3 * b + k];
+            else if (dof[3 * nbn + k] <= -2)
+              add_followed(im, row, na, 3 * nbn + k, Ka[3 * b + k], val,
+                           outside);
+        }
+        continue;
+      }
+      long ru; /* a prescribed dof that follows an unknown */
+      double rt;
+      if (!follows(im, 3 * na + i, &ru, &rt)) continue;
+      const long rn = im->unk_dof[ru] / 3;
+      for (int b = 0; b < st->n; b++)
+        for (int k = 0; k < 3; k++)
+          add_followed(im, ru, rn, 3 * st->node[b] + k, rt * Ka[3 * b + k], val,
+                       outside);
+    }
+  }
+}
+
 /* The assembled tangent in the pattern's order. */
 pm_err mpm_implicit_cb_values(void *ctx, const double *x, double *val) {
   mpm_implicit *im = ctx;
   const mpm_model *m = im->m;
   mpm_implicit_fill_u(im, x);
   memset(val, 0, sizeof(double) * (size_t)im->pat_ptr[im->nheld]);
+  if (im->fbar) return mpm_implicit_fbar_values(im, val);
   im->fail_p = -1;
-  const long *dof = im->dof;
+  bool outside = false;
   FOR_PARTICLES(im, {
     double F[9], An[81], G[MPM_STENCIL_MAX][27];
+    double K[9 * MPM_STENCIL_MAX * MPM_STENCIL_MAX];
     particle_F(im, p, &st, im->u, F);
     if (!particle_tangent(im, p, F, An)) {
       note_failure(im, p, "no tangent: J <= 0", pm_t_det(F));
@@ -79,29 +163,19 @@ pm_err mpm_implicit_cb_values(void *ctx, const double *x, double *val) {
         G[b][iJk] = V0 * (An[3 * iJk] * st.grad[b][0] +
                           An[3 * iJk + 1] * st.grad[b][1] +
                           An[3 * iJk + 2] * st.grad[b][2]);
-    for (int a = 0; a < st.n; a++) {
-      const long na = st.node[a];
-      for (int i = 0; i < 3; i++) {
-        const long row = dof[3 * na + i];
-        if (row < 0) continue;
-        for (int b = 0; b < st.n; b++) {
-          const long nbn = st.node[b];
-          const int off = im->nb_off[na * im->nnb + im->soff[a][b]];
-          if (off < 0) continue;
-          long pos = im->pat_ptr[row] + off;
+    const int n3 = 3 * st.n;
+    for (int a = 0; a < st.n; a++)
+      for (int i = 0; i < 3; i++)
+        for (int b = 0; b < st.n; b++)
           for (int k = 0; k < 3; k++) {
-            if (dof[3 * nbn + k] < 0) continue;
             double s = 0;
             for (int J = 0; J < 3; J++)
               s += st.grad[a][J] * G[b][9 * i + 3 * J + k];
-            val[pos++] += s;
+            K[(3 * a + i) * n3 + 3 * b + k] = s;
           }
-        }
-      }
-    }
+    mpm_implicit_scatter_block(im, &st, K, val, &outside);
   })
-  if (im->fail_p >= 0) return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
-  return PM_SUCCESS;
+  return mpm_implicit_values_status(im, outside);
 }
 
 /* The tangent's diagonal, for the matrix-free operator's Jacobi
