@@ -137,6 +137,11 @@ static inline void fixture_defaults(fixture *fx) {
     if (!strcmp(k->name, "boundary_penalty"))
       fx->opt.boundary_penalty = atof(k->def);
     if (!strcmp(k->name, "stiffening")) fx->opt.stiffening = atof(k->def);
+    if (!strcmp(k->name, "volume_penalty"))
+      fx->opt.volume_penalty = atof(k->def);
+    if (!strcmp(k->name, "stiffening_jump"))
+      fx->opt.stiffening_jump =
+          strcmp(k->def, "quadratic") ? FPM_JUMP_LINEAR : FPM_JUMP_QUADRATIC;
     if (!strcmp(k->name, "jump"))
       fx->opt.jump =
           strcmp(k->def, "quadratic") ? FPM_JUMP_LINEAR : FPM_JUMP_QUADRATIC;

@@ -28,14 +28,21 @@ static double stored_energy(const fpm_model *m, fpm_state *st) {
  * along a random direction, by central differences, equals f . d (relative
  * 1e-6).  The incomplete flux is not a gradient: its mismatch is printed.
  * k = 3: SIPG with fpm.stiffening (p_s = 1e6, so that its quartic energy
- * is a sizeable part of the interfaces' at this small rough field). */
+ * is a sizeable part of the interfaces' at this small rough field); k = 4:
+ * SIPG, quadratic jump, the stiffening on it (p_s = 1e9, its jump being
+ * smaller); k = 5: SIPG, quadratic jump, fpm.volume_penalty p_v = 1e4. */
 static void test_sipg_is_gradient(void **state) {
   (void)state;
-  for (int k = 0; k < 4; k++) {
+  for (int k = 0; k < 6; k++) {
     fixture *fx = fixture_new(3, 0.03, 100, false);
     fx->opt.flux = k == 1 ? FPM_FLUX_IIPG : FPM_FLUX_SIPG;
-    fx->opt.jump = k == 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
+    fx->opt.jump = k == 2 || k >= 4 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
     if (k == 3) fx->opt.stiffening = 1e6;
+    if (k == 4) {
+      fx->opt.stiffening = 1e9;
+      fx->opt.stiffening_jump = FPM_JUMP_QUADRATIC;
+    }
+    if (k == 5) fx->opt.volume_penalty = 1e4;
     fpm_model *m;
     fpm_state *st;
     fixture_model(fx, &m, &st);
@@ -53,12 +60,15 @@ static void test_sipg_is_gradient(void **state) {
     em = stored_energy(m, st);
     double dE = (ep - em) / (2 * eps);
     double rel = fabs(dE - fd) / fabs(fd);
+    static const char *const names[] = {
+        "SIPG",
+        "IIPG",
+        "SIPG, quadratic jump",
+        "SIPG, stiffening",
+        "SIPG, stiffening on the quadratic jump",
+        "SIPG, volume penalty"};
     print_message("%s: dE/de = %.10g, f . d = %.10g, relative mismatch %.3g\n",
-                  k == 0   ? "SIPG"
-                  : k == 1 ? "IIPG"
-                  : k == 2 ? "SIPG, quadratic jump"
-                           : "SIPG, stiffening",
-                  dE, fd, rel);
+                  names[k], dE, fd, rel);
     if (k != 1) assert_true(rel <= 1e-6);
     free(u0);
     free(d);
@@ -71,31 +81,43 @@ static void test_sipg_is_gradient(void **state) {
 /* The F2 cube at mesh size h, p = 20, with the flux and jump of variant k
  * (bit 0: SIPG, bit 1: quadratic jump), or for k = 4 the default
  * formulation (with its boundary penalty), for k = 5 the default with
- * fpm.stiffening p_s = 1e5: its model and state. */
+ * fpm.stiffening p_s = 1e5, for k = 6 with p_s = 1e7 on the quadratic
+ * jump, for k = 7 with fpm.volume_penalty p_v = 1e3: its model and state. */
 static fixture *variant(double h, int k, fpm_model **m, fpm_state **st) {
   fixture *fx = fixture_new(3, h, 20, true);
   fx->opt.flux = k & 1 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
   fx->opt.jump = k & 2 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
   if (k >= 4) fixture_defaults(fx);
   if (k == 5) fx->opt.stiffening = 1e5;
+  if (k == 6) {
+    fx->opt.stiffening = 1e7;
+    fx->opt.stiffening_jump = FPM_JUMP_QUADRATIC;
+  }
+  if (k == 7) fx->opt.volume_penalty = 1e3;
   fixture_model(fx, m, st);
   return fx;
 }
 
 static const char *variant_name(int k) {
   static const char *const names[] = {
-      "IIPG, linear jump",       "SIPG, linear jump",
-      "IIPG, quadratic jump",    "SIPG, quadratic jump",
-      "the default formulation", "the default formulation with stiffening"};
+      "IIPG, linear jump",
+      "SIPG, linear jump",
+      "IIPG, quadratic jump",
+      "SIPG, quadratic jump",
+      "the default formulation",
+      "the default formulation with stiffening",
+      "the default with stiffening on the quadratic jump",
+      "the default with the volume penalty"};
   return names[k];
 }
 
 /* fpm_force_linear is the derivative of fpm_force: K d against central
  * differences of f along a random d at a finite deformation, for both
- * fluxes and both jumps and the stiffening (relative 1e-6 of |K d|). */
+ * fluxes and both jumps, the stiffening on either jump and the volume
+ * penalty (relative 1e-6 of |K d|). */
 static void test_force_linearisation(void **state) {
   (void)state;
-  for (int k = 0; k < 6; k++) {
+  for (int k = 0; k < 8; k++) {
     fpm_model *m;
     fpm_state *st;
     fixture *fx = variant(0.03, k, &m, &st);
@@ -138,11 +160,47 @@ static void test_static_tangent(void **state) {
   }
 }
 
+/* The tests above would pass with a term that does nothing: the
+ * stiffening on the quadratic jump and the volume penalty change the
+ * force of the default formulation (variants 6 and 7 against 4) by more
+ * than 1e-3 of its norm at the finite deformation they are tested at. */
+static void test_terms_act(void **state) {
+  (void)state;
+  double *f4 = NULL;
+  long nd = 0;
+  for (int k = 4; k < 8; k += (k == 4 ? 2 : 1)) {
+    fpm_model *m;
+    fpm_state *st;
+    fixture *fx = variant(0.03, k, &m, &st);
+    nd = 3 * m->n;
+    smooth_plus_rough(m, 777, 0.2, 1e-3, st->u, NULL);
+    assert_int_equal(fpm_force(m, st), -1);
+    if (k == 4) {
+      f4 = calloc(nd, sizeof *f4);
+      memcpy(f4, st->f, nd * sizeof *f4);
+    } else {
+      double dif = 0, norm = 0;
+      for (long i = 0; i < nd; i++) {
+        dif += (st->f[i] - f4[i]) * (st->f[i] - f4[i]);
+        norm += f4[i] * f4[i];
+      }
+      print_message("%s: |f - f_default| / |f_default| = %.3g\n",
+                    variant_name(k), sqrt(dif / norm));
+      assert_true(sqrt(dif / norm) > 1e-3);
+    }
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+  free(f4);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sipg_is_gradient),
       cmocka_unit_test(test_force_linearisation),
       cmocka_unit_test(test_static_tangent),
+      cmocka_unit_test(test_terms_act),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

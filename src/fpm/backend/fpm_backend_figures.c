@@ -204,8 +204,13 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
   PM_CALL(pm_json_string(j, "jump", m->q ? "quadratic" : "linear"));
   if (m->boundary_penalty > 0)
     PM_CALL(pm_json_number(j, "boundary_penalty", m->boundary_penalty));
-  if (m->stiffening > 0)
+  if (m->stiffening > 0) {
     PM_CALL(pm_json_number(j, "stiffening", m->stiffening));
+    PM_CALL(pm_json_string(j, "stiffening_jump",
+                           m->stiffen_quadratic ? "quadratic" : "linear"));
+  }
+  if (m->volume_penalty > 0)
+    PM_CALL(pm_json_number(j, "volume_penalty", m->volume_penalty));
   if (sim->local_model) PM_CALL(summary_ranks(j, sim));
   if (m->q) {
     PM_CALL(pm_json_integer(j, "fit_points_two_rings", m->n_qwide));

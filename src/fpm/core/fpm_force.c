@@ -10,6 +10,7 @@
 #include "fpm_gfd.h"
 #include "fpm_model.h"
 #include "fpm_volumetric.h"
+#include "fpm_penalty_terms.h"
 #include "pm_material.h"
 #include "pm_omp.h"
 #include "pm_tensor.h"
@@ -23,6 +24,10 @@ typedef struct {
   /* linearisation only: u and H of the state linearised about (NULL for
    * the force) */
   const double *bu, *bH;
+  /* fpm.volume_penalty's phi per point (the state's, or the base's), its
+   * increments (linearisation only), and the base's fits (quadratic
+   * stiffening's linearisation only) */
+  const double *vphi, *vdphi, *btheta;
 } fields;
 
 /* Pass 1: F_i = I + sum_k (u_k - u_i) (x) g_ik, then P_i, W_i, J_i.
@@ -120,8 +125,14 @@ static inline void linear_jump(const double *ui, const double *uk,
            Hk[3 * c + 2] * dk[2];
 }
 
-static inline double dot3(const double *a, const double *b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+/* The jump of the quadratic fits: u_i + theta_i phi_i - u_k - theta_k
+ * phi_k. */
+static inline void quad_jump(const double *ui, const double *uk,
+                             const double *thi, const double *thk,
+                             const double *phi_i, const double *phi_k,
+                             double *j) {
+  for (int c = 0; c < 3; c++)
+    j[c] = ui[c] - uk[c] + fit_at(thi, c, phi_i) - fit_at(thk, c, phi_k);
 }
 
 /* Pass 2: per point i, over its interfaces e with outward area vector a,
@@ -141,8 +152,11 @@ static inline double dot3(const double *a, const double *b) {
  * interfaces' linear-jump penalty (beta_b |e| = rec[19], zero elsewhere)
  * leaves through r and Q as the linear jump's does.  The stiffening
  * (fpm.stiffening, c_e |e| = rec[20]) adds s = c_e |e| |j|^2 j to the
- * linear jump's force, the gradient of c_e |e| |j|^4 / 4.  The energy
- * counts the model's own points. */
+ * force of the linear jump, or with fpm.stiffening_jump: quadratic of the
+ * quadratic one, the gradient of c_e |e| |j|^4 / 4.  The volume penalty
+ * (fpm.volume_penalty, rec[21]) adds 1/2 c |e| phi_e |j|^2 on the linear
+ * jump and its derivative through each point's J (fpm_penalty_terms.h).
+ * The energy counts the model's own points. */
 static double flux_pass(const fpm_model *m, const fields *fl) {
   const long n = m->n_flux, n_own = m->n_own;
   const long *restrict ptr = m->nbr_ptr;
@@ -161,51 +175,53 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   const bool sym = m->flux == FPM_FLUX_SIPG;
   const double *restrict th = fl->theta;
   double *restrict zq = fl->zq, *restrict Zq = fl->Zq;
-  const bool quad = th != NULL;
+  const bool quad = th != NULL, squad = quad && m->stiffen_quadratic;
+  const bool vol_on = m->volume_penalty > 0;
+  const double *vphi = fl->vphi, *vdphi = fl->vdphi, *bth = fl->btheta;
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
          shared(n, n_own, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat,
-                mats, ms, mss, sym, th, zq, Zq, quad, base, bu, bH))
+                mats, ms, mss, sym, th, zq, Zq, quad, base, bu, bH, squad,
+                vol_on, vphi, vdphi, bth))
   for (long i = 0; i < n; i++) {
     const bool counted = i < n_own;
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
     double Q[9] = {0}, ri[3] = {0}, B[9] = {0}, z[3] = {0}, Z[27] = {0};
     double B0[9] = {0}; /* linearisation, SIPG: sum_e K_e at the base */
+    double Tv[9] = {0}, va = 0, vda = 0; /* the volume penalty's flux */
     for (long e = ptr[i]; e < ptr[i + 1]; e++) {
       const long k = nbr[e];
       const double *rec = erec + FPM_EREC * e;
       const double *a = rec, *Mc = rec + 3, *di = rec + 12, *dk = rec + 15;
-      const double be = rec[18], bl = rec[19], cs = rec[20];
+      const double be = rec[18], bl = rec[19], cs = rec[20], cv = rec[21];
       const double *Pk = P + 9 * k, *Hk = H + 9 * k, *uk = u + 3 * k;
-      double w[3], phi_i[FPM_QFIT], phi_k[FPM_QFIT], jv[3], sv[3] = {0};
+      double w[3], phi_i[FPM_QFIT], phi_k[FPM_QFIT], jv[3], jq[3], j0[3];
+      double sv[3] = {0}, sq[3] = {0}; /* linear, quadratic jump's extra */
+      double eadd = 0;
       if (quad) {
         fpm_gfd_phi(di, phi_i);
         fpm_gfd_phi(dk, phi_k);
-      }
-      linear_jump(ui, uk, Hi, Hk, di, dk, jv);
-      if (cs != 0) {
-        /* the stiffening: s = c |j|^2 j, linearised c (|j0|^2 dj + 2 (j0 .
-         * dj) j0) about the base's jump j0 */
-        if (base) {
-          double j0[3];
-          linear_jump(bu + 3 * i, bu + 3 * k, bH + 9 * i, bH + 9 * k, di, dk,
-                      j0);
-          const double jj = dot3(j0, j0), jd = dot3(j0, jv);
-          for (int c = 0; c < 3; c++)
-            sv[c] = cs * (jj * jv[c] + 2 * jd * j0[c]);
-        } else {
-          const double jj = dot3(jv, jv);
-          for (int c = 0; c < 3; c++) sv[c] = cs * jj * jv[c];
-          if (counted) epen += 0.125 * cs * jj * jj;
+        quad_jump(ui, uk, th + 27 * i, th + 27 * k, phi_i, phi_k, jq);
+        if (cs != 0 && squad) {
+          double jq0[3];
+          if (base)
+            quad_jump(bu + 3 * i, bu + 3 * k, bth + 27 * i, bth + 27 * k, phi_i,
+                      phi_k, jq0);
+          eadd += fpm_stiffen(cs, jq, base ? jq0 : NULL, sq);
         }
       }
+      linear_jump(ui, uk, Hi, Hk, di, dk, jv);
+      if (base && (cv != 0 || (cs != 0 && !squad)))
+        linear_jump(bu + 3 * i, bu + 3 * k, bH + 9 * i, bH + 9 * k, di, dk, j0);
+      if (cs != 0 && !squad) eadd += fpm_stiffen(cs, jv, base ? j0 : NULL, sv);
+      if (cv != 0)
+        eadd += fpm_volume_entry(cv, vphi[i], vphi[k], jv, base ? j0 : NULL,
+                                 base ? vdphi[i] + vdphi[k] : 0, sv, &va, &vda);
+      if (counted) epen += eadd;
       for (int c = 0; c < 3; c++) {
         const double jump = jv[c];
-        const double pjump = quad ? ui[c] - uk[c] +
-                                        fit_at(th + 27 * i, c, phi_i) -
-                                        fit_at(th + 27 * k, c, phi_k)
-                                  : jump;
-        const double b = be * pjump;
+        const double pjump = quad ? jq[c] : jump;
+        const double b = be * pjump + sq[c];
         w[c] = 0.5 * (Pk[3 * c] * a[0] + Pk[3 * c + 1] * a[1] +
                       Pk[3 * c + 2] * a[2]) -
                (quad ? bl * jump : b) - sv[c];
@@ -283,6 +299,8 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
         }
       }
     }
+    if (vol_on)
+      fpm_volume_flux(base ? bH + 9 * i : Hi, base ? Hi : NULL, va, vda, Tv);
     if (quad) {
       for (int c = 0; c < 3; c++) zq[3 * i + c] = z[c];
       for (int q = 0; q < 27; q++) Zq[27 * i + q] = Z[q];
@@ -293,7 +311,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
                                     Pi[3 * c + 2] * A[2]);
       for (int q = 0; q < 3; q++)
         T[9 * i + 3 * c + q] =
-            vol[i] * Pi[3 * c + q] - Q[3 * c + q] -
+            vol[i] * Pi[3 * c + q] - Q[3 * c + q] + Tv[3 * c + q] -
             0.5 * (Pi[3 * c] * Bm[q] + Pi[3 * c + 1] * Bm[3 + q] +
                    Pi[3 * c + 2] * Bm[6 + q]);
     }
@@ -409,8 +427,10 @@ long fpm_force(const fpm_model *m, fpm_state *st) {
                      .zq = st->zq,
                      .Zq = st->Zq,
                      .f = st->f,
-                     .bflux = st->bflux};
+                     .bflux = st->bflux,
+                     .vphi = st->vphi};
   if (st->theta) fit_pass(m, st->u, st->theta);
+  if (st->vphi) fpm_volume_phi(m->n_stress, st->J, st->vphi);
   st->penalty_energy = flux_pass(m, &fl);
   boundary_pass(m, &fl, st);
   gather_pass(m, &fl);
@@ -424,6 +444,8 @@ struct fpm_linear {
   double *T, *r, *zq, *Zq; /* 9 n, 3 n, 3 n, 27 n */
   double *bu, *bH;         /* 3 n, 9 n: the state linearised about */
   fpm_volumetric_lin vol;  /* fpm.volumetric: averaged (else NULLs) */
+  double *btheta;          /* 27 n: its fits (quadratic stiffening only) */
+  double *vphi, *vdphi;    /* n, n: fpm.volume_penalty's phi there, dphi */
 };
 
 pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
@@ -443,6 +465,12 @@ pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
     PM_TRY(PM_ALLOC(l->theta, 27 * n, "fit increments"));
     PM_TRY(PM_ALLOC(l->zq, 3 * n, "penalty force increments"));
     PM_TRY(PM_ALLOC(l->Zq, 27 * n, "penalty fit force increments"));
+    if (m->stiffen_quadratic && m->stiffening > 0)
+      PM_TRY(PM_ALLOC(l->btheta, 27 * n, "linearisation point's fits"));
+  }
+  if (m->volume_penalty > 0) {
+    PM_TRY(PM_ALLOC(l->vphi, n, "volume penalty"));
+    PM_TRY(PM_ALLOC(l->vdphi, n, "volume penalty increments"));
   }
   if (m->vavg) PM_TRY(fpm_volumetric_lin_create(m, &l->vol));
   *out = l;
@@ -465,12 +493,18 @@ void fpm_linear_destroy(fpm_linear *l) {
   free(l->bu);
   free(l->bH);
   fpm_volumetric_lin_free(&l->vol);
+  free(l->btheta);
+  free(l->vphi);
+  free(l->vdphi);
   free(l);
 }
 
 size_t fpm_linear_bytes(const fpm_model *m) {
-  return (size_t)m->n * (81 + 9 + 9 + 9 + 3 + 12 + (m->q ? 57 : 0)) *
-             sizeof(double) +
+  const bool bth = m->q && m->stiffen_quadratic && m->stiffening > 0;
+  return (size_t)m->n *
+         (81 + 9 + 9 + 9 + 3 + 12 + (m->q ? 57 : 0) + (bth ? 27 : 0) +
+          (m->volume_penalty > 0 ? 2 : 0)) *
+         sizeof(double) +
          fpm_volumetric_lin_bytes(m);
 }
 
@@ -485,6 +519,8 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
   const long mss = m->mstate_stride;
   memcpy(l->bu, st->u, 3 * n * sizeof(double));
   memcpy(l->bH, st->H, 9 * n * sizeof(double));
+  if (l->btheta) memcpy(l->btheta, st->theta, 27 * n * sizeof(double));
+  if (l->vphi) fpm_volume_dphi(ns, st->H, NULL, l->vphi, NULL);
   PM_OMP(parallel for schedule(static) default(none)
          shared(ns, H, D, mat, mats, ms, mss))
   for (long i = 0; i < ns; i++) {
@@ -539,8 +575,12 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
                      .Zq = l->Zq,
                      .f = df,
                      .bu = l->bu,
-                     .bH = l->bH};
+                     .bH = l->bH,
+                     .vphi = l->vphi,
+                     .vdphi = l->vdphi,
+                     .btheta = l->btheta};
   if (l->theta) fit_pass(m, du, l->theta);
+  if (l->vdphi) fpm_volume_dphi(n, l->bH, dH, NULL, l->vdphi);
   flux_pass(m, &fl);
   boundary_pass(m, &fl, NULL);
   gather_pass(m, &fl);

@@ -198,6 +198,7 @@ static void build_interfaces(fpm_model *m) {
                           (xk[2] - xi[2]) * (xk[2] - xi[2]);
         r[20] = m->stiffening * unit_beta(m, i, k, f) / h2;
       }
+      r[21] = m->volume_penalty * unit_beta(m, i, k, f);
     }
   }
 }
@@ -366,6 +367,9 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   m->penalty = o->penalty;
   m->boundary_penalty = o->boundary_penalty;
   m->stiffening = o->stiffening;
+  m->stiffen_quadratic =
+      o->stiffening_jump == FPM_JUMP_QUADRATIC && o->jump == FPM_JUMP_QUADRATIC;
+  m->volume_penalty = o->volume_penalty;
   m->flux = (fpm_flux)o->flux;
   m->jump = (fpm_jump)o->jump;
   m->n_own = m->n_flux = m->n_stress = m->n;
@@ -420,6 +424,7 @@ pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
   PM_TRY(PM_ALLOC(st->r, 3 * n, "interface force"));
   PM_TRY(PM_ALLOC(st->W, n, "strain energy density"));
   PM_TRY(PM_ALLOC(st->J, n, "volume ratio"));
+  if (m->volume_penalty > 0) PM_TRY(PM_ALLOC(st->vphi, n, "volume penalty"));
   if (m->q) {
     PM_TRY(PM_ALLOC(st->theta, 27 * n, "quadratic fits"));
     PM_TRY(PM_ALLOC(st->zq, 3 * n, "penalty forces"));
@@ -452,6 +457,7 @@ void fpm_state_destroy(fpm_state *st) {
   free(st->r);
   free(st->W);
   free(st->J);
+  free(st->vphi);
   free(st->theta);
   free(st->zq);
   free(st->Zq);
@@ -470,7 +476,8 @@ size_t fpm_state_bytes(const fpm_model *m) {
          (size_t)m->n_cdofs * sizeof(double) +
          (size_t)fpm_contact_state_size(m->contact) * sizeof(double) +
          (m->q ? (size_t)m->n * 57 * sizeof(double) : 0) +
-         (m->vavg ? (size_t)m->n * 2 * sizeof(double) : 0);
+         (m->vavg ? (size_t)m->n * 2 * sizeof(double) : 0) +
+         (m->volume_penalty > 0 ? (size_t)m->n * sizeof(double) : 0);
 }
 
 double fpm_stable_dt(const fpm_model *m, long *critical_point) {
@@ -495,5 +502,7 @@ double fpm_stable_dt(const fpm_model *m, long *critical_point) {
   if (m->q && m->boundary_penalty > p) p = m->boundary_penalty;
   /* the stiffening's penalty 3 p_s (|j| / h)^2, taken at |j| <= h / 4 */
   if (0.1875 * m->stiffening > p) p = 0.1875 * m->stiffening;
+  /* the volume penalty's p_v (ln J)^2, taken at J >= 1/2 */
+  if (0.48 * m->volume_penalty > p) p = 0.48 * m->volume_penalty;
   return fpm_contact_stable_dt(m->contact, 2.0 / sqrt(lam_max) / sqrt(p));
 }

@@ -16,7 +16,7 @@
 #define FPM_MAX_MATERIALS 16
 
 struct fpm_contact;
-#define FPM_EREC 21 /* doubles per support-entry record */
+#define FPM_EREC 22 /* doubles per support-entry record */
 
 /* Everything that does not change during a run.  Arrays are per point
  * (n), per support entry (nnz, in the CSR order of the dual's adjacency) or
@@ -40,7 +40,8 @@ typedef struct {
    * d_i = x_e - X_i (3), d_k = x_e - X_k (3), beta |e| = p E / h_e |e| (1),
    * and with the quadratic jump the linear jump's beta_b |e| = p_b E / h_e
    * |e| on the interfaces of boundary points, else 0 (1), and the
-   * stiffening penalty's c_e |e| = p_s E / h_e^3 |e| (1, 0 without it).
+   * stiffening penalty's c_e |e| = p_s E / h_e^3 |e| (1, 0 without it),
+   * and the volume penalty's p_v E / h_e |e| (1, 0 without it).
    * Entries stream in order in the flux pass; moments about the centroid
    * keep M - a (x) X_i = Mc + a (x) d_i free of cancellation. */
   double *erec;   /* FPM_EREC nnz */
@@ -56,7 +57,9 @@ typedef struct {
   double *mass;            /* n: lumped mass rho V */
   double penalty;          /* p */
   double boundary_penalty; /* p_b (quadratic jump only) */
-  double stiffening;       /* p_s: the linear jump's quartic penalty */
+  double stiffening;       /* p_s: the quartic penalty on the jump */
+  bool stiffen_quadratic;  /* it measures the quadratic jump (else linear) */
+  double volume_penalty;   /* p_v: linear-jump penalty scaled by (ln J)^2 */
   fpm_flux flux;           /* IIPG or SIPG */
   /* fpm.volumetric: averaged (fpm_volumetric.h): the weights a_ik of each
    * support entry and a_ii of each point (both NULL with standard). */
@@ -146,6 +149,7 @@ typedef struct {
   double *Zq;               /* 27 n: sum_e b_e (x) phi(d_i), through theta_i */
   double *Jbar, *dUbar;     /* n each: averaged J and U'(Jbar) (fpm.volumetric:
                                averaged; else NULL) */
+  double *vphi;             /* n: (ln J)^2 (fpm.volume_penalty), else NULL */
   double *bflux;        /* 3 n_dpts: that flux per point: the supports' force on
                            the body, with f on the prescribed dofs */
   double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous

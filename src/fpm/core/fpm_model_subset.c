@@ -223,6 +223,8 @@ pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
   s->penalty = m->penalty;
   s->boundary_penalty = m->boundary_penalty;
   s->stiffening = m->stiffening;
+  s->stiffen_quadratic = m->stiffen_quadratic;
+  s->volume_penalty = m->volume_penalty;
   s->flux = m->flux;
   s->jump = m->jump;
   s->n_mats = m->n_mats;

@@ -65,6 +65,26 @@ static const pm_key fpm_keys[] = {
             "|e| |[[u]]|^4 / 4 on the jump of the points' linear fields "
             "across every interface, negligible where the field is smooth "
             "(jump O(h^2)) and strong where the fits part (jump O(h))"},
+    {.name = "stiffening_jump",
+     .type = PM_KEY_ENUM,
+     .offset = offsetof(fpm_options, stiffening_jump),
+     .def = "linear",
+     .names = jump_names,
+     .doc =
+         "the jump fpm.stiffening measures: linear (each point's linear "
+         "field) or quadratic (the quadratic fits' jump, O(h^3) where the "
+         "field is smooth, so weaker there; the linear jump's with fpm.jump: "
+         "linear)"},
+    {.name = "volume_penalty",
+     .type = PM_KEY_NUMBER,
+     .offset = offsetof(fpm_options, volume_penalty),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .unit = "",
+     .doc = "a penalty that grows with the points' volume change: the energy "
+            "p_v E / (2 h) |e| phi |[[u]]|^2 on the jump of the points' "
+            "linear fields, phi = ((ln J_i)^2 + (ln J_k)^2) / 2, nil where J "
+            "= 1 and without bound as a point collapses (J -> 0)"},
     {.name = "flux",
      .type = PM_KEY_ENUM,
      .offset = offsetof(fpm_options, flux),

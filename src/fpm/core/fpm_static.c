@@ -106,9 +106,11 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   no.relax_after = (int)s->time.qs_relax_after;
   no.easy_iterations = 3;
   no.petsc_options = s->time.qs_solver_options;
-  /* SIPG: the assembled tangent lacks the adjoint term's derivative; it
-   * preconditions the exact tangent applied matrix-free. */
-  if (m->flux == FPM_FLUX_SIPG) no.op = PM_NEWTON_MATRIX_FREE;
+  /* SIPG, the stiffening and the volume penalty: the assembled tangent
+   * lacks the adjoint term's and the state-dependent penalties'
+   * derivatives; it preconditions the exact tangent applied matrix-free. */
+  if (m->flux == FPM_FLUX_SIPG || m->stiffening > 0 || m->volume_penalty > 0)
+    no.op = PM_NEWTON_MATRIX_FREE;
   /* fpm.volumetric averaged: the assembled tangent lacks the averages'
    * coupling (it keeps each point's own volumetric stiffness); it
    * preconditions the exact tangent applied matrix-free. */

@@ -246,9 +246,9 @@ static void add_S_row(const fpm_model *m, bool quad, long k, srow *w) {
  * t_ek J_em with [[u]]_e = sum_m J_em u_m and t_ek = d[[u]]_e / d u_k
  * through point i's side only (the force of the side's own field); with
  * the quadratic jump, plus the boundary interfaces' linear-jump term.
- * fpm.stiffening's quartic term is not in S (its tangent depends on the
- * state and the direction): with it this tangent is approximate, while
- * fpm_force_linear's linearisation holds it exactly. */
+ * fpm.stiffening's quartic term and fpm.volume_penalty are not in S (their
+ * tangents depend on the state): with them this tangent is approximate and
+ * preconditions fpm_force_linear's exact linearisation (fpm_static.c). */
 static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
   pm_err ret = PM_SUCCESS;
   const long n = m->n, rows = m->n_own;

@@ -1,0 +1,30 @@
+/* fpm_penalty_terms: the per-point passes of fpm.volume_penalty (phi =
+ * (ln J)^2 and its increments), run before the flux pass reads them. */
+#include "fpm_penalty_terms.h"
+
+#include "pm_omp.h"
+
+void fpm_volume_phi(long n, const double *J, double *phi) {
+  PM_OMP(parallel for schedule(static) default(none) shared(n, J, phi))
+  for (long i = 0; i < n; i++) {
+    const double l = log(J[i]);
+    phi[i] = l * l;
+  }
+}
+
+void fpm_volume_dphi(long n, const double *bH, const double *dH, double *phi,
+                     double *dphi) {
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, bH, dH, phi, dphi))
+  for (long i = 0; i < n; i++) {
+    double F[9], C[9];
+    for (int q = 0; q < 9; q++) F[q] = bH[9 * i + q];
+    F[0] += 1;
+    F[4] += 1;
+    F[8] += 1;
+    pm_t_cofactor(F, C); /* C = J F^-T */
+    const double J = pm_t_det(F), l = log(J);
+    if (phi) phi[i] = l * l;
+    if (dphi) dphi[i] = 2 * l * pm_t_ddot(C, dH + 9 * i) / J;
+  }
+}

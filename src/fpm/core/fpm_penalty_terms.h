@@ -1,0 +1,84 @@
+/* fpm_penalty_terms: the state-dependent interface penalties of the flux
+ * pass (fpm.stiffening on either jump, fpm.volume_penalty): their forces,
+ * energies and exact linearisations, inlined into fpm_force's passes. */
+#ifndef FPM_PENALTY_TERMS_H
+#define FPM_PENALTY_TERMS_H
+
+#include <math.h>
+
+#include "fpm_model.h"
+#include "pm_tensor.h"
+
+/* The stiffening on jump j: adds s += c |j|^2 j, the gradient of c |j|^4 /
+ * 4, and returns the energy share c |j|^4 / 8 of the entry (each interface
+ * is seen twice).  With the base's jump j0 (linearisation, j then the
+ * increment): adds c (|j0|^2 j + 2 (j0 . j) j0) and returns 0. */
+static inline double fpm_stiffen(double c, const double *j, const double *j0,
+                                 double *s) {
+  if (j0) {
+    const double jj = pm_v_dot(j0, j0), jd = pm_v_dot(j0, j);
+    for (int a = 0; a < 3; a++) s[a] += c * (jj * j[a] + 2 * jd * j0[a]);
+    return 0;
+  }
+  const double jj = pm_v_dot(j, j);
+  for (int a = 0; a < 3; a++) s[a] += c * jj * j[a];
+  return 0.125 * c * jj * jj;
+}
+
+/* The volume penalty of one entry (i, k) on the linear jump j: the energy
+ * 1/2 c phi_e |j|^2 with phi_e = (phi_i + phi_k) / 2, phi = (ln J)^2.  Adds
+ * its force c phi_e j to s, the weight 1/4 c |j|^2 of dphi_i / dF_i to *a
+ * (the derivative through point i's own J, fpm_volume_flux) and returns the
+ * energy share 1/4 c phi_e |j|^2.  Linearised (j0 the base's jump, j the
+ * increment, dphi_i + dphi_k = dsum): adds c (phi_e j + dsum / 2 j0) to s,
+ * 1/2 c j0 . j to *da, 1/4 c |j0|^2 to *a, and returns 0. */
+static inline double fpm_volume_entry(double c, double phi_i, double phi_k,
+                                      const double *j, const double *j0,
+                                      double dsum, double *s, double *a,
+                                      double *da) {
+  const double pe = 0.5 * (phi_i + phi_k);
+  if (j0) {
+    for (int q = 0; q < 3; q++) s[q] += c * (pe * j[q] + 0.5 * dsum * j0[q]);
+    *da += 0.5 * c * pm_v_dot(j0, j);
+    *a += 0.25 * c * pm_v_dot(j0, j0);
+    return 0;
+  }
+  const double jj = pm_v_dot(j, j);
+  for (int q = 0; q < 3; q++) s[q] += c * pe * j[q];
+  *a += 0.25 * c * jj;
+  return 0.25 * c * pe * jj;
+}
+
+/* The volume penalty's flux through point i's J (F = I + Hb, the state's
+ * or the base's): T += a dphi/dF with dphi/dF = 2 ln J F^-T; linearised
+ * along dH (not NULL): T += da dphi/dF + a d2phi/dF2 [dH], with d2phi/dF2
+ * [dH] = 2 (G : dH) G - 2 ln J G dH^T G, G = F^-T. */
+static inline void fpm_volume_flux(const double *Hb, const double *dH, double a,
+                                   double da, double *T) {
+  double F[9], G[9];
+  for (int q = 0; q < 9; q++) F[q] = Hb[q];
+  F[0] += 1;
+  F[4] += 1;
+  F[8] += 1;
+  pm_t_cofactor(F, G);
+  const double J = pm_t_det(F), l = log(J);
+  for (int q = 0; q < 9; q++) G[q] /= J;
+  const double w = dH ? da : a;
+  for (int q = 0; q < 9; q++) T[q] += 2 * w * l * G[q];
+  if (!dH) return;
+  double GdT[9], M[9]; /* G dH^T, then G dH^T G */
+  pm_t_mult(G, dH, GdT);
+  pm_t_mul(GdT, G, M);
+  const double gd = pm_t_ddot(G, dH);
+  for (int q = 0; q < 9; q++) T[q] += 2 * a * (gd * G[q] - l * M[q]);
+}
+
+/* phi_i = (ln J_i)^2 of the points [0, n) from their J (the force). */
+void fpm_volume_phi(long n, const double *J, double *phi);
+
+/* The base's phi_i and the increments dphi_i = 2 ln J_i F_i^-T : dH_i of
+ * the points [0, n) (F = I + bH; phi NULL: only dphi). */
+void fpm_volume_dphi(long n, const double *bH, const double *dH, double *phi,
+                     double *dphi);
+
+#endif
