@@ -502,9 +502,9 @@ void fpm_linear_destroy(fpm_linear *l) {
 size_t fpm_linear_bytes(const fpm_model *m) {
   const bool bth = m->q && m->stiffen_quadratic && m->stiffening > 0;
   return (size_t)m->n *
-         (81 + 9 + 9 + 9 + 3 + 12 + (m->q ? 57 : 0) + (bth ? 27 : 0) +
-          (m->volume_penalty > 0 ? 2 : 0)) *
-         sizeof(double) +
+             (81 + 9 + 9 + 9 + 3 + 12 + (m->q ? 57 : 0) + (bth ? 27 : 0) +
+              (m->volume_penalty > 0 ? 2 : 0)) *
+             sizeof(double) +
          fpm_volumetric_lin_bytes(m);
 }
 
