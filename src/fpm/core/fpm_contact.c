@@ -41,16 +41,13 @@ static double gap(const pm_scene_bc *bc, const double d[3], const double x[3],
 }
 
 /* Static solves: whether a point at gap g (anchor: its anchor, NaN for
- * none) touches.  A point anchored on the surface (within tol, as the
- * faces that start on a plate are) holds on: sticking's tangent k I there
- * is what keeps a block between plates from floating at the start. */
-static bool touching_fixed(double g, const double *anchor, double tol) {
-  return g < 0 || (!isnan(anchor[0]) && g <= tol);
-}
-
-/* The tolerance of touching, fpm_contact_commit's anchoring too. */
-static double touch_tol(const fpm_model *m) {
-  return 1e-9 * m->scene->mesh_size;
+ * none) touches.  An anchored point holds on over the whole load step
+ * (fpm_contact_commit lets it go at a converged step where it has come
+ * off): its force is then smooth in the displacement, where a release
+ * inside the step would make the residual jump by its tangential part and
+ * Newton chatter between the two. */
+static bool touching_fixed(double g, const double *anchor) {
+  return g < 0 || !isnan(anchor[0]);
 }
 
 /* The force on a point at x touching (g < 0, normal n) the body displaced
@@ -235,18 +232,17 @@ static double bodies_force(const fpm_model *m, fpm_state *st, double t,
     const double *restrict kq = c->pair_k;
     const long q0 = c->pair_ptr[b], q1 = c->pair_ptr[b + 1];
     double d[3], rx = 0, ry = 0, rz = 0, e = 0, s2 = 0;
-    const double tol = touch_tol(m);
     body_displacement(bc, t, scale, d);
     PM_OMP(parallel for schedule(static) default(none)
            reduction(+ : rx, ry, rz, e, s2)
-           shared(q0, q1, pt, kq, S, f, u, x, bc, d, fixed, tol))
+           shared(q0, q1, pt, kq, S, f, u, x, bc, d, fixed))
     for (long q = q0; q < q1; q++) {
       const long i = pt[q];
       double xi[3], F[3], ei, n[3];
       for (int a = 0; a < 3; a++) xi[a] = x[3 * i + a] + u[3 * i + a];
       if (fixed) {
         const double g = gap(bc, d, xi, n);
-        if (!touching_fixed(g, S + 3 * q, tol)) continue;
+        if (!touching_fixed(g, S + 3 * q)) continue;
         const double *anchor = isnan(S[3 * q]) ? NULL : S + 3 * q;
         ei = touch_force(kq[q], d, xi, g, n, anchor, F);
       } else if (!fpm_contact_point(bc, kq[q], d, xi, S + 3 * q, F, &ei)) {
@@ -347,17 +343,16 @@ void fpm_contact_tangent_fixed(const fpm_model *m, const fpm_state *st,
     const double *restrict kq = c->pair_k;
     const long q0 = c->pair_ptr[b], q1 = c->pair_ptr[b + 1];
     double d[3];
-    const double tol = touch_tol(m);
     body_displacement(bc, t, scale, d);
     /* (a point is one pair of each body: no two threads share a block) */
     PM_OMP(parallel for schedule(static) default(none)
-           shared(q0, q1, pt, kq, S, u, x, bc, d, K, tol))
+           shared(q0, q1, pt, kq, S, u, x, bc, d, K))
     for (long q = q0; q < q1; q++) {
       const long i = pt[q];
       double xi[3], n[3], Kq[9];
       for (int a = 0; a < 3; a++) xi[a] = x[3 * i + a] + u[3 * i + a];
       const double g = gap(bc, d, xi, n);
-      if (!touching_fixed(g, S + 3 * q, tol)) continue;
+      if (!touching_fixed(g, S + 3 * q)) continue;
       touch_tangent(bc, kq[q], g, n, !isnan(S[3 * q]), Kq);
       for (int a = 0; a < 9; a++) K[9 * i + a] += Kq[a];
     }
@@ -368,7 +363,7 @@ void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
                         double scale) {
   const fpm_contact *c = m->contact;
   if (!c) return;
-  const double tol = touch_tol(m);
+  const double tol = 1e-9 * m->scene->mesh_size;
   for (int b = 0; b < c->n_bodies; b++) {
     const pm_scene_bc *bc = &m->scene->bcs[c->bc[b]];
     if (bc->contact != PM_CONTACT_STICKING) continue;

@@ -77,11 +77,11 @@ double fpm_contact_work_scaled(const fpm_model *m, fpm_state *st, double t,
 
 /* Static solves (fpm_static): the contact as a function of the
  * displacement alone, the anchors held as the last converged load step
- * left them (fpm_contact_commit).  A point touching (gap < 0, or for an
- * anchored point gap <= 1e-9 mesh_size) with an anchor sticks to it
- * (tangent k I); one without (frictionless bodies, and sticking points
- * that touch anew within the step) is pushed along the normal (k n n,
- * plus the sphere's curvature term).
+ * left them (fpm_contact_commit).  A point with an anchor sticks to it
+ * (tangent k I) through the load step, wherever it goes; one without
+ * (frictionless bodies, and sticking points that touch anew within the
+ * step) is pushed along the normal while its gap is < 0 (k n n, plus the
+ * sphere's curvature term).
  *
  * fpm_contact_force_fixed: the forces at the bodies' displacements
  * scale d(t) subtracted from st->f, the reactions kept in st->contact and
@@ -94,8 +94,10 @@ double fpm_contact_force_fixed(const fpm_model *m, fpm_state *st, double t,
 void fpm_contact_tangent_fixed(const fpm_model *m, const fpm_state *st,
                                double t, double scale, double *K);
 /* After a converged load step (and at the start): every sticking point
- * touching (gap below 1e-9 mesh_size) without an anchor is anchored
- * where it is; an anchored point now apart is let go. */
+ * touching (gap at most 1e-9 mesh_size: the faces that start on a plate
+ * too) without an anchor is anchored where it is; an anchored point now
+ * apart (gap above that: the contact pulled it) is let go for the next
+ * step. */
 void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
                         double scale);
 
