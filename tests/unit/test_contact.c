@@ -9,10 +9,12 @@
 #include <cmocka.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fpm_backend.h"
 #include "fpm_contact.h"
+#include "fpm_static.h"
 #include "pm_app.h"
 #include "pm_scene.h"
 #include "pm_testing.h"
@@ -193,10 +195,6 @@ static void test_bad_keys(void **state) {
              dr, "contact.yaml:11:", "only with a plate or a sphere");
   load_fails("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
              "displacement: {z: -0.01}}",
-             "fpm", "static", "contact.yaml:11:",
-             "contact needs time.quasi_static.method dynamic-relaxation");
-  load_fails("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
-             "displacement: {z: -0.01}}",
              "mpm-implicit", "static",
              "contact.yaml:11:", "contact needs method mpm or fpm");
 }
@@ -219,6 +217,76 @@ static void test_plate_inside(void **state) {
   pm_scene_destroy(s);
 }
 
+/* The static solve's tangent with a rigid body pressed into the top of
+ * the block (u_z stretches it 2 mm past the plate or into the sphere, with
+ * a lateral shear, 1 mm more since the anchors were set): the assembled
+ * tangent equals the one coloured from
+ * the linearised force and central differences of the residual (relative
+ * 1e-6), for a frictionless plate, a sticking plate (every other touching
+ * point anchored by fpm_contact_commit at a state 1 mm shallower, the rest
+ * touching anew) and a frictionless sphere. */
+static void check_static_tangent(const char *body, const char *what) {
+  pm_scene *s = NULL;
+  fpm_sim *sim = NULL;
+  assert_ok(load(body, "fpm", "static", &s));
+  assert_ok(fpm_sim_create(s, &sim));
+  const fpm_model *m = sim->model;
+  fpm_state *st = sim->state;
+  const long nd = 3 * m->n;
+  double ztop = 0;
+  for (long i = 0; i < m->n; i++) ztop = fmax(ztop, m->x[3 * i + 2]);
+  double *u = calloc(nd, sizeof *u);
+  for (int pass = 0; pass < 2; pass++) {
+    /* pass 0: 1 mm less deep, where the anchors are set */
+    const double a = (0.101 + 0.001 * pass - ztop) / ztop;
+    for (long i = 0; i < m->n; i++) {
+      const double *x = m->x + 3 * i;
+      u[3 * i] = (0.02 + 0.01 * pass) * x[2] + 1e-4 * sin(97 * x[1]);
+      u[3 * i + 1] = -0.01 * x[2] + 1e-4 * cos(53 * x[0]);
+      u[3 * i + 2] = a * x[2] + 1e-5 * sin(71 * x[0] + 31 * x[1]);
+    }
+    if (pass == 1) break;
+    memcpy(st->u, u, nd * sizeof *u);
+    fpm_contact_commit(m, st, 1, 0);
+  }
+  long anchored = 0;
+  for (long q = 0; q < m->contact->pair_ptr[1]; q++) {
+    double *A = st->contact + 3 * q;
+    if (isnan(A[0])) continue;
+    if (q % 2)
+      anchored++;
+    else
+      A[0] = A[1] = A[2] = NAN; /* touching anew */
+  }
+  double ea, ed;
+  assert_ok(fpm_static_check_tangent(m, st, u, &ea, &ed));
+  double R[3] = {0, 0, 0};
+  fpm_contact_reaction(m, st, 1, R);
+  print_message("%s: reaction (%.4g, %.4g) N in x, z, %ld points anchored; "
+                "assembled "
+                "tangent against coloured %.3g, against differences %.3g\n",
+                what, R[0], R[2], anchored, ea, ed);
+  assert_true(R[2] < 0);
+  assert_true(ea <= 1e-10);
+  assert_true(ed <= 1e-6);
+  free(u);
+  fpm_sim_destroy(sim);
+  pm_scene_destroy(s);
+}
+
+static void test_static_tangent(void **state) {
+  (void)state;
+  check_static_tangent("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
+                       "displacement: {z: -0.01}}",
+                       "frictionless plate");
+  check_static_tangent("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
+                       "displacement: {z: -0.01}, contact: sticking}",
+                       "sticking plate");
+  check_static_tangent("{sphere: {center: [0.05, 0.05, 0.3], radius: "
+                       "0.2}, displacement: {z: -0.01}}",
+                       "frictionless sphere");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_plate_frictionless),
@@ -227,6 +295,7 @@ int main(void) {
       cmocka_unit_test(test_keys),
       cmocka_unit_test(test_bad_keys),
       cmocka_unit_test(test_plate_inside),
+      cmocka_unit_test(test_static_tangent),
   };
   if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -4,8 +4,8 @@
 #    the implicit MPM) writes its report, every method within its own
 #    tolerance of the exact field (FPM and implicit MPM 1e-6, explicit MPM
 #    5e-3, the bound of verify_mpm_f2) and of the FE referee's reaction;
-#  - the hard cases, coarse (cases/bench/hard-tiny.yaml): every outcome,
-#    a refused run among them, in one table, the panel against its FE
+#  - the hard cases, coarse (cases/bench/hard-tiny.yaml): every outcome
+#    in one table (F4 between plates by a static solve among them), the panel against its FE
 #    referee's tip displacement;
 #  - a two-case suite whose second case goes unstable: the failure is
 #    listed with its diagnosis, the first case still reported, exit 2;
@@ -86,21 +86,27 @@ refused "tiny again: refused without --overwrite" \
 
 # ---- the hard cases, coarse ----------------------------------------------
 # hard-tiny.yaml: the near-incompressible panel at 157 points, F3 200% and
-# F4 60% at 237, F4 between plates, the reduced shock tube.  The static
-# solve refuses contact: its run on the plates is refused, listed with the
-# reason in the one table, and the suite goes on (exit 1, a refused scene).
+# F4 60% at 237, F4 between plates, the reduced shock tube.  Every run
+# completes (exit 0); F4 between plates by a static solve (contact in
+# Newton's problem) converges, +15.0% against the contact referee's N = 12
+# measured at 237 points (the coarse resolution's error: -0.5% by
+# relaxation at 1851 points, docs/validation.md).
 out=$work/hard-tiny
 "$bin" bench "$src/cases/bench/hard-tiny.yaml" --out "$out" --quiet \
   >"$out.log" 2>"$work/err"
 rc=$?
 cat "$out.log"
-check "hard-tiny: exit 1, a refused run (got $rc)" test $rc -eq 1
+check "hard-tiny: exit 0, every run completed (got $rc)" test $rc -eq 0
 csv=$out/bench.csv
 md=$out/bench.md
 s=$(field "$csv" f4-plates-40 fpm-static status)
-check "hard-tiny: the plates by a static solve refused ($s)" test "$s" = refused
-check "hard-tiny: its reason in the table's diagnosis column" grep -Eq \
-  '^\| f4-plates-40 \| 0.02 \| fpm-static \| refused \|.*contact.* \|$' "$md"
+check "hard-tiny: the plates by a static solve converged ($s)" \
+  test "$s" = converged
+t=$(field "$csv" f4-plates-40 fpm-static reaction_error_fe)
+check "hard-tiny: the plates' reaction within 20% of the contact referee ($t)" \
+  awk -v t="$t" 'BEGIN { exit !(t != "" && t * t <= 0.20 * 0.20) }'
+check "hard-tiny: the plates in the table" grep -Eq \
+  '^\| f4-plates-40 \| 0.02 \| fpm-static \| converged \|' "$md"
 for m in fpm-static fpm-paper; do
   s=$(field "$csv" panel $m status)
   check "hard-tiny: panel by $m converged ($s)" test "$s" = converged
@@ -130,7 +136,7 @@ for c in f3-200 f4-60; do
   check "hard-tiny: $c in the table" grep -Eq "^\| $c \| 0.02 \| fpm-static \| $s \|" "$md"
 done
 s=$(field "$csv" m2-shock-tube mpm status)
-check "hard-tiny: the shock tube completed after the refusal ($s)" \
+check "hard-tiny: the shock tube completed ($s)" \
   test "$s" = completed
 
 # ---- a failing case does not stop the suite ------------------------------

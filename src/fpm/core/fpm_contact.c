@@ -26,6 +26,50 @@ pm_err fpm_contact_state_init(const fpm_contact *c, double **out) {
   return PM_SUCCESS;
 }
 
+/* Static solves: whether a point at gap g (anchor: its anchor, NaN for
+ * none) touches.  An anchored point holds on over the whole load step
+ * (fpm_contact_commit lets it go at a converged step where it has come
+ * off): its force is then smooth in the displacement, where a release
+ * inside the step would make the residual jump by its tangential part and
+ * Newton chatter between the two. */
+static bool touching_fixed(double g, const double *anchor) {
+  return g < 0 || !isnan(anchor[0]);
+}
+
+/* The force on a point at x touching (g < 0, normal n) the body displaced
+ * by d: sticking to anchor (non-NULL), else pushed along n; its energy. */
+static double touch_force(double k, const double d[3], const double x[3],
+                          double g, const double n[3], const double *anchor,
+                          double F[3]) {
+  if (!anchor) {
+    for (int a = 0; a < 3; a++) F[a] = -k * g * n[a];
+    return 0.5 * k * g * g;
+  }
+  double e = 0;
+  for (int a = 0; a < 3; a++) {
+    const double s = x[a] - d[a] - anchor[a];
+    F[a] = -k * s;
+    e += s * s;
+  }
+  return 0.5 * k * e;
+}
+
+/* dF = -K dx of touch_force at x (g < 0, normal n): k I sticking, else
+ * k n n, plus on a sphere the turn of n, dn/dx = (I - n n) / r. */
+static void touch_tangent(const pm_scene_bc *bc, double k, double g,
+                          const double n[3], bool sticking, double K[9]) {
+  memset(K, 0, 9 * sizeof(double));
+  if (sticking) {
+    K[0] = K[4] = K[8] = k;
+    return;
+  }
+  double q = 0;
+  if (bc->on == PM_ON_SPHERE) q = g / (g + bc->rigid_radius);
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++)
+      K[3 * a + b] = k * (n[a] * n[b] + q * ((a == b) - n[a] * n[b]));
+}
+
 bool fpm_contact_point(const pm_scene_bc *bc, double k, const double d[3],
                        const double x[3], double anchor[3], double F[3],
                        double *energy) {
@@ -37,20 +81,10 @@ bool fpm_contact_point(const pm_scene_bc *bc, double k, const double d[3],
     anchor[0] = anchor[1] = anchor[2] = NAN;
     return false;
   }
-  if (bc->contact == PM_CONTACT_FRICTIONLESS) {
-    for (int a = 0; a < 3; a++) F[a] = -k * g * n[a];
-    *energy = 0.5 * k * g * g;
-    return true;
-  }
-  if (isnan(anchor[0]))
+  const bool sticking = bc->contact == PM_CONTACT_STICKING;
+  if (sticking && isnan(anchor[0]))
     for (int a = 0; a < 3; a++) anchor[a] = x[a] - d[a] - g * n[a];
-  double e = 0;
-  for (int a = 0; a < 3; a++) {
-    const double s = x[a] - d[a] - anchor[a];
-    F[a] = -k * s;
-    e += s * s;
-  }
-  *energy = 0.5 * k * e;
+  *energy = touch_force(k, d, x, g, n, sticking ? anchor : NULL, F);
   return true;
 }
 
@@ -59,19 +93,16 @@ void fpm_contact_tangent(const pm_scene_bc *bc, double k, const double d[3],
                          double K[9]) {
   double n[3];
   const double g = pm_rigid_gap(bc, d, x, n);
+  (void)anchor;
   memset(K, 0, 9 * sizeof(double));
-  if (!(g < 0)) return;
-  if (bc->contact == PM_CONTACT_STICKING) {
-    (void)anchor;
-    K[0] = K[4] = K[8] = k;
-    return;
-  }
-  /* F = -k g n: on a sphere n turns with x, dn/dx = (I - n n) / r. */
-  double q = 0;
-  if (bc->on == PM_ON_SPHERE) q = g / (g + bc->rigid_radius);
-  for (int a = 0; a < 3; a++)
-    for (int b = 0; b < 3; b++)
-      K[3 * a + b] = k * (n[a] * n[b] + q * ((a == b) - n[a] * n[b]));
+  if (g < 0) touch_tangent(bc, k, g, n, bc->contact == PM_CONTACT_STICKING, K);
+}
+
+/* The rigid body's displacement at time t: ramp(t) d(t), times scale. */
+static void body_displacement(const pm_scene_bc *bc, double t, double scale,
+                              double d[3]) {
+  pm_rigid_displacement(bc, t, d);
+  for (int a = 0; a < 3; a++) d[a] *= scale;
 }
 
 /* Each point's boundary area (sum of its facets' areas) into area (n). */
@@ -170,9 +201,13 @@ void fpm_contact_destroy(fpm_contact *c) {
   free(c);
 }
 
-void fpm_contact_force(const fpm_model *m, fpm_state *st, double t) {
+/* The rigid bodies' forces at time t (displacements times scale) added to
+ * st->f, the reactions and energy kept in st->contact and the energy added
+ * to st->penalty_energy; returns |F|^2.  fixed: the anchors are read, not
+ * written (a sticking point without one is pushed along the normal). */
+static double bodies_force(const fpm_model *m, fpm_state *st, double t,
+                           double scale, bool fixed) {
   const fpm_contact *c = m->contact;
-  if (!c) return;
   double *restrict S = st->contact, *restrict f = st->f;
   const double *restrict u = st->u, *restrict x = m->x;
   double energy = 0, fsq = 0;
@@ -182,15 +217,22 @@ void fpm_contact_force(const fpm_model *m, fpm_state *st, double t) {
     const double *restrict kq = c->pair_k;
     const long q0 = c->pair_ptr[b], q1 = c->pair_ptr[b + 1];
     double d[3], rx = 0, ry = 0, rz = 0, e = 0, s2 = 0;
-    pm_rigid_displacement(bc, t, d);
+    body_displacement(bc, t, scale, d);
     PM_OMP(parallel for schedule(static) default(none)
            reduction(+ : rx, ry, rz, e, s2)
-           shared(q0, q1, pt, kq, S, f, u, x, bc, d))
+           shared(q0, q1, pt, kq, S, f, u, x, bc, d, fixed))
     for (long q = q0; q < q1; q++) {
       const long i = pt[q];
-      double xi[3], F[3], ei;
+      double xi[3], F[3], ei, n[3];
       for (int a = 0; a < 3; a++) xi[a] = x[3 * i + a] + u[3 * i + a];
-      if (!fpm_contact_point(bc, kq[q], d, xi, S + 3 * q, F, &ei)) continue;
+      if (fixed) {
+        const double g = pm_rigid_gap(bc, d, xi, n);
+        if (!touching_fixed(g, S + 3 * q)) continue;
+        const double *anchor = isnan(S[3 * q]) ? NULL : S + 3 * q;
+        ei = touch_force(kq[q], d, xi, g, n, anchor, F);
+      } else if (!fpm_contact_point(bc, kq[q], d, xi, S + 3 * q, F, &ei)) {
+        continue;
+      }
       for (int a = 0; a < 3; a++) f[3 * i + a] -= F[a];
       rx += F[0];
       ry += F[1];
@@ -207,27 +249,38 @@ void fpm_contact_force(const fpm_model *m, fpm_state *st, double t) {
   }
   S[ST_BODY(c, c->n_bodies)] = energy;
   st->penalty_energy += energy;
-  st->fext_sq += fsq;
+  return fsq;
+}
+
+void fpm_contact_force(const fpm_model *m, fpm_state *st, double t) {
+  if (!m->contact) return;
+  st->fext_sq += bodies_force(m, st, t, 1, false);
   st->fext_norm = sqrt(st->fext_sq);
 }
 
-void fpm_contact_start(const fpm_model *m, fpm_state *st, double t) {
+void fpm_contact_start_scaled(const fpm_model *m, fpm_state *st, double t,
+                              double scale) {
   const fpm_contact *c = m->contact;
   if (!c) return;
   for (int b = 0; b < c->n_bodies; b++) {
     double *B = st->contact + ST_BODY(c, b);
     memcpy(B + 3, B, 3 * sizeof(double));
-    pm_rigid_displacement(&m->scene->bcs[c->bc[b]], t, B + 6);
+    body_displacement(&m->scene->bcs[c->bc[b]], t, scale, B + 6);
   }
 }
 
-double fpm_contact_work(const fpm_model *m, fpm_state *st, double t) {
+void fpm_contact_start(const fpm_model *m, fpm_state *st, double t) {
+  fpm_contact_start_scaled(m, st, t, 1);
+}
+
+double fpm_contact_work_scaled(const fpm_model *m, fpm_state *st, double t,
+                               double scale) {
   const fpm_contact *c = m->contact;
   if (!c) return 0;
   double work = 0;
   for (int b = 0; b < c->n_bodies; b++) {
     double *B = st->contact + ST_BODY(c, b), d[3];
-    pm_rigid_displacement(&m->scene->bcs[c->bc[b]], t, d);
+    body_displacement(&m->scene->bcs[c->bc[b]], t, scale, d);
     for (int a = 0; a < 3; a++) {
       work += 0.5 * (B[3 + a] + B[a]) * (d[a] - B[6 + a]);
       B[3 + a] = B[a];
@@ -235,6 +288,10 @@ double fpm_contact_work(const fpm_model *m, fpm_state *st, double t) {
     }
   }
   return work;
+}
+
+double fpm_contact_work(const fpm_model *m, fpm_state *st, double t) {
+  return fpm_contact_work_scaled(m, st, t, 1);
 }
 
 void fpm_contact_reaction(const fpm_model *m, const fpm_state *st, int b,
@@ -249,4 +306,63 @@ void fpm_contact_reaction(const fpm_model *m, const fpm_state *st, int b,
 double fpm_contact_stable_dt(const fpm_contact *c, double dt) {
   if (!c || !(c->max_k_over_m > 0)) return dt;
   return 2 / sqrt(4 / (dt * dt) + c->max_k_over_m);
+}
+
+/* ---- static solves: the bodies at scale d(t), anchors held fixed ---- */
+
+double fpm_contact_force_fixed(const fpm_model *m, fpm_state *st, double t,
+                               double scale) {
+  return m->contact ? bodies_force(m, st, t, scale, true) : 0;
+}
+
+void fpm_contact_tangent_fixed(const fpm_model *m, const fpm_state *st,
+                               double t, double scale, double *K) {
+  const fpm_contact *c = m->contact;
+  if (!c) return;
+  memset(K, 0, 9 * (size_t)m->n_own * sizeof(double));
+  const double *restrict S = st->contact, *restrict u = st->u,
+                         *restrict x = m->x;
+  for (int b = 0; b < c->n_bodies; b++) {
+    const pm_scene_bc *bc = &m->scene->bcs[c->bc[b]];
+    const long *restrict pt = c->pair_point;
+    const double *restrict kq = c->pair_k;
+    const long q0 = c->pair_ptr[b], q1 = c->pair_ptr[b + 1];
+    double d[3];
+    body_displacement(bc, t, scale, d);
+    /* (a point is one pair of each body: no two threads share a block) */
+    PM_OMP(parallel for schedule(static) default(none)
+           shared(q0, q1, pt, kq, S, u, x, bc, d, K))
+    for (long q = q0; q < q1; q++) {
+      const long i = pt[q];
+      double xi[3], n[3], Kq[9];
+      for (int a = 0; a < 3; a++) xi[a] = x[3 * i + a] + u[3 * i + a];
+      const double g = pm_rigid_gap(bc, d, xi, n);
+      if (!touching_fixed(g, S + 3 * q)) continue;
+      touch_tangent(bc, kq[q], g, n, !isnan(S[3 * q]), Kq);
+      for (int a = 0; a < 9; a++) K[9 * i + a] += Kq[a];
+    }
+  }
+}
+
+void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
+                        double scale) {
+  const fpm_contact *c = m->contact;
+  if (!c) return;
+  const double tol = 1e-9 * m->scene->mesh_size;
+  for (int b = 0; b < c->n_bodies; b++) {
+    const pm_scene_bc *bc = &m->scene->bcs[c->bc[b]];
+    if (bc->contact != PM_CONTACT_STICKING) continue;
+    double d[3];
+    body_displacement(bc, t, scale, d);
+    for (long q = c->pair_ptr[b]; q < c->pair_ptr[b + 1]; q++) {
+      const long i = c->pair_point[q];
+      double xi[3], n[3], *A = st->contact + 3 * q;
+      for (int a = 0; a < 3; a++) xi[a] = m->x[3 * i + a] + st->u[3 * i + a];
+      const double g = pm_rigid_gap(bc, d, xi, n);
+      if (g > tol)
+        A[0] = A[1] = A[2] = NAN;
+      else if (isnan(A[0]))
+        for (int a = 0; a < 3; a++) A[a] = xi[a] - d[a] - g * n[a];
+    }
+  }
 }

@@ -67,6 +67,40 @@ void fpm_contact_start(const fpm_model *m, fpm_state *st, double t);
  * mean reaction times the displacement increment), remembered next. */
 double fpm_contact_work(const fpm_model *m, fpm_state *st, double t);
 
+/* The same with every body's displacement d(t) times scale: a static
+ * solve's proportional load path (t the end of the ramps, scale the load
+ * factor). */
+void fpm_contact_start_scaled(const fpm_model *m, fpm_state *st, double t,
+                              double scale);
+double fpm_contact_work_scaled(const fpm_model *m, fpm_state *st, double t,
+                               double scale);
+
+/* Static solves (fpm_static): the contact as a function of the
+ * displacement alone, the anchors held as the last converged load step
+ * left them (fpm_contact_commit).  A point with an anchor sticks to it
+ * (tangent k I) through the load step, wherever it goes; one without
+ * (frictionless bodies, and sticking points that touch anew within the
+ * step) is pushed along the normal while its gap is < 0 (k n n, plus the
+ * sphere's curvature term).
+ *
+ * fpm_contact_force_fixed: the forces at the bodies' displacements
+ * scale d(t) subtracted from st->f, the reactions kept in st->contact and
+ * the energy added to st->penalty_energy, as fpm_contact_force; returns
+ * |F|^2 (st->fext_sq is left alone).  Allocates nothing. */
+double fpm_contact_force_fixed(const fpm_model *m, fpm_state *st, double t,
+                               double scale);
+/* Its tangent at st->u: K (9 per own point, row-major, the caller's)
+ * with dF_i = -K_i du_i summed over the bodies, 0 where apart. */
+void fpm_contact_tangent_fixed(const fpm_model *m, const fpm_state *st,
+                               double t, double scale, double *K);
+/* After a converged load step (and at the start): every sticking point
+ * touching (gap at most 1e-9 mesh_size: the faces that start on a plate
+ * too) without an anchor is anchored where it is; an anchored point now
+ * apart (gap above that: the contact pulled it) is let go for the next
+ * step. */
+void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
+                        double scale);
+
 /* Add the reaction of condition b (the force of the rigid body on the body)
  * to R; nothing when b is no rigid body. */
 void fpm_contact_reaction(const fpm_model *m, const fpm_state *st, int b,

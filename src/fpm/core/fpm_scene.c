@@ -194,15 +194,6 @@ static pm_err check_boundary(const pm_scene *s) {
   char p[64];
   for (int i = 0; i < s->n_bcs; i++) {
     const pm_scene_bc *bc = &s->bcs[i];
-    if (PM_BC_RIGID(bc) && s->time.qs == PM_QS_STATIC)
-      return pm_scene_fail(
-          s,
-          PM_PATH(p, "boundary.%d.%s", i,
-                  bc->on == PM_ON_PLATE ? "plate" : "sphere"),
-          true,
-          "contact needs time.quasi_static.method dynamic-relaxation (or "
-          "damping, none) for now: static solves have no contact tangent "
-          "yet, got method static");
     if (bc->velocity_mask || bc->absorbing)
       return pm_scene_fail(
           s,

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_contact.h"
 #include "fpm_static_impl.h"
 #include "pm_progress.h"
 
@@ -85,6 +86,8 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   PM_TRY(fpm_static_admissible(
       c, fpm_static_evaluate(c, resumed && !m->xc ? v.x : NULL)));
   fpm_support_start(m, st);
+  if (!resumed) fpm_contact_commit(m, st, c->load_end, 0);
+  fpm_contact_start_scaled(m, st, c->load_end, ss->load.lambda);
   memcpy(c->u_old, st->u, 3 * m->n * sizeof(double));
   /* The figures of the state (a resumed one's too, for a run that fails
    * before its next step); only the initial state is a frame. */

@@ -47,7 +47,12 @@ typedef struct {
   double *du;    /* 3 n work */
   double *df;    /* 3 n work */
   double *u_old; /* 3 n: the last converged displacement */
-  double load_end, t;
+  double load_end, t, lambda;
+  /* Rigid bodies in contact (m->contact): the contact tangent's blocks at
+   * the linearisation point (9 per own point, fpm_contact_tangent_fixed)
+   * and |F|^2 of the contact forces last evaluated. */
+  double *contact_K;
+  double contact_fsq;
   fpm_observer observer;
   void *octx;
   fpm_step_info si;

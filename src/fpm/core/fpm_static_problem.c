@@ -7,13 +7,20 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_contact.h"
 #include "fpm_static_impl.h"
 
 /* The state at the free values x (prescribed dofs as set by set_load). */
 long fpm_static_evaluate(fpm_static_ctx *c, const double *x) {
   if (x)
     for (long j = 0; j < c->nheld; j++) c->st->u[c->dof[j]] = x[j];
-  return fpm_force(c->m, c->st);
+  const long bad = fpm_force(c->m, c->st);
+  /* the rigid bodies at lambda times their displacement at the end of the
+   * ramps, as the supports */
+  if (bad < 0 && c->m->contact)
+    c->contact_fsq =
+        fpm_contact_force_fixed(c->m, c->st, c->load_end, c->lambda);
+  return bad;
 }
 
 static pm_err inadmissible(const fpm_static_ctx *c, long p) {
@@ -50,6 +57,9 @@ static pm_err prepare(void *ctx, const double *x) {
   long bad = fpm_static_evaluate(c, x);
   if (bad >= 0) return inadmissible(c, bad);
   fpm_linear_prepare(c->m, c->st, c->lin);
+  if (c->contact_K)
+    fpm_contact_tangent_fixed(c->m, c->st, c->load_end, c->lambda,
+                              c->contact_K);
   return PM_SUCCESS;
 }
 
@@ -59,6 +69,13 @@ static pm_err apply(void *ctx, const double *x, const double *dx, double *dr) {
   memset(c->du, 0, 3 * c->m->n * sizeof(double));
   for (long j = 0; j < c->nheld; j++) c->du[c->dof[j]] = dx[j];
   fpm_force_linear(c->m, c->lin, c->du, c->df);
+  if (c->contact_K) /* the contact's blocks: dr_i += K_i du_i */
+    for (long i = 0; i < c->m->n_own; i++) {
+      const double *K = c->contact_K + 9 * i, *d = c->du + 3 * i;
+      for (int a = 0; a < 3; a++)
+        c->df[3 * i + a] +=
+            K[3 * a] * d[0] + K[3 * a + 1] * d[1] + K[3 * a + 2] * d[2];
+    }
   for (long j = 0; j < c->nf; j++) dr[j] = c->df[c->dof[j]];
   for (long j = c->nf; j < c->nheld; j++) dr[j] = 0;
   return PM_SUCCESS;
@@ -95,6 +112,7 @@ pm_err fpm_static_set_load(void *ctx, double lambda) {
   fpm_static_ctx *c = ctx;
   const fpm_model *m = c->m;
   c->t = lambda * c->load_end;
+  c->lambda = lambda;
   long key = 0;
   pm_err e = own_loads(c, lambda, &key);
   if (m->xc) {
@@ -126,7 +144,8 @@ void fpm_static_figures(fpm_static_ctx *c, long step) {
   }
   for (long d = 0; d < 3 * n; d++) c->du[d] = st->u[d] - c->u_old[d];
   double rr;
-  const double work = fpm_support_work(m, st, c->du, 1, &rr);
+  const double work = fpm_support_work(m, st, c->du, 1, &rr) +
+                      fpm_contact_work_scaled(m, st, c->load_end, c->lambda);
   memcpy(c->u_old, st->u, 3 * n * sizeof(double));
   double bflux = st->bflux_norm, penalty = st->penalty_energy;
   double sums[6] = {se, rf, rr, work, st->bflux_sq, penalty};
@@ -137,7 +156,8 @@ void fpm_static_figures(fpm_static_ctx *c, long step) {
     penalty = sums[5];
   }
   *c->ext_work += sums[3];
-  double ref = sqrt(rr) + bflux + st->fext_norm;
+  /* (contact runs on one process: its forces are all the model's) */
+  double ref = sqrt(rr) + bflux + st->fext_norm + sqrt(c->contact_fsq);
   fpm_step_info *si = &c->si;
   si->step = step;
   si->t = c->t;
@@ -164,6 +184,9 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
     x = c->held;
   }
   PM_CALL(fpm_static_admissible(c, fpm_static_evaluate(c, x)));
+  /* the contact's state of this step: sticking points that touched anew
+   * hold on from here (the residual at x is the same) */
+  fpm_contact_commit(c->m, c->st, c->load_end, lambda);
   fpm_static_figures(c, step);
   c->si.converged = lambda >= 1;
   c->si.last = c->si.converged;
@@ -221,6 +244,7 @@ void fpm_static_solve_free(fpm_static_solve *v) {
   free(v->c.du);
   free(v->c.df);
   free(v->c.u_old);
+  free(v->c.contact_K);
   free(v->free_of);
   free(v->ptr);
   free(v->idx);
@@ -241,6 +265,8 @@ pm_err fpm_static_setup(const fpm_model *m, fpm_state *st,
   PM_CALL(PM_ALLOC(c->du, 3 * n, "displacement increment"));
   PM_CALL(PM_ALLOC(c->df, 3 * n, "force increment"));
   PM_CALL(PM_ALLOC(c->u_old, 3 * n, "converged displacement"));
+  if (m->contact)
+    PM_CALL(PM_ALLOC(c->contact_K, 9 * m->n_own, "contact tangent"));
   for (long d = 0; d < 3 * n; d++) {
     v->free_of[d] = -1;
     if (d < 3 * m->n_own && !m->fixed[d]) {

@@ -339,7 +339,8 @@ pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
     }
   }
   const long *free_of = c->free_of, *pat = c->pat_ptr;
-  PM_OMP(parallel default(none) shared(n, rows, m, t, free_of, pat, val)) {
+  const double *K = c->contact_K;
+  PM_OMP(parallel default(none) shared(n, rows, m, t, free_of, pat, val, K)) {
     int th = 0;
 #ifdef _OPENMP
     th = omp_get_thread_num();
@@ -370,6 +371,8 @@ pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
         double *b = blk + 9 * mark[t->S_m[q]];
         for (int cc = 0; cc < 3; cc++) b[4 * cc] += t->S[q];
       }
+      if (K) /* the contact's block on the diagonal */
+        for (int a = 0; a < 9; a++) blk[9 * mark[k] + a] += K[9 * k + a];
       for (int cc = 0; cc < 3; cc++) {
         long row = free_of[3 * k + cc];
         if (row < 0) continue;
