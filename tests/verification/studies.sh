@@ -83,8 +83,11 @@ done
 # The scenes' own formulation (IIPG, quadratic jump, p = 0.05), errors of the
 # displacement at the FE lattice and of the top reaction against the
 # CalculiX referee the scene names.  F3 60%: both rates >= 1.8 (the FE
-# reaction is converged to 5e-4).  F4 20%: the displacement rate >= 1.6 (the
-# bound of the self-convergence check); its reaction rate is printed, not
+# reaction is converged to 5e-4).  F4 20%: the displacement rate >= 1.5, the
+# issue's bound (1.50 measured against the lattice of the converged, graded
+# referee; against the uniform N = 20 mesh it replaced, whose error at the
+# clamped edges was correlated with a uniform point cloud's, it read 1.6 and
+# more); its reaction rate is printed, not
 # asserted (FE's own reaction converges only at order 1.6 on meshes graded
 # towards the clamped edges; the referee is their Richardson limit).
 for c in f3-extension-60 f4-compression-20; do
@@ -100,7 +103,7 @@ for c in f3-extension-60 f4-compression-20; do
     check "$c against FE: displacement rate q = $q >= 1.8" ge "$q" 1.8
     check "$c against FE: reaction error rate q = $qr >= 1.8" ge "$qr" 1.8
   else
-    check "$c against FE: displacement rate q = $q >= 1.6" ge "$q" 1.6
+    check "$c against FE: displacement rate q = $q >= 1.5" ge "$q" 1.5
     echo "  $c against FE: reaction error rate q = $qr (not asserted)"
   fi
   # The finest level (mesh size 8.72e-3 m, h = 1.09e-2 m, 1851 points) is
