@@ -155,6 +155,81 @@ static pm_err mesh_from_raw(gm_gmsh_mesh *raw, gm_mesh **out) {
 /* Not thread-safe: gmsh keeps global state, initialized and finalized here. */
 pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
                    gm_mesh **out) {
+  return gm_mesh_box_graded(dim, min, max, h, NULL, out);
+}
+
+double gm_grade_size(const gm_grade *g, int dim, const double min[3],
+                     const double max[3], double h, const double x[3]) {
+  if (!g || !g->faces) return h;
+  double d = INFINITY;
+  for (int f = 0; f < 2 * dim; f++)
+    if (g->faces & (1u << f)) {
+      const double plane = (f % 2) ? max[f / 2] : min[f / 2];
+      d = fmin(d, fabs(x[f / 2] - plane));
+    }
+  if (d >= g->distance) return h;
+  return g->size + (h - g->size) * d / g->distance;
+}
+
+/* The Distance field on the graded faces (surfaces in 3D, curves in 2D)
+ * and the Threshold field from it, as the background mesh. */
+static pm_err grade_fields(int dim, const double min[3], const double max[3],
+                           double h, const gm_grade *g) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0;
+  double tags[6];
+  size_t n = 0;
+  /* Wide enough for OpenCASCADE's enlarged bounding boxes, far from the
+   * opposite face. */
+  double eps = INFINITY;
+  for (int k = 0; k < dim; k++) eps = fmin(eps, 1e-3 * (max[k] - min[k]));
+  for (int f = 0; f < 2 * dim; f++) {
+    if (!(g->faces & (1u << f))) continue;
+    double lo[3] = {min[0] - eps, min[1] - eps, dim == 3 ? min[2] - eps : -eps};
+    double hi[3] = {max[0] + eps, max[1] + eps, dim == 3 ? max[2] + eps : eps};
+    const double plane = (f % 2) ? max[f / 2] : min[f / 2];
+    lo[f / 2] = plane - eps;
+    hi[f / 2] = plane + eps;
+    int *dt = NULL;
+    size_t ndt = 0;
+    gmshModelGetEntitiesInBoundingBox(lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
+                                      &dt, &ndt, dim - 1, &ierr);
+    GM_GMSH_CHECK("finding a graded face", NULL);
+    for (size_t i = 0; i + 1 < ndt && n < 6; i += 2) tags[n++] = dt[i + 1];
+    gmshFree(dt);
+  }
+  const int dist = gmshModelMeshFieldAdd("Distance", -1, &ierr);
+  GM_GMSH_CHECK("adding the Distance field", NULL);
+  gmshModelMeshFieldSetNumbers(dist, dim == 3 ? "FacesList" : "EdgesList", tags,
+                               n, &ierr);
+  GM_GMSH_CHECK("setting the graded faces", NULL);
+  const int thr = gmshModelMeshFieldAdd("Threshold", -1, &ierr);
+  GM_GMSH_CHECK("adding the Threshold field", NULL);
+  const struct {
+    const char *name;
+    double value;
+  } opt[] = {{"IField", dist},
+             {"LcMin", g->size},
+             {"LcMax", h},
+             {"DistMin", 0.0},
+             {"DistMax", g->distance}};
+  for (size_t i = 0; i < sizeof opt / sizeof opt[0]; i++) {
+    gmshModelMeshFieldSetNumber(thr, opt[i].name, opt[i].value, &ierr);
+    GM_GMSH_CHECK(opt[i].name, NULL);
+  }
+  gmshModelMeshFieldSetAsBackgroundMesh(thr, &ierr);
+  GM_GMSH_CHECK("setting the background mesh", NULL);
+  gmshOptionSetNumber("Mesh.MeshSizeMin", g->size, &ierr);
+  GM_GMSH_CHECK("Mesh.MeshSizeMin", NULL);
+  gmshOptionSetNumber("Mesh.MeshSizeExtendFromBoundary", 0, &ierr);
+  GM_GMSH_CHECK("Mesh.MeshSizeExtendFromBoundary", NULL);
+done:
+  return ret;
+}
+
+/* Not thread-safe: gmsh keeps global state, initialized and finalized here. */
+pm_err gm_mesh_box_graded(int dim, const double min[3], const double max[3],
+                          double h, const gm_grade *g, gm_mesh **out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_mesh_box: out is NULL");
   *out = NULL;
   PM_CHECK(dim == 2 || dim == 3, PM_ERR_ARG, "mesh dimension %d is not 2 or 3",
@@ -166,6 +241,15 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
     PM_CHECK(isfinite(min[k]) && isfinite(max[k]) && max[k] > min[k],
              PM_ERR_ARG, "empty box along axis %d: [%g, %g]", k, min[k],
              max[k]);
+  if (g && g->faces) {
+    PM_CHECK(isfinite(g->size) && g->size > 0.0 && g->size <= h, PM_ERR_ARG,
+             "graded size must be in (0, %g] (got %g)", h, g->size);
+    PM_CHECK(isfinite(g->distance) && g->distance > 0.0, PM_ERR_ARG,
+             "grading distance must be positive (got %g)", g->distance);
+    PM_CHECK(g->faces < (1u << (2 * dim)), PM_ERR_ARG,
+             "graded faces 0x%x: a face the dimension %d has not", g->faces,
+             dim);
+  }
 
   pm_err ret = PM_SUCCESS;
   gm_mesh *m = NULL;
@@ -185,6 +269,7 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
   GM_GMSH_CHECK("adding the box", NULL);
   gmshModelOccSynchronize(&ierr);
   GM_GMSH_CHECK("synchronize", NULL);
+  if (g && g->faces) PM_TRY(grade_fields(dim, min, max, h, g));
   gmshModelMeshGenerate(dim, &ierr);
   GM_GMSH_CHECK("mesh generation", NULL);
   PM_TRY(gm_gmsh_read(NULL, dim, false, &raw));

@@ -44,6 +44,28 @@ typedef struct {
 pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
                    gm_mesh **out);
 
+/* A grading of a box mesh toward some of its faces: element size `size` on
+ * them, growing linearly with the distance d from the nearest of them to the
+ * box's own size h at d >= distance. */
+typedef struct {
+  unsigned faces;  /* bit f: face f (xmin = 0 ... zmax = 5, as pm_face); 0:
+                      no grading */
+  double size;     /* element size on the faces, 0 < size <= h */
+  double distance; /* where the size reaches h, > 0 */
+} gm_grade;
+
+/* gm_mesh_box with the element size graded by g (gmsh's Distance and
+ * Threshold fields as the background mesh); g NULL or g->faces 0: as
+ * gm_mesh_box.  Errors as gm_mesh_box, and PM_ERR_ARG for a size outside
+ * (0, h], a distance <= 0 or a face the dimension has not. */
+pm_err gm_mesh_box_graded(int dim, const double min[3], const double max[3],
+                          double h, const gm_grade *g, gm_mesh **out);
+
+/* The element size g asks at x in the box [min, max] of a mesh of size h
+ * (h where g is NULL or grades no face). */
+double gm_grade_size(const gm_grade *g, int dim, const double min[3],
+                     const double max[3], double h, const double x[3]);
+
 /* Mesh the volume (the surface in the z = 0 plane in 2D) of a gmsh-readable
  * file (.geo, .msh, .step/.stp, .brep), read and meshed as gm_volume_load
  * does (same h rule: a mesh in the file is used as it is; otherwise gmsh

@@ -260,6 +260,12 @@ typedef struct pm_scene {
   int dimension;                    /* 2 (plane strain) or 3 */
   double box_min[3], box_max[3];    /* domain.box; z 0 in 2D */
   double mesh_size;                 /* discretization.mesh_size, m, > 0 */
+  struct {
+    unsigned near;   /* discretization.refine.near: bit f for face f
+                        (pm_face); 0: a uniform mesh */
+    double size;     /* discretization.refine.size, m, in (0, mesh_size] */
+    double distance; /* discretization.refine.distance, m, > 0 */
+  } refine;
   pm_scene_material *materials;
   int n_materials;
   pm_scene_body *bodies;

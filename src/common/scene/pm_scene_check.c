@@ -19,6 +19,32 @@ static pm_err finish_domain(pm_reader *r, pm_scene *s) {
   return PM_SUCCESS;
 }
 
+/* discretization.refine: faces of the box's dimension, a size at most the
+ * mesh size, and a box FPM meshes (not MPM's grid, not a mesh file). */
+static pm_err finish_refine(pm_reader *r, pm_scene *s) {
+  if (!s->refine.near) return PM_SUCCESS;
+  char what[128];
+  if (s->refine.near >= (1u << (2 * s->dimension)))
+    return pm_reader_expected(r, "discretization.refine.near",
+                              "a list of names from xmin, xmax, ymin, ymax "
+                              "(dimension 2)");
+  if (s->refine.size > s->mesh_size) {
+    snprintf(what, sizeof what, "a number <= discretization.mesh_size (%g)",
+             s->mesh_size);
+    return pm_reader_expected(r, "discretization.refine.size", what);
+  }
+  if (!s->method || strcmp(s->method, "fpm") != 0)
+    return pm_reader_fail(r, "discretization.refine", true,
+                          "expected method fpm (a graded gmsh mesh), got "
+                          "method %s",
+                          s->method ? s->method : "(none)");
+  if (s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH)
+    return pm_reader_fail(r, "discretization.refine", true,
+                          "expected a box domain: the body's mesh file sets "
+                          "its own sizes");
+  return PM_SUCCESS;
+}
+
 /* A path given relative to the scene file's folder, made usable from the
  * working directory (an absolute path is kept). */
 static pm_err relative_to_scene(const pm_scene *s, char **path) {
@@ -452,6 +478,7 @@ static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
 pm_err pm_scene_finish(pm_reader *r, pm_scene *s) {
   PM_CALL(finish_domain(r, s));
   PM_CALL(finish_bodies(r, s));
+  PM_CALL(finish_refine(r, s));
   PM_CALL(finish_time(r, s));
   PM_CALL(finish_bcs(r, s));
   if (s->reference_fe) PM_CALL(relative_to_scene(s, &s->reference_fe));

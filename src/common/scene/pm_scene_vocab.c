@@ -69,6 +69,38 @@ static const pm_key domain_keys[] = {
      .doc = "FPM: the block meshed; MPM: the grid (faces on grid planes)"},
     {0}};
 
+static const pm_name face_names[] = {{"xmin", 1u << PM_FACE_XMIN},
+                                     {"xmax", 1u << PM_FACE_XMAX},
+                                     {"ymin", 1u << PM_FACE_YMIN},
+                                     {"ymax", 1u << PM_FACE_YMAX},
+                                     {"zmin", 1u << PM_FACE_ZMIN},
+                                     {"zmax", 1u << PM_FACE_ZMAX},
+                                     {NULL, 0}};
+static const pm_key refine_keys[] = {
+    {.name = "near",
+     .type = PM_KEY_FLAGS,
+     .offset = S(refine.near),
+     .flags = PM_KEY_REQUIRED,
+     .min_count = 1,
+     .names = face_names,
+     .doc = "faces of domain.box the mesh is graded toward"},
+    {.name = "size",
+     .type = PM_KEY_NUMBER,
+     .offset = S(refine.size),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .unit = "m",
+     .doc = "element size on those faces, at most mesh_size"},
+    {.name = "distance",
+     .type = PM_KEY_NUMBER,
+     .offset = S(refine.distance),
+     .flags = PM_KEY_REQUIRED,
+     .range = PM_RANGE_GT,
+     .unit = "m",
+     .doc = "distance from the nearest of them where the size, growing "
+            "linearly, reaches mesh_size"},
+    {0}};
+
 static const pm_key discretization_keys[] = {
     {.name = "mesh_size",
      .type = PM_KEY_NUMBER,
@@ -77,6 +109,11 @@ static const pm_key discretization_keys[] = {
      .range = PM_RANGE_GT,
      .unit = "m",
      .doc = "FPM: gmsh element size; MPM: cell size"},
+    {.name = "refine",
+     .type = PM_KEY_MAPPING,
+     .keys = refine_keys,
+     .doc = "FPM box domain: a mesh graded toward faces (singular edges "
+            "of clamped faces); unset: uniform at mesh_size"},
     {0}};
 
 static const pm_key body_box_keys[] = {{.name = "min",

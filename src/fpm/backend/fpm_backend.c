@@ -62,9 +62,13 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   if (domain >= 0)
     PM_TRY(gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
                         &sim->mesh));
-  else
-    PM_TRY(gm_mesh_box(s->dimension, s->box_min, s->box_max, s->mesh_size,
-                       &sim->mesh));
+  else {
+    const gm_grade grade = {.faces = s->refine.near,
+                            .size = s->refine.size,
+                            .distance = s->refine.distance};
+    PM_TRY(gm_mesh_box_graded(s->dimension, s->box_min, s->box_max,
+                              s->mesh_size, &grade, &sim->mesh));
+  }
   pm_timers_stop(&sim->timers, sim->tm_mesh);
   sim->mean_edge = gm_mesh_mean_edge(sim->mesh);
   pm_timers_start(&sim->timers, sim->tm_dual);
