@@ -273,10 +273,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
       const double *Hb = base ? bH + 9 * i : Hi;
       const double *msi = ms ? ms + mss * i : NULL;
       double F[9], dP[9];
-      for (int k = 0; k < 9; k++) F[k] = Hb[k];
-      F[0] += 1;
-      F[4] += 1;
-      F[8] += 1;
+      fpm_deformation(Hb, F);
       pm_material_tangent(&mats[mat[i]], F, msi, B, dP);
       for (int k = 0; k < 9; k++) Q[k] += 0.5 * dP[k];
       if (base) {
@@ -525,10 +522,7 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
          shared(ns, H, D, mat, mats, ms, mss))
   for (long i = 0; i < ns; i++) {
     double F[9], E[9] = {0}, dP[9];
-    for (int k = 0; k < 9; k++) F[k] = H[9 * i + k];
-    F[0] += 1;
-    F[4] += 1;
-    F[8] += 1;
+    fpm_deformation(H + 9 * i, F);
     for (int b = 0; b < 9; b++) {
       E[b] = 1;
       pm_material_tangent(&mats[mat[i]], F, ms ? ms + mss * i : NULL, E, dP);

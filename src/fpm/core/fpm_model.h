@@ -122,6 +122,15 @@ typedef struct {
                         with the model), or NULL */
 } fpm_model;
 
+/* The deformation gradient F = I + H of a point's displacement gradient H
+ * (9, row-major). */
+static inline void fpm_deformation(const double *H, double F[9]) {
+  for (int a = 0; a < 9; a++) F[a] = H[a];
+  F[0] += 1;
+  F[4] += 1;
+  F[8] += 1;
+}
+
 /* Point i's index on one process (for messages). */
 static inline long fpm_point_id(const fpm_model *m, long i) {
   return m->gid ? m->gid[i] : i;

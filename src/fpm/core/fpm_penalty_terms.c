@@ -18,10 +18,7 @@ void fpm_volume_dphi(long n, const double *bH, const double *dH, double *phi,
          shared(n, bH, dH, phi, dphi))
   for (long i = 0; i < n; i++) {
     double F[9], C[9];
-    for (int q = 0; q < 9; q++) F[q] = bH[9 * i + q];
-    F[0] += 1;
-    F[4] += 1;
-    F[8] += 1;
+    fpm_deformation(bH + 9 * i, F);
     pm_t_cofactor(F, C); /* C = J F^-T */
     const double J = pm_t_det(F), l = log(J);
     if (phi) phi[i] = l * l;

@@ -75,10 +75,7 @@ void fpm_volumetric_stress(const fpm_model *m, fpm_state *st) {
     double uj[3], F[9], cof[9];
     pm_material_volumetric(&mats[mat[k]], J[k], uj);
     const double q = average(m, k, dUb, 0) - uj[1];
-    for (int a = 0; a < 9; a++) F[a] = H[9 * k + a];
-    F[0] += 1;
-    F[4] += 1;
-    F[8] += 1;
+    fpm_deformation(H + 9 * k, F);
     pm_t_cofactor(F, cof);
     for (int a = 0; a < 9; a++) P[9 * k + a] += q * cof[a];
   }
@@ -125,10 +122,7 @@ void fpm_volumetric_prepare(const fpm_model *m, const fpm_state *st,
     pm_material_volumetric(&mats[mat[k]], Jb[k], ub);
     d2[k] = uj[2];
     d2b[k] = ub[2];
-    for (int a = 0; a < 9; a++) F[a] = H[9 * k + a];
-    F[0] += 1;
-    F[4] += 1;
-    F[8] += 1;
+    fpm_deformation(H + 9 * k, F);
     pm_t_cofactor(F, c);
     /* (pt - U'(J)) d cof[E_b] with d cof[dF] = (dJ cof - cof dF^T cof) / J,
      * dJ = cof : dF; E_b = e_r (x) e_s, b = 3 r + s */

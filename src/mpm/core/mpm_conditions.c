@@ -207,13 +207,8 @@ static void apply_once(const mpm_ctx *ctx, double *vel, bool mark,
     for (long k = 0; k < bc->n_cols; k++) {
       long col = bc->col[k];
       /* Face position of the column. */
-      double x[3] = {0, 0, 0};
-      long rem = col;
-      for (int c = 2; c >= 0; c--) {
-        long i = rem / g->stride[c];
-        rem -= i * g->stride[c];
-        x[c] = g->origin[c] + (i + g->offset[c]) * g->h;
-      }
+      double x[3];
+      mpm_grid_node_position(g, col, x);
       x[a] = bc->plane;
       double v[3] = {0, 0, 0};
       if (!fold)

@@ -80,15 +80,6 @@ static void mark_touched(const mpm_model *m, const mpm_state *s,
   }
 }
 
-/* Position of node i of grid g. */
-static void node_position(const mpm_grid *g, long i, double x[3]) {
-  for (int c = 2; c >= 0; c--) {
-    const long k = i / g->stride[c];
-    i -= k * g->stride[c];
-    x[c] = g->origin[c] + (k + g->offset[c]) * g->h;
-  }
-}
-
 /* The axis a plate is normal to (its normal +-e_a), or -1 (a sphere, an
  * oblique plate). */
 static int plate_axis(const pm_scene_bc *bc) {
@@ -138,7 +129,7 @@ static bool node_contact(const mpm_grid *g, const mpm_nodes *nd,
   *j = -1;
   *T = 0;
   if (!(touched[i] & 1u) || !(nd->mass[i] > 0)) return false;
-  node_position(g, i, x);
+  mpm_grid_node_position(g, i, x);
   const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
   if (!(gap < b->reach)) return false;
   memcpy(vc, b->V, 3 * sizeof(double));
@@ -180,7 +171,7 @@ static void gather_fold(const mpm_ctx *ctx, const body_step *b, long j,
     if (!(touched[i] & b->bit)) continue;
     double x[3], n[3];
     long ki;
-    node_position(g, i, x);
+    mpm_grid_node_position(g, i, x);
     const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
     if (anchor_of(g, nd->mass, i, gap, n, a, &ki) != j) continue;
     const double T = gap / (gap + ki * g->h);
@@ -245,7 +236,7 @@ static double body_contact(const mpm_ctx *ctx, const body_step *b, int bi,
     if (!(touched[i] & b->bit) || !(mass[i] > 0)) continue;
     double x[3], n[3], vc[3], dv[3] = {0, 0, 0};
     long k;
-    node_position(g, i, x);
+    mpm_grid_node_position(g, i, x);
     const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
     memcpy(vc, b->V, sizeof vc);
     const long j =

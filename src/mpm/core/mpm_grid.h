@@ -65,6 +65,16 @@ static inline bool mpm_node_owned(const mpm_nodes *n, long i) {
   return !n->owned || n->owned[i];
 }
 
+/* Node i's position (x, y[, z]; 0 beyond the grid's dimension). */
+static inline void mpm_grid_node_position(const mpm_grid *g, long i,
+                                          double x[3]) {
+  for (int c = 2; c >= 0; c--) {
+    const long k = i / g->stride[c];
+    i -= k * g->stride[c];
+    x[c] = c < g->dim ? g->origin[c] + (double)(k + g->offset[c]) * g->h : 0;
+  }
+}
+
 /* Lay the grid over the box [box_min, box_max] in cells of h (dim 2 or 3).
  * Fails with PM_ERR_SCENE, naming the scene file `path` and
  * discretization.mesh_size, when the grid would be too large. */

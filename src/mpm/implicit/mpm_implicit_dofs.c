@@ -112,14 +112,6 @@ static pm_err prescribe(mpm_implicit *im, long node, int c, int b, double v,
   return PM_SUCCESS;
 }
 
-/* Node k's position on the solver's grid. */
-void mpm_implicit_node_position(const mpm_grid *g, long k, double x[3]) {
-  long ijk[3] = {k % g->nn[0], (k / g->nn[0]) % g->nn[1], k / g->stride[2]};
-  for (int c = 0; c < 3; c++)
-    x[c] =
-        c < g->dim ? g->origin[c] + (double)(ijk[c] + g->offset[c]) * g->h : 0;
-}
-
 /* Condition b on the kept grid (the reference, where its face is a fixed
  * plane).  Quadratic B-splines reach a node beyond the face: setting it
  * to the face's value (as a linear grid may) bends every field that
@@ -155,7 +147,7 @@ static pm_err extend_kept(mpm_implicit *im, int b, double scale, bool mirror) {
     const double d = ((double)i - sf) * h * out;
     if (mirror && d <= eps) continue;
     double x[3];
-    mpm_implicit_node_position(g, k, x);
+    mpm_grid_node_position(g, k, x);
     const long kan = k + (i_from - i) * g->stride[a];
     const bool has_an = i_from >= 0 && i_from < g->nn[a] && im->active[kan];
     PM_CHECK(has_an || !im->ranks || (i_from >= 0 && i_from < g->nn[a]),
@@ -378,7 +370,7 @@ static pm_err make_near_null(mpm_implicit *im, int *count) {
     long d = im->unk_dof[k], node = d / 3;
     int c = (int)(d % 3);
     double x[3];
-    mpm_implicit_node_position(&im->g, node, x);
+    mpm_grid_node_position(&im->g, node, x);
     for (int r = 0; r < nr; r++) z[(long)r * im->nunk + k] = 0;
     z[(long)c * im->nunk + k] = 1; /* translations */
     if (im->dim == 2) {

@@ -316,7 +316,6 @@ void mpm_implicit_make_buckets(mpm_implicit *im);
 pm_err mpm_implicit_make_dofs(mpm_implicit *im);
 pm_err mpm_implicit_make_solver(mpm_implicit *im);
 pm_err mpm_implicit_rebuild(mpm_implicit *im);
-void mpm_implicit_node_position(const mpm_grid *g, long k, double x[3]);
 /* Add v to the tangent's entry (row unknown of node rn, column dof cd) in
  * the pattern's order (val); false when the entry is outside the
  * pattern. */

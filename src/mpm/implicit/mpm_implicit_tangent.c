@@ -227,7 +227,7 @@ static void smooth_field(const mpm_implicit *im, double amp, double *x) {
   for (long k = 0; k < im->nunk; k++) {
     double y[3];
     long d = im->unk_dof[k];
-    mpm_implicit_node_position(&im->g, d / 3, y);
+    mpm_grid_node_position(&im->g, d / 3, y);
     double h = im->g.h * 10;
     x[k] = amp * sin(y[0] / h + 0.3 * (double)(d % 3)) * cos(y[1] / h) *
            (1 + 0.2 * sin(y[2] / h));
