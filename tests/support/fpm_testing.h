@@ -150,6 +150,20 @@ static inline void fixture_defaults(fixture *fx) {
   }
 }
 
+/* A share's force on its own points is the whole model's bit for bit: f,
+ * P and J of each own point of share s (its state ss) against the whole
+ * model's state st. */
+static inline void assert_share_is_whole(const fpm_model *s,
+                                         const fpm_state *ss,
+                                         const fpm_state *st) {
+  for (long i = 0; i < s->n_own; i++) {
+    const long g = s->gid[i];
+    assert_memory_equal(ss->f + 3 * i, st->f + 3 * g, 3 * sizeof(double));
+    assert_memory_equal(ss->P + 9 * i, st->P + 9 * g, 9 * sizeof(double));
+    assert_memory_equal(ss->J + i, st->J + g, sizeof(double));
+  }
+}
+
 /* |K d - (f(u0 + eps d) - f(u0 - eps d)) / 2 eps| / |K d| at the state
  * u0 = smooth_plus_rough(seed, smooth 0.2, rough 1e-3), d its rough part,
  * eps = 1e-6: how far fpm_force_linear is from the force's derivative. */

@@ -297,12 +297,7 @@ static void test_shares(void **state) {
         }
         ghosts += s->n - s->n_own;
         assert_int_equal(fpm_force(s, ss), -1);
-        for (long i = 0; i < s->n_own; i++) {
-          const long g = s->gid[i];
-          assert_memory_equal(ss->f + 3 * i, st->f + 3 * g, 3 * sizeof(double));
-          assert_memory_equal(ss->P + 9 * i, st->P + 9 * g, 9 * sizeof(double));
-          assert_memory_equal(ss->J + i, st->J + g, sizeof(double));
-        }
+        assert_share_is_whole(s, ss, st);
         /* A point moved far: the points it turns inside out are named by
          * their owners alone, by their indices on one process, and the
          * smallest is the one the whole model names. */

@@ -57,6 +57,17 @@ check "f2 on 1 rank: one process, bit for bit" \
 want=3 across f4-quadratic "$f4" 2 --set discretization.mesh_size=8.72e-3 \
   --set time.max_steps=200 --set output.every=50
 
+# The averaged volume (fpm.volumetric: averaged): the ghosts' U'(Jbar)
+# come from their owners inside the force, so its runs are one process's
+# as the others: F2 (linear jump) to the same bounds through the
+# relaxation, F4 60% (quadratic jump, 100 steps) bit for bit.
+avg="--set fpm.volumetric=averaged"
+want=3 across f2-averaged "$f2" 2 $f2set $avg
+want=3 across f4-averaged "$f4" 2 --set discretization.mesh_size=8.72e-3 \
+  --set time.max_steps=100 --set output.every=50 $avg
+check "f4 averaged on 2 ranks: one process's, bit for bit" \
+  $same "$work/f4-averaged-1" "$work/f4-averaged-2"
+
 # plan on 2 ranks prints every rank's share; plan --ranks 2 on one
 # process predicts the same.
 ranks 2 "$bin" plan "$f2" >"$work/plan-2" 2>"$work/err"
@@ -74,6 +85,14 @@ check "plan --ranks 2 predicts the shares of 2 ranks" \
 # (the point by its index on one process).
 fails_alike inverted 3 'step [0-9]*, .*(J = [^)]*)' "$f2" \
   --set time.dt=1e-3 --set output.every=5
+# The same with the averaged volume, whose force is collective (the
+# ghosts' U'(Jbar)): a rank whose own point inverted, or whose condition
+# is not finite, still takes part in the other ranks' exchange.
+fails_alike inverted-averaged 2 'step [0-9]*, .*(J = [^)]*)' "$f2" \
+  --set time.dt=1e-3 --set output.every=5 $avg
+fails_alike not-finite-averaged 2 'step [0-9]*, .* = nan' "$f2" $avg \
+  --set discretization.mesh_size=0.015 --set output.every=5 \
+  --set 'boundary.3.displacement.z=-0.04*sqrt(0.005 - 20*t*x)'
 
 # The static solver (Newton on the shared layer): F2 on 2 and 3 ranks by
 # LU (the Newton iterates are one process's; measured 2e-12, the fields),
@@ -88,6 +107,10 @@ bounds="residual=inf" across f2-sipg "$f2" 2 $static $coarse \
   --set fpm.flux=sipg
 bounds="residual=inf" across f2-quadratic "$f2" 2 $static $coarse \
   --set fpm.jump=quadratic --set fpm.penalty=1
+# The averaged volume by Newton: its exact tangent applied matrix-free
+# (the averages' coupling exchanged as in the force), GMRES preconditioned
+# by LU of the tangent without the coupling.
+bounds="residual=inf" across f2-static-averaged "$f2" 2 $static $coarse $avg
 
 # Interrupted on 2 ranks and resumed: on 2 ranks bit for bit the run that
 # was not interrupted (the partition is the same), on one process to
@@ -97,6 +120,14 @@ want=3 resume_on "$work/cut" 1 2
 check "interrupted on 2 ranks, resumed on 2: the run of 2 ranks, bit for bit" \
   $same "$work/f2-2" "$work/cut-2"
 roundoff "interrupted on 2 ranks, resumed on 1" "$work/f2-1" "$work/cut-1"
+# The same with the averaged volume (its state is u and v alone: Jbar and
+# U'(Jbar) are made again by the force).
+interrupt 2 "$work/acut" "$f2" $f2set $avg
+want=3 resume_on "$work/acut" 1 2
+check "averaged, interrupted on 2 ranks, resumed on 2: bit for bit" \
+  $same "$work/f2-averaged-2" "$work/acut-2"
+roundoff "averaged, interrupted on 2 ranks, resumed on 1" \
+  "$work/f2-averaged-1" "$work/acut-1"
 
 # A static run interrupted on 2 ranks after 3 of 20 load steps: resumed
 # on 2 ranks bit for bit the run not interrupted (GMRES with ILU(0) in

@@ -186,11 +186,6 @@ static pm_err create(const pm_scene *s, void **out) {
   pm_err e = pm_par_agree(fpm_sim_create(s, &sim));
   if (!e && pm_par_active() && sim->model->contact)
     e = fpm_contact_refuse_ranks(s);
-  if (!e && pm_par_active() && sim->model->vavg)
-    e = pm_scene_fail(s, "fpm.volumetric", true,
-                      "expected standard for a run across ranks (averaged "
-                      "needs one process for now: its averages reach two "
-                      "rings of ghosts), got averaged");
   if (!e && pm_par_active()) {
     const double t0 = pm_wtime();
     e = fpm_par_create(sim->model, &sim->local_model);

@@ -14,6 +14,9 @@ typedef struct fpm_exchange {
   /* The ghosts' values, 3 doubles per point held (the displacements, or
    * anything laid out as they are), from their owners. */
   void (*ghosts)(void *ctx, double *u);
+  /* The same for one double per point held (the averaged volume's
+   * pressure U'(Jbar) and its increments, fpm_volumetric.h). */
+  void (*ghost_scalars)(void *ctx, double *v);
   /* Every rank's failure e, placed by key in one process's order: every
    * rank returns the one one process meets first. */
   pm_err (*agree)(void *ctx, pm_err e, long key);
@@ -29,6 +32,11 @@ typedef struct fpm_exchange {
 
 static inline void fpm_exchange_ghosts(const fpm_exchange *xc, double *u) {
   if (xc) xc->ghosts(xc->ctx, u);
+}
+
+static inline void fpm_exchange_ghost_scalars(const fpm_exchange *xc,
+                                              double *v) {
+  if (xc) xc->ghost_scalars(xc->ctx, v);
 }
 
 static inline pm_err fpm_exchange_agree(const fpm_exchange *xc, pm_err e,

@@ -411,10 +411,15 @@ static void fit_gather_pass(const fpm_model *m, const fields *fl) {
   }
 }
 
+void fpm_force_skipped(const fpm_model *m, fpm_state *st) {
+  if (m->vavg) fpm_volumetric_stress_skipped(m, st);
+}
+
 long fpm_force(const fpm_model *m, fpm_state *st) {
   long bad = stress_pass(m, st);
+  if (m->vavg && bad < 0) fpm_volumetric_stress(m, st);
+  if (m->vavg && bad >= 0) fpm_volumetric_stress_skipped(m, st);
   if (bad >= 0) return bad;
-  if (m->vavg) fpm_volumetric_stress(m, st);
   const fields fl = {.u = st->u,
                      .H = st->H,
                      .P = st->P,

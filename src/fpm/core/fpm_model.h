@@ -234,8 +234,12 @@ pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
 
 /* The net nodal force f = f_int(u) - f_ext(t) into st->f (also F, P, W, J,
  * T, r).  Returns -1, or the smallest point id whose deformation gradient
- * is inadmissible (J <= 0 or not finite). */
+ * is inadmissible (J <= 0 or not finite).  On a share with
+ * fpm.volumetric: averaged it is collective (the averaged pressure of the
+ * ghosts comes from their owners, fpm_volumetric.h): a rank that does not
+ * evaluate the force when the others do calls fpm_force_skipped. */
 long fpm_force(const fpm_model *m, fpm_state *st);
+void fpm_force_skipped(const fpm_model *m, fpm_state *st);
 
 /* The linearisation of fpm_force about a state: df = K du with K the
  * consistent tangent (exact but for the SIPG adjoint term's derivative of
@@ -251,7 +255,8 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st, fpm_linear *l);
 /* The tangent moduli dP/dF of the last prepare: 81 per point, row-major
  * (row a = 3 i + j of P, column b of F). */
 const double *fpm_linear_tangent(const fpm_linear *l);
-/* df (3 n) = K du (3 n), every dof (prescribed ones included). */
+/* df (3 n) = K du (3 n), every dof (prescribed ones included); collective
+ * on a share with fpm.volumetric: averaged. */
 void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
                       double *df);
 

@@ -93,6 +93,21 @@ static pm_err subset_points(const fpm_model *m, fpm_model *s, const int *lof) {
   return PM_SUCCESS;
 }
 
+/* The averaging weights of fpm.volumetric: averaged, the whole model's
+ * (they read the supports' volumes of two rings): a_ik of the rows the
+ * share holds, a_ii of its points. */
+static pm_err subset_averages(const fpm_model *m, fpm_model *s) {
+  PM_CALL(PM_ALLOC(s->vavg, s->nnz + 1, "share's averaging weights"));
+  PM_CALL(PM_ALLOC(s->vself, s->n, "share's averaging weights"));
+  for (long li = 0; li < s->n_stress; li++) {
+    const long e0 = m->nbr_ptr[s->gid[li]], f0 = s->nbr_ptr[li];
+    memcpy(s->vavg + f0, m->vavg + e0,
+           sizeof(double) * (size_t)(s->nbr_ptr[li + 1] - f0));
+  }
+  copy_items(s->vself, m->vself, s->gid, s->n, 1);
+  return PM_SUCCESS;
+}
+
 /* The quadratic fits of the points whose stress the share computes, and
  * for its own points the fits that hold them, in one process's order
  * (the order of their entries). */
@@ -230,6 +245,7 @@ pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
   s->n_mats = m->n_mats;
   memcpy(s->mats, m->mats, sizeof s->mats);
   PM_TRY(subset_points(m, s, lof));
+  if (m->vavg) PM_TRY(subset_averages(m, s));
   if (m->qs_ptr) PM_TRY(subset_fits(m, s, lof));
   PM_TRY(subset_boundary(m, s, lof));
   *out = s;

@@ -111,7 +111,7 @@ static const pm_key fpm_keys[] = {
             "or averaged (an F-bar kind: each point's J averaged over its "
             "support, the exact gradient of sum V U(Jbar); for models split "
             "as W_iso + U(J): neo-hookean, neo-hookean-log, mooney-rivlin, "
-            "ogden, holzapfel-gasser-ogden; IIPG flux, one process)"},
+            "ogden, holzapfel-gasser-ogden; IIPG flux)"},
     {.name = "cells",
      .type = PM_KEY_STRING,
      .offset = offsetof(fpm_options, cells),

@@ -183,6 +183,8 @@ static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
       e = unstable(m, st, step, t, dt, bad, 0);
       key = 2 * KEY_STAGE + fpm_point_id(m, bad);
     }
+  } else {
+    fpm_force_skipped(m, st); /* (the other ranks' force is collective) */
   }
   return fpm_exchange_agree(m->xc, e, key);
 }

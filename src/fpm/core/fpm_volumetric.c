@@ -51,16 +51,22 @@ done:
   return ret;
 }
 
+/* Across ranks (a share, fpm_model.n_own) Jbar_i = sum_k a_ik J_k of an
+ * own point reads J over its support, which the share's stress holds;
+ * pt_k of a point whose stress the share computes reads U'(Jbar) over its
+ * support, up to the displacement ghosts: so Jbar and U'(Jbar) are the
+ * own points', and the ghosts' U'(Jbar) come from their owners (the same
+ * operations in the same order: one process's values). */
 void fpm_volumetric_stress(const fpm_model *m, fpm_state *st) {
-  const long n = m->n_stress;
+  const long n = m->n_stress, n_own = m->n_own;
   const double *restrict J = st->J, *restrict H = st->H;
   double *restrict Jb = st->Jbar, *restrict dUb = st->dUbar,
                    *restrict W = st->W, *restrict P = st->P;
   const int *restrict mat = m->mat;
   const pm_material *mats = m->mats;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(n, m, J, Jb, dUb, W, mat, mats))
-  for (long i = 0; i < n; i++) {
+         shared(n_own, m, J, Jb, dUb, W, mat, mats))
+  for (long i = 0; i < n_own; i++) {
     double ub[3], uj[3];
     const double jb = 1 + average(m, i, J, 1);
     pm_material_volumetric(&mats[mat[i]], jb, ub);
@@ -69,6 +75,7 @@ void fpm_volumetric_stress(const fpm_model *m, fpm_state *st) {
     dUb[i] = ub[1];
     W[i] += ub[0] - uj[0];
   }
+  fpm_exchange_ghost_scalars(m->xc, dUb);
   PM_OMP(parallel for schedule(static) default(none)
          shared(n, m, J, H, dUb, P, mat, mats))
   for (long k = 0; k < n; k++) {
@@ -79,6 +86,10 @@ void fpm_volumetric_stress(const fpm_model *m, fpm_state *st) {
     pm_t_cofactor(F, cof);
     for (int a = 0; a < 9; a++) P[9 * k + a] += q * cof[a];
   }
+}
+
+void fpm_volumetric_stress_skipped(const fpm_model *m, fpm_state *st) {
+  fpm_exchange_ghost_scalars(m->xc, st->dUbar);
 }
 
 pm_err fpm_volumetric_lin_create(const fpm_model *m, fpm_volumetric_lin *v) {
@@ -113,15 +124,18 @@ void fpm_volumetric_prepare(const fpm_model *m, const fpm_state *st,
   double *restrict cof = v->cof, *restrict d2 = v->d2, *restrict d2b = v->d2bar;
   const int *restrict mat = m->mat;
   const pm_material *mats = m->mats;
+  const long n_own = m->n_own; /* (Jbar: the own points') */
   PM_OMP(parallel for schedule(static) default(none)
-         shared(n, m, J, H, Jb, dUb, cof, d2, d2b, D, mat, mats))
+         shared(n, n_own, m, J, H, Jb, dUb, cof, d2, d2b, D, mat, mats))
   for (long k = 0; k < n; k++) {
     double uj[3], ub[3], F[9];
     double *c = cof + 9 * k;
     pm_material_volumetric(&mats[mat[k]], J[k], uj);
-    pm_material_volumetric(&mats[mat[k]], Jb[k], ub);
     d2[k] = uj[2];
-    d2b[k] = ub[2];
+    if (k < n_own) {
+      pm_material_volumetric(&mats[mat[k]], Jb[k], ub);
+      d2b[k] = ub[2];
+    }
     fpm_deformation(H + 9 * k, F);
     pm_t_cofactor(F, c);
     /* (pt - U'(J)) d cof[E_b] with d cof[dF] = (dJ cof - cof dF^T cof) / J,
@@ -151,8 +165,12 @@ void fpm_volumetric_apply(const fpm_model *m, fpm_volumetric_lin *v,
     for (int a = 0; a < 9; a++) s += cof[9 * k + a] * dH[9 * k + a];
     dJ[k] = s;
   }
-  PM_OMP(parallel for schedule(static) default(none) shared(n, m, d2b, dJ, dq))
-  for (long i = 0; i < n; i++) dq[i] = d2b[i] * average(m, i, dJ, 0);
+  /* (as the stress: the own points' dq, the ghosts' from their owners) */
+  const long n_own = m->n_own;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n_own, m, d2b, dJ, dq))
+  for (long i = 0; i < n_own; i++) dq[i] = d2b[i] * average(m, i, dJ, 0);
+  fpm_exchange_ghost_scalars(m->xc, dq);
   PM_OMP(parallel for schedule(static) default(none)
          shared(n, m, cof, d2, dJ, dq, dP))
   for (long k = 0; k < n; k++) {

@@ -18,12 +18,16 @@
 pm_err fpm_volumetric_build(fpm_model *m);
 
 /* After the stress pass (st->H, P, W, J of the points [0, m->n_stress),
- * all admissible): Jbar_i = sum_k a_ik J_k and U'(Jbar_i) into st->Jbar
- * and st->dUbar, then P_k += (pt_k - U'(J_k)) cof F_k with pt = A U'(Jbar),
- * and W_k += U(Jbar_k) - U(J_k).  Then sum_i V_i W_i is the energy above
- * and V_k P_k its derivative with respect to F_k along the GFD gradient.
- * Allocates nothing. */
+ * the own ones admissible): Jbar_i = sum_k a_ik J_k and U'(Jbar_i) into
+ * st->Jbar and st->dUbar and W_i += U(Jbar_i) - U(J_i) for the own points
+ * [0, m->n_own), U'(Jbar) of the ghosts from their owners, then
+ * P_k += (pt_k - U'(J_k)) cof F_k with pt = A U'(Jbar) on [0, n_stress).
+ * Then sum_i V_i W_i is the energy above and V_k P_k its derivative with
+ * respect to F_k along the GFD gradient.  Across ranks it is collective
+ * (the ghosts' exchange): a rank whose own points are not admissible calls
+ * fpm_volumetric_stress_skipped instead.  Allocates nothing. */
 void fpm_volumetric_stress(const fpm_model *m, fpm_state *st);
+void fpm_volumetric_stress_skipped(const fpm_model *m, fpm_state *st);
 
 /* The linearisation's arrays (fpm_force_linear): cof F_k (9 n), U''(J_k)
  * and U''(Jbar_k) (n each), and work for dJ and U''(Jbar) dJbar (n each). */
@@ -46,7 +50,9 @@ void fpm_volumetric_prepare(const fpm_model *m, const fpm_state *st,
                             fpm_volumetric_lin *v, double *D);
 
 /* The coupling: dP_k += (A (U''(Jbar) A dJ)_k - U''(J_k) dJ_k) cof F_k
- * with dJ_k = cof F_k : dH_k, for the points [0, m->n_stress). */
+ * with dJ_k = cof F_k : dH_k, for the points [0, m->n_stress); the inner
+ * product U''(Jbar) A dJ of the own points, the ghosts' from their owners
+ * (collective across ranks). */
 void fpm_volumetric_apply(const fpm_model *m, fpm_volumetric_lin *v,
                           const double *dH, double *dP);
 

@@ -7,7 +7,9 @@
  *  - one exchange: once the rank's own displacements are updated and the
  *    supports moved, the ghosts' displacements come from their owners (a
  *    PETSc star forest whose leaves are the ghosts and whose roots their
- *    owners' points);
+ *    owners' points); with fpm.volumetric: averaged a second, inside the
+ *    force, of one double a ghost: the averaged pressure U'(Jbar) of the
+ *    owners' points (fpm_volumetric.h);
  *  - sums over the own points (energies, the residual, the supports' work,
  *    dynamic relaxation's Rayleigh quotient) summed over the ranks, and
  *    the smallest J; every rank then holds the same figures, damping and
@@ -60,7 +62,9 @@ const int *fpm_par_owner(const fpm_model *m);
 const fpm_share_counts *fpm_par_counts(const fpm_model *m);
 
 /* What the exchanges cost this rank so far: bytes it received of ghost
- * displacements, and the seconds of the exchanges and the gathers. */
+ * values (displacements, and with fpm.volumetric: averaged the pressures
+ * U'(Jbar)), the exchanges of displacements (one a step), and the seconds
+ * of the exchanges and the gathers. */
 typedef struct {
   double ghost_bytes, exchange_seconds, gather_seconds;
   long exchanges;

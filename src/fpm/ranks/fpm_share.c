@@ -179,13 +179,15 @@ void fpm_share_print(const fpm_model *m, const int *owner, int parts,
               c[r].flux_ghosts, c[r].stress_ghosts, c[r].u_ghosts,
               c[r].bytes / 1048576.0);
   }
+  /* with the averaged volume also their pressures U'(Jbar) */
+  const double per = (m->vavg ? 4.0 : 3.0) * sizeof(double);
   fprintf(out,
           "             ghost points per rank %.0f on average, %ld at most: a "
-          "rank receives their displacements, %.0f bytes per step on "
+          "rank receives their displacements%s, %.0f bytes per step on "
           "average, %.0f at most\n",
           (double)ghosts / parts, most_ghosts,
-          3.0 * sizeof(double) * ghosts / parts,
-          3.0 * sizeof(double) * most_ghosts);
+          m->vavg ? " and averaged pressures" : "", per * ghosts / parts,
+          per * most_ghosts);
 }
 
 pm_err fpm_share_predict(const fpm_model *m, int parts, FILE *out) {

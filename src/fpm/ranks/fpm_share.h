@@ -20,7 +20,10 @@
  * With the linear jump that is three rings of support around a rank's
  * points, with the quadratic up to five; the interfaces, boundary facets
  * and conditions of every point held come with it from the whole model,
- * computed once at setup. */
+ * computed once at setup.  fpm.volumetric: averaged needs no more rings:
+ * the pressure of a stress ghost reads U'(Jbar) over its support, which
+ * the force takes from the owners in a second exchange of one double a
+ * ghost (fpm_volumetric.h), in place of two more rings of J and Jbar. */
 #ifndef FPM_SHARE_H
 #define FPM_SHARE_H
 
