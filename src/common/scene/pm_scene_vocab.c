@@ -712,7 +712,20 @@ static const pm_key quasi_static_keys[] = {
      .doc = "method static and mpm-implicit: direct (LU), gmres-gamg, "
             "gmres-ilu, cg-jacobi or cg-gamg (symmetric problems); "
             "mpm-implicit without it: direct up to 30000 unknowns in 3-D "
-            "and 100000 in 2-D, gmres-gamg beyond"},
+            "and 100000 in 2-D, gmres-gamg beyond; FPM static without "
+            "it: direct up to 60000 free dofs, gmres-gamg beyond"},
+    {.name = "reuse_iterations",
+     .type = PM_KEY_INTEGER,
+     .offset = S(time.qs_reuse),
+     .def = "10",
+     .range = PM_RANGE_GE,
+     .lo = 0,
+     .unit = "",
+     .doc = "method static (FPM): keep the factorisation or preconditioner "
+            "over Newton iterations and load steps while the linear solves "
+            "it preconditions (GMRES) take at most this many iterations, a "
+            "new one after a solve that took more; 0: a new one at every "
+            "Newton iteration"},
     {.name = "solver_options",
      .type = PM_KEY_STRING,
      .offset = S(time.qs_solver_options),

@@ -20,6 +20,8 @@ static void add_solve(pm_load_report *rep, const pm_newton_report *nr) {
   rep->time_residual += nr->time_residual;
   rep->time_assembly += nr->time_assembly;
   rep->time_linear += nr->time_linear;
+  rep->time_setup += nr->time_setup;
+  rep->pc_setups += nr->pc_setups;
 }
 
 static bool recoverable(pm_err e) {
@@ -52,6 +54,8 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
     rep->time_residual += tr.time_residual;
     rep->time_assembly += tr.time_assembly;
     rep->time_linear += tr.time_linear;
+    rep->time_setup += tr.time_setup;
+    rep->pc_setups += tr.pc_setups;
   }
   if (e == PM_SUCCESS)
     for (long i = 0; i < n; i++) x[i] += xc[i];

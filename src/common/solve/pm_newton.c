@@ -230,8 +230,7 @@ pm_err pm_newton_tangent_solve(pm_newton *s, const double *x, const double *b,
   PetscErrorCode code = pm_newton_snes_jacobian(s->snes, s->X, A, B, s);
   if (!code) code = KSPSetOperators(s->ksp, A, B);
   if (!code) {
-    pm_newton_linear_presolve(s->ksp, s->Work, s->R, s);
-    code = KSPSolve(s->ksp, s->Work, s->R);
+    code = KSPSolve(s->ksp, s->Work, s->R); /* (its presolve times it) */
     if (s->in_linear) pm_newton_linear_postsolve(s->ksp, s->Work, s->R, s);
   }
   PetscOptionsPop();

@@ -130,6 +130,11 @@ typedef struct {
    * Read by pm_newton_create, not kept (at most 16).  Optional (0, NULL). */
   int near_null_count;
   const double *near_null;
+  /* Unknowns come in blocks of this many (a point's displacement
+   * components, consecutive), on one process: the assembled matrix says
+   * so, and algebraic multigrid aggregates whole blocks.  0 or 1: no
+   * blocks.  Optional. */
+  int block_size;
 
   /* Across ranks (see above): the problem is shared by the ranks when
    * this is set and more than one rank runs; ghost lists the global
@@ -221,7 +226,18 @@ typedef struct {
   pm_newton_operator op;   /* PM_NEWTON_ASSEMBLED */
   /* Matrix-free operators: rebuild the preconditioner every pc_lag Newton
    * iterations (1: every one). */
-  int pc_lag;                 /* 1 */
+  int pc_lag; /* 1 */
+  /* Keep the factorisation or preconditioner while the linear solves it
+   * serves converge in at most this many iterations: the next Jacobian
+   * after a solve that took more (or failed) builds a new one, the others
+   * are applied (the current one, assembled or matrix-free) with the kept
+   * one preconditioning GMRES (the direct solver too).  0: a new one at
+   * every Jacobian (every pc_lag with a matrix-free operator). */
+  int pc_reuse_its; /* 0 */
+  /* Algebraic multigrid (the gamg solvers): keep the hierarchy's
+   * interpolation from one preconditioner set-up to the next, recomputing
+   * only the coarse operators (PETSc's -pc_gamg_reuse_interpolation). */
+  bool amg_reuse;             /* false */
   pm_coloring_order coloring; /* PM_COLORING_LARGEST_FIRST */
   pm_line_search line_search; /* PM_LINE_SEARCH_BT */
 
@@ -315,8 +331,12 @@ typedef struct pm_newton_report {
   /* Wall seconds: residual calls; Jacobian preparation and assembly
    * (colouring applications and insertion); linear solves (factorisation,
    * Krylov iterations, matrix-free applications); the whole solve (the
-   * rest is vector work and the line search's own Jacobian product). */
+   * rest is vector work and the line search's own Jacobian product);
+   * time_setup: the part of time_linear that set the preconditioner up
+   * (the factorisation, the multigrid hierarchy). */
   double time_residual, time_assembly, time_linear, time_total;
+  double time_setup;
+  int pc_setups; /* factorisations or preconditioner set-ups */
 } pm_newton_report;
 
 /* What load stepping did. */
@@ -328,6 +348,8 @@ typedef struct {
   int newton_iterations;
   int linear_iterations;
   double time_residual, time_assembly, time_linear, time_total;
+  double time_setup;     /* of time_linear: preconditioner set-ups */
+  int pc_setups;         /* their number */
   pm_newton_report last; /* the last Newton solve (the failing one on
                             failure) */
   /* The relaxation fallback: relaxations run, steps they let converge,

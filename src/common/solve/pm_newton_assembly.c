@@ -123,8 +123,15 @@ pm_err pm_newton_create_matrix(const pm_newton *s, const pm_pattern *pat,
     PM_TRY(PM_ALLOC(nnz, n, "matrix row lengths"));
     for (long i = 0; i < n; i++)
       nnz[i] = (PetscInt)(pat->ptr[i + 1] - pat->ptr[i]);
+    PM_PETSC(MatCreate(PETSC_COMM_SELF, M));
     PM_PETSC(
-        MatCreateSeqAIJ(PETSC_COMM_SELF, (PetscInt)n, (PetscInt)n, 0, nnz, M));
+        MatSetSizes(*M, (PetscInt)n, (PetscInt)n, (PetscInt)n, (PetscInt)n));
+    PM_PETSC(MatSetType(*M, MATSEQAIJ));
+    /* unknowns in blocks (a point's components): multigrid aggregates
+     * the blocks and fits the near null space on them */
+    if (s->p.block_size > 1 && n % s->p.block_size == 0)
+      PM_PETSC(MatSetBlockSize(*M, (PetscInt)s->p.block_size));
+    PM_PETSC(MatSeqAIJSetPreallocation(*M, 0, nnz));
   }
   PM_PETSC(MatSetOption(*M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   PM_TRY(pm_newton_insert_values(s, *M, pat, *cols, zeros));

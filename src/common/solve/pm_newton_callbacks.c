@@ -66,7 +66,19 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
    * sets a PC up again only when the matrix's state has changed. */
   bool rebuild =
       s->o.op == PM_NEWTON_ASSEMBLED || s->jacobians % s->o.pc_lag == 0;
+  bool new_pc = rebuild;
+  if (s->o.pc_reuse_its > 0) {
+    /* a new preconditioner when the kept one has stopped paying; an
+     * assembled Jacobian is the operator: its values are always new */
+    new_pc = !s->pc_built || s->lin_failed || s->lin_its > s->o.pc_reuse_its;
+    rebuild = new_pc || s->o.op == PM_NEWTON_ASSEMBLED;
+    if (new_pc) s->pc_built = true;
+    PetscCall(
+        KSPSetReusePreconditioner(s->ksp, new_pc ? PETSC_FALSE : PETSC_TRUE));
+    PetscCall(SNESSetLagPreconditioner(s->snes, new_pc ? 1 : -1));
+  }
   s->jacobians++;
+  if (new_pc && s->rep) s->rep->pc_setups++;
   if (e == PM_SUCCESS && rebuild) {
     if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
       e = pm_newton_color_values(s, s->p.precond_apply, &s->pcol, x, s->pvals);
@@ -142,6 +154,11 @@ PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
   (void)x;
   s->linear_started = pm_wtime();
   s->in_linear = true;
+  /* The preconditioner's set-up (a factorisation, a multigrid hierarchy)
+   * now, to time it apart; KSPSolve's own set-up then finds it done. */
+  PetscCall(KSPSetUp(ksp));
+  PetscCall(KSPSetUpOnBlocks(ksp));
+  if (s->rep) s->rep->time_setup += pm_wtime() - s->linear_started;
   return 0;
 }
 
@@ -152,5 +169,11 @@ PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx) {
   (void)x;
   if (s->rep) s->rep->time_linear += pm_wtime() - s->linear_started;
   s->in_linear = false;
+  PetscInt its;
+  KSPConvergedReason why;
+  PetscCall(KSPGetIterationNumber(ksp, &its));
+  PetscCall(KSPGetConvergedReason(ksp, &why));
+  s->lin_its = (int)its;
+  s->lin_failed = why < 0;
   return 0;
 }

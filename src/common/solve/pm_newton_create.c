@@ -43,6 +43,8 @@ static pm_err check_options(const pm_newton_options *o) {
            o->stall_after);
   PM_CHECK(o->linear_max_iter >= 1, PM_ERR_ARG,
            "linear_max_iter must be >= 1 (got %d)", o->linear_max_iter);
+  PM_CHECK(o->pc_reuse_its >= 0, PM_ERR_ARG,
+           "pc_reuse_its must be >= 0 (got %d)", o->pc_reuse_its);
   PM_CHECK(o->pc_lag >= 1, PM_ERR_ARG, "pc_lag must be >= 1 (got %d)",
            o->pc_lag);
   PM_CHECK(o->load_steps >= 1, PM_ERR_ARG, "load_steps must be >= 1 (got %d)",
@@ -97,6 +99,9 @@ static pm_err configure_snes(pm_newton *s) {
   /* MUMPS: a singular matrix (a limit point) factors with its null pivots
    * set aside instead of failing with an error. */
   PM_PETSC_CALL(PetscOptionsInsertString(s->opts, "-pm_mat_mumps_icntl_24 1"));
+  if (o->amg_reuse)
+    PM_PETSC_CALL(PetscOptionsInsertString(
+        s->opts, "-pm_pc_gamg_reuse_interpolation true"));
   if (s->petsc_options) {
     PetscErrorCode code = PetscOptionsInsertString(s->opts, s->petsc_options);
     PM_CHECK(code == 0, PM_ERR_ARG, "PETSc options \"%s\" not understood",

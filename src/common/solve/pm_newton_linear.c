@@ -132,7 +132,8 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
   case PM_NEWTON_DIRECT:
     /* With a matrix-free operator the factorisation preconditions GMRES
      * (exactly, for a current J: one iteration). */
-    PM_PETSC(KSPSetType(ksp, matrix_free ? KSPGMRES : KSPPREONLY));
+    PM_PETSC(KSPSetType(ksp, matrix_free || o->pc_reuse_its > 0 ? KSPGMRES
+                                                                : KSPPREONLY));
     PM_PETSC(PCSetType(pc, PCLU));
 #ifdef PETSC_HAVE_MUMPS
     PM_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
@@ -182,6 +183,7 @@ pm_err pm_newton_replace_linear(pm_newton *s) {
   KSPDestroy(&ksp); /* SNES holds it */
   PM_PETSC_CALL(code);
   s->ksp = held;
+  s->pc_built = false;
   return PM_SUCCESS;
 }
 

@@ -60,6 +60,10 @@ struct pm_newton {
   /* The last linear solve's residual norms: first and last (the linear
    * solver's convergence test records them). */
   double lin_r0, lin_r;
+  /* pc_reuse_its: a preconditioner was built, and the last linear
+   * solve's iterations and whether it failed. */
+  bool pc_built, lin_failed;
+  int lin_its;
   bool started; /* the initial state was admissible */
 };
 

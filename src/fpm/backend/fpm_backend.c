@@ -47,10 +47,12 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   sim->tm_dual = pm_timers_add(&sim->timers, "subdomains");
   sim->tm_operators = pm_timers_add(&sim->timers, "GFD operators and BCs");
   sim->tm_force = pm_timers_add(&sim->timers, "internal force");
-  sim->tm_assembly = sim->tm_linear = -1;
+  sim->tm_assembly = sim->tm_linear = sim->tm_pcsetup = -1;
   if (s->time.qs == PM_QS_STATIC) {
     sim->tm_update = pm_timers_add(&sim->timers, "load steps and output");
     sim->tm_assembly = pm_timers_add(&sim->timers, "tangent (colouring)");
+    sim->tm_pcsetup =
+        pm_timers_add(&sim->timers, "factorisation or preconditioner set-up");
     sim->tm_linear = pm_timers_add(&sim->timers, "linear solves");
   } else {
     sim->tm_update = pm_timers_add(&sim->timers, "time integration");

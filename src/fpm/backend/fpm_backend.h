@@ -35,9 +35,9 @@ typedef struct {
   double mean_edge;   /* mean mesh edge length, m */
   pm_timers timers;
   int tm_mesh, tm_dual, tm_operators, tm_force, tm_update;
-  int tm_assembly, tm_linear; /* static solves only (else -1) */
-  double setup_wall;          /* mesh + dual + operators, s */
-  double *scratch;            /* 11 n: output buffer */
+  int tm_assembly, tm_pcsetup, tm_linear; /* static solves only (else -1) */
+  double setup_wall;                      /* mesh + dual + operators, s */
+  double *scratch;                        /* 11 n: output buffer */
   /* the run */
   pm_status status;
   fpm_step_info last;      /* the last step's figures */

@@ -227,6 +227,12 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(pm_json_integer(j, "static_linear_iterations",
                             r->load.linear_iterations));
     PM_CALL(pm_json_number(j, "static_setup_seconds", r->setup_seconds));
+    PM_CALL(
+        pm_json_number(j, "static_residual_seconds", r->load.time_residual));
+    PM_CALL(pm_json_number(j, "static_tangent_seconds", r->load.time_assembly));
+    PM_CALL(pm_json_number(j, "static_pc_setup_seconds", r->load.time_setup));
+    PM_CALL(pm_json_integer(j, "static_pc_setups", r->load.pc_setups));
+    PM_CALL(pm_json_number(j, "static_linear_seconds", r->load.time_linear));
     PM_CALL(pm_json_integer(j, "static_relaxations", r->load.relaxations));
     PM_CALL(pm_json_integer(j, "static_relaxed_steps", r->load.relaxed_steps));
     PM_CALL(pm_json_integer(j, "static_relax_iterations",

@@ -7,6 +7,7 @@
 
 #include "fpm_backend_impl.h"
 #include "fpm_par.h"
+#include "fpm_static.h"
 #include "pm_omp.h"
 #include "pm_par.h"
 
@@ -103,22 +104,48 @@ static double plan_head(fpm_sim *sim, FILE *out) {
   fprintf(out, "             %d. gather forces\n", stage++);
   if (s->time.qs == PM_QS_STATIC) {
     static const char *const linear[] = {"direct (LU)", "GMRES + GAMG",
-                                         "CG + Jacobi", "GMRES + ILU(0)"};
+                                         "CG + Jacobi", "GMRES + ILU(0)",
+                                         "CG + GAMG"};
+    long nfree = 0; /* this process's model's free dofs */
+    for (long d = 0; d < 3 * m->n_own; d++) nfree += !m->fixed[d];
+    pm_newton_options no = pm_newton_options_default();
+    fpm_static_choose_linear(s, nfree, &no);
+    char why[96] = "time.quasi_static.linear_solver";
+    if (!pm_scene_has(s, "time.quasi_static.linear_solver"))
+      snprintf(why, sizeof why, "default: %ld free dofs %s %ld", nfree,
+               nfree <= FPM_STATIC_DIRECT_MAX ? "<=" : ">",
+               FPM_STATIC_DIRECT_MAX);
+    fprintf(
+        out,
+        "             %d. Newton's method in %ld proportional load steps "
+        "(at most %ld iterations each), %ld prescribed dofs\n"
+        "             tangent assembled directly (%s), linear solver "
+        "%s (%s)%s\n",
+        stage++, s->time.qs_load_steps, s->time.qs_max_iterations, m->n_cdofs,
+        m->flux == FPM_FLUX_SIPG || m->vavg
+            ? "preconditioning the exact tangent applied matrix-free"
+            : "exact",
+        linear[no.linear], why,
+        s->time.qs_reuse > 0 ? ", kept while GMRES takes few iterations" : "");
+    /* The tangent and its factors or multigrid hierarchy, per tangent
+     * entry as measured (peak memory of whole runs over the entries, F3
+     * at 1851 and 4036 points: 175 bytes with LU, 90-110 with GAMG), at
+     * about 650 entries a free dof with the quadratic jump (3 rings). */
+    const bool lu = no.linear == PM_NEWTON_DIRECT;
+    const double entries = 650.0 * (double)nfree;
+    if (!m->q) {
+      fprintf(out,
+              "memory       %.1f MiB (operators and state; the tangent and "
+              "its factors come on top)\n",
+              (bytes + fpm_linear_bytes(m)) / 1048576.0);
+      return 0;
+    }
     fprintf(out,
-            "             %d. Newton's method in %ld proportional load steps "
-            "(at most %ld iterations each), %ld prescribed dofs\n"
-            "             tangent assembled directly (%s), linear solver "
-            "%s\n",
-            stage++, s->time.qs_load_steps, s->time.qs_max_iterations,
-            m->n_cdofs,
-            m->flux == FPM_FLUX_SIPG
-                ? "preconditioning the exact tangent applied matrix-free"
-                : "exact",
-            linear[s->time.qs_linear]);
-    fprintf(out,
-            "memory       %.1f MiB (operators and state; the tangent "
-            "and its factors come on top)\n",
-            (bytes + fpm_linear_bytes(m)) / 1048576.0);
+            "memory       %.1f MiB (operators and state) + about %.0f MiB "
+            "for the tangent (~%.3g entries) and its %s\n",
+            (bytes + fpm_linear_bytes(m)) / 1048576.0,
+            entries * (lu ? 175.0 : 110.0) / 1048576.0, entries,
+            lu ? "LU factors" : "multigrid hierarchy");
     return 0;
   }
   fprintf(out, "             %d. central difference%s, %ld prescribed dofs\n",

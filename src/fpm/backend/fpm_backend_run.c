@@ -216,7 +216,9 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
     tm[sim->tm_force].calls += r->load.newton_iterations;
     tm[sim->tm_assembly].seconds += r->load.time_assembly;
     tm[sim->tm_assembly].calls += r->load.newton_iterations;
-    tm[sim->tm_linear].seconds += r->load.time_linear;
+    tm[sim->tm_pcsetup].seconds += r->load.time_setup;
+    tm[sim->tm_pcsetup].calls += r->load.newton_iterations;
+    tm[sim->tm_linear].seconds += r->load.time_linear - r->load.time_setup;
     tm[sim->tm_linear].calls += r->load.newton_iterations;
     tm[sim->tm_update].seconds += wall - r->load.time_residual -
                                   r->load.time_assembly - r->load.time_linear;

@@ -36,6 +36,26 @@ static double force_floor(const fpm_model *m) {
   return 1e-12 * emax * diag2;
 }
 
+pm_newton_linear fpm_static_default_linear(long unknowns) {
+  return unknowns <= FPM_STATIC_DIRECT_MAX ? PM_NEWTON_DIRECT
+                                           : PM_NEWTON_GMRES_GAMG;
+}
+
+void fpm_static_choose_linear(const pm_scene *s, long unknowns,
+                              pm_newton_options *o) {
+  o->linear = pm_scene_has(s, "time.quasi_static.linear_solver")
+                  ? pm_newton_linear_of(s->time.qs_linear)
+                  : fpm_static_default_linear(unknowns);
+  if (o->linear != PM_NEWTON_GMRES_GAMG && o->linear != PM_NEWTON_CG_GAMG)
+    return;
+  /* Multigrid: a bounded Krylov solve (a failure cuts the load step with
+   * its reason), its hierarchy's interpolation kept over a load step's
+   * Newton iterations (only the coarse operators are recomputed). */
+  o->linear_rtol = FPM_STATIC_AMG_RTOL;
+  o->linear_max_iter = 1000;
+  o->amg_reuse = true;
+}
+
 pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
                       void *ctx, fpm_step_info *info, fpm_static_report *rep) {
   fpm_static_state ss;
@@ -101,7 +121,8 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   /* A step Newton creeps through (short line-search steps from a state
    * outside its basin) is cut sooner than at max_iter. */
   no.stall_after = 6;
-  no.linear = pm_newton_linear_of(s->time.qs_linear);
+  fpm_static_choose_linear(s, rep->unknowns, &no);
+  no.pc_reuse_its = (int)s->time.qs_reuse;
   no.load_steps = (int)s->time.qs_load_steps;
   no.predictor = true;
   /* Steps Newton cannot finish get dynamic relaxation within the step;

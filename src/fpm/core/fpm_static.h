@@ -19,6 +19,29 @@ typedef struct {
   double setup_seconds; /* pattern, tangent geometry, PETSc objects */
 } fpm_static_report;
 
+/* Free dofs (over all ranks) up to which a static solve's default linear
+ * solver is direct (MUMPS LU of the assembled tangent, kept over Newton
+ * iterations: time.quasi_static.reuse_iterations); above, GMRES with
+ * algebraic multigrid (GAMG on the rigid-body near null space, blocks of
+ * a point's components), whose memory grows linearly where the
+ * factorisation's grows faster: at 13762 points (41 000 dofs) the LU
+ * takes 5 GB, at 32715 it did not fit in 23 GB.  At 1851 and 4036 points
+ * the LU is the faster (docs/validation.md, "Static solves that
+ * scale"). */
+#define FPM_STATIC_DIRECT_MAX 60000L
+/* The multigrid solve's relative tolerance. */
+#define FPM_STATIC_AMG_RTOL 1e-6
+
+/* The default linear solver for a static solve of this many unknowns. */
+pm_newton_linear fpm_static_default_linear(long unknowns);
+
+/* o's linear solver for scene s and this many unknowns (over all ranks):
+ * the scene's time.quasi_static.linear_solver when it gives one, else
+ * fpm_static_default_linear; a multigrid one with its tolerance and set-up
+ * reuse. */
+void fpm_static_choose_linear(const pm_scene *s, long unknowns,
+                              pm_newton_options *o);
+
 /* Solve from rest with the settings of the model's scene
  * (time.quasi_static: tolerance, load_steps, max_iterations, linear_solver,
  * solver_options; stability.min_jacobian).  observer sees the initial state

@@ -116,4 +116,9 @@ pm_err fpm_static_number_ghosts(const fpm_model *m, long *free_of,
 int fpm_static_rigid_modes(const fpm_model *m, const long *dof, long nf,
                            double *rigid);
 
+/* The size of the blocks the free dofs dof (nf, by point, in order) come
+ * in: the number of free components of every point that has any, when
+ * all have as many (3 for a body clamped on whole faces); else 1. */
+int fpm_static_block_size(const long *dof, long nf);
+
 #endif

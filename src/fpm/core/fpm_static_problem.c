@@ -289,21 +289,23 @@ pm_err fpm_static_setup(const fpm_model *m, fpm_state *st,
   PM_CALL(fpm_static_tangent_build(m, &c->tg));
   PM_CALL(PM_ALLOC(v->rigid, 6 * c->nf, "rigid motions"));
   const int n_rigid = fpm_static_rigid_modes(m, c->dof, c->nf, v->rigid);
-  v->prob = (pm_newton_problem){.n = c->nf,
-                                .ctx = c,
-                                .residual = residual,
-                                .jacobian_apply = apply,
-                                .jacobian_prepare = prepare,
-                                .jacobian_values = fpm_static_tangent_values,
-                                .pat_ptr = v->ptr,
-                                .pat_idx = v->idx,
-                                .near_null_count = n_rigid,
-                                .near_null = v->rigid,
-                                .shared = m->xc != NULL,
-                                .n_ghost = c->nheld - c->nf,
-                                .ghost = c->ghost,
-                                .set_load = fpm_static_set_load,
-                                .on_step = on_step,
-                                .diagnose = diagnose};
+  v->prob =
+      (pm_newton_problem){.n = c->nf,
+                          .ctx = c,
+                          .residual = residual,
+                          .jacobian_apply = apply,
+                          .jacobian_prepare = prepare,
+                          .jacobian_values = fpm_static_tangent_values,
+                          .pat_ptr = v->ptr,
+                          .pat_idx = v->idx,
+                          .near_null_count = n_rigid,
+                          .near_null = v->rigid,
+                          .block_size = fpm_static_block_size(c->dof, c->nf),
+                          .shared = m->xc != NULL,
+                          .n_ghost = c->nheld - c->nf,
+                          .ghost = c->ghost,
+                          .set_load = fpm_static_set_load,
+                          .on_step = on_step,
+                          .diagnose = diagnose};
   return PM_SUCCESS;
 }

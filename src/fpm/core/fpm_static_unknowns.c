@@ -87,3 +87,15 @@ pm_err fpm_static_state_init(fpm_static_state *s, const fpm_model *m) {
 void fpm_static_state_free(fpm_static_state *s) {
   pm_load_state_free(&s->load);
 }
+
+int fpm_static_block_size(const long *dof, long nf) {
+  int size = 0;
+  for (long j = 0; j < nf;) {
+    long k = j + 1; /* the run of dofs of point dof[j] / 3 */
+    while (k < nf && dof[k] / 3 == dof[j] / 3) k++;
+    if (size == 0) size = (int)(k - j);
+    if (k - j != size) return 1;
+    j = k;
+  }
+  return size > 1 ? size : 1;
+}
