@@ -16,6 +16,11 @@
 #include "fpm_static.h"
 #include "fpm_testing.h"
 
+/* The stiffening's onset tau of the tests: about half the interfaces of
+ * their rough fields have a linear jump beyond tau h (printed by
+ * test_onset_free_below). */
+#define ONSET_TEST 0.012
+
 static double stored_energy(const fpm_model *m, fpm_state *st) {
   assert_int_equal(fpm_force(m, st), -1);
   double e = st->penalty_energy;
@@ -30,10 +35,12 @@ static double stored_energy(const fpm_model *m, fpm_state *st) {
  * k = 3: SIPG with fpm.stiffening (p_s = 1e6, so that its quartic energy
  * is a sizeable part of the interfaces' at this small rough field); k = 4:
  * SIPG, quadratic jump, the stiffening on it (p_s = 1e9, its jump being
- * smaller); k = 5: SIPG, quadratic jump, fpm.volume_penalty p_v = 1e4. */
+ * smaller); k = 5: SIPG, quadratic jump, fpm.volume_penalty p_v = 1e4;
+ * k = 6: SIPG with the stiffening from an onset (fpm.stiffening_onset,
+ * ONSET_TEST: some interfaces beyond it, some below). */
 static void test_sipg_is_gradient(void **state) {
   (void)state;
-  for (int k = 0; k < 6; k++) {
+  for (int k = 0; k < 7; k++) {
     fixture *fx = fixture_new(3, 0.03, 100, false);
     fx->opt.flux = k == 1 ? FPM_FLUX_IIPG : FPM_FLUX_SIPG;
     fx->opt.jump = k == 2 || k >= 4 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
@@ -43,6 +50,10 @@ static void test_sipg_is_gradient(void **state) {
       fx->opt.stiffening_jump = FPM_JUMP_QUADRATIC;
     }
     if (k == 5) fx->opt.volume_penalty = 1e4;
+    if (k == 6) {
+      fx->opt.stiffening = 1e6;
+      fx->opt.stiffening_onset = 0.1 * ONSET_TEST; /* its field is smoother */
+    }
     fpm_model *m;
     fpm_state *st;
     fixture_model(fx, &m, &st);
@@ -66,7 +77,8 @@ static void test_sipg_is_gradient(void **state) {
         "SIPG, quadratic jump",
         "SIPG, stiffening",
         "SIPG, stiffening on the quadratic jump",
-        "SIPG, volume penalty"};
+        "SIPG, volume penalty",
+        "SIPG, stiffening from an onset"};
     print_message("%s: dE/de = %.10g, f . d = %.10g, relative mismatch %.3g\n",
                   names[k], dE, fd, rel);
     if (k != 1) assert_true(rel <= 1e-6);
@@ -82,7 +94,8 @@ static void test_sipg_is_gradient(void **state) {
  * (bit 0: SIPG, bit 1: quadratic jump), or for k = 4 the default
  * formulation (with its boundary penalty), for k = 5 the default with
  * fpm.stiffening p_s = 1e5, for k = 6 with p_s = 1e7 on the quadratic
- * jump, for k = 7 with fpm.volume_penalty p_v = 1e3: its model and state. */
+ * jump, for k = 7 with fpm.volume_penalty p_v = 1e3, for k = 8 with p_s =
+ * 1e5 from the onset ONSET_TEST: its model and state. */
 static fixture *variant(double h, int k, fpm_model **m, fpm_state **st) {
   fixture *fx = fixture_new(3, h, 20, true);
   fx->opt.flux = k & 1 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
@@ -94,6 +107,10 @@ static fixture *variant(double h, int k, fpm_model **m, fpm_state **st) {
     fx->opt.stiffening_jump = FPM_JUMP_QUADRATIC;
   }
   if (k == 7) fx->opt.volume_penalty = 1e3;
+  if (k == 8) {
+    fx->opt.stiffening = 1e5;
+    fx->opt.stiffening_onset = ONSET_TEST;
+  }
   fixture_model(fx, m, st);
   return fx;
 }
@@ -107,7 +124,8 @@ static const char *variant_name(int k) {
       "the default formulation",
       "the default formulation with stiffening",
       "the default with stiffening on the quadratic jump",
-      "the default with the volume penalty"};
+      "the default with the volume penalty",
+      "the default with stiffening from an onset"};
   return names[k];
 }
 
@@ -117,7 +135,7 @@ static const char *variant_name(int k) {
  * penalty (relative 1e-6 of |K d|). */
 static void test_force_linearisation(void **state) {
   (void)state;
-  for (int k = 0; k < 8; k++) {
+  for (int k = 0; k < 9; k++) {
     fpm_model *m;
     fpm_state *st;
     fixture *fx = variant(0.03, k, &m, &st);
@@ -195,12 +213,85 @@ static void test_terms_act(void **state) {
   free(f4);
 }
 
+/* The onset makes the stiffening free below it and active beyond: on the
+ * rough field of test_terms_act, the fraction of interfaces whose linear
+ * jump exceeds tau h is printed (it must be strictly between 0 and 1, so
+ * both branches are exercised above); with tau above every jump the
+ * force equals the default formulation's exactly, and with ONSET_TEST it
+ * differs from it by more than 1e-4 of its norm and from the plain
+ * quartic's (tau = 0) too. */
+static void test_onset_free_below(void **state) {
+  (void)state;
+  double *f[3] = {NULL, NULL, NULL};
+  static const double onset[3] = {0, ONSET_TEST, 10};
+  long nd = 0;
+  for (int v = 0; v < 4; v++) {
+    fpm_model *m;
+    fpm_state *st;
+    fixture *fx = variant(0.03, v < 3 ? 5 : 4, &m, &st);
+    nd = 3 * m->n;
+    if (v < 3) {
+      fpm_state_destroy(st);
+      fpm_model_destroy(m);
+      fx->opt.stiffening_onset = onset[v];
+      fixture_model(fx, &m, &st);
+    }
+    smooth_plus_rough(m, 777, 0.2, 1e-3, st->u, NULL);
+    assert_int_equal(fpm_force(m, st), -1);
+    if (v == 1) {
+      long beyond = 0;
+      for (long i = 0; i < m->n; i++)
+        for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+          const double *r = m->erec + FPM_EREC * e, *ui = st->u + 3 * i,
+                       *uk = st->u + 3 * m->nbr[e];
+          double jj = 0;
+          for (int c = 0; c < 3; c++) {
+            double j = ui[c] - uk[c];
+            for (int a = 0; a < 3; a++)
+              j += st->H[9 * i + 3 * c + a] * r[12 + a] -
+                   st->H[9 * m->nbr[e] + 3 * c + a] * r[15 + a];
+            jj += j * j;
+          }
+          beyond += jj > r[22];
+        }
+      const double frac = (double)beyond / (double)m->nnz;
+      print_message("onset %g: %.3g of the interfaces beyond it\n", ONSET_TEST,
+                    frac);
+      assert_true(frac > 0.05 && frac < 0.95);
+    }
+    if (v < 3) {
+      f[v] = calloc(nd, sizeof *f[v]);
+      memcpy(f[v], st->f, nd * sizeof *f[v]);
+    } else {
+      double d_off = 0, d_on = 0, d_q = 0, norm = 0;
+      for (long i = 0; i < nd; i++) {
+        d_off = fmax(d_off, fabs(f[2][i] - st->f[i]));
+        d_on += (f[1][i] - st->f[i]) * (f[1][i] - st->f[i]);
+        d_q += (f[1][i] - f[0][i]) * (f[1][i] - f[0][i]);
+        norm += st->f[i] * st->f[i];
+      }
+      print_message("onset above every jump: max |f - f_default| = %.3g; "
+                    "onset %g: |f - f_default| / |f_default| = %.3g, "
+                    "|f - f_quartic| / |f_default| = %.3g\n",
+                    d_off, ONSET_TEST, sqrt(d_on / norm), sqrt(d_q / norm));
+      assert_true(d_off == 0);
+      assert_true(sqrt(d_on / norm) > 1e-4);
+      assert_true(sqrt(d_q / norm) > 1e-4);
+    }
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+  for (int v = 0; v < 3; v++) free(f[v]);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sipg_is_gradient),
       cmocka_unit_test(test_force_linearisation),
       cmocka_unit_test(test_static_tangent),
       cmocka_unit_test(test_terms_act),
+      cmocka_unit_test(test_onset_free_below),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

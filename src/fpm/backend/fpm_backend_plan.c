@@ -77,13 +77,14 @@ static double plan_head(fpm_sim *sim, FILE *out) {
             "             2. quadratic fit per point, %ld entries (%ld "
             "points over two rings, %ld linear)\n",
             m->qs_ptr[m->n], m->n_qwide, m->n_qlinear);
-  char extra[160] = "";
+  char extra[200] = "";
   if (m->boundary_penalty > 0 || m->stiffening > 0 || m->volume_penalty > 0)
     snprintf(extra, sizeof extra,
-             "; boundary penalty %g, stiffening %g on the %s jump, volume "
-             "penalty %g",
+             "; boundary penalty %g, stiffening %g on the %s jump from %g h, "
+             "volume penalty %g",
              m->boundary_penalty, m->stiffening,
-             m->stiffen_quadratic ? "quadratic" : "linear", m->volume_penalty);
+             m->stiffen_quadratic ? "quadratic" : "linear", m->stiffening_onset,
+             m->volume_penalty);
   fprintf(out,
           "             %d. interface flux (%s, penalty %g on the %s "
           "jump%s), %ld support entries\n",

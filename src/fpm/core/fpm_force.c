@@ -151,9 +151,10 @@ static inline void quad_jump(const double *ui, const double *uk,
  * by the fit weights in pass 3) instead of r and Q; the boundary
  * interfaces' linear-jump penalty (beta_b |e| = rec[19], zero elsewhere)
  * leaves through r and Q as the linear jump's does.  The stiffening
- * (fpm.stiffening, c_e |e| = rec[20]) adds s = c_e |e| |j|^2 j to the
+ * (fpm.stiffening, c_e |e| = rec[20], from the onset (tau h_e)^2 =
+ * rec[22]) adds the gradient of c_e |e| phi(|j|^2 - (tau h_e)^2) / 4 to the
  * force of the linear jump, or with fpm.stiffening_jump: quadratic of the
- * quadratic one, the gradient of c_e |e| |j|^4 / 4.  The volume penalty
+ * quadratic one (fpm_stiffen; |j|^4 at tau = 0).  The volume penalty
  * (fpm.volume_penalty, rec[21]) adds 1/2 c |e| phi_e |j|^2 on the linear
  * jump and its derivative through each point's J (fpm_penalty_terms.h).
  * The energy counts the model's own points. */
@@ -207,13 +208,14 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
           if (base)
             quad_jump(bu + 3 * i, bu + 3 * k, bth + 27 * i, bth + 27 * k, phi_i,
                       phi_k, jq0);
-          eadd += fpm_stiffen(cs, jq, base ? jq0 : NULL, sq);
+          eadd += fpm_stiffen(cs, rec[22], jq, base ? jq0 : NULL, sq);
         }
       }
       linear_jump(ui, uk, Hi, Hk, di, dk, jv);
       if (base && (cv != 0 || (cs != 0 && !squad)))
         linear_jump(bu + 3 * i, bu + 3 * k, bH + 9 * i, bH + 9 * k, di, dk, j0);
-      if (cs != 0 && !squad) eadd += fpm_stiffen(cs, jv, base ? j0 : NULL, sv);
+      if (cs != 0 && !squad)
+        eadd += fpm_stiffen(cs, rec[22], jv, base ? j0 : NULL, sv);
       if (cv != 0)
         eadd += fpm_volume_entry(cv, vphi[i], vphi[k], jv, base ? j0 : NULL,
                                  base ? vdphi[i] + vdphi[k] : 0, sv, &va, &vda);

@@ -197,6 +197,7 @@ static void build_interfaces(fpm_model *m) {
                           (xk[1] - xi[1]) * (xk[1] - xi[1]) +
                           (xk[2] - xi[2]) * (xk[2] - xi[2]);
         r[20] = m->stiffening * unit_beta(m, i, k, f) / h2;
+        r[22] = m->stiffening_onset * m->stiffening_onset * h2;
       }
       r[21] = m->volume_penalty * unit_beta(m, i, k, f);
     }
@@ -370,6 +371,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   m->stiffen_quadratic =
       o->stiffening_jump == FPM_JUMP_QUADRATIC && o->jump == FPM_JUMP_QUADRATIC;
   m->volume_penalty = o->volume_penalty;
+  m->stiffening_onset = o->stiffening_onset;
   m->flux = (fpm_flux)o->flux;
   m->jump = (fpm_jump)o->jump;
   m->n_own = m->n_flux = m->n_stress = m->n;
@@ -500,8 +502,13 @@ double fpm_stable_dt(const fpm_model *m, long *critical_point) {
   if (critical_point) *critical_point = crit;
   double p = m->penalty > 1 ? m->penalty : 1;
   if (m->q && m->boundary_penalty > p) p = m->boundary_penalty;
-  /* the stiffening's penalty 3 p_s (|j| / h)^2, taken at |j| <= h / 4 */
-  if (0.1875 * m->stiffening > p) p = 0.1875 * m->stiffening;
+  /* the stiffening's penalty p_s (3 |j|^2 - (tau h)^2) / h^2, taken at
+   * |j| <= h / 4 */
+  {
+    const double tau2 = m->stiffening_onset * m->stiffening_onset;
+    const double ps = (0.1875 - tau2) * m->stiffening;
+    if (ps > p) p = ps;
+  }
   /* the volume penalty's p_v (ln J)^2, taken at J >= 1/2 */
   if (0.48 * m->volume_penalty > p) p = 0.48 * m->volume_penalty;
   return fpm_contact_stable_dt(m->contact, 2.0 / sqrt(lam_max) / sqrt(p));

@@ -16,7 +16,7 @@
 #define FPM_MAX_MATERIALS 16
 
 struct fpm_contact;
-#define FPM_EREC 22 /* doubles per support-entry record */
+#define FPM_EREC 23 /* doubles per support-entry record */
 
 /* Everything that does not change during a run.  Arrays are per point
  * (n), per support entry (nnz, in the CSR order of the dual's adjacency) or
@@ -41,7 +41,8 @@ typedef struct {
    * and with the quadratic jump the linear jump's beta_b |e| = p_b E / h_e
    * |e| on the interfaces of boundary points, else 0 (1), and the
    * stiffening penalty's c_e |e| = p_s E / h_e^3 |e| (1, 0 without it),
-   * and the volume penalty's p_v E / h_e |e| (1, 0 without it).
+   * the volume penalty's p_v E / h_e |e| (1, 0 without it), and the
+   * stiffening's onset (tau h_e)^2 (1).
    * Entries stream in order in the flux pass; moments about the centroid
    * keep M - a (x) X_i = Mc + a (x) d_i free of cancellation. */
   double *erec;   /* FPM_EREC nnz */
@@ -59,6 +60,7 @@ typedef struct {
   double boundary_penalty; /* p_b (quadratic jump only) */
   double stiffening;       /* p_s: the quartic penalty on the jump */
   bool stiffen_quadratic;  /* it measures the quadratic jump (else linear) */
+  double stiffening_onset; /* tau: it acts beyond |[[u]]| = tau h */
   double volume_penalty;   /* p_v: linear-jump penalty scaled by (ln J)^2 */
   fpm_flux flux;           /* IIPG or SIPG */
   /* fpm.volumetric: averaged (fpm_volumetric.h): the weights a_ik of each

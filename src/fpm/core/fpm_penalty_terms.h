@@ -9,20 +9,31 @@
 #include "fpm_model.h"
 #include "pm_tensor.h"
 
-/* The stiffening on jump j: adds s += c |j|^2 j, the gradient of c |j|^4 /
- * 4, and returns the energy share c |j|^4 / 8 of the entry (each interface
- * is seen twice).  With the base's jump j0 (linearisation, j then the
- * increment): adds c (|j0|^2 j + 2 (j0 . j) j0) and returns 0. */
-static inline double fpm_stiffen(double c, const double *j, const double *j0,
-                                 double *s) {
+/* The stiffening on jump j with onset t2 = (tau h)^2: the energy
+ * c phi(g) / 4 with g = |j|^2 - t2 and phi(g) = g^3 / (g + t2) for g > 0,
+ * 0 below; t2 = 0 gives the quartic c |j|^4 / 4, and with t2 > 0 phi is
+ * twice differentiable at the onset (phi' = phi'' = 0 there), so the force
+ * and its derivative are continuous.  Adds the gradient s += c phi'(g) j / 2
+ * and returns the entry's energy share c phi(g) / 8 (each interface is
+ * seen twice).  With the base's jump j0 (linearisation, j then the
+ * increment): adds c (phi'(g0) j + 2 phi''(g0) (j0 . j) j0) / 2, returns
+ * 0. */
+static inline double fpm_stiffen(double c, double t2, const double *j,
+                                 const double *j0, double *s) {
+  const double *jb = j0 ? j0 : j;
+  const double g = pm_v_dot(jb, jb) - t2;
+  if (g <= 0) return 0;
+  const double w = g + t2, w2 = w * w;
+  const double d1 = (2 * g + 3 * t2) * g * g / w2; /* phi'(g) */
   if (j0) {
-    const double jj = pm_v_dot(j0, j0), jd = pm_v_dot(j0, j);
-    for (int a = 0; a < 3; a++) s[a] += c * (jj * j[a] + 2 * jd * j0[a]);
+    const double d2 = 2 * g * (g * g + 3 * g * t2 + 3 * t2 * t2) / (w2 * w);
+    const double jd = pm_v_dot(j0, j);
+    for (int a = 0; a < 3; a++)
+      s[a] += 0.5 * c * (d1 * j[a] + 2 * d2 * jd * j0[a]);
     return 0;
   }
-  const double jj = pm_v_dot(j, j);
-  for (int a = 0; a < 3; a++) s[a] += c * jj * j[a];
-  return 0.125 * c * jj * jj;
+  for (int a = 0; a < 3; a++) s[a] += 0.5 * c * d1 * j[a];
+  return 0.125 * c * g * g * g / w;
 }
 
 /* The volume penalty of one entry (i, k) on the linear jump j: the energy

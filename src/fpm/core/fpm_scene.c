@@ -75,6 +75,18 @@ static const pm_key fpm_keys[] = {
          "field) or quadratic (the quadratic fits' jump, O(h^3) where the "
          "field is smooth, so weaker there; the linear jump's with fpm.jump: "
          "linear)"},
+    {.name = "stiffening_onset",
+     .type = PM_KEY_NUMBER,
+     .offset = offsetof(fpm_options, stiffening_onset),
+     .def = "0",
+     .range = PM_RANGE_GE,
+     .unit = "",
+     .doc = "where fpm.stiffening begins, as a jump relative to the points' "
+            "spacing: its energy becomes p_s E / h^3 |e| phi(g) / 4, g = "
+            "|[[u]]|^2 - (tau h)^2, phi = g^3 / (g + (tau h)^2) where "
+            "|[[u]]| > tau h and nil below, so it costs nothing where every "
+            "jump stays under tau h (0: the plain quartic, acting at every "
+            "jump)"},
     {.name = "volume_penalty",
      .type = PM_KEY_NUMBER,
      .offset = offsetof(fpm_options, volume_penalty),

@@ -41,6 +41,8 @@ typedef struct {
   double stiffening;       /* fpm.stiffening p_s >= 0: quartic penalty on
                               the linear jump, |e| p_s E/h^3 |[[u]]|^4 / 4 */
   int stiffening_jump;     /* fpm.stiffening_jump: the fpm_jump it measures */
+  double stiffening_onset; /* fpm.stiffening_onset tau >= 0: the stiffening
+                              acts on |[[u]]|^2 - (tau h)^2 beyond it */
   double volume_penalty;   /* fpm.volume_penalty p_v >= 0: linear-jump
                               penalty p_v E / h (ln J)^2 */
   int flux;                /* fpm_flux */
