@@ -114,14 +114,19 @@ typedef struct {
 /* The anchor of node i (gap `gap`, normal n along axis a) in its column:
  * the first node at least h/2 inside (beyond the nodes in contact, whose
  * reach is 1e-6 h short of h/2, so no thread writes what another reads),
- * or -1 where there is none with mass; its distance k h from i in *k. */
+ * or -1 where there is none with mass (glued: none with a quarter of i's
+ * mass or more, so that a light node at the body's fringe, whose velocity
+ * the grid's force makes large, is not carried to the nodes in contact
+ * by the line); its
+ * distance k h from i in *k. */
 static long anchor_of(const mpm_grid *g, const double *mass, long i, double gap,
-                      const double n[3], int a, long *k) {
+                      const double n[3], int a, bool glue, long *k) {
   *k = (long)ceil((0.5 - 1e-9) - gap * g->inv_h);
   const long ia = i / g->stride[a] % g->nn[a];
   const long ja = ia + (n[a] > 0 ? *k : -*k);
   const long j = i + (ja - ia) * g->stride[a];
   if (*k < 1 || ja < 0 || ja >= g->nn[a] || !(mass[j] > 0)) return -1;
+  if (glue && mass[j] < 0.25 * mass[i]) return -1;
   return j;
 }
 
@@ -145,7 +150,8 @@ static bool node_contact(const mpm_grid *g, const mpm_nodes *nd,
   if (!(gap < b->reach)) return false;
   memcpy(vc, b->V, 3 * sizeof(double));
   long k;
-  if (b->axis >= 0) *j = anchor_of(g, nd->mass, i, gap, n, b->axis, &k);
+  if (b->axis >= 0)
+    *j = anchor_of(g, nd->mass, i, gap, n, b->axis, b->glue, &k);
   if (*j < 0 && gap > 0) return false;
   if (*j >= 0) {
     *T = gap / (gap + k * g->h);
@@ -185,7 +191,7 @@ static void gather_fold(const mpm_ctx *ctx, const body_step *b, long j,
     long ki;
     mpm_grid_node_position(g, i, x);
     const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
-    if (anchor_of(g, nd->mass, i, gap, n, a, &ki) != j) continue;
+    if (anchor_of(g, nd->mass, i, gap, n, a, b->glue, &ki) != j) continue;
     const double T = gap / (gap + ki * g->h);
     for (int c = 0; c < g->dim; c++)
       if (sets(b, n, c)) fold[c] += T * (nd->force[3 * i + c] + cf[3 * i + c]);
@@ -252,7 +258,7 @@ static double body_contact(const mpm_ctx *ctx, const body_step *b, int bi,
     const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
     memcpy(vc, b->V, sizeof vc);
     const long j =
-        b->axis >= 0 ? anchor_of(g, mass, i, gap, n, b->axis, &k) : -1;
+        b->axis >= 0 ? anchor_of(g, mass, i, gap, n, b->axis, b->glue, &k) : -1;
     if (j >= 0)
       for (int c = 0; c < 3; c++)
         vc[c] += (vel[3 * j + c] - b->V[c]) * gap / (gap + k * g->h);

@@ -38,9 +38,10 @@ pm_err mpm_contacts_check(const pm_scene *s, const struct mpm_model *m);
  * component; sticking: all of them; either only where that pushes the
  * body away (no pull).  Glued (a grip on a face): every node with mass
  * at or past the surface or within h/2 inside it, all components,
- * pulling too.  With reactions (the grid update) the nodes in
- * contact are found; without, MUSL's remap keeps the update's.  With
- * reactions: add the force this applies to the
+ * pulling too, the line taken only to an anchor with a quarter of the
+ * node's mass or more (else V at and past the surface, free inside).  With
+ * reactions (the grid update) the nodes in contact are found; without, MUSL's
+ * remap keeps the update's.  With reactions: add the force this applies to the
  * conditions' reactions, mark the dofs it sets (owner) and return its
  * work over the step (J); else 0.  Parallel over nodes; allocates
  * nothing. */
