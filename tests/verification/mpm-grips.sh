@@ -59,6 +59,17 @@ check "grip bar: first order (error at h 0.01 <= 0.6 x at 0.02)" \
   shrinks "$(awk -v r="$r1" -v f="$ref1" 'BEGIN { print r / f }')" \
   "$(awk -v r="$r2" -v f="$ref2" 'BEGIN { print r / f }')" 1 0.6
 
+# Glued plates on the bar's end faces: they hold the grid nodes at and
+# past the faces, so the gauge is the whole bar, E A u / 0.4 = 0.4 N
+# (-0.05% measured at h 0.02, where the grips above are -5.4%).
+glued=$scenes/mpm-glued-bar.yaml
+"$bin" run "$glued" --out "$work/gl" --quiet 2>"$work/err"
+check "glued bar h 0.02: completes" test $? -eq 0
+rg=$(last "$work/gl/history.csv" reaction_top_y)
+check "glued bar h 0.02: reaction $rg within 0.5% of 0.4" within "$rg" 0.4 0.005
+check "glued bar h 0.02: the plates' reactions balance" \
+  within "$(last "$work/gl/history.csv" reaction_bottom_y)" "-$rg" 1e-3
+
 # The traction: u = (t / E) (y - y_held) at the top layer.
 "$bin" run "$trac" --out "$work/t2" --quiet 2>"$work/err"
 check "traction bar h 0.02: completes" test $? -eq 0
@@ -99,6 +110,14 @@ bad_scene traction-on-region-implicit "$trac" \
 bad_scene grip-implicit "$grip" 's/method: mpm$/method: mpm-implicit/' \
   'region: "0.01 - y"' \
   'boundary.0.region: expected on: a face of domain.box for method mpm-implicit'
+
+bad_scene glued-grips-nothing "$glued" 's/point: \[0, 0.4\]/point: [0, 0.45]/' \
+  'point: \[0, 0.45\]' 'boundary.1.plate: expected a glued plate on a body'
+bad_scene glued-fpm "$glued" \
+  's/method: mpm$/method: fpm/; s/min: \[-0.02, -0.02\], max: \[0.06, 0.44\]/min: [0, 0], max: [0.04, 0.4]/' \
+  'contact: glued' 'boundary.0.contact: expected frictionless or sticking for method fpm'
+bad_scene glued-implicit "$glued" 's/method: mpm$/method: mpm-implicit/' \
+  'plate: {point: \[0, 0\]' 'boundary.0.plate: contact needs method mpm or fpm'
 
 echo "mpm-grips: $passes passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -211,7 +211,9 @@ typedef enum {
 /* How a rigid body holds what touches it. */
 typedef enum {
   PM_CONTACT_FRICTIONLESS = 0, /* normal force only */
-  PM_CONTACT_STICKING          /* held tangentially where it touched */
+  PM_CONTACT_STICKING,         /* held tangentially where it touched */
+  PM_CONTACT_GLUED /* held in every direction, pulling too (explicit MPM's
+                      grip on a face) */
 } pm_contact;
 
 /* Whether a condition is a rigid body in contact (plate or sphere). */

@@ -19,6 +19,7 @@ static const pm_name ramp_names[] = {{"smooth", PM_RAMP_SMOOTH},
 static const pm_name contact_names[] = {
     {"frictionless", PM_CONTACT_FRICTIONLESS},
     {"sticking", PM_CONTACT_STICKING},
+    {"glued", PM_CONTACT_GLUED},
     {NULL, 0}};
 static const pm_name qs_names[] = {
     {"none", PM_QS_NONE},
@@ -637,8 +638,10 @@ static const pm_key bc_keys[] = {
      .offset = C(contact),
      .def = "frictionless",
      .names = contact_names,
-     .doc = "plate, sphere: frictionless (normal force only) or sticking "
-            "(a point that touches is held where it touched)"},
+     .doc = "plate, sphere: frictionless (normal force only), sticking "
+            "(a point that touches is held where it touched) or glued "
+            "(method mpm: the body's face is held in every direction, "
+            "pulled as well as pushed: a grip)"},
     {.name = "penalty",
      .type = PM_KEY_NUMBER,
      .offset = C(contact_penalty),

@@ -159,6 +159,13 @@ pm_err fpm_contact_create(const fpm_model *m, const pm_scene *s,
   for (int b = 0, k = 0; b < s->n_bcs; b++) {
     const pm_scene_bc *bc = &s->bcs[b];
     if (!PM_BC_RIGID(bc)) continue;
+    if (bc->contact == PM_CONTACT_GLUED) {
+      char key[64];
+      PM_TRY(pm_scene_fail(s, PM_PATH(key, "boundary.%d.contact", b), true,
+                           "expected frictionless or sticking for method fpm "
+                           "(glued plates are the explicit MPM's grips), got "
+                           "glued"));
+    }
     c->bc[k] = b;
     c->pair_ptr[k] = q;
     for (long i = 0; i < m->n_own; i++) {

@@ -38,11 +38,14 @@ pm_err mpm_contacts_check(const pm_scene *s, const mpm_model *m) {
                            "expected at most %d rigid bodies for method mpm "
                            "(a bit of a node's flag each), got more",
                            MPM_CONTACT_MAX);
+    long glued = 0, seen = 0;
     for (int gi = 0; gi < m->n_groups; gi++) {
       if (!in_contact(m, gi)) continue;
       for (long p = m->group[gi].begin; p < m->group[gi].end; p++) {
         const double *x = m->x0 + 3 * p;
         double n[3], g = pm_rigid_gap(bc, zero, x, n);
+        seen++;
+        glued += g - 0.5 * pow(m->vol0[p], 1.0 / m->dim) <= 1e-6 * m->grid.h;
         if (!(g < 0)) continue;
         return pm_scene_fail(
             s, key, false,
@@ -51,6 +54,13 @@ pm_err mpm_contacts_check(const pm_scene *s, const mpm_model *m) {
             p, m->group[gi].name, x[0], x[1], x[2], -g);
       }
     }
+    if (bc->contact == PM_CONTACT_GLUED && glued == 0)
+      return pm_scene_fail(s, key, false,
+                           "expected a glued plate on a body's face (a "
+                           "particle within half its size of it at t = 0), "
+                           "got none of the %ld particles there (a grip that "
+                           "grips nothing)",
+                           seen);
   }
   return PM_SUCCESS;
 }
@@ -97,20 +107,26 @@ typedef struct {
   double dm[3], V[3], reach;
   int axis;
   bool stick;
+  bool glue;         /* glued: every node with mass within reach, pulling too */
   unsigned char bit; /* its bit in touched: the nodes in contact */
 } body_step;
 
 /* The anchor of node i (gap `gap`, normal n along axis a) in its column:
  * the first node at least h/2 inside (beyond the nodes in contact, whose
  * reach is 1e-6 h short of h/2, so no thread writes what another reads),
- * or -1 where there is none with mass; its distance k h from i in *k. */
+ * or -1 where there is none with mass (glued: none with a quarter of i's
+ * mass or more, so that a light node at the body's fringe, whose velocity
+ * the grid's force makes large, is not carried to the nodes in contact
+ * by the line); its
+ * distance k h from i in *k. */
 static long anchor_of(const mpm_grid *g, const double *mass, long i, double gap,
-                      const double n[3], int a, long *k) {
+                      const double n[3], int a, bool glue, long *k) {
   *k = (long)ceil((0.5 - 1e-9) - gap * g->inv_h);
   const long ia = i / g->stride[a] % g->nn[a];
   const long ja = ia + (n[a] > 0 ? *k : -*k);
   const long j = i + (ja - ia) * g->stride[a];
   if (*k < 1 || ja < 0 || ja >= g->nn[a] || !(mass[j] > 0)) return -1;
+  if (glue && mass[j] < 0.25 * mass[i]) return -1;
   return j;
 }
 
@@ -128,18 +144,20 @@ static bool node_contact(const mpm_grid *g, const mpm_nodes *nd,
   double x[3];
   *j = -1;
   *T = 0;
-  if (!(touched[i] & 1u) || !(nd->mass[i] > 0)) return false;
+  if (!(nd->mass[i] > 0) || !(b->glue || (touched[i] & 1u))) return false;
   mpm_grid_node_position(g, i, x);
   const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
   if (!(gap < b->reach)) return false;
   memcpy(vc, b->V, 3 * sizeof(double));
   long k;
-  if (b->axis >= 0) *j = anchor_of(g, nd->mass, i, gap, n, b->axis, &k);
+  if (b->axis >= 0)
+    *j = anchor_of(g, nd->mass, i, gap, n, b->axis, b->glue, &k);
   if (*j < 0 && gap > 0) return false;
   if (*j >= 0) {
     *T = gap / (gap + k * g->h);
     for (int c = 0; c < 3; c++) vc[c] += (vel[3 * *j + c] - b->V[c]) * *T;
   }
+  if (b->glue) return true; /* it pulls as well */
   double push = 0;
   for (int c = 0; c < g->dim; c++) push += (vc[c] - vel[3 * i + c]) * n[c];
   return push > 0; /* else the body leaves it: no pull */
@@ -173,7 +191,7 @@ static void gather_fold(const mpm_ctx *ctx, const body_step *b, long j,
     long ki;
     mpm_grid_node_position(g, i, x);
     const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
-    if (anchor_of(g, nd->mass, i, gap, n, a, &ki) != j) continue;
+    if (anchor_of(g, nd->mass, i, gap, n, a, b->glue, &ki) != j) continue;
     const double T = gap / (gap + ki * g->h);
     for (int c = 0; c < g->dim; c++)
       if (sets(b, n, c)) fold[c] += T * (nd->force[3 * i + c] + cf[3 * i + c]);
@@ -240,7 +258,7 @@ static double body_contact(const mpm_ctx *ctx, const body_step *b, int bi,
     const double gap = pm_rigid_gap(b->bc, b->dm, x, n);
     memcpy(vc, b->V, sizeof vc);
     const long j =
-        b->axis >= 0 ? anchor_of(g, mass, i, gap, n, b->axis, &k) : -1;
+        b->axis >= 0 ? anchor_of(g, mass, i, gap, n, b->axis, b->glue, &k) : -1;
     if (j >= 0)
       for (int c = 0; c < 3; c++)
         vc[c] += (vel[3 * j + c] - b->V[c]) * gap / (gap + k * g->h);
@@ -282,7 +300,8 @@ double mpm_contacts_apply(const mpm_ctx *ctx, double *vel, bool reactions) {
     if (!bc) continue;
     body_step bs = {.bc = bc,
                     .axis = plate_axis(bc),
-                    .stick = bc->contact == PM_CONTACT_STICKING,
+                    .stick = bc->contact != PM_CONTACT_FRICTIONLESS,
+                    .glue = bc->contact == PM_CONTACT_GLUED,
                     .bit = (unsigned char)(2u << k++)};
     bs.reach = bs.axis >= 0 ? (0.5 - 1e-6) * m->grid.h : 0.0;
     double d0[3], d1[3];
@@ -292,7 +311,7 @@ double mpm_contacts_apply(const mpm_ctx *ctx, double *vel, bool reactions) {
       bs.V[c] = (d1[c] - d0[c]) / dt;
       bs.dm[c] = 0.5 * (d0[c] + d1[c]);
     }
-    if (find) mark_touched(m, ctx->state, bc, d1, cw->touched);
+    if (find && !bs.glue) mark_touched(m, ctx->state, bc, d1, cw->touched);
     double R[3] = {0, 0, 0};
     work += body_contact(ctx, &bs, b, vel, reactions, find, R);
     if (!reactions) continue;

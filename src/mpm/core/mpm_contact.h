@@ -19,7 +19,8 @@ struct mpm_model;
 int mpm_contacts_count(const mpm_bc *bcs, int n);
 
 /* Check the rigid bodies of model m (scene s, particles seeded): one that
- * starts inside a body (a particle's centre past its surface at t = 0), or
+ * starts inside a body (a particle's centre past its surface at t = 0), a
+ * glued one that no particle reaches at t = 0 (a grip that grips nothing), or
  * more than MPM_CONTACT_MAX of them, fail with PM_ERR_SCENE at the key
  * (file:line:col), naming the particle.
  * Nothing to do without rigid bodies. */
@@ -35,9 +36,12 @@ pm_err mpm_contacts_check(const pm_scene *s, const struct mpm_model *m);
  * least h/2 inside (the extension a face condition makes), so that a
  * linear field stays linear through the plate.  Frictionless: the normal
  * component; sticking: all of them; either only where that pushes the
- * body away (no pull).  With reactions (the grid update) the nodes in
- * contact are found; without, MUSL's remap keeps the update's.  With
- * reactions: add the force this applies to the
+ * body away (no pull).  Glued (a grip on a face): every node with mass
+ * at or past the surface or within h/2 inside it, all components,
+ * pulling too, the line taken only to an anchor with a quarter of the
+ * node's mass or more (else V at and past the surface, free inside).  With
+ * reactions (the grid update) the nodes in contact are found; without, MUSL's
+ * remap keeps the update's.  With reactions: add the force this applies to the
  * conditions' reactions, mark the dofs it sets (owner) and return its
  * work over the step (J); else 0.  Parallel over nodes; allocates
  * nothing. */
