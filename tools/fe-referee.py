@@ -116,9 +116,9 @@ PLATE_THICKNESS = 0.01  # m
 # Contact: normal slope (Pa/m) and the tension at large clearance (Pa),
 # Coulomb coefficient (0: frictionless) and stick slope (Pa/m).  The
 # lateral faces that roll onto the plates slide on them: CalculiX's
-# face-to-face friction (mu 5, stick slope 3e8 or 3e7 Pa/m) stops the
-# graded C3D20 N = 8 ladder at 61.5% of F4 40%, where the contact band
-# forms; frictionless it reaches the load (--friction MU for the study,
+# face-to-face friction (mu 5, stick slope 3e8 Pa/m) stops the graded
+# C3D20 N = 8 at 61.5% of F4 40%, where the contact band forms;
+# frictionless it reaches the load (--friction MU for the study,
 # cases/fe/README.md, "F4 between plates").
 CONTACT = dict(slope=3.0e8, tension=1.0e-3, friction=0.0, stick=3.0e8)
 # Face-to-face penalty contact: CalculiX's node-to-face contact is not
