@@ -108,9 +108,9 @@ F4_MESH = dict(grading=2.0, element="full", ladder=LADDER_F4)
 # they are held as the plates move (the clamped conditions).  The lateral
 # faces meet the plates as they roll over: face-to-face contact with
 # each plate's face and a stiff linear pressure-overclosure law (see
-# CONTACT for the friction).  Each plate is a rigid slab of one linear brick over the
-# quarter's side, larger than the barrelled block, every node moved as
-# the plate.  The reaction is the top face's plus the top plate's.
+# CONTACT for the friction).  Each plate is a rigid slab of one linear
+# brick over the quarter's side, larger than the barrelled block, every
+# node moved as the plate.  The reaction is the top face's plus the top plate's.
 PLATE_REACH = 0.2  # m: the plates' extent along x and y (the block: 0.1)
 PLATE_THICKNESS = 0.01  # m
 # Contact: normal slope (Pa/m) and the tension at large clearance (Pa),
