@@ -78,8 +78,8 @@ fpm_form() {
     --set time.dt_rule=spectral --set time.dt_safety=0.5)
   case $1 in
   scene | quadratic) form=() ;;
-  paper) form=(--set fpm.jump=linear --set fpm.penalty=20) ;;
-  p0) form=(--set fpm.jump=linear --set fpm.penalty=0) ;;
+  paper) form=(--set fpm.formulation=paper) ;;
+  p0) form=(--set fpm.formulation=paper --set fpm.penalty=0) ;;
   sipg) form=("${sipg[@]}" --set fpm.jump=linear) ;;
   sipg-quadratic) form=("${sipg[@]}") ;;
   *)

@@ -8,7 +8,7 @@ bench_name=f1-figure bench_out=${FIGURE_OUT:-out/f1-figure}
 # shellcheck source=bench-lib.sh
 . "$(dirname "$0")/bench-lib.sh"
 for p in 0 20; do
-  "$bin" run --overwrite cases/fpm/f1-extension.yaml --set fpm.jump=linear \
+  "$bin" run --overwrite cases/fpm/f1-extension.yaml --set fpm.formulation=paper \
     --set fpm.penalty=$p --quiet \
     --out "$out/p$p"
 done

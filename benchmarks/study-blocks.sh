@@ -11,8 +11,8 @@
 #   CASE: f3-extension-60 f3-extension-100 f3-extension-200
 #         f4-compression-20 f4-compression-40 f4-compression-60
 # FORMULATION chooses the flux, jump and penalty (TAG is its name):
-#   scene  the scenes' own (default): IIPG, quadratic jump, p = 0.05 (F3
-#          200% too, whose scene keeps the paper's at its finer levels)
+#   scene  the scenes' own (default): IIPG, quadratic jump, p = 0.05,
+#          averaged volume
 #   paper  the FPM paper's: IIPG, linear jump, p = 20
 #   sipg   symmetric: SIPG, linear jump, p = 100
 # QS=static solves each state by Newton's method instead of dynamic
@@ -33,9 +33,6 @@ if [ "${QS:-}" = static ]; then
   tag=$tag-static
 fi
 for c in "${cases[@]}"; do
-  own=()
-  [ "${FORMULATION:-scene}" = scene ] && [ "$c" = f3-extension-200 ] &&
-    own=(--set fpm.jump=quadratic --set fpm.penalty=0.05)
   if [ "${REFERENCE:-last}" = fe ]; then
     ref=(--reference "fe:cases/fe/$c")
     sizes=${SIZES:-8.72e-3,6.42e-3,4.15e-3,2.98e-3}
@@ -44,6 +41,6 @@ for c in "${cases[@]}"; do
     sizes=${SIZES:-8.72e-3,6.42e-3,4.15e-3,2.98e-3,2.15e-3}
   fi
   "$bin" convergence --overwrite "cases/fpm/$c.yaml" --quiet \
-    "${own[@]}" "${form[@]}" --set output.every=1000000 "${ref[@]}" \
+    "${form[@]}" --set output.every=1000000 "${ref[@]}" \
     --set-ladder discretization.mesh_size=$sizes --out "$out/study-$c-$tag"
 done

@@ -134,7 +134,8 @@ static void test_defaults(void **state) {
   assert_int_equal(s->bodies[0].material, 0);
   assert_null(s->bodies[0].region);
   assert_int_equal(s->n_bcs, 0);
-  /* the default formulation: quadratic jump, small penalty */
+  /* the default formulation: quadratic jump, small penalty (the averaged
+   * volume is test_volumetric_default's) */
   assert_int_equal(fpm_scene_options(s)->formulation, FPM_FORMULATION_DEFAULT);
   assert_int_equal(fpm_scene_options(s)->jump, FPM_JUMP_QUADRATIC);
   assert_near(fpm_scene_options(s)->penalty, 0.05, 0);
@@ -392,6 +393,36 @@ static void test_vocabulary(void **state) {
   pm_scene_destroy(s);
 }
 
+/* fpm.volumetric: averaged is the default where it applies; the paper's
+ * formulation, the SIPG flux and a model without the volumetric split get
+ * the standard term unless the scene asks, and an asked averaged volume
+ * that cannot be honoured is refused at the key. */
+static void test_volumetric_default(void **state) {
+  (void)state;
+  const char *def[] = {"fpm.formulation=default"};
+  pm_scene *s = load_ok(F2, 1, def);
+  assert_int_equal(fpm_scene_options(s)->volumetric, FPM_VOLUMETRIC_AVERAGED);
+  pm_scene_destroy(s);
+  s = load_ok(F2, 0, NULL); /* the scene's formulation: paper */
+  assert_int_equal(fpm_scene_options(s)->volumetric, FPM_VOLUMETRIC_STANDARD);
+  pm_scene_destroy(s);
+  const char *sipg[] = {"fpm.formulation=default", "fpm.flux=sipg"};
+  s = load_ok(F2, 2, sipg);
+  assert_int_equal(fpm_scene_options(s)->volumetric, FPM_VOLUMETRIC_STANDARD);
+  pm_scene_destroy(s);
+  const char *linear[] = {"fpm.formulation=default",
+                          "materials.0={name: gel, model: linear-elastic, "
+                          "density: 1000, youngs_modulus: 3000, "
+                          "poisson_ratio: 0.3}"};
+  s = load_ok(F2, 2, linear);
+  assert_int_equal(fpm_scene_options(s)->volumetric, FPM_VOLUMETRIC_STANDARD);
+  pm_scene_destroy(s);
+  const char *asked[] = {"fpm.formulation=default", "fpm.flux=sipg",
+                         "fpm.volumetric=averaged"};
+  load_fails(F2, 3, asked, PM_ERR_SCENE, "fpm.volumetric",
+             "expected standard with fpm.flux sipg");
+}
+
 static void test_ramp_and_names(void **state) {
   (void)state;
   assert_near(pm_ramp_factor(PM_RAMP_NONE, 1, 0), 1, 0);
@@ -530,6 +561,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_f2_values),
       cmocka_unit_test(test_defaults),
+      cmocka_unit_test(test_volumetric_default),
       cmocka_unit_test(test_malformed),
       cmocka_unit_test(test_missing_file),
       cmocka_unit_test(test_overrides),

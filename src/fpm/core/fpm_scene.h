@@ -28,8 +28,9 @@ typedef enum {
 /* A named set of defaults for the flux keys. */
 typedef enum {
   FPM_FORMULATION_DEFAULT = 0, /* accurate and stable: quadratic jump, small
-                                  p, linear jump on boundary interfaces */
-  FPM_FORMULATION_PAPER        /* the FPM paper's: linear jump, p = 20 */
+                                  p, averaged volume where it applies */
+  FPM_FORMULATION_PAPER        /* the FPM paper's: linear jump, p = 20,
+                                  standard volume */
 } fpm_formulation;
 
 /* Options of the fpm section. */
