@@ -84,14 +84,16 @@ done
 # averaged volume), errors of the displacement at the FE lattice and of the
 # top reaction against the CalculiX referee the scene names.  F3 60%: both
 # rates >= 1.8 (measured 2.30 and 2.62; the FE reaction is converged to
-# 5e-4).  F4 20%: both rates are printed, not asserted.  The displacement
+# 5e-4).  F4 20%: the reaction rate is printed, not asserted.  The displacement
 # rate was held to the 1.5 while the default was the standard
 # volumetric term (1.50 measured against the lattice of the converged,
 # graded referee); with the averaged volume the least-squares displacement
 # rate on this uniform ladder is 1.36 (its finest level's reaction error
 # +6.08% against the standard volume's +8.35%): the bound is not
 # met by the default on uniform clouds, and that stays open
-# (docs/validation.md, "The default formulation, measured").  The reaction
+# (docs/validation.md, "The default formulation, measured").  The check
+# below holds the default's own rate, 1.36, with a margin (>= 1.25) so that
+# a regression shows; it does not claim the 1.5.  The reaction
 # rate (1.06) is not asserted either: FE's own reaction converges only at
 # order 1.6 on meshes graded towards the clamped edges, and the referee is
 # their Richardson limit.
@@ -108,8 +110,9 @@ for c in f3-extension-60 f4-compression-20; do
     check "$c against FE: displacement rate q = $q >= 1.8" ge "$q" 1.8
     check "$c against FE: reaction error rate q = $qr >= 1.8" ge "$qr" 1.8
   else
-    echo "  $c against FE: displacement rate q = $q, reaction error rate" \
-      "q = $qr (not asserted; measured 1.36 and 1.06)"
+    check "$c against FE: displacement rate q = $q >= 1.25 (measured 1.36)" \
+      ge "$q" 1.25
+    echo "  $c against FE: reaction error rate q = $qr (not asserted)"
   fi
   # The finest level (mesh size 8.72e-3 m, h = 1.09e-2 m, 1851 points) is
   # the block scene as committed at the paper's coarsest resolution, the run
