@@ -119,9 +119,10 @@ static void test_sphere(void **state) {
   check_tangent(&bc, k, d, x, a);
 }
 
-/* A scene text with the plate entry given, loaded as NAME. */
-static pm_err load(const char *plate, const char *method, const char *qs,
-                   pm_scene **s) {
+/* A scene text with the plate entry given, loaded as NAME; extra: more
+ * top-level lines ("" for none). */
+static pm_err load_with(const char *plate, const char *method, const char *qs,
+                        const char *extra, pm_scene **s) {
   char text[2048];
   snprintf(text, sizeof text,
            "name: contact\n"
@@ -136,9 +137,15 @@ static pm_err load(const char *plate, const char *method, const char *qs,
            "boundary:\n"
            "  - {on: zmin, displacement: {x: 0, y: 0, z: 0}}\n"
            "  - %s\n"
-           "time: {end: 1, quasi_static: {method: %s}}\n",
-           method, plate, qs);
+           "time: {end: 1, quasi_static: {method: %s}}\n"
+           "%s",
+           method, plate, qs, extra);
   return pm_scene_load_text(text, strlen(text), "contact.yaml", 0, NULL, s);
+}
+
+static pm_err load(const char *plate, const char *method, const char *qs,
+                   pm_scene **s) {
+  return load_with(plate, method, qs, "", s);
 }
 
 /* Loading fails with a message holding frag1 and frag2. */
@@ -228,7 +235,11 @@ static void test_plate_inside(void **state) {
 static void check_static_tangent(const char *body, const char *what) {
   pm_scene *s = NULL;
   fpm_sim *sim = NULL;
-  assert_ok(load(body, "fpm", "static", &s));
+  /* The standard volumetric term: the assembled tangent is then the whole
+   * tangent (the averaged volume's coupling is applied matrix-free, and
+   * unit.test_fpm_volumetric checks its linearisation). */
+  assert_ok(
+      load_with(body, "fpm", "static", "fpm: {volumetric: standard}\n", &s));
   assert_ok(fpm_sim_create(s, &sim));
   const fpm_model *m = sim->model;
   fpm_state *st = sim->state;
