@@ -145,27 +145,29 @@ static pm_err count_shares(struct fpm_par *P, const fpm_model *full,
 /* The exchange's operations (fpm_exchange.h) on a share's ranks.  The
  * bytes count every ghost value received; `exchanges` counts the
  * displacements' (one a step), so that their ratio is the bytes a step. */
-static void exchange_ghosts(void *ctx, double *u) {
-  struct fpm_par *P = ctx;
+/* Broadcast the owners' values of width doubles a point (MPI type unit)
+ * to the ghosts, counting the bytes and the time. */
+static void bcast_ghosts(struct fpm_par *P, MPI_Datatype unit, int width,
+                         double *v) {
   const double t0 = pm_wtime();
   /* Nothing to report: a star forest set up once fails only on MPI's own
    * failures, which stop every rank (MPI_ERRORS_ARE_FATAL). */
-  PetscSFBcastBegin(P->ghosts, P->three, u, u, MPI_REPLACE);
-  PetscSFBcastEnd(P->ghosts, P->three, u, u, MPI_REPLACE);
-  P->costs.ghost_bytes += 3.0 * sizeof(double) * (double)P->n_ghost;
-  pm_par_count_sent(3.0 * sizeof(double) * (double)P->n_ghost);
-  P->costs.exchanges++;
+  PetscSFBcastBegin(P->ghosts, unit, v, v, MPI_REPLACE);
+  PetscSFBcastEnd(P->ghosts, unit, v, v, MPI_REPLACE);
+  const double bytes = width * sizeof(double) * (double)P->n_ghost;
+  P->costs.ghost_bytes += bytes;
+  pm_par_count_sent(bytes);
   P->costs.exchange_seconds += pm_wtime() - t0;
 }
 
-static void exchange_ghost_scalars(void *ctx, double *v) {
+static void exchange_ghosts(void *ctx, double *u) {
   struct fpm_par *P = ctx;
-  const double t0 = pm_wtime();
-  PetscSFBcastBegin(P->ghosts, MPI_DOUBLE, v, v, MPI_REPLACE);
-  PetscSFBcastEnd(P->ghosts, MPI_DOUBLE, v, v, MPI_REPLACE);
-  P->costs.ghost_bytes += sizeof(double) * (double)P->n_ghost;
-  pm_par_count_sent(sizeof(double) * (double)P->n_ghost);
-  P->costs.exchange_seconds += pm_wtime() - t0;
+  bcast_ghosts(P, P->three, 3, u);
+  P->costs.exchanges++;
+}
+
+static void exchange_ghost_scalars(void *ctx, double *v) {
+  bcast_ghosts(ctx, MPI_DOUBLE, 1, v);
 }
 
 static pm_err agree(void *ctx, pm_err e, long key) {
