@@ -25,7 +25,6 @@ import datetime
 import math
 import os
 import re
-import resource
 import shutil
 import subprocess
 import sys
@@ -764,8 +763,11 @@ def job_name(name, spec, n, reduced):
 
 
 def run_ccx(name, spec, n, mesh, reduced, rundir, job, threads):
-    """Write the deck into a fresh rundir and run ccx on it; returns the
-    wall and CPU times (s), also kept in rundir/times.txt."""
+    """Write the deck into a fresh rundir and run ccx on it with threads
+    threads (OMP_NUM_THREADS and CCX_NPROC_EQUATION_SOLVER, _RESULTS and
+    _STIFFNESS, which CalculiX reads); returns the wall and CPU times (s,
+    CPU: user and system of ccx alone) and ccx's peak resident memory
+    (bytes), also kept in rundir/times.txt."""
     shutil.rmtree(rundir, ignore_errors=True)
     os.makedirs(rundir)
     write_deck(os.path.join(rundir, job + ".inp"), name, spec, n, mesh,
@@ -774,17 +776,20 @@ def run_ccx(name, spec, n, mesh, reduced, rundir, job, threads):
                CCX_NPROC_EQUATION_SOLVER=str(threads),
                CCX_NPROC_RESULTS=str(threads),
                CCX_NPROC_STIFFNESS=str(threads))
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     with open(os.path.join(rundir, "ccx.log"), "w") as log:
-        subprocess.run(["ccx", "-i", job], cwd=rundir, stdout=log,
-                       stderr=subprocess.STDOUT, env=env)
+        p = subprocess.Popen(["ccx", "-i", job], cwd=rundir, stdout=log,
+                             stderr=subprocess.STDOUT, env=env)
+        # wait4: this child's own usage (RUSAGE_CHILDREN would mix the
+        # peaks of every child so far).
+        _, status, usage = os.wait4(p.pid, 0)
+        p.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime
+    cpu = usage.ru_utime + usage.ru_stime
+    memory = usage.ru_maxrss * 1024.0  # KiB on Linux
     with open(os.path.join(rundir, "times.txt"), "w") as f:
-        f.write("%.6f %.6f\n" % (wall, cpu))
-    return wall, cpu
+        f.write("%.6f %.6f %.0f\n" % (wall, cpu, memory))
+    return wall, cpu, memory
 
 
 def run_case(name, spec, n, reduced, work, threads, reuse=False):
@@ -803,10 +808,11 @@ def run_case(name, spec, n, reduced, work, threads, reuse=False):
     times = os.path.join(rundir, "times.txt")
     if reuse and os.path.exists(times):
         with open(times) as f:
-            wall, cpu = (float(v) for v in f.read().split())
+            v = [float(t) for t in f.read().split()]
+        wall, cpu, memory = (v + [math.nan])[:3]  # older runs: no memory
     else:
-        wall, cpu = run_ccx(name, spec, n, mesh, reduced, rundir, job,
-                            threads)
+        wall, cpu, memory = run_ccx(name, spec, n, mesh, reduced, rundir,
+                                    job, threads)
     increments, iterations, reached = read_sta(os.path.join(rundir,
                                                             job + ".sta"))
     converged = abs(reached - 1.0) < 1e-9
@@ -817,7 +823,8 @@ def run_case(name, spec, n, reduced, work, threads, reuse=False):
                reaction_x=math.nan, reaction_y=math.nan, reaction_z=math.nan,
                mean_sed=math.nan, von_mises_centre=math.nan,
                increments=increments, iterations=iterations, wall_seconds=wall,
-               cpu_seconds=cpu, work_density=math.nan,
+               cpu_seconds=cpu, peak_memory_bytes=memory,
+               work_density=math.nan,
                load_fraction=reached,
                status="converged" if converged else "stopped")
     lattice = None
@@ -877,7 +884,7 @@ COLUMNS = ["N", "nodes", "dofs", "element", "h", "reaction_x", "reaction_y",
            "reaction_z", "mean_sed", "von_mises_centre", "increments",
            "wall_seconds", "ccx_version", "model", "iterations",
            "cpu_seconds", "work_density", "load_fraction", "status",
-           "grading", "h_min"]
+           "grading", "h_min", "peak_memory_bytes"]
 
 
 def cell(v):
@@ -1190,6 +1197,10 @@ def main():
                     help="where decks run (default /tmp/fe-referee)")
     ap.add_argument("--threads", type=int, default=1,
                     help="threads given to ccx (default 1)")
+    ap.add_argument("--lattices", action="store_true",
+                    help="also write lattice-N<k>.csv for every mesh that "
+                    "reached the full load (pointmech bench measures each "
+                    "level's displacement against the case's referee)")
     ap.add_argument("--keep", action="store_true",
                     help="keep the run folders under --work")
     ap.add_argument("--reuse", action="store_true",
@@ -1265,6 +1276,13 @@ def main():
         for old in os.listdir(folder):
             if old.startswith("lattice") or old == "tolerance.csv":
                 os.remove(os.path.join(folder, old))
+        if a.lattices:
+            for row in done:
+                write_lattice(os.path.join(folder, "lattice-N%d.csv"
+                                           % row["N"]),
+                              header + "# lattice of the mesh N = %d (%s)\n"
+                              % (row["N"], row["element"]),
+                              lattices[row["N"]])
         # A referee needs two meshes at the full load to say how far it is
         # converged; otherwise the ladder alone records what was reached.
         if len(done) < 2:

@@ -132,9 +132,13 @@ static void usage(FILE *out) {
           "tabulate every\n"
           "         run's NRMSE and reaction error against the FE referee "
           "(or the\n"
-          "         analytic field) beside its wall time and memory, with the "
-          "referee's\n"
-          "         own ladder; OUT/accuracy-cost.png by tools/plot-bench.py "
+          "         analytic field) beside its wall time and memory, and a "
+          "case's key\n"
+          "         fe: {ladder: [N, ...], threads} runs CalculiX on those "
+          "meshes, timed,\n"
+          "         in rows fe beside the methods' (else the referee's "
+          "recorded ladder);\n"
+          "         OUT/accuracy-cost.png by tools/plot-bench.py "
           "(default OUT:\n"
           "         out/NAME-bench); a failed case is listed with its "
           "diagnosis and the\n"
@@ -377,6 +381,7 @@ static int cmd_bench(const cli_args *a) {
       .out_dir = a->out,
       .quiet = a->quiet,
       .overwrite = a->overwrite,
+      .fe_tool = PM_TOOLS_DIR "/fe-referee.py",
   };
   char dir[1024];
   pm_err e = pm_bench_run(&o, stdout, dir, sizeof dir);

@@ -7,6 +7,11 @@
 #  - the hard cases, coarse (cases/bench/hard-tiny.yaml): every outcome
 #    in one table (F4 between plates by a static solve among them), the panel against its FE
 #    referee's tip displacement;
+#  - FE beside every method (cases/bench/cost-tiny.yaml): CalculiX on
+#    N = 2, 4, 6 timed in the same table as FPM, errors against the
+#    referee decreasing with N, the figure drawn; the referee's own mesh
+#    marked reference, not measured against itself; without ccx the FE row
+#    says so and FPM's rows stand;
 #  - a two-case suite whose second case goes unstable: the failure is
 #    listed with its diagnosis, the first case still reported, exit 2;
 #  - variants of one method under labels, with their own overrides;
@@ -34,12 +39,20 @@ print(last)
 EOF
 }
 
+# Runs suite into $work/NAME with more arguments: out, rc (its exit
+# status) and csv set, its progress printed.
+run_suite() { # name, suite, more arguments
+  out=$work/$1
+  local suite=$2
+  shift 2
+  "$bin" bench "$suite" --out "$out" --quiet "$@" >"$out.log" 2>"$work/err"
+  rc=$?
+  cat "$out.log"
+  csv=$out/bench.csv
+}
+
 # ---- the CI suite --------------------------------------------------------
-out=$work/tiny
-"$bin" bench "$src/cases/bench/tiny.yaml" --out "$out" --quiet >"$out.log" \
-  2>"$work/err"
-rc=$?
-cat "$out.log"
+run_suite tiny "$src/cases/bench/tiny.yaml"
 check "tiny: exit 0 (got $rc)" test $rc -eq 0
 for f in bench.md bench.csv f2/h-0.0125/compare.md f2/h-0.02/fpm/summary.json \
   f2/h-0.02/mpm/summary.json f2/h-0.02/mpm-implicit/summary.json; do
@@ -66,8 +79,8 @@ for m in fpm mpm mpm-implicit; do
   t=$(field "$csv" f2 $m wall_seconds)
   check "tiny: $m wall time $t tabulated" lt 0 "$t"
 done
-check "tiny: the FE referee's ladder tabulated" \
-  grep -q '^fe,f2,,fe,CalculiX' "$csv"
+check "tiny: the FE referee's recorded ladder tabulated" \
+  grep -q '^fe-recorded,f2,,fe,CalculiX' "$csv"
 check "tiny: bench.md table" \
   grep -Eq '^\| f2 \| 0.02 \| mpm-implicit \| converged \|' "$out/bench.md"
 # The verdict: FPM and the implicit MPM hold F2's exact state at both
@@ -84,6 +97,99 @@ refused "tiny again: refused without --overwrite" \
   'already holds a bench' "$out/none" \
   "$bin" bench "$src/cases/bench/tiny.yaml" --out "$out" --quiet
 
+# ---- FE beside every method (cost-tiny.yaml) ----------------------------
+# F3 60%: FPM at 237 points and CalculiX on N = 2, 4, 6, each timed, each
+# against the referee (N = 20, cases/fe/f3-extension-60).  Measured: FE
+# +2.47%, +1.10%, +0.38%; FPM (static, default) at 237 points about +5%.
+if command -v ccx >/dev/null && /usr/bin/python3 -c 'import numpy' 2>/dev/null
+then
+  run_suite cost-tiny "$src/cases/bench/cost-tiny.yaml"
+  check "cost-tiny: exit 0 (got $rc)" test $rc -eq 0
+  fe_rows() { # name: the column of the fe rows, coarsest first
+    /usr/bin/python3 - "$csv" "$1" <<'EOF2'
+import csv, sys
+print(" ".join(r[sys.argv[2]] for r in csv.DictReader(open(sys.argv[1]))
+               if r["kind"] == "method" and r["label"] == "fe"))
+EOF2
+  }
+  check "cost-tiny: three FE rows, N = 2 4 6 ($(fe_rows fe_n))" \
+    test "$(fe_rows fe_n)" = "2 4 6"
+  check "cost-tiny: every FE mesh converged ($(fe_rows status))" \
+    test "$(fe_rows status)" = "converged converged converged"
+  read -r e2 e4 e6 <<<"$(fe_rows reaction_error_fe)"
+  check "cost-tiny: FE errors decrease with N ($e2 > $e4 > $e6 > 0)" \
+    awk -v a="$e2" -v b="$e4" -v c="$e6" \
+    'BEGIN { exit !(a != "" && c != "" && a + 0 > b + 0 && b + 0 > c + 0 && c + 0 > 0) }'
+  # The referee's own differences (its ladder.csv): 14.516944, 14.322796,
+  # 14.220632 against 14.16684 N.
+  check "cost-tiny: FE N = 2 at +2.47% of the referee ($e2)" \
+    awk -v e="$e2" 'BEGIN { exit !(e != "" && (e - 0.02471) ^ 2 < 1e-8) }'
+  read -r n2 n4 n6 <<<"$(fe_rows nrmse_fe)"
+  check "cost-tiny: FE NRMSE at the lattice decreases ($n2 > $n4 > $n6)" \
+    awk -v a="$n2" -v b="$n4" -v c="$n6" \
+    'BEGIN { exit !(c != "" && a + 0 > b + 0 && b + 0 > c + 0 && c + 0 > 0) }'
+  for t in wall_seconds cpu_seconds memory_bytes; do
+    v=$(fe_rows $t)
+    check "cost-tiny: FE $t timed ($v)" \
+      awk -v v="$v" 'BEGIN { n = split(v, a, " "); ok = n == 3;
+        for (i = 1; i <= n; i++) ok = ok && a[i] + 0 > 0; exit !ok }'
+  done
+  check "cost-tiny: one thread, as the suite asks ($(fe_rows threads))" \
+    test "$(fe_rows threads)" = "1 1 1"
+  s=$(field "$csv" f3-60 fpm-static status)
+  check "cost-tiny: FPM converged ($s)" test "$s" = converged
+  r=$(field "$csv" f3-60 fpm-static reaction_error_fe)
+  check "cost-tiny: FPM's reaction within 10% of the referee ($r)" \
+    awk -v r="$r" 'BEGIN { exit !(r != "" && r * r <= 0.01) }'
+  check "cost-tiny: FE rows in bench.md" grep -Eq \
+    '^\| f3-60 \| N 4 \| fe \| converged \| 141 \|' "$out/bench.md"
+  check "cost-tiny: ccx's threads said" grep -q \
+    'FE of f3-60: ccx with 1 thread (OMP_NUM_THREADS' "$out/bench.md"
+  check "cost-tiny: the FE levels' lattices kept" \
+    test -s "$out/f3-60/fe/f3-extension-60/lattice-N6.csv"
+  if /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then
+    check "cost-tiny: accuracy-cost.png drawn" test -s "$out/accuracy-cost.png"
+  fi
+  # A referee of N = 2, 4 (made here), given on the command line: N = 4
+  # is its own mesh, marked reference and not measured against itself.
+  # FPM coarse (3e-2) and quick: these runs check the FE rows alone.
+  cat >"$work/cost-ref.yaml" <<EOF2
+name: cost-ref
+methods: [{label: fpm-static, method: fpm, set: [time.quasi_static.method=static]}]
+cases:
+  - {name: f3-60, scene: $src/cases/fpm/f3-extension-60.yaml,
+     resolutions: [3e-2], fe: {ladder: [2, 4], threads: 1}}
+EOF2
+  /usr/bin/python3 "$src/tools/fe-referee.py" f3-extension-60 --run \
+    --ladder 2,4 --out "$work/ref" --work "$work/ref-work" >"$work/ref.log" 2>&1
+  run_suite cost-ref "$work/cost-ref.yaml" \
+    --set "reference.fe=$work/ref/f3-extension-60"
+  check "cost-ref: N = 4 is the reference ($(fe_rows status))" \
+    test "$(fe_rows status)" = "converged reference"
+  # N = 2 against N = 4: 14.516944 / 14.322796 - 1.
+  read -r e2 e4 <<<"$(fe_rows reaction_error_fe)"
+  check "cost-ref: N = 2 against the referee N = 4 ($e2), none for N = 4 ($e4)" \
+    awk -v e="$e2" -v f="$e4" \
+    'BEGIN { exit !(f == "" && e != "" && (e - 0.013555) ^ 2 < 1e-10) }'
+  # Without ccx on PATH (a stand-in ssh for MPI's start-up alone): the FE
+  # row says so, FPM's rows stand.
+  mkdir -p "$work/noccx"
+  printf '#!/bin/sh\nexit 1\n' >"$work/noccx/ssh"
+  chmod +x "$work/noccx/ssh"
+  out=$work/cost-noccx
+  PATH=$work/noccx "$bin" bench "$work/cost-ref.yaml" --out "$out" --quiet \
+    >"$out.log" 2>"$work/err"
+  rc=$?
+  csv=$out/bench.csv
+  check "cost-noccx: exit 0 without ccx (got $rc)" test $rc -eq 0
+  check "cost-noccx: the FE row says ccx is missing" grep -q \
+    '^method,f3-60,,fe,fe,not-run,.*CalculiX (ccx) is not on PATH' "$csv"
+  s=$(field "$csv" f3-60 fpm-static status)
+  check "cost-noccx: FPM converged all the same ($s)" test "$s" = converged
+else
+  echo "bench: no ccx or numpy: the FE rows are not checked"
+fi
+
 # ---- the hard cases, coarse ----------------------------------------------
 # hard-tiny.yaml: the near-incompressible panel at 157 points, F3 200% and
 # F4 60% at 237, F4 between plates, the reduced shock tube.  Every run
@@ -94,13 +200,8 @@ refused "tiny again: refused without --overwrite" \
 # N, which was stiff).  The bound, 25%, follows the referee, not the code:
 # the same run, the coarse resolution's error (+4.0% by relaxation at 1851
 # points, docs/validation.md, "F4 between plates, converged referee").
-out=$work/hard-tiny
-"$bin" bench "$src/cases/bench/hard-tiny.yaml" --out "$out" --quiet \
-  >"$out.log" 2>"$work/err"
-rc=$?
-cat "$out.log"
+run_suite hard-tiny "$src/cases/bench/hard-tiny.yaml"
 check "hard-tiny: exit 0, every run completed (got $rc)" test $rc -eq 0
-csv=$out/bench.csv
 md=$out/bench.md
 s=$(field "$csv" f4-plates-40 fpm-static status)
 check "hard-tiny: the plates by a static solve converged ($s)" \
@@ -124,7 +225,7 @@ t=$(field "$csv" panel fpm-static tip_error_fe)
 check "hard-tiny: panel by the default within 5% of FE ($t)" \
   awk -v t="$t" 'BEGIN { exit !(t != "" && t * t <= 0.05 * 0.05) }'
 check "hard-tiny: the referee's tip ladder tabulated" \
-  grep -q '^fe,panel,,fe,CalculiX CPE8R,converged,.*,[-0-9.e]*,$' "$csv"
+  grep -q '^fe-recorded,panel,,fe,CalculiX CPE8R,converged,.*,[-0-9.e]*,,,,$' "$csv"
 # F3 200% at 237 points against its referee (31.38 N, C3D20R N = 20):
 # the default formulation measured +9.2%, the paper's +160%.
 t=$(field "$csv" f3-200 fpm-static reaction_error_fe)

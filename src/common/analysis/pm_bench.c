@@ -136,14 +136,20 @@ static void run_one(const pm_bench_suite *S, const pm_bench_options *o,
   fflush(out);
 }
 
-/* The FE referee of case C, when its scene names one. */
-static void case_fe(const pm_bench_suite *S, const pm_bench_case *C,
+/* The FE referee of case C, when its scene names one (with the case's
+ * overrides and then the command line's, as its runs see it). */
+static void case_fe(const pm_bench_options *o, const pm_bench_case *C,
                     pm_bench_fe *F) {
   pm_scene *s = NULL;
   pm_fe_reference *r = NULL;
+  const char *sets[BENCH_SETS + 64];
+  int n = 0;
   memset(F, 0, sizeof *F);
-  if (pm_scene_load(C->scene, C->n_sets, C->sets, &s) == PM_SUCCESS &&
-      s->reference_fe && pm_fe_load(s->reference_fe, &r) == PM_SUCCESS) {
+  for (int k = 0; k < C->n_sets; k++) sets[n++] = C->sets[k];
+  for (int k = 0; k < o->n_sets && n < BENCH_SETS + 64; k++)
+    sets[n++] = o->sets[k];
+  if (pm_scene_load(C->scene, n, sets, &s) == PM_SUCCESS && s->reference_fe &&
+      pm_fe_load(s->reference_fe, &r) == PM_SUCCESS) {
     F->have = true;
     snprintf(F->dir, sizeof F->dir, "%s", r->dir);
     F->axis = 0;
@@ -160,7 +166,6 @@ static void case_fe(const pm_bench_suite *S, const pm_bench_case *C,
     for (int k = 0; k < F->n; k++) F->rows[k] = r->rows[k];
   }
   pm_error_clear();
-  (void)S;
   pm_fe_free(r);
   pm_scene_destroy(s);
 }
@@ -199,7 +204,7 @@ pm_err pm_bench_run(const pm_bench_options *o, FILE *out, char *dir,
   for (int c = 0; c < S->n_cases; c++) {
     const pm_bench_case *C = &S->c[c];
     if (!selected(o->only, C->name)) continue;
-    case_fe(S, C, &fe[c]);
+    case_fe(o, C, &fe[c]);
     for (int j = 0; j < (C->n_res ? C->n_res : 1); j++) {
       pm_bench_comparison *R = &runs[n_runs++];
       R->c = c;
@@ -225,6 +230,13 @@ pm_err pm_bench_run(const pm_bench_options *o, FILE *out, char *dir,
       fflush(out);
     }
     run_one(S, o, R, out);
+    /* After a case's last resolution: its FE ladder, timed alike. */
+    if (R->err != PM_ERR_INTERRUPTED &&
+        (i + 1 == n_runs || runs[i + 1].c != R->c)) {
+      char case_dir[PM_PATH_MAX + 1];
+      PM_TRY(pm_path_join(case_dir, sizeof case_dir, out_dir, C->name));
+      pm_bench_fe_ladder(C, &fe[R->c], o->fe_tool, case_dir, out);
+    }
     if (R->err != PM_SUCCESS && first == PM_SUCCESS) {
       first = R->err;
       first_run = i;

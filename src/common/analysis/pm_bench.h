@@ -18,6 +18,8 @@
  *       resolutions: [2e-2, 1e-2]     # discretization.mesh_size; default
  *                                     # the scene's own
  *       set: [time.end=5, "mpm:time.quasi_static.tolerance=1e-4"]
+ *       fe: {ladder: [2, 4, 8], threads: 2}  # CalculiX on these meshes,
+ *                                     # timed beside the methods (rows "fe")
  */
 #ifndef PM_BENCH_H
 #define PM_BENCH_H
@@ -37,13 +39,17 @@ typedef struct {
   const char *out_dir; /* NULL: out/NAME-bench */
   bool quiet;          /* the runs' own progress off (the suite's stays) */
   bool overwrite;      /* replace an earlier bench's runs */
+  const char *fe_tool; /* tools/fe-referee.py, which runs a case's FE
+                          ladder (key fe); NULL: the FE rows say so */
 } pm_bench_options;
 
 /* Read the suite (every problem in it fails before anything runs, at its
  * FILE:LINE:COL), then run each case at each resolution into
  * OUT/CASE/h-RES by pm_compare_run, printing a line per run and one per
- * method as they finish.  A case whose comparison fails or whose methods
- * fail is listed with its diagnosis and the suite goes on.  Writes
+ * method as they finish; then the case's FE ladder (key fe) by CalculiX
+ * into OUT/CASE/fe, each mesh a row "fe" beside the methods' (a missing
+ * ccx is said in those rows, not a failure).  A case whose comparison fails or
+ * whose methods fail is listed with its diagnosis and the suite goes on. Writes
  * OUT/bench.md (the table, the failures, the definitions) and
  * OUT/bench.csv (a row per method run and per FE ladder level, for
  * tools/plot-bench.py), and returns the first failure (the report is

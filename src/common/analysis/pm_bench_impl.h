@@ -19,6 +19,7 @@
 #define BENCH_RES 8   /* resolutions of a case */
 #define BENCH_SETS 32 /* overrides of a method or a case */
 #define BENCH_FE_ROWS 16
+#define BENCH_FE_LEVELS 12 /* meshes of the FE ladder a case runs */
 #define MIB (1024.0 * 1024.0)
 
 typedef struct {
@@ -37,6 +38,9 @@ typedef struct {
   double res[BENCH_RES]; /* discretization.mesh_size (none: the scene's) */
   int n_sets;
   const char *sets[BENCH_SETS];
+  int n_fe; /* the FE ladder CalculiX solves (key fe; 0: none) */
+  int fe_ladder[BENCH_FE_LEVELS];
+  int fe_threads; /* ccx's threads (0: OMP_NUM_THREADS, else the cores) */
 } pm_bench_case;
 
 /* One comparison: a case at a resolution. */
@@ -51,6 +55,20 @@ typedef struct {
   double seconds; /* the comparison's wall time */
 } pm_bench_comparison;
 
+/* A mesh of the FE ladder a bench ran, measured against the case's
+ * referee. */
+typedef struct {
+  int n; /* elements per edge */
+  long nodes, increments;
+  char element[PM_FE_TEXT_MAX];
+  char status[32]; /* converged, stopped, or reference (the referee's own
+                      mesh or a finer one: not measured against itself) */
+  double h, wall_seconds, cpu_seconds, memory_bytes;
+  double error; /* the reaction's (a traction case's: the tip's) relative
+                   error against the referee's figure; NaN when none */
+  double nrmse; /* the displacement at the referee's lattice */
+} pm_bench_fe_level;
+
 /* The FE referee of a case: its ladder's reactions and times. */
 typedef struct {
   bool have;
@@ -62,7 +80,25 @@ typedef struct {
   double tol;      /* its relative tolerance on that (NaN: none) */
   int axis;
   bool tip; /* a traction case: judged by the tip displacement */
+  /* The ladder the bench ran (the case's key fe): its levels, ccx's
+   * threads, where it ran, and why it did not when it did not. */
+  int n_levels, threads;
+  pm_bench_fe_level levels[BENCH_FE_LEVELS];
+  char run_dir[PM_PATH_MAX + 1];
+  char message[PM_COMPARE_MESSAGE_MAX];
 } pm_bench_fe;
+
+/* Runs case C's FE ladder (C->fe_ladder) by CalculiX through tool
+ * (tools/fe-referee.py, under /usr/bin/python3) into dir/fe, each mesh
+ * timed (wall, CPU, peak memory of ccx alone, threads as F->threads), and
+ * measures each level against the case's referee F (loaded by the
+ * caller): reaction (tip) error and lattice NRMSE; a level at or finer than
+ * the referee's finest mesh is marked "reference", not measured against
+ * itself.  Never fails: when ccx, the tool or python is missing or the
+ * tool stops, F->message says why (and the levels it reached stay).
+ * Prints a line per level to out (NULL: none). */
+void pm_bench_fe_ladder(const pm_bench_case *C, pm_bench_fe *F,
+                        const char *tool, const char *dir, FILE *out);
 
 /* A run's error against the FE referee's figure (relative): the loaded
  * reaction's, or a traction case's tip displacement's. */

@@ -130,13 +130,16 @@ static void md_fe_level(FILE *m, const char *name, const pm_fe_row *r, int axis,
           pm_table_number(b[2], 100 * err, 3), r->wall_seconds);
 }
 
-/* A row "fe" of bench.csv: err under reaction_error_fe, or under
- * tip_error_fe for a traction case (axis -1). */
+/* A row "fe-recorded" of bench.csv (the referee's ladder as recorded when
+ * it was made): err under reaction_error_fe, or under tip_error_fe for a
+ * traction case (axis -1). */
 static void csv_fe_level(FILE *f, const char *name, const pm_fe_row *r,
                          int axis, double err) {
   char b[2][PM_TABLE_NUMBER];
   pm_table_number(b[1], err, 10);
-  fprintf(f, "fe,%s,,fe,CalculiX %s,converged,%ld,%s,%ld,,,,,%s,,,%.6g,,,%s,\n",
+  fprintf(f,
+          "fe-recorded,%s,,fe,CalculiX %s,converged,%ld,%s,%ld,,,,,%s,,,%.6g,"
+          ",,%s,,,,\n",
           name, r->element, r->nodes, pm_table_number(b[0], r->h, 10),
           r->increments, axis >= 0 ? b[1] : "", r->wall_seconds,
           axis >= 0 ? "" : b[1]);
@@ -159,6 +162,54 @@ static void md_first_line(FILE *m, const char *msg) {
   fprintf(m, " |\n");
 }
 
+/* Rows "fe" of bench.md's table: the case's FE ladder as the bench ran
+ * it, or why it did not. */
+static void md_fe_rows(FILE *m, const char *name, const pm_bench_fe *F) {
+  char b[4][PM_TABLE_NUMBER];
+  if (F->n_levels == 0 && F->message[0]) {
+    fprintf(m, "| %s | | fe | not-run | | | | | | | | | | ", name);
+    md_first_line(m, F->message);
+  }
+  for (int k = 0; k < F->n_levels; k++) {
+    const pm_bench_fe_level *L = &F->levels[k];
+    fprintf(m,
+            "| %s | N %d | fe | %s | %ld | %s | %ld | %s | %s | %s | %.3g | "
+            "%.3g | %.1f | CalculiX %s |\n",
+            name, L->n, L->status, L->nodes, pm_table_number(b[0], L->h, 4),
+            L->increments, pm_table_number(b[1], L->nrmse, 3),
+            isfinite(L->nrmse) ? "FE" : "",
+            pm_table_number(b[2], 100 * L->error, 3), L->wall_seconds,
+            L->cpu_seconds, L->memory_bytes / MIB, L->element);
+  }
+}
+
+/* Rows "method" labelled fe of bench.csv: the case's FE ladder as the
+ * bench ran it (or one row saying why not), the error under
+ * reaction_error_fe or, for a traction case, tip_error_fe. */
+static void csv_fe_rows(FILE *f, const char *name, const pm_bench_fe *F) {
+  char b[5][PM_TABLE_NUMBER];
+  if (F->n_levels == 0 && F->message[0]) {
+    fprintf(f, "method,%s,,fe,fe,not-run,,,,,,,,,,,,,,,,,,", name);
+    pm_csv_text(f, F->message);
+    fputc('\n', f);
+  }
+  for (int k = 0; k < F->n_levels; k++) {
+    const pm_bench_fe_level *L = &F->levels[k];
+    pm_table_number(b[2], L->error, 10);
+    fprintf(f,
+            "method,%s,%s,fe,CalculiX %s,%s,%ld,%s,%ld,%s,%s,,%s,%s,,,%.6g,,"
+            "%s,%s,%.6g,%d,%d,",
+            name, pm_table_number(b[0], L->h, 10), L->element, L->status,
+            L->nodes, b[0], L->increments, pm_table_number(b[1], L->nrmse, 10),
+            isfinite(L->nrmse) ? "FE" : "", pm_table_number(b[3], L->nrmse, 10),
+            F->tip ? "" : b[2], L->wall_seconds,
+            pm_table_number(b[4], L->memory_bytes, 12), F->tip ? b[2] : "",
+            L->cpu_seconds, F->threads, L->n);
+    pm_csv_text(f, F->message);
+    fputc('\n', f);
+  }
+}
+
 static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
                      int n_runs, const pm_bench_fe *fe, double seconds,
                      FILE *m) {
@@ -170,13 +221,13 @@ static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
           S->name, S->path, S->n_cases, n_runs, seconds);
   fprintf(m, "| case | resolution (m) | method | status | points | h (m) | "
              "steps | NRMSE | against | reaction (tip) error (FE) | wall (s) "
-             "| memory (MiB) | diagnosis |\n|---|---|---|---|---|---|---|---|"
-             "---|---|---|---|---|\n");
+             "| CPU (s) | memory (MiB) | diagnosis |\n|---|---|---|---|---|---|"
+             "---|---|---|---|---|---|---|---|\n");
   for (int i = 0; i < n_runs; i++) {
     const pm_bench_comparison *R = &runs[i];
     pm_bench_res_text(res, sizeof res, R->res);
     if (R->n_rows == 0) {
-      fprintf(m, "| %s | %s | | failed | | | | | | | | | ", S->c[R->c].name,
+      fprintf(m, "| %s | %s | | failed | | | | | | | | | | ", S->c[R->c].name,
               res);
       md_first_line(m, R->message);
       n_fail++;
@@ -196,34 +247,60 @@ static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
       fprintf(m, " %s | %s | %s |", pm_table_number(b[1], e, 3), against,
               pm_table_number(b[2], 100 * pm_bench_fe_error(r), 3));
       if (r->ran)
-        fprintf(m, " %.3g | %.1f | ", r->wall_seconds,
+        fprintf(m, " %.3g | | %.1f | ", r->wall_seconds,
                 (double)r->memory_bytes / MIB);
       else
-        fprintf(m, " | | ");
+        fprintf(m, " | | | ");
       md_first_line(m, r->message);
     }
+    if (i + 1 == n_runs || runs[i + 1].c != R->c)
+      md_fe_rows(m, S->c[R->c].name, &fe[R->c]);
   }
   fprintf(m, "\nReaction error in %% of the FE referee's loaded reaction; "
              "for a case loaded by a traction (its reaction is the load), "
              "the tip displacement's error (the mean displacement on the "
              "loaded face, negative when the run is stiffer).  Diagnosis: "
              "the first sentence of why a run stopped (all of it under "
-             "Failures).\n");
+             "Failures).  Rows fe: CalculiX on the case's FE ladder (key "
+             "fe), resolution N elements per edge, points its nodes, steps "
+             "its load increments, wall and CPU time of ccx alone (the "
+             "deck's writing and reading excluded) on the threads said "
+             "below; a mesh at or finer than the referee's own is marked "
+             "reference and not measured against itself.  CPU is given "
+             "for FE only: the methods run in this process, one after the "
+             "other.\n");
+  for (int c = 0; c < S->n_cases; c++)
+    if (fe[c].n_levels)
+      fprintf(m,
+              "\nFE of %s: ccx with %d thread%s (OMP_NUM_THREADS and "
+              "CCX_NPROC_EQUATION_SOLVER, _RESULTS, _STIFFNESS), in "
+              "%s.\n",
+              S->c[c].name, fe[c].threads, fe[c].threads > 1 ? "s" : "",
+              fe[c].run_dir);
   bool any_fe = false;
   for (int c = 0; c < S->n_cases; c++) any_fe = any_fe || fe[c].have;
   if (any_fe) {
-    fprintf(m, "\n## The FE referee's ladder\n\n| case | N | nodes | h (m) | "
+    fprintf(m, "\n## The FE referee's recorded ladder\n\n| case | N | "
+               "nodes | h (m) | "
                "reaction (N) or tip (m) | error (%%) | wall (s) |\n"
                "|---|---|---|---|---|---|---|\n");
     each_fe_level(S, fe, m, md_fe_level);
-    fprintf(m, "\nErrors against the referee's finest converged level, "
-               "whose own uncertainty its tolerance.csv gives; the coarser "
-               "levels show what FE accuracy costs in time (CalculiX, its "
-               "recorded wall time).\n");
+    fprintf(m, "\nAs recorded when the referee was made (cases/fe/CASE/"
+               "ladder.csv, one thread, another day's load): errors against "
+               "the referee's figure (its finest converged level, or the "
+               "Richardson limit where surer), whose own uncertainty its "
+               "tolerance.csv gives.  The rows fe above are timed in this "
+               "bench.\n");
   }
   md_verdict(S, runs, n_runs, fe, m);
   if (n_fail) {
     fprintf(m, "\n## Failures\n\n");
+    for (int c = 0; c < S->n_cases; c++)
+      if (fe[c].message[0]) {
+        fprintf(m, "- %s, fe: ", S->c[c].name);
+        pm_md_text(m, fe[c].message);
+        fprintf(m, "\n");
+      }
     for (int i = 0; i < n_runs; i++) {
       const pm_bench_comparison *R = &runs[i];
       pm_bench_res_text(res, sizeof res, R->res);
@@ -258,13 +335,13 @@ static void write_csv(const pm_bench_suite *S, const pm_bench_comparison *runs,
   fprintf(f, "kind,case,resolution,label,method,status,points,h,steps,"
              "nrmse,against,nrmse_analytic,nrmse_fe,reaction_error_fe,"
              "sed_error_fe,min_jacobian,wall_seconds,setup_seconds,"
-             "memory_bytes,tip_error_fe,message\n");
+             "memory_bytes,tip_error_fe,cpu_seconds,threads,fe_n,message\n");
   for (int i = 0; i < n_runs; i++) {
     const pm_bench_comparison *R = &runs[i];
     const char *cname = S->c[R->c].name;
     pm_table_number(b[0], R->res, 10);
     if (R->n_rows == 0) {
-      fprintf(f, "method,%s,%s,,,failed,,,,,,,,,,,,,,,", cname, b[0]);
+      fprintf(f, "method,%s,%s,,,failed,,,,,,,,,,,,,,,,,,", cname, b[0]);
       pm_csv_text(f, R->message);
       fputc('\n', f);
     }
@@ -290,10 +367,12 @@ static void write_csv(const pm_bench_suite *S, const pm_bench_comparison *runs,
                 r->memory_bytes);
       else
         fprintf(f, ",,,");
-      fprintf(f, "%s,", pm_table_number(b[8], r->tip_fe, 10));
+      fprintf(f, "%s,,,,", pm_table_number(b[8], r->tip_fe, 10));
       pm_csv_text(f, r->message);
       fputc('\n', f);
     }
+    if (i + 1 == n_runs || runs[i + 1].c != R->c)
+      csv_fe_rows(f, cname, &fe[R->c]);
   }
   each_fe_level(S, fe, f, csv_fe_level);
 }

@@ -143,13 +143,59 @@ static pm_err read_method(pm_bench_suite *S, int i) {
   return sets_at(d, q, M->sets, &M->n_sets, false);
 }
 
+/* The whole number at path, lo to hi, into *v. */
+static pm_err count_at(const pm_sdoc *d, const char *path, int lo, int hi,
+                       int *v, const char *what) {
+  double x;
+  const char *t = pm_sdoc_scalar(d, pm_sdoc_find(d, path, false));
+  if (!t || !pm_parse_number(t, &x) || x != floor(x) || x < lo || x > hi)
+    return pm_sdoc_expected(d, path, what);
+  *v = (int)x;
+  return PM_SUCCESS;
+}
+
+/* A case's FE ladder (at path, absent: none): {ladder: [N, ...], threads:
+ * T}, the meshes CalculiX solves (tools/fe-referee.py), coarsest first. */
+static pm_err read_fe(const pm_sdoc *d, const char *path, pm_bench_case *C) {
+  char q[PM_SDOC_PATH + 16];
+  C->n_fe = C->fe_threads = 0;
+  if (!pm_sdoc_find(d, path, false)) return PM_SUCCESS;
+  PM_CALL(mapping_at(d, path, "ladder,threads",
+                     "a mapping {ladder: [N, ...], threads}"));
+  const char *items[BENCH_FE_LEVELS];
+  snprintf(q, sizeof q, "%s.ladder", path);
+  if (!pm_sdoc_find(d, q, false))
+    return pm_sdoc_expected(d, q, "a list of meshes N (elements per edge)");
+  PM_CALL(scalars_at(d, q, BENCH_FE_LEVELS, items, &C->n_fe,
+                     "a list of meshes N (elements per edge)"));
+  if (C->n_fe < 1)
+    return pm_sdoc_expected(d, q, "a list of at least one mesh N");
+  for (int k = 0; k < C->n_fe; k++) {
+    char at[PM_SDOC_PATH + 32];
+    snprintf(at, sizeof at, "%s.%d", q, k);
+    PM_CALL(count_at(d, at, 1, 64, &C->fe_ladder[k],
+                     "a mesh N: a whole number of elements per edge, 1 to "
+                     "64, above the one before"));
+    if (k && C->fe_ladder[k] <= C->fe_ladder[k - 1])
+      return pm_sdoc_expected(d, at,
+                              "a mesh N above the one before (coarsest "
+                              "first)");
+  }
+  snprintf(q, sizeof q, "%s.threads", path);
+  if (pm_sdoc_find(d, q, false))
+    PM_CALL(count_at(d, q, 1, 256, &C->fe_threads,
+                     "a number of threads for CalculiX, 1 to 256"));
+  return PM_SUCCESS;
+}
+
 static pm_err read_case(pm_bench_suite *S, int i) {
   const pm_sdoc *d = &S->doc;
   pm_bench_case *C = &S->c[i];
   char p[32], q[64];
   snprintf(p, sizeof p, "cases.%d", i);
-  PM_CALL(mapping_at(d, p, "name,scene,methods,resolutions,set",
-                     "a mapping {name, scene, methods, resolutions, set}"));
+  PM_CALL(mapping_at(d, p, "name,scene,methods,resolutions,set,fe",
+                     "a mapping {name, scene, methods, resolutions, set, "
+                     "fe}"));
   snprintf(q, sizeof q, "%s.name", p);
   PM_CALL(name_at(d, q, C->name, sizeof C->name,
                   "a case name of up to 63 characters without ':', '/', "
@@ -218,6 +264,8 @@ static pm_err read_case(pm_bench_suite *S, int i) {
         !isfinite(C->res[k]))
       return pm_sdoc_expected(d, at, "a size above 0 (m)");
   }
+  snprintf(q, sizeof q, "%s.fe", p);
+  PM_CALL(read_fe(d, q, C));
   /* Overrides: every method, or LABEL:KEY=VALUE one of them. */
   snprintf(q, sizeof q, "%s.set", p);
   return sets_at(d, q, C->sets, &C->n_sets, true);

@@ -127,6 +127,8 @@ enum {
   C_TIP_FACE,
   C_TIP_AXIS,
   C_TIP_U,
+  C_CPU,
+  C_MEMORY,
   C_COUNT
 };
 static const char *const ladder_columns[C_COUNT] = {
@@ -138,7 +140,8 @@ static const char *const ladder_columns[C_COUNT] = {
     "increments",  "wall_seconds",
     "ccx_version", "load_fraction",
     "status",      "tip_face",
-    "tip_axis",    "tip_u"};
+    "tip_axis",    "tip_u",
+    "cpu_seconds", "peak_memory_bytes"};
 
 /* A traction case's tip columns: face name and component into indices
  * (-1 when the ladder has none). */
@@ -199,9 +202,13 @@ static pm_err ladder_row(const table *t, const int *col, pm_fe_row *r) {
     PM_CALL(table_number(t, col[C_RX + k], nan_ok, &r->reaction[k]));
   PM_CALL(table_number(t, col[C_SED], nan_ok, &r->mean_sed));
   PM_CALL(table_number(t, col[C_VM], nan_ok, &r->von_mises_centre));
-  r->tip_u = NAN;
+  r->tip_u = r->cpu_seconds = r->memory_bytes = NAN;
   if (col[C_TIP_U] >= 0)
     PM_CALL(table_number(t, col[C_TIP_U], nan_ok, &r->tip_u));
+  if (col[C_CPU] >= 0)
+    PM_CALL(table_number(t, col[C_CPU], true, &r->cpu_seconds));
+  if (col[C_MEMORY] >= 0)
+    PM_CALL(table_number(t, col[C_MEMORY], true, &r->memory_bytes));
   PM_CHECK(r->h > 0, PM_ERR_ARG,
            "%s:%ld: column h: expected a size > 0, got %g", t->in.path,
            t->in.line, r->h);
@@ -241,8 +248,6 @@ static pm_err read_ladder(const char *path, pm_fe_reference *r) {
     }
     r->n_rows++;
   }
-  PM_ENSURE(r->finest >= 0, PM_ERR_ARG,
-            "FE ladder '%s' holds no mesh that reached the full load", path);
 done:
   pm_lines_close(&t.in);
   return ret;
@@ -378,6 +383,8 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
   r->tip_face = r->tip_axis = -1;
   PM_TRY(pm_path_join(path, sizeof path, r->dir, "ladder.csv"));
   PM_TRY(read_ladder(path, r));
+  PM_ENSURE(r->finest >= 0, PM_ERR_ARG,
+            "FE ladder '%s' holds no mesh that reached the full load", path);
   PM_TRY(pm_path_join(path, sizeof path, r->dir, "lattice.csv"));
   PM_TRY(pm_fe_read_lattice(path, &r->n, &r->x, &r->u));
   PM_TRY(pm_path_join(path, sizeof path, r->dir, "tolerance.csv"));
@@ -418,6 +425,20 @@ pm_err pm_fe_load(const char *dir, pm_fe_reference **out) {
   r = NULL;
 done:
   pm_fe_free(r);
+  return ret;
+}
+
+pm_err pm_fe_read_ladder(const char *path, pm_fe_row **rows, int *n_rows) {
+  pm_err ret = PM_SUCCESS;
+  pm_fe_reference r = {.n_rows = 0};
+  *rows = NULL;
+  *n_rows = 0;
+  PM_TRY(read_ladder(path, &r));
+  *rows = r.rows;
+  *n_rows = r.n_rows;
+  r.rows = NULL;
+done:
+  free(r.rows);
   return ret;
 }
 

@@ -30,6 +30,8 @@ typedef struct {
   double tip_u;         /* a traction case's tip displacement (m): the mean of u
                            along the reference's tip_axis over the lattice points
                            on its tip_face; NaN when the ladder has none */
+  double cpu_seconds;   /* ccx's CPU time (user + system); NaN when absent */
+  double memory_bytes;  /* ccx's peak resident memory; NaN when absent */
 } pm_fe_row;
 
 /* The relative tolerances the case is claimed converged to (tolerance.csv:
@@ -77,6 +79,11 @@ typedef struct {
  * released by pm_fe_free. */
 pm_err pm_fe_load(const char *dir, pm_fe_reference **out);
 void pm_fe_free(pm_fe_reference *r);
+
+/* The rows of a ladder.csv alone (no lattice, no claim: a ladder just run,
+ * whose meshes may all have stopped short of the load) into *rows (*n_rows
+ * of them, the caller's to free).  Malformed files fail as pm_fe_load's. */
+pm_err pm_fe_read_ladder(const char *path, pm_fe_row **rows, int *n_rows);
 
 /* A lattice file (x,y,z,u_x,u_y,u_z rows under that header) into new
  * [n][3] arrays. */
