@@ -304,6 +304,12 @@ bad "bad resolution" 's/resolutions: \[2e-2\]}/resolutions: [-1]}/' \
   "bad.yaml:10:50: cases.1.resolutions.0: expected a size above 0 (m), got -1"
 bad "method as an override" 's/set: \[time.dt=0.05\]/set: [method=fpm]/' \
   "not an override"
+bad "FE ladder not ascending" \
+  's/resolutions: \[2e-2\]}/resolutions: [2e-2], fe: {ladder: [4, 2]}}/' \
+  "cases.1.fe.ladder.1: expected a mesh N above the one before (coarsest first), got 2"
+bad "FE threads" \
+  's/resolutions: \[2e-2\]}/resolutions: [2e-2], fe: {ladder: [2], threads: 0}}/' \
+  "cases.1.fe.threads: expected a number of threads for CalculiX, 1 to 256, got 0"
 bad "missing scene" 's#cases/mpm/f2-unconstrained-compression.yaml#no-such.yaml#' \
   "cases.0.scene: cannot read scene"
 
