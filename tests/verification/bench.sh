@@ -138,6 +138,8 @@ EOF2
     test "$(fe_rows threads)" = "1 1 1"
   s=$(field "$csv" f3-60 fpm-static status)
   check "cost-tiny: FPM converged ($s)" test "$s" = converged
+  t=$(field "$csv" f3-60 fpm-static cpu_seconds)
+  check "cost-tiny: FPM's CPU time tabulated ($t)" lt 0 "$t"
   r=$(field "$csv" f3-60 fpm-static reaction_error_fe)
   check "cost-tiny: FPM's reaction within 10% of the referee ($r)" \
     awk -v r="$r" 'BEGIN { exit !(r != "" && r * r <= 0.01) }'

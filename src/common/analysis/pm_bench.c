@@ -96,8 +96,8 @@ static void print_row(FILE *out, const pm_compare_row *r) {
     sep = ", ";
   }
   if (r->ran)
-    fprintf(out, "%s%.2f s, %.0f MiB", sep, r->wall_seconds,
-            (double)r->memory_bytes / MIB);
+    fprintf(out, "%s%.2f s wall, %.2f s CPU, %.0f MiB", sep, r->wall_seconds,
+            r->cpu_seconds, (double)r->memory_bytes / MIB);
   if (r->message[0]) fprintf(out, "\n      %s", r->message);
   fprintf(out, "\n");
 }

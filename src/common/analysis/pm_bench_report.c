@@ -247,7 +247,8 @@ static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
       fprintf(m, " %s | %s | %s |", pm_table_number(b[1], e, 3), against,
               pm_table_number(b[2], 100 * pm_bench_fe_error(r), 3));
       if (r->ran)
-        fprintf(m, " %.3g | | %.1f | ", r->wall_seconds,
+        fprintf(m, " %.3g | %s | %.1f | ", r->wall_seconds,
+                pm_table_number(b[3], r->cpu_seconds, 3),
                 (double)r->memory_bytes / MIB);
       else
         fprintf(m, " | | | ");
@@ -266,9 +267,10 @@ static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
              "its load increments, wall and CPU time of ccx alone (the "
              "deck's writing and reading excluded) on the threads said "
              "below; a mesh at or finer than the referee's own is marked "
-             "reference and not measured against itself.  CPU is given "
-             "for FE only: the methods run in this process, one after the "
-             "other.\n");
+             "reference and not measured against itself.  CPU: user and "
+             "system time of every thread, a method's over its setup and "
+             "time loop (so against wall plus setup), ccx's over its "
+             "run.\n");
   for (int c = 0; c < S->n_cases; c++)
     if (fe[c].n_levels)
       fprintf(m,
@@ -367,7 +369,8 @@ static void write_csv(const pm_bench_suite *S, const pm_bench_comparison *runs,
                 r->memory_bytes);
       else
         fprintf(f, ",,,");
-      fprintf(f, "%s,,,,", pm_table_number(b[8], r->tip_fe, 10));
+      fprintf(f, "%s,%s,,,", pm_table_number(b[8], r->tip_fe, 10),
+              pm_table_number(b[9], r->cpu_seconds, 6));
       pm_csv_text(f, r->message);
       fputc('\n', f);
     }

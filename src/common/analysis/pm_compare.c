@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "pm_compare_impl.h"
 #include "pm_memory.h"
@@ -167,6 +168,14 @@ done:
   return ret;
 }
 
+/* The process's CPU time so far (user + system, every thread), s. */
+static double cpu_now(void) {
+  struct rusage u;
+  if (getrusage(RUSAGE_SELF, &u) != 0) return NAN;
+  return (double)(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * (double)(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 /* Load, run and map method k; its failures are its own (recorded in it
  * and returned), the others' runs go on. */
 static pm_err run_method(cmp_study *c, int k, FILE *out) {
@@ -175,7 +184,7 @@ static pm_err run_method(cmp_study *c, int k, FILE *out) {
   pm_scene *s = NULL;
   void *sim = NULL;
   pm_err e;
-  M->von_mises_centre = NAN;
+  M->von_mises_centre = M->cpu_seconds = NAN;
   snprintf(M->status, sizeof M->status, "refused");
   if (out)
     fprintf(out, "method %d/%d: %s -> %s\n", k + 1, c->n, M->name, M->dir);
@@ -186,6 +195,7 @@ static pm_err run_method(cmp_study *c, int k, FILE *out) {
     goto done;
   }
   M->n_bcs = s->n_bcs;
+  const double cpu0 = cpu_now();
   e = s->backend->create(s, &sim);
   if (e != PM_SUCCESS) {
     method_failed(M, e, "failed", NULL);
@@ -194,6 +204,7 @@ static pm_err run_method(cmp_study *c, int k, FILE *out) {
   unsigned flags =
       (o->quiet ? PM_RUN_QUIET : 0u) | (o->overwrite ? PM_RUN_OVERWRITE : 0u);
   e = pm_run_sim(s, sim, M->dir, flags, &M->out);
+  M->cpu_seconds = cpu_now() - cpu0;
   const pm_status st = M->out.fig.status;
   snprintf(M->status, sizeof M->status, "%s", pm_status_name(st));
   if (e != PM_SUCCESS) method_failed(M, e, NULL, M->out.message);
@@ -258,6 +269,7 @@ static void fill_rows(const cmp_study *c, pm_compare_row *rows, int *n) {
     r->h = r->ran ? g->h : NAN;
     r->wall_seconds = r->ran ? g->wall_seconds : NAN;
     r->setup_seconds = r->ran ? g->setup_seconds : NAN;
+    r->cpu_seconds = r->ran ? M->cpu_seconds : NAN;
     r->memory_bytes = g->memory_bytes;
     r->e_analytic = M->e_analytic;
     r->e_fe = M->e_fe;

@@ -25,6 +25,8 @@ typedef struct {
   bool ran;                             /* it has a run's figures */
   long points, steps, flagged;
   double h, wall_seconds, setup_seconds;
+  double cpu_seconds; /* the process's CPU time (user + system, every
+                         thread) over the run's setup and time loop */
   size_t memory_bytes;
   /* NRMSE against the analytic field, the FE lattice, a reference run;
    * the loaded face's reaction and the mean SED against FE's (relative);

@@ -37,6 +37,8 @@ typedef struct {
    * where there is no such reference. */
   double e_analytic, e_fe, e_fe_interior, reaction_fe, sed_fe, e_run;
   double tip_fe; /* a traction case's tip error against FE (pm_fe_errors) */
+  double cpu_seconds; /* CPU (user + system, every thread) over create and
+                         run; NaN when it did not run */
 } cmp_method;
 
 typedef struct {
