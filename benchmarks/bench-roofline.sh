@@ -171,7 +171,9 @@ for c in cases:
         dcpu = cpu[1] - cpu[0]  # the CPU seconds of the extra steps
         dwall = r2['step_seconds'] - r1['step_seconds']
         cpu1 = cpu1 or dcpu
-        print(f'  {t} thread(s): {n / dwall:.3g} point-steps/s by the wall '
+        # (a loaded machine can make the longer run's steps the faster)
+        wall = f'{n / dwall:.3g}' if dwall > 0 else 'n/a'
+        print(f'  {t} thread(s): {wall} point-steps/s by the wall '
               f'clock, {n / dcpu:.3g} per CPU second (CPU-time '
               f'efficiency {cpu1 / dcpu:.0%}): '
               f'{fl_sum * n / dcpu / 1e9:.2f} GFLOP/s, '
