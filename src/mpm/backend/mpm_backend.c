@@ -208,8 +208,15 @@ static pm_err run(void *p, const pm_observer *obs) {
 
 /* ---- plan --------------------------------------------------------------- */
 
+/* A scene graded for FPM (discretization.refine) runs on MPM's uniform
+ * grid: said once, on the standard error of rank 0, not refused. */
 static pm_err create(const pm_scene *s, void **out) {
   mpm_sim *r = NULL;
+  if (s->refine.near && pm_par_root())
+    fprintf(stderr,
+            "pointmech: note: discretization.refine grades FPM's point "
+            "cloud; MPM's grid stays uniform at mesh_size %g m\n",
+            s->mesh_size);
   PM_CALL(mpm_sim_create(s, &r));
   *out = r;
   return PM_SUCCESS;
