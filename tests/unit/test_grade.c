@@ -3,6 +3,7 @@
  * the uniform mesh's budget, refused bad input at file:line:col. */
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -157,18 +158,30 @@ static void test_scene_key(void **state) {
 
 /* A scene without refine: the override size_ratio=1 alone loads (the
  * uniform cloud, as in any scene), another ratio alone asks for the faces. */
-static void test_uniform_override(void **state) {
-  char text[2048], path[512];
+/* The 3D scene of 0.1 m graded toward zmin at size_ratio 0.5 (without its
+ * refine line if plain), written to a file in *state and loaded with the
+ * override set (NULL: none); fails the test if it does not load. */
+static pm_scene *ratio_scene(void **state, bool plain, const char *set,
+                             char *path) {
+  char text[2048];
   snprintf(text, sizeof text, SCENE_HEAD SCENE_TAIL, "fpm", 3, "0, 0, 0",
            "0.1, 0.1, 0.1", "zmin", ", size_ratio: 0.5");
-  char *line = strstr(text, "  refine:");
-  memmove(line, strchr(line, '\n') + 1, strlen(strchr(line, '\n') + 1) + 1);
-  pm_test_write_file(*state, "plain.yaml", text, path);
+  if (plain) {
+    char *line = strstr(text, "  refine:"), *next = strchr(line, '\n') + 1;
+    memmove(line, next, strlen(next) + 1);
+  }
+  pm_test_write_file(*state, "ratio.yaml", text, path);
   pm_scene *s = NULL;
-  const char *const one[] = {"discretization.refine.size_ratio=1"};
   pm_error_clear();
-  if (pm_scene_load(path, 1, one, &s) != PM_SUCCESS)
+  if (pm_scene_load(path, set ? 1 : 0, set ? &set : NULL, &s) != PM_SUCCESS)
     fail_msg("%s", pm_error_message());
+  return s;
+}
+
+static void test_uniform_override(void **state) {
+  char path[512];
+  pm_scene *s =
+      ratio_scene(state, true, "discretization.refine.size_ratio=1", path);
   gm_grade g;
   double far;
   fpm_grade_of(s, &g, &far);
@@ -189,14 +202,8 @@ static void test_uniform_override(void **state) {
  * 0.1 = 1.6 (r = 1/2), k = 1.1696; the mesh has about the uniform mesh's
  * nodes; size_ratio 1 is the uniform mesh itself. */
 static void test_ratio_budget(void **state) {
-  char text[2048], path[512];
-  snprintf(text, sizeof text, SCENE_HEAD SCENE_TAIL, "fpm", 3, "0, 0, 0",
-           "0.1, 0.1, 0.1", "zmin", ", size_ratio: 0.5");
-  pm_test_write_file(*state, "ratio.yaml", text, path);
-  pm_scene *s = NULL;
-  pm_error_clear();
-  if (pm_scene_load(path, 0, NULL, &s) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
+  char path[512];
+  pm_scene *s = ratio_scene(state, false, NULL, path);
   gm_grade g;
   double far;
   fpm_grade_of(s, &g, &far);
