@@ -72,14 +72,17 @@ paper_mesh_size() {
 #   sipg-quadratic    SIPG, quadratic jump, p = 100 (the symmetric flux
 #                     needs this penalty for coercivity: p = 10 diverges in
 #                     undamped dynamics)
-# (SIPG with the measured stable step x 0.5).
+# (SIPG with the measured stable step x 0.5).  All but the scenes' own run
+# the paper's uniform clouds (discretization.refine.size_ratio=1; F4 20%'s
+# scene is graded toward its clamped faces).
 fpm_form() {
-  local sipg=(--set fpm.flux=sipg --set fpm.penalty=100
+  local uniform=(--set discretization.refine.size_ratio=1)
+  local sipg=("${uniform[@]}" --set fpm.flux=sipg --set fpm.penalty=100
     --set time.dt_rule=spectral --set time.dt_safety=0.5)
   case $1 in
   scene | quadratic) form=() ;;
-  paper) form=(--set fpm.formulation=paper) ;;
-  p0) form=(--set fpm.formulation=paper --set fpm.penalty=0) ;;
+  paper) form=("${uniform[@]}" --set fpm.formulation=paper) ;;
+  p0) form=("${uniform[@]}" --set fpm.formulation=paper --set fpm.penalty=0) ;;
   sipg) form=("${sipg[@]}" --set fpm.jump=linear) ;;
   sipg-quadratic) form=("${sipg[@]}") ;;
   *)

@@ -11,9 +11,10 @@
 #    finite-element referee: displacement and reaction error rates (see
 #    below);
 #  - the finest level of those ladders, F3 60% and F4 20% at the paper's
-#    coarsest resolution (h = 1.09e-2 m, 1851 points), against FE: converged,
-#    top reaction within 1% (F3) and 7% (F4), displacement NRMSE at the FE
-#    lattice at or below the paper's figure (F3);
+#    coarsest resolution (h = 1.09e-2 m, 1851 points; F4's graded cloud has
+#    2009 for that budget), against FE: converged, top reaction within 1%
+#    (F3) and 3% (F4), displacement NRMSE at the FE lattice at or below the
+#    paper's figure (F3);
 #  - F3 200% and F4 60% at the coarsest paper resolution: converged, J > 0
 #    throughout, energy balance within 1% of the external work.
 # The self-convergence and extreme checks use the symmetric flux
@@ -64,9 +65,12 @@ for kind in extension compression-guided; do
 done
 
 # ---- rates on coarse ladders -----------------------------------------------
+# On the uniform clouds (discretization.refine.size_ratio=1: F4 20%'s scene
+# is graded toward its clamped faces by default; the rates and bounds here
+# were measured on uniform clouds, and F3's scenes are uniform).
 ladder=discretization.mesh_size=0.025,0.02,0.016,0.0125,0.00872
 common="--set fpm.flux=sipg --set fpm.jump=linear --set fpm.penalty=100
-  --set time.dt_rule=spectral
+  --set time.dt_rule=spectral --set discretization.refine.size_ratio=1
   --set time.dt_safety=0.5 --set output.every=100000"
 for c in f3-extension-60 f4-compression-20; do
   out=$work/$c
@@ -80,23 +84,19 @@ for c in f3-extension-60 f4-compression-20; do
 done
 
 # ---- rates against the finite-element referee ------------------------------
-# The scenes' own formulation, the default (IIPG, quadratic jump, p = 0.05,
-# averaged volume), errors of the displacement at the FE lattice and of the
-# top reaction against the CalculiX referee the scene names.  F3 60%: both
-# rates >= 1.8 (measured 2.30 and 2.62; the FE reaction is converged to
-# 5e-4).  F4 20%: the reaction rate is printed, not asserted.  The displacement
-# rate was held to the issue's 1.5 while the default was the standard
-# volumetric term (1.50 measured against the lattice of the converged,
-# graded referee); with the averaged volume the least-squares displacement
-# rate on this uniform ladder is 1.36 (its finest level's reaction error
-# +6.08% against the standard volume's +8.35%): the issue's bound is not
-# met by the default on uniform clouds, and that stays open
-# (docs/validation.md, "The default formulation, measured").  The check
-# below holds the default's own rate, 1.36, with a margin (>= 1.25) so that
-# a regression shows; it does not claim the issue's 1.5.  The reaction
-# rate (1.06) is not asserted either: FE's own reaction converges only at
-# order 1.6 on meshes graded towards the clamped edges, and the referee is
-# their Richardson limit.
+# The scenes as committed, with the default formulation (IIPG, quadratic
+# jump, p = 0.05, averaged volume), errors of the displacement at the FE
+# lattice and of the top reaction against the CalculiX referee the scene
+# names.  F3 60% (uniform cloud): both rates >= 1.8 (measured 2.30 and
+# 2.62; the FE reaction is converged to 5e-4).  F4 20% runs its scene's
+# cloud, graded toward the clamped faces with mesh_size as the point
+# budget (237, 351, 544, 889, 2009 points): its displacement rate is held
+# to the issue's 1.5 (measured 1.76; the uniform ladder's was 1.36, held to
+# 1.25 before the scene was graded; docs/validation.md, "Graded clouds
+# relative to mesh_size").  F4's reaction rate is printed, not asserted:
+# its errors on this ladder are not monotone (-1.1% at the coarsest level,
+# +8.5% at the next), and FE's own reaction converges only at order 1.6
+# on meshes graded towards the clamped edges.
 for c in f3-extension-60 f4-compression-20; do
   out=$work/fe-$c
   "$bin" convergence "$src/cases/fpm/$c.yaml" --quiet \
@@ -110,21 +110,18 @@ for c in f3-extension-60 f4-compression-20; do
     check "$c against FE: displacement rate q = $q >= 1.8" ge "$q" 1.8
     check "$c against FE: reaction error rate q = $qr >= 1.8" ge "$qr" 1.8
   else
-    check "$c against FE: displacement rate q = $q >= 1.25 (measured 1.36)" \
-      ge "$q" 1.25
+    check "$c against FE: displacement rate q = $q >= 1.5 (measured 1.76)" \
+      ge "$q" 1.5
     echo "  $c against FE: reaction error rate q = $qr (not asserted)"
   fi
-  # The finest level (mesh size 8.72e-3 m, h = 1.09e-2 m, 1851 points) is
-  # the block scene as committed at the paper's coarsest resolution, the run
-  # verify_fe_blocks made for these two cases before it was asked here: the
-  # top reaction within 1% of FE for F3 (measured +0.63%; the standard
-  # volume's +0.92% was held to 2%) and 7% for F4 20% (measured +6.08%
-  # against the referee's Richardson limit, uncertain by 8e-4; the standard
-  # volume's +8.35% was held to 10%): the issue's 3% is reached only on a
-  # cloud graded toward the clamped faces, not on this uniform one.  F3's
-  # displacement NRMSE at the FE lattice at or below the FPM paper's figure
-  # for this h, 1.11e-2 (F4 20%'s, 1.74e-2, is printed beside the paper's
-  # 8.59e-3).
+  # The finest level (mesh size 8.72e-3 m, h = 1.09e-2 m: 1851 points for
+  # F3, the budget of F4's graded cloud, 2009 points) is the block scene as
+  # committed at the paper's coarsest resolution, against FE: the top
+  # reaction within 1% for F3 (measured +0.63%) and within the issue's 3%
+  # for F4 20% (measured +2.44% on the graded cloud; the uniform cloud's
+  # +6.08% was held to 7%).  F3's displacement NRMSE at the FE lattice at
+  # or below the FPM paper's figure for this h, 1.11e-2 (F4 20%'s, 1.41e-2,
+  # is printed beside the paper's 8.59e-3: not met).
   csv=$out/convergence.csv
   st=$(col "$csv" 5 status)
   re=$(col "$csv" 5 reaction_error)
@@ -136,9 +133,10 @@ for c in f3-extension-60 f4-compression-20; do
     check "$c at 1851 points against FE: NRMSE $e <= 1.11e-2 (paper)" \
       le "$e" 1.11e-2
   else
-    check "$c at 1851 points against FE: reaction error $re within 7%" \
-      absle "$re" 0.07
-    echo "  $c at 1851 points against FE: NRMSE $e (paper 8.59e-3, not asserted)"
+    check "$c at the 1851-point budget against FE: reaction error $re within 3%" \
+      absle "$re" 0.03
+    echo "  $c at the 1851-point budget against FE: NRMSE $e (paper 8.59e-3," \
+      "not asserted)"
   fi
 done
 

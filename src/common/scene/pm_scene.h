@@ -263,10 +263,16 @@ typedef struct pm_scene {
   double box_min[3], box_max[3];    /* domain.box; z 0 in 2D */
   double mesh_size;                 /* discretization.mesh_size, m, > 0 */
   struct {
-    unsigned near;   /* discretization.refine.near: bit f for face f
-                        (pm_face); 0: a uniform mesh */
-    double size;     /* discretization.refine.size, m, in (0, mesh_size] */
-    double distance; /* discretization.refine.distance, m, > 0 */
+    unsigned near;     /* discretization.refine.near: bit f for face f
+                          (pm_face); 0: a uniform mesh */
+    double size;       /* discretization.refine.size, m, in (0, mesh_size];
+                          0 when size_ratio is given */
+    double size_ratio; /* discretization.refine.size_ratio: the size on the
+                          faces over the size far from them, in (0, 1]; 0
+                          when size is given.  Then mesh_size is the point
+                          budget: FPM meshes far from the faces at the size
+                          giving about the uniform cloud's points */
+    double distance;   /* discretization.refine.distance, m, > 0 */
   } refine;
   pm_scene_material *materials;
   int n_materials;

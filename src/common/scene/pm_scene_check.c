@@ -19,25 +19,40 @@ static pm_err finish_domain(pm_reader *r, pm_scene *s) {
   return PM_SUCCESS;
 }
 
-/* discretization.refine: faces of the box's dimension, a size at most the
- * mesh size, and a box FPM meshes (not MPM's grid, not a mesh file). */
+/* discretization.refine: faces of the box's dimension, one of size (at most
+ * the mesh size) and size_ratio, and for FPM a box it meshes (not a mesh
+ * file).  MPM's grid stays uniform at mesh_size: its backend notes the key
+ * and does not refuse it, so that one scene serves both methods. */
 static pm_err finish_refine(pm_reader *r, pm_scene *s) {
-  if (!s->refine.near) return PM_SUCCESS;
+  if (!pm_reader_has(r, "discretization.refine")) return PM_SUCCESS;
   char what[128];
   if (s->refine.near >= (1u << (2 * s->dimension)))
     return pm_reader_expected(r, "discretization.refine.near",
                               "a list of names from xmin, xmax, ymin, ymax "
                               "(dimension 2)");
-  if (s->refine.size > s->mesh_size) {
+  const bool size = pm_reader_has(r, "discretization.refine.size");
+  const bool ratio = pm_reader_has(r, "discretization.refine.size_ratio");
+  /* size_ratio: 1 is the uniform cloud whatever else refine says, so that
+   * one override makes any scene's cloud uniform, graded or not. */
+  if (ratio && !size && s->refine.size_ratio == 1.0) return PM_SUCCESS;
+  if (!s->refine.near)
+    return pm_reader_fail(r, "discretization.refine", true,
+                          "expected near: [faces] (or size_ratio: 1, the "
+                          "uniform cloud)");
+  if (size == ratio)
+    return pm_reader_fail(r, "discretization.refine", true,
+                          "expected one of size (m) and size_ratio (of the "
+                          "far size), got %s",
+                          size ? "both" : "neither");
+  if (!pm_reader_has(r, "discretization.refine.distance"))
+    return pm_reader_fail(r, "discretization.refine", true,
+                          "expected distance: a number > 0 (m)");
+  if (!s->method || strcmp(s->method, "fpm") != 0) return PM_SUCCESS;
+  if (size && s->refine.size > s->mesh_size) {
     snprintf(what, sizeof what, "a number <= discretization.mesh_size (%g)",
              s->mesh_size);
     return pm_reader_expected(r, "discretization.refine.size", what);
   }
-  if (!s->method || strcmp(s->method, "fpm") != 0)
-    return pm_reader_fail(r, "discretization.refine", true,
-                          "expected method fpm (a graded gmsh mesh), got "
-                          "method %s",
-                          s->method ? s->method : "(none)");
   if (s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH)
     return pm_reader_fail(r, "discretization.refine", true,
                           "expected a box domain: the body's mesh file sets "

@@ -81,25 +81,37 @@ static const pm_key refine_keys[] = {
     {.name = "near",
      .type = PM_KEY_FLAGS,
      .offset = S(refine.near),
-     .flags = PM_KEY_REQUIRED,
      .min_count = 1,
      .names = face_names,
-     .doc = "faces of domain.box the mesh is graded toward"},
+     .doc = "faces of domain.box the mesh is graded toward (required but "
+            "with size_ratio 1 alone, the uniform cloud)"},
+    {.name = "size_ratio",
+     .type = PM_KEY_NUMBER,
+     .offset = S(refine.size_ratio),
+     .range = PM_RANGE_GT | PM_RANGE_LE,
+     .lo = 0,
+     .hi = 1,
+     .doc = "element size on those faces over the size far from them (one "
+            "of size_ratio, size); mesh_size then stays the point budget: "
+            "the far size is set so that the cloud has about the points of "
+            "the uniform one at mesh_size, at every rung of a mesh_size "
+            "ladder; 1: the uniform cloud"},
     {.name = "size",
      .type = PM_KEY_NUMBER,
      .offset = S(refine.size),
-     .flags = PM_KEY_REQUIRED,
      .range = PM_RANGE_GT,
      .unit = "m",
-     .doc = "element size on those faces, at most mesh_size"},
+     .doc = "element size on those faces, at most mesh_size, which is then "
+            "the size far from them (one of size, size_ratio)"},
     {.name = "distance",
      .type = PM_KEY_NUMBER,
      .offset = S(refine.distance),
-     .flags = PM_KEY_REQUIRED,
      .range = PM_RANGE_GT,
      .unit = "m",
      .doc = "distance from the nearest of them where the size, growing "
-            "linearly, reaches mesh_size"},
+            "linearly, reaches the far size (required but with size_ratio 1); "
+            "fixed in metres, so that a mesh_size ladder is a self-similar "
+            "family"},
     {0}};
 
 static const pm_key discretization_keys[] = {
@@ -114,7 +126,8 @@ static const pm_key discretization_keys[] = {
      .type = PM_KEY_MAPPING,
      .keys = refine_keys,
      .doc = "FPM box domain: a mesh graded toward faces (singular edges "
-            "of clamped faces); unset: uniform at mesh_size"},
+            "of clamped faces); unset: uniform at mesh_size.  MPM's grid "
+            "stays uniform at mesh_size (noted, not refused)"},
     {0}};
 
 static const pm_key body_box_keys[] = {{.name = "min",

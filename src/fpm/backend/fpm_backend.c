@@ -12,6 +12,7 @@
 #include "fpm_contact.h"
 #include "fpm_estimate.h"
 #include "fpm_gfd.h"
+#include "fpm_grade.h"
 #include "fpm_par.h"
 #include "fpm_scene.h"
 #include "gm_cells.h"
@@ -61,15 +62,16 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   pm_timers_start(&sim->timers, sim->tm_mesh);
   /* The domain: the box, or the scene's one gmsh volume. */
   int domain = fpm_domain_body(s);
+  sim->far_size = s->mesh_size;
   if (domain >= 0)
     PM_TRY(gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
                         &sim->mesh));
   else {
-    const gm_grade grade = {.faces = s->refine.near,
-                            .size = s->refine.size,
-                            .distance = s->refine.distance};
+    gm_grade grade;
+    fpm_grade_of(s, &grade, &sim->far_size);
     PM_TRY(gm_mesh_box_graded(s->dimension, s->box_min, s->box_max,
-                              s->mesh_size, &grade, &sim->mesh));
+                              sim->far_size, &grade, &sim->mesh));
+    sim->near_size = grade.faces ? grade.size : 0.0;
   }
   pm_timers_stop(&sim->timers, sim->tm_mesh);
   sim->mean_edge = gm_mesh_mean_edge(sim->mesh);

@@ -33,6 +33,9 @@ typedef struct {
                          measured */
   long dt_point;      /* point that sets the paper's bound */
   double mean_edge;   /* mean mesh edge length, m */
+  double far_size;    /* the mesh's size away from graded faces, m
+                         (mesh_size unless refine.size_ratio) */
+  double near_size;   /* its size on the graded faces, m; 0: uniform */
   pm_timers timers;
   int tm_mesh, tm_dual, tm_operators, tm_force, tm_update;
   int tm_assembly, tm_pcsetup, tm_linear; /* static solves only (else -1) */

@@ -54,6 +54,14 @@ static double plan_head(fpm_sim *sim, FILE *out) {
           m->dim == 2 ? "plane strain" : "solid");
   fprintf(out, "points       %ld (mesh size %g m, mean edge %.4g m)\n", m->n,
           s->mesh_size, sim->mean_edge);
+  if (sim->near_size > 0)
+    fprintf(out,
+            "             graded (discretization.refine): %.4g m on the faces, "
+            "%.4g m from %g m away%s\n",
+            sim->near_size, sim->far_size, s->refine.distance,
+            s->refine.size_ratio > 0 ? "; mesh_size is the uniform cloud's "
+                                       "point budget"
+                                     : "");
   const gm_dual *d = sim->dual;
   fprintf(out,
           "cells        %s, one per node of %ld simplices: %ld interfaces, %ld "

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "fpm_gfd.h"
+#include "fpm_grade.h"
 #include "gm_mesh.h"
 #include "fpm_model.h"
 #include "fpm_scene.h"
@@ -23,32 +24,13 @@
  * per point: measured as peak resident memory above the operators. */
 #define MESH_BYTES 2500.0
 
-/* The points of a graded mesh over those of the uniform one: the mean of
- * (mesh_size / size(x))^dim over a lattice of the box (1 ungraded). */
+/* The points of a graded mesh over those of the uniform one at mesh_size
+ * (1 ungraded, about 1 for the ratio form, which keeps the budget). */
 static double grade_factor(const pm_scene *s) {
-  if (!s->refine.near) return 1.0;
-  const gm_grade g = {.faces = s->refine.near,
-                      .size = s->refine.size,
-                      .distance = s->refine.distance};
-  enum { N = 48 };
-  const int dim = s->dimension;
-  double sum = 0.0;
-  long count = 0;
-  for (int i = 0; i < N; i++)
-    for (int j = 0; j < N; j++)
-      for (int k = 0; k < (dim == 3 ? N : 1); k++) {
-        const int ijk[3] = {i, j, k};
-        double x[3] = {0, 0, 0};
-        for (int c = 0; c < dim; c++)
-          x[c] = s->box_min[c] +
-                 (ijk[c] + 0.5) / N * (s->box_max[c] - s->box_min[c]);
-        const double r =
-            s->mesh_size /
-            gm_grade_size(&g, dim, s->box_min, s->box_max, s->mesh_size, x);
-        sum += dim == 3 ? r * r * r : r * r;
-        count++;
-      }
-  return sum / (double)count;
+  gm_grade g;
+  double far;
+  fpm_grade_of(s, &g, &far);
+  return fpm_grade_density(s, &g, far) * pow(s->mesh_size / far, s->dimension);
 }
 
 size_t fpm_estimate_bytes(const pm_scene *s, long *points) {

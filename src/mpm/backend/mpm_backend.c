@@ -38,8 +38,15 @@ pm_err mpm_sim_figures_work(const mpm_model *m, mpm_work **out) {
 }
 
 /* The simulation of s: explicit (its step's workspace) or implicit (its
- * solver; the workspace holds only the reactions and the timers). */
+ * solver; the workspace holds only the reactions and the timers).  A scene
+ * graded for FPM (discretization.refine) runs on MPM's uniform grid: said
+ * once, on the standard error of rank 0, not refused. */
 pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out) {
+  if (s->refine.near && s->refine.size_ratio != 1.0 && pm_par_root())
+    fprintf(stderr,
+            "pointmech: note: discretization.refine grades FPM's point "
+            "cloud; MPM's grid stays uniform at mesh_size %g m\n",
+            s->mesh_size);
   pm_err ret = PM_SUCCESS;
   mpm_sim *r = NULL;
   *out = NULL;
