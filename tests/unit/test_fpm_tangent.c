@@ -39,20 +39,25 @@ static double stored_energy(const fpm_model *m, fpm_state *st) {
  * k = 6: SIPG with the stiffening from an onset (fpm.stiffening_onset,
  * ONSET_TEST: some interfaces beyond it, some below); k = 7: the same
  * with the onset in the current spacing (fpm.stiffening_spacing: current,
- * whose onset depends on the state). */
+ * whose onset depends on the state); k = 8: k = 4's stiffening on the
+ * quadratic jump from that onset in the current spacing. */
 static void test_sipg_is_gradient(void **state) {
   (void)state;
-  for (int k = 0; k < 8; k++) {
+  for (int k = 0; k < 9; k++) {
     fixture *fx = fixture_new(3, 0.03, 100, false);
     fx->opt.flux = k == 1 ? FPM_FLUX_IIPG : FPM_FLUX_SIPG;
     fx->opt.jump = k == 2 || k >= 4 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
     if (k == 3) fx->opt.stiffening = 1e6;
-    if (k == 4) {
+    if (k == 4 || k == 8) {
       fx->opt.stiffening = 1e9;
       fx->opt.stiffening_jump = FPM_JUMP_QUADRATIC;
     }
     if (k == 5) fx->opt.volume_penalty = 1e4;
-    if (k >= 6) {
+    if (k == 8) {
+      fx->opt.stiffening_onset = 1e-3 * ONSET_TEST; /* its jump is smaller */
+      fx->opt.stiffening_spacing = FPM_SPACING_CURRENT;
+    }
+    if (k == 6 || k == 7) {
       fx->opt.stiffening = 1e6;
       fx->opt.stiffening_onset = 0.1 * ONSET_TEST; /* its field is smoother */
       if (k == 7) fx->opt.stiffening_spacing = FPM_SPACING_CURRENT;
@@ -82,7 +87,8 @@ static void test_sipg_is_gradient(void **state) {
         "SIPG, stiffening on the quadratic jump",
         "SIPG, volume penalty",
         "SIPG, stiffening from an onset",
-        "SIPG, stiffening from an onset in the current spacing"};
+        "SIPG, stiffening from an onset in the current spacing",
+        "SIPG, quadratic-jump stiffening, onset in the current spacing"};
     print_message("%s: dE/de = %.10g, f . d = %.10g, relative mismatch %.3g\n",
                   names[k], dE, fd, rel);
     if (k != 1) assert_true(rel <= 1e-6);
