@@ -37,22 +37,30 @@ static double stored_energy(const fpm_model *m, fpm_state *st) {
  * SIPG, quadratic jump, the stiffening on it (p_s = 1e9, its jump being
  * smaller); k = 5: SIPG, quadratic jump, fpm.volume_penalty p_v = 1e4;
  * k = 6: SIPG with the stiffening from an onset (fpm.stiffening_onset,
- * ONSET_TEST: some interfaces beyond it, some below). */
+ * ONSET_TEST: some interfaces beyond it, some below); k = 7: the same
+ * with the onset in the current spacing (fpm.stiffening_spacing: current,
+ * whose onset depends on the state); k = 8: k = 4's stiffening on the
+ * quadratic jump from that onset in the current spacing. */
 static void test_sipg_is_gradient(void **state) {
   (void)state;
-  for (int k = 0; k < 7; k++) {
+  for (int k = 0; k < 9; k++) {
     fixture *fx = fixture_new(3, 0.03, 100, false);
     fx->opt.flux = k == 1 ? FPM_FLUX_IIPG : FPM_FLUX_SIPG;
     fx->opt.jump = k == 2 || k >= 4 ? FPM_JUMP_QUADRATIC : FPM_JUMP_LINEAR;
     if (k == 3) fx->opt.stiffening = 1e6;
-    if (k == 4) {
+    if (k == 4 || k == 8) {
       fx->opt.stiffening = 1e9;
       fx->opt.stiffening_jump = FPM_JUMP_QUADRATIC;
     }
     if (k == 5) fx->opt.volume_penalty = 1e4;
-    if (k == 6) {
+    if (k == 8) {
+      fx->opt.stiffening_onset = 1e-3 * ONSET_TEST; /* its jump is smaller */
+      fx->opt.stiffening_spacing = FPM_SPACING_CURRENT;
+    }
+    if (k == 6 || k == 7) {
       fx->opt.stiffening = 1e6;
       fx->opt.stiffening_onset = 0.1 * ONSET_TEST; /* its field is smoother */
+      if (k == 7) fx->opt.stiffening_spacing = FPM_SPACING_CURRENT;
     }
     fpm_model *m;
     fpm_state *st;
@@ -78,7 +86,9 @@ static void test_sipg_is_gradient(void **state) {
         "SIPG, stiffening",
         "SIPG, stiffening on the quadratic jump",
         "SIPG, volume penalty",
-        "SIPG, stiffening from an onset"};
+        "SIPG, stiffening from an onset",
+        "SIPG, stiffening from an onset in the current spacing",
+        "SIPG, quadratic-jump stiffening, onset in the current spacing"};
     print_message("%s: dE/de = %.10g, f . d = %.10g, relative mismatch %.3g\n",
                   names[k], dE, fd, rel);
     if (k != 1) assert_true(rel <= 1e-6);
@@ -95,7 +105,8 @@ static void test_sipg_is_gradient(void **state) {
  * formulation (with its boundary penalty), for k = 5 the default with
  * fpm.stiffening p_s = 1e5, for k = 6 with p_s = 1e7 on the quadratic
  * jump, for k = 7 with fpm.volume_penalty p_v = 1e3, for k = 8 with p_s =
- * 1e5 from the onset ONSET_TEST: its model and state. */
+ * 1e5 from the onset ONSET_TEST, for k = 9 the same in the current
+ * spacing: its model and state. */
 static fixture *variant(double h, int k, fpm_model **m, fpm_state **st) {
   fixture *fx = fixture_new(3, h, 20, true);
   fx->opt.flux = k & 1 ? FPM_FLUX_SIPG : FPM_FLUX_IIPG;
@@ -107,9 +118,10 @@ static fixture *variant(double h, int k, fpm_model **m, fpm_state **st) {
     fx->opt.stiffening_jump = FPM_JUMP_QUADRATIC;
   }
   if (k == 7) fx->opt.volume_penalty = 1e3;
-  if (k == 8) {
+  if (k >= 8) {
     fx->opt.stiffening = 1e5;
     fx->opt.stiffening_onset = ONSET_TEST;
+    if (k == 9) fx->opt.stiffening_spacing = FPM_SPACING_CURRENT;
   }
   fixture_model(fx, m, st);
   return fx;
@@ -125,7 +137,8 @@ static const char *variant_name(int k) {
       "the default formulation with stiffening",
       "the default with stiffening on the quadratic jump",
       "the default with the volume penalty",
-      "the default with stiffening from an onset"};
+      "the default with stiffening from an onset",
+      "the default with stiffening from an onset in the current spacing"};
   return names[k];
 }
 
@@ -135,7 +148,7 @@ static const char *variant_name(int k) {
  * penalty (relative 1e-6 of |K d|). */
 static void test_force_linearisation(void **state) {
   (void)state;
-  for (int k = 0; k < 9; k++) {
+  for (int k = 0; k < 10; k++) {
     fpm_model *m;
     fpm_state *st;
     fixture *fx = variant(0.03, k, &m, &st);
@@ -285,6 +298,37 @@ static void test_onset_free_below(void **state) {
   for (int v = 0; v < 3; v++) free(f[v]);
 }
 
+/* The onset in the current spacing is not the reference one's: on the
+ * rough field of test_terms_act, at 20% smooth strain, the forces of
+ * variants 8 and 9 differ by more than 1e-4 of variant 8's norm. */
+static void test_current_spacing_acts(void **state) {
+  (void)state;
+  double *f8 = NULL, dif = 0, norm = 0;
+  for (int k = 8; k < 10; k++) {
+    fpm_model *m;
+    fpm_state *st;
+    fixture *fx = variant(0.03, k, &m, &st);
+    const long nd = 3 * m->n;
+    smooth_plus_rough(m, 777, 0.2, 1e-3, st->u, NULL);
+    assert_int_equal(fpm_force(m, st), -1);
+    if (k == 8) {
+      f8 = calloc(nd, sizeof *f8);
+      memcpy(f8, st->f, nd * sizeof *f8);
+    } else
+      for (long i = 0; i < nd; i++) {
+        dif += (st->f[i] - f8[i]) * (st->f[i] - f8[i]);
+        norm += f8[i] * f8[i];
+      }
+    fpm_state_destroy(st);
+    fpm_model_destroy(m);
+    fixture_free(fx);
+  }
+  print_message("current against reference spacing: |f9 - f8| / |f8| = %.3g\n",
+                sqrt(dif / norm));
+  assert_true(sqrt(dif / norm) > 1e-4);
+  free(f8);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sipg_is_gradient),
@@ -292,6 +336,7 @@ int main(void) {
       cmocka_unit_test(test_static_tangent),
       cmocka_unit_test(test_terms_act),
       cmocka_unit_test(test_onset_free_below),
+      cmocka_unit_test(test_current_spacing_acts),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

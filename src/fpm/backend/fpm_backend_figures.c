@@ -209,6 +209,8 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(pm_json_string(j, "stiffening_jump",
                            m->stiffen_quadratic ? "quadratic" : "linear"));
     PM_CALL(pm_json_number(j, "stiffening_onset", m->stiffening_onset));
+    PM_CALL(pm_json_string(j, "stiffening_spacing",
+                           m->stiffen_current ? "current" : "reference"));
   }
   if (m->volume_penalty > 0)
     PM_CALL(pm_json_number(j, "volume_penalty", m->volume_penalty));

@@ -88,11 +88,11 @@ static double plan_head(fpm_sim *sim, FILE *out) {
   char extra[200] = "";
   if (m->boundary_penalty > 0 || m->stiffening > 0 || m->volume_penalty > 0)
     snprintf(extra, sizeof extra,
-             "; boundary penalty %g, stiffening %g on the %s jump from %g h, "
-             "volume penalty %g",
+             "; boundary penalty %g, stiffening %g on the %s jump from %g h "
+             "(%s spacing), volume penalty %g",
              m->boundary_penalty, m->stiffening,
              m->stiffen_quadratic ? "quadratic" : "linear", m->stiffening_onset,
-             m->volume_penalty);
+             m->stiffen_current ? "current" : "reference", m->volume_penalty);
   fprintf(out,
           "             %d. interface flux (%s, penalty %g on the %s "
           "jump%s), %ld support entries\n",

@@ -154,9 +154,11 @@ static inline void quad_jump(const double *ui, const double *uk,
  * (fpm.stiffening, c_e |e| = rec[20], from the onset (tau h_e)^2 =
  * rec[22]) adds the gradient of c_e |e| phi(|j|^2 - (tau h_e)^2) / 4 to the
  * force of the linear jump, or with fpm.stiffening_jump: quadratic of the
- * quadratic one (fpm_stiffen; |j|^4 at tau = 0).  The volume penalty
- * (fpm.volume_penalty, rec[21]) adds 1/2 c |e| phi_e |j|^2 on the linear
- * jump and its derivative through each point's J (fpm_penalty_terms.h).
+ * quadratic one (fpm_stiffen; |j|^4 at tau = 0); with
+ * fpm.stiffening_spacing: current the onset is tau |dc|, dc the points'
+ * deformed distance, whose derivative leaves through r (sd).  The volume
+ * penalty (fpm.volume_penalty, rec[21]) adds 1/2 c |e| phi_e |j|^2 on the
+ * linear jump and its derivative through each point's J (fpm_penalty_terms.h).
  * The energy counts the model's own points. */
 static double flux_pass(const fpm_model *m, const fields *fl) {
   const long n = m->n_flux, n_own = m->n_own;
@@ -183,7 +185,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
          shared(n, n_own, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat,
                 mats, ms, mss, sym, th, zq, Zq, quad, base, bu, bH, squad,
-                vol_on, vphi, vdphi, bth))
+                vol_on, vphi, vdphi, bth, m))
   for (long i = 0; i < n; i++) {
     const bool counted = i < n_own;
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
@@ -198,6 +200,9 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
       const double *Pk = P + 9 * k, *Hk = H + 9 * k, *uk = u + 3 * k;
       double w[3], phi_i[FPM_QFIT], phi_k[FPM_QFIT], jv[3], jq[3], j0[3];
       double sv[3] = {0}, sq[3] = {0}; /* linear, quadratic jump's extra */
+      double sd[3] = {0}; /* the onset's, through u_k - u_i (current) */
+      const double *bui = base ? bu + 3 * i : NULL,
+                   *buk = base ? bu + 3 * k : NULL;
       double eadd = 0;
       if (quad) {
         fpm_gfd_phi(di, phi_i);
@@ -208,14 +213,16 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
           if (base)
             quad_jump(bu + 3 * i, bu + 3 * k, bth + 27 * i, bth + 27 * k, phi_i,
                       phi_k, jq0);
-          eadd += fpm_stiffen(cs, rec[22], jq, base ? jq0 : NULL, sq);
+          eadd += fpm_stiffen_entry(m, cs, rec[22], jq, base ? jq0 : NULL, ui,
+                                    uk, bui, buk, di, dk, sq, sd);
         }
       }
       linear_jump(ui, uk, Hi, Hk, di, dk, jv);
       if (base && (cv != 0 || (cs != 0 && !squad)))
         linear_jump(bu + 3 * i, bu + 3 * k, bH + 9 * i, bH + 9 * k, di, dk, j0);
       if (cs != 0 && !squad)
-        eadd += fpm_stiffen(cs, rec[22], jv, base ? j0 : NULL, sv);
+        eadd += fpm_stiffen_entry(m, cs, rec[22], jv, base ? j0 : NULL, ui, uk,
+                                  bui, buk, di, dk, sv, sd);
       if (cv != 0)
         eadd += fpm_volume_entry(cv, vphi[i], vphi[k], jv, base ? j0 : NULL,
                                  base ? vdphi[i] + vdphi[k] : 0, sv, &va, &vda);
@@ -227,7 +234,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
         w[c] = 0.5 * (Pk[3 * c] * a[0] + Pk[3 * c + 1] * a[1] +
                       Pk[3 * c + 2] * a[2]) -
                (quad ? bl * jump : b) - sv[c];
-        ri[c] -= w[c];
+        ri[c] -= w[c] + sd[c];
         if (quad) {
           z[c] += b;
           for (int q = 0; q < FPM_QFIT; q++)

@@ -372,6 +372,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
       o->stiffening_jump == FPM_JUMP_QUADRATIC && o->jump == FPM_JUMP_QUADRATIC;
   m->volume_penalty = o->volume_penalty;
   m->stiffening_onset = o->stiffening_onset;
+  m->stiffen_current = o->stiffening_spacing == FPM_SPACING_CURRENT;
   m->flux = (fpm_flux)o->flux;
   m->jump = (fpm_jump)o->jump;
   m->n_own = m->n_flux = m->n_stress = m->n;

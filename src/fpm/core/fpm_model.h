@@ -61,6 +61,7 @@ typedef struct {
   double stiffening;       /* p_s: the quartic penalty on the jump */
   bool stiffen_quadratic;  /* it measures the quadratic jump (else linear) */
   double stiffening_onset; /* tau: it acts beyond |[[u]]| = tau h */
+  bool stiffen_current;    /* h of the onset: the points' current distance */
   double volume_penalty;   /* p_v: linear-jump penalty scaled by (ln J)^2 */
   fpm_flux flux;           /* IIPG or SIPG */
   /* fpm.volumetric: averaged (fpm_volumetric.h): the weights a_ik of each

@@ -239,6 +239,7 @@ pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
   s->boundary_penalty = m->boundary_penalty;
   s->stiffening = m->stiffening;
   s->stiffen_quadratic = m->stiffen_quadratic;
+  s->stiffen_current = m->stiffen_current;
   s->stiffening_onset = m->stiffening_onset;
   s->volume_penalty = m->volume_penalty;
   s->flux = m->flux;

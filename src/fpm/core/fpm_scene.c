@@ -18,6 +18,10 @@ static const pm_name volumetric_names[] = {
     {"averaged", FPM_VOLUMETRIC_AVERAGED},
     {NULL, 0}};
 
+static const pm_name spacing_names[] = {{"reference", FPM_SPACING_REFERENCE},
+                                        {"current", FPM_SPACING_CURRENT},
+                                        {NULL, 0}};
+
 static const pm_name formulation_names[] = {
     {"default", FPM_FORMULATION_DEFAULT},
     {"paper", FPM_FORMULATION_PAPER},
@@ -89,6 +93,17 @@ static const pm_key fpm_keys[] = {
             "|[[u]]| > tau h and nil below, so it costs nothing where every "
             "jump stays under tau h (0: the plain quartic, acting at every "
             "jump)"},
+    {.name = "stiffening_spacing",
+     .type = PM_KEY_ENUM,
+     .offset = offsetof(fpm_options, stiffening_spacing),
+     .def = "reference",
+     .names = spacing_names,
+     .doc = "the spacing h of fpm.stiffening_onset: reference (the two "
+            "points' distance in the reference configuration) or current "
+            "(their deformed distance |x_k + u_k - x_i - u_i|, so the onset "
+            "grows where the body stretches and shrinks where it is "
+            "compressed; the energy stays exact, its force and tangent "
+            "include the onset's derivative)"},
     {.name = "volume_penalty",
      .type = PM_KEY_NUMBER,
      .offset = offsetof(fpm_options, volume_penalty),

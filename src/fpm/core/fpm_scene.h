@@ -33,6 +33,10 @@ typedef enum {
                                   standard volume */
 } fpm_formulation;
 
+/* fpm.stiffening_spacing: the spacing the stiffening's onset is measured
+ * in: the points' reference distance, or their current (deformed) one. */
+typedef enum { FPM_SPACING_REFERENCE = 0, FPM_SPACING_CURRENT } fpm_spacing;
+
 /* Options of the fpm section. */
 typedef struct {
   int formulation;         /* fpm_formulation */
@@ -44,6 +48,8 @@ typedef struct {
   int stiffening_jump;     /* fpm.stiffening_jump: the fpm_jump it measures */
   double stiffening_onset; /* fpm.stiffening_onset tau >= 0: the stiffening
                               acts on |[[u]]|^2 - (tau h)^2 beyond it */
+  int stiffening_spacing;  /* fpm.stiffening_spacing: fpm_spacing, the h of
+                              the onset (reference or current) */
   double volume_penalty;   /* fpm.volume_penalty p_v >= 0: linear-jump
                               penalty p_v E / h (ln J)^2 */
   int flux;                /* fpm_flux */
