@@ -373,3 +373,67 @@ void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
     }
   }
 }
+
+/* ---- static solves: the sticking set updated between Newton iterations ----
+ */
+
+long fpm_contact_touch_fixed(const fpm_model *m, fpm_state *st, double t,
+                             double scale) {
+  const fpm_contact *c = m->contact;
+  if (!c) return 0;
+  long added = 0;
+  for (int b = 0; b < c->n_bodies; b++) {
+    const pm_scene_bc *bc = &m->scene->bcs[c->bc[b]];
+    if (bc->contact != PM_CONTACT_STICKING) continue;
+    double d[3];
+    body_displacement(bc, t, scale, d);
+    for (long q = c->pair_ptr[b]; q < c->pair_ptr[b + 1]; q++) {
+      double *A = st->contact + 3 * q, xi[3], n[3];
+      if (!isnan(A[0])) continue;
+      const long i = c->pair_point[q];
+      for (int a = 0; a < 3; a++) xi[a] = m->x[3 * i + a] + st->u[3 * i + a];
+      const double g = pm_rigid_gap(bc, d, xi, n);
+      if (!(g < 0)) continue;
+      /* the surface point under it: x - d - A = g n, so the sticking force
+       * -k (x - d - A) is the normal push -k g n it had: the residual at
+       * this state is unchanged */
+      for (int a = 0; a < 3; a++) A[a] = xi[a] - d[a] - g * n[a];
+      added++;
+    }
+  }
+  return added;
+}
+
+long fpm_contact_release_fixed(const fpm_model *m, fpm_state *st, double t,
+                               double scale, unsigned char *let_go,
+                               fpm_contact_release *out) {
+  const fpm_contact *c = m->contact;
+  *out = (fpm_contact_release){.first = -1, .frozen_first = -1};
+  if (!c) return 0;
+  const double tol = 1e-9 * m->scene->mesh_size;
+  long released = 0;
+  for (int b = 0; b < c->n_bodies; b++) {
+    const pm_scene_bc *bc = &m->scene->bcs[c->bc[b]];
+    if (bc->contact != PM_CONTACT_STICKING) continue;
+    double d[3];
+    body_displacement(bc, t, scale, d);
+    for (long q = c->pair_ptr[b]; q < c->pair_ptr[b + 1]; q++) {
+      double *A = st->contact + 3 * q, xi[3], n[3];
+      if (isnan(A[0])) continue;
+      const long i = c->pair_point[q];
+      for (int a = 0; a < 3; a++) xi[a] = m->x[3 * i + a] + st->u[3 * i + a];
+      const double g = pm_rigid_gap(bc, d, xi, n);
+      if (!(g > tol)) continue;
+      if (let_go[q]) { /* let go once already: it grazes; held */
+        out->frozen++;
+        if (g > out->frozen_gap) out->frozen_first = i, out->frozen_gap = g;
+        continue;
+      }
+      let_go[q] = 1;
+      A[0] = A[1] = A[2] = NAN;
+      if (g > out->first_gap) out->first = i, out->first_gap = g;
+      released++;
+    }
+  }
+  return released;
+}
