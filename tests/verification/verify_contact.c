@@ -23,6 +23,16 @@
 
 #define CASES PM_SOURCE_DIR "/cases/fpm/"
 
+/* The scene at path with n settings run to convergence: its scene, run
+ * and outcome (the caller destroys the first two). */
+static void run_converged(const char *path, int n, const char **sets,
+                          pm_scene **s, fpm_sim **sim, pm_outcome *o) {
+  assert_ok(pm_scene_load(path, n, sets, s));
+  assert_ok(fpm_sim_create(*s, sim));
+  assert_ok(pm_run_sim(*s, *sim, NULL, true, o));
+  assert_int_equal((*sim)->status, PM_STATUS_CONVERGED);
+}
+
 /* The plate's reaction against the exact one, P_zz of uniaxial stress at
  * axial stretch 0.6 times the face's 0.01 m^2, and the displacement NRMSE
  * against the exact field, on 145 points (mesh_size 0.025): the penalty's
@@ -39,12 +49,9 @@ static void run_plate(const char *penalty, const char *method,
                         "time.dt_rule=spectral",
                         "time.quasi_static.tolerance=1e-7", set_method};
   pm_scene *s = NULL;
-  assert_ok(pm_scene_load(CASES "f2-plates.yaml", 5, sets, &s));
   fpm_sim *sim = NULL;
-  assert_ok(fpm_sim_create(s, &sim));
   pm_outcome o;
-  assert_ok(pm_run_sim(s, sim, NULL, true, &o));
-  assert_int_equal(sim->status, PM_STATUS_CONVERGED);
+  run_converged(CASES "f2-plates.yaml", 5, sets, &s, &sim, &o);
   const fpm_model *m = sim->model;
   double lat[2], P[9], W, J;
   assert_ok(pm_material_uniaxial(&m->mats[0], NULL, 0.6, lat));
@@ -110,12 +117,9 @@ static void test_plate_static(void **state) {
 static void test_plate_touch_static(void **state) {
   (void)state;
   pm_scene *s = NULL;
-  assert_ok(pm_scene_load(CASES "plate-touch.yaml", 0, NULL, &s));
   fpm_sim *sim = NULL;
-  assert_ok(fpm_sim_create(s, &sim));
   pm_outcome o;
-  assert_ok(pm_run_sim(s, sim, NULL, true, &o));
-  assert_int_equal(sim->status, PM_STATUS_CONVERGED);
+  run_converged(CASES "plate-touch.yaml", 0, NULL, &s, &sim, &o);
   const fpm_model *m = sim->model;
   const fpm_contact *c = m->contact;
   double K = 0, pen = 0;
