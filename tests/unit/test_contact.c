@@ -298,6 +298,83 @@ static void test_static_tangent(void **state) {
                        "frictionless sphere");
 }
 
+/* The sticking set of a static solve updated between Newton iterations:
+ * the points a uniform compression pushes 1 mm into a sticking plate are
+ * anchored where they penetrate, which leaves every force as it was (the
+ * normal push -k g n becomes the anchor's pull of the same value); a
+ * second call anchors none; drawn 2 mm back, every one is let go, the
+ * farthest 1 mm off, and none is left anchored; pushed in and drawn back
+ * once more, they are anchored again and then held as grazing, not let go
+ * a second time within the step. */
+static void test_static_touch_release(void **state) {
+  (void)state;
+  pm_scene *s = NULL;
+  fpm_sim *sim = NULL;
+  assert_ok(load(
+      "{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, displacement: {z: "
+      "-0.01}, contact: sticking}",
+      "fpm", "static", &s));
+  assert_ok(fpm_sim_create(s, &sim));
+  const fpm_model *m = sim->model;
+  fpm_state *st = sim->state;
+  const long nd = 3 * m->n, np = m->contact->pair_ptr[1];
+  double *f0 = calloc(nd, sizeof *f0), ztop = 0;
+  for (long i = 0; i < m->n; i++) ztop = fmax(ztop, m->x[3 * i + 2]);
+  for (long i = 0; i < m->n; i++) /* the top 1 mm past the plate at 0.09 */
+    st->u[3 * i + 2] = (0.091 - ztop) / ztop * m->x[3 * i + 2];
+  for (long q = 0; q < np; q++) assert_true(isnan(st->contact[3 * q]));
+  memset(st->f, 0, nd * sizeof *st->f);
+  fpm_contact_force_fixed(m, st, 1, 1);
+  memcpy(f0, st->f, nd * sizeof *f0);
+  const long added = fpm_contact_touch_fixed(m, st, 1, 1);
+  assert_int_equal(fpm_contact_touch_fixed(m, st, 1, 1), 0);
+  memset(st->f, 0, nd * sizeof *st->f);
+  fpm_contact_force_fixed(m, st, 1, 1);
+  double df = 0, fmax_ = 0;
+  for (long d = 0; d < nd; d++) {
+    df = fmax(df, fabs(st->f[d] - f0[d]));
+    fmax_ = fmax(fmax_, fabs(f0[d]));
+  }
+  long top = 0;
+  for (long i = 0; i < m->n; i++) top += m->x[3 * i + 2] > ztop - 1e-12;
+  for (long i = 0; i < m->n; i++)
+    st->u[3 * i + 2] -= 0.002 * m->x[3 * i + 2] / ztop;
+  unsigned char *let_go = calloc(np, 1);
+  fpm_contact_release r;
+  const long released = fpm_contact_release_fixed(m, st, 1, 1, let_go, &r);
+  long left = 0;
+  for (long q = 0; q < np; q++) left += !isnan(st->contact[3 * q]);
+  /* pushed in again, anchored again, drawn back again: they graze and
+   * are held (frozen) this time */
+  for (long i = 0; i < m->n; i++)
+    st->u[3 * i + 2] += 0.002 * m->x[3 * i + 2] / ztop;
+  const long again = fpm_contact_touch_fixed(m, st, 1, 1);
+  for (long i = 0; i < m->n; i++)
+    st->u[3 * i + 2] -= 0.002 * m->x[3 * i + 2] / ztop;
+  fpm_contact_release r2;
+  const long released2 = fpm_contact_release_fixed(m, st, 1, 1, let_go, &r2);
+  print_message("sticking set: %ld top points, %ld anchored on touching "
+                "(force changed by %.2g of %.3g N), %ld let go drawn back (the "
+                "farthest %.3g m off), %ld left; anchored again %ld, then %ld "
+                "let go and %ld held grazing (%.3g m off)\n",
+                top, added, df, fmax_, released, r.first_gap, left, again,
+                released2, r2.frozen, r2.frozen_gap);
+  assert_int_equal(added, top);
+  assert_true(df <= 1e-12 * fmax_);
+  assert_int_equal(released, top);
+  assert_true(r.first >= 0 && fabs(m->x[3 * r.first + 2] - ztop) < 1e-12);
+  assert_near(r.first_gap, 0.001, 1e-12);
+  assert_int_equal(left, 0);
+  assert_int_equal(again, top);
+  assert_int_equal(released2, 0);
+  assert_int_equal(r2.frozen, top);
+  assert_near(r2.frozen_gap, 0.001, 1e-12);
+  free(let_go);
+  free(f0);
+  fpm_sim_destroy(sim);
+  pm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_plate_frictionless),
@@ -307,6 +384,7 @@ int main(void) {
       cmocka_unit_test(test_bad_keys),
       cmocka_unit_test(test_plate_inside),
       cmocka_unit_test(test_static_tangent),
+      cmocka_unit_test(test_static_touch_release),
   };
   if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -101,6 +101,36 @@ static pm_err relax_step(pm_newton *s, double *x, const double *xc,
   return e;
 }
 
+/* A step Newton solved (x, from the converged state xc) with its set made
+ * consistent (pm_newton_problem.settle): solved again while the set
+ * changes, at most PM_SETTLE_PASSES times; a set still changing then is a
+ * recoverable failure (the step is cut) naming what changed. */
+static pm_err settle_step(pm_newton *s, double *x, const double *xc,
+                          double r_ref, pm_load_report *rep) {
+  const pm_newton_problem *p = pm_newton_problem_of(s);
+  /* (the tolerance stays relative to the step's first imbalance) */
+  const double ref = fmax(r_ref, rep->last.residual_norm[0]);
+  for (int pass = 0;; pass++) {
+    long changed = 0;
+    char what[256] = "";
+    PM_CALL(p->settle(p->ctx, x, &changed, what, sizeof what));
+    if (changed == 0) return PM_SUCCESS;
+    if (pass == PM_SETTLE_PASSES) {
+      rep->unsettled++;
+      rep->last.status = PM_ERR_NOT_CONVERGED;
+      snprintf(rep->last.message, sizeof rep->last.message,
+               "the set did not settle: solved %d times, and the last solve "
+               "changed %ld entries again (%s)",
+               pass + 1, changed, what);
+      return PM_ERROR(PM_ERR_NOT_CONVERGED, "%s", rep->last.message);
+    }
+    rep->resolves++;
+    pm_err e = pm_newton_solve_from(s, x, xc, ref, &rep->last);
+    add_solve(rep, &rep->last);
+    if (e != PM_SUCCESS) return e;
+  }
+}
+
 pm_err pm_load_state_init(pm_load_state *state, long n) {
   memset(state, 0, sizeof *state);
   pm_err ret = PM_SUCCESS;
@@ -229,6 +259,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       if (e == PM_SUCCESS) rep->relaxed_steps++;
       if (e == PM_ERR_UNSUPPORTED) e = PM_ERR_NOT_CONVERGED;
     }
+    if (e == PM_SUCCESS && p->settle) e = settle_step(s, x, xc, r_ref, rep);
     if (e == PM_SUCCESS) {
       memcpy(xprev, xc, (size_t)n * sizeof *xc);
       memcpy(xc, x, (size_t)n * sizeof *xc);

@@ -158,7 +158,19 @@ typedef struct {
    * positions; appended to the failure's message.  A failure of its own
    * is ignored.  Optional. */
   pm_err (*diagnose)(void *ctx, const double *x, char *buf, long cap);
+  /* Load stepping: after a step's Newton solve has converged at x, a set
+   * the residual depends on made consistent with x (contact: the points
+   * the solution pulls off a body let go).  *changed: how many entries
+   * changed (0: x stands, the step is done; else Newton solves the step
+   * again from x, at most PM_SETTLE_PASSES times, and a set still changing
+   * then fails the step, which is cut, with what into buf: cap bytes, one
+   * line naming what changed).  Optional. */
+  pm_err (*settle)(void *ctx, const double *x, long *changed, char *buf,
+                   long cap);
 } pm_newton_problem;
+
+/* The most times a load step is solved again for its settle callback. */
+#define PM_SETTLE_PASSES 4
 
 /* The linear solver of each Newton iteration.  With a matrix-free operator
  * the factorisation or preconditioner is built from the assembled matrix
@@ -357,6 +369,9 @@ typedef struct {
   int relaxations, relaxed_steps;
   long relax_iterations;
   double time_relax;
+  /* Newton solves run again for pm_newton_problem.settle, and the steps
+   * that failed as their set did not settle. */
+  int resolves, unsettled;
 } pm_load_report;
 
 /* A solver for one problem: the colouring, PETSc's matrix, vectors, SNES

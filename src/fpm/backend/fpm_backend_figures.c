@@ -241,6 +241,11 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(pm_json_integer(j, "static_relax_iterations",
                             r->load.relax_iterations));
     PM_CALL(pm_json_number(j, "static_relax_seconds", r->load.time_relax));
+    PM_CALL(pm_json_integer(j, "static_resolves", r->load.resolves));
+    PM_CALL(pm_json_integer(j, "static_unsettled", r->load.unsettled));
+    PM_CALL(pm_json_integer(j, "static_contact_frozen", r->contact_frozen));
+    PM_CALL(
+        pm_json_number(j, "static_contact_frozen_gap", r->contact_frozen_gap));
   }
   return pm_json_number(j, "max_support_condition", worst);
 }

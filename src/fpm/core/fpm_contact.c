@@ -351,25 +351,92 @@ void fpm_contact_tangent_fixed(const fpm_model *m, const fpm_state *st,
   }
 }
 
-void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
-                        double scale) {
+/* Body b of a static solve's contact when it is sticking (NULL if not),
+ * with its displacement d at t times scale. */
+static const pm_scene_bc *sticking_body(const fpm_model *m, int b, double t,
+                                        double scale, double d[3]) {
+  const pm_scene_bc *bc = &m->scene->bcs[m->contact->bc[b]];
+  if (bc->contact != PM_CONTACT_STICKING) return NULL;
+  body_displacement(bc, t, scale, d);
+  return bc;
+}
+
+/* The gap of pair q's point (at xi, the normal into n) to body bc at d. */
+static double pair_gap(const fpm_model *m, const fpm_state *st,
+                       const pm_scene_bc *bc, const double d[3], long q,
+                       double xi[3], double n[3]) {
+  const long i = m->contact->pair_point[q];
+  for (int a = 0; a < 3; a++) xi[a] = m->x[3 * i + a] + st->u[3 * i + a];
+  return pm_rigid_gap(bc, d, xi, n);
+}
+
+/* The static solve's updates of the sticking set (anchors and releases,
+ * fpm_contact_commit, fpm_contact_touch_fixed, fpm_contact_release_fixed). */
+typedef enum { SET_COMMIT, SET_TOUCH, SET_RELEASE } set_update;
+
+/* One pass of an update over the sticking pairs: COMMIT anchors the points
+ * touching (gap at most 1e-9 h) without an anchor and lets go those above;
+ * TOUCH anchors the penetrating ones without an anchor; RELEASE lets go
+ * the anchored points pulled off (let_go: the marks of those let go in
+ * the attempt; out: what was done).  Returns how many changed. */
+static long update_set(const fpm_model *m, fpm_state *st, double t,
+                       double scale, set_update mode, unsigned char *let_go,
+                       fpm_contact_release *out) {
   const fpm_contact *c = m->contact;
-  if (!c) return;
+  if (!c) return 0;
   const double tol = 1e-9 * m->scene->mesh_size;
+  long changed = 0;
   for (int b = 0; b < c->n_bodies; b++) {
-    const pm_scene_bc *bc = &m->scene->bcs[c->bc[b]];
-    if (bc->contact != PM_CONTACT_STICKING) continue;
-    double d[3];
-    body_displacement(bc, t, scale, d);
+    double d[3], xi[3], n[3];
+    const pm_scene_bc *bc = sticking_body(m, b, t, scale, d);
+    if (!bc) continue;
     for (long q = c->pair_ptr[b]; q < c->pair_ptr[b + 1]; q++) {
-      const long i = c->pair_point[q];
-      double xi[3], n[3], *A = st->contact + 3 * q;
-      for (int a = 0; a < 3; a++) xi[a] = m->x[3 * i + a] + st->u[3 * i + a];
-      const double g = pm_rigid_gap(bc, d, xi, n);
-      if (g > tol)
-        A[0] = A[1] = A[2] = NAN;
-      else if (isnan(A[0]))
+      double *A = st->contact + 3 * q;
+      const bool loose = isnan(A[0]); /* no anchor */
+      if ((mode == SET_TOUCH && !loose) || (mode == SET_RELEASE && loose))
+        continue;
+      const double g = pair_gap(m, st, bc, d, q, xi, n);
+      const bool off = g > tol;
+      if (mode == SET_COMMIT ? !off && loose : mode == SET_TOUCH && g < 0) {
+        /* the surface point under it: x - d - A = g n, so the sticking
+         * force -k (x - d - A) is the normal push -k g n it had: the
+         * residual at this state is unchanged */
         for (int a = 0; a < 3; a++) A[a] = xi[a] - d[a] - g * n[a];
+        changed++;
+        continue;
+      }
+      if (mode == SET_TOUCH || !off || loose) continue;
+      const long i = c->pair_point[q];
+      if (mode == SET_RELEASE && let_go[q]) { /* it grazes: held */
+        out->frozen++;
+        if (g > out->frozen_gap) out->frozen_first = i, out->frozen_gap = g;
+        continue;
+      }
+      A[0] = A[1] = A[2] = NAN;
+      changed++;
+      if (mode == SET_COMMIT) continue;
+      let_go[q] = 1;
+      if (g > out->first_gap) out->first = i, out->first_gap = g;
     }
   }
+  return changed;
+}
+
+void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
+                        double scale) {
+  update_set(m, st, t, scale, SET_COMMIT, NULL, NULL);
+}
+
+/* ---- static solves: the sticking set between Newton iterations ---- */
+
+long fpm_contact_touch_fixed(const fpm_model *m, fpm_state *st, double t,
+                             double scale) {
+  return update_set(m, st, t, scale, SET_TOUCH, NULL, NULL);
+}
+
+long fpm_contact_release_fixed(const fpm_model *m, fpm_state *st, double t,
+                               double scale, unsigned char *let_go,
+                               fpm_contact_release *out) {
+  *out = (fpm_contact_release){.first = -1, .frozen_first = -1};
+  return update_set(m, st, t, scale, SET_RELEASE, let_go, out);
 }

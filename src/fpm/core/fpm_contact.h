@@ -101,6 +101,30 @@ void fpm_contact_tangent_fixed(const fpm_model *m, const fpm_state *st,
 void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
                         double scale);
 
+/* The sticking set of a static solve, updated between Newton iterations
+ * (fpm_static): fpm_contact_touch_fixed anchors every sticking point that
+ * penetrates its body (gap < 0) at st->u without an anchor, at the surface
+ * point under it, so that its force there is unchanged (the normal push
+ * becomes the sticking pull of the same value); returns how many.
+ * fpm_contact_release_fixed lets go every anchored point that the state
+ * st->u pulls off its body (gap above 1e-9 mesh_size), returning how
+ * many, and marks it in let_go (one per pair, the caller's, cleared at
+ * each attempt at a step).  A point marked already, anchored again since,
+ * grazes the body (let go, it comes back): it is held (frozen) instead,
+ * and counted in out.  Both allocate nothing. */
+typedef struct {
+  long first;        /* the point let go farthest off (-1: none) */
+  double first_gap;  /* its gap, m */
+  long frozen;       /* points held though pulled off (grazing) */
+  long frozen_first; /* the farthest of those (-1: none) */
+  double frozen_gap; /* its gap, m */
+} fpm_contact_release;
+long fpm_contact_touch_fixed(const fpm_model *m, fpm_state *st, double t,
+                             double scale);
+long fpm_contact_release_fixed(const fpm_model *m, fpm_state *st, double t,
+                               double scale, unsigned char *let_go,
+                               fpm_contact_release *out);
+
 /* Add the reaction of condition b (the force of the rigid body on the body)
  * to R; nothing when b is no rigid body. */
 void fpm_contact_reaction(const fpm_model *m, const fpm_state *st, int b,

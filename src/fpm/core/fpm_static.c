@@ -107,6 +107,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
       c, fpm_static_evaluate(c, resumed && !m->xc ? v.x : NULL)));
   fpm_support_start(m, st);
   if (!resumed) fpm_contact_commit(m, st, c->load_end, 0);
+  fpm_static_keep_anchors(c);
   fpm_contact_start_scaled(m, st, c->load_end, ss->load.lambda);
   memcpy(c->u_old, st->u, 3 * m->n * sizeof(double));
   /* The figures of the state (a resumed one's too, for a run that fails
@@ -145,6 +146,8 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   ret = pm_load_steps_from(solver, v.x, &ss->load, &rep->load);
 done:
   if (info) *info = c->si;
+  rep->contact_frozen = c->contact_frozen;
+  rep->contact_frozen_gap = c->contact_frozen_gap;
   pm_newton_destroy(&solver);
   fpm_static_solve_free(&v);
   return ret;

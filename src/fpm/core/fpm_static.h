@@ -17,6 +17,11 @@ typedef struct {
   long unknowns;        /* free dofs */
   long pattern_entries; /* stored Jacobian entries */
   double setup_seconds; /* pattern, tangent geometry, PETSc objects */
+  /* Sticking contact: points held at a converged step though pulled off
+   * their body (grazing: let go once in the step, they came back), summed
+   * over steps, and the largest gap one was held at (m). */
+  long contact_frozen;
+  double contact_frozen_gap;
 } fpm_static_report;
 
 /* Free dofs (over all ranks) up to which a static solve's default linear

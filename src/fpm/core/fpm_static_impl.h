@@ -53,6 +53,16 @@ typedef struct {
    * and |F|^2 of the contact forces last evaluated. */
   double *contact_K;
   double contact_fsq;
+  /* The sticking anchors at the last converged load step (3 per pair):
+   * each attempt at a step starts from them (fpm_static_set_load), as
+   * the anchors set within it belong to that attempt. */
+  double *contact_kept;
+  /* Per pair: let go within the current attempt at a step
+   * (fpm_contact_release_fixed); and over the run, the grazing points
+   * held at a converged step and the largest gap one was held at (m). */
+  unsigned char *contact_let_go;
+  long contact_frozen;
+  double contact_frozen_gap;
   fpm_observer observer;
   void *octx;
   fpm_step_info si;
@@ -84,6 +94,9 @@ pm_err fpm_static_admissible(const fpm_static_ctx *c, long bad);
 /* The loads at load factor lambda (pm_newton_problem.set_load; ctx is the
  * fpm_static_ctx). */
 pm_err fpm_static_set_load(void *ctx, double lambda);
+/* The sticking anchors of c->st as a converged step left them, kept for
+ * the next step's attempts (nothing without contact). */
+void fpm_static_keep_anchors(fpm_static_ctx *c);
 /* The figures of the state in c->st into c->si (collective). */
 void fpm_static_figures(fpm_static_ctx *c, long step);
 /* Everything a solve needs of model m with state st into *v (zeroed but

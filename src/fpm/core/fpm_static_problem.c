@@ -57,6 +57,10 @@ static pm_err prepare(void *ctx, const double *x) {
   long bad = fpm_static_evaluate(c, x);
   if (bad >= 0) return inadmissible(c, bad);
   fpm_linear_prepare(c->m, c->st, c->lin);
+  /* Sticking points that reached their body since the last iterate hold
+   * on from here, anchored where they penetrate (the residual at x is the
+   * same), and the tangent is the sticking one (k I) for them. */
+  fpm_contact_touch_fixed(c->m, c->st, c->load_end, c->lambda);
   if (c->contact_K)
     fpm_contact_tangent_fixed(c->m, c->st, c->load_end, c->lambda,
                               c->contact_K);
@@ -108,9 +112,51 @@ static pm_err own_loads(fpm_static_ctx *c, double lambda, long *key) {
   return PM_SUCCESS;
 }
 
+/* The anchors are the first 3 doubles per pair of the contact's state. */
+static size_t anchor_bytes(const fpm_contact *k) {
+  return 3 * (size_t)k->pair_ptr[k->n_bodies] * sizeof(double);
+}
+
+void fpm_static_keep_anchors(fpm_static_ctx *c) {
+  if (c->contact_kept)
+    memcpy(c->contact_kept, c->st->contact, anchor_bytes(c->m->contact));
+}
+
+/* After a step's Newton solve (pm_newton_problem.settle): the sticking
+ * points the solution x pulls off their body let go, their number in
+ * *changed, the one farthest off named in buf; grazing ones held. */
+static pm_err settle(void *ctx, const double *x, long *changed, char *buf,
+                     long cap) {
+  fpm_static_ctx *c = ctx;
+  const fpm_model *m = c->m;
+  PM_CALL(fpm_static_admissible(c, fpm_static_evaluate(c, x)));
+  fpm_contact_touch_fixed(m, c->st, c->load_end, c->lambda);
+  fpm_contact_release r;
+  *changed = fpm_contact_release_fixed(m, c->st, c->load_end, c->lambda,
+                                       c->contact_let_go, &r);
+  if (*changed > 0) {
+    const double *xp = m->x + 3 * r.first;
+    snprintf(buf, (size_t)cap,
+             "contact at lambda %.6g: %ld sticking points pulled off their "
+             "body, the farthest point %ld at (%g, %g, %g), %.3g m off",
+             c->lambda, *changed, fpm_point_id(m, r.first), xp[0], xp[1], xp[2],
+             r.first_gap);
+  } else {
+    c->contact_frozen += r.frozen;
+    c->contact_frozen_gap = fmax(c->contact_frozen_gap, r.frozen_gap);
+  }
+  return PM_SUCCESS;
+}
+
 pm_err fpm_static_set_load(void *ctx, double lambda) {
   fpm_static_ctx *c = ctx;
   const fpm_model *m = c->m;
+  /* a new attempt at a step: the anchors of the last converged one */
+  if (c->contact_kept) {
+    memcpy(c->st->contact, c->contact_kept, anchor_bytes(m->contact));
+    memset(c->contact_let_go, 0,
+           (size_t)m->contact->pair_ptr[m->contact->n_bodies]);
+  }
   c->t = lambda * c->load_end;
   c->lambda = lambda;
   long key = 0;
@@ -187,6 +233,7 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
   /* the contact's state of this step: sticking points that touched anew
    * hold on from here (the residual at x is the same) */
   fpm_contact_commit(c->m, c->st, c->load_end, lambda);
+  fpm_static_keep_anchors(c);
   fpm_static_figures(c, step);
   c->si.converged = lambda >= 1;
   c->si.last = c->si.converged;
@@ -245,6 +292,8 @@ void fpm_static_solve_free(fpm_static_solve *v) {
   free(v->c.df);
   free(v->c.u_old);
   free(v->c.contact_K);
+  free(v->c.contact_kept);
+  free(v->c.contact_let_go);
   free(v->free_of);
   free(v->ptr);
   free(v->idx);
@@ -265,8 +314,16 @@ pm_err fpm_static_setup(const fpm_model *m, fpm_state *st,
   PM_CALL(PM_ALLOC(c->du, 3 * n, "displacement increment"));
   PM_CALL(PM_ALLOC(c->df, 3 * n, "force increment"));
   PM_CALL(PM_ALLOC(c->u_old, 3 * n, "converged displacement"));
-  if (m->contact)
+  if (m->contact) {
     PM_CALL(PM_ALLOC(c->contact_K, 9 * m->n_own, "contact tangent"));
+    PM_CALL(PM_ALLOC(c->contact_kept,
+                     3 * m->contact->pair_ptr[m->contact->n_bodies],
+                     "contact anchors"));
+    PM_CALL(PM_ALLOC(c->contact_let_go,
+                     m->contact->pair_ptr[m->contact->n_bodies],
+                     "contact let go"));
+    fpm_static_keep_anchors(c);
+  }
   for (long d = 0; d < 3 * n; d++) {
     v->free_of[d] = -1;
     if (d < 3 * m->n_own && !m->fixed[d]) {
@@ -306,6 +363,7 @@ pm_err fpm_static_setup(const fpm_model *m, fpm_state *st,
                           .ghost = c->ghost,
                           .set_load = fpm_static_set_load,
                           .on_step = on_step,
-                          .diagnose = diagnose};
+                          .diagnose = diagnose,
+                          .settle = m->contact ? settle : NULL};
   return PM_SUCCESS;
 }
