@@ -13,6 +13,12 @@ double pm_wtime(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+double pm_cputime(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 /* ---- Stage timers ------------------------------------------------------ */
 
 void pm_timers_init(pm_timers *t) { memset(t, 0, sizeof *t); }

@@ -8,6 +8,8 @@
 
 /* Seconds from an arbitrary origin on CLOCK_MONOTONIC (never jumps). */
 double pm_wtime(void);
+/* CPU seconds of the process (all its threads) from its start. */
+double pm_cputime(void);
 
 /* ---- Stage timers ------------------------------------------------------ */
 

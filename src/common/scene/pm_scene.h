@@ -297,6 +297,8 @@ typedef struct pm_scene {
     long qs_relax_after;    /* ...relax_after: cuts before relaxation */
     pm_linear_solver qs_linear; /* ...linear_solver */
     long qs_reuse;              /* ...reuse_iterations (FPM static) */
+    bool qs_inexact;            /* ...inexact: Eisenstat-Walker (FPM) */
+    bool qs_coupled;            /* ...averaged_coupling (FPM) */
     char *qs_solver_options;    /* ...solver_options: PETSc options */
     long max_steps;             /* time.max_steps; 0: no limit */
   } time;

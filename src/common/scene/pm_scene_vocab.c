@@ -742,6 +742,26 @@ static const pm_key quasi_static_keys[] = {
             "it preconditions (GMRES) take at most this many iterations, a "
             "new one after a solve that took more; 0: a new one at every "
             "Newton iteration"},
+    {.name = "inexact",
+     .type = PM_KEY_BOOL,
+     .offset = S(time.qs_inexact),
+     .def = "true",
+     .doc = "method static (FPM): inexact Newton where the linear solve is "
+            "iterative (GMRES with a kept factorisation or with multigrid, "
+            "or a matrix-free tangent): each linear solve to the "
+            "Eisenstat-Walker tolerance, at most 1e-2, tightening as Newton "
+            "converges; false: every linear solve to 1e-10 (1e-6 with "
+            "multigrid), the solver before it"},
+    {.name = "averaged_coupling",
+     .type = PM_KEY_BOOL,
+     .offset = S(time.qs_coupled),
+     .def = "true",
+     .doc = "method static (FPM, fpm.volumetric averaged, direct solver, "
+            "one process): factorise the tangent with the averages' "
+            "coupling, one unknown more per point (the exact tangent's LU: "
+            "GMRES takes an iteration or two); false: the LU of the tangent "
+            "without it, which preconditions GMRES on the exact tangent "
+            "(the solver before)"},
     {.name = "solver_options",
      .type = PM_KEY_STRING,
      .offset = S(time.qs_solver_options),

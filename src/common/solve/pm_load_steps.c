@@ -14,14 +14,28 @@
  * to 1 exactly). */
 #define PM_LOAD_END_SLACK 1e-12
 
-static void add_solve(pm_load_report *rep, const pm_newton_report *nr) {
-  rep->newton_iterations += nr->iterations;
-  rep->linear_iterations += nr->linear_iterations;
+/* The times and counts of one solve (or tangent solve) into rep. */
+static void add_costs(pm_load_report *rep, const pm_newton_report *nr) {
   rep->time_residual += nr->time_residual;
   rep->time_assembly += nr->time_assembly;
   rep->time_linear += nr->time_linear;
   rep->time_setup += nr->time_setup;
   rep->pc_setups += nr->pc_setups;
+  rep->time_apply += nr->time_apply;
+  rep->cpu_residual += nr->cpu_residual;
+  rep->cpu_assembly += nr->cpu_assembly;
+  rep->cpu_linear += nr->cpu_linear;
+  rep->cpu_setup += nr->cpu_setup;
+  rep->cpu_apply += nr->cpu_apply;
+  rep->residual_evaluations += nr->residual_evaluations;
+  rep->jacobians += nr->jacobians;
+  rep->jacobian_applications += nr->jacobian_applications;
+}
+
+static void add_solve(pm_load_report *rep, const pm_newton_report *nr) {
+  rep->newton_iterations += nr->iterations;
+  rep->linear_iterations += nr->linear_iterations;
+  add_costs(rep, nr);
 }
 
 static bool recoverable(pm_err e) {
@@ -51,11 +65,7 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
     pm_newton_report tr;
     memset(&tr, 0, sizeof tr);
     e = pm_newton_tangent_solve(s, xc, rh, x, &tr);
-    rep->time_residual += tr.time_residual;
-    rep->time_assembly += tr.time_assembly;
-    rep->time_linear += tr.time_linear;
-    rep->time_setup += tr.time_setup;
-    rep->pc_setups += tr.pc_setups;
+    add_costs(rep, &tr);
   }
   if (e == PM_SUCCESS)
     for (long i = 0; i < n; i++) x[i] += xc[i];

@@ -20,6 +20,7 @@ pm_newton_options pm_newton_options_default(void) {
                              .max_iter = 25,
                              .linear = PM_NEWTON_DIRECT,
                              .linear_rtol = 1e-10,
+                             .linear_ew_max = 1e-2,
                              .linear_max_iter = 1000,
                              .op = PM_NEWTON_ASSEMBLED,
                              .pc_lag = 1,
@@ -153,6 +154,7 @@ pm_err pm_newton_solve_from(pm_newton *s, double *x, const double *x_start,
   s->domain_last = false;
   s->domain_msg[0] = '\0';
   s->r0 = s->e0 = s->incr = s->energy = 0;
+  s->ew_rprev = s->ew_eta = 0;
   s->r_ref = r_ref;
   s->jacobians = 0;
   s->in_linear = false;
@@ -186,6 +188,7 @@ pm_err pm_newton_solve_from(pm_newton *s, double *x, const double *x_start,
     const char *what = pm_petsc_last_message(&cause);
     s->in_linear = false;
     rep->time_linear += pm_wtime() - s->linear_started;
+    rep->cpu_linear += pm_cputime() - s->linear_started_cpu;
     if (cause != PETSC_ERR_LIB && cause != PETSC_ERR_MAT_LU_ZRPVT &&
         cause != PETSC_ERR_MAT_CH_ZRPVT && cause != PETSC_ERR_FP &&
         cause != PETSC_ERR_NOT_CONVERGED) {

@@ -124,6 +124,20 @@ typedef struct {
   const long *pc_pat_ptr;
   const long *pc_pat_idx;
 
+  /* A preconditioner factorised from a larger matrix (the direct solver
+   * with op PM_NEWTON_MATRIX_FREE, one process): M = [J0 G; C I] over the
+   * n unknowns and aux_n more, on the pattern aux_ptr/aux_idx (CSR over
+   * n + aux_n; copied), its values from aux_values at each new
+   * preconditioner (after jacobian_prepare, in the pattern's order,
+   * repeated entries summed).  The LU of M applied to [r; 0], first n
+   * values, is (J0 - G C)^-1 r: the exact inverse of J when J is J0
+   * coupled through aux_n intermediate values (an averaged volume's).
+   * Used in place of the assembled Jacobian (jacobian_values is then not
+   * called).  Optional (0, NULL). */
+  long aux_n;
+  const long *aux_ptr, *aux_idx;
+  pm_err (*aux_values)(void *ctx, const double *x, double *val);
+
   /* Vectors (near_null_count of n values each, one after the other) the
    * Jacobian nearly annihilates -- for a solid, its rigid motions -- given
    * to algebraic multigrid (gmres-gamg) to build its coarse spaces from.
@@ -234,8 +248,17 @@ typedef struct {
 
   pm_newton_linear linear; /* PM_NEWTON_DIRECT */
   double linear_rtol;      /* iterative solvers: 1e-10 */
-  int linear_max_iter;     /* iterative solvers: 1000 */
-  pm_newton_operator op;   /* PM_NEWTON_ASSEMBLED */
+  /* Inexact Newton (Eisenstat-Walker, choice 2) for an iterative linear
+   * solve (a Krylov method, the direct solver's too when it preconditions
+   * a matrix-free operator or a kept factorisation): each linear solve
+   * to eta_k = 0.9 (|r_k| / |r_(k-1)|)^2, safeguarded by 0.9 eta_(k-1)^2
+   * when that exceeds 0.1, at most linear_ew_max (the first of a solve:
+   * linear_ew_max), no tighter than half of Newton's residual target over
+   * |r_k| nor than linear_rtol.  false: every solve to linear_rtol. */
+  bool linear_ew;        /* false */
+  double linear_ew_max;  /* 1e-2 (when linear_ew) */
+  int linear_max_iter;   /* iterative solvers: 1000 */
+  pm_newton_operator op; /* PM_NEWTON_ASSEMBLED */
   /* Matrix-free operators: rebuild the preconditioner every pc_lag Newton
    * iterations (1: every one). */
   int pc_lag; /* 1 */
@@ -349,6 +372,11 @@ typedef struct pm_newton_report {
   double time_residual, time_assembly, time_linear, time_total;
   double time_setup;
   int pc_setups; /* factorisations or preconditioner set-ups */
+  /* Of time_linear: the matrix-free products (jacobian_apply). */
+  double time_apply;
+  /* The process's CPU seconds (all threads) in the same parts. */
+  double cpu_residual, cpu_assembly, cpu_linear, cpu_setup, cpu_apply;
+  int jacobians; /* linearisations: jacobian_prepare and assembly calls */
 } pm_newton_report;
 
 /* What load stepping did. */
@@ -360,8 +388,14 @@ typedef struct {
   int newton_iterations;
   int linear_iterations;
   double time_residual, time_assembly, time_linear, time_total;
-  double time_setup;     /* of time_linear: preconditioner set-ups */
-  int pc_setups;         /* their number */
+  double time_setup; /* of time_linear: preconditioner set-ups */
+  int pc_setups;     /* their number */
+  /* Of time_linear: matrix-free products; CPU seconds (all threads) of
+   * the parts; counts of residuals, linearisations and products (those
+   * of the relaxation fallback not included). */
+  double time_apply;
+  double cpu_residual, cpu_assembly, cpu_linear, cpu_setup, cpu_apply;
+  long residual_evaluations, jacobians, jacobian_applications;
   pm_newton_report last; /* the last Newton solve (the failing one on
                             failure) */
   /* The relaxation fallback: relaxations run, steps they let converge,

@@ -16,7 +16,7 @@ PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
   double *r;
   Vec xl, rl;
   PetscFunctionBeginUser;
-  double t = pm_wtime();
+  double t = pm_wtime(), tc = pm_cputime();
   PetscCall(pm_newton_in_get(s, X, s->Gx, &xl, &x));
   PetscCall(pm_newton_out_get(s, R, s->Gr, &rl, &r));
   pm_err e = s->p.residual(s->p.ctx, x, r);
@@ -32,6 +32,7 @@ PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
   PetscCall(pm_newton_in_done(s, s->Gx, &xl, &x));
   if (s->rep) {
     s->rep->time_residual += pm_wtime() - t;
+    s->rep->cpu_residual += pm_cputime() - tc;
     s->rep->residual_evaluations++;
   }
   s->domain_last = e != PM_SUCCESS;
@@ -56,7 +57,7 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
   (void)snes;
   (void)A;
   PetscFunctionBeginUser;
-  double t = pm_wtime();
+  double t = pm_wtime(), tc = pm_cputime();
   PetscCall(VecCopy(X, s->Xlin));
   PetscCall(pm_newton_in_get(s, X, s->Glin, &xl, &x));
   pm_err e = PM_SUCCESS;
@@ -80,7 +81,9 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
   s->jacobians++;
   if (new_pc && s->rep) s->rep->pc_setups++;
   if (e == PM_SUCCESS && rebuild) {
-    if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
+    if (s->aug) {
+      e = pm_newton_agreed(s, pm_newton_aug_values(s, x));
+    } else if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
       e = pm_newton_color_values(s, s->p.precond_apply, &s->pcol, x, s->pvals);
       if (e == PM_SUCCESS)
         e = pm_newton_insert_values(s, B, &s->ppat, s->pcols, s->pvals);
@@ -92,7 +95,11 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
   }
   e = pm_newton_agreed(s, e);
   PetscCall(pm_newton_in_done(s, s->Glin, &xl, &x));
-  if (s->rep) s->rep->time_assembly += pm_wtime() - t;
+  if (s->rep) {
+    s->rep->time_assembly += pm_wtime() - t;
+    s->rep->cpu_assembly += pm_cputime() - tc;
+    s->rep->jacobians++;
+  }
   if (e != PM_SUCCESS) {
     s->hard = e;
     SETERRQ(s->comm, PETSC_ERR_USER, "Jacobian callback failed: %s",
@@ -108,6 +115,7 @@ PetscErrorCode pm_newton_shell_mult(Mat A, Vec in, Vec out) {
   Vec xl, dxl, drl;
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(A, &s));
+  const double t = pm_wtime(), tc = pm_cputime();
   /* The linearisation point's held values are Glin's since the Jacobian
    * was made there. */
   xl = s->Xlin;
@@ -116,11 +124,15 @@ PetscErrorCode pm_newton_shell_mult(Mat A, Vec in, Vec out) {
   PetscCall(pm_newton_in_get(s, in, s->Gdx, &dxl, &dx));
   PetscCall(pm_newton_out_get(s, out, s->Gdr, &drl, &dr));
   pm_err e = pm_newton_agreed(s, s->p.jacobian_apply(s->p.ctx, x, dx, dr));
-  if (s->rep) s->rep->jacobian_applications++;
   PetscCall(pm_newton_out_done(s, out, s->Gdr, &drl, &dr, e == PM_SUCCESS));
   PetscCall(pm_newton_in_done(s, s->Gdx, &dxl, &dx));
   PetscCall(VecRestoreArrayRead(xl, &x));
   if (s->dist) PetscCall(VecGhostRestoreLocalForm(s->Glin, &xl));
+  if (s->rep) {
+    s->rep->jacobian_applications++;
+    s->rep->time_apply += pm_wtime() - t;
+    s->rep->cpu_apply += pm_cputime() - tc;
+  }
   if (e != PM_SUCCESS) {
     s->hard = e;
     SETERRQ(s->comm, PETSC_ERR_USER, "jacobian_apply failed: %s",
@@ -147,18 +159,48 @@ PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
   PetscFunctionReturn(0);
 }
 
+/* linear_ew: the forcing term of the linear solve whose right-hand side
+ * has norm rk (pm_newton.h, linear_ew). */
+static double forcing_term(pm_newton *s, double rk) {
+  const pm_newton_options *o = &s->o;
+  double eta = o->linear_ew_max;
+  if (s->ew_rprev > 0) {
+    const double q = rk / s->ew_rprev, safe = 0.9 * s->ew_eta * s->ew_eta;
+    eta = 0.9 * q * q;
+    if (safe > 0.1 && safe > eta) eta = safe;
+    if (eta > o->linear_ew_max) eta = o->linear_ew_max;
+  }
+  /* no tighter than the last Newton iteration needs */
+  const double target = fmax(o->rtol * s->r0, o->atol);
+  if (rk > 0 && eta < 0.5 * target / rk) eta = 0.5 * target / rk;
+  if (eta > o->linear_ew_max) eta = o->linear_ew_max;
+  if (eta < o->linear_rtol) eta = o->linear_rtol;
+  s->ew_rprev = rk;
+  s->ew_eta = eta;
+  return eta;
+}
+
 PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
   pm_newton *s = ctx;
-  (void)ksp;
-  (void)b;
   (void)x;
+  if (s->o.linear_ew) {
+    PetscReal rk;
+    PetscCall(VecNorm(b, NORM_2, &rk));
+    PetscCall(KSPSetTolerances(ksp, forcing_term(s, rk), PETSC_DEFAULT,
+                               PETSC_DEFAULT, s->o.linear_max_iter));
+  }
   s->linear_started = pm_wtime();
+  s->linear_started_cpu = pm_cputime();
   s->in_linear = true;
   /* The preconditioner's set-up (a factorisation, a multigrid hierarchy)
    * now, to time it apart; KSPSolve's own set-up then finds it done. */
   PetscCall(KSPSetUp(ksp));
   PetscCall(KSPSetUpOnBlocks(ksp));
-  if (s->rep) s->rep->time_setup += pm_wtime() - s->linear_started;
+  PetscCall(pm_newton_aug_factor(s));
+  if (s->rep) {
+    s->rep->time_setup += pm_wtime() - s->linear_started;
+    s->rep->cpu_setup += pm_cputime() - s->linear_started_cpu;
+  }
   return 0;
 }
 
@@ -167,7 +209,10 @@ PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx) {
   (void)ksp;
   (void)b;
   (void)x;
-  if (s->rep) s->rep->time_linear += pm_wtime() - s->linear_started;
+  if (s->rep) {
+    s->rep->time_linear += pm_wtime() - s->linear_started;
+    s->rep->cpu_linear += pm_cputime() - s->linear_started_cpu;
+  }
   s->in_linear = false;
   PetscInt its;
   KSPConvergedReason why;

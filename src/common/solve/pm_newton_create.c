@@ -98,7 +98,8 @@ static pm_err configure_snes(pm_newton *s) {
   PM_PETSC_CALL(PetscOptionsCreate(&s->opts));
   /* MUMPS: a singular matrix (a limit point) factors with its null pivots
    * set aside instead of failing with an error. */
-  PM_PETSC_CALL(PetscOptionsInsertString(s->opts, "-pm_mat_mumps_icntl_24 1"));
+  PM_PETSC_CALL(PetscOptionsInsertString(
+      s->opts, "-pm_mat_mumps_icntl_24 1 -pm_aug_mat_mumps_icntl_24 1"));
   if (o->amg_reuse)
     PM_PETSC_CALL(PetscOptionsInsertString(
         s->opts, "-pm_pc_gamg_reuse_interpolation true"));
@@ -150,10 +151,10 @@ static pm_err create_petsc_objects(pm_newton *s) {
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Work));
   if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
     PM_CALL(pm_newton_create_matrix(s, &s->ppat, &s->pcols, s->pvals, &s->P));
-  } else {
+  } else if (!s->aug) {
     PM_CALL(pm_newton_create_matrix(s, &s->jpat, &s->jcols, s->jvals, &s->J));
   }
-  if (s->p.near_null_count > 0) {
+  if (s->p.near_null_count > 0 && !s->aug) {
     Mat A, B;
     pm_newton_operators(s, &A, &B);
     PM_CALL(pm_newton_set_near_null(s, B));
@@ -164,7 +165,8 @@ static pm_err create_petsc_objects(pm_newton *s) {
     PM_PETSC_CALL(MatShellSetOperation(s->Shell, MATOP_MULT,
                                        (void (*)(void))pm_newton_shell_mult));
   }
-  return configure_snes(s);
+  PM_CALL(configure_snes(s));
+  return pm_newton_aug_objects(s);
 }
 
 pm_err pm_newton_create(const pm_newton_problem *problem,
@@ -211,6 +213,8 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
     PM_TRY(pm_coloring_build(&s->ppat, options->coloring, &s->pcol));
     PM_TRY(PM_ALLOC(s->pvals, s->ppat.ptr[n], "preconditioner values"));
   }
+  PM_TRY(pm_newton_aug_init(s, problem));
+  s->p.aux_ptr = s->p.aux_idx = NULL; /* the caller's: copied */
   PM_TRY(PM_ALLOC(s->seed, n, "colour seed"));
   PM_TRY(PM_ALLOC(s->dr, n, "colour image"));
   s->p.ghost = problem->ghost;
@@ -231,6 +235,7 @@ void pm_newton_destroy(pm_newton **sp) {
   pm_newton *s = *sp;
   /* Destruction never fails in practice; its codes have nowhere to go. */
   SNESDestroy(&s->snes);
+  pm_newton_aug_free(s);
   MatDestroy(&s->Shell);
   MatDestroy(&s->J);
   MatDestroy(&s->P);

@@ -134,6 +134,10 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
      * (exactly, for a current J: one iteration). */
     PM_PETSC(KSPSetType(ksp, matrix_free || o->pc_reuse_its > 0 ? KSPGMRES
                                                                 : KSPPREONLY));
+    if (s->aug) { /* the augmented matrix's LU (pm_newton_augmented.c) */
+      PM_PETSC(pm_newton_aug_set_pc(s, pc));
+      break;
+    }
     PM_PETSC(PCSetType(pc, PCLU));
 #ifdef PETSC_HAVE_MUMPS
     PM_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
@@ -191,7 +195,9 @@ pm_err pm_newton_replace_linear(pm_newton *s) {
  * from (B). */
 void pm_newton_operators(const pm_newton *s, Mat *A, Mat *B) {
   *A = s->o.op == PM_NEWTON_ASSEMBLED ? s->J : s->Shell;
-  *B = s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P : s->J;
+  *B = s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P
+       : s->aug                                  ? s->Shell
+                                                 : s->J;
 }
 
 pm_newton_linear pm_newton_linear_of(pm_linear_solver l) {

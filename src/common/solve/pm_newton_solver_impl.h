@@ -55,7 +55,7 @@ struct pm_newton {
   double r_ref;        /* a reference residual larger than |r(x_0)| (0: none) */
   double incr, energy; /* |dx_k|, |dx_k . r(x_k)| of the current step */
   long jacobians;      /* Jacobian callbacks in this solve (for pc_lag) */
-  double linear_started;
+  double linear_started, linear_started_cpu;
   bool in_linear; /* between the linear solver's pre- and postsolve */
   /* The last linear solve's residual norms: first and last (the linear
    * solver's convergence test records them). */
@@ -63,8 +63,21 @@ struct pm_newton {
   /* pc_reuse_its: a preconditioner was built, and the last linear
    * solve's iterations and whether it failed. */
   bool pc_built, lin_failed;
+  /* linear_ew: |r| at the last linear solve of this Newton solve (0:
+   * none yet) and the tolerance it was given. */
+  double ew_rprev, ew_eta;
   int lin_its;
   bool started; /* the initial state was admissible */
+  /* pm_newton_problem.aux_n: the augmented matrix's pattern, columns and
+   * values (asrc: in the caller's order), the matrix, its LU (ka) and
+   * its right-hand side and solution; dirty: new values not factorised. */
+  bool aug, aug_dirty;
+  pm_pattern apat;
+  PetscInt *acols;
+  double *avals, *asrc;
+  Mat Ma;
+  KSP ka;
+  Vec Ab, Ay;
 };
 
 /* A callback's failure that aborts the solve (not an inadmissible state);
@@ -137,6 +150,19 @@ PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
                                   PetscBool *changed, void *ctx);
 PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx);
 PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx);
+
+/* ---- pm_newton_augmented.c: pm_newton_problem.aux_n ---- */
+
+/* The augmented matrix's pattern and values (at create), its PETSc
+ * objects, its values at x (the Jacobian callback), its factorisation if
+ * new values wait (the linear presolve), the shell preconditioner on pc,
+ * and the release of it all. */
+pm_err pm_newton_aug_init(pm_newton *s, const pm_newton_problem *p);
+pm_err pm_newton_aug_objects(pm_newton *s);
+pm_err pm_newton_aug_values(pm_newton *s, const double *x);
+PetscErrorCode pm_newton_aug_factor(pm_newton *s);
+PetscErrorCode pm_newton_aug_set_pc(pm_newton *s, PC pc);
+void pm_newton_aug_free(pm_newton *s);
 
 /* ---- pm_newton_convergence.c ---- */
 

@@ -223,6 +223,7 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     const fpm_static_report *r = &sim->static_report;
     PM_CALL(pm_json_integer(j, "static_unknowns", r->unknowns));
     PM_CALL(pm_json_integer(j, "static_jacobian_entries", r->pattern_entries));
+    PM_CALL(pm_json_integer(j, "static_coupled_entries", r->coupled_entries));
     PM_CALL(pm_json_integer(j, "static_load_steps", r->load.steps));
     PM_CALL(pm_json_integer(j, "static_cuts", r->load.cuts));
     PM_CALL(pm_json_integer(j, "static_newton_iterations",
@@ -236,6 +237,20 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(pm_json_number(j, "static_pc_setup_seconds", r->load.time_setup));
     PM_CALL(pm_json_integer(j, "static_pc_setups", r->load.pc_setups));
     PM_CALL(pm_json_number(j, "static_linear_seconds", r->load.time_linear));
+    PM_CALL(pm_json_number(j, "static_apply_seconds", r->load.time_apply));
+    PM_CALL(
+        pm_json_number(j, "static_residual_cpu_seconds", r->load.cpu_residual));
+    PM_CALL(
+        pm_json_number(j, "static_tangent_cpu_seconds", r->load.cpu_assembly));
+    PM_CALL(
+        pm_json_number(j, "static_pc_setup_cpu_seconds", r->load.cpu_setup));
+    PM_CALL(pm_json_number(j, "static_linear_cpu_seconds", r->load.cpu_linear));
+    PM_CALL(pm_json_number(j, "static_apply_cpu_seconds", r->load.cpu_apply));
+    PM_CALL(
+        pm_json_integer(j, "static_residuals", r->load.residual_evaluations));
+    PM_CALL(pm_json_integer(j, "static_tangents", r->load.jacobians));
+    PM_CALL(
+        pm_json_integer(j, "static_products", r->load.jacobian_applications));
     PM_CALL(pm_json_integer(j, "static_relaxations", r->load.relaxations));
     PM_CALL(pm_json_integer(j, "static_relaxed_steps", r->load.relaxed_steps));
     PM_CALL(pm_json_integer(j, "static_relax_iterations",

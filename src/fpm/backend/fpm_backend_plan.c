@@ -124,22 +124,30 @@ static double plan_head(fpm_sim *sim, FILE *out) {
       snprintf(why, sizeof why, "default: %ld free dofs %s %ld", nfree,
                nfree <= FPM_STATIC_DIRECT_MAX ? "<=" : ">",
                FPM_STATIC_DIRECT_MAX);
+    /* fpm_static_run_from's choice: the averages' coupling factorised */
+    const bool coupled = m->vavg && !m->xc && no.linear == PM_NEWTON_DIRECT &&
+                         s->time.qs_coupled;
     fprintf(
         out,
         "             %d. Newton's method in %ld proportional load steps "
         "(at most %ld iterations each), %ld prescribed dofs\n"
         "             tangent assembled directly (%s), linear solver "
-        "%s (%s)%s\n",
+        "%s (%s)%s%s\n",
         stage++, s->time.qs_load_steps, s->time.qs_max_iterations, m->n_cdofs,
-        m->flux == FPM_FLUX_SIPG || m->vavg
+        coupled ? "with the averages' coupling through one unknown a point: "
+                  "the exact tangent's LU"
+        : m->flux == FPM_FLUX_SIPG || m->vavg
             ? "preconditioning the exact tangent applied matrix-free"
             : "exact",
         linear[no.linear], why,
-        s->time.qs_reuse > 0 ? ", kept while GMRES takes few iterations" : "");
+        s->time.qs_reuse > 0 ? ", kept while GMRES takes few iterations" : "",
+        s->time.qs_inexact ? ", inexact Newton" : "");
     /* The tangent and its factors or multigrid hierarchy, per tangent
      * entry as measured (peak memory of whole runs over the entries, F3
      * at 1851 and 4036 points: 175 bytes with LU, 90-110 with GAMG), at
-     * about 650 entries a free dof with the quadratic jump (3 rings). */
+     * about 650 entries a free dof with the quadratic jump (3 rings);
+     * the coupled LU of the averaged volume: 320 bytes (F3 60%, 1851
+     * points: 805 MiB for 2.66e6 tangent entries). */
     const bool lu = no.linear == PM_NEWTON_DIRECT;
     const double entries = 650.0 * (double)nfree;
     if (!m->q) {
@@ -153,8 +161,12 @@ static double plan_head(fpm_sim *sim, FILE *out) {
             "memory       %.1f MiB (operators and state) + about %.0f MiB "
             "for the tangent (~%.3g entries) and its %s\n",
             (bytes + fpm_linear_bytes(m)) / 1048576.0,
-            entries * (lu ? 175.0 : 110.0) / 1048576.0, entries,
-            lu ? "LU factors" : "multigrid hierarchy");
+            entries *
+                (coupled ? 320.0
+                 : lu    ? 175.0
+                         : 110.0) /
+                1048576.0,
+            entries, lu ? "LU factors" : "multigrid hierarchy");
     return 0;
   }
   fprintf(out, "             %d. central difference%s, %ld prescribed dofs\n",

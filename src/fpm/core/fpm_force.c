@@ -596,3 +596,7 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
 }
 
 const double *fpm_linear_tangent(const fpm_linear *l) { return l->D; }
+
+const fpm_volumetric_lin *fpm_linear_volumetric(const fpm_linear *l) {
+  return &l->vol;
+}

@@ -16,6 +16,7 @@ typedef struct {
   pm_load_report load;  /* steps, cuts, iterations, times */
   long unknowns;        /* free dofs */
   long pattern_entries; /* stored Jacobian entries */
+  long coupled_entries; /* those of the coupled factorisation (0: none) */
   double setup_seconds; /* pattern, tangent geometry, PETSc objects */
   /* Sticking contact: points held at a converged step though pulled off
    * their body (grazing: let go once in the step, they came back), summed

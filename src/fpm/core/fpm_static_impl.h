@@ -25,14 +25,35 @@ typedef struct {
   long *Dg_ptr; /* n + 1: point j's records start at Dg_ptr[j] */
   long max_reach;
   int threads;
-  long *mark;   /* threads x n: a row's points */
-  double *work; /* threads x 9 max_reach: a row's blocks */
+  long *mark;        /* threads x n: a row's points */
+  double *work;      /* threads x 9 max_reach: a row's blocks */
+  const double *Dpc; /* the moduli to assemble with (NULL: the tangent's) */
 } fpm_static_tangent;
+
+/* The averaged volume's coupling in the preconditioner (fpm.volumetric
+ * averaged, one process): the matrix [K0 G; C I] over the free dofs and
+ * one value z per point, z = U''(Jbar) A dJ, with K0 the tangent without
+ * the volumetric stiffness U''(J) cof F (x) cof F of each point, G z the
+ * force of the stresses (A z)_j cof F_j and C u = -U''(Jbar) A dJ(u); its
+ * Schur complement K0 - G C is the exact tangent (fpm_volumetric_apply).
+ * Built by fpm_static_coupled_build (fpm_static_coupled.c). */
+typedef struct {
+  long *Z_ptr, *Z_i; /* per own point k: the z whose stresses reach f_k */
+  long *U_ptr, *U_m; /* per point i: the points whose u reach z_i */
+  long *ptr, *idx;   /* the matrix's pattern over nf + n */
+  double *D;         /* 81 n: the moduli less the volumetric stiffness */
+  double *jv;        /* K0's values in the tangent's pattern */
+  long maxlen;       /* the longest Z or U list */
+  int threads;
+  long *mark;  /* threads x n */
+  double *acc; /* threads x 3 maxlen */
+} fpm_static_coupled;
 
 typedef struct {
   const fpm_model *m;
   fpm_state *st;
   fpm_static_tangent tg;
+  fpm_static_coupled cp; /* (zeroed when not used) */
   const long *pat_ptr;
   const long *free_of;
   fpm_linear *lin;
@@ -80,6 +101,32 @@ typedef struct {
   double *rigid; /* the rigid motions on the free dofs (for multigrid) */
   pm_newton_problem prob;
 } fpm_static_solve;
+
+/* The weight of u_m in H_j for the r-th member of j's closed support
+ * (r = 0: j itself, -gsum_j; else its (r-1)-th neighbour), and that point. */
+static inline long closed_member(const fpm_model *m, long j, long r,
+                                 const double **w) {
+  if (r == 0) {
+    *w = m->gsum + 3 * j;
+    return j;
+  }
+  long e = m->nbr_ptr[j] + r - 1;
+  *w = m->g + 3 * e;
+  return m->nbr[e];
+}
+
+static inline long closed_size(const fpm_model *m, long j) {
+  return m->nbr_ptr[j + 1] - m->nbr_ptr[j] + 1;
+}
+
+/* fpm_static_coupled.c: the averaged volume's coupled preconditioner
+ * (fpm_static_coupled above) for solve v on one process: its lists and
+ * pattern (into v->prob's aux_n, aux_ptr, aux_idx, aux_values), its
+ * values (pm_newton_problem.aux_values; ctx is the fpm_static_ctx), and
+ * their release.  PM_ERR_MEMORY. */
+pm_err fpm_static_coupled_build(fpm_static_solve *v);
+pm_err fpm_static_coupled_values(void *ctx, const double *x, double *val);
+void fpm_static_coupled_free(fpm_static_coupled *cp);
 
 /* fpm_static_problem.c: the problem pm_newton solves. */
 

@@ -285,6 +285,7 @@ static pm_err diagnose(void *ctx, const double *x, char *buf, long cap) {
 void fpm_static_solve_free(fpm_static_solve *v) {
   fpm_linear_destroy(v->c.lin);
   fpm_static_tangent_free(&v->c.tg);
+  fpm_static_coupled_free(&v->c.cp);
   free(v->c.dof);
   free(v->c.ghost);
   free(v->c.held);

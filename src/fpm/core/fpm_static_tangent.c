@@ -10,23 +10,6 @@
 #include "fpm_static_impl.h"
 #include "pm_omp.h"
 
-/* The weight of u_m in H_j for the r-th member of j's closed support
- * (r = 0: j itself, -gsum_j; else its (r-1)-th neighbour), and that point. */
-static inline long closed_member(const fpm_model *m, long j, long r,
-                                 const double **w) {
-  if (r == 0) {
-    *w = m->gsum + 3 * j;
-    return j;
-  }
-  long e = m->nbr_ptr[j] + r - 1;
-  *w = m->g + 3 * e;
-  return m->nbr[e];
-}
-
-static inline long closed_size(const fpm_model *m, long j) {
-  return m->nbr_ptr[j + 1] - m->nbr_ptr[j] + 1;
-}
-
 void fpm_static_tangent_free(fpm_static_tangent *t) {
   free(t->R_ptr);
   free(t->R_list);
@@ -319,7 +302,7 @@ pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
   const fpm_model *m = c->m;
   fpm_static_tangent *t = &c->tg;
   const long n = m->n, ns = m->n_stress, rows = m->n_own;
-  const double *D = fpm_linear_tangent(c->lin);
+  const double *D = t->Dpc ? t->Dpc : fpm_linear_tangent(c->lin);
   /* D_j gamma_jm for every j (whose stress the rows read) and member m of
    * its closed support */
   PM_OMP(parallel for schedule(static) default(none) shared(ns, m, t, D))
@@ -341,10 +324,7 @@ pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
   const long *free_of = c->free_of, *pat = c->pat_ptr;
   const double *K = c->contact_K;
   PM_OMP(parallel default(none) shared(n, rows, m, t, free_of, pat, val, K)) {
-    int th = 0;
-#ifdef _OPENMP
-    th = omp_get_thread_num();
-#endif
+    const int th = pm_omp_thread();
     long *mark = t->mark + (size_t)th * n;
     double *blk = t->work + (size_t)th * 9 * t->max_reach;
     PM_OMP(for schedule(dynamic, 16))

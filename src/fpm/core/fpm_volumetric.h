@@ -35,6 +35,10 @@ typedef struct {
   double *cof, *d2, *d2bar, *dJ, *dq;
 } fpm_volumetric_lin;
 
+/* The arrays of the last fpm_linear_prepare (fpm.volumetric averaged;
+ * else NULLs), owned by l. */
+const fpm_volumetric_lin *fpm_linear_volumetric(const fpm_linear *l);
+
 /* Make (zeroed, released by fpm_volumetric_lin_free) or release them.
  * PM_ERR_MEMORY. */
 pm_err fpm_volumetric_lin_create(const fpm_model *m, fpm_volumetric_lin *v);
