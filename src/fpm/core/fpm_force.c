@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fpm_gfd.h"
+#include "fpm_linear_impl.h"
 #include "fpm_model.h"
 #include "fpm_volumetric.h"
 #include "fpm_penalty_terms.h"
@@ -449,76 +450,6 @@ long fpm_force(const fpm_model *m, fpm_state *st) {
   return -1;
 }
 
-struct fpm_linear {
-  double *D;               /* 81 n: dP/dF at each point, row-major (9 x 9) */
-  double *dH, *dP, *theta; /* 9 n, 9 n, 27 n (NULL with the linear jump) */
-  double *T, *r, *zq, *Zq; /* 9 n, 3 n, 3 n, 27 n */
-  double *bu, *bH;         /* 3 n, 9 n: the state linearised about */
-  fpm_volumetric_lin vol;  /* fpm.volumetric: averaged (else NULLs) */
-  double *btheta;          /* 27 n: its fits (quadratic stiffening only) */
-  double *vphi, *vdphi;    /* n, n: fpm.volume_penalty's phi there, dphi */
-};
-
-pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
-  pm_err ret = PM_SUCCESS;
-  fpm_linear *l = NULL;
-  const long n = m->n;
-  *out = NULL;
-  PM_TRY(PM_ALLOC(l, 1, "FPM linearisation"));
-  PM_TRY(PM_ALLOC(l->D, 81 * n, "tangent moduli"));
-  PM_TRY(PM_ALLOC(l->dH, 9 * n, "gradient increments"));
-  PM_TRY(PM_ALLOC(l->dP, 9 * n, "stress increments"));
-  PM_TRY(PM_ALLOC(l->T, 9 * n, "flux tensor increments"));
-  PM_TRY(PM_ALLOC(l->r, 3 * n, "interface force increments"));
-  PM_TRY(PM_ALLOC(l->bu, 3 * n, "linearisation point"));
-  PM_TRY(PM_ALLOC(l->bH, 9 * n, "linearisation point"));
-  if (m->q) {
-    PM_TRY(PM_ALLOC(l->theta, 27 * n, "fit increments"));
-    PM_TRY(PM_ALLOC(l->zq, 3 * n, "penalty force increments"));
-    PM_TRY(PM_ALLOC(l->Zq, 27 * n, "penalty fit force increments"));
-    if (m->stiffen_quadratic && m->stiffening > 0)
-      PM_TRY(PM_ALLOC(l->btheta, 27 * n, "linearisation point's fits"));
-  }
-  if (m->volume_penalty > 0) {
-    PM_TRY(PM_ALLOC(l->vphi, n, "volume penalty"));
-    PM_TRY(PM_ALLOC(l->vdphi, n, "volume penalty increments"));
-  }
-  if (m->vavg) PM_TRY(fpm_volumetric_lin_create(m, &l->vol));
-  *out = l;
-  l = NULL;
-done:
-  fpm_linear_destroy(l);
-  return ret;
-}
-
-void fpm_linear_destroy(fpm_linear *l) {
-  if (!l) return;
-  free(l->D);
-  free(l->dH);
-  free(l->dP);
-  free(l->theta);
-  free(l->T);
-  free(l->r);
-  free(l->zq);
-  free(l->Zq);
-  free(l->bu);
-  free(l->bH);
-  fpm_volumetric_lin_free(&l->vol);
-  free(l->btheta);
-  free(l->vphi);
-  free(l->vdphi);
-  free(l);
-}
-
-size_t fpm_linear_bytes(const fpm_model *m) {
-  const bool bth = m->q && m->stiffen_quadratic && m->stiffening > 0;
-  return (size_t)m->n *
-             (81 + 9 + 9 + 9 + 3 + 12 + (m->q ? 57 : 0) + (bth ? 27 : 0) +
-              (m->volume_penalty > 0 ? 2 : 0)) *
-             sizeof(double) +
-         fpm_volumetric_lin_bytes(m);
-}
-
 void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
                         fpm_linear *l) {
   const long n = m->n, ns = m->n_stress; /* (the stress's points) */
@@ -593,10 +524,4 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
   boundary_pass(m, &fl, NULL);
   gather_pass(m, &fl);
   if (l->theta) fit_gather_pass(m, &fl);
-}
-
-const double *fpm_linear_tangent(const fpm_linear *l) { return l->D; }
-
-const fpm_volumetric_lin *fpm_linear_volumetric(const fpm_linear *l) {
-  return &l->vol;
 }
