@@ -1,12 +1,15 @@
 /* Verification against the finite-element referee: cases F3 100% and 200%
  * (constrained extension) at the paper's coarsest resolution, h = 1.09e-2 m
- * (1851 points), run as the program runs their scenes (the default
- * formulation: IIPG, quadratic jump, p = 0.05, averaged volume; dynamic
- * relaxation), and set against the CalculiX references they name
- * (cases/fe: 20-node hexahedra, N = 20).  Asserted:
- *  - the top reaction within 1% of FE for F3 100% (measured +0.82%; the
- *    former default, the standard volume at p = 0.05, gave +1.15% and was
- *    held to 2%) and within 2% for F3 200% (+1.59%; the former +1.80%);
+ * (1851 points; F3 200%'s scene grades its cloud toward the clamped
+ * faces with mesh_size the point budget: 2009 points), run as the program
+ * runs their scenes (the default formulation: IIPG, quadratic jump,
+ * p = 0.05, averaged volume; dynamic relaxation), and set against the
+ * CalculiX references they name (cases/fe: 20-node hexahedra, N = 20).
+ * Asserted:
+ *  - the top reaction within the issue's 1% of FE for F3 100% (measured
+ *    +0.82%; the former default, the standard volume at p = 0.05, gave
+ *    +1.15% and was held to 2%) and for F3 200% (graded: +0.32%; on the
+ *    uniform cloud +1.59%, held to 2% before the scene was graded);
  *  - the displacement NRMSE at the FE lattice at or below the FPM paper's
  *    figures for this h (1.28e-2, 1.63e-2 against its dense run).
  * F3 60% and F4 20% at this h are the finest level of the ladders that
@@ -103,7 +106,7 @@ static void test_f3_100(void **state) {
 }
 static void test_f3_200(void **state) {
   (void)state;
-  check_case(&(fe_case){"f3-extension-200.yaml", 0.02, 1.63e-2, 1});
+  check_case(&(fe_case){"f3-extension-200.yaml", 0.01, 1.63e-2, 1});
 }
 
 int main(void) {

@@ -745,7 +745,7 @@ static const pm_key quasi_static_keys[] = {
     {.name = "inexact",
      .type = PM_KEY_BOOL,
      .offset = S(time.qs_inexact),
-     .def = "true",
+     .def = "false",
      .doc = "method static (FPM): inexact Newton where the linear solve is "
             "iterative (GMRES with a kept factorisation or with multigrid, "
             "or a matrix-free tangent): each linear solve to the "
@@ -755,7 +755,7 @@ static const pm_key quasi_static_keys[] = {
     {.name = "averaged_coupling",
      .type = PM_KEY_BOOL,
      .offset = S(time.qs_coupled),
-     .def = "true",
+     .def = "false",
      .doc = "method static (FPM, fpm.volumetric averaged, direct solver, "
             "one process): factorise the tangent with the averages' "
             "coupling, one unknown more per point (the exact tangent's LU: "
