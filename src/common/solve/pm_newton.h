@@ -178,7 +178,9 @@ typedef struct {
    * changed (0: x stands, the step is done; else Newton solves the step
    * again from x, at most PM_SETTLE_PASSES times, and a set still changing
    * then fails the step, which is cut, with what into buf: cap bytes, one
-   * line naming what changed).  Optional. */
+   * line naming what changed).  Called on every process; *changed must be
+   * the same on all (a count over the whole problem), since they solve the
+   * step again together.  Optional. */
   pm_err (*settle)(void *ctx, const double *x, long *changed, char *buf,
                    long cap);
 } pm_newton_problem;

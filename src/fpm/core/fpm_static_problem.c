@@ -124,7 +124,9 @@ void fpm_static_keep_anchors(fpm_static_ctx *c) {
 
 /* After a step's Newton solve (pm_newton_problem.settle): the sticking
  * points the solution x pulls off their body let go, their number in
- * *changed, the one farthest off named in buf; grazing ones held. */
+ * *changed, the one farthest off named in buf; grazing ones held.  Contact
+ * runs on one process (fpm_contact_refuse_ranks), so the count is the
+ * whole problem's. */
 static pm_err settle(void *ctx, const double *x, long *changed, char *buf,
                      long cap) {
   fpm_static_ctx *c = ctx;
