@@ -9,47 +9,23 @@
 #include "fpm_model.h"
 #include "pm_tensor.h"
 
-/* The stiffening on jump j with onset t2 = (tau h)^2: the energy
- * c phi(g) / 4 with g = |j|^2 - t2 and phi(g) = g^3 / (g + t2) for g > 0,
- * 0 below; t2 = 0 gives the quartic c |j|^4 / 4, and with t2 > 0 phi is
- * twice differentiable at the onset (phi' = phi'' = 0 there), so the force
- * and its derivative are continuous.  Adds the gradient s += c phi'(g) j / 2
- * and returns the entry's energy share c phi(g) / 8 (each interface is
- * seen twice).  With the base's jump j0 (linearisation, j then the
- * increment): adds c (phi'(g0) j + 2 phi''(g0) (j0 . j) j0) / 2, returns
- * 0. */
-static inline double fpm_stiffen(double c, double t2, const double *j,
-                                 const double *j0, double *s) {
-  const double *jb = j0 ? j0 : j;
-  const double g = pm_v_dot(jb, jb) - t2;
-  if (g <= 0) return 0;
-  const double w = g + t2, w2 = w * w;
-  const double d1 = (2 * g + 3 * t2) * g * g / w2; /* phi'(g) */
-  if (j0) {
-    const double d2 = 2 * g * (g * g + 3 * g * t2 + 3 * t2 * t2) / (w2 * w);
-    const double jd = pm_v_dot(j0, j);
-    for (int a = 0; a < 3; a++)
-      s[a] += 0.5 * c * (d1 * j[a] + 2 * d2 * jd * j0[a]);
-    return 0;
-  }
-  for (int a = 0; a < 3; a++) s[a] += 0.5 * c * d1 * j[a];
-  return 0.125 * c * g * g * g / w;
-}
-
-/* The stiffening from an onset in the current spacing: t2 = tau2 |dc|^2
- * with dc = x_k + u_k - x_i - u_i the points' deformed distance (seen from
- * i), s = |j|^2, g = s - t2 and the energy c phi / 4, phi = g^3 / s for
- * g > 0 (fpm_stiffen's phi with t2 now a function of the state).  Adds
- * dE/dj = c phi_s j / 2 to *s and dE/ddc = c phi_t tau2 dc / 2 to *sd and
- * returns the entry's share c phi / 8.  Linearised (j0, dc0 the base's,
- * j, dc the increments): adds the second derivatives along (j, dc) to *s
- * and *sd, returns 0. */
-static inline double fpm_stiffen_current(double c, double tau2, const double *j,
-                                         const double *j0, const double *dc,
-                                         const double *dc0, double *s,
-                                         double *sd) {
+/* The stiffening on jump j: the energy c phi / 4 with s = |j|^2,
+ * g = s - t2 and phi = g^3 / s for g > 0, 0 below (phi = g^3 / (g + t2)
+ * as a function of g).  t2 = 0 gives the quartic c |j|^4 / 4, and with
+ * t2 > 0 phi is twice differentiable at the onset (phi' = phi'' = 0
+ * there), so the force and its derivative are continuous.  The onset:
+ * with dc NULL, t2 = tau2, fixed ((tau h)^2, fpm.stiffening_spacing:
+ * reference); else t2 = tau2 |dc|^2 with dc = x_k + u_k - x_i - u_i the
+ * points' deformed distance (seen from i; current), whose derivative
+ * dE/ddc = c phi_t tau2 dc / 2 it adds to *sd.  Adds dE/dj = c phi_s j / 2
+ * to *s and returns the entry's energy share c phi / 8 (each interface is
+ * seen twice).  Linearised (j0, dc0 the base's, j, dc the increments):
+ * adds the second derivatives along (j, dc) to *s (and *sd), returns 0. */
+static inline double fpm_stiffen(double c, double tau2, const double *j,
+                                 const double *j0, const double *dc,
+                                 const double *dc0, double *s, double *sd) {
   const double *jb = j0 ? j0 : j, *db = dc0 ? dc0 : dc;
-  const double q = pm_v_dot(jb, jb), t2 = tau2 * pm_v_dot(db, db);
+  const double q = pm_v_dot(jb, jb), t2 = db ? tau2 * pm_v_dot(db, db) : tau2;
   const double g = q - t2;
   if (g <= 0) return 0;
   const double x = g / q; /* g / s in (0, 1] */
@@ -57,24 +33,24 @@ static inline double fpm_stiffen_current(double c, double tau2, const double *j,
   if (j0) {
     const double pss = x * (6 - 6 * x + 2 * x * x), pst = x * (3 * x - 6),
                  ptt = 6 * x;
-    const double jd = pm_v_dot(j0, j), dd = tau2 * pm_v_dot(dc0, dc);
+    const double jd = pm_v_dot(j0, j), dd = dc ? tau2 * pm_v_dot(dc0, dc) : 0;
     const double aj = pss * jd + pst * dd, ad = pst * jd + ptt * dd;
     for (int a = 0; a < 3; a++) {
       s[a] += 0.5 * c * (ps * j[a] + 2 * aj * j0[a]);
-      sd[a] += 0.5 * c * tau2 * (pt * dc[a] + 2 * ad * dc0[a]);
+      if (dc) sd[a] += 0.5 * c * tau2 * (pt * dc[a] + 2 * ad * dc0[a]);
     }
     return 0;
   }
   for (int a = 0; a < 3; a++) {
     s[a] += 0.5 * c * ps * j[a];
-    sd[a] += 0.5 * c * tau2 * pt * dc[a];
+    if (dc) sd[a] += 0.5 * c * tau2 * pt * dc[a];
   }
   return 0.125 * c * g * g * x;
 }
 
 /* The stiffening of entry (i, k) on jump j (j0: the base's when
  * linearised): fpm_stiffen with the onset t2 = (tau h_e)^2 of the record,
- * or with fpm.stiffening_spacing: current fpm_stiffen_current on the
+ * or with fpm.stiffening_spacing: current with its onset on the
  * points' deformed distance dc = d_i - d_k + u_k - u_i (the base's from bu
  * when bui is not NULL, u then the increments), whose derivative it adds
  * to *sd.  Returns the entry's energy share (0 linearised). */
@@ -84,14 +60,15 @@ static inline double fpm_stiffen_entry(const fpm_model *m, double c, double t2,
                                        const double *bui, const double *buk,
                                        const double *di, const double *dk,
                                        double *s, double *sd) {
-  if (!m->stiffen_current) return fpm_stiffen(c, t2, j, j0, s);
+  if (!m->stiffen_current)
+    return fpm_stiffen(c, t2, j, j0, NULL, NULL, s, NULL);
   double dc[3], dc0[3];
   for (int a = 0; a < 3; a++) {
     dc[a] = bui ? uk[a] - ui[a] : di[a] - dk[a] + uk[a] - ui[a];
     dc0[a] = bui ? di[a] - dk[a] + buk[a] - bui[a] : dc[a];
   }
   const double tau2 = m->stiffening_onset * m->stiffening_onset;
-  return fpm_stiffen_current(c, tau2, j, j0, dc, bui ? dc0 : NULL, s, sd);
+  return fpm_stiffen(c, tau2, j, j0, dc, bui ? dc0 : NULL, s, sd);
 }
 
 /* The volume penalty of one entry (i, k) on the linear jump j: the energy
