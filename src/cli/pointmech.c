@@ -1,14 +1,11 @@
 /* pointmech: the command-line program.  It knows the methods only through
  * the backend table (pm_app registers them): it loads the scene, whose
  * method names its backend, and runs it through the one run driver. */
-#include <errno.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <spawn.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "mpm_isonormal.h"
@@ -22,6 +19,7 @@
 #include "pm_bench.h"
 #include "pm_run.h"
 #include "pm_scene.h"
+#include "pm_spawn.h"
 #include "pm_study.h"
 #include "pm_wait_policy.h"
 
@@ -329,20 +327,16 @@ static int cmd_convergence(const cli_args *a) {
 static void draw_pictures(const char *dir, const char *tool) {
   const char *python = "/usr/bin/python3";
   char *const args[] = {(char *)python, (char *)tool, (char *)dir, NULL};
-  pid_t pid;
-  int st = 0;
-  extern char **environ;
   const char *why = "no /usr/bin/python3 or no plotting tool here";
-  /* posix_spawn, not fork: no atfork handlers (MPI's) run in the child. */
   if (access(python, X_OK) == 0 && access(tool, R_OK) == 0) {
-    if (posix_spawn(&pid, python, NULL, NULL, args, environ) != 0 ||
-        waitpid(pid, &st, 0) != pid || !WIFEXITED(st))
+    const int st = pm_spawn_wait(args, NULL);
+    if (st < 0)
       why = "the plotting tool did not run to its end";
-    else if (WEXITSTATUS(st) == 0)
+    else if (st == 0)
       return;
     else
-      why = WEXITSTATUS(st) == 3 ? "no matplotlib for /usr/bin/python3"
-                                 : "the plotting tool failed";
+      why = st == 3 ? "no matplotlib for /usr/bin/python3"
+                    : "the plotting tool failed";
   }
   fprintf(stderr,
           "pointmech: no pictures drawn (%s); draw them with: python3 %s "

@@ -1,19 +1,16 @@
 /* pm_bench_fe: a bench case's finite-element ladder run by CalculiX
  * (tools/fe-referee.py), each mesh timed and measured against the case's
  * referee, so that FE's cost sits beside every method's. */
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
-#include <spawn.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "pm_bench_impl.h"
 #include "pm_fe.h"
 #include "pm_files.h"
 #include "pm_metrics.h"
+#include "pm_spawn.h"
 
 #define PYTHON "/usr/bin/python3"
 
@@ -64,29 +61,13 @@ static void last_line(const char *path, char *buf, size_t size) {
 static int spawn_tool(const char *tool, const char *name, const char *ladder,
                       int threads, const char *out, const char *work,
                       const char *log) {
-  extern char **environ;
   char th[16];
   snprintf(th, sizeof th, "%d", threads);
   char *const args[] = {
       (char *)PYTHON, (char *)tool, (char *)name, "--run",  "--ladder",
       (char *)ladder, "--out",      (char *)out,  "--work", (char *)work,
       "--threads",    th,           "--lattices", NULL};
-  posix_spawn_file_actions_t fa;
-  pid_t pid;
-  int st = 0, ok = -1;
-  if (posix_spawn_file_actions_init(&fa) != 0) return -1;
-  if (posix_spawn_file_actions_addopen(
-          &fa, 1, log, O_WRONLY | O_CREAT | O_TRUNC, 0644) == 0 &&
-      posix_spawn_file_actions_adddup2(&fa, 1, 2) == 0 &&
-      /* posix_spawn, not fork: no atfork handlers (MPI's) run in the
-       * child. */
-      posix_spawn(&pid, PYTHON, &fa, NULL, args, environ) == 0) {
-    while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
-    }
-    ok = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  }
-  posix_spawn_file_actions_destroy(&fa);
-  return ok;
+  return pm_spawn_wait(args, log);
 }
 
 /* The index of the referee's finest mesh that reached the load (-1:
