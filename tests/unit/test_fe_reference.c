@@ -277,17 +277,23 @@ static void test_tip(void **state) {
  * and keeps the whole lattice's normaliser: on a 3 x 3 x 3 lattice an error
  * at a face point leaves it zero, and one at the centre (the one interior
  * point) gives |d| / max|u| there, sqrt(27) times the whole lattice's. */
-static void test_interior_nrmse(void **state) {
-  (void)state;
-  double x[81], u[81], mapped[81];
-  pm_fe_reference r = {.n = 27, .x = x, .u = u, .dim = 3};
+/* A 3 x 3 x 3 lattice of spacing 0.05 (x, [27][3]) under u_z = -0.4 z (u:
+ * |u| from 0 to 0.04). */
+static void cube27(double *x, double *u) {
   for (int k = 0; k < 27; k++) {
     x[3 * k] = 0.05 * (k % 3);
     x[3 * k + 1] = 0.05 * (k / 3 % 3);
     x[3 * k + 2] = 0.05 * (k / 9);
     u[3 * k] = u[3 * k + 1] = 0;
-    u[3 * k + 2] = -0.4 * x[3 * k + 2]; /* largest |u|: 0.04 */
+    u[3 * k + 2] = -0.4 * x[3 * k + 2];
   }
+}
+
+static void test_interior_nrmse(void **state) {
+  (void)state;
+  double x[81], u[81], mapped[81];
+  pm_fe_reference r = {.n = 27, .x = x, .u = u, .dim = 3};
+  cube27(x, u);
   memcpy(mapped, u, sizeof u);
   mapped[3 * 1 + 0] += 1e-3; /* a point on the face y = 0 */
   assert_true(pm_fe_nrmse_interior(&r, mapped) == 0);
@@ -309,13 +315,7 @@ static void test_volume_nrmse(void **state) {
   (void)state;
   double x[81], u[81], mapped[81];
   pm_fe_reference r = {.n = 27, .x = x, .u = u, .dim = 3};
-  for (int k = 0; k < 27; k++) {
-    x[3 * k] = 0.05 * (k % 3);
-    x[3 * k + 1] = 0.05 * (k / 3 % 3);
-    x[3 * k + 2] = 0.05 * (k / 9);
-    u[3 * k] = u[3 * k + 1] = 0;
-    u[3 * k + 2] = -0.4 * x[3 * k + 2]; /* |u| from 0 to 0.04 */
-  }
+  cube27(x, u);
   /* The same error everywhere: e / range, whatever the weights. */
   for (int k = 0; k < 81; k++) mapped[k] = u[k] + (k % 3 == 0 ? 3e-4 : 0);
   assert_close(pm_fe_nrmse_volume(&r, mapped), 3e-4 / 0.04, 1e-13, 0);
