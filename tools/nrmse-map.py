@@ -19,7 +19,8 @@ point: position, the referee's and the run's displacement), and prints:
   * the share of the squared error in each region: the clamped faces'
     edges (the singular lines), the rest of the clamped faces, the free
     lateral faces, the bands next to the clamped faces inside the block,
-    and the interior.
+    and the interior (3-D block cases, clamped or loaded on zmin and
+    zmax, as F3 and F4).
 
 usage: tools/nrmse-map.py RUN_DIR/fe-errors.csv [--referee cases/fe/CASE]
        [--plot out.png]
