@@ -22,8 +22,18 @@ point: position, the referee's and the run's displacement), and prints:
     and the interior (3-D block cases, clamped or loaded on zmin and
     zmax, as F3 and F4).
 
+With --fe-run WORK (a referee run kept by `tools/fe-referee.py CASE --run
+--ladder N --keep --work WORK --out DIR`) it also reads the run's own
+points (RUN_DIR/results) and prints what the mapping costs: the referee's
+field evaluated at the run's points and mapped back to the lattice by a
+twin of pointmech's moving least squares (pm_mls: linear, cubic B-spline
+over 2.2 mean spacings) and by a quadratic one, the run against the
+referee under each, and the run at its own points (no mapping, each point
+weighted by its share of the Delaunay volume), split into its local
+smooth part and its point-to-point part.
+
 usage: tools/nrmse-map.py RUN_DIR/fe-errors.csv [--referee cases/fe/CASE]
-       [--plot out.png]
+       [--plot out.png] [--fe-run WORK --case f4-compression-20 --n 12]
 """
 import argparse
 import glob
@@ -121,12 +131,119 @@ def referee_lattices(ref_dir, x):
                                                            order): limit}
 
 
+# ---- the mapping and the run's own points (--fe-run) ------------------------
+
+
+def referee_field(work, case, n):
+    """The kept CalculiX run's displacement as a function of points."""
+    import importlib.util
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                        "fe-referee.py")
+    spec = importlib.util.spec_from_file_location("fe_referee", path)
+    fer = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(fer)
+    c = fer.CASES[case]
+    mesh = fer.make_mesh(c, n)
+    reduced = c.get("element", "full") == "reduced"
+    job = fer.job_name(case, c, n, reduced)
+    blocks = fer.read_dat(os.path.join(work, job, job + ".dat"))
+    disp = fer.last_block(blocks, "displacements", "NALL")
+    u = np.zeros((mesh.n_nodes, 3))
+    for r in disp[3]:
+        u[int(r[0]) - 1] = r[1:4]
+    return lambda pts: np.array([mesh.displacement(p, u) for p in pts])
+
+
+def mls(x, f, q, quadratic=False, local=None, factor=2.2):
+    """pm_mls_fit's twin: the fit a + B (x - q) (plus the quadratic terms)
+    weighted by the cubic B-spline of |x - q| / R, R = factor spacings
+    (the cloud's mean, or local[k]), grown by half until the fit has
+    3 (or 3 x 10 / 4) times its unknowns in points and is regular."""
+    h = (np.prod(x.max(0) - x.min(0)) / len(x)) ** (1 / 3)
+    need = 30 if quadratic else 12
+    out = np.zeros((len(q), f.shape[1]))
+    for k, p in enumerate(q):
+        R = factor * (local[k] if local is not None else h)
+        while True:
+            d = np.linalg.norm(x - p, axis=1)
+            m = d < R
+            if m.sum() >= need:
+                s = d[m] / R
+                w = np.where(s <= 0.5, 1 - 6 * s**2 + 6 * s**3,
+                             2 * (1 - s)**3)
+                y = (x[m] - p) / R
+                A = np.c_[np.ones(m.sum()), y]
+                if quadratic:
+                    A = np.c_[A, y**2, y[:, 0] * y[:, 1], y[:, 1] * y[:, 2],
+                              y[:, 0] * y[:, 2]]
+                M = (A.T * w) @ A
+                if np.linalg.cond(M) < 1e10:
+                    out[k] = np.linalg.solve(M, (A.T * w) @ f[m])[0]
+                    break
+            R *= 1.5
+    return out
+
+
+def run_points(run_dir):
+    """The run's points, last displacement and each point's share of the
+    Delaunay volume (results/mesh.h5 and the last frame)."""
+    import h5py
+    with h5py.File(os.path.join(run_dir, "results", "mesh.h5"), "r") as f:
+        x, cells = f["coordinates"][:], f["cells"][:]
+    last = sorted(glob.glob(os.path.join(run_dir, "results", "frame_*.h5")))
+    with h5py.File(last[-1], "r") as f:
+        u = f["displacement"][:]
+    a, b, c, e = (x[cells[:, i]] for i in range(4))
+    vol = np.abs(np.einsum("ij,ij->i", b - a, np.cross(c - a, e - a))) / 6
+    share = np.zeros(len(x))
+    for i in range(4):
+        np.add.at(share, cells[:, i], vol / 4)
+    return x, u, share
+
+
+def mapping_report(run_dir, q, fe_at):
+    x, u, share = run_points(run_dir)
+    fq, fx = fe_at(q), fe_at(x)
+    scale = np.linalg.norm(fq, axis=1).max()
+    w, _ = weights(q)
+    one = np.ones(len(q))
+    print("| mapping | exact FE field (lattice / volume) | run against FE "
+          "(lattice / volume) |")
+    print("|---|---|---|")
+    for label, quad in (("linear MLS (pointmech's)", False),
+                        ("quadratic MLS", True)):
+        mf, mu = mls(x, fx, q, quad), mls(x, u, q, quad)
+        print("| %s | %.3e / %.3e | %.3e / %.3e |" % (
+            label, nrmse(mf - fq, fq, one, scale), nrmse(mf - fq, fq, w, scale),
+            nrmse(mu - fq, fq, one, scale), nrmse(mu - fq, fq, w, scale)))
+    d = u - fx
+    dist = np.linalg.norm(x[:, None, :] - x[None, :, :], axis=2)
+    near = np.argsort(dist, 1)[:, 1:9]
+    smooth = mls(x, d, x, local=np.cbrt(share[near].mean(1)))
+    print("\nat the run's points (volume-weighted): %.3e, its smooth part "
+          "%.3e, point to point %.3e" % (nrmse(d, fx, share, scale),
+                                        nrmse(smooth, fx, share, scale),
+                                        nrmse(d - smooth, fx, share, scale)))
+    e2 = share * np.sum(d * d, 1)
+    lo, hi = x[:, 2].min(), x[:, 2].max()
+    band = (x[:, 2] < lo + 0.15 * (hi - lo)) | (x[:, 2] > hi - 0.15 * (hi - lo))
+    print("within 15%% of the height of zmin or zmax: %.1f%% of the volume, "
+          "%.1f%% of the squared error\n" % (100 * share[band].sum() /
+                                             share.sum(),
+                                             100 * e2[band].sum() / e2.sum()))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("errors", nargs="+", help="fe-errors.csv files")
     ap.add_argument("--referee", help="the FE folder (cases/fe/CASE)")
     ap.add_argument("--plot", help="a PNG of the error on the mid plane")
+    ap.add_argument("--fe-run", help="a kept referee run's work folder")
+    ap.add_argument("--case", default="f4-compression-20",
+                    help="its case (default f4-compression-20)")
+    ap.add_argument("--n", type=int, default=12, help="its mesh N (12)")
     a = ap.parse_args()
+    fe_at = referee_field(a.fe_run, a.case, a.n) if a.fe_run else None
     for path in a.errors:
         t = read_csv(path)
         x = np.c_[t["x"], t["y"], t["z"]]
@@ -151,6 +268,8 @@ def main():
         for name, m, share, rms in regions(x, u - fe):
             print("| %s | %d | %.1f%% | %.2e |" % (name, m, 100 * share, rms))
         print()
+        if fe_at:
+            mapping_report(os.path.dirname(os.path.abspath(path)), x, fe_at)
         if a.plot:
             import matplotlib
             matplotlib.use("Agg")
