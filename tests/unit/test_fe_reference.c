@@ -277,17 +277,23 @@ static void test_tip(void **state) {
  * and keeps the whole lattice's normaliser: on a 3 x 3 x 3 lattice an error
  * at a face point leaves it zero, and one at the centre (the one interior
  * point) gives |d| / max|u| there, sqrt(27) times the whole lattice's. */
-static void test_interior_nrmse(void **state) {
-  (void)state;
-  double x[81], u[81], mapped[81];
-  pm_fe_reference r = {.n = 27, .x = x, .u = u, .dim = 3};
+/* A 3 x 3 x 3 lattice of spacing 0.05 (x, [27][3]) under u_z = -0.4 z (u:
+ * |u| from 0 to 0.04). */
+static void cube27(double *x, double *u) {
   for (int k = 0; k < 27; k++) {
     x[3 * k] = 0.05 * (k % 3);
     x[3 * k + 1] = 0.05 * (k / 3 % 3);
     x[3 * k + 2] = 0.05 * (k / 9);
     u[3 * k] = u[3 * k + 1] = 0;
-    u[3 * k + 2] = -0.4 * x[3 * k + 2]; /* largest |u|: 0.04 */
+    u[3 * k + 2] = -0.4 * x[3 * k + 2];
   }
+}
+
+static void test_interior_nrmse(void **state) {
+  (void)state;
+  double x[81], u[81], mapped[81];
+  pm_fe_reference r = {.n = 27, .x = x, .u = u, .dim = 3};
+  cube27(x, u);
   memcpy(mapped, u, sizeof u);
   mapped[3 * 1 + 0] += 1e-3; /* a point on the face y = 0 */
   assert_true(pm_fe_nrmse_interior(&r, mapped) == 0);
@@ -299,6 +305,36 @@ static void test_interior_nrmse(void **state) {
                sqrt(27.0) * pm_nrmse_vector(27, 7u, mapped, u), 1e-14, 0);
   r.n = 9; /* one layer z = 0: no point is inside */
   assert_true(isnan(pm_fe_nrmse_interior(&r, mapped)));
+}
+
+/* The volume-weighted NRMSE (the paper's sampling): on a 3 x 3 x 3 lattice
+ * of spacing 0.05 each point stands for its share of the cube (1 inside,
+ * 1/2 on a face, 1/4 on an edge, 1/8 at a corner; 8 in all), and the
+ * normaliser is max |u| - min |u|. */
+static void test_volume_nrmse(void **state) {
+  (void)state;
+  double x[81], u[81], mapped[81];
+  pm_fe_reference r = {.n = 27, .x = x, .u = u, .dim = 3};
+  cube27(x, u);
+  /* The same error everywhere: e / range, whatever the weights. */
+  for (int k = 0; k < 81; k++) mapped[k] = u[k] + (k % 3 == 0 ? 3e-4 : 0);
+  assert_close(pm_fe_nrmse_volume(&r, mapped), 3e-4 / 0.04, 1e-13, 0);
+  /* The centre alone stands for 1/8 of the cube, a corner for 1/64. */
+  memcpy(mapped, u, sizeof u);
+  mapped[3 * 13 + 2] += 2e-3;
+  assert_close(pm_fe_nrmse_volume(&r, mapped), 2e-3 / 0.04 / sqrt(8.0), 1e-13,
+               0);
+  memcpy(mapped, u, sizeof u);
+  mapped[3 * 26 + 1] += 2e-3;
+  assert_close(pm_fe_nrmse_volume(&r, mapped), 2e-3 / 0.04 / 8.0, 1e-13, 0);
+  /* The range, not the largest |u|: shift the reference off zero. */
+  for (int k = 0; k < 27; k++) u[3 * k] = 0.01;
+  for (int k = 0; k < 81; k++) mapped[k] = u[k] + (k % 3 == 0 ? 3e-4 : 0);
+  const double range = sqrt(0.01 * 0.01 + 0.04 * 0.04) - 0.01;
+  assert_close(pm_fe_nrmse_volume(&r, mapped), 3e-4 / range, 1e-13, 0);
+  /* A reference that does not move has no range. */
+  memset(u, 0, sizeof u);
+  assert_true(isnan(pm_fe_nrmse_volume(&r, mapped)));
 }
 
 /* A malformed file: its text (the others are good), the line at fault and
@@ -395,6 +431,7 @@ int main(void) {
                                       pm_test_drop_dir),
       cmocka_unit_test(test_f2_exact),
       cmocka_unit_test(test_interior_nrmse),
+      cmocka_unit_test(test_volume_nrmse),
       cmocka_unit_test_setup_teardown(test_good, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_extrapolated, pm_test_make_dir,

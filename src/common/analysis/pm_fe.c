@@ -1,14 +1,12 @@
 /* pm_fe: the finite-element reference of a block case read from its text
- * files (ladder, lattice, claimed tolerances), and a run compared with it. */
+ * files (ladder, lattice, claimed tolerances); pm_fe_errors.c compares a
+ * run with it. */
 #include "pm_fe.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-
-#include "pm_metrics.h"
-#include "pm_probe.h"
 
 #define MAX_COLS 32
 #define SHOW_MAX 60 /* bytes of a bad field quoted in errors */
@@ -463,80 +461,4 @@ bool pm_fe_names_reference(const char *spec, char *buf, size_t size) {
   }
   if (!is_file(path)) return false;
   return (size_t)snprintf(buf, size, "%s", spec) < size;
-}
-
-double pm_fe_nrmse_interior(const pm_fe_reference *r, const double *mapped) {
-  double lo[3], hi[3], big = 0, sum = 0;
-  long m = 0;
-  const int dim = r->dim == 2 ? 2 : 3;
-  for (int c = 0; c < 3; c++) lo[c] = INFINITY, hi[c] = -INFINITY;
-  for (long j = 0; j < r->n; j++)
-    for (int c = 0; c < 3; c++) {
-      lo[c] = fmin(lo[c], r->x[3 * j + c]);
-      hi[c] = fmax(hi[c], r->x[3 * j + c]);
-    }
-  for (long j = 0; j < r->n; j++) {
-    double u2 = 0, d2 = 0;
-    bool inside = true;
-    for (int c = 0; c < dim; c++) {
-      double tol = 1e-9 * (hi[c] - lo[c]);
-      double xc = r->x[3 * j + c];
-      if (xc <= lo[c] + tol || xc >= hi[c] - tol) inside = false;
-      double d = mapped[3 * j + c] - r->u[3 * j + c];
-      d2 += d * d;
-      u2 += r->u[3 * j + c] * r->u[3 * j + c];
-    }
-    big = fmax(big, sqrt(u2));
-    if (inside) {
-      sum += d2;
-      m++;
-    }
-  }
-  if (m == 0 || !(big > 0)) return NAN;
-  return sqrt(sum / (double)m) / big;
-}
-
-double pm_fe_tip(const pm_fe_reference *r, const double *mapped) {
-  if (r->tip_face < 0 || r->tip_axis < 0 || r->n < 1) return NAN;
-  int a = r->tip_face / 2;
-  double plane = r->x[a];
-  for (long j = 1; j < r->n; j++)
-    plane = r->tip_face % 2 ? fmax(plane, r->x[3 * j + a])
-                            : fmin(plane, r->x[3 * j + a]);
-  double sum = 0, tol = 1e-9 * fmax(1.0, fabs(plane));
-  long m = 0;
-  for (long j = 0; j < r->n; j++)
-    if (fabs(r->x[3 * j + a] - plane) <= tol) {
-      sum += mapped[3 * j + r->tip_axis];
-      m++;
-    }
-  return sum / (double)m;
-}
-
-void pm_fe_errors_of(const pm_fe_reference *r, const double *mapped,
-                     const pm_outcome *o, pm_fe_errors *e) {
-  e->nrmse = pm_nrmse_vector(r->n, r->dim == 2 ? 3u : 7u, mapped, r->u);
-  e->nrmse_interior = pm_fe_nrmse_interior(r, mapped);
-  e->reaction_error = NAN;
-  /* A traction case's reaction is the applied load: no check. */
-  int axis = r->tip_face < 0 ? o->loaded_axis : -1;
-  if (axis >= 0 && axis < 3)
-    e->reaction_error =
-        (o->loaded_reaction - r->reaction[axis]) / r->reaction[axis];
-  e->sed_error = (o->fig.mean_sed - r->mean_sed) / r->mean_sed;
-  e->tip_error = (pm_fe_tip(r, mapped) - r->tip_u) / r->tip_u;
-}
-
-pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
-                     const pm_outcome *o, pm_fe_errors *e) {
-  pm_err ret = PM_SUCCESS;
-  double *mapped = NULL;
-  e->nrmse = e->nrmse_interior = e->reaction_error = e->sed_error = NAN;
-  e->tip_error = NAN;
-  PM_TRY(PM_ALLOC(mapped, 3 * r->n, "displacement at the FE lattice"));
-  PM_TRY(pm_probe_map(out_dir, -1, r->n, r->x, mapped));
-  pm_fe_errors_of(r, mapped, o, e);
-done:
-  free(mapped);
-  return ret;
 }

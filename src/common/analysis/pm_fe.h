@@ -100,6 +100,12 @@ typedef struct {
                             lattice's bounding faces (away from the clamped
                             edges and the free surface), with the whole
                             lattice's normaliser */
+  double nrmse_volume;   /* the paper's sampling (eq. 28 over a dense
+                            mesh's nodes, spread evenly through the
+                            volume): the lattice's points weighted by the
+                            volume each stands for (trapezoid weights: 1/2
+                            on a face, 1/4 on an edge, 1/8 at a corner),
+                            over max |u_fe| - min |u_fe| */
   double reaction_error; /* (R - R_fe) / R_fe on the loaded face, along
                             the loaded component: > 0 when the run's
                             reaction is the larger (the run is stiffer) */
@@ -121,13 +127,24 @@ double pm_fe_tip(const pm_fe_reference *r, const double *mapped);
  * lattice's figure; NaN when no point is inside. */
 double pm_fe_nrmse_interior(const pm_fe_reference *r, const double *mapped);
 
+/* pm_fe_errors' nrmse_volume of mapped ([r->n][3]) against r; NaN when
+ * the reference does not move. */
+double pm_fe_nrmse_volume(const pm_fe_reference *r, const double *mapped);
+
+/* Write PATH: one row a lattice point, its position, the reference's and
+ * the run's displacement (mapped, [r->n][3]) and |difference|, for maps of
+ * where the error lives (tools/nrmse-map.py).  Fails with PM_ERR_IO. */
+pm_err pm_fe_write_errors(const pm_fe_reference *r, const double *mapped,
+                          const char *path);
+
 /* The errors of a run whose displacement at the lattice is mapped
  * ([r->n][3]) and whose outcome is o. */
 void pm_fe_errors_of(const pm_fe_reference *r, const double *mapped,
                      const pm_outcome *o, pm_fe_errors *e);
 
 /* Compare the run written to out_dir (its last frame, mapped onto the
- * lattice by moving least squares) and its outcome o with r.  The
+ * lattice by moving least squares) and its outcome o with r; the pointwise
+ * errors go to out_dir/fe-errors.csv (pm_fe_write_errors).  The
  * reaction error is NaN when o has no loaded face. */
 pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
                      const pm_outcome *o, pm_fe_errors *e);
