@@ -155,8 +155,9 @@ static void test_f4_static_relaxation(void **state) {
 
 /* F3 60% with the averaged volume (mesh size 0.0145 m), a matrix-free
  * operator: the linear solver of large problems (GMRES + GAMG, the
- * default above FPM_STATIC_DIRECT_MAX unknowns) and the opt-in coupled
- * factorisation with inexact Newton give the top reaction of a direct solve
+ * default above FPM_STATIC_DIRECT_MAX unknowns) and the coupled
+ * factorisation with inexact Newton (the default, row 2, its keys named)
+ * give the top reaction of a direct solve
  * refactorised at every iteration, to 1e-6 (Newton's tolerance is 1e-8 of the
  * residual; measured 2.5e-14 and 0).  (Here GMRES takes about 58 iterations
  * with a fresh LU, so the default refactorises too; the LU kept over iterations

@@ -27,8 +27,23 @@ static inline int pm_omp_team(void) { return 1; }
  * with OpenMP's for the cores.  One thread for OpenBLAS when it is the BLAS
  * loaded; nothing with another BLAS. */
 void openblas_set_num_threads(int n) __attribute__((weak));
+int openblas_get_num_threads(void) __attribute__((weak));
 static inline void pm_blas_single_thread(void) {
   if (openblas_set_num_threads) openblas_set_num_threads(1);
+}
+
+/* Where no OpenMP loop runs beside it (a sparse factorisation's dense
+ * fronts), OpenBLAS on the OpenMP threads: pm_blas_widen() returns the
+ * threads it had, which pm_blas_restore(that) gives back.  Nothing with
+ * another BLAS (0 returned). */
+static inline int pm_blas_widen(void) {
+  if (!openblas_set_num_threads || !openblas_get_num_threads) return 0;
+  const int had = openblas_get_num_threads();
+  if (pm_omp_threads() > had) openblas_set_num_threads(pm_omp_threads());
+  return had;
+}
+static inline void pm_blas_restore(int had) {
+  if (had > 0 && openblas_set_num_threads) openblas_set_num_threads(had);
 }
 
 #endif

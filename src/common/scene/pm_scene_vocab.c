@@ -745,23 +745,26 @@ static const pm_key quasi_static_keys[] = {
     {.name = "inexact",
      .type = PM_KEY_BOOL,
      .offset = S(time.qs_inexact),
-     .def = "false",
+     .def = "true",
      .doc = "method static (FPM): inexact Newton where the linear solve is "
             "iterative (GMRES with a kept factorisation or with multigrid, "
             "or a matrix-free tangent): each linear solve to the "
             "Eisenstat-Walker tolerance, at most 1e-2, tightening as Newton "
-            "converges; false: every linear solve to 1e-10 (1e-6 with "
-            "multigrid), the solver before it"},
+            "converges (the state is Newton's to its tolerance; runs on "
+            "different rank counts agree to that, not to round-off); "
+            "false: every linear solve to 1e-10 (1e-6 with multigrid), "
+            "ranks agree to round-off"},
     {.name = "averaged_coupling",
      .type = PM_KEY_BOOL,
      .offset = S(time.qs_coupled),
-     .def = "false",
+     .def = "true",
      .doc = "method static (FPM, fpm.volumetric averaged, direct solver, "
             "one process): factorise the tangent with the averages' "
             "coupling, one unknown more per point (the exact tangent's LU: "
-            "GMRES takes an iteration or two); false: the LU of the tangent "
-            "without it, which preconditions GMRES on the exact tangent "
-            "(the solver before)"},
+            "GMRES takes an iteration or two; 1.8 times the LU's memory, "
+            "so by default only up to 15000 free dofs); false: the LU of "
+            "the tangent without it, which preconditions GMRES on the exact "
+            "tangent"},
     {.name = "solver_options",
      .type = PM_KEY_STRING,
      .offset = S(time.qs_solver_options),

@@ -38,6 +38,14 @@ static void add_solve(pm_load_report *rep, const pm_newton_report *nr) {
   add_costs(rep, nr);
 }
 
+/* The problem's load set to lambda, and the solver told (a factorisation
+ * it keeps remembers the load it was made under). */
+static pm_err set_load(pm_newton *s, double lambda) {
+  const pm_newton_problem *p = pm_newton_problem_of(s);
+  pm_newton_note_load(s, lambda);
+  return p->set_load(p->ctx, lambda);
+}
+
 static bool recoverable(pm_err e) {
   return e == PM_ERR_NOT_CONVERGED || e == PM_ERR_UNSTABLE;
 }
@@ -55,9 +63,9 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
   const pm_newton_problem *p = pm_newton_problem_of(s);
   const long n = p->n;
   const double h = 1e-6 * (target - lambda);
-  pm_err e = p->set_load(p->ctx, lambda + h);
+  pm_err e = set_load(s, lambda + h);
   if (e == PM_SUCCESS) e = pm_newton_residual(s, xc, rh);
-  if (e == PM_SUCCESS) e = p->set_load(p->ctx, lambda);
+  if (e == PM_SUCCESS) e = set_load(s, lambda);
   if (e == PM_SUCCESS) e = pm_newton_residual(s, xc, r);
   if (e == PM_SUCCESS) {
     const double f = (target - lambda) / h;
@@ -69,7 +77,7 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
   }
   if (e == PM_SUCCESS)
     for (long i = 0; i < n; i++) x[i] += xc[i];
-  pm_err e2 = p->set_load(p->ctx, target);
+  pm_err e2 = set_load(s, target);
   return e != PM_SUCCESS ? e : e2;
 }
 
@@ -146,6 +154,7 @@ pm_err pm_load_state_init(pm_load_state *state, long n) {
   pm_err ret = PM_SUCCESS;
   PM_TRY(PM_ALLOC(state->xc, n, "converged state"));
   PM_TRY(PM_ALLOC(state->xprev, n, "previous converged state"));
+  PM_TRY(PM_ALLOC(state->pc_x, n, "kept factorisation's state"));
 done:
   if (ret != PM_SUCCESS) pm_load_state_free(state);
   return ret;
@@ -154,7 +163,8 @@ done:
 void pm_load_state_free(pm_load_state *state) {
   free(state->xc);
   free(state->xprev);
-  state->xc = state->xprev = NULL;
+  free(state->pc_x);
+  state->xc = state->xprev = state->pc_x = NULL;
 }
 
 pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
@@ -214,12 +224,18 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     st->good = st->have_prev = 0;
     rep->dlambda_min = nominal;
   }
+  if (resumed && st->pc_built) {
+    /* The factorisation the first run kept, made again where it was. */
+    PM_TRY(set_load(s, st->pc_lambda));
+    PM_TRY(
+        pm_newton_pc_rebuild(s, st->pc_x, (int)st->pc_its, st->pc_failed != 0));
+  }
   int cuts = 0;
   while (st->lambda < 1) {
     const double lambda = st->lambda, lambda_prev = st->lambda_prev;
     double target = lambda + st->dl;
     if (target > 1 - PM_LOAD_END_SLACK) target = 1;
-    PM_TRY(p->set_load(p->ctx, target));
+    PM_TRY(set_load(s, target));
     memcpy(x, xc, (size_t)n * sizeof *x);
     bool predicted = false;
     if (o->predictor && st->have_prev && lambda > lambda_prev) {
@@ -294,6 +310,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
         st->dl = fmin(1.5 * st->dl, nominal);
         st->good = 0;
       }
+      PM_TRY(pm_newton_pc_save(s, st));
       if (p->on_step)
         PM_TRY(p->on_step(p->ctx, rep->steps, target, xc, &rep->last));
       continue;
@@ -329,7 +346,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
 done:
   memcpy(x, xc, (size_t)n * sizeof *x);
   /* The load stays that of the state returned. */
-  if (ret != PM_SUCCESS) (void)p->set_load(p->ctx, rep->lambda);
+  if (ret != PM_SUCCESS) (void)set_load(s, rep->lambda);
   rep->time_total += pm_wtime() - t0;
   free(r);
   free(rh);
@@ -350,6 +367,11 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
     if (n > 0) {
       PM_CALL(pm_ckpt_doubles(ck, NAME("xc"), n, st->xc));
       PM_CALL(pm_ckpt_doubles(ck, NAME("xprev"), n, st->xprev));
+      PM_CALL(pm_ckpt_long(ck, NAME("pc_built"), &st->pc_built));
+      PM_CALL(pm_ckpt_long(ck, NAME("pc_its"), &st->pc_its));
+      PM_CALL(pm_ckpt_long(ck, NAME("pc_failed"), &st->pc_failed));
+      PM_CALL(pm_ckpt_double(ck, NAME("pc_lambda"), &st->pc_lambda));
+      PM_CALL(pm_ckpt_doubles(ck, NAME("pc_x"), n, st->pc_x));
     }
   }
   long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,

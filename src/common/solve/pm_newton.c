@@ -12,6 +12,7 @@
 
 #include "pm_newton_impl.h"
 #include "pm_newton_solver_impl.h"
+#include "pm_omp.h"
 #include "pm_petsc.h"
 #include "pm_progress.h"
 
@@ -217,21 +218,32 @@ done:
   return ret;
 }
 
+/* What a solve's Jacobian callback does, outside a solve: the Jacobian
+ * at x (into s->X) made and given to the linear solver, with this
+ * solver's PETSc options pushed (the caller pops them); PETSc's failure
+ * into *code, a callback's into s->hard. */
+static pm_err linearise_at(pm_newton *s, const double *x,
+                           PetscErrorCode *code) {
+  Mat A, B;
+  pm_newton_operators(s, &A, &B);
+  s->hard = PM_SUCCESS;
+  s->jacobians = 0;
+  PM_CALL(pm_newton_copy_in(s->X, x, s->p.n));
+  PM_PETSC_CALL(PetscOptionsPush(s->opts));
+  *code = pm_newton_snes_jacobian(s->snes, s->X, A, B, s);
+  if (!*code) *code = KSPSetOperators(s->ksp, A, B);
+  return PM_SUCCESS;
+}
+
 pm_err pm_newton_tangent_solve(pm_newton *s, const double *x, const double *b,
                                double *dx, pm_newton_report *rep) {
   pm_err ret = PM_SUCCESS;
   long n = s->p.n;
-  Mat A, B;
-  pm_newton_operators(s, &A, &B);
   KSPConvergedReason kr;
+  PetscErrorCode code;
   s->rep = rep;
-  s->hard = PM_SUCCESS;
-  s->jacobians = 0;
-  PM_TRY(pm_newton_copy_in(s->X, x, n));
   PM_TRY(pm_newton_copy_in(s->Work, b, n));
-  PM_PETSC(PetscOptionsPush(s->opts));
-  PetscErrorCode code = pm_newton_snes_jacobian(s->snes, s->X, A, B, s);
-  if (!code) code = KSPSetOperators(s->ksp, A, B);
+  PM_TRY(linearise_at(s, x, &code));
   if (!code) {
     code = KSPSolve(s->ksp, s->Work, s->R); /* (its presolve times it) */
     if (s->in_linear) pm_newton_linear_postsolve(s->ksp, s->Work, s->R, s);
@@ -268,4 +280,37 @@ pm_err pm_newton_solve(pm_newton *s, double *x, pm_newton_report *report) {
   pm_newton_report local;
   PM_CHECK(s && x, PM_ERR_ARG, "pm_newton_solve: solver and x are required");
   return pm_newton_solve_from(s, x, x, 0, report ? report : &local);
+}
+
+pm_err pm_newton_pc_rebuild(pm_newton *s, const double *x, int its,
+                            bool failed) {
+  pm_err ret = PM_SUCCESS;
+  PetscErrorCode code;
+  s->rep = NULL;
+  s->pc_built = false; /* the Jacobian below builds a new one */
+  /* as in a solve: the Jacobian's values at x, then the linear solver's
+   * set-up (the factorisation of B, or of the augmented matrix) */
+  PM_TRY(linearise_at(s, x, &code));
+  const int blas = pm_blas_widen();
+  if (!code) code = KSPSetUp(s->ksp);
+  if (!code) code = KSPSetUpOnBlocks(s->ksp);
+  if (!code) code = pm_newton_aug_factor(s);
+  pm_blas_restore(blas);
+  PetscOptionsPop();
+  if (s->hard != PM_SUCCESS) {
+    ret = pm_error_trace(s->hard, __FILE__, __LINE__, __func__,
+                         "the kept factorisation of a resumed run");
+    goto done;
+  }
+  if (code) {
+    PetscErrorCode cause;
+    ret = PM_ERROR(PM_ERR_LINALG,
+                   "the kept factorisation of a resumed run, made again: %s",
+                   pm_petsc_last_message(&cause));
+    goto done;
+  }
+  s->lin_its = its;
+  s->lin_failed = failed;
+done:
+  return ret;
 }

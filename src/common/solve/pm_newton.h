@@ -473,6 +473,14 @@ typedef struct {
   long have_prev; /* xprev holds a converged state */
   double *xc;     /* n: the last converged state */
   double *xprev;  /* n: the one before */
+  /* options.pc_reuse_its: the factorisation or preconditioner kept then,
+   * built (1) or not (0) at the state pc_x (n values) under the load
+   * pc_lambda, and the iterations of the last linear solve it served and
+   * whether that failed.  A resume builds it anew there, so that the
+   * steps that follow repeat the first run's. */
+  long pc_built, pc_its, pc_failed;
+  double pc_lambda;
+  double *pc_x;
 } pm_load_state;
 
 /* Allocate a state's arrays for a problem of n unknowns, zeroed (lambda 0:
@@ -490,8 +498,9 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *state,
                           pm_load_report *report);
 
 /* Write or read load stepping's state (st, over n unknowns; NULL: none;
- * n = 0: its figures without the states xc and xprev, which the caller
- * keeps in a form of its own) and the counters of rep, as checkpoint items
+ * n = 0: its figures without the states xc, xprev and pc_x, which the
+ * caller keeps in a form of its own, and without the kept factorisation's
+ * figures) and the counters of rep, as checkpoint items
  * named PREFIX.lambda, ... (pm_checkpoint.h: the same calls write and
  * read). */
 pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,

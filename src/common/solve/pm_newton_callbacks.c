@@ -8,6 +8,7 @@
 #include <petscsnes.h>
 
 #include "pm_newton_solver_impl.h"
+#include "pm_omp.h"
 #include "pm_progress.h"
 
 PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
@@ -73,7 +74,11 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
      * assembled Jacobian is the operator: its values are always new */
     new_pc = !s->pc_built || s->lin_failed || s->lin_its > s->o.pc_reuse_its;
     rebuild = new_pc || s->o.op == PM_NEWTON_ASSEMBLED;
-    if (new_pc) s->pc_built = true;
+    if (new_pc) {
+      s->pc_built = true;
+      s->pc_load = s->load;
+      PetscCall(VecCopy(X, s->Xpc));
+    }
     PetscCall(
         KSPSetReusePreconditioner(s->ksp, new_pc ? PETSC_FALSE : PETSC_TRUE));
     PetscCall(SNESSetLagPreconditioner(s->snes, new_pc ? 1 : -1));
@@ -194,9 +199,12 @@ PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
   s->in_linear = true;
   /* The preconditioner's set-up (a factorisation, a multigrid hierarchy)
    * now, to time it apart; KSPSolve's own set-up then finds it done. */
-  PetscCall(KSPSetUp(ksp));
-  PetscCall(KSPSetUpOnBlocks(ksp));
-  PetscCall(pm_newton_aug_factor(s));
+  const int blas = pm_blas_widen(); /* the factorisation on every core */
+  PetscErrorCode code = KSPSetUp(ksp);
+  if (!code) code = KSPSetUpOnBlocks(ksp);
+  if (!code) code = pm_newton_aug_factor(s);
+  pm_blas_restore(blas);
+  PetscCall(code);
   if (s->rep) {
     s->rep->time_setup += pm_wtime() - s->linear_started;
     s->rep->cpu_setup += pm_cputime() - s->linear_started_cpu;

@@ -147,6 +147,7 @@ static pm_err create_petsc_objects(pm_newton *s) {
   PM_PETSC_CALL(VecDuplicate(s->X, &s->R));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Xstart));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Xlin));
+  PM_PETSC_CALL(VecDuplicate(s->X, &s->Xpc));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Xacc));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Work));
   if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
@@ -243,6 +244,7 @@ void pm_newton_destroy(pm_newton **sp) {
   VecDestroy(&s->R);
   VecDestroy(&s->Xstart);
   VecDestroy(&s->Xlin);
+  VecDestroy(&s->Xpc);
   VecDestroy(&s->Xacc);
   VecDestroy(&s->Work);
   VecDestroy(&s->Gx);

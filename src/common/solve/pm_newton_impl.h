@@ -21,6 +21,24 @@ pm_err pm_newton_solve_from(pm_newton *s, double *x, const double *x_start,
 pm_err pm_newton_tangent_solve(pm_newton *s, const double *x, const double *b,
                                double *dx, pm_newton_report *rep);
 
+/* The load the problem was last set to (by load stepping): what a
+ * factorisation built from here on is made under. */
+void pm_newton_note_load(pm_newton *s, double lambda);
+
+/* The kept factorisation or preconditioner (options.pc_reuse_its) into
+ * st: whether one is built, the owned values of the state and the load it
+ * was made at, the last linear solve's iterations and failure (st->pc_x
+ * has the n owned values).  PETSc's failures as PM_ERR_LINALG. */
+pm_err pm_newton_pc_save(const pm_newton *s, pm_load_state *st);
+
+/* A resume's: the factorisation or preconditioner built at the owned
+ * values x (under the load set), as if the last linear solve it served
+ * took its iterations and failed or not: what the first run kept, made
+ * again from the same values (collective across ranks).  A callback's
+ * failure or PETSc's is returned. */
+pm_err pm_newton_pc_rebuild(pm_newton *s, const double *x, int its,
+                            bool failed);
+
 /* r = the residual at x (both of the n owned values): the problem's
  * callback, through the held values of a shared problem (collective then,
  * with the ranks' agreed answer). */

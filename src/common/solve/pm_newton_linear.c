@@ -210,3 +210,14 @@ pm_newton_linear pm_newton_linear_of(pm_linear_solver l) {
   }
   return PM_NEWTON_DIRECT;
 }
+
+void pm_newton_note_load(pm_newton *s, double lambda) { s->load = lambda; }
+
+pm_err pm_newton_pc_save(const pm_newton *s, pm_load_state *st) {
+  st->pc_built = s->pc_built;
+  st->pc_its = s->lin_its;
+  st->pc_failed = s->lin_failed;
+  st->pc_lambda = s->pc_load;
+  if (!s->pc_built) return PM_SUCCESS;
+  return pm_newton_copy_out(s->Xpc, st->pc_x, s->p.n);
+}

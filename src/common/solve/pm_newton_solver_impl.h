@@ -26,6 +26,10 @@ struct pm_newton {
   double *seed, *dr;       /* colour seed and its image */
   double *srcvals;         /* jacobian_values: values in the caller's order */
   Vec X, R, Xstart, Xlin, Xacc, Work;
+  /* pc_reuse_its: where the kept factorisation or preconditioner was
+   * built (Xpc) and under which load (pc_load; load: the last set). */
+  Vec Xpc;
+  double load, pc_load;
   Mat J;     /* assembled Jacobian (not in the cheap mode) */
   Mat P;     /* assembled cheap operator (cheap mode only) */
   Mat Shell; /* matrix-free Jacobian (matrix-free modes only) */

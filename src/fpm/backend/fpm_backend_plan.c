@@ -125,8 +125,7 @@ static double plan_head(fpm_sim *sim, FILE *out) {
                nfree <= FPM_STATIC_DIRECT_MAX ? "<=" : ">",
                FPM_STATIC_DIRECT_MAX);
     /* fpm_static_run_from's choice: the averages' coupling factorised */
-    const bool coupled = m->vavg && !m->xc && no.linear == PM_NEWTON_DIRECT &&
-                         s->time.qs_coupled;
+    const bool coupled = fpm_static_couples(s, m, nfree, no.linear);
     fprintf(
         out,
         "             %d. Newton's method in %ld proportional load steps "

@@ -49,23 +49,32 @@ static void load_scalars(fpm_static_state *to, const fpm_static_state *from) {
   to->load.dl = from->load.dl;
   to->load.good = from->load.good;
   to->load.have_prev = from->load.have_prev;
+  to->load.pc_built = from->load.pc_built;
+  to->load.pc_its = from->load.pc_its;
+  to->load.pc_failed = from->load.pc_failed;
+  to->load.pc_lambda = from->load.pc_lambda;
   to->external_work = from->external_work;
 }
 
+/* A load state's k-th state over the free dofs: the last converged, the
+ * one before, the kept factorisation's. */
+static double *load_state_x(const fpm_static_state *s, int k) {
+  return k == 0 ? s->load.xc : k == 1 ? s->load.xprev : s->load.pc_x;
+}
+
 /* A static solve across ranks: the shares' load stepping into rank 0's
- * whole one, in one process's order (its two states through the points'
+ * whole one, in one process's order (its three states through the points'
  * displacements), for a checkpoint (collective). */
 static pm_err gather_static(fpm_sim *sim) {
   const fpm_model *lm = sim->local_model, *m = sim->model;
   const fpm_static_state *ls = &sim->local_static;
   fpm_static_state *ws = &sim->static_state;
-  for (int k = 0; k < 2; k++) {
-    fpm_static_nodal(lm, k ? ls->load.xprev : ls->load.xc, sim->static_local);
+  for (int k = 0; k < 3; k++) {
+    fpm_static_nodal(lm, load_state_x(ls, k), sim->static_local);
     PM_CALL(fpm_par_gather_points(lm, sim->static_local,
                                   pm_par_root() ? sim->static_whole : NULL));
     if (pm_par_root())
-      fpm_static_unknowns(m, sim->static_whole,
-                          k ? ws->load.xprev : ws->load.xc);
+      fpm_static_unknowns(m, sim->static_whole, load_state_x(ws, k));
   }
   if (!pm_par_root()) return PM_SUCCESS;
   load_scalars(ws, ls);
@@ -80,12 +89,12 @@ static void scatter_static(fpm_sim *sim) {
   const fpm_static_state *ws = &sim->static_state;
   fpm_static_state *ls = &sim->local_static;
   double *held = sim->local_state->u; /* 3 per point held */
-  for (int k = 1; k >= 0; k--) {      /* xc last: its displacements stay */
-    fpm_static_nodal(m, k ? ws->load.xprev : ws->load.xc, sim->static_whole);
+  for (int k = 2; k >= 0; k--) {      /* xc last: its displacements stay */
+    fpm_static_nodal(m, load_state_x(ws, k), sim->static_whole);
     for (long i = 0; i < lm->n; i++)
       memcpy(held + 3 * i, sim->static_whole + 3 * lm->gid[i],
              3 * sizeof(double));
-    fpm_static_unknowns(lm, held, k ? ls->load.xprev : ls->load.xc);
+    fpm_static_unknowns(lm, held, load_state_x(ls, k));
   }
   load_scalars(ls, ws);
 }

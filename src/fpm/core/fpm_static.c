@@ -41,6 +41,14 @@ pm_newton_linear fpm_static_default_linear(long unknowns) {
                                            : PM_NEWTON_GMRES_GAMG;
 }
 
+bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
+                        pm_newton_linear linear) {
+  if (!m->vavg || m->xc || linear != PM_NEWTON_DIRECT || !s->time.qs_coupled)
+    return false;
+  return pm_scene_has(s, "time.quasi_static.averaged_coupling") ||
+         unknowns <= FPM_STATIC_COUPLED_MAX;
+}
+
 void fpm_static_choose_linear(const pm_scene *s, long unknowns,
                               pm_newton_options *o) {
   o->linear = pm_scene_has(s, "time.quasi_static.linear_solver")
@@ -143,8 +151,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   if (m->vavg) no.op = PM_NEWTON_MATRIX_FREE;
   /* ...unless the factorisation takes the coupling in (one value per
    * point more): then GMRES converges in an iteration or two. */
-  if (m->vavg && !m->xc && no.linear == PM_NEWTON_DIRECT &&
-      s->time.qs_coupled) {
+  if (fpm_static_couples(s, m, rep->unknowns, no.linear)) {
     PM_TRY(fpm_static_coupled_build(&v));
     rep->coupled_entries = v.c.cp.ptr[c->nf + m->n];
   }

@@ -35,8 +35,22 @@ typedef struct {
  * the LU is the faster (docs/validation.md, "Static solves that
  * scale"). */
 #define FPM_STATIC_DIRECT_MAX 60000L
+/* Free dofs (over all ranks) up to which the averaged volume's coupling
+ * is factorised by default (time.quasi_static.averaged_coupling): its LU
+ * takes about 1.8 times the memory of the tangent's (805 against 457 MiB
+ * at 4359 free dofs, 13 GB at 41 000), about 4 GB here; above, the
+ * tangent's LU without the coupling preconditions GMRES. */
+#define FPM_STATIC_COUPLED_MAX 15000L
 /* The multigrid solve's relative tolerance. */
 #define FPM_STATIC_AMG_RTOL 1e-6
+
+/* Whether a static solve of scene s (model m, with this many free dofs
+ * over all ranks, linear solver `linear`) factorises the averaged
+ * volume's coupling: the averaged volume, one process, the direct
+ * solver, time.quasi_static.averaged_coupling, and when the key is not
+ * given at most FPM_STATIC_COUPLED_MAX free dofs. */
+bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
+                        pm_newton_linear linear);
 
 /* The default linear solver for a static solve of this many unknowns. */
 pm_newton_linear fpm_static_default_linear(long unknowns);
