@@ -159,7 +159,7 @@ static void test_f4_static_relaxation(void **state) {
  * factorisation with inexact Newton (the default, row 2, its keys named)
  * give the top reaction of a direct solve
  * refactorised at every iteration, to 1e-6 (Newton's tolerance is 1e-8 of the
- * residual; measured 2.5e-14 and 0).  (Here GMRES takes about 58 iterations
+ * residual; measured 9.2e-10 and 2e-13).  (Here GMRES takes about 58 iterations
  * with a fresh LU, so the default refactorises too; the LU kept over iterations
  * is checked on the standard term by the test above, the default there.) */
 static void test_static_linear_solvers(void **state) {
@@ -177,8 +177,7 @@ static void test_static_linear_solvers(void **state) {
   const char *extra[ROWS][3] = {{"time.quasi_static.reuse_iterations=0",
                                  "time.quasi_static.averaged_coupling=false",
                                  "time.quasi_static.inexact=false"},
-                                {"time.quasi_static.linear_solver=gmres-gamg",
-                                 "time.quasi_static.inexact=true"},
+                                {"time.quasi_static.linear_solver=gmres-gamg"},
                                 {"time.quasi_static.reuse_iterations=10",
                                  "time.quasi_static.averaged_coupling=true",
                                  "time.quasi_static.inexact=true"},
@@ -187,7 +186,8 @@ static void test_static_linear_solvers(void **state) {
                                  "time.quasi_static.inexact=false"}};
   const char *name[ROWS] = {
       "direct without the coupling, new factors each iteration, to 1e-10",
-      "gmres-gamg, inexact", "coupled, factors kept, inexact",
+      "gmres-gamg (its defaults: inexact, GMRES(200), hierarchy kept)",
+      "coupled, factors kept, inexact",
       "coupled, new factors each iteration, to 1e-10"};
   double R[ROWS];
   for (int k = 0; k < ROWS; k++) {
@@ -208,6 +208,12 @@ static void test_static_linear_solvers(void **state) {
      * each Newton iteration's and the first step's predictor) */
     if (k == 3)
       assert_true(lr->linear_iterations <= 2 * (lr->newton_iterations + 1));
+    /* multigrid with its defaults (smoothing with the assembled tangent,
+     * inexact solves, the hierarchy kept): measured 704 GMRES iterations
+     * in 30 Newton iterations, 23 a solve (2434 with every solve to 1e-6
+     * and PETSc's smoothing with the matrix-free operator) */
+    if (k == 1)
+      assert_true(lr->linear_iterations <= 30 * (lr->newton_iterations + 1));
     done(&r);
   }
   for (int k = 1; k < ROWS; k++)

@@ -729,7 +729,9 @@ static const pm_key quasi_static_keys[] = {
             "gmres-ilu, cg-jacobi or cg-gamg (symmetric problems); "
             "mpm-implicit without it: direct up to 30000 unknowns in 3-D "
             "and 100000 in 2-D, gmres-gamg beyond; FPM static without "
-            "it: direct up to 60000 free dofs, gmres-gamg beyond"},
+            "it: direct up to 8000 free dofs, gmres-gamg beyond; FPM "
+            "static with gamg: inexact and reuse_iterations 40 unless "
+            "set"},
     {.name = "reuse_iterations",
      .type = PM_KEY_INTEGER,
      .offset = S(time.qs_reuse),

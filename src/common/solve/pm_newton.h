@@ -257,9 +257,12 @@ typedef struct {
    * when that exceeds 0.1, at most linear_ew_max (the first of a solve:
    * linear_ew_max), no tighter than half of Newton's residual target over
    * |r_k| nor than linear_rtol.  false: every solve to linear_rtol. */
-  bool linear_ew;        /* false */
-  double linear_ew_max;  /* 1e-2 (when linear_ew) */
-  int linear_max_iter;   /* iterative solvers: 1000 */
+  bool linear_ew;       /* false */
+  double linear_ew_max; /* 1e-2 (when linear_ew) */
+  int linear_max_iter;  /* iterative solvers: 1000 */
+  /* GMRES's restart: the Krylov vectors kept (each of n values); 0:
+   * PETSc's (30).  -pm_ksp_gmres_restart in petsc_options overrides it. */
+  int gmres_restart;     /* 0 */
   pm_newton_operator op; /* PM_NEWTON_ASSEMBLED */
   /* Matrix-free operators: rebuild the preconditioner every pc_lag Newton
    * iterations (1: every one). */
@@ -274,9 +277,14 @@ typedef struct {
   /* Algebraic multigrid (the gamg solvers): keep the hierarchy's
    * interpolation from one preconditioner set-up to the next, recomputing
    * only the coarse operators (PETSc's -pc_gamg_reuse_interpolation). */
-  bool amg_reuse;             /* false */
-  pm_coloring_order coloring; /* PM_COLORING_LARGEST_FIRST */
-  pm_line_search line_search; /* PM_LINE_SEARCH_BT */
+  bool amg_reuse; /* false */
+  /* Multigrid preconditioning a matrix-free operator: the finest level's
+   * smoother and residual multiply by the assembled preconditioning
+   * matrix, not the operator (PETSc's -pc_use_amat false; with PETSc's
+   * default they call jacobian_apply about four times a V-cycle). */
+  bool amg_assembled_smoother; /* false */
+  pm_coloring_order coloring;  /* PM_COLORING_LARGEST_FIRST */
+  pm_line_search line_search;  /* PM_LINE_SEARCH_BT */
 
   /* Load stepping (pm_load_steps). */
   int load_steps;     /* nominal steps from lambda 0 to 1: 10 */

@@ -43,6 +43,8 @@ static pm_err check_options(const pm_newton_options *o) {
            o->stall_after);
   PM_CHECK(o->linear_max_iter >= 1, PM_ERR_ARG,
            "linear_max_iter must be >= 1 (got %d)", o->linear_max_iter);
+  PM_CHECK(o->gmres_restart >= 0, PM_ERR_ARG,
+           "gmres_restart must be >= 0 (got %d)", o->gmres_restart);
   PM_CHECK(o->pc_reuse_its >= 0, PM_ERR_ARG,
            "pc_reuse_its must be >= 0 (got %d)", o->pc_reuse_its);
   PM_CHECK(o->pc_lag >= 1, PM_ERR_ARG, "pc_lag must be >= 1 (got %d)",

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <petscsnes.h>
 
@@ -146,6 +147,7 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
   case PM_NEWTON_GMRES_GAMG:
     PM_PETSC(KSPSetType(ksp, KSPGMRES));
     PM_PETSC(PCSetType(pc, PCGAMG));
+    if (o->amg_assembled_smoother) PM_PETSC(PCSetUseAmat(pc, PETSC_FALSE));
     break;
   case PM_NEWTON_CG_JACOBI:
     PM_PETSC(KSPSetType(ksp, KSPCG));
@@ -159,10 +161,17 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
   case PM_NEWTON_CG_GAMG:
     PM_PETSC(KSPSetType(ksp, KSPCG));
     PM_PETSC(PCSetType(pc, PCGAMG));
+    if (o->amg_assembled_smoother) PM_PETSC(PCSetUseAmat(pc, PETSC_FALSE));
     break;
   }
   PM_PETSC(KSPSetTolerances(ksp, o->linear_rtol, PETSC_DEFAULT, PETSC_DEFAULT,
                             o->linear_max_iter));
+  if (o->gmres_restart > 0) {
+    KSPType type;
+    PM_PETSC(KSPGetType(ksp, &type));
+    if (!strcmp(type, KSPGMRES))
+      PM_PETSC(KSPGMRESSetRestart(ksp, (PetscInt)o->gmres_restart));
+  }
   PM_PETSC(KSPSetPreSolve(ksp, linear_presolve, s));
   PM_PETSC(KSPSetPostSolve(ksp, pm_newton_linear_postsolve, s));
   PM_PETSC(PetscOptionsPush(s->opts));

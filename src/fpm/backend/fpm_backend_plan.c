@@ -139,16 +139,19 @@ static double plan_head(fpm_sim *sim, FILE *out) {
             ? "preconditioning the exact tangent applied matrix-free"
             : "exact",
         linear[no.linear], why,
-        s->time.qs_reuse > 0 ? ", kept while GMRES takes few iterations" : "",
-        s->time.qs_inexact ? ", inexact Newton" : "");
+        no.pc_reuse_its > 0 ? ", kept while GMRES takes few iterations" : "",
+        no.linear_ew ? ", inexact Newton" : "");
     /* The tangent and its factors or multigrid hierarchy, per tangent
      * entry as measured (peak memory of whole runs over the entries, F3
-     * at 1851 and 4036 points: 175 bytes with LU, 90-110 with GAMG), at
-     * about 650 entries a free dof with the quadratic jump (3 rings);
-     * the coupled LU of the averaged volume: 320 bytes (F3 60%, 1851
-     * points: 805 MiB for 2.66e6 tangent entries). */
+     * 60%, docs/validation.md "Static solves at 13762 and 32715 points"):
+     * the LU 175 bytes at 1851 points (4359 free dofs), the coupled LU of
+     * the averaged volume 320, both growing with the fill about as the
+     * free dofs to the power 0.25 (the coupled LU: 13.0 GB at 13762
+     * points, 36 549 free dofs); GAMG about 110, flat; at about 650
+     * entries a free dof with the quadratic jump (3 rings). */
     const bool lu = no.linear == PM_NEWTON_DIRECT;
-    const double entries = 650.0 * (double)nfree;
+    const double entries = 650.0 * (double)nfree,
+                 fill = pow((double)nfree / 4359.0, 0.25);
     if (!m->q) {
       fprintf(out,
               "memory       %.1f MiB (operators and state; the tangent and "
@@ -161,8 +164,8 @@ static double plan_head(fpm_sim *sim, FILE *out) {
             "for the tangent (~%.3g entries) and its %s\n",
             (bytes + fpm_linear_bytes(m)) / 1048576.0,
             entries *
-                (coupled ? 320.0
-                 : lu    ? 175.0
+                (coupled ? 320.0 * fill
+                 : lu    ? 175.0 * fill
                          : 110.0) /
                 1048576.0,
             entries, lu ? "LU factors" : "multigrid hierarchy");

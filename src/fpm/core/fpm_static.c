@@ -54,14 +54,27 @@ void fpm_static_choose_linear(const pm_scene *s, long unknowns,
   o->linear = pm_scene_has(s, "time.quasi_static.linear_solver")
                   ? pm_newton_linear_of(s->time.qs_linear)
                   : fpm_static_default_linear(unknowns);
+  o->pc_reuse_its = (int)s->time.qs_reuse;
+  o->linear_ew = s->time.qs_inexact;
   if (o->linear != PM_NEWTON_GMRES_GAMG && o->linear != PM_NEWTON_CG_GAMG)
     return;
   /* Multigrid: a bounded Krylov solve (a failure cuts the load step with
    * its reason), its hierarchy's interpolation kept over a load step's
-   * Newton iterations (only the coarse operators are recomputed). */
+   * Newton iterations (only the coarse operators are recomputed), the
+   * finest level smoothed with the assembled tangent (not the matrix-free
+   * one: a third less CPU at 1851 points), GMRES not
+   * restarted short of FPM_STATIC_AMG_RESTART, and, unless the scene
+   * says otherwise, inexact Newton and the hierarchy kept while a solve
+   * takes at most FPM_STATIC_AMG_REUSE iterations (docs/validation.md,
+   * "Static solves at 13762 and 32715 points"). */
   o->linear_rtol = FPM_STATIC_AMG_RTOL;
   o->linear_max_iter = 1000;
   o->amg_reuse = true;
+  o->amg_assembled_smoother = true;
+  o->gmres_restart = FPM_STATIC_AMG_RESTART;
+  if (!pm_scene_has(s, "time.quasi_static.inexact")) o->linear_ew = true;
+  if (!pm_scene_has(s, "time.quasi_static.reuse_iterations"))
+    o->pc_reuse_its = FPM_STATIC_AMG_REUSE;
 }
 
 pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
@@ -131,8 +144,6 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
    * outside its basin) is cut sooner than at max_iter. */
   no.stall_after = 6;
   fpm_static_choose_linear(s, rep->unknowns, &no);
-  no.pc_reuse_its = (int)s->time.qs_reuse;
-  no.linear_ew = s->time.qs_inexact;
   no.load_steps = (int)s->time.qs_load_steps;
   no.predictor = true;
   /* Steps Newton cannot finish get dynamic relaxation within the step;

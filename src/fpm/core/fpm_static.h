@@ -29,20 +29,29 @@ typedef struct {
  * solver is direct (MUMPS LU of the assembled tangent, kept over Newton
  * iterations: time.quasi_static.reuse_iterations); above, GMRES with
  * algebraic multigrid (GAMG on the rigid-body near null space, blocks of
- * a point's components), whose memory grows linearly where the
- * factorisation's grows faster: at 13762 points (41 000 dofs) the LU
- * takes 5 GB, at 32715 it did not fit in 23 GB.  At 1851 and 4036 points
- * the LU is the faster (docs/validation.md, "Static solves that
- * scale"). */
-#define FPM_STATIC_DIRECT_MAX 60000L
+ * a point's components; FPM_STATIC_AMG_*), whose memory grows with the
+ * tangent where the factorisation's grows faster.  Measured on F3 60%
+ * (docs/validation.md, "Static solves at 13762 and 32715 points"): at
+ * 1851 points (4359 free dofs) multigrid costs the CPU of the coupled LU
+ * and less than the uncoupled one's, at 4036 (10 071) less than either;
+ * at 13762 (36 549) the coupled LU took 13 GB. */
+#define FPM_STATIC_DIRECT_MAX 8000L
 /* Free dofs (over all ranks) up to which the averaged volume's coupling
  * is factorised by default (time.quasi_static.averaged_coupling): its LU
  * takes about 1.8 times the memory of the tangent's (805 against 457 MiB
  * at 4359 free dofs, 13 GB at 41 000), about 4 GB here; above, the
- * tangent's LU without the coupling preconditions GMRES. */
+ * tangent's LU without the coupling preconditions GMRES.  It matters
+ * where a scene names the direct solver above FPM_STATIC_DIRECT_MAX. */
 #define FPM_STATIC_COUPLED_MAX 15000L
 /* The multigrid solve's relative tolerance. */
 #define FPM_STATIC_AMG_RTOL 1e-6
+/* GMRES's restart with multigrid (the tangent of the quadratic jump takes
+ * tens of iterations a solve; PETSc's 30 restarts and stalls). */
+#define FPM_STATIC_AMG_RESTART 200
+/* With multigrid and no time.quasi_static.reuse_iterations: the hierarchy
+ * is kept while the solves it preconditions take at most this many
+ * iterations. */
+#define FPM_STATIC_AMG_REUSE 40
 
 /* Whether a static solve of scene s (model m, with this many free dofs
  * over all ranks, linear solver `linear`) factorises the averaged
@@ -57,8 +66,9 @@ pm_newton_linear fpm_static_default_linear(long unknowns);
 
 /* o's linear solver for scene s and this many unknowns (over all ranks):
  * the scene's time.quasi_static.linear_solver when it gives one, else
- * fpm_static_default_linear; a multigrid one with its tolerance and set-up
- * reuse. */
+ * fpm_static_default_linear; with the scene's reuse_iterations and
+ * inexact; a multigrid one with its tolerance, restart and set-up reuse,
+ * and inexact Newton unless the scene sets it. */
 void fpm_static_choose_linear(const pm_scene *s, long unknowns,
                               pm_newton_options *o);
 
