@@ -284,6 +284,26 @@ static void test_relaxation_fallback(void **state) {
   assert_true(rep.relaxed_steps >= 1);
   pm_newton_destroy(&s);
 
+  /* With pseudo-transient continuation first: through to lambda = 1 on
+   * the left root, without relaxation, the tangent negative on the way. */
+  opt.ptc_max_iter = 60;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  x = sqrt(3);
+  assert_ok(pm_load_steps(s, &x, &rep));
+  print_message("with continuation: %d steps, %d cuts, %d continuations (%ld "
+                "iterations), %d steps converged by it, %d relaxations, "
+                "smallest curvature %.3f, x = %.15f against %.15f\n",
+                rep.steps, rep.cuts, rep.ptc_runs, rep.ptc_iterations,
+                rep.ptc_steps, rep.relaxations, rep.ptc_curvature, x,
+                snap_root(3.6));
+  assert_close(rep.lambda, 1, 0, 0);
+  assert_close(x, snap_root(3.6), 1e-9, 0);
+  assert_true(rep.ptc_steps >= 1);
+  assert_int_equal(rep.relaxations, 0);
+  assert_true(rep.ptc_curvature < 0);
+  pm_newton_destroy(&s);
+  opt.ptc_max_iter = 0;
+
   /* Bad options are named. */
   opt.relax_rtol = 2;
   assert_ok(pm_newton_create(&prob, &opt, &s));

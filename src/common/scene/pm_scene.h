@@ -295,6 +295,7 @@ typedef struct pm_scene {
     long qs_load_steps;     /* time.quasi_static.load_steps (static) */
     long qs_max_iterations; /* ...max_iterations per load step */
     long qs_relax_after;    /* ...relax_after: cuts before relaxation */
+    long qs_ptc;            /* ...pseudo_transient: continuation iterations */
     pm_linear_solver qs_linear; /* ...linear_solver */
     long qs_reuse;              /* ...reuse_iterations (FPM static) */
     bool qs_inexact;            /* ...inexact: Eisenstat-Walker (FPM) */

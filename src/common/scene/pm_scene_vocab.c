@@ -712,6 +712,21 @@ static const pm_key quasi_static_keys[] = {
      .doc = "method static (FPM, one process): after this many halvings of "
             "a load step in a row, and at the smallest step, dynamic "
             "relaxation within the step, then Newton again; 0: never"},
+    {.name = "pseudo_transient",
+     .type = PM_KEY_INTEGER,
+     .offset = S(time.qs_ptc),
+     .def = "60",
+     .range = PM_RANGE_GE,
+     .lo = 0,
+     .unit = "",
+     .doc = "method static (FPM, one process): where relax_after would "
+            "relax a load step, first pseudo-transient continuation "
+            "within it: Newton on the tangent plus the relaxation's "
+            "masses over a pseudo time step that grows as the residual "
+            "falls, at most this many iterations (one linear solve "
+            "each), relaxation only if it fails; it passes where the "
+            "tangent turns singular or indefinite (a fold); 0: "
+            "relaxation alone (the solver before)"},
     {.name = "max_iterations",
      .type = PM_KEY_INTEGER,
      .offset = S(time.qs_max_iterations),

@@ -41,10 +41,7 @@ void pm_relax_work_free(pm_relax_work *w) {
   memset(w, 0, sizeof *w);
 }
 
-/* Masses m_i = sum_j |K_ij| / 2 of the tangent K at x (Gershgorin: every
- * frequency of M^-1 K at most 2, within the central difference's limit
- * of 4 at a unit step), a row without entries taking the largest. */
-static pm_err masses(pm_newton *s, const double *x, double *m) {
+pm_err pm_relax_masses(pm_newton *s, const double *x, double *m) {
   const long n = s->p.n;
   if (s->p.jacobian_prepare) PM_CALL(s->p.jacobian_prepare(s->p.ctx, x));
   PM_CALL(pm_newton_values_at(s, x, s->jvals));
@@ -63,14 +60,29 @@ static pm_err masses(pm_newton *s, const double *x, double *m) {
   return PM_SUCCESS;
 }
 
-/* r = the residual at x; |r| into *norm (inadmissible when not finite). */
-static pm_err residual(pm_newton *s, const double *x, double *r, double *norm) {
+pm_err pm_relax_residual(pm_newton *s, const double *x, double *r,
+                         double *norm) {
   pm_err e = pm_newton_residual(s, x, r);
   if (e != PM_SUCCESS) return e;
   *norm = pm_newton_norm(s, r);
-  if (!isfinite(*norm))
-    return PM_ERROR(PM_ERR_UNSTABLE, "relaxation: residual not finite");
+  if (!isfinite(*norm)) return PM_ERROR(PM_ERR_UNSTABLE, "residual not finite");
   return PM_SUCCESS;
+}
+
+pm_err pm_relax_outcome(pm_err e, const char *what, double rn, double r0,
+                        double goal, long it, const char *tail, char *msg,
+                        long cap) {
+  if (e == PM_SUCCESS || e == PM_ERR_NOT_CONVERGED)
+    snprintf(msg, (size_t)cap,
+             "%s %s: residual %.2e from %.2e (goal %.2e) in %ld iterations, "
+             "%s",
+             what,
+             e == PM_SUCCESS ? "reached its goal" : "did not reach its goal",
+             rn, r0, goal, it, tail);
+  else if (!pm_newton_hard_failure(e))
+    snprintf(msg, (size_t)cap, "%s failed after %ld iterations: %s", what, it,
+             pm_error_message());
+  return e == PM_ERR_NOT_CONVERGED ? PM_ERROR(e, "%s", msg) : e;
 }
 
 bool pm_load_relax_available(const pm_newton *s) {
@@ -91,8 +103,8 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
   PM_CHECK(!s->dist, PM_ERR_UNSUPPORTED,
            "relaxation: one process's problems only");
   rep->relaxations++;
-  if ((e = residual(s, x, r, &r0)) != PM_SUCCESS) goto out;
-  if ((e = masses(s, x, m)) != PM_SUCCESS) goto out;
+  if ((e = pm_relax_residual(s, x, r, &r0)) != PM_SUCCESS) goto out;
+  if ((e = pm_relax_masses(s, x, m)) != PM_SUCCESS) goto out;
   *r_start = r0;
   goal = fmax(goal, rel * r0);
   rn = r0;
@@ -110,7 +122,7 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
       xt[i] = x[i] + v[i];
     }
     double rtn = 0;
-    e = residual(s, xt, rt, &rtn);
+    e = pm_relax_residual(s, xt, rt, &rtn);
     if (e != PM_SUCCESS) {
       if (pm_newton_hard_failure(e)) goto out;
       /* Inadmissible: the increment is not taken; heavier masses, at rest. */
@@ -147,17 +159,10 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
     rn = rtn;
   }
   e = rn <= goal ? PM_SUCCESS : PM_ERR_NOT_CONVERGED;
-out:
-  if (e == PM_SUCCESS || e == PM_ERR_NOT_CONVERGED)
-    snprintf(msg, (size_t)cap,
-             "relaxation %s: residual %.2e from %.2e (goal %.2e) in %ld "
-             "iterations, %ld increments inadmissible",
-             e == PM_SUCCESS ? "reached its goal" : "did not reach its goal",
-             rn, r0, goal, it, rejected);
-  else if (!pm_newton_hard_failure(e))
-    snprintf(msg, (size_t)cap, "relaxation failed after %ld iterations: %s", it,
-             pm_error_message());
-  if (e == PM_ERR_NOT_CONVERGED) e = PM_ERROR(e, "%s", msg);
+out:;
+  char tail[64];
+  snprintf(tail, sizeof tail, "%ld increments inadmissible", rejected);
+  e = pm_relax_outcome(e, "relaxation", rn, r0, goal, it, tail, msg, cap);
   rep->relax_iterations += it;
   rep->time_relax += pm_wtime() - t0;
   return e;

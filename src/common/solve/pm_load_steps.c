@@ -14,8 +14,7 @@
  * to 1 exactly). */
 #define PM_LOAD_END_SLACK 1e-12
 
-/* The times and counts of one solve (or tangent solve) into rep. */
-static void add_costs(pm_load_report *rep, const pm_newton_report *nr) {
+void pm_load_add_costs(pm_load_report *rep, const pm_newton_report *nr) {
   rep->time_residual += nr->time_residual;
   rep->time_assembly += nr->time_assembly;
   rep->time_linear += nr->time_linear;
@@ -35,7 +34,7 @@ static void add_costs(pm_load_report *rep, const pm_newton_report *nr) {
 static void add_solve(pm_load_report *rep, const pm_newton_report *nr) {
   rep->newton_iterations += nr->iterations;
   rep->linear_iterations += nr->linear_iterations;
-  add_costs(rep, nr);
+  pm_load_add_costs(rep, nr);
 }
 
 /* The problem's load set to lambda, and the solver told (a factorisation
@@ -73,7 +72,7 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
     pm_newton_report tr;
     memset(&tr, 0, sizeof tr);
     e = pm_newton_tangent_solve(s, xc, rh, x, &tr);
-    add_costs(rep, &tr);
+    pm_load_add_costs(rep, &tr);
   }
   if (e == PM_SUCCESS)
     for (long i = 0; i < n; i++) x[i] += xc[i];
@@ -117,6 +116,42 @@ static pm_err relax_step(pm_newton *s, double *x, const double *xc,
     rep->last.message[0] = '\0';
   }
   return e;
+}
+
+/* The fallback of a step Newton could not finish, at the step's load (set):
+ * pseudo-transient continuation from the last converged state xc to
+ * Newton's tolerance (options.ptc_max_iter > 0), and where it fails the
+ * relaxation of relax_step.  x, msg and cap as relax_step's. */
+static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
+                            double r_ref, pm_relax_work *w, pm_load_report *rep,
+                            char *msg, size_t cap) {
+  const pm_newton_options *o = pm_newton_options_of(s);
+  const long n = pm_newton_problem_of(s)->n;
+  if (o->ptc_max_iter <= 0) return relax_step(s, x, xc, w, rep, msg, cap);
+  /* the goal: Newton's, relative to the step's imbalance at xc */
+  double r0 = 0, q = 0;
+  if (pm_newton_residual(s, xc, w->r) == PM_SUCCESS)
+    r0 = pm_newton_norm(s, w->r);
+  pm_error_clear();
+  const double goal = fmax(o->rtol * fmax(r0, r_ref), o->atol);
+  memcpy(x, xc, (size_t)n * sizeof *x);
+  pm_err e = pm_load_ptc(s, x, goal, w, rep, &r0, &q, msg, (long)cap);
+  if (rep->ptc_runs == 1 || q < rep->ptc_curvature) rep->ptc_curvature = q;
+  if (e == PM_SUCCESS) {
+    rep->ptc_steps++;
+    rep->last.reason = PM_NEWTON_CONVERGED_RESIDUAL;
+    rep->last.status = PM_SUCCESS;
+    rep->last.message[0] = '\0';
+    return e;
+  }
+  if (!recoverable(e)) return e;
+  pm_error_clear();
+  const size_t used = strlen(msg);
+  char *rest = msg + used;
+  const size_t left = cap - used;
+  if (left < 3) return PM_ERR_NOT_CONVERGED;
+  snprintf(rest, left, "; ");
+  return relax_step(s, x, xc, w, rep, rest + 2, left - 2);
 }
 
 /* A step Newton solved (x, from the converged state xc) with its set made
@@ -272,7 +307,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       e = pm_newton_solve_from(s, x, xc, r_ref, &rep->last);
       add_solve(rep, &rep->last);
     }
-    char relaxed[768] = "", failed[sizeof rep->last.message] = "";
+    char relaxed[1024] = "", failed[sizeof rep->last.message] = "";
     if (e != PM_SUCCESS && recoverable(e) && relaxing && st->dl != relaxed_dl &&
         (cuts == o->relax_after || cuts >= o->max_cuts ||
          st->dl / 2 < o->min_dlambda * (1 - 1e-12))) {
@@ -281,8 +316,9 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       pm_error_clear();
       relaxed_dl = st->dl;
       snprintf(failed, sizeof failed, "%s", rep->last.message);
-      e = relax_step(s, x, xc, &rw, rep, relaxed, sizeof relaxed);
-      if (e == PM_SUCCESS) rep->relaxed_steps++;
+      const int ptc_before = rep->ptc_steps;
+      e = fallback_step(s, x, xc, r_ref, &rw, rep, relaxed, sizeof relaxed);
+      if (e == PM_SUCCESS && rep->ptc_steps == ptc_before) rep->relaxed_steps++;
       if (e == PM_ERR_UNSUPPORTED) e = PM_ERR_NOT_CONVERGED;
     }
     if (e == PM_SUCCESS && p->settle) e = settle_step(s, x, xc, r_ref, rep);

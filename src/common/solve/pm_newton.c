@@ -67,8 +67,11 @@ static pm_err classify(pm_newton *s, pm_newton_report *rep) {
   PM_PETSC_CALL(SNESGetConvergedReason(s->snes, &sr));
   int it = rep->iterations;
   double r = it <= PM_NEWTON_MAX_ITER ? rep->residual_norm[it] : NAN;
-  char figures[96];
-  snprintf(figures, sizeof figures, "residual %.2e from %.2e", r, s->r0);
+  char figures[160];
+  snprintf(figures, sizeof figures,
+           "residual %.2e from %.2e; smallest cosine of dx and J dx "
+           "%.2f",
+           r, s->r0, rep->min_curvature);
   size_t cap = sizeof rep->message;
   if (sr > 0) {
     rep->reason = s->reason;

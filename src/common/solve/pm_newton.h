@@ -312,12 +312,22 @@ typedef struct {
   int relax_after;    /* 2 */
   int relax_max_iter; /* 20000 */
   double relax_rtol;  /* 1e-3 */
-  bool predictor;     /* start each step from the linear extrapolation of
-                         the last two converged states, or where there are
-                         not two (the first step) from the tangent
-                         predictor: xc + dx with J(xc) dx = -(r(xc) + the
-                         change of r over the step linearised in the
-                         load), one extra linear solve: false */
+  /* Before that relaxation, where relax_after would try it: pseudo-
+   * transient continuation within the step (pm_load_ptc.c), from the last
+   * converged state under the step's load to Newton's tolerance: Newton
+   * on J + M / dtau (M the relaxation's masses), dtau growing as the
+   * residual falls, at most ptc_max_iter iterations (one linear solve
+   * each); relaxation follows only if it fails.  It passes where the
+   * tangent is singular or indefinite along the path (a fold, a
+   * bifurcation), which stalls Newton at any step size.  0: never (the
+   * relaxation alone).  One process's problems only. */
+  int ptc_max_iter; /* 0 */
+  bool predictor;   /* start each step from the linear extrapolation of
+                       the last two converged states, or where there are
+                       not two (the first step) from the tangent
+                       predictor: xc + dx with J(xc) dx = -(r(xc) + the
+                       change of r over the step linearised in the
+                       load), one extra linear solve: false */
 
   /* PETSc options for this solver's SNES, KSP, PC, line search and the
    * objects PETSc makes inside them (factor matrices, multigrid levels),
@@ -373,6 +383,12 @@ typedef struct pm_newton_report {
   double increment_norm[PM_NEWTON_MAX_ITER + 1]; /* |dx_{k-1}| (0: 0) */
   double energy[PM_NEWTON_MAX_ITER + 1];         /* |dx_{k-1}.r(x_{k-1})| */
   double step_length[PM_NEWTON_MAX_ITER + 1];    /* alpha_{k-1} (0: 0) */
+  /* The tangent's smallest curvature along a Newton direction over the
+   * iterations, as the cosine dx.J dx / (|dx| |J dx|) = -dx.r / (|dx|
+   * |r|) (0: none): negative, J is indefinite there (a fold, a
+   * bifurcation), and the direction climbs the energy where r is its
+   * gradient. */
+  double min_curvature;
   /* Wall seconds: residual calls; Jacobian preparation and assembly
    * (colouring applications and insertion); linear solves (factorisation,
    * Krylov iterations, matrix-free applications); the whole solve (the
@@ -413,6 +429,13 @@ typedef struct {
   int relaxations, relaxed_steps;
   long relax_iterations;
   double time_relax;
+  /* The pseudo-transient fallback: continuations run, steps they let
+   * converge, their iterations (one linear solve each), wall seconds, and
+   * the smallest curvature dx.J dx / dx.M dx met along their increments
+   * (negative: an indefinite tangent; 0 before any). */
+  int ptc_runs, ptc_steps;
+  long ptc_iterations;
+  double time_ptc, ptc_curvature;
   /* Newton solves run again for pm_newton_problem.settle, and the steps
    * that failed as their set did not settle. */
   int resolves, unsettled;

@@ -50,6 +50,24 @@ PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
   PetscFunctionReturn(0);
 }
 
+/* Pseudo-transient continuation's shift added to the diagonal of the
+ * matrix factorised: B's, or the augmented matrix's first n rows. */
+static PetscErrorCode add_shift(pm_newton *s, Mat B) {
+  PetscFunctionBeginUser;
+  if (!s->aug) {
+    PetscCall(MatDiagonalSet(B, s->Shift, ADD_VALUES));
+    PetscFunctionReturn(0);
+  }
+  const double *d;
+  PetscCall(VecGetArrayRead(s->Shift, &d));
+  for (PetscInt i = 0; i < (PetscInt)s->p.n; i++)
+    PetscCall(MatSetValue(s->Ma, i, i, d[i], ADD_VALUES));
+  PetscCall(VecRestoreArrayRead(s->Shift, &d));
+  PetscCall(MatAssemblyBegin(s->Ma, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(s->Ma, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
                                        void *ctx) {
   pm_newton *s = ctx;
@@ -97,6 +115,9 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
       if (e == PM_SUCCESS)
         e = pm_newton_insert_values(s, B, &s->jpat, s->jcols, s->jvals);
     }
+    /* pseudo-transient continuation: the shift in the matrix factorised
+     * (and, assembled, multiplied by) */
+    if (e == PM_SUCCESS && s->shifted) PetscCall(add_shift(s, B));
   }
   e = pm_newton_agreed(s, e);
   PetscCall(pm_newton_in_done(s, s->Glin, &xl, &x));
@@ -131,6 +152,10 @@ PetscErrorCode pm_newton_shell_mult(Mat A, Vec in, Vec out) {
   pm_err e = pm_newton_agreed(s, s->p.jacobian_apply(s->p.ctx, x, dx, dr));
   PetscCall(pm_newton_out_done(s, out, s->Gdr, &drl, &dr, e == PM_SUCCESS));
   PetscCall(pm_newton_in_done(s, s->Gdx, &dxl, &dx));
+  if (s->shifted && e == PM_SUCCESS) { /* pseudo-transient continuation */
+    PetscCall(VecPointwiseMult(s->ShiftWork, s->Shift, in));
+    PetscCall(VecAXPY(out, 1.0, s->ShiftWork));
+  }
   PetscCall(VecRestoreArrayRead(xl, &x));
   if (s->dist) PetscCall(VecGhostRestoreLocalForm(s->Glin, &xl));
   if (s->rep) {
@@ -161,6 +186,14 @@ PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
   PetscCall(VecNorm(Y, NORM_2, &s->incr));
   PetscCall(VecDot(Y, F, &dot));
   s->energy = fabs(dot);
+  /* dx = -Y, J dx = -r: dx.J dx / (|dx| |J dx|) = Y.r / (|Y| |r|) */
+  PetscReal rn;
+  PetscCall(VecNorm(F, NORM_2, &rn));
+  if (s->rep && s->incr > 0 && rn > 0) {
+    const double q = dot / (s->incr * rn);
+    if (s->rep->min_curvature == 0 || q < s->rep->min_curvature)
+      s->rep->min_curvature = q;
+  }
   PetscFunctionReturn(0);
 }
 

@@ -152,6 +152,10 @@ static pm_err create_petsc_objects(pm_newton *s) {
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Xpc));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Xacc));
   PM_PETSC_CALL(VecDuplicate(s->X, &s->Work));
+  if (!s->dist) {
+    PM_PETSC_CALL(VecDuplicate(s->X, &s->Shift));
+    PM_PETSC_CALL(VecDuplicate(s->X, &s->ShiftWork));
+  }
   if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
     PM_CALL(pm_newton_create_matrix(s, &s->ppat, &s->pcols, s->pvals, &s->P));
   } else if (!s->aug) {
@@ -249,6 +253,8 @@ void pm_newton_destroy(pm_newton **sp) {
   VecDestroy(&s->Xpc);
   VecDestroy(&s->Xacc);
   VecDestroy(&s->Work);
+  VecDestroy(&s->Shift);
+  VecDestroy(&s->ShiftWork);
   VecDestroy(&s->Gx);
   VecDestroy(&s->Glin);
   VecDestroy(&s->Gdx);

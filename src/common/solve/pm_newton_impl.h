@@ -47,6 +47,10 @@ pm_err pm_newton_residual(pm_newton *s, const double *x, double *r);
 /* The Euclidean norm of v (the n owned values) over all ranks. */
 double pm_newton_norm(const pm_newton *s, const double *v);
 
+/* The times and counts of one Newton solve (or linear solve) nr added to
+ * rep's (pm_load_steps.c). */
+void pm_load_add_costs(pm_load_report *rep, const pm_newton_report *nr);
+
 /* ---- pm_load_relax.c: dynamic relaxation within a load step ---- */
 
 /* Its work space: n values each. */
@@ -70,5 +74,42 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
 
 /* Whether s can relax (options.relax_after > 0, one process's problem). */
 bool pm_load_relax_available(const pm_newton *s);
+
+/* r = the residual at x (n values), |r| into *norm; inadmissible
+ * (PM_ERR_UNSTABLE) when not finite, the callback's failure as it is. */
+pm_err pm_relax_residual(pm_newton *s, const double *x, double *r,
+                         double *norm);
+
+/* The end of a relaxation or continuation named what, in one line into
+ * msg (cap bytes): reached its goal or not (residual rn from r0, goal,
+ * it iterations, then tail), or failed (with the error's message).
+ * Returns e, PM_ERR_NOT_CONVERGED raised with that line. */
+pm_err pm_relax_outcome(pm_err e, const char *what, double rn, double r0,
+                        double goal, long it, const char *tail, char *msg,
+                        long cap);
+
+/* Masses m_i = sum_j |K_ij| / 2 of the tangent K at x (Gershgorin: every
+ * frequency of M^-1 K at most 2, within the central difference's limit
+ * of 4 at a unit step), a row without entries taking the largest; into m
+ * (n values).  PM_ERR_UNSTABLE for a tangent zero or not finite. */
+pm_err pm_relax_masses(pm_newton *s, const double *x, double *m);
+
+/* ---- pm_load_ptc.c: pseudo-transient continuation within a load step ---- */
+
+/* Pseudo-transient continuation at the load set, from x (in/out: the last
+ * admissible state reached) until |r| <= goal or options.ptc_max_iter
+ * iterations: x += dx with (J(x) + M / dtau) dx = -r(x), M the
+ * relaxation's masses at the start, dtau growing as |r| falls (switched
+ * evolution relaxation) so that the last iterations are Newton's.  An
+ * inadmissible or diverging trial is not taken and dtau is cut.  The
+ * start's residual into *r_start; the smallest curvature along the
+ * increments, min dx.J dx / dx.M dx (negative: J is indefinite there),
+ * into *curvature.  Work space w (pm_relax_work's); counts and times to
+ * rep; msg (cap bytes) one line of what it did.  PM_SUCCESS at the goal,
+ * PM_ERR_NOT_CONVERGED short of it, PM_ERR_UNSTABLE for an inadmissible
+ * start, a hard failure of a callback as it is.  One process only. */
+pm_err pm_load_ptc(pm_newton *s, double *x, double goal, pm_relax_work *w,
+                   pm_load_report *rep, double *r_start, double *curvature,
+                   char *msg, long cap);
 
 #endif

@@ -33,6 +33,11 @@ struct pm_newton {
   Mat J;     /* assembled Jacobian (not in the cheap mode) */
   Mat P;     /* assembled cheap operator (cheap mode only) */
   Mat Shell; /* matrix-free Jacobian (matrix-free modes only) */
+  /* Pseudo-transient continuation (pm_load_ptc.c): while shifted, the
+   * linear solves are of J + diag(Shift) (ShiftWork: the shell's term);
+   * one process only. */
+  Vec Shift, ShiftWork;
+  bool shifted;
   SNES snes;
   KSP ksp;
   SNESLineSearch ls;

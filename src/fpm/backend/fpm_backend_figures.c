@@ -256,6 +256,13 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(pm_json_integer(j, "static_relax_iterations",
                             r->load.relax_iterations));
     PM_CALL(pm_json_number(j, "static_relax_seconds", r->load.time_relax));
+    PM_CALL(pm_json_integer(j, "static_continuations", r->load.ptc_runs));
+    PM_CALL(pm_json_integer(j, "static_continued_steps", r->load.ptc_steps));
+    PM_CALL(pm_json_integer(j, "static_continuation_iterations",
+                            r->load.ptc_iterations));
+    PM_CALL(pm_json_number(j, "static_continuation_seconds", r->load.time_ptc));
+    PM_CALL(pm_json_number(j, "static_continuation_curvature",
+                           r->load.ptc_curvature));
     PM_CALL(pm_json_integer(j, "static_resolves", r->load.resolves));
     PM_CALL(pm_json_integer(j, "static_unsettled", r->load.unsettled));
     PM_CALL(pm_json_integer(j, "static_contact_frozen", r->contact_frozen));

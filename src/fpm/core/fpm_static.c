@@ -146,9 +146,11 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   fpm_static_choose_linear(s, rep->unknowns, &no);
   no.load_steps = (int)s->time.qs_load_steps;
   no.predictor = true;
-  /* Steps Newton cannot finish get dynamic relaxation within the step;
+  /* Steps Newton cannot finish get pseudo-transient continuation, then
+   * dynamic relaxation, within the step;
    * steps grow back after cuts at once when Newton found them easy. */
   no.relax_after = (int)s->time.qs_relax_after;
+  no.ptc_max_iter = (int)s->time.qs_ptc;
   no.easy_iterations = 3;
   no.petsc_options = s->time.qs_solver_options;
   /* SIPG, the stiffening and the volume penalty: the assembled tangent
