@@ -11,8 +11,8 @@ scene=$src/cases/mpm/f2-unconstrained-compression.yaml
 # shellcheck source=lib.sh
 . "$(dirname "$0")/lib.sh"
 
-# VAR (OMP_WAIT_POLICY or GOMP_SPINCOUNT) in the environment of a run one
-# second in ("" if unset).
+# VAR (OMP_WAIT_POLICY or GOMP_SPINCOUNT) in the environment of a run that
+# has begun its work ("" if unset).
 setting_of_run() { # variable, env settings...
   local var=$1
   shift
@@ -20,7 +20,13 @@ setting_of_run() { # variable, env settings...
     "$bin" run "$scene" --set time.max_steps=100000000 --set time.end=1e9 \
     --out "$work/out" --quiet >/dev/null 2>&1 &
   local pid=$!
-  sleep 1
+  # Past its start (the restart comes first) once it has made its output
+  # folder; a loaded machine may take longer than a second to get there.
+  local waited=0
+  while [ ! -d "$work/out" ] && [ $waited -lt 200 ] && kill -0 $pid 2>/dev/null; do
+    sleep 0.1
+    waited=$((waited + 1))
+  done
   tr '\0' '\n' <"/proc/$pid/environ" | sed -n "s/^$var=//p"
   kill -KILL $pid 2>/dev/null
   wait $pid 2>/dev/null
