@@ -220,7 +220,7 @@ def run_case(name, spec, n, reduced, work, threads, reuse=False):
             row["von_mises_centre"] = von_mises(s)
         pts = lattice_points(dim)
         lattice = np.array([mesh.displacement(p, u) for p in pts])
-        lattice += np.array(spec.get("shift", (0.0,) * 3))[:dim]
+        lattice += np.array(spec.get("shift", (0.0,) * 3))[: lattice.shape[1]]
         lattice = np.hstack([np.pad(pts, ((0, 0), (0, 3 - dim))), lattice])
     if spec["traction"]:
         face, comp = spec["traction"][0], "xyz"[spec["traction"][1]]
