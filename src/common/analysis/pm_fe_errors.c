@@ -27,49 +27,42 @@ static bool on_plane(const pm_fe_reference *r, long j, int c,
   return xc <= lo[c] + tol || xc >= hi[c] - tol;
 }
 
-double pm_fe_nrmse_interior(const pm_fe_reference *r, const double *mapped) {
-  double lo[3], hi[3], big = 0, sum = 0;
-  long m = 0;
+/* The weighted root mean square of the error over the lattice, each
+ * point's weight halved on every bounding plane it lies on (volume) or
+ * nil on any (interior); the smallest and largest |u| of the reference
+ * over every point into *small and *big.  NAN for no weight. */
+static double lattice_rms(const pm_fe_reference *r, const double *mapped,
+                          bool interior, double *small, double *big) {
+  double lo[3], hi[3], sum = 0, weight = 0;
   const int dim = r->dim == 2 ? 2 : 3;
   lattice_box(r, lo, hi);
-  for (long j = 0; j < r->n; j++) {
-    double u2 = 0, d2 = 0;
-    bool inside = true;
-    for (int c = 0; c < dim; c++) {
-      if (on_plane(r, j, c, lo, hi)) inside = false;
-      double d = mapped[3 * j + c] - r->u[3 * j + c];
-      d2 += d * d;
-      u2 += r->u[3 * j + c] * r->u[3 * j + c];
-    }
-    big = fmax(big, sqrt(u2));
-    if (inside) {
-      sum += d2;
-      m++;
-    }
-  }
-  if (m == 0 || !(big > 0)) return NAN;
-  return sqrt(sum / (double)m) / big;
-}
-
-double pm_fe_nrmse_volume(const pm_fe_reference *r, const double *mapped) {
-  double lo[3], hi[3], small = INFINITY, big = 0, sum = 0, weight = 0;
-  const int dim = r->dim == 2 ? 2 : 3;
-  lattice_box(r, lo, hi);
+  *small = INFINITY, *big = 0;
   for (long j = 0; j < r->n; j++) {
     double u2 = 0, d2 = 0, w = 1;
     for (int c = 0; c < dim; c++) {
-      if (on_plane(r, j, c, lo, hi)) w *= 0.5;
+      if (on_plane(r, j, c, lo, hi)) w *= interior ? 0 : 0.5;
       double d = mapped[3 * j + c] - r->u[3 * j + c];
       d2 += d * d;
       u2 += r->u[3 * j + c] * r->u[3 * j + c];
     }
-    small = fmin(small, sqrt(u2));
-    big = fmax(big, sqrt(u2));
+    *small = fmin(*small, sqrt(u2));
+    *big = fmax(*big, sqrt(u2));
     sum += w * d2;
     weight += w;
   }
-  if (!(big > small) || !(weight > 0)) return NAN;
-  return sqrt(sum / weight) / (big - small);
+  return weight > 0 ? sqrt(sum / weight) : NAN;
+}
+
+double pm_fe_nrmse_interior(const pm_fe_reference *r, const double *mapped) {
+  double small, big;
+  const double rms = lattice_rms(r, mapped, true, &small, &big);
+  return big > 0 ? rms / big : NAN;
+}
+
+double pm_fe_nrmse_volume(const pm_fe_reference *r, const double *mapped) {
+  double small, big;
+  const double rms = lattice_rms(r, mapped, false, &small, &big);
+  return big > small ? rms / (big - small) : NAN;
 }
 
 pm_err pm_fe_write_errors(const pm_fe_reference *r, const double *mapped,
