@@ -29,17 +29,24 @@ roundoff() { # label, run, run
   check "$1: to $tol" test $rc -eq 0
 }
 
-# One process (once), then N ranks, of SCENE with overrides, compared to
-# round-off; the runs end with exit status $want (default 0).
+# One process (once) beside N ranks, of SCENE with overrides, compared to
+# round-off; the runs end with exit status $want (default 0).  The
+# one-process run has one thread and the test holds both cores: run after
+# the ranks, it left one of them idle; it now runs beside them (the runs
+# are independent: their own folders, the comparison after both).
 across() { # label, scene, ranks, overrides...
-  local label=$1 scene=$2 n=$3 want=${want:-0}
+  local label=$1 scene=$2 n=$3 want=${want:-0} one_pid=""
   shift 3
   local one=$work/$label-1 many=$work/$label-$n
-  [ -d "$one" ] || "$bin" run "$scene" --out "$one" --quiet "$@" \
-    >/dev/null 2>"$work/err"
+  if [ ! -d "$one" ]; then
+    "$bin" run "$scene" --out "$one" --quiet "$@" >/dev/null \
+      2>"$work/err1" &
+    one_pid=$!
+  fi
   ranks "$n" "$bin" run "$scene" --out "$many" --quiet "$@" >/dev/null \
     2>"$work/err"
   local rc=$?
+  [ -z "$one_pid" ] || wait "$one_pid"
   check "$label on $n ranks: exit $want (got $rc)" test $rc -eq "$want"
   roundoff "$label, $n ranks against one process" "$one" "$many"
 }
@@ -89,14 +96,17 @@ resume_on() { # out, counts...
 # A run of SCENE with overrides that fails: on N ranks it stops every rank
 # with one process's message (what PATTERN matches of it: the step, the
 # point or particle by its index on one process), exit 2, status unstable.
+# The one-process run beside the ranks' (as in across).
 fails_alike() { # label, ranks, pattern, scene, overrides...
-  local label=$1 n=$2 pattern=$3 scene=$4 rc
+  local label=$1 n=$2 pattern=$3 scene=$4 rc one_pid
   shift 4
   "$bin" run "$scene" --out "$work/$label-1" --quiet "$@" >/dev/null \
-    2>"$work/err1"
+    2>"$work/err1" &
+  one_pid=$!
   ranks "$n" "$bin" run "$scene" --out "$work/$label-$n" --quiet "$@" \
     >/dev/null 2>"$work/err"
   rc=$?
+  wait "$one_pid"
   check "$label on $n ranks: exit 2 (got $rc)" test $rc -eq 2
   check "$label on $n ranks: one process's message" \
     grep -qF "$(grep -o "$pattern" "$work/err1")" "$work/err"
