@@ -76,21 +76,29 @@ interrupt() { # ranks, out, scene, overrides...
 
 # Resume copies of the interrupted run OUT on each count of ranks (1: one
 # process, without mpirun) into OUT-N; they end with exit status $want
-# (default 0).
+# (default 0).  The one-process resume (one thread) runs beside the
+# ranks' (as in across); its exit status is checked last.
 resume_on() { # out, counts...
-  local out=$1 want=${want:-0} n rc
+  local out=$1 want=${want:-0} n rc one_pid=""
   shift
+  for n in "$@"; do cp -r "$out" "$out-$n"; done
   for n in "$@"; do
-    cp -r "$out" "$out-$n"
     if [ "$n" -eq 1 ]; then
-      "$bin" resume "$out-$n" --quiet >/dev/null 2>"$work/err"
-    else
-      ranks "$n" "$bin" resume "$out-$n" --quiet >/dev/null 2>"$work/err"
+      "$bin" resume "$out-1" --quiet >/dev/null 2>"$work/err1" &
+      one_pid=$!
+      continue
     fi
+    ranks "$n" "$bin" resume "$out-$n" --quiet >/dev/null 2>"$work/err"
     rc=$?
     check "interrupted, resumed on $n: exit $want (got $rc)" \
       test $rc -eq "$want"
   done
+  if [ -n "$one_pid" ]; then
+    wait "$one_pid"
+    rc=$?
+    check "interrupted, resumed on 1: exit $want (got $rc)" \
+      test $rc -eq "$want"
+  fi
 }
 
 # A run of SCENE with overrides that fails: on N ranks it stops every rank
