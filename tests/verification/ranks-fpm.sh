@@ -154,11 +154,14 @@ roundoff "averaged, interrupted on 2 ranks, resumed on 1" \
 # different counts agree to GMRES's tolerance, 1e-10, not to round-off).
 slow="$static $coarse --set time.quasi_static.load_steps=20
   --set time.quasi_static.linear_solver=gmres-ilu"
-"$bin" run "$f2" --out "$work/s-1" --quiet $slow >/dev/null 2>&1
+# (The one-process run, one thread, beside the runs on ranks.)
+"$bin" run "$f2" --out "$work/s-1" --quiet $slow >/dev/null 2>&1 &
+s1=$!
 for n in 2 3; do
   ranks $n "$bin" run "$f2" --out "$work/s-$n" --quiet $slow >/dev/null 2>&1
 done
 interrupt 2 "$work/scut" "$f2" $slow
+wait $s1
 resume_on "$work/scut" 1 2 3
 check "static, interrupted on 2 ranks, resumed on 2: bit for bit" \
   $same "$work/s-2" "$work/scut-2"
