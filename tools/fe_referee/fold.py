@@ -13,9 +13,9 @@ from .ccx import last_block, read_dat
 from .deck import job_name
 from .mesh import make_mesh, serendipity, serendipity_gradient
 
-# The reaction is split at this distance (m) from the free edges of the
-# loaded face: the traction inside it against the rest.
-INNER = 0.01
+# The strain energy is split at this distance (m) from the loaded face's
+# edges with the free faces: the band along them against the rest.
+BAND = 0.005
 
 
 def displacement(spec, n, reduced, work):
@@ -63,9 +63,10 @@ def fold(spec, n, reduced, work):
     the highest free-face node above it (mm) with its depth below the edge
     and its distance outside the block (mm), the number of free-face nodes
     above the plane, the smallest J at the 27 Gauss points and at 6 x 6
-    points of the loaded face, the face points with J <= 0, the nodal
-    reaction (whole block, N) and its traction more than INNER from the
-    free edges."""
+    points of the loaded face, the face points with J <= 0, the loaded
+    face's nodal force (whole block, N; the plates' share not in it) and
+    the mean strain energy density (J/m^3 of the part) within BAND of the
+    loaded face's edges with the free faces and elsewhere."""
     mesh, u, reached = displacement(spec, n, reduced, work)
     X, x = mesh.x, mesh.x + u
     hi = mesh.hi
@@ -83,38 +84,44 @@ def fold(spec, n, reduced, work):
     all_e = np.arange(len(mesh.conn))
     gx, gw = leggauss(3)
     force = np.zeros((mesh.n_nodes, 3))
-    jmin = np.inf
+    jmin, band, rest = np.inf, 0.0, 0.0
     vol = np.prod(mesh.size / 2.0, axis=1)
+    corners = X[mesh.conn - 1]
     for i, a in enumerate(gx):
         for j, b in enumerate(gx):
             for k, c in enumerate(gx):
                 F, dN = gradients(mesh, u, (a, b, c), all_e)
-                jmin = min(jmin, float(np.min(np.linalg.det(F))))
+                J = np.linalg.det(F)
+                jmin = min(jmin, float(np.min(J)))
                 w = gw[i] * gw[j] * gw[k] * vol
+                shape = np.array([serendipity(o, (a, b, c))
+                                  for o in mesh.local])
+                at = np.einsum("a,eak->ek", shape, corners)
+                near = np.hypot(hi[2] - at[:, 2], np.minimum(
+                    hi[0] - at[:, 0], hi[1] - at[:, 1])) < BAND
+                I1 = np.einsum("eij,eij->e", F, F)
+                W = (0.5 * mu * (np.abs(J) ** (-2.0 / 3.0) * I1 - 3.0)
+                     + 0.5 * kappa * (J - 1.0) ** 2) * w
+                band += float(np.sum(W[near]))
+                rest += float(np.sum(W[~near]))
                 fe = np.einsum("eij,eaj->eai", piola(F, mu, kappa), dN)
                 np.add.at(force, mesh.conn - 1, fe * w[:, None, None])
     loaded = np.abs(X[:, 2] - hi[2]) < 1e-12
     out["jmin_gauss"] = jmin
     out["reaction"] = scale * float(np.sum(force[loaded, 2]))
-    # The loaded face's points: J, and the traction away from the edges.
-    px, pw = leggauss(6)
-    face_e = np.where(np.abs(X[mesh.conn - 1][:, :, 2].max(axis=1)
-                             - hi[2]) < 1e-12)[0]
-    jface, bad, inner = np.inf, 0, 0.0
-    for i, a in enumerate(px):
-        for j, b in enumerate(px):
-            F, _ = gradients(mesh, u, (a, b, 1.0), face_e)
-            J = np.linalg.det(F)
+    # The loaded face's points: J.
+    px = leggauss(6)[0]
+    face_e = np.where(np.abs(corners[:, :, 2].max(axis=1) - hi[2])
+                      < 1e-12)[0]
+    jface, bad = np.inf, 0
+    for a in px:
+        for b in px:
+            J = np.linalg.det(gradients(mesh, u, (a, b, 1.0), face_e)[0])
             jface = min(jface, float(np.min(J)))
             bad += int(np.sum(J <= 0.0))
-            shape = np.array([serendipity(o, (a, b, 1.0)) for o in mesh.local])
-            at = np.einsum("a,eak->ek", shape, X[mesh.conn[face_e] - 1])
-            edge = np.minimum(hi[0] - at[:, 0], hi[1] - at[:, 1])
-            area = pw[i] * pw[j] * np.prod(mesh.size[face_e, :2] / 2.0,
-                                           axis=1)
-            t = piola(F, mu, kappa)[:, 2, 2] * area
-            inner += float(np.sum(t[edge >= INNER]))
-    out.update(jmin_face=jface, inverted_face=bad, inner=scale * inner)
+    part = np.prod(np.array(hi) - np.array(mesh.lo))
+    out.update(jmin_face=jface, inverted_face=bad, sed_band=band / part,
+               sed_rest=rest / part)
     return out
 
 
@@ -124,14 +131,15 @@ def fold_table(name, spec, ladder, reduced, work):
     lines = ["| N | load reached | rise above the clamp's plane (mm) | at "
              "(mm below the edge, outside) | free-face nodes above | min J, "
              "Gauss points | min J, loaded face | face points J <= 0 | "
-             "loaded face's force (N) | of it > %g mm from the free edges |"
-             % (INNER * 1e3), "|" + "---|" * 10]
+             "loaded face's force (N) | mean SED within %g mm of the loaded "
+             "face's free edges (J/m^3) | elsewhere (J/m^3) |"
+             % (BAND * 1e3), "|" + "---|" * 11]
     for n in ladder:
         f = fold(spec, n, reduced, work)
         lines.append("| %d | %.3f | %.2f | %.1f, %.1f | %d of %d | %.3f | "
-                     "%.3f | %d | %.4f | %.3f |" % (
+                     "%.3f | %d | %.4f | %.3f | %.3f |" % (
                          n, f["reached"], f["rise"], f["depth"], f["outside"],
                          f["above"], f["free"], f["jmin_gauss"],
                          f["jmin_face"], f["inverted_face"], f["reaction"],
-                         f["inner"]))
+                         f["sed_band"], f["sed_rest"]))
     return "\n".join(lines)
