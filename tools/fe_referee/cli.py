@@ -11,6 +11,7 @@ from .cases import CASES, CONTACT, with_options
 from .ccx import ccx_version, run_case
 from .deck import job_name, write_deck
 from .extrapolate import write_tolerance
+from .fold import fold_table
 from .ladder import (describe, provenance, summary, write_ladder,
                      write_lattice)
 from .mesh import make_mesh
@@ -75,6 +76,11 @@ def main(epilog=None):
     ap.add_argument("--reuse", action="store_true",
                     help="read back the meshes kept under --work (--keep) "
                     "instead of running them again")
+    ap.add_argument("--fold", action="store_true",
+                    help="F4: measure the fold at the clamped edges on the "
+                    "meshes of --ladder kept under --work (--keep): rise "
+                    "past the clamp's plane, smallest J, the reaction away "
+                    "from the edges")
     a = ap.parse_args()
     if a.friction is not None:
         CONTACT["friction"] = a.friction
@@ -93,6 +99,15 @@ def main(epilog=None):
     unknown = [n for n in names if n not in CASES]
     if unknown or not names:
         ap.error("name cases (or --all): %s" % ", ".join(CASES))
+    if a.fold:
+        for name in names:
+            spec = with_options(CASES[name], a)
+            ladder = [int(v) for v in a.ladder.split(",")] if a.ladder \
+                else spec["ladder"]
+            print("%s (kept under %s)\n" % (name, a.work))
+            print(fold_table(name, spec, ladder,
+                             spec["element"] == "reduced", a.work))
+        return 0
     os.makedirs(a.work, exist_ok=True)
     if not a.run:
         for name in names:
