@@ -196,10 +196,9 @@ fi
 # hard-tiny.yaml: the near-incompressible panel at 157 points, F3 200% and
 # F4 60% at 237, F4 between plates, the reduced shock tube.  Every run
 # completes (exit 0); F4 between plates by a static solve (contact in
-# Newton's problem) converges, -28.857 N at 237 points: +20.25% against the
-# contact referee's N = 12 (graded C3D20, face-to-face contact, -23.996 N;
-# it was +15.0% against the uniform C3D20R, node-to-face N = 12, -25.089
-# N, which was stiff).  The bound, 25%, follows the referee, not the code:
+# Newton's problem) converges at 237 points to +18.35% against the contact
+# referee (graded C3D20 N = 4 to 14, face-to-face contact, limit -23.238 N,
+# uncertain by 1.8%; +14.6% against the earlier N = 12, -23.996 N).  The bound, 25%, follows the referee, not the code:
 # the same run, the coarse resolution's error (+4.0% by relaxation at 1851
 # points, docs/validation.md, "F4 between plates, converged referee").
 run_suite hard-tiny "$src/cases/bench/hard-tiny.yaml"
