@@ -198,9 +198,9 @@ fi
 # completes (exit 0); F4 between plates by a static solve (contact in
 # Newton's problem) converges at 237 points to +18.35% against the contact
 # referee (graded C3D20 N = 4 to 14, face-to-face contact, limit -23.238 N,
-# uncertain by 1.8%; +14.6% against the earlier N = 12, -23.996 N).  The bound, 25%, follows the referee, not the code:
-# the same run, the coarse resolution's error (+4.0% by relaxation at 1851
-# points, docs/validation.md, "F4 between plates, converged referee").
+# uncertain by 1.8%; +14.6% against the earlier N = 12, -23.996 N).  The
+# bound, 25%, follows the referee, not the code: the same scene at 1851
+# points is +4.1% (docs/validation.md, "F4 40%: the referee converged").
 run_suite hard-tiny "$src/cases/bench/hard-tiny.yaml"
 check "hard-tiny: exit 0, every run completed (got $rc)" test $rc -eq 0
 md=$out/bench.md
