@@ -158,31 +158,48 @@ pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
   return gm_mesh_box_graded(dim, min, max, h, NULL, out);
 }
 
+/* The distance from x to the nearest graded face, or to the nearest edge
+ * bounding a graded face: in 3D the line where the face meets a face across
+ * axis b, in 2D that line's trace, the corner (the same expression). */
+static double grade_distance(const gm_grade *g, int dim, const double min[3],
+                             const double max[3], const double x[3]) {
+  double d = INFINITY;
+  for (int f = 0; f < 2 * dim; f++) {
+    if (!(g->faces & (1u << f))) continue;
+    const int a = f / 2;
+    const double da = x[a] - ((f % 2) ? max[a] : min[a]);
+    if (!g->edges) {
+      d = fmin(d, fabs(da));
+      continue;
+    }
+    for (int b = 0; b < dim; b++)
+      if (b != a)
+        d = fmin(d, fmin(hypot(da, x[b] - min[b]), hypot(da, x[b] - max[b])));
+  }
+  return d;
+}
+
 double gm_grade_size(const gm_grade *g, int dim, const double min[3],
                      const double max[3], double h, const double x[3]) {
   if (!g || !g->faces) return h;
-  double d = INFINITY;
-  for (int f = 0; f < 2 * dim; f++)
-    if (g->faces & (1u << f)) {
-      const double plane = (f % 2) ? max[f / 2] : min[f / 2];
-      d = fmin(d, fabs(x[f / 2] - plane));
-    }
+  const double d = grade_distance(g, dim, min, max, x);
   if (d >= g->distance) return h;
   return g->size + (h - g->size) * d / g->distance;
 }
 
-/* The Distance field on the graded faces (surfaces in 3D, curves in 2D)
- * and the Threshold field from it, as the background mesh. */
-static pm_err grade_fields(int dim, const double min[3], const double max[3],
-                           double h, const gm_grade *g) {
+/* The gmsh tags of the graded faces (surfaces in 3D, curves in 2D), or of
+ * the edges bounding them (curves in 3D, points in 2D), each once, into
+ * tags[*n] (at most 12). */
+static pm_err grade_entities(int dim, const double min[3], const double max[3],
+                             const gm_grade *g, double tags[12], size_t *n) {
   pm_err ret = PM_SUCCESS;
   int ierr = 0;
-  double tags[6];
-  size_t n = 0;
+  *n = 0;
   /* Wide enough for OpenCASCADE's enlarged bounding boxes, far from the
    * opposite face. */
   double eps = INFINITY;
   for (int k = 0; k < dim; k++) eps = fmin(eps, 1e-3 * (max[k] - min[k]));
+  const int edim = g->edges ? dim - 2 : dim - 1;
   for (int f = 0; f < 2 * dim; f++) {
     if (!(g->faces & (1u << f))) continue;
     double lo[3] = {min[0] - eps, min[1] - eps, dim == 3 ? min[2] - eps : -eps};
@@ -193,16 +210,43 @@ static pm_err grade_fields(int dim, const double min[3], const double max[3],
     int *dt = NULL;
     size_t ndt = 0;
     gmshModelGetEntitiesInBoundingBox(lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
-                                      &dt, &ndt, dim - 1, &ierr);
+                                      &dt, &ndt, edim, &ierr);
     GM_GMSH_CHECK("finding a graded face", NULL);
-    for (size_t i = 0; i + 1 < ndt && n < 6; i += 2) tags[n++] = dt[i + 1];
+    for (size_t i = 0; i + 1 < ndt && *n < 12; i += 2) {
+      size_t j = 0;
+      while (j < *n && tags[j] != dt[i + 1]) j++;
+      if (j == *n) tags[(*n)++] = dt[i + 1];
+    }
     gmshFree(dt);
   }
+done:
+  return ret;
+}
+
+/* The Distance field on the graded faces or edges and the Threshold field
+ * from it, as the background mesh. */
+static pm_err grade_fields(int dim, const double min[3], const double max[3],
+                           double h, const gm_grade *g) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0;
+  double tags[12];
+  size_t n = 0;
+  PM_TRY(grade_entities(dim, min, max, g, tags, &n));
   const int dist = gmshModelMeshFieldAdd("Distance", -1, &ierr);
   GM_GMSH_CHECK("adding the Distance field", NULL);
-  gmshModelMeshFieldSetNumbers(dist, dim == 3 ? "FacesList" : "EdgesList", tags,
-                               n, &ierr);
+  const int edim = g->edges ? dim - 2 : dim - 1;
+  const char *list[] = {"NodesList", "EdgesList", "FacesList"};
+  gmshModelMeshFieldSetNumbers(dist, list[edim], tags, n, &ierr);
   GM_GMSH_CHECK("setting the graded faces", NULL);
+  if (g->edges && edim == 1) {
+    /* Samples along each curve a quarter of the graded size apart (gmsh's
+     * default 20 a curve would put steps in the distance). */
+    double len = 0.0;
+    for (int k = 0; k < dim; k++) len = fmax(len, max[k] - min[k]);
+    gmshModelMeshFieldSetNumber(dist, "NNodesByEdge",
+                                fmax(20.0, ceil(4.0 * len / g->size)), &ierr);
+    GM_GMSH_CHECK("NNodesByEdge", NULL);
+  }
   const int thr = gmshModelMeshFieldAdd("Threshold", -1, &ierr);
   GM_GMSH_CHECK("adding the Threshold field", NULL);
   const struct {

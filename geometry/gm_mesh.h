@@ -4,6 +4,7 @@
 #ifndef GM_MESH_H
 #define GM_MESH_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "pm_error.h"
@@ -44,14 +45,17 @@ typedef struct {
 pm_err gm_mesh_box(int dim, const double min[3], const double max[3], double h,
                    gm_mesh **out);
 
-/* A grading of a box mesh toward some of its faces: element size `size` on
- * them, growing linearly with the distance d from the nearest of them to the
- * box's own size h at d >= distance. */
+/* A grading of a box mesh toward some of its faces, or toward the edges
+ * bounding them: element size `size` on them, growing linearly with the
+ * distance d from the nearest of them to the box's own size h at
+ * d >= distance. */
 typedef struct {
   unsigned faces;  /* bit f: face f (xmin = 0 ... zmax = 5, as pm_face); 0:
                       no grading */
-  double size;     /* element size on the faces, 0 < size <= h */
+  double size;     /* element size on the faces (edges), 0 < size <= h */
   double distance; /* where the size reaches h, > 0 */
+  bool edges;      /* false: d is the distance to the faces; true: to the
+                      edges bounding them (the corners in 2D) */
 } gm_grade;
 
 /* gm_mesh_box with the element size graded by g (gmsh's Distance and

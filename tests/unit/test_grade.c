@@ -73,6 +73,67 @@ static void test_graded_2d(void **state) {
   check_graded(2);
 }
 
+/* Nodes with coordinate a in [alo, ahi] and coordinate c below cmax. */
+static long count_bar(const gm_mesh *m, int a, double alo, double ahi, int c,
+                      double cmax) {
+  long n = 0;
+  for (long i = 0; i < m->n_nodes; i++) {
+    const double *x = m->x + 3 * i;
+    if (x[a] >= alo && x[a] <= ahi && x[c] < cmax) n++;
+  }
+  return n;
+}
+
+/* Graded toward the edges of zmin (3D; ymin's corners in 2D) at a third of
+ * the size within 0.4: the bar along an edge holds several times the nodes
+ * of the bar of the same volume along the face's middle, which grading
+ * toward the whole face fills alike. */
+static void check_graded_edges(int dim) {
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const int c = dim - 1;
+  const gm_grade g = {
+      .faces = 1u << (2 * c), .size = 0.1, .distance = 0.4, .edges = true};
+  const gm_grade gf = {.faces = 1u << (2 * c), .size = 0.1, .distance = 0.4};
+  /* gm_grade_size: on an edge, at the face's middle (0.5 from the edges,
+   * beyond distance: h, where the face grading gives its size), 0.2 from
+   * an edge along the free face, and on the diagonal off it. */
+  double x[3] = {0.0, 0.5, 0.5};
+  x[c] = 0.0;
+  assert_near(gm_grade_size(&g, dim, lo, hi, 0.3, x), 0.1, 1e-12);
+  x[0] = 0.5;
+  assert_near(gm_grade_size(&g, dim, lo, hi, 0.3, x), 0.3, 1e-12);
+  assert_near(gm_grade_size(&gf, dim, lo, hi, 0.3, x), 0.1, 1e-12);
+  x[0] = 0.0;
+  x[c] = 0.2;
+  assert_near(gm_grade_size(&g, dim, lo, hi, 0.3, x), 0.2, 1e-12);
+  x[0] = 0.1;
+  x[c] = 0.1;
+  assert_near(gm_grade_size(&g, dim, lo, hi, 0.3, x),
+              0.1 + 0.2 * sqrt(0.02) / 0.4, 1e-12);
+  gm_mesh *m = NULL, *f = NULL;
+  assert_int_equal(gm_mesh_box_graded(dim, lo, hi, 0.3, &g, &m), PM_SUCCESS);
+  assert_int_equal(gm_mesh_box_graded(dim, lo, hi, 0.3, &gf, &f), PM_SUCCESS);
+  const long edge = count_bar(m, 0, 0.0, 0.2, c, 0.2);
+  const long mid = count_bar(m, 0, 0.4, 0.6, c, 0.2);
+  const long fedge = count_bar(f, 0, 0.0, 0.2, c, 0.2);
+  const long fmid = count_bar(f, 0, 0.4, 0.6, c, 0.2);
+  /* Asked: the edge bar twice the middle one's nodes; the face grading's
+   * two bars within a factor 1.6 of each other (both on the face). */
+  if (edge < 2 * mid || fmid * 1.6 < fedge)
+    fail_msg("dim %d: edges %ld at the edge, %ld mid; faces %ld, %ld", dim,
+             edge, mid, fedge, fmid);
+  /* Fewer nodes than the face grading: only the edges' tubes are fine. */
+  assert_true(m->n_nodes < f->n_nodes);
+  gm_mesh_destroy(m);
+  gm_mesh_destroy(f);
+}
+
+static void test_graded_edges(void **state) {
+  (void)state;
+  check_graded_edges(3);
+  check_graded_edges(2);
+}
+
 static void test_graded_bad_args(void **state) {
   (void)state;
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
@@ -124,6 +185,8 @@ static void scene_case(void **state, const char *method, int dim,
     else
       assert_near(s->refine.size, 0.005, 0);
     assert_near(s->refine.distance, 0.03, 0);
+    assert_int_equal(s->refine.to,
+                     strstr(size, "edges") ? PM_REFINE_EDGES : PM_REFINE_FACES);
     pm_scene_destroy(s);
     return;
   }
@@ -141,6 +204,11 @@ static void test_scene_key(void **state) {
    * form. */
   scene_case(state, "mpm", 3, "zmin, xmin", ", size: 0.005", NULL, NULL);
   scene_case(state, "fpm", 3, "zmin, xmin", ", size_ratio: 0.25", NULL, NULL);
+  scene_case(state, "fpm", 3, "zmin, xmin", ", size_ratio: 0.25, to: edges",
+             NULL, NULL);
+  /* A distance measured to something the key does not name. */
+  scene_case(state, "fpm", 3, "zmin", ", size: 0.005, to: corners", "corners",
+             "edges");
   /* A size above mesh_size, at the size. */
   scene_case(state, "fpm", 3, "zmin", ", size: 0.03", "0.03,",
              "discretization.refine.size");
@@ -236,6 +304,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_graded_3d),
       cmocka_unit_test(test_graded_2d),
+      cmocka_unit_test(test_graded_edges),
       cmocka_unit_test(test_graded_bad_args),
       cmocka_unit_test_setup_teardown(test_scene_key, pm_test_make_dir,
                                       pm_test_drop_dir),

@@ -125,6 +125,10 @@ typedef enum {
 /* The scene's words for them (membrane.normals). */
 extern const pm_name pm_normals_names[];
 
+/* discretization.refine.to: what the grading's distance is measured to. */
+enum { PM_REFINE_FACES = 0, PM_REFINE_EDGES = 1 };
+extern const pm_name pm_refine_to_names[];
+
 typedef struct {
   int material;        /* index into materials */
   char *material_name; /* as the scene gives it */
@@ -273,6 +277,9 @@ typedef struct pm_scene {
                           budget: FPM meshes far from the faces at the size
                           giving about the uniform cloud's points */
     double distance;   /* discretization.refine.distance, m, > 0 */
+    int to;            /* discretization.refine.to: PM_REFINE_FACES (the
+                          distance to the faces) or PM_REFINE_EDGES (to the
+                          edges bounding them) */
   } refine;
   pm_scene_material *materials;
   int n_materials;

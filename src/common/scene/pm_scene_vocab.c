@@ -77,6 +77,8 @@ static const pm_name face_names[] = {{"xmin", 1u << PM_FACE_XMIN},
                                      {"zmin", 1u << PM_FACE_ZMIN},
                                      {"zmax", 1u << PM_FACE_ZMAX},
                                      {NULL, 0}};
+const pm_name pm_refine_to_names[] = {
+    {"faces", PM_REFINE_FACES}, {"edges", PM_REFINE_EDGES}, {NULL, 0}};
 static const pm_key refine_keys[] = {
     {.name = "near",
      .type = PM_KEY_FLAGS,
@@ -112,6 +114,15 @@ static const pm_key refine_keys[] = {
             "linearly, reaches the far size (required but with size_ratio 1); "
             "fixed in metres, so that a mesh_size ladder is a self-similar "
             "family"},
+    {.name = "to",
+     .type = PM_KEY_ENUM,
+     .offset = S(refine.to),
+     .def = "faces",
+     .names = pm_refine_to_names,
+     .doc = "what size and distance are measured to: faces (the named "
+            "faces, whole) or edges (the edges bounding them, where a "
+            "clamped face meets the free ones: singular lines; the corners "
+            "in 2D)"},
     {0}};
 
 static const pm_key discretization_keys[] = {

@@ -56,9 +56,11 @@ static double plan_head(fpm_sim *sim, FILE *out) {
           s->mesh_size, sim->mean_edge);
   if (sim->near_size > 0)
     fprintf(out,
-            "             graded (discretization.refine): %.4g m on the faces, "
+            "             graded (discretization.refine): %.4g m on the %s, "
             "%.4g m from %g m away%s\n",
-            sim->near_size, sim->far_size, s->refine.distance,
+            sim->near_size,
+            s->refine.to == PM_REFINE_EDGES ? "faces' edges" : "faces",
+            sim->far_size, s->refine.distance,
             s->refine.size_ratio > 0 ? "; mesh_size is the uniform cloud's "
                                        "point budget"
                                      : "");

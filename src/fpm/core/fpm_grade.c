@@ -29,7 +29,8 @@ double fpm_grade_density(const pm_scene *s, const gm_grade *g, double h) {
 void fpm_grade_of(const pm_scene *s, gm_grade *g, double *far) {
   *g = (gm_grade){.faces = s->refine.near,
                   .size = s->refine.size,
-                  .distance = s->refine.distance};
+                  .distance = s->refine.distance,
+                  .edges = s->refine.to == PM_REFINE_EDGES};
   *far = s->mesh_size;
   const double r = s->refine.size_ratio;
   if (!g->faces || r <= 0.0) return;
