@@ -63,8 +63,10 @@ typedef struct {
   double *mass;    /* per node */
   double *mom;     /* 3 per node: momentum */
   double *force;   /* 3 per node: internal + external force */
-  double *vel0;    /* 3 per node: velocity before the update */
-  double *vel_new; /* 3 per node: updated (Lagrangian) velocity */
+  double *vel0;    /* 3 per node (and 1 double of padding at the end):
+                      velocity before the update */
+  double *vel_new; /* 3 per node (and the padding): updated (Lagrangian)
+                      velocity */
   double *vel;     /* 3 per node: the velocity of USF (before the update)
                       or MUSL (remapped), with the boundary conditions;
                       NULL for USL */

@@ -169,15 +169,17 @@ g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
   double *restrict dx = w->dx;
   PM_OMP(for schedule(static) nowait)
   for (long p = gr->begin; p < gr->end; p++) {
-    double vn[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+    /* A node's three components read as four (the nodal arrays are
+     * padded), the fourth lane unused; lane by lane the scalar sums. */
+    mpm_v4 vn4 = {0, 0, 0, 0}, dv4 = vn4;
     MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
-      const double *v1 = vel_new + 3 * node;
-      const double *v0 = vel0 + 3 * node;
-      for (int c = 0; c < 3; c++) {
-        vn[c] += wk * v1[c];
-        dv[c] += wk * (v1[c] - v0[c]);
-      }
+      const mpm_v4 v1 = mpm_v4_load(vel_new + 3 * node);
+      const mpm_v4 v0 = mpm_v4_load(vel0 + 3 * node);
+      vn4 += wk * v1;
+      dv4 += wk * (v1 - v0);
     });
+    const double vn[3] = {vn4[0], vn4[1], vn4[2]},
+                 dv[3] = {dv4[0], dv4[1], dv4[2]};
     double *vp = v + 3 * p;
     for (int c = 0; c < 3; c++) {
       vp[c] = flip * (vp[c] + dv[c]) + (1.0 - flip) * vn[c];
@@ -187,12 +189,12 @@ g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
       mpm_fail(w, p, "velocity is not finite (|v|^2 = %g, v_x = %g)",
                vp[0] * vp[0] + vp[1] * vp[1] + vp[2] * vp[2], vp[0]);
     if (remap) {
+      /* As mpm_p2g's w m (1, v): the mass lane is not read back. */
       const double mp = mass[p];
+      const mpm_v4 mv = {1.0, vp[0], vp[1], vp[2]};
       MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
         double *r = acc + node * S;
-        r[MPM_ACC_P + 0] += wk * mp * vp[0];
-        r[MPM_ACC_P + 1] += wk * mp * vp[1];
-        r[MPM_ACC_P + 2] += wk * mp * vp[2];
+        mpm_v4_store(r + MPM_ACC_M, mpm_v4_load(r + MPM_ACC_M) + wk * mp * mv);
       });
     }
   }
