@@ -118,9 +118,10 @@ size_t mpm_nodes_bytes(const mpm_nodes *n, const mpm_grid *g);
 
 /* ---- the stencil ---------------------------------------------------------
  * A particle's nodes in tensor-product order (x fastest), with their
- * weights S_I(x_p) and gradients grad S_I(x_p).  Expanded once per particle
- * and transfer, then walked by a flat loop.  The products are formed in
- * one fixed order (w_x (w_y w_z), ...), which every transfer shares. */
+ * weights S_I(x_p) and gradients grad S_I(x_p): expanded into arrays (the
+ * implicit solver, the conditions) or walked in place (MPM_STENCIL_FOR: the
+ * explicit step's transfers).  Both form the products in one fixed order
+ * (w_x (w_y w_z), ...), which every transfer shares. */
 
 #define MPM_STENCIL_MAX 27
 enum { MPM_STENCIL_W = 1, MPM_STENCIL_GRAD = 2 };
@@ -132,71 +133,16 @@ typedef struct {
   double grad[MPM_STENCIL_MAX][3]; /* with MPM_STENCIL_GRAD, 1/m */
 } mpm_stencil;
 
-/* The expansion for a constant dimension and width (the shape follows the
- * width), so that its loops unroll. */
-static inline __attribute__((always_inline)) void
-mpm_stencil_expand(const mpm_grid *g, const double x[3], int what,
-                   mpm_stencil *st, const int dim, const int width) {
-  const mpm_basis shape = width == 3 ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;
-  const int nz = dim == 3 ? width : 1;
-  long base = 0;
-  double w[3][3], dw[3][3];
-  w[2][0] = 1;
-  dw[2][0] = 0;
-  for (int c = 0; c < dim; c++) {
-    long i0;
-    mpm_shape_1d(shape, (x[c] - g->origin[c]) * g->inv_h, g->inv_h, &i0, w[c],
-                 dw[c]);
-    base += (i0 - g->offset[c]) * g->stride[c];
-  }
-  int k = 0;
-  for (int c = 0; c < nz; c++)
-    for (int b = 0; b < width; b++) {
-      const double wbc = w[1][b] * w[2][c];
-      const double gy = dw[1][b] * w[2][c];
-      const double gz = w[1][b] * dw[2][c];
-      const long row = base + b * g->stride[1] + c * g->stride[2];
-      for (int a = 0; a < width; a++, k++) {
-        st->node[k] = row + a;
-        if (what & MPM_STENCIL_W) st->w[k] = w[0][a] * wbc;
-        if (what & MPM_STENCIL_GRAD) {
-          st->grad[k][0] = dw[0][a] * wbc;
-          st->grad[k][1] = w[0][a] * gy;
-          st->grad[k][2] = w[0][a] * gz;
-        }
-      }
-    }
-  st->n = k;
-}
-
-/* Expand the stencil of a particle at x (inside the grid's reach, lo <= x
- * < hi) into st: what = MPM_STENCIL_W, MPM_STENCIL_GRAD or both.  Inline so
- * that a constant `what` leaves no test in the loop. */
-static inline void mpm_stencil_at(const mpm_grid *g, const double x[3],
-                                  int what, mpm_stencil *st) {
-  if (g->dim == 3) {
-    if (g->width == 3)
-      mpm_stencil_expand(g, x, what, st, 3, 3);
-    else
-      mpm_stencil_expand(g, x, what, st, 3, 2);
-  } else {
-    if (g->width == 3)
-      mpm_stencil_expand(g, x, what, st, 2, 3);
-    else
-      mpm_stencil_expand(g, x, what, st, 2, 2);
-  }
-}
-
 /* ---- the stencil walked in place ----------------------------------------
- * The same nodes, weights and gradients as mpm_stencil_expand, in the same
- * order and formed by the same products (so every sum is the same to the
- * bit), but computed where they are used: nothing is stored and read
- * back, and the compiler drops what the body does not read.  DIM and WIDTH
- * must be constants.  The body sees `node` (the node's index), `wk` (its
- * weight), `gk0`, `gk1`, `gk2` (its gradient, 1/m) and `gkv` (the same
- * gradient as a vector, the same products lane by lane, the last lane a
- * copy of the third: no lane is built as a zero, whose instruction
- * (vmovq between registers) Valgrind cannot run). */
+ * A particle's nodes in tensor-product order (x fastest), each weight and
+ * gradient formed by the products w_x (w_y w_z), ... (those
+ * mpm_stencil_expand stores, so every sum is the same to the bit), where
+ * they are used: nothing is stored and read back, and the compiler drops what
+ * the body does not read.  DIM and WIDTH must be constants.  The body sees
+ * `node` (the node's index), `wk` (its weight), `gk0`, `gk1`, `gk2` (its
+ * gradient, 1/m) and `gkv` (the same gradient as a vector, the same products
+ * lane by lane, the last lane a copy of the third: no lane is built as a zero,
+ * whose instruction (vmovq between registers) Valgrind cannot run). */
 #define MPM_STENCIL_FOR(g, x, DIM, WIDTH, ...)                                 \
   do {                                                                         \
     const mpm_basis sh_ =                                                      \
@@ -245,6 +191,43 @@ static inline void mpm_stencil_at(const mpm_grid *g, const double x[3],
     else                                                                       \
       FN(__VA_ARGS__, 2, 2);                                                   \
   } while (0)
+
+/* The expansion for a constant dimension and width (the shape follows the
+ * width), so that its loops unroll: the walk above, stored. */
+static inline __attribute__((always_inline)) void
+mpm_stencil_expand(const mpm_grid *g, const double x[3], int what,
+                   mpm_stencil *st, const int dim, const int width) {
+  int k = 0;
+  MPM_STENCIL_FOR(g, x, dim, width, {
+    st->node[k] = node;
+    if (what & MPM_STENCIL_W) st->w[k] = wk;
+    if (what & MPM_STENCIL_GRAD) {
+      st->grad[k][0] = gk0;
+      st->grad[k][1] = gk1;
+      st->grad[k][2] = gk2;
+    }
+    k++;
+  });
+  st->n = k;
+}
+
+/* Expand the stencil of a particle at x (inside the grid's reach, lo <= x
+ * < hi) into st: what = MPM_STENCIL_W, MPM_STENCIL_GRAD or both.  Inline so
+ * that a constant `what` leaves no test in the loop. */
+static inline void mpm_stencil_at(const mpm_grid *g, const double x[3],
+                                  int what, mpm_stencil *st) {
+  if (g->dim == 3) {
+    if (g->width == 3)
+      mpm_stencil_expand(g, x, what, st, 3, 3);
+    else
+      mpm_stencil_expand(g, x, what, st, 3, 2);
+  } else {
+    if (g->width == 3)
+      mpm_stencil_expand(g, x, what, st, 2, 3);
+    else
+      mpm_stencil_expand(g, x, what, st, 2, 2);
+  }
+}
 
 /* Velocity gradient L_ij = sum_I v_Ii dS_I/dx_j at x from the nodal
  * velocities vel (3 per node), for a constant dimension and width. */
