@@ -25,13 +25,15 @@ static bool stress(const pm_material *m, const double F[9], const double *st,
   pm_t_cofactor(F, cof);
   double lnJ = log1p(Jm1);
   double Jm23 = exp(-2.0 / 3.0 * lnJ);
-  double Jm23m1 = expm1(-2.0 / 3.0 * lnJ);
   double I1m3 = 2 * pm_t_trace(H) + pm_t_ddot(H, H); /* tr(F^T F) - 3 */
   double I1 = 3 + I1m3;
   /* F - I1/3 F^-T = F - I1/(3J) cof F */
   double a = mu * Jm23, b = -a * I1 / (3 * J) + kappa * Jm1;
   for (int k = 0; k < 9; k++) P[k] = a * F[k] + b * cof[k];
-  if (W) *W = 0.5 * mu * (Jm23 * I1m3 + 3 * Jm23m1) + 0.5 * kappa * Jm1 * Jm1;
+  /* J^-2/3 - 1 only for the energy: the stress alone skips the expm1. */
+  if (W)
+    *W = 0.5 * mu * (Jm23 * I1m3 + 3 * expm1(-2.0 / 3.0 * lnJ)) +
+         0.5 * kappa * Jm1 * Jm1;
   return pm_hyper_finite(P);
 }
 

@@ -58,9 +58,11 @@ pm_err mpm_nodes_create(mpm_nodes *n, const mpm_grid *g, bool with_vel,
   PM_CALL(PM_ALLOC(n->mass, nn, "grid masses"));
   PM_CALL(PM_ALLOC(n->mom, 3 * nn, "grid momenta"));
   PM_CALL(PM_ALLOC(n->force, 3 * nn, "grid forces"));
-  PM_CALL(PM_ALLOC(n->vel0, 3 * nn, "grid velocities"));
+  /* One double past the last node: g2p reads a node's three components
+   * as four (the fourth unused). */
+  PM_CALL(PM_ALLOC(n->vel0, 3 * nn + 1, "grid velocities"));
   if (with_vel) PM_CALL(PM_ALLOC(n->vel, 3 * nn, "grid velocities"));
-  PM_CALL(PM_ALLOC(n->vel_new, 3 * nn, "grid velocities"));
+  PM_CALL(PM_ALLOC(n->vel_new, 3 * nn + 1, "grid velocities"));
   n->vel_stress = n->vel ? n->vel : n->vel_new;
   n->threads = threads;
   n->acc_stride = with_impedance ? MPM_ACC_BASE + 2 : MPM_ACC_BASE;

@@ -1,7 +1,7 @@
 /* mpm_grid: the MPM background grid: its geometry (fixed after setup), the
- * nodal arrays a step fills, and a particle's stencil expanded into flat
- * lists of nodes, weights and weight gradients, which every transfer
- * walks. */
+ * nodal arrays a step fills, and a particle's stencil, expanded into flat
+ * lists of nodes, weights and weight gradients or walked in place by the
+ * explicit step's transfers. */
 #ifndef MPM_GRID_H
 #define MPM_GRID_H
 
@@ -33,8 +33,29 @@ typedef struct {
   double node_volume;  /* h^dim */
 } mpm_grid;
 
-/* Node accumulator record in the per-thread buffers. */
-enum { MPM_ACC_M = 0, MPM_ACC_P = 1, MPM_ACC_F = 4, MPM_ACC_BASE = 7 };
+/* Node accumulator record in the per-thread buffers: mass and momentum,
+ * then the force and a pad (never read), each four doubles that a transfer
+ * adds as one vector, then the impedance sums. */
+enum {
+  MPM_ACC_M = 0,
+  MPM_ACC_P = 1,
+  MPM_ACC_F = 4,
+  MPM_ACC_PAD = 7,
+  MPM_ACC_BASE = 8
+};
+
+/* Four doubles as one vector (GNU C vector extension: AVX's 256-bit
+ * registers on x86-64-v3, two 128-bit halves on v2), loaded and stored
+ * without alignment. */
+typedef double mpm_v4 __attribute__((vector_size(32)));
+static inline mpm_v4 mpm_v4_load(const double *p) {
+  mpm_v4 v;
+  memcpy(&v, p, sizeof v);
+  return v;
+}
+static inline void mpm_v4_store(double *p, mpm_v4 v) {
+  memcpy(p, &v, sizeof v);
+}
 
 /* The nodal arrays of a step.  Workspace: every step rebuilds them from
  * the particles, so a checkpoint never writes them. */
@@ -42,15 +63,17 @@ typedef struct {
   double *mass;    /* per node */
   double *mom;     /* 3 per node: momentum */
   double *force;   /* 3 per node: internal + external force */
-  double *vel0;    /* 3 per node: velocity before the update */
-  double *vel_new; /* 3 per node: updated (Lagrangian) velocity */
+  double *vel0;    /* 3 per node (and 1 double of padding at the end):
+                      velocity before the update */
+  double *vel_new; /* 3 per node (and the padding): updated (Lagrangian)
+                      velocity */
   double *vel;     /* 3 per node: the velocity of USF (before the update)
                       or MUSL (remapped), with the boundary conditions;
                       NULL for USL */
   const double *vel_stress; /* the velocity the stress update reads */
   /* Per-thread accumulators [threads][n_nodes][acc_stride]. */
   double *acc;
-  int acc_stride; /* 7, or 9 with the impedance sums */
+  int acc_stride; /* 8, or 10 with the impedance sums */
   int threads;
   double *impedance; /* 2 per node: sum w m c_p, sum w m c_s (absorbing
                         faces only) */
@@ -95,9 +118,10 @@ size_t mpm_nodes_bytes(const mpm_nodes *n, const mpm_grid *g);
 
 /* ---- the stencil ---------------------------------------------------------
  * A particle's nodes in tensor-product order (x fastest), with their
- * weights S_I(x_p) and gradients grad S_I(x_p).  Expanded once per particle
- * and transfer, then walked by a flat loop.  The products are formed in
- * one fixed order (w_x (w_y w_z), ...), which every transfer shares. */
+ * weights S_I(x_p) and gradients grad S_I(x_p): expanded into arrays (the
+ * implicit solver, the conditions) or walked in place (MPM_STENCIL_FOR: the
+ * explicit step's transfers).  Both form the products in one fixed order
+ * (w_x (w_y w_z), ...), which every transfer shares. */
 
 #define MPM_STENCIL_MAX 27
 enum { MPM_STENCIL_W = 1, MPM_STENCIL_GRAD = 2 };
@@ -109,40 +133,81 @@ typedef struct {
   double grad[MPM_STENCIL_MAX][3]; /* with MPM_STENCIL_GRAD, 1/m */
 } mpm_stencil;
 
+/* ---- the stencil walked in place ----------------------------------------
+ * A particle's nodes in tensor-product order (x fastest), each weight and
+ * gradient formed by the products w_x (w_y w_z), ... (those
+ * mpm_stencil_expand stores, so every sum is the same to the bit), where
+ * they are used: nothing is stored and read back, and the compiler drops what
+ * the body does not read.  DIM and WIDTH must be constants.  The body sees
+ * `node` (the node's index), `wk` (its weight), `gk0`, `gk1`, `gk2` (its
+ * gradient, 1/m) and `gkv` (the same gradient as a vector, the same products
+ * lane by lane, the last lane a copy of the third: no lane is built as a zero,
+ * whose instruction (vmovq between registers) Valgrind cannot run). */
+#define MPM_STENCIL_FOR(g, x, DIM, WIDTH, ...)                                 \
+  do {                                                                         \
+    const mpm_basis sh_ =                                                      \
+        (WIDTH) == 3 ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;                 \
+    long base_ = 0;                                                            \
+    double w_[3][3], dw_[3][3];                                                \
+    w_[2][0] = 1;                                                              \
+    dw_[2][0] = 0;                                                             \
+    for (int c_ = 0; c_ < (DIM); c_++) {                                       \
+      long i0_;                                                                \
+      mpm_shape_1d(sh_, ((x)[c_] - (g)->origin[c_]) * (g)->inv_h, (g)->inv_h,  \
+                   &i0_, w_[c_], dw_[c_]);                                     \
+      base_ += (i0_ - (g)->offset[c_]) * (g)->stride[c_];                      \
+    }                                                                          \
+    for (int c_ = 0; c_ < ((DIM) == 3 ? (WIDTH) : 1); c_++)                    \
+      for (int b_ = 0; b_ < (WIDTH); b_++) {                                   \
+        const double wbc_ = w_[1][b_] * w_[2][c_];                             \
+        const double gy_ = dw_[1][b_] * w_[2][c_];                             \
+        const double gz_ = w_[1][b_] * dw_[2][c_];                             \
+        const long row_ = base_ + b_ * (g)->stride[1] + c_ * (g)->stride[2];   \
+        for (int a_ = 0; a_ < (WIDTH); a_++) {                                 \
+          const long node = row_ + a_;                                         \
+          const double wk = w_[0][a_] * wbc_;                                  \
+          const double gk0 = dw_[0][a_] * wbc_;                                \
+          const double gk1 = w_[0][a_] * gy_;                                  \
+          const double gk2 = w_[0][a_] * gz_;                                  \
+          const mpm_v4 gkv =                                                   \
+              (mpm_v4){dw_[0][a_], w_[0][a_], w_[0][a_], w_[0][a_]} *          \
+              (mpm_v4){wbc_, gy_, gz_, gz_};                                   \
+          (void)node, (void)wk, (void)gk0, (void)gk1, (void)gk2, (void)gkv;    \
+          __VA_ARGS__                                                          \
+        }                                                                      \
+      }                                                                        \
+  } while (0)
+
+/* Call FN(..., dim, width) with the grid's dimension and width as
+ * constants (FN inline: one copy of its loops a combination). */
+#define MPM_STENCIL_DISPATCH(g, FN, ...)                                       \
+  do {                                                                         \
+    if ((g)->dim == 3 && (g)->width == 3)                                      \
+      FN(__VA_ARGS__, 3, 3);                                                   \
+    else if ((g)->dim == 3)                                                    \
+      FN(__VA_ARGS__, 3, 2);                                                   \
+    else if ((g)->width == 3)                                                  \
+      FN(__VA_ARGS__, 2, 3);                                                   \
+    else                                                                       \
+      FN(__VA_ARGS__, 2, 2);                                                   \
+  } while (0)
+
 /* The expansion for a constant dimension and width (the shape follows the
- * width), so that its loops unroll. */
+ * width), so that its loops unroll: the walk above, stored. */
 static inline __attribute__((always_inline)) void
 mpm_stencil_expand(const mpm_grid *g, const double x[3], int what,
                    mpm_stencil *st, const int dim, const int width) {
-  const mpm_basis shape = width == 3 ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;
-  const int nz = dim == 3 ? width : 1;
-  long base = 0;
-  double w[3][3], dw[3][3];
-  w[2][0] = 1;
-  dw[2][0] = 0;
-  for (int c = 0; c < dim; c++) {
-    long i0;
-    mpm_shape_1d(shape, (x[c] - g->origin[c]) * g->inv_h, g->inv_h, &i0, w[c],
-                 dw[c]);
-    base += (i0 - g->offset[c]) * g->stride[c];
-  }
   int k = 0;
-  for (int c = 0; c < nz; c++)
-    for (int b = 0; b < width; b++) {
-      const double wbc = w[1][b] * w[2][c];
-      const double gy = dw[1][b] * w[2][c];
-      const double gz = w[1][b] * dw[2][c];
-      const long row = base + b * g->stride[1] + c * g->stride[2];
-      for (int a = 0; a < width; a++, k++) {
-        st->node[k] = row + a;
-        if (what & MPM_STENCIL_W) st->w[k] = w[0][a] * wbc;
-        if (what & MPM_STENCIL_GRAD) {
-          st->grad[k][0] = dw[0][a] * wbc;
-          st->grad[k][1] = w[0][a] * gy;
-          st->grad[k][2] = w[0][a] * gz;
-        }
-      }
+  MPM_STENCIL_FOR(g, x, dim, width, {
+    st->node[k] = node;
+    if (what & MPM_STENCIL_W) st->w[k] = wk;
+    if (what & MPM_STENCIL_GRAD) {
+      st->grad[k][0] = gk0;
+      st->grad[k][1] = gk1;
+      st->grad[k][2] = gk2;
     }
+    k++;
+  });
   st->n = k;
 }
 
@@ -165,30 +230,29 @@ static inline void mpm_stencil_at(const mpm_grid *g, const double x[3],
 }
 
 /* Velocity gradient L_ij = sum_I v_Ii dS_I/dx_j at x from the nodal
+ * velocities vel (3 per node), for a constant dimension and width. */
+static inline __attribute__((always_inline)) void
+mpm_velocity_gradient_dw(const mpm_grid *g, const double *vel,
+                         const double x[3], double L[9], const int dim,
+                         const int width) {
+  /* Three rows of L as vectors, l_i += v_i grad S, lane by lane the
+   * products and sums of the scalar loop. */
+  mpm_v4 r0 = {0, 0, 0, 0}, r1 = r0, r2 = r0;
+  MPM_STENCIL_FOR(g, x, dim, width, {
+    const double *v = vel + 3 * node;
+    r0 += v[0] * gkv;
+    r1 += v[1] * gkv;
+    r2 += v[2] * gkv;
+  });
+  L[0] = r0[0], L[1] = r0[1], L[2] = r0[2], L[3] = r1[0], L[4] = r1[1];
+  L[5] = r1[2], L[6] = r2[0], L[7] = r2[1], L[8] = r2[2];
+}
+
+/* Velocity gradient L_ij = sum_I v_Ii dS_I/dx_j at x from the nodal
  * velocities vel (3 per node). */
 static inline void mpm_velocity_gradient(const mpm_grid *g, const double *vel,
                                          const double x[3], double L[9]) {
-  mpm_stencil st;
-  mpm_stencil_at(g, x, MPM_STENCIL_GRAD, &st);
-  /* Nine named sums: held in registers.  As an array, the compiler
-   * vectorises the sums across nodes (in order, to keep them exact) at
-   * twice the instructions. */
-  double l0 = 0, l1 = 0, l2 = 0, l3 = 0, l4 = 0, l5 = 0, l6 = 0, l7 = 0, l8 = 0;
-  for (int k = 0; k < st.n; k++) {
-    const double *v = vel + 3 * st.node[k];
-    const double g0 = st.grad[k][0], g1 = st.grad[k][1], g2 = st.grad[k][2];
-    l0 += v[0] * g0;
-    l1 += v[0] * g1;
-    l2 += v[0] * g2;
-    l3 += v[1] * g0;
-    l4 += v[1] * g1;
-    l5 += v[1] * g2;
-    l6 += v[2] * g0;
-    l7 += v[2] * g1;
-    l8 += v[2] * g2;
-  }
-  L[0] = l0, L[1] = l1, L[2] = l2, L[3] = l3, L[4] = l4;
-  L[5] = l5, L[6] = l6, L[7] = l7, L[8] = l8;
+  MPM_STENCIL_DISPATCH(g, mpm_velocity_gradient_dw, g, vel, x, L);
 }
 
 #endif

@@ -124,7 +124,7 @@ void mpm_pipeline_build(mpm_model *m) {
            o->null_velocity ? ", null directions" : "",
            m->n_moving ? ", nodes of moving bodies at their velocity" : "",
            n_rigid ? ", rigid bodies in the grid's contact" : "");
-  st = add(pl, "g2p", mpm_stage_g2p);
+  mpm_stage *g2p = st = add(pl, "g2p", mpm_stage_g2p);
   snprintf(st->detail, sizeof st->detail,
            "particle velocities (FLIP %g / PIC %g)", o->flip, 1 - o->flip);
   if (m->n_moving > 0) {
@@ -145,9 +145,16 @@ void mpm_pipeline_build(mpm_model *m) {
              n_grips, n_grips == 1 ? "" : "s");
   }
   if (o->update == MPM_MUSL) {
+    /* With no stage between them that moves particles' velocities, g2p
+     * scatters the remap's momentum at the weights it has just used. */
+    const bool fused = m->n_moving == 0 && n_grips == 0;
+    g2p->mode = fused ? MPM_P2G_MOM : 0;
     st = add(pl, "remap", mpm_stage_remap);
-    snprintf(st->detail, sizeof st->detail,
-             "MUSL: momentum from the updated particles");
+    st->mode = fused ? 0 : MPM_P2G_MOM;
+    snprintf(st->detail, sizeof st->detail, "%s",
+             fused ? "MUSL: momentum from the updated particles (scattered "
+                     "by g2p), the grid velocity"
+                   : "MUSL: momentum from the updated particles");
   }
   if (o->update != MPM_USF) add_stress(m);
   st = add(pl, "move", mpm_stage_move);

@@ -117,7 +117,9 @@ static pm_err fluid_stress(mpm_ctx *ctx, const mpm_stage *self) {
   double maxdiv = 0, Jlow = INFINITY;
   int itmax = 0;
   long capped = 0;
-  PM_OMP(parallel for schedule(static) default(none)
+  /* Chunks dealt in turn: the iterations of the energy update gather at
+   * the shock and the fan, which a thread's one block would hold alone. */
+  PM_OMP(parallel for schedule(static, 256) default(none)
          shared(g, fp, fl, w, dt, h, c0, c1, begin, end, vel, x, mass, vol0,
                 rho_a, e_a, p_a, vol, sigma, qa)
          reduction(max : maxdiv, itmax) reduction(+ : capped)

@@ -1,5 +1,5 @@
-/* mpm_transfer: the transfers between particles and grid, each a flat
- * loop over a particle's expanded stencil. */
+/* mpm_transfer: the transfers between particles and grid, each a loop
+ * over a particle's stencil walked in place (MPM_STENCIL_FOR). */
 #include "mpm_transfer.h"
 
 #include <math.h>
@@ -20,23 +20,19 @@ static inline int thread_id(void) {
 }
 
 /* One thread's share of the particles of a group into its accumulators
- * acc.  Inline, so that each constant mode gets its own loop. */
+ * acc.  Inline, so that each constant mode, dimension and width gets its
+ * own loop. */
 static inline __attribute__((always_inline)) void
 p2g_group(const mpm_model *m, const mpm_state *s, const mpm_work *w,
           const mpm_group *gr, double *restrict acc, const int mode,
-          const bool imp) {
+          const bool imp, const int dim, const int width) {
   const mpm_grid *g = &m->grid;
   const int S = w->nodes.acc_stride;
-  const bool weights = (mode & (MPM_P2G_MASS | MPM_P2G_MOM)) || imp;
-  const int what = (weights ? MPM_STENCIL_W : 0) |
-                   (mode & MPM_P2G_FORCE ? MPM_STENCIL_GRAD : 0);
   const double *restrict x = s->x, *restrict v = s->v, *restrict vol = s->vol,
                          *restrict sigma = s->sigma, *restrict mass = m->mass;
   const double *restrict cp_p = w->cp, *restrict cs_p = w->cs;
   PM_OMP(for schedule(static) nowait)
   for (long p = gr->begin; p < gr->end; p++) {
-    mpm_stencil st;
-    mpm_stencil_at(g, x + 3 * p, what, &st);
     const double mp = mass[p];
     const double *vp = v + 3 * p;
     double sg[9] = {0};
@@ -49,42 +45,57 @@ p2g_group(const mpm_model *m, const mpm_state *s, const mpm_work *w,
       cp = cp_p[p] * rho;
       cs = cs_p[p] * rho;
     }
-    for (int k = 0; k < st.n; k++) {
-      double *r = acc + st.node[k] * S;
-      if (mode & MPM_P2G_MASS) r[MPM_ACC_M] += st.w[k] * mp;
+    /* Mass and momentum as one vector: w m (1, v) (a nil mass lane
+     * without MPM_P2G_MASS); the force as the columns of -V sigma times
+     * the gradient's components, summed in the scalar order, the pad lane
+     * a copy of the third (not a zero: see MPM_STENCIL_FOR). */
+    const mpm_v4 mv = {mode & MPM_P2G_MASS ? 1.0 : 0.0, vp[0], vp[1], vp[2]};
+    const mpm_v4 s0 = {sg[0], sg[3], sg[6], sg[6]},
+                 s1 = {sg[1], sg[4], sg[7], sg[7]},
+                 s2 = {sg[2], sg[5], sg[8], sg[8]};
+    MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
+      double *r = acc + node * S;
       if (mode & MPM_P2G_MOM) {
-        r[MPM_ACC_P + 0] += st.w[k] * mp * vp[0];
-        r[MPM_ACC_P + 1] += st.w[k] * mp * vp[1];
-        r[MPM_ACC_P + 2] += st.w[k] * mp * vp[2];
+        const mpm_v4 r0 = mpm_v4_load(r + MPM_ACC_M);
+        mpm_v4_store(r + MPM_ACC_M, r0 + wk * mp * mv);
+      } else if (mode & MPM_P2G_MASS) {
+        r[MPM_ACC_M] += wk * mp;
       }
       if (mode & MPM_P2G_FORCE) {
-        const double *gr3 = st.grad[k];
-        r[MPM_ACC_F + 0] += sg[0] * gr3[0] + sg[1] * gr3[1] + sg[2] * gr3[2];
-        r[MPM_ACC_F + 1] += sg[3] * gr3[0] + sg[4] * gr3[1] + sg[5] * gr3[2];
-        r[MPM_ACC_F + 2] += sg[6] * gr3[0] + sg[7] * gr3[1] + sg[8] * gr3[2];
+        const mpm_v4 r1 = mpm_v4_load(r + MPM_ACC_F);
+        mpm_v4_store(r + MPM_ACC_F, r1 + (s0 * gk0 + s1 * gk1 + s2 * gk2));
         if (imp) {
-          r[MPM_ACC_BASE + 0] += st.w[k] * mp * cp;
-          r[MPM_ACC_BASE + 1] += st.w[k] * mp * cs;
+          r[MPM_ACC_BASE + 0] += wk * mp * cp;
+          r[MPM_ACC_BASE + 1] += wk * mp * cs;
         }
       }
-    }
+    });
   }
+}
+
+/* Every group into acc, with a constant mode, dimension and width. */
+static inline __attribute__((always_inline)) void
+p2g_groups_dw(const mpm_model *m, const mpm_state *s, const mpm_work *w,
+              double *acc, const int mode, const bool imp, const int dim,
+              const int width) {
+  for (int gi = 0; gi < m->n_groups; gi++)
+    p2g_group(m, s, w, &m->group[gi], acc, mode, imp, dim, width);
 }
 
 /* Every group into acc, with a constant mode. */
 static inline __attribute__((always_inline)) void
 p2g_groups(const mpm_model *m, const mpm_state *s, const mpm_work *w,
            double *acc, const int mode, const bool imp) {
-  for (int gi = 0; gi < m->n_groups; gi++)
-    p2g_group(m, s, w, &m->group[gi], acc, mode, imp);
+  MPM_STENCIL_DISPATCH(&m->grid, p2g_groups_dw, m, s, w, acc, mode, imp);
 }
 
 /* The threads' accumulators summed in thread order into the nodal arrays
- * (inside the parallel region). */
+ * (inside the parallel region, as its last loop: the region's end is the
+ * barrier after it). */
 static void reduce_nodes(mpm_nodes *nd, long nn, int mode, bool imp) {
   const int S = nd->acc_stride;
   const int T = pm_omp_team();
-  PM_OMP(for schedule(static))
+  PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < nn; i++) {
     double sum[MPM_ACC_BASE + 2] = {0};
     for (int t = 0; t < T; t++) {
@@ -140,31 +151,35 @@ pm_err mpm_stage_p2g(mpm_ctx *ctx, const mpm_stage *self) {
   return mpm_p2g(ctx, self->mode);
 }
 
-pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
-  const mpm_model *m = ctx->model;
-  mpm_state *s = ctx->state;
-  mpm_work *w = ctx->work;
+/* The FLIP/PIC velocities and the position increments of a group's
+ * particles (this thread's share), for a constant dimension and width;
+ * with `remap`, MUSL's momentum of the updated velocities scattered at the
+ * same weights into acc (this thread's accumulators), as mpm_p2g's
+ * MPM_P2G_MOM would: the same particles a thread, the same order. */
+static inline __attribute__((always_inline)) void
+g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
+          const double *restrict x, double *restrict v, double *restrict acc,
+          const bool remap, const int dim, const int width) {
   const mpm_grid *g = &m->grid;
-  const long n = m->n;
-  const double flip = m->opt.flip, dt = s->dt;
-  const double *restrict vel_new = w->nodes.vel_new, *restrict vel0 =
-                                                         w->nodes.vel0;
-  const double *restrict x = s->x;
-  double *restrict v = s->v, *restrict dx = w->dx;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(g, n, flip, dt, vel_new, vel0, x, v, dx, w))
-  for (long p = 0; p < n; p++) {
-    mpm_stencil st;
-    mpm_stencil_at(g, x + 3 * p, MPM_STENCIL_W, &st);
-    double vn[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
-    for (int k = 0; k < st.n; k++) {
-      const double *v1 = vel_new + 3 * st.node[k];
-      const double *v0 = vel0 + 3 * st.node[k];
-      for (int c = 0; c < 3; c++) {
-        vn[c] += st.w[k] * v1[c];
-        dv[c] += st.w[k] * (v1[c] - v0[c]);
-      }
-    }
+  const double flip = m->opt.flip;
+  const int S = w->nodes.acc_stride;
+  const double *restrict vel_new = w->nodes.vel_new,
+                         *restrict vel0 = w->nodes.vel0,
+                         *restrict mass = m->mass;
+  double *restrict dx = w->dx;
+  PM_OMP(for schedule(static) nowait)
+  for (long p = gr->begin; p < gr->end; p++) {
+    /* A node's three components read as four (the nodal arrays are
+     * padded), the fourth lane unused; lane by lane the scalar sums. */
+    mpm_v4 vn4 = {0, 0, 0, 0}, dv4 = vn4;
+    MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
+      const mpm_v4 v1 = mpm_v4_load(vel_new + 3 * node);
+      const mpm_v4 v0 = mpm_v4_load(vel0 + 3 * node);
+      vn4 += wk * v1;
+      dv4 += wk * (v1 - v0);
+    });
+    const double vn[3] = {vn4[0], vn4[1], vn4[2]},
+                 dv[3] = {dv4[0], dv4[1], dv4[2]};
     double *vp = v + 3 * p;
     for (int c = 0; c < 3; c++) {
       vp[c] = flip * (vp[c] + dv[c]) + (1.0 - flip) * vn[c];
@@ -173,13 +188,57 @@ pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
     if (!isfinite(vp[0] + vp[1] + vp[2]))
       mpm_fail(w, p, "velocity is not finite (|v|^2 = %g, v_x = %g)",
                vp[0] * vp[0] + vp[1] * vp[1] + vp[2] * vp[2], vp[0]);
+    if (remap) {
+      /* As mpm_p2g's w m (1, v): the mass lane is not read back. */
+      const double mp = mass[p];
+      const mpm_v4 mv = {1.0, vp[0], vp[1], vp[2]};
+      MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
+        double *r = acc + node * S;
+        mpm_v4_store(r + MPM_ACC_M, mpm_v4_load(r + MPM_ACC_M) + wk * mp * mv);
+      });
+    }
   }
+}
+
+/* Every group, for a constant dimension and width. */
+static inline __attribute__((always_inline)) void
+g2p_groups(mpm_work *w, const mpm_model *m, double dt, const double *x,
+           double *v, double *acc, const bool remap, const int dim,
+           const int width) {
+  for (int gi = 0; gi < m->n_groups; gi++)
+    g2p_group(w, m, &m->group[gi], dt, x, v, acc, remap, dim, width);
+}
+
+pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
+  const mpm_model *m = ctx->model;
+  mpm_state *s = ctx->state;
+  mpm_work *w = ctx->work;
+  mpm_nodes *nd = &w->nodes;
+  const mpm_grid *g = &m->grid;
+  const long nn = g->n_nodes;
+  const double dt = s->dt;
+  const double *x = s->x;
+  double *v = s->v;
+  const bool remap = self->mode == MPM_P2G_MOM;
+  PM_OMP(parallel num_threads(nd->threads) default(none)
+             shared(m, w, nd, g, nn, dt, x, v, remap)) {
+    double *acc = nd->acc + (size_t)thread_id() * nn * nd->acc_stride;
+    if (remap) {
+      memset(acc, 0, sizeof(double) * nn * nd->acc_stride);
+      MPM_STENCIL_DISPATCH(g, g2p_groups, w, m, dt, x, v, acc, true);
+      PM_OMP(barrier)
+      reduce_nodes(nd, nn, MPM_P2G_MOM, false);
+    } else {
+      MPM_STENCIL_DISPATCH(g, g2p_groups, w, m, dt, x, v, acc, false);
+    }
+  }
+  if (remap) PM_CALL(mpm_xc_sum_nodes(m, nd, MPM_P2G_MOM, false));
   return mpm_stage_status(ctx, self);
 }
 
 pm_err mpm_stage_remap(mpm_ctx *ctx, const mpm_stage *self) {
-  (void)self;
-  PM_CALL(mpm_p2g(ctx, MPM_P2G_MOM));
+  /* Mode 0: g2p scattered the momentum already. */
+  if (self->mode) PM_CALL(mpm_p2g(ctx, MPM_P2G_MOM));
   mpm_grid_velocity(ctx);
   return mpm_conditions_status(ctx);
 }
