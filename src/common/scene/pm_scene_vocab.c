@@ -31,6 +31,10 @@ static const pm_name linear_names[] = {
     {"direct", PM_LINEAR_DIRECT},       {"gmres-gamg", PM_LINEAR_GMRES_GAMG},
     {"cg-jacobi", PM_LINEAR_CG_JACOBI}, {"gmres-ilu", PM_LINEAR_GMRES_ILU},
     {"cg-gamg", PM_LINEAR_CG_GAMG},     {NULL, 0}};
+static const pm_name amg_operator_names[] = {{"support", PM_AMG_SUPPORT},
+                                             {"support2", PM_AMG_SUPPORT2},
+                                             {"tangent", PM_AMG_TANGENT},
+                                             {NULL, 0}};
 static const pm_name dt_rule_names[] = {
     {"paper", PM_DT_PAPER}, {"spectral", PM_DT_SPECTRAL}, {NULL, 0}};
 static const pm_name field_names[] = {
@@ -782,6 +786,18 @@ static const pm_key quasi_static_keys[] = {
             "so by default only up to 15000 free dofs); false: the LU of "
             "the tangent without it, which preconditions GMRES on the exact "
             "tangent"},
+    {.name = "multigrid_operator",
+     .type = PM_KEY_ENUM,
+     .offset = S(time.qs_amg),
+     .def = "support",
+     .names = amg_operator_names,
+     .doc = "method static (FPM, gmres-gamg or cg-gamg, one process): what "
+            "multigrid is built on: support, the tangent's blocks of each "
+            "point's own support (its neighbours; a tenth of the "
+            "tangent's entries); support2, those of its supports' "
+            "supports; tangent, the whole assembled tangent (3 rings with "
+            "the quadratic jump); the exact tangent is the Krylov "
+            "operator in every case"},
     {.name = "solver_options",
      .type = PM_KEY_STRING,
      .offset = S(time.qs_solver_options),

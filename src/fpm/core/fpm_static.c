@@ -168,6 +168,20 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
     PM_TRY(fpm_static_coupled_build(&v));
     rep->coupled_entries = v.c.cp.ptr[c->nf + m->n];
   }
+  /* Multigrid on one process: built on the tangent on each point's own
+   * support (fpm_static_support.c), the exact tangent applied matrix-free
+   * (docs/validation.md, "Static solves at 13762 points: a cheaper
+   * preconditioner"). */
+  if ((no.linear == PM_NEWTON_GMRES_GAMG || no.linear == PM_NEWTON_CG_GAMG) &&
+      !m->xc && s->time.qs_amg != PM_AMG_TANGENT) {
+    const int rings = s->time.qs_amg == PM_AMG_SUPPORT ? 1 : 2;
+    PM_TRY(fpm_static_support_build(m, v.free_of, c->nf, rings, &c->sp));
+    v.prob.precond_values = fpm_static_support_values;
+    v.prob.pc_pat_ptr = c->sp.ptr;
+    v.prob.pc_pat_idx = c->sp.idx;
+    no.op = PM_NEWTON_MATRIX_FREE_CHEAP_PC;
+    no.pc_right = true;
+  }
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
   c->solver = solver;
   rep->setup_seconds = pm_wtime() - w0;
