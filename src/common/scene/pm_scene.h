@@ -41,9 +41,9 @@ typedef enum {
 /* What algebraic multigrid is built on in an FPM static solve
  * (time.quasi_static.multigrid_operator). */
 typedef enum {
-  PM_AMG_SUPPORT = 0, /* the tangent on each point's own support */
-  PM_AMG_SUPPORT2,    /* the tangent on its supports' supports */
-  PM_AMG_TANGENT      /* the assembled tangent (3 rings) */
+  PM_AMG_TANGENT = 0, /* the assembled tangent (3 rings) */
+  PM_AMG_SUPPORT,     /* the tangent on each point's own support */
+  PM_AMG_SUPPORT2     /* the tangent on its supports' supports */
 } pm_amg_operator;
 
 /* How the stable time step is found. */

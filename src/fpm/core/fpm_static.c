@@ -49,6 +49,12 @@ bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
          unknowns <= FPM_STATIC_COUPLED_MAX;
 }
 
+bool fpm_static_amg_on_support(const pm_scene *s, const fpm_model *m,
+                               pm_newton_linear linear) {
+  return (linear == PM_NEWTON_GMRES_GAMG || linear == PM_NEWTON_CG_GAMG) &&
+         !m->xc && s->time.qs_amg != PM_AMG_TANGENT;
+}
+
 void fpm_static_choose_linear(const pm_scene *s, long unknowns,
                               pm_newton_options *o) {
   o->linear = pm_scene_has(s, "time.quasi_static.linear_solver")
@@ -168,12 +174,12 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
     PM_TRY(fpm_static_coupled_build(&v));
     rep->coupled_entries = v.c.cp.ptr[c->nf + m->n];
   }
-  /* Multigrid on one process: built on the tangent on each point's own
-   * support (fpm_static_support.c), the exact tangent applied matrix-free
-   * (docs/validation.md, "Static solves at 13762 points: a cheaper
-   * preconditioner"). */
-  if ((no.linear == PM_NEWTON_GMRES_GAMG || no.linear == PM_NEWTON_CG_GAMG) &&
-      !m->xc && s->time.qs_amg != PM_AMG_TANGENT) {
+  /* Multigrid on one process built on the tangent on each point's own
+   * support (multigrid_operator support or support2,
+   * fpm_static_support.c), the exact tangent applied matrix-free: less
+   * memory, more CPU (docs/validation.md, "Static solves at 13762 points:
+   * a cheaper preconditioner"). */
+  if (fpm_static_amg_on_support(s, m, no.linear)) {
     const int rings = s->time.qs_amg == PM_AMG_SUPPORT ? 1 : 2;
     PM_TRY(fpm_static_support_build(m, v.free_of, c->nf, rings, &c->sp));
     v.prob.precond_values = fpm_static_support_values;
