@@ -38,6 +38,14 @@ typedef enum {
   PM_LINEAR_CG_GAMG     /* CG + algebraic multigrid (symmetric problems) */
 } pm_linear_solver;
 
+/* What algebraic multigrid is built on in an FPM static solve
+ * (time.quasi_static.multigrid_operator). */
+typedef enum {
+  PM_AMG_TANGENT = 0, /* the assembled tangent (3 rings) */
+  PM_AMG_SUPPORT,     /* the tangent on each point's own support */
+  PM_AMG_SUPPORT2     /* the tangent on its supports' supports */
+} pm_amg_operator;
+
 /* How the stable time step is found. */
 typedef enum {
   PM_DT_PAPER = 0, /* the method's bound (FPM: eqs. 24-26 of its paper) */
@@ -307,6 +315,7 @@ typedef struct pm_scene {
     long qs_reuse;              /* ...reuse_iterations (FPM static) */
     bool qs_inexact;            /* ...inexact: Eisenstat-Walker (FPM) */
     bool qs_coupled;            /* ...averaged_coupling (FPM) */
+    pm_amg_operator qs_amg;     /* ...multigrid_operator (FPM) */
     char *qs_solver_options;    /* ...solver_options: PETSc options */
     long max_steps;             /* time.max_steps; 0: no limit */
   } time;

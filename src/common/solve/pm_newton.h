@@ -123,6 +123,12 @@ typedef struct {
                           double *dr);
   const long *pc_pat_ptr;
   const long *pc_pat_idx;
+  /* The cheaper operator's values at x (after jacobian_prepare there) in
+   * the order of its pattern (val[k] for pc_pat_idx[k]; repeated entries
+   * are summed): the caller assembles it, and no colouring is made (in
+   * place of precond_apply; op PM_NEWTON_MATRIX_FREE_CHEAP_PC only).  A
+   * failure aborts the solve.  Optional (NULL). */
+  pm_err (*precond_values)(void *ctx, const double *x, double *val);
 
   /* A preconditioner factorised from a larger matrix (the direct solver
    * with op PM_NEWTON_MATRIX_FREE, one process): M = [J0 G; C I] over the
@@ -207,7 +213,8 @@ typedef enum {
   PM_NEWTON_MATRIX_FREE,         /* J applied by jacobian_apply; J assembled
                                     by colouring for the preconditioner */
   PM_NEWTON_MATRIX_FREE_CHEAP_PC /* J applied by jacobian_apply; P assembled
-                                    by colouring from precond_apply */
+                                    by colouring from precond_apply, or by
+                                    the caller (precond_values) */
 } pm_newton_operator;
 
 typedef enum {
@@ -283,8 +290,14 @@ typedef struct {
    * matrix, not the operator (PETSc's -pc_use_amat false; with PETSc's
    * default they call jacobian_apply about four times a V-cycle). */
   bool amg_assembled_smoother; /* false */
-  pm_coloring_order coloring;  /* PM_COLORING_LARGEST_FIRST */
-  pm_line_search line_search;  /* PM_LINE_SEARCH_BT */
+  /* Krylov solvers preconditioned on the right: their residual and
+   * tolerance are the true residual's (on the left, PETSc's default, the
+   * preconditioned one's, which says little of the true residual when the
+   * preconditioner comes from a cheaper operator: inexact Newton's steps
+   * then miss their tolerance).  -pm_ksp_pc_side overrides it. */
+  bool pc_right;              /* false */
+  pm_coloring_order coloring; /* PM_COLORING_LARGEST_FIRST */
+  pm_line_search line_search; /* PM_LINE_SEARCH_BT */
 
   /* Load stepping (pm_load_steps). */
   int load_steps;     /* nominal steps from lambda 0 to 1: 10 */

@@ -58,6 +58,16 @@ pm_err pm_newton_values_at(pm_newton *s, const double *x, double *vals) {
   return PM_SUCCESS;
 }
 
+pm_err pm_newton_precond_values(pm_newton *s, const double *x) {
+  if (!s->p.precond_values)
+    return pm_newton_color_values(s, s->p.precond_apply, &s->pcol, x, s->pvals);
+  PM_CALL(s->p.precond_values(s->p.ctx, x, s->psrcvals));
+  memset(s->pvals, 0, (size_t)s->ppat.ptr[s->ppat.n] * sizeof *s->pvals);
+  for (long k = 0; k < s->ppat.nsrc; k++)
+    s->pvals[s->ppat.src[k]] += s->psrcvals[k];
+  return PM_SUCCESS;
+}
+
 /* Rows of the pattern into M: their values (one process), or added to
  * the rows they are a part of, by local numbers (across ranks). */
 static pm_err set_rows(Mat M, bool dist, const pm_pattern *pat,

@@ -107,7 +107,7 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
     if (s->aug) {
       e = pm_newton_agreed(s, pm_newton_aug_values(s, x));
     } else if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
-      e = pm_newton_color_values(s, s->p.precond_apply, &s->pcol, x, s->pvals);
+      e = pm_newton_precond_values(s, x);
       if (e == PM_SUCCESS)
         e = pm_newton_insert_values(s, B, &s->ppat, s->pcols, s->pvals);
     } else {

@@ -73,9 +73,11 @@ static pm_err check_problem(const pm_newton_problem *p,
   PM_CHECK(p->pat_ptr[rows] + rows <= PETSC_MAX_INT, PM_ERR_ARG,
            "Newton problem: %ld pattern entries exceed PETSc's indices",
            p->pat_ptr[rows]);
-  PM_CHECK(o->op != PM_NEWTON_MATRIX_FREE_CHEAP_PC || p->precond_apply,
+  PM_CHECK(o->op != PM_NEWTON_MATRIX_FREE_CHEAP_PC || p->precond_apply ||
+               p->precond_values,
            PM_ERR_ARG,
-           "Newton problem: the cheap preconditioner needs precond_apply");
+           "Newton problem: the cheap preconditioner needs precond_apply or "
+           "precond_values");
   PM_CHECK(!p->pc_pat_ptr == !p->pc_pat_idx, PM_ERR_ARG,
            "Newton problem: give both pc_pat_ptr and pc_pat_idx, or neither");
   if (!p->shared || !pm_par_active()) return PM_SUCCESS;
@@ -217,7 +219,11 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
     const long *idx =
         problem->pc_pat_ptr ? problem->pc_pat_idx : problem->pat_idx;
     PM_TRY(pm_pattern_build(n, ptr, idx, true, &s->ppat));
-    PM_TRY(pm_coloring_build(&s->ppat, options->coloring, &s->pcol));
+    if (problem->precond_values)
+      PM_TRY(PM_ALLOC(s->psrcvals, s->ppat.nsrc > 0 ? s->ppat.nsrc : 1,
+                      "preconditioner values"));
+    else
+      PM_TRY(pm_coloring_build(&s->ppat, options->coloring, &s->pcol));
     PM_TRY(PM_ALLOC(s->pvals, s->ppat.ptr[n], "preconditioner values"));
   }
   PM_TRY(pm_newton_aug_init(s, problem));
@@ -271,6 +277,7 @@ void pm_newton_destroy(pm_newton **sp) {
   free(s->jvals);
   free(s->srcvals);
   free(s->pvals);
+  free(s->psrcvals);
   free(s->seed);
   free(s->dr);
   free(s->petsc_options);

@@ -172,6 +172,8 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
     if (!strcmp(type, KSPGMRES))
       PM_PETSC(KSPGMRESSetRestart(ksp, (PetscInt)o->gmres_restart));
   }
+  if (o->pc_right && o->linear != PM_NEWTON_DIRECT)
+    PM_PETSC(KSPSetPCSide(ksp, PC_RIGHT));
   PM_PETSC(KSPSetPreSolve(ksp, linear_presolve, s));
   PM_PETSC(KSPSetPostSolve(ksp, pm_newton_linear_postsolve, s));
   PM_PETSC(PetscOptionsPush(s->opts));

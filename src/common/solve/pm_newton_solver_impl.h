@@ -25,6 +25,7 @@ struct pm_newton {
   double *jvals, *pvals;   /* values in pattern order */
   double *seed, *dr;       /* colour seed and its image */
   double *srcvals;         /* jacobian_values: values in the caller's order */
+  double *psrcvals;        /* precond_values: values in the caller's order */
   Vec X, R, Xstart, Xlin, Xacc, Work;
   /* pc_reuse_its: where the kept factorisation or preconditioner was
    * built (Xpc) and under which load (pc_load; load: the last set). */
@@ -115,6 +116,10 @@ pm_err pm_newton_color_values(pm_newton *s, apply_fn f, const pm_coloring *col,
 /* The Jacobian's values at x in pattern order: the caller's assembly when
  * it gives one, else colouring. */
 pm_err pm_newton_values_at(pm_newton *s, const double *x, double *vals);
+/* The cheaper operator's values at x into s->pvals (pattern order): the
+ * caller's assembly (precond_values) when it gives one, else colouring of
+ * precond_apply. */
+pm_err pm_newton_precond_values(pm_newton *s, const double *x);
 
 /* M = vals on the pattern (the matrix's preallocated structure). */
 pm_err pm_newton_insert_values(const pm_newton *s, Mat M, const pm_pattern *pat,

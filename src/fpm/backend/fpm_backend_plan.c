@@ -133,7 +133,7 @@ static double plan_head(fpm_sim *sim, FILE *out) {
         "             %d. Newton's method in %ld proportional load steps "
         "(at most %ld iterations each), %ld prescribed dofs\n"
         "             tangent assembled directly (%s), linear solver "
-        "%s (%s)%s%s\n",
+        "%s (%s)%s%s%s\n",
         stage++, s->time.qs_load_steps, s->time.qs_max_iterations, m->n_cdofs,
         coupled ? "with the averages' coupling through one unknown a point: "
                   "the exact tangent's LU"
@@ -141,6 +141,9 @@ static double plan_head(fpm_sim *sim, FILE *out) {
             ? "preconditioning the exact tangent applied matrix-free"
             : "exact",
         linear[no.linear], why,
+        fpm_static_amg_on_support(s, m, no.linear)
+            ? ", built on each point's support (multigrid_operator)"
+            : "",
         no.pc_reuse_its > 0 ? ", kept while GMRES takes few iterations" : "",
         no.linear_ew ? ", inexact Newton" : "");
     /* The tangent and its factors or multigrid hierarchy, per tangent

@@ -49,6 +49,12 @@ bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
          unknowns <= FPM_STATIC_COUPLED_MAX;
 }
 
+bool fpm_static_amg_on_support(const pm_scene *s, const fpm_model *m,
+                               pm_newton_linear linear) {
+  return (linear == PM_NEWTON_GMRES_GAMG || linear == PM_NEWTON_CG_GAMG) &&
+         !m->xc && s->time.qs_amg != PM_AMG_TANGENT;
+}
+
 void fpm_static_choose_linear(const pm_scene *s, long unknowns,
                               pm_newton_options *o) {
   o->linear = pm_scene_has(s, "time.quasi_static.linear_solver")
@@ -167,6 +173,20 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   if (fpm_static_couples(s, m, rep->unknowns, no.linear)) {
     PM_TRY(fpm_static_coupled_build(&v));
     rep->coupled_entries = v.c.cp.ptr[c->nf + m->n];
+  }
+  /* Multigrid on one process built on the tangent on each point's own
+   * support (multigrid_operator support or support2,
+   * fpm_static_support.c), the exact tangent applied matrix-free: less
+   * memory, more CPU (docs/validation.md, "Static solves at 13762 points:
+   * a cheaper preconditioner"). */
+  if (fpm_static_amg_on_support(s, m, no.linear)) {
+    const int rings = s->time.qs_amg == PM_AMG_SUPPORT ? 1 : 2;
+    PM_TRY(fpm_static_support_build(m, v.free_of, c->nf, rings, &c->sp));
+    v.prob.precond_values = fpm_static_support_values;
+    v.prob.pc_pat_ptr = c->sp.ptr;
+    v.prob.pc_pat_idx = c->sp.idx;
+    no.op = PM_NEWTON_MATRIX_FREE_CHEAP_PC;
+    no.pc_right = true;
   }
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
   c->solver = solver;

@@ -61,6 +61,13 @@ typedef struct {
 bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
                         pm_newton_linear linear);
 
+/* Whether multigrid (linear solver `linear`) is built on the tangent of
+ * each point's support in a static solve of scene s, model m (one
+ * process, time.quasi_static.multigrid_operator support or support2; not
+ * the default): see fpm_static_support.c. */
+bool fpm_static_amg_on_support(const pm_scene *s, const fpm_model *m,
+                               pm_newton_linear linear);
+
 /* The default linear solver for a static solve of this many unknowns. */
 pm_newton_linear fpm_static_default_linear(long unknowns);
 

@@ -49,10 +49,21 @@ typedef struct {
   double *acc; /* threads x 3 maxlen */
 } fpm_static_coupled;
 
+/* The cheaper operator for multigrid (fpm_static_support.c): the
+ * tangent's blocks of each own point k's rings of neighbours, the rest
+ * left out: its support (1 ring: about a tenth of the tangent's entries
+ * with the quadratic jump) or its supports' supports (2 rings). */
+typedef struct {
+  int rings;
+  long *L_ptr, *L; /* per own point k: the points (k first) */
+  long *ptr, *idx; /* the pattern over the free dofs (NULL: not used) */
+} fpm_static_support;
+
 typedef struct {
   const fpm_model *m;
   fpm_state *st;
   fpm_static_tangent tg;
+  fpm_static_support sp; /* (zeroed when not used) */
   fpm_static_coupled cp; /* (zeroed when not used) */
   const long *pat_ptr;
   const long *free_of;
@@ -159,6 +170,22 @@ void fpm_static_solve_free(fpm_static_solve *v);
 pm_err fpm_static_tangent_build(const fpm_model *m, fpm_static_tangent *t);
 pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val);
 void fpm_static_tangent_free(fpm_static_tangent *t);
+
+/* fpm_static_support.c: the support operator of this many rings (1 or
+ * 2) over the nf unknowns of one process (free_of: dof -> unknown) into
+ * sp (PM_ERR_MEMORY); the row of own point k into val in its pattern's
+ * order, from the tangent's blocks blk of the points of k's reach (mark:
+ * a point's place among them); and its release. */
+pm_err fpm_static_support_build(const fpm_model *m, const long *free_of,
+                                long nf, int rings, fpm_static_support *sp);
+void fpm_static_support_row(long k, const long *free_of, const long *mark,
+                            const double *blk, const fpm_static_support *sp,
+                            double *val);
+void fpm_static_support_free(fpm_static_support *sp);
+/* The support operator's values at the tangent's linearisation point
+ * (pm_newton_problem.precond_values; ctx is the fpm_static_ctx), in
+ * fpm_static_tangent.c. */
+pm_err fpm_static_support_values(void *ctx, const double *x, double *val);
 
 /* fpm_static_pattern.c: the Jacobian's pattern over the nf unknowns
  * (free_of: dof -> unknown, -1 for none) into *ptr_out, *idx_out (CSR,

@@ -288,6 +288,7 @@ void fpm_static_solve_free(fpm_static_solve *v) {
   fpm_linear_destroy(v->c.lin);
   fpm_static_tangent_free(&v->c.tg);
   fpm_static_coupled_free(&v->c.cp);
+  fpm_static_support_free(&v->c.sp);
   free(v->c.dof);
   free(v->c.ghost);
   free(v->c.held);

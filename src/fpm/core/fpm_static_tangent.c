@@ -296,9 +296,10 @@ pm_err fpm_static_tangent_build(const fpm_model *m, fpm_static_tangent *t) {
   return PM_SUCCESS;
 }
 
-pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
-  fpm_static_ctx *c = ctx;
-  (void)x;
+/* The tangent's values into val: in the Jacobian's pattern, or (sp) in
+ * the support operator's. */
+static void tangent_values(fpm_static_ctx *c, const fpm_static_support *sp,
+                           double *val) {
   const fpm_model *m = c->m;
   fpm_static_tangent *t = &c->tg;
   const long n = m->n, ns = m->n_stress, rows = m->n_own;
@@ -323,7 +324,8 @@ pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
   }
   const long *free_of = c->free_of, *pat = c->pat_ptr;
   const double *K = c->contact_K;
-  PM_OMP(parallel default(none) shared(n, rows, m, t, free_of, pat, val, K)) {
+  PM_OMP(parallel default(none)
+             shared(n, rows, m, t, free_of, pat, val, K, sp)) {
     const int th = pm_omp_thread();
     long *mark = t->mark + (size_t)th * n;
     double *blk = t->work + (size_t)th * 9 * t->max_reach;
@@ -353,7 +355,8 @@ pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
       }
       if (K) /* the contact's block on the diagonal */
         for (int a = 0; a < 9; a++) blk[9 * mark[k] + a] += K[9 * k + a];
-      for (int cc = 0; cc < 3; cc++) {
+      if (sp) fpm_static_support_row(k, free_of, mark, blk, sp, val);
+      for (int cc = 0; cc < 3 && !sp; cc++) {
         long row = free_of[3 * k + cc];
         if (row < 0) continue;
         long w = pat[row];
@@ -365,5 +368,17 @@ pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
       for (long a = 0; a < nr; a++) mark[t->R_list[r0 + a]] = -1;
     }
   }
+}
+
+pm_err fpm_static_tangent_values(void *ctx, const double *x, double *val) {
+  (void)x;
+  tangent_values(ctx, NULL, val);
+  return PM_SUCCESS;
+}
+
+pm_err fpm_static_support_values(void *ctx, const double *x, double *val) {
+  fpm_static_ctx *c = ctx;
+  (void)x;
+  tangent_values(c, &c->sp, val);
   return PM_SUCCESS;
 }
