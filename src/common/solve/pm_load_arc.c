@@ -21,6 +21,9 @@
  * first. */
 #define ARC_EASY 4
 #define ARC_MIN_FRACTION 1e-4
+/* A corrector whose residual grows past this multiple of the predictor's
+ * is abandoned for a shorter arc. */
+#define ARC_GROWTH 10.0
 
 pm_err pm_arc_work_init(pm_arc_work *w, long n) {
   memset(w, 0, sizeof *w);
@@ -125,10 +128,13 @@ pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
   if (!(ol > 0)) ol = 1;
   if ((e = path_tangent(s, xa, la, r, S, w->ox, ol, w, rep, &tl)) != PM_SUCCESS)
     goto out;
-  /* the first arc: the length of a quarter of the nominal step along the
-   * tangent, at least the step that failed */
+  /* the first arc: the last converged step's length (Crisfield), at
+   * most that of a quarter of the nominal step along the tangent */
   const double nominal = 1.0 / s->o.load_steps;
-  const double ds0 = S * sqrt(2.0) * fmax(0.25 * nominal, target - lambda);
+  double last2 = S * S * ol * ol;
+  for (long i = 0; i < n; i++) last2 += w->ox[i] * w->ox[i];
+  const double ds0 =
+      fmin(sqrt(last2), S * sqrt(2.0) * fmax(0.25 * nominal, target - lambda));
   double ds = ds0;
   while (steps < ARC_STEPS) {
     PM_CALL(pm_interrupt_check("in the arc-length continuation"));
@@ -138,6 +144,7 @@ pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
     for (long i = 0; i < n; i++) x[i] = xa[i] + ds * t[i];
     bool ok = false;
     int k = 0;
+    double r_pred = 0;
     for (; k < ARC_ITERS; k++) {
       its++;
       pm_newton_note_load(s, l);
@@ -148,6 +155,8 @@ pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
         ok = true;
         break;
       }
+      if (k == 0) r_pred = rn;
+      if (rn > ARC_GROWTH * r_pred) break; /* diverging: a shorter arc */
       e = load_derivative(s, x, l, r, w->fl);
       for (long i = 0; i < n; i++) w->b[i] = -r[i];
       if (e == PM_SUCCESS) e = solve(s, x, w->b, w->dxr, rep);
@@ -180,6 +189,8 @@ pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
     }
     steps++;
     if (l < la) back++;
+    fprintf(stderr, "pointmech: arc %d: lambda %.8g, %d iterations\n", steps, l,
+            k);
     if (l >= target) {
       /* past the step's load: Newton there, from the point of the chord
        * at the step's load */
