@@ -61,8 +61,12 @@ static pm_err load_derivative(pm_newton *s, const double *x, double lambda,
   return e2;
 }
 
+/* dx solves K(x) dx = b.  fresh: a new factorisation at x (near a fold a
+ * kept one, made at another state, left GMRES hundreds of iterations);
+ * the second solve at the same x reuses it. */
 static pm_err solve(pm_newton *s, const double *x, const double *b, double *dx,
-                    pm_load_report *rep) {
+                    bool fresh, pm_load_report *rep) {
+  if (fresh) s->pc_built = false;
   pm_newton_report tr;
   memset(&tr, 0, sizeof tr);
   pm_err e = pm_newton_tangent_solve(s, x, b, dx, &tr);
@@ -87,7 +91,7 @@ static pm_err path_tangent(pm_newton *s, const double *x, double lambda,
   PM_CALL(load_derivative(s, x, lambda, r, w->fl));
   PM_OMP(parallel for schedule(static))
   for (long i = 0; i < n; i++) w->b[i] = -w->fl[i];
-  PM_CALL(solve(s, x, w->b, w->t, rep)); /* K dx/dl = -dr/dl */
+  PM_CALL(solve(s, x, w->b, w->t, true, rep)); /* K dx/dl = -dr/dl */
   const double norm = sqrt(dot(n, w->t, w->t) + S * S);
   double l = 1 / norm;
   for (long i = 0; i < n; i++) w->t[i] /= norm;
@@ -159,9 +163,9 @@ pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
       if (rn > ARC_GROWTH * r_pred) break; /* diverging: a shorter arc */
       e = load_derivative(s, x, l, r, w->fl);
       for (long i = 0; i < n; i++) w->b[i] = -r[i];
-      if (e == PM_SUCCESS) e = solve(s, x, w->b, w->dxr, rep);
+      if (e == PM_SUCCESS) e = solve(s, x, w->b, w->dxr, true, rep);
       for (long i = 0; i < n; i++) w->b[i] = -w->fl[i];
-      if (e == PM_SUCCESS) e = solve(s, x, w->b, w->dxf, rep);
+      if (e == PM_SUCCESS) e = solve(s, x, w->b, w->dxf, false, rep);
       if (e != PM_SUCCESS) break;
       /* t.dx + S^2 tl dl = 0 with dx = dxr + dl dxf */
       const double den = dot(n, t, w->dxf) + S * S * tl;
@@ -240,6 +244,7 @@ out:;
   rep->arc_steps += steps;
   rep->arc_iterations += its;
   rep->time_arc += pm_wtime() - t0;
+  s->pc_built = false; /* Newton's next solve factorises at its own state */
   if (e == PM_ERR_NOT_CONVERGED) e = PM_ERROR(PM_ERR_NOT_CONVERGED, "%s", msg);
   return e;
 }
