@@ -15,7 +15,7 @@
 
 /* Corrector iterations of one arc step, and arc steps of one fallback. */
 #define ARC_ITERS 12
-#define ARC_STEPS 200
+#define ARC_STEPS 60
 /* An arc step converged in at most this many iterations lengthens the
  * next by half; a failed one halves it, down to ARC_MIN_FRACTION of the
  * first. */
@@ -193,6 +193,13 @@ pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
     }
     steps++;
     if (l < la) back++;
+    if (l < lambda - 1.5) {
+      e = PM_ERROR(PM_ERR_NOT_CONVERGED,
+                   "arc length: the path went back 1.5 loads (to lambda "
+                   "%.4g) without passing the step's load",
+                   l);
+      goto out;
+    }
     fprintf(stderr, "pointmech: arc %d: lambda %.8g, %d iterations\n", steps, l,
             k);
     if (l >= target) {
