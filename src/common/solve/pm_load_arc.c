@@ -13,7 +13,9 @@
 #include "pm_omp.h"
 #include "pm_progress.h"
 
-/* Corrector iterations of one arc step, and arc steps of one fallback. */
+/* Corrector iterations of one arc step, and arc steps of one fallback (a
+ * path that goes back by more than 1.5 loads is abandoned too: the cubic
+ * snap-through of unit.test_load_steps goes back 1.18). */
 #define ARC_ITERS 12
 #define ARC_STEPS 60
 /* An arc step converged in at most this many iterations lengthens the
