@@ -740,8 +740,13 @@ static const pm_key quasi_static_keys[] = {
             "masses over a pseudo time step that grows as the residual "
             "falls, at most this many iterations (one linear solve "
             "each), relaxation only if it fails; it passes where the "
-            "tangent turns singular or indefinite (a fold); 0: "
-            "relaxation alone (the solver before)"},
+            "tangent turns singular or indefinite (a fold); before it, "
+            "the tangent's lowest mode at the last converged state: "
+            "its eigenvalue negative (past a bifurcation), the "
+            "continuation starts off the state along the mode; not "
+            "negative (a limit point), arc length follows the path "
+            "round the fold first; 0: relaxation alone (the solver "
+            "before)"},
     {.name = "max_iterations",
      .type = PM_KEY_INTEGER,
      .offset = S(time.qs_max_iterations),

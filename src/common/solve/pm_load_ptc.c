@@ -13,21 +13,32 @@
 #include "pm_petsc.h"
 #include "pm_progress.h"
 
-/* The first shift 1 / dtau, in units of the masses (whose Gershgorin bound
- * puts every frequency of M^-1 K at most 2): small enough that the stiff
- * modes settle in a few iterations, large enough to dominate a tangent's
- * small negative eigenvalues. */
-#define PTC_SHIFT0 1e-2
+/* The first shift 1 / dtau is PM_PTC_SHIFT0 (pm_newton_impl.h), in units
+ * of the masses (whose Gershgorin bound puts every frequency of M^-1 K at
+ * most 2): small enough that the stiff modes settle in a few iterations,
+ * large enough to dominate a tangent's small negative eigenvalues; a
+ * caller that knows the lowest eigenvalue passes one above it. */
+/* The factorisation kept while the shift stays within this factor of the
+ * one it was made at (beyond, GMRES on it takes hundreds of iterations). */
+#define PTC_REFACTOR 2.0
 /* A trial that multiplies the residual by more than this is not taken. */
 #define PTC_GROWTH 10.0
 /* A shift raised past this (by rejected trials) ends the continuation. */
 #define PTC_SHIFT_MAX 1e6
 
 /* The linear solve (J(x) + diag(shift m)) dx = -r. */
+/* A new factorisation when shift is not within PTC_REFACTOR of *made, the
+ * shift the kept one was made at (0: none kept), which it then updates. */
 static pm_err shifted_solve(pm_newton *s, const double *x, const double *r,
-                            const double *m, double shift, double *b,
-                            double *dx, pm_load_report *rep) {
+                            const double *m, double shift, double *made,
+                            double *b, double *dx, pm_load_report *rep) {
   const long n = s->p.n;
+  if (!(*made > 0 && shift <= PTC_REFACTOR * *made &&
+        shift * PTC_REFACTOR >= *made) ||
+      !s->pc_built) {
+    s->pc_built = false;
+    *made = shift;
+  }
   double *d;
   PM_PETSC_CALL(VecGetArray(s->Shift, &d));
   for (long i = 0; i < n; i++) d[i] = shift * m[i];
@@ -42,15 +53,16 @@ static pm_err shifted_solve(pm_newton *s, const double *x, const double *r,
   return e;
 }
 
-pm_err pm_load_ptc(pm_newton *s, double *x, double goal, pm_relax_work *w,
-                   pm_load_report *rep, double *r_start, double *curvature,
-                   char *msg, long cap) {
+pm_err pm_load_ptc(pm_newton *s, double *x, double goal, double shift0,
+                   pm_relax_work *w, pm_load_report *rep, double *r_start,
+                   double *curvature, char *msg, long cap) {
   const long n = s->p.n;
   const long max_iter = s->o.ptc_max_iter;
   const double t0 = pm_wtime();
   /* (the relaxation's work space: its velocities hold the increment) */
   double *m = w->mass, *dx = w->v, *r = w->r, *rt = w->rt, *xt = w->xt;
-  double rn = 0, r0 = 0, shift = PTC_SHIFT0, qmin = INFINITY;
+  double rn = 0, r0 = 0, qmin = INFINITY, made = 0;
+  double shift = shift0 > 0 ? shift0 : PM_PTC_SHIFT0;
   long it = 0, rejected = 0;
   pm_err e;
   msg[0] = '\0';
@@ -66,7 +78,7 @@ pm_err pm_load_ptc(pm_newton *s, double *x, double goal, pm_relax_work *w,
     if ((e = pm_interrupt_check("in the continuation of a load step")) !=
         PM_SUCCESS)
       goto out;
-    e = shifted_solve(s, x, r, m, shift, rt, dx, rep);
+    e = shifted_solve(s, x, r, m, shift, &made, rt, dx, rep);
     double rtn = 0;
     if (e == PM_SUCCESS) {
       /* dx.J dx = -dx.r - shift dx.M dx: the curvature along dx */
@@ -108,6 +120,8 @@ pm_err pm_load_ptc(pm_newton *s, double *x, double goal, pm_relax_work *w,
   }
   e = rn <= goal ? PM_SUCCESS : PM_ERR_NOT_CONVERGED;
 out:;
+  /* the kept factorisation is of a shifted matrix: Newton makes its own */
+  s->pc_built = false;
   char tail[80];
   snprintf(tail, sizeof tail, "%ld not taken, smallest curvature %.2e",
            rejected, isfinite(qmin) ? qmin : 0.0);

@@ -27,6 +27,7 @@ pm_err pm_relax_work_init(pm_relax_work *w, long n) {
   PM_TRY(PM_ALLOC(w->r, n, "relaxation residual"));
   PM_TRY(PM_ALLOC(w->rt, n, "relaxation residual"));
   PM_TRY(PM_ALLOC(w->xt, n, "relaxation state"));
+  PM_TRY(PM_ALLOC(w->mode, n, "lowest mode"));
 done:
   if (ret != PM_SUCCESS) pm_relax_work_free(w);
   return ret;
@@ -38,6 +39,7 @@ void pm_relax_work_free(pm_relax_work *w) {
   free(w->r);
   free(w->rt);
   free(w->xt);
+  free(w->mode);
   memset(w, 0, sizeof *w);
 }
 

@@ -118,25 +118,63 @@ static pm_err relax_step(pm_newton *s, double *x, const double *xc,
   return e;
 }
 
-/* The fallback of a step Newton could not finish, at the step's load (set):
- * pseudo-transient continuation from the last converged state xc to
- * Newton's tolerance (options.ptc_max_iter > 0), and where it fails the
- * relaxation of relax_step.  x, msg and cap as relax_step's. */
+/* The fallback of a step Newton could not finish, at the step's load
+ * (target, set; the last converged state xc at load lambda, the one before
+ * xprev at lambda_prev), with options.ptc_max_iter > 0: the tangent's
+ * lowest mode at xc (pm_load_mode_at), then where its eigenvalue is
+ * negative (xc is unstable: past a bifurcation) the continuation started
+ * off xc along the mode (pm_load_branch_switch), else arc length round a limit
+ * point (pm_load_arc); where that fails the continuation from xc, shifted
+ * above a negative eigenvalue; where that fails the relaxation of
+ * relax_step.  x, msg and cap as relax_step's. */
 static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
-                            double r_ref, pm_relax_work *w, pm_load_report *rep,
-                            char *msg, size_t cap) {
+                            const double *xprev, double lambda,
+                            double lambda_prev, double target, double r_ref,
+                            pm_relax_work *w, pm_arc_work *aw,
+                            pm_load_report *rep, char *msg, size_t cap) {
   const pm_newton_options *o = pm_newton_options_of(s);
   const long n = pm_newton_problem_of(s)->n;
   if (o->ptc_max_iter <= 0) return relax_step(s, x, xc, w, rep, msg, cap);
   /* the goal: Newton's, relative to the step's imbalance at xc */
-  double r0 = 0, q = 0;
+  double r0 = 0, eig = NAN;
   if (pm_newton_residual(s, xc, w->r) == PM_SUCCESS)
     r0 = pm_newton_norm(s, w->r);
   pm_error_clear();
   const double goal = fmax(o->rtol * fmax(r0, r_ref), o->atol);
-  memcpy(x, xc, (size_t)n * sizeof *x);
-  pm_err e = pm_load_ptc(s, x, goal, w, rep, &r0, &q, msg, (long)cap);
-  if (rep->ptc_runs == 1 || q < rep->ptc_curvature) rep->ptc_curvature = q;
+  pm_err e = pm_load_mode_at(s, lambda, target, xc, w, rep, &eig,
+                             rep->mode_note, sizeof rep->mode_note);
+  if (e != PM_SUCCESS && !recoverable(e)) return e;
+  pm_error_clear();
+  msg[0] = '\0';
+  if (rep->mode_note[0]) {
+    fprintf(stderr, "pointmech: load step %d (lambda %.6g -> %.6g): %s\n",
+            rep->steps + 1, lambda, target, rep->mode_note);
+    snprintf(msg, cap, "%s", rep->mode_note);
+  }
+  /* a shift above the negative eigenvalue: the shifted tangent definite */
+  const double shift0 =
+      isfinite(eig) && eig < 0 ? fmax(PM_PTC_SHIFT0, -4 * eig) : 0;
+  e = PM_ERR_NOT_CONVERGED;
+  if (isfinite(eig) && eig < 0) {
+    e = pm_load_branch_switch(s, x, xc, goal, shift0, w, rep, msg, cap);
+  } else if (isfinite(eig)) {
+    const size_t used = strlen(msg);
+    snprintf(msg + used, cap - used, "%s", used ? "; " : "");
+    const size_t used2 = strlen(msg);
+    e = pm_load_arc(s, x, xc, xprev, lambda, lambda_prev, target, goal, aw, rep,
+                    msg + used2, (long)(cap - used2));
+    if (e == PM_SUCCESS) {
+      fprintf(stderr, "pointmech: load step %d: %s\n", rep->steps + 1,
+              msg + used2);
+      return e;
+    }
+  }
+  if (e != PM_SUCCESS && recoverable(e)) {
+    pm_error_clear();
+    memcpy(x, xc, (size_t)n * sizeof *x);
+    e = pm_load_ptc_noted(s, x, goal, shift0, w, rep,
+                          msg[0] ? "; from the state: " : "", msg, cap);
+  }
   if (e == PM_SUCCESS) {
     rep->ptc_steps++;
     rep->last.reason = PM_NEWTON_CONVERGED_RESIDUAL;
@@ -217,6 +255,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
   pm_load_report local;
   pm_load_report *rep = report ? report : &local;
   pm_relax_work rw = {0};
+  pm_arc_work aw = {0};
   double *r = NULL, *rh = NULL;
   double t0 = pm_wtime();
   const bool resumed = st && st->lambda > 0;
@@ -245,6 +284,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       o->relax_after, o->relax_max_iter, o->relax_rtol);
   const bool relaxing = pm_load_relax_available(s);
   if (relaxing) PM_TRY(pm_relax_work_init(&rw, n));
+  if (relaxing && o->ptc_max_iter > 0) PM_TRY(pm_arc_work_init(&aw, n));
   if (o->predictor) {
     PM_TRY(PM_ALLOC(r, n, "residual"));
     PM_TRY(PM_ALLOC(rh, n, "residual"));
@@ -307,7 +347,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       e = pm_newton_solve_from(s, x, xc, r_ref, &rep->last);
       add_solve(rep, &rep->last);
     }
-    char relaxed[1024] = "", failed[sizeof rep->last.message] = "";
+    char relaxed[2048] = "", failed[sizeof rep->last.message] = "";
     if (e != PM_SUCCESS && recoverable(e) && relaxing && st->dl != relaxed_dl &&
         (cuts == o->relax_after || cuts >= o->max_cuts ||
          st->dl / 2 < o->min_dlambda * (1 - 1e-12))) {
@@ -316,9 +356,12 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       pm_error_clear();
       relaxed_dl = st->dl;
       snprintf(failed, sizeof failed, "%s", rep->last.message);
-      const int ptc_before = rep->ptc_steps;
-      e = fallback_step(s, x, xc, r_ref, &rw, rep, relaxed, sizeof relaxed);
-      if (e == PM_SUCCESS && rep->ptc_steps == ptc_before) rep->relaxed_steps++;
+      const int ptc_before = rep->ptc_steps, arc_before = rep->arc_passes;
+      e = fallback_step(s, x, xc, xprev, lambda, lambda_prev, target, r_ref,
+                        &rw, &aw, rep, relaxed, sizeof relaxed);
+      if (e == PM_SUCCESS && rep->ptc_steps == ptc_before &&
+          rep->arc_passes == arc_before)
+        rep->relaxed_steps++;
       if (e == PM_ERR_UNSUPPORTED) e = PM_ERR_NOT_CONVERGED;
     }
     if (e == PM_SUCCESS && p->settle) e = settle_step(s, x, xc, r_ref, rep);
@@ -387,6 +430,7 @@ done:
   free(r);
   free(rh);
   pm_relax_work_free(&rw);
+  pm_arc_work_free(&aw);
   return ret;
 }
 

@@ -178,6 +178,10 @@ typedef struct {
    * positions; appended to the failure's message.  A failure of its own
    * is ignored.  Optional. */
   pm_err (*diagnose)(void *ctx, const double *x, char *buf, long cap);
+  /* Where a vector of the unknowns v (a mode of the tangent) stands: one
+   * line into buf (cap bytes), say the point where it is largest and its
+   * mirror symmetry.  A failure of its own is ignored.  Optional. */
+  pm_err (*describe_mode)(void *ctx, const double *v, char *buf, long cap);
   /* Load stepping: after a step's Newton solve has converged at x, a set
    * the residual depends on made consistent with x (contact: the points
    * the solution pulls off a body let go).  *changed: how many entries
@@ -449,6 +453,21 @@ typedef struct {
   int ptc_runs, ptc_steps;
   long ptc_iterations;
   double time_ptc, ptc_curvature;
+  /* The tangent's lowest mode at the converged state before each
+   * continuation (pm_load_branch.c): how many were computed, the smallest
+   * eigenvalue of K v = q M v met (negative: that state is unstable, past
+   * a bifurcation), the continuations started off the state along the
+   * mode that let their step converge (branch switches), and the last
+   * mode's line. */
+  int mode_runs, branch_switches;
+  double mode_eigenvalue;
+  char mode_note[400];
+  /* Arc-length continuations (pm_load_arc.c; where the lowest eigenvalue
+   * is not negative: a limit point) run, those that passed the fold, their
+   * arcs and corrector iterations, and wall seconds. */
+  int arc_runs, arc_passes;
+  long arc_steps, arc_iterations;
+  double time_arc;
   /* Newton solves run again for pm_newton_problem.settle, and the steps
    * that failed as their set did not settle. */
   int resolves, unsettled;

@@ -56,6 +56,7 @@ void pm_load_add_costs(pm_load_report *rep, const pm_newton_report *nr);
 /* Its work space: n values each. */
 typedef struct {
   double *mass, *v, *r, *rt, *xt;
+  double *mode; /* the tangent's lowest mode (pm_load_branch.c) */
 } pm_relax_work;
 pm_err pm_relax_work_init(pm_relax_work *w, long n);
 void pm_relax_work_free(pm_relax_work *w);
@@ -108,8 +109,72 @@ pm_err pm_relax_masses(pm_newton *s, const double *x, double *m);
  * rep; msg (cap bytes) one line of what it did.  PM_SUCCESS at the goal,
  * PM_ERR_NOT_CONVERGED short of it, PM_ERR_UNSTABLE for an inadmissible
  * start, a hard failure of a callback as it is.  One process only. */
-pm_err pm_load_ptc(pm_newton *s, double *x, double goal, pm_relax_work *w,
-                   pm_load_report *rep, double *r_start, double *curvature,
-                   char *msg, long cap);
+pm_err pm_load_ptc(pm_newton *s, double *x, double goal, double shift0,
+                   pm_relax_work *w, pm_load_report *rep, double *r_start,
+                   double *curvature, char *msg, long cap);
+
+/* The continuation's first shift, in units of the masses, when no lowest
+ * mode says otherwise. */
+#define PM_PTC_SHIFT0 1e-2
+
+/* ---- pm_load_branch.c: the lowest mode and the branch switch ---- */
+
+/* The eigenvalue q of K(x) v = q M v nearest zero (M diagonal, m; K the
+ * tangent at x, factorised afresh there) by inverse iteration from a fixed
+ * start, at most 12 iterations: into *eig, the mode (v.M v = 1) into v,
+ * the iterations into *iters; u and b are work space (n values each).
+ * The next Newton solve factorises again.  The linear solve's failure as
+ * it is (recoverable: PM_ERR_NOT_CONVERGED); one process only. */
+pm_err pm_load_lowest_mode(pm_newton *s, const double *x, const double *m,
+                           double *v, double *u, double *b, pm_load_report *rep,
+                           double *eig, int *iters);
+
+/* The lowest mode (into w->mode, its eigenvalue into *eig) of the tangent
+ * at the converged state x of load lambda, with the relaxation's masses
+ * there (w->mass); the load is set back to target.  One line into msg
+ * (cap bytes): the eigenvalue and, by the problem's describe_mode, where
+ * the mode is.  Counts to rep (mode_runs, mode_eigenvalue). */
+pm_err pm_load_mode_at(pm_newton *s, double lambda, double target,
+                       const double *x, pm_relax_work *w, pm_load_report *rep,
+                       double *eig, char *msg, long cap);
+
+/* pm_load_ptc from x with the first shift shift0, its line appended to msg
+ * (cap bytes) after label, and its smallest curvature kept in rep. */
+pm_err pm_load_ptc_noted(pm_newton *s, double *x, double goal, double shift0,
+                         pm_relax_work *w, pm_load_report *rep,
+                         const char *label, char *msg, size_t cap);
+
+/* The continuation (pm_load_ptc, first shift shift0) from xc + a w->mode
+ * at the step's load (set), the mode scaled so that its largest entry is
+ * 1% of xc's, taken with + first, then with -: the imperfection a
+ * symmetric path needs to leave a bifurcation.  Goal, x and msg (cap
+ * bytes, appended to) as pm_load_ptc's; counts to rep (branch_switches
+ * for a success).  PM_SUCCESS, or the last continuation's failure. */
+pm_err pm_load_branch_switch(pm_newton *s, double *x, const double *xc,
+                             double goal, double shift0, pm_relax_work *w,
+                             pm_load_report *rep, char *msg, size_t cap);
+
+/* ---- pm_load_arc.c: arc-length continuation within a load step ---- */
+
+/* Its work space: n values each. */
+typedef struct {
+  double *xa, *r, *t, *fl, *b, *dxr, *dxf, *ox;
+} pm_arc_work;
+pm_err pm_arc_work_init(pm_arc_work *w, long n);
+void pm_arc_work_free(pm_arc_work *w);
+
+/* Arc-length continuation (Riks: predictor along the path's tangent,
+ * corrector in its normal plane, the load factor an unknown, dr/dlambda
+ * by a forward difference) from the converged state xc at lambda (xprev
+ * at lambda_prev orients it) until the path passes target, then Newton at
+ * target from the chord's point there; |r| <= goal ends a corrector.  x:
+ * the state at target on success, else xc; the load is left at target.
+ * Counts to rep (arc_*); msg (cap bytes) one line of what it did.
+ * PM_SUCCESS; PM_ERR_NOT_CONVERGED raised with that line; a hard failure
+ * of a callback as it is.  One process only. */
+pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
+                   const double *xprev, double lambda, double lambda_prev,
+                   double target, double goal, pm_arc_work *w,
+                   pm_load_report *rep, char *msg, long cap);
 
 #endif

@@ -263,6 +263,17 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(pm_json_number(j, "static_continuation_seconds", r->load.time_ptc));
     PM_CALL(pm_json_number(j, "static_continuation_curvature",
                            r->load.ptc_curvature));
+    PM_CALL(pm_json_integer(j, "static_lowest_modes", r->load.mode_runs));
+    PM_CALL(
+        pm_json_number(j, "static_lowest_eigenvalue", r->load.mode_eigenvalue));
+    PM_CALL(
+        pm_json_integer(j, "static_branch_switches", r->load.branch_switches));
+    PM_CALL(pm_json_integer(j, "static_arc_lengths", r->load.arc_runs));
+    PM_CALL(pm_json_integer(j, "static_arc_passes", r->load.arc_passes));
+    PM_CALL(pm_json_integer(j, "static_arcs", r->load.arc_steps));
+    PM_CALL(
+        pm_json_integer(j, "static_arc_iterations", r->load.arc_iterations));
+    PM_CALL(pm_json_number(j, "static_arc_seconds", r->load.time_arc));
     PM_CALL(pm_json_integer(j, "static_resolves", r->load.resolves));
     PM_CALL(pm_json_integer(j, "static_unsettled", r->load.unsettled));
     PM_CALL(pm_json_integer(j, "static_contact_frozen", r->contact_frozen));

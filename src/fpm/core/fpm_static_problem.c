@@ -284,6 +284,74 @@ static pm_err diagnose(void *ctx, const double *x, char *buf, long cap) {
   return PM_SUCCESS;
 }
 
+/* The mode's value at dof d (0 where d is prescribed). */
+static double mode_at(const fpm_static_ctx *c, const double *v, long d) {
+  const long k = c->free_of[d];
+  return k >= 0 && k < c->nf ? v[k] : 0.0;
+}
+
+/* Where a mode v of the tangent stands: its largest point, and its
+ * antisymmetric share about the cloud's mid-planes x and y (each point
+ * against the point nearest its mirror image, within a third of the mean
+ * spacing): 0 for a mode that keeps the mirror symmetry, 1 for one that
+ * breaks it (a bifurcation's mode).  O(n^2): a diagnosis, run rarely. */
+static pm_err describe_mode(void *ctx, const double *v, char *buf, long cap) {
+  fpm_static_ctx *c = ctx;
+  const fpm_model *m = c->m;
+  const long n = m->n_own;
+  PM_CHECK(!m->xc && n > 0, PM_ERR_UNSUPPORTED, "mode: one process only");
+  double lo[3] = {INFINITY, INFINITY, INFINITY},
+         hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  long top = 0;
+  double top2 = -1;
+  for (long i = 0; i < n; i++) {
+    double a2 = 0;
+    for (int a = 0; a < 3; a++) {
+      lo[a] = fmin(lo[a], m->x[3 * i + a]);
+      hi[a] = fmax(hi[a], m->x[3 * i + a]);
+      const double va = mode_at(c, v, 3 * i + a);
+      a2 += va * va;
+    }
+    if (a2 > top2) top2 = a2, top = i;
+  }
+  const double vol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+  const double tol = cbrt(vol / (double)n) / 3;
+  double anti[2] = {0, 0}, all[2] = {0, 0};
+  long matched[2] = {0, 0};
+  for (int ax = 0; ax < 2; ax++) {
+    const double mid = lo[ax] + hi[ax];
+    for (long i = 0; i < n; i++) {
+      double y[3] = {m->x[3 * i], m->x[3 * i + 1], m->x[3 * i + 2]};
+      y[ax] = mid - y[ax];
+      long best = -1;
+      double d2best = tol * tol;
+      for (long j = 0; j < n; j++) {
+        const double *xj = m->x + 3 * j;
+        const double d2 = (xj[0] - y[0]) * (xj[0] - y[0]) +
+                          (xj[1] - y[1]) * (xj[1] - y[1]) +
+                          (xj[2] - y[2]) * (xj[2] - y[2]);
+        if (d2 < d2best) d2best = d2, best = j;
+      }
+      if (best < 0) continue;
+      matched[ax]++;
+      for (int a = 0; a < 3; a++) {
+        const double vi = mode_at(c, v, 3 * i + a);
+        const double vj = (a == ax ? -1 : 1) * mode_at(c, v, 3 * best + a);
+        anti[ax] += 0.25 * (vi - vj) * (vi - vj);
+        all[ax] += vi * vi;
+      }
+    }
+  }
+  const double *xt = m->x + 3 * top;
+  snprintf(buf, (size_t)cap,
+           "largest at point %ld (%g, %g, %g); antisymmetric share about the "
+           "mid-plane x %.3f, y %.3f (%ld, %ld of %ld points mirrored)",
+           fpm_point_id(m, top), xt[0], xt[1], xt[2],
+           all[0] > 0 ? anti[0] / all[0] : 0.0,
+           all[1] > 0 ? anti[1] / all[1] : 0.0, matched[0], matched[1], n);
+  return PM_SUCCESS;
+}
+
 void fpm_static_solve_free(fpm_static_solve *v) {
   fpm_linear_destroy(v->c.lin);
   fpm_static_tangent_free(&v->c.tg);
@@ -368,6 +436,7 @@ pm_err fpm_static_setup(const fpm_model *m, fpm_state *st,
                           .set_load = fpm_static_set_load,
                           .on_step = on_step,
                           .diagnose = diagnose,
+                          .describe_mode = describe_mode,
                           .settle = m->contact ? settle : NULL};
   return PM_SUCCESS;
 }
