@@ -80,8 +80,8 @@ out, cases = sys.argv[1], sys.argv[2].split()
 # pattern (one thread: the parallel regions' outlined functions).
 KERNELS = {
   'f2': [('stress: gradient, P(F)', r'stress_pass\._omp'),
-         ('flux', r'flux_pass\._omp'),
-         ('gather', r'gather_pass\._omp'),
+         ('flux', r'flux_pass\._omp|fpm_stream_flux\._omp'),
+         ('gather', r'gather_pass\._omp|fpm_stream_gather\._omp'),
          ('boundary', r'boundary_pass\._omp'),
          ('update and sums', r'fpm_run\._omp')],
   'block': [('p2g', r'mpm_stage_p2g$'), ('grid update', r'mpm_stage_grid_update$'),
