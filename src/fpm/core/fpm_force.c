@@ -151,9 +151,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   const long n = m->n_flux, n_own = m->n_own;
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr;
-  const double *restrict erec = m->erec, *restrict pa = m->p_area,
-                         *restrict pm = m->p_mrel,
-                         *restrict vol = m->dual->volume;
+  const double *restrict erec = m->erec;
   const double *restrict u = fl->u, *restrict H = fl->H, *restrict P = fl->P;
   double *restrict T = fl->T, *restrict r = fl->r;
   const double *bu = fl->bu, *bH = fl->bH;
@@ -170,7 +168,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   const double *vphi = fl->vphi, *vdphi = fl->vdphi, *bth = fl->btheta;
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
-         shared(n, n_own, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat,
+         shared(n, n_own, ptr, nbr, erec, u, H, P, T, r, mat,
                 mats, ms, mss, sym, th, zq, Zq, quad, base, bu, bH, squad,
                 vol_on, vphi, vdphi, bth, m))
   for (long i = 0; i < n; i++) {
@@ -298,16 +296,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
       for (int c = 0; c < 3; c++) zq[3 * i + c] = z[c];
       for (int q = 0; q < 27; q++) Zq[27 * i + q] = Z[q];
     }
-    const double *A = pa + 3 * i, *Bm = pm + 9 * i;
-    for (int c = 0; c < 3; c++) {
-      r[3 * i + c] = ri[c] - 0.5 * (Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] +
-                                    Pi[3 * c + 2] * A[2]);
-      for (int q = 0; q < 3; q++)
-        T[9 * i + 3 * c + q] =
-            vol[i] * Pi[3 * c + q] - Q[3 * c + q] + Tv[3 * c + q] -
-            0.5 * (Pi[3 * c] * Bm[q] + Pi[3 * c + 1] * Bm[3 + q] +
-                   Pi[3 * c + 2] * Bm[6 + q]);
-    }
+    fpm_flux_close(m, i, Pi, Q, ri, Tv, r, T);
   }
   return epen;
 }

@@ -80,12 +80,10 @@ double fpm_stream_flux(const fpm_model *m, const double *restrict u,
   const long n = m->n_flux, n_own = m->n_own;
   const long *restrict bp = m->fs_ptr;
   const int *restrict nb = m->fs_nbr;
-  const double *restrict R = m->fs_rec, *restrict pa = m->p_area,
-                         *restrict pm = m->p_mrel,
-                         *restrict vol = m->dual->volume;
+  const double *restrict R = m->fs_rec;
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
-         shared(n, n_own, bp, nb, R, pa, pm, vol, u, H, P, T, r))
+         shared(m, n, n_own, bp, nb, R, u, H, P, T, r))
   for (long i = 0; i < n; i++) {
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
     fpm_lanes Qa[9] = {0}, ra[3] = {0}, ea = {0};
@@ -137,16 +135,8 @@ double fpm_stream_flux(const fpm_model *m, const double *restrict u,
     }
     for (int l = 0; l < FPM_LANES; l++) e += ea[l];
     if (i < n_own) epen += e;
-    const double *A = pa + 3 * i, *Bm = pm + 9 * i;
-    for (int c = 0; c < 3; c++) {
-      r[3 * i + c] = ri[c] - 0.5 * (Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] +
-                                    Pi[3 * c + 2] * A[2]);
-      for (int q = 0; q < 3; q++)
-        T[9 * i + 3 * c + q] =
-            vol[i] * Pi[3 * c + q] - Q[3 * c + q] -
-            0.5 * (Pi[3 * c] * Bm[q] + Pi[3 * c + 1] * Bm[3 + q] +
-                   Pi[3 * c + 2] * Bm[6 + q]);
-    }
+    const double Tv[9] = {0};
+    fpm_flux_close(m, i, Pi, Q, ri, Tv, r, T);
   }
   return epen;
 }

@@ -83,4 +83,23 @@ static inline void fpm_stream_gradient(const fpm_model *m,
     h[a] = acc[a][0] + acc[a][1] + acc[a][2] + acc[a][3];
 }
 
+/* The closing terms of point i's flux: r_i = ri - 1/2 P_i A_i and
+ * T_i = V_i P_i - Q + Tv - 1/2 P_i Bm_i (A_i, Bm_i the point's sums of area
+ * vectors and moments, m->p_area and m->p_mrel); writes r_i and T_i. */
+static inline void fpm_flux_close(const fpm_model *m, long i, const double *Pi,
+                                  const double Q[9], const double ri[3],
+                                  const double Tv[9], double *r, double *T) {
+  const double *A = m->p_area + 3 * i, *Bm = m->p_mrel + 9 * i;
+  const double vol = m->dual->volume[i];
+  for (int c = 0; c < 3; c++) {
+    r[3 * i + c] = ri[c] - 0.5 * (Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] +
+                                  Pi[3 * c + 2] * A[2]);
+    for (int q = 0; q < 3; q++)
+      T[9 * i + 3 * c + q] =
+          vol * Pi[3 * c + q] - Q[3 * c + q] + Tv[3 * c + q] -
+          0.5 * (Pi[3 * c] * Bm[q] + Pi[3 * c + 1] * Bm[3 + q] +
+                 Pi[3 * c + 2] * Bm[6 + q]);
+  }
+}
+
 #endif
