@@ -7,6 +7,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "fpm_stream.h"
 #include "fpm_gfd.h"
 #include "fpm_grade.h"
 #include "gm_mesh.h"
@@ -55,6 +56,13 @@ size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
     per_point +=
         (dim == 2 ? QFIT_2D : QFIT_3D) * (FPM_QFIT * d + 3 * sizeof(int)) +
         FPM_QFIT * d + 2 * sizeof(long) + 57 * d;
+  /* The entry stream (fpm_stream_bytes), with the flux records for the
+   * plain formulation; a row's padding is (FPM_LANES - 1) / 2 entries on
+   * average. */
+  const bool plain = !quadratic && o->flux != FPM_FLUX_SIPG &&
+                     o->stiffening == 0 && o->volume_penalty == 0;
+  per_point += (double)fpm_stream_bytes(
+      1, (long)ceil(nnz + (FPM_LANES - 1) / 2.0), plain);
   /* Newton's method adds the tangent (3 x 3 blocks per support entry and
    * per point) and fpm_linear_bytes. */
   if (s->time.qs == PM_QS_STATIC)

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_stream.h"
 #include "fpm_gfd.h"
 #include "fpm_linear_impl.h"
 #include "fpm_model.h"
@@ -36,9 +37,7 @@ typedef struct {
  * ghost's is its owner's to find). */
 static long stress_pass(const fpm_model *m, fpm_state *st) {
   const long n = m->n_stress, n_own = m->n_own;
-  const long *restrict ptr = m->nbr_ptr;
-  const int *restrict nbr = m->nbr;
-  const double *restrict g = m->g, *restrict u = st->u;
+  const double *restrict u = st->u;
   double *restrict H = st->H, *restrict P = st->P, *restrict W = st->W,
                    *restrict J = st->J;
   const int *restrict mat = m->mat;
@@ -47,26 +46,11 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
   const long mss = m->mstate_stride;
   long bad = n_own;
   PM_OMP(parallel for schedule(static) default(none)
-         shared(n, n_own, ptr, nbr, g, u, H, P, W, J, mat, mats, ms, mss)
+         shared(m, n, n_own, u, H, P, W, J, mat, mats, ms, mss)
          reduction(min : bad))
   for (long i = 0; i < n; i++) {
-    double h[9] = {0};
-    const double u0 = u[3 * i], u1 = u[3 * i + 1], u2 = u[3 * i + 2];
-    for (long e = ptr[i]; e < ptr[i + 1]; e++) {
-      const long k = nbr[e];
-      const double d0 = u[3 * k] - u0, d1 = u[3 * k + 1] - u1,
-                   d2 = u[3 * k + 2] - u2;
-      const double g0 = g[3 * e], g1 = g[3 * e + 1], g2 = g[3 * e + 2];
-      h[0] += d0 * g0;
-      h[1] += d0 * g1;
-      h[2] += d0 * g2;
-      h[3] += d1 * g0;
-      h[4] += d1 * g1;
-      h[5] += d1 * g2;
-      h[6] += d2 * g0;
-      h[7] += d2 * g1;
-      h[8] += d2 * g2;
-    }
+    double h[9];
+    fpm_stream_gradient(m, u, i, h);
     double F[9];
     for (int a = 0; a < 9; a++) {
       H[9 * i + a] = h[a];
@@ -162,12 +146,12 @@ static inline void quad_jump(const double *ui, const double *uk,
  * linear jump and its derivative through each point's J (fpm_penalty_terms.h).
  * The energy counts the model's own points. */
 static double flux_pass(const fpm_model *m, const fields *fl) {
+  /* The plain formulation streams its entries (fpm_stream.h). */
+  if (m->fs_rec) return fpm_stream_flux(m, fl->u, fl->H, fl->P, fl->T, fl->r);
   const long n = m->n_flux, n_own = m->n_own;
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr;
-  const double *restrict erec = m->erec, *restrict pa = m->p_area,
-                         *restrict pm = m->p_mrel,
-                         *restrict vol = m->dual->volume;
+  const double *restrict erec = m->erec;
   const double *restrict u = fl->u, *restrict H = fl->H, *restrict P = fl->P;
   double *restrict T = fl->T, *restrict r = fl->r;
   const double *bu = fl->bu, *bH = fl->bH;
@@ -184,7 +168,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   const double *vphi = fl->vphi, *vdphi = fl->vdphi, *bth = fl->btheta;
   double epen = 0;
   PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
-         shared(n, n_own, ptr, nbr, erec, pa, pm, vol, u, H, P, T, r, mat,
+         shared(n, n_own, ptr, nbr, erec, u, H, P, T, r, mat,
                 mats, ms, mss, sym, th, zq, Zq, quad, base, bu, bH, squad,
                 vol_on, vphi, vdphi, bth, m))
   for (long i = 0; i < n; i++) {
@@ -312,16 +296,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
       for (int c = 0; c < 3; c++) zq[3 * i + c] = z[c];
       for (int q = 0; q < 27; q++) Zq[27 * i + q] = Z[q];
     }
-    const double *A = pa + 3 * i, *Bm = pm + 9 * i;
-    for (int c = 0; c < 3; c++) {
-      r[3 * i + c] = ri[c] - 0.5 * (Pi[3 * c] * A[0] + Pi[3 * c + 1] * A[1] +
-                                    Pi[3 * c + 2] * A[2]);
-      for (int q = 0; q < 3; q++)
-        T[9 * i + 3 * c + q] =
-            vol[i] * Pi[3 * c + q] - Q[3 * c + q] + Tv[3 * c + q] -
-            0.5 * (Pi[3 * c] * Bm[q] + Pi[3 * c + 1] * Bm[3 + q] +
-                   Pi[3 * c + 2] * Bm[6 + q]);
-    }
+    fpm_flux_close(m, i, Pi, Q, ri, Tv, r, T);
   }
   return epen;
 }
@@ -369,32 +344,10 @@ static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
   }
 }
 
-/* Pass 3: f_k = sum_{i in S(k)} T_i g_ik - T_k sum_j g_kj + r_k. */
+/* Pass 3: f_k = sum_{i in S(k)} T_i g_ik - T_k sum_j g_kj + r_k, over the
+ * entries streamed (fpm_stream.h). */
 static void gather_pass(const fpm_model *m, const fields *fl) {
-  const long n = m->n_own;
-  const long *restrict ptr = m->nbr_ptr;
-  const int *restrict nbr = m->nbr, *restrict mir = m->mirror;
-  const double *restrict g = m->g, *restrict gs = m->gsum, *restrict T = fl->T,
-                         *restrict r = fl->r;
-  double *restrict f = fl->f;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(n, ptr, nbr, mir, g, gs, T, r, f))
-  for (long k = 0; k < n; k++) {
-    const double *Tk = T + 9 * k, *s = gs + 3 * k;
-    double fk[3];
-    for (int c = 0; c < 3; c++)
-      fk[c] = r[3 * k + c] -
-              (Tk[3 * c] * s[0] + Tk[3 * c + 1] * s[1] + Tk[3 * c + 2] * s[2]);
-    for (long e = ptr[k]; e < ptr[k + 1]; e++) {
-      const double *Ti = T + 9 * nbr[e], *gik = g + 3 * mir[e];
-      for (int c = 0; c < 3; c++)
-        fk[c] += Ti[3 * c] * gik[0] + Ti[3 * c + 1] * gik[1] +
-                 Ti[3 * c + 2] * gik[2];
-    }
-    f[3 * k] = fk[0];
-    f[3 * k + 1] = fk[1];
-    f[3 * k + 2] = fk[2];
-  }
+  fpm_stream_gather(m, fl->T, fl->r, fl->f);
 }
 
 /* With fpm.jump: quadratic, the penalty force through the fits:

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fpm_contact.h"
+#include "fpm_stream.h"
 #include "fpm_gfd.h"
 #include "fpm_volumetric.h"
 #include "gm_shape.h"
@@ -26,6 +27,11 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->erec);
   free(m->p_area);
   free(m->p_mrel);
+  free(m->fs_ptr);
+  free(m->fs_nbr);
+  free(m->fs_rec);
+  free(m->fs_g);
+  free(m->fs_gm);
   free(m->mat);
   free(m->mstate);
   free(m->mass);
@@ -71,7 +77,11 @@ size_t fpm_model_bytes(const fpm_model *m) {
          (m->q ? (size_t)m->qs_ptr[m->n] * (FPM_QFIT * d + 3 * sizeof(int)) +
                      (size_t)m->n * (FPM_QFIT * d + 2 * sizeof(long))
                : 0) +
-         (m->vavg ? (size_t)(m->nnz + m->n) * d : 0);
+         (m->vavg ? (size_t)(m->nnz + m->n) * d : 0) +
+         (m->fs_ptr
+              ? fpm_stream_bytes(m->n_stress,
+                                 FPM_LANES * m->fs_ptr[m->n_stress], m->fs_rec)
+              : 0);
 }
 
 /* Entry (k, i) for every entry (i, k): supports are symmetric (mesh
@@ -402,6 +412,7 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   if (m->jump == FPM_JUMP_QUADRATIC && m->boundary_penalty > 0)
     PM_TRY(boundary_penalty(m));
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
+  PM_TRY(fpm_stream_build(m));
   if (o->volumetric == FPM_VOLUMETRIC_AVERAGED) PM_TRY(fpm_volumetric_build(m));
   PM_TRY(fpm_build_boundary(m, s, mesh));
   PM_TRY(fpm_contact_create(m, s, &m->contact));

@@ -17,6 +17,7 @@
 
 struct fpm_contact;
 #define FPM_EREC 23 /* doubles per support-entry record */
+#define FPM_LANES 4 /* entries a block of the plain flux stream */
 
 /* Everything that does not change during a run.  Arrays are per point
  * (n), per support entry (nnz, in the CSR order of the dual's adjacency) or
@@ -48,6 +49,16 @@ typedef struct {
   double *erec;   /* FPM_EREC nnz */
   double *p_area; /* 3 n: sum of a_e (outward from i) */
   double *p_mrel; /* 9 n: sum of M_e - a_e (x) X_i (outward) */
+  /* The entries streamed (fpm_stream.h): point i's entries in blocks
+   * fs_ptr[i] .. fs_ptr[i+1] of FPM_LANES entries, padded; per block
+   * FPM_LANES neighbours, their g_ik, the mirror entries' g_ki and with the
+   * plain formulation the records' first 19 fields (else fs_rec NULL), each
+   * field's lanes contiguous. */
+  long *fs_ptr;   /* n_stress + 1 */
+  int *fs_nbr;    /* FPM_LANES blocks */
+  double *fs_g;   /* 3 FPM_LANES blocks */
+  double *fs_gm;  /* 3 FPM_LANES blocks */
+  double *fs_rec; /* 19 FPM_LANES blocks, or NULL */
   /* Materials. */
   int n_mats;
   pm_material mats[FPM_MAX_MATERIALS];

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_stream.h"
 #include "fpm_gfd.h"
 #include "fpm_model.h"
 
@@ -250,6 +251,7 @@ pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
   if (m->vavg) PM_TRY(subset_averages(m, s));
   if (m->qs_ptr) PM_TRY(subset_fits(m, s, lof));
   PM_TRY(subset_boundary(m, s, lof));
+  PM_TRY(fpm_stream_build(s));
   *out = s;
   s = NULL;
 done:
