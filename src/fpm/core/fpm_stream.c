@@ -86,25 +86,24 @@ double fpm_stream_flux(const fpm_model *m, const double *restrict u,
          shared(m, n, n_own, bp, nb, R, u, H, P, T, r))
   for (long i = 0; i < n; i++) {
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
-    fpm_lanes Qa[9] = {0}, ra[3] = {0}, ea = {0};
+    pm_v4 Qa[9] = {0}, ra[3] = {0}, ea = {0};
     for (long b = bp[i]; b < bp[i + 1]; b++) {
       const double *rb = R + FS_FIELDS * FPM_LANES * b;
       const int *kb = nb + FPM_LANES * b;
       const int k3[4] = {3 * kb[0], 3 * kb[1], 3 * kb[2], 3 * kb[3]};
       const int k9[4] = {9 * kb[0], 9 * kb[1], 9 * kb[2], 9 * kb[3]};
-      fpm_lanes Pk[9], Mc[9], di[3], dk[3], jv[3], w[3];
+      pm_v4 Pk[9], Mc[9], di[3], dk[3], jv[3], w[3];
       for (int f = 0; f < 9; f++) {
         Pk[f] = FPM_GATHER(P, k9, f);
-        Mc[f] = fpm_load_lanes(rb + FPM_LANES * (3 + f));
+        Mc[f] = pm_v4_load(rb + FPM_LANES * (3 + f));
       }
       for (int c = 0; c < 3; c++) {
-        di[c] = fpm_load_lanes(rb + FPM_LANES * (12 + c));
-        dk[c] = fpm_load_lanes(rb + FPM_LANES * (15 + c));
+        di[c] = pm_v4_load(rb + FPM_LANES * (12 + c));
+        dk[c] = pm_v4_load(rb + FPM_LANES * (15 + c));
       }
-      const fpm_lanes a0 = fpm_load_lanes(rb),
-                      a1 = fpm_load_lanes(rb + FPM_LANES),
-                      a2 = fpm_load_lanes(rb + 2 * FPM_LANES),
-                      be = fpm_load_lanes(rb + 18 * FPM_LANES);
+      const pm_v4 a0 = pm_v4_load(rb), a1 = pm_v4_load(rb + FPM_LANES),
+                  a2 = pm_v4_load(rb + 2 * FPM_LANES),
+                  be = pm_v4_load(rb + 18 * FPM_LANES);
       for (int c = 0; c < 3; c++) {
         jv[c] = ui[c] - FPM_GATHER(u, k3, c) + Hi[3 * c] * di[0] +
                 Hi[3 * c + 1] * di[1] + Hi[3 * c + 2] * di[2] -
@@ -153,13 +152,13 @@ void fpm_stream_gather(const fpm_model *m, const double *restrict T,
          shared(n, bp, nb, G, gs, T, r, f))
   for (long k = 0; k < n; k++) {
     const double *Tk = T + 9 * k, *s = gs + 3 * k;
-    fpm_lanes fa[3] = {0};
+    pm_v4 fa[3] = {0};
     for (long b = bp[k]; b < bp[k + 1]; b++) {
       const int *kb = nb + FPM_LANES * b;
       const int k9[4] = {9 * kb[0], 9 * kb[1], 9 * kb[2], 9 * kb[3]};
-      const fpm_lanes g0 = fpm_load_lanes(G + FPM_LANES * 3 * b),
-                      g1 = fpm_load_lanes(G + FPM_LANES * (3 * b + 1)),
-                      g2 = fpm_load_lanes(G + FPM_LANES * (3 * b + 2));
+      const pm_v4 g0 = pm_v4_load(G + FPM_LANES * 3 * b),
+                  g1 = pm_v4_load(G + FPM_LANES * (3 * b + 1)),
+                  g2 = pm_v4_load(G + FPM_LANES * (3 * b + 2));
       for (int c = 0; c < 3; c++)
         fa[c] += FPM_GATHER(T, k9, 3 * c) * g0 +
                  FPM_GATHER(T, k9, 3 * c + 1) * g1 +

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "fpm_model.h"
+#include "pm_v4.h"
 
 /* Whether the model's formulation is the plain one whose flux pass the
  * stream serves (linear jump, incomplete flux, no stiffening or volume
@@ -39,23 +40,11 @@ double fpm_stream_flux(const fpm_model *m, const double *u, const double *H,
 void fpm_stream_gather(const fpm_model *m, const double *T, const double *r,
                        double *f);
 
-/* FPM_LANES doubles as one vector (GNU C vector extension; a narrower
- * instruction set splits it). */
-typedef double fpm_lanes
-    __attribute__((vector_size(FPM_LANES * sizeof(double))));
-
-static inline fpm_lanes fpm_load_lanes(const double *p) {
-  fpm_lanes v;
-  memcpy(&v, p, sizeof v);
-  return v;
-}
+_Static_assert(FPM_LANES == 4, "a block of the stream is one pm_v4");
 
 /* Component c of the items at offsets k[0..3] of A (four lanes). */
-_Static_assert(FPM_LANES == 4, "FPM_GATHER spells out four lanes");
 #define FPM_GATHER(A, k, c)                                                    \
-  (fpm_lanes) {                                                                \
-    A[(k)[0] + (c)], A[(k)[1] + (c)], A[(k)[2] + (c)], A[(k)[3] + (c)]         \
-  }
+  (pm_v4) { A[(k)[0] + (c)], A[(k)[1] + (c)], A[(k)[2] + (c)], A[(k)[3] + (c)] }
 
 /* The displacement gradient of point i < m->n_stress over its streamed
  * entries: h = sum_k (u_k - u_i) (x) g_ik (row-major 3 x 3, out).  Equal to
@@ -63,17 +52,16 @@ _Static_assert(FPM_LANES == 4, "FPM_GATHER spells out four lanes");
 static inline void fpm_stream_gradient(const fpm_model *m,
                                        const double *restrict u, long i,
                                        double h[9]) {
-  fpm_lanes acc[9] = {0};
+  pm_v4 acc[9] = {0};
   const double *ui = u + 3 * i;
   for (long b = m->fs_ptr[i]; b < m->fs_ptr[i + 1]; b++) {
     const int *kb = m->fs_nbr + FPM_LANES * b;
     const int k3[4] = {3 * kb[0], 3 * kb[1], 3 * kb[2], 3 * kb[3]};
     const double *gb = m->fs_g + 3 * FPM_LANES * b;
-    const fpm_lanes g0 = fpm_load_lanes(gb),
-                    g1 = fpm_load_lanes(gb + FPM_LANES),
-                    g2 = fpm_load_lanes(gb + 2 * FPM_LANES);
+    const pm_v4 g0 = pm_v4_load(gb), g1 = pm_v4_load(gb + FPM_LANES),
+                g2 = pm_v4_load(gb + 2 * FPM_LANES);
     for (int c = 0; c < 3; c++) {
-      const fpm_lanes d = FPM_GATHER(u, k3, c) - ui[c];
+      const pm_v4 d = FPM_GATHER(u, k3, c) - ui[c];
       acc[3 * c] += d * g0;
       acc[3 * c + 1] += d * g1;
       acc[3 * c + 2] += d * g2;

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "mpm_shape.h"
+#include "pm_v4.h"
 #include "pm_error.h"
 
 /* Geometry of a uniform Cartesian grid over the domain box, with `ghost`
@@ -43,19 +44,6 @@ enum {
   MPM_ACC_PAD = 7,
   MPM_ACC_BASE = 8
 };
-
-/* Four doubles as one vector (GNU C vector extension: AVX's 256-bit
- * registers on x86-64-v3, two 128-bit halves on v2), loaded and stored
- * without alignment. */
-typedef double mpm_v4 __attribute__((vector_size(32)));
-static inline mpm_v4 mpm_v4_load(const double *p) {
-  mpm_v4 v;
-  memcpy(&v, p, sizeof v);
-  return v;
-}
-static inline void mpm_v4_store(double *p, mpm_v4 v) {
-  memcpy(p, &v, sizeof v);
-}
 
 /* The nodal arrays of a step.  Workspace: every step rebuilds them from
  * the particles, so a checkpoint never writes them. */
@@ -169,9 +157,9 @@ typedef struct {
           const double gk0 = dw_[0][a_] * wbc_;                                \
           const double gk1 = w_[0][a_] * gy_;                                  \
           const double gk2 = w_[0][a_] * gz_;                                  \
-          const mpm_v4 gkv =                                                   \
-              (mpm_v4){dw_[0][a_], w_[0][a_], w_[0][a_], w_[0][a_]} *          \
-              (mpm_v4){wbc_, gy_, gz_, gz_};                                   \
+          const pm_v4 gkv =                                                    \
+              (pm_v4){dw_[0][a_], w_[0][a_], w_[0][a_], w_[0][a_]} *           \
+              (pm_v4){wbc_, gy_, gz_, gz_};                                    \
           (void)node, (void)wk, (void)gk0, (void)gk1, (void)gk2, (void)gkv;    \
           __VA_ARGS__                                                          \
         }                                                                      \
@@ -237,7 +225,7 @@ mpm_velocity_gradient_dw(const mpm_grid *g, const double *vel,
                          const int width) {
   /* Three rows of L as vectors, l_i += v_i grad S, lane by lane the
    * products and sums of the scalar loop. */
-  mpm_v4 r0 = {0, 0, 0, 0}, r1 = r0, r2 = r0;
+  pm_v4 r0 = {0, 0, 0, 0}, r1 = r0, r2 = r0;
   MPM_STENCIL_FOR(g, x, dim, width, {
     const double *v = vel + 3 * node;
     r0 += v[0] * gkv;

@@ -49,21 +49,21 @@ p2g_group(const mpm_model *m, const mpm_state *s, const mpm_work *w,
      * without MPM_P2G_MASS); the force as the columns of -V sigma times
      * the gradient's components, summed in the scalar order, the pad lane
      * a copy of the third (not a zero: see MPM_STENCIL_FOR). */
-    const mpm_v4 mv = {mode & MPM_P2G_MASS ? 1.0 : 0.0, vp[0], vp[1], vp[2]};
-    const mpm_v4 s0 = {sg[0], sg[3], sg[6], sg[6]},
-                 s1 = {sg[1], sg[4], sg[7], sg[7]},
-                 s2 = {sg[2], sg[5], sg[8], sg[8]};
+    const pm_v4 mv = {mode & MPM_P2G_MASS ? 1.0 : 0.0, vp[0], vp[1], vp[2]};
+    const pm_v4 s0 = {sg[0], sg[3], sg[6], sg[6]},
+                s1 = {sg[1], sg[4], sg[7], sg[7]},
+                s2 = {sg[2], sg[5], sg[8], sg[8]};
     MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
       double *r = acc + node * S;
       if (mode & MPM_P2G_MOM) {
-        const mpm_v4 r0 = mpm_v4_load(r + MPM_ACC_M);
-        mpm_v4_store(r + MPM_ACC_M, r0 + wk * mp * mv);
+        const pm_v4 r0 = pm_v4_load(r + MPM_ACC_M);
+        pm_v4_store(r + MPM_ACC_M, r0 + wk * mp * mv);
       } else if (mode & MPM_P2G_MASS) {
         r[MPM_ACC_M] += wk * mp;
       }
       if (mode & MPM_P2G_FORCE) {
-        const mpm_v4 r1 = mpm_v4_load(r + MPM_ACC_F);
-        mpm_v4_store(r + MPM_ACC_F, r1 + (s0 * gk0 + s1 * gk1 + s2 * gk2));
+        const pm_v4 r1 = pm_v4_load(r + MPM_ACC_F);
+        pm_v4_store(r + MPM_ACC_F, r1 + (s0 * gk0 + s1 * gk1 + s2 * gk2));
         if (imp) {
           r[MPM_ACC_BASE + 0] += wk * mp * cp;
           r[MPM_ACC_BASE + 1] += wk * mp * cs;
@@ -171,10 +171,10 @@ g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
   for (long p = gr->begin; p < gr->end; p++) {
     /* A node's three components read as four (the nodal arrays are
      * padded), the fourth lane unused; lane by lane the scalar sums. */
-    mpm_v4 vn4 = {0, 0, 0, 0}, dv4 = vn4;
+    pm_v4 vn4 = {0, 0, 0, 0}, dv4 = vn4;
     MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
-      const mpm_v4 v1 = mpm_v4_load(vel_new + 3 * node);
-      const mpm_v4 v0 = mpm_v4_load(vel0 + 3 * node);
+      const pm_v4 v1 = pm_v4_load(vel_new + 3 * node);
+      const pm_v4 v0 = pm_v4_load(vel0 + 3 * node);
       vn4 += wk * v1;
       dv4 += wk * (v1 - v0);
     });
@@ -191,10 +191,10 @@ g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
     if (remap) {
       /* As mpm_p2g's w m (1, v): the mass lane is not read back. */
       const double mp = mass[p];
-      const mpm_v4 mv = {1.0, vp[0], vp[1], vp[2]};
+      const pm_v4 mv = {1.0, vp[0], vp[1], vp[2]};
       MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
         double *r = acc + node * S;
-        mpm_v4_store(r + MPM_ACC_M, mpm_v4_load(r + MPM_ACC_M) + wk * mp * mv);
+        pm_v4_store(r + MPM_ACC_M, pm_v4_load(r + MPM_ACC_M) + wk * mp * mv);
       });
     }
   }
