@@ -16,17 +16,19 @@
 #define MODE_ITERS 12
 #define MODE_RTOL 1e-4
 
-/* The M-products v.M v and v.M u (M diagonal, m). */
+/* The M-products v.M v, v.M u and u.M u (M diagonal, m), in one pass. */
 static void mass_dots(long n, const double *m, const double *v, const double *u,
-                      double *vmv, double *vmu) {
-  double a = 0, b = 0;
-  PM_OMP(parallel for schedule(static) reduction(+ : a, b))
+                      double *vmv, double *vmu, double *umu) {
+  double a = 0, b = 0, c = 0;
+  PM_OMP(parallel for schedule(static) reduction(+ : a, b, c))
   for (long i = 0; i < n; i++) {
     a += m[i] * v[i] * v[i];
     b += m[i] * v[i] * u[i];
+    c += m[i] * u[i] * u[i];
   }
   *vmv = a;
   *vmu = b;
+  *umu = c;
 }
 
 pm_err pm_load_lowest_mode(pm_newton *s, const double *x, const double *m,
@@ -51,12 +53,9 @@ pm_err pm_load_lowest_mode(pm_newton *s, const double *x, const double *m,
     pm_load_add_costs(rep, &tr);
     if (e != PM_SUCCESS) break;
     /* K u = M v: for an eigenvector v of eigenvalue q, u = v / q */
-    double vmv, vmu;
-    mass_dots(n, m, v, u, &vmv, &vmu);
+    double vmv, vmu, umu;
+    mass_dots(n, m, v, u, &vmv, &vmu, &umu);
     const double next = vmv / vmu;
-    double umu = 0;
-    PM_OMP(parallel for schedule(static) reduction(+ : umu))
-    for (long i = 0; i < n; i++) umu += m[i] * u[i] * u[i];
     PM_CHECK(umu > 0 && isfinite(umu) && isfinite(next), PM_ERR_UNSTABLE,
              "lowest mode: the inverse iterate is not finite");
     const double sc = 1.0 / sqrt(umu);
