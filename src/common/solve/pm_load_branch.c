@@ -110,9 +110,7 @@ pm_err pm_load_ptc_noted(pm_newton *s, double *x, double goal, double shift0,
                          pm_relax_work *w, pm_load_report *rep,
                          const char *label, char *msg, size_t cap) {
   double r0 = 0, q = 0;
-  size_t used = strlen(msg);
-  snprintf(msg + used, cap - used, "%s", label);
-  used = strlen(msg);
+  const size_t used = pm_msg_appendf(msg, cap, "%s", label);
   pm_err e = pm_load_ptc(s, x, goal, shift0, w, rep, &r0, &q, msg + used,
                          (long)(cap - used));
   if (rep->ptc_runs == 1 || q < rep->ptc_curvature) rep->ptc_curvature = q;

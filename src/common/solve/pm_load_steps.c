@@ -103,12 +103,10 @@ static pm_err relax_step(pm_newton *s, double *x, const double *xc,
   add_solve(rep, &rep->last);
   if (e == PM_SUCCESS || !recoverable(e)) return e;
   pm_error_clear();
-  const size_t used = strlen(msg);
-  snprintf(msg + used, cap - used, "; then %s", rep->last.message);
+  pm_msg_appendf(msg, cap, "; then %s", rep->last.message);
   e = pm_load_relax(s, x, 0, fmax(o->rtol * r0, o->atol), w, rep, &r1, part,
                     sizeof part);
-  const size_t used2 = strlen(msg);
-  snprintf(msg + used2, cap - used2, "; on from there: %s", part);
+  pm_msg_appendf(msg, cap, "; on from there: %s", part);
   if (e == PM_SUCCESS) {
     /* Converged by the residual criterion, by relaxation alone. */
     rep->last.reason = PM_NEWTON_CONVERGED_RESIDUAL;
@@ -158,9 +156,7 @@ static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
   if (isfinite(eig) && eig < 0) {
     e = pm_load_branch_switch(s, x, xc, goal, shift0, w, rep, msg, cap);
   } else if (isfinite(eig)) {
-    const size_t used = strlen(msg);
-    snprintf(msg + used, cap - used, "%s", used ? "; " : "");
-    const size_t used2 = strlen(msg);
+    const size_t used2 = pm_msg_appendf(msg, cap, "%s", msg[0] ? "; " : "");
     e = pm_load_arc(s, x, xc, xprev, lambda, lambda_prev, target, goal, aw, rep,
                     msg + used2, (long)(cap - used2));
     if (e == PM_SUCCESS) {

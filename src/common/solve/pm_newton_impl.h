@@ -5,6 +5,25 @@
 
 #include "pm_newton.h"
 
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Appends printf-style text to the message msg (capacity cap, NUL-ended,
+ * truncated to fit); returns msg's length after it. */
+__attribute__((format(printf, 3, 4))) static inline size_t
+pm_msg_appendf(char *msg, size_t cap, const char *fmt, ...) {
+  size_t used = strlen(msg);
+  if (used + 1 < cap) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg + used, cap - used, fmt, ap);
+    va_end(ap);
+    used = strlen(msg);
+  }
+  return used;
+}
+
 const pm_newton_problem *pm_newton_problem_of(const pm_newton *s);
 const pm_newton_options *pm_newton_options_of(const pm_newton *s);
 
