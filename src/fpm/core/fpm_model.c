@@ -450,8 +450,9 @@ pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
   }
   PM_TRY(PM_ALLOC(st->tf_value, 3 * m->n_tfacets, "tractions"));
   PM_TRY(PM_ALLOC(st->bflux, 3 * m->n_dpts, "boundary flux"));
-  PM_TRY(
-      PM_ALLOC(st->support_prev, m->n_cdofs + 3 * m->n_dpts, "support forces"));
+  PM_TRY(PM_ALLOC(st->support_prev,
+                  m->n_cdofs + 3 * m->n_dpts + 6 * m->n_tfacets,
+                  "support forces"));
   if (m->contact) PM_TRY(fpm_contact_state_init(m->contact, &st->contact));
   *out = st;
   st = NULL;

@@ -176,7 +176,9 @@ typedef struct {
   double *bflux;        /* 3 n_dpts: that flux per point: the supports' force on
                            the body, with f on the prescribed dofs */
   double *support_prev; /* n_cdofs + 3 n_dpts: those forces at the previous
-                           step (trapezoidal work of the supports) */
+                           step (trapezoidal work of the supports); then
+                           3 n_tfacets tractions and 3 n_tfacets of the
+                           displacements they work on (fpm_support_work) */
   double *contact;      /* the rigid bodies' contact state
                            (fpm_contact_state_size), or NULL */
   /* What the time loop carries from step to step (fpm_run continues from

@@ -73,11 +73,30 @@ double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
   return lam > 0 ? 2 / sqrt(lam) : INFINITY;
 }
 
+/* What a traction facet's traction works on: the displacement of its
+ * point carried to the facet by the point's gradient, times the area,
+ * |f| u_i + H_i |f| (c_f - X_i) (the force puts -t (x) tf_rel into the
+ * point's flux tensor, whose conjugate is H).  Three per facet. */
+static void traction_displacement(const fpm_model *m, const fpm_state *st,
+                                  long k, double w[3]) {
+  const long i = m->tf_point[k];
+  const double *H = st->H + 9 * i, *rel = m->tf_rel + 3 * k;
+  for (int a = 0; a < 3; a++)
+    w[a] = m->tf_area[k] * st->u[3 * i + a] + H[3 * a] * rel[0] +
+           H[3 * a + 1] * rel[1] + H[3 * a + 2] * rel[2];
+}
+
 void fpm_support_start(const fpm_model *m, fpm_state *st) {
   for (long k = 0; k < m->n_cdofs; k++)
     st->support_prev[k] = st->f[3 * m->cd_point[k] + m->cd_comp[k]];
   for (long k = 0; k < 3 * m->n_dpts; k++)
     st->support_prev[m->n_cdofs + k] = st->bflux[k];
+  double *tp = st->support_prev + m->n_cdofs + 3 * m->n_dpts;
+  double *wp = tp + 3 * m->n_tfacets;
+  for (long k = 0; k < m->n_tfacets; k++) {
+    memcpy(tp + 3 * k, st->tf_value + 3 * k, 3 * sizeof(double));
+    traction_displacement(m, st, k, wp + 3 * k);
+  }
 }
 
 double fpm_support_work(const fpm_model *m, fpm_state *st, const double *du,
@@ -99,10 +118,20 @@ double fpm_support_work(const fpm_model *m, fpm_state *st, const double *du,
                 scale;
       prev_b[3 * p + a] = fb;
     }
-  for (long k = 0; k < m->n_tfacets; k++)
-    for (int a = 0; a < 3 && m->tf_point[k] < m->n_own; a++)
-      work += st->tf_value[3 * k + a] * m->tf_area[k] *
-              du[3 * m->tf_point[k] + a] * scale;
+  /* Tractions: the trapezoidal rule on what they work on (a ghost's facet
+   * is its owner's work). */
+  double *tp = prev_b + 3 * m->n_dpts, *wp = tp + 3 * m->n_tfacets;
+  for (long k = 0; k < m->n_tfacets; k++) {
+    double w[3];
+    traction_displacement(m, st, k, w);
+    for (int a = 0; a < 3; a++) {
+      const double t = st->tf_value[3 * k + a];
+      if (m->tf_point[k] < m->n_own)
+        work += 0.5 * (tp[3 * k + a] + t) * (w[a] - wp[3 * k + a]);
+      tp[3 * k + a] = t;
+      wp[3 * k + a] = w[a];
+    }
+  }
   if (rr) *rr = r2;
   return work;
 }

@@ -73,10 +73,10 @@ double fpm_energy_error(const fpm_step_info *s);
  * flux) of the state, remembered as the start of the next increment. */
 void fpm_support_start(const fpm_model *m, fpm_state *st);
 
-/* Work of the supports over an increment du * scale (trapezoidal rule
- * between the remembered forces and the state's, which are remembered
- * next) and of the current tractions; *rr (may be NULL) receives the sum of
- * the squared forces on prescribed dofs. */
+/* Work of the supports over an increment du * scale and of the tractions
+ * since the last call (both by the trapezoidal rule between the remembered
+ * forces and the state's, which are remembered next); *rr (may be NULL)
+ * receives the sum of the squared forces on prescribed dofs. */
 double fpm_support_work(const fpm_model *m, fpm_state *st, const double *du,
                         double scale, double *rr);
 
