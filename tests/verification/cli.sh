@@ -131,6 +131,29 @@ check "probe: exit 0 (got $rc)" test $rc -eq 0
 check "probe: u_z = -0.4 z at every point" awk -F, '
   NR > 1 { n++; if ((($6 + 0.4 * $3) ^ 2) ^ 0.5 > 1e-6) bad++ }
   END { exit !(n == 3 && bad == 0) }' "$work/probe"
+# probe --at points: every point's own values, no fit (u_z = -0.4 z holds
+# at each point of the exact state); one point asked for by its
+# coordinates (printed to 10 digits: found within 1e-9 m); a coordinate at
+# no point refused with its file and line.
+"$bin" probe "$out" --at points >"$work/own" 2>"$work/err"
+rc=$?
+check "probe --at points: exit 0 (got $rc)" test $rc -eq 0
+check "probe --at points: header" grep -q '^point,x,y,z,displacement_x,displacement_y,displacement_z' "$work/own"
+npts=$(grep -o '"points": [0-9]*' "$out/summary.json" | grep -o '[0-9]*$')
+check "probe --at points: a row per point ($npts), u_z = -0.4 z" awk -F, -v n="$npts" '
+  NR > 1 { k++; if ((($7 + 0.4 * $4) ^ 2) ^ 0.5 > 1e-6) bad++ }
+  END { exit !(k == n && n > 0 && bad == 0) }' "$work/own"
+awk -F, 'NR == 1 { print "x,y,z" } NR == 12 { print $2 "," $3 "," $4 }' "$work/own" >"$work/one.csv"
+"$bin" probe "$out" --at points --points "$work/one.csv" >"$work/one" 2>"$work/err"
+check "probe --at points --points: the point itself, at distance 0" awk -F, '
+  NR == 1 { next } { n++; if ($4 > 1e-9 || $5 != 10) bad++ }
+  END { exit !(n == 1 && bad == 0) }' "$work/one"
+printf 'x,y,z\n0.05,0.05,0.05\n5,5,5\n' >"$work/far.csv"
+"$bin" probe "$out" --at points --points "$work/far.csv" >"$work/far" 2>"$work/err"
+rc=$?
+check "probe --at points far away: exit 1 (got $rc)" test $rc -eq 1
+check "probe --at points far away: names $work/far.csv:3" grep -q "far.csv:3: no point" "$work/err"
+check "probe --at points far away: no partial table" test ! -s "$work/far"
 
 # Convergence against the finite-element referee the scene names
 # (reference.fe): the displacement at the FE lattice, the reaction and the

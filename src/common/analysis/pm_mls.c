@@ -223,7 +223,8 @@ static bool fit(const pm_mls *c, const double *q, long m, double R, int nc,
 
 /* The nearest of the points within growing radii of q, other than point
  * self (-1: none); its distance. */
-static double nearest_other(pm_mls *m, const double *q, long self) {
+static double nearest_other(pm_mls *m, const double *q, long self,
+                            long *which) {
   double R = m->spacing, rmax2 = 0.0;
   for (int a = 0; a < m->d; a++) {
     int k = m->axis[a];
@@ -233,8 +234,13 @@ static double nearest_other(pm_mls *m, const double *q, long self) {
   for (;;) {
     long found = gather(m, q, R);
     double best = INFINITY;
-    for (long j = 0; j < found; j++)
-      if (m->near[j] != self) best = fmin(best, dist2(m, q, m->near[j]));
+    for (long j = 0; j < found; j++) {
+      const double d2 = m->near[j] != self ? dist2(m, q, m->near[j]) : INFINITY;
+      if (d2 < best) {
+        best = d2;
+        if (which) *which = m->near[j];
+      }
+    }
     /* Every point within R was gathered: the nearest is among them. */
     if (isfinite(best) || R * R > rmax2) return sqrt(best);
     R *= 2;
@@ -242,14 +248,21 @@ static double nearest_other(pm_mls *m, const double *q, long self) {
 }
 
 double pm_mls_nearest(pm_mls *m, const double *q) {
-  return nearest_other(m, q, -1);
+  return nearest_other(m, q, -1, NULL);
+}
+
+long pm_mls_nearest_point(pm_mls *m, const double *q, double *dist) {
+  long which = -1;
+  const double d = nearest_other(m, q, -1, &which);
+  if (dist) *dist = d;
+  return which;
 }
 
 double pm_mls_gap(pm_mls *m) {
   if (m->gap >= 0) return m->gap;
   double sum = 0;
   for (long i = 0; i < m->n && m->n > 1; i++)
-    sum += nearest_other(m, m->x + 3 * i, i);
+    sum += nearest_other(m, m->x + 3 * i, i, NULL);
   m->gap = m->n > 1 ? sum / (double)m->n : 0;
   return m->gap;
 }

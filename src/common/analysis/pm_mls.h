@@ -29,6 +29,10 @@ double pm_mls_spacing(const pm_mls *m);
 /* The distance from q to the nearest point of the cloud, along its axes. */
 double pm_mls_nearest(pm_mls *m, const double *q);
 
+/* The nearest point of the cloud to q (its index), and its distance along
+ * the cloud's axes into *dist (may be NULL). */
+long pm_mls_nearest_point(pm_mls *m, const double *q, double *dist);
+
 /* The mean distance from a point of the cloud to its nearest other point
  * (computed at the first call; 0 for a single point): the spacing a query
  * point farther than about that from every point lies off the cloud by. */

@@ -17,6 +17,17 @@
 pm_err pm_probe(const char *out_dir, const char *points_csv, long frame,
                 FILE *out);
 
+/* The values at the points themselves (no fit): every per-point field of
+ * frame `frame` (last when < 0) of OUT/results.h5 (float datasets with a
+ * row per point: vectors as _x _y _z columns, 3 x 3 tensors as _xx .. _zz),
+ * as CSV rows "point,x,y,z,FIELDS..." (x the reference coordinates).  With
+ * points_csv (as pm_probe reads it; NULL: every point), one row per query
+ * for the nearest point, after "query_x,query_y,query_z,distance"; a query
+ * farther than half the points' mean gap from every point is refused with
+ * its file and line.  Nothing is written when anything fails. */
+pm_err pm_probe_points(const char *out_dir, const char *points_csv, long frame,
+                       FILE *out);
+
 /* Read the reference coordinates and the displacement of frame `frame`
  * (last when < 0) of OUT/results.h5 into new [n][3] arrays. */
 pm_err pm_results_read(const char *out_dir, long frame, long *n, double **x,
