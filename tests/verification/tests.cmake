@@ -51,6 +51,10 @@ add_test(NAME verification.membranes
   COMMAND bash ${PM_VERIFY_DIR}/membranes.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.membranes PROPERTIES LABELS verification TIMEOUT 900 PROCESSORS 2)
 
+add_test(NAME verification.python
+  COMMAND bash ${PM_VERIFY_DIR}/python.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.python PROPERTIES LABELS verification TIMEOUT 120 PROCESSORS 1)
+
 add_test(NAME verification.compare
   COMMAND bash ${PM_VERIFY_DIR}/compare.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.compare PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 1)

@@ -1,0 +1,205 @@
+"""Read a pointmech run folder from Python, with Debian's h5py and numpy.
+
+    import pointmech
+    r = pointmech.open("out/f2-unconstrained-compression")
+    u = r.frames[-1]["displacement"]        # numpy array, one row a point
+    x = r.mesh["coordinates"]               # reference coordinates
+    r.history["time"], r.history["reaction_zmax_z"]
+    r.summary["status"]
+    for frame in r.follow():                # every frame, as it is written
+        print(frame.step, frame.time, frame["von_mises"].max())
+
+A run folder holds one HDF5 file per frame (results/frame_NNNNNN.h5),
+each written under a temporary name and renamed once it is complete, and
+the mesh (results/mesh.h5).  This module reads those files directly and
+holds none of them open between calls, so it reads a run while it goes
+on and never blocks the writer.
+"""
+
+import builtins
+import csv
+import json
+import os
+import re
+import time as _time
+
+import h5py
+import numpy as np
+
+__all__ = ["open", "Run", "Frame"]
+
+_FRAME = re.compile(r"^frame_(\d{6,})\.h5$")
+
+
+def _read_group(path):
+    """Every dataset of an HDF5 file as numpy arrays, and its attributes."""
+    data = {}
+    with h5py.File(path, "r") as f:
+        def take(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                data[name] = obj[()]
+        f.visititems(take)
+        attrs = {k: (v.item() if hasattr(v, "item") else v)
+                 for k, v in f.attrs.items()}
+    return data, attrs
+
+
+class Frame:
+    """One output frame: its fields by name (numpy arrays, read at the
+    first access), `step`, `time` and `index`."""
+
+    def __init__(self, path, index):
+        self.path = path
+        self.index = index
+        self._data = None
+        self._attrs = None
+
+    def _load(self):
+        if self._data is None:
+            self._data, self._attrs = _read_group(self.path)
+
+    def __getitem__(self, name):
+        self._load()
+        try:
+            return self._data[name]
+        except KeyError:
+            raise KeyError("frame %d (%s) has no field %r; it has %s" % (
+                self.index, self.path, name,
+                ", ".join(sorted(self._data)))) from None
+
+    def __contains__(self, name):
+        self._load()
+        return name in self._data
+
+    def keys(self):
+        self._load()
+        return self._data.keys()
+
+    @property
+    def step(self):
+        self._load()
+        return int(self._attrs.get("step", -1))
+
+    @property
+    def time(self):
+        self._load()
+        return float(self._attrs.get("time", float("nan")))
+
+    def __repr__(self):
+        return "<pointmech.Frame %d of %s>" % (self.index, self.path)
+
+
+class _Frames:
+    """The frames on disk now, in order: len(), [i] (negative too), and
+    iteration.  Listed afresh at each call, so a running run's new frames
+    appear."""
+
+    def __init__(self, folder):
+        self._dir = os.path.join(folder, "results")
+
+    def _paths(self):
+        try:
+            names = os.listdir(self._dir)
+        except FileNotFoundError:
+            return []
+        found = sorted((int(m.group(1)), n) for n in names
+                       for m in [_FRAME.match(n)] if m)
+        return [(i, os.path.join(self._dir, n)) for i, n in found]
+
+    def __len__(self):
+        return len(self._paths())
+
+    def __getitem__(self, k):
+        paths = self._paths()
+        if isinstance(k, slice):
+            return [Frame(p, i) for i, p in paths[k]]
+        i, p = paths[k]
+        return Frame(p, i)
+
+    def __iter__(self):
+        return iter([Frame(p, i) for i, p in self._paths()])
+
+
+class Run:
+    """A run folder (`pointmech run ... --out FOLDER`)."""
+
+    def __init__(self, folder):
+        if not os.path.isdir(folder):
+            raise FileNotFoundError("no run folder %r" % folder)
+        self.folder = folder
+        self.frames = _Frames(folder)
+        self._mesh = None
+
+    @property
+    def summary(self):
+        """summary.json as a dict (read afresh: "status" is "running"
+        until the run ends)."""
+        with builtins.open(os.path.join(self.folder, "summary.json")) as f:
+            return json.load(f)
+
+    @property
+    def history(self):
+        """history.csv as a dict of numpy arrays, one per column."""
+        path = os.path.join(self.folder, "history.csv")
+        with builtins.open(path, newline="") as f:
+            rows = list(csv.reader(f))
+        if not rows:
+            return {}
+        head, body = rows[0], rows[1:]
+        cols = {}
+        for k, name in enumerate(head):
+            values = [r[k] for r in body if len(r) == len(head)]
+            try:
+                cols[name] = np.array(values, dtype=float)
+            except ValueError:
+                cols[name] = np.array(values)
+        return cols
+
+    @property
+    def mesh(self):
+        """results/mesh.h5: "coordinates" (reference, one row a point),
+        "cells", and "surface" where the run has a membrane."""
+        if self._mesh is None:
+            self._mesh, _ = _read_group(
+                os.path.join(self.folder, "results", "mesh.h5"))
+        return self._mesh
+
+    def running(self):
+        """Whether the run is still going (summary.json says so)."""
+        try:
+            return self.summary.get("status") == "running"
+        except (FileNotFoundError, ValueError):
+            return True  # not written yet, or being replaced
+
+    def follow(self, poll=0.5, timeout=None):
+        """Yield every frame in order, waiting for new ones while the run
+        goes on; stops when the run has ended and its last frame was
+        yielded, or after `timeout` seconds without a new frame."""
+        seen = 0
+        idle_since = _time.monotonic()
+        while True:
+            paths = self.frames._paths()
+            for i, p in paths[seen:]:
+                yield Frame(p, i)
+            if len(paths) > seen:
+                seen = len(paths)
+                idle_since = _time.monotonic()
+            if not self.running():
+                # the end: frames written before the summary's last word
+                paths = self.frames._paths()
+                for i, p in paths[seen:]:
+                    yield Frame(p, i)
+                return
+            if timeout is not None and \
+                    _time.monotonic() - idle_since > timeout:
+                return
+            _time.sleep(poll)
+
+    def __repr__(self):
+        return "<pointmech.Run %s: %d frames>" % (self.folder,
+                                                 len(self.frames))
+
+
+def open(folder):
+    """Open the run folder `folder`."""
+    return Run(folder)
