@@ -64,5 +64,17 @@ wait $pid
 check "the followed run ends well" test $? -eq 0
 echo "python: $(cat "$work/read"); followed: $(cat "$work/follow.txt")"
 
+# tools/paraview-open.py where ParaView is installed (Debian's paraview and
+# python3-paraview; xvfb-run for a machine without a display): a picture of
+# the coarse F2 run coloured by von Mises, and a state file.
+if command -v pvbatch >/dev/null && command -v xvfb-run >/dev/null; then
+  (cd "$work" && timeout 300 xvfb-run -a pvbatch "$src/tools/paraview-open.py" \
+    "$work/f2" --screenshot f2.png --state f2.pvsm) >"$work/pv" 2>"$work/err"
+  check "paraview-open: coloured by von_mises" grep -q "coloured by von_mises" "$work/pv"
+  check "paraview-open: a picture and a state" test -s "$work/f2.png" -a -s "$work/f2.pvsm"
+else
+  echo "paraview-open: skipped (pvbatch or xvfb-run not installed)"
+fi
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
