@@ -66,6 +66,14 @@ set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 4
 # Runs across MPI ranks (mpirun -np 2 and 3) against the same scenes on one
 # process, explicit MPM (ranks.sh) and FPM (ranks-fpm.sh); ranks_migrate
 # checks that migration moves particles and nothing else.
+# One core each (PROCESSORS 1), one at a time (RESOURCE_LOCK mpirun): their
+# ranks run one thread and yield their core while they wait, and the
+# scripts spend most of their time outside the ranks' work (starting
+# mpirun and the one-process runs, Python comparisons, signals awaited):
+# ranks_fpm used 51 CPU s where it held both cores for 86 s of wall
+# (docs/validation.md, "The suite, cut again"), so ctest -j2 runs a
+# one-core test beside them.  Never two of them together: their ranks
+# would yield to each other's on the same two cores.
 if(PM_MPI)
   add_executable(ranks_migrate ${PM_VERIFY_DIR}/ranks_migrate.c)
   target_link_libraries(ranks_migrate PRIVATE pm_app)
@@ -73,7 +81,8 @@ if(PM_MPI)
     COMMAND bash ${PM_VERIFY_DIR}/ranks.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_migrate>)
   set_tests_properties(verification.ranks PROPERTIES LABELS verification
-    TIMEOUT 600 PROCESSORS 2)
+    TIMEOUT 600 PROCESSORS 1
+    RESOURCE_LOCK mpirun)
   # The Newton layer and the implicit MPM across ranks.
   add_executable(ranks_newton ${PM_VERIFY_DIR}/ranks_newton.c)
   target_link_libraries(ranks_newton PRIVATE pm_app)
@@ -81,19 +90,22 @@ if(PM_MPI)
     COMMAND bash ${PM_VERIFY_DIR}/ranks-implicit.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_newton>)
   set_tests_properties(verification.ranks_implicit PROPERTIES LABELS
-    verification TIMEOUT 600 PROCESSORS 2)
+    verification TIMEOUT 600 PROCESSORS 1
+    RESOURCE_LOCK mpirun)
   add_test(NAME verification.ranks_fpm
     COMMAND bash ${PM_VERIFY_DIR}/ranks-fpm.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR})
   set_tests_properties(verification.ranks_fpm PROPERTIES LABELS verification
-    TIMEOUT 600 PROCESSORS 2)
+    TIMEOUT 600 PROCESSORS 1
+    RESOURCE_LOCK mpirun)
   # Membranes (their neighbours on other ranks) and bodies moving as
   # prescribed across ranks.
   add_test(NAME verification.ranks_membranes
     COMMAND bash ${PM_VERIFY_DIR}/ranks-membranes.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_migrate>)
   set_tests_properties(verification.ranks_membranes PROPERTIES LABELS
-    verification TIMEOUT 600 PROCESSORS 2)
+    verification TIMEOUT 600 PROCESSORS 1
+    RESOURCE_LOCK mpirun)
 endif()
 
 # Grips on regions of particles and tractions on faces (explicit MPM):
