@@ -259,9 +259,9 @@ static double residual(const mpm_ctx *ctx) {
 
 /* Nodal velocities before and after the Lagrangian update, null
  * directions, boundary conditions, reactions and the residual. */
-bool mpm_grid_nodes_fused(const mpm_ctx *ctx, int mode) {
+bool mpm_grid_nodes_fused(const mpm_ctx *ctx, int mode, bool update) {
   return (mode & MPM_NODES_FUSED) && !mpm_xc_shared(ctx->model) &&
-         !ctx->work->cond.fold;
+         !(update && ctx->work->cond.fold);
 }
 
 void mpm_grid_update_nodes(const mpm_ctx *ctx) {
@@ -291,7 +291,7 @@ pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
   const mpm_model *m = ctx->model;
   mpm_nodes *nd = &ctx->work->nodes;
   if (ctx->work->cond.fold) mpm_conditions_fold(ctx);
-  if (!mpm_grid_nodes_fused(ctx, self->mode)) {
+  if (!mpm_grid_nodes_fused(ctx, self->mode, true)) {
     PM_OMP(parallel default(none) shared(ctx))
     mpm_grid_update_nodes(ctx);
   }
@@ -331,7 +331,7 @@ static void grid_velocity_conditions(mpm_ctx *ctx) {
 void mpm_grid_velocity(mpm_ctx *ctx) { mpm_grid_velocity_after(ctx, 0); }
 
 void mpm_grid_velocity_after(mpm_ctx *ctx, int mode) {
-  if (!mpm_grid_nodes_fused(ctx, mode)) {
+  if (!mpm_grid_nodes_fused(ctx, mode, false)) {
     PM_OMP(parallel default(none) shared(ctx))
     mpm_grid_velocity_nodes(ctx);
   }

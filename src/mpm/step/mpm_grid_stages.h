@@ -19,9 +19,9 @@ void mpm_grid_velocity_after(mpm_ctx *ctx, int mode);
 
 /* Whether a stage of mode `mode` runs (as transfer) or left (as grid
  * stage) the grid stage's node loop in the transfer's region: the
- * MPM_NODES_FUSED bit on one process, and for the grid update no folded
- * conditions (their fold comes before its loop). */
-bool mpm_grid_nodes_fused(const mpm_ctx *ctx, int mode);
+ * MPM_NODES_FUSED bit on one process, and for the grid update (`update`)
+ * no folded conditions (their fold comes before its loop). */
+bool mpm_grid_nodes_fused(const mpm_ctx *ctx, int mode, bool update);
 
 /* The node loops of the grid update (v and v^L from the nodal sums) and
  * of the grid velocity: this thread's static share of the nodes, no

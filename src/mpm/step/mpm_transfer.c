@@ -155,7 +155,7 @@ pm_err mpm_p2g(mpm_ctx *ctx, int mode) { return p2g_then(ctx, mode, false); }
 
 pm_err mpm_stage_p2g(mpm_ctx *ctx, const mpm_stage *self) {
   return p2g_then(ctx, self->mode & ~MPM_NODES_FUSED,
-                  mpm_grid_nodes_fused(ctx, self->mode));
+                  mpm_grid_nodes_fused(ctx, self->mode, true));
 }
 
 /* The FLIP/PIC velocities and the position increments of a group's
@@ -227,7 +227,7 @@ pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
   const double *x = s->x;
   double *v = s->v;
   const bool remap = (self->mode & ~MPM_NODES_FUSED) == MPM_P2G_MOM;
-  const bool velocity = remap && mpm_grid_nodes_fused(ctx, self->mode);
+  const bool velocity = remap && mpm_grid_nodes_fused(ctx, self->mode, false);
   PM_OMP(parallel num_threads(nd->threads) default(none)
              shared(m, w, nd, g, nn, dt, x, v, remap, velocity, ctx)) {
     double *acc = nd->acc + (size_t)thread_id() * nn * nd->acc_stride;
