@@ -2,17 +2,17 @@
 # The explicit kernels of two builds side by side, for a quiet machine: F2
 # (FPM, 1851 points), the MPM 3-D block (110592 particles) and the shock
 # tube (20000 particles), each on 1 and 2 OpenMP threads, the two builds in
-# turn, ROUNDS times (default 3); the medians of point_steps_per_second
+# turn, REPEATS times (default 3); the medians of point_steps_per_second
 # (summary.json: the step loop, setup excluded) and the efficiency on two
 # threads (the 2-thread rate over twice the 1-thread rate).  Each run is
 # about 5-10 s on one quiet core; STEPS_F2, STEPS_BLOCK, STEPS_TUBE change
 # the step counts, TUBE the tube's scene.
 # usage: benchmarks/kernels-quiet.sh OLD_BUILD NEW_BUILD   (about 6 min)
 bench_name=kernels-quiet
-bench_env="ROUNDS STEPS_F2 STEPS_BLOCK STEPS_TUBE TUBE"
+bench_env="REPEATS STEPS_F2 STEPS_BLOCK STEPS_TUBE TUBE"
 source "$(dirname "$0")/bench-lib.sh"
 old=$1 new=${2:?usage: benchmarks/kernels-quiet.sh OLD_BUILD NEW_BUILD}
-rounds=${ROUNDS:-3}
+repeats=${REPEATS:-3}
 # The runtime's own waiting policy, as pointmech sets it (a short spin).
 export GOMP_SPINCOUNT=${GOMP_SPINCOUNT:-3000}
 cases=(
@@ -22,7 +22,7 @@ cases=(
 )
 rates=$out/rates.txt
 : >"$rates"
-for ((r = 1; r <= rounds; r++)); do
+for ((r = 1; r <= repeats; r++)); do
   for c in "${cases[@]}"; do
     read -r name scene steps <<<"$c"
     for threads in 1 2; do
