@@ -205,12 +205,6 @@ static pm_err create(const pm_scene *s, void **out) {
     }
     sim->setup_wall += pm_wtime() - t0;
   }
-  /* An explicit run of the plain formulation reads its support entries
-   * from the stream alone. */
-  if (!e && s->time.qs != PM_QS_STATIC) {
-    fpm_model_drop_static(sim->model);
-    if (sim->local_model) fpm_model_drop_static(sim->local_model);
-  }
   if (e) {
     fpm_sim_destroy(sim);
     return e;

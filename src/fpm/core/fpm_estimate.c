@@ -58,13 +58,9 @@ size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
         FPM_QFIT * d + 2 * sizeof(long) + 57 * d;
   /* The entry stream (fpm_stream_bytes), with the flux records for the
    * plain formulation; a row's padding is (FPM_LANES - 1) / 2 entries on
-   * average.  An explicit run of the plain formulation then frees the
-   * interface records and the weights (fpm_model_drop_static): during the
-   * setup both are held, which the mesh's share covers. */
+   * average. */
   const bool plain = !quadratic && o->flux != FPM_FLUX_SIPG &&
                      o->stiffening == 0 && o->volume_penalty == 0;
-  if (plain && s->time.qs != PM_QS_STATIC)
-    per_point -= nnz * (3 + FPM_EREC) * d;
   per_point += (double)fpm_stream_bytes(
       1, (long)ceil(nnz + (FPM_LANES - 1) / 2.0), plain);
   /* Newton's method adds the tangent (3 x 3 blocks per support entry and

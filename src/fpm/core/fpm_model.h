@@ -228,8 +228,9 @@ pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s, const gm_mesh *mesh);
 void fpm_model_destroy(fpm_model *m);
 /* With the plain formulation (its stream holds the flux records, m->fs_rec),
  * frees the interface records erec and the weights g, which only static
- * solves, the general flux pass and fpm_stable_dt read: for an explicit run
- * once its shares and time step are made.  Otherwise nothing. */
+ * solves, the general flux pass, fpm_stable_dt and the shares built from
+ * the model read: for an explicit run, before its time loop.  Otherwise
+ * nothing. */
 void fpm_model_drop_static(fpm_model *m);
 /* Bytes held by the model (not counting the dual). */
 size_t fpm_model_bytes(const fpm_model *m);
