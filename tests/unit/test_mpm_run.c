@@ -274,9 +274,11 @@ static void test_solver_observer(void **state) {
 }
 
 /* MUSL's remap scattered by g2p at the weights it has just used (the
- * pipeline's choice when no stage between them changes velocities) and the
- * remap as its own transfer: the same state to the bit after 15 steps, for
- * two material groups, both shapes, FLIP and PIC. */
+ * pipeline's choice when no stage between them changes velocities), with
+ * the grid velocity's and the grid update's node loops in the regions of
+ * g2p and p2g (MPM_NODES_FUSED), and every stage on its own: the same
+ * state to the bit after 15 steps, for two material groups, both shapes,
+ * FLIP and PIC. */
 static void test_fused_remap_same_bits(void **state) {
   char path[512];
   pm_test_write_file(*state, "two-bodies.yaml", TWO_BODIES, path);
@@ -287,10 +289,12 @@ static void test_fused_remap_same_bits(void **state) {
   for (int k = 0; k < 2; k++) {
     model a = make_model(path, 3, sets[k]);
     model b = make_model(path, 3, sets[k]);
-    /* b: the remap as its own transfer. */
-    int fused = 0;
+    /* b: the remap as its own transfer, every node loop in its stage. */
+    int fused = 0, nodes = 0;
     mpm_pipeline *pl = &b.model->pipeline;
     for (int j = 0; j < pl->n; j++) {
+      nodes += (pl->stage[j].mode & MPM_NODES_FUSED) != 0;
+      pl->stage[j].mode &= ~MPM_NODES_FUSED;
       if (strcmp(pl->stage[j].name, "g2p") == 0) {
         fused += pl->stage[j].mode == MPM_P2G_MOM;
         pl->stage[j].mode = 0;
@@ -301,6 +305,7 @@ static void test_fused_remap_same_bits(void **state) {
       }
     }
     assert_int_equal(fused, 2);
+    assert_int_equal(nodes, 4); /* p2g, grid update, g2p, remap */
     for (int n = 0; n < 15; n++) {
       step(&a);
       step(&b);

@@ -236,6 +236,11 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
     return e;
   }
   sim->first_step = st->step;
+  /* The explicit loop of the plain formulation reads its support entries
+   * from the stream alone (a plan, made from the same model, still builds
+   * shares from the records). */
+  if (sim->model) fpm_model_drop_static(sim->model); /* (a view released) */
+  if (sim->local_model) fpm_model_drop_static(sim->local_model);
   e = fpm_run(lm, st, &opt, observe, sim, &sim->last, stage);
   e = pm_view_end(&sim->view, e); /* the state it ended in, for figures */
   if (sim->local_model) ranks_costs(sim);

@@ -30,12 +30,27 @@ typedef struct {
    * increments (linearisation only), and the base's fits (quadratic
    * stiffening's linearisation only) */
   const double *vphi, *vdphi, *btheta;
+  /* the team's sums (shared, zero at the region's start): the interface
+   * energy, the boundary flux's squared norm */
+  double *sums;
 } fields;
 
+/* Adds this thread's part to *sum (shared) and waits for the team; every
+ * thread then reads the whole.  The parts are added one thread after
+ * another as OpenMP's reduction clause adds them, so the sum has the bits
+ * of the reduction it replaces. */
+static inline double team_sum(double *sum, double part) {
+  PM_OMP(atomic)
+  *sum += part;
+  PM_OMP(barrier)
+  return *sum;
+}
+
 /* Pass 1: F_i = I + sum_k (u_k - u_i) (x) g_ik, then P_i, W_i, J_i.
- * Returns the smallest inadmissible point of the model's own, or -1 (a
- * ghost's is its owner's to find). */
-static long stress_pass(const fpm_model *m, fpm_state *st) {
+ * Lowers *bad (shared, the model's own count at the region's start) to the
+ * smallest inadmissible point of the model's own (a ghost's is its
+ * owner's to find); every thread sees the result after the pass. */
+static void stress_pass(const fpm_model *m, fpm_state *st, long *bad_all) {
   const long n = m->n_stress, n_own = m->n_own;
   const double *restrict u = st->u;
   double *restrict H = st->H, *restrict P = st->P, *restrict W = st->W,
@@ -45,9 +60,7 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
   const double *ms = m->mstate;
   const long mss = m->mstate_stride;
   long bad = n_own;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(m, n, n_own, u, H, P, W, J, mat, mats, ms, mss)
-         reduction(min : bad))
+  PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < n; i++) {
     double h[9];
     fpm_stream_gradient(m, u, i, h);
@@ -64,19 +77,20 @@ static long stress_pass(const fpm_model *m, fpm_state *st) {
         i < bad)
       bad = i;
   }
-  return bad < n_own ? bad : -1;
+  PM_OMP(critical(fpm_force_bad))
+  if (bad < *bad_all) *bad_all = bad;
+  PM_OMP(barrier)
 }
 
 /* With fpm.jump: quadratic, the fit of each point:
- * theta_i = sum_m (u_m - u_i) (x) q_im (3 x FPM_QFIT). */
+ * theta_i = sum_m (u_m - u_i) (x) q_im (3 x FPM_QFIT) (no barrier after it). */
 static void fit_pass(const fpm_model *m, const double *restrict u,
                      double *restrict th) {
   const long n = m->n_stress;
   const long *restrict ptr = m->qs_ptr;
   const int *restrict nbr = m->qs_nbr;
   const double *restrict q = m->q;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(n, ptr, nbr, q, u, th))
+  PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < n; i++) {
     double t[27] = {0};
     const double *ui = u + 3 * i;
@@ -144,10 +158,9 @@ static inline void quad_jump(const double *ui, const double *uk,
  * deformed distance, whose derivative leaves through r (sd).  The volume
  * penalty (fpm.volume_penalty, rec[21]) adds 1/2 c |e| phi_e |j|^2 on the
  * linear jump and its derivative through each point's J (fpm_penalty_terms.h).
- * The energy counts the model's own points. */
-static double flux_pass(const fpm_model *m, const fields *fl) {
-  /* The plain formulation streams its entries (fpm_stream.h). */
-  if (m->fs_rec) return fpm_stream_flux(m, fl->u, fl->H, fl->P, fl->T, fl->r);
+ * The energy counts the model's own points.  The general pass: this
+ * thread's points (no barrier after them) and its share of the energy. */
+static double flux_general(const fpm_model *m, const fields *fl) {
   const long n = m->n_flux, n_own = m->n_own;
   const long *restrict ptr = m->nbr_ptr;
   const int *restrict nbr = m->nbr;
@@ -167,10 +180,7 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   const bool vol_on = m->volume_penalty > 0;
   const double *vphi = fl->vphi, *vdphi = fl->vdphi, *bth = fl->btheta;
   double epen = 0;
-  PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
-         shared(n, n_own, ptr, nbr, erec, u, H, P, T, r, mat,
-                mats, ms, mss, sym, th, zq, Zq, quad, base, bu, bH, squad,
-                vol_on, vphi, vdphi, bth, m))
+  PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < n; i++) {
     const bool counted = i < n_own;
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
@@ -301,6 +311,16 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
   return epen;
 }
 
+/* Pass 2 over the team (the plain formulation streams its entries,
+ * fpm_stream.h), then a barrier; the interface energy of the model's own
+ * points. */
+static double flux_pass(const fpm_model *m, const fields *fl) {
+  const double part =
+      m->fs_rec ? fpm_stream_flux(m, fl->u, fl->H, fl->P, fl->T, fl->r)
+                : flux_general(m, fl);
+  return team_sum(fl->sums + 0, part);
+}
+
 /* Boundary terms: the consistency flux on facets with displacement
  * conditions, projected on the prescribed components
  * (r_i -= Pi P_i a_f, T_i -= Pi P_i (M_f - a_f (x) X_i)), and prescribed
@@ -313,8 +333,7 @@ static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
   const double *restrict P = fl->P;
   double *restrict T = fl->T, *restrict r = fl->r, *restrict bf = fl->bflux;
   double norm2 = 0;
-  PM_OMP(parallel for schedule(static) default(none) reduction(+ : norm2)
-         shared(nd, n_own, dp, da, dm, P, T, r, bf))
+  PM_OMP(for schedule(static) nowait)
   for (long p = 0; p < nd; p++) {
     const long i = dp[p];
     const double *Pi = P + 9 * i;
@@ -330,16 +349,26 @@ static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
                                 Pi[3 * c + 2] * B[6 + q];
     }
   }
+  norm2 = team_sum(fl->sums + 1, norm2);
   if (!st) return; /* the linearisation: tractions do not depend on u */
-  st->bflux_sq = norm2;
-  st->bflux_norm = sqrt(norm2);
+  if (m->n_tfacets == 0) {
+    PM_OMP(masked) {
+      st->bflux_sq = norm2;
+      st->bflux_norm = sqrt(norm2);
+    }
+    return;
+  }
   /* Several facets share a point: serial (boundary only). */
-  for (long k = 0; k < m->n_tfacets; k++) {
-    const long i = m->tf_point[k];
-    const double *t = st->tf_value + 3 * k, *rel = m->tf_rel + 3 * k;
-    for (int c = 0; c < 3; c++) {
-      r[3 * i + c] -= t[c] * m->tf_area[k];
-      for (int q = 0; q < 3; q++) T[9 * i + 3 * c + q] -= t[c] * rel[q];
+  PM_OMP(single) {
+    st->bflux_sq = norm2;
+    st->bflux_norm = sqrt(norm2);
+    for (long k = 0; k < m->n_tfacets; k++) {
+      const long i = m->tf_point[k];
+      const double *t = st->tf_value + 3 * k, *rel = m->tf_rel + 3 * k;
+      for (int c = 0; c < 3; c++) {
+        r[3 * i + c] -= t[c] * m->tf_area[k];
+        for (int q = 0; q < 3; q++) T[9 * i + 3 * c + q] -= t[c] * rel[q];
+      }
     }
   }
 }
@@ -359,8 +388,8 @@ static void fit_gather_pass(const fpm_model *m, const fields *fl) {
   const double *restrict q = m->q, *restrict qs = m->qsum,
                          *restrict zq = fl->zq, *restrict Zq = fl->Zq;
   double *restrict f = fl->f;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(n, tp, te, own, q, qs, zq, Zq, f))
+  /* f_k of the points the gather gave this thread: no barrier between */
+  PM_OMP(for schedule(static) nowait)
   for (long k = 0; k < n; k++) {
     double fk[3];
     for (int c = 0; c < 3; c++)
@@ -378,11 +407,38 @@ void fpm_force_skipped(const fpm_model *m, fpm_state *st) {
   if (m->vavg) fpm_volumetric_stress_skipped(m, st);
 }
 
+/* The passes after the stress over the team of the enclosing parallel
+ * region: the fits (theta, with the quadratic jump) and the volume penalty's
+ * phi (one barrier), the flux, the boundary, the gather.  The gather and the
+ * fits' gather end without a barrier (the region's end is one). */
+static void force_passes(const fpm_model *m, const fields *fl, double *theta,
+                         fpm_state *st) {
+  if (theta) fit_pass(m, fl->u, theta);
+  if (st && st->vphi) fpm_volume_phi(m->n_stress, st->J, st->vphi);
+  if (fl->theta || (st && st->vphi)) {
+    PM_OMP(barrier)
+  }
+  const double epen = flux_pass(m, fl);
+  if (st) {
+    PM_OMP(masked)
+    st->penalty_energy = epen;
+  }
+  boundary_pass(m, fl, st);
+  gather_pass(m, fl);
+  if (fl->theta) fit_gather_pass(m, fl);
+}
+
+/* One parallel region for the explicit force: a step's passes fork the
+ * team once, and a barrier (not a fork and a join) separates them.  The
+ * averaged volume's exchange between the stress and the flux needs the
+ * ranks' order, so with it the stress is its own region. */
 long fpm_force(const fpm_model *m, fpm_state *st) {
-  long bad = stress_pass(m, st);
-  if (m->vavg && bad < 0) fpm_volumetric_stress(m, st);
-  if (m->vavg && bad >= 0) fpm_volumetric_stress_skipped(m, st);
-  if (bad >= 0) return bad;
+  return fpm_force_then(m, st, NULL, NULL);
+}
+
+long fpm_force_then(const fpm_model *m, fpm_state *st, void (*tail)(void *),
+                    void *ctx) {
+  double sums[2] = {0, 0};
   const fields fl = {.u = st->u,
                      .H = st->H,
                      .P = st->P,
@@ -393,13 +449,26 @@ long fpm_force(const fpm_model *m, fpm_state *st) {
                      .Zq = st->Zq,
                      .f = st->f,
                      .bflux = st->bflux,
-                     .vphi = st->vphi};
-  if (st->theta) fit_pass(m, st->u, st->theta);
-  if (st->vphi) fpm_volume_phi(m->n_stress, st->J, st->vphi);
-  st->penalty_energy = flux_pass(m, &fl);
-  boundary_pass(m, &fl, st);
-  gather_pass(m, &fl);
-  if (st->theta) fit_gather_pass(m, &fl);
+                     .vphi = st->vphi,
+                     .sums = sums};
+  const bool whole = m->vavg == NULL;
+  long bad = m->n_own;
+  PM_OMP(parallel default(none) shared(m, st, fl, whole, bad, tail, ctx)) {
+    stress_pass(m, st, &bad);
+    if (whole && bad == m->n_own) {
+      force_passes(m, &fl, st->theta, st);
+      if (tail) tail(ctx);
+    }
+  }
+  if (whole || bad < m->n_own) {
+    if (m->vavg) fpm_volumetric_stress_skipped(m, st);
+    return bad < m->n_own ? bad : -1;
+  }
+  fpm_volumetric_stress(m, st);
+  PM_OMP(parallel default(none) shared(m, st, fl, tail, ctx)) {
+    force_passes(m, &fl, st->theta, st);
+    if (tail) tail(ctx);
+  }
   return -1;
 }
 
@@ -457,6 +526,7 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
     }
   }
   if (m->vavg) fpm_volumetric_apply(m, &l->vol, dH, dP);
+  double sums[2] = {0, 0};
   const fields fl = {.u = du,
                      .H = dH,
                      .P = dP,
@@ -470,11 +540,9 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
                      .bH = l->bH,
                      .vphi = l->vphi,
                      .vdphi = l->vdphi,
-                     .btheta = l->btheta};
-  if (l->theta) fit_pass(m, du, l->theta);
+                     .btheta = l->btheta,
+                     .sums = sums};
   if (l->vdphi) fpm_volume_dphi(n, l->bH, dH, NULL, l->vdphi);
-  flux_pass(m, &fl);
-  boundary_pass(m, &fl, NULL);
-  gather_pass(m, &fl);
-  if (l->theta) fit_gather_pass(m, &fl);
+  PM_OMP(parallel default(none) shared(m, fl, l))
+  force_passes(m, &fl, l->theta, NULL);
 }

@@ -67,11 +67,19 @@ void fpm_model_destroy(fpm_model *m) {
   free(m);
 }
 
+void fpm_model_drop_static(fpm_model *m) {
+  if (!m->fs_rec) return;
+  free(m->erec);
+  free(m->g);
+  m->erec = NULL;
+  m->g = NULL;
+}
+
 size_t fpm_model_bytes(const fpm_model *m) {
   size_t d = sizeof(double);
-  return m->nnz * (3 + FPM_EREC) * d + m->nnz * 2 * sizeof(int) +
-         m->n * (3 + 1 + 3 + 9 + 1) * d + m->n * (sizeof(int) + 3) +
-         m->n_dpts * (36 * d + sizeof(long)) +
+  return m->nnz * ((m->g ? 3 : 0) + (m->erec ? FPM_EREC : 0)) * d +
+         m->nnz * 2 * sizeof(int) + m->n * (3 + 1 + 3 + 9 + 1) * d +
+         m->n * (sizeof(int) + 3) + m->n_dpts * (36 * d + sizeof(long)) +
          m->n_tfacets * (7 * d + sizeof(long) + sizeof(int)) +
          m->n_cdofs * (d + sizeof(long) + 2 * sizeof(int)) +
          (m->q ? (size_t)m->qs_ptr[m->n] * (FPM_QFIT * d + 3 * sizeof(int)) +

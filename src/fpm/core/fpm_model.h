@@ -228,6 +228,12 @@ int fpm_domain_body(const pm_scene *s);
  * consistency flux on prescribed facets and the traction facets. */
 pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s, const gm_mesh *mesh);
 void fpm_model_destroy(fpm_model *m);
+/* With the plain formulation (its stream holds the flux records, m->fs_rec),
+ * frees the interface records erec and the weights g, which only static
+ * solves, the general flux pass, fpm_stable_dt and the shares built from
+ * the model read: for an explicit run, before its time loop.  Otherwise
+ * nothing. */
+void fpm_model_drop_static(fpm_model *m);
 /* Bytes held by the model (not counting the dual). */
 size_t fpm_model_bytes(const fpm_model *m);
 
@@ -256,6 +262,13 @@ pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
  * evaluate the force when the others do calls fpm_force_skipped. */
 long fpm_force(const fpm_model *m, fpm_state *st);
 void fpm_force_skipped(const fpm_model *m, fpm_state *st);
+/* fpm_force, then, when it succeeds, tail(ctx) by every thread of the
+ * force's parallel region (tail NULL: nothing), each thread right after
+ * its share of the gather: a loop over the model's own points with
+ * schedule(static) and nowait reads the f of its own points without a
+ * barrier.  The region's end is the tail's barrier. */
+long fpm_force_then(const fpm_model *m, fpm_state *st, void (*tail)(void *),
+                    void *ctx);
 
 /* The linearisation of fpm_force about a state: df = K du with K the
  * consistent tangent (exact but for the SIPG adjoint term's derivative of

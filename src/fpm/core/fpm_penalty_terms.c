@@ -5,7 +5,7 @@
 #include "pm_omp.h"
 
 void fpm_volume_phi(long n, const double *J, double *phi) {
-  PM_OMP(parallel for schedule(static) default(none) shared(n, J, phi))
+  PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < n; i++) {
     const double l = log(J[i]);
     phi[i] = l * l;

@@ -119,7 +119,8 @@ static inline void fpm_volume_flux(const double *Hb, const double *dH, double a,
   for (int q = 0; q < 9; q++) T[q] += 2 * a * (gd * G[q] - l * M[q]);
 }
 
-/* phi_i = (ln J_i)^2 of the points [0, n) from their J (the force). */
+/* phi_i = (ln J_i)^2 of the points [0, n) from their J (the force),
+ * shared by the team of the enclosing parallel region (no barrier after). */
 void fpm_volume_phi(long n, const double *J, double *phi);
 
 /* The base's phi_i and the increments dphi_i = 2 ln J_i F_i^-T : dH_i of

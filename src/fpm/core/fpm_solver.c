@@ -191,7 +191,8 @@ static pm_err unstable(const fpm_model *m, const fpm_state *st, long step,
  * added to *seconds): PM_ERR_UNSTABLE naming the condition or the point of
  * the first failure, the same on every rank. */
 static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
-                       double dt, double move_dt, double *seconds) {
+                       double dt, double move_dt, double *seconds,
+                       void (*tail)(void *), void *ctx) {
   pm_err e = PM_SUCCESS;
   long key = 0;
   long bad = move_dt >= 0 ? apply_prescribed(m, st, t, move_dt) : -1;
@@ -205,8 +206,11 @@ static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
   fpm_exchange_ghosts(m->xc, st->u);
   if (e == PM_SUCCESS) {
     const double w = pm_wtime();
-    bad = fpm_force(m, st);
+    /* The contact force adds to f after the force's region: then the
+     * tail is a region of its own. */
+    bad = fpm_force_then(m, st, m->contact ? NULL : tail, ctx);
     if (bad < 0) fpm_contact_force(m, st, t);
+    if (bad < 0 && m->contact && tail) PM_OMP(parallel) tail(ctx);
     *seconds += pm_wtime() - w;
     if (bad >= 0) {
       e = unstable(m, st, step, t, dt, bad, 0);
@@ -250,6 +254,51 @@ enum {
   SUMS
 };
 
+/* A step's sums over the model's own points after the force: s3, rf,
+ * kin, se start at zero and jmin at infinity; each thread adds its points'
+ * parts as OpenMP's reduction clause would (one thread after another). */
+typedef struct {
+  const fpm_model *m;
+  const fpm_state *st;
+  double dt;
+  double s3, rf, kin, se, jmin;
+} step_sums;
+
+/* The tail of the force's region (fpm_force_then): this thread's share of
+ * the points, the same static share as the gather's, so no barrier. */
+static void sums_after(void *ctx) {
+  step_sums *ss = ctx;
+  const fpm_model *m = ss->m;
+  const long n = m->n_own;
+  const double dt = ss->dt;
+  const double *restrict mass = m->mass, *restrict vol = m->dual->volume;
+  const unsigned char *restrict fixed = m->fixed;
+  const double *restrict v = ss->st->v, *restrict f = ss->st->f,
+                         *restrict W = ss->st->W, *restrict Jp = ss->st->J;
+  double s3 = 0, rf = 0, kin = 0, se = 0, jmin = INFINITY;
+  PM_OMP(for schedule(static) nowait)
+  for (long i = 0; i < n; i++) {
+    se += vol[i] * W[i];
+    jmin = Jp[i] < jmin ? Jp[i] : jmin;
+    for (int a = 0; a < 3; a++) {
+      const long dof = 3 * i + a;
+      /* Prescribed dofs move as the supports dictate: their kinetic
+       * energy comes from outside the balance, like their inertia. */
+      if (fixed[dof]) continue;
+      kin += 0.5 * mass[i] * v[dof] * v[dof];
+      s3 += dt * v[dof] * f[dof];
+      rf += f[dof] * f[dof];
+    }
+  }
+  PM_OMP(critical(fpm_step_sums)) {
+    ss->s3 += s3;
+    ss->rf += rf;
+    ss->kin += kin;
+    ss->se += se;
+    if (jmin < ss->jmin) ss->jmin = jmin;
+  }
+}
+
 /* Stop the loop at step, time t: the last figures and the stages'
  * seconds to the caller, and e. */
 static pm_err stop_at(pm_err e, fpm_step_info *si, long step, double t,
@@ -281,7 +330,8 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
            dt);
   /* A resumed state has its supports in place: only the tractions and the
    * force (functions of u and t) are computed again. */
-  PM_CALL(force_at(m, st, st->step, t, dt, resumed ? -1 : 0, seconds));
+  PM_CALL(
+      force_at(m, st, st->step, t, dt, resumed ? -1 : 0, seconds, NULL, NULL));
   fpm_support_start(m, st);
   fpm_contact_start(m, st, t);
 
@@ -330,31 +380,14 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
     }
     t += dt;
     const double force_before = seconds[0];
-    pm_err stop = force_at(m, st, step, t, dt, dt, seconds);
+    step_sums ss = {.m = m, .st = st, .dt = dt, .jmin = INFINITY};
+    pm_err stop = force_at(m, st, step, t, dt, dt, seconds, sums_after, &ss);
     seconds[1] -= seconds[0] - force_before;
     if (stop != PM_SUCCESS) {
       seconds[1] += pm_wtime() - w0;
       return stop_at(stop, &si, step, t, info, stage_seconds, seconds);
     }
-    double s3 = 0, rf = 0, kin = 0, se = 0, jmin = INFINITY;
-    const double *restrict W = st->W, *restrict vol = m->dual->volume,
-                           *restrict Jp = st->J;
-    PM_OMP(parallel for schedule(static) default(none)
-           reduction(+ : s3, rf, kin, se) reduction(min : jmin)
-           shared(n, mass, fixed, v, f, W, vol, Jp, dt))
-    for (long i = 0; i < n; i++) {
-      se += vol[i] * W[i];
-      jmin = Jp[i] < jmin ? Jp[i] : jmin;
-      for (int a = 0; a < 3; a++) {
-        const long dof = 3 * i + a;
-        /* Prescribed dofs move as the supports dictate: their kinetic
-         * energy comes from outside the balance, like their inertia. */
-        if (fixed[dof]) continue;
-        kin += 0.5 * mass[i] * v[dof] * v[dof];
-        s3 += dt * v[dof] * f[dof];
-        rf += f[dof] * f[dof];
-      }
-    }
+    double s3 = ss.s3, rf = ss.rf, kin = ss.kin, se = ss.se, jmin = ss.jmin;
     /* The supports' force on the body is the boundary consistency flux
      * plus the force left on prescribed dofs; its work (trapezoidal rule
      * over the step), and that of the tractions, give the external work. */

@@ -73,7 +73,7 @@ done:
  * optional terms absent: [[u]] = u_i + H_i d_i - u_k - H_k d_k,
  * w = 1/2 P_k a - beta |e| [[u]], r_i -= w,
  * Q_i += 1/2 P_k Mc + w (x) d_i, FPM_LANES entries at a time; the lanes'
- * sums are added at the end. */
+ * sums are added at the end.  This thread's points, no barrier after. */
 double fpm_stream_flux(const fpm_model *m, const double *restrict u,
                        const double *restrict H, const double *restrict P,
                        double *restrict T, double *restrict r) {
@@ -82,8 +82,7 @@ double fpm_stream_flux(const fpm_model *m, const double *restrict u,
   const int *restrict nb = m->fs_nbr;
   const double *restrict R = m->fs_rec;
   double epen = 0;
-  PM_OMP(parallel for schedule(static) default(none) reduction(+ : epen)
-         shared(m, n, n_own, bp, nb, R, u, H, P, T, r))
+  PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < n; i++) {
     const double *Pi = P + 9 * i, *Hi = H + 9 * i, *ui = u + 3 * i;
     pm_v4 Qa[9] = {0}, ra[3] = {0}, ea = {0};
@@ -141,15 +140,15 @@ double fpm_stream_flux(const fpm_model *m, const double *restrict u,
 }
 
 /* f_k = r_k - T_k sum_j g_kj + sum_{i in S(k)} T_i g_ik as fpm_force.c's
- * gather pass, FPM_LANES entries at a time. */
+ * gather pass, FPM_LANES entries at a time.  This thread's points, no
+ * barrier after. */
 void fpm_stream_gather(const fpm_model *m, const double *restrict T,
                        const double *restrict r, double *restrict f) {
   const long n = m->n_own;
   const long *restrict bp = m->fs_ptr;
   const int *restrict nb = m->fs_nbr;
   const double *restrict G = m->fs_gm, *restrict gs = m->gsum;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(n, bp, nb, G, gs, T, r, f))
+  PM_OMP(for schedule(static) nowait)
   for (long k = 0; k < n; k++) {
     const double *Tk = T + 9 * k, *s = gs + 3 * k;
     pm_v4 fa[3] = {0};

@@ -29,14 +29,17 @@ size_t fpm_stream_bytes(long rows, long entries, bool plain);
 pm_err fpm_stream_build(fpm_model *m);
 
 /* The flux pass (fpm_force.c's pass 2) of the plain formulation: r and T
- * of points [0, m->n_flux) from u, H, P; returns the interface energy of
- * the model's own points.  Needs m->fs_rec.  Equal to the general pass to
- * round-off (the entries' sums are taken FPM_LANES at a time). */
+ * of points [0, m->n_flux) from u, H, P; returns this thread's share of the
+ * interface energy of the model's own points.  Inside a parallel region
+ * the team shares the points (a static schedule, no barrier after); alone,
+ * one thread takes them all.  Needs m->fs_rec.  Equal to the general pass
+ * to round-off (the entries' sums are taken FPM_LANES at a time). */
 double fpm_stream_flux(const fpm_model *m, const double *u, const double *H,
                        const double *P, double *T, double *r);
 
 /* The gather pass (fpm_force.c's pass 3): f of points [0, m->n_own) from T
- * and r.  Equal to the general pass to round-off. */
+ * and r, shared by the team as the flux pass (no barrier after).  Equal
+ * to the general pass to round-off. */
 void fpm_stream_gather(const fpm_model *m, const double *T, const double *r,
                        double *f);
 

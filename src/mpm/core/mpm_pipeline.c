@@ -117,6 +117,11 @@ void mpm_pipeline_build(mpm_model *m) {
   /* The conditions belong to the update: it books their work. */
   st->books = m->n_bcs > 0 || m->n_moving > 0 ? MPM_BOOKS_WORK : 0;
   pl->update = st->index;
+  /* A transfer right before the update sums the nodes it starts from. */
+  if (st->index > 0 && pl->stage[st->index - 1].run == mpm_stage_p2g) {
+    pl->stage[st->index - 1].mode |= MPM_NODES_FUSED;
+    st->mode |= MPM_NODES_FUSED;
+  }
   const int n_rigid = mpm_contacts_count(m->bcs, m->n_bcs);
   snprintf(st->detail, sizeof st->detail,
            "v^L = v + dt f / m, %d boundary condition%s%s%s%s", m->n_bcs,
@@ -146,11 +151,12 @@ void mpm_pipeline_build(mpm_model *m) {
   }
   if (o->update == MPM_MUSL) {
     /* With no stage between them that moves particles' velocities, g2p
-     * scatters the remap's momentum at the weights it has just used. */
+     * scatters the remap's momentum at the weights it has just used, and
+     * its region goes on to the grid velocity. */
     const bool fused = m->n_moving == 0 && n_grips == 0;
-    g2p->mode = fused ? MPM_P2G_MOM : 0;
+    g2p->mode = fused ? MPM_P2G_MOM | MPM_NODES_FUSED : 0;
     st = add(pl, "remap", mpm_stage_remap);
-    st->mode = fused ? 0 : MPM_P2G_MOM;
+    st->mode = fused ? MPM_NODES_FUSED : MPM_P2G_MOM;
     snprintf(st->detail, sizeof st->detail, "%s",
              fused ? "MUSL: momentum from the updated particles (scattered "
                      "by g2p), the grid velocity"

@@ -10,6 +10,7 @@
 #include "mpm_grip.h"
 #include "mpm_kind.h"
 #include "mpm_state.h"
+#include "mpm_transfer.h"
 #include "pm_omp.h"
 #include "mpm_exchange.h"
 
@@ -258,16 +259,19 @@ static double residual(const mpm_ctx *ctx) {
 
 /* Nodal velocities before and after the Lagrangian update, null
  * directions, boundary conditions, reactions and the residual. */
-pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
+bool mpm_grid_nodes_fused(const mpm_ctx *ctx, int mode, bool update) {
+  return (mode & MPM_NODES_FUSED) && !mpm_xc_shared(ctx->model) &&
+         !(update && ctx->work->cond.fold);
+}
+
+void mpm_grid_update_nodes(const mpm_ctx *ctx) {
   const mpm_model *m = ctx->model;
   mpm_nodes *nd = &ctx->work->nodes;
   const unsigned nul = m->opt.null_velocity;
   const long nn = m->grid.n_nodes;
   const double dt = ctx->state->dt;
   const double *fold = ctx->work->cond.fold;
-  if (fold) mpm_conditions_fold(ctx);
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(nd, nul, nn, dt, fold))
+  PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < nn; i++) {
     double mi = nd->mass[i];
     for (int k = 0; k < 3; k++) {
@@ -281,6 +285,16 @@ pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
       nd->vel_new[3 * i + k] = v1;
     }
   }
+}
+
+pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
+  const mpm_model *m = ctx->model;
+  mpm_nodes *nd = &ctx->work->nodes;
+  if (ctx->work->cond.fold) mpm_conditions_fold(ctx);
+  if (!mpm_grid_nodes_fused(ctx, self->mode, true)) {
+    PM_OMP(parallel default(none) shared(ctx))
+    mpm_grid_update_nodes(ctx);
+  }
   double work = mpm_conditions_apply(ctx, nd->vel_new, true);
   work += mpm_grips_apply(ctx, nd->vel_new, true);
   if (m->n_moving > 0) work += mpm_motion_apply(ctx, nd->vel_new, true);
@@ -291,23 +305,37 @@ pm_err mpm_stage_grid_update(mpm_ctx *ctx, const mpm_stage *self) {
   return mpm_conditions_status(ctx);
 }
 
-void mpm_grid_velocity(mpm_ctx *ctx) {
-  mpm_nodes *nd = &ctx->work->nodes;
+void mpm_grid_velocity_nodes(const mpm_ctx *ctx) {
+  const mpm_nodes *nd = &ctx->work->nodes;
   const unsigned nul = ctx->model->opt.null_velocity;
   const long nn = ctx->model->grid.n_nodes;
   const double *restrict mass = nd->mass, *restrict mom = nd->mom;
   double *restrict vel = nd->vel;
-  PM_OMP(parallel for schedule(static) default(none)
-         shared(nul, nn, mass, mom, vel))
+  PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < nn; i++) {
     double m = mass[i];
     for (int k = 0; k < 3; k++)
       vel[3 * i + k] = (m > 0 && !(nul >> k & 1u)) ? mom[3 * i + k] / m : 0.0;
   }
+}
+
+/* The conditions on the velocities of mpm_grid_velocity_nodes. */
+static void grid_velocity_conditions(mpm_ctx *ctx) {
+  mpm_nodes *nd = &ctx->work->nodes;
   mpm_conditions_apply(ctx, nd->vel, false);
   mpm_grips_apply(ctx, nd->vel, false);
   if (ctx->model->n_moving > 0) mpm_motion_apply(ctx, nd->vel, false);
   mpm_contacts_apply(ctx, nd->vel, false);
+}
+
+void mpm_grid_velocity(mpm_ctx *ctx) { mpm_grid_velocity_after(ctx, 0); }
+
+void mpm_grid_velocity_after(mpm_ctx *ctx, int mode) {
+  if (!mpm_grid_nodes_fused(ctx, mode, false)) {
+    PM_OMP(parallel default(none) shared(ctx))
+    mpm_grid_velocity_nodes(ctx);
+  }
+  grid_velocity_conditions(ctx);
 }
 
 pm_err mpm_stage_grid_velocity(mpm_ctx *ctx, const mpm_stage *self) {

@@ -13,6 +13,21 @@ struct mpm_state;
  * conditions applied, into the work's vel: the velocity USF and MUSL take
  * the stress from. */
 void mpm_grid_velocity(mpm_ctx *ctx);
+/* The same after a transfer of mode `mode`, whose region ran the
+ * velocities' loop when fused (mpm_grid_nodes_fused). */
+void mpm_grid_velocity_after(mpm_ctx *ctx, int mode);
+
+/* Whether a stage of mode `mode` runs (as transfer) or left (as grid
+ * stage) the grid stage's node loop in the transfer's region: the
+ * MPM_NODES_FUSED bit on one process, and for the grid update (`update`)
+ * no folded conditions (their fold comes before its loop). */
+bool mpm_grid_nodes_fused(const mpm_ctx *ctx, int mode, bool update);
+
+/* The node loops of the grid update (v and v^L from the nodal sums) and
+ * of the grid velocity: this thread's static share of the nodes, no
+ * barrier after (inside a parallel region, orphaned). */
+void mpm_grid_update_nodes(const mpm_ctx *ctx);
+void mpm_grid_velocity_nodes(const mpm_ctx *ctx);
 
 /* Stable step: dt_safety h over the largest of (wave speed + |v|) and the
  * viscous and artificial viscous terms (LS-DYNA form), over all particles;

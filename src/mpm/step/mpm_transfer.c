@@ -115,7 +115,9 @@ static void reduce_nodes(mpm_nodes *nd, long nn, int mode, bool imp) {
   }
 }
 
-pm_err mpm_p2g(mpm_ctx *ctx, int mode) {
+/* mpm_p2g, with the grid update's node loop after the reduction when
+ * `update` (mpm_grid_nodes_fused). */
+static pm_err p2g_then(mpm_ctx *ctx, int mode, bool update) {
   const mpm_model *m = ctx->model;
   const mpm_state *s = ctx->state;
   mpm_work *w = ctx->work;
@@ -127,7 +129,7 @@ pm_err mpm_p2g(mpm_ctx *ctx, int mode) {
       m->group[gi].kind->wave_speeds(m, s, &m->group[gi], w->cp, w->cs);
   /* The accumulators were sized for nd->threads: run exactly that many. */
   PM_OMP(parallel num_threads(nd->threads) default(none)
-             shared(m, s, w, nd, nn, mode, imp)) {
+             shared(m, s, w, nd, nn, mode, imp, ctx, update)) {
     double *acc = nd->acc + (size_t)thread_id() * nn * nd->acc_stride;
     memset(acc, 0, sizeof(double) * nn * nd->acc_stride);
     const int all = MPM_P2G_MASS | MPM_P2G_MOM | MPM_P2G_FORCE;
@@ -143,12 +145,17 @@ pm_err mpm_p2g(mpm_ctx *ctx, int mode) {
       p2g_groups(m, s, w, acc, mode, imp);
     PM_OMP(barrier)
     reduce_nodes(nd, nn, mode, imp);
+    /* the nodes this thread has just summed: the same static share */
+    if (update) mpm_grid_update_nodes(ctx);
   }
   return mpm_xc_sum_nodes(m, nd, mode, imp);
 }
 
+pm_err mpm_p2g(mpm_ctx *ctx, int mode) { return p2g_then(ctx, mode, false); }
+
 pm_err mpm_stage_p2g(mpm_ctx *ctx, const mpm_stage *self) {
-  return mpm_p2g(ctx, self->mode);
+  return p2g_then(ctx, self->mode & ~MPM_NODES_FUSED,
+                  mpm_grid_nodes_fused(ctx, self->mode, true));
 }
 
 /* The FLIP/PIC velocities and the position increments of a group's
@@ -219,15 +226,17 @@ pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
   const double dt = s->dt;
   const double *x = s->x;
   double *v = s->v;
-  const bool remap = self->mode == MPM_P2G_MOM;
+  const bool remap = (self->mode & ~MPM_NODES_FUSED) == MPM_P2G_MOM;
+  const bool velocity = remap && mpm_grid_nodes_fused(ctx, self->mode, false);
   PM_OMP(parallel num_threads(nd->threads) default(none)
-             shared(m, w, nd, g, nn, dt, x, v, remap)) {
+             shared(m, w, nd, g, nn, dt, x, v, remap, velocity, ctx)) {
     double *acc = nd->acc + (size_t)thread_id() * nn * nd->acc_stride;
     if (remap) {
       memset(acc, 0, sizeof(double) * nn * nd->acc_stride);
       MPM_STENCIL_DISPATCH(g, g2p_groups, w, m, dt, x, v, acc, true);
       PM_OMP(barrier)
       reduce_nodes(nd, nn, MPM_P2G_MOM, false);
+      if (velocity) mpm_grid_velocity_nodes(ctx);
     } else {
       MPM_STENCIL_DISPATCH(g, g2p_groups, w, m, dt, x, v, acc, false);
     }
@@ -238,8 +247,8 @@ pm_err mpm_stage_g2p(mpm_ctx *ctx, const mpm_stage *self) {
 
 pm_err mpm_stage_remap(mpm_ctx *ctx, const mpm_stage *self) {
   /* Mode 0: g2p scattered the momentum already. */
-  if (self->mode) PM_CALL(mpm_p2g(ctx, MPM_P2G_MOM));
-  mpm_grid_velocity(ctx);
+  if (self->mode & MPM_P2G_MOM) PM_CALL(mpm_p2g(ctx, MPM_P2G_MOM));
+  mpm_grid_velocity_after(ctx, self->mode);
   return mpm_conditions_status(ctx);
 }
 

@@ -10,6 +10,13 @@
 /* What a particle-to-grid transfer moves (or-ed; a stage's mode). */
 enum { MPM_P2G_MASS = 1, MPM_P2G_MOM = 2, MPM_P2G_FORCE = 4 };
 
+/* A stage's mode bit: on one process (no nodal sums across ranks between
+ * them), the grid stage that follows a transfer has its loop over the
+ * nodes run by the transfer's parallel region, each thread right after its
+ * share of the reduction (mpm_grid_nodes_fused).  Set on the transfer and
+ * on the grid stage by the pipeline. */
+enum { MPM_NODES_FUSED = 64 };
+
 /* Particle to grid of what `mode` says into the nodal arrays: mass,
  * momentum, and the internal force -V sigma grad S (with the impedances
  * sum S m rho c when the grid has them).  Per-thread accumulators, reduced
