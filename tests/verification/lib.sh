@@ -75,19 +75,25 @@ bad_scene() { # name, scene, sed expression, line pattern, message
 }
 
 # Run SCENE in the background and send it SIGTERM once OUT/history.csv
-# holds LINES lines (0: once OUT exists, the setup begun) and SECONDS more
-# have passed; sets rc (its exit status) and lag (seconds from the signal
-# to the exit).
+# holds LINES lines (0: once OUT exists, the setup begun; ksp: once a
+# linear solve has begun, by the -pm_ksp_monitor the arguments must ask
+# for) and SECONDS more have passed; sets rc (its exit status) and lag
+# (seconds from the signal to the exit).
 stop_after() { # lines, seconds, out, scene, args...
   local n=$1 secs=$2 out=$3 scene=$4
   shift 4
-  "$bin" run "$scene" --out "$out" --quiet "$@" >/dev/null 2>"$work/err" &
+  "$bin" run "$scene" --out "$out" --quiet "$@" >"$work/stdout" 2>"$work/err" &
   local pid=$!
-  if [ "$n" -gt 0 ]; then
+  if [ "$n" != ksp ] && [ "$n" -gt 0 ]; then
     wait_rows $pid "$out" "$n"
   else
     local waited=0
-    while [ ! -e "$out" ] && kill -0 $pid 2>/dev/null && [ $waited -lt 3000 ]; do
+    while kill -0 $pid 2>/dev/null && [ $waited -lt 6000 ]; do
+      if [ "$n" = ksp ]; then
+        grep -q "KSP Residual norm" "$work/stdout" && break
+      elif [ -e "$out" ]; then
+        break
+      fi
       sleep 0.01
       waited=$((waited + 1))
     done
