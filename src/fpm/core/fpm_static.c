@@ -44,8 +44,8 @@ static double force_floor(const fpm_model *m) {
  * dissection's factors grow as n^(4/3) against the tangent's n; the
  * coupled LU took 13.0 GB at 36 549 free dofs); multigrid (GAMG, its
  * operator complexity included) 116 at 4359, taken as 120, flat.  Entries
- * per free dof:
- * 650 with the quadratic jump (3 rings), 403 with the linear jump. */
+ * per free dof: 650 with the quadratic jump (3 rings), 403 with the linear
+ * jump. */
 double fpm_static_solver_bytes(long free_dofs, bool quadratic,
                                pm_newton_linear linear, bool coupled,
                                double *entries) {
