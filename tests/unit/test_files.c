@@ -9,11 +9,14 @@
 #include "pm_testing.h"
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -220,6 +223,64 @@ static void test_outdir(void **state) {
   assert_int_equal(pm_outdir_claim(path, PM_OUTDIR_RESUME, &d), PM_ERR_IO);
   assert_null(d);
   pm_error_clear();
+}
+
+/* Three processes claim and release one folder that each claim creates
+ * and leaves empty, so that each release unlinks the lock file and
+ * removes the folder while another may hold the file open: never two
+ * holders at once (a shared count of holders, its largest value). */
+static void test_outdir_race(void **state) {
+  const char *dir = *state;
+  char out[512], shm[] = "/dev/shm/pm_test_XXXXXX";
+  /* On a tmpfs where there is one: the claims' folder syncs (pm_mkdir_p)
+   * cost milliseconds each on a disk. */
+  const bool on_shm = mkdtemp(shm) != NULL;
+  snprintf(out, sizeof out, "%s/race", on_shm ? shm : dir);
+  char count[600];
+  snprintf(count, sizeof count, "%s/holders", dir);
+  int fd = open(count, O_RDWR | O_CREAT, 0644);
+  assert_true(fd >= 0 && ftruncate(fd, 2 * sizeof(int)) == 0);
+  int *shared =
+      mmap(NULL, 2 * sizeof(int), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  assert_true(shared != MAP_FAILED);
+  close(fd);
+  shared[0] = shared[1] = 0; /* holders now, most holders at once */
+  enum { PROCS = 3, CLAIMS = 3000 };
+  pid_t kids[PROCS];
+  for (int k = 0; k < PROCS; k++) {
+    kids[k] = fork();
+    assert_true(kids[k] >= 0);
+    if (kids[k] > 0) continue;
+    for (int c = 0; c < CLAIMS; c++) {
+      pm_outdir *d = NULL;
+      if (pm_outdir_claim(out, PM_OUTDIR_NEW, &d) != PM_SUCCESS) {
+        pm_error_clear();
+        continue;
+      }
+      int now = __atomic_add_fetch(&shared[0], 1, __ATOMIC_SEQ_CST);
+      int top = __atomic_load_n(&shared[1], __ATOMIC_SEQ_CST);
+      while (now > top &&
+             !__atomic_compare_exchange_n(&shared[1], &top, now, false,
+                                          __ATOMIC_SEQ_CST, __ATOMIC_SEQ_CST)) {
+      }
+      /* a hold long enough for the others to try */
+      nanosleep(&(struct timespec){.tv_nsec = 20000}, NULL);
+      __atomic_sub_fetch(&shared[0], 1, __ATOMIC_SEQ_CST);
+      pm_outdir_release(d);
+    }
+    _exit(0);
+  }
+  for (int k = 0; k < PROCS; k++) {
+    int st = 0;
+    assert_int_equal(waitpid(kids[k], &st, 0), kids[k]);
+    assert_true(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+  }
+  printf("outdir race: at most %d holder(s) at once over %d claims\n",
+         shared[1], PROCS * CLAIMS);
+  const int most = shared[1];
+  munmap(shared, 2 * sizeof(int));
+  if (on_shm) pm_test_remove_tree(shm); /* before a failure leaves it */
+  assert_int_equal(most, 1);
 }
 
 /* ---- JSON -------------------------------------------------------------- */
@@ -435,6 +496,8 @@ int main(void) {
       cmocka_unit_test_setup_teardown(test_bad_directory, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_outdir, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_outdir_race, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_history, pm_test_make_dir,
                                       pm_test_drop_dir),

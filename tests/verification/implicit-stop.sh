@@ -15,29 +15,10 @@ export OMP_NUM_THREADS=2
 f2=$src/cases/mpm/f2-unconstrained-compression.yaml
 coarse=(--set method=mpm-implicit --set discretization.mesh_size=0.02)
 
-now() { date +%s.%N; }
-
-# SIGTERM once the history holds N lines and S seconds have passed; sets rc
-# and lag (seconds from the signal to the exit).
-stop_after() { # lines, seconds, out, args...
-  local n=$1 secs=$2 out=$3
-  shift 3
-  "$bin" run "$f2" --out "$out" --quiet "$@" >/dev/null 2>"$work/err" &
-  local pid=$!
-  wait_rows $pid "$out" "$n"
-  sleep "$secs"
-  local t0
-  t0=$(now)
-  kill -TERM $pid 2>/dev/null
-  wait $pid
-  rc=$?
-  lag=$(awk -v a="$t0" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }')
-}
-
 # 1. A linear solve that would run for hours (GMRES without a
 # preconditioner to a relative residual of 1e-30): the signal stops it.
 out=$work/long
-stop_after 1 3 "$out" "${coarse[@]}" \
+stop_after 1 3 "$out" "$f2" "${coarse[@]}" \
   --set time.quasi_static.linear_solver=gmres-ilu \
   --set 'time.quasi_static.solver_options=-pm_pc_type none -pm_ksp_rtol 1e-30 -pm_ksp_atol 0 -pm_ksp_max_it 1000000000'
 echo "SIGTERM in a linear solve: exit $rc after $lag s"
@@ -58,7 +39,7 @@ straight=$work/straight
   >/dev/null 2>"$work/err"
 check "straight F2: exit 0" test $? -eq 0
 out=$work/stopped
-stop_after 3 0.3 "$out" "${coarse[@]}" "${steps[@]}"
+stop_after 3 0.3 "$out" "$f2" "${coarse[@]}" "${steps[@]}"
 echo "SIGTERM after converged load steps: exit $rc after $lag s"
 check "stopped: exit 4 (got $rc)" test $rc -eq 4
 check "stopped: within 2 s of the signal (took $lag s)" \

@@ -100,3 +100,36 @@ bad_scene() { # name, scene, sed expression, line pattern, message
   check "$name: says '$msg'" grep -qF -- "$msg" "$work/err"
   check "$name: no output created" test ! -e "$work/out-$name"
 }
+
+# Run SCENE in the background and send it SIGTERM once OUT/history.csv
+# holds LINES lines (0: once OUT exists, the setup begun; ksp: once a
+# linear solve has begun, by the -pm_ksp_monitor the arguments must ask
+# for) and SECONDS more have passed; sets rc (its exit status) and lag
+# (seconds from the signal to the exit).
+stop_after() { # lines, seconds, out, scene, args...
+  local n=$1 secs=$2 out=$3 scene=$4
+  shift 4
+  "$bin" run "$scene" --out "$out" --quiet "$@" >"$work/stdout" 2>"$work/err" &
+  local pid=$!
+  if [ "$n" != ksp ] && [ "$n" -gt 0 ]; then
+    wait_rows $pid "$out" "$n"
+  else
+    local waited=0
+    while kill -0 $pid 2>/dev/null && [ $waited -lt 6000 ]; do
+      if [ "$n" = ksp ]; then
+        grep -q "KSP Residual norm" "$work/stdout" && break
+      elif [ -e "$out" ]; then
+        break
+      fi
+      sleep 0.01
+      waited=$((waited + 1))
+    done
+  fi
+  sleep "$secs"
+  local t0
+  t0=$(date +%s.%N)
+  kill -TERM $pid 2>/dev/null
+  wait $pid
+  rc=$?
+  lag=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }')
+}

@@ -44,6 +44,18 @@ too_big "FPM convergence, a level at mesh size 1e-4" "$work/out-study" \
 too_big "MPM run, cell size 1e-5" "$work/out-mpm" \
   "$bin" run "$mpm" --set discretization.mesh_size=1e-5 --out "$work/out-mpm" --quiet
 
+# A static solve counts its tangent's factors: F2 at 1851 points by LU
+# peaks at 379 MiB (docs/validation.md), so a 200 MiB cap refuses it before
+# meshing, where the same scene by dynamic relaxation (no factors) runs
+# under it; implicit MPM's grid solve likewise (I2 peaks at 197 MiB).
+POINTMECH_MEMORY_LIMIT=200M refused "static F2, capped at 200 MiB" \
+  "POINTMECH_MEMORY_LIMIT=200M" "$work/out-static" "$bin" run "$fpm" \
+  --set time.quasi_static.method=static --out "$work/out-static" --quiet
+POINTMECH_MEMORY_LIMIT=200M "$bin" plan "$fpm" >/dev/null 2>"$work/err"
+check "F2 by dynamic relaxation under a 200 MiB cap: planned" test $? -eq 0
+POINTMECH_MEMORY_LIMIT=150M refused "I2 implicit MPM, capped at 150 MiB" \
+  "POINTMECH_MEMORY_LIMIT=150M" "$work/out-i2" "$bin" run \
+  "$src/cases/mpm/i2-vessel-slice.yaml" --out "$work/out-i2" --quiet
 # A cap below a small scene's estimate refuses it, naming the cap; with
 # --force-memory it is planned and run.
 POINTMECH_MEMORY_LIMIT=1M refused "capped at 1 MiB" "POINTMECH_MEMORY_LIMIT=1M" \

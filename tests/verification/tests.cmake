@@ -119,3 +119,11 @@ set_tests_properties(verification.mpm_contact PROPERTIES LABELS verification TIM
 add_test(NAME verification.implicit_stop
   COMMAND bash ${PM_VERIFY_DIR}/implicit-stop.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.implicit_stop PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 2)
+
+add_test(NAME verification.disks
+  COMMAND bash ${PM_VERIFY_DIR}/disks.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.disks PROPERTIES LABELS verification TIMEOUT 120 PROCESSORS 1 SKIP_RETURN_CODE 77)
+
+add_test(NAME verification.static_stop
+  COMMAND bash ${PM_VERIFY_DIR}/static-stop.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.static_stop PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 1)

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <sys/types.h>
 #include <unistd.h>
 
@@ -110,6 +111,22 @@ struct pm_afile {
   char paths[];
 };
 
+/* Why a write into path failed (err: the errno seen, which a stream's
+ * buffered write may have left stale): its folder gone (removed during the
+ * run), a read-only or full file system, else err's text. */
+static const char *write_cause(const char *path, int err) {
+  char dir[PM_PATH_MAX + 1];
+  snprintf(dir, sizeof dir, "%s", path);
+  char *slash = strrchr(dir, '/');
+  if (slash) *slash = '\0';
+  struct statvfs fs;
+  if (statvfs(slash ? (dir[0] ? dir : "/") : ".", &fs) != 0)
+    return errno == ENOENT ? "its folder no longer exists" : strerror(err);
+  if (fs.f_flag & ST_RDONLY) return strerror(EROFS);
+  if (fs.f_bavail == 0) return strerror(ENOSPC);
+  return strerror(err);
+}
+
 pm_err pm_afile_open(const char *final_path, pm_afile **out) {
   pm_err ret = PM_SUCCESS;
   pm_afile *f = NULL;
@@ -135,7 +152,7 @@ pm_err pm_afile_open(const char *final_path, pm_afile **out) {
             "temporary name of '%s' truncated", final_path);
   f->fp = fopen(f->tmp_path, "w");
   PM_ENSURE(f->fp, PM_ERR_IO, "cannot open '%s' for writing: %s", f->tmp_path,
-            strerror(errno));
+            write_cause(f->tmp_path, errno));
   *out = f;
   f = NULL;
 done:
@@ -154,9 +171,10 @@ pm_err pm_afile_commit(pm_afile *f) {
   FILE *fp;
   if (!f) return PM_SUCCESS;
   fp = f->fp;
-  PM_ENSURE(!ferror(fp), PM_ERR_IO, "write error on '%s'", f->tmp_path);
+  PM_ENSURE(!ferror(fp), PM_ERR_IO, "cannot write '%s': %s", f->tmp_path,
+            write_cause(f->tmp_path, errno));
   PM_ENSURE(fflush(fp) == 0, PM_ERR_IO, "cannot write '%s': %s", f->tmp_path,
-            strerror(errno));
+            write_cause(f->tmp_path, errno));
   PM_ENSURE(fsync(fileno(fp)) == 0, PM_ERR_IO, "cannot sync '%s': %s",
             f->tmp_path, strerror(errno));
   f->fp = NULL; /* closed by fclose even when it fails */

@@ -125,22 +125,53 @@ static pm_err drop_tmp(const char *dir) {
   return ret;
 }
 
-static pm_err take_lock(const char *dir, int *fd_out) {
+/* Whether fd is still the lock file at path: a run releasing a folder it
+ * created and left empty unlinks the lock file (and removes the folder)
+ * before it closes the file, and a claim that opened the file before the
+ * unlink gets the lock of a file no longer in the folder once that close
+ * comes.  A third claim would then create a new lock file and lock that
+ * too: two runs in one folder. */
+static bool lock_current(int fd, const char *path) {
+  struct stat a, b;
+  return fstat(fd, &a) == 0 && a.st_nlink > 0 && stat(path, &b) == 0 &&
+         a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+}
+
+/* Lock dir's lock file, writing the process id into it.  A lock file
+ * unlinked while it was taken (lock_current) is let go and the claim
+ * repeated; make: a folder removed meanwhile by that release is made
+ * again (*remade). */
+static pm_err take_lock(const char *dir, bool make, int *fd_out, bool *remade) {
   char path[PM_PATH_MAX + 1], pid[32];
   *fd_out = -1;
   PM_CALL(pm_path_join(path, sizeof path, dir, LOCK_NAME));
-  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  PM_CHECK(fd >= 0, PM_ERR_IO, "output folder '%s' is not writable: %s", dir,
-           strerror(errno));
-  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    ssize_t n = pread(fd, pid, sizeof pid - 1, 0);
-    pid[n > 0 ? n : 0] = '\0';
-    pid[strcspn(pid, "\n")] = '\0';
+  int fd = -1;
+  for (int attempt = 0;; attempt++) {
+    fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0 && errno == ENOENT && make && attempt < 100) {
+      PM_CALL(pm_mkdir_p(dir));
+      *remade = true;
+      continue;
+    }
+    PM_CHECK(fd >= 0, PM_ERR_IO, "output folder '%s' is not writable: %s", dir,
+             strerror(errno));
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      ssize_t n = pread(fd, pid, sizeof pid - 1, 0);
+      pid[n > 0 ? n : 0] = '\0';
+      pid[strcspn(pid, "\n")] = '\0';
+      close(fd);
+      return PM_ERROR(PM_ERR_IO,
+                      "output folder '%s' is in use by a running pointmech "
+                      "(pid %s): wait for it, stop it, or choose another "
+                      "--out",
+                      dir, pid[0] ? pid : "unknown");
+    }
+    if (lock_current(fd, path)) break;
     close(fd);
-    return PM_ERROR(PM_ERR_IO,
-                    "output folder '%s' is in use by a running pointmech (pid "
-                    "%s): wait for it, stop it, or choose another --out",
-                    dir, pid[0] ? pid : "unknown");
+    PM_CHECK(attempt < 100, PM_ERR_IO,
+             "cannot lock output folder '%s': its lock file '%s' keeps "
+             "being replaced",
+             dir, path);
   }
   int n = snprintf(pid, sizeof pid, "%ld\n", (long)getpid());
   if (ftruncate(fd, 0) != 0 || pwrite(fd, pid, (size_t)n, 0) != n) {
@@ -175,7 +206,9 @@ pm_err pm_outdir_claim(const char *dir, pm_outdir_mode mode, pm_outdir **out) {
   d->fd = -1;
   d->created = !existed;
   snprintf(d->dir, sizeof d->dir, "%s", dir);
-  PM_TRY(take_lock(dir, &d->fd));
+  bool remade = false;
+  PM_TRY(take_lock(dir, mode != PM_OUTDIR_RESUME, &d->fd, &remade));
+  d->created = d->created || remade;
   if (mode == PM_OUTDIR_NEW && holds_run(dir, &which)) {
     char status[64];
     pm_summary_status(dir, status, sizeof status);
@@ -201,7 +234,10 @@ done:
 
 void pm_outdir_release(pm_outdir *d) {
   if (!d) return;
-  /* A folder this claim created and nothing was written to goes again. */
+  /* A folder this claim created and nothing was written to goes again:
+   * the lock file is unlinked while it is still locked, and a claim that
+   * had opened it finds it gone once it gets the lock (lock_current) and
+   * claims anew, making the folder again. */
   if (d->created && d->fd >= 0) {
     char path[PM_PATH_MAX + 1];
     DIR *dd = opendir(d->dir);

@@ -16,6 +16,7 @@
 #include "fpm_par.h"
 #include "fpm_scene.h"
 #include "gm_cells.h"
+#include "pm_interrupt.h"
 #include "pm_par.h"
 
 void fpm_sim_destroy(fpm_sim *sim) {
@@ -74,14 +75,19 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
     sim->near_size = grade.faces ? grade.size : 0.0;
   }
   pm_timers_stop(&sim->timers, sim->tm_mesh);
+  /* A signal stops the setup between its stages (gmsh's meshing and the
+   * stages themselves run to their end: seconds at 1e5 points). */
+  PM_TRY(pm_interrupt_check("after meshing (nothing written)"));
   sim->mean_edge = gm_mesh_mean_edge(sim->mesh);
   pm_timers_start(&sim->timers, sim->tm_dual);
   const fpm_options *o = fpm_scene_options(s);
   sim->cells = gm_cells_find(o->cells);
   PM_TRY(sim->cells->build(sim->mesh, &sim->dual));
   pm_timers_stop(&sim->timers, sim->tm_dual);
+  PM_TRY(pm_interrupt_check("after the subdomains (nothing written)"));
   pm_timers_start(&sim->timers, sim->tm_operators);
   PM_TRY(fpm_model_create(s, o, sim->mesh, sim->dual, &sim->model));
+  PM_TRY(pm_interrupt_check("after the operators (nothing written)"));
   PM_TRY(fpm_state_create(sim->model, &sim->state));
   if (s->time.qs == PM_QS_STATIC)
     PM_TRY(fpm_static_state_init(&sim->static_state, sim->model));

@@ -146,33 +146,14 @@ static double plan_head(fpm_sim *sim, FILE *out) {
             : "",
         no.pc_reuse_its > 0 ? ", kept while GMRES takes few iterations" : "",
         no.linear_ew ? ", inexact Newton" : "");
-    /* The tangent and its factors or multigrid hierarchy, per tangent
-     * entry as measured (peak memory of whole runs over the entries, F3
-     * 60%, docs/validation.md "Static solves at 13762 and 32715 points"):
-     * the LU 175 bytes at 1851 points (4359 free dofs), the coupled LU of
-     * the averaged volume 320, both growing with the fill about as the
-     * free dofs to the power 0.25 (the coupled LU: 13.0 GB at 13762
-     * points, 36 549 free dofs); GAMG about 110, flat; at about 650
-     * entries a free dof with the quadratic jump (3 rings). */
     const bool lu = no.linear == PM_NEWTON_DIRECT;
-    const double entries = 650.0 * (double)nfree,
-                 fill = pow((double)nfree / 4359.0, 0.25);
-    if (!m->q) {
-      fprintf(out,
-              "memory       %.1f MiB (operators and state; the tangent and "
-              "its factors come on top)\n",
-              (bytes + fpm_linear_bytes(m)) / 1048576.0);
-      return 0;
-    }
+    double entries = 0;
+    const double solver = fpm_static_solver_bytes(nfree, m->q != NULL,
+                                                  no.linear, coupled, &entries);
     fprintf(out,
             "memory       %.1f MiB (operators and state) + about %.0f MiB "
             "for the tangent (~%.3g entries) and its %s\n",
-            (bytes + fpm_linear_bytes(m)) / 1048576.0,
-            entries *
-                (coupled ? 320.0 * fill
-                 : lu    ? 175.0 * fill
-                         : 110.0) /
-                1048576.0,
+            (bytes + fpm_linear_bytes(m)) / 1048576.0, solver / 1048576.0,
             entries, lu ? "LU factors" : "multigrid hierarchy");
     return 0;
   }

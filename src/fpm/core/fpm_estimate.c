@@ -13,6 +13,7 @@
 #include "gm_mesh.h"
 #include "fpm_model.h"
 #include "fpm_scene.h"
+#include "fpm_static.h"
 
 /* Support entries per point (mesh edges, both ways): 11.8-12.4 on the 3D
  * blocks of cases/fpm, 5.4 in 2D; quadratic-fit entries per point over two
@@ -63,12 +64,27 @@ size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
                      o->stiffening == 0 && o->volume_penalty == 0;
   per_point += (double)fpm_stream_bytes(
       1, (long)ceil(nnz + (FPM_LANES - 1) / 2.0), plain);
-  /* Newton's method adds the tangent (3 x 3 blocks per support entry and
-   * per point) and fpm_linear_bytes. */
-  if (s->time.qs == PM_QS_STATIC)
-    per_point += (nnz + 1) * (9 * d + sizeof(int)) +
-                 (81 + 9 + 9 + 9 + 3 + 12 + (quadratic ? 57 : 0)) * d;
+  /* Newton's method adds fpm_linear_bytes, and the tangent with its
+   * factors or multigrid hierarchy: those of every point's 3 dofs free
+   * (the prescribed are a few percent), by the solver the solve would
+   * choose (fpm_static_choose_linear, fpm_static_couples). */
+  double solver = 0;
+  if (s->time.qs == PM_QS_STATIC) {
+    per_point += (81 + 9 + 9 + 9 + 3 + 12 + (quadratic ? 57 : 0)) * d;
+    const double dofs = fmin(3 * n, (double)LONG_MAX / 2);
+    const pm_newton_linear linear =
+        pm_scene_has(s, "time.quasi_static.linear_solver")
+            ? pm_newton_linear_of(s->time.qs_linear)
+            : fpm_static_default_linear((long)dofs);
+    const bool coupled =
+        o->volumetric == FPM_VOLUMETRIC_AVERAGED &&
+        linear == PM_NEWTON_DIRECT && s->time.qs_coupled &&
+        (pm_scene_has(s, "time.quasi_static.averaged_coupling") ||
+         dofs <= FPM_STATIC_COUPLED_MAX);
+    solver =
+        fpm_static_solver_bytes((long)dofs, quadratic, linear, coupled, NULL);
+  }
   *points = n < (double)LONG_MAX ? (long)n : LONG_MAX;
-  double bytes = n * per_point;
+  double bytes = n * per_point + solver;
   return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
 }

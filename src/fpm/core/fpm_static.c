@@ -36,6 +36,26 @@ static double force_floor(const fpm_model *m) {
   return 1e-12 * emax * diag2;
 }
 
+/* Per tangent entry, measured as the peak memory of whole F2 and F3 60%
+ * runs over the tangent's entries: the LU 180 (F3, quadratic jump) to
+ * 207 (F2, linear jump) bytes at 4359 and 4759 free dofs, taken as 210;
+ * the coupled LU of the averaged volume 318, taken as 330; both growing
+ * with the fill about as the free dofs to the power 0.25 (nested
+ * dissection's factors grow as n^(4/3) against the tangent's n; the
+ * coupled LU took 13.0 GB at 36 549 free dofs); multigrid (GAMG, its
+ * operator complexity included) 116 at 4359, taken as 120, flat.  Entries
+ * per free dof: 650 with the quadratic jump (3 rings), 403 with the linear
+ * jump. */
+double fpm_static_solver_bytes(long free_dofs, bool quadratic,
+                               pm_newton_linear linear, bool coupled,
+                               double *entries) {
+  const double n = (double)free_dofs, nnz = (quadratic ? 650.0 : 403.0) * n,
+               fill = pow(n / 4359.0, 0.25);
+  if (entries) *entries = nnz;
+  if (linear != PM_NEWTON_DIRECT) return 120.0 * nnz;
+  return (coupled ? 330.0 : 210.0) * fill * nnz;
+}
+
 pm_newton_linear fpm_static_default_linear(long unknowns) {
   return unknowns <= FPM_STATIC_DIRECT_MAX ? PM_NEWTON_DIRECT
                                            : PM_NEWTON_GMRES_GAMG;

@@ -68,6 +68,16 @@ bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
 bool fpm_static_amg_on_support(const pm_scene *s, const fpm_model *m,
                                pm_newton_linear linear);
 
+/* Bytes of a static solve's tangent with its LU factors (coupled: of
+ * the averaged volume's coupled matrix) or its multigrid hierarchy, for
+ * this many free dofs; *entries (if given): the tangent's entries.  The
+ * figures are whole runs' peak memory over the tangent's entries
+ * (docs/validation.md, "Bad disks, memory for solves, and signals"), so
+ * they hold the operators and state too: an upper bound. */
+double fpm_static_solver_bytes(long free_dofs, bool quadratic,
+                               pm_newton_linear linear, bool coupled,
+                               double *entries);
+
 /* The default linear solver for a static solve of this many unknowns. */
 pm_newton_linear fpm_static_default_linear(long unknowns);
 

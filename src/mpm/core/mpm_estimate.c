@@ -109,26 +109,41 @@ static double kind_doubles(const pm_scene_material *sm, const pm_scene_body *b,
   return mpm_kind_of(sm, mpm_body_role_of(b))->estimate_doubles(sm, fbar);
 }
 
-size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
-  const int dim = s->dimension;
+/* The grid of s: its nodes (returned; the quadratic basis's ghost layer
+ * and the room kept beside the box included), cells and the box's volume,
+ * and h its cell size. */
+static double grid_of(const pm_scene *s, double *cells, double *box,
+                      double *h) {
   const mpm_settings *o = mpm_scene_settings(s);
   mpm_layout lay;
   if (!mpm_grid_layout(s, &lay)) lay.h = s->mesh_size;
-  const double h = lay.h, d = sizeof(double);
   const int ghost = o->shape == MPM_BASIS_QUADRATIC ? 1 : 0;
-  double box = 1, nodes = 1, ppc = 1, cells = 1;
-  for (int c = 0; c < dim; c++) {
+  double nodes = 1;
+  *box = *cells = 1;
+  *h = lay.h;
+  for (int c = 0; c < s->dimension; c++) {
     double len = s->box_max[c] - s->box_min[c];
-    double k = fmax(1, ceil(len / h - 1e-9));
-    box *= len;
-    cells *= k;
+    double k = fmax(1, ceil(len / lay.h - 1e-9));
+    *box *= len;
+    *cells *= k;
     nodes *= k + 1 + 2 * ghost + (double)(lay.room[c][0] + lay.room[c][1]);
-    ppc *= o->ppc[c];
   }
+  return nodes;
+}
+
+/* mpm_estimate_bytes, and the nodes the bodies touch (*active): those of
+ * a cube of the cells the bodies seeded in cells fill (every cell where
+ * any body is seeded apart), with the basis's reach, at most the grid's. */
+static size_t estimate(const pm_scene *s, long *points, double *active) {
+  const int dim = s->dimension;
+  const mpm_settings *o = mpm_scene_settings(s);
+  double box, cells, h, ppc = 1;
+  const double nodes = grid_of(s, &cells, &box, &h), d = sizeof(double);
+  for (int c = 0; c < dim; c++) ppc *= o->ppc[c];
   const bool fbar = o->fbar != MPM_FBAR_NONE;
   /* Particles: per body, at most the domain's.  Membranes' points and
    * image voxels' particles are not seeded in cells: apart. */
-  double n = 0, own = 0, top = ppc, apart = 0;
+  double n = 0, own = 0, top = ppc, apart = 0, filled = 0;
   for (int b = 0; b < s->n_bodies; b++) {
     const pm_scene_body *body = &s->bodies[b];
     double bppc = ppc;
@@ -144,6 +159,7 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
     } else {
       nb = body_volume(s, body, box) / pow(h, dim) * bppc;
       top = fmax(top, bppc);
+      filled += nb / bppc;
     }
     n += nb;
     own += nb * kind_doubles(&s->materials[body->material], body, fbar);
@@ -168,5 +184,20 @@ size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
                     (fbar ? (2 * pm_omp_threads() + 1) * d : 0);
   bytes += nodes * per_node;
   *points = n < (double)LONG_MAX ? (long)n : LONG_MAX;
+  const double reach = o->shape == MPM_BASIS_QUADRATIC ? 3 : 1;
+  filled = apart > 0 ? cells : fmin(filled, cells);
+  *active = fmin(nodes, pow(pow(filled, 1.0 / dim) + reach, dim));
   return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
+}
+
+size_t mpm_estimate_bytes(const pm_scene *s, long *points) {
+  double active;
+  return estimate(s, points, &active);
+}
+
+double mpm_estimate_active_nodes(const pm_scene *s) {
+  long points;
+  double active;
+  estimate(s, &points, &active);
+  return active;
 }

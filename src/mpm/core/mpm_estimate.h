@@ -14,4 +14,9 @@
  * when the bodies do not overlap.  Sets *points to the particles. */
 size_t mpm_estimate_bytes(const pm_scene *s, long *points);
 
+/* The grid nodes the bodies of s touch: those of a cube of the cells they
+ * fill, with the basis's reach (every cell where a body is seeded apart:
+ * images, membranes), at most the grid's. */
+double mpm_estimate_active_nodes(const pm_scene *s);
+
 #endif

@@ -2,10 +2,12 @@
  * (see mpm_implicit.h for the formulation): setup, queries and plan. */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "mpm_estimate.h"
 #include "mpm_exchange.h"
 #include "mpm_implicit_impl.h"
 #include "mpm_kind.h"
@@ -78,6 +80,44 @@ static pm_err reset_grid(mpm_implicit *im, const pm_scene *s) {
  * "Implicit MPM that never hangs"). */
 #define MPM_IMPLICIT_DIRECT_MAX_2D 100000L
 #define MPM_IMPLICIT_DIRECT_MAX_3D 30000L
+
+/* Bytes of the grid solve's tangent with its LU factors or multigrid
+ * hierarchy: on the nodes the bodies touch, dimension x (3 or 5)^dimension
+ * entries an unknown (linear or quadratic basis).  Per entry, measured as
+ * whole runs' peak memory above that of the run at the smallest grid
+ * (docs/validation.md, "Bad disks, memory for solves, and signals"): the
+ * LU 177 bytes in 2-D (I2, 8190 -> 32766 unknowns) and 156 in 3-D (F2,
+ * quadratic, 700 -> 4200), taken as 200 at 30 000 unknowns in 2-D and
+ * 4 200 in 3-D and growing with the fill: in 2-D as log n (nested
+ * dissection's n log n), in 3-D as n^0.25, as FPM's (fpm_static.c);
+ * multigrid 120, flat (FPM's).  The matrix-free operator stores none.
+ * On top, PETSc's and MPI's own: F2 at 700 unknowns peaked at 107 MiB
+ * with 0.7 MiB of model and state. */
+#define MPM_IMPLICIT_BASE_BYTES (100.0 * 1048576.0)
+static double solve_bytes(const pm_scene *s, const mpm_settings *ms) {
+  const int dim = s->dimension;
+  const double n = dim * mpm_estimate_active_nodes(s),
+               width = ms->shape == MPM_BASIS_QUADRATIC ? 5 : 3,
+               nnz = n * dim * pow(width, dim);
+  if (ms->implicit.op == MPM_OP_MATRIX_FREE) return MPM_IMPLICIT_BASE_BYTES;
+  const long cap =
+      dim == 3 ? MPM_IMPLICIT_DIRECT_MAX_3D : MPM_IMPLICIT_DIRECT_MAX_2D;
+  const pm_newton_linear linear =
+      pm_scene_has(s, "time.quasi_static.linear_solver")
+          ? pm_newton_linear_of(s->time.qs_linear)
+      : n <= (double)cap ? PM_NEWTON_DIRECT
+                         : PM_NEWTON_GMRES_GAMG;
+  if (linear != PM_NEWTON_DIRECT) return MPM_IMPLICIT_BASE_BYTES + 120.0 * nnz;
+  const double fill =
+      dim == 3 ? pow(n / 4200.0, 0.25) : log2(fmax(n, 2)) / log2(30000.0);
+  return MPM_IMPLICIT_BASE_BYTES + 200.0 * fill * nnz;
+}
+
+size_t mpm_implicit_estimate_bytes(const pm_scene *s, long *points) {
+  const double bytes = (double)mpm_estimate_bytes(s, points) +
+                       solve_bytes(s, mpm_scene_settings(s));
+  return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
+}
 
 /* The linear solver: the scene's, else direct below the size above and
  * GMRES + GAMG beyond; a multigrid solve is bounded (relative residual

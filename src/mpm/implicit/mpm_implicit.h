@@ -50,6 +50,12 @@
 
 typedef struct mpm_implicit mpm_implicit;
 
+/* mpm_estimate_bytes of scene s and, on top, the grid solve's tangent
+ * with its factors or multigrid hierarchy, by the linear solver the setup
+ * would choose: the estimate that refuses a scene too large for the
+ * machine before anything is allocated. */
+size_t mpm_implicit_estimate_bytes(const pm_scene *s, long *points);
+
 /* What one converged load step reports. */
 typedef struct {
   int step;            /* load step, from 1 */
