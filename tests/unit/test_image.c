@@ -147,9 +147,8 @@ static void test_bad_files(void **state) {
   gm_image_free(&ref);
 }
 
-/* A page that announces 100000 x 100000 pixels in a file of 126 bytes
- * (a fuzzer's finding) is refused from its header, before 20 GB are
- * allocated for it. */
+/* A page that announces 100000 x 100000 pixels in a file of 126 bytes is
+ * refused from its header, before 20 GB are allocated for it. */
 static void test_tiff_without_data(void **state) {
   (void)state;
   const char *tif =
