@@ -89,7 +89,7 @@ esac
 
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1
 # What the distribution's libraries leak by themselves (tests/lsan.supp).
-export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp
+export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:fast_unwind_on_malloc=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 exec "$build/tests/fuzz_$target" "$budget" -max_len=$max_len \
   -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
