@@ -46,8 +46,11 @@ esac
 build=build-fuzz
 CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DPM_FUZZ=ON -DPM_OPENMP=OFF -DPM_VERIFICATION=OFF >/dev/null
-cmake --build "$build" -j"${PM_FUZZ_BUILD_JOBS:-1}" \
-  --target "fuzz_$target" pointmech
+# The program makes the scene's dictionary and the run whose checkpoint
+# and results seed those targets.
+targets=("fuzz_$target")
+case $target in scene | checkpoint | index) targets+=(pointmech) ;; esac
+cmake --build "$build" -j"${PM_FUZZ_BUILD_JOBS:-1}" --target "${targets[@]}"
 
 seeds=$build/seeds-$target
 corpus=$build/corpus-$target
