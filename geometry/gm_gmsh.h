@@ -66,6 +66,28 @@ typedef struct {
  * inconsistent gmsh data, PM_ERR_MEMORY.  On failure out holds nothing. */
 pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out);
 
+/* The model's nodes by tag, sorted: each with its number among the
+ * elements' corners (-1 for a node no element uses). */
+typedef struct {
+  size_t n;
+  size_t *tag;
+  long *number;
+} gm_gmsh_nodes;
+
+/* Number the nodes the elements use as corners (ctag[0..nc), gmsh node
+ * tags) in gmsh's node order: corner[k] the number of ctag[k]'s node, *x
+ * (3 per node, the caller frees it) their coordinates, *nn their count,
+ * and *nodes (gm_gmsh_nodes_free) every node's number by tag.  Tags are
+ * looked up in a sorted list, so the memory follows the node count
+ * whatever the tags a file gives (one may tag a node 4e9).  PM_ERR_MESH
+ * naming name for a corner without coordinates, PM_ERR_MEMORY. */
+pm_err gm_gmsh_corners(const char *name, const size_t *ctag, size_t nc,
+                       long *corner, double **x, long *nn,
+                       gm_gmsh_nodes *nodes);
+/* The number of the node tagged tag, -1 for none or one no element uses. */
+long gm_gmsh_node_number(const gm_gmsh_nodes *nodes, size_t tag);
+void gm_gmsh_nodes_free(gm_gmsh_nodes *nodes);
+
 /* Checks, before gmsh sees it (gmsh reports a missing file without
  * failing), that path is a regular file this process can read: PM_ERR_IO
  * otherwise, with "cannot open WHAT 'PATH': REASON" (what: "volume file",

@@ -120,10 +120,10 @@ static pm_err check_plane(const char *name, gm_gmsh_mesh *m) {
   return PM_SUCCESS;
 }
 
-/* Physical groups of dimension dim - 1, their faces numbered through map
- * (node tag -> node number, -1 for a node no element uses). */
-static pm_err read_groups(const char *name, int dim, const long *map,
-                          size_t max_tag, gm_gmsh_mesh *out) {
+/* Physical groups of dimension dim - 1, their faces numbered as nodes
+ * numbers them (-1 for a node no element uses). */
+static pm_err read_groups(const char *name, int dim, const gm_gmsh_nodes *nodes,
+                          gm_gmsh_mesh *out) {
   pm_err ret = PM_SUCCESS;
   int ierr = 0, *dimtags = NULL, *ents = NULL;
   size_t n_dimtags = 0, n_ents = 0, *ftag = NULL;
@@ -156,12 +156,109 @@ static pm_err read_groups(const char *name, int dim, const long *map,
   }
   PM_TRY(PM_ALLOC(out->group_face, (size_t)dim * nf, "physical group faces"));
   for (size_t k = 0; k < (size_t)dim * nf; k++)
-    out->group_face[k] = ftag[k] <= max_tag ? map[ftag[k]] : -1;
+    out->group_face[k] = gm_gmsh_node_number(nodes, ftag[k]);
 done:
   free(ftag);
   if (dimtags) gmshFree(dimtags);
   if (ents) gmshFree(ents);
   if (pname) gmshFree(pname);
+  return ret;
+}
+
+/* ---- node numbering ------------------------------------------------------ */
+
+typedef struct {
+  size_t tag, at; /* a node's tag and its place in gmsh's list */
+} tag_at;
+
+static int tag_order(const void *a, const void *b) {
+  const size_t s = ((const tag_at *)a)->tag, t = ((const tag_at *)b)->tag;
+  return (s > t) - (s < t);
+}
+
+/* Index of tag in nodes->tag (sorted), -1 when absent. */
+static long tag_index(const gm_gmsh_nodes *nodes, size_t tag) {
+  size_t lo = 0, hi = nodes->n;
+  while (lo < hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (nodes->tag[mid] < tag)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo < nodes->n && nodes->tag[lo] == tag ? (long)lo : -1;
+}
+
+long gm_gmsh_node_number(const gm_gmsh_nodes *nodes, size_t tag) {
+  const long j = tag_index(nodes, tag);
+  return j >= 0 ? nodes->number[j] : -1;
+}
+
+void gm_gmsh_nodes_free(gm_gmsh_nodes *nodes) {
+  free(nodes->tag);
+  free(nodes->number);
+  memset(nodes, 0, sizeof *nodes);
+}
+
+pm_err gm_gmsh_corners(const char *name, const size_t *ctag, size_t nc,
+                       long *corner, double **x, long *nn,
+                       gm_gmsh_nodes *nodes) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0;
+  size_t *tags = NULL, n_tags = 0, n_coord = 0, n_param = 0;
+  double *coord = NULL, *param = NULL;
+  tag_at *sorted = NULL;
+  long *number = NULL; /* by place in gmsh's list */
+  *x = NULL;
+  *nn = 0;
+  memset(nodes, 0, sizeof *nodes);
+  gmshModelMeshGetNodes(&tags, &n_tags, &coord, &n_coord, &param, &n_param, -1,
+                        -1, 0, 0, &ierr);
+  GM_GMSH_CHECK("reading the nodes of", name);
+  PM_ENSURE(n_coord == 3 * n_tags, PM_ERR_MESH,
+            "gmsh returned %zu coordinates for %zu nodes of '%s'", n_coord,
+            n_tags, label(name));
+  PM_TRY(PM_ALLOC(sorted, n_tags, "node tags"));
+  PM_TRY(PM_ALLOC(number, n_tags, "node numbers"));
+  for (size_t i = 0; i < n_tags; i++) {
+    sorted[i] = (tag_at){tags[i], i};
+    number[i] = -1;
+  }
+  qsort(sorted, n_tags, sizeof *sorted, tag_order);
+  PM_TRY(PM_ALLOC(nodes->tag, n_tags, "node tags"));
+  PM_TRY(PM_ALLOC(nodes->number, n_tags, "node numbers"));
+  nodes->n = n_tags;
+  for (size_t j = 0; j < n_tags; j++) nodes->tag[j] = sorted[j].tag;
+  /* corner[k] first holds its node's place, number[] -2 for a corner. */
+  for (size_t k = 0; k < nc; k++) {
+    const long j = tag_index(nodes, ctag[k]);
+    PM_ENSURE(j >= 0, PM_ERR_MESH,
+              "an element of '%s' refers to node %zu without coordinates",
+              label(name), ctag[k]);
+    corner[k] = (long)sorted[j].at;
+    number[sorted[j].at] = -2;
+  }
+  long count = 0;
+  for (size_t i = 0; i < n_tags; i++)
+    if (number[i] == -2) number[i] = count++;
+  PM_TRY(PM_ALLOC(*x, 3 * (size_t)count, "mesh coordinates"));
+  for (size_t i = 0; i < n_tags; i++)
+    if (number[i] >= 0)
+      memcpy(*x + 3 * number[i], coord + 3 * i, 3 * sizeof *coord);
+  for (size_t k = 0; k < nc; k++) corner[k] = number[corner[k]];
+  for (size_t j = 0; j < n_tags; j++) nodes->number[j] = number[sorted[j].at];
+  *nn = count;
+done:
+  if (ret) {
+    free(*x);
+    *x = NULL;
+    gm_gmsh_nodes_free(nodes);
+  }
+  free(sorted);
+  free(number);
+  if (tags) gmshFree(tags);
+  if (coord) gmshFree(coord);
+  if (param) gmshFree(param);
   return ret;
 }
 
@@ -172,9 +269,9 @@ pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out) {
            "mesh dimension must be 2 or 3 (got %d) for '%s'", dim, label(name));
   pm_err ret = PM_SUCCESS;
   int ierr = 0;
-  size_t *tags = NULL, n_tags = 0, n_coord = 0, n_param = 0, *ctag = NULL;
-  double *coord = NULL, *param = NULL;
-  long *map = NULL, n = 0;
+  size_t *ctag = NULL;
+  gm_gmsh_nodes nodes = {0};
+  long n = 0, nn = 0;
   const size_t npc = (size_t)dim + 1;
   out->dim = dim;
   PM_TRY(append_corners(name, dim, -1, NULL, &ctag, &n));
@@ -185,50 +282,17 @@ pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out) {
             "solid?",
             label(name), simplices(dim), ierr ? -1 : model_dim, dim);
   }
-  gmshModelMeshGetNodes(&tags, &n_tags, &coord, &n_coord, &param, &n_param, -1,
-                        -1, 0, 0, &ierr);
-  GM_GMSH_CHECK("reading the nodes of", name);
-  PM_ENSURE(n_coord == 3 * n_tags, PM_ERR_MESH,
-            "gmsh returned %zu coordinates for %zu nodes of '%s'", n_coord,
-            n_tags, label(name));
-  size_t max_tag = 0;
-  for (size_t i = 0; i < n_tags; i++)
-    if (tags[i] > max_tag) max_tag = tags[i];
-  /* map[tag]: -1 unused, -2 a corner, then the corner's number: the nodes
-   * elements use, numbered in gmsh's node order. */
-  PM_TRY(PM_ALLOC(map, max_tag + 1, "node tag map"));
-  for (size_t t = 0; t <= max_tag; t++) map[t] = -1;
-  for (size_t k = 0; k < npc * (size_t)n; k++) {
-    PM_ENSURE(ctag[k] <= max_tag, PM_ERR_MESH,
-              "an element of '%s' refers to node %zu without coordinates",
-              label(name), ctag[k]);
-    map[ctag[k]] = -2;
-  }
-  long nn = 0;
-  for (size_t i = 0; i < n_tags; i++)
-    if (map[tags[i]] == -2) map[tags[i]] = nn++;
-  for (size_t k = 0; k < npc * (size_t)n; k++)
-    PM_ENSURE(map[ctag[k]] >= 0, PM_ERR_MESH,
-              "an element of '%s' refers to node %zu without coordinates",
-              label(name), ctag[k]);
-  PM_TRY(PM_ALLOC(out->x, 3 * nn, "mesh coordinates"));
   PM_TRY(PM_ALLOC(out->elem, npc * (size_t)n, "mesh elements"));
-  for (size_t i = 0; i < n_tags; i++) {
-    long k = map[tags[i]];
-    if (k >= 0) memcpy(out->x + 3 * k, coord + 3 * i, 3 * sizeof *coord);
-  }
-  for (size_t k = 0; k < npc * (size_t)n; k++) out->elem[k] = map[ctag[k]];
+  PM_TRY(gm_gmsh_corners(name, ctag, npc * (size_t)n, out->elem, &out->x, &nn,
+                         &nodes));
   out->n_nodes = nn;
   out->n_elems = n;
   if (dim == 2) PM_TRY(check_plane(name, out));
-  if (groups) PM_TRY(read_groups(name, dim, map, max_tag, out));
+  if (groups) PM_TRY(read_groups(name, dim, &nodes, out));
 done:
   if (ret) gm_gmsh_mesh_free(out);
   free(ctag);
-  free(map);
-  if (tags) gmshFree(tags);
-  if (coord) gmshFree(coord);
-  if (param) gmshFree(param);
+  gm_gmsh_nodes_free(&nodes);
   return ret;
 }
 

@@ -133,13 +133,21 @@ pm_err gm_image_read_points(const char *file, double unit, const long n[3],
   memset(out, 0, sizeof *out);
   pm_err ret = PM_SUCCESS;
   FILE *f = fopen(file, "r");
-  char line[1024];
+  char *line = NULL;
+  size_t cap = 0;
+  ssize_t len;
   long ln = 0;
   PM_ENSURE(f, PM_ERR_IO, "%s: cannot open it (%s)", file, strerror(errno));
   PM_TRY(gm_image_alloc(out, n, d, o));
   out->bits = 8;
-  while (fgets(line, sizeof line, f)) {
+  /* Whole lines, however long: a fixed buffer would read the rest of a
+   * long line as a line of its own. */
+  while ((len = getline(&line, &cap, f)) >= 0) {
     ln++;
+    const size_t text = strlen(line);
+    PM_ENSURE(text == (size_t)len, PM_ERR_SCENE,
+              "%s:%ld:%zu: expected text, got a NUL byte (a binary file?)",
+              file, ln, text + 1);
     char *hash = strchr(line, '#');
     if (hash) *hash = '\0';
     double x[3] = {0, 0, 0};
@@ -176,6 +184,7 @@ pm_err gm_image_read_points(const char *file, double unit, const long n[3],
             strerror(errno));
 done:
   if (f) fclose(f);
+  free(line);
   if (ret) gm_image_free(out);
   return ret;
 }

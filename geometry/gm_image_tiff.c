@@ -45,6 +45,53 @@ static bool page_format(TIFF *t, uint32_t *w, uint32_t *h, uint16_t *bits,
   return true;
 }
 
+/* The most bytes of pixels one byte of compressed data can give, by
+ * compression: none 1; PackBits 64 (a run of 128 in 2 bytes); deflate
+ * 1032 (zlib's bound); LZW's codes of 9 to 12 bits, each at most as long
+ * as the table, under 4096; for the others (JPEG, LZMA, ZSTD...) 65536,
+ * a bound no real stack nears. */
+static uint64_t tiff_ratio(uint16_t compression) {
+  switch (compression) {
+  case COMPRESSION_NONE: return 1;
+  case COMPRESSION_PACKBITS: return 64;
+  case COMPRESSION_ADOBE_DEFLATE:
+  case COMPRESSION_DEFLATE: return 1032;
+  case COMPRESSION_LZW: return 4096;
+  default: return 65536;
+  }
+}
+
+/* Whether the current page's data (its strips' or tiles' bytes) can hold
+ * its w x h pixels of `bits`, checked before anything is allocated for
+ * them: a page of a few bytes that announces 1e10 pixels is damaged, not
+ * an image to make room for.  The strips' bytes count at most the file's
+ * size (file_size), and there are no more strips than bytes. */
+static bool page_holds(TIFF *t, uint32_t w, uint32_t h, uint16_t bits,
+                       uint64_t file_size, char *why, size_t size) {
+  uint16_t compression = COMPRESSION_NONE;
+  TIFFGetFieldDefaulted(t, TIFFTAG_COMPRESSION, &compression);
+  /* In doubles: a hostile page's sizes overflow 64-bit integers. */
+  const double need = (double)w * h * (bits / 8);
+  const double ratio = (double)tiff_ratio(compression);
+  const uint32_t n =
+      TIFFIsTiled(t) ? TIFFNumberOfTiles(t) : TIFFNumberOfStrips(t);
+  /* The bytes its strips claim, at most the file's. */
+  uint64_t bytes = 0;
+  if (n <= file_size + 1)
+    for (uint32_t k = 0; k < n && bytes < file_size; k++) {
+      const uint64_t b = TIFFGetStrileByteCount(t, k);
+      bytes = b < file_size - bytes ? bytes + b : file_size;
+    }
+  const double have = (double)bytes * ratio;
+  if (have >= need) return true;
+  snprintf(why, size,
+           "expected data for %u x %u pixels of %u bits (%.0f bytes), got "
+           "%u strips or tiles that hold at most %.0f (compression %u): "
+           "truncated or damaged",
+           w, h, (unsigned)bits, need, n, have, (unsigned)compression);
+  return false;
+}
+
 /* Page p of t (w x h of `bits`) into dst (w h values), row by row (or tile
  * by tile); false on a read error (tiff_msg says why). */
 static bool read_page(TIFF *t, uint32_t w, uint32_t h, uint16_t bits,
@@ -104,6 +151,9 @@ static pm_err tiff_pass(int nfiles, const char *const *files, gm_image *im,
     PM_CHECK(t, PM_ERR_IO, "%s: cannot read it as a TIFF (%s)", files[f],
              tiff_msg[0] ? tiff_msg : strerror(errno));
     long p = 0, expect = 0;
+    struct stat st;
+    const uint64_t file_size =
+        stat(files[f], &st) == 0 ? (uint64_t)st.st_size : 0;
     do {
       uint32_t w = 0, h = 0;
       uint16_t bits = 0;
@@ -111,6 +161,10 @@ static pm_err tiff_pass(int nfiles, const char *const *files, gm_image *im,
       if (!page_format(t, &w, &h, &bits, why, sizeof why)) {
         TIFFClose(t);
         return PM_ERROR(PM_ERR_ARG, "%s: page %ld: %s", files[f], p + 1, why);
+      }
+      if (!im && !page_holds(t, w, h, bits, file_size, why, sizeof why)) {
+        TIFFClose(t);
+        return PM_ERROR(PM_ERR_IO, "%s: page %ld: %s", files[f], p + 1, why);
       }
       if (*pages == 0) {
         *w0 = w, *h0 = h, *b0 = bits;

@@ -109,61 +109,6 @@ done:
   return ret;
 }
 
-/* The coordinates of the nodes the n triangles use, numbered in gmsh's
- * node order: *x (3 per point, malloc'd), *np, and the triangles' corners
- * as those numbers into corner (3 n). */
-static pm_err corner_points(const char *path, const size_t *ctag, long n,
-                            double **x, long *np, long *corner) {
-  pm_err ret = PM_SUCCESS;
-  int ierr = 0;
-  size_t *tags = NULL, n_tags = 0, n_coord = 0, n_param = 0;
-  double *coord = NULL, *param = NULL;
-  long *map = NULL;
-  gmshModelMeshGetNodes(&tags, &n_tags, &coord, &n_coord, &param, &n_param, -1,
-                        -1, 0, 0, &ierr);
-  GM_GMSH_CHECK("reading the nodes of", path);
-  PM_ENSURE(n_coord == 3 * n_tags, PM_ERR_MESH,
-            "gmsh returned %zu coordinates for %zu nodes of '%s'", n_coord,
-            n_tags, path);
-  size_t max_tag = 0;
-  for (size_t i = 0; i < n_tags; i++)
-    if (tags[i] > max_tag) max_tag = tags[i];
-  /* map[tag]: -1 unused, -2 a corner, then the corner's number. */
-  PM_TRY(PM_ALLOC(map, max_tag + 1, "node tag map"));
-  for (size_t t = 0; t <= max_tag; t++) map[t] = -1;
-  for (size_t k = 0; k < 3 * (size_t)n; k++) {
-    PM_ENSURE(ctag[k] <= max_tag, PM_ERR_MESH,
-              "an element of '%s' refers to node %zu without coordinates", path,
-              ctag[k]);
-    map[ctag[k]] = -2;
-  }
-  long nn = 0;
-  for (size_t i = 0; i < n_tags; i++)
-    if (map[tags[i]] == -2) map[tags[i]] = nn++;
-  PM_TRY(PM_ALLOC(*x, 3 * (size_t)nn, "surface points"));
-  for (size_t i = 0; i < n_tags; i++) {
-    const long k = map[tags[i]];
-    if (k >= 0) memcpy(*x + 3 * k, coord + 3 * i, 3 * sizeof *coord);
-  }
-  for (size_t k = 0; k < 3 * (size_t)n; k++) {
-    corner[k] = map[ctag[k]];
-    PM_ENSURE(corner[k] >= 0, PM_ERR_MESH,
-              "an element of '%s' refers to node %zu without coordinates", path,
-              ctag[k]);
-  }
-  *np = nn;
-done:
-  if (ret) {
-    free(*x);
-    *x = NULL;
-  }
-  free(map);
-  if (tags) gmshFree(tags);
-  if (coord) gmshFree(coord);
-  if (param) gmshFree(param);
-  return ret;
-}
-
 /* ---- merging coincident points ------------------------------------------ */
 
 /* Cells of side tol over the points' box, hashed: each lists the merged
@@ -320,6 +265,7 @@ pm_err gm_trisurf_load(const char *path, gm_trisurf *out) {
   size_t *ctag = NULL;
   long n = 0, np = 0, *corner = NULL;
   double *x = NULL;
+  gm_gmsh_nodes nodes = {0};
   gm_gmsh_session session = {.threads = 0, .open = false};
   PM_TRY(gm_gmsh_begin(&session, path));
   gmshOpen(path, &ierr);
@@ -333,10 +279,11 @@ pm_err gm_trisurf_load(const char *path, gm_trisurf *out) {
             path, ierr ? -1 : dim);
   }
   PM_TRY(PM_ALLOC(corner, 3 * (size_t)n, "surface triangles"));
-  PM_TRY(corner_points(path, ctag, n, &x, &np, corner));
+  PM_TRY(gm_gmsh_corners(path, ctag, 3 * (size_t)n, corner, &x, &np, &nodes));
   PM_TRY(build_surface(path, x, np, corner, n, out));
 done:
   gm_gmsh_end(&session);
+  gm_gmsh_nodes_free(&nodes);
   if (ret) gm_trisurf_free(out);
   free(ctag);
   free(corner);

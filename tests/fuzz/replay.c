@@ -1,13 +1,14 @@
-/* replay: runs the fuzz harness (fuzz_scene.c) over every file of the
- * folders given, without a fuzzer, so that a build with any compiler
- * replays the corpus and the regression inputs.  Exits 1 when a folder
- * cannot be read or holds no input; a crash or a sanitizer report is the
- * failure the replay exists to catch. */
+/* replay: runs a fuzz harness (fuzz_TARGET.c) over every file of the
+ * folders given (their subfolders aside), without a fuzzer, so that a build
+ * with any compiler replays the corpus and the regression inputs.  Exits 1 when
+ * a folder cannot be read or holds no input; a crash or a sanitizer report is
+ * the failure the replay exists to catch. */
 #include <dirent.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -47,7 +48,7 @@ done:
   return ret;
 }
 
-/* Replay every regular file of dir (README files aside); *count adds the
+/* Replay every file of dir (README files and folders aside); *count adds the
  * inputs replayed. */
 static int replay_dir(const char *dir, long *count) {
   DIR *d = opendir(dir);
@@ -60,6 +61,8 @@ static int replay_dir(const char *dir, long *count) {
   for (struct dirent *e; (e = readdir(d)) && !ret;) {
     if (e->d_name[0] == '.' || strncmp(e->d_name, "README", 6) == 0) continue;
     snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) continue;
     ret = replay_file(path);
     (*count)++;
   }

@@ -85,6 +85,24 @@ static void test_three_sources(void **state) {
   gm_image_free(&ref);
 }
 
+/* Point file pts of text (len bytes; 0: up to the NUL) is refused with
+ * "pts:want". */
+static void bad_points(const char *pts, const char *text, size_t len,
+                       const char *want) {
+  const long n[3] = {7, 5, 3};
+  const double d[3] = {1e-6, 1e-6, 1e-6}, o[3] = {0, 0, 0};
+  FILE *f = fopen(pts, "wb");
+  assert_non_null(f);
+  fwrite(text, 1, len ? len : strlen(text), f);
+  fclose(f);
+  gm_image a;
+  assert_int_equal(gm_image_read_points(pts, 1e-6, n, d, o, &a), PM_ERR_SCENE);
+  char where[192];
+  snprintf(where, sizeof where, "%s:%s", pts, want);
+  assert_non_null(strstr(pm_error_message(), where));
+  assert_null(a.v);
+}
+
 static void test_bad_files(void **state) {
   (void)state;
   gm_image ref, a;
@@ -115,24 +133,33 @@ static void test_bad_files(void **state) {
   assert_int_equal(gm_image_read_raw(raw, n, 8, d, o, &a), PM_ERR_IO);
   assert_non_null(strstr(pm_error_message(), "expected 105 bytes"));
   assert_non_null(strstr(pm_error_message(), "got 100"));
-  /* A point between voxel centres. */
-  f = fopen(pts, "w");
-  assert_non_null(f);
-  fprintf(f, "0.5 0.5 0.5\n1.5 2.0 0.5\n");
-  fclose(f);
-  assert_int_equal(gm_image_read_points(pts, 1e-6, n, d, o, &a), PM_ERR_SCENE);
-  char where[192];
-  snprintf(where, sizeof where, "%s:2:1: expected a voxel centre", pts);
-  assert_non_null(strstr(pm_error_message(), where));
-  /* A bad number. */
-  f = fopen(pts, "w");
-  assert_non_null(f);
-  fprintf(f, "0.5 0.5 0.5\n1.5 x 0.5\n");
-  fclose(f);
-  assert_int_equal(gm_image_read_points(pts, 1e-6, n, d, o, &a), PM_ERR_SCENE);
-  snprintf(where, sizeof where, "%s:2:5: expected a number", pts);
-  assert_non_null(strstr(pm_error_message(), where));
+  /* A point between voxel centres, a bad number, a line longer than any
+   * buffer (one line: its bad value 2000 bytes in is in column 2001, and a
+   * long good line is one point), a NUL byte. */
+  bad_points(pts, "0.5 0.5 0.5\n1.5 2.0 0.5\n", 0,
+             "2:1: expected a voxel centre");
+  bad_points(pts, "0.5 0.5 0.5\n1.5 x 0.5\n", 0, "2:5: expected a number");
+  char text[4096];
+  snprintf(text, sizeof text, "%1996s0.5 0.5 0.5\n%2000sx\n", "", "");
+  bad_points(pts, text, 0, "2:2001: expected a number");
+  bad_points(pts, "0.5 0.5 0.5\n1.5\0 0.5 0.5\n", 25,
+             "2:4: expected text, got a NUL byte");
   gm_image_free(&ref);
+}
+
+/* A page that announces 100000 x 100000 pixels in a file of 126 bytes is
+ * refused from its header, before 20 GB are allocated for it. */
+static void test_tiff_without_data(void **state) {
+  (void)state;
+  const char *tif =
+      PM_SOURCE_DIR "/tests/fuzz/regressions/tiff/pixels-without-data.tif";
+  const double d[3] = {1e-6, 1e-6, 1e-6}, o[3] = {0, 0, 0};
+  gm_image im;
+  assert_int_equal(gm_image_read_tiff_path(tif, d, o, &im), PM_ERR_IO);
+  assert_non_null(strstr(pm_error_message(), tif));
+  assert_non_null(strstr(pm_error_message(),
+                         "page 1: expected data for 100000 x 100000 pixels"));
+  assert_null(im.v);
 }
 
 /* The vessel slice carried under cases/mpm/data: its size and its 50760
@@ -198,6 +225,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_three_sources),
       cmocka_unit_test(test_bad_files),
+      cmocka_unit_test(test_tiff_without_data),
       cmocka_unit_test(test_vessel_slice),
       cmocka_unit_test(test_components),
   };

@@ -228,6 +228,15 @@ static void test_msh_groups(void **state) {
   assert_true(fabs(s.area[3] - sqrt(3.0) / 2) <= 1e-15);
   gm_dual_destroy(d);
   gm_mesh_destroy(m);
+  /* A node tagged 4e8 (.msh 4.1): numbered like the others, in memory that
+   * follows the node count, not the largest tag. */
+  assert_ok(gm_mesh_file(PM_SOURCE_DIR
+                         "/tests/fuzz/regressions/gmsh/node-tag-4e8.msh",
+                         3, 0.0, &m));
+  assert_int_equal(m->n_cells, 1);
+  assert_int_equal(m->n_nodes, 4);
+  assert_true(fabs(gm_mesh_volume(m) - 1.0 / 6) <= 1e-15);
+  gm_mesh_destroy(m);
 }
 
 /* A disk in 2D, its rim a physical curve: the facets are the rim's half

@@ -71,12 +71,26 @@ done:
   return ret;
 }
 
+/* Whether attribute attr (name) holds one value: H5Aread writes every
+ * value it holds, and a damaged file's array would be written past the one
+ * the reader has room for (its strings, for a string, left allocated). */
+static pm_err one_value(hid_t attr, const char *name, const char *path) {
+  hid_t space = H5Aget_space(attr);
+  const hssize_t n = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
+  if (space >= 0) H5Sclose(space);
+  PM_CHECK(n == 1, PM_ERR_HDF5,
+           "'%s' is damaged: attribute %s holds %lld values, expected one",
+           path, name, (long long)n);
+  return PM_SUCCESS;
+}
+
 /* Read scalar attribute name of loc into value (memory type mtype). */
 pm_err pm_h5_read_attr(hid_t loc, const char *name, hid_t mtype, void *value,
                        const char *obj, const char *path) {
   pm_err ret = PM_SUCCESS;
   hid_t attr = -1;
   H5_OK(attr = H5Aopen(loc, name, H5P_DEFAULT), "H5Aopen", obj, path);
+  PM_TRY(one_value(attr, name, path));
   H5_OK(H5Aread(attr, mtype, value), "H5Aread", obj, path);
   H5_OK(H5Aclose(attr), "H5Aclose", obj, path);
   attr = -1;
@@ -97,6 +111,7 @@ pm_err pm_h5_read_string_attr(hid_t loc, const char *name, char **out,
   H5_OK(type = H5Aget_type(attr), "H5Aget_type", name, path);
   PM_ENSURE(H5Tget_class(type) == H5T_STRING && H5Tis_variable_str(type) > 0,
             PM_ERR_HDF5, "attribute %s of '%s' is not a string", name, path);
+  PM_TRY(one_value(attr, name, path));
   H5_OK(H5Aread(attr, type, &value), "H5Aread", name, path);
   *out = strdup(value ? value : "");
   PM_ENSURE(*out, PM_ERR_MEMORY, "cannot copy attribute %s of '%s'", name,

@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# Fuzz one reader: build tests/fuzz/fuzz_TARGET.c with clang, libFuzzer,
+# AddressSanitizer and UndefinedBehaviorSanitizer in build-fuzz/, then run
+# one campaign job seeded from the project's own files of that kind
+# (cases/, tests/data/, /work/shared/data where present) and the replayed
+# corpus.
+#
+#   scripts/fuzz.sh TARGET [SECONDS | -runs=N] [LIBFUZZER OPTION]...
+#
+# TARGET: scene (the scene loader and --set overrides), tiff (TIFF
+# stacks), raw (raw volumes), points (point clouds and voxel centres),
+# table (CSV tables: FE ladders, lattices, tolerances, history.csv), gmsh
+# (.msh volume and surface meshes), checkpoint (checkpoint.h5), index (the
+# results folder `resume` reopens).
+#
+# New inputs go to build-fuzz/corpus-TARGET/; crashes, leaks and hangs to
+# build-fuzz/findings-TARGET/.  To fold a campaign back into the small
+# replayed corpus (tests/fuzz/corpus-TARGET, tests/fuzz/corpus for the
+# scene): build-fuzz/tests/fuzz_TARGET -merge=1 NEWDIR CORPUS
+# build-fuzz/corpus-TARGET, then replace CORPUS with NEWDIR.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+usage() {
+  echo "usage: $0 scene|tiff|raw|points|table|gmsh|checkpoint|index" \
+    "[SECONDS | -runs=N] [LIBFUZZER OPTION]..." >&2
+  exit 1
+}
+target=${1:-}
+case $target in
+scene | tiff | raw | points | table | gmsh | checkpoint | index) ;;
+*) usage ;;
+esac
+shift
+command -v clang >/dev/null || {
+  echo "clang is not installed (Debian: apt-get install clang)" >&2
+  exit 1
+}
+limit=${1:-600}
+shift || true
+case $limit in
+-runs=*) budget=$limit ;;
+*[!0-9]* | '') usage ;;
+*) budget=-max_total_time=$limit ;;
+esac
+
+build=build-fuzz
+CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DPM_FUZZ=ON -DPM_OPENMP=OFF -DPM_VERIFICATION=OFF >/dev/null
+# The program makes the scene's dictionary and the run whose checkpoint
+# and results seed those targets.
+targets=("fuzz_$target")
+case $target in scene | checkpoint | index) targets+=(pointmech) ;; esac
+cmake --build "$build" -j"${PM_FUZZ_BUILD_JOBS:-1}" --target "${targets[@]}"
+
+seeds=$build/seeds-$target
+corpus=$build/corpus-$target
+findings=$build/findings-$target
+replayed=tests/fuzz/corpus-$target
+[ "$target" = scene ] && replayed=tests/fuzz/corpus
+rm -rf "$seeds"
+mkdir -p "$seeds" "$corpus" "$findings"
+bash tests/fuzz/seeds.sh "$target" "$seeds" "$build/pointmech"
+
+# The largest input: past it a reader's time goes to sizes no seed has
+# (gmsh and HDF5 parse whole files; a scene is short text).
+max_len=16384
+extra=()
+case $target in
+scene)
+  # The dictionary: every key name and every name a key takes, the
+  # expression functions and YAML's own tokens.
+  dict=$build/scene.dict
+  {
+    "$build/pointmech" keys |
+      grep -oE '^[a-z0-9_.N]+' | tr '.' '\n' | grep -vE '^(N|)$' | sort -u |
+      sed 's/.*/"&:"/'
+    "$build/pointmech" keys | grep -oE 'one of [a-z0-9_, -]+' |
+      sed 's/^one of //' | tr ',' '\n' | tr -d ' ' | grep -v '^$' | sort -u |
+      sed 's/.*/"&"/'
+    for w in sqrt exp log sin cos tan asin acos atan sinh cosh tanh abs step \
+      delta nandelta erf pi e x y z t; do echo "\"$w\""; done
+    for w in '{' '}' '[' ']' ': ' '- ' '&a ' '*a' '!!str ' '---' '...' '"' \
+      "'" '=' '\x00' '.nan' '.inf' '-.inf' 'nan' 'inf' '1e999' '1/0' '^' '('; do
+      echo "\"$w\""
+    done
+  } >"$dict"
+  extra+=(-dict="$dict")
+  ;;
+checkpoint | index) max_len=81920 ;;
+gmsh) max_len=8192 ;;
+esac
+
+export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1
+# What the distribution's libraries leak by themselves (tests/lsan.supp).
+export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:fast_unwind_on_malloc=0
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+exec "$build/tests/fuzz_$target" "$budget" -max_len=$max_len \
+  -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  -artifact_prefix="$findings/" "${extra[@]}" "$@" "$corpus" "$seeds" \
+  "$replayed"

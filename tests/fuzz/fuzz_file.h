@@ -1,0 +1,26 @@
+/* fuzz_file: the files a reader under a fuzzer opens by name.  Each
+ * process has one private folder in /dev/shm (in $TMPDIR, else /tmp,
+ * where /dev/shm is missing), removed with everything in it at exit, so
+ * an input written for a reader costs no disk and leaves nothing behind. */
+#ifndef FUZZ_FILE_H
+#define FUZZ_FILE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* The private folder (created on first use; aborts when it cannot be). */
+const char *fuzz_dir(void);
+
+/* Write size bytes of data to the file at relative path name in the
+ * private folder (its parent folders made) and return the full path, valid
+ * until the next call.  Aborts when the file cannot be written. */
+const char *fuzz_file(const char *name, const uint8_t *data, size_t size);
+
+/* The full path of name in the private folder, without writing it. */
+const char *fuzz_path(const char *name);
+
+/* Remove everything in the private folder (the folder stays): between two
+ * inputs, so that no file of one is read with the next. */
+void fuzz_clear(void);
+
+#endif
