@@ -1,6 +1,6 @@
 #!/bin/bash
 # What a frame costs as a run grows: a tiny scene (tests/data/scenes
-# minimal-2d at mesh size 0.25, 45 points) writing a frame at every step,
+# minimal-2d at mesh size 0.25, 32 points) writing a frame at every step,
 # run for N steps for each N in NS, as CPU seconds (user + system, from
 # /usr/bin/time) per frame: the run's less those of the same run writing
 # only its first and last frame, over the frames that adds.  A cost per

@@ -43,23 +43,6 @@ for row in sorted(rng.sample(range(4, 2 * total // 3), n)):
 EOF
 )
 
-# results.h5 lists only frames on disk, as its attribute says; results.xdmf
-# parses and has a grid per frame of the index or one fewer.
-readable() { # out
-  $py - "$1" <<'EOF'
-import os, sys, h5py, xml.etree.ElementTree as ET
-out = sys.argv[1]
-with h5py.File(os.path.join(out, "results.h5"), "r") as f:
-    n = len(f["frames"])
-    assert f.attrs["frames"] == n
-    for k in f["frames"]:
-        assert "displacement" in f["frames"][k]
-grids = ET.parse(os.path.join(out, "results.xdmf")).getroot().findall(
-    "Domain/Grid/Grid")
-assert len(grids) in (n, n - 1), (len(grids), n)
-EOF
-}
-
 out=$work/soak
 term=0 kill=0 missed=0 failed=0 unreadable=0
 start=("$bin" run "$scene" --out "$out" --quiet "${args[@]}")
@@ -82,7 +65,8 @@ while read -r row delay sig; do
     sed "s/^/    $sig, exit $rc: /" "$work/err" | head -3
     ;;
   esac
-  [ "$sig" = KILL ] && ! readable "$out" 2>>"$work/err" &&
+  [ "$sig" = KILL ] &&
+    ! $py "$here/results_readable.py" "$out" >/dev/null 2>>"$work/err" &&
     unreadable=$((unreadable + 1))
   start=("$bin" resume "$out" --quiet)
 done <<<"$plan"

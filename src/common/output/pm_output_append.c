@@ -25,17 +25,6 @@
 #include "pm_h5.h"
 #include "pm_output_impl.h"
 
-/* fsync the closed file path. */
-static pm_err sync_file(const char *path) {
-  int fd = open(path, O_RDONLY | O_CLOEXEC);
-  PM_CHECK(fd >= 0, PM_ERR_IO, "cannot reopen '%s' to sync it: %s", path,
-           strerror(errno));
-  int rc = fsync(fd), e = errno;
-  close(fd);
-  PM_CHECK(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", path, strerror(e));
-  return PM_SUCCESS;
-}
-
 /* to replaced whole by a synced copy of from. */
 static pm_err copy_file(const char *from, const char *to) {
   pm_err ret = PM_SUCCESS;
@@ -88,7 +77,7 @@ static pm_err index_append(const pm_results *r, long from, long n) {
   hid_t f = file;
   file = -1;
   H5_OK(H5Fclose(f), "H5Fclose", "/", path);
-  PM_TRY(sync_file(path));
+  PM_TRY(pm_sync_file(path));
 done:
   pm_h5_close_quiet(&attr);
   pm_h5_close_quiet(&frames);
@@ -96,11 +85,15 @@ done:
   return ret;
 }
 
-/* The spare XDMF given r's grids from byte off on before its closing tags
- * (checked to be XDMF_TAIL), in place. */
-static pm_err xdmf_append(const pm_results *r, size_t off) {
+/* The spare XDMF, holding frames [0, from), given r's grids of frames
+ * [from, n) before its closing tags (checked to be XDMF_TAIL), in place. */
+static pm_err xdmf_append(const pm_results *r, long from, long n) {
   pm_err ret = PM_SUCCESS;
   const char *path = r->xdmf_spare_path;
+  /* r's text holds frames [text_from, n), frame n - 1 from last_at. */
+  PM_CHECK(from == r->text_from || from == n - 1, PM_ERR_INTERNAL,
+           "the XDMF grids of frames %ld to %ld are not at hand", from, n - 1);
+  const size_t off = from == r->text_from ? 0 : r->last_at;
   const size_t tail = sizeof XDMF_TAIL - 1, len = r->frames.len - off;
   char seen[sizeof XDMF_TAIL];
   struct stat st;
@@ -141,50 +134,59 @@ static pm_err rotate(const char *published, const char *spare, const char *prev,
   return PM_SUCCESS;
 }
 
-/* results.h5 at n frames: appended to its spare when results.h5 holds
- * n - 1, else rewritten whole. */
-static pm_err publish_index(pm_results *r, long n) {
-  if (r->index_published != n - 1 || n < 1) {
-    PM_CALL(pm_output_index_commit(r));
-    r->index_published = n;
-    return PM_SUCCESS;
-  }
-  long from = r->index_spare;
-  r->index_spare = -1; /* until the append is done */
-  if (from < 0 || from > n - 1 || index_append(r, from, n) != PM_SUCCESS) {
-    pm_error_clear();
-    PM_CALL(copy_file(r->index_path, r->index_spare_path));
-    PM_CALL(index_append(r, n - 1, n));
-  }
-  return rotate(r->index_path, r->index_spare_path, r->index_prev_path, n,
-                &r->index_published, &r->index_spare);
-}
+/* One of the files that describe the frames, with its spare. */
+typedef struct {
+  const char *path, *spare, *prev;
+  long *published, *spare_n; /* the frames each holds (-1: unknown) */
+  long min_n;                /* fewest frames to append to */
+  pm_err (*whole)(const pm_results *r);
+  pm_err (*append)(const pm_results *r, long from, long n);
+} described_by;
 
-/* results.xdmf at n frames: r's grids appended to its spare when
- * results.xdmf holds n - 1 >= 1 frames, else rewritten whole. */
-static pm_err publish_xdmf(pm_results *r, long n) {
-  if (r->xdmf_published != n - 1 || n < 2) {
-    PM_CALL(pm_output_xdmf_commit(r));
-    r->xdmf_published = n;
+/* The file at n frames: appended to its spare when it holds n - 1 (at
+ * least min_n - 1), else rewritten whole.  A spare that is not as
+ * expected is first made a copy of the file. */
+static pm_err publish_one(pm_results *r, long n, const described_by *d) {
+  if (*d->published != n - 1 || n < d->min_n) {
+    PM_CALL(d->whole(r));
+    *d->published = n;
     return PM_SUCCESS;
   }
-  long from = r->xdmf_spare;
-  r->xdmf_spare = -1;
-  bool known = from >= 1 && (from == r->text_from || from == n - 1);
-  size_t off = from == r->text_from ? 0 : r->last_at;
-  if (!known || xdmf_append(r, off) != PM_SUCCESS) {
+  long from = *d->spare_n;
+  *d->spare_n = -1; /* until the append is done */
+  if (from < 0 || from > n - 1 || d->append(r, from, n) != PM_SUCCESS) {
     pm_error_clear();
-    PM_CALL(copy_file(r->xdmf_path, r->xdmf_spare_path));
-    PM_CALL(xdmf_append(r, r->last_at));
+    PM_CALL(copy_file(d->path, d->spare));
+    PM_CALL(d->append(r, n - 1, n));
   }
-  return rotate(r->xdmf_path, r->xdmf_spare_path, r->xdmf_prev_path, n,
-                &r->xdmf_published, &r->xdmf_spare);
+  return rotate(d->path, d->spare, d->prev, n, d->published, d->spare_n);
 }
 
 pm_err pm_output_publish(pm_results *r) {
   long n = r->n_frames;
-  PM_CALL(publish_index(r, n));
-  PM_CALL(publish_xdmf(r, n));
+  const described_by index = {
+      .path = r->index_path,
+      .spare = r->index_spare_path,
+      .prev = r->index_prev_path,
+      .published = &r->index_published,
+      .spare_n = &r->index_spare,
+      .min_n = 1,
+      .whole = pm_output_index_commit,
+      .append = index_append,
+  };
+  /* An XDMF of no frame is the bare mesh, without the frames' tail. */
+  const described_by xdmf = {
+      .path = r->xdmf_path,
+      .spare = r->xdmf_spare_path,
+      .prev = r->xdmf_prev_path,
+      .published = &r->xdmf_published,
+      .spare_n = &r->xdmf_spare,
+      .min_n = 2,
+      .whole = pm_output_xdmf_commit,
+      .append = xdmf_append,
+  };
+  PM_CALL(publish_one(r, n, &index));
+  PM_CALL(publish_one(r, n, &xdmf));
   /* Only the last grid is needed again (by the spare, one frame behind). */
   if (n >= 1 && r->text_from < n - 1) {
     size_t keep = r->frames.len - r->last_at;
