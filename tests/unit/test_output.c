@@ -87,9 +87,9 @@ static void test_write_read(void **state) {
    * the index, the XDMF and the results folder, no temporary file. */
   assert_int_equal(pm_test_count_entries(dir, &tmp), 3);
   assert_int_equal(tmp, 0);
+  /* mesh, two frames and the spares of the index and the XDMF */
   snprintf(path, sizeof path, "%s/results", dir);
-  assert_int_equal(pm_test_count_entries(path, &tmp),
-                   3); /* mesh and two frames */
+  assert_int_equal(pm_test_count_entries(path, &tmp), 5);
   assert_int_equal(tmp, 0);
   pm_results_close(r, true);
   assert_int_equal(pm_test_count_entries(dir, &tmp), 3);
@@ -236,8 +236,9 @@ static void test_moving_and_reopen(void **state) {
   pos[0] = 7;
   assert_ok(pm_results_write_frame(r, 25, 2.5, 2, f));
   pm_results_close(r, true);
+  /* mesh.h5, three frames and the spares of the index and the XDMF. */
   snprintf(path, sizeof path, "%s/results", dir);
-  assert_int_equal(pm_test_count_entries(path, &tmp), 4);
+  assert_int_equal(pm_test_count_entries(path, &tmp), 6);
   assert_int_equal(tmp, 0);
   snprintf(path, sizeof path, "%s/results.xdmf", dir);
   x = pm_test_slurp(path);
@@ -253,6 +254,100 @@ static void test_moving_and_reopen(void **state) {
   hsize_t dims[2] = {NP, 3};
   read_doubles(file, "/frames/000002/position", back, 3 * NP, 2, dims);
   assert_true(back[0] == 7);
+  H5Fclose(file);
+}
+
+static int count_in(const char *from, const char *to, const char *needle);
+
+/* The index lists frames 000000 .. n-1 in creation order, and says n. */
+static void check_index(const char *dir, long n) {
+  char path[512], name[32];
+  long held = -1;
+  snprintf(path, sizeof path, "%s/results.h5", dir);
+  hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+  assert_true(file >= 0);
+  hid_t a = H5Aopen(file, "frames", H5P_DEFAULT);
+  assert_true(H5Aread(a, H5T_NATIVE_LONG, &held) >= 0);
+  H5Aclose(a);
+  assert_int_equal(held, n);
+  hid_t g = H5Gopen2(file, "frames", H5P_DEFAULT);
+  H5G_info_t info;
+  assert_true(H5Gget_info(g, &info) >= 0);
+  assert_int_equal(info.nlinks, n);
+  for (long k = 0; k < n; k++) {
+    assert_true(H5Lget_name_by_idx(g, ".", H5_INDEX_CRT_ORDER, H5_ITER_INC,
+                                   (hsize_t)k, name, sizeof name,
+                                   H5P_DEFAULT) == 6);
+    assert_int_equal(strtol(name, NULL, 10), k);
+  }
+  H5Gclose(g);
+  H5Fclose(file);
+}
+
+/* Damage a file: cut its last bytes (a torn tail). */
+static void cut_tail(const char *path) {
+  struct stat st;
+  assert_int_equal(stat(path, &st), 0);
+  assert_int_equal(truncate(path, st.st_size - 5), 0);
+}
+
+/* Frames appended to the spares of the index and the XDMF: after every
+ * frame both list exactly the frames written; the appended XDMF is byte for
+ * byte the one rewritten whole (by a reopen); spares torn or missing are
+ * rebuilt. */
+static void test_many_frames(void **state) {
+  const char *dir = *state;
+  pm_results *r = NULL;
+  double u[3 * NP], damage[NP], stress[9 * NP];
+  char path[512], spare[512];
+  pm_field f[3] = {
+      {"displacement", 3, u}, {"damage", 1, damage}, {"stress", 9, stress}};
+  const long n = 40;
+  assert_ok(pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "v", &r));
+  for (long k = 0; k < n; k++) {
+    fill_frame((int)k, u, damage, stress);
+    if (k == 20) { /* torn spares: detected, rebuilt from the published */
+      snprintf(spare, sizeof spare, "%s/results/.spare-results.xdmf", dir);
+      cut_tail(spare);
+      snprintf(spare, sizeof spare, "%s/results/.spare-results.h5", dir);
+      cut_tail(spare);
+    }
+    if (k == 30) { /* missing spares */
+      snprintf(spare, sizeof spare, "%s/results/.spare-results.xdmf", dir);
+      assert_int_equal(unlink(spare), 0);
+      snprintf(spare, sizeof spare, "%s/results/.spare-results.h5", dir);
+      assert_int_equal(unlink(spare), 0);
+    }
+    assert_ok(pm_results_write_frame(r, 10 * k, 0.5 * (double)k, 3, f));
+    check_index(dir, k + 1);
+    snprintf(path, sizeof path, "%s/results.xdmf", dir);
+    char *x = pm_test_slurp(path);
+    assert_int_equal(count_in(x, x + strlen(x), "<Time Value="), k + 1);
+    free(x);
+  }
+  pm_results_close(r, true);
+  snprintf(path, sizeof path, "%s/results.xdmf", dir);
+  char *appended = pm_test_slurp(path);
+  python_check_xdmf(dir, "len(x.findall(\"Domain/Grid/Grid\")) == 40");
+  /* A reopen keeping every frame rewrites both files whole. */
+  assert_ok(pm_results_reopen(dir, NP, n, &r));
+  pm_results_close(r, true);
+  char *whole = pm_test_slurp(path);
+  assert_string_equal(appended, whole);
+  free(appended);
+  free(whole);
+  check_index(dir, n);
+  /* The reopen removed the spares (a killed run's may be torn). */
+  snprintf(spare, sizeof spare, "%s/results/.spare-results.h5", dir);
+  assert_int_equal(access(spare, F_OK), -1);
+  /* Frame 17's fields through the index's link. */
+  snprintf(path, sizeof path, "%s/results.h5", dir);
+  hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+  assert_true(file >= 0);
+  double back[NP];
+  hsize_t dims[1] = {NP};
+  read_doubles(file, "/frames/000017/damage", back, NP, 1, dims);
+  assert_true(back[2] == 0.2 + 17);
   H5Fclose(file);
 }
 
@@ -510,6 +605,8 @@ int main(void) {
       cmocka_unit_test_setup_teardown(test_abort_and_point_cloud,
                                       pm_test_make_dir, pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_moving_and_reopen, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_many_frames, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_bad_arguments, pm_test_make_dir,
                                       pm_test_drop_dir),

@@ -39,6 +39,10 @@ set_tests_properties(verification.studies PROPERTIES LABELS verification TIMEOUT
 add_test(NAME verification.restart
   COMMAND bash ${PM_VERIFY_DIR}/restart.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.restart PROPERTIES LABELS verification TIMEOUT 600 PROCESSORS 2)
+# Ten interruptions (the 50-interruption soak: benchmarks/soak-resume.sh).
+add_test(NAME verification.soak
+  COMMAND bash ${PM_VERIFY_DIR}/soak.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR} 10 1)
+set_tests_properties(verification.soak PROPERTIES LABELS verification TIMEOUT 300)
 add_test(NAME verification.memory
   COMMAND bash ${PM_VERIFY_DIR}/memory.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.memory PROPERTIES LABELS verification TIMEOUT 120)

@@ -92,13 +92,18 @@ pm_err pm_rename(const char *from, const char *to) {
   return PM_SUCCESS;
 }
 
-pm_err pm_sync_rename(const char *tmp, const char *path) {
-  int fd = open(tmp, O_RDONLY | O_CLOEXEC);
-  PM_CHECK(fd >= 0, PM_ERR_IO, "cannot reopen '%s' to sync it: %s", tmp,
+pm_err pm_sync_file(const char *path) {
+  int fd = open(path, O_RDONLY | O_CLOEXEC);
+  PM_CHECK(fd >= 0, PM_ERR_IO, "cannot reopen '%s' to sync it: %s", path,
            strerror(errno));
   int rc = fsync(fd), e = errno;
   close(fd);
-  PM_CHECK(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", tmp, strerror(e));
+  PM_CHECK(rc == 0, PM_ERR_IO, "cannot sync '%s': %s", path, strerror(e));
+  return PM_SUCCESS;
+}
+
+pm_err pm_sync_rename(const char *tmp, const char *path) {
+  PM_CALL(pm_sync_file(tmp));
   return pm_rename(tmp, path);
 }
 

@@ -56,6 +56,10 @@ void pm_afile_abort(pm_afile *f);
  * possible.  Fails with PM_ERR_IO naming both paths. */
 pm_err pm_rename(const char *from, const char *to);
 
+/* Make the closed file path durable (fsync).  PM_ERR_IO naming the path
+ * and the reason. */
+pm_err pm_sync_file(const char *path);
+
 /* Make the closed file tmp durable (fsync) and rename it to path, as
  * pm_rename.  A write the system refused (full disk, file size limit)
  * shows here at the latest.  PM_ERR_IO naming the path and the reason. */

@@ -1,6 +1,7 @@
 /* pm_output: results as one synced file per frame, an index (results.h5)
- * of external links and results.xdmf, both rewritten atomically after each
- * frame: creating the results, writing a frame, closing. */
+ * of external links and results.xdmf, both replaced atomically after each
+ * frame (pm_output_append.c): creating the results, writing a frame,
+ * closing. */
 #include "pm_output.h"
 
 #include <errno.h>
@@ -100,6 +101,18 @@ pm_err pm_output_set_paths(pm_results *r, const char *dir) {
   PM_CALL(pm_path_join(r->sub, sizeof r->sub, dir, RESULTS_SUBDIR));
   PM_CALL(pm_path_join(r->index_path, sizeof r->index_path, dir, "results.h5"));
   PM_CALL(pm_path_join(r->xdmf_path, sizeof r->xdmf_path, dir, "results.xdmf"));
+  PM_CALL(pm_path_join(r->index_spare_path, sizeof r->index_spare_path, r->sub,
+                       INDEX_SPARE));
+  PM_CALL(pm_path_join(r->index_prev_path, sizeof r->index_prev_path, r->sub,
+                       INDEX_SPARE ".prev"));
+  PM_CALL(pm_path_join(r->xdmf_spare_path, sizeof r->xdmf_spare_path, r->sub,
+                       XDMF_SPARE));
+  PM_CALL(pm_path_join(r->xdmf_prev_path, sizeof r->xdmf_prev_path, r->sub,
+                       XDMF_SPARE ".prev"));
+  /* Nothing known of the files on disk yet: the first frames rewrite
+   * them whole. */
+  r->index_published = r->index_spare = -1;
+  r->xdmf_published = r->xdmf_spare = -1;
   return pm_path_join(r->mesh_path, sizeof r->mesh_path, r->sub, "mesh.h5");
 }
 
@@ -231,6 +244,8 @@ void pm_results_close(pm_results *r, bool keep) {
     unlink(r->index_path);
     unlink(r->xdmf_path);
     unlink(r->mesh_path);
+    unlink(r->index_spare_path);
+    unlink(r->xdmf_spare_path);
     rmdir(r->sub);
   }
   pm_output_free(r);
@@ -277,7 +292,7 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
   char path[PM_PATH_MAX + 1], tmp[PM_PATH_MAX + 40];
   const char *names[16];
   int ncomp[16];
-  size_t frames_len;
+  size_t frames_len, last_at;
   PM_CHECK(r, PM_ERR_ARG, "pm_results_write_frame: NULL results");
   PM_CALL(check_fields(n_fields, fields));
   PM_CHECK(n_fields <= 16, PM_ERR_ARG, "results frame: %d fields (16 at most)",
@@ -289,6 +304,7 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
     bytes += 8.0 * fields[i].ncomp * (double)r->n_points;
   PM_CALL(pm_output_check_room(r->sub, path, bytes));
   frames_len = r->frames.len;
+  last_at = r->last_at;
   errno = 0;
   ret = write_frame_file(r, tmp, step, time, n_fields, fields);
   int saved = errno;
@@ -307,11 +323,17 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
   if (ret != PM_SUCCESS) { /* back to the frames before */
     r->n_frames--;
     r->frames.len = frames_len;
+    r->last_at = last_at;
+    pm_output_spares_unknown(r);
     unlink(path);
     /* The index may already list the frame: list the others again (best
      * effort; the earlier index and XDMF stay otherwise). */
     pm_err first = ret;
-    if (pm_output_index_commit(r) != PM_SUCCESS) pm_error_clear();
+    r->index_published = r->n_frames;
+    if (pm_output_index_commit(r) != PM_SUCCESS) {
+      pm_error_clear();
+      r->index_published = -1;
+    }
     ret = first;
     PM_TRY(pm_output_classify(ret, saved, r->index_path));
   }

@@ -3,10 +3,13 @@
  * so ParaView opens them directly, also while the run goes on.
  *
  * Every frame is a file of its own, written under a temporary name, synced
- * and renamed; then the index (results.h5) and results.xdmf are rewritten
- * the same way.  A process killed at any moment leaves every earlier frame
- * whole and an index and XDMF that point only at frames that exist; no
- * file is held open between frames, so readers never meet a lock.
+ * and renamed; then the index (results.h5) and results.xdmf are replaced
+ * the same way, by spares one frame behind (results/.spare-results.h5 and
+ * .spare-results.xdmf) given the new frame in place, so that a frame costs
+ * the same at any length of run.  A process killed at any moment leaves
+ * every earlier frame whole and an index and XDMF that point only at
+ * frames that exist; no file is held open between frames, so readers never
+ * meet a lock.
  *
  * Layout (every name fixed; readers such as probe rely on it):
  *   OUT/results/mesh.h5          /coordinates float64 [n_points][3]
@@ -100,19 +103,19 @@ pm_err pm_results_create(const char *dir, int dim, long n_points,
                          const char *version, pm_results **out);
 
 /* Continue the results in dir with their first n_keep frames (a resumed
- * run): later frames are deleted, the index and results.xdmf rewritten
- * from the frames kept (and mesh.h5's surface, if any).  n_points must
- * match the mesh.  Fails with PM_ERR_IO / PM_ERR_HDF5 naming what is
- * missing or unreadable. */
+ * run): later frames and the spares are deleted, the index and
+ * results.xdmf rewritten whole from the frames kept (and mesh.h5's
+ * surface, if any).  n_points must match the mesh.  Fails with
+ * PM_ERR_IO / PM_ERR_HDF5 naming what is missing or unreadable. */
 pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
                          pm_results **out);
 
 /* Append frame NNNNNN (the next index) with attributes step and time and
- * one dataset per field, synced to disk, then rewrite the index and the
- * XDMF.  Fails with PM_ERR_ARG (bad field: name, ncomp, NULL data,
- * duplicate) before writing anything, PM_ERR_IO (a write refused, e.g. the
- * disk is full or the file size limit is reached: naming the file and the
- * reason) or PM_ERR_HDF5; after a failure the frame's temporary file is
+ * one dataset per field, synced to disk, then replace the index and the
+ * XDMF (through their spares).  Fails with PM_ERR_ARG (bad field: name, ncomp,
+ * NULL data, duplicate) before writing anything, PM_ERR_IO (a write refused,
+ * e.g. the disk is full or the file size limit is reached: naming the file and
+ * the reason) or PM_ERR_HDF5; after a failure the frame's temporary file is
  * gone and the earlier frames, index and XDMF are as they were. */
 pm_err pm_results_write_frame(pm_results *r, long step, double time,
                               int n_fields, const pm_field *fields);

@@ -33,14 +33,35 @@ struct pm_results {
   long n_surface; /* triangles in mesh.h5's /surface (grid SURFACE_NAME) */
   bool created;   /* by pm_results_create: removed by close(!keep, no frame) */
   char *scene_text, *version;
-  /* The XDMF of the frames so far (one <Grid> each), rewritten whole. */
+  /* The XDMF grids of frames [text_from, n_frames), the last one from
+   * byte last_at: all of them after a reopen, else the one or two that
+   * the spare XDMF lacks. */
   xml_text frames;
+  long text_from;
+  size_t last_at;
+  /* results.h5 and results.xdmf each have a spare, the file they replaced
+   * (results/.spare-*): the next frame is appended to the spare in place,
+   * which then replaces the published file, so a frame costs the same at
+   * any length of run.  Frames each holds; -1: unknown (rebuilt). */
+  long index_published, index_spare, xdmf_published, xdmf_spare;
   char dir[PM_PATH_MAX + 1];
   char sub[PM_PATH_MAX + 1];        /* dir/results */
   char index_path[PM_PATH_MAX + 1]; /* dir/results.h5 */
   char xdmf_path[PM_PATH_MAX + 1];  /* dir/results.xdmf */
   char mesh_path[PM_PATH_MAX + 1];  /* dir/results/mesh.h5 */
+  char index_spare_path[PM_PATH_MAX + 1], index_prev_path[PM_PATH_MAX + 1];
+  char xdmf_spare_path[PM_PATH_MAX + 1], xdmf_prev_path[PM_PATH_MAX + 1];
 };
+
+/* The names of the spares in dir/results (with ".prev": the published
+ * file's second name while a spare replaces it). */
+#define SPARE_PREFIX ".spare-"
+#define INDEX_SPARE SPARE_PREFIX "results.h5"
+#define XDMF_SPARE SPARE_PREFIX "results.xdmf"
+
+/* How results.xdmf ends once it holds a frame (its temporal collection
+ * closed). */
+#define XDMF_TAIL "    </Grid>\n  </Domain>\n</Xdmf>\n"
 
 /* ---- pm_output_write.c ---- */
 
@@ -91,7 +112,18 @@ pm_err pm_output_xdmf_frame(pm_results *r, long k, long step, double time,
  * and the frames). */
 pm_err pm_output_index_commit(const pm_results *r);
 
-/* Rewrites results.h5 and results.xdmf whole, in that order. */
-pm_err pm_output_publish(const pm_results *r);
+/* Rewrites results.xdmf whole from r's text, which must hold every
+ * frame's grid. */
+pm_err pm_output_xdmf_commit(const pm_results *r);
+
+/* ---- pm_output_append.c ---- */
+
+/* Brings results.h5, then results.xdmf, to r's n_frames frames: through
+ * the spares when they lack one or two frames, else rewritten whole (r's
+ * text then holds every frame's grid). */
+pm_err pm_output_publish(pm_results *r);
+
+/* Forget the spares' contents (after a failure: they are rebuilt). */
+void pm_output_spares_unknown(pm_results *r);
 
 #endif

@@ -1,6 +1,7 @@
-/* pm_output_index: the files that describe the frames, rewritten whole
- * after each: results.xdmf (a temporal collection of grids) and results.h5
- * (attributes and external links to the mesh and the frames). */
+/* pm_output_index: the files that describe the frames written whole:
+ * results.xdmf (a temporal collection of grids) and results.h5 (attributes
+ * and external links to the mesh and the frames); and the XDMF grid of a
+ * frame.  pm_output_append.c appends to them. */
 #include <hdf5.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -149,15 +150,19 @@ pm_err pm_output_xdmf_frame(pm_results *r, long k, long step, double time,
            "        <Information Name=\"step\" Value=\"%ld\"/>\n",
            tbuf, step);
   grid_data g = {file, nf, names, ncomp};
+  r->last_at = r->frames.len;
   return grid_add(&r->frames, r, 6, name, head, &g);
 }
 
 /* results.xdmf: the frames' temporal collection (or the bare mesh). */
-static pm_err xdmf_commit(const pm_results *r) {
+pm_err pm_output_xdmf_commit(const pm_results *r) {
   pm_err ret = PM_SUCCESS;
   pm_afile *f = NULL;
   xml_text bare = {0};
   const xml_text *grids = &r->frames;
+  PM_CHECK(r->text_from == 0, PM_ERR_INTERNAL,
+           "results.xdmf: the grids of frames before %ld are not at hand",
+           r->text_from);
   if (r->n_frames == 0) {
     grid_data none = {NULL, 0, NULL, NULL};
     PM_TRY(grid_add(&bare, r, 4, "mesh", "", &none));
@@ -172,8 +177,7 @@ static pm_err xdmf_commit(const pm_results *r) {
     fprintf(fp, "    <Grid Name=\"pointmech\" GridType=\"Collection\" "
                 "CollectionType=\"Temporal\">\n");
   fwrite(grids->s, 1, grids->len, fp);
-  if (r->n_frames > 0) fprintf(fp, "    </Grid>\n");
-  fprintf(fp, "  </Domain>\n</Xdmf>\n");
+  fputs(r->n_frames > 0 ? XDMF_TAIL : "  </Domain>\n</Xdmf>\n", fp);
   ret = pm_afile_commit(f);
 done:
   free(bare.s);
@@ -224,10 +228,4 @@ done:
   pm_h5_close_quiet(&file);
   if (ret != PM_SUCCESS) unlink(tmp);
   return ret;
-}
-
-/* Index, then XDMF: each replaced whole. */
-pm_err pm_output_publish(const pm_results *r) {
-  PM_CALL(pm_output_index_commit(r));
-  return xdmf_commit(r);
 }

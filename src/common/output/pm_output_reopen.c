@@ -12,8 +12,8 @@
 #include "pm_h5.h"
 #include "pm_output_impl.h"
 
-/* Remove frame files of index >= n_keep and temporary files left in
- * dir/results by a run that was killed. */
+/* Remove frame files of index >= n_keep, and the temporary files and
+ * spares (possibly torn) left in dir/results by a run that was killed. */
 static pm_err drop_later_frames(const pm_results *r, long n_keep) {
   DIR *d = opendir(r->sub);
   PM_CHECK(d, PM_ERR_IO, "cannot read '%s': %s", r->sub, strerror(errno));
@@ -23,7 +23,8 @@ static pm_err drop_later_frames(const pm_results *r, long n_keep) {
   while ((e = readdir(d))) {
     long k;
     int used = 0;
-    bool tmp = strstr(e->d_name, ".tmp.") != NULL;
+    bool tmp = strstr(e->d_name, ".tmp.") != NULL ||
+               strncmp(e->d_name, SPARE_PREFIX, strlen(SPARE_PREFIX)) == 0;
     bool later = sscanf(e->d_name, "frame_%ld.h5%n", &k, &used) == 1 &&
                  e->d_name[used] == '\0' && k >= n_keep;
     if (!tmp && !later) continue;

@@ -44,6 +44,17 @@ bool pm_run_wants(void *ctx, const pm_step_report *r, bool frame) {
   return frame || c->decided_sig || c->decided_ckpt;
 }
 
+/* The checkpoint of step; after a signal sig, a method that cannot write
+ * one is noted and the run stops all the same. */
+static pm_err checkpoint(pm_run_ctx *c, long step, int sig) {
+  pm_err e = pm_run_write_checkpoint(c, step);
+  if (e != PM_ERR_ARG || !sig) return e;
+  snprintf(c->ckpt_note, sizeof c->ckpt_note, "no checkpoint: %s",
+           pm_error_message());
+  pm_error_clear();
+  return PM_SUCCESS;
+}
+
 pm_err pm_run_observe(void *ctx, const pm_step_report *r, bool frame) {
   pm_run_ctx *c = ctx;
   decide(c, r);
@@ -56,6 +67,12 @@ pm_err pm_run_observe(void *ctx, const pm_step_report *r, bool frame) {
              r->step, r->residual);
     pm_progress_update(&c->progress, r->progress, status);
   }
+  /* A signal's frame off the schedule comes after the checkpoint: its
+   * history row would restart the figures a row gathers over its steps
+   * (the most iterations since the last row), which the checkpoint must
+   * hold as they were for the resumed run's next row. */
+  const bool extra = sig && !frame && c->results;
+  if (c->decided_ckpt && extra) PM_CALL(checkpoint(c, r->step, sig));
   if ((frame || sig) && c->results) {
     pm_timers_start(&c->out_timer, c->tm_output);
     pm_err e = pm_run_write_frame(c, r);
@@ -63,14 +80,7 @@ pm_err pm_run_observe(void *ctx, const pm_step_report *r, bool frame) {
     PM_CALL(e);
     c->extra_frame = !frame;
   }
-  if (c->decided_ckpt) {
-    pm_err e = pm_run_write_checkpoint(c, r->step);
-    if (e == PM_ERR_ARG && sig) /* the method cannot: say so, go on */
-      snprintf(c->ckpt_note, sizeof c->ckpt_note, "no checkpoint: %s",
-               pm_error_message());
-    else
-      PM_CALL(e);
-  }
+  if (c->decided_ckpt && !extra) PM_CALL(checkpoint(c, r->step, sig));
   if (!sig) return PM_SUCCESS;
   if (c->ckpt_step == r->step)
     return PM_ERROR(PM_ERR_INTERRUPTED,
