@@ -91,8 +91,16 @@ void gm_gmsh_nodes_free(gm_gmsh_nodes *nodes);
 /* Checks, before gmsh sees it (gmsh reports a missing file without
  * failing), that path is a regular file this process can read: PM_ERR_IO
  * otherwise, with "cannot open WHAT 'PATH': REASON" (what: "volume file",
- * "surface file"). */
+ * "surface file"); and a .geo by gm_geo_check. */
 pm_err gm_gmsh_check_file(const char *path, const char *what);
+
+/* A gmsh script (a path ending .geo; anything else passes) read as text
+ * before gmsh runs it: PM_ERR_MESH with its file and line when it calls a
+ * command that starts a program (SystemCall, NonBlockingSystemCall,
+ * OnelabRun, a solver's Executable option), or includes or merges a file
+ * not named by a plain string; the .geo files it includes or merges are
+ * checked the same way (gm_geo_check.c). */
+pm_err gm_geo_check(const char *path);
 
 /* Read a gmsh-readable file (.msh, .geo, .step/.stp, .brep) into out: checks
  * the file is a readable regular file (PM_ERR_IO naming it: gmsh reports a

@@ -306,7 +306,7 @@ pm_err gm_gmsh_check_file(const char *path, const char *what) {
   PM_CHECK(f, PM_ERR_IO, "cannot read %s '%s': %s", what, path,
            strerror(errno));
   fclose(f);
-  return PM_SUCCESS;
+  return gm_geo_check(path);
 }
 
 pm_err gm_gmsh_load(const char *path, int dim, double h, bool groups,

@@ -372,6 +372,29 @@ static void test_errors(void **state) {
                      "$Elements\n1\n1 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n",
                      path);
   expect_failure(path, 3, 0.1, PM_ERR_UNSUPPORTED, "Hexahedron");
+  /* gmsh scripts that would start a program are refused before gmsh runs
+   * them (each would create the file "ran"), also through an Include; a
+   * command's name in a comment or a string is not a call; an Include
+   * named by an expression cannot be followed. */
+  char ran[512];
+  snprintf(ran, sizeof ran, "%s/ran", (char *)*state);
+  pm_test_write_file(*state, "call.geo",
+                     "// SystemCall \"touch ran\";\nPrintf(\"OnelabRun\");\n"
+                     "SetFactory(\"OpenCASCADE\");\nSphere(1) = {0, 0, 0, 1};\n"
+                     "SystemCall \"touch ran\";\n",
+                     path);
+  expect_failure(path, 3, 0.5, PM_ERR_MESH,
+                 "call.geo:5: the gmsh script "
+                 "calls SystemCall");
+  pm_test_write_file(*state, "onelab.geo", "OnelabRun(\"x\", \"touch ran\");\n",
+                     path);
+  expect_failure(path, 3, 0.5, PM_ERR_MESH, "calls OnelabRun");
+  pm_test_write_file(*state, "outer.geo", "Include \"call.geo\";\n", path);
+  expect_failure(path, 3, 0.5, PM_ERR_MESH, "calls SystemCall");
+  pm_test_write_file(*state, "expr.geo",
+                     "Include StrCat(\"ca\", \"ll.geo\");\n", path);
+  expect_failure(path, 3, 0.5, PM_ERR_MESH, "not named by a plain string");
+  assert_int_equal(access(ran, F_OK), -1);
   /* Arguments. */
   expect_failure(path, 4, 0.1, PM_ERR_ARG, "2 or 3");
   expect_failure(path, 3, NAN, PM_ERR_ARG, "finite");
