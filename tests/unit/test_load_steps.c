@@ -95,6 +95,49 @@ static void test_load_steps_iterations(void **state) {
   chain_free(&ch);
 }
 
+/* A factorisation kept over Newton iterations (pc_reuse_its) and a load
+ * step large enough to leave it stale: GMRES on the kept LU cannot meet
+ * its tolerance within linear_max_iter.  Without pc_reuse_cost that linear
+ * failure fails Newton and cuts the step; with it the solve is made again
+ * on a new factorisation from the same iterate: no cut, and the state is
+ * the same to the tolerance. */
+static void test_load_steps_stale_factorisation(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 60, 2, 2);
+  ch.amp *= 2;
+  pm_newton_problem prob = chain_problem(&ch);
+  pm_load_report rep[2];
+  for (int cost = 0; cost < 2; cost++) {
+    pm_newton_options opt = pm_newton_options_default();
+    opt.load_steps = 1;
+    opt.rtol = 1e-9;
+    opt.predictor = true;
+    opt.pc_reuse_its = 2;
+    opt.linear_max_iter = 3;
+    opt.pc_reuse_cost = cost;
+    pm_err e = chain_load_steps(&ch, &prob, &opt, &rep[cost]);
+    print_message("pc_reuse_cost %d: %s, %d steps, %d cuts, %d Newton, %d "
+                  "linear iterations, %d set-ups\n",
+                  cost, e == PM_SUCCESS ? "completed" : pm_error_message(),
+                  rep[cost].steps, rep[cost].cuts, rep[cost].newton_iterations,
+                  rep[cost].linear_iterations, rep[cost].pc_setups);
+    if (cost == 0) {
+      /* the stale factorisation's failures cut the step (and here end
+       * the run) */
+      assert_true(e != PM_SUCCESS || rep[0].cuts >= 1);
+      pm_error_clear();
+      continue;
+    }
+    assert_ok(e);
+    assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+  }
+  assert_int_equal(rep[1].cuts, 0);
+  assert_int_equal(rep[1].steps, 1);
+  assert_true(rep[1].pc_setups >= 2);
+  chain_free(&ch);
+}
+
 /* A bar of saturating springs, T(s) = Tmax tanh(s / s0), fixed at one end
  * and pulled by lambda P = lambda 2.2 Tmax at the other, has no state beyond
  * lambda = 1/2.2: the stepping creeps up to it and gives up with a message
@@ -471,6 +514,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_load_steps_cut),
       cmocka_unit_test(test_load_steps_iterations),
+      cmocka_unit_test(test_load_steps_stale_factorisation),
       cmocka_unit_test(test_load_steps_impossible),
       cmocka_unit_test(test_relaxation_fallback),
       cmocka_unit_test(test_lowest_mode),

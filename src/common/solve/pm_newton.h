@@ -285,6 +285,15 @@ typedef struct {
    * one preconditioning GMRES (the direct solver too).  0: a new one at
    * every Jacobian (every pc_lag with a matrix-free operator). */
   int pc_reuse_its; /* 0 */
+  /* With pc_reuse_its: a linear solve on a kept one that has taken, beyond
+   * the iterations of the first solve the kept one served, pc_reuse_cost
+   * times what one set-up costs in iterations (the run's first set-up's
+   * CPU seconds over those of an iteration of the first solve it served,
+   * measured once and then kept, so that a resume decides as the first
+   * run did), or that fails, stops and is made again on a new one from
+   * the same iterate: no solve runs hundreds of iterations on a stale
+   * factorisation, and a stale one does not fail Newton.  0: off. */
+  double pc_reuse_cost; /* 1 */
   /* Algebraic multigrid (the gamg solvers): keep the hierarchy's
    * interpolation from one preconditioner set-up to the next, recomputing
    * only the coarse operators (PETSc's -pc_gamg_reuse_interpolation). */
@@ -544,6 +553,10 @@ typedef struct {
   long pc_built, pc_its, pc_failed;
   double pc_lambda;
   double *pc_x;
+  /* options.pc_reuse_cost: a set-up's cost in iterations (0: not measured
+   * yet) and the iterations of the first solve the kept one served (-1:
+   * none yet). */
+  long pc_budget, pc_first_its;
 } pm_load_state;
 
 /* Allocate a state's arrays for a problem of n unknowns, zeroed (lambda 0:

@@ -90,9 +90,12 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
   if (s->o.pc_reuse_its > 0) {
     /* a new preconditioner when the kept one has stopped paying; an
      * assembled Jacobian is the operator: its values are always new */
-    new_pc = !s->pc_built || s->lin_failed || s->lin_its > s->o.pc_reuse_its;
+    new_pc = !s->pc_built || s->lin_failed || s->lin_its > s->o.pc_reuse_its ||
+             s->pc_stale;
     rebuild = new_pc || s->o.op == PM_NEWTON_ASSEMBLED;
     if (new_pc) {
+      s->pc_pending = true;
+      s->pc_stale = false;
       s->pc_built = true;
       s->pc_load = s->load;
       PetscCall(VecCopy(X, s->Xpc));
@@ -238,11 +241,43 @@ PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
   if (!code) code = pm_newton_aug_factor(s);
   pm_blas_restore(blas);
   PetscCall(code);
+  s->iter_cpu0 = pm_cputime();
   if (s->rep) {
     s->rep->time_setup += pm_wtime() - s->linear_started;
-    s->rep->cpu_setup += pm_cputime() - s->linear_started_cpu;
+    s->rep->cpu_setup += s->iter_cpu0 - s->linear_started_cpu;
+  }
+  s->pc_fresh = s->pc_pending;
+  if (s->pc_pending) {
+    s->pc_pending = false;
+    s->pc_setup_cpu = s->iter_cpu0 - s->linear_started_cpu;
+    s->pc_first_its = -1;
   }
   return 0;
+}
+
+/* pc_reuse_cost: after a linear solve of its iterations on a new
+ * preconditioner, what they were; the first such solve of the run
+ * measures what a set-up costs in iterations (the most over the ranks:
+ * they decide together). */
+static void note_reuse(pm_newton *s, int its) {
+  if (s->o.pc_reuse_its <= 0 || s->o.pc_reuse_cost <= 0 || !s->pc_fresh) return;
+  s->pc_first_its = its;
+  if (s->pc_budget > 0 || its <= 0) return;
+  const double per_it = (pm_cputime() - s->iter_cpu0) / its;
+  double b = per_it > 0 ? ceil(s->o.pc_reuse_cost * s->pc_setup_cpu / per_it)
+                        : s->o.linear_max_iter;
+  if (s->dist) {
+    double any = b;
+    MPI_Allreduce(&b, &any, 1, MPI_DOUBLE, MPI_MAX, s->comm);
+    b = any;
+  }
+  s->pc_budget = (int)fmin(fmax(b, 1), s->o.linear_max_iter);
+}
+
+bool pm_newton_pc_spent(const pm_newton *s, int it) {
+  return s->o.pc_reuse_its > 0 && s->o.pc_reuse_cost > 0 && !s->pc_fresh &&
+         s->pc_budget > 0 && s->pc_first_its >= 0 &&
+         it - s->pc_first_its > s->pc_budget;
 }
 
 PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx) {
@@ -261,5 +296,13 @@ PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx) {
   PetscCall(KSPGetConvergedReason(ksp, &why));
   s->lin_its = (int)its;
   s->lin_failed = why < 0;
+  /* A kept preconditioner the solve failed on (its iteration limit, a
+   * breakdown) is spent too: the solve is made again on a new one rather
+   * than failing Newton (and cutting a load step) for a stale one. */
+  if (why < 0 && why != KSP_DIVERGED_PC_FAILED && !s->pc_fresh &&
+      s->o.pc_reuse_its > 0 && s->o.pc_reuse_cost > 0 &&
+      !pm_newton_stop_signal(s))
+    s->pc_stale = true;
+  if (!s->pc_stale) note_reuse(s, (int)its);
   return 0;
 }

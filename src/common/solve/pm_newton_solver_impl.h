@@ -73,6 +73,20 @@ struct pm_newton {
   /* pc_reuse_its: a preconditioner was built, and the last linear
    * solve's iterations and whether it failed. */
   bool pc_built, lin_failed;
+  /* pc_reuse_cost: a set-up waits for the next linear solve (pending),
+   * which is then the kept one's first (fresh); the last solve was
+   * stopped because the kept one no longer pays (stale); a set-up's cost
+   * in iterations (budget, 0: not measured yet) and the CPU seconds of
+   * the one that measures it; the iterations of the kept one's first
+   * solve (-1: none yet); the CPU seconds at the current solve's first
+   * iteration. */
+  bool pc_pending, pc_fresh, pc_stale;
+  int pc_budget, pc_first_its;
+  double pc_setup_cpu, iter_cpu0;
+  /* A solve made again from its last iterate after a stopped linear
+   * solve: the Newton and linear iterations before (it_base indexes the
+   * report's arrays). */
+  int it_base, lin_base;
   /* linear_ew: |r| at the last linear solve of this Newton solve (0:
    * none yet) and the tolerance it was given. */
   double ew_rprev, ew_eta;
@@ -164,6 +178,10 @@ PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
                                   PetscBool *changed, void *ctx);
 PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx);
 PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx);
+/* pc_reuse_cost: the kept preconditioner, at iteration it of a solve it
+ * did not start fresh, has cost more than a set-up (the solve is to stop
+ * and be made again on a new one). */
+bool pm_newton_pc_spent(const pm_newton *s, int it);
 
 /* ---- pm_newton_augmented.c: pm_newton_problem.aux_n ---- */
 
