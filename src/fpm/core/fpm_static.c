@@ -158,9 +158,10 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   no.relax_after = (int)s->time.qs_relax_after;
   no.ptc_max_iter = (int)s->time.qs_ptc;
   no.easy_iterations = 3;
-  /* ...and grow past 1/load_steps up to max_load_step: the largest step
-   * that converges (docs/validation.md, "Static solves: big steps, cheap
-   * cuts"). */
+  /* ...and, with max_load_step, grow past 1/load_steps up to it (not by
+   * default: larger steps cost fewer Newton iterations but more CPU, the
+   * kept factorisation going stale sooner; docs/validation.md, "Static
+   * solves: big steps, cheap cuts"). */
   no.max_dlambda = s->time.qs_max_step;
   no.petsc_options = s->time.qs_solver_options;
   /* SIPG, the stiffening and the volume penalty: the assembled tangent
