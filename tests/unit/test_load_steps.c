@@ -69,18 +69,29 @@ static void test_load_steps_cut(void **state) {
  * starts from the tangent predictor (the linear response to the load
  * increment), which leaves Newton only the nonlinear remainder: no cut
  * and fewer iterations. */
+/* The chain pulled twice as far as its default, and the options of one
+ * load step to 1e-9. */
+static pm_newton_problem far_chain(chain *ch) {
+  chain_init(ch, 60, 2, 2);
+  ch->amp *= 2;
+  return chain_problem(ch);
+}
+
+static pm_newton_options one_step(void) {
+  pm_newton_options opt = pm_newton_options_default();
+  opt.load_steps = 1;
+  opt.rtol = 1e-9;
+  return opt;
+}
+
 static void test_load_steps_iterations(void **state) {
   (void)state;
   chain ch;
-  chain_init(&ch, 60, 2, 2);
-  ch.amp *= 2;
-  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_problem prob = far_chain(&ch);
   int iterations[2];
   for (int predictor = 0; predictor < 2; predictor++) {
-    pm_newton_options opt = pm_newton_options_default();
-    opt.load_steps = 1;
+    pm_newton_options opt = one_step();
     opt.max_iter = 4;
-    opt.rtol = 1e-9;
     opt.predictor = predictor;
     pm_load_report rep;
     assert_ok(chain_load_steps(&ch, &prob, &opt, &rep));
@@ -104,14 +115,10 @@ static void test_load_steps_iterations(void **state) {
 static void test_load_steps_stale_factorisation(void **state) {
   (void)state;
   chain ch;
-  chain_init(&ch, 60, 2, 2);
-  ch.amp *= 2;
-  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_problem prob = far_chain(&ch);
   pm_load_report rep[2];
   for (int cost = 0; cost < 2; cost++) {
-    pm_newton_options opt = pm_newton_options_default();
-    opt.load_steps = 1;
-    opt.rtol = 1e-9;
+    pm_newton_options opt = one_step();
     opt.predictor = true;
     opt.pc_reuse_its = 2;
     opt.linear_max_iter = 3;

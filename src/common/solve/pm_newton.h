@@ -285,14 +285,11 @@ typedef struct {
    * one preconditioning GMRES (the direct solver too).  0: a new one at
    * every Jacobian (every pc_lag with a matrix-free operator). */
   int pc_reuse_its; /* 0 */
-  /* With pc_reuse_its: a linear solve on a kept one that has taken, beyond
-   * the iterations of the first solve the kept one served, pc_reuse_cost
-   * times what one set-up costs in iterations (the run's first set-up's
-   * CPU seconds over those of an iteration of the first solve it served,
-   * measured once and then kept, so that a resume decides as the first
-   * run did), or that fails, stops and is made again on a new one from
-   * the same iterate: no solve runs hundreds of iterations on a stale
-   * factorisation, and a stale one does not fail Newton.  0: off. */
+  /* With pc_reuse_its: a linear solve on a kept one that fails, or takes
+   * more iterations than the kept one's first solve by pc_reuse_cost times
+   * a set-up's cost in iterations (the run's first set-up's CPU over an
+   * iteration's of its first solve, measured once and kept: a resume
+   * decides alike), is made again on a new one.  0: off. */
   double pc_reuse_cost; /* 1 */
   /* Algebraic multigrid (the gamg solvers): keep the hierarchy's
    * interpolation from one preconditioner set-up to the next, recomputing
@@ -553,9 +550,8 @@ typedef struct {
   long pc_built, pc_its, pc_failed;
   double pc_lambda;
   double *pc_x;
-  /* options.pc_reuse_cost: a set-up's cost in iterations (0: not measured
-   * yet) and the iterations of the first solve the kept one served (-1:
-   * none yet). */
+  /* pc_reuse_cost: a set-up's cost in iterations (0: not measured), the
+   * kept one's first solve's iterations (-1: none) */
   long pc_budget, pc_first_its;
 } pm_load_state;
 
