@@ -81,6 +81,11 @@ void fpm_static_choose_linear(const pm_scene *s, long unknowns,
   if (!pm_scene_has(s, "time.quasi_static.inexact")) o->linear_ew = true;
   if (!pm_scene_has(s, "time.quasi_static.reuse_iterations"))
     o->pc_reuse_its = FPM_STATIC_AMG_REUSE;
+  /* A new hierarchy's solves take tens of iterations, varying with inexact
+   * Newton's tolerance, and a set-up costs a few: stopping a solve for a
+   * new one cost 1.8 times the CPU at 4036 points (docs/validation.md,
+   * "Static solves: big steps, cheap cuts"). */
+  o->pc_reuse_cost = 0;
 }
 
 pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
