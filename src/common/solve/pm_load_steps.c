@@ -447,7 +447,6 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
       PM_CALL(pm_ckpt_long(ck, NAME("pc_failed"), &st->pc_failed));
       PM_CALL(pm_ckpt_double(ck, NAME("pc_lambda"), &st->pc_lambda));
       PM_CALL(pm_ckpt_doubles(ck, NAME("pc_x"), n, st->pc_x));
-      PM_CALL(pm_ckpt_long(ck, NAME("pc_budget"), &st->pc_budget));
       PM_CALL(pm_ckpt_long(ck, NAME("pc_first_its"), &st->pc_first_its));
     }
   }

@@ -25,7 +25,7 @@ pm_newton_options pm_newton_options_default(void) {
                              .linear_max_iter = 1000,
                              .op = PM_NEWTON_ASSEMBLED,
                              .pc_lag = 1,
-                             .pc_reuse_cost = 1,
+                             .pc_reuse_cost = 4,
                              .coloring = PM_COLORING_LARGEST_FIRST,
                              .line_search = PM_LINE_SEARCH_BT,
                              .load_steps = 10,
@@ -334,7 +334,7 @@ pm_err pm_newton_pc_rebuild(pm_newton *s, const pm_load_state *st) {
   s->lin_its = (int)st->pc_its;
   s->lin_failed = st->pc_failed != 0;
   s->pc_pending = false; /* set up above: not timed as the run's first */
-  s->pc_budget = (int)st->pc_budget;
+  s->pc_budget = pm_newton_pc_budget(s);
   s->pc_first_its = (int)st->pc_first_its;
 done:
   return ret;

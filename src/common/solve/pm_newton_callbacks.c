@@ -4,6 +4,7 @@
  * timing. */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <petscsnes.h>
 
@@ -241,37 +242,31 @@ PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
   if (!code) code = pm_newton_aug_factor(s);
   pm_blas_restore(blas);
   PetscCall(code);
-  s->iter_cpu0 = pm_cputime();
   if (s->rep) {
     s->rep->time_setup += pm_wtime() - s->linear_started;
-    s->rep->cpu_setup += s->iter_cpu0 - s->linear_started_cpu;
+    s->rep->cpu_setup += pm_cputime() - s->linear_started_cpu;
   }
   s->pc_fresh = s->pc_pending;
   if (s->pc_pending) {
     s->pc_pending = false;
-    s->pc_setup_cpu = s->iter_cpu0 - s->linear_started_cpu;
     s->pc_first_its = -1;
+    s->pc_budget = pm_newton_pc_budget(s);
   }
   return 0;
 }
 
-/* pc_reuse_cost: after a linear solve of its iterations on a new
- * preconditioner, what they were; the first such solve of the run
- * measures what a set-up costs in iterations (the most over the ranks:
- * they decide together). */
+int pm_newton_pc_budget(const pm_newton *s) {
+  /* An iteration count, the same on every rank and in every run (a timed
+   * cost would let two runs of one scene decide differently). */
+  if (s->o.pc_reuse_its <= 0 || s->o.pc_reuse_cost <= 0) return 0;
+  return (int)fmin(ceil(s->o.pc_reuse_cost * s->o.pc_reuse_its),
+                   s->o.linear_max_iter);
+}
+
+/* pc_reuse_cost: the iterations of the first linear solve on a new
+ * preconditioner. */
 static void note_reuse(pm_newton *s, int its) {
-  if (s->o.pc_reuse_its <= 0 || s->o.pc_reuse_cost <= 0 || !s->pc_fresh) return;
-  s->pc_first_its = its;
-  if (s->pc_budget > 0 || its <= 0) return;
-  const double per_it = (pm_cputime() - s->iter_cpu0) / its;
-  double b = per_it > 0 ? ceil(s->o.pc_reuse_cost * s->pc_setup_cpu / per_it)
-                        : s->o.linear_max_iter;
-  if (s->dist) {
-    double any = b;
-    MPI_Allreduce(&b, &any, 1, MPI_DOUBLE, MPI_MAX, s->comm);
-    b = any;
-  }
-  s->pc_budget = (int)fmin(fmax(b, 1), s->o.linear_max_iter);
+  if (s->pc_fresh) s->pc_first_its = its;
 }
 
 bool pm_newton_pc_spent(const pm_newton *s, int it) {

@@ -53,7 +53,7 @@ pm_err pm_newton_pc_save(const pm_newton *s, pm_load_state *st);
 /* A resume's: the factorisation or preconditioner built at st->pc_x
  * (owned values, under the load set), as if the last linear solve it
  * served took st->pc_its iterations and failed or not, with the reuse
- * figures of st (pc_budget, pc_first_its): what the first run
+ * figure of st (pc_first_its): what the first run
  * kept, made again from the same values (collective across ranks).  A
  * callback's failure or PETSc's is returned. */
 pm_err pm_newton_pc_rebuild(pm_newton *s, const pm_load_state *st);

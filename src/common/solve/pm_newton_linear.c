@@ -235,7 +235,6 @@ pm_err pm_newton_pc_save(const pm_newton *s, pm_load_state *st) {
   st->pc_its = s->lin_its;
   st->pc_failed = s->lin_failed;
   st->pc_lambda = s->pc_load;
-  st->pc_budget = s->pc_budget;
   st->pc_first_its = s->pc_first_its;
   if (!s->pc_built) return PM_SUCCESS;
   return pm_newton_copy_out(s->Xpc, st->pc_x, s->p.n);

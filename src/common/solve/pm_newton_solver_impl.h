@@ -75,14 +75,11 @@ struct pm_newton {
   bool pc_built, lin_failed;
   /* pc_reuse_cost: a set-up waits for the next linear solve (pending),
    * which is then the kept one's first (fresh); the last solve was
-   * stopped because the kept one no longer pays (stale); a set-up's cost
-   * in iterations (budget, 0: not measured yet) and the CPU seconds of
-   * the one that measures it; the iterations of the kept one's first
-   * solve (-1: none yet); the CPU seconds at the current solve's first
-   * iteration. */
+   * stopped because the kept one no longer pays (stale); the kept one's
+   * set-up cost in iterations (budget, 0: unknown, no stop) and the
+   * iterations of its first solve (-1: none yet). */
   bool pc_pending, pc_fresh, pc_stale;
   int pc_budget, pc_first_its;
-  double pc_setup_cpu, iter_cpu0;
   /* A solve made again from its last iterate after a stopped linear
    * solve: the Newton and linear iterations before (it_base indexes the
    * report's arrays). */
@@ -182,6 +179,9 @@ PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx);
  * did not start fresh, has cost more than a set-up (the solve is to stop
  * and be made again on a new one). */
 bool pm_newton_pc_spent(const pm_newton *s, int it);
+/* pc_reuse_cost: the iterations a solve on a kept preconditioner may take
+ * beyond its first solve's (0: no stop). */
+int pm_newton_pc_budget(const pm_newton *s);
 
 /* ---- pm_newton_augmented.c: pm_newton_problem.aux_n ---- */
 
