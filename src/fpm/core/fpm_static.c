@@ -62,9 +62,9 @@ void fpm_static_choose_linear(const pm_scene *s, long unknowns,
                   : fpm_static_default_linear(unknowns);
   o->pc_reuse_its = (int)s->time.qs_reuse;
   o->linear_ew = s->time.qs_inexact;
-  /* The stop of a solve on a stale factorisation is decided by a timed
-   * cost: runs then agree to Newton's tolerance, as inexact ones do; exact
-   * solves (inexact: false) promise round-off, so they go without it. */
+  /* The stop of a solve on a stale factorisation is decided by iteration
+   * counts, which round-off across ranks can move by one: exact solves
+   * (inexact: false) promise round-off agreement, so they go without it. */
   if (!o->linear_ew) o->pc_reuse_cost = 0;
   if (o->linear != PM_NEWTON_GMRES_GAMG && o->linear != PM_NEWTON_CG_GAMG)
     return;
