@@ -333,7 +333,7 @@ pm_err pm_newton_pc_rebuild(pm_newton *s, const pm_load_state *st) {
   }
   s->lin_its = (int)st->pc_its;
   s->lin_failed = st->pc_failed != 0;
-  s->pc_pending = false; /* set up above: not timed as the run's first */
+  s->pc_pending = false; /* set up above; the next solve is not its first */
   s->pc_budget = pm_newton_pc_budget(s);
   s->pc_first_its = (int)st->pc_first_its;
 done:
