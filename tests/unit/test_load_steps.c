@@ -69,18 +69,29 @@ static void test_load_steps_cut(void **state) {
  * starts from the tangent predictor (the linear response to the load
  * increment), which leaves Newton only the nonlinear remainder: no cut
  * and fewer iterations. */
+/* The chain pulled twice as far as its default, and the options of one
+ * load step to 1e-9. */
+static pm_newton_problem far_chain(chain *ch) {
+  chain_init(ch, 60, 2, 2);
+  ch->amp *= 2;
+  return chain_problem(ch);
+}
+
+static pm_newton_options one_step(void) {
+  pm_newton_options opt = pm_newton_options_default();
+  opt.load_steps = 1;
+  opt.rtol = 1e-9;
+  return opt;
+}
+
 static void test_load_steps_iterations(void **state) {
   (void)state;
   chain ch;
-  chain_init(&ch, 60, 2, 2);
-  ch.amp *= 2;
-  pm_newton_problem prob = chain_problem(&ch);
+  pm_newton_problem prob = far_chain(&ch);
   int iterations[2];
   for (int predictor = 0; predictor < 2; predictor++) {
-    pm_newton_options opt = pm_newton_options_default();
-    opt.load_steps = 1;
+    pm_newton_options opt = one_step();
     opt.max_iter = 4;
-    opt.rtol = 1e-9;
     opt.predictor = predictor;
     pm_load_report rep;
     assert_ok(chain_load_steps(&ch, &prob, &opt, &rep));
@@ -92,6 +103,45 @@ static void test_load_steps_iterations(void **state) {
     iterations[predictor] = rep.newton_iterations;
   }
   assert_true(iterations[1] < iterations[0]);
+  chain_free(&ch);
+}
+
+/* A factorisation kept over Newton iterations (pc_reuse_its) and a load
+ * step large enough to leave it stale: GMRES on the kept LU cannot meet
+ * its tolerance within linear_max_iter.  Without pc_reuse_cost that linear
+ * failure fails Newton and cuts the step; with it the solve is made again
+ * on a new factorisation from the same iterate: no cut, and the state is
+ * the same to the tolerance. */
+static void test_load_steps_stale_factorisation(void **state) {
+  (void)state;
+  chain ch;
+  pm_newton_problem prob = far_chain(&ch);
+  pm_load_report rep[2];
+  for (int cost = 0; cost < 2; cost++) {
+    pm_newton_options opt = one_step();
+    opt.predictor = true;
+    opt.pc_reuse_its = 2;
+    opt.linear_max_iter = 3;
+    opt.pc_reuse_cost = cost;
+    pm_err e = chain_load_steps(&ch, &prob, &opt, &rep[cost]);
+    print_message("pc_reuse_cost %d: %s, %d steps, %d cuts, %d Newton, %d "
+                  "linear iterations, %d set-ups\n",
+                  cost, e == PM_SUCCESS ? "completed" : pm_error_message(),
+                  rep[cost].steps, rep[cost].cuts, rep[cost].newton_iterations,
+                  rep[cost].linear_iterations, rep[cost].pc_setups);
+    if (cost == 0) {
+      /* the stale factorisation's failures cut the step (and here end
+       * the run) */
+      assert_true(e != PM_SUCCESS || rep[0].cuts >= 1);
+      pm_error_clear();
+      continue;
+    }
+    assert_ok(e);
+    assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+  }
+  assert_int_equal(rep[1].cuts, 0);
+  assert_int_equal(rep[1].steps, 1);
+  assert_true(rep[1].pc_setups >= 2);
   chain_free(&ch);
 }
 
@@ -471,6 +521,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_load_steps_cut),
       cmocka_unit_test(test_load_steps_iterations),
+      cmocka_unit_test(test_load_steps_stale_factorisation),
       cmocka_unit_test(test_load_steps_impossible),
       cmocka_unit_test(test_relaxation_fallback),
       cmocka_unit_test(test_lowest_mode),

@@ -308,6 +308,7 @@ typedef struct pm_scene {
     double qs_tolerance;    /* time.quasi_static.tolerance: relative residual */
     double qs_damping;      /* time.quasi_static.damping: 1/s for damping */
     long qs_load_steps;     /* time.quasi_static.load_steps (static) */
+    double qs_max_step;     /* ...max_load_step (FPM static), in [0, 1] */
     long qs_max_iterations; /* ...max_iterations per load step */
     long qs_relax_after;    /* ...relax_after: cuts before relaxation */
     long qs_ptc;            /* ...pseudo_transient: continuation iterations */

@@ -717,6 +717,20 @@ static const pm_key quasi_static_keys[] = {
      .unit = "",
      .doc = "method static: load steps along the scene's ramps (a step that "
             "fails is halved and retried)"},
+    {.name = "max_load_step",
+     .type = PM_KEY_NUMBER,
+     .offset = S(time.qs_max_step),
+     .def = "0",
+     .range = PM_RANGE_GE | PM_RANGE_LE,
+     .lo = 0,
+     .hi = 1,
+     .unit = "",
+     .doc = "method static (FPM): the largest load step, a fraction of the "
+            "load: after a step Newton finished in at most 3 iterations "
+            "the next grows by half, up to this (1: the largest step that "
+            "converges); 0: steps of 1/load_steps, grown back to it after "
+            "cuts (fewer Newton iterations with growth, but more CPU: the "
+            "kept factorisation goes stale sooner)"},
     {.name = "relax_after",
      .type = PM_KEY_INTEGER,
      .offset = S(time.qs_relax_after),

@@ -298,8 +298,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
   if (resumed && st->pc_built) {
     /* The factorisation the first run kept, made again where it was. */
     PM_TRY(set_load(s, st->pc_lambda));
-    PM_TRY(
-        pm_newton_pc_rebuild(s, st->pc_x, (int)st->pc_its, st->pc_failed != 0));
+    PM_TRY(pm_newton_pc_rebuild(s, st));
   }
   int cuts = 0;
   while (st->lambda < 1) {
@@ -448,6 +447,7 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
       PM_CALL(pm_ckpt_long(ck, NAME("pc_failed"), &st->pc_failed));
       PM_CALL(pm_ckpt_double(ck, NAME("pc_lambda"), &st->pc_lambda));
       PM_CALL(pm_ckpt_doubles(ck, NAME("pc_x"), n, st->pc_x));
+      PM_CALL(pm_ckpt_long(ck, NAME("pc_first_its"), &st->pc_first_its));
     }
   }
   long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,

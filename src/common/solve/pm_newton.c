@@ -25,6 +25,7 @@ pm_newton_options pm_newton_options_default(void) {
                              .linear_max_iter = 1000,
                              .op = PM_NEWTON_ASSEMBLED,
                              .pc_lag = 1,
+                             .pc_reuse_cost = 4,
                              .coloring = PM_COLORING_LARGEST_FIRST,
                              .line_search = PM_LINE_SEARCH_BT,
                              .load_steps = 10,
@@ -163,19 +164,32 @@ pm_err pm_newton_solve_from(pm_newton *s, double *x, const double *x_start,
   s->jacobians = 0;
   s->in_linear = false;
   s->started = false;
+  s->pc_stale = false;
+  s->it_base = s->lin_base = 0;
   PM_TRY(pm_newton_copy_in(s->X, x, n));
   PM_TRY(pm_newton_copy_in(s->Xstart, x_start, n));
   PM_PETSC(VecCopy(s->X, s->Xacc));
-  /* Objects PETSc creates inside the solve (the factor matrix, multigrid
-   * levels) read the default options database: this solver's, for now. */
-  PM_PETSC(PetscOptionsPush(s->opts));
-  PetscErrorCode code = SNESSolve(s->snes, NULL, s->X);
-  PetscOptionsPop();
+  PetscErrorCode code;
   PetscInt its = 0, lits = 0;
-  SNESGetIterationNumber(s->snes, &its);
-  SNESGetLinearSolveIterations(s->snes, &lits);
-  rep->iterations = (int)its;
-  rep->linear_iterations = (int)lits;
+  for (;;) {
+    /* Objects PETSc creates inside the solve (the factor matrix, multigrid
+     * levels) read the default options database: this solver's, for now. */
+    PM_PETSC(PetscOptionsPush(s->opts));
+    code = SNESSolve(s->snes, NULL, s->X);
+    PetscOptionsPop();
+    SNESGetIterationNumber(s->snes, &its);
+    SNESGetLinearSolveIterations(s->snes, &lits);
+    if (code || !s->pc_stale || s->hard != PM_SUCCESS) break;
+    /* A linear solve stopped because the kept preconditioner cost more
+     * than a new one: Newton goes on from its last iterate (the residual
+     * reference kept) with a new one, the iterations counted on. */
+    s->it_base += (int)its;
+    s->lin_base += (int)lits + s->lin_its;
+    s->r_ref = s->r0;
+    PM_PETSC(VecCopy(s->Xacc, s->X));
+  }
+  rep->iterations = s->it_base + (int)its;
+  rep->linear_iterations = s->lin_base + (int)lits;
   if (s->hard != PM_SUCCESS) {
     ret = pm_error_trace(s->hard, __FILE__, __LINE__, __func__,
                          "a callback of the Newton solve");
@@ -246,12 +260,18 @@ pm_err pm_newton_tangent_solve(pm_newton *s, const double *x, const double *b,
   PetscErrorCode code;
   s->rep = rep;
   PM_TRY(pm_newton_copy_in(s->Work, b, n));
-  PM_TRY(linearise_at(s, x, &code));
-  if (!code) {
-    code = KSPSolve(s->ksp, s->Work, s->R); /* (its presolve times it) */
-    if (s->in_linear) pm_newton_linear_postsolve(s->ksp, s->Work, s->R, s);
+  s->pc_stale = false;
+  for (int pass = 0; pass < 2; pass++) {
+    /* (a second pass on a new preconditioner when the kept one was
+     * spent) */
+    PM_TRY(linearise_at(s, x, &code));
+    if (!code) {
+      code = KSPSolve(s->ksp, s->Work, s->R); /* (its presolve times it) */
+      if (s->in_linear) pm_newton_linear_postsolve(s->ksp, s->Work, s->R, s);
+    }
+    PetscOptionsPop();
+    if (code || !s->pc_stale || s->hard != PM_SUCCESS) break;
   }
-  PetscOptionsPop();
   if (s->hard != PM_SUCCESS) {
     ret = pm_error_trace(s->hard, __FILE__, __LINE__, __func__,
                          "the tangent of a load step's predictor");
@@ -285,15 +305,14 @@ pm_err pm_newton_solve(pm_newton *s, double *x, pm_newton_report *report) {
   return pm_newton_solve_from(s, x, x, 0, report ? report : &local);
 }
 
-pm_err pm_newton_pc_rebuild(pm_newton *s, const double *x, int its,
-                            bool failed) {
+pm_err pm_newton_pc_rebuild(pm_newton *s, const pm_load_state *st) {
   pm_err ret = PM_SUCCESS;
   PetscErrorCode code;
   s->rep = NULL;
   s->pc_built = false; /* the Jacobian below builds a new one */
   /* as in a solve: the Jacobian's values at x, then the linear solver's
    * set-up (the factorisation of B, or of the augmented matrix) */
-  PM_TRY(linearise_at(s, x, &code));
+  PM_TRY(linearise_at(s, st->pc_x, &code));
   const int blas = pm_blas_widen();
   if (!code) code = KSPSetUp(s->ksp);
   if (!code) code = KSPSetUpOnBlocks(s->ksp);
@@ -312,8 +331,11 @@ pm_err pm_newton_pc_rebuild(pm_newton *s, const double *x, int its,
                    pm_petsc_last_message(&cause));
     goto done;
   }
-  s->lin_its = its;
-  s->lin_failed = failed;
+  s->lin_its = (int)st->pc_its;
+  s->lin_failed = st->pc_failed != 0;
+  s->pc_pending = false; /* set up above; the next solve is not its first */
+  s->pc_budget = pm_newton_pc_budget(s);
+  s->pc_first_its = (int)st->pc_first_its;
 done:
   return ret;
 }

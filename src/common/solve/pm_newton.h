@@ -285,6 +285,11 @@ typedef struct {
    * one preconditioning GMRES (the direct solver too).  0: a new one at
    * every Jacobian (every pc_lag with a matrix-free operator). */
   int pc_reuse_its; /* 0 */
+  /* With pc_reuse_its: a linear solve on a kept one that fails, or takes
+   * more iterations than the kept one's first solve by pc_reuse_cost times
+   * pc_reuse_its (about what a new LU costs in iterations where FPM keeps
+   * one: 17-60), is made again on a new one.  0: off. */
+  double pc_reuse_cost; /* 4 */
   /* Algebraic multigrid (the gamg solvers): keep the hierarchy's
    * interpolation from one preconditioner set-up to the next, recomputing
    * only the coarse operators (PETSc's -pc_gamg_reuse_interpolation). */
@@ -544,6 +549,7 @@ typedef struct {
   long pc_built, pc_its, pc_failed;
   double pc_lambda;
   double *pc_x;
+  long pc_first_its; /* pc_reuse_cost: the kept one's first solve's its */
 } pm_load_state;
 
 /* Allocate a state's arrays for a problem of n unknowns, zeroed (lambda 0:

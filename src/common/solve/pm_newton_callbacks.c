@@ -4,6 +4,7 @@
  * timing. */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <petscsnes.h>
 
@@ -90,9 +91,12 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
   if (s->o.pc_reuse_its > 0) {
     /* a new preconditioner when the kept one has stopped paying; an
      * assembled Jacobian is the operator: its values are always new */
-    new_pc = !s->pc_built || s->lin_failed || s->lin_its > s->o.pc_reuse_its;
+    new_pc = !s->pc_built || s->lin_failed || s->lin_its > s->o.pc_reuse_its ||
+             s->pc_stale;
     rebuild = new_pc || s->o.op == PM_NEWTON_ASSEMBLED;
     if (new_pc) {
+      s->pc_pending = true;
+      s->pc_stale = false;
       s->pc_built = true;
       s->pc_load = s->load;
       PetscCall(VecCopy(X, s->Xpc));
@@ -242,7 +246,33 @@ PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
     s->rep->time_setup += pm_wtime() - s->linear_started;
     s->rep->cpu_setup += pm_cputime() - s->linear_started_cpu;
   }
+  s->pc_fresh = s->pc_pending;
+  if (s->pc_pending) {
+    s->pc_pending = false;
+    s->pc_first_its = -1;
+    s->pc_budget = pm_newton_pc_budget(s);
+  }
   return 0;
+}
+
+int pm_newton_pc_budget(const pm_newton *s) {
+  /* An iteration count, the same on every rank and in every run (a timed
+   * cost would let two runs of one scene decide differently). */
+  if (s->o.pc_reuse_its <= 0 || s->o.pc_reuse_cost <= 0) return 0;
+  return (int)fmin(ceil(s->o.pc_reuse_cost * s->o.pc_reuse_its),
+                   s->o.linear_max_iter);
+}
+
+/* pc_reuse_cost: the iterations of the first linear solve on a new
+ * preconditioner. */
+static void note_reuse(pm_newton *s, int its) {
+  if (s->pc_fresh) s->pc_first_its = its;
+}
+
+bool pm_newton_pc_spent(const pm_newton *s, int it) {
+  return s->o.pc_reuse_its > 0 && s->o.pc_reuse_cost > 0 && !s->pc_fresh &&
+         s->pc_budget > 0 && s->pc_first_its >= 0 &&
+         it - s->pc_first_its > s->pc_budget;
 }
 
 PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx) {
@@ -261,5 +291,13 @@ PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx) {
   PetscCall(KSPGetConvergedReason(ksp, &why));
   s->lin_its = (int)its;
   s->lin_failed = why < 0;
+  /* A kept preconditioner the solve failed on (its iteration limit, a
+   * breakdown) is spent too: the solve is made again on a new one rather
+   * than failing Newton (and cutting a load step) for a stale one. */
+  if (why < 0 && why != KSP_DIVERGED_PC_FAILED && !s->pc_fresh &&
+      s->o.pc_reuse_its > 0 && s->o.pc_reuse_cost > 0 &&
+      !pm_newton_stop_signal(s))
+    s->pc_stale = true;
+  if (!s->pc_stale) note_reuse(s, (int)its);
   return 0;
 }

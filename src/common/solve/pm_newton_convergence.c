@@ -21,6 +21,9 @@ PetscErrorCode pm_newton_converged_test(SNES snes, PetscInt it, PetscReal xnorm,
   (void)snorm;
   PetscFunctionBeginUser;
   *reason = SNES_CONVERGED_ITERATING;
+  const PetscInt it_snes = it;
+  /* (a solve made again from its last iterate counts on) */
+  it += s->it_base;
   if (it <= PM_NEWTON_MAX_ITER) rep->residual_norm[it] = fnorm;
   if (!isfinite(fnorm)) {
     s->reason = PM_NEWTON_DIVERGED_NAN;
@@ -29,7 +32,7 @@ PetscErrorCode pm_newton_converged_test(SNES snes, PetscInt it, PetscReal xnorm,
   }
   PetscCall(SNESGetSolution(snes, &X));
   PetscCall(VecCopy(X, s->Xacc));
-  if (it == 0) {
+  if (it_snes == 0) {
     s->started = true;
     s->r0 = fmax(fnorm, s->r_ref);
     if (fnorm <= o->atol || fnorm == 0) {

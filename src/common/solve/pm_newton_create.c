@@ -47,6 +47,8 @@ static pm_err check_options(const pm_newton_options *o) {
            "gmres_restart must be >= 0 (got %d)", o->gmres_restart);
   PM_CHECK(o->pc_reuse_its >= 0, PM_ERR_ARG,
            "pc_reuse_its must be >= 0 (got %d)", o->pc_reuse_its);
+  PM_CHECK(o->pc_reuse_cost >= 0, PM_ERR_ARG,
+           "pc_reuse_cost must be >= 0 (got %g)", o->pc_reuse_cost);
   PM_CHECK(o->pc_lag >= 1, PM_ERR_ARG, "pc_lag must be >= 1 (got %d)",
            o->pc_lag);
   PM_CHECK(o->load_steps >= 1, PM_ERR_ARG, "load_steps must be >= 1 (got %d)",
@@ -191,6 +193,7 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
   PM_TRY(PM_ALLOC(s, 1, "Newton solver"));
   s->p = *problem;
   s->o = *options;
+  s->pc_first_its = -1;
   s->p.pat_ptr = s->p.pat_idx = s->p.pc_pat_ptr = s->p.pc_pat_idx = NULL;
   s->dist = problem->shared && pm_par_active();
   s->comm = s->dist ? PETSC_COMM_WORLD : PETSC_COMM_SELF;

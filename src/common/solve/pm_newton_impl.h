@@ -50,13 +50,13 @@ void pm_newton_note_load(pm_newton *s, double lambda);
  * has the n owned values).  PETSc's failures as PM_ERR_LINALG. */
 pm_err pm_newton_pc_save(const pm_newton *s, pm_load_state *st);
 
-/* A resume's: the factorisation or preconditioner built at the owned
- * values x (under the load set), as if the last linear solve it served
- * took its iterations and failed or not: what the first run kept, made
- * again from the same values (collective across ranks).  A callback's
- * failure or PETSc's is returned. */
-pm_err pm_newton_pc_rebuild(pm_newton *s, const double *x, int its,
-                            bool failed);
+/* A resume's: the factorisation or preconditioner built at st->pc_x
+ * (owned values, under the load set), as if the last linear solve it
+ * served took st->pc_its iterations and failed or not, with the reuse
+ * figure of st (pc_first_its): what the first run
+ * kept, made again from the same values (collective across ranks).  A
+ * callback's failure or PETSc's is returned. */
+pm_err pm_newton_pc_rebuild(pm_newton *s, const pm_load_state *st);
 
 /* r = the residual at x (both of the n owned values): the problem's
  * callback, through the held values of a shared problem (collective then,

@@ -69,6 +69,12 @@ static PetscErrorCode linear_test(KSP ksp, PetscInt it, PetscReal rnorm,
   if (*reason == KSP_CONVERGED_ITERATING &&
       stopped(s, "a linear solve, linear iteration", (int)it, rnorm, s->lin_r0))
     *reason = KSP_DIVERGED_ITS;
+  /* a kept preconditioner that now costs more than a new one: the solve
+   * stops, to be made again on a new one */
+  if (*reason == KSP_CONVERGED_ITERATING && pm_newton_pc_spent(s, (int)it)) {
+    s->pc_stale = true;
+    *reason = KSP_DIVERGED_ITS;
+  }
   return 0;
 }
 
@@ -229,6 +235,7 @@ pm_err pm_newton_pc_save(const pm_newton *s, pm_load_state *st) {
   st->pc_its = s->lin_its;
   st->pc_failed = s->lin_failed;
   st->pc_lambda = s->pc_load;
+  st->pc_first_its = s->pc_first_its;
   if (!s->pc_built) return PM_SUCCESS;
   return pm_newton_copy_out(s->Xpc, st->pc_x, s->p.n);
 }

@@ -73,6 +73,17 @@ struct pm_newton {
   /* pc_reuse_its: a preconditioner was built, and the last linear
    * solve's iterations and whether it failed. */
   bool pc_built, lin_failed;
+  /* pc_reuse_cost: a set-up waits for the next linear solve (pending),
+   * which is then the kept one's first (fresh); the last solve was
+   * stopped because the kept one no longer pays (stale); the kept one's
+   * set-up cost in iterations (budget, 0: unknown, no stop) and the
+   * iterations of its first solve (-1: none yet). */
+  bool pc_pending, pc_fresh, pc_stale;
+  int pc_budget, pc_first_its;
+  /* A solve made again from its last iterate after a stopped linear
+   * solve: the Newton and linear iterations before (it_base indexes the
+   * report's arrays). */
+  int it_base, lin_base;
   /* linear_ew: |r| at the last linear solve of this Newton solve (0:
    * none yet) and the tolerance it was given. */
   double ew_rprev, ew_eta;
@@ -164,6 +175,13 @@ PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
                                   PetscBool *changed, void *ctx);
 PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx);
 PetscErrorCode pm_newton_linear_postsolve(KSP ksp, Vec b, Vec x, void *ctx);
+/* pc_reuse_cost: the kept preconditioner, at iteration it of a solve it
+ * did not start fresh, has cost more than a set-up (the solve is to stop
+ * and be made again on a new one). */
+bool pm_newton_pc_spent(const pm_newton *s, int it);
+/* pc_reuse_cost: the iterations a solve on a kept preconditioner may take
+ * beyond its first solve's (0: no stop). */
+int pm_newton_pc_budget(const pm_newton *s);
 
 /* ---- pm_newton_augmented.c: pm_newton_problem.aux_n ---- */
 

@@ -53,6 +53,7 @@ static void load_scalars(fpm_static_state *to, const fpm_static_state *from) {
   to->load.pc_its = from->load.pc_its;
   to->load.pc_failed = from->load.pc_failed;
   to->load.pc_lambda = from->load.pc_lambda;
+  to->load.pc_first_its = from->load.pc_first_its;
   to->external_work = from->external_work;
 }
 

@@ -82,6 +82,10 @@ void fpm_static_choose_linear(const pm_scene *s, long unknowns,
                   : fpm_static_default_linear(unknowns);
   o->pc_reuse_its = (int)s->time.qs_reuse;
   o->linear_ew = s->time.qs_inexact;
+  /* The stop of a solve on a stale factorisation is decided by iteration
+   * counts, which round-off across ranks can move by one: exact solves
+   * (inexact: false) promise round-off agreement, so they go without it. */
+  if (!o->linear_ew) o->pc_reuse_cost = 0;
   if (o->linear != PM_NEWTON_GMRES_GAMG && o->linear != PM_NEWTON_CG_GAMG)
     return;
   /* Multigrid: a bounded Krylov solve (a failure cuts the load step with
@@ -101,6 +105,11 @@ void fpm_static_choose_linear(const pm_scene *s, long unknowns,
   if (!pm_scene_has(s, "time.quasi_static.inexact")) o->linear_ew = true;
   if (!pm_scene_has(s, "time.quasi_static.reuse_iterations"))
     o->pc_reuse_its = FPM_STATIC_AMG_REUSE;
+  /* A new hierarchy's solves take tens of iterations, varying with inexact
+   * Newton's tolerance, and a set-up costs a few: stopping a solve for a
+   * new one cost 1.8 times the CPU at 4036 points (docs/validation.md,
+   * "Static solves: big steps, cheap cuts"). */
+  o->pc_reuse_cost = 0;
 }
 
 pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
@@ -178,6 +187,11 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   no.relax_after = (int)s->time.qs_relax_after;
   no.ptc_max_iter = (int)s->time.qs_ptc;
   no.easy_iterations = 3;
+  /* ...and, with max_load_step, grow past 1/load_steps up to it (not by
+   * default: larger steps cost fewer Newton iterations but more CPU, the
+   * kept factorisation going stale sooner; docs/validation.md, "Static
+   * solves: big steps, cheap cuts"). */
+  no.max_dlambda = s->time.qs_max_step;
   no.petsc_options = s->time.qs_solver_options;
   /* SIPG, the stiffening and the volume penalty: the assembled tangent
    * lacks the adjoint term's and the state-dependent penalties'
