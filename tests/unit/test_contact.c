@@ -96,6 +96,32 @@ static void test_plate_sticking(void **state) {
   assert_true(isnan(a[0]));
 }
 
+/* Glued: held where it touched, and pulled back when it leaves: the
+ * anchor stays and the force is k times the distance from it, normal part
+ * included; the tangent is k I on either side of the surface. */
+static void test_plate_glued(void **state) {
+  (void)state;
+  const double p[3] = {0, 0, 0}, n[3] = {0, 0, 1}, d[3] = {0, 0, 0};
+  pm_scene_bc bc = rigid(PM_ON_PLATE, PM_CONTACT_GLUED, p, n, 0);
+  const double k = 10;
+  double x[3] = {0.2, 0.1, 0.001}, a[3] = {NAN, NAN, NAN}, F[3], e;
+  /* apart and not anchored: free */
+  assert_false(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  assert_true(isnan(a[0]));
+  x[2] = -0.01;
+  assert_true(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  assert_near(a[2], 0, 1e-15);
+  assert_near(F[2], 0.1, 1e-14);
+  x[0] += 0.03; /* slides 0.03 along x and leaves by 0.002 */
+  x[2] = 0.002;
+  assert_true(fpm_contact_point(&bc, k, d, x, a, F, &e));
+  assert_near(a[0], 0.2, 1e-15);
+  assert_near(F[0], -0.3, 1e-14);
+  assert_near(F[2], -0.02, 1e-14);
+  assert_near(e, 0.5 * k * (0.03 * 0.03 + 0.002 * 0.002), 1e-15);
+  check_tangent(&bc, k, d, x, a);
+}
+
 /* A sphere of radius 0.02 moved by (0, 0, -0.01): the force is along the
  * radius through the point, k times the depth, and the tangent holds the
  * turning of the normal. */
@@ -206,17 +232,25 @@ static void test_bad_keys(void **state) {
              "contact.yaml:11:", "contact needs method mpm or fpm");
 }
 
+/* The scene with the plate entry given, method fpm, and its simulation
+ * made: what fpm_sim_create returned. */
+static pm_err make_fpm(const char *plate, const char *qs, pm_scene **s,
+                       fpm_sim **sim) {
+  assert_ok(load(plate, "fpm", qs, s));
+  pm_error_clear();
+  return fpm_sim_create(*s, sim);
+}
+
 /* A plate that starts 5 mm inside the block is refused when the points
  * are made, at its key, naming a point. */
 static void test_plate_inside(void **state) {
   (void)state;
   pm_scene *s = NULL;
   fpm_sim *sim = NULL;
-  assert_ok(load("{plate: {point: [0, 0, 0.095], normal: [0, 0, -1]}, "
-                 "displacement: {z: -0.01}}",
-                 "fpm", "dynamic-relaxation", &s));
-  pm_error_clear();
-  assert_int_equal(fpm_sim_create(s, &sim), PM_ERR_SCENE);
+  assert_int_equal(make_fpm("{plate: {point: [0, 0, 0.095], normal: [0, 0, "
+                            "-1]}, displacement: {z: -0.01}}",
+                            "dynamic-relaxation", &s, &sim),
+                   PM_ERR_SCENE);
   const char *msg = pm_error_message();
   if (!strstr(msg, "contact.yaml:11:") || !strstr(msg, "inside"))
     fail_msg("message \"%s\"", msg);
@@ -375,16 +409,65 @@ static void test_static_touch_release(void **state) {
   pm_scene_destroy(s);
 }
 
+/* A glued plate on the cube's top face: its points are anchored at rest,
+ * and a static solve's set updates never let them go; drawn 1 mm off
+ * the plate, each is pulled back by k times 1 mm, the plate's reaction
+ * the sum of them. */
+static void test_static_glued(void **state) {
+  (void)state;
+  pm_scene *s = NULL;
+  fpm_sim *sim = NULL;
+  assert_ok(make_fpm("{plate: {point: [0, 0, 0.1], normal: [0, 0, -1]}, "
+                     "displacement: {z: -0.01}, contact: glued}",
+                     "static", &s, &sim));
+  const fpm_model *m = sim->model;
+  fpm_state *st = sim->state;
+  const fpm_contact *c = m->contact;
+  const long nd = 3 * m->n, np = c->pair_ptr[1];
+  double ztop = 0;
+  for (long i = 0; i < m->n; i++) ztop = fmax(ztop, m->x[3 * i + 2]);
+  long top = 0, anchored = 0;
+  for (long i = 0; i < m->n; i++) top += m->x[3 * i + 2] > ztop - 1e-12;
+  for (long q = 0; q < np; q++) anchored += !isnan(st->contact[3 * q]);
+  assert_int_equal(anchored, top);
+  for (long i = 0; i < m->n; i++) /* the top 1 mm below the plate */
+    st->u[3 * i + 2] = -0.001 * m->x[3 * i + 2] / ztop;
+  unsigned char *let_go = calloc(np, 1);
+  fpm_contact_release r;
+  assert_int_equal(fpm_contact_release_fixed(m, st, 0, 0, let_go, &r), 0);
+  fpm_contact_commit(m, st, 0, 0);
+  memset(st->f, 0, nd * sizeof *st->f);
+  fpm_contact_force_fixed(m, st, 0, 0);
+  double R[3] = {0, 0, 0}, ksum = 0;
+  fpm_contact_reaction(m, st, 1, R);
+  for (long q = 0; q < np; q++) {
+    if (isnan(st->contact[3 * q])) continue;
+    ksum += c->pair_k[q];
+    const long i = c->pair_point[q];
+    assert_near(st->f[3 * i + 2], -c->pair_k[q] * 0.001, 1e-12 * c->pair_k[q]);
+  }
+  print_message("glued top: %ld points anchored at rest, none let go 1 mm "
+                "off; reaction %.6g N (k sum x 1 mm %.6g N)\n",
+                anchored, R[2], ksum * 0.001);
+  assert_int_equal(r.first, -1);
+  assert_near(R[2], ksum * 0.001, 1e-12 * ksum);
+  free(let_go);
+  fpm_sim_destroy(sim);
+  pm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_plate_frictionless),
       cmocka_unit_test(test_plate_sticking),
+      cmocka_unit_test(test_plate_glued),
       cmocka_unit_test(test_sphere),
       cmocka_unit_test(test_keys),
       cmocka_unit_test(test_bad_keys),
       cmocka_unit_test(test_plate_inside),
       cmocka_unit_test(test_static_tangent),
       cmocka_unit_test(test_static_touch_release),
+      cmocka_unit_test(test_static_glued),
   };
   if (pm_app_init() != PM_SUCCESS) return 1;
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -113,9 +113,6 @@ bad_scene grip-implicit "$grip" 's/method: mpm$/method: mpm-implicit/' \
 
 bad_scene glued-grips-nothing "$glued" 's/point: \[0, 0.4\]/point: [0, 0.45]/' \
   'point: \[0, 0.45\]' 'boundary.1.plate: expected a glued plate on a body'
-bad_scene glued-fpm "$glued" \
-  's/method: mpm$/method: fpm/; s/min: \[-0.02, -0.02\], max: \[0.06, 0.44\]/min: [0, 0], max: [0.04, 0.4]/' \
-  'contact: glued' 'boundary.0.contact: expected frictionless or sticking for method fpm'
 bad_scene glued-implicit "$glued" 's/method: mpm$/method: mpm-implicit/' \
   'plate: {point: \[0, 0\]' 'boundary.0.plate: contact needs method mpm or fpm'
 

@@ -667,9 +667,11 @@ static const pm_key bc_keys[] = {
      .def = "frictionless",
      .names = contact_names,
      .doc = "plate, sphere: frictionless (normal force only), sticking "
-            "(a point that touches is held where it touched) or glued "
-            "(method mpm: the body's face is held in every direction, "
-            "pulled as well as pushed: a grip)"},
+            "(a point that touches is held where it touched, let go when "
+            "it comes off) or glued (held in every direction, pulled as "
+            "well as pushed: a face tied to it, a grip; method mpm: the "
+            "face it starts on; method fpm: the points on it at t = 0 and "
+            "those that touch later)"},
     {.name = "penalty",
      .type = PM_KEY_NUMBER,
      .offset = C(contact_penalty),

@@ -22,7 +22,8 @@ long fpm_contact_state_size(const fpm_contact *c) {
 pm_err fpm_contact_state_init(const fpm_contact *c, double **out) {
   const long n = fpm_contact_state_size(c);
   PM_CALL(PM_ALLOC(*out, n, "contact state"));
-  for (long k = 0; k < 3 * c->pair_ptr[c->n_bodies]; k++) (*out)[k] = NAN;
+  memcpy(*out, c->anchor0,
+         3 * (size_t)c->pair_ptr[c->n_bodies] * sizeof(double));
   return PM_SUCCESS;
 }
 
@@ -75,13 +76,15 @@ bool fpm_contact_point(const pm_scene_bc *bc, double k, const double d[3],
                        double *energy) {
   double n[3];
   const double g = pm_rigid_gap(bc, d, x, n);
+  const bool glued = bc->contact == PM_CONTACT_GLUED;
   *energy = 0;
-  if (!(g < 0)) {
+  /* a glued point stays held once anchored, pulled off as well as pushed */
+  if (!(g < 0) && !(glued && !isnan(anchor[0]))) {
     F[0] = F[1] = F[2] = 0;
-    anchor[0] = anchor[1] = anchor[2] = NAN;
+    if (!glued) anchor[0] = anchor[1] = anchor[2] = NAN;
     return false;
   }
-  const bool sticking = bc->contact == PM_CONTACT_STICKING;
+  const bool sticking = bc->contact != PM_CONTACT_FRICTIONLESS;
   if (sticking && isnan(anchor[0]))
     for (int a = 0; a < 3; a++) anchor[a] = x[a] - d[a] - g * n[a];
   *energy = touch_force(k, d, x, g, n, sticking ? anchor : NULL, F);
@@ -93,9 +96,10 @@ void fpm_contact_tangent(const pm_scene_bc *bc, double k, const double d[3],
                          double K[9]) {
   double n[3];
   const double g = pm_rigid_gap(bc, d, x, n);
-  (void)anchor;
+  const bool glued = bc->contact == PM_CONTACT_GLUED;
   memset(K, 0, 9 * sizeof(double));
-  if (g < 0) touch_tangent(bc, k, g, n, bc->contact == PM_CONTACT_STICKING, K);
+  if (g < 0 || (glued && !isnan(anchor[0])))
+    touch_tangent(bc, k, g, n, bc->contact != PM_CONTACT_FRICTIONLESS, K);
 }
 
 /* The rigid body's displacement at time t: ramp(t) d(t), times scale. */
@@ -135,6 +139,25 @@ static pm_err check_start(const fpm_model *m, const fpm_contact *c, int b) {
   return PM_SUCCESS;
 }
 
+/* The anchors at rest (3 per pair): a glued body's points on its surface
+ * at t = 0 (gap at most 1e-9 mesh_size) held where they are from the
+ * start, as a face tied to it; NaN for the rest (apart, or not glued). */
+static void start_anchors(const fpm_model *m, fpm_contact *c) {
+  const double zero[3] = {0, 0, 0}, tol = 1e-9 * m->scene->mesh_size;
+  for (long q = 0; q < 3 * c->pair_ptr[c->n_bodies]; q++) c->anchor0[q] = NAN;
+  for (int b = 0; b < c->n_bodies; b++) {
+    const pm_scene_bc *bc = &m->scene->bcs[c->bc[b]];
+    if (bc->contact != PM_CONTACT_GLUED) continue;
+    for (long q = c->pair_ptr[b]; q < c->pair_ptr[b + 1]; q++) {
+      const double *x = m->x + 3 * c->pair_point[q];
+      double n[3];
+      const double g = pm_rigid_gap(bc, zero, x, n);
+      if (g > tol) continue;
+      for (int a = 0; a < 3; a++) c->anchor0[3 * q + a] = x[a] - g * n[a];
+    }
+  }
+}
+
 pm_err fpm_contact_create(const fpm_model *m, const pm_scene *s,
                           fpm_contact **out) {
   pm_err ret = PM_SUCCESS;
@@ -155,17 +178,11 @@ pm_err fpm_contact_create(const fpm_model *m, const pm_scene *s,
   PM_TRY(PM_ALLOC(c->pair_ptr, nb + 1, "contact pairs"));
   PM_TRY(PM_ALLOC(c->pair_point, nb * nbp, "contact pairs"));
   PM_TRY(PM_ALLOC(c->pair_k, nb * nbp, "contact pairs"));
+  PM_TRY(PM_ALLOC(c->anchor0, 3 * nb * nbp, "contact anchors"));
   long q = 0;
   for (int b = 0, k = 0; b < s->n_bcs; b++) {
     const pm_scene_bc *bc = &s->bcs[b];
     if (!PM_BC_RIGID(bc)) continue;
-    if (bc->contact == PM_CONTACT_GLUED) {
-      char key[64];
-      PM_TRY(pm_scene_fail(s, PM_PATH(key, "boundary.%d.contact", b), true,
-                           "expected frictionless or sticking for method fpm "
-                           "(glued plates are the explicit MPM's grips), got "
-                           "glued"));
-    }
     c->bc[k] = b;
     c->pair_ptr[k] = q;
     for (long i = 0; i < m->n_own; i++) {
@@ -179,6 +196,7 @@ pm_err fpm_contact_create(const fpm_model *m, const pm_scene *s,
     c->pair_ptr[++k] = q;
   }
   for (int b = 0; b < nb; b++) PM_TRY(check_start(m, c, b));
+  start_anchors(m, c);
   *out = c;
   c = NULL;
 done:
@@ -205,6 +223,7 @@ void fpm_contact_destroy(fpm_contact *c) {
   free(c->pair_ptr);
   free(c->pair_point);
   free(c->pair_k);
+  free(c->anchor0);
   free(c);
 }
 
@@ -351,12 +370,13 @@ void fpm_contact_tangent_fixed(const fpm_model *m, const fpm_state *st,
   }
 }
 
-/* Body b of a static solve's contact when it is sticking (NULL if not),
+/* Body b of a static solve's contact when it is sticking or glued (NULL if
+ * frictionless),
  * with its displacement d at t times scale. */
 static const pm_scene_bc *sticking_body(const fpm_model *m, int b, double t,
                                         double scale, double d[3]) {
   const pm_scene_bc *bc = &m->scene->bcs[m->contact->bc[b]];
-  if (bc->contact != PM_CONTACT_STICKING) return NULL;
+  if (bc->contact == PM_CONTACT_FRICTIONLESS) return NULL;
   body_displacement(bc, t, scale, d);
   return bc;
 }
@@ -390,6 +410,7 @@ static long update_set(const fpm_model *m, fpm_state *st, double t,
     double d[3], xi[3], n[3];
     const pm_scene_bc *bc = sticking_body(m, b, t, scale, d);
     if (!bc) continue;
+    const bool glued = bc->contact == PM_CONTACT_GLUED;
     for (long q = c->pair_ptr[b]; q < c->pair_ptr[b + 1]; q++) {
       double *A = st->contact + 3 * q;
       const bool loose = isnan(A[0]); /* no anchor */
@@ -405,7 +426,8 @@ static long update_set(const fpm_model *m, fpm_state *st, double t,
         changed++;
         continue;
       }
-      if (mode == SET_TOUCH || !off || loose) continue;
+      /* a glued point is never let go: it is pulled as well as pushed */
+      if (mode == SET_TOUCH || !off || loose || glued) continue;
       const long i = c->pair_point[q];
       if (mode == SET_RELEASE && let_go[q]) { /* it grazes: held */
         out->frozen++;

@@ -15,6 +15,8 @@ typedef struct fpm_contact {
   long *pair_point; /* the point of each pair */
   double *pair_k;   /* its penalty stiffness kappa E A / h, N/m */
   double max_k_over_m; /* the largest k / m of a pair, 1/s^2 */
+  double *anchor0;     /* 3 per pair: the anchors at rest (glued: the points
+                          on the body at t = 0; NaN elsewhere) */
 } fpm_contact;
 
 /* Doubles of state a contact holds (fpm_state.contact): per pair the
@@ -22,7 +24,8 @@ typedef struct fpm_contact {
  * previous reaction and the previous displacement (3 each), and the
  * contact energy (1). */
 long fpm_contact_state_size(const fpm_contact *c);
-/* Make that state (*out, the caller's to free): at rest, apart. */
+/* Make that state (*out, the caller's to free): at rest, apart but for
+ * the points on a glued body, anchored where they are. */
 pm_err fpm_contact_state_init(const fpm_contact *c, double **out);
 
 /* Penalty contact of one point at position x (3) against one rigid body
@@ -30,7 +33,9 @@ pm_err fpm_contact_state_init(const fpm_contact *c, double **out);
  * force on the point F (3) and its energy.  Frictionless: F = -k g n.
  * Sticking: F = -k (x - d - anchor), anchor (3, in the body's frame) the
  * surface point where it touched, set on touching and NaN while apart.
- * Returns whether the point touches (g < 0). */
+ * Glued: as sticking, but an anchored point is never let go (pulled off
+ * as well as pushed: a face tied to the body).  Returns whether the point
+ * touches (g < 0, or glued and anchored). */
 bool fpm_contact_point(const pm_scene_bc *bc, double k, const double d[3],
                        const double x[3], double anchor[3], double F[3],
                        double *energy);
@@ -97,7 +102,7 @@ void fpm_contact_tangent_fixed(const fpm_model *m, const fpm_state *st,
  * touching (gap at most 1e-9 mesh_size: the faces that start on a plate
  * too) without an anchor is anchored where it is; an anchored point now
  * apart (gap above that: the contact pulled it) is let go for the next
- * step. */
+ * step; a glued body's points are anchored likewise and never let go. */
 void fpm_contact_commit(const fpm_model *m, fpm_state *st, double t,
                         double scale);
 
