@@ -102,6 +102,11 @@ pm_err gm_gmsh_check_file(const char *path, const char *what);
  * checked the same way (gm_geo_check.c). */
 pm_err gm_geo_check(const char *path);
 
+/* The node count a .msh file (ASCII 2.x or 4.x, binary 2.x) states in its
+ * $Nodes header, read without gmsh; -1 when the file cannot be read or
+ * states none this reads. */
+long gm_msh_node_count(const char *path);
+
 /* Read a gmsh-readable file (.msh, .geo, .step/.stp, .brep) into out: checks
  * the file is a readable regular file (PM_ERR_IO naming it: gmsh reports a
  * missing file without failing), opens it in a session of its own, meshes

@@ -339,3 +339,45 @@ done:
   gm_gmsh_end(&session);
   return ret;
 }
+
+/* Whether line (from fgets) starts with word and ends there. */
+static bool line_is(const char *line, const char *word) {
+  size_t n = strlen(word);
+  return strncmp(line, word, n) == 0 &&
+         (line[n] == '\n' || line[n] == '\r' || line[n] == '\0');
+}
+
+long gm_msh_node_count(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return -1;
+  char line[4096];
+  long count = -1;
+  double version = 0;
+  int binary = -1;
+  bool at_start = true; /* line holds the start of a line of the file */
+  while (fgets(line, sizeof line, f)) {
+    const bool start = at_start;
+    at_start = strchr(line, '\n') != NULL;
+    if (!start) continue;
+    if (line_is(line, "$MeshFormat")) {
+      if (!fgets(line, sizeof line, f) ||
+          sscanf(line, "%lf %d", &version, &binary) != 2)
+        break;
+      at_start = strchr(line, '\n') != NULL;
+    } else if (line_is(line, "$Nodes")) {
+      /* 2.x: the count alone; 4.x: blocks, nodes, smallest and largest
+       * tag (in binary 4.x the header is binary: not read here). */
+      if (binary != 0 && !(binary == 1 && version < 3)) break;
+      long a = -1, b = -1;
+      if (!fgets(line, sizeof line, f)) break;
+      int got = sscanf(line, "%ld %ld", &a, &b);
+      if (version >= 4 && got == 2)
+        count = b;
+      else if (version > 0 && version < 3 && got >= 1)
+        count = a;
+      break;
+    }
+  }
+  fclose(f);
+  return count >= 0 ? count : -1;
+}

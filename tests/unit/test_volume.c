@@ -19,6 +19,7 @@
 #include <gmshc.h>
 
 #include "gm_dual.h"
+#include "gm_gmsh.h"
 #include "gm_volume.h"
 #include "pm_omp.h"
 
@@ -352,6 +353,21 @@ static void test_errors(void **state) {
                      "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n",
                      path);
   expect_failure(path, 3, 0.1, PM_ERR_MESH, "no tetrahedra");
+  /* The node count its header states, read without gmsh (plan's points):
+   * 2.2 as above, 4.1 (blocks, nodes, tags), binary 4.1 and no file. */
+  assert_int_equal(gm_msh_node_count(path), 3);
+  char v4[512];
+  pm_test_write_file(*state, "v4.msh",
+                     "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n"
+                     "0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities\n"
+                     "$Nodes\n2 1201 1 1201\n",
+                     v4);
+  assert_int_equal(gm_msh_node_count(v4), 1201);
+  pm_test_write_file(*state, "v4b.msh",
+                     "$MeshFormat\n4.1 1 8\n\x01\n$EndMeshFormat\n$Nodes\n",
+                     v4);
+  assert_int_equal(gm_msh_node_count(v4), -1);
+  assert_int_equal(gm_msh_node_count(missing), -1);
   /* ... which is fine in 2D. */
   assert_ok(gm_volume_load(path, 2, 0.1, &v));
   assert_true(fabs(gm_volume_measure(v) - 0.5) <= 1e-15);

@@ -10,6 +10,7 @@
 #include "fpm_stream.h"
 #include "fpm_gfd.h"
 #include "fpm_grade.h"
+#include "gm_gmsh.h"
 #include "gm_mesh.h"
 #include "fpm_model.h"
 #include "fpm_scene.h"
@@ -45,6 +46,10 @@ size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
   for (int c = 0; c < dim; c++)
     n *= (s->box_max[c] - s->box_min[c]) / s->mesh_size + 1;
   n *= grade_factor(s);
+  /* A meshed body (.msh) is used as it is: its points are its nodes. */
+  const int body = fpm_domain_body(s);
+  const long nodes = body >= 0 ? gm_msh_node_count(s->bodies[body].mesh) : -1;
+  if (nodes > 0) n = (double)nodes;
   const double d = sizeof(double);
   const double nnz = dim == 2 ? NNZ_2D : NNZ_3D;
   /* As fpm_model_bytes and fpm_state_bytes count them, per point; every
