@@ -70,6 +70,12 @@ echo "python: $(cat "$work/read"); followed: $(cat "$work/follow.txt")"
 if command -v pvbatch >/dev/null && command -v xvfb-run >/dev/null; then
   (cd "$work" && timeout 300 xvfb-run -a pvbatch "$src/tools/paraview-open.py" \
     "$work/f2" --screenshot f2.png --state f2.pvsm) >"$work/pv" 2>"$work/err"
+fi
+if grep -q "bad X server connection" "$work/err" 2>/dev/null; then
+  # xvfb-run's server was not there for pvbatch (seen in 3 of 16 runs here):
+  # the machine's, not the script's; said, not counted.
+  echo "paraview-open: skipped (xvfb-run gave pvbatch no X server)"
+elif command -v pvbatch >/dev/null && command -v xvfb-run >/dev/null; then
   check "paraview-open: coloured by von_mises" grep -q "coloured by von_mises" "$work/pv"
   check "paraview-open: a picture and a state" test -s "$work/f2.png" -a -s "$work/f2.pvsm"
 else
