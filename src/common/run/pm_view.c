@@ -5,6 +5,8 @@
 
 #include "pm_par.h"
 
+bool pm_view_keeps_whole(void) { return pm_par_active() && pm_par_root(); }
+
 void pm_view_release(pm_view *v) {
   if (v->ranks && !pm_par_root() && v->release) v->release(v->ctx);
 }

@@ -24,6 +24,12 @@ typedef struct {
   const pm_observer *obs; /* the run's, while it runs (rank 0 reports) */
 } pm_view;
 
+/* Whether this rank holds the whole model and state through a run: across
+ * ranks, rank 0 while frames, checkpoints and the end's figures are
+ * gathered into its view.  Setup builds the whole model only where this is
+ * true (and a share everywhere across ranks). */
+bool pm_view_keeps_whole(void);
+
 /* The run starts with observer obs (which may be NULL): across ranks, the
  * ranks other than 0 release their view. */
 void pm_view_start(pm_view *v, const pm_observer *obs);
