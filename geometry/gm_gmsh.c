@@ -2,9 +2,17 @@
 #include "gm_gmsh.h"
 
 #include <gmshc.h>
+#include <math.h>
 #include <stddef.h>
 
 #include "pm_omp.h"
+#include "pm_scene.h"
+
+/* A scene's discretization.mesh_sizes is a gm_sizes. */
+_Static_assert((int)GM_SIZES_SCALE == (int)PM_MESH_SIZES_SCALE &&
+                   (int)GM_SIZES_REPLACE == (int)PM_MESH_SIZES_REPLACE &&
+                   (int)GM_SIZES_FILE == (int)PM_MESH_SIZES_FILE,
+               "gm_sizes and PM_MESH_SIZES_* in one order");
 
 #if defined(__has_feature)
 #if __has_feature(address_sanitizer)
@@ -86,4 +94,78 @@ pm_err gm_gmsh_size(double h, const char *path) {
       {"Mesh.MeshSizeMax", h},
   };
   return set_options(size, sizeof size / sizeof size[0], path);
+}
+
+/* The longest edge of the open model's mesh of its curves (0 without one),
+ * which the caller then clears. */
+static pm_err longest_curve_edge(const char *path, double *len) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0;
+  size_t *etag = NULL, *ntag = NULL, n_e = 0, n_n = 0;
+  double *a = NULL, *b = NULL, *pa = NULL, *pb = NULL;
+  size_t na = 0, nb = 0, npa = 0, npb = 0;
+  *len = 0;
+  gmshModelMeshGenerate(1, &ierr);
+  GM_GMSH_CHECK("meshing the curves of", path);
+  /* gmsh type 1: the two-node line */
+  gmshModelMeshGetElementsByType(1, &etag, &n_e, &ntag, &n_n, -1, 0, 1, &ierr);
+  GM_GMSH_CHECK("reading the curves' mesh of", path);
+  for (size_t k = 0; k + 1 < n_n; k += 2) {
+    gmshModelMeshGetNode(ntag[k], &a, &na, &pa, &npa, &ierr);
+    GM_GMSH_CHECK("reading the curves' mesh of", path);
+    gmshModelMeshGetNode(ntag[k + 1], &b, &nb, &pb, &npb, &ierr);
+    GM_GMSH_CHECK("reading the curves' mesh of", path);
+    if (na == 3 && nb == 3)
+      *len = fmax(*len, hypot(hypot(a[0] - b[0], a[1] - b[1]), a[2] - b[2]));
+    gmshFree(a);
+    gmshFree(b);
+    if (pa) gmshFree(pa);
+    if (pb) gmshFree(pb);
+    a = b = pa = pb = NULL;
+  }
+done:
+  if (a) gmshFree(a);
+  if (b) gmshFree(b);
+  if (pa) gmshFree(pa);
+  if (pb) gmshFree(pb);
+  if (etag) gmshFree(etag);
+  if (ntag) gmshFree(ntag);
+  return ret;
+}
+
+pm_err gm_gmsh_sizes(gm_sizes rule, double h, const char *path,
+                     double *factor) {
+  double f = 1;
+  if (rule == GM_SIZES_SCALE) {
+    pm_err ret = PM_SUCCESS;
+    int ierr = 0;
+    double len = 0, was = 1;
+    PM_TRY(longest_curve_edge(path, &len));
+    gmshModelMeshClear(NULL, 0, &ierr);
+    GM_GMSH_CHECK("clearing the curves' mesh of", path);
+    if (len > 0 && isfinite(len)) {
+      gmshOptionGetNumber("Mesh.MeshSizeFactor", &was, &ierr);
+      GM_GMSH_CHECK("Mesh.MeshSizeFactor", path);
+      double max = 0;
+      gmshOptionGetNumber("Mesh.MeshSizeMax", &max, &ierr);
+      GM_GMSH_CHECK("Mesh.MeshSizeMax", path);
+      f = h / len;
+      /* and at most h (gmsh multiplies the size it clamps to MeshSizeMax
+       * by the factor): a curve shorter than its size is one edge, and a
+       * file without sizes is meshed at gmsh's (the bounding box's) */
+      const gm_option scaled[] = {{"Mesh.MeshSizeFactor", was * f},
+                                  {"Mesh.MeshSizeMax", fmin(max, h / f)}};
+      PM_TRY(set_options(scaled, 2, path));
+    } else {
+      rule = GM_SIZES_REPLACE;
+    }
+  done:
+    if (ret) return ret;
+  }
+  if (rule == GM_SIZES_REPLACE) {
+    f = 0;
+    PM_CALL(gm_gmsh_size(h, path));
+  }
+  if (factor) *factor = f;
+  return PM_SUCCESS;
 }

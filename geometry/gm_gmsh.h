@@ -22,6 +22,23 @@ pm_err gm_gmsh_begin(gm_gmsh_session *s, const char *path);
 void gm_gmsh_end(gm_gmsh_session *s);
 /* Element size h everywhere (overrides sizes a file sets). */
 pm_err gm_gmsh_size(double h, const char *path);
+
+/* How the element sizes a file sets itself (point sizes, size fields, its
+ * Mesh options) meet a size h where gmsh meshes the file. */
+typedef enum {
+  GM_SIZES_SCALE = 0, /* the file's sizes times one factor, so that the
+                         longest edge of the mesh of its curves at its own
+                         sizes becomes h, and at most h: the file's grading
+                         at h's level */
+  GM_SIZES_REPLACE,   /* h everywhere (gm_gmsh_size) */
+  GM_SIZES_FILE,      /* the file's sizes as written (h unused) */
+} gm_sizes;
+
+/* Apply rule to the open session's model before it is meshed.  *factor
+ * (may be NULL): what multiplies the file's sizes (1 for file, 0 for
+ * replace).  Scale meshes the curves once to measure them; a model without
+ * curves is meshed at h (replace, *factor 0). */
+pm_err gm_gmsh_sizes(gm_sizes rule, double h, const char *path, double *factor);
 /* The last gmsh error as PM_ERR_MESH: "gmsh: WHAT['PATH'] failed: MSG". */
 pm_err gm_gmsh_fail(const char *what, const char *path);
 
@@ -47,12 +64,15 @@ typedef struct {
   long *elem; /* (dim + 1) * n_elems: corner nodes, 0-based, as gmsh lists
                  them (not reoriented) */
   int n_groups;
-  char **group_name; /* n_groups: the physical name, or "surface-TAG" for a
-                        group without one */
-  long *group_ptr;   /* n_groups + 1: faces of group g are
-                        group_face[dim * group_ptr[g] .. dim * group_ptr[g+1]) */
-  long *group_face;  /* dim corner nodes per face (0-based like elem); -1 for
-                        a node that is no element's corner */
+  char **group_name;  /* n_groups: the physical name, or "surface-TAG" for a
+                         group without one */
+  long *group_ptr;    /* n_groups + 1: faces of group g are
+                         group_face[dim * group_ptr[g] .. dim * group_ptr[g+1]) */
+  long *group_face;   /* dim corner nodes per face (0-based like elem); -1 for
+                         a node that is no element's corner */
+  bool meshed;        /* gmsh meshed the file (it held no mesh) */
+  double size_factor; /* then: what multiplied the file's sizes (0: h
+                         replaced them; gm_gmsh_sizes) */
 } gm_gmsh_mesh;
 
 /* Read the open session's model into out (zeroed first): every element of
@@ -107,16 +127,21 @@ pm_err gm_geo_check(const char *path);
  * states none this reads. */
 long gm_msh_node_count(const char *path);
 
+/* The bounding box [lo, hi] of the geometry (or mesh) in a gmsh-readable
+ * file, checked as gm_gmsh_load checks it; z = 0 in 2D.  PM_ERR_IO,
+ * PM_ERR_MESH (gmsh fails, or the box is empty along an axis of dim). */
+pm_err gm_file_bounds(const char *path, int dim, double lo[3], double hi[3]);
+
 /* Read a gmsh-readable file (.msh, .geo, .step/.stp, .brep) into out: checks
  * the file is a readable regular file (PM_ERR_IO naming it: gmsh reports a
  * missing file without failing), opens it in a session of its own, meshes
- * it at element size h when it holds no element of dimension dim (h <= 0:
- * the file's and gmsh's own sizes; a mesh in the file is used whatever h),
- * reads it as gm_gmsh_read does and closes gmsh whatever happens.  Not
- * thread-safe (gmsh keeps global state); must not run inside another
- * session. */
-pm_err gm_gmsh_load(const char *path, int dim, double h, bool groups,
-                    gm_gmsh_mesh *out);
+ * it by rule at size h (gm_gmsh_sizes; h <= 0: the file's own sizes
+ * whatever the rule) when it holds no element of dimension dim (a mesh in
+ * the file is used as it is), reads it as gm_gmsh_read does and closes
+ * gmsh whatever happens.  Not thread-safe (gmsh keeps global state); must
+ * not run inside another session. */
+pm_err gm_gmsh_load(const char *path, int dim, double h, gm_sizes rule,
+                    bool groups, gm_gmsh_mesh *out);
 
 /* Frees the arrays of m and zeroes it; NULL is a no-op. */
 void gm_gmsh_mesh_free(gm_gmsh_mesh *m);

@@ -309,8 +309,108 @@ pm_err gm_gmsh_check_file(const char *path, const char *what) {
   return gm_geo_check(path);
 }
 
-pm_err gm_gmsh_load(const char *path, int dim, double h, bool groups,
-                    gm_gmsh_mesh *out) {
+/* Open path in session (which the caller ends whatever happens): its
+ * element types of dimension dim, counted. */
+static pm_err open_counting(const char *path, int dim, gm_gmsh_session *session,
+                            size_t *n_types) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0, *types = NULL;
+  *n_types = 0;
+  PM_TRY(gm_gmsh_begin(session, path));
+  gmshOpen(path, &ierr);
+  GM_GMSH_CHECK("reading", path);
+  gmshModelMeshGetElementTypes(&types, n_types, dim, -1, &ierr);
+  GM_GMSH_CHECK("listing the element types of", path);
+done:
+  if (types) gmshFree(types);
+  return ret;
+}
+
+/* Two node tags, an edge, in increasing order. */
+typedef struct {
+  size_t a, b;
+} edge_key;
+
+static int edge_cmp(const void *p, const void *q) {
+  const edge_key *e = p, *f = q;
+  if (e->a != f->a) return e->a < f->a ? -1 : 1;
+  return e->b < f->b ? -1 : e->b > f->b;
+}
+
+/* Whether the open model's triangles (gmsh type 2) close a surface: every
+ * edge in exactly two of them. */
+static pm_err triangles_closed(const char *path, bool *closed) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0;
+  size_t *etag = NULL, *ntag = NULL, n_e = 0, n_n = 0;
+  edge_key *edges = NULL;
+  *closed = false;
+  gmshModelMeshGetElementsByType(2, &etag, &n_e, &ntag, &n_n, -1, 0, 1, &ierr);
+  GM_GMSH_CHECK("reading the triangles of", path);
+  const size_t n_tri = n_n / 3;
+  if (n_tri < 4) goto done;
+  PM_TRY(PM_ALLOC(edges, 3 * n_tri, "surface edges"));
+  for (size_t t = 0; t < n_tri; t++)
+    for (int k = 0; k < 3; k++) {
+      const size_t a = ntag[3 * t + k], b = ntag[3 * t + (k + 1) % 3];
+      edges[3 * t + k] = (edge_key){a < b ? a : b, a < b ? b : a};
+    }
+  qsort(edges, 3 * n_tri, sizeof *edges, edge_cmp);
+  *closed = true;
+  for (size_t i = 0; i < 3 * n_tri && *closed; i += 2)
+    *closed = i + 1 < 3 * n_tri && !edge_cmp(&edges[i], &edges[i + 1]) &&
+              (i + 2 >= 3 * n_tri || edge_cmp(&edges[i + 1], &edges[i + 2]));
+done:
+  free(edges);
+  if (etag) gmshFree(etag);
+  if (ntag) gmshFree(ntag);
+  return ret;
+}
+
+/* A file that holds a closed surface mesh and no volume (.stl, .ply, a
+ * .msh of triangles): the volume it closes, its triangles kept as the boundary
+ * (gmsh classifies them into surfaces at 40-degree edges and builds a
+ * volume on all of them).  *closed: whether there was one to close. */
+static pm_err close_surface_mesh(const char *path, bool *closed) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0, *vol = NULL, *types = NULL, *surf = NULL, *tags = NULL;
+  size_t n_vol = 0, n_types = 0, n_surf = 0;
+  *closed = false;
+  gmshModelGetEntities(&vol, &n_vol, 3, &ierr);
+  GM_GMSH_CHECK("listing the volumes of", path);
+  gmshModelMeshGetElementTypes(&types, &n_types, 2, -1, &ierr);
+  GM_GMSH_CHECK("listing the element types of", path);
+  if (n_vol > 0 || n_types == 0) goto done;
+  bool whole = false;
+  PM_TRY(triangles_closed(path, &whole));
+  if (!whole) goto done; /* no volume in it: "gives no tetrahedra" */
+  const double pi = 3.14159265358979323846;
+  gmshModelMeshClassifySurfaces(40 * pi / 180, 1, 0, pi, 0, &ierr);
+  GM_GMSH_CHECK("classifying the surface mesh of", path);
+  gmshModelMeshCreateGeometry(NULL, 0, &ierr);
+  GM_GMSH_CHECK("building surfaces from the mesh of", path);
+  gmshModelGetEntities(&surf, &n_surf, 2, &ierr);
+  GM_GMSH_CHECK("listing the surfaces of", path);
+  PM_ENSURE(n_surf > 0, PM_ERR_MESH, "'%s': no surface to close", path);
+  PM_TRY(PM_ALLOC(tags, n_surf / 2, "surface tags"));
+  for (size_t k = 0; k < n_surf / 2; k++) tags[k] = surf[2 * k + 1];
+  int loop = gmshModelGeoAddSurfaceLoop(tags, n_surf / 2, -1, &ierr);
+  GM_GMSH_CHECK("closing the surfaces of", path);
+  gmshModelGeoAddVolume(&loop, 1, -1, &ierr);
+  GM_GMSH_CHECK("adding the volume of", path);
+  gmshModelGeoSynchronize(&ierr);
+  GM_GMSH_CHECK("adding the volume of", path);
+  *closed = true;
+done:
+  if (vol) gmshFree(vol);
+  if (types) gmshFree(types);
+  if (surf) gmshFree(surf);
+  free(tags);
+  return ret;
+}
+
+pm_err gm_gmsh_load(const char *path, int dim, double h, gm_sizes rule,
+                    bool groups, gm_gmsh_mesh *out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_gmsh_load: out is NULL");
   memset(out, 0, sizeof *out);
   PM_CHECK(path && path[0], PM_ERR_ARG, "no volume file name");
@@ -320,22 +420,24 @@ pm_err gm_gmsh_load(const char *path, int dim, double h, bool groups,
            "mesh size h must be finite (got %g) for '%s'", h, path);
   PM_CALL(gm_gmsh_check_file(path, "volume file"));
   pm_err ret = PM_SUCCESS;
-  int ierr = 0, *types = NULL;
+  int ierr = 0;
   size_t n_types = 0;
   gm_gmsh_session session = {.threads = 0, .open = false};
-  PM_TRY(gm_gmsh_begin(&session, path));
-  gmshOpen(path, &ierr);
-  GM_GMSH_CHECK("reading", path);
-  gmshModelMeshGetElementTypes(&types, &n_types, dim, -1, &ierr);
-  GM_GMSH_CHECK("listing the element types of", path);
+  PM_TRY(open_counting(path, dim, &session, &n_types));
+  double factor = 1;
   if (n_types == 0) {
-    if (h > 0.0) PM_TRY(gm_gmsh_size(h, path));
+    bool closed = false;
+    if (dim == 3) PM_TRY(close_surface_mesh(path, &closed));
+    /* a closed surface mesh keeps its triangles: none to scale */
+    if (closed && rule == GM_SIZES_SCALE) rule = GM_SIZES_REPLACE;
+    if (h > 0.0) PM_TRY(gm_gmsh_sizes(rule, h, path, &factor));
     gmshModelMeshGenerate(dim, &ierr);
     GM_GMSH_CHECK("meshing", path);
   }
   PM_TRY(gm_gmsh_read(path, dim, groups, out));
+  out->meshed = n_types == 0;
+  out->size_factor = factor;
 done:
-  if (types) gmshFree(types);
   gm_gmsh_end(&session);
   return ret;
 }
@@ -380,4 +482,38 @@ long gm_msh_node_count(const char *path) {
   }
   fclose(f);
   return count >= 0 ? count : -1;
+}
+
+pm_err gm_file_bounds(const char *path, int dim, double lo[3], double hi[3]) {
+  PM_CHECK(path && path[0], PM_ERR_ARG, "no geometry file name");
+  PM_CALL(gm_gmsh_check_file(path, "geometry file"));
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0;
+  size_t n_types = 0;
+  gm_gmsh_mesh raw = {.dim = 0};
+  gm_gmsh_session session = {.threads = 0, .open = false};
+  PM_TRY(open_counting(path, dim, &session, &n_types));
+  if (n_types > 0) {
+    /* a mesh: the corners of its elements of dimension dim (what FPM
+     * meshes; a .msh's entity boxes are what the file says) */
+    PM_TRY(gm_gmsh_read(path, dim, false, &raw));
+    for (int c = 0; c < 3; c++) lo[c] = hi[c] = raw.x[c];
+    for (long k = 3; k < 3 * raw.n_nodes; k++) {
+      lo[k % 3] = fmin(lo[k % 3], raw.x[k]);
+      hi[k % 3] = fmax(hi[k % 3], raw.x[k]);
+    }
+  } else {
+    gmshModelGetBoundingBox(-1, -1, &lo[0], &lo[1], &lo[2], &hi[0], &hi[1],
+                            &hi[2], &ierr);
+    GM_GMSH_CHECK("bounding", path);
+  }
+  for (int c = 0; c < dim; c++)
+    PM_ENSURE(isfinite(lo[c]) && isfinite(hi[c]) && hi[c] > lo[c], PM_ERR_MESH,
+              "'%s' bounds nothing along %c ([%g, %g])", path, "xyz"[c], lo[c],
+              hi[c]);
+  if (dim == 2) lo[2] = hi[2] = 0;
+done:
+  gm_gmsh_mesh_free(&raw);
+  gm_gmsh_end(&session);
+  return ret;
 }

@@ -335,14 +335,17 @@ done:
 }
 
 /* Not thread-safe: gm_gmsh_load runs a gmsh session of its own. */
-pm_err gm_mesh_file(const char *path, int dim, double h, gm_mesh **out) {
+pm_err gm_mesh_file(const char *path, int dim, double h, gm_sizes rule,
+                    gm_mesh **out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_mesh_file: out is NULL");
   *out = NULL;
   pm_err ret = PM_SUCCESS;
   gm_mesh *m = NULL;
   gm_gmsh_mesh raw = {.dim = 0};
-  PM_TRY(gm_gmsh_load(path, dim, h, true, &raw));
+  PM_TRY(gm_gmsh_load(path, dim, h, rule, true, &raw));
   PM_TRY(mesh_from_raw(&raw, &m));
+  m->meshed = raw.meshed;
+  m->size_factor = raw.size_factor;
   for (int k = 0; k < 3; k++) {
     m->box_min[k] = m->box_max[k] = m->x[k];
     for (long i = 1; i < m->n_nodes; i++) {

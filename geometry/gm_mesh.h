@@ -7,6 +7,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "gm_gmsh.h"
 #include "pm_error.h"
 #include "pm_face.h"
 
@@ -32,6 +33,10 @@ typedef struct {
   int n_surfaces;
   char **surface_name; /* n_surfaces, owned */
   int *face_surface;   /* nodes_per_cell * n_cells, or NULL: no surfaces */
+  bool meshed;         /* gm_mesh_file: gmsh meshed the file (it held no
+                          mesh: else used as it is) */
+  double size_factor;  /* then: what multiplied the file's own sizes (0:
+                          replaced by h; gm_sizes) */
 } gm_mesh;
 
 /* Mesh the box [min, max] (dim 3: tetrahedra; dim 2: triangles in the z = 0
@@ -73,10 +78,10 @@ double gm_grade_size(const gm_grade *g, int dim, const double min[3],
 /* Mesh the volume (the surface in the z = 0 plane in 2D) of a gmsh-readable
  * file (.geo, .msh, .step/.stp, .brep), read and meshed as gm_volume_load
  * does (same h rule: a mesh in the file is used as it is; otherwise gmsh
- * meshes it at size h, or at the file's own sizes for h <= 0; higher-order
- * elements count through their corners).  Its surfaces are the physical
- * groups of dimension dim - 1 (Physical Surface in 3D, Physical Curve in
- * 2D), in gmsh's order (by tag), named by their physical names
+ * meshes it at size h by rule, or at the file's own sizes for h <= 0;
+ * higher-order elements count through their corners).  Its surfaces are the
+ * physical groups of dimension dim - 1 (Physical Surface in 3D, Physical Curve
+ * in 2D), in gmsh's order (by tag), named by their physical names
  * ("surface-TAG" for a group without one).  A boundary face takes
  * the surface of the group element with the same nodes (of the last such
  * group in gmsh's order), -1 when none has them; group elements that are
@@ -88,7 +93,8 @@ double gm_grade_size(const gm_grade *g, int dim, const double min[3],
  * triangles off z = 0), PM_ERR_UNSUPPORTED (non-simplex elements in the
  * volume or in a group), PM_ERR_GEOMETRY (a flat cell), PM_ERR_MEMORY.  Not
  * thread-safe, like gm_mesh_box. */
-pm_err gm_mesh_file(const char *path, int dim, double h, gm_mesh **out);
+pm_err gm_mesh_file(const char *path, int dim, double h, gm_sizes rule,
+                    gm_mesh **out);
 
 /* Build a mesh from given arrays (copied): x holds 3 coordinates per node,
  * cells dim + 1 nodes per cell (0-based).  Cells with negative volume are

@@ -164,7 +164,8 @@ static void cylinder_bounds(const gm_shape *s, double lo[3], double hi[3]) {
 
 static pm_err mesh_init(gm_shape *s, const pm_scene_body *b, double h) {
   PM_CHECK(b->mesh && b->mesh[0], PM_ERR_ARG, "mesh body without a file");
-  return gm_volume_load(b->mesh, s->dim, h, &s->volume);
+  /* the inside of the body at the grid's size */
+  return gm_volume_load(b->mesh, s->dim, h, GM_SIZES_REPLACE, &s->volume);
 }
 
 static bool mesh_contains(const gm_shape *s, const double x[3]) {

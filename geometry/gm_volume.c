@@ -214,13 +214,14 @@ done:
   return ret;
 }
 
-pm_err gm_volume_load(const char *path, int dim, double h, gm_volume **out) {
+pm_err gm_volume_load(const char *path, int dim, double h, gm_sizes rule,
+                      gm_volume **out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_volume_load: out is NULL");
   *out = NULL;
   pm_err ret = PM_SUCCESS;
   gm_gmsh_mesh raw = {.dim = 0};
   double *corners = NULL;
-  PM_TRY(gm_gmsh_load(path, dim, h, false, &raw));
+  PM_TRY(gm_gmsh_load(path, dim, h, rule, false, &raw));
   const size_t npc = (size_t)dim + 1;
   PM_TRY(PM_ALLOC(corners, 3 * npc * (size_t)raw.n_elems, "element corners"));
   for (size_t k = 0; k < npc * (size_t)raw.n_elems; k++)

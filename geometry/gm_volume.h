@@ -5,6 +5,7 @@
 
 #include <stdbool.h>
 
+#include "gm_gmsh.h"
 #include "pm_error.h"
 
 /* A volume: linear simplices (tetrahedra in 3D, triangles in the z = 0
@@ -13,8 +14,9 @@
 typedef struct gm_volume gm_volume;
 
 /* Load a gmsh-readable file (.msh, .geo, .step/.stp, .brep).  If it holds no
- * mesh of dimension dim (2 or 3), mesh it with gmsh at element size h
- * (h <= 0: the file's and gmsh's own size settings); a mesh already in the
+ * mesh of dimension dim (2 or 3), mesh it with gmsh at element size h by
+ * rule (gm_gmsh_sizes; h <= 0: the file's and gmsh's own size settings);
+ * a mesh already in the
  * file is used as it is, whatever h.  Higher-order elements count through
  * their corner nodes; flat (zero-measure) elements are dropped.  In 2D the
  * triangles must lie in the z = 0 plane.
@@ -31,7 +33,8 @@ typedef struct gm_volume gm_volume;
  * initializes gmsh, and finalizes it before returning (success or not), so
  * it must not run while another thread uses gmsh, nor while the caller has
  * a gmsh session of its own open.  The OpenMP thread count is restored. */
-pm_err gm_volume_load(const char *path, int dim, double h, gm_volume **out);
+pm_err gm_volume_load(const char *path, int dim, double h, gm_sizes rule,
+                      gm_volume **out);
 
 /* Frees the volume; NULL is a no-op. */
 void gm_volume_destroy(gm_volume *v);

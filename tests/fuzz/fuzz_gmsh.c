@@ -14,7 +14,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const char *path = fuzz_file("mesh.msh", data, size);
   for (int dim = 3; dim >= 2; dim--) {
     gm_mesh *m = NULL;
-    (void)gm_mesh_file(path, dim, 0.1, &m);
+    (void)gm_mesh_file(path, dim, 0.1, GM_SIZES_REPLACE, &m);
     gm_mesh_destroy(m);
     pm_error_clear();
   }

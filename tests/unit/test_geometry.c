@@ -378,7 +378,8 @@ static void test_file_meshes(void **state) {
   for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
     gm_mesh *m = NULL;
     gm_dual *d = NULL;
-    assert_ok(gm_mesh_file(files[k].path, files[k].dim, files[k].h, &m));
+    assert_ok(gm_mesh_file(files[k].path, files[k].dim, files[k].h,
+                           GM_SIZES_REPLACE, &m));
     assert_ok(gm_dual_build(m, &d));
     print_message("  %s\n", files[k].path);
     check_partition(m, d);

@@ -96,7 +96,7 @@ static void test_block_file(void **state) {
   gm_mesh *m = NULL;
   gm_dual *d = NULL;
   char buf[128];
-  assert_ok(gm_mesh_file(DATA "block.geo", 3, 0.02, &m));
+  assert_ok(gm_mesh_file(DATA "block.geo", 3, 0.02, GM_SIZES_REPLACE, &m));
   assert_ok(gm_dual_build(m, &d));
   print_message("  block.geo: %ld nodes, %ld cells, surfaces %s\n", m->n_nodes,
                 m->n_cells, gm_mesh_surface_list(m, buf, sizeof buf));
@@ -128,7 +128,7 @@ static void test_cylinder_file(void **state) {
   const double r = 0.05, len = 0.1, h = 0.01;
   gm_mesh *m = NULL;
   gm_dual *d = NULL;
-  assert_ok(gm_mesh_file(DATA "cylinder.geo", 3, h, &m));
+  assert_ok(gm_mesh_file(DATA "cylinder.geo", 3, h, GM_SIZES_REPLACE, &m));
   assert_ok(gm_dual_build(m, &d));
   assert_int_equal(m->n_surfaces, 2);
   int top = gm_mesh_surface_find(m, "top");
@@ -173,7 +173,7 @@ static void check_same_as_box(int dim, const char *path, double h) {
   const double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, dim == 3 ? 0.1 : 0};
   gm_mesh *a = NULL, *b = NULL;
   assert_ok(gm_mesh_box(dim, lo, hi, h, &a));
-  assert_ok(gm_mesh_file(path, dim, h, &b));
+  assert_ok(gm_mesh_file(path, dim, h, GM_SIZES_REPLACE, &b));
   print_message("  %dD: box %ld nodes, file %ld nodes\n", dim, a->n_nodes,
                 b->n_nodes);
   assert_int_equal(a->n_nodes, b->n_nodes);
@@ -205,7 +205,7 @@ static void test_msh_groups(void **state) {
   char buf[64];
   gm_mesh *m = NULL;
   gm_dual *d = NULL;
-  assert_ok(gm_mesh_file(DATA "tet-groups.msh", 3, 0.0, &m));
+  assert_ok(gm_mesh_file(DATA "tet-groups.msh", 3, 0.0, GM_SIZES_REPLACE, &m));
   assert_int_equal(m->n_cells, 1);
   assert_int_equal(m->n_nodes, 4);
   assert_string_equal(gm_mesh_surface_list(m, buf, sizeof buf),
@@ -232,7 +232,7 @@ static void test_msh_groups(void **state) {
    * follows the node count, not the largest tag. */
   assert_ok(gm_mesh_file(PM_SOURCE_DIR
                          "/tests/fuzz/regressions/gmsh/node-tag-4e8.msh",
-                         3, 0.0, &m));
+                         3, 0.0, GM_SIZES_REPLACE, &m));
   assert_int_equal(m->n_cells, 1);
   assert_int_equal(m->n_nodes, 4);
   assert_true(fabs(gm_mesh_volume(m) - 1.0 / 6) <= 1e-15);
@@ -246,7 +246,7 @@ static void test_disk_2d(void **state) {
   const double r = 0.5, h = 0.05;
   gm_mesh *m = NULL;
   gm_dual *d = NULL;
-  assert_ok(gm_mesh_file(DATA "disk.geo", 2, h, &m));
+  assert_ok(gm_mesh_file(DATA "disk.geo", 2, h, GM_SIZES_REPLACE, &m));
   assert_ok(gm_dual_build(m, &d));
   assert_int_equal(m->n_surfaces, 1);
   assert_string_equal(m->surface_name[0], "rim");
@@ -265,24 +265,120 @@ static void test_disk_2d(void **state) {
   gm_mesh_destroy(m);
 }
 
+/* The shortest and longest edges of m's cells near x0 (within r) and of
+ * all of them. */
+static void edge_range(const gm_mesh *m, const double x0[3], double r,
+                       double *near_min, double *all_max) {
+  *near_min = INFINITY;
+  *all_max = 0;
+  const int k = m->nodes_per_cell;
+  for (long c = 0; c < m->n_cells; c++)
+    for (int a = 0; a < k; a++)
+      for (int b = a + 1; b < k; b++) {
+        const double *p = m->x + 3 * m->cells[k * c + a],
+                     *q = m->x + 3 * m->cells[k * c + b];
+        const double len = hypot(hypot(p[0] - q[0], p[1] - q[1]), p[2] - q[2]);
+        *all_max = fmax(*all_max, len);
+        if (hypot(p[0] - x0[0], p[1] - x0[1]) < r)
+          *near_min = fmin(*near_min, len);
+      }
+}
+
+/* A .geo's own sizes meet the scene's h by rule: scale keeps the corner's
+ * tenfold refinement at h's level (its curves' longest edge h, none
+ * longer than about h; halving h halves every size), replace meshes at h
+ * everywhere, file keeps the file's sizes whatever h. */
+static void test_file_sizes(void **state) {
+  (void)state;
+  const double origin[3] = {0, 0, 0};
+  struct {
+    double h;
+    gm_sizes rule;
+    double factor, near_lo, near_hi, max_hi;
+  } want[] = {
+      /* the corner asks 0.05 at lc 0.5: 0.05 h / 0.5 */
+      {0.5, GM_SIZES_SCALE, 1, 0.02, 0.1, 0.75},
+      {0.25, GM_SIZES_SCALE, 0.5, 0.01, 0.05, 0.375},
+      {0.5, GM_SIZES_REPLACE, 0, 0.2, 0.75, 0.75},
+      {0.25, GM_SIZES_FILE, 1, 0.02, 0.1, 0.75},
+  };
+  long n[4];
+  for (int i = 0; i < 4; i++) {
+    gm_mesh *m = NULL;
+    assert_ok(
+        gm_mesh_file(DATA "panel-corner.geo", 2, want[i].h, want[i].rule, &m));
+    double near_min, all_max;
+    edge_range(m, origin, 0.5, &near_min, &all_max);
+    print_message("  rule %d h %g: %ld nodes, factor %g, shortest edge near "
+                  "the corner %.4g, longest %.4g\n",
+                  (int)want[i].rule, want[i].h, m->n_nodes, m->size_factor,
+                  near_min, all_max);
+    assert_true(m->meshed);
+    assert_true(fabs(m->size_factor - want[i].factor) <
+                0.05 * want[i].factor + 1e-12);
+    assert_true(near_min > want[i].near_lo && near_min < want[i].near_hi);
+    assert_true(all_max < want[i].max_hi);
+    n[i] = m->n_nodes;
+    gm_mesh_destroy(m);
+  }
+  /* halving h: about four times the nodes (3.5-4.2 with the boundary) */
+  assert_true(n[1] > 3.4 * n[0] && n[1] < 4.3 * n[0]);
+  assert_true(n[2] < n[0] / 2);
+  assert_int_equal(n[3], n[0]);
+}
+
+/* A closed surface mesh without a volume (an STL of the unit cube, twelve
+ * triangles) is the boundary of the volume gmsh meshes in it: the tets
+ * fill the cube exactly, its triangles kept. */
+static void test_stl_volume(void **state) {
+  (void)state;
+  gm_mesh *m = NULL;
+  assert_ok(gm_mesh_file(DATA "cube.stl", 3, 0.25, GM_SIZES_SCALE, &m));
+  double vol = 0;
+  for (long c = 0; c < m->n_cells; c++) {
+    const long *t = m->cells + 4 * c;
+    double e[3][3];
+    for (int a = 0; a < 3; a++)
+      for (int k = 0; k < 3; k++)
+        e[a][k] = m->x[3 * t[a + 1] + k] - m->x[3 * t[0] + k];
+    vol += (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+            e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+            e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
+           6;
+  }
+  print_message("  cube.stl: %ld nodes, %ld tets, volume %.15f\n", m->n_nodes,
+                m->n_cells, vol);
+  assert_true(fabs(vol - 1) < 1e-12);
+  assert_true(m->meshed && m->size_factor == 0); /* scale: replaced */
+  for (int k = 0; k < 3; k++) {
+    assert_true(m->box_min[k] == 0 && m->box_max[k] == 1);
+  }
+  assert_true(m->n_nodes > 8); /* nodes inside */
+  gm_mesh_destroy(m);
+}
+
 /* The errors of gm_mesh_file of its own (those of reading the file, which
  * it shares with gm_volume_load, are in test_volume). */
 static void test_errors(void **state) {
   (void)state;
   gm_mesh *m = (gm_mesh *)0x1;
   /* A quadrangle in a physical surface. */
-  assert_int_equal(gm_mesh_file(DATA "quad-in-group.msh", 3, 0.1, &m),
-                   PM_ERR_UNSUPPORTED);
+  assert_int_equal(
+      gm_mesh_file(DATA "quad-in-group.msh", 3, 0.1, GM_SIZES_REPLACE, &m),
+      PM_ERR_UNSUPPORTED);
   assert_null(m);
   print_message("  %s\n", pm_error_message());
   assert_non_null(strstr(pm_error_message(), "quad-in-group.msh"));
   assert_non_null(strstr(pm_error_message(), "physical group 'lid'"));
   /* A flat tetrahedron. */
-  assert_int_equal(gm_mesh_file(DATA "flat-tet.msh", 3, 0.1, &m),
-                   PM_ERR_GEOMETRY);
+  assert_int_equal(
+      gm_mesh_file(DATA "flat-tet.msh", 3, 0.1, GM_SIZES_REPLACE, &m),
+      PM_ERR_GEOMETRY);
   print_message("  %s\n", pm_error_message());
   assert_non_null(strstr(pm_error_message(), "flat-tet.msh"));
-  assert_int_equal(gm_mesh_file(DATA "flat-tet.msh", 3, 0.1, NULL), PM_ERR_ARG);
+  assert_int_equal(
+      gm_mesh_file(DATA "flat-tet.msh", 3, 0.1, GM_SIZES_REPLACE, NULL),
+      PM_ERR_ARG);
   assert_null(m);
   pm_error_clear();
 }
@@ -292,6 +388,7 @@ int main(void) {
       cmocka_unit_test(test_box_names),     cmocka_unit_test(test_block_file),
       cmocka_unit_test(test_cylinder_file), cmocka_unit_test(test_same_as_box),
       cmocka_unit_test(test_msh_groups),    cmocka_unit_test(test_disk_2d),
+      cmocka_unit_test(test_file_sizes),    cmocka_unit_test(test_stl_volume),
       cmocka_unit_test(test_errors),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

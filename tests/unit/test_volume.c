@@ -74,7 +74,7 @@ static void test_sphere(void **state) {
   char cwd[1024], cwd2[1024];
   assert_non_null(getcwd(cwd, sizeof cwd));
   gm_volume *v = NULL;
-  assert_ok(gm_volume_load(path, 3, h, &v));
+  assert_ok(gm_volume_load(path, 3, h, GM_SIZES_REPLACE, &v));
   assert_non_null(getcwd(cwd2, sizeof cwd2));
   assert_string_equal(cwd, cwd2); /* gmsh left the working directory */
   assert_int_equal(gm_volume_dim(v), 3);
@@ -128,7 +128,7 @@ static void test_sphere(void **state) {
   gm_volume_destroy(v);
 
   /* h <= 0: gmsh's own sizes (coarser here), still an inscribed mesh. */
-  assert_ok(gm_volume_load(path, 3, 0.0, &v));
+  assert_ok(gm_volume_load(path, 3, 0.0, GM_SIZES_REPLACE, &v));
   m = gm_volume_measure(v);
   print_message("  sphere, gmsh default size: %ld tetrahedra, volume %.6f\n",
                 gm_volume_elements(v), m);
@@ -149,7 +149,7 @@ static void test_box(void **state) {
                      path);
   const double lo[3] = {-1, 0, 2}, hi[3] = {1, 1, 2.5};
   gm_volume *v = NULL;
-  assert_ok(gm_volume_load(path, 3, 0.2, &v));
+  assert_ok(gm_volume_load(path, 3, 0.2, GM_SIZES_REPLACE, &v));
   double blo[3], bhi[3];
   gm_volume_bounds(v, blo, bhi);
   double m = gm_volume_measure(v);
@@ -196,7 +196,7 @@ static void test_disk_2d(void **state) {
                      "Disk(1) = {0, 0, 0, 0.5};\n",
                      path);
   gm_volume *v = NULL;
-  assert_ok(gm_volume_load(path, 2, h, &v));
+  assert_ok(gm_volume_load(path, 2, h, GM_SIZES_REPLACE, &v));
   assert_int_equal(gm_volume_dim(v), 2);
   const double exact = PI * r * r;
   double m = gm_volume_measure(v), rel = (exact - m) / exact;
@@ -241,7 +241,7 @@ static void test_msh_tetrahedra(void **state) {
                      "$EndElements\n",
                      path);
   gm_volume *v = NULL;
-  assert_ok(gm_volume_load(path, 3, 0.01, &v));
+  assert_ok(gm_volume_load(path, 3, 0.01, GM_SIZES_REPLACE, &v));
   assert_int_equal(gm_volume_elements(v), 2);
   assert_true(fabs(gm_volume_measure(v) - 2.0 / 6.0) <= 1e-15);
   double lo[3], hi[3];
@@ -298,7 +298,7 @@ static void test_cad_files(void **state) {
   const double r = 0.5, h = 0.1, ball = 4.0 / 3.0 * PI * r * r * r;
   for (int i = 0; i < 2; i++) {
     gm_volume *v = NULL;
-    assert_ok(gm_volume_load(path[i], 3, h, &v));
+    assert_ok(gm_volume_load(path[i], 3, h, GM_SIZES_REPLACE, &v));
     double m = gm_volume_measure(v), rel = (1.0 + ball - m) / ball;
     print_message("  %s: %ld tetrahedra, volume %.6f (box + ball %.6f, ball "
                   "deficit %.2e)\n",
@@ -322,12 +322,12 @@ static void expect_failure(const char *path, int dim, double h, pm_err code,
                            const char *what) {
   gm_volume *v = (gm_volume *)0x1;
   gm_mesh *m = (gm_mesh *)0x1;
-  assert_int_equal(gm_volume_load(path, dim, h, &v), code);
+  assert_int_equal(gm_volume_load(path, dim, h, GM_SIZES_REPLACE, &v), code);
   assert_null(v);
   print_message("  %s\n", pm_error_message());
   assert_non_null(strstr(pm_error_message(), what));
   if (path) assert_non_null(strstr(pm_error_message(), path));
-  assert_int_equal(gm_mesh_file(path, dim, h, &m), code);
+  assert_int_equal(gm_mesh_file(path, dim, h, GM_SIZES_REPLACE, &m), code);
   assert_null(m);
   assert_non_null(strstr(pm_error_message(), what));
   if (path) assert_non_null(strstr(pm_error_message(), path));
@@ -369,7 +369,7 @@ static void test_errors(void **state) {
   assert_int_equal(gm_msh_node_count(v4), -1);
   assert_int_equal(gm_msh_node_count(missing), -1);
   /* ... which is fine in 2D. */
-  assert_ok(gm_volume_load(path, 2, 0.1, &v));
+  assert_ok(gm_volume_load(path, 2, 0.1, GM_SIZES_REPLACE, &v));
   assert_true(fabs(gm_volume_measure(v) - 0.5) <= 1e-15);
   gm_volume_destroy(v);
   /* A syntax error: gmsh's own message is quoted. */
@@ -415,7 +415,8 @@ static void test_errors(void **state) {
   expect_failure(path, 4, 0.1, PM_ERR_ARG, "2 or 3");
   expect_failure(path, 3, NAN, PM_ERR_ARG, "finite");
   expect_failure(NULL, 3, 0.1, PM_ERR_ARG, "no volume file name");
-  assert_int_equal(gm_volume_load(path, 3, 0.1, NULL), PM_ERR_ARG);
+  assert_int_equal(gm_volume_load(path, 3, 0.1, GM_SIZES_REPLACE, NULL),
+                   PM_ERR_ARG);
   gm_volume_destroy(NULL);
   pm_error_clear();
 }
@@ -435,9 +436,9 @@ static void test_gmsh_state(void **state) {
   pm_omp_set_threads(2);
   int threads = pm_omp_threads();
   assert_ok(gm_mesh_box(3, lo, hi, 0.25, &m1));
-  assert_ok(gm_volume_load(path, 3, 0.1, &v1));
+  assert_ok(gm_volume_load(path, 3, 0.1, GM_SIZES_REPLACE, &v1));
   assert_ok(gm_mesh_box(3, lo, hi, 0.25, &m2));
-  assert_ok(gm_volume_load(path, 3, 0.1, &v2));
+  assert_ok(gm_volume_load(path, 3, 0.1, GM_SIZES_REPLACE, &v2));
   assert_int_equal(pm_omp_threads(), threads);
   pm_omp_set_threads(before);
   assert_int_equal(m1->n_cells, m2->n_cells);

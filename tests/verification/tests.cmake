@@ -131,3 +131,7 @@ set_tests_properties(verification.disks PROPERTIES LABELS verification TIMEOUT 1
 add_test(NAME verification.static_stop
   COMMAND bash ${PM_VERIFY_DIR}/static-stop.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.static_stop PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 1)
+
+add_test(NAME verification.kirsch
+  COMMAND bash ${PM_VERIFY_DIR}/kirsch.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.kirsch PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 1)

@@ -133,6 +133,16 @@ typedef enum {
 /* The scene's words for them (membrane.normals). */
 extern const pm_name pm_normals_names[];
 
+/* discretization.mesh_sizes: how a gmsh file's own element sizes meet
+ * mesh_size where gmsh meshes it (gm_sizes' order). */
+enum {
+  PM_MESH_SIZES_SCALE = 0, /* the file's sizes times one factor: the longest
+                              edge of its curves' mesh becomes mesh_size */
+  PM_MESH_SIZES_REPLACE,   /* mesh_size everywhere (the file's sizes ignored) */
+  PM_MESH_SIZES_FILE,      /* the file's sizes as written */
+};
+extern const pm_name pm_mesh_sizes_names[];
+
 /* discretization.refine.to: what the grading's distance is measured to. */
 enum { PM_REFINE_FACES = 0, PM_REFINE_EDGES = 1 };
 extern const pm_name pm_refine_to_names[];
@@ -273,7 +283,11 @@ typedef struct pm_scene {
   const struct pm_backend *backend; /* the registered backend of method */
   int dimension;                    /* 2 (plane strain) or 3 */
   double box_min[3], box_max[3];    /* domain.box; z 0 in 2D */
+  bool domain_from_body;            /* domain not given: box_min, box_max
+                                       bound the scene's body (FPM) */
   double mesh_size;                 /* discretization.mesh_size, m, > 0 */
+  int mesh_sizes;                   /* discretization.mesh_sizes:
+                                       PM_MESH_SIZES_SCALE ... */
   struct {
     unsigned near;     /* discretization.refine.near: bit f for face f
                           (pm_face); 0: a uniform mesh */
@@ -343,6 +357,15 @@ typedef struct pm_scene {
   void *section_opts[PM_SCENE_SECTIONS];
   pm_sdoc doc;
 } pm_scene;
+
+/* The bounds [lo, hi] of the geometry in a gmsh-readable file (dimension
+ * dim), for a scene that gives no domain; its error names the file. */
+typedef pm_err (*pm_scene_file_bounds_fn)(const char *path, int dim,
+                                          double lo[3], double hi[3]);
+/* The reader of such bounds (the program sets the geometry layer's,
+ * gm_file_bounds, at start); without one a scene whose domain would come
+ * from a file fails. */
+void pm_scene_set_file_bounds(pm_scene_file_bounds_fn fn);
 
 /* Load a scene file, apply overrides ("key.path=value", e.g.
  * "discretization.mesh_size=8.02e-3", "boundary.3.displacement.z=-0.06"),

@@ -8,17 +8,6 @@
 
 #include "pm_scene_vocab.h"
 
-static pm_err finish_domain(pm_reader *r, pm_scene *s) {
-  char p[PM_SDOC_PATH], what[128];
-  for (int c = 0; c < s->dimension; c++)
-    if (!(s->box_max[c] > s->box_min[c])) {
-      snprintf(what, sizeof what, "a number > domain.box.min.%d (%g)", c,
-               s->box_min[c]);
-      return pm_reader_expected(r, PM_PATH(p, "domain.box.max.%d", c), what);
-    }
-  return PM_SUCCESS;
-}
-
 /* discretization.refine: faces of the box's dimension, one of size (at most
  * the mesh size) and size_ratio, and for FPM a box it meshes (not a mesh
  * file).  MPM's grid stays uniform at mesh_size: its backend notes the key
@@ -491,8 +480,8 @@ static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
 }
 
 pm_err pm_scene_finish(pm_reader *r, pm_scene *s) {
-  PM_CALL(finish_domain(r, s));
   PM_CALL(finish_bodies(r, s));
+  PM_CALL(pm_scene_finish_domain(r, s));
   PM_CALL(finish_refine(r, s));
   PM_CALL(finish_time(r, s));
   PM_CALL(finish_bcs(r, s));

@@ -81,6 +81,10 @@ static const pm_name face_names[] = {{"xmin", 1u << PM_FACE_XMIN},
                                      {"zmin", 1u << PM_FACE_ZMIN},
                                      {"zmax", 1u << PM_FACE_ZMAX},
                                      {NULL, 0}};
+const pm_name pm_mesh_sizes_names[] = {{"scale", PM_MESH_SIZES_SCALE},
+                                       {"replace", PM_MESH_SIZES_REPLACE},
+                                       {"file", PM_MESH_SIZES_FILE},
+                                       {NULL, 0}};
 const pm_name pm_refine_to_names[] = {
     {"faces", PM_REFINE_FACES}, {"edges", PM_REFINE_EDGES}, {NULL, 0}};
 static const pm_key refine_keys[] = {
@@ -137,6 +141,21 @@ static const pm_key discretization_keys[] = {
      .range = PM_RANGE_GT,
      .unit = "m",
      .doc = "FPM: gmsh element size; MPM: cell size"},
+    {.name = "mesh_sizes",
+     .type = PM_KEY_ENUM,
+     .offset = S(mesh_sizes),
+     .def = "scale",
+     .names = pm_mesh_sizes_names,
+     .doc = "how the element sizes a gmsh geometry sets itself (.geo point "
+            "sizes, size fields, Mesh options) meet mesh_size where gmsh "
+            "meshes it: scale (all of them times one factor, so that the "
+            "longest edge of the mesh of its curves at the file's own sizes "
+            "becomes mesh_size, and at most mesh_size: its grading kept, its "
+            "level set by mesh_size; a file without sizes is meshed at "
+            "mesh_size), replace (mesh_size everywhere, the file's sizes "
+            "ignored) or file (the file's sizes as written; mesh_size then "
+            "sizes MPM's grid alone).  A file that holds a mesh (.msh) is "
+            "used as it is"},
     {.name = "refine",
      .type = PM_KEY_MAPPING,
      .keys = refine_keys,
@@ -508,7 +527,8 @@ static const pm_key body_keys[] = {
     {.name = "mesh",
      .type = PM_KEY_STRING,
      .offset = B(mesh),
-     .doc = "a gmsh-readable volume (.msh .geo .step .brep), relative to the "
+     .doc = "a gmsh-readable volume (.msh .geo .step .brep, or .stl: a closed "
+            "surface), relative to the "
             "scene"},
     {.name = "membrane",
      .type = PM_KEY_MAPPING,
@@ -978,9 +998,11 @@ const pm_key pm_scene_keys[] = {
      .doc = "3, or 2 for plane strain"},
     {.name = "domain",
      .type = PM_KEY_MAPPING,
-     .flags = PM_KEY_REQUIRED,
      .keys = domain_keys,
-     .doc = "{box: {min, max}}"},
+     .doc = "{box: {min, max}}; FPM may leave it out where one gmsh volume "
+            "(or one box body) is the geometry: its bounds are the box "
+            "(faces xmin ... zmax); MPM needs it (the grid, with room for "
+            "the bodies' motion)"},
     {.name = "discretization",
      .type = PM_KEY_MAPPING,
      .flags = PM_KEY_REQUIRED,

@@ -38,4 +38,9 @@ void pm_scene_release_expr(void *dst);
  * indices, and the checks across keys, each failing at the key at fault. */
 pm_err pm_scene_finish(pm_reader *r, pm_scene *s);
 
+/* domain.box: the one given, checked, or for FPM without it the bounds of
+ * the body that bounds the scene (pm_scene_domain.c; after the bodies'
+ * paths are resolved). */
+pm_err pm_scene_finish_domain(pm_reader *r, pm_scene *s);
+
 #endif

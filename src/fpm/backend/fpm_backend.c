@@ -66,7 +66,7 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   sim->far_size = s->mesh_size;
   if (domain >= 0)
     PM_TRY(gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
-                        &sim->mesh));
+                        (gm_sizes)s->mesh_sizes, &sim->mesh));
   else {
     gm_grade grade;
     fpm_grade_of(s, &grade, &sim->far_size);

@@ -54,6 +54,35 @@ static double plan_head(fpm_sim *sim, FILE *out) {
           m->dim == 2 ? "plane strain" : "solid");
   fprintf(out, "points       %ld (mesh size %g m, mean edge %.4g m)\n", m->n,
           s->mesh_size, sim->mean_edge);
+  const int body = fpm_domain_body(s);
+  if (body >= 0 && sim->mesh && !sim->mesh->meshed)
+    fprintf(out,
+            "             %s holds a mesh: used as it is (mesh_size does "
+            "not remesh it)\n",
+            s->bodies[body].mesh);
+  else if (body >= 0 && sim->mesh && sim->mesh->size_factor > 0)
+    fprintf(out,
+            "             %s meshed by gmsh at its own sizes times %.4g "
+            "(discretization.mesh_sizes: %s)\n",
+            s->bodies[body].mesh, sim->mesh->size_factor,
+            s->mesh_sizes == PM_MESH_SIZES_FILE
+                ? "file"
+                : "scale: its "
+                  "curves' longest edge becomes mesh_size");
+  else if (body >= 0 && sim->mesh)
+    fprintf(out,
+            "             %s meshed by gmsh at mesh_size everywhere, its own "
+            "sizes replaced (discretization.mesh_sizes: replace)\n",
+            s->bodies[body].mesh);
+  if (s->domain_from_body) {
+    fprintf(out,
+            "domain       not given: the bounds of bodies.%d, [%g, %g] x "
+            "[%g, %g]",
+            body >= 0 ? body : 0, s->box_min[0], s->box_max[0], s->box_min[1],
+            s->box_max[1]);
+    if (m->dim == 3) fprintf(out, " x [%g, %g]", s->box_min[2], s->box_max[2]);
+    fprintf(out, " (its faces xmin ... %s)\n", m->dim == 3 ? "zmax" : "ymax");
+  }
   if (sim->near_size > 0)
     fprintf(out,
             "             graded (discretization.refine): %.4g m on the %s, "
