@@ -34,7 +34,7 @@ out=$(
   # the methods never know each other; src/common and geometry neither
   check "FPM includes MPM" "$(names src/mpm)" $(find src/fpm -name '*.[ch]')
   check "MPM includes FPM" "$(names src/fpm)" $(find src/mpm -name '*.[ch]')
-  check "common includes a method" "$(names src/fpm src/mpm src/cli)" $(find src/common geometry -name '*.[ch]' -o -name '*.cpp')
+  check "common includes a method" "$(names src/fpm src/mpm src/cli src/api include)" $(find src/common geometry -name '*.[ch]' -o -name '*.cpp')
 )
 [ -n "$out" ] && { echo "$out"; bad=$((bad + $(echo "$out" | wc -l))); }
 

@@ -49,7 +49,7 @@ static pm_err open_outputs(pm_run_ctx *c, const char *out_dir, unsigned flags,
 
 pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
                    unsigned flags, pm_outcome *o, pm_outdir **outdir,
-                   pm_run_resume_info *rs) {
+                   pm_run_resume_info *rs, const pm_observer *also) {
   pm_err ret = PM_SUCCESS, run_err = PM_SUCCESS;
   pm_run_ctx *c = NULL;
   const bool quiet = flags & PM_RUN_QUIET;
@@ -64,6 +64,7 @@ pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
   c->be = s->backend;
   c->sim = sim;
   c->o = o;
+  c->also = also;
   c->show_progress = !quiet;
   c->tm_output = pm_timers_add(&c->out_timer, "output");
   c->tm_checkpoint = pm_timers_add(&c->out_timer, "checkpoint");
@@ -129,7 +130,7 @@ done:
 
 pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir,
                   unsigned flags, pm_outcome *o) {
-  return pm_run_root(s, sim, out_dir, flags, o, NULL, NULL);
+  return pm_run_root(s, sim, out_dir, flags, o, NULL, NULL, NULL);
 }
 
 /* A rank other than 0 of a run across ranks: it steps its share and joins
@@ -149,10 +150,12 @@ pm_err pm_run_worker(const pm_scene *s, void *sim, pm_outcome *o) {
   return e;
 }
 
-pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
-                    pm_outcome *o) {
+pm_err pm_run_scene_observed(const pm_scene *s, const char *out_dir,
+                             unsigned flags, const pm_observer *also,
+                             void **simp, pm_outcome *o) {
   pm_err ret = PM_SUCCESS;
   void *sim = NULL;
+  *simp = NULL;
   pm_outdir *outdir = NULL;
   const bool ranks = pm_par_active(), root = pm_par_root();
   PM_CALL(pm_run_check_not_interrupted(o));
@@ -176,14 +179,23 @@ pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
   } else {
     PM_TRY(s->backend->create(s, &sim));
   }
+  *simp = sim; /* the caller's observer reads it during the run */
   if (root)
-    ret = pm_run_root(s, sim, out_dir, flags, o, &outdir, NULL);
+    ret = pm_run_root(s, sim, out_dir, flags, o, &outdir, NULL, also);
   else
     ret = pm_run_worker(s, sim, o);
 done:
-  if (sim) s->backend->destroy(sim);
+  *simp = sim;
   pm_outdir_release(outdir);
   return ret;
+}
+
+pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
+                    pm_outcome *o) {
+  void *sim = NULL;
+  pm_err e = pm_run_scene_observed(s, out_dir, flags, NULL, &sim, o);
+  if (sim) s->backend->destroy(sim);
+  return e;
 }
 
 pm_err pm_plan_scene(const pm_scene *s, FILE *out) {

@@ -56,6 +56,15 @@ pm_err pm_run_sim(const pm_scene *s, void *sim, const char *out_dir,
 pm_err pm_run_scene(const pm_scene *s, const char *out_dir, unsigned flags,
                     pm_outcome *o);
 
+/* pm_run_scene with the caller's observer also (NULL: none), told of
+ * every step after the driver has written what the step writes (on rank 0
+ * across ranks; the shares gathered where its wants asks), and the
+ * simulation kept: *sim, the backend's, for the caller to read and destroy
+ * (s->backend->destroy), NULL when the setup failed. */
+pm_err pm_run_scene_observed(const pm_scene *s, const char *out_dir,
+                             unsigned flags, const pm_observer *also,
+                             void **sim, pm_outcome *o);
+
 /* Continue the run in out_dir from its checkpoint.h5: the scene is loaded
  * again from the file and overrides the checkpoint names (refused when its
  * text changed, when the checkpoint comes from another program version, or

@@ -52,6 +52,7 @@ typedef struct {
   bool decided;
   int decided_sig;
   bool decided_ckpt;
+  const pm_observer *also; /* the caller's observer, after the driver's */
 } pm_run_ctx;
 
 /* The driver's items of a checkpoint, before the backend's: what the run
@@ -144,10 +145,11 @@ void pm_run_report(pm_run_ctx *c);
 
 /* Runs sim on rank 0 (or one process): outputs in out_dir (NULL: none),
  * outdir the folder claimed by the caller (taken over) or NULL, rs the
- * checkpoint it resumes from or NULL. */
+ * checkpoint it resumes from or NULL, also the caller's observer or
+ * NULL. */
 pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
                    unsigned flags, pm_outcome *o, pm_outdir **outdir,
-                   pm_run_resume_info *rs);
+                   pm_run_resume_info *rs, const pm_observer *also);
 
 /* A rank other than 0 of a run across ranks: steps its share. */
 pm_err pm_run_worker(const pm_scene *s, void *sim, pm_outcome *o);

@@ -41,7 +41,9 @@ static void decide(pm_run_ctx *c, const pm_step_report *r) {
 bool pm_run_wants(void *ctx, const pm_step_report *r, bool frame) {
   pm_run_ctx *c = ctx;
   decide(c, r);
-  return frame || c->decided_sig || c->decided_ckpt;
+  const bool also =
+      c->also && c->also->wants && c->also->wants(c->also->ctx, r, frame);
+  return frame || c->decided_sig || c->decided_ckpt || also;
 }
 
 /* The checkpoint of step; after a signal sig, a method that cannot write
@@ -81,6 +83,7 @@ pm_err pm_run_observe(void *ctx, const pm_step_report *r, bool frame) {
     c->extra_frame = !frame;
   }
   if (c->decided_ckpt && !extra) PM_CALL(checkpoint(c, r->step, sig));
+  if (c->also) PM_CALL(c->also->step(c->also->ctx, r, frame));
   if (!sig) return PM_SUCCESS;
   if (c->ckpt_step == r->step)
     return PM_ERROR(PM_ERR_INTERRUPTED,

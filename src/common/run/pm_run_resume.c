@@ -90,7 +90,7 @@ pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o) {
   PM_TRY(pm_par_agree(pm_memory_check(s)));
   PM_TRY(s->backend->create(s, &sim));
   if (pm_par_root())
-    ret = pm_run_root(s, sim, out_dir, flags, o, &outdir, &rs);
+    ret = pm_run_root(s, sim, out_dir, flags, o, &outdir, &rs, NULL);
   else
     ret = resume_worker(s, sim, &rs, o);
 done:
