@@ -1,0 +1,131 @@
+/* test_output_pieces: a frame written in pieces (as ranks write it), joined
+ * by a frame file of virtual datasets: read whole through the index, in
+ * piece order with the one-process indices beside, by HDF5 and by the
+ * Python reader (in one-process order); pieces that do not add up to the
+ * results' points refused. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "pm_testing.h"
+
+#include <hdf5.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output_testing.h"
+#include "pm_output.h"
+
+/* The five points shared by two pieces, out of one-process order. */
+static const long piece_index[2][3] = {{4, 1, 2}, {0, 3}};
+static const long piece_n[2] = {3, 2};
+
+/* Point i's displacement component c at frame k, and its J. */
+static double u_of(long i, int c, int k) { return 10.0 * i + c + 0.5 * k; }
+static double j_of(long i, int k) { return 1.0 + 0.01 * i + k; }
+
+/* Piece p of frame k of the results in dir. */
+static void write_piece(const char *dir, int k, int p) {
+  double u[3 * 3], J[3];
+  for (long j = 0; j < piece_n[p]; j++) {
+    for (int c = 0; c < 3; c++) u[3 * j + c] = u_of(piece_index[p][j], c, k);
+    J[j] = j_of(piece_index[p][j], k);
+  }
+  const pm_field f[2] = {{"displacement", 3, u}, {"jacobian", 1, J}};
+  assert_ok(pm_results_write_piece(dir, k, p, piece_n[p], piece_index[p],
+                                   10 * k, 0.1 * k, 2, f));
+}
+
+/* Dataset name of frame k, read through results.h5 into out (n values). */
+static void read_frame(const char *dir, int k, const char *name, hid_t mtype,
+                       void *out) {
+  char path[512], obj[64];
+  snprintf(path, sizeof path, "%s/results.h5", dir);
+  snprintf(obj, sizeof obj, "/frames/%06d/%s", k, name);
+  hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+  assert_true(file >= 0);
+  hid_t d = H5Dopen2(file, obj, H5P_DEFAULT);
+  assert_true(d >= 0);
+  assert_true(H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) >= 0);
+  H5Dclose(d);
+  H5Fclose(file);
+}
+
+static void test_pieces(void **state) {
+  const char *dir = *state;
+  pm_results *r = NULL;
+  const pm_points pts = {.n = NP, .x = coords, .nodes_per_cell = 1};
+  assert_ok(pm_results_create_ex(dir, 3, &pts, scene, "v", &r));
+  const double u0[3] = {0, 0, 0}, J0 = 1;
+  const pm_field names[2] = {{"displacement", 3, u0}, {"jacobian", 1, &J0}};
+  for (int k = 0; k < 2; k++) {
+    for (int p = 0; p < 2; p++) write_piece(dir, k, p);
+    assert_ok(pm_results_join_pieces(r, 10 * k, 0.1 * k, 2, piece_n, 2, names));
+  }
+  assert_int_equal(pm_results_frames(r), 2);
+
+  /* Pieces that do not hold the results' points are refused. */
+  const long short_n[2] = {3, 1};
+  assert_int_equal(pm_results_join_pieces(r, 20, 0.2, 2, short_n, 2, names),
+                   PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "pieces hold 4 points"));
+  pm_error_clear();
+  assert_int_equal(pm_results_frames(r), 2);
+  pm_results_close(r, true);
+
+  /* Each frame reads whole: piece order, the indices beside. */
+  for (int k = 0; k < 2; k++) {
+    double u[3 * NP], J[NP];
+    long index[NP];
+    read_frame(dir, k, "displacement", H5T_NATIVE_DOUBLE, u);
+    read_frame(dir, k, "jacobian", H5T_NATIVE_DOUBLE, J);
+    read_frame(dir, k, PM_PIECE_INDEX, H5T_NATIVE_LONG, index);
+    long row = 0;
+    for (int p = 0; p < 2; p++)
+      for (long j = 0; j < piece_n[p]; j++, row++) {
+        const long i = piece_index[p][j];
+        assert_int_equal(index[row], i);
+        assert_true(J[row] == j_of(i, k));
+        for (int c = 0; c < 3; c++)
+          assert_true(u[3 * row + c] == u_of(i, c, k));
+      }
+  }
+
+  /* The XDMF shows one field a frame over all the points. */
+  char path[512];
+  snprintf(path, sizeof path, "%s/results.xdmf", dir);
+  char *x = pm_test_slurp(path);
+  const char *end = x + strlen(x);
+  assert_int_equal(count_in(x, end, "results/frame_000001.h5:/displacement<"),
+                   1);
+  assert_int_equal(count_in(x, end, "NumberOfElements=\"5\""), 2);
+  assert_int_equal(count_in(x, end, "piece_"), 0);
+  free(x);
+  python_check_xdmf(dir, "len(x.findall(\".//Time\")) == 2");
+
+  /* The Python reader gives the fields in one-process order. */
+  char cmd[2048];
+  if (access("/usr/bin/python3", X_OK) == 0) {
+    snprintf(cmd, sizeof cmd,
+             "PYTHONPATH=%s /usr/bin/python3 -c 'import sys, pointmech; "
+             "f = pointmech.open(sys.argv[1]).frames[-1]; "
+             "u = f[\"displacement\"]; J = f[\"jacobian\"]; "
+             "assert [list(u[i]) for i in range(5)] == "
+             "[[10.0 * i + c + 0.5 for c in range(3)] for i in range(5)], u; "
+             "assert list(J) == [1.0 + 0.01 * i + 1 for i in range(5)], J; "
+             "assert \"index\" not in f.keys()' %s",
+             PM_SOURCE_DIR "/python", dir);
+    assert_int_equal(system(cmd), 0);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test_setup_teardown(test_pieces, pm_test_make_dir,
+                                      pm_test_drop_dir),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
