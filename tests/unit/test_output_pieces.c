@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "frame_read.h"
 #include "output_testing.h"
 #include "pm_output.h"
 
@@ -39,19 +40,10 @@ static void write_piece(const char *dir, int k, int p) {
                                    10 * k, 0.1 * k, 2, f));
 }
 
-/* Dataset name of frame k, read through results.h5 into out (n values). */
+/* Dataset name of frame k, read through results.h5 into out. */
 static void read_frame(const char *dir, int k, const char *name, hid_t mtype,
                        void *out) {
-  char path[512], obj[64];
-  snprintf(path, sizeof path, "%s/results.h5", dir);
-  snprintf(obj, sizeof obj, "/frames/%06d/%s", k, name);
-  hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-  assert_true(file >= 0);
-  hid_t d = H5Dopen2(file, obj, H5P_DEFAULT);
-  assert_true(d >= 0);
-  assert_true(H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) >= 0);
-  H5Dclose(d);
-  H5Fclose(file);
+  assert_true(pm_test_read_frame(dir, k, name, mtype, out));
 }
 
 static void test_pieces(void **state) {
