@@ -20,7 +20,7 @@ for n in 2 3; do
   check "a frame in pieces on $n ranks is the gathered frame" \
     ranks "$n" "$tool" "$out" 7 5 3
   check "the Python module reads $n ranks' pieces in one-process order" \
-    env PYTHONPATH="$src/python" $py -c '
+    env PYTHONPATH="$src/python" "$py" -c '
 import sys, h5py, numpy as np, pointmech
 r = pointmech.open(sys.argv[1])
 whole, pieces = r.frames[0], r.frames[1]
