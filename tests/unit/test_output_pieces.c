@@ -11,6 +11,7 @@
 
 #include "pm_testing.h"
 
+#include <dirent.h>
 #include <hdf5.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,14 +31,19 @@ static double j_of(long i, int k) { return 1.0 + 0.01 * i + k; }
 
 /* Piece p of frame k of the results in dir. */
 static void write_piece(const char *dir, int k, int p) {
-  double u[3 * 3], J[3];
+  double x[3 * 3], u[3 * 3], J[3];
   for (long j = 0; j < piece_n[p]; j++) {
-    for (int c = 0; c < 3; c++) u[3 * j + c] = u_of(piece_index[p][j], c, k);
-    J[j] = j_of(piece_index[p][j], k);
+    const long i = piece_index[p][j];
+    for (int c = 0; c < 3; c++) {
+      u[3 * j + c] = u_of(i, c, k);
+      x[3 * j + c] = coords[3 * i + c] + u[3 * j + c];
+    }
+    J[j] = j_of(i, k);
   }
-  const pm_field f[2] = {{"displacement", 3, u}, {"jacobian", 1, J}};
+  const pm_field f[3] = {
+      {"position", 3, x}, {"displacement", 3, u}, {"jacobian", 1, J}};
   assert_ok(pm_results_write_piece(dir, k, p, piece_n[p], piece_index[p],
-                                   10 * k, 0.1 * k, 2, f));
+                                   10 * k, 0.1 * k, 3, f));
 }
 
 /* Dataset name of frame k, read through results.h5 into out. */
@@ -46,24 +52,45 @@ static void read_frame(const char *dir, int k, const char *name, hid_t mtype,
   assert_true(pm_test_read_frame(dir, k, name, mtype, out));
 }
 
+/* The files in dir whose names start with prefix. */
+static int count_named(const char *dir, const char *prefix) {
+  DIR *d = opendir(dir);
+  assert_non_null(d);
+  int n = 0;
+  for (struct dirent *e; (e = readdir(d));)
+    n += strncmp(e->d_name, prefix, strlen(prefix)) == 0;
+  closedir(d);
+  return n;
+}
+
 static void test_pieces(void **state) {
   const char *dir = *state;
   pm_results *r = NULL;
   const pm_points pts = {.n = NP, .x = coords, .nodes_per_cell = 1};
   assert_ok(pm_results_create_ex(dir, 3, &pts, scene, "v", &r));
   const double u0[3] = {0, 0, 0}, J0 = 1;
-  const pm_field names[2] = {{"displacement", 3, u0}, {"jacobian", 1, &J0}};
+  const pm_field names[3] = {
+      {"position", 3, u0}, {"displacement", 3, u0}, {"jacobian", 1, &J0}};
+  char path[512];
+  snprintf(path, sizeof path, "%s/results.xdmf", dir);
+  char *one = NULL; /* the XDMF of one frame, for the resume below */
   for (int k = 0; k < 2; k++) {
     for (int p = 0; p < 2; p++) write_piece(dir, k, p);
-    assert_ok(pm_results_join_pieces(r, 10 * k, 0.1 * k, 2, piece_n, 2, names));
+    assert_ok(pm_results_join_pieces(r, 10 * k, 0.1 * k, 2, piece_n, 3, names));
+    if (k == 0) one = pm_test_slurp(path);
   }
   assert_int_equal(pm_results_frames(r), 2);
 
   /* Pieces that do not hold the results' points are refused. */
   const long short_n[2] = {3, 1};
-  assert_int_equal(pm_results_join_pieces(r, 20, 0.2, 2, short_n, 2, names),
+  assert_int_equal(pm_results_join_pieces(r, 20, 0.2, 2, short_n, 3, names),
                    PM_ERR_ARG);
   assert_non_null(strstr(pm_error_message(), "pieces hold 4 points"));
+  pm_error_clear();
+  /* Without "position" the frame has no geometry in piece order. */
+  assert_int_equal(pm_results_join_pieces(r, 20, 0.2, 2, piece_n, 2, names + 1),
+                   PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "no field \"position\""));
   pm_error_clear();
   assert_int_equal(pm_results_frames(r), 2);
   pm_results_close(r, true);
@@ -87,13 +114,13 @@ static void test_pieces(void **state) {
   }
 
   /* The XDMF shows one field a frame over all the points. */
-  char path[512];
-  snprintf(path, sizeof path, "%s/results.xdmf", dir);
   char *x = pm_test_slurp(path);
   const char *end = x + strlen(x);
   assert_int_equal(count_in(x, end, "results/frame_000001.h5:/displacement<"),
                    1);
   assert_int_equal(count_in(x, end, "NumberOfElements=\"5\""), 2);
+  assert_int_equal(count_in(x, end, "results/frame_000001.h5:/position<"), 1);
+  assert_int_equal(count_in(x, end, "mesh.h5:/coordinates"), 0);
   assert_int_equal(count_in(x, end, "piece_"), 0);
   free(x);
   python_check_xdmf(dir, "len(x.findall(\".//Time\")) == 2");
@@ -112,6 +139,27 @@ static void test_pieces(void **state) {
              PM_SOURCE_DIR "/python", dir);
     assert_int_equal(system(cmd), 0);
   }
+
+  /* A resumed run keeping one frame: the later frame and its pieces gone,
+   * the XDMF that of one frame, byte for byte (the index no field). */
+  assert_ok(pm_results_reopen(dir, NP, 1, &r));
+  pm_results_close(r, true);
+  x = pm_test_slurp(path);
+  assert_string_equal(x, one);
+  free(x);
+  free(one);
+  char name[512];
+  snprintf(name, sizeof name, "%s/results", dir);
+  assert_int_equal(count_named(name, "frame_000001"), 0);
+  assert_int_equal(count_named(name, "frame_000000"), 3);
+
+  /* Cells index the points in one-process order: no pieces over them. */
+  assert_ok(pm_results_create(dir, 3, NP, coords, NC, 4, tets, scene, "v", &r));
+  assert_int_equal(pm_results_join_pieces(r, 0, 0, 2, piece_n, 3, names),
+                   PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "only points"));
+  pm_error_clear();
+  pm_results_close(r, false);
 }
 
 int main(void) {

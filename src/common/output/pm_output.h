@@ -133,7 +133,9 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
  * virtual datasets joining the pieces in piece order, and the index and
  * results.xdmf as for any frame: ParaView and h5py read one dataset per
  * field a frame.  Its points are in piece order; /index puts them in one
- * process's order (point index[i] is row i). */
+ * process's order (point index[i] is row i).  Points only (no cells, no
+ * surface: those index one-process order), with a field "position", the
+ * frame's geometry. */
 #define PM_PIECE_INDEX "index"
 
 /* Piece piece (>= 0) of frame frame of the results in dir: n >= 0 points,

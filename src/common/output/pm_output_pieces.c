@@ -118,6 +118,18 @@ pm_err pm_results_join_pieces(pm_results *r, long step, double time,
   PM_CALL(pm_output_check_fields(n_fields, fields));
   PM_CHECK(n_fields <= 16, PM_ERR_ARG, "results frame: %d fields (16 at most)",
            n_fields);
+  /* The pieces' rows are in piece order: the mesh's coordinates, cells
+   * and triangles, in one-process order, cannot be drawn over them. */
+  PM_CHECK(r->nodes_per_cell == 1 && r->n_surface == 0, PM_ERR_ARG,
+           "results frame in pieces: only points without cells or a surface "
+           "(these have %ld cells of %d points and %ld triangles)",
+           r->n_cells, r->nodes_per_cell, r->n_surface);
+  bool geometry = false;
+  for (int i = 0; i < n_fields; i++)
+    geometry |= fields[i].ncomp == 3 && strcmp(fields[i].name, "position") == 0;
+  PM_CHECK(geometry, PM_ERR_ARG,
+           "results frame in pieces: no field \"position\" (each piece's "
+           "points, the frame's geometry)");
   long total = 0;
   for (int k = 0; k < n_pieces; k++) {
     PM_CHECK(counts[k] >= 0, PM_ERR_ARG, "results piece %d: %ld points", k,
