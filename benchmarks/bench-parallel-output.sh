@@ -1,9 +1,11 @@
 #!/bin/bash
-# A frame across ranks written three ways (tools/bench_parallel_output.c):
-# gathered to rank 0 and written in one-process order (what pointmech
-# does), one file a rank with an XDMF index of the pieces, and one file
-# collectively through parallel HDF5 (each rank's particles at their
-# one-process places, or as one block a rank with their indices beside),
+# A frame across ranks written five ways (tools/bench_parallel_output.c):
+# gathered to rank 0 and written in one-process order (what a run does),
+# one file a rank with an XDMF index of the pieces, the same joined by
+# rank 0's frame file of virtual datasets (pm_results_join_pieces's way),
+# and one file collectively through parallel HDF5 (each rank's particles
+# at their one-process places, or as one block a rank with their indices
+# beside),
 # for the particles of the full oocyte (56^3 = 175 616) and of a million,
 # on 1 and 2 ranks, each synced to disk and renamed as pointmech's frames
 # are.  The ways take turns, REPS times (5); each line gives the median

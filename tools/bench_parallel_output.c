@@ -16,10 +16,14 @@
  *               transfers), each rank writing its runs at their places;
  *   coll-block  the same, each rank's particles one block after the ranks'
  *               before it, with their one-process indices beside (a
- *               reader's permutation).
+ *               reader's permutation);
+ *   pieces      per-rank's files, joined by rank 0's frame file of HDF5
+ *               virtual datasets (a block a rank, the indices beside), as
+ *               pm_results_join_pieces writes a frame across ranks.
  * Prints, per way, the median and the fastest of REPS frames (seconds) and
- * the bytes of a frame.  Usage (under mpirun):
- *   bench-parallel-output DIR NX NY NZ [REPS]
+ * the bytes of a frame.  WAYS: the ways to run, comma-separated (all by
+ * default).  Usage (under mpirun):
+ *   bench-parallel-output DIR NX NY NZ [REPS [WAYS]]
  * The HDF5 is Debian's openmpi build (libhdf5-openmpi-dev, which PETSc
  * brings); the program links nothing else of pointmech's. */
 #define _POSIX_C_SOURCE 200809L
@@ -118,9 +122,50 @@ static void frame_gather(const char *dir, long N, long n, const long *gid,
   MPI_Bcast(&cnt, 1, MPI_INT, 0, MPI_COMM_WORLD); /* the frame is whole */
 }
 
-/* Per rank: each rank's own file, then rank 0's XDMF index of the pieces. */
+/* Rank 0's frame file of virtual datasets joining the pieces (all[r]
+ * particles in rank r's), a block a rank. */
+static void join_pieces(const char *dir, const long *all) {
+  char tmp[512], path[512], src[64];
+  snprintf(tmp, sizeof tmp, "%s/joined.h5.tmp", dir);
+  snprintf(path, sizeof path, "%s/joined.h5", dir);
+  hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  if (file < 0) fail("H5Fcreate");
+  long N = 0;
+  for (int r = 0; r < size; r++) N += all[r];
+  for (int f = -1; f < NFIELDS; f++) {
+    const int nc = f < 0 ? 1 : ncomp[f];
+    hsize_t dims[2] = {(hsize_t)N, (hsize_t)nc}, start[2] = {0, 0};
+    hid_t vs = H5Screate_simple(nc > 1 ? 2 : 1, dims, NULL);
+    hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    for (int r = 0; r < size; r++) {
+      hsize_t block[2] = {(hsize_t)all[r], (hsize_t)nc};
+      if (!all[r]) continue;
+      H5Sselect_hyperslab(vs, H5S_SELECT_SET, start, NULL, block, NULL);
+      hid_t ss = H5Screate_simple(nc > 1 ? 2 : 1, block, NULL);
+      snprintf(src, sizeof src, "piece_%04d.h5", r);
+      if (H5Pset_virtual(dcpl, vs, src, f < 0 ? "index" : names[f], ss) < 0)
+        fail("H5Pset_virtual");
+      H5Sclose(ss);
+      start[0] += block[0];
+    }
+    H5Sselect_all(vs);
+    hid_t d = H5Dcreate2(file, f < 0 ? "index" : names[f],
+                         f < 0 ? H5T_STD_I64LE : H5T_IEEE_F64LE, vs,
+                         H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (d < 0) fail("H5Dcreate2 (virtual)");
+    H5Dclose(d);
+    H5Pclose(dcpl);
+    H5Sclose(vs);
+  }
+  H5Fclose(file);
+  sync_file(tmp);
+  if (rename(tmp, path) != 0) fail("rename");
+}
+
+/* Per rank: each rank's own file, then rank 0's XDMF index of the pieces
+ * (or, joined, its frame file of virtual datasets). */
 static void frame_per_rank(const char *dir, long n, const long *gid,
-                           double *mine) {
+                           double *mine, bool joined) {
   char tmp[512], path[512];
   snprintf(tmp, sizeof tmp, "%s/piece_%04d.h5.tmp", dir, rank);
   snprintf(path, sizeof path, "%s/piece_%04d.h5", dir, rank);
@@ -147,6 +192,11 @@ static void frame_per_rank(const char *dir, long n, const long *gid,
   long *all = rank == 0 ? malloc(sizeof(long) * (size_t)size) : NULL;
   MPI_Gather(&n, 1, MPI_LONG, all, 1, MPI_LONG, 0, MPI_COMM_WORLD);
   if (rank != 0) return;
+  if (joined) {
+    join_pieces(dir, all);
+    free(all);
+    return;
+  }
   snprintf(tmp, sizeof tmp, "%s/pieces.xdmf.tmp", dir);
   snprintf(path, sizeof path, "%s/pieces.xdmf", dir);
   FILE *x = fopen(tmp, "w");
@@ -257,6 +307,16 @@ static void frame_collective(const char *dir, long N, long n, const long *gid,
   MPI_Barrier(MPI_COMM_WORLD);
 }
 
+/* Whether way is in the comma-separated list only (NULL: every way). */
+static bool chosen(const char *only, const char *way) {
+  if (!only) return true;
+  const size_t n = strlen(way);
+  for (const char *p = only; (p = strstr(p, way)); p += n)
+    if ((p == only || p[-1] == ',') && (p[n] == ',' || p[n] == '\0'))
+      return true;
+  return false;
+}
+
 static int by_value(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
   return (x > y) - (x < y);
@@ -275,6 +335,7 @@ int main(int argc, char **argv) {
   const char *dir = argv[1];
   const long nx = atol(argv[2]), ny = atol(argv[3]), nz = atol(argv[4]);
   const int reps = argc > 5 ? atoi(argv[5]) : 5;
+  const char *only = argc > 6 ? argv[6] : NULL;
   const long N = nx * ny * nz;
   /* Rank r: the particles with x in [nx r / size, nx (r + 1) / size). */
   const long x0 = nx * rank / size, x1 = nx * (rank + 1) / size;
@@ -296,20 +357,21 @@ int main(int argc, char **argv) {
   if (!gid || !mine || !counts || !displs || (rank == 0 && !allgid))
     fail("out of memory");
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-  enum { WAYS = 4 };
+  enum { WAYS = 5 };
   static const char *ways[WAYS] = {"gather", "per-rank", "collective",
-                                   "coll-block"};
+                                   "coll-block", "pieces"};
   double *t = malloc(sizeof(double) * WAYS * (size_t)reps);
   /* The ways take turns, so that the machine's drift falls on all. */
   for (int r = 0; r < reps; r++)
     for (int w = 0; w < WAYS; w++) {
+      if (!chosen(only, ways[w])) continue;
       MPI_Barrier(MPI_COMM_WORLD);
       double t0 = MPI_Wtime();
       if (w == 0)
         frame_gather(dir, N, n, gid, mine, all, ordered, allgid, counts,
                      displs);
-      else if (w == 1)
-        frame_per_rank(dir, n, gid, mine);
+      else if (w == 1 || w == 4)
+        frame_per_rank(dir, n, gid, mine, w == 4);
       else
         frame_collective(dir, N, n, gid, mine, w == 3);
       MPI_Barrier(MPI_COMM_WORLD);
@@ -319,6 +381,7 @@ int main(int argc, char **argv) {
     printf("%-10s %5s %11s %9s %11s %11s\n", "way", "ranks", "particles", "MB",
            "median s", "fastest s");
     for (int w = 0; w < WAYS; w++) {
+      if (!chosen(only, ways[w])) continue;
       double *v = t + w * reps;
       qsort(v, (size_t)reps, sizeof *v, by_value);
       printf("%-10s %5d %11ld %9.1f %11.4f %11.4f\n", ways[w], size, N,

@@ -11,7 +11,9 @@
 
 A run folder holds one HDF5 file per frame (results/frame_NNNNNN.h5),
 each written under a temporary name and renamed once it is complete, and
-the mesh (results/mesh.h5).  This module reads those files directly and
+the mesh (results/mesh.h5).  A run across ranks writes a frame in pieces,
+one a rank, joined by the frame's file; its fields read here in one
+process's order all the same.  This module reads those files directly and
 holds none of them open between calls, so it reads a run while it goes
 on and never blocks the writer.
 """
@@ -41,7 +43,22 @@ def _read_group(path):
         f.visititems(take)
         attrs = {k: (v.item() if hasattr(v, "item") else v)
                  for k, v in f.attrs.items()}
-    return data, attrs
+    return _one_process_order(data), attrs
+
+
+def _one_process_order(data):
+    """A frame written in pieces (a run across ranks) holds its points in
+    piece order, with "index" (each row's one-process index) beside: every
+    field put back in one process's order, "index" dropped."""
+    index = data.pop("index", None)
+    if index is None:
+        return data
+    for name, a in data.items():
+        if a.shape[:1] == index.shape:
+            whole = np.empty_like(a)
+            whole[index] = a
+            data[name] = whole
+    return data
 
 
 class Frame:

@@ -102,6 +102,16 @@ if(PM_MPI)
   set_tests_properties(verification.ranks_fpm PROPERTIES LABELS verification
     TIMEOUT 600 PROCESSORS 1
     RESOURCE_LOCK mpirun)
+  # A frame across ranks written in pieces against the gathered frame.
+  add_executable(ranks_output ${PM_VERIFY_DIR}/ranks_output.c)
+  target_link_libraries(ranks_output PRIVATE pm_common)
+  target_include_directories(ranks_output PRIVATE ${PM_TEST_SUPPORT})
+  add_test(NAME verification.ranks_output
+    COMMAND bash ${PM_VERIFY_DIR}/ranks-output.sh ${PROJECT_SOURCE_DIR}
+      $<TARGET_FILE:ranks_output>)
+  set_tests_properties(verification.ranks_output PROPERTIES LABELS
+    verification TIMEOUT 300 PROCESSORS 1
+    RESOURCE_LOCK mpirun)
   # Membranes (their neighbours on other ranks) and bodies moving as
   # prescribed across ranks.
   add_test(NAME verification.ranks_membranes

@@ -71,7 +71,7 @@ pm_err pm_output_check_dir(const char *dir) {
   return PM_SUCCESS;
 }
 
-static pm_err check_fields(int n_fields, const pm_field *fields) {
+pm_err pm_output_check_fields(int n_fields, const pm_field *fields) {
   PM_CHECK(n_fields >= 0 && (n_fields == 0 || fields), PM_ERR_ARG,
            "results frame: %d fields", n_fields);
   for (int i = 0; i < n_fields; i++) {
@@ -253,10 +253,8 @@ void pm_results_close(pm_results *r, bool keep) {
 
 /* ---- Frames ------------------------------------------------------------- */
 
-/* The frame's HDF5 file, under tmp. */
-static pm_err write_frame_file(const pm_results *r, const char *tmp, long step,
-                               double time, int n_fields,
-                               const pm_field *fields) {
+pm_err pm_output_frame_open(const char *tmp, long step, double time,
+                            hid_t *out) {
   pm_err ret = PM_SUCCESS;
   hid_t file = -1, fcpl = -1;
   const char *path = tmp;
@@ -271,14 +269,7 @@ static pm_err write_frame_file(const pm_results *r, const char *tmp, long step,
                           path));
   PM_TRY(pm_h5_write_attr(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
                           &time, path));
-  for (int i = 0; i < n_fields; i++) {
-    const pm_field *f = &fields[i];
-    hsize_t dims[3] = {(hsize_t)r->n_points, 3, 3};
-    int rank = f->ncomp == 1 ? 1 : f->ncomp == 3 ? 2 : 3;
-    PM_TRY(pm_output_dataset(file, f->name, rank, dims, H5T_IEEE_F64LE,
-                             H5T_NATIVE_DOUBLE, f->data, path, NULL));
-  }
-  H5_OK(H5Fclose(file), "H5Fclose", "/", path);
+  *out = file;
   file = -1;
 done:
   pm_h5_close_quiet(&fcpl);
@@ -286,30 +277,44 @@ done:
   return ret;
 }
 
-pm_err pm_results_write_frame(pm_results *r, long step, double time,
-                              int n_fields, const pm_field *fields) {
+pm_err pm_output_frame_file(const char *tmp, long n, const long *index,
+                            long step, double time, int n_fields,
+                            const pm_field *fields) {
   pm_err ret = PM_SUCCESS;
-  char path[PM_PATH_MAX + 1], tmp[PM_PATH_MAX + 40];
+  hid_t file = -1;
+  const char *path = tmp;
+  PM_TRY(pm_output_frame_open(tmp, step, time, &file));
+  for (int i = 0; i < n_fields; i++) {
+    const pm_field *f = &fields[i];
+    hsize_t dims[3] = {(hsize_t)n, 3, 3};
+    int rank = f->ncomp == 1 ? 1 : f->ncomp == 3 ? 2 : 3;
+    PM_TRY(pm_output_dataset(file, f->name, rank, dims, H5T_IEEE_F64LE,
+                             H5T_NATIVE_DOUBLE, f->data, path, NULL));
+  }
+  if (index) {
+    const hsize_t dim = (hsize_t)n;
+    PM_TRY(pm_output_dataset(file, PM_PIECE_INDEX, 1, &dim, H5T_STD_I64LE,
+                             H5T_NATIVE_LONG, index, path, NULL));
+  }
+  H5_OK(H5Fclose(file), "H5Fclose", "/", path);
+  file = -1;
+done:
+  pm_h5_close_quiet(&file);
+  return ret;
+}
+
+pm_err pm_output_add_frame(pm_results *r, const char *tmp, pm_err written,
+                           int written_errno, long step, double time,
+                           int n_fields, const pm_field *fields) {
+  pm_err ret = PM_SUCCESS;
+  char path[PM_PATH_MAX + 1];
+  pm_output_frame_path(r, r->n_frames, path, sizeof path);
+  PM_TRY(pm_output_classify(written, written_errno, path));
+  PM_TRY(pm_sync_rename(tmp, path));
   const char *names[16];
   int ncomp[16];
-  size_t frames_len, last_at;
-  PM_CHECK(r, PM_ERR_ARG, "pm_results_write_frame: NULL results");
-  PM_CALL(check_fields(n_fields, fields));
-  PM_CHECK(n_fields <= 16, PM_ERR_ARG, "results frame: %d fields (16 at most)",
-           n_fields);
-  pm_output_frame_path(r, r->n_frames, path, sizeof path);
-  pm_output_tmp_name(tmp, sizeof tmp, path);
-  double bytes = H5_OVERHEAD;
-  for (int i = 0; i < n_fields; i++)
-    bytes += 8.0 * fields[i].ncomp * (double)r->n_points;
-  PM_CALL(pm_output_check_room(r->sub, path, bytes));
-  frames_len = r->frames.len;
-  last_at = r->last_at;
-  errno = 0;
-  ret = write_frame_file(r, tmp, step, time, n_fields, fields);
-  int saved = errno;
-  PM_TRY(pm_output_classify(ret, saved, path));
-  PM_TRY(pm_sync_rename(tmp, path));
+  const size_t frames_len = r->frames.len, last_at = r->last_at;
+  int saved = 0;
   for (int i = 0; i < n_fields; i++) {
     names[i] = fields[i].name;
     ncomp[i] = fields[i].ncomp;
@@ -340,6 +345,26 @@ pm_err pm_results_write_frame(pm_results *r, long step, double time,
 done:
   unlink(tmp);
   return ret;
+}
+
+pm_err pm_results_write_frame(pm_results *r, long step, double time,
+                              int n_fields, const pm_field *fields) {
+  char path[PM_PATH_MAX + 1], tmp[PM_PATH_MAX + 40];
+  PM_CHECK(r, PM_ERR_ARG, "pm_results_write_frame: NULL results");
+  PM_CALL(pm_output_check_fields(n_fields, fields));
+  PM_CHECK(n_fields <= 16, PM_ERR_ARG, "results frame: %d fields (16 at most)",
+           n_fields);
+  pm_output_frame_path(r, r->n_frames, path, sizeof path);
+  pm_output_tmp_name(tmp, sizeof tmp, path);
+  double bytes = H5_OVERHEAD;
+  for (int i = 0; i < n_fields; i++)
+    bytes += 8.0 * fields[i].ncomp * (double)r->n_points;
+  PM_CALL(pm_output_check_room(r->sub, path, bytes));
+  errno = 0;
+  pm_err written = pm_output_frame_file(tmp, r->n_points, NULL, step, time,
+                                        n_fields, fields);
+  return pm_output_add_frame(r, tmp, written, errno, step, time, n_fields,
+                             fields);
 }
 
 long pm_results_frames(const pm_results *r) { return r ? r->n_frames : 0; }

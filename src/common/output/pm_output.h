@@ -120,6 +120,41 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
 pm_err pm_results_write_frame(pm_results *r, long step, double time,
                               int n_fields, const pm_field *fields);
 
+/* ---- A frame in pieces (a run shared among ranks) ----------------------
+ * Each rank writes its own points of a frame, and no process holds them
+ * all:
+ *   OUT/results/frame_NNNNNN.piece_RRRR.h5  piece RRRR (a rank's points):
+ *                                root attributes step and time, one
+ *                                dataset per field over its points (as a
+ *                                frame's), and /index int64 [n] their
+ *                                one-process indices
+ * then rank 0, once every piece is on disk, the frame's own file
+ * frame_NNNNNN.h5, whose datasets (each field, and /index) are HDF5
+ * virtual datasets joining the pieces in piece order, and the index and
+ * results.xdmf as for any frame: ParaView and h5py read one dataset per
+ * field a frame.  Its points are in piece order; /index puts them in one
+ * process's order (point index[i] is row i).  Points only (no cells, no
+ * surface: those index one-process order), with a field "position", the
+ * frame's geometry. */
+#define PM_PIECE_INDEX "index"
+
+/* Piece piece (>= 0) of frame frame of the results in dir: n >= 0 points,
+ * their one-process indices index[0..n), the fields over them (as
+ * pm_results_write_frame's), synced and renamed whole.  Errors as
+ * pm_results_write_frame's. */
+pm_err pm_results_write_piece(const char *dir, long frame, int piece, long n,
+                              const long *index, long step, double time,
+                              int n_fields, const pm_field *fields);
+
+/* The next frame of r from its n_pieces pieces already on disk, counts[k]
+ * points in piece k (summing to r's points), with the fields the pieces
+ * hold (names and components as given; data unread): frame_NNNNNN.h5 of
+ * virtual datasets, then the index and XDMF.  Errors as
+ * pm_results_write_frame's. */
+pm_err pm_results_join_pieces(pm_results *r, long step, double time,
+                              int n_pieces, const long *counts, int n_fields,
+                              const pm_field *fields);
+
 /* Number of frames written so far (with those kept by pm_results_reopen). */
 long pm_results_frames(const pm_results *r);
 

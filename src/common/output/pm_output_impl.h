@@ -101,6 +101,30 @@ void pm_output_frame_path(const pm_results *r, long k, char *buf, size_t size);
 /* Frees r and all it holds (NULL accepted). */
 void pm_output_free(pm_results *r);
 
+/* PM_ERR_ARG unless n_fields fields are well formed (plain unique names,
+ * 1, 3 or 9 components, data). */
+pm_err pm_output_check_fields(int n_fields, const pm_field *fields);
+
+/* A frame's HDF5 file created under tmp (*out, open) with its attributes
+ * step and time, its datasets to keep their order of creation. */
+pm_err pm_output_frame_open(const char *tmp, long step, double time,
+                            hid_t *out);
+
+/* A frame's HDF5 file of n points under tmp: attributes step and time, a
+ * dataset per field, and with index (a piece of a frame across ranks) the
+ * points' one-process indices as dataset PM_PIECE_INDEX. */
+pm_err pm_output_frame_file(const char *tmp, long n, const long *index,
+                            long step, double time, int n_fields,
+                            const pm_field *fields);
+
+/* Frame r->n_frames, written under tmp (written: how that went, with the
+ * errno it left), renamed into place, then into the XDMF text, the index
+ * and results.xdmf; tmp is gone after, and after a failure the frame too,
+ * the index and XDMF being those of the frames before. */
+pm_err pm_output_add_frame(pm_results *r, const char *tmp, pm_err written,
+                           int written_errno, long step, double time,
+                           int n_fields, const pm_field *fields);
+
 /* ---- pm_output_index.c ---- */
 
 /* Appends frame k's grid (nf fields: their names and component counts)

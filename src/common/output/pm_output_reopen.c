@@ -25,8 +25,14 @@ static pm_err drop_later_frames(const pm_results *r, long n_keep) {
     int used = 0;
     bool tmp = strstr(e->d_name, ".tmp.") != NULL ||
                strncmp(e->d_name, SPARE_PREFIX, strlen(SPARE_PREFIX)) == 0;
+    int piece;
     bool later = sscanf(e->d_name, "frame_%ld.h5%n", &k, &used) == 1 &&
                  e->d_name[used] == '\0' && k >= n_keep;
+    /* A frame's pieces (written across ranks) go with it. */
+    used = 0;
+    later = later || (sscanf(e->d_name, "frame_%ld.piece_%d.h5%n", &k, &piece,
+                             &used) == 2 &&
+                      used > 0 && e->d_name[used] == '\0' && k >= n_keep);
     if (!tmp && !later) continue;
     if (pm_path_join(path, sizeof path, r->sub, e->d_name) != PM_SUCCESS)
       continue;
@@ -44,9 +50,10 @@ static pm_err drop_later_frames(const pm_results *r, long n_keep) {
 static pm_err reread_frame(pm_results *r, long k) {
   pm_err ret = PM_SUCCESS;
   hid_t file = -1, dset = -1, space = -1;
-  char path[PM_PATH_MAX + 1], names_buf[16][FIELD_NAME_MAX + 2];
-  const char *names[16];
-  int ncomp[16], nf = 0;
+  /* 16 fields at most, and a frame in pieces its index besides. */
+  char path[PM_PATH_MAX + 1], names_buf[17][FIELD_NAME_MAX + 2];
+  const char *names[17];
+  int ncomp[17], nf = 0;
   H5G_info_t info;
   double time;
   long step;
@@ -56,7 +63,7 @@ static pm_err reread_frame(pm_results *r, long k) {
   PM_TRY(pm_h5_read_attr(file, "time", H5T_NATIVE_DOUBLE, &time, "/", path));
   PM_TRY(pm_h5_read_attr(file, "step", H5T_NATIVE_LONG, &step, "/", path));
   H5_OK(H5Gget_info(file, &info), "H5Gget_info", "/", path);
-  PM_ENSURE(info.nlinks <= 16, PM_ERR_HDF5,
+  PM_ENSURE(info.nlinks <= 17, PM_ERR_HDF5,
             "'%s' holds %llu fields (16 at most)", path,
             (unsigned long long)info.nlinks);
   for (hsize_t i = 0; i < info.nlinks; i++, nf++) {
@@ -68,6 +75,11 @@ static pm_err reread_frame(pm_results *r, long k) {
           "H5Lget_name_by_idx", "/", path);
     PM_ENSURE((size_t)len < sizeof names_buf[nf], PM_ERR_HDF5,
               "field name too long in '%s'", path);
+    /* A frame in pieces: its points' one-process indices, not a field. */
+    if (strcmp(names_buf[nf], PM_PIECE_INDEX) == 0) {
+      nf--;
+      continue;
+    }
     names[nf] = names_buf[nf];
     H5_OK(dset = H5Dopen2(file, names[nf], H5P_DEFAULT), "H5Dopen2", names[nf],
           path);
@@ -82,6 +94,8 @@ static pm_err reread_frame(pm_results *r, long k) {
     pm_h5_close_quiet(&space);
     pm_h5_close_quiet(&dset);
   }
+  PM_ENSURE(nf <= 16, PM_ERR_HDF5, "'%s' holds %d fields (16 at most)", path,
+            nf);
   PM_TRY(pm_output_xdmf_frame(r, k, step, time, nf, names, ncomp));
 done:
   pm_h5_close_quiet(&space);
