@@ -58,6 +58,41 @@ static void test_resultant(void **state) {
   drop_model(&m);
 }
 
+/* In 3-D, on a Physical Surface: the forces add up to the traction times
+ * the face's area (1 m^2). */
+static void test_resultant_3d(void **state) {
+  char path[512];
+  pm_test_write_file(*state, "block.geo",
+                     "SetFactory(\"OpenCASCADE\");\n"
+                     "Box(1) = {0, 0, 0, 1, 1, 2};\n"
+                     "Physical Volume(\"block\") = {1};\n"
+                     "Physical Surface(\"top\") = {6};\n",
+                     path);
+  pm_test_write_file(
+      *state, "block.yaml",
+      "name: block\nmethod: mpm-implicit\ndimension: 3\n"
+      "domain: {box: {min: [0, 0, 0], max: [1, 1, 2]}}\n"
+      "discretization: {mesh_size: 0.5}\n"
+      "materials:\n  - {name: gel, model: neo-hookean, density: 1000, "
+      "youngs_modulus: 3000, poisson_ratio: 0.3}\n"
+      "bodies: [{material: gel, mesh: block.geo}]\n"
+      "boundary:\n  - {on: zmin, displacement: {x: 0, y: 0, z: 0}}\n"
+      "  - {on: top, traction: {y: -30, z: 100}}\n"
+      "time: {end: 1, quasi_static: {method: static, load_steps: 2}}\n",
+      path);
+  model m = make_model(path, 0, NULL);
+  const long n3 = 3 * m.model->grid.n_nodes;
+  double *f = calloc((size_t)n3, sizeof *f), sum[3] = {0, 0, 0};
+  assert_non_null(f);
+  mpm_tractions_nodal(m.model, &m.model->grid, m.model->x0, 1.0, f);
+  for (long i = 0; i < n3; i++) sum[i % 3] -= f[i];
+  assert_near(sum[0], 0.0, 1e-12);
+  assert_near(sum[1], -30.0, 1e-11);
+  assert_near(sum[2], 100.0, 1e-11);
+  free(f);
+  drop_model(&m);
+}
+
 /* A name no gmsh body has is refused, naming the key. */
 static void test_unknown_name(void **state) {
   char path[512];
@@ -71,6 +106,17 @@ static void test_unknown_name(void **state) {
   assert_non_null(strstr(pm_error_message(), "boundary.1.on"));
   assert_non_null(strstr(pm_error_message(), "nowhere"));
   pm_scene_destroy(s);
+}
+
+/* A named edge holds no displacement in MPM: refused at its key. */
+static void test_refused(void **state) {
+  char path[512];
+  write_panel(*state, path);
+  const char *set[] = {"boundary.0.on=clamped"};
+  pm_scene *s = NULL;
+  assert_int_equal(pm_scene_load(path, 1, set, &s), PM_ERR_SCENE);
+  assert_non_null(strstr(pm_error_message(), "boundary.0.on"));
+  assert_non_null(strstr(pm_error_message(), "carries tractions only"));
 }
 
 /* The energy balance of the static run: strain energy = the tractions'
@@ -92,6 +138,10 @@ static void test_energy(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup_teardown(test_resultant, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_resultant_3d, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_refused, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_unknown_name, pm_test_make_dir,
                                       pm_test_drop_dir),
