@@ -38,6 +38,17 @@ static void write_panel(const char *dir, char path[512]) {
   pm_test_write_file(dir, "panel.yaml", SCENE, path);
 }
 
+/* The sum of the tractions' nodal forces at full load into sum. */
+static void resultant(const model *m, double sum[3]) {
+  const long n3 = 3 * m->model->grid.n_nodes;
+  double *f = calloc((size_t)n3, sizeof *f);
+  assert_non_null(f);
+  mpm_tractions_nodal(m->model, &m->model->grid, m->model->x0, 1.0, f);
+  for (int c = 0; c < 3; c++) sum[c] = 0;
+  for (long i = 0; i < n3; i++) sum[i % 3] -= f[i];
+  free(f);
+}
+
 /* Sum of the nodal forces = traction x edge length (2 m). */
 static void test_resultant(void **state) {
   char path[512];
@@ -47,14 +58,10 @@ static void test_resultant(void **state) {
   double length = 0;
   for (long k = 0; k < bc->n_held; k++) length += bc->area[k];
   assert_near(length, 2.0, 1e-12);
-  const long n3 = 3 * m.model->grid.n_nodes;
-  double *f = calloc((size_t)n3, sizeof *f), sum[3] = {0, 0, 0};
-  assert_non_null(f);
-  mpm_tractions_nodal(m.model, &m.model->grid, m.model->x0, 1.0, f);
-  for (long i = 0; i < n3; i++) sum[i % 3] -= f[i];
+  double sum[3];
+  resultant(&m, sum);
   assert_near(sum[0], 4.0, 1e-12);
   assert_near(sum[1], 20.0, 1e-12);
-  free(f);
   drop_model(&m);
 }
 
@@ -81,15 +88,11 @@ static void test_resultant_3d(void **state) {
       "time: {end: 1, quasi_static: {method: static, load_steps: 2}}\n",
       path);
   model m = make_model(path, 0, NULL);
-  const long n3 = 3 * m.model->grid.n_nodes;
-  double *f = calloc((size_t)n3, sizeof *f), sum[3] = {0, 0, 0};
-  assert_non_null(f);
-  mpm_tractions_nodal(m.model, &m.model->grid, m.model->x0, 1.0, f);
-  for (long i = 0; i < n3; i++) sum[i % 3] -= f[i];
+  double sum[3];
+  resultant(&m, sum);
   assert_near(sum[0], 0.0, 1e-12);
   assert_near(sum[1], -30.0, 1e-11);
   assert_near(sum[2], 100.0, 1e-11);
-  free(f);
   drop_model(&m);
 }
 
