@@ -3,6 +3,7 @@
 #include "mpm_traction.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -207,10 +208,18 @@ static pm_err surface_carriers(const pm_scene *s, mpm_model *m, int b) {
     if (!e)
       e = buckets_create(&bk, m, m->body_begin[i], m->body_end[i], m->grid.h);
     for (long f = f0; !e && f < f1; f++) {
+      /* A facet with a node no element uses lies on no element: it
+       * carries nothing (its points sit at its first usable node). */
       const double *c[3] = {NULL, NULL, NULL};
+      bool lone = false;
+      for (int k = 0; k < dim; k++) {
+        const long id = mesh.group_face[dim * f + k];
+        lone = lone || id < 0;
+        c[k] = id >= 0 ? mesh.x + 3 * id : NULL;
+      }
       for (int k = 0; k < dim; k++)
-        c[k] = mesh.x + 3 * mesh.group_face[dim * f + k];
-      const double A = facet_measure(dim, c) / ng;
+        if (!c[k]) c[k] = c[(k + 1) % dim] ? c[(k + 1) % dim] : mesh.x;
+      const double A = lone ? 0 : facet_measure(dim, c) / ng;
       for (int q = 0; q < ng; q++) {
         double w[3], X[3] = {0, 0, 0};
         gauss_weights(dim, q, w);
