@@ -42,7 +42,7 @@ bad_scene fluid-without-pressure "$tube" 's/, pressure: 0.001//' \
 bad_scene traction-on-region-in-mpm "$tube" \
   's/{on: xmax, velocity: {x: 0}/{region: "x - 0.9", traction: {x: 0}/' \
   'region: "x - 0.9"' \
-  'boundary.1.traction: expected displacement or velocity on a region (a grip; tractions act on a face) (method mpm), got traction'
+  'boundary.1.traction: expected a traction on a face of domain.box or a named surface (method mpm; a region holds particles by a displacement or velocity), got traction with region'
 bad_scene flip-2 "$tube" 's/flip: 1.0/flip: 2/' 'flip:' \
   'mpm.flip: expected a number in [0, 1], got 2'
 bad_scene unknown-mpm-key "$tube" 's/^  update: musl$/  update: musl\n  updat: usf/' \

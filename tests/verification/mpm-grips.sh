@@ -102,14 +102,14 @@ bad_scene grip-on-absorbing "$grip" \
   'absorbing: true' 'expected displacement or velocity on a region'
 bad_scene traction-on-region "$trac" \
   's/on: ymax, traction/region: "y - 0.39", traction/' 'region: "y - 0.39"' \
-  'boundary.1.traction: expected displacement or velocity on a region'
+  'boundary.1.traction: expected a traction on a face of domain.box or a named surface (method mpm;'
 bad_scene traction-on-region-implicit "$trac" \
   's/method: mpm$/method: mpm-implicit/; s/on: ymax, traction/region: "y - 0.39", traction/' \
   'region: "y - 0.39"' \
-  'boundary.1.traction: expected displacement (method mpm-implicit), got traction'
+  'boundary.1.traction: expected a traction on a face of domain.box or a named surface (method mpm-implicit;'
 bad_scene grip-implicit "$grip" 's/method: mpm$/method: mpm-implicit/' \
   'region: "0.01 - y"' \
-  'boundary.0.region: expected on: a face of domain.box for method mpm-implicit'
+  'boundary.0.region: expected on: a face of domain.box (displacement or traction) or a named surface (traction) for method mpm-implicit'
 
 bad_scene glued-grips-nothing "$glued" 's/point: \[0, 0.4\]/point: [0, 0.45]/' \
   'point: \[0, 0.45\]' 'boundary.1.plate: expected a glued plate on a body'

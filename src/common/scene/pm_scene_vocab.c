@@ -644,8 +644,8 @@ static const pm_key bc_keys[] = {
      .offset = C(traction),
      .count_offset = C(traction_mask),
      .unit = "Pa",
-     .doc = "nominal traction at full load (FPM; MPM on a face: its "
-            "surface particles carry it)"},
+     .doc = "nominal traction at full load (FPM; MPM on a face or a named "
+            "surface or edge of a gmsh body: the particles at it carry it)"},
     {.name = "velocity",
      .type = PM_KEY_COMPONENTS,
      .offset = C(velocity),

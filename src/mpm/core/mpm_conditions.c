@@ -36,10 +36,11 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
       bc->rigid = sb;
       continue;
     }
-    /* A grip has no columns: its held particles act. */
-    bc->grip = sb->on != PM_ON_FACE;
+    /* A grip has no columns: its held particles act; nor has a traction
+     * on a named surface: the particles at it carry it. */
+    bc->grip = sb->on == PM_ON_REGION;
     bc->region = sb->region;
-    if (bc->grip) continue;
+    if (sb->on != PM_ON_FACE) continue;
     bc->face = sb->face;
     bc->axis = pm_face_axis(sb->face);
     bc->plane = pm_face_plane(sb->face, s->box_min, s->box_max);
@@ -70,7 +71,7 @@ void mpm_conditions_destroy(mpm_bc *bcs, int n_bcs) {
     free(bcs[b].col);
     free(bcs[b].held);
     free(bcs[b].area);
-    free(bcs[b].reach);
+    free(bcs[b].offset);
   }
   free(bcs);
 }
@@ -335,4 +336,25 @@ double mpm_conditions_apply(const mpm_ctx *ctx, double *vel, bool reactions) {
   /* Every rank's share of the reactions: the residual's scale. */
   mpm_xc_sum(m, cw->reaction, 3 * m->n_bcs);
   return work;
+}
+
+bool mpm_supports_still(const mpm_bc *bcs, int n_bcs, const double lo[3],
+                        const double hi[3], double t_end) {
+  for (int b = 0; b < n_bcs; b++) {
+    const mpm_bc *bc = &bcs[b];
+    if (bc->vel_mask || bc->rigid) return false;
+    for (int c = 0; c < 3; c++) {
+      if (!bc->disp[c]) continue;
+      for (int k = 0; k < 18; k++) { /* the corners and the centre */
+        const int corner = k % 9;
+        double x[3];
+        for (int a = 0; a < 3; a++)
+          x[a] = corner == 8 ? 0.5 * (lo[a] + hi[a])
+                             : (corner >> a & 1 ? hi[a] : lo[a]);
+        if (pm_expr_eval(bc->disp[c], x[0], x[1], x[2], k < 9 ? 0 : t_end) != 0)
+          return false;
+      }
+    }
+  }
+  return true;
 }

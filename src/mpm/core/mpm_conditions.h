@@ -35,13 +35,14 @@ typedef struct {
   const pm_expr *region;
   long n_held;
   long *held;
-  /* A traction (nominal, Pa, at full load; NULL where not given): the
-   * particles that carry it are held[0..n_held), with their areas and
-   * their reference distances to the face (owned; found by
-   * mpm_tractions_create). */
+  /* A traction (nominal, Pa, at full load; NULL where not given), on a
+   * face or on a named surface of a gmsh body: the particles that carry
+   * it are held[0..n_held) (a particle may carry several points), each
+   * point with its area and its reference offset from its particle (3 per
+   * point; owned; found by mpm_tractions_create). */
   unsigned traction_mask;
   const pm_expr *traction[3];
-  double *area, *reach;
+  double *area, *offset;
   /* A rigid plate or sphere in the grid's contact (mpm_contact.h): the
    * scene's condition (borrowed; NULL for other conditions), and no
    * columns. */
@@ -105,5 +106,12 @@ double mpm_conditions_apply(const mpm_ctx *ctx, double *vel, bool reactions);
  * value that is not finite in this step: "step N, t = T s: node I at (x):
  * KEY: "TEXT" = nan, not a finite value" (pm_expr_fail_value). */
 pm_err mpm_conditions_status(const mpm_ctx *ctx);
+
+/* Whether conditions bcs[0..n_bcs) hold still: no velocities, no rigid
+ * bodies, and every prescribed displacement 0 at the corners and the
+ * centre of the box [lo, hi] at t = 0 and t_end (fixed supports, which do
+ * no work). */
+bool mpm_supports_still(const mpm_bc *bcs, int n_bcs, const double lo[3],
+                        const double hi[3], double t_end);
 
 #endif

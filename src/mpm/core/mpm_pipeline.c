@@ -61,8 +61,9 @@ static void add_grid_forces(mpm_model *m) {
     st->after_update = mpm_book_tractions;
     st->books = MPM_BOOKS_WORK;
     snprintf(st->detail, sizeof st->detail,
-             "%d traction%s: t A on the face's particles, to the nodes "
-             "through the shape functions; its work after the update",
+             "%d traction%s: t A on the particles at its face or surface, "
+             "to the nodes through the shape functions; its work after "
+             "the update",
              n_tractions, n_tractions == 1 ? "" : "s");
   }
   if (m->has_absorbing) {

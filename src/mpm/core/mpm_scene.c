@@ -290,20 +290,28 @@ pm_err mpm_check_scene(const pm_scene *s) {
                              s->method);
       continue;
     }
-    if (bc->traction_mask && bc->on != PM_ON_FACE)
-      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.traction", i), true,
-                           "expected %s (method %s), got traction",
-                           implicit ? "displacement"
-                                    : "displacement or velocity on a region "
-                                      "(a grip; tractions act on a face)",
-                           s->method);
-    if (bc->on == PM_ON_SURFACE)
+    if (bc->traction_mask && bc->on == PM_ON_REGION)
+      return pm_scene_fail(
+          s, PM_PATH(p, "boundary.%d.traction", i), true,
+          "expected a traction on a face of domain.box or a named surface "
+          "(method %s; a region holds particles by a displacement or "
+          "velocity), got traction with region",
+          s->method);
+    if (bc->on == PM_ON_SURFACE && !bc->traction_mask)
       return pm_scene_fail(
           s, PM_PATH(p, "boundary.%d.on", i), false,
           "expected on: a face of domain.box (xmin, xmax, ymin, ymax, zmin, "
-          "zmax)%s for method %s, got %s",
+          "zmax)%s for method %s, got %s (a named surface carries "
+          "tractions only)",
           implicit ? "" : " or region: (a grip on the particles in it)",
           s->method, bc->surface);
+    if (bc->on == PM_ON_SURFACE &&
+        (bc->disp_mask | bc->velocity_mask || bc->absorbing))
+      return pm_scene_fail(
+          s, PM_PATH(p, "boundary.%d.traction", i), true,
+          "expected traction alone on a named surface (method %s), got it "
+          "with %s",
+          s->method, bc->absorbing ? "absorbing" : "a prescribed motion");
     if (bc->on == PM_ON_REGION && bc->absorbing)
       return pm_scene_fail(s, PM_PATH(p, "boundary.%d.absorbing", i), true,
                            "expected displacement or velocity on a region "
@@ -360,16 +368,17 @@ pm_err mpm_implicit_check_scene(const pm_scene *s) {
     if (bc->on == PM_ON_REGION)
       return pm_scene_fail(
           s, PM_PATH(p, "boundary.%d.region", i), true,
-          "expected on: a face of domain.box for method mpm-implicit (grips "
-          "on regions of particles run by method mpm), got region");
+          "expected on: a face of domain.box (displacement or traction) or "
+          "a named surface (traction) for method mpm-implicit (grips on "
+          "regions of particles run by method mpm), got region");
     if (bc->velocity_mask || bc->absorbing)
       return pm_scene_fail(
           s,
           PM_PATH(p, "boundary.%d.%s", i,
                   bc->absorbing ? "absorbing" : "velocity"),
           true,
-          "expected displacement for method mpm-implicit (quasi-static load "
-          "steps have no velocity), got %s",
+          "expected displacement or traction for method mpm-implicit "
+          "(quasi-static load steps have no velocity), got %s",
           bc->absorbing ? "absorbing" : "velocity");
   }
   return PM_SUCCESS;

@@ -3,9 +3,12 @@
 #include "mpm_traction.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "gm_gmsh.h"
 #include "mpm_exchange.h"
 #include "mpm_kind.h"
 #include "mpm_model.h"
@@ -31,39 +34,228 @@ static void body_face(const pm_scene *s, const mpm_model *m, int i, pm_face f,
   *spacing = m->grid.h / ppc;
 }
 
+/* The carriers of traction bc on face f: the particles of the volume
+ * bodies within one particle spacing of the face, each with its area (its
+ * volume over its spacing normal to the face) and its offset to the face
+ * along the face's normal (at a particle the tractions would leave the
+ * nodes beyond it out of balance: a residual of 1% on a bar).  Counts
+ * only when held is NULL. */
+static long face_carriers(const pm_scene *s, const mpm_model *m,
+                          const mpm_bc *bc, pm_face f, long *held, double *area,
+                          double *offset) {
+  const int a = pm_face_axis(f);
+  long n = 0;
+  for (int i = 0; i < s->n_bodies; i++) {
+    if (mpm_body_role_of(&s->bodies[i]) != MPM_BODY_VOLUME) continue;
+    double plane, hs;
+    body_face(s, m, i, f, &plane, &hs);
+    for (long q = m->body_begin[i]; q < m->body_end[i]; q++) {
+      const double d = (plane - m->x0[3 * q + a]) * bc->outward;
+      if (!(d >= 0 && d < hs * (1 - 1e-9))) continue;
+      if (held) {
+        held[n] = q;
+        area[n] = m->vol0[q] / hs;
+        for (int c = 0; c < 3; c++)
+          offset[3 * n + c] = c == a ? d * bc->outward : 0;
+      }
+      n++;
+    }
+  }
+  return n;
+}
+
+/* Room for n carriers of traction bc (n_held set). */
+static pm_err carriers_alloc(mpm_bc *bc, long n) {
+  bc->n_held = n;
+  PM_CALL(PM_ALLOC(bc->held, n > 0 ? n : 1, "traction particles"));
+  PM_CALL(PM_ALLOC(bc->area, n > 0 ? n : 1, "traction areas"));
+  PM_CALL(PM_ALLOC(bc->offset, 3 * (n > 0 ? n : 1), "traction points"));
+  return PM_SUCCESS;
+}
+
+/* Gauss points of a facet, in barycentric weights of its corners: 2 on a
+ * segment (exact for cubic tractions along it), 3 on a triangle (exact for
+ * quadratic ones). */
+#define GAUSS_N(dim) ((dim) == 2 ? 2 : 3)
+static void gauss_weights(int dim, int g, double w[3]) {
+  if (dim == 2) {
+    const double r = 0.5 / sqrt(3.0);
+    w[0] = 0.5 + (g ? r : -r);
+    w[1] = 1 - w[0];
+    w[2] = 0;
+    return;
+  }
+  for (int c = 0; c < 3; c++) w[c] = c == g ? 2.0 / 3.0 : 1.0 / 6.0;
+}
+
+/* The measure of a facet (a segment's length, a triangle's area). */
+static double facet_measure(int dim, const double *p[3]) {
+  double e1[3], e2[3];
+  for (int c = 0; c < 3; c++) {
+    e1[c] = p[1][c] - p[0][c];
+    e2[c] = dim == 3 ? p[2][c] - p[0][c] : 0;
+  }
+  if (dim == 2) return sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                       e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+  return 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+/* Particles [p0, p1) of a body in buckets of edge h: the nearest one to a
+ * point, found in the buckets around it (a surface point's nearest
+ * particle lies within a cell: particles fill their cells). */
+typedef struct {
+  double lo[3], h;
+  long n[3], *start, *order;
+  long p0;
+} buckets;
+
+static long bucket_of(const buckets *bk, const double *x, long off[3]) {
+  long k = 0;
+  for (int c = 2; c >= 0; c--) {
+    long i = (long)floor((x[c] - bk->lo[c]) / bk->h) + (off ? off[c] : 0);
+    if (i < 0 || i >= bk->n[c]) return -1;
+    k = k * bk->n[c] + i;
+  }
+  return k;
+}
+
+static pm_err buckets_create(buckets *bk, const mpm_model *m, long p0, long p1,
+                             double h) {
+  *bk = (buckets){.h = h, .p0 = p0};
+  double hi[3];
+  for (int c = 0; c < 3; c++) bk->lo[c] = hi[c] = m->x0[3 * p0 + c];
+  for (long q = p0; q < p1; q++)
+    for (int c = 0; c < 3; c++) {
+      bk->lo[c] = fmin(bk->lo[c], m->x0[3 * q + c]);
+      hi[c] = fmax(hi[c], m->x0[3 * q + c]);
+    }
+  long nb = 1;
+  for (int c = 0; c < 3; c++) {
+    bk->n[c] = (long)floor((hi[c] - bk->lo[c]) / h) + 1;
+    nb *= bk->n[c];
+  }
+  PM_CALL(PM_ALLOC(bk->start, nb + 1, "traction buckets"));
+  PM_CALL(PM_ALLOC(bk->order, p1 - p0 > 0 ? p1 - p0 : 1, "traction buckets"));
+  for (long q = p0; q < p1; q++)
+    bk->start[bucket_of(bk, m->x0 + 3 * q, NULL) + 1]++;
+  for (long k = 0; k < nb; k++) bk->start[k + 1] += bk->start[k];
+  for (long q = p0; q < p1; q++)
+    bk->order[bk->start[bucket_of(bk, m->x0 + 3 * q, NULL)]++] = q;
+  for (long k = nb; k > 0; k--) bk->start[k] = bk->start[k - 1];
+  bk->start[0] = 0;
+  return PM_SUCCESS;
+}
+
+/* The particle nearest x (x clamped to the buckets' box), -1 for none. */
+static long nearest(const buckets *bk, const mpm_model *m, const double *x) {
+  double xc[3];
+  for (int c = 0; c < 3; c++)
+    xc[c] = fmin(fmax(x[c], bk->lo[c]), bk->lo[c] + (bk->n[c] - 0.5) * bk->h);
+  long best = -1;
+  double d2min = INFINITY;
+  /* Past the ring where one is found, one more: a nearer one may lie
+   * there. */
+  for (int r = 1, last = 64; r <= last && r < 64; r++) {
+    if (best >= 0 && last == 64) last = r;
+    const int rz = bk->n[2] > 1 ? r : 0;
+    for (long dz = -rz; dz <= rz; dz++)
+      for (long dy = -r; dy <= r; dy++)
+        for (long dx = -r; dx <= r; dx++) {
+          long off[3] = {dx, dy, dz};
+          const long k = bucket_of(bk, xc, off);
+          if (k < 0) continue;
+          for (long j = bk->start[k]; j < bk->start[k + 1]; j++) {
+            const double *p = m->x0 + 3 * bk->order[j];
+            const double d2 = (p[0] - x[0]) * (p[0] - x[0]) +
+                              (p[1] - x[1]) * (p[1] - x[1]) +
+                              (p[2] - x[2]) * (p[2] - x[2]);
+            if (d2 < d2min) d2min = d2, best = bk->order[j];
+          }
+        }
+  }
+  return best;
+}
+
+/* The carriers of traction b on a named surface (3-D) or edge (2-D) of a
+ * gmsh body: the Gauss points of the boundary facets of its physical group
+ * (from the body's mesh at the seeding's element size), each with its
+ * share of its facet's area, carried by the body's particle nearest it at
+ * the offset from that particle to the point. */
+static pm_err surface_carriers(const pm_scene *s, mpm_model *m, int b) {
+  const char *name = s->bcs[b].surface;
+  mpm_bc *bc = &m->bcs[b];
+  const int dim = s->dimension, ng = GAUSS_N(dim);
+  char p[64];
+  for (int i = 0; i < s->n_bodies; i++) {
+    const pm_scene_body *body = &s->bodies[i];
+    if (body->shape != PM_BODY_MESH ||
+        mpm_body_role_of(body) != MPM_BODY_VOLUME ||
+        m->body_end[i] <= m->body_begin[i])
+      continue;
+    gm_gmsh_mesh mesh;
+    PM_CALL(gm_gmsh_load(body->mesh, dim, 0.5 * s->mesh_size, true, &mesh));
+    int g = 0;
+    while (g < mesh.n_groups && strcmp(mesh.group_name[g], name) != 0) g++;
+    if (g == mesh.n_groups) {
+      gm_gmsh_mesh_free(&mesh);
+      continue;
+    }
+    const long f0 = mesh.group_ptr[g], f1 = mesh.group_ptr[g + 1];
+    pm_err e = carriers_alloc(bc, (f1 - f0) * ng);
+    buckets bk = {0};
+    if (!e)
+      e = buckets_create(&bk, m, m->body_begin[i], m->body_end[i], m->grid.h);
+    for (long f = f0; !e && f < f1; f++) {
+      /* A facet with a node no element uses lies on no element: it
+       * carries nothing (its points sit at its first usable node). */
+      const double *c[3] = {NULL, NULL, NULL};
+      bool lone = false;
+      for (int k = 0; k < dim; k++) {
+        const long id = mesh.group_face[dim * f + k];
+        lone = lone || id < 0;
+        c[k] = id >= 0 ? mesh.x + 3 * id : NULL;
+      }
+      for (int k = 0; k < dim; k++)
+        if (!c[k]) c[k] = c[(k + 1) % dim] ? c[(k + 1) % dim] : mesh.x;
+      const double A = lone ? 0 : facet_measure(dim, c) / ng;
+      for (int q = 0; q < ng; q++) {
+        double w[3], X[3] = {0, 0, 0};
+        gauss_weights(dim, q, w);
+        for (int k = 0; k < dim; k++)
+          for (int a = 0; a < 3; a++) X[a] += w[k] * c[k][a];
+        const long n = (f - f0) * ng + q, pq = nearest(&bk, m, X);
+        bc->held[n] = pq < 0 ? m->body_begin[i] : pq;
+        bc->area[n] = A;
+        for (int a = 0; a < 3; a++)
+          bc->offset[3 * n + a] = X[a] - m->x0[3 * bc->held[n] + a];
+      }
+    }
+    free(bk.start);
+    free(bk.order);
+    gm_gmsh_mesh_free(&mesh);
+    return e;
+  }
+  return pm_scene_fail(s, PM_PATH(p, "boundary.%d.on", b), false,
+                       "expected a face of domain.box or the name of a "
+                       "physical %s of a gmsh body, got %s",
+                       dim == 2 ? "curve" : "surface", name);
+}
+
 pm_err mpm_tractions_create(const pm_scene *s, mpm_model *m) {
   for (int b = 0; b < m->n_bcs; b++) {
     mpm_bc *bc = &m->bcs[b];
     if (!bc->traction_mask) continue;
-    const pm_face f = s->bcs[b].face;
-    const int a = pm_face_axis(f);
-    const double out = bc->outward;
-    long n = 0;
-    for (int pass = 0; pass < 2; pass++) {
-      if (pass == 1) {
-        PM_CALL(PM_ALLOC(bc->held, n > 0 ? n : 1, "traction particles"));
-        PM_CALL(PM_ALLOC(bc->area, n > 0 ? n : 1, "traction areas"));
-        PM_CALL(PM_ALLOC(bc->reach, n > 0 ? n : 1, "traction areas"));
-      }
-      n = 0;
-      for (int i = 0; i < s->n_bodies; i++) {
-        if (mpm_body_role_of(&s->bodies[i]) != MPM_BODY_VOLUME) continue;
-        double plane, hs;
-        body_face(s, m, i, f, &plane, &hs);
-        for (long q = m->body_begin[i]; q < m->body_end[i]; q++) {
-          const double d = (plane - m->x0[3 * q + a]) * out;
-          if (!(d >= 0 && d < hs * (1 - 1e-9))) continue;
-          if (pass == 1) {
-            bc->held[n] = q;
-            bc->area[n] = m->vol0[q] / hs;
-            bc->reach[n] = d;
-          }
-          n++;
-        }
-      }
+    if (s->bcs[b].on == PM_ON_SURFACE) {
+      PM_CALL(surface_carriers(s, m, b));
+      continue;
     }
-    bc->n_held = n;
-    if (n == 0) {
+    const pm_face f = s->bcs[b].face;
+    bc->axis = pm_face_axis(f);
+    PM_CALL(carriers_alloc(bc, face_carriers(s, m, bc, f, NULL, NULL, NULL)));
+    face_carriers(s, m, bc, f, bc->held, bc->area, bc->offset);
+    if (bc->n_held == 0) {
       char p[64];
       return pm_scene_fail(s, PM_PATH(p, "boundary.%d.on", b), false,
                            "expected a face some volume body touches (its "
@@ -75,21 +267,19 @@ pm_err mpm_tractions_create(const pm_scene *s, mpm_model *m) {
   return PM_SUCCESS;
 }
 
-/* The point of the face over the k-th particle of traction bc: the
- * particle moved by its reference distance to the face along the face's
- * normal (at a particle the tractions would leave the nodes beyond it out
- * of balance: a residual of 1% on a bar). */
-static void face_point(const mpm_model *m, const mpm_bc *bc, long k,
-                       const double *x, double xs[3]) {
-  for (int c = 0; c < 3; c++) xs[c] = x[3 * bc->held[k] + c];
-  xs[bc->axis] += bc->outward * bc->reach[k];
-  (void)m;
+/* The point of the surface the k-th carrier of traction bc stands for:
+ * its particle at x moved by its reference offset. */
+static void face_point(const mpm_bc *bc, long k, const double *x,
+                       double xs[3]) {
+  for (int c = 0; c < 3; c++)
+    xs[c] = x[3 * bc->held[k] + c] + bc->offset[3 * k + c];
 }
 
 /* The force traction bc applies to its k-th particle at time t. */
 static void particle_force(const mpm_model *m, const mpm_bc *bc, long k,
                            double t, double f[3]) {
-  const double *X = m->x0 + 3 * bc->held[k];
+  double X[3];
+  face_point(bc, k, m->x0, X);
   const double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t) * bc->area[k];
   for (int c = 0; c < 3; c++)
     f[c] = bc->traction[c] && c < m->dim
@@ -116,7 +306,7 @@ pm_err mpm_stage_tractions(mpm_ctx *ctx, const mpm_stage *self) {
       }
       mpm_stencil st;
       double xs[3];
-      face_point(m, bc, k, x, xs);
+      face_point(bc, k, x, xs);
       mpm_stencil_at(&m->grid, xs, MPM_STENCIL_W, &st);
       for (int j = 0; j < st.n; j++)
         for (int c = 0; c < 3; c++) force[3 * st.node[j] + c] += st.w[j] * f[c];
@@ -140,7 +330,7 @@ pm_err mpm_book_tractions(mpm_ctx *ctx, const mpm_stage *self) {
       particle_force(m, bc, k, t, f);
       mpm_stencil st;
       double xs[3];
-      face_point(m, bc, k, x, xs);
+      face_point(bc, k, x, xs);
       mpm_stencil_at(&m->grid, xs, MPM_STENCIL_W, &st);
       for (int c = 0; c < 3; c++) reaction[3 * b + c] += f[c];
       for (int j = 0; j < st.n; j++) {
@@ -164,7 +354,7 @@ void mpm_tractions_nodal(const mpm_model *m, const mpm_grid *g,
     for (long k = 0; k < bc->n_held; k++) {
       double ft[3], xs[3];
       particle_force(m, bc, k, T, ft);
-      face_point(m, bc, k, xb, xs);
+      face_point(bc, k, xb, xs);
       mpm_stencil st;
       mpm_stencil_at(g, xs, MPM_STENCIL_W, &st);
       for (int j = 0; j < st.n; j++)
@@ -172,4 +362,41 @@ void mpm_tractions_nodal(const mpm_model *m, const mpm_grid *g,
           f[3 * st.node[j] + c] -= lam * st.w[j] * ft[c];
     }
   }
+}
+
+long mpm_tractions_points(const mpm_model *m, const double *x, double *at) {
+  long n = 0;
+  for (int b = 0; b < m->n_bcs; b++) {
+    const mpm_bc *bc = &m->bcs[b];
+    if (!bc->traction_mask) continue;
+    for (long k = 0; k < bc->n_held; k++, n++)
+      if (at) face_point(bc, k, x, at + 3 * n);
+  }
+  return n;
+}
+
+double mpm_tractions_work(const mpm_model *m, const mpm_grid *g,
+                          const double *xb, const double *u, double *at,
+                          double lam_old, double lam_new) {
+  const double T = m->opt.t_load, lam = 0.5 * (lam_old + lam_new);
+  double work = 0;
+  long n = 0;
+  for (int b = 0; b < m->n_bcs; b++) {
+    const mpm_bc *bc = &m->bcs[b];
+    if (!bc->traction_mask) continue;
+    for (long k = 0; k < bc->n_held; k++, n++) {
+      double ft[3], xs[3], *y = at + 3 * n;
+      particle_force(m, bc, k, T, ft);
+      face_point(bc, k, xb, xs);
+      mpm_stencil st;
+      mpm_stencil_at(g, xs, MPM_STENCIL_W, &st);
+      for (int j = 0; j < st.n; j++)
+        for (int c = 0; c < 3; c++) xs[c] += st.w[j] * u[3 * st.node[j] + c];
+      for (int c = 0; c < 3; c++) {
+        work += lam * ft[c] * (xs[c] - y[c]);
+        y[c] = xs[c];
+      }
+    }
+  }
+  return work;
 }

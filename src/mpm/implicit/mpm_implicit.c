@@ -10,6 +10,7 @@
 #include "mpm_estimate.h"
 #include "mpm_exchange.h"
 #include "mpm_implicit_impl.h"
+#include "mpm_traction.h"
 #include "mpm_kind.h"
 #include "pm_interrupt.h"
 #include "pm_omp.h"
@@ -246,6 +247,9 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   PM_TRY(PM_ALLOC(im->f, 3 * nn, "nodal forces"));
   PM_TRY(PM_ALLOC(im->df, 3 * nn, "nodal force changes"));
   PM_TRY(PM_ALLOC(im->reaction, 3 * m->n_bcs + 1, "reactions"));
+  PM_TRY(PM_ALLOC(im->trac_at, 3 * mpm_tractions_points(m, st->x, NULL) + 1,
+                  "traction points"));
+  mpm_tractions_points(m, st->x, im->trac_at);
   /* Newton's settings */
   pm_newton_options *o = &im->opt;
   *o = pm_newton_options_default();
@@ -316,6 +320,7 @@ void mpm_implicit_destroy(mpm_implicit *im) {
   pm_newton_destroy(&im->solver);
   pm_load_state_free(&im->ls);
   free(im->grp);
+  free(im->trac_at);
   free(im->tmin);
   free(im->order);
   free(im->bucket);

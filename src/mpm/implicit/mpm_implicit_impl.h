@@ -64,8 +64,10 @@ struct mpm_implicit {
   long *face_ptr, *face;
   /* nodal work, 3 per node */
   double *u, *du, *f, *df, *diag;
-  double *x_unk;  /* unknowns */
-  double *x_held; /* across ranks: the owned unknowns and the ghosts' */
+  double *trac_at; /* the tractions' points where the last step left them
+                      (3 per point; mpm_tractions_work) */
+  double *x_unk;   /* unknowns */
+  double *x_held;  /* across ranks: the owned unknowns and the ghosts' */
   /* load: the base's global load, the step's end, the local load */
   double lam0, lam1, lam_local;
   pm_newton_options opt;

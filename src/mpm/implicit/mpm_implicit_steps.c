@@ -7,6 +7,7 @@
 
 #include "mpm_exchange.h"
 #include "mpm_implicit_impl.h"
+#include "mpm_traction.h"
 #include "mpm_kind.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
@@ -16,7 +17,7 @@
 
 /* The particles at the converged unknowns x: position, F, stress and
  * volume; the reactions and the residual. */
-static pm_err commit(mpm_implicit *im, const double *x) {
+static pm_err commit(mpm_implicit *im, const double *x, double lam_new) {
   const mpm_model *m = im->m;
   mpm_state *st = im->st;
   if (im->ranks) { /* the ghost nodes' unknowns too */
@@ -75,6 +76,8 @@ static pm_err commit(mpm_implicit *im, const double *x) {
     })
   const long n = im->n;
   const double *u = im->u;
+  st->external_work += mpm_tractions_work(m, &im->g, im->xb, u, im->trac_at,
+                                          im->lambda, lam_new);
   long bad = -1;
   PM_OMP(parallel for schedule(static) reduction(max : bad))
   for (long p = 0; p < n; p++) {
@@ -133,9 +136,10 @@ pm_err mpm_implicit_on_step(void *ctx, int step, double lambda, const double *x,
   (void)step;
   mpm_implicit *im = ctx;
   if (im->mode == MPM_GRID_RESET && lambda < 1) return PM_SUCCESS;
-  pm_err e = commit(im, x);
+  const double lam_new = im->lam0 + lambda * (im->lam1 - im->lam0);
+  pm_err e = commit(im, x, lam_new);
   PM_CALL(im->ranks ? mpm_xc_agree(im->m, e) : e);
-  im->lambda = im->lam0 + lambda * (im->lam1 - im->lam0);
+  im->lambda = lam_new;
   return report_step(im, report);
 }
 
