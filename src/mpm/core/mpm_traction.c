@@ -195,7 +195,8 @@ static pm_err surface_carriers(const pm_scene *s, mpm_model *m, int b) {
         m->body_end[i] <= m->body_begin[i])
       continue;
     gm_gmsh_mesh mesh;
-    PM_CALL(gm_gmsh_load(body->mesh, dim, 0.5 * s->mesh_size, true, &mesh));
+    PM_CALL(gm_gmsh_load(body->mesh, dim, 0.5 * s->mesh_size, GM_SIZES_REPLACE,
+                         true, &mesh));
     int g = 0;
     while (g < mesh.n_groups && strcmp(mesh.group_name[g], name) != 0) g++;
     if (g == mesh.n_groups) {
