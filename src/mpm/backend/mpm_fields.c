@@ -150,6 +150,8 @@ void mpm_sim_figures(void *p, pm_figures *f, bool with_fields) {
   f->dt_stable = s->dt_stable / m->opt.dt_safety;
   f->residual = r->work->residual;
   mpm_energies(m, s, &f->kinetic, &f->strain, &f->internal);
+  /* the implicit F-bar's energy is that of Fbar, not of each F */
+  if (r->imp) mpm_implicit_strain_energy(r->imp, &f->strain);
   f->interface = 0;
   f->external_work = s->external_work;
   f->dissipated = s->dissipated;

@@ -212,6 +212,7 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   choose_fbar(im, s);
   im->threads = pm_omp_threads();
   PM_TRY(PM_ALLOC(im->tmin, im->threads, "thread minima"));
+  if (im->fbar) PM_TRY(PM_ALLOC(im->wbar, im->n, "F-bar energies"));
   if (im->mode == MPM_GRID_KEPT) {
     im->g = m->grid;
     im->xb = m->x0;
@@ -322,6 +323,7 @@ void mpm_implicit_destroy(mpm_implicit *im) {
   free(im->grp);
   free(im->trac_at);
   free(im->tmin);
+  free(im->wbar);
   free(im->order);
   free(im->bucket);
   free(im->cbuck);
@@ -359,6 +361,11 @@ const double *mpm_implicit_reactions(const mpm_implicit *im) {
   return im->reaction;
 }
 double mpm_implicit_residual(const mpm_implicit *im) { return im->residual; }
+bool mpm_implicit_strain_energy(const mpm_implicit *im, double *e) {
+  if (!im->fbar) return false;
+  *e = im->strain_energy;
+  return true;
+}
 double mpm_implicit_lambda(const mpm_implicit *im) { return im->lambda; }
 const pm_load_report *mpm_implicit_report(const mpm_implicit *im) {
   return &im->rep;

@@ -97,6 +97,10 @@ pm_err mpm_implicit_run(mpm_implicit *im, mpm_implicit_observer obs, void *ctx);
 const double *mpm_implicit_reactions(const mpm_implicit *im);
 /* The residual over the reactions at the last converged state. */
 double mpm_implicit_residual(const mpm_implicit *im);
+/* With F-bar: true and *e the strain energy sum V0 W(Fbar) at the last
+ * converged state (every rank's), the energy the residual derives from
+ * (the particles' own F give another); without: false. */
+bool mpm_implicit_strain_energy(const mpm_implicit *im, double *e);
 /* The load factor reached. */
 double mpm_implicit_lambda(const mpm_implicit *im);
 /* The run's totals: load steps, cuts, Newton and linear iterations, and

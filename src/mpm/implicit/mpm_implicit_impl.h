@@ -84,8 +84,11 @@ struct mpm_implicit {
   /* why the linear solver and F-bar are what they are (for plan) */
   char why_linear[192], why_fbar[256];
   int threads;
-  double *tmin;        /* per thread: smallest J of a force evaluation */
-  double min_jacobian; /* of the last force evaluation */
+  double *tmin;         /* per thread: smallest J of a force evaluation */
+  double *wbar;         /* F-bar: V0 W(Fbar) a particle at the last
+                           converged state (NULL without F-bar) */
+  double strain_energy; /* F-bar: their sum over every rank's particles */
+  double min_jacobian;  /* of the last force evaluation */
   long fail_p;
   char fail_msg[256];
   bool has_gravity;

@@ -62,9 +62,11 @@ static pm_err commit(mpm_implicit *im, const double *x, double lam_new) {
         particle_F(im, p, &stn, im->u, F);
         fbar_scale(im->dim, pow(Jbar / pm_t_det(F), 1.0 / im->dim), F, Fbar);
         const mpm_solid_view *v = &im->view[im->grp[p]];
-        if (!pm_material_stress(v->mat, Fbar, model_state(im, p), P, NULL,
-                                NULL))
+        double W = 0;
+        im->wbar[p] = 0;
+        if (!pm_material_stress(v->mat, Fbar, model_state(im, p), P, &W, NULL))
           continue; /* nodal_force succeeded on the same state */
+        im->wbar[p] = m->vol0[p] * W;
         double *sig = st->sigma + 9 * p;
         for (int i = 0; i < 3; i++)
           for (int j = 0; j < 3; j++)
@@ -74,6 +76,15 @@ static pm_err commit(mpm_implicit *im, const double *x, double lam_new) {
                 Jbar;
       }
     })
+  if (im->fbar) { /* in the particles' order: the same sum every run */
+    const long np = im->n;
+    const double *wb = im->wbar;
+    double e = 0;
+    PM_OMP(parallel for schedule(static) reduction(+ : e))
+    for (long p = 0; p < np; p++) e += wb[p];
+    if (im->ranks) mpm_xc_sum(m, &e, 1);
+    im->strain_energy = e;
+  }
   const long n = im->n;
   const double *u = im->u;
   st->external_work += mpm_tractions_work(m, &im->g, im->xb, u, im->trac_at,
