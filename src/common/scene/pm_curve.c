@@ -37,6 +37,7 @@ static pm_err read_table(pm_curve *c) {
   pm_err ret = PM_SUCCESS;
   pm_lines in = {0};
   long cap = 0;
+  bool header = false;
   char *text, *fields[3];
   double t, f;
   PM_TRY(pm_lines_open(&in, c->file, "load curve"));
@@ -46,10 +47,11 @@ static pm_err read_table(pm_curve *c) {
     const int nf = pm_split_fields(text, fields, 2);
     if (nf != 2 || !pm_parse_number(fields[0], &t) ||
         !pm_parse_number(fields[1], &f)) {
-      /* a header line first is allowed: it names the columns */
-      if (c->n == 0 && in.line == 1 && nf == 2 &&
-          !pm_parse_number(fields[0], &t))
+      /* a header first is allowed: it names the columns */
+      if (c->n == 0 && !header && nf == 2 && !pm_parse_number(fields[0], &t)) {
+        header = true;
         continue;
+      }
       ret = PM_ERROR(PM_ERR_SCENE,
                      "%s:%ld: expected two numbers t, factor, got %d "
                      "field%s",

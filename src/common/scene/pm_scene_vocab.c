@@ -637,9 +637,9 @@ static const pm_key bc_keys[] = {
      .offset = C(force),
      .count_offset = C(force_mask),
      .unit = "N",
-     .doc = "concentrated force at full load, f(x, y, z, t) at the point, "
+     .doc = "concentrated force at full load, f(x, y, z, t) at the point: "
             "on the point nearest at, or shared equally among the points "
-            "where region > 0 (FPM)"},
+            "of the facets on or region selects (FPM)"},
     {.name = "at",
      .type = PM_KEY_POINT,
      .offset = C(at),
