@@ -16,32 +16,11 @@
 #include <string.h>
 
 #include "fpm_backend.h"
+#include "fpm_run_testing.h"
 #include "fpm_solver.h"
 #include "pm_app.h"
 #include "pm_run.h"
 #include "pm_scene.h"
-
-#define CASES PM_SOURCE_DIR "/cases/fpm/"
-
-typedef struct {
-  pm_scene *scene;
-  fpm_sim *sim;
-  pm_outcome out;
-} run_t;
-
-static void run(const char *file, int n_sets, const char **sets, run_t *r) {
-  if (pm_scene_load(file, n_sets, sets, &r->scene) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
-  if (fpm_sim_create(r->scene, &r->sim) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
-  if (pm_run_sim(r->scene, r->sim, NULL, true, &r->out) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
-}
-
-static void done(run_t *r) {
-  fpm_sim_destroy(r->sim);
-  pm_scene_destroy(r->scene);
-}
 
 /* The column hanging under gravity (129 points): NRMSE of u against the
  * exact field below 2e-3 (measured 9.4e-4; 1.7e-4 and 4.6e-5 at half and a
@@ -56,10 +35,10 @@ static void test_column_gravity(void **state) {
   const char *body[] = {"gravity=[0, 0]", "body_force.y=-10"};
   const char *curved[] = {"body_curve=2*t"};
   run_t a = {0}, b = {0}, c = {0}, d = {0};
-  run(CASES "column-gravity.yaml", 0, NULL, &a);
-  run(CASES "column-gravity.yaml", 1, one, &b);
-  run(CASES "column-gravity.yaml", 2, body, &c);
-  run(CASES "column-gravity.yaml", 1, curved, &d);
+  fpm_test_run(CASES "column-gravity.yaml", 0, NULL, &a);
+  fpm_test_run(CASES "column-gravity.yaml", 1, one, &b);
+  fpm_test_run(CASES "column-gravity.yaml", 2, body, &c);
+  fpm_test_run(CASES "column-gravity.yaml", 1, curved, &d);
   double R[3];
   fpm_reaction(a.sim->model, a.sim->state, 0, R);
   print_message("column: %ld points, NRMSE u %.3e, reaction %.10g N, "
@@ -94,7 +73,7 @@ static void test_column_explicit(void **state) {
     const char *sets[] = {"time.quasi_static.method=none", "time.end=0.05",
                           "fpm.flux=sipg", safety[k]};
     run_t r = {0};
-    run(CASES "column-gravity.yaml", 4, sets, &r);
+    fpm_test_run(CASES "column-gravity.yaml", 4, sets, &r);
     e[k] = r.out.fig.energy_error;
     print_message("column, explicit, %s: %ld steps, energy balance %.4e\n",
                   safety[k], r.sim->last.step, e[k]);
@@ -133,8 +112,8 @@ static void test_ring_pressure(void **state) {
   const char *dr[] = {"time.quasi_static.method=dynamic-relaxation",
                       "time.end=200", "time.ramp=5"};
   run_t s = {0}, d = {0};
-  run(CASES "ring/ring-pressure.yaml", 0, NULL, &s);
-  run(CASES "ring/ring-pressure.yaml", 3, dr, &d);
+  fpm_test_run(CASES "ring/ring-pressure.yaml", 0, NULL, &s);
+  fpm_test_run(CASES "ring/ring-pressure.yaml", 3, dr, &d);
   const double ref = 0.272230, us = inner_radial(s.sim),
                ud = inner_radial(d.sim);
   double R[3];
@@ -167,7 +146,7 @@ static void test_point_forces(void **state) {
                           "time.quasi_static.load_steps=40"};
   for (int k = 0; k < 2; k++) {
     run_t r = {0};
-    run(CASES "point-forces.yaml", 1, &steps[k], &r);
+    fpm_test_run(CASES "point-forces.yaml", 1, &steps[k], &r);
     double R[3];
     fpm_reaction(r.sim->model, r.sim->state, 0, R);
     e[k] = r.out.fig.energy_error;
