@@ -1,5 +1,6 @@
 /* fuzz_table: the readers of CSV tables under a fuzzer.  An input is one
- * text file, read as an FE ladder, as an FE lattice, as the claimed
+ * text file, read as an FE ladder, as an FE lattice, as a load curve's
+ * table, as the claimed
  * tolerances of an FE reference folder whose ladder and lattice are valid,
  * and as the history.csv a resumed run cuts back to its checkpoint's
  * rows. */
@@ -9,6 +10,7 @@
 #include <string.h>
 
 #include "fuzz_file.h"
+#include "pm_curve.h"
 #include "pm_fe.h"
 #include "pm_history_csv.h"
 
@@ -50,6 +52,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   (void)pm_fe_read_lattice(path, &n, &x, &u);
   free(x);
   free(u);
+  pm_error_clear();
+  pm_curve *c = NULL;
+  if (pm_curve_create(path, NULL, &c) == PM_SUCCESS)
+    (void)pm_curve_at(c, 0.5 * pm_curve_end(c));
+  pm_curve_destroy(c);
   pm_error_clear();
   write_text("fe/ladder.csv", ladder);
   write_text("fe/lattice.csv", lattice);

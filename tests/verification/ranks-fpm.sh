@@ -169,6 +169,18 @@ for n in 1 3; do
   bounds="residual=inf" roundoff \
     "static, interrupted on 2 ranks, resumed on $n" "$work/s-$n" "$work/scut-$n"
 done
+# Loads (2-D): the ring's follower pressure and the point forces (one on
+# the nearest point, one shared by an edge's points, on a table curve)
+# with gravity, by dynamic relaxation (300 steps, not yet quasi-static)
+# and statically with every linear solve to 1e-10.
+relax="--set time.quasi_static.method=dynamic-relaxation
+  --set time.max_steps=300 --set output.every=100"
+want=3 across ring "$fpm/ring/ring-pressure.yaml" 2 $relax
+want=3 across point-forces "$fpm/point-forces.yaml" 2 $relax
+bounds="residual=inf" across ring-static "$fpm/ring/ring-pressure.yaml" 2 \
+  $static
+bounds="residual=inf" across point-forces-static "$fpm/point-forces.yaml" \
+  2 $static
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

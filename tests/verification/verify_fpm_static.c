@@ -18,33 +18,17 @@
 #include <string.h>
 
 #include "fpm_backend.h"
+#include "fpm_run_testing.h"
 #include "fpm_static.h"
 #include "pm_app.h"
 #include "pm_metrics.h"
 #include "pm_run.h"
 #include "pm_scene.h"
 
-#define CASES PM_SOURCE_DIR "/cases/fpm/"
-
-typedef struct {
-  pm_scene *scene;
-  fpm_sim *sim;
-  pm_outcome out;
-} run_t;
-
+/* A run that must converge. */
 static void run(const char *file, int n_sets, const char **sets, run_t *r) {
-  if (pm_scene_load(file, n_sets, sets, &r->scene) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
-  if (fpm_sim_create(r->scene, &r->sim) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
-  if (pm_run_sim(r->scene, r->sim, NULL, true, &r->out) != PM_SUCCESS)
-    fail_msg("%s", pm_error_message());
+  fpm_test_run(file, n_sets, sets, r);
   assert_int_equal(r->sim->status, PM_STATUS_CONVERGED);
-}
-
-static void done(run_t *r) {
-  fpm_sim_destroy(r->sim);
-  pm_scene_destroy(r->scene);
 }
 
 /* F2 (mesh size 0.02 m): NRMSE of u_z against -0.4 z below 1e-9; in the

@@ -21,7 +21,7 @@ double pm_rigid_gap(const pm_scene_bc *bc, const double d[3], const double x[3],
 }
 
 void pm_rigid_displacement(const pm_scene_bc *bc, double t, double d[3]) {
-  const double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
+  const double r = pm_bc_factor(bc, t);
   for (int a = 0; a < 3; a++)
     d[a] = bc->disp[a] ? r * pm_expr_eval(bc->disp[a], 0, 0, 0, t) : 0;
 }

@@ -238,12 +238,21 @@ double pm_scene_load_end(const pm_scene *s) {
   double end = 0;
   for (int b = 0; b < s->n_bcs; b++) {
     const pm_scene_bc *bc = &s->bcs[b];
-    if (bc->ramp == PM_RAMP_NONE ||
-        !(bc->disp_mask | bc->traction_mask | bc->velocity_mask))
+    if (!(bc->disp_mask | bc->traction_mask | bc->velocity_mask |
+          bc->force_mask) &&
+        !bc->pressure)
       continue;
+    /* a table's last row, where its factor stops changing */
+    if (pm_curve_end(bc->curve) > end) end = pm_curve_end(bc->curve);
+    if (bc->ramp == PM_RAMP_NONE) continue;
     if (bc->ramp_time > end) end = bc->ramp_time;
   }
+  if (pm_curve_end(s->body_curve) > end) end = pm_curve_end(s->body_curve);
   return end;
+}
+
+double pm_bc_factor(const pm_scene_bc *bc, double t) {
+  return pm_curve_at(bc->curve, t) * pm_ramp_factor(bc->ramp, bc->ramp_time, t);
 }
 
 double pm_ramp_factor(pm_ramp kind, double T, double t) {

@@ -9,6 +9,7 @@
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "pm_curve.h"
 #include "pm_error.h"
 #include "pm_expr.h"
 #include "pm_face.h"
@@ -227,7 +228,8 @@ typedef enum {
                      physical group) */
   PM_ON_REGION,   /* the boundary where region(x, y, z) > 0 */
   PM_ON_PLATE,    /* a rigid plane pushing where it touches (contact) */
-  PM_ON_SPHERE    /* a rigid sphere pushing where it touches (contact) */
+  PM_ON_SPHERE,   /* a rigid sphere pushing where it touches (contact) */
+  PM_ON_POINT     /* the point nearest a position (at: [x, y, z]) */
 } pm_on;
 
 /* How a rigid body holds what touches it. */
@@ -243,8 +245,10 @@ typedef enum {
 
 /* A boundary condition.  Displacement components are prescribed values at
  * full load (expressions in x, y, z and t, in m); traction components are
- * nominal tractions at full load (Pa); velocity components (m/s).  The
- * value applied at time t is ramp(t) * value(x, y, z, t). */
+ * nominal tractions at full load (Pa); pressure a follower pressure on the
+ * deformed face (Pa); force components a concentrated force on the points
+ * selected (N, shared equally among them); velocity components (m/s).  The
+ * value applied at time t is curve(t) * ramp(t) * value(x, y, z, t). */
 typedef struct {
   pm_on on;
   pm_face face;       /* PM_ON_FACE */
@@ -254,9 +258,14 @@ typedef struct {
   pm_expr *disp[3];   /* NULL where not prescribed */
   unsigned traction_mask;
   pm_expr *traction[3];
+  pm_expr *pressure; /* follower pressure, or NULL */
+  unsigned force_mask;
+  pm_expr *force[3];
+  double at[3]; /* PM_ON_POINT: the position whose nearest point is loaded */
   unsigned velocity_mask;
   pm_expr *velocity[3];
-  bool absorbing; /* viscous (absorbing) boundary */
+  struct pm_curve *curve; /* curve: the load curve, or NULL (factor 1) */
+  bool absorbing;         /* viscous (absorbing) boundary */
   pm_ramp ramp;
   double ramp_time; /* s; time.ramp when not given */
   /* A rigid body (PM_ON_PLATE, PM_ON_SPHERE): its reference geometry,
@@ -311,6 +320,11 @@ typedef struct pm_scene {
   int n_bcs;
   double gravity[3]; /* gravity: m/s^2 */
   bool has_gravity;
+  /* body_force: a force per unit mass f(x, y, z, t) per component (N/kg),
+   * added to gravity; both times body_curve(t) (NULL: 1) */
+  unsigned body_force_mask;
+  pm_expr *body_force[3];
+  struct pm_curve *body_curve;
   struct {
     double end;             /* time.end, s, > 0 */
     double dt;              /* time.dt, s; 0: the stable step */
@@ -411,6 +425,10 @@ void pm_scene_print_keys(FILE *out);
 /* Ramp factor in [0, 1] at time t for ramp kind and duration T:
  * smooth is C2 (10 s^3 - 15 s^4 + 6 s^5), linear is s, none is 1. */
 double pm_ramp_factor(pm_ramp kind, double T, double t);
+
+/* The factor of condition bc's values at time t: its curve times its
+ * ramp. */
+double pm_bc_factor(const pm_scene_bc *bc, double t);
 
 /* Time at which every ramped condition of the scene (with a displacement
  * or velocity) has reached its full value. */

@@ -365,10 +365,15 @@ static pm_err finish_rigid(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc,
         "expected no %s with %s (a rigid body acts where it touches), "
         "got %s",
         bc->surface ? "on" : "region", key, bc->surface ? "on" : "region");
-  static const char *const other[] = {"traction", "velocity", "absorbing"};
-  const bool has[] = {bc->traction_mask != 0, bc->velocity_mask != 0,
-                      bc->absorbing};
-  for (int k = 0; k < 3; k++)
+  static const char *const other[] = {"traction", "velocity", "absorbing",
+                                      "pressure", "force",    "at"};
+  const bool has[] = {bc->traction_mask != 0,
+                      bc->velocity_mask != 0,
+                      bc->absorbing,
+                      bc->pressure != NULL,
+                      bc->force_mask != 0,
+                      pm_reader_has(r, PM_PATH(p, "boundary.%d.at", i))};
+  for (int k = 0; k < 6; k++)
     if (has[k])
       return pm_reader_fail(r, PM_PATH(p, "boundary.%d.%s", i, other[k]), true,
                             "expected displacement only with %s (its rigid "
@@ -426,13 +431,25 @@ static pm_err finish_on(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc) {
                             "it with %s",
                             rigid_only[k], bc->region ? "region" : "on");
   bool has_on = bc->surface != NULL, has_region = bc->region != NULL;
+  if (pm_reader_has(r, PM_PATH(p, "boundary.%d.at", i))) {
+    if (has_on || has_region)
+      return pm_reader_fail(r, p, true, "expected at or %s, got both",
+                            has_on ? "on" : "region");
+    if (!bc->force_mask || bc->disp_mask || bc->traction_mask || bc->pressure)
+      return pm_reader_fail(r, p, true,
+                            "expected at only with a force (and no "
+                            "displacement, traction or pressure: a point "
+                            "has no face), got at");
+    bc->on = PM_ON_POINT;
+    return PM_SUCCESS;
+  }
   if (has_on == has_region) {
     if (has_on)
       return pm_reader_fail(r, PM_PATH(p, "boundary.%d.region", i), true,
                             "expected on or region, got both");
     return pm_reader_fail(r, PM_PATH(p, "boundary.%d", i), false,
                           "missing required key on (a face xmin ... zmax or "
-                          "a named surface) or region");
+                          "a named surface), region or at");
   }
   if (has_region) {
     bc->on = PM_ON_REGION;
@@ -459,10 +476,11 @@ static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
         r->doc, pm_sdoc_find(r->doc, PM_PATH(p, "boundary.%d", i), false));
     PM_CALL(finish_on(r, s, i, bc));
     if (!bc->disp_mask && !bc->traction_mask && !bc->velocity_mask &&
-        !bc->absorbing)
+        !bc->force_mask && !bc->pressure && !bc->absorbing)
       return pm_reader_fail(r, PM_PATH(p, "boundary.%d", i), false,
-                            "expected a displacement, traction or velocity "
-                            "component, or absorbing: true, got none");
+                            "expected a displacement, traction, pressure, "
+                            "force or velocity component, or absorbing: "
+                            "true, got none");
     static const char *const other[] = {"velocity", "traction"};
     unsigned both[2] = {bc->disp_mask & bc->velocity_mask,
                         bc->disp_mask & bc->traction_mask};

@@ -69,6 +69,44 @@ pm_err pm_scene_read_region(pm_reader *r, int id, const char *path,
   return pm_reader_expr(r, path, text, "xyz", &b->region);
 }
 
+pm_err pm_scene_read_curve(pm_reader *r, int id, const char *path,
+                           const pm_key *k, void *dst) {
+  (void)k;
+  const char *text = pm_sdoc_scalar(r->doc, id);
+  if (!text || !text[0])
+    return pm_reader_expected(r, path, "an expression of t or a .csv table");
+  char dir[PM_SDOC_PATH * 4] = "";
+  const char *scene = r->doc->path, *slash = scene ? strrchr(scene, '/') : NULL;
+  if (slash && (size_t)(slash - scene) < sizeof dir)
+    snprintf(dir, sizeof dir, "%.*s", (int)(slash - scene), scene);
+  pm_curve *c = NULL;
+  if (pm_curve_create(text, dir, &c) == PM_SUCCESS) {
+    for (int v = 0; c->expr && v < 3; v++)
+      if (pm_expr_uses(c->expr, "xyz"[v])) {
+        pm_curve_destroy(c);
+        return pm_reader_fail(r, path, false,
+                              "expected a function of t only, got %s, which "
+                              "uses %c",
+                              text, "xyz"[v]);
+      }
+    *(pm_curve **)dst = c;
+    return PM_SUCCESS;
+  }
+  /* the table's FILE:LINE, or the expression's complaint, at the key */
+  char why[512];
+  snprintf(why, sizeof why, "%s", pm_error_message());
+  pm_error_clear();
+  return pm_reader_fail(r, path, false,
+                        "expected an expression of t or a "
+                        ".csv table of rows t, factor: %s",
+                        why);
+}
+
+void pm_scene_release_curve(void *dst) {
+  pm_curve_destroy(*(pm_curve **)dst);
+  *(pm_curve **)dst = NULL;
+}
+
 void pm_scene_release_expr(void *dst) {
   pm_expr_destroy(*(pm_expr **)dst);
   *(pm_expr **)dst = NULL;

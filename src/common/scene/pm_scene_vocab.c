@@ -646,6 +646,35 @@ static const pm_key bc_keys[] = {
      .unit = "Pa",
      .doc = "nominal traction at full load (FPM; MPM on a face or a named "
             "surface or edge of a gmsh body: the particles at it carry it)"},
+    {.name = "pressure",
+     .type = PM_KEY_EXPR,
+     .offset = C(pressure),
+     .unit = "Pa",
+     .doc = "follower pressure at full load, f(x, y, z, t): normal to the "
+            "deformed face, pushing on it (FPM; with on or region)"},
+    {.name = "force",
+     .type = PM_KEY_COMPONENTS,
+     .offset = C(force),
+     .count_offset = C(force_mask),
+     .unit = "N",
+     .doc = "concentrated force at full load, f(x, y, z, t) at the point: "
+            "on the point nearest at, or shared equally among the points "
+            "of the facets on or region selects (FPM)"},
+    {.name = "at",
+     .type = PM_KEY_POINT,
+     .offset = C(at),
+     .unit = "m",
+     .doc = "force: the position whose nearest point carries it (instead "
+            "of on or region)"},
+    {.name = "curve",
+     .type = PM_KEY_CUSTOM,
+     .offset = C(curve),
+     .read = pm_scene_read_curve,
+     .release = pm_scene_release_curve,
+     .what = "an expression of t or a .csv table",
+     .doc = "load curve multiplying the values (and the ramp): an "
+            "expression of t, or FILE.csv of rows t, factor (relative to "
+            "the scene; linear between rows, held outside them); default 1"},
     {.name = "velocity",
      .type = PM_KEY_COMPONENTS,
      .offset = C(velocity),
@@ -1040,7 +1069,23 @@ const pm_key pm_scene_keys[] = {
      .type = PM_KEY_POINT,
      .offset = S(gravity),
      .unit = "m/s^2",
-     .doc = "body force per mass (MPM)"},
+     .doc = "body force per mass (FPM, MPM); not ramped: times body_curve "
+            "(FPM)"},
+    {.name = "body_force",
+     .type = PM_KEY_COMPONENTS,
+     .offset = S(body_force),
+     .count_offset = S(body_force_mask),
+     .unit = "N/kg",
+     .doc = "body force per mass f(x, y, z, t) per component, added to "
+            "gravity (FPM); not ramped: times body_curve"},
+    {.name = "body_curve",
+     .type = PM_KEY_CUSTOM,
+     .offset = S(body_curve),
+     .read = pm_scene_read_curve,
+     .release = pm_scene_release_curve,
+     .what = "an expression of t or a .csv table",
+     .doc = "load curve of gravity and body_force (FPM): an expression of "
+            "t, or FILE.csv of rows t, factor; default 1"},
     {.name = "output",
      .type = PM_KEY_MAPPING,
      .keys = output_keys,

@@ -31,8 +31,16 @@ pm_err pm_scene_read_fibres(pm_reader *r, int id, const char *path,
 pm_err pm_scene_read_region(pm_reader *r, int id, const char *path,
                             const pm_key *k, void *dst);
 
+/* A load curve (curve, body_curve): an expression of t, or a .csv table
+ * relative to the scene's folder, a bad row failing at the key with the
+ * table's FILE:LINE. */
+pm_err pm_scene_read_curve(pm_reader *r, int id, const char *path,
+                           const pm_key *k, void *dst);
+
 /* Release of an expression key (dst: a pm_expr *, set to NULL). */
 void pm_scene_release_expr(void *dst);
+/* Release of a curve key (dst: a pm_curve *, set to NULL). */
+void pm_scene_release_curve(void *dst);
 
 /* After reading: defaults that depend on other keys, names resolved to
  * indices, and the checks across keys, each failing at the key at fault. */

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_loads.h"
 #include "fpm_model.h"
 
 /* The facets of each condition, as CSR lists bcf_ptr / bcf_facet: on a
@@ -24,7 +25,8 @@ static pm_err select_facets(fpm_model *m, const pm_scene *s,
       const pm_scene_bc *bc = &s->bcs[b];
       int surf = -1;
       m->bcf_ptr[b] = n;
-      if (PM_BC_RIGID(bc)) continue; /* in contact: fpm_contact */
+      /* in contact: fpm_contact; at a point: fpm_loads */
+      if (PM_BC_RIGID(bc) || bc->on == PM_ON_POINT) continue;
       if (bc->on != PM_ON_REGION) {
         surf = gm_mesh_surface_find(mesh, bc->surface);
         if (surf < 0) {
@@ -83,7 +85,7 @@ pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s,
       for (int c = 0; c < 3; c++)
         if (bc->disp_mask & (1u << c)) bc_of[3 * i + c] = b;
       if (bc->disp_mask && dpt_of[i] < 0) dpt_of[i] = m->n_dpts++;
-      if (bc->traction_mask) m->n_tfacets++;
+      if (bc->traction_mask || bc->pressure) m->n_tfacets++;
     }
   }
   /* In 2D (plane strain) the out-of-plane component is fixed at zero. */
@@ -120,6 +122,7 @@ pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s,
   PM_TRY(PM_ALLOC(m->tf_rel, 3 * m->n_tfacets, "traction facets"));
   PM_TRY(PM_ALLOC(m->tf_centroid, 3 * m->n_tfacets, "traction facets"));
   PM_TRY(PM_ALLOC(m->tf_base, 3 * m->n_tfacets, "traction facets"));
+  PM_TRY(PM_ALLOC(m->tf_normal, 3 * m->n_tfacets, "traction facets"));
   long nt = 0;
   for (int b = 0; b < s->n_bcs; b++) {
     const pm_scene_bc *bc = &s->bcs[b];
@@ -141,14 +144,17 @@ pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s,
           }
         }
       }
-      if (bc->traction_mask) {
+      if (bc->traction_mask || bc->pressure) {
         m->tf_point[nt] = i;
         m->tf_bc[nt] = b;
         m->tf_area[nt] = d->facet_area[f];
         for (int a = 0; a < 3; a++) {
           m->tf_rel[3 * nt + a] = d->facet_area[f] * (cf[a] - xi[a]);
           m->tf_centroid[3 * nt + a] = cf[a];
+          m->tf_normal[3 * nt + a] = af[a] / d->facet_area[f];
         }
+        if (bc->pressure && pm_expr_uses(bc->pressure, 't'))
+          m->tf_time_dependent = true;
         for (int c = 0; c < 3; c++) {
           if (!(bc->traction_mask & (1u << c))) continue;
           m->tf_base[3 * nt + c] =
@@ -159,6 +165,7 @@ pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s,
       }
     }
   }
+  PM_TRY(fpm_build_loads(m, s));
 done:
   free(bc_of);
   free(dpt_of);
@@ -167,7 +174,7 @@ done:
 
 double fpm_prescribed(const fpm_model *m, long k, double t) {
   const pm_scene_bc *bc = &m->scene->bcs[m->cd_bc[k]];
-  double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
+  double r = pm_bc_factor(bc, t);
   if (!m->cd_time_dependent) return r * m->cd_base[k];
   const double *xi = m->x + 3 * m->cd_point[k];
   return r * pm_expr_eval(bc->disp[m->cd_comp[k]], xi[0], xi[1], xi[2], t);
@@ -179,8 +186,14 @@ long fpm_update_tractions(const fpm_model *m, fpm_state *st, double t) {
   long bad = -1;
   for (long k = 0; k < m->n_tfacets; k++) {
     const pm_scene_bc *bc = &m->scene->bcs[m->tf_bc[k]];
-    double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t);
+    double r = pm_bc_factor(bc, t);
     const double *c = m->tf_centroid + 3 * k;
+    /* the pressure's traction follows the face: the force sets it */
+    double p =
+        bc->pressure ? r * pm_expr_eval(bc->pressure, c[0], c[1], c[2], t) : 0;
+    if (!isfinite(p) && bad < 0) bad = 3 * k;
+    st->tf_p[k] = p;
+    if (m->tf_point[k] < n_own) norm2 += p * p * m->tf_area[k] * m->tf_area[k];
     for (int a = 0; a < 3; a++) {
       double v = 0;
       if (!(bc->traction_mask & (1u << a)))
@@ -205,6 +218,11 @@ pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
   if (traction) {
     const pm_scene_bc *bc = &m->scene->bcs[m->tf_bc[k / 3]];
     const pm_expr *e = bc->traction[k % 3];
+    if (!e || (bc->pressure && k % 3 == 0 &&
+               !isfinite(pm_expr_eval(bc->pressure, m->tf_centroid[k],
+                                      m->tf_centroid[k + 1],
+                                      m->tf_centroid[k + 2], t))))
+      e = bc->pressure;
     const double *c = m->tf_centroid + 3 * (k / 3);
     return pm_expr_fail_value(e, pm_expr_eval(e, c[0], c[1], c[2], t), step, t,
                               "facet of point",

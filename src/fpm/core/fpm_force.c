@@ -10,6 +10,7 @@
 #include "fpm_stream.h"
 #include "fpm_gfd.h"
 #include "fpm_linear_impl.h"
+#include "fpm_loads.h"
 #include "fpm_model.h"
 #include "fpm_volumetric.h"
 #include "fpm_penalty_terms.h"
@@ -30,6 +31,9 @@ typedef struct {
    * increments (linearisation only), and the base's fits (quadratic
    * stiffening's linearisation only) */
   const double *vphi, *vdphi, *btheta;
+  /* the loads: the pressures and body and point forces (the state's; the
+   * linearisation's pressures, whose forces do not change) */
+  const double *tf_p, *fload;
   /* the team's sums (shared, zero at the region's start): the interface
    * energy, the boundary flux's squared norm */
   double *sums;
@@ -328,6 +332,12 @@ static double flux_pass(const fpm_model *m, const fields *fl) {
  * counts the model's own points. */
 static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
   const long nd = m->n_dpts, n_own = m->n_own;
+  if (fl->fload) { /* body and point forces (before the flux's nowait) */
+    const double *restrict fb = fl->fload;
+    double *restrict rb = fl->r;
+    PM_OMP(for schedule(static))
+    for (long d = 0; d < 3 * n_own; d++) rb[d] -= fb[d];
+  }
   const long *restrict dp = m->dpt_point;
   const double *restrict da = m->dpt_area, *restrict dm = m->dpt_mrel;
   const double *restrict P = fl->P;
@@ -350,7 +360,24 @@ static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
     }
   }
   norm2 = team_sum(fl->sums + 1, norm2);
-  if (!st) return; /* the linearisation: tractions do not depend on u */
+  if (!st) { /* the linearisation: only the pressures' tractions change */
+    if (m->n_tfacets && fl->tf_p) {
+      PM_OMP(single)
+      for (long k = 0; k < m->n_tfacets; k++) {
+        if (fl->tf_p[k] == 0) continue;
+        const long i = m->tf_point[k];
+        const double *rel = m->tf_rel + 3 * k;
+        double t[3];
+        fpm_pressure_dtraction(fl->bH + 9 * i, fl->H + 9 * i, fl->tf_p[k],
+                               m->tf_normal + 3 * k, t);
+        for (int c = 0; c < 3; c++) {
+          r[3 * i + c] -= t[c] * m->tf_area[k];
+          for (int q = 0; q < 3; q++) T[9 * i + 3 * c + q] -= t[c] * rel[q];
+        }
+      }
+    }
+    return;
+  }
   if (m->n_tfacets == 0) {
     PM_OMP(masked) {
       st->bflux_sq = norm2;
@@ -364,7 +391,12 @@ static void boundary_pass(const fpm_model *m, const fields *fl, fpm_state *st) {
     st->bflux_norm = sqrt(norm2);
     for (long k = 0; k < m->n_tfacets; k++) {
       const long i = m->tf_point[k];
-      const double *t = st->tf_value + 3 * k, *rel = m->tf_rel + 3 * k;
+      const double *rel = m->tf_rel + 3 * k;
+      double *t = st->tf_load + 3 * k;
+      /* the pressure's traction on the face as it is now */
+      fpm_pressure_traction(fl->H + 9 * i, st->tf_p[k], m->tf_normal + 3 * k,
+                            t);
+      for (int c = 0; c < 3; c++) t[c] += st->tf_value[3 * k + c];
       for (int c = 0; c < 3; c++) {
         r[3 * i + c] -= t[c] * m->tf_area[k];
         for (int q = 0; q < 3; q++) T[9 * i + 3 * c + q] -= t[c] * rel[q];
@@ -450,6 +482,8 @@ long fpm_force_then(const fpm_model *m, fpm_state *st, void (*tail)(void *),
                      .f = st->f,
                      .bflux = st->bflux,
                      .vphi = st->vphi,
+                     .tf_p = st->tf_p,
+                     .fload = m->bf_base || m->n_pforces ? st->fload : NULL,
                      .sums = sums};
   const bool whole = m->vavg == NULL;
   long bad = m->n_own;
@@ -484,6 +518,7 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st,
   memcpy(l->bu, st->u, 3 * n * sizeof(double));
   memcpy(l->bH, st->H, 9 * n * sizeof(double));
   if (l->btheta) memcpy(l->btheta, st->theta, 27 * n * sizeof(double));
+  if (l->tf_p) memcpy(l->tf_p, st->tf_p, m->n_tfacets * sizeof(double));
   if (l->vphi) fpm_volume_dphi(ns, st->H, NULL, l->vphi, NULL);
   PM_OMP(parallel for schedule(static) default(none)
          shared(ns, H, D, mat, mats, ms, mss))
@@ -541,6 +576,7 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
                      .vphi = l->vphi,
                      .vdphi = l->vdphi,
                      .btheta = l->btheta,
+                     .tf_p = l->tf_p,
                      .sums = sums};
   if (l->vdphi) fpm_volume_dphi(n, l->bH, dH, NULL, l->vdphi);
   PM_OMP(parallel default(none) shared(m, fl, l))

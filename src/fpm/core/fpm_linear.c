@@ -31,6 +31,9 @@ pm_err fpm_linear_create(const fpm_model *m, fpm_linear **out) {
     PM_TRY(PM_ALLOC(l->vdphi, n, "volume penalty increments"));
   }
   if (m->vavg) PM_TRY(fpm_volumetric_lin_create(m, &l->vol));
+  for (int b = 0; b < m->scene->n_bcs; b++)
+    if (m->scene->bcs[b].pressure && !l->tf_p)
+      PM_TRY(PM_ALLOC(l->tf_p, m->n_tfacets + 1, "pressures"));
   *out = l;
   l = NULL;
 done:
@@ -54,6 +57,7 @@ void fpm_linear_destroy(fpm_linear *l) {
   free(l->btheta);
   free(l->vphi);
   free(l->vdphi);
+  free(l->tf_p);
   free(l);
 }
 
@@ -63,7 +67,7 @@ size_t fpm_linear_bytes(const fpm_model *m) {
              (81 + 9 + 9 + 9 + 3 + 12 + (m->q ? 57 : 0) + (bth ? 27 : 0) +
               (m->volume_penalty > 0 ? 2 : 0)) *
              sizeof(double) +
-         fpm_volumetric_lin_bytes(m);
+         (size_t)m->n_tfacets * sizeof(double) + fpm_volumetric_lin_bytes(m);
 }
 
 const double *fpm_linear_tangent(const fpm_linear *l) { return l->D; }

@@ -14,6 +14,7 @@ struct fpm_linear {
   fpm_volumetric_lin vol;  /* fpm.volumetric: averaged (else NULLs) */
   double *btheta;          /* 27 n: its fits (quadratic stiffening only) */
   double *vphi, *vdphi;    /* n, n: fpm.volume_penalty's phi there, dphi */
+  double *tf_p; /* n_tfacets: the pressures there (NULL: no pressure) */
 };
 
 #endif

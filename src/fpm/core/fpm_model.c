@@ -44,6 +44,11 @@ void fpm_model_destroy(fpm_model *m) {
   free(m->tf_rel);
   free(m->tf_centroid);
   free(m->tf_base);
+  free(m->tf_normal);
+  free(m->bf_base);
+  free(m->pf_point);
+  free(m->pf_bc);
+  free(m->pf_share);
   free(m->cd_point);
   free(m->cd_comp);
   free(m->cd_bc);
@@ -457,6 +462,10 @@ pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
     PM_TRY(PM_ALLOC(st->dUbar, n, "averaged pressure"));
   }
   PM_TRY(PM_ALLOC(st->tf_value, 3 * m->n_tfacets, "tractions"));
+  PM_TRY(PM_ALLOC(st->tf_p, m->n_tfacets + 1, "pressures"));
+  PM_TRY(PM_ALLOC(st->tf_load, 3 * m->n_tfacets + 1, "tractions"));
+  PM_TRY(PM_ALLOC(st->fload, 3 * n, "body and point forces"));
+  PM_TRY(PM_ALLOC(st->fload_prev, 3 * n, "body and point forces"));
   PM_TRY(PM_ALLOC(st->bflux, 3 * m->n_dpts, "boundary flux"));
   PM_TRY(PM_ALLOC(st->support_prev,
                   m->n_cdofs + 3 * m->n_dpts + 6 * m->n_tfacets,
@@ -487,6 +496,10 @@ void fpm_state_destroy(fpm_state *st) {
   free(st->Jbar);
   free(st->dUbar);
   free(st->tf_value);
+  free(st->tf_p);
+  free(st->tf_load);
+  free(st->fload);
+  free(st->fload_prev);
   free(st->bflux);
   free(st->support_prev);
   free(st->contact);
@@ -494,8 +507,9 @@ void fpm_state_destroy(fpm_state *st) {
 }
 
 size_t fpm_state_bytes(const fpm_model *m) {
-  return (size_t)m->n * (3 * 4 + 9 * 3 + 2) * sizeof(double) +
-         (size_t)(m->n_tfacets + 2 * m->n_dpts) * 3 * sizeof(double) +
+  return (size_t)m->n * (3 * 6 + 9 * 3 + 2) * sizeof(double) +
+         (size_t)(2 * m->n_tfacets + 2 * m->n_dpts) * 3 * sizeof(double) +
+         (size_t)m->n_tfacets * sizeof(double) +
          (size_t)m->n_cdofs * sizeof(double) +
          (size_t)fpm_contact_state_size(m->contact) * sizeof(double) +
          (m->q ? (size_t)m->n * 57 * sizeof(double) : 0) +

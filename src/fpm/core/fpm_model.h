@@ -108,6 +108,14 @@ typedef struct {
   double *tf_centroid;    /* 3 n_tfacets */
   double *tf_base;        /* 3 n_tfacets: traction at full load (t = 0) */
   bool tf_time_dependent; /* some traction expression uses t */
+  double *tf_normal;      /* 3 n_tfacets: unit outward normal N (pressure) */
+  /* Body forces and concentrated forces (fpm_loads.h). */
+  double *bf_base;        /* 3 n: m_i (g + b(X_i, 0)), or NULL when none */
+  bool bf_time_dependent; /* body_force uses t */
+  long n_pforces;         /* concentrated forces: one row per point */
+  long *pf_point;         /* n_pforces */
+  int *pf_bc;             /* n_pforces: the condition */
+  double *pf_share;       /* n_pforces: 1 / its condition's points */
   /* Prescribed displacement components. */
   long n_cdofs;
   long *cd_point;
@@ -161,6 +169,11 @@ typedef struct {
   double *W;                /* n: strain energy density */
   double *J;                /* n: det F */
   double *tf_value;         /* 3 n_tfacets: traction at the current time */
+  double *tf_p;             /* n_tfacets: pressure at the current time */
+  double *tf_load;          /* 3 n_tfacets: the nominal traction applied,
+                               tf_value - p cof(F_i) N (set by the force) */
+  double *fload;            /* 3 n: body and concentrated forces now */
+  double *fload_prev;       /* 3 n: at the last step (their work) */
   double fext_norm;         /* |f_ext| of the current tractions */
   double bflux_norm;        /* |consistency flux on prescribed faces| */
   double fext_sq, bflux_sq; /* their squares over the model's own points

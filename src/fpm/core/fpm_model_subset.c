@@ -193,7 +193,29 @@ static pm_err subset_boundary(const fpm_model *m, fpm_model *s,
   copy_items(s->tf_rel, m->tf_rel, idx, c, 3);
   copy_items(s->tf_centroid, m->tf_centroid, idx, c, 3);
   copy_items(s->tf_base, m->tf_base, idx, c, 3);
+  PM_TRY(PM_ALLOC(s->tf_normal, 3 * c + 1, "share's traction facets"));
+  copy_items(s->tf_normal, m->tf_normal, idx, c, 3);
   s->tf_time_dependent = m->tf_time_dependent;
+  /* body forces of its points, concentrated forces on its own */
+  s->bf_time_dependent = m->bf_time_dependent;
+  if (m->bf_base) {
+    PM_TRY(PM_ALLOC(s->bf_base, 3 * s->n, "share's body forces"));
+    copy_items(s->bf_base, m->bf_base, s->gid, s->n, 3);
+  }
+  c = 0;
+  for (long k = 0; k < m->n_pforces; k++)
+    if (lof[m->pf_point[k]] >= 0 && lof[m->pf_point[k]] < no) c++;
+  s->n_pforces = c;
+  PM_TRY(PM_ALLOC(s->pf_point, c + 1, "share's point forces"));
+  PM_TRY(PM_ALLOC(s->pf_bc, c + 1, "share's point forces"));
+  PM_TRY(PM_ALLOC(s->pf_share, c + 1, "share's point forces"));
+  c = 0;
+  for (long k = 0; k < m->n_pforces; k++)
+    if (lof[m->pf_point[k]] >= 0 && lof[m->pf_point[k]] < no) {
+      s->pf_point[c] = lof[m->pf_point[k]];
+      s->pf_bc[c] = m->pf_bc[k];
+      s->pf_share[c++] = m->pf_share[k];
+    }
   c = 0;
   for (long k = 0; k < m->n_cdofs; k++)
     if (lof[m->cd_point[k]] >= 0 && lof[m->cd_point[k]] < no) idx[c++] = k;

@@ -285,8 +285,5 @@ pm_err fpm_check_scene(const pm_scene *s) {
   PM_CALL(check_volumetric(s));
   PM_CALL(check_bodies(s));
   PM_CALL(check_boundary(s));
-  if (pm_scene_has(s, "gravity"))
-    return pm_scene_fail(s, "gravity", true,
-                         "expected no gravity for method fpm, got gravity");
   return PM_SUCCESS;
 }

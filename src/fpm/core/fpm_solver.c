@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fpm_contact.h"
+#include "fpm_loads.h"
 #include "pm_backend.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
@@ -38,6 +39,7 @@ double fpm_spectral_dt(const fpm_model *m, fpm_state *st, int iterations,
   double *v = st->v, lam = 0;
   memset(st->u, 0, nd * sizeof(double));
   fpm_update_tractions(m, st, 0);
+  fpm_update_loads(m, st, 0);
   fpm_force(m, st);
   memcpy(base, st->f, nd * sizeof(double));
   unsigned long long seed = 88172645463325252ull;
@@ -94,9 +96,10 @@ void fpm_support_start(const fpm_model *m, fpm_state *st) {
   double *tp = st->support_prev + m->n_cdofs + 3 * m->n_dpts;
   double *wp = tp + 3 * m->n_tfacets;
   for (long k = 0; k < m->n_tfacets; k++) {
-    memcpy(tp + 3 * k, st->tf_value + 3 * k, 3 * sizeof(double));
+    memcpy(tp + 3 * k, st->tf_load + 3 * k, 3 * sizeof(double));
     traction_displacement(m, st, k, wp + 3 * k);
   }
+  fpm_loads_start(m, st);
 }
 
 double fpm_support_work(const fpm_model *m, fpm_state *st, const double *du,
@@ -125,13 +128,16 @@ double fpm_support_work(const fpm_model *m, fpm_state *st, const double *du,
     double w[3];
     traction_displacement(m, st, k, w);
     for (int a = 0; a < 3; a++) {
-      const double t = st->tf_value[3 * k + a];
+      const double t = st->tf_load[3 * k + a];
       if (m->tf_point[k] < m->n_own)
         work += 0.5 * (tp[3 * k + a] + t) * (w[a] - wp[3 * k + a]);
       tp[3 * k + a] = t;
       wp[3 * k + a] = w[a];
     }
   }
+  /* Body and point forces: the trapezoidal rule on the points' own
+   * displacements. */
+  work += fpm_loads_work(m, st, du, scale);
   if (rr) *rr = r2;
   return work;
 }
@@ -202,6 +208,10 @@ static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
   } else if ((bad = fpm_update_tractions(m, st, t)) >= 0) {
     e = fpm_condition_failure(m, true, bad, step, t);
     key = KEY_STAGE + 3 * (m->tf_gid ? m->tf_gid[bad / 3] : bad / 3) + bad % 3;
+  } else if ((bad = fpm_update_loads(m, st, t)) >= 0) {
+    e = fpm_load_failure(m, bad, step, t);
+    /* after the tractions' keys: their facets number fewer than 2^39 */
+    key = KEY_STAGE + (1L << 39) + bad;
   }
   fpm_exchange_ghosts(m->xc, st->u);
   if (e == PM_SUCCESS) {

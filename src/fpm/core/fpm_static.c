@@ -202,6 +202,10 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
    * coupling (it keeps each point's own volumetric stiffness); it
    * preconditions the exact tangent applied matrix-free. */
   if (m->vavg) no.op = PM_NEWTON_MATRIX_FREE;
+  /* A follower pressure: the assembled tangent lacks its load stiffness
+   * (fpm_loads.h); it preconditions the exact tangent likewise. */
+  for (int b = 0; b < s->n_bcs; b++)
+    if (s->bcs[b].pressure) no.op = PM_NEWTON_MATRIX_FREE;
   /* ...unless the factorisation takes the coupling in (one value per
    * point more): then GMRES converges in an iteration or two. */
   if (fpm_static_couples(s, m, rep->unknowns, no.linear)) {

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fpm_contact.h"
+#include "fpm_loads.h"
 #include "fpm_static_impl.h"
 
 /* The state at the free values x (prescribed dofs as set by set_load). */
@@ -100,15 +101,16 @@ static pm_err own_loads(fpm_static_ctx *c, double lambda, long *key) {
     }
     c->st->u[3 * m->cd_point[k] + m->cd_comp[k]] = lambda * u;
   }
-  if (m->n_tfacets > 0) {
-    long bad = fpm_update_tractions(m, c->st, c->load_end);
-    if (bad >= 0) {
-      *key = fpm_point_id(m, m->tf_point[bad / 3]);
-      return fpm_condition_failure(m, true, bad, -1, c->load_end);
-    }
-    for (long k = 0; k < 3 * m->n_tfacets; k++) c->st->tf_value[k] *= lambda;
-    c->st->fext_norm *= lambda;
+  long bad = fpm_update_tractions(m, c->st, c->load_end);
+  if (bad >= 0) {
+    *key = fpm_point_id(m, m->tf_point[bad / 3]);
+    return fpm_condition_failure(m, true, bad, -1, c->load_end);
   }
+  if ((bad = fpm_update_loads(m, c->st, c->load_end)) >= 0) {
+    *key = bad;
+    return fpm_load_failure(m, bad, -1, c->load_end);
+  }
+  fpm_loads_scale(m, c->st, lambda);
   return PM_SUCCESS;
 }
 

@@ -266,8 +266,31 @@ static pm_err check_bodies(const pm_scene *s) {
   return PM_SUCCESS;
 }
 
+/* The loads of method fpm that MPM does not take (yet): body_force,
+ * body_curve and a condition's pressure, force, at and curve. */
+static pm_err refuse_fpm_loads(const pm_scene *s) {
+  char p[64];
+  static const char *const top[] = {"body_force", "body_curve"};
+  static const char *const per_bc[] = {"pressure", "force", "at", "curve"};
+  for (int k = 0; k < 2; k++)
+    if (pm_scene_has(s, top[k]))
+      return pm_scene_fail(s, top[k], true,
+                           "expected no %s for method %s (FPM only; MPM "
+                           "takes gravity), got %s",
+                           top[k], s->method, top[k]);
+  for (int i = 0; i < s->n_bcs; i++)
+    for (int k = 0; k < 4; k++)
+      if (pm_scene_has(s, PM_PATH(p, "boundary.%d.%s", i, per_bc[k])))
+        return pm_scene_fail(s, p, true,
+                             "expected no %s for method %s (FPM only), got "
+                             "%s",
+                             per_bc[k], s->method, per_bc[k]);
+  return PM_SUCCESS;
+}
+
 pm_err mpm_check_scene(const pm_scene *s) {
   char p[64], what[192];
+  PM_CALL(refuse_fpm_loads(s));
   PM_CALL(check_bodies(s));
   /* The box faces are grid planes, where conditions act. */
   mpm_layout lay;
