@@ -156,6 +156,34 @@ void pm_par_bcast(void *p, size_t n) {
 #endif
 }
 
+void pm_par_gather_double(double v, double *all) {
+#ifdef PM_HAVE_MPI
+  if (par_size > 1) {
+    MPI_Gather(&v, 1, MPI_DOUBLE, all, 1, MPI_DOUBLE, 0, par_comm);
+    par_sent += sizeof(double);
+    return;
+  }
+#endif
+  all[0] = v;
+}
+
+int pm_par_host_ranks(void) {
+#ifdef PM_HAVE_MPI
+  static int host_ranks = 0; /* counted once: the ranks do not move */
+  if (par_size == 1) return 1;
+  if (host_ranks == 0) {
+    MPI_Comm host;
+    MPI_Comm_split_type(par_comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL,
+                        &host);
+    MPI_Comm_size(host, &host_ranks);
+    MPI_Comm_free(&host);
+  }
+  return host_ranks;
+#else
+  return 1;
+#endif
+}
+
 pm_err pm_par_agree(pm_err e) { return pm_par_agree_first(e, 0); }
 
 pm_err pm_par_agree_first(pm_err e, long key) {

@@ -220,6 +220,12 @@ static pm_err create(const pm_scene *s, void **out) {
   return PM_SUCCESS;
 }
 
+/* The ghosts reach 3 rings of support, 5 where the quadratic fits take
+ * two rings (fpm_share.h). */
+static double ghost_layers(const pm_scene *s) {
+  return fpm_scene_options(s)->jump == FPM_JUMP_QUADRATIC ? 5 : 3;
+}
+
 static void destroy(void *sim) { fpm_sim_destroy(sim); }
 
 const pm_backend fpm_backend = {
@@ -231,6 +237,8 @@ const pm_backend fpm_backend = {
     .check = fpm_check_scene,
     .create = create,
     .estimate_bytes = fpm_estimate_bytes,
+    .ghost_layers = ghost_layers,
+    .setup_whole = true,
     .destroy = destroy,
     .plan = fpm_backend_plan,
     .run = fpm_backend_run,
