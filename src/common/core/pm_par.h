@@ -49,7 +49,7 @@ void pm_par_bcast(void *p, size_t n);
  * there; ignored on the other ranks). */
 void pm_par_gather_double(double v, double *all);
 /* The ranks on this machine (those that share its memory), this one
- * among them; 1 on one process (collective the first time). */
+ * among them; 1 on one process. */
 int pm_par_host_ranks(void);
 
 /* Every rank's e: the same answer on all of them.  PM_SUCCESS when every

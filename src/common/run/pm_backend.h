@@ -154,7 +154,7 @@ typedef struct pm_backend {
   /* Across ranks (pm_memory_rank_estimate): the layers of ghost points
    * around a rank's share (NULL: every rank may hold the whole run), and
    * whether the setup builds the whole model on every rank before each
-   * takes its share. */
+   * takes its share (else only where pm_view_keeps_whole). */
   double (*ghost_layers)(const struct pm_scene *s);
   bool setup_whole;
   void (*destroy)(void *sim);

@@ -14,6 +14,7 @@
 #include "pm_backend.h"
 #include "pm_json.h"
 #include "pm_par.h"
+#include "pm_view.h"
 
 static bool force_memory;
 
@@ -163,7 +164,8 @@ double pm_memory_share_points(double n, int ranks, int dim, double layers) {
   return held < n ? held : n;
 }
 
-size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, long *points) {
+size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
+                               long *points) {
   const pm_backend *b = s->backend;
   const size_t whole = b->estimate_bytes(s, points);
   if (ranks <= 1 || !b->ghost_layers || *points <= 0) return whole;
@@ -171,7 +173,8 @@ size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, long *points) {
   const double held =
       pm_memory_share_points(n, ranks, s->dimension, b->ghost_layers(s));
   *points = (long)held;
-  const double bytes = (b->setup_whole ? whole : 0) + whole * held / n;
+  const double bytes =
+      (b->setup_whole || whole_here ? whole : 0) + whole * held / n;
   return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
 }
 
@@ -179,7 +182,8 @@ pm_err pm_memory_check(const pm_scene *s) {
   if (!s->backend || !s->backend->estimate_bytes) return PM_SUCCESS;
   long points = 0;
   const int ranks = pm_par_size();
-  size_t need = pm_memory_rank_estimate(s, ranks, &points);
+  const bool whole = s->backend->setup_whole || pm_view_keeps_whole();
+  size_t need = pm_memory_rank_estimate(s, ranks, whole, &points);
   pm_memory_available avail;
   pm_err e = pm_memory_query(&avail);
   if (e == PM_ERR_IO) {
@@ -192,15 +196,13 @@ pm_err pm_memory_check(const pm_scene *s) {
   if (ranks > 1)
     return PM_ERROR(
         PM_ERR_MEMORY,
-        "%s: on %d ranks the largest rank of the %s simulation needs an "
-        "estimated %s (%zu bytes: %ld points held, %s) but %s (%zu bytes) "
-        "is available to a rank (%s); nothing was allocated "
-        "(--force-memory runs it anyway)",
-        s->path, ranks, s->method, pm_memory_format(need, a, sizeof a), need,
-        points,
-        s->backend->setup_whole ? "the whole model its setup builds and its "
-                                  "share"
-                                : "its share",
+        "%s: on %d ranks rank %d of the %s simulation needs an estimated "
+        "%s (%zu bytes: %ld points held, %s) but %s (%zu bytes) is "
+        "available to a rank (%s); nothing was allocated (--force-memory "
+        "runs it anyway)",
+        s->path, ranks, pm_par_rank(), s->method,
+        pm_memory_format(need, a, sizeof a), need, points,
+        whole ? "its share and the whole model, which it builds" : "its share",
         pm_memory_format(avail.bytes, b, sizeof b), avail.bytes, avail.source);
   return PM_ERROR(PM_ERR_MEMORY,
                   "%s: the %s simulation needs an estimated %s (%zu bytes, "
@@ -230,17 +232,21 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
           pm_memory_format(avail.bytes, b, sizeof b), avail.source);
   if (ranks > 1 && s->backend->ghost_layers) {
     long held = 0;
-    need = pm_memory_rank_estimate(s, ranks, &held);
-    fprintf(out,
-            "memory/rank  %s before setup on each of %d ranks at most (%ld "
-            "points held: %s)%s\n",
-            pm_memory_format(need, a, sizeof a), ranks, held,
-            s->backend->setup_whole ? "the whole model its setup builds, "
-                                      "and its share with its ghosts"
-                                    : "its share with its ghosts",
-            pm_par_active() ? ""
-                            : "; a run refuses it above the memory "
-                              "available to a rank");
+    const size_t share = pm_memory_rank_estimate(s, ranks, false, &held);
+    need = pm_memory_rank_estimate(s, ranks, true, &held);
+    if (s->backend->setup_whole)
+      fprintf(out,
+              "memory/rank  %s before setup on each of %d ranks at most "
+              "(%ld points held: the whole model its setup builds, and its "
+              "share with its ghosts)\n",
+              pm_memory_format(need, a, sizeof a), ranks, held);
+    else
+      fprintf(out,
+              "memory/rank  %s before setup on each of %d ranks at most (its "
+              "share with its ghosts, %ld points); %s on a rank that keeps "
+              "the whole model (rank 0 where the frames are gathered)\n",
+              pm_memory_format(share, a, sizeof a), ranks, held,
+              pm_memory_format(need, b, sizeof b));
   }
 }
 

@@ -37,8 +37,7 @@ pm_err pm_memory_available_shared(const char *meminfo, const char *cgroup_max,
 
 /* The same from /proc/meminfo, /sys/fs/cgroup/memory.{max,current} and
  * the environment variable POINTMECH_MEMORY_LIMIT, for one rank: the
- * machine's figure shared by the ranks on it (collective the first time
- * across ranks). */
+ * machine's figure shared by the ranks on it. */
 pm_err pm_memory_query(pm_memory_available *out);
 
 /* Run scenes whose estimate exceeds the available memory anyway (the
@@ -55,14 +54,17 @@ double pm_memory_share_points(double n, int ranks, int dim, double layers);
  * the bytes of the rank that holds the most, its share of the whole run's
  * estimate by the points it holds (pm_memory_share_points with the
  * backend's ghost layers), and the whole where the backend's setup builds
- * it on every rank; on one rank, or for a backend without ghost layers,
- * the whole run's.  *points: the points that rank holds. */
-size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, long *points);
+ * it on every rank or whole_here (this rank keeps it); on one rank, or for a
+ * backend without ghost layers, the whole run's.  *points: the points that rank
+ * holds. */
+size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
+                               long *points);
 
 /* Refuse s with PM_ERR_MEMORY when its backend's estimate exceeds the
  * memory available, naming both figures and their sources, unless forced:
- * across ranks, the estimate of the largest rank against the memory
- * available to a rank (pm_memory_query), the same rule on every rank.
+ * across ranks, each rank's estimate (with the whole model where it
+ * builds it: pm_view_keeps_whole) against the memory available to a rank
+ * (pm_memory_query), agreed by the caller.
  * Succeeds when the backend gives no estimate or no figure is available. */
 pm_err pm_memory_check(const pm_scene *s);
 
