@@ -106,10 +106,21 @@ static void check_options(fixture *fx, const char *what) {
     for (int r = 0; r < parts; r++) {
       fpm_model *cut, *built;
       assert_int_equal(fpm_share_create(m, owner, r, &cut), PM_SUCCESS);
-      assert_int_equal(fpm_share_build(&fx->scene, &fx->opt, fx->mesh, fx->dual,
-                                       owner, r, &built),
+      assert_int_equal(fpm_share_build(&fx->scene, &fx->opt, fx->mesh,
+                                       &fx->dual, false, owner, r, &built),
                        PM_SUCCESS);
       assert_same_share(cut, built);
+      if (r == 0) { /* the whole cells let go on the way: the same share */
+        gm_dual *cells = NULL;
+        fpm_model *again;
+        assert_int_equal(gm_dual_build(fx->mesh, &cells), PM_SUCCESS);
+        assert_int_equal(fpm_share_build(&fx->scene, &fx->opt, fx->mesh, &cells,
+                                         true, owner, r, &again),
+                         PM_SUCCESS);
+        assert_null(cells);
+        assert_same_share(cut, again);
+        fpm_model_destroy(again);
+      }
       held += built->n;
       least = built->n < least ? built->n : least;
       fpm_model_destroy(cut);

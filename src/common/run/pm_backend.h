@@ -157,6 +157,9 @@ typedef struct pm_backend {
    * takes its share (else only where pm_view_keeps_whole). */
   double (*ghost_layers)(const struct pm_scene *s);
   bool setup_whole;
+  /* The part of estimate_bytes every rank holds whole even so (FPM: the
+   * mesh and its cells), or NULL (none). */
+  size_t (*geometry_bytes)(const struct pm_scene *s);
   void (*destroy)(void *sim);
   /* Print the pipeline, counts, time step, steps, memory and an estimated
    * run time, without running. */

@@ -173,8 +173,11 @@ size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
   const double held =
       pm_memory_share_points(n, ranks, s->dimension, b->ghost_layers(s));
   *points = (long)held;
-  const double bytes =
-      (b->setup_whole || whole_here ? whole : 0) + whole * held / n;
+  /* The geometry every rank holds whole, the rest by the points held. */
+  const double geometry =
+      b->geometry_bytes ? fmin((double)b->geometry_bytes(s), (double)whole) : 0;
+  const double bytes = (b->setup_whole || whole_here ? whole : geometry) +
+                       (whole - geometry) * held / n;
   return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
 }
 

@@ -51,7 +51,8 @@ void pm_memory_set_force(bool force);
 double pm_memory_share_points(double n, int ranks, int dim, double layers);
 
 /* The backend's estimate for s on `ranks` ranks, from the scene alone:
- * the bytes of the rank that holds the most, its share of the whole run's
+ * the bytes of the rank that holds the most: the geometry every rank
+ * holds whole (the backend's geometry_bytes), the rest of the whole run's
  * estimate by the points it holds (pm_memory_share_points with the
  * backend's ghost layers), and the whole where the backend's setup builds
  * it on every rank or whole_here (this rank keeps it); on one rank, or for a

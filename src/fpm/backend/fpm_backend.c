@@ -222,7 +222,7 @@ static pm_err checkpoint_whole(fpm_sim *sim, pm_ckpt *ck, fpm_state *st, long n,
  * the time it takes to keep its share of it. */
 static pm_err checkpoint_share(fpm_sim *sim, pm_ckpt *ck) {
   pm_err ret = PM_SUCCESS;
-  const long n = sim->dual->n_points;
+  const long n = sim->n_whole;
   const bool is_static = sim->scene->time.qs == PM_QS_STATIC;
   fpm_state whole = {0};
   fpm_static_state ws = {0};
@@ -276,7 +276,7 @@ static void shares_dt(fpm_sim *sim) {
  * whole run into its share (collective). */
 static pm_err whole_fixed(fpm_sim *sim) {
   const fpm_model *lm = sim->local_model;
-  const long n = sim->dual->n_points;
+  const long n = sim->n_whole;
   double *mask = NULL;
   pm_err ret = PM_SUCCESS;
   PM_TRY(PM_ALLOC(mask, 3 * n + 1, "prescribed dofs"));
@@ -310,7 +310,8 @@ static pm_err create_share(const pm_scene *s, fpm_sim **out) {
   const double t0 = pm_wtime();
   if (!e) {
     pm_timers_start(&sim->timers, sim->tm_operators);
-    e = fpm_par_create(s, sim->mesh, sim->dual, sim->model, &sim->local_model);
+    sim->n_whole = sim->dual->n_points;
+    e = fpm_par_create(s, sim->mesh, &sim->dual, sim->model, &sim->local_model);
     pm_timers_stop(&sim->timers, sim->tm_operators);
   }
   if (!e)
@@ -374,6 +375,7 @@ const pm_backend fpm_backend = {
     .create = create,
     .estimate_bytes = fpm_estimate_bytes,
     .ghost_layers = ghost_layers,
+    .geometry_bytes = fpm_estimate_geometry_bytes,
     .destroy = destroy,
     .plan = fpm_backend_plan,
     .run = fpm_backend_run,

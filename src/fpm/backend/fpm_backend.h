@@ -62,6 +62,8 @@ typedef struct {
    * hold the mesh and cells, and no model but their share. */
   fpm_model *local_model;
   fpm_state *local_state;
+  long n_whole;          /* the whole model's points (a rank without it lets the
+                            whole cells, dual above, go once its share is made) */
   double ranks_costs[4]; /* summed over the ranks at the end: ghost bytes,
                             exchanges; the slowest's exchange and gather
                             seconds */

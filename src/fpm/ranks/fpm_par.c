@@ -197,22 +197,24 @@ static long offset(void *ctx, long count) {
   return pm_par_offset(count);
 }
 
-pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, const gm_dual *d,
+pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, gm_dual **cells,
                       const fpm_model *whole, fpm_model **local) {
   pm_err ret = PM_SUCCESS;
   struct fpm_par *P = NULL;
   fpm_model *s = NULL;
+  const long n = (*cells)->n_points;
   *local = NULL;
   PM_TRY(pm_par_agree(PM_ALLOC(P, 1, "FPM ranks")));
   P->rank = pm_par_rank();
   P->size = pm_par_size();
   PM_TRY(pm_par_agree(pm_petsc_init()));
-  PM_TRY(partition(P, d));
+  PM_TRY(partition(P, *cells));
   PM_TRY(pm_par_agree(whole ? fpm_share_create(whole, P->owner, P->rank, &s)
                             : fpm_share_build(sc, fpm_scene_options(sc), mesh,
-                                              d, P->owner, P->rank, &s)));
-  PM_TRY(pm_par_agree(make_forests(P, d->n_points, s)));
-  PM_TRY(pm_par_agree(count_shares(P, d->n_points, s)));
+                                              cells, true, P->owner, P->rank,
+                                              &s)));
+  PM_TRY(pm_par_agree(make_forests(P, n, s)));
+  PM_TRY(pm_par_agree(count_shares(P, n, s)));
   P->n_ghost = s->n - s->n_own;
   P->xc = (fpm_exchange){.ctx = P,
                          .ghosts = exchange_ghosts,

@@ -32,17 +32,18 @@
 #include "fpm_model.h"
 #include "fpm_share.h"
 
-/* This rank's share of the model of scene sc on the cells d of the whole
- * mesh, which every rank holds (collective; every rank returns the same
- * error): rank 0 partitions the points (fpm_partition) after checking that
- * every rank meshed the same graph, every rank makes its share and the
- * exchanges are set up: the share's exchange (fpm_exchange.h: the ghosts'
- * displacements, the sums and minima, the failures agreed) is this rank's.
- * whole: the whole model where this rank holds it (the share is cut from
- * it), else NULL: the share is built from the cells around its points
- * (fpm_region.h), the same model bit for bit.  *local owns its arrays and
- * the exchanges (fpm_model_destroy). */
-pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, const gm_dual *d,
+/* This rank's share of the model of scene sc on the cells *cells of the
+ * whole mesh, which every rank holds (collective; every rank returns the
+ * same error): rank 0 partitions the points (fpm_partition) after checking
+ * that every rank meshed the same graph, every rank makes its share and
+ * the exchanges are set up: the share's exchange (fpm_exchange.h: the
+ * ghosts' displacements, the sums and minima, the failures agreed) is this
+ * rank's.  whole: the whole model where this rank holds it (the share is
+ * cut from it), else NULL: the share is built from the cells around its
+ * points (fpm_region.h), the same model bit for bit, and the whole cells
+ * are let go on the way (*cells NULL on return).  *local owns its arrays
+ * and the exchanges (fpm_model_destroy). */
+pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, gm_dual **cells,
                       const fpm_model *whole, fpm_model **local);
 /* A share's state from the whole run's, which every rank holds (a
  * checkpoint read by every rank): displacements and velocities of every

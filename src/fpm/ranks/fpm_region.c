@@ -173,9 +173,10 @@ static pm_err traction_ids(const pm_scene *s, fpm_model *pm, const long *wptr,
 }
 
 pm_err fpm_share_build(const pm_scene *s, const fpm_options *o,
-                       const gm_mesh *mesh, const gm_dual *d, const int *owner,
-                       int r, fpm_model **out) {
+                       const gm_mesh *mesh, gm_dual **whole, bool release,
+                       const int *owner, int r, fpm_model **out) {
   pm_err ret = PM_SUCCESS;
+  const gm_dual *d = *whole;
   const long n = d->n_points;
   const int held = o->jump == FPM_JUMP_QUADRATIC ? 5 : 3;
   int *ring = NULL, *part_owner = NULL;
@@ -195,11 +196,19 @@ pm_err fpm_share_build(const pm_scene *s, const fpm_options *o,
   for (long i = 0; i < n; i++)
     if (lof[i] >= 0) gid[lof[i]] = i;
   PM_TRY(part_dual(d, ring, held + 1, np, gid, lof, &pd, &fgid));
+  PM_TRY(PM_ALLOC(part_owner, np + 1, "part's partition"));
+  for (long li = 0; li < np; li++) part_owner[li] = owner[gid[li]];
+  free(ring);
+  free(lof);
+  ring = NULL;
+  lof = NULL;
+  if (release) { /* the part's cells are all the model reads */
+    gm_dual_destroy(*whole);
+    *whole = NULL;
+  }
   PM_TRY(fpm_model_create_part(s, o, mesh, pd, gid, &pm));
   if (pm->contact) PM_TRY(fpm_contact_refuse_ranks(s));
   PM_TRY(traction_ids(s, pm, wptr, wf, fgid));
-  PM_TRY(PM_ALLOC(part_owner, np + 1, "part's partition"));
-  for (long li = 0; li < np; li++) part_owner[li] = owner[gid[li]];
   PM_TRY(fpm_share_create(pm, part_owner, r, out));
 done:
   fpm_model_destroy(pm);

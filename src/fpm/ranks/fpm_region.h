@@ -20,12 +20,15 @@
 #include "gm_mesh.h"
 
 /* Rank r's share of the model of scene s (fpm options o) on the whole
- * mesh's cells d, under partition owner (d->n_points ranks), without the
+ * mesh's cells *whole, under partition owner (n_points ranks), without the
  * whole model: the model fpm_share_create makes of the whole model, bit
  * for bit.  Errors of the scene's conditions are the whole model's (a
- * condition that selects no facet of the whole).  *out owns its arrays. */
+ * condition that selects no facet of the whole).  With release, *whole is
+ * destroyed (and NULL) once the part's cells are taken from it, before
+ * the part's model is built, so that the two are never held together.
+ * *out owns its arrays. */
 pm_err fpm_share_build(const pm_scene *s, const fpm_options *o,
-                       const gm_mesh *mesh, const gm_dual *d, const int *owner,
-                       int r, fpm_model **out);
+                       const gm_mesh *mesh, gm_dual **whole, bool release,
+                       const int *owner, int r, fpm_model **out);
 
 #endif
