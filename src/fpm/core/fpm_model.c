@@ -434,7 +434,9 @@ pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
   if (m->jump == FPM_JUMP_QUADRATIC && m->boundary_penalty > 0)
     PM_TRY(boundary_penalty(m));
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
-  PM_TRY(fpm_stream_build(m));
+  /* A part's share streams its own entries (fpm_model_subset); the part
+   * is never stepped. */
+  if (!gid) PM_TRY(fpm_stream_build(m));
   if (o->volumetric == FPM_VOLUMETRIC_AVERAGED) PM_TRY(fpm_volumetric_build(m));
   PM_TRY(fpm_build_boundary(m, s, mesh));
   PM_TRY(fpm_contact_create(m, s, &m->contact));

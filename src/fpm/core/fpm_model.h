@@ -203,7 +203,8 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
  * (ascending), its rows are those of the whole where held, and empty
  * where not (the part's edge); every per-point and per-entry figure of a
  * point whose rows, and whose neighbours' rows, are held is the whole
- * model's, bit for bit.  Conditions may select none of its facets.
+ * model's, bit for bit.  Conditions may select none of its facets.  It
+ * has no entry stream (it is never stepped: its shares are, with theirs).
  * gid is copied (m->gid). */
 pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
                              const gm_mesh *mesh, const gm_dual *d,
