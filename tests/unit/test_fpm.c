@@ -284,7 +284,7 @@ static void test_shares(void **state) {
     assert_int_equal(fpm_force(m, st), -1);
     int *owner = malloc(sizeof(int) * m->n), *owned = calloc(m->n, sizeof(int));
     for (int parts = 2; parts <= 3; parts++) {
-      assert_int_equal(fpm_partition(m, parts, owner), PM_SUCCESS);
+      assert_int_equal(fpm_partition(m->dual, parts, owner), PM_SUCCESS);
       memset(owned, 0, sizeof(int) * m->n);
       long ghosts = 0, first = m->n;
       for (int r = 0; r < parts; r++) {

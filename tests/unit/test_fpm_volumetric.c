@@ -161,7 +161,7 @@ static void shares_as_whole(bool defaults) {
   assert_int_equal(fpm_force(m, st), -1);
   int *owner = malloc(sizeof(int) * m->n);
   for (int parts = 2; parts <= 3; parts++) {
-    assert_int_equal(fpm_partition(m, parts, owner), PM_SUCCESS);
+    assert_int_equal(fpm_partition(m->dual, parts, owner), PM_SUCCESS);
     for (int r = 0; r < parts; r++) {
       fpm_model *s;
       fpm_state *ss;

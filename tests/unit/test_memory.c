@@ -9,6 +9,7 @@
 
 #include "pm_testing.h"
 
+#include <math.h>
 #include <stdint.h>
 
 #include "pm_app.h"
@@ -64,6 +65,50 @@ static void test_available(void **state) {
                PM_ERR_ARG, "POINTMECH_MEMORY_LIMIT");
   assert_fails(pm_memory_available_from(nothing, nothing, nothing, NULL, &a),
                PM_ERR_IO, "no memory figure");
+
+  /* Across ranks: the machine's figure shared by its 4 ranks, the cap
+   * each one's. */
+  assert_ok(pm_memory_available_shared(meminfo, max, current, NULL, 4, &a));
+  assert_int_equal(a.bytes, (size_t)96 << 20);
+  assert_non_null(strstr(a.source, "shared by the 4 ranks on this machine"));
+  assert_ok(
+      pm_memory_available_shared(meminfo, nothing, nothing, "200M", 4, &a));
+  assert_int_equal(a.bytes, (size_t)200 << 20);
+  assert_ok(
+      pm_memory_available_shared(meminfo, nothing, nothing, "300M", 4, &a));
+  assert_int_equal(a.bytes, (size_t)256 << 20);
+}
+
+/* ---- a rank's share ------------------------------------------------------ */
+
+/* The points a rank holds: its part and the ghost layers over two faces
+ * of a cube of its points, at most all of them; and a rank's estimate: its
+ * share of the whole, with the whole where the setup builds it. */
+static void test_rank_estimate(void **state) {
+  (void)state;
+  assert_true(fabs(pm_memory_share_points(8e6, 8, 3, 2) - (1e6 + 2 * 2 * 1e4)) <
+              1e-6);
+  assert_true(pm_memory_share_points(1e6, 1, 3, 5) == 1e6);
+  assert_true(pm_memory_share_points(4000, 2, 3, 5) <= 4000);
+  char path[1024];
+  snprintf(path, sizeof path, "%s/cases/fpm/f2-unconstrained-compression.yaml",
+           PM_SOURCE_DIR);
+  pm_scene *s = NULL;
+  assert_ok(pm_scene_load(path, 0, NULL, &s));
+  long whole_points = 0, held = 0;
+  const size_t whole = pm_memory_rank_estimate(s, 1, false, &whole_points);
+  assert_int_equal(whole, s->backend->estimate_bytes(s, &held));
+  const size_t rank = pm_memory_rank_estimate(s, 1000, false, &held);
+  assert_true(held > 0 && held < whole_points);
+  const double geometry = (double)s->backend->geometry_bytes(s);
+  const double share = ((double)whole - geometry) * held / whole_points;
+  const double expect = (s->backend->setup_whole ? whole : geometry) + share;
+  /* held is the figure's whole points (a point's bytes apart) */
+  assert_true(fabs((double)rank - expect) <= 1 + (double)whole / whole_points);
+  print_message("f2 at %ld points: %zu bytes on one process, %zu on the "
+                "largest of 1000 ranks (%ld points held)\n",
+                whole_points, whole, rank, held);
+  pm_scene_destroy(s);
 }
 
 /* ---- estimates against measured memory --------------------------------- */
@@ -143,6 +188,7 @@ int main(void) {
       cmocka_unit_test_setup_teardown(test_available, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test(test_estimates),
+      cmocka_unit_test(test_rank_estimate),
       cmocka_unit_test(test_refusal),
   };
   if (pm_app_init() != PM_SUCCESS) return 1;

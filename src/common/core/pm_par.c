@@ -9,7 +9,7 @@
 
 #include "pm_par_mpi.h"
 
-static int par_rank = 0, par_size = 1;
+static int par_rank = 0, par_size = 1, par_host_ranks = 1;
 #ifdef PM_HAVE_MPI
 static MPI_Comm par_comm = MPI_COMM_NULL; /* NULL until pm_par_attach */
 #endif
@@ -70,6 +70,11 @@ pm_err pm_par_attach(MPI_Comm comm) {
   par_comm = comm;
   MPI_Comm_rank(comm, &par_rank);
   MPI_Comm_size(comm, &par_size);
+  /* The ranks that share this one's machine (its memory). */
+  MPI_Comm host;
+  MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &host);
+  MPI_Comm_size(host, &par_host_ranks);
+  MPI_Comm_free(&host);
   return PM_SUCCESS;
 #endif
 }
@@ -155,6 +160,19 @@ void pm_par_bcast(void *p, size_t n) {
   (void)p, (void)n;
 #endif
 }
+
+void pm_par_gather_double(double v, double *all) {
+#ifdef PM_HAVE_MPI
+  if (par_size > 1) {
+    MPI_Gather(&v, 1, MPI_DOUBLE, all, 1, MPI_DOUBLE, 0, par_comm);
+    par_sent += sizeof(double);
+    return;
+  }
+#endif
+  all[0] = v;
+}
+
+int pm_par_host_ranks(void) { return par_host_ranks; }
 
 pm_err pm_par_agree(pm_err e) { return pm_par_agree_first(e, 0); }
 

@@ -45,6 +45,13 @@ long pm_par_offset(long n);
 /* Rank 0's n bytes at p on every rank. */
 void pm_par_bcast(void *p, size_t n);
 
+/* Every rank's v into all[rank] on rank 0 (all: pm_par_size() values
+ * there; ignored on the other ranks). */
+void pm_par_gather_double(double v, double *all);
+/* The ranks on this machine (those that share its memory), this one
+ * among them; 1 on one process. */
+int pm_par_host_ranks(void);
+
 /* Every rank's e: the same answer on all of them.  PM_SUCCESS when every
  * rank has it; else the failure of the lowest rank that failed, whose
  * message every rank then records as its own (so rank 0 reports it). */

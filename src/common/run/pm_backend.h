@@ -151,6 +151,15 @@ typedef struct pm_backend {
    * estimate); the run driver refuses scenes estimated past the memory
    * available (pm_memory). */
   size_t (*estimate_bytes)(const struct pm_scene *s, long *points);
+  /* Across ranks (pm_memory_rank_estimate): the layers of ghost points
+   * around a rank's share (NULL: every rank may hold the whole run), and
+   * whether the setup builds the whole model on every rank before each
+   * takes its share (else only where pm_view_keeps_whole). */
+  double (*ghost_layers)(const struct pm_scene *s);
+  bool setup_whole;
+  /* The part of estimate_bytes every rank holds whole even so (FPM: the
+   * mesh and its cells), or NULL (none). */
+  size_t (*geometry_bytes)(const struct pm_scene *s);
   void (*destroy)(void *sim);
   /* Print the pipeline, counts, time step, steps, memory and an estimated
    * run time, without running. */

@@ -8,7 +8,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <math.h>
+#include <sys/resource.h>
+
 #include "pm_backend.h"
+#include "pm_json.h"
+#include "pm_par.h"
+#include "pm_view.h"
 
 static bool force_memory;
 
@@ -82,6 +88,13 @@ static pm_err parse_limit(const char *text, size_t *bytes) {
 pm_err pm_memory_available_from(const char *meminfo, const char *cgroup_max,
                                 const char *cgroup_current, const char *limit,
                                 pm_memory_available *out) {
+  return pm_memory_available_shared(meminfo, cgroup_max, cgroup_current, limit,
+                                    1, out);
+}
+
+pm_err pm_memory_available_shared(const char *meminfo, const char *cgroup_max,
+                                  const char *cgroup_current, const char *limit,
+                                  int sharing, pm_memory_available *out) {
   char a[32], b[32];
   size_t avail = 0, max = 0, current = 0, cap = 0;
   bool have = read_meminfo(meminfo, &avail);
@@ -108,6 +121,13 @@ pm_err pm_memory_available_from(const char *meminfo, const char *cgroup_max,
       have = true;
     }
   }
+  /* The machine's memory is shared by its ranks; the cap is each one's. */
+  if (have && sharing > 1) {
+    out->bytes /= (size_t)sharing;
+    size_t len = strlen(out->source);
+    snprintf(out->source + len, sizeof out->source - len,
+             ", shared by the %d ranks on this machine", sharing);
+  }
   if (limit && *limit) {
     PM_CALL(parse_limit(limit, &cap));
     if (cap < out->bytes) {
@@ -132,15 +152,41 @@ pm_err pm_memory_available_from(const char *meminfo, const char *cgroup_max,
 }
 
 pm_err pm_memory_query(pm_memory_available *out) {
-  return pm_memory_available_from("/proc/meminfo", "/sys/fs/cgroup/memory.max",
-                                  "/sys/fs/cgroup/memory.current",
-                                  getenv("POINTMECH_MEMORY_LIMIT"), out);
+  return pm_memory_available_shared(
+      "/proc/meminfo", "/sys/fs/cgroup/memory.max",
+      "/sys/fs/cgroup/memory.current", getenv("POINTMECH_MEMORY_LIMIT"),
+      pm_par_host_ranks(), out);
+}
+
+double pm_memory_share_points(double n, int ranks, int dim, double layers) {
+  const double own = n / (ranks > 1 ? ranks : 1);
+  const double held = own + 2 * layers * pow(own, (dim - 1.0) / dim);
+  return held < n ? held : n;
+}
+
+size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
+                               long *points) {
+  const pm_backend *b = s->backend;
+  const size_t whole = b->estimate_bytes(s, points);
+  if (ranks <= 1 || !b->ghost_layers || *points <= 0) return whole;
+  const double n = (double)*points;
+  const double held =
+      pm_memory_share_points(n, ranks, s->dimension, b->ghost_layers(s));
+  *points = (long)held;
+  /* The geometry every rank holds whole, the rest by the points held. */
+  const double geometry =
+      b->geometry_bytes ? fmin((double)b->geometry_bytes(s), (double)whole) : 0;
+  const double bytes = (b->setup_whole || whole_here ? whole : geometry) +
+                       (whole - geometry) * held / n;
+  return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
 }
 
 pm_err pm_memory_check(const pm_scene *s) {
   if (!s->backend || !s->backend->estimate_bytes) return PM_SUCCESS;
   long points = 0;
-  size_t need = s->backend->estimate_bytes(s, &points);
+  const int ranks = pm_par_size();
+  const bool whole = s->backend->setup_whole || pm_view_keeps_whole();
+  size_t need = pm_memory_rank_estimate(s, ranks, whole, &points);
   pm_memory_available avail;
   pm_err e = pm_memory_query(&avail);
   if (e == PM_ERR_IO) {
@@ -150,6 +196,17 @@ pm_err pm_memory_check(const pm_scene *s) {
   PM_CALL(e);
   if (need <= avail.bytes || force_memory) return PM_SUCCESS;
   char a[32], b[32];
+  if (ranks > 1)
+    return PM_ERROR(
+        PM_ERR_MEMORY,
+        "%s: on %d ranks rank %d of the %s simulation needs an estimated "
+        "%s (%zu bytes: %ld points held, %s) but %s (%zu bytes) is "
+        "available to a rank (%s); nothing was allocated (--force-memory "
+        "runs it anyway)",
+        s->path, ranks, pm_par_rank(), s->method,
+        pm_memory_format(need, a, sizeof a), need, points,
+        whole ? "its share and the whole model, which it builds" : "its share",
+        pm_memory_format(avail.bytes, b, sizeof b), avail.bytes, avail.source);
   return PM_ERROR(PM_ERR_MEMORY,
                   "%s: the %s simulation needs an estimated %s (%zu bytes, "
                   "%ld points) but %s (%zu bytes) is available (%s); nothing "
@@ -163,6 +220,7 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
   if (!s->backend || !s->backend->estimate_bytes) return;
   long points = 0;
   size_t need = s->backend->estimate_bytes(s, &points);
+  const int ranks = pm_par_active() ? pm_par_size() : pm_par_plan_ranks();
   char a[32], b[32];
   pm_memory_available avail;
   if (pm_memory_query(&avail) != PM_SUCCESS) {
@@ -175,4 +233,62 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
           "with the mesh or grid); %s available (%s)\n",
           pm_memory_format(need, a, sizeof a), points,
           pm_memory_format(avail.bytes, b, sizeof b), avail.source);
+  if (ranks > 1 && s->backend->ghost_layers) {
+    long held = 0;
+    const size_t share = pm_memory_rank_estimate(s, ranks, false, &held);
+    need = pm_memory_rank_estimate(s, ranks, true, &held);
+    if (s->backend->setup_whole)
+      fprintf(out,
+              "memory/rank  %s before setup on each of %d ranks at most "
+              "(%ld points held: the whole model its setup builds, and its "
+              "share with its ghosts)\n",
+              pm_memory_format(need, a, sizeof a), ranks, held);
+    else
+      fprintf(out,
+              "memory/rank  %s before setup on each of %d ranks at most (its "
+              "share with its ghosts, %ld points); %s on a rank that keeps "
+              "the whole model (rank 0 where the frames are gathered)\n",
+              pm_memory_format(share, a, sizeof a), ranks, held,
+              pm_memory_format(need, b, sizeof b));
+  }
+}
+
+/* Each rank's peak resident memory, bytes, on rank 0 (pm_memory_gather_peaks).
+ */
+static double *peaks;
+static int n_peaks;
+
+double pm_memory_peak_rss(void) {
+  struct rusage u;
+  if (getrusage(RUSAGE_SELF, &u) != 0) return NAN;
+  return 1024.0 * (double)u.ru_maxrss; /* kB on Linux */
+}
+
+pm_err pm_memory_gather_peaks(void) {
+  const int ranks = pm_par_size();
+  pm_err e = PM_SUCCESS;
+  if (pm_par_root() && n_peaks != ranks) {
+    free(peaks);
+    peaks = NULL;
+    n_peaks = 0;
+    e = PM_ALLOC(peaks, ranks, "peak memory per rank");
+    if (!e) n_peaks = ranks;
+  }
+  PM_CALL(pm_par_agree(e));
+  pm_par_gather_double(pm_memory_peak_rss(), peaks); /* NULL off rank 0 */
+  return PM_SUCCESS;
+}
+
+pm_err pm_memory_summary(struct pm_json *j) {
+  if (n_peaks < 1) return PM_SUCCESS;
+  double most = 0;
+  PM_CALL(pm_json_begin_object(j, "memory"));
+  PM_CALL(pm_json_begin_array(j, "peak_rss_per_rank"));
+  for (int r = 0; r < n_peaks; r++) {
+    PM_CALL(pm_json_number(j, NULL, peaks[r]));
+    most = peaks[r] > most ? peaks[r] : most;
+  }
+  PM_CALL(pm_json_end_array(j));
+  PM_CALL(pm_json_number(j, "peak_rss_max", most));
+  return pm_json_end_object(j);
 }

@@ -47,6 +47,11 @@ static pm_err open_outputs(pm_run_ctx *c, const char *out_dir, unsigned flags,
   return pm_run_write_summary(c, true);
 }
 
+/* Every rank's peak memory onto rank 0 for the summary, once the run has
+ * ended (collective); without room for a double per rank the summary goes
+ * without (the run's own outcome stands). */
+static void gather_peaks(void) { (void)pm_memory_gather_peaks(); }
+
 pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
                    unsigned flags, pm_outcome *o, pm_outdir **outdir,
                    pm_run_resume_info *rs, const pm_observer *also) {
@@ -96,6 +101,7 @@ pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
   agreed = true;
   PM_TRY(pm_par_agree(PM_SUCCESS));
   run_err = pm_run_interrupted_inside(c, c->be->run(sim, &obs));
+  gather_peaks();
   pm_run_release_interrupts(old_handlers);
   if (!quiet) pm_progress_finish(&c->progress);
   c->be->figures(sim, &o->fig, true);
@@ -144,7 +150,10 @@ pm_err pm_run_worker(const pm_scene *s, void *sim, pm_outcome *o) {
   sigaction(SIGINT, &ignore, &old[0]);
   sigaction(SIGTERM, &ignore, &old[1]);
   pm_err e = pm_par_agree(PM_SUCCESS); /* rank 0's outputs are open */
-  if (!e) e = s->backend->run(sim, NULL);
+  if (!e) {
+    e = s->backend->run(sim, NULL);
+    gather_peaks();
+  }
   pm_run_release_interrupts(old);
   if (e) snprintf(o->message, sizeof o->message, "%s", pm_error_message());
   return e;

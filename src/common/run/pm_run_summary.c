@@ -6,6 +6,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "pm_memory.h"
 #include "pm_omp.h"
 #include "pm_output.h"
 #include "pm_run_impl.h"
@@ -126,6 +127,7 @@ pm_err pm_run_write_summary(pm_run_ctx *c, bool running) {
     PM_TRY(pm_json_integer(j, "frames", pm_results_frames(c->results)));
     PM_TRY(summary_figures(c, j));
     PM_TRY(summary_cost(c, j));
+    PM_TRY(pm_memory_summary(j));
     PM_TRY(summary_accuracy(c, j));
     if (c->be->summary) PM_TRY(c->be->summary(c->sim, j));
   }

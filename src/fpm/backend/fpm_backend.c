@@ -4,6 +4,7 @@
  * (fpm_backend_figures.c) and the plan (fpm_backend_plan.c). */
 #include "fpm_backend.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,6 +26,7 @@ void fpm_sim_destroy(fpm_sim *sim) {
   fpm_model_destroy(sim->local_model);
   fpm_static_state_free(&sim->static_state);
   fpm_static_state_free(&sim->local_static);
+  free(sim->whole_fixed);
   free(sim->static_local);
   free(sim->static_whole);
   fpm_state_destroy(sim->state);
@@ -35,7 +37,9 @@ void fpm_sim_destroy(fpm_sim *sim) {
   free(sim);
 }
 
-pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
+/* The cheap geometry every rank holds: the mesh of the domain and its
+ * cells (points, supports, interfaces' and facets' shapes). */
+static pm_err sim_geometry(const pm_scene *s, fpm_sim **out) {
   pm_err ret = PM_SUCCESS;
   fpm_sim *sim = NULL;
   *out = NULL;
@@ -80,32 +84,58 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   PM_TRY(pm_interrupt_check("after meshing (nothing written)"));
   sim->mean_edge = gm_mesh_mean_edge(sim->mesh);
   pm_timers_start(&sim->timers, sim->tm_dual);
-  const fpm_options *o = fpm_scene_options(s);
-  sim->cells = gm_cells_find(o->cells);
+  sim->cells = gm_cells_find(fpm_scene_options(s)->cells);
   PM_TRY(sim->cells->build(sim->mesh, &sim->dual));
   pm_timers_stop(&sim->timers, sim->tm_dual);
   PM_TRY(pm_interrupt_check("after the subdomains (nothing written)"));
-  pm_timers_start(&sim->timers, sim->tm_operators);
-  PM_TRY(fpm_model_create(s, o, sim->mesh, sim->dual, &sim->model));
-  PM_TRY(pm_interrupt_check("after the operators (nothing written)"));
-  PM_TRY(fpm_state_create(sim->model, &sim->state));
-  if (s->time.qs == PM_QS_STATIC)
-    PM_TRY(fpm_static_state_init(&sim->static_state, sim->model));
-  PM_TRY(PM_ALLOC(sim->scratch, 11 * sim->model->n, "output buffer"));
-  sim->dt_paper = fpm_stable_dt(sim->model, &sim->dt_point);
-  sim->dt_stable = sim->dt_paper;
-  if (s->time.dt_rule == PM_DT_SPECTRAL) {
-    fpm_sim_measure_spectrum(sim);
-    sim->dt_stable = sim->dt_spectral;
-  }
-  sim->dt = s->time.dt > 0 ? s->time.dt : s->time.dt_safety * sim->dt_stable;
-  pm_timers_stop(&sim->timers, sim->tm_operators);
   sim->setup_wall = pm_wtime() - t0;
   *out = sim;
   sim = NULL;
 done:
   fpm_sim_destroy(sim);
   return ret;
+}
+
+/* The step: time.dt, else dt_safety times the stable step of the scene's
+ * rule. */
+static void pick_dt(fpm_sim *sim) {
+  const pm_scene *s = sim->scene;
+  sim->dt_stable =
+      s->time.dt_rule == PM_DT_SPECTRAL ? sim->dt_spectral : sim->dt_paper;
+  sim->dt = s->time.dt > 0 ? s->time.dt : s->time.dt_safety * sim->dt_stable;
+}
+
+/* The whole model on the geometry, its state and step. */
+static pm_err sim_model(fpm_sim *sim) {
+  const pm_scene *s = sim->scene;
+  const double t0 = pm_wtime();
+  pm_timers_start(&sim->timers, sim->tm_operators);
+  PM_CALL(fpm_model_create(s, fpm_scene_options(s), sim->mesh, sim->dual,
+                           &sim->model));
+  PM_CALL(pm_interrupt_check("after the operators (nothing written)"));
+  PM_CALL(fpm_state_create(sim->model, &sim->state));
+  if (s->time.qs == PM_QS_STATIC)
+    PM_CALL(fpm_static_state_init(&sim->static_state, sim->model));
+  PM_CALL(PM_ALLOC(sim->scratch, 11 * sim->model->n, "output buffer"));
+  sim->dt_paper = fpm_stable_dt(sim->model, &sim->dt_point);
+  if (s->time.dt_rule == PM_DT_SPECTRAL) fpm_sim_measure_spectrum(sim);
+  pick_dt(sim);
+  pm_timers_stop(&sim->timers, sim->tm_operators);
+  sim->setup_wall += pm_wtime() - t0;
+  return PM_SUCCESS;
+}
+
+pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
+  fpm_sim *sim = NULL;
+  *out = NULL;
+  PM_CALL(sim_geometry(s, &sim));
+  pm_err e = sim_model(sim);
+  if (e) {
+    fpm_sim_destroy(sim);
+    return e;
+  }
+  *out = sim;
+  return PM_SUCCESS;
 }
 
 /* Power iterations for the spectral radius: the Rayleigh quotient
@@ -135,23 +165,22 @@ static const pm_timers *timers(void *p) { return &((fpm_sim *)p)->timers; }
  * what the run reports over all its steps. */
 /* A static solve's load stepping: where it is, its last two converged
  * states over the free dofs, and its counters. */
-static pm_err checkpoint_static(fpm_sim *sim, pm_ckpt *ck) {
-  fpm_static_state *ss = &sim->static_state;
+static pm_err checkpoint_static(fpm_sim *sim, fpm_static_state *ss,
+                                pm_ckpt *ck) {
   PM_CALL(pm_load_checkpoint(ck, "static", ss->free_dofs, &ss->load,
                              &sim->static_report.load));
   return pm_ckpt_double(ck, "static.external_work", &ss->external_work);
 }
 
-/* The time loop's state (fpm_state: u, v and what the loop carries; or a
- * static solve's load stepping) and what the run reports over all its
- * steps. */
-static pm_err checkpoint(void *p, pm_ckpt *ck) {
-  fpm_sim *sim = p;
-  fpm_state *st = sim->state;
-  const long n3 = 3 * sim->model->n;
+/* The time loop's state st of the whole run (fpm_state: u, v and what the
+ * loop carries, of n points; or a static solve's load stepping ss) and
+ * what the run reports over all its steps. */
+static pm_err checkpoint_whole(fpm_sim *sim, pm_ckpt *ck, fpm_state *st, long n,
+                               fpm_static_state *ss) {
+  const long n3 = 3 * n;
   const bool is_static = sim->scene->time.qs == PM_QS_STATIC;
   if (is_static) {
-    PM_CALL(checkpoint_static(sim, ck));
+    PM_CALL(checkpoint_static(sim, ss, ck));
   } else {
     PM_CALL(pm_ckpt_doubles(ck, "fpm.u", n3, st->u));
     PM_CALL(pm_ckpt_doubles(ck, "fpm.v", n3, st->v));
@@ -175,9 +204,8 @@ static pm_err checkpoint(void *p, pm_ckpt *ck) {
     sim->resumed = true;
     if (is_static) {
       sim->last.step = sim->static_report.load.steps;
-      sim->last.t =
-          sim->static_state.load.lambda * pm_scene_load_end(sim->scene);
-      sim->last.external_work = sim->static_state.external_work;
+      sim->last.t = ss->load.lambda * pm_scene_load_end(sim->scene);
+      sim->last.external_work = ss->external_work;
     } else {
       sim->last.step = st->step;
       sim->last.t = st->t;
@@ -189,35 +217,150 @@ static pm_err checkpoint(void *p, pm_ckpt *ck) {
   return PM_SUCCESS;
 }
 
-/* Across ranks every rank sets up the whole model (the same on every
- * rank), then takes its share (collective). */
-static pm_err create(const pm_scene *s, void **out) {
-  fpm_sim *sim = NULL;
-  pm_err e = pm_par_agree(fpm_sim_create(s, &sim));
-  if (!e && pm_par_active() && sim->model->contact)
-    e = fpm_contact_refuse_ranks(s);
-  if (!e && pm_par_active()) {
-    const double t0 = pm_wtime();
-    e = fpm_par_create(sim->model, &sim->local_model);
-    if (!e)
-      e = pm_par_agree(fpm_state_create(sim->local_model, &sim->local_state));
-    if (!e && s->time.qs == PM_QS_STATIC) { /* its load stepping's share */
-      const fpm_model *lm = sim->local_model;
-      e = fpm_static_state_init(&sim->local_static, lm);
-      if (!e) e = PM_ALLOC(sim->static_local, 3 * lm->n + 1, "nodal gather");
-      if (!e)
-        e = PM_ALLOC(sim->static_whole, 3 * sim->model->n, "nodal gather");
-      e = pm_par_agree(e);
-    }
-    sim->setup_wall += pm_wtime() - t0;
+/* A rank that does not hold the whole model resumes: every rank reads the
+ * checkpoint (rank 0 writes it), this one into the whole run's state for
+ * the time it takes to keep its share of it. */
+static pm_err checkpoint_share(fpm_sim *sim, pm_ckpt *ck) {
+  pm_err ret = PM_SUCCESS;
+  const long n = sim->n_whole;
+  const bool is_static = sim->scene->time.qs == PM_QS_STATIC;
+  fpm_state whole = {0};
+  fpm_static_state ws = {0};
+  double *nodal = NULL;
+  PM_ENSURE(pm_ckpt_reading(ck), PM_ERR_INTERNAL,
+            "a rank without the whole model writes no checkpoint");
+  PM_TRY(PM_ALLOC(whole.u, 3 * n + 1, "checkpoint's displacements"));
+  PM_TRY(PM_ALLOC(whole.v, 3 * n + 1, "checkpoint's velocities"));
+  if (is_static) {
+    ws.free_dofs = sim->free_whole;
+    PM_TRY(pm_load_state_init(&ws.load, ws.free_dofs > 0 ? ws.free_dofs : 1));
+    PM_TRY(PM_ALLOC(nodal, 3 * n + 1, "checkpoint's displacements"));
   }
+  PM_TRY(checkpoint_whole(sim, ck, &whole, n, &ws));
+  if (is_static)
+    fpm_backend_scatter_static(sim, sim->whole_fixed, n, &ws, nodal);
+  else
+    fpm_par_scatter(sim->local_model, &whole, sim->local_state);
+  sim->scattered = true;
+done:
+  free(whole.u);
+  free(whole.v);
+  free(nodal);
+  if (is_static) fpm_static_state_free(&ws);
+  return ret;
+}
+
+static pm_err checkpoint(void *p, pm_ckpt *ck) {
+  fpm_sim *sim = p;
+  if (!sim->model) return checkpoint_share(sim, ck);
+  return checkpoint_whole(sim, ck, sim->state, sim->model->n,
+                          &sim->static_state);
+}
+
+/* The stable step of the paper's bound across ranks: the largest lambda
+ * over the shares, and the point one process names (the smallest index
+ * among those that have it) (collective). */
+static void shares_dt(fpm_sim *sim) {
+  const fpm_model *lm = sim->local_model;
+  long crit = 0;
+  double lam = fpm_stable_lambda(lm, &crit), most = lam;
+  pm_par_max(&most, 1);
+  long first = lam == most ? -crit : -LONG_MAX;
+  pm_par_max_long(&first, 1);
+  sim->dt_point = -first;
+  sim->dt_paper = fpm_stable_dt_of(lm, most);
+}
+
+/* A static solve across ranks: the whole run's prescribed dofs (3 per
+ * point) and free dofs, with which every rank reads a checkpoint of the
+ * whole run into its share (collective). */
+static pm_err whole_fixed(fpm_sim *sim) {
+  const fpm_model *lm = sim->local_model;
+  const long n = sim->n_whole;
+  double *mask = NULL;
+  pm_err ret = PM_SUCCESS;
+  PM_TRY(PM_ALLOC(mask, 3 * n + 1, "prescribed dofs"));
+  PM_TRY(PM_ALLOC(sim->whole_fixed, 3 * n + 1, "prescribed dofs"));
+  for (long i = 0; i < lm->n_own; i++)
+    for (int c = 0; c < 3; c++) mask[3 * lm->gid[i] + c] = lm->fixed[3 * i + c];
+done:
+  ret = pm_par_agree(ret);
+  if (!ret) {
+    pm_par_max(mask, (int)(3 * n));
+    for (long d = 0; d < 3 * n; d++) sim->whole_fixed[d] = mask[d] > 0;
+    sim->free_whole = sim->local_static.free_dofs;
+    pm_par_sum_long(&sim->free_whole, 1);
+  }
+  free(mask);
+  return ret;
+}
+
+/* Across ranks every rank holds the geometry (fpm_region.h); the whole
+ * model is built only where this rank keeps it (pm_view_keeps_whole), and
+ * each rank makes its share, from the whole model there, from the cells
+ * around its points elsewhere (collective). */
+static pm_err create_share(const pm_scene *s, fpm_sim **out) {
+  fpm_sim *sim = NULL;
+  const bool whole = pm_view_keeps_whole();
+  pm_err e = pm_par_agree(sim_geometry(s, &sim));
+  if (!e) e = pm_par_agree(whole ? sim_model(sim) : PM_SUCCESS);
+  if (!e)
+    e = pm_par_agree(whole && sim->model->contact ? fpm_contact_refuse_ranks(s)
+                                                  : PM_SUCCESS);
+  const double t0 = pm_wtime();
+  if (!e) {
+    pm_timers_start(&sim->timers, sim->tm_operators);
+    sim->n_whole = sim->dual->n_points;
+    e = fpm_par_create(s, sim->mesh, &sim->dual, sim->model, &sim->local_model);
+    pm_timers_stop(&sim->timers, sim->tm_operators);
+  }
+  if (!e)
+    e = pm_par_agree(fpm_state_create(sim->local_model, &sim->local_state));
+  if (!e && s->time.qs == PM_QS_STATIC) { /* its load stepping's share */
+    const fpm_model *lm = sim->local_model;
+    e = fpm_static_state_init(&sim->local_static, lm);
+    if (!e) e = PM_ALLOC(sim->static_local, 3 * lm->n + 1, "nodal gather");
+    if (!e && whole)
+      e = PM_ALLOC(sim->static_whole, 3 * sim->model->n, "nodal gather");
+    e = pm_par_agree(e);
+    if (!e) e = whole_fixed(sim);
+  }
+  if (!e) {
+    shares_dt(sim);
+    /* The spectral radius of the whole model, where it is held. */
+    double spectral = sim->dt_spectral;
+    pm_par_bcast(&spectral, sizeof spectral);
+    if (s->time.dt_rule == PM_DT_SPECTRAL && !(spectral > 0))
+      e = PM_ERROR(PM_ERR_UNSUPPORTED,
+                   "%s: time.dt_rule: spectral measures the whole model, "
+                   "which no rank holds here; across ranks use time.dt_rule: "
+                   "paper or set time.dt",
+                   s->path);
+    sim->dt_spectral = spectral;
+    pick_dt(sim);
+  }
+  if (sim) sim->setup_wall += pm_wtime() - t0;
   if (e) {
     fpm_sim_destroy(sim);
     return e;
   }
+  *out = sim;
+  return PM_SUCCESS;
+}
+
+static pm_err create(const pm_scene *s, void **out) {
+  fpm_sim *sim = NULL;
+  pm_err e = pm_par_active() ? create_share(s, &sim) : fpm_sim_create(s, &sim);
+  if (e) return e;
   fpm_backend_view_init(sim);
   *out = sim;
   return PM_SUCCESS;
+}
+
+/* The ghosts reach 3 rings of support, 5 where the quadratic fits take
+ * two rings (fpm_share.h). */
+static double ghost_layers(const pm_scene *s) {
+  return fpm_scene_options(s)->jump == FPM_JUMP_QUADRATIC ? 5 : 3;
 }
 
 static void destroy(void *sim) { fpm_sim_destroy(sim); }
@@ -231,6 +374,8 @@ const pm_backend fpm_backend = {
     .check = fpm_check_scene,
     .create = create,
     .estimate_bytes = fpm_estimate_bytes,
+    .ghost_layers = ghost_layers,
+    .geometry_bytes = fpm_estimate_geometry_bytes,
     .destroy = destroy,
     .plan = fpm_backend_plan,
     .run = fpm_backend_run,

@@ -56,12 +56,14 @@ typedef struct {
   bool resumed;                    /* the state came from a checkpoint */
   long first_step;                 /* the step this run started from */
   /* Across MPI ranks (fpm_par.h): this rank's share of the model and its
-   * state, which it steps.  Rank 0 keeps the whole model and state above
-   * as the run's view, gathered into where the run writes; the other ranks
-   * let them go when the run starts (until then they hold them, so that a
-   * checkpoint is read into them). */
+   * state, which it steps.  Only a rank that keeps the whole model
+   * (pm_view_keeps_whole: rank 0, as the run's view, gathered into where
+   * the run writes) builds the whole model and state above; the others
+   * hold the mesh and cells, and no model but their share. */
   fpm_model *local_model;
   fpm_state *local_state;
+  long n_whole;          /* the whole model's points (a rank without it lets the
+                            whole cells, dual above, go once its share is made) */
   double ranks_costs[4]; /* summed over the ranks at the end: ghost bytes,
                             exchanges; the slowest's exchange and gather
                             seconds */
@@ -71,6 +73,12 @@ typedef struct {
    * that: 3 per own point, and on rank 0 3 per point of the whole model */
   fpm_static_state local_static;
   double *static_local, *static_whole;
+  /* On every rank of a static solve: the whole run's prescribed dofs (3 per
+   * point) and its free dofs, with which a rank that does not hold the
+   * whole model reads a checkpoint into its share. */
+  unsigned char *whole_fixed;
+  long free_whole;
+  bool scattered; /* the share has the checkpoint's state already */
 } fpm_sim;
 
 /* Mesh the scene's domain, build subdomains, operators and state, and pick

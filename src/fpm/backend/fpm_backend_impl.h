@@ -15,6 +15,13 @@
  * the run's view (pm_view; across ranks when sim has a share). */
 pm_err fpm_backend_run(void *p, const pm_observer *obs);
 void fpm_backend_view_init(fpm_sim *sim);
+/* A static solve resumed across ranks: the share's load stepping and
+ * displacements (of every point it holds) from the whole run's ws, which
+ * every rank read from the checkpoint, with the whole run's prescribed
+ * dofs fixed (3 n) and nodal, room for 3 n. */
+void fpm_backend_scatter_static(fpm_sim *sim, const unsigned char *fixed,
+                                long n, const fpm_static_state *ws,
+                                double *nodal);
 
 /* fpm_backend_figures.c: the points, fields, figures, history columns and
  * summary of the run (pm_backend's entries of those names). */

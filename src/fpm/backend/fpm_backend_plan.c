@@ -217,13 +217,15 @@ static double plan_head(fpm_sim *sim, FILE *out) {
 static pm_err plan_ranks(fpm_sim *sim, FILE *out) {
   const fpm_model *lm = sim->local_model;
   double steps = 0;
-  if (pm_par_root()) {
+  /* Rank 0 prints from the whole model where it keeps it. */
+  const bool view = pm_par_root() && sim->model;
+  if (view) {
     steps = plan_head(sim, out);
     fpm_share_print(sim->model, fpm_par_owner(lm), pm_par_size(),
                     fpm_par_counts(lm), out);
   }
   double per_step = time_force(lm, sim->local_state);
-  if (pm_par_root()) plan_estimate(sim, per_step, steps, out);
+  if (view) plan_estimate(sim, per_step, steps, out);
   return PM_SUCCESS;
 }
 

@@ -82,19 +82,16 @@ static pm_err gather_static(fpm_sim *sim) {
   return PM_SUCCESS;
 }
 
-/* A static solve resumed across ranks: the share's load stepping and
- * displacements (of every point it holds) from the whole run's, which
- * every rank read from the checkpoint. */
-static void scatter_static(fpm_sim *sim) {
-  const fpm_model *lm = sim->local_model, *m = sim->model;
-  const fpm_static_state *ws = &sim->static_state;
+void fpm_backend_scatter_static(fpm_sim *sim, const unsigned char *fixed,
+                                long n, const fpm_static_state *ws,
+                                double *nodal) {
+  const fpm_model *lm = sim->local_model;
   fpm_static_state *ls = &sim->local_static;
   double *held = sim->local_state->u; /* 3 per point held */
   for (int k = 2; k >= 0; k--) {      /* xc last: its displacements stay */
-    fpm_static_nodal(m, load_state_x(ws, k), sim->static_whole);
+    fpm_static_nodal_fixed(n, fixed, load_state_x(ws, k), nodal);
     for (long i = 0; i < lm->n; i++)
-      memcpy(held + 3 * i, sim->static_whole + 3 * lm->gid[i],
-             3 * sizeof(double));
+      memcpy(held + 3 * i, nodal + 3 * lm->gid[i], 3 * sizeof(double));
     fpm_static_unknowns(lm, held, load_state_x(ls, k));
   }
   load_scalars(ls, ws);
@@ -191,9 +188,10 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
   fpm_model *lm = sim->local_model ? sim->local_model : m;
   fpm_state *st = sim->local_model ? sim->local_state : sim->state;
   const bool is_static = s->time.qs == PM_QS_STATIC;
-  if (sim->local_model && sim->resumed) {
+  if (sim->local_model && sim->resumed && !sim->scattered) {
     if (is_static)
-      scatter_static(sim);
+      fpm_backend_scatter_static(sim, m->fixed, m->n, &sim->static_state,
+                                 sim->static_whole);
     else
       fpm_par_scatter(lm, sim->state, st);
   }

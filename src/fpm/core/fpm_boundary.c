@@ -10,21 +10,19 @@
 #include "fpm_loads.h"
 #include "fpm_model.h"
 
-/* The facets of each condition, as CSR lists bcf_ptr / bcf_facet: on a
- * named surface of the mesh (the box's faces are its surfaces xmin ...
- * zmax), or where the region expression is positive at the facet's
- * centroid.  A condition that selects nothing is an error at its key. */
-static pm_err select_facets(fpm_model *m, const pm_scene *s,
-                            const gm_mesh *mesh) {
-  const gm_dual *d = m->dual;
+pm_err fpm_select_facets(const gm_dual *d, const pm_scene *s,
+                         const gm_mesh *mesh, bool whole, long **ptr,
+                         long **facet) {
   char path[64], names[512];
-  PM_CALL(PM_ALLOC(m->bcf_ptr, s->n_bcs + 1, "boundary facet lists"));
+  *facet = NULL;
+  PM_CALL(PM_ALLOC(*ptr, s->n_bcs + 1, "boundary facet lists"));
+  long *bcf_ptr = *ptr;
   for (int pass = 0; pass < 2; pass++) {
     long n = 0;
     for (int b = 0; b < s->n_bcs; b++) {
       const pm_scene_bc *bc = &s->bcs[b];
       int surf = -1;
-      m->bcf_ptr[b] = n;
+      bcf_ptr[b] = n;
       /* in contact: fpm_contact; at a point: fpm_loads */
       if (PM_BC_RIGID(bc) || bc->on == PM_ON_POINT) continue;
       if (bc->on != PM_ON_REGION) {
@@ -37,17 +35,17 @@ static pm_err select_facets(fpm_model *m, const pm_scene *s,
                                names, bc->surface);
         }
       }
-      m->bcf_ptr[b] = n;
+      bcf_ptr[b] = n;
       for (long f = 0; f < d->n_facets; f++) {
         const double *c = d->facet_centroid + 3 * f;
         bool in = bc->on == PM_ON_REGION
                       ? pm_expr_eval(bc->region, c[0], c[1], c[2], 0) > 0
                       : d->facet_surface[f] == surf;
         if (!in) continue;
-        if (pass) m->bcf_facet[n] = f;
+        if (pass) (*facet)[n] = f;
         n++;
       }
-      if (n == m->bcf_ptr[b]) {
+      if (whole && n == bcf_ptr[b]) {
         snprintf(path, sizeof path, "boundary.%d.%s", b,
                  bc->on == PM_ON_REGION ? "region" : "on");
         return pm_scene_fail(
@@ -56,8 +54,8 @@ static pm_err select_facets(fpm_model *m, const pm_scene *s,
             bc->on == PM_ON_REGION ? pm_expr_text(bc->region) : bc->surface);
       }
     }
-    m->bcf_ptr[s->n_bcs] = n;
-    if (!pass) PM_CALL(PM_ALLOC(m->bcf_facet, n, "boundary facet lists"));
+    bcf_ptr[s->n_bcs] = n;
+    if (!pass) PM_CALL(PM_ALLOC(*facet, n, "boundary facet lists"));
   }
   return PM_SUCCESS;
 }
@@ -77,7 +75,8 @@ pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s,
   for (long i = 0; i < m->n; i++) dpt_of[i] = -1;
   m->n_dpts = 0;
   m->n_tfacets = 0;
-  PM_TRY(select_facets(m, s, mesh));
+  /* A part of the whole (m->gid) may hold no facet of a condition. */
+  PM_TRY(fpm_select_facets(d, s, mesh, !m->gid, &m->bcf_ptr, &m->bcf_facet));
   for (int b = 0; b < s->n_bcs; b++) {
     const pm_scene_bc *bc = &s->bcs[b];
     for (long e = m->bcf_ptr[b]; e < m->bcf_ptr[b + 1]; e++) {

@@ -93,3 +93,9 @@ size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
   double bytes = n * per_point + solver;
   return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
 }
+
+size_t fpm_estimate_geometry_bytes(const pm_scene *s) {
+  long points = 0;
+  fpm_estimate_bytes(s, &points);
+  return (size_t)(MESH_BYTES * (double)points);
+}

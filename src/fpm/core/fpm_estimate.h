@@ -13,5 +13,8 @@
  * measures (pm_figures.memory_bytes) plus the mesh.  Sets *points to the
  * points it expects. */
 size_t fpm_estimate_bytes(const pm_scene *s, long *points);
+/* The part of it every rank holds across ranks: the mesh and its cells
+ * (fpm_region.h). */
+size_t fpm_estimate_geometry_bytes(const pm_scene *s);
 
 #endif

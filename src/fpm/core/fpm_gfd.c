@@ -58,6 +58,10 @@ pm_err fpm_gfd_weights(int dim, long n, const double *x, const long *nbr_ptr,
   for (long i = 0; i < n; i++) {
     double A[9], lam[3];
     const double *xi = x + 3 * i;
+    if (nbr_ptr[i] == nbr_ptr[i + 1]) { /* a part's edge (fpm_model.h) */
+      if (cond) cond[i] = 0;
+      continue;
+    }
     const double wsum = moments(dim, i, x, NULL, nbr_ptr, nbr, A);
     int info = LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', dim, A, dim, lam);
     double c = (info == 0 && lam[0] > 0) ? lam[dim - 1] / lam[0] : INFINITY;

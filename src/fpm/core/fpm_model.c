@@ -104,6 +104,10 @@ static pm_err build_mirror(fpm_model *m) {
     for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
       long k = m->nbr[e], lo = m->nbr_ptr[k], hi = m->nbr_ptr[k + 1] - 1;
       long found = -1;
+      if (m->gid && lo > hi) { /* a part's edge: k's row is not held */
+        m->mirror[e] = -1;
+        continue;
+      }
       while (lo <= hi) {
         long mid = (lo + hi) / 2;
         if (m->nbr[mid] == i) {
@@ -377,10 +381,20 @@ int fpm_domain_body(const pm_scene *s) {
 pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
                         const gm_mesh *mesh, const gm_dual *d,
                         fpm_model **out) {
+  return fpm_model_create_part(s, o, mesh, d, NULL, out);
+}
+
+pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
+                             const gm_mesh *mesh, const gm_dual *d,
+                             const long *gid, fpm_model **out) {
   pm_err ret = PM_SUCCESS;
   fpm_model *m = NULL;
   *out = NULL;
   PM_TRY(PM_ALLOC(m, 1, "FPM model"));
+  if (gid) {
+    PM_TRY(PM_ALLOC(m->gid, d->n_points + 1, "part's point indices"));
+    memcpy(m->gid, gid, sizeof(long) * (size_t)d->n_points);
+  }
   m->dim = d->dim;
   m->n = d->n_points;
   m->dual = d;
@@ -425,7 +439,9 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
   if (m->jump == FPM_JUMP_QUADRATIC && m->boundary_penalty > 0)
     PM_TRY(boundary_penalty(m));
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
-  PM_TRY(fpm_stream_build(m));
+  /* A part's share streams its own entries (fpm_model_subset); the part
+   * is never stepped. */
+  if (!gid) PM_TRY(fpm_stream_build(m));
   if (o->volumetric == FPM_VOLUMETRIC_AVERAGED) PM_TRY(fpm_volumetric_build(m));
   PM_TRY(fpm_build_boundary(m, s, mesh));
   PM_TRY(fpm_contact_create(m, s, &m->contact));
@@ -518,9 +534,13 @@ size_t fpm_state_bytes(const fpm_model *m) {
 }
 
 double fpm_stable_dt(const fpm_model *m, long *critical_point) {
+  return fpm_stable_dt_of(m, fpm_stable_lambda(m, critical_point));
+}
+
+double fpm_stable_lambda(const fpm_model *m, long *critical_point) {
   double lam_max = 0;
   long crit = 0;
-  for (long j = 0; j < m->n; j++) {
+  for (long j = 0; j < m->n_own; j++) {
     double c2 = m->mats[m->mat[j]].wave_speed;
     c2 *= c2;
     double C2 = 0;
@@ -534,7 +554,11 @@ double fpm_stable_dt(const fpm_model *m, long *critical_point) {
       crit = j;
     }
   }
-  if (critical_point) *critical_point = crit;
+  if (critical_point) *critical_point = fpm_point_id(m, crit);
+  return lam_max;
+}
+
+double fpm_stable_dt_of(const fpm_model *m, double lam_max) {
   double p = m->penalty > 1 ? m->penalty : 1;
   if (m->q && m->boundary_penalty > p) p = m->boundary_penalty;
   /* the stiffening's penalty p_s (3 |j|^2 - (tau h)^2) / h^2, taken at

@@ -211,6 +211,18 @@ typedef struct {
 pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
                         const gm_mesh *mesh, const gm_dual *d, fpm_model **out);
 
+/* The same on the cells d of a part of the whole mesh (a rank's share and
+ * the rings around it, fpm_region.h): d's point i is the whole's gid[i]
+ * (ascending), its rows are those of the whole where held, and empty
+ * where not (the part's edge); every per-point and per-entry figure of a
+ * point whose rows, and whose neighbours' rows, are held is the whole
+ * model's, bit for bit.  Conditions may select none of its facets.  It
+ * has no entry stream (it is never stepped: its shares are, with theirs).
+ * gid is copied (m->gid). */
+pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
+                             const gm_mesh *mesh, const gm_dual *d,
+                             const long *gid, fpm_model **out);
+
 /* The points a model holds of a whole model's (a rank's share): its own
  * points [0, n_own), then the ghosts whose flux [n_own, n_flux), stress
  * [n_flux, n_stress) and displacement [n_stress, n) its passes read (see
@@ -240,6 +252,15 @@ int fpm_domain_body(const pm_scene *s);
  * (none is an error at the condition's key), prescribed dofs, the
  * consistency flux on prescribed facets and the traction facets. */
 pm_err fpm_build_boundary(fpm_model *m, const pm_scene *s, const gm_mesh *mesh);
+/* The facets of d each condition of s acts on, as CSR lists *ptr (n_bcs +
+ * 1) and *facet, each in d's order: on a named surface of the mesh (the
+ * box's faces are its surfaces xmin ... zmax), or where the region
+ * expression is positive at the facet's centroid.  A condition that
+ * selects nothing is an error at its key where d is whole.  The caller
+ * frees both. */
+pm_err fpm_select_facets(const gm_dual *d, const pm_scene *s,
+                         const gm_mesh *mesh, bool whole, long **ptr,
+                         long **facet);
 void fpm_model_destroy(fpm_model *m);
 /* With the plain formulation (its stream holds the flux records, m->fs_rec),
  * frees the interface records erec and the weights g, which only static
@@ -308,5 +329,11 @@ void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,
  * dt = 2 / sqrt(max lambda_j) / sqrt(max(p, 1)).  Also returns the point
  * that sets it. */
 double fpm_stable_dt(const fpm_model *m, long *critical_point);
+/* Its parts: the largest lambda_j over the model's own points, and the
+ * point that has it first (by its index on one process); the step of a
+ * largest lambda (the penalties' and rigid bodies' bounds with it).  Across
+ * ranks, the largest over the shares gives one process's step. */
+double fpm_stable_lambda(const fpm_model *m, long *critical_point);
+double fpm_stable_dt_of(const fpm_model *m, double lam_max);
 
 #endif

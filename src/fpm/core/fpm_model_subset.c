@@ -274,6 +274,13 @@ pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
   if (m->qs_ptr) PM_TRY(subset_fits(m, s, lof));
   PM_TRY(subset_boundary(m, s, lof));
   PM_TRY(fpm_stream_build(s));
+  /* The points and traction facets of a part (m->gid) by their indices on
+   * one process. */
+  if (m->gid)
+    for (long li = 0; li < s->n; li++) s->gid[li] = m->gid[s->gid[li]];
+  if (m->tf_gid)
+    for (long k = 0; k < s->n_tfacets; k++)
+      s->tf_gid[k] = m->tf_gid[s->tf_gid[k]];
   *out = s;
   s = NULL;
 done:

@@ -114,6 +114,9 @@ typedef struct {
  * dofs), and back: how load stepping's states cross between a share and
  * the whole model. */
 void fpm_static_nodal(const fpm_model *m, const double *x, double *u);
+/* The same over n points whose prescribed dofs are fixed (3 n). */
+void fpm_static_nodal_fixed(long n, const unsigned char *fixed, const double *x,
+                            double *u);
 void fpm_static_unknowns(const fpm_model *m, const double *u, double *x);
 
 /* A state for model m (from rest).  PM_ERR_MEMORY. */

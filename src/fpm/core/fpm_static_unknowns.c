@@ -68,8 +68,13 @@ int fpm_static_rigid_modes(const fpm_model *m, const long *dof, long nf,
 }
 
 void fpm_static_nodal(const fpm_model *m, const double *x, double *u) {
+  fpm_static_nodal_fixed(m->n_own, m->fixed, x, u);
+}
+
+void fpm_static_nodal_fixed(long n, const unsigned char *fixed, const double *x,
+                            double *u) {
   long j = 0;
-  for (long d = 0; d < 3 * m->n_own; d++) u[d] = m->fixed[d] ? 0 : x[j++];
+  for (long d = 0; d < 3 * n; d++) u[d] = fixed[d] ? 0 : x[j++];
 }
 
 void fpm_static_unknowns(const fpm_model *m, const double *u, double *x) {

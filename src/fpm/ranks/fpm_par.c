@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fpm_region.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
 #include "pm_petsc.h"
@@ -43,14 +44,15 @@ static void par_destroy(void *ctx) {
 }
 
 /* A digest of the support graph and the positions (FNV-1a). */
-static uint64_t graph_digest(const fpm_model *m) {
+static uint64_t graph_digest(const gm_dual *d) {
   uint64_t h = 1469598103934665603ull;
-  const unsigned char *parts[3] = {(const unsigned char *)m->nbr_ptr,
-                                   (const unsigned char *)m->nbr,
-                                   (const unsigned char *)m->x};
-  const size_t bytes[3] = {sizeof(long) * (size_t)(m->n + 1),
-                           sizeof(int) * (size_t)m->nnz,
-                           sizeof(double) * 3 * (size_t)m->n};
+  const long n = d->n_points;
+  const unsigned char *parts[3] = {(const unsigned char *)d->nbr_ptr,
+                                   (const unsigned char *)d->nbr,
+                                   (const unsigned char *)d->x};
+  const size_t bytes[3] = {sizeof(long) * (size_t)(n + 1),
+                           sizeof(long) * (size_t)d->nbr_ptr[n],
+                           sizeof(double) * 3 * (size_t)n};
   for (int k = 0; k < 3; k++)
     for (size_t b = 0; b < bytes[k]; b++) {
       h ^= parts[k][b];
@@ -61,8 +63,8 @@ static uint64_t graph_digest(const fpm_model *m) {
 
 /* The partition, made on rank 0 and sent to every rank, which must hold the
  * same graph (each meshed the domain itself). */
-static pm_err partition(struct fpm_par *P, const fpm_model *m) {
-  uint64_t mine = graph_digest(m), first = mine;
+static pm_err partition(struct fpm_par *P, const gm_dual *d) {
+  uint64_t mine = graph_digest(d), first = mine;
   pm_par_bcast(&first, sizeof first);
   PM_CALL(pm_par_agree(
       first == mine
@@ -71,27 +73,27 @@ static pm_err partition(struct fpm_par *P, const fpm_model *m) {
                      "rank %d meshed the domain into another graph of "
                      "points than rank 0 (%ld points): the ranks cannot "
                      "share it",
-                     P->rank, m->n)));
-  PM_CALL(PM_ALLOC(P->owner, m->n + 1, "partition"));
-  PM_CALL(pm_par_agree(P->rank == 0 ? fpm_partition(m, P->size, P->owner)
+                     P->rank, d->n_points)));
+  PM_CALL(PM_ALLOC(P->owner, d->n_points + 1, "partition"));
+  PM_CALL(pm_par_agree(P->rank == 0 ? fpm_partition(d, P->size, P->owner)
                                     : PM_SUCCESS));
-  pm_par_bcast(P->owner, sizeof(int) * (size_t)m->n);
+  pm_par_bcast(P->owner, sizeof(int) * (size_t)d->n_points);
   return PM_SUCCESS;
 }
 
 /* The star forests: ghosts to their owners' own points (each rank's own
  * points are in one-process order, so an owner's index of a point is the
  * count of its points before it), own points to rank 0's whole arrays. */
-static pm_err make_forests(struct fpm_par *P, const fpm_model *full,
+static pm_err make_forests(struct fpm_par *P, long n_whole,
                            const fpm_model *s) {
   pm_err ret = PM_SUCCESS;
   const long n_ghost = s->n - s->n_own;
   long *index = NULL, *seen = NULL;
   PetscInt *leaf = NULL;
   PetscSFNode *root = NULL;
-  PM_TRY(PM_ALLOC(index, full->n + 1, "owners' indices"));
+  PM_TRY(PM_ALLOC(index, n_whole + 1, "owners' indices"));
   PM_TRY(PM_ALLOC(seen, P->size, "owners' indices"));
-  for (long i = 0; i < full->n; i++) index[i] = seen[P->owner[i]]++;
+  for (long i = 0; i < n_whole; i++) index[i] = seen[P->owner[i]]++;
   PM_TRY(PM_ALLOC(leaf, n_ghost + 1, "ghost points"));
   PM_TRY(PM_ALLOC(root, (n_ghost > s->n_own ? n_ghost : s->n_own) + 1,
                   "ghost points' owners"));
@@ -110,7 +112,7 @@ static pm_err make_forests(struct fpm_par *P, const fpm_model *full,
     root[k].index = (PetscInt)s->gid[k];
   }
   PM_PETSC(PetscSFCreate(PETSC_COMM_WORLD, &P->to_root));
-  PM_PETSC(PetscSFSetGraph(P->to_root, P->rank == 0 ? (PetscInt)full->n : 0,
+  PM_PETSC(PetscSFSetGraph(P->to_root, P->rank == 0 ? (PetscInt)n_whole : 0,
                            (PetscInt)s->n_own, NULL, PETSC_COPY_VALUES, root,
                            PETSC_COPY_VALUES));
   PM_PETSC(PetscSFSetUp(P->to_root));
@@ -127,7 +129,7 @@ done:
 }
 
 /* Every rank's share counted on rank 0, and every point owned once. */
-static pm_err count_shares(struct fpm_par *P, const fpm_model *full,
+static pm_err count_shares(struct fpm_par *P, long n_whole,
                            const fpm_model *s) {
   fpm_share_counts mine;
   fpm_share_count(s, &mine);
@@ -137,8 +139,8 @@ static pm_err count_shares(struct fpm_par *P, const fpm_model *full,
              MPI_BYTE, 0, pm_par_comm());
   long own = s->n_own;
   pm_par_sum_long(&own, 1);
-  PM_CHECK(own == full->n, PM_ERR_INTERNAL,
-           "the ranks' shares own %ld points of %ld", own, full->n);
+  PM_CHECK(own == n_whole, PM_ERR_INTERNAL,
+           "the ranks' shares own %ld points of %ld", own, n_whole);
   return PM_SUCCESS;
 }
 
@@ -195,19 +197,24 @@ static long offset(void *ctx, long count) {
   return pm_par_offset(count);
 }
 
-pm_err fpm_par_create(const fpm_model *m, fpm_model **local) {
+pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, gm_dual **cells,
+                      const fpm_model *whole, fpm_model **local) {
   pm_err ret = PM_SUCCESS;
   struct fpm_par *P = NULL;
   fpm_model *s = NULL;
+  const long n = (*cells)->n_points;
   *local = NULL;
   PM_TRY(pm_par_agree(PM_ALLOC(P, 1, "FPM ranks")));
   P->rank = pm_par_rank();
   P->size = pm_par_size();
   PM_TRY(pm_par_agree(pm_petsc_init()));
-  PM_TRY(partition(P, m));
-  PM_TRY(pm_par_agree(fpm_share_create(m, P->owner, P->rank, &s)));
-  PM_TRY(pm_par_agree(make_forests(P, m, s)));
-  PM_TRY(pm_par_agree(count_shares(P, m, s)));
+  PM_TRY(partition(P, *cells));
+  PM_TRY(pm_par_agree(whole ? fpm_share_create(whole, P->owner, P->rank, &s)
+                            : fpm_share_build(sc, fpm_scene_options(sc), mesh,
+                                              cells, true, P->owner, P->rank,
+                                              &s)));
+  PM_TRY(pm_par_agree(make_forests(P, n, s)));
+  PM_TRY(pm_par_agree(count_shares(P, n, s)));
   P->n_ghost = s->n - s->n_own;
   P->xc = (fpm_exchange){.ctx = P,
                          .ghosts = exchange_ghosts,

@@ -18,7 +18,8 @@
  *    finite) agreed by every rank: the one one process meets first wins,
  *    and every rank stops with its message, which names the point by its
  *    index on one process.
- * Rank 0 keeps the whole model and gathers the state into it where the run
+ * No rank builds the whole model but where it keeps it (pm_view.h); rank 0
+ * keeps the whole model and gathers the state into it where the run
  * writes (another star forest, its own points to rank 0's whole arrays):
  * frames, history and checkpoints are those of one process.  The
  * functions below take a share (m->xc set by fpm_par_create); only
@@ -31,14 +32,19 @@
 #include "fpm_model.h"
 #include "fpm_share.h"
 
-/* This rank's share of model m, which every rank holds whole (collective;
- * every rank returns the same error): rank 0 partitions the points
- * (fpm_partition) after checking that every rank meshed the same graph,
- * every rank takes its share and the exchanges are set up: the share's
- * exchange (fpm_exchange.h: the ghosts' displacements, the sums and
- * minima, the failures agreed) is this rank's.  *local owns its arrays and
- * the exchanges (fpm_model_destroy). */
-pm_err fpm_par_create(const fpm_model *m, fpm_model **local);
+/* This rank's share of the model of scene sc on the cells *cells of the
+ * whole mesh, which every rank holds (collective; every rank returns the
+ * same error): rank 0 partitions the points (fpm_partition) after checking
+ * that every rank meshed the same graph, every rank makes its share and
+ * the exchanges are set up: the share's exchange (fpm_exchange.h: the
+ * ghosts' displacements, the sums and minima, the failures agreed) is this
+ * rank's.  whole: the whole model where this rank holds it (the share is
+ * cut from it), else NULL: the share is built from the cells around its
+ * points (fpm_region.h), the same model bit for bit, and the whole cells
+ * are let go on the way (*cells NULL on return).  *local owns its arrays
+ * and the exchanges (fpm_model_destroy). */
+pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, gm_dual **cells,
+                      const fpm_model *whole, fpm_model **local);
 /* A share's state from the whole run's, which every rank holds (a
  * checkpoint read by every rank): displacements and velocities of every
  * point it holds, and what the time loop carries. */

@@ -12,9 +12,9 @@
 /* ---- partition ------------------------------------------------------------
  */
 
-pm_err fpm_partition(const fpm_model *m, int parts, int *owner) {
+pm_err fpm_partition(const gm_dual *d, int parts, int *owner) {
   pm_err ret = PM_SUCCESS;
-  const long n = m->n, nnz = m->nbr_ptr[m->n];
+  const long n = d->n_points, nnz = d->nbr_ptr[n];
   Mat adj = NULL;
   MatPartitioning part = NULL;
   IS is = NULL;
@@ -29,11 +29,10 @@ pm_err fpm_partition(const fpm_model *m, int parts, int *owner) {
   PM_PETSC(PetscMalloc1(n + 1, &ia));
   PM_PETSC(PetscMalloc1(nnz + 1, &ja));
   PM_PETSC(PetscMalloc1(n + 1, &w));
-  for (long i = 0; i <= n; i++) ia[i] = (PetscInt)m->nbr_ptr[i];
-  for (long e = 0; e < nnz; e++) ja[e] = (PetscInt)m->nbr[e];
+  for (long i = 0; i <= n; i++) ia[i] = (PetscInt)d->nbr_ptr[i];
+  for (long e = 0; e < nnz; e++) ja[e] = (PetscInt)d->nbr[e];
   for (long i = 0; i < n; i++)
-    w[i] = (PetscInt)(1 + m->nbr_ptr[i + 1] - m->nbr_ptr[i] +
-                      (m->qs_ptr ? m->qs_ptr[i + 1] - m->qs_ptr[i] : 0));
+    w[i] = (PetscInt)(1 + d->nbr_ptr[i + 1] - d->nbr_ptr[i]);
   /* The adjacency and the weights are PETSc's from here. */
   PetscInt *a = ia, *b = ja;
   ia = ja = NULL;
@@ -179,6 +178,15 @@ void fpm_share_print(const fpm_model *m, const int *owner, int parts,
               c[r].flux_ghosts, c[r].stress_ghosts, c[r].u_ghosts,
               c[r].bytes / 1048576.0);
   }
+  int largest = 0;
+  for (int r = 1; r < parts; r++)
+    if (c[r].bytes > c[largest].bytes) largest = r;
+  fprintf(out,
+          "             memory per rank: %.1f MiB at most (rank %d's share, "
+          "operators and state); a rank that keeps the whole model (rank 0 "
+          "where the frames are gathered) holds its %.1f MiB besides\n",
+          c[largest].bytes / 1048576.0, largest,
+          (double)(fpm_model_bytes(m) + fpm_state_bytes(m)) / 1048576.0);
   /* with the averaged volume also their pressures U'(Jbar) */
   const double per = (m->vavg ? 4.0 : 3.0) * sizeof(double);
   fprintf(out,
@@ -197,7 +205,7 @@ pm_err fpm_share_predict(const fpm_model *m, int parts, FILE *out) {
   fpm_model *s = NULL;
   PM_TRY(PM_ALLOC(owner, m->n + 1, "partition"));
   PM_TRY(PM_ALLOC(c, parts, "shares"));
-  PM_TRY(fpm_partition(m, parts, owner));
+  PM_TRY(fpm_partition(m->dual, parts, owner));
   for (int r = 0; r < parts; r++) {
     PM_TRY(fpm_share_create(m, owner, r, &s));
     fpm_share_count(s, &c[r]);

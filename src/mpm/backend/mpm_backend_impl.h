@@ -83,6 +83,11 @@ pm_err mpm_sim_summary(void *p, pm_json *j);
 pm_err mpm_sim_implicit_summary(void *p, pm_json *j);
 const pm_timers *mpm_sim_timers(void *p);
 pm_err mpm_sim_plan(void *p, FILE *out);
+/* The layers of ghosts around a rank's share (pm_backend.ghost_layers):
+ * the grid's ghost node layers, at most 2 (quadratic B-splines), counted
+ * as layers of particles (a bound: particles have no ghosts but linked
+ * points'). */
+double mpm_sim_ghost_layers(const pm_scene *s);
 pm_err mpm_sim_implicit_plan(void *p, FILE *out);
 
 #endif
