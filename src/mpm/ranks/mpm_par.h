@@ -29,9 +29,12 @@
  *    point changed rank;
  *  - a body moving as prescribed sums its mass at the nodes over the
  *    ranks before it sets their velocities.
- * Rank 0 also keeps the whole model and gathers the state into it when
- * the run writes (frames, history, checkpoints): the output of a run
- * across ranks is that of one process, in the same order.
+ * Each rank seeds its own share from the scene (mpm_par_create_seeded),
+ * with the particles of its cells in one process's order: no rank builds
+ * the whole model for it.  Rank 0 may keep a whole model of its own and
+ * gather the state into it when the run writes (frames, history,
+ * checkpoints): the output of a run across ranks is that of one process,
+ * in the same order.
  *
  * The decomposition balances particles, not cells: along each axis it
  * splits, the cuts divide the particles of the initial state into equal
