@@ -54,31 +54,25 @@ pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out) {
   PM_TRY(PM_ALLOC(r, 1, "MPM simulation"));
   r->scene = s;
   double t0 = pm_wtime();
-  /* The whole model: on one process, where a rank keeps the run's view
-   * (pm_view_keeps_whole), and on every rank for the implicit MPM, whose
-   * shares are cut from it. */
+  /* The whole model: on one process, and where a rank keeps the run's
+   * view (pm_view_keeps_whole).  Across ranks each rank seeds its share
+   * from the scene: the particles of its cells by their reference
+   * positions, in one process's order. */
   const bool par = pm_par_active();
-  const bool whole = !par || implicit || pm_view_keeps_whole();
-  PM_TRY(pm_par_agree(whole ? mpm_model_create(s, &r->model, &r->state)
-                            : PM_SUCCESS));
-  if (implicit && par) {
-    /* Each rank's share: the particles of its cells by their reference
-     * positions (the grid moves with them: none migrates). */
-    PM_TRY(mpm_sim_figures_work(r->model, &r->work));
-    PM_TRY(pm_par_agree(mpm_par_create(s, r->model, r->state, NULL,
-                                       &r->local_model, &r->local_state)));
-    PM_TRY(pm_par_agree(
-        mpm_implicit_create(s, r->local_model, r->local_state, &r->imp)));
-    r->run_min_jacobian = 1;
-  } else if (implicit) {
-    PM_TRY(mpm_sim_figures_work(r->model, &r->work));
-    PM_TRY(mpm_implicit_create(s, r->model, r->state, &r->imp));
-    r->run_min_jacobian = 1;
-  } else if (par) {
-    /* Each rank's share seeded from the scene: no rank builds the whole
-     * model for it. */
+  PM_TRY(pm_par_agree(!par || pm_view_keeps_whole()
+                          ? mpm_model_create(s, &r->model, &r->state)
+                          : PM_SUCCESS));
+  if (par)
     PM_TRY(pm_par_agree(mpm_par_create_seeded(
         s, r->model != NULL, &r->local_model, &r->local_state)));
+  if (implicit) { /* (across ranks the grid moves with the particles: none
+                     migrates) */
+    PM_TRY(mpm_sim_figures_work(par ? r->local_model : r->model, &r->work));
+    PM_TRY(pm_par_agree(
+        par ? mpm_implicit_create(s, r->local_model, r->local_state, &r->imp)
+            : mpm_implicit_create(s, r->model, r->state, &r->imp)));
+    r->run_min_jacobian = 1;
+  } else if (par) {
     PM_TRY(pm_par_agree(mpm_work_create(r->local_model, &r->local_work)));
     PM_TRY(pm_par_agree(r->model ? mpm_sim_figures_work(r->model, &r->work)
                                  : PM_SUCCESS));
