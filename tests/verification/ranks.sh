@@ -75,6 +75,17 @@ rc=$?
 tail -1 "$work/mig"
 check "migration on 2 ranks (shock tube): exit 0 (got $rc)" test $rc -eq 0
 
+# Each rank seeds its share from the scene alone, the share cut from the
+# whole model bit for bit (ranks_migrate's first check): a membrane with
+# bodies inside and outside it and cylinders (the reduced oocyte), dynamic
+# relaxation's nodal arrays (F2) and a TIFF image's voxels (I2's slice).
+for sc in m4-oocyte-reduced f2-unconstrained-compression i2-vessel-slice; do
+  ranks 3 "$migrate" "$mpm/$sc.yaml" 1 >"$work/mig" 2>&1
+  rc=$?
+  tail -1 "$work/mig"
+  check "shares seeded on 3 ranks ($sc): exit 0 (got $rc)" test $rc -eq 0
+done
+
 # A particle that leaves the grid stops every rank with one process's
 # message (the particle by its index on one process), not a hang.
 fails_alike left-the-grid 2 'step [0-9]*, .*left the grid' \

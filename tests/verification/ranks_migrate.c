@@ -17,7 +17,11 @@
  *    are fitted per cell, its nearby points are exactly the points of
  *    other ranks in the cells within the fits' reach of the rank's box.  It
  * prints how many triangles (or a curve's segments) span two ranks or more and
- * how many membrane points moved. Usage: ranks_migrate SCENE STEPS
+ * how many membrane points moved.  First, each rank's share seeded from the
+ * scene with no whole model on any rank (mpm_par_create_seeded) is the
+ * share cut from the whole model (mpm_par_create), bit for bit: its
+ * decomposition, particles, constants, state, groups, bodies and first
+ * step. Usage: ranks_migrate SCENE STEPS
  * [KEY=VALUE...]; prints a line per check and exits 0 when all hold. */
 #include <math.h>
 #include <mpi.h>
@@ -145,6 +149,53 @@ static bool nearby_right(const mpm_model *m, const mpm_model *ref,
   return ok;
 }
 
+static bool same_doubles(const double *a, const double *b, long n) {
+  return n == 0 || !memcmp(a, b, sizeof(double) * (size_t)n);
+}
+
+/* Whether shares a (seeded) and b (cut from the whole) are alike. */
+static bool shares_alike(const mpm_model *a, const mpm_state *as,
+                         const mpm_model *b, const mpm_state *bs) {
+  const mpm_decomp *da = mpm_par_decomp(a), *db = mpm_par_decomp(b);
+  bool ok = a->n == b->n && a->cap == b->cap && a->n_groups == b->n_groups &&
+            a->n_bodies == b->n_bodies && a->n_moving == b->n_moving &&
+            a->n_bcs == b->n_bcs && a->kinds == b->kinds &&
+            a->grid.n_nodes == b->grid.n_nodes &&
+            !memcmp(a->grid.offset, b->grid.offset, sizeof a->grid.offset) &&
+            !memcmp(da->box, db->box, sizeof(long) * 6 * (size_t)da->size) &&
+            !memcmp(da->count, db->count, sizeof(long) * (size_t)da->size) &&
+            as->dt == bs->dt && as->dt_stable == bs->dt_stable &&
+            as->damping == bs->damping;
+  if (!ok) return false;
+  const long n = a->n;
+  ok = (n == 0 || !memcmp(a->gid, b->gid, sizeof(long) * (size_t)n)) &&
+       same_doubles(a->x0, b->x0, 3 * n) && same_doubles(a->mass, b->mass, n) &&
+       same_doubles(a->vol0, b->vol0, n) && same_doubles(as->x, bs->x, 3 * n) &&
+       same_doubles(as->v, bs->v, 3 * n) && same_doubles(as->vol, bs->vol, n) &&
+       same_doubles(as->sigma, bs->sigma, 9 * n);
+  for (int gi = 0; ok && gi < a->n_groups; gi++) {
+    const mpm_group *ga = &a->group[gi], *gb = &b->group[gi];
+    const mpm_group_state *sa = &as->group[gi], *sb = &bs->group[gi];
+    ok = ga->begin == gb->begin && ga->end == gb->end && ga->cap == gb->cap &&
+         ga->kind == gb->kind && sa->n == sb->n;
+    for (int k = 0; ok && k < sa->n; k++)
+      ok = sa->array[k].ncomp == sb->array[k].ncomp &&
+           sa->array[k].count == sb->array[k].count &&
+           same_doubles(sa->array[k].data, sb->array[k].data,
+                        sa->array[k].ncomp * sa->array[k].count);
+  }
+  for (int k = 0; ok && k < a->n_bodies; k++)
+    ok = a->body_begin[k] == b->body_begin[k] &&
+         a->body_end[k] == b->body_end[k] &&
+         a->body_links[k] == b->body_links[k] &&
+         a->body_normals[k] == b->body_normals[k];
+  for (int k = 0; ok && k < a->n_moving; k++)
+    ok = a->moving[k].begin == b->moving[k].begin &&
+         a->moving[k].end == b->moving[k].end &&
+         a->moving[k].first == b->moving[k].first;
+  return ok;
+}
+
 /* Total mass and momentum in one-process order. */
 static void totals(const mpm_model *m, const mpm_state *s, double t[4]) {
   t[0] = t[1] = t[2] = t[3] = 0;
@@ -180,7 +231,19 @@ int main(int argc, char **argv) {
   /* Every rank's reference: the model as one process has it. */
   mpm_model *ref = NULL;
   mpm_state *ref_state = NULL;
+  mpm_model *seeded = NULL, *cut = NULL;
+  mpm_state *seeded_state = NULL, *cut_state = NULL;
+  if (mpm_par_create_seeded(sc, false, &seeded, &seeded_state)) return 2;
   if (mpm_model_create(sc, &ref, &ref_state)) return 2;
+  if (mpm_par_create(sc, ref, ref_state, NULL, &cut, &cut_state)) return 2;
+  expect(shares_alike(seeded, seeded_state, cut, cut_state),
+         "the share seeded from the scene is the share cut from the whole "
+         "model, bit for bit",
+         0);
+  mpm_state_destroy(seeded_state);
+  mpm_model_destroy(seeded);
+  mpm_state_destroy(cut_state);
+  mpm_model_destroy(cut);
   mpm_model *m = r->local_model;
   mpm_state *s = r->local_state;
   mpm_work *w = r->local_work;

@@ -12,6 +12,7 @@
 #include "mpm_estimate.h"
 #include "mpm_par.h"
 #include "pm_par.h"
+#include "pm_view.h"
 
 /* Doubles per particle of the output buffer: strain energy density, J,
  * density, pressure, internal energy, the stress's von Mises and mean, the
@@ -53,28 +54,34 @@ pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out) {
   PM_TRY(PM_ALLOC(r, 1, "MPM simulation"));
   r->scene = s;
   double t0 = pm_wtime();
-  PM_TRY(pm_par_agree(mpm_model_create(s, &r->model, &r->state)));
-  if (implicit && pm_par_active()) {
-    /* Each rank's share: the particles of its cells by their reference
-     * positions (the grid moves with them: none migrates). */
-    PM_TRY(mpm_sim_figures_work(r->model, &r->work));
-    PM_TRY(pm_par_agree(mpm_par_create(s, r->model, r->state, NULL,
-                                       &r->local_model, &r->local_state)));
+  /* The whole model: on one process, and where a rank keeps the run's
+   * view (pm_view_keeps_whole).  Across ranks each rank seeds its share
+   * from the scene: the particles of its cells by their reference
+   * positions, in one process's order. */
+  const bool par = pm_par_active();
+  PM_TRY(pm_par_agree(!par || pm_view_keeps_whole()
+                          ? mpm_model_create(s, &r->model, &r->state)
+                          : PM_SUCCESS));
+  if (par)
+    PM_TRY(pm_par_agree(mpm_par_create_seeded(
+        s, r->model != NULL, &r->local_model, &r->local_state)));
+  if (implicit) { /* (across ranks the grid moves with the particles: none
+                     migrates) */
+    PM_TRY(mpm_sim_figures_work(par ? r->local_model : r->model, &r->work));
     PM_TRY(pm_par_agree(
-        mpm_implicit_create(s, r->local_model, r->local_state, &r->imp)));
+        par ? mpm_implicit_create(s, r->local_model, r->local_state, &r->imp)
+            : mpm_implicit_create(s, r->model, r->state, &r->imp)));
     r->run_min_jacobian = 1;
-  } else if (implicit) {
-    PM_TRY(mpm_sim_figures_work(r->model, &r->work));
-    PM_TRY(mpm_implicit_create(s, r->model, r->state, &r->imp));
-    r->run_min_jacobian = 1;
-  } else if (pm_par_active()) {
-    PM_TRY(mpm_view_setup(r));
+  } else if (par) {
+    PM_TRY(pm_par_agree(mpm_work_create(r->local_model, &r->local_work)));
+    PM_TRY(pm_par_agree(r->model ? mpm_sim_figures_work(r->model, &r->work)
+                                 : PM_SUCCESS));
   } else {
     PM_TRY(mpm_work_create(r->model, &r->work));
   }
   mpm_view_init(r, implicit);
   r->setup_wall = pm_wtime() - t0;
-  if (pm_par_root()) { /* the outputs' (rank 0's across ranks) */
+  if (r->model && pm_par_root()) { /* the outputs' (rank 0's across ranks) */
     PM_TRY(PM_ALLOC(r->scratch,
                     mpm_sim_scratch_per_particle(r->model) * r->model->n,
                     "output buffer"));
@@ -112,11 +119,12 @@ void mpm_sim_destroy(mpm_sim *r) {
 /* Everything the simulation holds: model, state, workspace and buffer
  * (across ranks, rank 0's: its share and the whole run's view). */
 size_t mpm_sim_bytes(const mpm_sim *r) {
-  size_t bytes = mpm_model_bytes(r->model) +
-                 mpm_state_bytes(r->model, r->state) +
-                 mpm_work_bytes(r->model, r->work) +
-                 mpm_sim_scratch_per_particle(r->model) * sizeof(double) *
-                     (size_t)r->model->n;
+  size_t bytes = 0;
+  if (r->model)
+    bytes += mpm_model_bytes(r->model) + mpm_state_bytes(r->model, r->state) +
+             mpm_work_bytes(r->model, r->work) +
+             mpm_sim_scratch_per_particle(r->model) * sizeof(double) *
+                 (size_t)r->model->n;
   if (r->local_model) /* (the implicit solver has no step workspace) */
     bytes +=
         mpm_model_bytes(r->local_model) +
@@ -257,6 +265,10 @@ static pm_err ranks_checkpoint(mpm_sim *r, pm_ckpt *ck) {
 static pm_err checkpoint(void *p, pm_ckpt *ck) {
   mpm_sim *r = p;
   long iter_max_row = r->iter_max_row;
+  /* A rank without the whole model reads a checkpoint of the whole run
+   * into one, from which its share is cut anew (mpm_view_reshare). */
+  if (pm_ckpt_reading(ck) && !r->model)
+    PM_CALL(mpm_model_create(r->scene, &r->model, &r->state));
   PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
   PM_CALL(pm_ckpt_double(ck, "run.energy0", &r->energy0));
   PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &r->run_min_jacobian));

@@ -112,6 +112,10 @@ static pm_err implicit_run(void *p, const pm_observer *obs) {
 
 static pm_err implicit_checkpoint(void *p, pm_ckpt *ck) {
   mpm_sim *r = p;
+  /* A rank without the whole model reads a checkpoint of the whole run
+   * into one, whose state its particles then take. */
+  if (pm_ckpt_reading(ck) && !r->model)
+    PM_CALL(mpm_model_create(r->scene, &r->model, &r->state));
   PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
   /* A resumed run across ranks: each rank's particles take the state read
    * (they are those of its cells by their reference positions, as at the

@@ -197,8 +197,9 @@ pm_err mpm_sim_plan(void *p, FILE *out) {
   return PM_SUCCESS;
 }
 
-pm_err mpm_sim_implicit_plan(void *p, FILE *out) {
-  mpm_sim *r = p;
+/* The whole run's lines of an implicit plan: the scene, grid, particles,
+ * groups and bodies (rank 0's, where it holds the whole model). */
+static void implicit_head(const mpm_sim *r, FILE *out) {
   const mpm_model *m = r->model;
   const pm_scene *s = r->scene;
   const mpm_grid *g = &m->grid;
@@ -212,11 +213,20 @@ pm_err mpm_sim_implicit_plan(void *p, FILE *out) {
   fprintf(out, "particles    %ld\n", m->n);
   plan_groups(m, out);
   plan_bodies(r, out);
+}
+
+pm_err mpm_sim_implicit_plan(void *p, FILE *out) {
+  mpm_sim *r = p;
+  const mpm_model *m = r->model;
+  /* Across ranks a rank without the whole model has its share's lines
+   * alone (the decomposition's are collective). */
+  if (m) implicit_head(r, out);
   mpm_implicit_plan(r->imp, out);
   if (r->local_model) /* across ranks: the decomposition, each rank's share */
-    mpm_par_plan(r->local_model, NULL, out);
+    mpm_par_plan(r->local_model, NULL, m ? out : NULL);
   else
     PM_CALL(plan_decomposition(r, out));
+  if (!m) return PM_SUCCESS;
   fprintf(out,
           "memory       %.1f MiB (model %.1f, state %.1f, output %.1f; "
           "PETSc's matrix and solver besides)\n",

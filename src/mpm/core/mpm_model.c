@@ -44,14 +44,18 @@ void mpm_options_from_scene(const pm_scene *s, mpm_options *o) {
   }
 }
 
-/* The first step's size: time.dt, or the stable step of the initial
- * state. */
-static pm_err initial_step(const pm_scene *s, const mpm_model *m,
-                           mpm_state *st) {
+pm_err mpm_model_start(mpm_model *m, mpm_state *st) {
   double *cp = NULL;
-  PM_CALL(PM_ALLOC(cp, m->n, "particle wave speeds"));
+  mpm_pipeline_build(m);
+  st->damping = m->opt.qs == PM_QS_DAMPING ? m->opt.qs_damping : 0;
+  PM_CALL(PM_ALLOC(cp, m->n + 1, "particle wave speeds"));
   st->dt_stable = mpm_stable_dt(m, st, cp);
   free(cp);
+  return PM_SUCCESS;
+}
+
+pm_err mpm_model_first_dt(const pm_scene *s, const mpm_model *m,
+                          mpm_state *st) {
   PM_CHECK(m->opt.dt_fixed > 0 || isfinite(st->dt_stable), PM_ERR_SCENE,
            "%s: no stable time step: no particle has a wave speed or a "
            "velocity (set time.dt)",
@@ -60,13 +64,10 @@ static pm_err initial_step(const pm_scene *s, const mpm_model *m,
   return PM_SUCCESS;
 }
 
-pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
-                        mpm_state **state) {
+pm_err mpm_model_frame(const pm_scene *s, mpm_model **out) {
   pm_err ret = PM_SUCCESS;
   mpm_model *m = NULL;
-  mpm_state *st = NULL;
-  *model = NULL;
-  *state = NULL;
+  *out = NULL;
   PM_ENSURE(s->method && (strcmp(s->method, "mpm") == 0 ||
                           strcmp(s->method, "mpm-implicit") == 0),
             PM_ERR_ARG, "mpm_model_create: scene %s has method %s", s->path,
@@ -86,14 +87,36 @@ pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
   PM_TRY(mpm_conditions_create(s, &m->grid, &m->bcs, &m->n_bcs));
   for (int b = 0; b < m->n_bcs; b++)
     if (m->bcs[b].absorbing) m->has_absorbing = true;
-  /* The state's arrays follow the groups and the conditions. */
-  PM_TRY(mpm_seed(s, m, &st));
-  PM_TRY(mpm_grips_create(s, m));
-  PM_TRY(mpm_tractions_create(s, m));
-  PM_TRY(mpm_contacts_check(s, m));
-  mpm_pipeline_build(m);
-  st->damping = m->opt.qs == PM_QS_DAMPING ? m->opt.qs_damping : 0;
-  PM_TRY(initial_step(s, m, st));
+  *out = m;
+  m = NULL;
+done:
+  mpm_model_destroy(m);
+  return ret;
+}
+
+/* The whole model (sh NULL), or share sh of it on grid block `block`. */
+static pm_err build(const pm_scene *s, const mpm_grid *block,
+                    mpm_seed_share *sh, mpm_model **model, mpm_state **state) {
+  pm_err ret = PM_SUCCESS;
+  mpm_model *m = NULL;
+  mpm_state *st = NULL;
+  *model = NULL;
+  *state = NULL;
+  PM_TRY(mpm_model_frame(s, &m));
+  /* The state's arrays follow the groups and the conditions.  A share is
+   * seeded and finished on the whole grid (a membrane's fits read its
+   * cells), then moved onto its block; grips, tractions and rigid bodies
+   * run on one process (mpm_par_check). */
+  PM_TRY(mpm_seed_for_share(s, m, sh, &st));
+  if (sh) {
+    PM_TRY(mpm_model_narrow(s, block, sh, m, st));
+  } else {
+    PM_TRY(mpm_grips_create(s, m));
+    PM_TRY(mpm_tractions_create(s, m));
+    PM_TRY(mpm_contacts_check(s, m));
+  }
+  PM_TRY(mpm_model_start(m, st));
+  if (!sh) PM_TRY(mpm_model_first_dt(s, m, st));
   *model = m;
   *state = st;
   m = NULL;
@@ -102,6 +125,17 @@ done:
   mpm_state_destroy(st);
   mpm_model_destroy(m);
   return ret;
+}
+
+pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
+                        mpm_state **state) {
+  return build(s, NULL, NULL, model, state);
+}
+
+pm_err mpm_model_share(const pm_scene *s, const mpm_grid *block,
+                       mpm_seed_share *sh, mpm_model **model,
+                       mpm_state **state) {
+  return build(s, block, sh, model, state);
 }
 
 void mpm_model_destroy(mpm_model *m) {

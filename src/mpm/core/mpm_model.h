@@ -112,6 +112,40 @@ void mpm_options_from_scene(const pm_scene *s, mpm_options *o);
  * failure *model and *state are NULL. */
 pm_err mpm_model_create(const pm_scene *s, mpm_model **model,
                         struct mpm_state **state);
+/* The model's frame: its options, grid and conditions, without particles
+ * (what a share's seeding and a decomposition start from).  The failures of
+ * mpm_model_create before the seeding. */
+pm_err mpm_model_frame(const pm_scene *s, mpm_model **out);
+
+/* The initial state's start: the model's pipeline, the damping, and the
+ * stable step of the initial state (dt_stable). */
+pm_err mpm_model_start(mpm_model *m, struct mpm_state *st);
+/* The first step's size: time.dt, or the stable step dt_stable (of the
+ * whole run: across ranks the least of the shares'); PM_ERR_SCENE when
+ * there is neither. */
+pm_err mpm_model_first_dt(const pm_scene *s, const mpm_model *m,
+                          struct mpm_state *st);
+
+struct mpm_seed_share;
+/* A share of the model (a rank's) made from the scene alone, never the
+ * whole: the particles sh keeps (mpm_seed_share), numbered and ordered as
+ * on one process, a membrane's narrowed to them once it is finished whole
+ * (its links kept whole by its kind's ranks_share), on grid block `block`
+ * (as mpm_model_subset's) with the conditions on the block and the
+ * pipeline, and its initial state, whose dt_stable is the share's own
+ * (the caller takes the least over the shares, then mpm_model_first_dt).
+ * The body ranges and the exchange are the caller's, as for
+ * mpm_model_subset. */
+pm_err mpm_model_share(const pm_scene *s, const mpm_grid *block,
+                       struct mpm_seed_share *sh, mpm_model **model,
+                       struct mpm_state **state);
+/* The share's groups kept whole by the seeding narrowed to sh's particles
+ * in place, and the share moved onto grid block `block` with its
+ * conditions (mpm_model_share's step after the seeding). */
+pm_err mpm_model_narrow(const pm_scene *s, const mpm_grid *block,
+                        struct mpm_seed_share *sh, mpm_model *m,
+                        struct mpm_state *st);
+
 /* Release a model (NULL accepted); its states and workspaces first. */
 void mpm_model_destroy(mpm_model *m);
 

@@ -4,7 +4,9 @@
  * particles are the vertices of its surface; an image body's, n^d per
  * labelled voxel, apart from the cells and from the other bodies.
  * Particles are grouped by material, and within a group by body, so that
- * each body's particles are one range. */
+ * each body's particles are one range.  A share (a rank's) keeps the
+ * particles its test keeps, numbered as on one process (gid), and every
+ * particle of a group that is finished whole (a membrane). */
 #include "mpm_seed.h"
 
 #include <math.h>
@@ -17,6 +19,7 @@
 #include "gm_shape.h"
 #include "gm_trisurf.h"
 #include "mpm_kind.h"
+#include "mpm_seed_impl.h"
 #include "pm_tensor.h"
 
 typedef struct {
@@ -38,113 +41,6 @@ typedef struct {
 static int body_at(const seeder *sd, const double x[3]) {
   return gm_shape_last_containing((const gm_shape *const *)sd->shape,
                                   sd->s->n_bodies, x);
-}
-
-/* A located failure at bodies.B(.KEY): the message of the call that
- * failed, after the scene position. */
-static pm_err body_fail(const pm_scene *s, int b, const char *key,
-                        const char *what) {
-  char p[PM_SDOC_PATH], msg[1024];
-  snprintf(msg, sizeof msg, "%s", pm_error_message());
-  if (key)
-    snprintf(p, sizeof p, "bodies.%d.%s", b, key);
-  else
-    snprintf(p, sizeof p, "bodies.%d", b);
-  return pm_scene_fail(s, p, key != NULL, "%s: %s", what, msg);
-}
-
-/* A curve's or point cloud's points as a surface without triangles. */
-static void points_only(long n, double *x, gm_trisurf *out) {
-  *out = (gm_trisurf){.n_points = n, .x = x};
-}
-
-/* Each point's share of the point cloud of body b: the file's column, or
- * membrane.area shared equally. */
-static pm_err cloud_shares(const pm_scene *s, int b, long n, double **share) {
-  const pm_scene_body *body = &s->bodies[b];
-  if (*share) return PM_SUCCESS;
-  char p[PM_SDOC_PATH];
-  if (!(body->membrane.area > 0))
-    return pm_scene_fail(s, PM_PATH(p, "bodies.%d.membrane.points", b), true,
-                         "expected a file with an area per point (a last "
-                         "column), or membrane.area: the file %s gives none",
-                         body->membrane.file);
-  PM_CALL(PM_ALLOC(*share, n, "membrane point areas"));
-  for (long k = 0; k < n; k++) (*share)[k] = body->membrane.area / (double)n;
-  return PM_SUCCESS;
-}
-
-/* The points of membrane body b (and its triangles), each point's share
- * of its area (length in 2D), all inside the grid. */
-static pm_err make_surface(const pm_scene *s, int b, gm_trisurf *out,
-                           double **share) {
-  const pm_scene_body *body = &s->bodies[b];
-  pm_err e = PM_SUCCESS;
-  const char *key = "membrane";
-  gm_curve cv = {0};
-  long n = 0;
-  double *x = NULL;
-  switch (body->membrane.surface) {
-  case PM_SURFACE_SPHERE:
-    e = gm_trisurf_sphere(body->a, body->radius, (int)body->membrane.refinement,
-                          out);
-    key = "membrane.sphere";
-    break;
-  case PM_SURFACE_RECTANGLE:
-    e = gm_trisurf_rectangle(body->a, body->b, body->membrane.edge_v,
-                             (long)body->membrane.points[0],
-                             (long)body->membrane.points[1], out);
-    key = "membrane.rectangle";
-    break;
-  case PM_SURFACE_FILE:
-    e = gm_trisurf_load(body->membrane.file, out);
-    key = "membrane.file";
-    break;
-  case PM_SURFACE_CURVE:
-    key = "membrane.curve";
-    e = gm_curve_parametric(
-        body->membrane.curve[0], body->membrane.curve[1],
-        body->membrane.curve_range[0], body->membrane.curve_range[1],
-        body->membrane.curve_points, body->membrane.closed, &cv);
-    if (e) break;
-    points_only(cv.n, cv.x, out);
-    e = PM_ALLOC(*share, cv.n, "membrane point lengths");
-    if (!e) gm_curve_point_lengths(&cv, *share);
-    break;
-  case PM_SURFACE_POINTS:
-    key = "membrane.points";
-    e = gm_points_load(body->membrane.file, s->dimension, &n, &x, share);
-    if (e) {
-      /* The reader's message names the file, line and column. */
-      char p[PM_SDOC_PATH], msg[1024];
-      snprintf(msg, sizeof msg, "%s", pm_error_message());
-      return pm_scene_fail(s, PM_PATH(p, "bodies.%d.%s", b, key), true, "%s",
-                           msg);
-    }
-    points_only(n, x, out);
-    PM_CALL(cloud_shares(s, b, n, share));
-    break;
-  }
-  if (e) return body_fail(s, b, key, "expected a surface");
-  if (!*share) {
-    PM_CALL(PM_ALLOC(*share, out->n_points, "membrane point areas"));
-    gm_trisurf_point_areas(out, *share);
-  }
-  double lo[3], hi[3];
-  gm_trisurf_bounds(out, lo, hi);
-  for (int c = 0; c < s->dimension; c++) {
-    double tol = 1e-9 * (s->box_max[c] - s->box_min[c]);
-    if (lo[c] < s->box_min[c] - tol || hi[c] > s->box_max[c] + tol) {
-      char p[PM_SDOC_PATH];
-      return pm_scene_fail(s, PM_PATH(p, "bodies.%d.%s", b, key), true,
-                           "expected a surface inside domain.box (%c in [%g, "
-                           "%g]), got one reaching %c = %g: its particles "
-                           "would be outside the grid",
-                           "xyz"[c], s -> box_min[c], s -> box_max[c], "xyz"[c],
-                           lo[c] < s -> box_min[c] ? lo[c] : hi[c]);
-    }
-  }
-  return PM_SUCCESS;
 }
 
 /* The inside or outside of membrane body mb for body b: of its closed
@@ -171,7 +67,7 @@ static pm_err membrane_region(const seeder *sd, int b, int mb, gm_shape **out) {
            "expected the name of a closed membrane (bodies.%d, whose "
            "surface splits the domain into an inside and an outside)",
            mb);
-  return body_fail(s, b, outside ? "outside" : "inside", what);
+  return mpm_seed_body_fail(s, b, outside ? "outside" : "inside", what);
 }
 
 /* A failure located at the value of bodies.b.image.KEY: what (if any),
@@ -237,7 +133,7 @@ static pm_err make_shapes(seeder *sd, const mpm_options *o) {
                       : body->n_ppc == 1 ? (int)body->ppc[0]
                                          : (int)body->ppc[c];
     if (body->shape == PM_BODY_MEMBRANE)
-      PM_CALL(make_surface(s, b, &sd->surf[b], &sd->share[b]));
+      PM_CALL(mpm_seed_surface(s, b, &sd->surf[b], &sd->share[b]));
   }
   for (int b = 0; b < nb; b++) {
     const pm_scene_body *body = &s->bodies[b];
@@ -319,12 +215,39 @@ typedef struct {
   int body; /* the image body being seeded */
   mpm_model *m;
   mpm_state *st;
+  /* a share: its test, each body's particles it keeps, each body's next
+   * one-process index, and the groups kept whole */
+  mpm_seed_share *sh;
+  long *kept;
+  long *gnext;
+  bool whole[MPM_MAX_GROUPS];
 } seed_ctx;
+
+/* Whether the share keeps a particle at x (every one without a share). */
+static bool keeps(const seed_ctx *c, const double x[3]) {
+  return !c->sh || c->sh->keep(c->sh->ctx, x);
+}
 
 static void count_seed(void *ctx, const double x[3], int body) {
   seed_ctx *c = ctx;
-  (void)x;
   c->count[body]++;
+  c->kept[body] += keeps(c, x);
+}
+
+static void count_voxel(void *ctx, const double x[3], double vol) {
+  (void)vol;
+  count_seed(ctx, x, ((seed_ctx *)ctx)->body);
+}
+
+/* The index of body b's next particle, at x, in the model, or -1 where
+ * the share leaves it out (its one-process index then passes). */
+static long next_index(seed_ctx *c, int b, const double x[3]) {
+  if (!c->sh) return c->next[b]++;
+  const long gp = c->gnext[b]++;
+  if (!c->whole[c->group_of[c->s->bodies[b].material]] && !keeps(c, x))
+    return -1;
+  c->m->gid[c->next[b]] = gp;
+  return c->next[b]++;
 }
 
 /* Particle p of body b at x with volume vol: constants, state, and its
@@ -359,12 +282,14 @@ static void place_seed(void *ctx, const double x[3], int b) {
     vol /= ppc[d];
     if (top > end + 1e-12 * hs) vol *= (end - (x[d] - 0.5 * hs)) / hs;
   }
-  place(c, b, c->next[b]++, x, vol);
+  const long p = next_index(c, b, x);
+  if (p >= 0) place(c, b, p, x, vol);
 }
 
 static void place_voxel(void *ctx, const double x[3], double vol) {
   seed_ctx *c = ctx;
-  place(c, c->body, c->next[c->body]++, x, vol);
+  const long p = next_index(c, c->body, x);
+  if (p >= 0) place(c, c->body, p, x, vol);
 }
 
 /* Image body b's particles (place NULL: their count). */
@@ -382,8 +307,8 @@ static pm_err place_membrane(seed_ctx *c, int b, long *t) {
   mpm_model *m = c->m;
   const double *area = c->sd->share[b];
   const long first = c->next[b];
-  for (long k = 0; k < sf->n_points; k++)
-    place(c, b, c->next[b]++, sf->x + 3 * k,
+  for (long k = 0; k < sf->n_points; k++) /* (kept whole) */
+    place(c, b, next_index(c, b, sf->x + 3 * k), sf->x + 3 * k,
           area[k] * body->membrane.thickness);
   m->body_links[b] = sf->n_tris > 0 ? MPM_LINKS_TRIANGLES
                      : body->membrane.surface != PM_SURFACE_CURVE
@@ -439,6 +364,42 @@ static pm_err make_groups(seed_ctx *c, long *total) {
   return PM_SUCCESS;
 }
 
+/* A share's ranges: the one-process ones (make_groups') into the share,
+ * then each group's and body's among the particles it keeps (all of a
+ * group kept whole), each group with the room the share asks.  *total:
+ * the particles on one process, then those kept. */
+static pm_err share_ranges(seed_ctx *c, long *total) {
+  const pm_scene *s = c->s;
+  mpm_model *m = c->m;
+  mpm_seed_share *sh = c->sh;
+  sh->n_full = *total;
+  PM_CALL(PM_ALLOC(sh->bbegin, s->n_bodies + 1, "body ranges"));
+  PM_CALL(PM_ALLOC(sh->bend, s->n_bodies + 1, "body ranges"));
+  for (int b = 0; b < s->n_bodies; b++) {
+    sh->bbegin[b] = c->gnext[b] = m->body_begin[b];
+    sh->bend[b] = m->body_end[b];
+  }
+  *total = 0;
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    mpm_group *g = &m->group[gi];
+    sh->gbegin[gi] = g->begin;
+    sh->gend[gi] = g->end;
+    c->whole[gi] = g->kind->finish || g->kind->ranks_share;
+    g->begin = *total;
+    for (int b = 0; b < s->n_bodies; b++)
+      if (c->group_of[s->bodies[b].material] == gi) {
+        c->next[b] = m->body_begin[b] = *total;
+        *total += c->whole[gi] ? c->count[b] : c->kept[b];
+        m->body_end[b] = *total;
+      }
+    g->end = *total;
+    g->cap = sh->room(g->end - g->begin);
+    for (int k = 0; k < g->n_arrays; k++)
+      g->layout[k].count = g->end - g->begin;
+  }
+  return PM_SUCCESS;
+}
+
 /* The triangles' ranges per group, and the moving bodies. */
 static pm_err make_lists(seed_ctx *c) {
   const pm_scene *s = c->s;
@@ -456,13 +417,58 @@ static pm_err make_lists(seed_ctx *c) {
     mpm_motion *mv = &m->moving[k++];
     mv->body = b;
     mv->begin = mv->first = m->body_begin[b];
+    if (c->sh) mv->first = c->sh->bbegin[b];
     mv->end = m->body_end[b];
     for (int d = 0; d < 3; d++) mv->v[d] = body->motion[d];
   }
   return PM_SUCCESS;
 }
 
+static void seeder_free(seeder *sd, int nb) {
+  for (int b = 0; sd->shape && b < nb; b++) gm_shape_destroy(sd->shape[b]);
+  for (int b = 0; sd->voxels && b < nb; b++) gm_shape_destroy(sd->voxels[b]);
+  for (int b = 0; sd->image && b < nb; b++) gm_image_free(&sd->image[b]);
+  for (int b = 0; sd->surf && b < nb; b++) gm_trisurf_free(&sd->surf[b]);
+  for (int b = 0; sd->share && b < nb; b++) free(sd->share[b]);
+  free(sd->share);
+  free(sd->shape);
+  free(sd->surf);
+  free(sd->ppc);
+  free(sd->voxels);
+  free(sd->image);
+}
+
+pm_err mpm_seed_visit(const pm_scene *s, const mpm_model *m,
+                      mpm_seed_share *sh) {
+  pm_err ret = PM_SUCCESS;
+  const int nb = s->n_bodies;
+  seeder sd = {.s = s};
+  seed_ctx c = {.s = s, .sd = &sd, .sh = sh};
+  PM_TRY(make_shapes(&sd, &m->opt));
+  PM_TRY(PM_ALLOC(c.count, nb, "body counts"));
+  PM_TRY(PM_ALLOC(c.kept, nb, "body counts"));
+  for (int b = 0; b < nb; b++) {
+    const gm_trisurf *sf = &sd.surf[b];
+    if (s->bodies[b].shape == PM_BODY_MEMBRANE)
+      for (long k = 0; k < sf->n_points; k++) sh->keep(sh->ctx, sf->x + 3 * k);
+    else if (s->bodies[b].shape == PM_BODY_IMAGE)
+      seed_voxels(&c, b, count_voxel);
+    else
+      for_each_seed(&sd, &m->grid, b, count_seed, &c);
+  }
+done:
+  seeder_free(&sd, nb);
+  free(c.count);
+  free(c.kept);
+  return ret;
+}
+
 pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
+  return mpm_seed_for_share(s, m, NULL, state);
+}
+
+pm_err mpm_seed_for_share(const pm_scene *s, mpm_model *m, mpm_seed_share *sh,
+                          mpm_state **state) {
   pm_err ret = PM_SUCCESS;
   seeder sd = {.s = s};
   seed_ctx c;
@@ -470,6 +476,7 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   c.s = s;
   c.sd = &sd;
   c.m = m;
+  c.sh = sh;
   *state = NULL;
   const int nb = s->n_bodies;
   PM_ENSURE(s->n_materials <= MPM_MAX_GROUPS, PM_ERR_SCENE,
@@ -478,6 +485,8 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   PM_TRY(make_shapes(&sd, &m->opt));
   PM_TRY(PM_ALLOC(c.count, nb, "body counts"));
   PM_TRY(PM_ALLOC(c.next, nb, "body counts"));
+  PM_TRY(PM_ALLOC(c.kept, nb, "body counts"));
+  PM_TRY(PM_ALLOC(c.gnext, nb, "body counts"));
   PM_TRY(PM_ALLOC(m->body_begin, nb, "body ranges"));
   PM_TRY(PM_ALLOC(m->body_end, nb, "body ranges"));
   PM_TRY(PM_ALLOC(m->body_tri_begin, nb, "body ranges"));
@@ -488,6 +497,8 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   for (int b = 0; b < nb; b++) {
     if (s->bodies[b].shape == PM_BODY_MEMBRANE)
       c.count[b] = sd.surf[b].n_points;
+    else if (s->bodies[b].shape == PM_BODY_IMAGE && sh)
+      seed_voxels(&c, b, count_voxel);
     else if (s->bodies[b].shape == PM_BODY_IMAGE)
       c.count[b] = seed_voxels(&c, b, NULL);
     else
@@ -499,10 +510,13 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
             "%s: no particles: no seed position (%d x %d x %d per cell of "
             "size %g) lies in a body",
             s->path, m->opt.ppc[0], m->opt.ppc[1], m->opt.ppc[2], s->mesh_size);
+  if (sh) PM_TRY(share_ranges(&c, &total));
   m->n = m->cap = total;
-  PM_TRY(PM_ALLOC(m->x0, 3 * total, "particle positions"));
-  PM_TRY(PM_ALLOC(m->mass, total, "particle masses"));
-  PM_TRY(PM_ALLOC(m->vol0, total, "particle volumes"));
+  if (sh) m->cap = sh->room(total);
+  PM_TRY(PM_ALLOC(m->x0, 3 * m->cap, "particle positions"));
+  PM_TRY(PM_ALLOC(m->mass, m->cap, "particle masses"));
+  PM_TRY(PM_ALLOC(m->vol0, m->cap, "particle volumes"));
+  if (sh) PM_TRY(PM_ALLOC(m->gid, m->cap, "particle indices"));
   PM_TRY(make_lists(&c));
   PM_TRY(mpm_state_create(m, &c.st));
   /* Triangles group by group, in body order within a group. */
@@ -527,18 +541,10 @@ pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state) {
   c.st = NULL;
 done:
   mpm_state_destroy(c.st);
-  for (int b = 0; sd.shape && b < nb; b++) gm_shape_destroy(sd.shape[b]);
-  for (int b = 0; sd.voxels && b < nb; b++) gm_shape_destroy(sd.voxels[b]);
-  for (int b = 0; sd.image && b < nb; b++) gm_image_free(&sd.image[b]);
-  for (int b = 0; sd.surf && b < nb; b++) gm_trisurf_free(&sd.surf[b]);
-  for (int b = 0; sd.share && b < nb; b++) free(sd.share[b]);
-  free(sd.share);
-  free(sd.shape);
-  free(sd.surf);
-  free(sd.ppc);
-  free(sd.voxels);
-  free(sd.image);
+  seeder_free(&sd, nb);
   free(c.count);
   free(c.next);
+  free(c.kept);
+  free(c.gnext);
   return ret;
 }

@@ -19,4 +19,34 @@
  * mpm_model_destroy. */
 pm_err mpm_seed(const pm_scene *s, mpm_model *m, mpm_state **state);
 
+/* A share of the particles (a rank's): those at positions x where
+ * keep(ctx, x) holds, each numbered as on one process. */
+typedef struct mpm_seed_share {
+  bool (*keep)(void *ctx, const double x[3]);
+  void *ctx;
+  long (*room)(long n); /* room for n particles (a model's, a group's) */
+  /* set by mpm_seed_for_share: the particles on one process and their groups'
+   * and bodies' ranges there (bbegin, bend: per body, the caller frees) */
+  long n_full;
+  long gbegin[MPM_MAX_GROUPS], gend[MPM_MAX_GROUPS];
+  long *bbegin, *bend;
+} mpm_seed_share;
+
+/* mpm_seed keeping share sh's particles only (sh NULL: all), with their
+ * one-process indices in m->gid, in one process's order; a group whose
+ * kind finishes on the whole group or shares its links across ranks (a
+ * membrane: mpm_kind.finish, ranks_share) is kept whole, for the caller
+ * to narrow (mpm_model_share).  m's arrays have room for sh->room(n), each
+ * group's for sh->room(its count).  Nothing but the seeding's memory grows
+ * with the particles sh leaves out. */
+pm_err mpm_seed_for_share(const pm_scene *s, mpm_model *m, mpm_seed_share *sh,
+                          mpm_state **state);
+
+/* Every seed position of scene s on m's grid (m->opt and m->grid set), as
+ * one process seeds them, to sh->keep (whose answer is not used): a count
+ * without storing a particle (the cells' counts of a decomposition).
+ * mpm_seed's failures. */
+pm_err mpm_seed_visit(const pm_scene *s, const mpm_model *m,
+                      mpm_seed_share *sh);
+
 #endif

@@ -109,28 +109,42 @@ static bool cut_allowed(const mpm_model *m, int a, long c) {
 }
 
 /* What the bisection works on: the model, the axes it may cut, the
- * particles' cells, a histogram, and the tree it grows. */
+ * particles per cell, a histogram, and the tree it grows. */
 typedef struct {
   const pm_scene *s;
   const mpm_model *m;
   mpm_decomp *d;
   bool splits[3];
-  long *cell; /* 3 per particle */
+  const long *per_cell; /* cells[0] x cells[1] x cells[2], x fastest */
   long *hist;
   int n_nodes;
 } bisection;
+
+/* The particles of box [lo, hi) in each slab across axis a into hist
+ * (hi[a] - lo[a] of them). */
+static void slabs(const bisection *B, const long lo[3], const long hi[3], int a,
+                  long *hist) {
+  const long *n = B->d->cells;
+  memset(hist, 0, sizeof(long) * (size_t)(hi[a] - lo[a]));
+  for (long k = lo[2]; k < hi[2]; k++)
+    for (long j = lo[1]; j < hi[1]; j++)
+      for (long i = lo[0]; i < hi[0]; i++) {
+        const long q[3] = {i, j, k};
+        hist[q[a] - lo[a]] += B->per_cell[i + n[0] * (j + n[1] * k)];
+      }
+}
 
 /* Cells of box [lo, hi). */
 static double box_cells(const long lo[3], const long hi[3]) {
   return (double)(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
 }
 
-/* Share n ranks from r0 among the particles idx[0..count) of box [lo, hi):
- * cut the box's longest axis that may be cut where the particles divide
- * in the ranks' proportion, and each side likewise.  Returns the tree
- * node it made, or -(r0 + 1) for a box of one rank. */
+/* Share n ranks from r0 among the count particles of box [lo, hi): cut
+ * the box's longest axis that may be cut where the particles divide in
+ * the ranks' proportion, and each side likewise.  Returns the tree node
+ * it made, or -(r0 + 1) for a box of one rank. */
 static pm_err bisect(bisection *B, int r0, int n, const long lo[3],
-                     const long hi[3], long *idx, long count, int *node) {
+                     const long hi[3], long count, int *node) {
   mpm_decomp *d = B->d;
   const long w = min_cells(&B->m->grid);
   if (n == 1) {
@@ -158,9 +172,7 @@ static pm_err bisect(bisection *B, int r0, int n, const long lo[3],
            hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], n, w,
            d->held[0] ? " (not cut: " : "", d->held[0] ? d->held : "");
   const long len = hi[axis] - lo[axis];
-  memset(B->hist, 0, sizeof(long) * (size_t)len);
-  for (long k = 0; k < count; k++)
-    B->hist[B->cell[3 * idx[k] + axis] - lo[axis]]++;
+  slabs(B, lo, hi, axis, B->hist);
   /* The cut nearest to the particles' share, in a whole cell; of the cuts
    * that share them alike (empty slabs), the middle one. */
   const double target = (double)count * nl / n;
@@ -197,14 +209,8 @@ static pm_err bisect(bisection *B, int r0, int n, const long lo[3],
            B->s->path, d->size, len, "xyz"[axis], n, w,
            face_clearance(&B->m->grid));
   const long at = lo[axis] + best;
-  /* The particles below the cut first. */
-  long split = 0;
-  for (long k = 0; k < count; k++)
-    if (B->cell[3 * idx[k] + axis] < at) {
-      long t = idx[k];
-      idx[k] = idx[split];
-      idx[split++] = t;
-    }
+  long split = 0; /* the particles below the cut */
+  for (long c = 0; c < best; c++) split += B->hist[c];
   const int me = B->n_nodes++;
   d->tree[me].axis = axis;
   d->tree[me].at = at;
@@ -214,22 +220,48 @@ static pm_err bisect(bisection *B, int r0, int n, const long lo[3],
   memcpy(mid_lo, lo, sizeof mid_lo);
   mid_hi[axis] = mid_lo[axis] = at;
   int child;
-  PM_CALL(bisect(B, r0, nl, lo, mid_hi, idx, split, &child));
+  PM_CALL(bisect(B, r0, nl, lo, mid_hi, split, &child));
   d->tree[me].child[0] = child;
-  PM_CALL(
-      bisect(B, r0 + nl, nr, mid_lo, hi, idx + split, count - split, &child));
+  PM_CALL(bisect(B, r0 + nl, nr, mid_lo, hi, count - split, &child));
   d->tree[me].child[1] = child;
   *node = me;
   return PM_SUCCESS;
 }
 
+long mpm_decomp_cells(const mpm_grid *g, long cells[3]) {
+  long n = 1;
+  for (int a = 0; a < 3; a++) {
+    cells[a] = a < g->dim ? g->nn[a] - 1 : 1;
+    n *= cells[a];
+  }
+  return n;
+}
+
+void mpm_decomp_count(const mpm_grid *g, const long cells[3], const double x[3],
+                      long *per_cell) {
+  long c[3];
+  cell_of(g, cells, x, c);
+  per_cell[c[0] + cells[0] * (c[1] + cells[1] * c[2])]++;
+}
+
 pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m, int size,
                          mpm_decomp *d) {
+  long cells[3], *per_cell = NULL;
+  PM_CALL(PM_ALLOC(per_cell, mpm_decomp_cells(&m->grid, cells),
+                   "particles per cell"));
+  for (long p = 0; p < m->n; p++)
+    mpm_decomp_count(&m->grid, cells, m->x0 + 3 * p, per_cell);
+  pm_err e = mpm_decomp_from_counts(s, m, size, per_cell, m->n, d);
+  free(per_cell);
+  return e;
+}
+
+pm_err mpm_decomp_from_counts(const pm_scene *s, const mpm_model *m, int size,
+                              const long *per_cell, long total, mpm_decomp *d) {
   pm_err ret = PM_SUCCESS;
   const mpm_grid *g = &m->grid;
-  bisection B = {.s = s, .m = m, .d = d};
+  bisection B = {.s = s, .m = m, .d = d, .per_cell = per_cell};
   const bool implicit = strcmp(s->method, "mpm-implicit") == 0;
-  long *idx = NULL;
   memset(d, 0, sizeof *d);
   d->size = size;
   d->ghost = g->width - 1;
@@ -254,19 +286,11 @@ pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m, int size,
   PM_TRY(PM_ALLOC(d->box, 6 * size, "decomposition boxes"));
   PM_TRY(PM_ALLOC(d->tree, size, "decomposition cuts"));
   PM_TRY(PM_ALLOC(d->count, size, "particles per rank"));
-  PM_TRY(PM_ALLOC(B.cell, 3 * m->n + 1, "particles' cells"));
   PM_TRY(PM_ALLOC(B.hist, most, "decomposition histogram"));
-  PM_TRY(PM_ALLOC(idx, m->n + 1, "particles' order"));
-  for (long p = 0; p < m->n; p++) {
-    cell_of(g, d->cells, m->x0 + 3 * p, B.cell + 3 * p);
-    idx[p] = p;
-  }
   const long lo[3] = {0, 0, 0};
   int root;
-  PM_TRY(bisect(&B, 0, size, lo, d->cells, idx, m->n, &root));
+  PM_TRY(bisect(&B, 0, size, lo, d->cells, total, &root));
 done:
-  free(idx);
-  free(B.cell);
   free(B.hist);
   if (ret) mpm_decomp_destroy(d);
   return ret;

@@ -5,11 +5,14 @@
 
 #include "mpm_kind.h"
 #include "mpm_par_impl.h"
+#include "mpm_seed.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
 #include "pm_petsc.h"
 
 static void fill_exchange(struct mpm_par *P);
+static pm_err share_links(pm_qs_method qs, const mpm_grid *whole, bool gather,
+                          mpm_model *lm, mpm_state *ls);
 static void par_free(struct mpm_par *P);
 
 /* ---- each rank's share -----------------------------------------------------
@@ -311,34 +314,7 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   if (!ret) P = NULL; /* lm holds it */
   if (!ret) ret = local_state(m, st, lm, accounts, &ls);
   PM_TRY(pm_par_agree(ret));
-  struct mpm_par *Q = par_of(lm);
-  PM_TRY(make_near(Q, m));
-  PM_TRY(mpm_ghosts_create(lm, ls, &Q->d, Q->gbegin, Q->gend, Q->near,
-                           Q->n_near, &Q->gh));
-  Q->rec = record_doubles(lm, &Q->width);
-  const long room = mpm_model_room(lm);
-  PM_TRY(PM_ALLOC(Q->dest, room, "migration ranks"));
-  PM_TRY(PM_ALLOC(Q->order, room, "migration order"));
-  PM_TRY(PM_ALLOC(Q->tmp, Q->width * room, "migration buffer"));
-  PM_TRY(PM_ALLOC(Q->scount, size, "migration counts"));
-  PM_TRY(PM_ALLOC(Q->rcount, size, "migration counts"));
-  PM_TRY(PM_ALLOC(Q->sdisp, size + 1, "migration offsets"));
-  PM_TRY(PM_ALLOC(Q->rdisp, size + 1, "migration offsets"));
-  PM_TRY(PM_ALLOC(Q->gcount, size, "gather counts"));
-  PM_TRY(PM_ALLOC(Q->gdisp, size + 1, "gather offsets"));
-  Q->sbuf_room = Q->rbuf_room = 64 + room / 8;
-  PM_TRY(PM_ALLOC(Q->sbuf, Q->sbuf_room * Q->rec, "migration buffer"));
-  PM_TRY(PM_ALLOC(Q->rbuf, Q->rbuf_room * Q->rec, "migration buffer"));
-  if (m->opt.qs == PM_QS_DYNAMIC_RELAXATION) {
-    PM_TRY(PM_ALLOC(Q->nodal, 3 * Q->n_owned + 1, "nodal gather"));
-    if (Q->rank == 0)
-      PM_TRY(PM_ALLOC(Q->whole, 3 * m->grid.n_nodes, "nodal gather"));
-  }
-  if (Q->rank == 0) {
-    PM_TRY(PM_ALLOC(Q->accounts, MPM_PAR_ACCOUNTS * size, "energy accounts"));
-    PM_TRY(PM_ALLOC(Q->ggid, m->n, "gather indices"));
-    PM_TRY(PM_ALLOC(Q->gbuf, Q->width * m->n, "gather buffer"));
-  }
+  PM_TRY(share_links(m->opt.qs, &m->grid, true, lm, ls));
   *local = lm;
   *local_state_out = ls;
   lm = NULL;
@@ -347,6 +323,138 @@ done:
   par_free(P);
   mpm_state_destroy(ls);
   mpm_model_destroy(lm);
+  return ret;
+}
+
+/* What links share lm (state ls) with the other ranks: the ranks near
+ * it, its membranes' ghosts, the migration's buffers and, with dynamic
+ * relaxation, the nodal gather's (on rank 0 of the whole grid `whole`);
+ * on rank 0 with `gather`, the buffers that gather the whole run. */
+static pm_err share_links(pm_qs_method qs, const mpm_grid *whole, bool gather,
+                          mpm_model *lm, mpm_state *ls) {
+  const int size = pm_par_size();
+  struct mpm_par *Q = par_of(lm);
+  PM_CALL(make_near(Q, lm));
+  PM_CALL(mpm_ghosts_create(lm, ls, &Q->d, Q->gbegin, Q->gend, Q->near,
+                            Q->n_near, &Q->gh));
+  Q->rec = record_doubles(lm, &Q->width);
+  const long room = mpm_model_room(lm);
+  PM_CALL(PM_ALLOC(Q->dest, room, "migration ranks"));
+  PM_CALL(PM_ALLOC(Q->order, room, "migration order"));
+  PM_CALL(PM_ALLOC(Q->tmp, Q->width * room, "migration buffer"));
+  PM_CALL(PM_ALLOC(Q->scount, size, "migration counts"));
+  PM_CALL(PM_ALLOC(Q->rcount, size, "migration counts"));
+  PM_CALL(PM_ALLOC(Q->sdisp, size + 1, "migration offsets"));
+  PM_CALL(PM_ALLOC(Q->rdisp, size + 1, "migration offsets"));
+  PM_CALL(PM_ALLOC(Q->gcount, size, "gather counts"));
+  PM_CALL(PM_ALLOC(Q->gdisp, size + 1, "gather offsets"));
+  Q->sbuf_room = Q->rbuf_room = 64 + room / 8;
+  PM_CALL(PM_ALLOC(Q->sbuf, Q->sbuf_room * Q->rec, "migration buffer"));
+  PM_CALL(PM_ALLOC(Q->rbuf, Q->rbuf_room * Q->rec, "migration buffer"));
+  if (qs == PM_QS_DYNAMIC_RELAXATION) {
+    PM_CALL(PM_ALLOC(Q->nodal, 3 * Q->n_owned + 1, "nodal gather"));
+    if (Q->rank == 0 && gather)
+      PM_CALL(PM_ALLOC(Q->whole, 3 * whole->n_nodes, "nodal gather"));
+  }
+  if (Q->rank == 0) {
+    PM_CALL(PM_ALLOC(Q->accounts, MPM_PAR_ACCOUNTS * size, "energy accounts"));
+    if (gather) {
+      PM_CALL(PM_ALLOC(Q->ggid, Q->n_full, "gather indices"));
+      PM_CALL(PM_ALLOC(Q->gbuf, Q->width * Q->n_full, "gather buffer"));
+    }
+  }
+  return PM_SUCCESS;
+}
+
+/* Each rank's particles at x: whether rank `rank` of d keeps them. */
+typedef struct {
+  const mpm_decomp *d;
+  const mpm_grid *g;
+  int rank;
+  long cells[3], *per_cell;
+} box_test;
+
+static bool in_box(void *ctx, const double x[3]) {
+  const box_test *bt = ctx;
+  return mpm_decomp_rank_at(bt->d, bt->g, x) == bt->rank;
+}
+
+static bool count_in_cell(void *ctx, const double x[3]) {
+  box_test *bt = ctx;
+  mpm_decomp_count(bt->g, bt->cells, x, bt->per_cell);
+  return false;
+}
+
+/* The decomposition of the whole run from the particles per cell, which
+ * every rank counts as one process seeds them (none stored). */
+static pm_err decompose(const pm_scene *s, const mpm_model *frame,
+                        mpm_decomp *d) {
+  box_test bt = {.g = &frame->grid};
+  PM_CALL(PM_ALLOC(bt.per_cell, mpm_decomp_cells(bt.g, bt.cells),
+                   "particles per cell"));
+  mpm_seed_share count = {.keep = count_in_cell, .ctx = &bt};
+  pm_err e = mpm_seed_visit(s, frame, &count);
+  long total = 0;
+  for (long c = 0; !e && c < bt.cells[0] * bt.cells[1] * bt.cells[2]; c++)
+    total += bt.per_cell[c];
+  if (!e)
+    e = mpm_decomp_from_counts(s, frame, pm_par_size(), bt.per_cell, total, d);
+  free(bt.per_cell);
+  return e;
+}
+
+pm_err mpm_par_create_seeded(const pm_scene *s, bool gather, mpm_model **local,
+                             mpm_state **local_state_out) {
+  pm_err ret = PM_SUCCESS;
+  struct mpm_par *P = NULL;
+  mpm_model *frame = NULL, *lm = NULL;
+  mpm_state *ls = NULL;
+  mpm_seed_share sh = {.room = mpm_par_room_for};
+  *local = NULL;
+  *local_state_out = NULL;
+  ret = pm_petsc_init();
+  if (!ret) ret = mpm_model_frame(s, &frame);
+  if (!ret) ret = PM_ALLOC(P, 1, "run across ranks");
+  if (!ret) ret = decompose(s, frame, &P->d);
+  PM_TRY(pm_par_agree(ret));
+  P->rank = pm_par_rank();
+  fill_exchange(P);
+  mpm_grid grid;
+  ret = local_grid(P, &frame->grid, &grid);
+  if (!ret) ret = make_ghosts(P, &frame->grid, &grid);
+  box_test bt = {.d = &P->d, .g = &frame->grid, .rank = P->rank};
+  sh.keep = in_box;
+  sh.ctx = &bt;
+  if (!ret) ret = mpm_model_share(s, &grid, &sh, &lm, &ls);
+  PM_TRY(pm_par_agree(ret));
+  /* The whole run's ranges, which migration keeps. */
+  for (int gi = 0; gi < lm->n_groups; gi++) {
+    P->gbegin[gi] = sh.gbegin[gi];
+    P->gend[gi] = sh.gend[gi];
+  }
+  P->n_full = sh.n_full;
+  P->bbegin = sh.bbegin;
+  P->bend = sh.bend;
+  sh.bbegin = sh.bend = NULL;
+  lm->xc = &P->xc;
+  P = NULL; /* lm holds it */
+  mpm_par_set_ranges(lm, ls);
+  /* The first step: the least of the shares' stable steps, as one
+   * process finds it over all its particles. */
+  pm_par_min(&ls->dt_stable, 1);
+  PM_TRY(pm_par_agree(mpm_model_first_dt(s, lm, ls)));
+  PM_TRY(share_links(lm->opt.qs, &frame->grid, gather, lm, ls));
+  *local = lm;
+  *local_state_out = ls;
+  lm = NULL;
+  ls = NULL;
+done:
+  free(sh.bbegin);
+  free(sh.bend);
+  par_free(P);
+  mpm_state_destroy(ls);
+  mpm_model_destroy(lm);
+  mpm_model_destroy(frame);
   return ret;
 }
 

@@ -29,9 +29,12 @@
  *    point changed rank;
  *  - a body moving as prescribed sums its mass at the nodes over the
  *    ranks before it sets their velocities.
- * Rank 0 also keeps the whole model and gathers the state into it when
- * the run writes (frames, history, checkpoints): the output of a run
- * across ranks is that of one process, in the same order.
+ * Each rank seeds its own share from the scene (mpm_par_create_seeded),
+ * with the particles of its cells in one process's order: no rank builds
+ * the whole model for it.  Rank 0 may keep a whole model of its own and
+ * gather the state into it when the run writes (frames, history,
+ * checkpoints): the output of a run across ranks is that of one process,
+ * in the same order.
  *
  * The decomposition balances particles, not cells: along each axis it
  * splits, the cuts divide the particles of the initial state into equal
@@ -79,6 +82,16 @@ typedef struct {
  * Release with mpm_decomp_destroy. */
 pm_err mpm_decomp_create(const pm_scene *s, const mpm_model *m, int size,
                          mpm_decomp *d);
+/* mpm_decomp_create from the particles per cell of the whole grid
+ * (per_cell: mpm_decomp_cells of them, x fastest; total particles): m
+ * needs its grid and conditions alone (mpm_model_frame). */
+pm_err mpm_decomp_from_counts(const pm_scene *s, const mpm_model *m, int size,
+                              const long *per_cell, long total, mpm_decomp *d);
+/* The cells of grid g per axis (1 on z in 2-D) and their count. */
+long mpm_decomp_cells(const mpm_grid *g, long cells[3]);
+/* Count a particle at x in its cell (clamped to the grid) of per_cell. */
+void mpm_decomp_count(const mpm_grid *g, const long cells[3], const double x[3],
+                      long *per_cell);
 void mpm_decomp_destroy(mpm_decomp *d);
 /* The rank that owns the cell of position x. */
 int mpm_decomp_rank_at(const mpm_decomp *d, const mpm_grid *g,
@@ -109,6 +122,17 @@ pm_err mpm_par_check_implicit(const pm_scene *s);
 pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
                       const mpm_state *st, const double *accounts,
                       mpm_model **local, mpm_state **local_state);
+
+/* This rank's model and state at the start of a run of scene s, made from
+ * the scene alone (collective): the decomposition from the particles per
+ * cell, counted as one process seeds them without storing one, then the
+ * particles of this rank's cells seeded in one process's order
+ * (mpm_model_share), the same share mpm_par_create makes from the whole
+ * model, bit for bit.  No rank builds the whole model; with `gather`,
+ * rank 0 has the buffers to gather the run into a whole model it keeps
+ * (mpm_par_gather). */
+pm_err mpm_par_create_seeded(const pm_scene *s, bool gather, mpm_model **local,
+                             mpm_state **local_state);
 
 /* The values of full state st (of full model m) of local model lm's
  * particles and nodes into local state ls, whose arrays have room for

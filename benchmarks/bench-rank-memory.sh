@@ -1,0 +1,45 @@
+#!/bin/bash
+# Peak resident memory of every rank of an MPM run (/usr/bin/time -v
+# around each rank), 20 steps, on 1, 2 and 4 ranks (4 oversubscribed on
+# fewer cores: memory, not time), for the 3-D block, the block at half its
+# cell (mesh_size 1.25e-3: 884 736 particles), the reduced oocyte and I2
+# by the implicit MPM at 256^2 cells (its 10 load steps); with
+# BEFORE=BUILD_DIR the same runs by that build beside.  One line per rank:
+# KiB and CPU seconds (user).  A tiny scene (the disks) gives each rank's
+# floor: the program and its libraries (MPI, PETSc, HDF5).
+# usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] benchmarks/bench-rank-memory.sh [BUILD_DIR]
+bench_name=rank-memory bench_env="BEFORE RANKS"
+source "$(dirname "$0")/bench-lib.sh"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
+  OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1 \
+  OMP_NUM_THREADS=1
+# One run under mpirun, each rank's figures into $d/time.RANK.
+measure() { # LABEL BIN N NAME SCENE [--set KEY=VALUE]...
+  local label=$1 b=$2 n=$3 name=$4 scene=$5 d
+  shift 5
+  d=$out/$label-$name-$n
+  rm -rf "$d" && mkdir -p "$d"
+  mpirun -np "$n" --bind-to none bash -c \
+    'exec /usr/bin/time -v -o "$0/time.$OMPI_COMM_WORLD_RANK" "$@"' "$d" \
+    "$b" run "$scene" --set time.max_steps=20 "$@" --out "$d/out" --quiet \
+    >"$d/log" 2>&1 || echo "$label $name on $n: failed (see $d/log)"
+  for ((r = 0; r < n; r++)); do
+    printf '%-8s %-18s %s ranks, rank %d: %8s KiB %6s s\n' "$label" "$name" \
+      "$n" "$r" "$(awk '/Maximum resident/ {print $NF}' "$d/time.$r")" \
+      "$(awk '/User time/ {print $NF}' "$d/time.$r")"
+  done
+}
+builds=("after:$bin")
+[ -n "${BEFORE:-}" ] && builds=("before:$BEFORE/pointmech" "${builds[@]}")
+fine=(--set discretization.mesh_size=1.25e-3 --set output.every=1000)
+i2=(--set discretization.mesh_size=2.1e-6 --set output.every=1000)
+for n in ${RANKS:-1 2 4}; do
+  measure floor "$bin" "$n" disks cases/mpm/disks-collision.yaml
+  for lb in "${builds[@]}"; do
+    l=${lb%%:*} b=${lb#*:}
+    measure "$l" "$b" "$n" block cases/mpm/bench-block.yaml
+    measure "$l" "$b" "$n" oocyte cases/mpm/m4-oocyte-reduced.yaml
+    measure "$l" "$b" "$n" block-fine cases/mpm/bench-block.yaml "${fine[@]}"
+    measure "$l" "$b" "$n" i2-256 cases/mpm/i2-vessel-slice.yaml "${i2[@]}"
+  done
+done
