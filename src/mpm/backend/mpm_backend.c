@@ -296,7 +296,8 @@ const pm_backend mpm_backend = {
     .create = create,
     .estimate_bytes = mpm_estimate_bytes,
     .ghost_layers = mpm_sim_ghost_layers,
-    .setup_whole = true,
+    .setup_whole =
+        false, /* each rank seeds its share (mpm_par_create_seeded) */
     .destroy = mpm_sim_destroy_any,
     .plan = mpm_sim_plan,
     .run = run,

@@ -144,7 +144,8 @@ const pm_backend mpm_implicit_backend = {
     .create = implicit_create,
     .estimate_bytes = mpm_implicit_estimate_bytes,
     .ghost_layers = mpm_sim_ghost_layers,
-    .setup_whole = true,
+    .setup_whole =
+        false, /* each rank seeds its share (mpm_par_create_seeded) */
     .destroy = mpm_sim_destroy_any,
     .plan = mpm_sim_implicit_plan,
     .run = implicit_run,
