@@ -113,6 +113,7 @@ void mpm_sim_destroy(mpm_sim *r) {
     free(r->surface[b]);
   free(r->surface);
   free(r->scratch);
+  free(r->share_scratch);
   free(r);
 }
 
@@ -193,6 +194,7 @@ static pm_err run(void *p, const pm_observer *obs) {
   if (r->view.ranks && r->resumed) /* the shares of the checkpoint's state */
     PM_CALL(mpm_view_reshare(r));
   pm_view_start(&r->view, obs);
+  PM_CALL(pm_view_start_pieces(&r->view, r->scene));
   mpm_model *lm = r->view.ranks ? r->local_model : r->model;
   mpm_state *ls = r->view.ranks ? r->local_state : r->state;
   mpm_work *lw = r->view.ranks ? r->local_work : r->work;
@@ -310,6 +312,7 @@ const pm_backend mpm_backend = {
     .summary = mpm_sim_summary,
     .timers = mpm_sim_timers,
     .checkpoint = checkpoint,
+    .pieces = mpm_sim_pieces,
 };
 
 /* ---- method mpm-implicit ------------------------------------------------ */
