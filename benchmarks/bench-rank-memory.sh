@@ -2,7 +2,8 @@
 # Peak resident memory of every rank of an MPM run (/usr/bin/time -v
 # around each rank), 20 steps, on 1, 2 and 4 ranks (4 oversubscribed on
 # fewer cores: memory, not time), for the 3-D block, the block at half its
-# cell (mesh_size 1.25e-3: 884 736 particles), the reduced oocyte and I2
+# cell (mesh_size 1.25e-3: 884 736 particles), the block with its frames
+# in pieces (output.ranks: pieces; label "pieces"), the reduced oocyte and I2
 # by the implicit MPM at 256^2 cells (its 10 load steps); with
 # BEFORE=BUILD_DIR the same runs by that build beside.  One line per rank:
 # KiB and CPU seconds (user).  A tiny scene (the disks) gives each rank's
@@ -38,6 +39,8 @@ for n in ${RANKS:-1 2 4}; do
   for lb in "${builds[@]}"; do
     l=${lb%%:*} b=${lb#*:}
     measure "$l" "$b" "$n" block cases/mpm/bench-block.yaml
+    [ "$l" = after ] && measure pieces "$b" "$n" block \
+      cases/mpm/bench-block.yaml --set output.ranks=pieces
     measure "$l" "$b" "$n" oocyte cases/mpm/m4-oocyte-reduced.yaml
     measure "$l" "$b" "$n" block-fine cases/mpm/bench-block.yaml "${fine[@]}"
     measure "$l" "$b" "$n" i2-256 cases/mpm/i2-vessel-slice.yaml "${i2[@]}"

@@ -29,6 +29,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 import numpy as np  # noqa: E402
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "python"))
+import pointmech  # noqa: E402
+
 
 def fail(msg):
     sys.exit(f"plot-points: {msg}")
@@ -44,7 +48,8 @@ def load(out, frame):
             for name in ("mesh/coordinates", "mesh/cells", "frames"):
                 if name not in f:
                     fail(f"{path}: missing /{name}")
-            x = np.asarray(f["mesh/coordinates"][()], dtype=float)
+            x = np.asarray(pointmech.read_rows(f["mesh"], "coordinates"),
+                           dtype=float)
             cells = np.asarray(f["mesh/cells"][()])
             frames = sorted(f["frames"].keys())
             if not frames:
@@ -55,7 +60,9 @@ def load(out, frame):
             name = frames[frame]
             if "displacement" not in f["frames"][name]:
                 fail(f"{path}: missing /frames/{name}/displacement")
-            u = np.asarray(f["frames"][name]["displacement"][()], dtype=float)
+            u = np.asarray(
+                pointmech.read_rows(f["frames"][name], "displacement"),
+                dtype=float)
     except OSError as e:
         fail(f"{path}: cannot read as HDF5: {e}")
     if x.ndim != 2 or x.shape[1] != 3 or u.shape != x.shape:

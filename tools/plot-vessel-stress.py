@@ -29,6 +29,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "python"))
+import pointmech  # noqa: E402
+
 
 def fail(msg):
     sys.exit(f"plot-vessel-stress: {msg}")
@@ -54,8 +58,8 @@ def last_frame(run):
     with h5py.File(path, "r") as f:
         names = sorted(f["frames"].keys())
         fr = f["frames"][names[-1]]
-        x0 = np.array(f["mesh"]["coordinates"])
-        vm = np.array(fr["von_mises"])
+        x0 = np.array(pointmech.read_rows(f["mesh"], "coordinates"))
+        vm = np.array(pointmech.read_rows(fr, "von_mises"))
     return x0, vm
 
 

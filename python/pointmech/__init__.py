@@ -28,7 +28,7 @@ import time as _time
 import h5py
 import numpy as np
 
-__all__ = ["open", "Run", "Frame"]
+__all__ = ["open", "Run", "Frame", "read_rows"]
 
 _FRAME = re.compile(r"^frame_(\d{6,})\.h5$")
 
@@ -59,6 +59,14 @@ def _one_process_order(data):
             whole[index] = a
             data[name] = whole
     return data
+
+
+def read_rows(group, name):
+    """Dataset name of an open h5py group (a frame's, or the mesh's, as
+    reached through results.h5) as a numpy array in one process's order:
+    a frame written in pieces is put back in order by its "index"."""
+    data = {k: group[k][()] for k in (name, "index") if k in group}
+    return _one_process_order(data)[name]
 
 
 class Frame:

@@ -1,5 +1,6 @@
 /* test_probe: moving-least-squares probing of results.h5 reproduces linear
- * fields in 3-D and 2-D, picks frames, and reports bad files and lines. */
+ * fields in 3-D and 2-D, picks frames, reads a frame written in pieces in
+ * one-process order, and reports bad files and lines. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -76,6 +77,45 @@ static void write_results(const char *dir, int dim) {
   free(x);
   free(u0);
   free(u1);
+}
+
+/* dir/results.h5 of write_results(dir, 3)'s lattice with FIELD0 in one
+ * frame written in two pieces across ranks (pm_results_join_pieces): the
+ * odd points last to first, then the even ones, each row with its
+ * one-process index.  x and u0 receive the lattice and FIELD0 in
+ * one-process order. */
+static void write_pieces(const char *dir, long n, double *x, double *u0) {
+  double *px = calloc(3 * n, sizeof *px), *pu = calloc(3 * n, sizeof *pu);
+  long *index = calloc(n, sizeof *index), counts[2] = {n / 2, n - n / 2};
+  unsigned seed = 12345u;
+  pm_results *r = NULL;
+  assert_true(px && pu && index);
+  for (long p = 0; p < n; p++) {
+    long idx[3] = {p % N_SIDE, (p / N_SIDE) % N_SIDE, p / (N_SIDE * N_SIDE)};
+    for (int k = 0; k < 3; k++) x[3 * p + k] = SPACING * idx[k] + jitter(&seed);
+    eval(&FIELD0, &x[3 * p], &u0[3 * p]);
+  }
+  for (long j = 0; j < n; j++)
+    index[j] = j < counts[0] ? n - 1 - 2 * j : 2 * (j - counts[0]);
+  for (long j = 0; j < n; j++)
+    for (int k = 0; k < 3; k++) {
+      pu[3 * j + k] = u0[3 * index[j] + k];
+      px[3 * j + k] = x[3 * index[j] + k] + pu[3 * j + k];
+    }
+  const pm_points pts = {.n = n, .x = x, .nodes_per_cell = 1};
+  assert_ok(pm_results_create_ex(dir, 3, &pts, "scene: test", "t", &r));
+  for (int piece = 0, at = 0; piece < 2; at += counts[piece++]) {
+    const pm_field f[2] = {{"position", 3, px + 3 * at},
+                           {"displacement", 3, pu + 3 * at}};
+    assert_ok(pm_results_write_piece(dir, 0, piece, counts[piece], index + at,
+                                     0, 0.0, 2, f));
+  }
+  const pm_field names[2] = {{"position", 3, px}, {"displacement", 3, pu}};
+  assert_ok(pm_results_join_pieces(r, 0, 0.0, 2, counts, 2, names));
+  pm_results_close(r, true);
+  free(px);
+  free(pu);
+  free(index);
 }
 
 static void write_text(const char *path, const char *text) {
@@ -227,6 +267,53 @@ static void test_frame_range(void **state) {
   assert_fails(probe(dir, csv, 1000000, rows, &n), PM_ERR_ARG, "0 to 1");
 }
 
+/* A frame written in pieces is read in one-process order: the points'
+ * displacements, the probe between them, and --at points' rows. */
+static void test_pieces(void **state) {
+  const char *dir = *state;
+  const long np = N_SIDE * N_SIDE * N_SIDE;
+  double *x = calloc(3 * np, sizeof *x), *u0 = calloc(3 * np, sizeof *u0);
+  double *rx = NULL, *ru = NULL, rows[MAX_ROWS][6];
+  long rn = 0;
+  int n;
+  char csv[256];
+  assert_true(x && u0);
+  write_pieces(dir, np, x, u0);
+  assert_ok(pm_results_read(dir, -1, &rn, &rx, &ru));
+  assert_int_equal(rn, np);
+  assert_memory_equal(rx, x, 3 * np * sizeof *x);
+  assert_memory_equal(ru, u0, 3 * np * sizeof *u0);
+  csv_path(csv, sizeof csv, dir);
+  write_text(csv, "0.35,0.35,0.35\n0.123,0.456,0.611\n0.05,0.65,0.3\n");
+  assert_ok(probe(dir, csv, 0, rows, &n));
+  assert_int_equal(n, 3);
+  check_rows(&FIELD0, rows, n);
+  /* Point 5's own row, by --at points: its coordinates and FIELD0 there. */
+  char *buf = NULL;
+  size_t size = 0;
+  FILE *out = open_memstream(&buf, &size);
+  assert_non_null(out);
+  assert_ok(pm_probe_points(dir, NULL, 0, out));
+  assert_int_equal(fclose(out), 0);
+  const char *s = buf;
+  for (int line = 0; line < 6; line++) s = strchr(s, '\n') + 1;
+  long point;
+  double v[6];
+  assert_int_equal(sscanf(s, "%ld,%lf,%lf,%lf,%lf,%lf,%lf", &point, &v[0],
+                          &v[1], &v[2], &v[3], &v[4], &v[5]),
+                   7);
+  assert_int_equal(point, 5);
+  for (int k = 0; k < 3; k++) {
+    assert_true(fabs(v[k] - x[15 + k]) <= 1e-9 * (1 + fabs(x[15 + k])));
+    assert_true(fabs(v[3 + k] - u0[15 + k]) <= 1e-9 * (1 + fabs(u0[15 + k])));
+  }
+  free(buf);
+  free(rx);
+  free(ru);
+  free(x);
+  free(u0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup_teardown(test_linear_3d, pm_test_make_dir,
@@ -238,6 +325,8 @@ int main(void) {
       cmocka_unit_test_setup_teardown(test_bad_points, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_frame_range, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_pieces, pm_test_make_dir,
                                       pm_test_drop_dir),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

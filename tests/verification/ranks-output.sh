@@ -3,17 +3,25 @@
 # 0's frame file of virtual datasets, against the same frame gathered to
 # rank 0 and written whole (ranks_output: bit for bit, in one-process
 # order), on 2 and 3 ranks; then the pieces' frame read as one field by the
-# Python module (one-process order) and by ParaView (pvpython, where
-# installed: one grid of every particle).
-# Usage: ranks-output.sh SOURCE_DIR RANKS_OUTPUT
+# Python module (one-process order), by `pointmech probe` and by ParaView
+# (pvpython, where installed: one grid of every particle).
+# Usage: ranks-output.sh SOURCE_DIR RANKS_OUTPUT POINTMECH
 set -u
 src=$1
 tool=$2
+bin=$3
 . "$(dirname "$0")/lib.sh"
 . "$(dirname "$0")/ranks-lib.sh"
 
 # command..., its output kept in $work/err (shown if it fails).
 quiet() { "$@" >"$work/err" 2>&1; }
+# The pieces' frame (1) by `pointmech probe --at points`, the same table as
+# the gathered frame's (0).
+probe_same() {
+  "$bin" probe "$1" --at points --frame 0 >"$work/p0.csv" &&
+    "$bin" probe "$1" --at points --frame 1 >"$work/p1.csv" &&
+    cmp "$work/p0.csv" "$work/p1.csv"
+}
 
 for n in 2 3; do
   out=$work/out-$n
@@ -30,7 +38,12 @@ for name in whole.keys():
 with h5py.File(sys.argv[1] + "/results.h5", "r") as f:
     assert f["frames/000001"].attrs["pieces"] == int(sys.argv[2])
     assert f["frames/000001/index"].shape == (105,)
+    for name in whole.keys():
+        assert np.array_equal(pointmech.read_rows(f["frames/000000"], name),
+                              pointmech.read_rows(f["frames/000001"], name))
 ' "$out" "$n"
+  check "probe reads $n ranks' pieces in one-process order" \
+    probe_same "$out"
   if command -v pvpython >/dev/null; then
     check "ParaView reads $n ranks' pieces as one grid a frame" \
       quiet timeout 120 pvpython -c '

@@ -92,6 +92,26 @@ fails_alike left-the-grid 2 'step [0-9]*, .*left the grid' \
   "$mpm/disks-collision.yaml" --set "bodies.1.velocity=[3,3]"
 
 # What runs on one process only is refused, naming the key; nothing written.
+# Frames in pieces (output.ranks: pieces): each rank writes its own
+# particles and rank 0 joins them; read in one-process order, the same
+# run's frames as gathered, bit for bit, and one process's to round-off.
+across disks-pieces $mpm/disks-collision.yaml 3 --set output.ranks=pieces
+check "disks on 3 ranks: frames in pieces as gathered, bit for bit" \
+  $same "$work/disks-3" "$work/disks-pieces-3"
+check "disks on 3 ranks: a piece a rank a frame" \
+  test "$(ls "$work/disks-pieces-3/results" | grep -c '\.piece_')" -eq \
+  $((3 * $(ls "$work/disks-pieces-3/results" | grep -c '^frame_[0-9]*\.h5$')))
+refused "frames in pieces with a membrane on 2 ranks" \
+  "frames in pieces hold particles without triangles" \
+  "$work/membrane-pieces-2" ranks 2 "$bin" run \
+  "$mpm/m3-gas-box-membrane.yaml" --set output.ranks=pieces \
+  --out "$work/membrane-pieces-2"
+refused "frames in pieces of FPM on 2 ranks" \
+  "method fpm writes each frame gathered into rank 0" \
+  "$work/fpm-pieces-2" ranks 2 "$bin" run \
+  "$src/cases/fpm/cube-pressure.yaml" --set output.ranks=pieces \
+  --out "$work/fpm-pieces-2"
+
 refused "F-bar over node patches on 2 ranks" \
   "mpm.fbar: F-bar over node patches runs on one process" \
   "$work/patch-2" ranks 2 "$bin" run "$mpm/locking-beam.yaml" \
@@ -114,6 +134,22 @@ check "interrupted on 2 ranks, resumed on 2: the run of 2 ranks, bit for bit" \
   $same "$work/long-2" "$work/cut-2"
 roundoff "interrupted on 2 ranks, resumed on 3" "$work/long-2" "$work/cut-3"
 roundoff "interrupted on 2 ranks, resumed on 1" "$work/long-1" "$work/cut-1"
+# The same with frames in pieces, resumed on 3 ranks: the frames after
+# the checkpoint (the signal's) and their pieces dropped, the later ones
+# in 3 pieces.
+interrupt 2 "$work/pcut" "$tube" $long --set output.ranks=pieces
+resume_on "$work/pcut" 3
+roundoff "in pieces, interrupted on 2 ranks, resumed on 3" "$work/long-2" \
+  "$work/pcut-3"
+check "in pieces, resumed on 3: no piece of a dropped frame" $py -c "
+import os, re, sys
+d = sys.argv[1] + '/results'
+frames = {m.group(1) for n in os.listdir(d)
+          for m in [re.match(r'frame_(\\d+)\\.h5$', n)] if m}
+pieces = {m.group(1) for n in os.listdir(d)
+          for m in [re.match(r'frame_(\\d+)\\.piece_\\d+\\.h5$', n)] if m}
+assert pieces == frames, sorted(pieces ^ frames)
+" "$work/pcut-3"
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

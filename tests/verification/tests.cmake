@@ -108,7 +108,7 @@ if(PM_MPI)
   target_include_directories(ranks_output PRIVATE ${PM_TEST_SUPPORT})
   add_test(NAME verification.ranks_output
     COMMAND bash ${PM_VERIFY_DIR}/ranks-output.sh ${PROJECT_SOURCE_DIR}
-      $<TARGET_FILE:ranks_output>)
+      $<TARGET_FILE:ranks_output> $<TARGET_FILE:pointmech>)
   set_tests_properties(verification.ranks_output PROPERTIES LABELS
     verification TIMEOUT 300 PROCESSORS 1
     RESOURCE_LOCK mpirun)

@@ -13,6 +13,7 @@
 #include "pm_files.h"
 #include "pm_h5.h"
 #include "pm_mls.h"
+#include "pm_output.h"
 
 #define OBJ_NAME_MAX 64
 #define SHOW_MAX 60 /* bytes of a bad CSV line quoted in errors */
@@ -70,6 +71,64 @@ done:
   return ret;
 }
 
+/* ---- One-process order ------------------------------------------------ */
+
+/* A frame written in pieces across ranks (pm_results_join_pieces) holds
+ * its rows in piece order with each row's one-process index beside, as
+ * dataset PM_PIECE_INDEX: *index that index, checked to be a permutation
+ * of the n points, or NULL for rows already in one-process order.  name is
+ * the index's path under loc, obj how messages show it. */
+static pm_err read_order(hid_t loc, const char *name, const char *obj,
+                         const char *path, long n, long **index) {
+  pm_err ret = PM_SUCCESS;
+  hid_t dset = -1, space = -1;
+  long *idx = NULL;
+  char *seen = NULL;
+  htri_t has;
+  *index = NULL;
+  H5_OK(has = H5Lexists(loc, name, H5P_DEFAULT), "H5Lexists", obj, path);
+  if (has <= 0) return PM_SUCCESS;
+  H5_OK(dset = H5Dopen2(loc, name, H5P_DEFAULT), "H5Dopen2", obj, path);
+  H5_OK(space = H5Dget_space(dset), "H5Dget_space", obj, path);
+  hssize_t count;
+  H5_OK(count = H5Sget_simple_extent_npoints(space),
+        "H5Sget_simple_extent_npoints", obj, path);
+  PM_ENSURE(count == n, PM_ERR_HDF5, "%s in '%s' has %lld rows for %ld points",
+            obj, path, (long long)count, n);
+  PM_TRY(PM_ALLOC(idx, (size_t)n, obj));
+  PM_TRY(PM_ALLOC(seen, (size_t)n, obj));
+  H5_OK(H5Dread(dset, H5T_NATIVE_LONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, idx),
+        "H5Dread", obj, path);
+  for (long i = 0; i < n; i++) {
+    PM_ENSURE(idx[i] >= 0 && idx[i] < n && !seen[idx[i]], PM_ERR_HDF5,
+              "%s in '%s': row %ld holds %ld, not a point of 0 to %ld once",
+              obj, path, i, idx[i], n - 1);
+    seen[idx[i]] = 1;
+  }
+  *index = idx;
+  idx = NULL;
+done:
+  free(idx);
+  free(seen);
+  if (space >= 0) H5Sclose(space);
+  if (dset >= 0) H5Dclose(dset);
+  return ret;
+}
+
+/* Rows v[n][width] in piece order into one-process order (index from
+ * read_order; nothing to do when NULL). */
+static pm_err put_in_order(double *v, long n, int width, const long *index) {
+  if (!index) return PM_SUCCESS;
+  double *tmp = NULL;
+  PM_CALL(PM_ALLOC(tmp, (size_t)n * width, "rows in one-process order"));
+  for (long i = 0; i < n; i++)
+    memcpy(tmp + (size_t)index[i] * width, v + (size_t)i * width,
+           (size_t)width * sizeof *v);
+  memcpy(v, tmp, (size_t)n * width * sizeof *v);
+  free(tmp);
+  return PM_SUCCESS;
+}
+
 /* The results file: its handle, the reference coordinates, and frame
  * `frame` (last when < 0) opened as a group, with that frame's index.
  * HDF5's own error printing is off while it is open (results_close
@@ -77,6 +136,7 @@ done:
 typedef struct {
   hid_t file, group;
   long frame;
+  long *order; /* the frame's rows' one-process indices, or NULL */
   H5E_auto2_t old_func;
   void *old_data;
 } results;
@@ -85,6 +145,8 @@ static void results_close(results *r) {
   if (r->group >= 0) H5Gclose(r->group);
   if (r->file >= 0) H5Fclose(r->file);
   r->group = r->file = -1;
+  free(r->order);
+  r->order = NULL;
   H5Eset_auto2(H5E_DEFAULT, r->old_func, r->old_data);
 }
 
@@ -93,8 +155,9 @@ static pm_err results_open(const char *path, long frame, cloud *c, results *r) {
   hid_t frames = -1;
   H5G_info_t info;
   char gname[32], obj[OBJ_NAME_MAX];
-  long nframes;
+  long nframes, *order = NULL;
   r->file = r->group = -1;
+  r->order = NULL;
   H5Eget_auto2(H5E_DEFAULT, &r->old_func, &r->old_data);
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   PM_ENSURE(access(path, R_OK) == 0, PM_ERR_IO,
@@ -104,6 +167,9 @@ static pm_err results_open(const char *path, long frame, cloud *c, results *r) {
   c->n = -1;
   PM_TRY(read_n3(r->file, "/mesh/coordinates", "/mesh/coordinates", path, &c->n,
                  &c->x));
+  PM_TRY(read_order(r->file, "/mesh/" PM_PIECE_INDEX, "/mesh/" PM_PIECE_INDEX,
+                    path, c->n, &order));
+  PM_TRY(put_in_order(c->x, c->n, 3, order));
   H5_OK(frames = H5Gopen2(r->file, "/frames", H5P_DEFAULT), "H5Gopen2",
         "/frames", path);
   H5_OK(H5Gget_info(frames, &info), "H5Gget_info", "/frames", path);
@@ -118,7 +184,10 @@ static pm_err results_open(const char *path, long frame, cloud *c, results *r) {
   snprintf(obj, sizeof obj, "/frames/%s", gname);
   H5_OK(r->group = H5Gopen2(frames, gname, H5P_DEFAULT), "H5Gopen2", obj, path);
   r->frame = frame;
+  snprintf(obj, sizeof obj, "/frames/%s/%s", gname, PM_PIECE_INDEX);
+  PM_TRY(read_order(r->group, PM_PIECE_INDEX, obj, path, c->n, &r->order));
 done:
+  free(order);
   if (frames >= 0) H5Gclose(frames);
   if (ret != PM_SUCCESS) results_close(r);
   return ret;
@@ -138,6 +207,7 @@ static pm_err read_results(const char *path, long frame, cloud *c) {
             r.frame, path);
   snprintf(obj, sizeof obj, "/frames/%06ld/displacement", r.frame);
   PM_TRY(read_n3(r.group, "displacement", obj, path, &c->n, &c->u));
+  PM_TRY(put_in_order(c->u, c->n, 3, r.order));
 done:
   results_close(&r);
   return ret;
@@ -419,7 +489,7 @@ pm_err pm_probe_points(const char *out_dir, const char *points_csv, long frame,
                        FILE *out) {
   pm_err ret = PM_SUCCESS;
   cloud c = {.n = 0};
-  results r = {.file = -1, .group = -1};
+  results r = {.file = -1, .group = -1, .order = NULL};
   queries qs = {.m = 0};
   field f[FIELDS_MAX] = {{.v = NULL}};
   int nf = 0;
@@ -430,6 +500,8 @@ pm_err pm_probe_points(const char *out_dir, const char *points_csv, long frame,
   PM_CALL(pm_path_join(path, sizeof path, out_dir, "results.h5"));
   PM_TRY(results_open(path, frame, &c, &r));
   PM_TRY(read_fields(r.group, path, c.n, f, &nf));
+  for (int k = 0; k < nf; k++)
+    PM_TRY(put_in_order(f[k].v, c.n, f[k].width, r.order));
   if (points_csv) {
     PM_TRY(read_points(points_csv, &qs));
     PM_TRY(index_cloud(&c, path));

@@ -106,6 +106,8 @@ typedef struct {
 /* The run's observer: called after every step (frame false) and on frame
  * steps and the last step (frame true).  A non-success return stops the
  * run with that error. */
+struct pm_view_pieces;
+
 typedef struct {
   void *ctx;
   pm_err (*step)(void *ctx, const pm_step_report *r, bool frame);
@@ -114,6 +116,12 @@ typedef struct {
    * signal), which it then decides for good: across ranks, the state is
    * gathered only then.  May be NULL (frame steps only). */
   bool (*wants)(void *ctx, const pm_step_report *r, bool frame);
+  /* The results folder (NULL: none), and the index of the frame that
+   * step, called next with the same report, writes (-1: none), decided
+   * for good: across ranks with frames in pieces, every rank writes its
+   * piece of it first.  frame_index may be NULL (frames written whole). */
+  const char *dir;
+  long (*frame_index)(void *ctx, const pm_step_report *r, bool frame);
 } pm_observer;
 
 /* A step of a run across MPI ranks (pm_par.h; collective): rank 0, which
@@ -201,6 +209,11 @@ typedef struct pm_backend {
    * before run).  Fails with PM_ERR_ARG naming what cannot be
    * checkpointed.  NULL: the method has no checkpoints. */
   pm_err (*checkpoint)(void *sim, pm_ckpt *ck);
+  /* Across ranks with output.ranks: pieces: the frame its ranks last wrote
+   * in pieces (pm_view.h), which the driver joins, or NULL where it writes
+   * a frame whole (one process).  NULL: frames are always written whole
+   * (the loader refuses pieces across ranks). */
+  const struct pm_view_pieces *(*pieces)(void *sim);
 } pm_backend;
 
 /* ---- registry ------------------------------------------------------------ */

@@ -92,7 +92,11 @@ pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
    * killing the process, so that the run can say what happened. */
   old_xfsz = signal(SIGXFSZ, SIG_IGN);
   if (out_dir) PM_TRY(open_outputs(c, out_dir, flags, outdir, rs));
-  pm_observer obs = {.ctx = c, .step = pm_run_observe, .wants = pm_run_wants};
+  pm_observer obs = {.ctx = c,
+                     .step = pm_run_observe,
+                     .wants = pm_run_wants,
+                     .dir = c->results ? out_dir : NULL,
+                     .frame_index = pm_run_frame_index};
   c->t_start = pm_wtime() - (rs ? rs->h.wall_seconds : 0);
   c->ckpt_last_wall = pm_wtime();
   struct sigaction old_handlers[2];

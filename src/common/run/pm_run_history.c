@@ -8,6 +8,7 @@
 #include "pm_metrics.h"
 #include "pm_output.h"
 #include "pm_run_impl.h"
+#include "pm_view.h"
 
 #define RUN_FIELDS 16
 
@@ -131,6 +132,13 @@ static pm_err write_row(pm_run_ctx *c) {
 }
 
 pm_err pm_run_write_frame(pm_run_ctx *c, const pm_step_report *r) {
+  /* Across ranks with frames in pieces, the ranks have written theirs. */
+  const pm_view_pieces *pc = c->be->pieces ? c->be->pieces(c->sim) : NULL;
+  if (pc) {
+    PM_CALL(pm_results_join_pieces(c->results, r->step, r->t, pc->n, pc->counts,
+                                   pc->n_fields, pc->fields));
+    return write_row(c);
+  }
   pm_field fields[RUN_FIELDS];
   int nf = c->be->fields(c->sim, c->s->output.fields, fields, RUN_FIELDS);
   PM_CALL(pm_results_write_frame(c->results, r->step, r->t, nf, fields));

@@ -101,6 +101,8 @@ void pm_run_release_interrupts(const struct sigaction old[2]);
  * frame, checkpoint; PM_ERR_INTERRUPTED after a signal). */
 bool pm_run_wants(void *ctx, const pm_step_report *r, bool frame);
 pm_err pm_run_observe(void *ctx, const pm_step_report *r, bool frame);
+/* The index of the frame pm_run_observe writes after r's step, or -1. */
+long pm_run_frame_index(void *ctx, const pm_step_report *r, bool frame);
 
 /* After the backend's loop ended with run_err: when a signal stopped it
  * inside a step (a linear solve, a Newton iteration), the checkpoint of the

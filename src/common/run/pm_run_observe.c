@@ -46,6 +46,13 @@ bool pm_run_wants(void *ctx, const pm_step_report *r, bool frame) {
   return frame || c->decided_sig || c->decided_ckpt || also;
 }
 
+long pm_run_frame_index(void *ctx, const pm_step_report *r, bool frame) {
+  pm_run_ctx *c = ctx;
+  decide(c, r);
+  return c->results && (frame || c->decided_sig) ? pm_results_frames(c->results)
+                                                 : -1;
+}
+
 /* The checkpoint of step; after a signal sig, a method that cannot write
  * one is noted and the run stops all the same. */
 static pm_err checkpoint(pm_run_ctx *c, long step, int sig) {

@@ -2,6 +2,8 @@
 #include "pm_view.h"
 
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "pm_par.h"
 
@@ -16,11 +18,56 @@ void pm_view_start(pm_view *v, const pm_observer *obs) {
   v->obs = obs;
 }
 
+pm_err pm_view_start_pieces(pm_view *v, const pm_scene *s) {
+  if (!v->ranks || !v->piece || s->output.ranks != PM_OUTPUT_PIECES)
+    return PM_SUCCESS;
+  const pm_observer *obs = pm_par_root() ? v->obs : NULL;
+  int on = obs && obs->dir && obs->frame_index;
+  if (on) snprintf(v->dir, sizeof v->dir, "%s", obs->dir);
+  pm_par_bcast(&on, sizeof on);
+  if (!on) return PM_SUCCESS; /* no results folder: no frames */
+  pm_par_bcast(v->dir, sizeof v->dir);
+  v->pieces.n = pm_par_size();
+  PM_CALL(pm_par_agree(PM_ALLOC(v->pieces.counts, v->pieces.n, "pieces")));
+  v->in_pieces = true;
+  return PM_SUCCESS;
+}
+
+/* A step with frames in pieces: rank 0's observer says whether it reads
+ * the view (a history row, a checkpoint) and which frame it writes; every
+ * rank writes its piece of that frame, rank 0 learns their counts, and
+ * then reports (collective). */
+static pm_err step_pieces(pm_view *v, const pm_step_report *r, bool frame) {
+  const pm_observer *obs = pm_par_root() ? v->obs : NULL;
+  long at[2] = {frame, -1}; /* wants the view, the frame's index */
+  if (obs) {
+    at[0] = frame || (obs->wants && obs->wants(obs->ctx, r, frame));
+    at[1] = obs->frame_index(obs->ctx, r, frame);
+  }
+  pm_par_bcast(at, sizeof at);
+  if (at[0]) PM_CALL(v->gather(v->ctx));
+  if (at[1] >= 0) {
+    pm_view_pieces *pc = &v->pieces;
+    long n = 0;
+    PM_CALL(pm_par_agree(
+        v->piece(v->ctx, v->dir, at[1], r, &n, &pc->n_fields, pc->fields)));
+    memset(pc->counts, 0, sizeof *pc->counts * (size_t)pc->n);
+    pc->counts[pm_par_rank()] = n;
+    pm_par_sum_long(pc->counts, pc->n);
+  }
+  return pm_par_agree(obs ? obs->step(obs->ctx, r, frame) : PM_SUCCESS);
+}
+
 pm_err pm_view_step(pm_view *v, const pm_step_report *r, bool frame) {
+  if (v->in_pieces) return step_pieces(v, r, frame);
   if (v->ranks)
     return pm_observer_share(pm_par_root() ? v->obs : NULL, r, frame, v->gather,
                              v->ctx);
   return v->obs ? v->obs->step(v->obs->ctx, r, frame) : PM_SUCCESS;
+}
+
+const pm_view_pieces *pm_view_frame_pieces(const pm_view *v) {
+  return v->in_pieces ? &v->pieces : NULL;
 }
 
 pm_err pm_view_stopped_inside(pm_view *v, const pm_step_report *r, pm_err e) {
@@ -40,5 +87,8 @@ pm_err pm_view_end(pm_view *v, pm_err e) {
     if (!e) e = g;
   }
   v->obs = NULL;
+  free(v->pieces.counts);
+  v->pieces.counts = NULL;
+  v->in_pieces = false;
   return e;
 }

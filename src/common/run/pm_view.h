@@ -11,8 +11,22 @@
 
 #include "pm_backend.h"
 #include "pm_error.h"
+#include "pm_files.h"
 
-typedef struct {
+/* The fields a frame has at most. */
+#define PM_VIEW_FIELDS 16
+
+/* The frame the ranks last wrote in pieces (output.ranks: pieces): each
+ * rank's count of points and the fields' names and sizes (their data are
+ * no longer valid), for rank 0's frame file joining the pieces. */
+typedef struct pm_view_pieces {
+  int n;        /* pieces: the ranks */
+  long *counts; /* [n], on rank 0 */
+  int n_fields;
+  pm_field fields[PM_VIEW_FIELDS];
+} pm_view_pieces;
+
+typedef struct pm_view {
   bool ranks; /* the run is shared among ranks */
   void *ctx;  /* the backend's simulation, passed to the callbacks */
   /* The shares' state into rank 0's view, with the figures every rank
@@ -21,7 +35,20 @@ typedef struct {
   /* On a rank other than 0: let the whole model and state go (the share
    * is all that rank runs). */
   void (*release)(void *ctx);
+  /* Frames in pieces (may be NULL: gathered): this rank's share of frame
+   * `frame` after r's step written as piece pm_par_rank() into the results
+   * folder dir (pm_results_write_piece); its points' count and the
+   * fields (at most PM_VIEW_FIELDS) into *n, *n_fields, fields. */
+  pm_err (*piece)(void *ctx, const char *dir, long frame,
+                  const pm_step_report *r, long *n, int *n_fields,
+                  pm_field *fields);
   const pm_observer *obs; /* the run's, while it runs (rank 0 reports) */
+  /* Across ranks with output.ranks: pieces and a results folder (rank 0's,
+   * passed to every rank at the start): the folder and the last frame's
+   * pieces. */
+  bool in_pieces;
+  char dir[PM_PATH_MAX + 1];
+  pm_view_pieces pieces;
 } pm_view;
 
 /* Whether this rank holds the whole model and state through a run: across
@@ -33,6 +60,12 @@ bool pm_view_keeps_whole(void);
 /* The run starts with observer obs (which may be NULL): across ranks, the
  * ranks other than 0 release their view. */
 void pm_view_start(pm_view *v, const pm_observer *obs);
+
+/* Then, for a backend that writes frames in pieces (v->piece): across
+ * ranks with output.ranks: pieces in scene s, every rank learns rank 0's
+ * results folder (from obs there) and the frames go in pieces
+ * (collective).  Fails only for want of memory (agreed). */
+pm_err pm_view_start_pieces(pm_view *v, const pm_scene *s);
 
 /* Across ranks, the ranks other than 0 let their view go (a plan, or the
  * start of a run).  Nothing on one process or on rank 0. */
@@ -55,5 +88,9 @@ pm_err pm_view_stopped_inside(pm_view *v, const pm_step_report *r, pm_err e);
  * too) gathered into rank 0's view for the figures (collective).  e, or the
  * gather's failure where e is PM_SUCCESS.  The observer is let go. */
 pm_err pm_view_end(pm_view *v, pm_err e);
+
+/* The frame the ranks last wrote in pieces, or NULL where frames are
+ * written whole (one process, output.ranks: gather, no results). */
+const pm_view_pieces *pm_view_frame_pieces(const pm_view *v);
 
 #endif

@@ -101,6 +101,12 @@ static pm_err read_scene(pm_scene *s) {
                          "method %s runs on one process (this run has %d "
                          "ranks): run it without mpirun, or with -np 1",
                          s->method, pm_par_size());
+  if (pm_par_active() && s->output.ranks == PM_OUTPUT_PIECES &&
+      !s->backend->pieces)
+    return pm_scene_fail(s, "output.ranks", false,
+                         "method %s writes each frame gathered into rank 0 "
+                         "(this run has %d ranks): take gather",
+                         s->method, pm_par_size());
   if (s->backend->check) PM_CALL(s->backend->check(s));
   return PM_SUCCESS;
 }

@@ -144,6 +144,13 @@ enum {
 };
 extern const pm_name pm_mesh_sizes_names[];
 
+/* output.ranks: how a run across MPI ranks writes its frames. */
+enum {
+  PM_OUTPUT_GATHER = 0, /* gathered into rank 0, which writes each whole */
+  PM_OUTPUT_PIECES,     /* each rank its own points, joined by rank 0 */
+};
+extern const pm_name pm_output_ranks_names[];
+
 /* discretization.refine.to: what the grading's distance is measured to. */
 enum { PM_REFINE_FACES = 0, PM_REFINE_EDGES = 1 };
 extern const pm_name pm_refine_to_names[];
@@ -356,6 +363,7 @@ typedef struct pm_scene {
   struct {
     long every;      /* output.every: frame every N steps (> 0) */
     unsigned fields; /* PM_FIELD_* mask */
+    int ranks;       /* output.ranks: PM_OUTPUT_GATHER or PM_OUTPUT_PIECES */
     struct {
       long every;     /* output.checkpoint.every: steps (0: never) */
       double minutes; /* output.checkpoint.minutes: wall time (0: never) */

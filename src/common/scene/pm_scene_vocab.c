@@ -85,6 +85,8 @@ const pm_name pm_mesh_sizes_names[] = {{"scale", PM_MESH_SIZES_SCALE},
                                        {"replace", PM_MESH_SIZES_REPLACE},
                                        {"file", PM_MESH_SIZES_FILE},
                                        {NULL, 0}};
+const pm_name pm_output_ranks_names[] = {
+    {"gather", PM_OUTPUT_GATHER}, {"pieces", PM_OUTPUT_PIECES}, {NULL, 0}};
 const pm_name pm_refine_to_names[] = {
     {"faces", PM_REFINE_FACES}, {"edges", PM_REFINE_EDGES}, {NULL, 0}};
 static const pm_key refine_keys[] = {
@@ -968,6 +970,16 @@ static const pm_key output_keys[] = {
      .min_count = 1,
      .names = field_names,
      .doc = "fields written in each frame"},
+    {.name = "ranks",
+     .type = PM_KEY_ENUM,
+     .offset = S(output.ranks),
+     .def = "gather",
+     .names = pm_output_ranks_names,
+     .doc = "a run across MPI ranks: gather (each frame gathered into rank "
+            "0 and written whole) or pieces (explicit MPM without "
+            "membranes: each rank writes its own particles, "
+            "results/frame_NNNNNN.piece_RRRR.h5, joined by rank 0's frame "
+            "file; readers put them in one-process order)"},
     {.name = "checkpoint",
      .type = PM_KEY_MAPPING,
      .keys = checkpoint_keys,

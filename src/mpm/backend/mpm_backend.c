@@ -113,6 +113,7 @@ void mpm_sim_destroy(mpm_sim *r) {
     free(r->surface[b]);
   free(r->surface);
   free(r->scratch);
+  free(r->share_scratch);
   free(r);
 }
 
@@ -193,6 +194,7 @@ static pm_err run(void *p, const pm_observer *obs) {
   if (r->view.ranks && r->resumed) /* the shares of the checkpoint's state */
     PM_CALL(mpm_view_reshare(r));
   pm_view_start(&r->view, obs);
+  e = pm_view_start_pieces(&r->view, r->scene); /* (agreed) */
   mpm_model *lm = r->view.ranks ? r->local_model : r->model;
   mpm_state *ls = r->view.ranks ? r->local_state : r->state;
   mpm_work *lw = r->view.ranks ? r->local_work : r->work;
@@ -207,7 +209,7 @@ static pm_err run(void *p, const pm_observer *obs) {
         r->run_min_jacobian =
             fmin(r->run_min_jacobian, r->state->vol[q] / r->model->vol0[q]);
     }
-    e = mpm_view_report(r, true, false);
+    if (!e) e = mpm_view_report(r, true, false);
   }
   mpm_run_options opt = {.t_end = lm->opt.t_end,
                          .max_steps = lm->opt.max_steps,
@@ -310,6 +312,7 @@ const pm_backend mpm_backend = {
     .summary = mpm_sim_summary,
     .timers = mpm_sim_timers,
     .checkpoint = checkpoint,
+    .pieces = mpm_sim_pieces,
 };
 
 /* ---- method mpm-implicit ------------------------------------------------ */

@@ -46,6 +46,10 @@ typedef struct {
   long *imp_ranks;
   double setup_wall; /* s */
   double *scratch;   /* output buffer (scratch_per_particle) */
+  /* Across ranks with frames in pieces: the share's output buffer, with
+   * room for share_scratch_cap particles (grown with the share). */
+  double *share_scratch;
+  long share_scratch_cap;
   /* history columns of its own: names (and their storage) */
   const char *hist_names[PM_HISTORY_MAX];
   char hist_store[PM_HISTORY_MAX][48];

@@ -66,6 +66,13 @@ pm_err mpm_view_implicit_gather(void *ctx);
 void mpm_sim_points(void *p, pm_points *pts);
 const double *mpm_sim_displacement(void *p);
 int mpm_sim_fields(void *p, unsigned want, pm_field *f, int max);
+/* Across ranks with frames in pieces: this rank's share of frame `frame`
+ * written into the results folder dir (pm_view.piece), and rank 0's
+ * record of the last frame's pieces (pm_backend.pieces). */
+pm_err mpm_sim_piece(void *p, const char *dir, long frame,
+                     const pm_step_report *rep, long *n, int *n_fields,
+                     pm_field *fields);
+const pm_view_pieces *mpm_sim_pieces(void *p);
 void mpm_sim_figures(void *p, pm_figures *f, bool with_fields);
 /* The history columns of its own (mpm_sim.hist_names), on rank 0.
  * PM_ERR_MEMORY. */

@@ -8,6 +8,7 @@
 #include "mpm_backend_impl.h"
 #include "pm_metrics.h"
 #include "pm_omp.h"
+#include "pm_par.h"
 #include "pm_tensor.h"
 
 void mpm_sim_points(void *p, pm_points *pts) {
@@ -19,24 +20,28 @@ void mpm_sim_points(void *p, pm_points *pts) {
                      .surface = r->model->tri};
 }
 
-/* u = x - x0 into the buffer's last 3 n. */
-const double *mpm_sim_displacement(void *p) {
-  mpm_sim *r = p;
-  const long n3 = 3 * r->model->n;
-  const double *x = r->state->x, *x0 = r->model->x0;
-  double *u = r->scratch + 6 * r->model->n;
+/* u = x - x0 of m's particles into the buffer's [6 n, 9 n). */
+static const double *displacement(const mpm_model *m, const mpm_state *s,
+                                  double *scratch) {
+  const long n3 = 3 * m->n;
+  const double *x = s->x, *x0 = m->x0;
+  double *u = scratch + 6 * m->n;
   PM_OMP(parallel for schedule(static) default(none) shared(n3, x, x0, u))
   for (long i = 0; i < n3; i++) u[i] = x[i] - x0[i];
   return u;
 }
 
-/* Per particle into the buffer: strain energy density, J, density,
+const double *mpm_sim_displacement(void *p) {
+  mpm_sim *r = p;
+  return displacement(r->model, r->state, r->scratch);
+}
+
+/* Per particle of m into the buffer: strain energy density, J, density,
  * pressure, internal energy (n each, in that order). */
-static void particle_fields(mpm_sim *r) {
-  const mpm_model *m = r->model;
-  const mpm_state *s = r->state;
+static void model_particle_fields(const mpm_model *m, const mpm_state *s,
+                                  double *scratch) {
   const long n = m->n;
-  double *sed = r->scratch, *jac = sed + n, *rho = sed + 2 * n,
+  double *sed = scratch, *jac = sed + n, *rho = sed + 2 * n,
          *pres = sed + 3 * n, *ener = sed + 4 * n;
   for (long p = 0; p < n; p++) {
     jac[p] = s->vol[p] / m->vol0[p];
@@ -46,16 +51,20 @@ static void particle_fields(mpm_sim *r) {
     m->group[gi].kind->fields(m, s, &m->group[gi], sed, pres, ener);
 }
 
-int mpm_sim_fields(void *p, unsigned want, pm_field *f, int max) {
-  mpm_sim *r = p;
-  const mpm_state *s = r->state;
-  const long n = r->model->n;
-  const mpm_model *m = r->model;
+static void particle_fields(mpm_sim *r) {
+  model_particle_fields(r->model, r->state, r->scratch);
+}
+
+/* The fields of m's particles (mpm_sim_fields), computed into scratch
+ * (mpm_sim_scratch_per_particle doubles a particle). */
+static int model_fields(const mpm_model *m, const mpm_state *s, double *scratch,
+                        unsigned want, pm_field *f, int max) {
+  const long n = m->n;
   int nf = 0;
   if (max < 15) return 0;
-  double *sed = r->scratch, *jac = sed + n, *rho = sed + 2 * n,
+  double *sed = scratch, *jac = sed + n, *rho = sed + 2 * n,
          *pres = sed + 3 * n, *ener = sed + 4 * n, *mat = sed + 11 * n;
-  particle_fields(r);
+  model_particle_fields(m, s, scratch);
   /* Each particle's material (the scene's index), to colour by. */
   for (int gi = 0; gi < m->n_groups; gi++)
     for (long p = m->group[gi].begin; p < m->group[gi].end; p++)
@@ -76,10 +85,10 @@ int mpm_sim_fields(void *p, unsigned want, pm_field *f, int max) {
   /* The particles' current positions are each frame's geometry. */
   f[nf++] = (pm_field){"position", 3, s->x};
   if (want & PM_FIELD_DISPLACEMENT)
-    f[nf++] = (pm_field){"displacement", 3, mpm_sim_displacement(r)};
+    f[nf++] = (pm_field){"displacement", 3, displacement(m, s, scratch)};
   if (want & PM_FIELD_VELOCITY) f[nf++] = (pm_field){"velocity", 3, s->v};
   if (want & PM_FIELD_STRESS) {
-    const bool has_pressure = r->model->kinds & MPM_KIND_INTERNAL_ENERGY;
+    const bool has_pressure = m->kinds & MPM_KIND_INTERNAL_ENERGY;
     double *vm = sed + 9 * n, *mean = has_pressure ? NULL : sed + 10 * n;
     pm_stress_invariants(n, s->sigma, vm, mean);
     f[nf++] = (pm_field){"stress", 9, s->sigma};
@@ -89,12 +98,47 @@ int mpm_sim_fields(void *p, unsigned want, pm_field *f, int max) {
   if (want & PM_FIELD_STRAIN_ENERGY_DENSITY)
     f[nf++] = (pm_field){"strain_energy_density", 1, sed};
   if (want & PM_FIELD_JACOBIAN) f[nf++] = (pm_field){"jacobian", 1, jac};
-  if (r->model->kinds & MPM_KIND_INTERNAL_ENERGY) {
+  if (m->kinds & MPM_KIND_INTERNAL_ENERGY) {
     f[nf++] = (pm_field){"density", 1, rho};
     f[nf++] = (pm_field){"pressure", 1, pres};
     f[nf++] = (pm_field){"internal_energy", 1, ener};
   }
   return nf;
+}
+
+int mpm_sim_fields(void *p, unsigned want, pm_field *f, int max) {
+  mpm_sim *r = p;
+  return model_fields(r->model, r->state, r->scratch, want, f, max);
+}
+
+pm_err mpm_sim_piece(void *p, const char *dir, long frame,
+                     const pm_step_report *rep, long *n, int *n_fields,
+                     pm_field *fields) {
+  (void)rep; /* rank 0's alone: the share's state has the step and time */
+  mpm_sim *r = p;
+  const mpm_model *m = r->local_model;
+  const mpm_state *s = r->local_state;
+  /* The share's buffer grows with the share (migration), as its arrays
+   * do: at a frame, not in a step. */
+  if (m->cap > r->share_scratch_cap) {
+    const long per = mpm_sim_scratch_per_particle(m);
+    double *grown =
+        realloc(r->share_scratch, (size_t)(per * m->cap) * sizeof *grown);
+    PM_CHECK(grown, PM_ERR_MEMORY,
+             "out of memory for the output of %ld particles (frame %ld)",
+             m->cap, frame);
+    r->share_scratch = grown;
+    r->share_scratch_cap = m->cap;
+  }
+  *n_fields = model_fields(m, s, r->share_scratch, r->scene->output.fields,
+                           fields, PM_VIEW_FIELDS);
+  *n = m->n;
+  return pm_results_write_piece(dir, frame, pm_par_rank(), m->n, m->gid,
+                                s->step, s->t, *n_fields, fields);
+}
+
+const pm_view_pieces *mpm_sim_pieces(void *p) {
+  return pm_view_frame_pieces(&((const mpm_sim *)p)->view);
 }
 
 /* Mean strain energy density of the particles that store it, largest von

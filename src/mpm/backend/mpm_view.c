@@ -72,7 +72,8 @@ void mpm_view_init(mpm_sim *r, bool implicit) {
   r->view = (pm_view){.ranks = r->local_model != NULL,
                       .ctx = r,
                       .gather = implicit ? mpm_view_implicit_gather : gather,
-                      .release = release};
+                      .release = release,
+                      .piece = implicit ? NULL : mpm_sim_piece};
 }
 
 pm_err mpm_view_report(mpm_sim *r, bool frame, bool last) {

@@ -23,6 +23,14 @@ pm_err mpm_par_check(const pm_scene *s) {
                          "run has %d ranks): take mpm.fbar: cell, or run with "
                          "-np 1",
                          pm_par_size());
+  for (int b = 0; s->output.ranks == PM_OUTPUT_PIECES && b < s->n_bodies; b++)
+    if (s->bodies[b].shape == PM_BODY_MEMBRANE)
+      return pm_scene_fail(s, "output.ranks", false,
+                           "frames in pieces hold particles without "
+                           "triangles, and body %d is a membrane (its "
+                           "triangles number the particles in one process's "
+                           "order): take gather",
+                           b);
   for (int i = 0; i < s->n_bcs; i++)
     if (PM_BC_RIGID(&s->bcs[i])) {
       char got[64];
