@@ -15,7 +15,7 @@ packages=(
   libtiff-dev
   libpetsc-real-dev
   calculix-ccx
-  clang-format python3-matplotlib python3-numpy python3-h5py
+  clang-format python3-matplotlib python3-numpy python3-h5py python3-scipy
 )
 
 missing=()
