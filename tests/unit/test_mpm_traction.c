@@ -111,15 +111,17 @@ static void test_unknown_name(void **state) {
   pm_scene_destroy(s);
 }
 
-/* A named edge holds no displacement in MPM: refused at its key. */
+/* A named edge takes a traction or a motion, not both: refused at its
+ * key. */
 static void test_refused(void **state) {
   char path[512];
   write_panel(*state, path);
-  const char *set[] = {"boundary.0.on=clamped"};
+  const char *set[] = {"boundary.1.traction={y: 10}",
+                       "boundary.1.displacement={x: 0}"};
   pm_scene *s = NULL;
-  assert_int_equal(pm_scene_load(path, 1, set, &s), PM_ERR_SCENE);
-  assert_non_null(strstr(pm_error_message(), "boundary.0.on"));
-  assert_non_null(strstr(pm_error_message(), "carries tractions only"));
+  assert_int_equal(pm_scene_load(path, 2, set, &s), PM_ERR_SCENE);
+  assert_non_null(strstr(pm_error_message(), "boundary.1.traction"));
+  assert_non_null(strstr(pm_error_message(), "one condition each"));
 }
 
 /* The energy balance of the static run: strain energy = the tractions'

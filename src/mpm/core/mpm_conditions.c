@@ -36,9 +36,11 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
       bc->rigid = sb;
       continue;
     }
-    /* A grip has no columns: its held particles act; nor has a traction
-     * on a named surface: the particles at it carry it. */
-    bc->grip = sb->on == PM_ON_REGION;
+    /* A grip has no columns: its held particles act (on a region, or the
+     * particles at a named surface that a motion holds); nor has a
+     * traction on a named surface: the particles at it carry it. */
+    bc->grip = sb->on == PM_ON_REGION ||
+               (sb->on == PM_ON_SURFACE && !sb->traction_mask);
     bc->region = sb->region;
     if (sb->on != PM_ON_FACE) continue;
     bc->face = sb->face;

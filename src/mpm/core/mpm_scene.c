@@ -320,21 +320,19 @@ pm_err mpm_check_scene(const pm_scene *s) {
           "(method %s; a region holds particles by a displacement or "
           "velocity), got traction with region",
           s->method);
-    if (bc->on == PM_ON_SURFACE && !bc->traction_mask)
+    if (bc->on == PM_ON_SURFACE && bc->absorbing)
       return pm_scene_fail(
-          s, PM_PATH(p, "boundary.%d.on", i), false,
-          "expected on: a face of domain.box (xmin, xmax, ymin, ymax, zmin, "
-          "zmax)%s for method %s, got %s (a named surface carries "
-          "tractions only)",
-          implicit ? "" : " or region: (a grip on the particles in it)",
-          s->method, bc->surface);
-    if (bc->on == PM_ON_SURFACE &&
-        (bc->disp_mask | bc->velocity_mask || bc->absorbing))
+          s, PM_PATH(p, "boundary.%d.absorbing", i), true,
+          "expected displacement%s or traction on a named surface (method "
+          "%s; absorbing acts on faces of domain.box), got absorbing",
+          implicit ? "" : ", velocity", s->method);
+    if (bc->on == PM_ON_SURFACE && bc->traction_mask &&
+        (bc->disp_mask | bc->velocity_mask))
       return pm_scene_fail(
           s, PM_PATH(p, "boundary.%d.traction", i), true,
-          "expected traction alone on a named surface (method %s), got it "
-          "with %s",
-          s->method, bc->absorbing ? "absorbing" : "a prescribed motion");
+          "expected a traction or a prescribed motion on a named surface "
+          "(method %s; one condition each), got traction with %s",
+          s->method, bc->disp_mask ? "displacement" : "velocity");
     if (bc->on == PM_ON_REGION && bc->absorbing)
       return pm_scene_fail(s, PM_PATH(p, "boundary.%d.absorbing", i), true,
                            "expected displacement or velocity on a region "
@@ -391,8 +389,8 @@ pm_err mpm_implicit_check_scene(const pm_scene *s) {
     if (bc->on == PM_ON_REGION)
       return pm_scene_fail(
           s, PM_PATH(p, "boundary.%d.region", i), true,
-          "expected on: a face of domain.box (displacement or traction) or "
-          "a named surface (traction) for method mpm-implicit (grips on "
+          "expected on: a face of domain.box or a named surface "
+          "(displacement or traction) for method mpm-implicit (grips on "
           "regions of particles run by method mpm), got region");
     if (bc->velocity_mask || bc->absorbing)
       return pm_scene_fail(

@@ -244,9 +244,36 @@ static pm_err surface_carriers(const pm_scene *s, mpm_model *m, int b) {
                        dim == 2 ? "curve" : "surface", name);
 }
 
+static int long_order(const void *a, const void *b) {
+  const long x = *(const long *)a, y = *(const long *)b;
+  return (x > y) - (x < y);
+}
+
+/* A motion on a named surface holds the particles that carry its Gauss
+ * points (each once), as a grip holds those of its region: the same
+ * particles a traction there would load, so the surface a user names is
+ * held where it is loaded, whatever its slope to the grid. */
+static pm_err surface_grip(const pm_scene *s, mpm_model *m, int b) {
+  mpm_bc *bc = &m->bcs[b];
+  PM_CALL(surface_carriers(s, m, b));
+  qsort(bc->held, (size_t)bc->n_held, sizeof(long), long_order);
+  long n = 0;
+  for (long k = 0; k < bc->n_held; k++)
+    if (n == 0 || bc->held[k] != bc->held[n - 1]) bc->held[n++] = bc->held[k];
+  bc->n_held = n;
+  free(bc->area);
+  free(bc->offset);
+  bc->area = bc->offset = NULL;
+  return PM_SUCCESS;
+}
+
 pm_err mpm_tractions_create(const pm_scene *s, mpm_model *m) {
   for (int b = 0; b < m->n_bcs; b++) {
     mpm_bc *bc = &m->bcs[b];
+    if (s->bcs[b].on == PM_ON_SURFACE && bc->grip) {
+      PM_CALL(surface_grip(s, m, b));
+      continue;
+    }
     if (!bc->traction_mask) continue;
     if (s->bcs[b].on == PM_ON_SURFACE) {
       PM_CALL(surface_carriers(s, m, b));

@@ -62,6 +62,9 @@ struct mpm_implicit {
   double *near_null;     /* rigid motions for algebraic multigrid */
   /* face particles of each condition (reset) */
   long *face_ptr, *face;
+  /* 2 per node: the mass of the particles, and of a grip's, that reach
+   * it (grid kept, a motion on a named surface only) */
+  double *grip_mass;
   /* nodal work, 3 per node */
   double *u, *du, *f, *df, *diag;
   double *trac_at; /* the tractions' points where the last step left them
