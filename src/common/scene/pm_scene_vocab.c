@@ -651,7 +651,8 @@ static const pm_key bc_keys[] = {
      .offset = C(pressure),
      .unit = "Pa",
      .doc = "follower pressure at full load, f(x, y, z, t): normal to the "
-            "deformed face, pushing on it (FPM; with on or region)"},
+            "deformed face, pushing on it (FPM: with on or region; MPM: on a "
+            "face or a named surface or edge, the particles at it carry it)"},
     {.name = "force",
      .type = PM_KEY_COMPONENTS,
      .offset = C(force),

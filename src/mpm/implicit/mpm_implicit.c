@@ -259,7 +259,7 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   PM_TRY(PM_ALLOC(im->reaction, 3 * m->n_bcs + 1, "reactions"));
   if (im->mode == MPM_GRID_KEPT && mpm_grips_count(m->bcs, m->n_bcs) > 0)
     PM_TRY(PM_ALLOC(im->grip_mass, 2 * nn, "held node masses"));
-  PM_TRY(PM_ALLOC(im->trac_at, 3 * mpm_tractions_points(m, st->x, NULL) + 1,
+  PM_TRY(PM_ALLOC(im->trac_at, 6 * mpm_tractions_points(m, st->x, NULL) + 1,
                   "traction points"));
   mpm_tractions_points(m, st->x, im->trac_at);
   /* Newton's settings */
