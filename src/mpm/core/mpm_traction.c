@@ -348,6 +348,41 @@ static void load_point(const mpm_bc *bc, long k, const double *x,
   for (int c = 0; c < 3; c++) xs[c] = x[3 * bc->held[k] + c];
 }
 
+/* The stencil on grid g through which the k-th point of condition bc
+ * acts over the particles at x: its load point's, on the nodes its
+ * carrier's stencil shares, the weights scaled back to 1.  A point on a
+ * surface off the grid's lines reaches nodes beyond the body that no
+ * particle reaches: they hold no displacement, and a force there is lost
+ * (the tapered panel on a grid shifted by 0.2 m lost 20% of its traction
+ * at cells of 0.0625 m).  The carrier's nodes are the body's; where the
+ * surface is a grid plane the point's weights there are already 1. */
+static void load_stencil(const mpm_grid *g, const mpm_bc *bc, long k,
+                         const double *x, mpm_stencil *st) {
+  double xs[3];
+  load_point(bc, k, x, xs);
+  mpm_stencil_at(g, xs, MPM_STENCIL_W, st);
+  if (bc->pressure) return; /* at its carrier */
+  mpm_stencil sc;
+  mpm_stencil_at(g, x + 3 * bc->held[k], MPM_STENCIL_W, &sc);
+  int n = 0;
+  double sum = 0;
+  for (int j = 0; j < st->n; j++) {
+    bool shared = false;
+    for (int i = 0; i < sc.n && !shared; i++)
+      shared = sc.node[i] == st->node[j];
+    if (!shared || st->w[j] == 0) continue;
+    st->node[n] = st->node[j];
+    st->w[n++] = st->w[j];
+    sum += st->w[j];
+  }
+  st->n = n;
+  if (!(sum > 0)) {
+    *st = sc;
+    return;
+  }
+  for (int j = 0; j < n; j++) st->w[j] /= sum;
+}
+
 /* The force of condition bc's traction at its k-th point at time t
  * (dead: nominal), into f. */
 static void traction_force(const mpm_model *m, const mpm_bc *bc, long k,
@@ -399,9 +434,7 @@ pm_err mpm_stage_tractions(mpm_ctx *ctx, const mpm_stage *self) {
         return mpm_stage_status(ctx, self);
       }
       mpm_stencil st;
-      double xs[3];
-      load_point(bc, k, x, xs);
-      mpm_stencil_at(&m->grid, xs, MPM_STENCIL_W, &st);
+      load_stencil(&m->grid, bc, k, x, &st);
       for (int j = 0; j < st.n; j++)
         for (int c = 0; c < 3; c++) force[3 * st.node[j] + c] += st.w[j] * f[c];
     }
@@ -423,9 +456,7 @@ pm_err mpm_book_tractions(mpm_ctx *ctx, const mpm_stage *self) {
       double f[3];
       state_force(m, ctx->state, bc, k, t, f);
       mpm_stencil st;
-      double xs[3];
-      load_point(bc, k, x, xs);
-      mpm_stencil_at(&m->grid, xs, MPM_STENCIL_W, &st);
+      load_stencil(&m->grid, bc, k, x, &st);
       for (int c = 0; c < 3; c++) reaction[3 * b + c] += f[c];
       for (int j = 0; j < st.n; j++) {
         const long i = st.node[j];
@@ -447,13 +478,12 @@ void mpm_tractions_nodal(const mpm_model *m, const mpm_grid *g,
     const mpm_bc *bc = &m->bcs[b];
     if (!MPM_BC_LOADS(bc)) continue;
     for (long k = 0; k < bc->n_held; k++) {
-      double ft[3], xs[3];
+      double ft[3];
       traction_force(m, bc, k, T, ft);
       if (bc->pressure)
         mpm_pressure_grid(m, g, xb, u, bc, k, point_pressure(m, bc, k, T), ft);
-      load_point(bc, k, xb, xs);
       mpm_stencil st;
-      mpm_stencil_at(g, xs, MPM_STENCIL_W, &st);
+      load_stencil(g, bc, k, xb, &st);
       for (int j = 0; j < st.n; j++)
         for (int c = 0; c < 3; c++)
           f[3 * st.node[j] + c] -= lam * st.w[j] * ft[c];
@@ -511,7 +541,7 @@ double mpm_tractions_work(const mpm_model *m, const mpm_grid *g,
                           lam_new * point_pressure(m, bc, k, T), fp);
       load_point(bc, k, xb, xs);
       mpm_stencil st;
-      mpm_stencil_at(g, xs, MPM_STENCIL_W, &st);
+      load_stencil(g, bc, k, xb, &st);
       for (int j = 0; j < st.n; j++)
         for (int c = 0; c < 3; c++) xs[c] += st.w[j] * u[3 * st.node[j] + c];
       for (int c = 0; c < 3; c++) {
