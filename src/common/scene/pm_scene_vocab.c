@@ -626,7 +626,8 @@ static const pm_key bc_keys[] = {
     {.name = "on",
      .type = PM_KEY_STRING,
      .offset = C(surface),
-     .doc = "xmin, xmax, ymin, ymax, zmin, zmax, or a named surface"},
+     .doc = "xmin, xmax, ymin, ymax, zmin, zmax, or a named surface (MPM: "
+            "the particles at it carry its loads and hold its motion)"},
     {.name = "region",
      .type = PM_KEY_EXPR,
      .offset = C(region),
