@@ -9,41 +9,16 @@
 
 #include <cmocka.h>
 
+#include "mpm_panel_testing.h"
 #include "mpm_testing.h"
 #include "mpm_traction.h"
-
-static const char *const GEO =
-    "lc = 1;\n"
-    "Point(1) = {0, 0, 0, lc}; Point(2) = {10, 1, 0, lc};\n"
-    "Point(3) = {10, 3, 0, lc}; Point(4) = {0, 4, 0, lc};\n"
-    "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
-    "Curve Loop(1) = {1, 2, 3, 4};\nPlane Surface(1) = {1};\n"
-    "Physical Curve(\"clamped\") = {4};\nPhysical Curve(\"tip\") = {2};\n"
-    "Physical Surface(\"panel\") = {1};\n";
-
-static const char *const SCENE =
-    "name: panel\nmethod: mpm-implicit\ndimension: 2\n"
-    "domain: {box: {min: [0, 0], max: [10, 4]}}\n"
-    "discretization: {mesh_size: 1}\n"
-    "mpm: {fbar: none}\n"
-    "materials:\n  - {name: gel, model: neo-hookean, density: 1000, "
-    "youngs_modulus: 3000, poisson_ratio: 0.45}\n"
-    "bodies: [{material: gel, mesh: panel.geo}]\n"
-    "boundary:\n  - {on: xmin, displacement: {x: 0, y: 0}}\n"
-    "  - {on: tip, traction: {x: 2, y: 10}, ramp: smooth}\n"
-    "time: {end: 1, quasi_static: {method: static, load_steps: 10}}\n";
-
-static void write_panel(const char *dir, char path[512]) {
-  pm_test_write_file(dir, "panel.geo", GEO, path);
-  pm_test_write_file(dir, "panel.yaml", SCENE, path);
-}
 
 /* The sum of the tractions' nodal forces at full load into sum. */
 static void resultant(const model *m, double sum[3]) {
   const long n3 = 3 * m->model->grid.n_nodes;
   double *f = calloc((size_t)n3, sizeof *f);
   assert_non_null(f);
-  mpm_tractions_nodal(m->model, &m->model->grid, m->model->x0, 1.0, f);
+  mpm_tractions_nodal(m->model, &m->model->grid, m->model->x0, NULL, 1.0, f);
   for (int c = 0; c < 3; c++) sum[c] = 0;
   for (long i = 0; i < n3; i++) sum[i % 3] -= f[i];
   free(f);
@@ -111,15 +86,17 @@ static void test_unknown_name(void **state) {
   pm_scene_destroy(s);
 }
 
-/* A named edge holds no displacement in MPM: refused at its key. */
+/* A named edge takes a traction or a motion, not both: refused at its
+ * key. */
 static void test_refused(void **state) {
   char path[512];
   write_panel(*state, path);
-  const char *set[] = {"boundary.0.on=clamped"};
+  const char *set[] = {"boundary.1.traction={y: 10}",
+                       "boundary.1.displacement={x: 0}"};
   pm_scene *s = NULL;
-  assert_int_equal(pm_scene_load(path, 1, set, &s), PM_ERR_SCENE);
-  assert_non_null(strstr(pm_error_message(), "boundary.0.on"));
-  assert_non_null(strstr(pm_error_message(), "carries tractions only"));
+  assert_int_equal(pm_scene_load(path, 2, set, &s), PM_ERR_SCENE);
+  assert_non_null(strstr(pm_error_message(), "boundary.1.traction"));
+  assert_non_null(strstr(pm_error_message(), "one condition each"));
 }
 
 /* The energy balance of the static run: strain energy = the tractions'

@@ -109,7 +109,7 @@ bad_scene traction-on-region-implicit "$trac" \
   'boundary.1.traction: expected a traction on a face of domain.box or a named surface (method mpm-implicit;'
 bad_scene grip-implicit "$grip" 's/method: mpm$/method: mpm-implicit/' \
   'region: "0.01 - y"' \
-  'boundary.0.region: expected on: a face of domain.box (displacement or traction) or a named surface (traction) for method mpm-implicit'
+  'boundary.0.region: expected on: a face of domain.box or a named surface (displacement or traction) for method mpm-implicit'
 
 bad_scene glued-grips-nothing "$glued" 's/point: \[0, 0.4\]/point: [0, 0.45]/' \
   'point: \[0, 0.45\]' 'boundary.1.plate: expected a glued plate on a body'

@@ -628,7 +628,8 @@ static const pm_key bc_keys[] = {
     {.name = "on",
      .type = PM_KEY_STRING,
      .offset = C(surface),
-     .doc = "xmin, xmax, ymin, ymax, zmin, zmax, or a named surface"},
+     .doc = "xmin, xmax, ymin, ymax, zmin, zmax, or a named surface (MPM: "
+            "the particles at it carry its loads and hold its motion)"},
     {.name = "region",
      .type = PM_KEY_EXPR,
      .offset = C(region),
@@ -653,7 +654,8 @@ static const pm_key bc_keys[] = {
      .offset = C(pressure),
      .unit = "Pa",
      .doc = "follower pressure at full load, f(x, y, z, t): normal to the "
-            "deformed face, pushing on it (FPM; with on or region)"},
+            "deformed face, pushing on it (FPM: with on or region; MPM: on a "
+            "face or a named surface or edge, the particles at it carry it)"},
     {.name = "force",
      .type = PM_KEY_COMPONENTS,
      .offset = C(force),

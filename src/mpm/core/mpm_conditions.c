@@ -20,6 +20,7 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
     bc->disp_mask = sb->disp_mask;
     bc->vel_mask = sb->velocity_mask;
     bc->traction_mask = sb->traction_mask;
+    bc->pressure = sb->pressure;
     bc->ramp = sb->ramp;
     bc->ramp_time = sb->ramp_time;
     bc->absorbing = sb->absorbing;
@@ -36,9 +37,11 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
       bc->rigid = sb;
       continue;
     }
-    /* A grip has no columns: its held particles act; nor has a traction
-     * on a named surface: the particles at it carry it. */
-    bc->grip = sb->on == PM_ON_REGION;
+    /* A grip has no columns: its held particles act (on a region, or the
+     * particles at a named surface that a motion holds); nor has a
+     * traction on a named surface: the particles at it carry it. */
+    bc->grip = sb->on == PM_ON_REGION ||
+               (sb->on == PM_ON_SURFACE && !MPM_BC_LOADS(sb));
     bc->region = sb->region;
     if (sb->on != PM_ON_FACE) continue;
     bc->face = sb->face;
@@ -72,6 +75,9 @@ void mpm_conditions_destroy(mpm_bc *bcs, int n_bcs) {
     free(bcs[b].held);
     free(bcs[b].area);
     free(bcs[b].offset);
+    free(bcs[b].normal);
+    free(bcs[b].corner);
+    free(bcs[b].coff);
   }
   free(bcs);
 }

@@ -43,11 +43,27 @@ typedef struct {
   unsigned traction_mask;
   const pm_expr *traction[3];
   double *area, *offset;
+  /* A follower pressure (Pa at full load; NULL if none) on the same
+   * points: -p cof(F) N per unit reference area, N each point's outward
+   * reference normal (3 per point; owned). */
+  const pm_expr *pressure;
+  double *normal;
+  /* On a named surface, the pressure acts on each facet as it deforms:
+   * the particle nearest each corner of a point's facet (3 per point; -1
+   * for a facet that carries nothing), and the corner's reference offset
+   * from it (9 per point), corners ordered so that their area vector
+   * points out (owned; NULL on a face, where cof(F) N of the carrier
+   * acts). */
+  long *corner;
+  double *coff;
   /* A rigid plate or sphere in the grid's contact (mpm_contact.h): the
    * scene's condition (borrowed; NULL for other conditions), and no
    * columns. */
   const pm_scene_bc *rigid;
 } mpm_bc;
+
+/* Whether condition bc loads its surface (a traction or a pressure). */
+#define MPM_BC_LOADS(bc) ((bc)->traction_mask || (bc)->pressure)
 
 /* What the conditions keep during a step: workspace. */
 typedef struct {

@@ -17,7 +17,8 @@ int mpm_grips_count(const mpm_bc *bcs, int n) {
   return k;
 }
 
-/* The share of a node's mass from which a grip holds it wholly: a node
+/* MPM_GRIP_SHARE (mpm_grip.h), the share of a node's mass from which a
+ * grip holds it wholly: a node
  * the grip's particles weigh on moves with them (as a face condition holds
  * the nodes at and beyond its wall), one they barely touch only in part
  * (the rest of its velocity is the grid's), so that a node the grip comes
@@ -27,7 +28,6 @@ int mpm_grips_count(const mpm_bc *bcs, int n) {
  * 60% 7.7% low against FE; at 0.25, 0.8%).  With the node's share alone
  * (the rigid kind's rule) the body's particles next to the grip drag its
  * nodes and the grip lets go. */
-#define MPM_GRIP_SHARE 0.25
 
 /* Whether particle p (reference position x0) lies in the region of bc. */
 static bool held_by(const mpm_bc *bc, const double x0[3]) {
@@ -37,15 +37,11 @@ static bool held_by(const mpm_bc *bc, const double x0[3]) {
 pm_err mpm_grips_create(const pm_scene *s, mpm_model *m) {
   for (int b = 0; b < m->n_bcs; b++) {
     mpm_bc *bc = &m->bcs[b];
-    if (!bc->grip) continue;
+    /* A named surface's particles are found with its tractions'
+     * (mpm_tractions_create). */
+    if (!bc->grip || s->bcs[b].on != PM_ON_REGION) continue;
     char p[64];
     snprintf(p, sizeof p, "boundary.%d.region", b);
-    if (s->bcs[b].on != PM_ON_REGION)
-      return pm_scene_fail(
-          s, PM_PATH(p, "boundary.%d.on", b), false,
-          "expected a face of domain.box (xmin ... zmax) or region: for "
-          "method mpm, got %s (named surfaces hold no particles yet)",
-          s->bcs[b].surface);
     long n = 0, volume = 0;
     for (int pass = 0; pass < 2; pass++) {
       if (pass == 1) PM_CALL(PM_ALLOC(bc->held, n > 0 ? n : 1, "grip"));

@@ -1,7 +1,9 @@
 /* mpm_grip: conditions on regions of particles (grips).  The particles of
- * the volume bodies in a condition's region at t = 0 are held: they move as
- * prescribed and impose that motion on the grid nodes they touch, and the
- * condition's reaction is the force the grip exerts on the body. */
+ * the volume bodies in a condition's region at t = 0 are held (or, for a
+ * motion on a named surface of a gmsh body, the particles that carry its
+ * Gauss points: mpm_traction.h): they move as prescribed and impose that
+ * motion on the grid nodes they touch, and the condition's reaction is the
+ * force the grip exerts on the body. */
 #ifndef MPM_GRIP_H
 #define MPM_GRIP_H
 
@@ -12,6 +14,10 @@
 #include "pm_scene.h"
 
 struct mpm_model;
+
+/* The share of a node's mass (of the particles that reach it) from which a
+ * grip's particles hold it wholly (why 0.25: mpm_grip.c). */
+#define MPM_GRIP_SHARE 0.25
 
 /* Find the held particles of each region condition of model m (scene s):
  * those of its volume bodies whose reference position lies in the region.

@@ -267,11 +267,11 @@ static pm_err check_bodies(const pm_scene *s) {
 }
 
 /* The loads of method fpm that MPM does not take (yet): body_force,
- * body_curve and a condition's pressure, force, at and curve. */
+ * body_curve and a condition's force, at and curve. */
 static pm_err refuse_fpm_loads(const pm_scene *s) {
   char p[64];
   static const char *const top[] = {"body_force", "body_curve"};
-  static const char *const per_bc[] = {"pressure", "force", "at", "curve"};
+  static const char *const per_bc[] = {"force", "at", "curve"};
   for (int k = 0; k < 2; k++)
     if (pm_scene_has(s, top[k]))
       return pm_scene_fail(s, top[k], true,
@@ -279,7 +279,7 @@ static pm_err refuse_fpm_loads(const pm_scene *s) {
                            "takes gravity), got %s",
                            top[k], s->method, top[k]);
   for (int i = 0; i < s->n_bcs; i++)
-    for (int k = 0; k < 4; k++)
+    for (int k = 0; k < 3; k++)
       if (pm_scene_has(s, PM_PATH(p, "boundary.%d.%s", i, per_bc[k])))
         return pm_scene_fail(s, p, true,
                              "expected no %s for method %s (FPM only), got "
@@ -320,21 +320,34 @@ pm_err mpm_check_scene(const pm_scene *s) {
           "(method %s; a region holds particles by a displacement or "
           "velocity), got traction with region",
           s->method);
-    if (bc->on == PM_ON_SURFACE && !bc->traction_mask)
+    if (bc->pressure && bc->on == PM_ON_REGION)
+      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.pressure", i), true,
+                           "expected a pressure on a face of domain.box or a "
+                           "named surface (method %s; the particles at it "
+                           "carry it), got pressure with region",
+                           s->method);
+    if (bc->pressure && (bc->disp_mask | bc->velocity_mask | bc->absorbing))
       return pm_scene_fail(
-          s, PM_PATH(p, "boundary.%d.on", i), false,
-          "expected on: a face of domain.box (xmin, xmax, ymin, ymax, zmin, "
-          "zmax)%s for method %s, got %s (a named surface carries "
-          "tractions only)",
-          implicit ? "" : " or region: (a grip on the particles in it)",
-          s->method, bc->surface);
-    if (bc->on == PM_ON_SURFACE &&
-        (bc->disp_mask | bc->velocity_mask || bc->absorbing))
+          s, PM_PATH(p, "boundary.%d.pressure", i), true,
+          "expected a pressure without a prescribed motion (method %s; it "
+          "acts on every component), got pressure with %s",
+          s->method,
+          bc->disp_mask       ? "displacement"
+          : bc->velocity_mask ? "velocity"
+                              : "absorbing");
+    if (bc->on == PM_ON_SURFACE && bc->absorbing)
+      return pm_scene_fail(
+          s, PM_PATH(p, "boundary.%d.absorbing", i), true,
+          "expected displacement%s or traction on a named surface (method "
+          "%s; absorbing acts on faces of domain.box), got absorbing",
+          implicit ? "" : ", velocity", s->method);
+    if (bc->on == PM_ON_SURFACE && bc->traction_mask &&
+        (bc->disp_mask | bc->velocity_mask))
       return pm_scene_fail(
           s, PM_PATH(p, "boundary.%d.traction", i), true,
-          "expected traction alone on a named surface (method %s), got it "
-          "with %s",
-          s->method, bc->absorbing ? "absorbing" : "a prescribed motion");
+          "expected a traction or a prescribed motion on a named surface "
+          "(method %s; one condition each), got traction with %s",
+          s->method, bc->disp_mask ? "displacement" : "velocity");
     if (bc->on == PM_ON_REGION && bc->absorbing)
       return pm_scene_fail(s, PM_PATH(p, "boundary.%d.absorbing", i), true,
                            "expected displacement or velocity on a region "
@@ -358,6 +371,7 @@ pm_err mpm_check_scene(const pm_scene *s) {
 
 pm_err mpm_implicit_check_scene(const pm_scene *s) {
   char p[PM_SDOC_PATH];
+  const mpm_settings *ms = mpm_scene_settings(s);
   if (mpm_scene_settings(s)->fbar == MPM_FBAR_PATCH)
     return pm_scene_expected(s, "mpm.fbar",
                              "none or cell for method mpm-implicit (a node's "
@@ -391,9 +405,26 @@ pm_err mpm_implicit_check_scene(const pm_scene *s) {
     if (bc->on == PM_ON_REGION)
       return pm_scene_fail(
           s, PM_PATH(p, "boundary.%d.region", i), true,
-          "expected on: a face of domain.box (displacement or traction) or "
-          "a named surface (traction) for method mpm-implicit (grips on "
+          "expected on: a face of domain.box or a named surface "
+          "(displacement or traction) for method mpm-implicit (grips on "
           "regions of particles run by method mpm), got region");
+    if (bc->pressure && ms->implicit.grid == MPM_GRID_RESET)
+      return pm_scene_fail(s, PM_PATH(p, "boundary.%d.pressure", i), true,
+                           "expected mpm.implicit.grid kept with a pressure "
+                           "(its load stiffness is taken on the kept grid), "
+                           "got grid reset");
+    const bool cg = pm_scene_has(s, "time.quasi_static.linear_solver") &&
+                    (s->time.qs_linear == PM_LINEAR_CG_JACOBI ||
+                     s->time.qs_linear == PM_LINEAR_CG_GAMG);
+    if (bc->pressure && (ms->implicit.op == MPM_OP_MATRIX_FREE || cg))
+      return pm_scene_fail(
+          s, PM_PATH(p, "boundary.%d.pressure", i), true,
+          "expected an assembled tangent and a linear solver for "
+          "unsymmetric matrices with a pressure (its load stiffness is not "
+          "symmetric; CG needs a symmetric one), got %s",
+          ms->implicit.op == MPM_OP_MATRIX_FREE ? "mpm.implicit.operator "
+                                                  "matrix-free"
+                                                : "a cg linear_solver");
     if (bc->velocity_mask || bc->absorbing)
       return pm_scene_fail(
           s,

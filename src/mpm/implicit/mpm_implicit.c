@@ -10,6 +10,7 @@
 #include "mpm_estimate.h"
 #include "mpm_exchange.h"
 #include "mpm_implicit_impl.h"
+#include "mpm_grip.h"
 #include "mpm_traction.h"
 #include "mpm_kind.h"
 #include "pm_interrupt.h"
@@ -28,6 +29,10 @@ static pm_err make_faces(mpm_implicit *im) {
   PM_CALL(PM_ALLOC(dmin, m->n_bcs + 1, "face distances"));
   for (int b = 0; b < m->n_bcs; b++) {
     const mpm_bc *bc = &m->bcs[b];
+    if (bc->grip) { /* a named surface's: the particles at it */
+      total += bc->n_held;
+      continue;
+    }
     dmin[b] = INFINITY;
     for (long p = 0; p < im->n; p++)
       dmin[b] = fmin(dmin[b], fabs(m->x0[3 * p + bc->axis] - bc->plane));
@@ -44,6 +49,10 @@ static pm_err make_faces(mpm_implicit *im) {
   for (int b = 0; b < m->n_bcs; b++) {
     const mpm_bc *bc = &m->bcs[b];
     im->face_ptr[b] = k;
+    if (bc->grip) {
+      for (long q = 0; q < bc->n_held; q++) im->face[k++] = bc->held[q];
+      continue;
+    }
     for (long p = 0; p < im->n; p++)
       if (fabs(m->x0[3 * p + bc->axis] - bc->plane) <= dmin[b] + 1e-6 * im->g.h)
         im->face[k++] = p;
@@ -248,7 +257,9 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   PM_TRY(PM_ALLOC(im->f, 3 * nn, "nodal forces"));
   PM_TRY(PM_ALLOC(im->df, 3 * nn, "nodal force changes"));
   PM_TRY(PM_ALLOC(im->reaction, 3 * m->n_bcs + 1, "reactions"));
-  PM_TRY(PM_ALLOC(im->trac_at, 3 * mpm_tractions_points(m, st->x, NULL) + 1,
+  if (im->mode == MPM_GRID_KEPT && mpm_grips_count(m->bcs, m->n_bcs) > 0)
+    PM_TRY(PM_ALLOC(im->grip_mass, 2 * nn, "held node masses"));
+  PM_TRY(PM_ALLOC(im->trac_at, 6 * mpm_tractions_points(m, st->x, NULL) + 1,
                   "traction points"));
   mpm_tractions_points(m, st->x, im->trac_at);
   /* Newton's settings */
@@ -354,6 +365,7 @@ void mpm_implicit_destroy(mpm_implicit *im) {
   free(im->x_held);
   free(im->whole);
   free(im->reaction);
+  free(im->grip_mass);
   free(im);
 }
 

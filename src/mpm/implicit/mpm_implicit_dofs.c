@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mpm_exchange.h"
+#include "mpm_grip.h"
 #include "mpm_implicit_impl.h"
 #include "mpm_kind.h"
 #include "pm_omp.h"
@@ -71,13 +72,13 @@ void mpm_implicit_make_buckets(mpm_implicit *im) {
   }
 }
 
-/* The full-load value of condition b's component c at x (face plane on its
- * axis). */
+/* The full-load value of condition b's component c at x (on a face: on
+ * its plane). */
 static double bc_value(const mpm_implicit *im, int b, int c,
                        const double x[3]) {
   const mpm_bc *bc = &im->m->bcs[b];
   double y[3] = {x[0], x[1], x[2]};
-  y[bc->axis] = bc->plane;
+  if (!bc->grip) y[bc->axis] = bc->plane;
   double T = im->m->opt.t_load;
   return pm_ramp_factor(bc->ramp, bc->ramp_time, T) *
          pm_expr_eval(bc->disp[c], y[0], y[1], y[2], T);
@@ -175,6 +176,38 @@ static pm_err extend_kept(mpm_implicit *im, int b, double scale, bool mirror) {
   return PM_SUCCESS;
 }
 
+/* A motion on a named surface (condition b) on the kept grid: the nodes
+ * its particles hold wholly in the explicit MPM's rule (mpm_grip.c), those
+ * where they weigh at least MPM_GRIP_SHARE of the mass of the particles
+ * that reach the node, take its value there.  On a surface along a node
+ * plane, with linear shapes, these are the plane's nodes: a face's. */
+static pm_err hold_surface(mpm_implicit *im, int b, double scale) {
+  const mpm_model *m = im->m;
+  const mpm_bc *bc = &m->bcs[b];
+  const mpm_grid *g = &im->g;
+  double *mass = im->grip_mass, *held = im->grip_mass + g->n_nodes;
+  memset(mass, 0, 2 * sizeof(double) * (size_t)g->n_nodes);
+  for (int pass = 0; pass < 2; pass++) {
+    const long n = pass ? bc->n_held : im->n;
+    for (long q = 0; q < n; q++) {
+      const long p = pass ? bc->held[q] : q;
+      mpm_stencil st;
+      mpm_stencil_at(g, im->xb + 3 * p, MPM_STENCIL_W, &st);
+      for (int k = 0; k < st.n; k++)
+        (pass ? held : mass)[st.node[k]] += st.w[k] * m->mass[p];
+    }
+  }
+  for (long k = 0; k < g->n_nodes; k++) {
+    if (!(held[k] > 0) || held[k] < MPM_GRIP_SHARE * mass[k]) continue;
+    double x[3];
+    mpm_grid_node_position(g, k, x);
+    for (int c = 0; c < im->dim; c++)
+      if (bc->disp_mask >> c & 1u)
+        PM_CALL(prescribe(im, k, c, b, scale * bc_value(im, b, c, x), -1, 0));
+  }
+  return PM_SUCCESS;
+}
+
 /* Every prescribed dof that follows another prescribed dof follows, in
  * the end, an unknown: substitute the anchors' own rules (a corner's
  * node follows across two faces). */
@@ -203,7 +236,9 @@ static pm_err make_prescribed(mpm_implicit *im) {
   for (int b = 0; b < m->n_bcs; b++) {
     const mpm_bc *bc = &m->bcs[b];
     if (!bc->disp_mask) continue;
-    if (im->mode == MPM_GRID_KEPT) {
+    if (im->mode == MPM_GRID_KEPT && bc->grip) {
+      PM_CALL(hold_surface(im, b, scale));
+    } else if (im->mode == MPM_GRID_KEPT) {
       PM_CALL(extend_kept(im, b, scale, false));
     } else {
       for (long q = im->face_ptr[b]; q < im->face_ptr[b + 1]; q++) {

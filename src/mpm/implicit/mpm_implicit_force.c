@@ -134,7 +134,7 @@ bool mpm_implicit_nodal_force(mpm_implicit *im, const double *u, double *f) {
   const double lam = im->lam0 + im->lam_local * (im->lam1 - im->lam0);
   if (im->fbar) {
     const bool ok = fbar_force(im, u, NULL, f);
-    mpm_tractions_nodal(m, &im->g, im->xb, lam, f);
+    mpm_tractions_nodal(m, &im->g, im->xb, u, lam, f);
     return ok;
   }
   memset(f, 0, 3 * sizeof(double) * (size_t)im->g.n_nodes);
@@ -169,7 +169,7 @@ bool mpm_implicit_nodal_force(mpm_implicit *im, const double *u, double *f) {
   im->min_jacobian = INFINITY;
   for (int t = 0; t < im->threads; t++)
     im->min_jacobian = fmin(im->min_jacobian, im->tmin[t]);
-  mpm_tractions_nodal(m, &im->g, im->xb, lam, f);
+  mpm_tractions_nodal(m, &im->g, im->xb, u, lam, f);
   return im->fail_p < 0;
 }
 
@@ -217,6 +217,25 @@ pm_err mpm_implicit_cb_set_load(void *ctx, double lambda) {
   return PM_SUCCESS;
 }
 
+/* df += the pressures' load stiffness times du (the matrix-free product:
+ * every entry, none left out). */
+typedef struct {
+  const double *du;
+  double *df;
+} pressure_product;
+
+static void pressure_entry(void *ctx, long row, long col, double v) {
+  pressure_product *pp = ctx;
+  pp->df[row] += v * pp->du[col];
+}
+
+static void pressure_apply(const mpm_implicit *im, const double *du,
+                           double *df) {
+  const double lam = im->lam0 + im->lam_local * (im->lam1 - im->lam0);
+  pressure_product pp = {du, df};
+  mpm_pressures_tangent(im->m, &im->g, im->xb, im->u, lam, pressure_entry, &pp);
+}
+
 /* dr = K dx: the directional derivative of the nodal force. */
 pm_err mpm_implicit_cb_apply(void *ctx, const double *x, const double *dx,
                              double *dr) {
@@ -227,6 +246,7 @@ pm_err mpm_implicit_cb_apply(void *ctx, const double *x, const double *dx,
   if (im->fbar) {
     if (!fbar_force(im, im->u, im->du, im->df))
       return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
+    pressure_apply(im, im->du, im->df);
     mpm_implicit_fold(im, im->df, dr);
     return PM_SUCCESS;
   }
@@ -255,6 +275,7 @@ pm_err mpm_implicit_cb_apply(void *ctx, const double *x, const double *dx,
     }
   })
   if (im->fail_p >= 0) return PM_ERROR(PM_ERR_INTERNAL, "%s", im->fail_msg);
+  pressure_apply(im, du, df);
   mpm_implicit_fold(im, df, dr);
   return PM_SUCCESS;
 }

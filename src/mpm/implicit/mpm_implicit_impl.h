@@ -62,6 +62,12 @@ struct mpm_implicit {
   double *near_null;     /* rigid motions for algebraic multigrid */
   /* face particles of each condition (reset) */
   long *face_ptr, *face;
+  /* 2 per node: the mass of the particles, and of a grip's, that reach
+   * it (grid kept, a motion on a named surface only) */
+  double *grip_mass;
+  /* the pressures' tangent entries outside the pattern at the last
+   * assembly (left out: the tangent is then inexact there) */
+  long pressure_left_out;
   /* nodal work, 3 per node */
   double *u, *du, *f, *df, *diag;
   double *trac_at; /* the tractions' points where the last step left them

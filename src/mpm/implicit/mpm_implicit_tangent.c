@@ -9,6 +9,7 @@
 #include "mpm_implicit_impl.h"
 #include "pm_interrupt.h"
 #include "mpm_kind.h"
+#include "mpm_traction.h"
 #include "pm_omp.h"
 #include "pm_progress.h"
 #include "pm_tensor.h"
@@ -139,13 +140,45 @@ void mpm_implicit_scatter_block(const mpm_implicit *im, const mpm_stencil *st,
   }
 }
 
+/* The pressures' load stiffness into the tangent's values: an entry
+ * through the unknowns its row and column follow; one outside the
+ * pattern (a facet's corners in cells apart) is left out and counted. */
+typedef struct {
+  const mpm_implicit *im;
+  double *val;
+  long left_out;
+} pressure_fill;
+
+static void pressure_entry(void *ctx, long row, long col, double v) {
+  pressure_fill *pf = ctx;
+  const mpm_implicit *im = pf->im;
+  long ru, cu;
+  double rt, ct;
+  if (v == 0 || !follows(im, row, &ru, &rt) || !follows(im, col, &cu, &ct))
+    return;
+  if (!mpm_implicit_add_entry(im, ru, im->unk_dof[ru] / 3, im->unk_dof[cu],
+                              rt * ct * v, pf->val))
+    pf->left_out++;
+}
+
+static pm_err pressure_values(mpm_implicit *im, double *val) {
+  const double lam = im->lam0 + im->lam_local * (im->lam1 - im->lam0);
+  pressure_fill pf = {im, val, 0};
+  mpm_pressures_tangent(im->m, &im->g, im->xb, im->u, lam, pressure_entry, &pf);
+  im->pressure_left_out = pf.left_out;
+  return PM_SUCCESS;
+}
+
 /* The assembled tangent in the pattern's order. */
 pm_err mpm_implicit_cb_values(void *ctx, const double *x, double *val) {
   mpm_implicit *im = ctx;
   const mpm_model *m = im->m;
   mpm_implicit_fill_u(im, x);
   memset(val, 0, sizeof(double) * (size_t)im->pat_ptr[im->nheld]);
-  if (im->fbar) return mpm_implicit_fbar_values(im, val);
+  if (im->fbar) {
+    PM_CALL(mpm_implicit_fbar_values(im, val));
+    return pressure_values(im, val);
+  }
   im->fail_p = -1;
   bool outside = false;
   FOR_PARTICLES(im, {
@@ -175,7 +208,8 @@ pm_err mpm_implicit_cb_values(void *ctx, const double *x, double *val) {
           }
     mpm_implicit_scatter_block(im, &st, K, val, &outside);
   })
-  return mpm_implicit_values_status(im, outside);
+  PM_CALL(mpm_implicit_values_status(im, outside));
+  return pressure_values(im, val);
 }
 
 /* The tangent's diagonal, for the matrix-free operator's Jacobi

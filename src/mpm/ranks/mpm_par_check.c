@@ -42,13 +42,16 @@ pm_err mpm_par_check(const pm_scene *s) {
                              got);
     }
   for (int i = 0; i < s->n_bcs; i++)
-    if (s->bcs[i].on == PM_ON_REGION || s->bcs[i].traction_mask) {
+    if (s->bcs[i].on == PM_ON_REGION || s->bcs[i].on == PM_ON_SURFACE ||
+        s->bcs[i].traction_mask || s->bcs[i].pressure) {
       const bool grip = s->bcs[i].on == PM_ON_REGION;
       char p[64];
       return pm_scene_fail(
-          s, PM_PATH(p, "boundary.%d.%s", i, grip ? "region" : "traction"),
-          true, "%s run on one process (this run has %d ranks): run with -np 1",
-          grip ? "grips on regions of particles" : "tractions on particles",
+          s, PM_PATH(p, "boundary.%d.%s", i, grip ? "region" : "on"), true,
+          "%s run on one process (this run has %d ranks): run with -np 1",
+          grip ? "grips on regions of particles"
+               : "conditions on particles (tractions, pressures, named "
+                 "surfaces)",
           pm_par_size());
     }
   return PM_SUCCESS;
