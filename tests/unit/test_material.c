@@ -14,7 +14,6 @@
 #include <string.h>
 
 #include "pm_eigen.h"
-#include "pm_tensor.h"
 #include "pm_material.h"
 #include "pm_testing.h"
 
@@ -262,23 +261,6 @@ static void test_eigen(void **state) {
   print_message("eigen: worst error %.2g of its tolerance\n", eigen_worst);
 }
 
-/* The stress's inline cube root against libm's: within 4 ulp over J from
- * 1e-300 to 1e300, and near J = 1 where the stresses live. */
-static void test_cbrt(void **state) {
-  (void)state;
-  double worst = 0;
-  for (double lx = -300; lx <= 300; lx += 0.00731) {
-    const double x = pow(10, lx), r = cbrt(x);
-    worst = fmax(worst, fabs(pm_cbrt_pos(x) - r) / r);
-  }
-  for (double d = -0.9; d < 3; d += 1.37e-5) {
-    const double x = 1 + d, r = cbrt(x);
-    worst = fmax(worst, fabs(pm_cbrt_pos(x) - r) / r);
-  }
-  print_message("  pm_cbrt_pos: %.2f ulp at worst\n", worst / DBL_EPSILON);
-  assert_true(worst <= 4 * DBL_EPSILON);
-}
-
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_pk2_and_cauchy),
@@ -287,7 +269,6 @@ int main(void) {
       cmocka_unit_test(test_bad_constants),
       cmocka_unit_test(test_bad_parameters),
       cmocka_unit_test(test_eigen),
-      cmocka_unit_test(test_cbrt),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -4,7 +4,6 @@
 #define PM_TENSOR_H
 
 #include <math.h>
-#include <stdint.h>
 #include <string.h>
 
 static inline void pm_t_identity(double A[9]) {
@@ -139,23 +138,6 @@ static inline double pm_t_von_mises(const double S[9]) {
   double a = S[0] - p, b = S[4] - p, c = S[8] - p;
   double sh = S[1] * S[1] + S[2] * S[2] + S[5] * S[5];
   return sqrt(1.5 * (a * a + b * b + c * c + 2 * sh));
-}
-
-/* x^(1/3) for x > 0 (finite, normal), within 4 ulp of cbrt: an
- * exponent-thirding first guess (a few percent) and three Halley steps
- * (cubic convergence), a fraction of libm's cbrt, which a stress
- * evaluation per point and step calls. */
-static inline double pm_cbrt_pos(double x) {
-  uint64_t i;
-  memcpy(&i, &x, sizeof i);
-  i = i / 3 + 0x2A9F7893782DA1CEull;
-  double c;
-  memcpy(&c, &i, sizeof c);
-  for (int k = 0; k < 3; k++) {
-    const double c3 = c * c * c;
-    c *= (c3 + 2 * x) / (2 * c3 + x);
-  }
-  return c;
 }
 
 #endif

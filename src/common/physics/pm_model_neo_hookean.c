@@ -5,7 +5,6 @@
 
 #include "pm_hyper.h"
 #include "pm_models.h"
-#include "pm_tensor.h"
 
 /* P = mu J^-2/3 (F - I1/3 F^-T) + K (J - 1) J F^-T, with J F^-T = cof F.
  * J - 1 and J^-2/3 - 1 are formed from H = F - I so that the stress and
@@ -24,19 +23,17 @@ static bool stress(const pm_material *m, const double F[9], const double *st,
   if (Jout) *Jout = J;
   if (!(J > 0)) return false;
   pm_t_cofactor(F, cof);
-  /* c = J^1/3 and c - 1 = (J - 1) / (c^2 + c + 1), so that J^-2/3 - 1 =
-   * -(c - 1)(c + 1) / c^2 keeps its relative accuracy as J -> 1 (one
-   * inline cube root where log1p, exp and expm1 took three calls). */
-  const double c = pm_cbrt_pos(J), Jm23 = 1 / (c * c);
+  double lnJ = log1p(Jm1);
+  double Jm23 = exp(-2.0 / 3.0 * lnJ);
   double I1m3 = 2 * pm_t_trace(H) + pm_t_ddot(H, H); /* tr(F^T F) - 3 */
   double I1 = 3 + I1m3;
   /* F - I1/3 F^-T = F - I1/(3J) cof F */
   double a = mu * Jm23, b = -a * I1 / (3 * J) + kappa * Jm1;
   for (int k = 0; k < 9; k++) P[k] = a * F[k] + b * cof[k];
-  if (W) {
-    const double Jm23m1 = -(Jm1 / (c * c + c + 1)) * (c + 1) * Jm23;
-    *W = 0.5 * mu * (Jm23 * I1m3 + 3 * Jm23m1) + 0.5 * kappa * Jm1 * Jm1;
-  }
+  /* J^-2/3 - 1 only for the energy: the stress alone skips the expm1. */
+  if (W)
+    *W = 0.5 * mu * (Jm23 * I1m3 + 3 * expm1(-2.0 / 3.0 * lnJ)) +
+         0.5 * kappa * Jm1 * Jm1;
   return pm_hyper_finite(P);
 }
 
