@@ -22,13 +22,16 @@ _Static_assert((int)GM_SIZES_SCALE == (int)PM_MESH_SIZES_SCALE &&
 #if defined(__SANITIZE_ADDRESS__) || defined(GM_GMSH_ASAN)
 /* gmsh 4.8 and OpenCASCADE leak a little on their own: meshing curved
  * surfaces (meshGFace), the .geo parser after a syntax error (its Malloc),
- * STEP reading and writing (OpenCASCADE's libTK*).  A sanitizer build
- * (detect_leaks=1) of any program that meshes through this module ignores
+ * STEP reading and writing (OpenCASCADE's libTK*), and an STL's triangles
+ * once classified into surfaces (GModel::readSTL's discrete face and the
+ * edges classifyFaces makes, which the new surfaces replace).  A sanitizer
+ * build (detect_leaks=1) of any program that meshes through this module ignores
  * exactly those, so that a leak of ours, or an array from the gmsh API left
  * without gmshFree, still fails. */
 const char *__lsan_default_suppressions(void);
 const char *__lsan_default_suppressions(void) {
-  return "leak:meshGFace\nleak:^Malloc(\nleak:libTK\n";
+  return "leak:meshGFace\nleak:^Malloc(\nleak:libTK\nleak:GModel::readSTL\n"
+         "leak:classifyFaces\nleak:discreteFace::_createGeometryFromSTL\n";
 }
 #endif
 
