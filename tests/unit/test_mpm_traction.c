@@ -121,6 +121,24 @@ static void test_energy(void **state) {
   }
 }
 
+/* A load curve on the traction (here the constant 0.5) scales it: the
+ * clamp holds half the force, and the balance still closes. */
+static void test_curve(void **state) {
+  char path[512], out[600];
+  write_panel(*state, path);
+  static const char *const set[] = {"boundary.1.curve=0.5"};
+  pm_scene *s = NULL;
+  assert_ok(pm_scene_load(path, 1, set, &s));
+  snprintf(out, sizeof out, "%s/run", (const char *)*state);
+  pm_outcome o;
+  assert_ok(pm_run_scene(s, out, true, &o));
+  print_message("  curve 0.5: clamp reaction %.12g N, energy error %.3g\n",
+                o.fig.reaction[0][1], o.fig.energy_error);
+  assert_near(o.fig.reaction[0][1], -10, 1e-8);
+  assert_near(o.fig.energy_error, 0, 1e-3);
+  pm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup_teardown(test_resultant, pm_test_make_dir,
@@ -130,6 +148,8 @@ int main(void) {
       cmocka_unit_test_setup_teardown(test_refused, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_unknown_name, pm_test_make_dir,
+                                      pm_test_drop_dir),
+      cmocka_unit_test_setup_teardown(test_curve, pm_test_make_dir,
                                       pm_test_drop_dir),
       cmocka_unit_test_setup_teardown(test_energy, pm_test_make_dir,
                                       pm_test_drop_dir),

@@ -23,6 +23,7 @@ pm_err mpm_conditions_create(const pm_scene *s, const mpm_grid *g, mpm_bc **bcs,
     bc->pressure = sb->pressure;
     bc->ramp = sb->ramp;
     bc->ramp_time = sb->ramp_time;
+    bc->curve = sb->curve;
     bc->absorbing = sb->absorbing;
     for (int c = 0; c < 3; c++) {
       bc->disp[c] = sb->disp[c];
@@ -123,15 +124,14 @@ size_t mpm_cond_work_bytes(const mpm_cond_work *cw, const mpm_grid *g) {
 
 double mpm_bc_velocity(const mpm_bc *bc, int c, const double x[3], double t,
                        double dt) {
-  double T = bc->ramp_time;
   if (bc->disp[c]) {
-    double u1 = pm_ramp_factor(bc->ramp, T, t + dt) *
+    double u1 = mpm_bc_factor(bc, t + dt) *
                 pm_expr_eval(bc->disp[c], x[0], x[1], x[2], t + dt);
-    double u0 = pm_ramp_factor(bc->ramp, T, t) *
-                pm_expr_eval(bc->disp[c], x[0], x[1], x[2], t);
+    double u0 =
+        mpm_bc_factor(bc, t) * pm_expr_eval(bc->disp[c], x[0], x[1], x[2], t);
     return (u1 - u0) / dt;
   }
-  return pm_ramp_factor(bc->ramp, T, t + dt) *
+  return mpm_bc_factor(bc, t + dt) *
          pm_expr_eval(bc->velocity[c], x[0], x[1], x[2], t + dt);
 }
 
@@ -140,8 +140,8 @@ double mpm_bc_velocity(const mpm_bc *bc, int c, const double x[3], double t,
 static double bc_wall(const mpm_bc *bc, const double x[3], double t) {
   int a = bc->axis;
   if (!bc->disp[a]) return bc->plane;
-  return bc->plane + pm_ramp_factor(bc->ramp, bc->ramp_time, t) *
-                         pm_expr_eval(bc->disp[a], x[0], x[1], x[2], t);
+  return bc->plane +
+         mpm_bc_factor(bc, t) * pm_expr_eval(bc->disp[a], x[0], x[1], x[2], t);
 }
 
 /* Record the first value of the run that is not finite: expression e at

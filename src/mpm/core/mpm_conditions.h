@@ -27,6 +27,7 @@ typedef struct {
   const pm_expr *disp[3], *velocity[3]; /* NULL where not prescribed */
   pm_ramp ramp;
   double ramp_time;
+  const pm_curve *curve; /* the scene's load curve (borrowed), NULL: 1 */
   bool absorbing;
   bool constant[3]; /* expression uses none of x, y, z */
   /* A grip (a condition on a region): the particles it holds (indices,
@@ -61,6 +62,12 @@ typedef struct {
    * columns. */
   const pm_scene_bc *rigid;
 } mpm_bc;
+
+/* The factor of bc's values at time t: its load curve times its ramp (as
+ * pm_bc_factor for the scene's condition). */
+static inline double mpm_bc_factor(const mpm_bc *bc, double t) {
+  return pm_curve_at(bc->curve, t) * pm_ramp_factor(bc->ramp, bc->ramp_time, t);
+}
 
 /* Whether condition bc loads its surface (a traction or a pressure). */
 #define MPM_BC_LOADS(bc) ((bc)->traction_mask || (bc)->pressure)

@@ -166,7 +166,7 @@ pm_err mpm_stage_grips(mpm_ctx *ctx, const mpm_stage *self) {
         double *vp = s->v + 3 * p + c;
         if (bc->disp[c]) {
           /* The prescribed position at the step's end: no drift. */
-          const double u = pm_ramp_factor(bc->ramp, bc->ramp_time, t1) *
+          const double u = mpm_bc_factor(bc, t1) *
                            pm_expr_eval(bc->disp[c], X[0], X[1], X[2], t1);
           dx[3 * p + c] = X[c] + u - s->x[3 * p + c];
         } else if (bc->velocity[c]) {

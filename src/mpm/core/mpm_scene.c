@@ -267,11 +267,11 @@ static pm_err check_bodies(const pm_scene *s) {
 }
 
 /* The loads of method fpm that MPM does not take (yet): body_force,
- * body_curve and a condition's force, at and curve. */
+ * body_curve and a condition's force and at. */
 static pm_err refuse_fpm_loads(const pm_scene *s) {
   char p[64];
   static const char *const top[] = {"body_force", "body_curve"};
-  static const char *const per_bc[] = {"force", "at", "curve"};
+  static const char *const per_bc[] = {"force", "at"};
   for (int k = 0; k < 2; k++)
     if (pm_scene_has(s, top[k]))
       return pm_scene_fail(s, top[k], true,
@@ -279,7 +279,7 @@ static pm_err refuse_fpm_loads(const pm_scene *s) {
                            "takes gravity), got %s",
                            top[k], s->method, top[k]);
   for (int i = 0; i < s->n_bcs; i++)
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 2; k++)
       if (pm_scene_has(s, PM_PATH(p, "boundary.%d.%s", i, per_bc[k])))
         return pm_scene_fail(s, p, true,
                              "expected no %s for method %s (FPM only), got "
@@ -461,8 +461,8 @@ double mpm_bc_largest_displacement(const pm_scene *s, int b, int comp,
                                  : s->box_min[a];
     int ax = pm_face_axis(bc->face);
     x[ax] = pm_face_plane(bc->face, s->box_min, s->box_max);
-    double u = pm_ramp_factor(bc->ramp, bc->ramp_time, T) *
-               pm_expr_eval(bc->disp[comp], x[0], x[1], x[2], T);
+    double u =
+        pm_bc_factor(bc, T) * pm_expr_eval(bc->disp[comp], x[0], x[1], x[2], T);
     if (isfinite(u)) umax = fmax(umax, sign != 0 ? sign * u : fabs(u));
   }
   return umax;

@@ -389,7 +389,7 @@ static void traction_force(const mpm_model *m, const mpm_bc *bc, long k,
                            double t, double f[3]) {
   double X[3];
   face_point(bc, k, m->x0, X);
-  const double r = pm_ramp_factor(bc->ramp, bc->ramp_time, t) * bc->area[k];
+  const double r = mpm_bc_factor(bc, t) * bc->area[k];
   for (int c = 0; c < 3; c++)
     f[c] = bc->traction[c] && c < m->dim
                ? r * pm_expr_eval(bc->traction[c], X[0], X[1], X[2], t)
@@ -403,8 +403,7 @@ static double point_pressure(const mpm_model *m, const mpm_bc *bc, long k,
   if (!bc->pressure) return 0;
   double X[3];
   face_point(bc, k, m->x0, X);
-  return pm_ramp_factor(bc->ramp, bc->ramp_time, t) *
-         pm_expr_eval(bc->pressure, X[0], X[1], X[2], t);
+  return mpm_bc_factor(bc, t) * pm_expr_eval(bc->pressure, X[0], X[1], X[2], t);
 }
 
 /* The force condition bc applies at its k-th point at time t over the

@@ -80,8 +80,7 @@ static double bc_value(const mpm_implicit *im, int b, int c,
   double y[3] = {x[0], x[1], x[2]};
   if (!bc->grip) y[bc->axis] = bc->plane;
   double T = im->m->opt.t_load;
-  return pm_ramp_factor(bc->ramp, bc->ramp_time, T) *
-         pm_expr_eval(bc->disp[c], y[0], y[1], y[2], T);
+  return mpm_bc_factor(bc, T) * pm_expr_eval(bc->disp[c], y[0], y[1], y[2], T);
 }
 
 /* Prescribe component c of node k by condition b: u = v at local load 1
