@@ -2,6 +2,7 @@
  * linear simplices and the named physical groups on their boundary.  The
  * one reader of gmsh meshes for gm_mesh and gm_volume. */
 #include "gm_gmsh.h"
+#include "gm_trisurf.h"
 
 #include <errno.h>
 #include <gmshc.h>
@@ -326,51 +327,36 @@ done:
   return ret;
 }
 
-/* Two node tags, an edge, in increasing order. */
-typedef struct {
-  size_t a, b;
-} edge_key;
-
-static int edge_cmp(const void *p, const void *q) {
-  const edge_key *e = p, *f = q;
-  if (e->a != f->a) return e->a < f->a ? -1 : 1;
-  return e->b < f->b ? -1 : e->b > f->b;
-}
-
-/* Whether the open model's triangles (gmsh type 2) close a surface: every
- * edge in exactly two of them. */
+/* Whether the open model's triangles (gmsh type 2) close a surface,
+ * consistently oriented (gm_trisurf_closed, on their node tags). */
 static pm_err triangles_closed(const char *path, bool *closed) {
   pm_err ret = PM_SUCCESS;
   int ierr = 0;
   size_t *etag = NULL, *ntag = NULL, n_e = 0, n_n = 0;
-  edge_key *edges = NULL;
+  gm_trisurf tags = {.n_points = 0};
   *closed = false;
   gmshModelMeshGetElementsByType(2, &etag, &n_e, &ntag, &n_n, -1, 0, 1, &ierr);
   GM_GMSH_CHECK("reading the triangles of", path);
-  const size_t n_tri = n_n / 3;
-  if (n_tri < 4) goto done;
-  PM_TRY(PM_ALLOC(edges, 3 * n_tri, "surface edges"));
-  for (size_t t = 0; t < n_tri; t++)
-    for (int k = 0; k < 3; k++) {
-      const size_t a = ntag[3 * t + k], b = ntag[3 * t + (k + 1) % 3];
-      edges[3 * t + k] = (edge_key){a < b ? a : b, a < b ? b : a};
-    }
-  qsort(edges, 3 * n_tri, sizeof *edges, edge_cmp);
-  *closed = true;
-  for (size_t i = 0; i < 3 * n_tri && *closed; i += 2)
-    *closed = i + 1 < 3 * n_tri && !edge_cmp(&edges[i], &edges[i + 1]) &&
-              (i + 2 >= 3 * n_tri || edge_cmp(&edges[i + 1], &edges[i + 2]));
+  tags.n_tris = (long)(n_n / 3);
+  if (tags.n_tris < 4) goto done;
+  PM_TRY(PM_ALLOC(tags.tri, 3 * (size_t)tags.n_tris, "surface triangles"));
+  for (size_t k = 0; k < 3 * (size_t)tags.n_tris; k++) {
+    tags.tri[k] = (long)ntag[k];
+    if (tags.tri[k] >= tags.n_points) tags.n_points = tags.tri[k] + 1;
+  }
+  *closed = gm_trisurf_closed(&tags, NULL, 0);
 done:
-  free(edges);
+  free(tags.tri);
   if (etag) gmshFree(etag);
   if (ntag) gmshFree(ntag);
   return ret;
 }
 
-/* A file that holds a closed surface mesh and no volume (.stl, .ply, a
- * .msh of triangles): the volume it closes, its triangles kept as the boundary
- * (gmsh classifies them into surfaces at 40-degree edges and builds a
- * volume on all of them).  *closed: whether there was one to close. */
+/* A file that holds a closed, consistently oriented surface mesh and no
+ * volume (.stl, .ply, a .msh of triangles): the volume it closes, its
+ * triangles kept as the boundary (gmsh classifies them into surfaces at
+ * 40-degree edges and builds a volume on all of them).  *closed: whether
+ * there was one to close. */
 static pm_err close_surface_mesh(const char *path, bool *closed) {
   pm_err ret = PM_SUCCESS;
   int ierr = 0, *vol = NULL, *types = NULL, *surf = NULL, *tags = NULL;
