@@ -3,9 +3,7 @@
 #define GM_GMSH_API_IMPL
 #include "gm_gmsh_api.h"
 
-#include <dlfcn.h>
-#include <stdbool.h>
-#include <string.h>
+#include <stddef.h>
 
 #ifndef PM_GMSH_SONAME
 #error "PM_GMSH_SONAME: the build names the gmsh library (CMakeLists.txt)"
@@ -13,41 +11,19 @@
 
 gm_gmsh_api_table gm_gmsh_api;
 
-/* Once filled, the table stays: the library is never closed, since gmsh and
- * OpenCASCADE keep state past gmshFinalize (static objects, handlers
- * registered at exit). */
-static bool loaded;
+#define PM_DL_TYPE gm_gmsh_api_table
+static const pm_dl_entry entries[] = {GM_GMSH_API(PM_DL_ENTRY)};
 
 pm_err gm_gmsh_api_load_from(const char *soname, const char *need) {
-  if (loaded) return PM_SUCCESS;
-  const char *why = need ? need : "meshing";
-  void *lib = dlopen(soname, RTLD_NOW | RTLD_LOCAL);
-  if (!lib) {
-    const char *msg = dlerror();
-    return PM_ERROR(PM_ERR_UNSUPPORTED,
-                    "gmsh library %s cannot be loaded, and %s needs it: %s "
-                    "(install gmsh's library, or add its folder to "
-                    "LD_LIBRARY_PATH)",
-                    soname, why, msg ? msg : "no reason given");
-  }
-  gm_gmsh_api_table t;
-  void *fn;
-#define GM_GMSH_API_RESOLVE(name)                                              \
-  fn = dlsym(lib, #name);                                                      \
-  if (!fn) {                                                                   \
-    dlclose(lib);                                                              \
-    return PM_ERROR(PM_ERR_UNSUPPORTED,                                        \
-                    "gmsh library %s lacks the function %s, and %s needs "     \
-                    "it: another gmsh than the one pointmech was built with "  \
-                    "(gmshc.h of gmsh %s)",                                    \
-                    soname, #name, why, GMSH_API_VERSION);                     \
-  }                                                                            \
-  memcpy(&t.name, &fn, sizeof fn);
-  GM_GMSH_API(GM_GMSH_API_RESOLVE)
-#undef GM_GMSH_API_RESOLVE
-  gm_gmsh_api = t;
-  loaded = true;
-  return PM_SUCCESS;
+  static pm_dl_library lib = {
+      .what = "gmsh",
+      .built = "gmshc.h of gmsh " GMSH_API_VERSION,
+      .entries = entries,
+      .n_entries = sizeof entries / sizeof entries[0],
+      .table = &gm_gmsh_api,
+  };
+  lib.soname = soname;
+  return pm_dl_load(&lib, need);
 }
 
 pm_err gm_gmsh_api_load(const char *need) {

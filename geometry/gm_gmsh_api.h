@@ -10,6 +10,7 @@
 
 #include <gmshc.h>
 
+#include "pm_dl.h"
 #include "pm_error.h"
 
 /* X(name): every function of gmshc.h the geometry modules call. */
@@ -50,18 +51,14 @@
   X(gmshOptionGetNumber)                                                       \
   X(gmshOptionSetNumber)
 
-typedef struct {
-#define GM_GMSH_API_ENTRY(name) __typeof__(name) *name;
-  GM_GMSH_API(GM_GMSH_API_ENTRY)
-#undef GM_GMSH_API_ENTRY
-} gm_gmsh_api_table;
+PM_DL_TABLE(GM_GMSH_API, gm_gmsh_api_table);
 
 extern gm_gmsh_api_table gm_gmsh_api;
 
 /* Opens libgmsh (the soname the build found, PM_GMSH_SONAME) once per
- * process and fills the table.  need names what asked for it (a file's
- * path, or "meshing a box") in the message of PM_ERR_UNSUPPORTED when the
- * library cannot be opened or lacks a function.  gm_gmsh_begin calls it:
+ * process and fills the table (pm_dl_load).  need names what asked for it (a
+ * file's path, or "meshing a box") in the message of PM_ERR_UNSUPPORTED when
+ * the library cannot be opened or lacks a function.  gm_gmsh_begin calls it:
  * every gmsh call runs inside a session. */
 pm_err gm_gmsh_api_load(const char *need);
 /* The same with the library named: soname is dlopen's argument. */

@@ -51,7 +51,7 @@ static void test_library_without_gmsh(void **state) {
   (void)state;
   assert_fails(gm_gmsh_api_load_from("libc.so.6", "meshing a box"),
                PM_ERR_UNSUPPORTED,
-               "gmsh library libc.so.6 lacks the function gmshFinalize, and "
+               "gmsh library libc.so.6 lacks gmshFinalize, and "
                "meshing a box needs it");
 }
 
