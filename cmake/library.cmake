@@ -25,6 +25,12 @@ target_include_directories(pointmech_lib
 # takes nothing more from them.  Calls inside the library bind to it.
 target_link_libraries(pointmech_lib PRIVATE pm_app)
 target_link_options(pointmech_lib PRIVATE -Wl,-Bsymbolic-functions)
+# --no-undefined: a function of a library opened on first use (gmsh) that
+# a call site reaches without its table stays undefined, and fails here.
+# Not with the sanitizers, whose runtime the program brings (clang's).
+if(NOT PM_SANITIZE AND NOT PM_FUZZ)
+  target_link_options(pointmech_lib PRIVATE -Wl,--no-undefined)
+endif()
 foreach(layer ${PM_LAYERS})
   add_dependencies(pointmech_lib ${layer})
 endforeach()

@@ -1,10 +1,11 @@
 /* gm_gmsh: one gmsh session setup for every geometry module. */
 #include "gm_gmsh.h"
 
-#include <gmshc.h>
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 
+#include "gm_gmsh_api.h"
 #include "pm_omp.h"
 #include "pm_scene.h"
 
@@ -69,10 +70,20 @@ pm_err gm_gmsh_begin(gm_gmsh_session *s, const char *path) {
       {"Mesh.RandomSeed", 1},
   };
   int ierr = 0;
+  s->threads = 0;
+  s->open = false;
+  /* The library is opened here, by the first session: a run that never
+   * meshes nor reads a gmsh file never maps it.  Without a file, the
+   * session meshes the scene's domain.box (gm_mesh_box). */
+  char need[512];
+  if (path)
+    snprintf(need, sizeof need, "reading '%s'", path);
+  else
+    snprintf(need, sizeof need, "meshing the box of domain.box");
+  PM_CALL(gm_gmsh_api_load(need));
   /* gmsh sets the process-wide OpenMP thread count from its own option:
    * gm_gmsh_end puts ours back. */
   s->threads = pm_omp_threads();
-  s->open = false;
   gmshInitialize(0, NULL, 0, &ierr);
   if (ierr) return gm_gmsh_fail("initialize", path);
   s->open = true;

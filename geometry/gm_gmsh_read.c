@@ -5,7 +5,7 @@
 #include "gm_trisurf.h"
 
 #include <errno.h>
-#include <gmshc.h>
+#include "gm_gmsh_api.h" /* gmshc.h, through the table */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

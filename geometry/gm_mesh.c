@@ -3,7 +3,7 @@
  * orientation and mean edge length. */
 #include "gm_mesh.h"
 
-#include <gmshc.h>
+#include "gm_gmsh_api.h" /* gmshc.h, through the table */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

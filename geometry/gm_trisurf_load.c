@@ -3,7 +3,7 @@
  * merged through a hash of cells the size of the merging tolerance. */
 #include "gm_trisurf.h"
 
-#include <gmshc.h>
+#include "gm_gmsh_api.h" /* gmshc.h, through the table */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>

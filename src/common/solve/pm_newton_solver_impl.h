@@ -8,6 +8,8 @@
 
 #include <petscsnes.h>
 
+#include "pm_petsc_api.h"
+
 #include "pm_coloring.h"
 #include "pm_newton.h"
 #include "pm_par.h"

@@ -3,7 +3,7 @@
 #ifndef PM_PETSC_H
 #define PM_PETSC_H
 
-#include <petscsys.h>
+#include "pm_petsc_api.h" /* petscsys.h and the rest, through the table */
 
 #include "pm_error.h"
 

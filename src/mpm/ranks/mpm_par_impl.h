@@ -7,6 +7,8 @@
 #include <mpi.h>
 #include <petscsf.h>
 
+#include "pm_petsc_api.h"
+
 #include "mpm_par.h"
 #include "mpm_par_ghosts.h"
 
