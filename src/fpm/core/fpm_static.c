@@ -234,7 +234,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
     no.pc_right = true;
     /* a narrow stencil (the 1-ring): the squared graph's aggregates, as
      * PETSc means them (unsquared at 474 points: 100 GMRES iterations a
-     * solve against 58) */
+     * solve against 52) */
     no.amg_unsquared = false;
   }
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
