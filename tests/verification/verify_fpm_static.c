@@ -196,15 +196,16 @@ static void test_static_linear_solvers(void **state) {
      * each Newton iteration's and the first step's predictor) */
     if (k == 3)
       assert_true(lr->linear_iterations <= 2 * (lr->newton_iterations + 1));
-    /* multigrid with its defaults (built on the tangent and smoothing
-     * with it, inexact solves, the hierarchy kept): measured 704 GMRES
-     * iterations in 30 Newton iterations, 23 a solve (2434 with every
-     * solve to 1e-6 and PETSc's smoothing with the matrix-free operator) */
+    /* multigrid with its defaults (built on the tangent, aggregated on
+     * its own graph and smoothing with it, inexact solves, the hierarchy
+     * kept): measured 606 GMRES iterations in 30 Newton iterations, 20 a
+     * solve (704 aggregated on the squared graph; 2434 with every solve
+     * to 1e-6 and PETSc's smoothing with the matrix-free operator) */
     if (k == 1)
       assert_true(lr->linear_iterations <= 30 * (lr->newton_iterations + 1));
     /* multigrid built on each point's support, GMRES preconditioned on
-     * the right: measured 2097 GMRES iterations in 36 Newton iterations,
-     * 57 a solve (each V-cycle on a tenth of the entries); preconditioned
+     * the right: measured 1940 GMRES iterations in 36 Newton iterations,
+     * 52 a solve (each V-cycle on a tenth of the entries); preconditioned
      * on the left, a solve ran to its 1000 iterations */
     if (k == 4)
       assert_true(lr->linear_iterations <= 80 * (lr->newton_iterations + 1));

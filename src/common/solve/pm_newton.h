@@ -290,15 +290,19 @@ typedef struct {
    * pc_reuse_its (about what a new LU costs in iterations where FPM keeps
    * one: 17-60), is made again on a new one.  0: off. */
   double pc_reuse_cost; /* 4 */
-  /* Algebraic multigrid (the gamg solvers): keep the hierarchy's
-   * interpolation from one preconditioner set-up to the next, recomputing
-   * only the coarse operators (PETSc's -pc_gamg_reuse_interpolation). */
+  /* gamg: keep the hierarchy's interpolation over set-ups, only the coarse
+   * operators recomputed (PETSc's -pc_gamg_reuse_interpolation). */
   bool amg_reuse; /* false */
+  /* GAMG aggregates on the matrix's graph, not on its square (PETSc's
+   * default; on a wide stencil: a coarse level of a few dozen unknowns). */
+  bool amg_unsquared; /* false */
   /* Multigrid preconditioning a matrix-free operator: the finest level's
    * smoother and residual multiply by the assembled preconditioning
    * matrix, not the operator (PETSc's -pc_use_amat false; with PETSc's
    * default they call jacobian_apply about four times a V-cycle). */
   bool amg_assembled_smoother; /* false */
+  /* and, on one process, on every OpenMP thread (pm_newton_fine.c) */
+  bool amg_threaded; /* false */
   /* Krylov solvers preconditioned on the right: their residual and
    * tolerance are the true residual's (on the left, PETSc's default, the
    * preconditioned one's, which says little of the true residual when the

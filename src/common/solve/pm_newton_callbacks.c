@@ -239,6 +239,7 @@ PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
   const int blas = pm_blas_widen(); /* the factorisation on every core */
   PetscErrorCode code = KSPSetUp(ksp);
   if (!code) code = KSPSetUpOnBlocks(ksp);
+  if (!code) code = pm_newton_fine_attach(s, ksp);
   if (!code) code = pm_newton_aug_factor(s);
   pm_blas_restore(blas);
   PetscCall(code);

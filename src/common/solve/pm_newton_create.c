@@ -109,6 +109,9 @@ static pm_err configure_snes(pm_newton *s) {
   if (o->amg_reuse)
     PM_PETSC_CALL(PetscOptionsInsertString(
         s->opts, "-pm_pc_gamg_reuse_interpolation true"));
+  if (o->amg_unsquared)
+    PM_PETSC_CALL(
+        PetscOptionsInsertString(s->opts, "-pm_pc_gamg_square_graph 0"));
   if (s->petsc_options) {
     PetscErrorCode code = PetscOptionsInsertString(s->opts, s->petsc_options);
     PM_CHECK(code == 0, PM_ERR_ARG, "PETSc options \"%s\" not understood",
@@ -165,6 +168,7 @@ static pm_err create_petsc_objects(pm_newton *s) {
   } else if (!s->aug) {
     PM_CALL(pm_newton_create_matrix(s, &s->jpat, &s->jcols, s->jvals, &s->J));
   }
+  PM_CALL(pm_newton_fine_create(s));
   if (s->p.near_null_count > 0 && !s->aug) {
     Mat A, B;
     pm_newton_operators(s, &A, &B);
@@ -253,6 +257,7 @@ void pm_newton_destroy(pm_newton **sp) {
   SNESDestroy(&s->snes);
   pm_newton_aug_free(s);
   MatDestroy(&s->Shell);
+  MatDestroy(&s->Fine);
   MatDestroy(&s->J);
   MatDestroy(&s->P);
   VecDestroy(&s->X);

@@ -36,6 +36,11 @@ struct pm_newton {
   Mat J;     /* assembled Jacobian (not in the cheap mode) */
   Mat P;     /* assembled cheap operator (cheap mode only) */
   Mat Shell; /* matrix-free Jacobian (matrix-free modes only) */
+  /* options.amg_threaded: the finest level's products on every thread
+   * (pm_newton_fine.c), and whether its rows come in threes (-1: not yet
+   * known) */
+  Mat Fine;
+  int fine_threes;
   /* Pseudo-transient continuation (pm_load_ptc.c): while shifted, the
    * linear solves are of J + diag(Shift) (ShiftWork: the shell's term);
    * one process only. */
@@ -173,6 +178,13 @@ PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx);
 PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
                                        void *ctx);
 PetscErrorCode pm_newton_shell_mult(Mat A, Vec in, Vec out);
+
+/* ---- pm_newton_fine.c: multigrid's finest level on every thread. */
+/* The shell Fine, when options.amg_threaded applies (else none). */
+pm_err pm_newton_fine_create(pm_newton *s);
+/* After the preconditioner's set-up: Fine in the finest smoother and
+ * residual (again after a new hierarchy). */
+PetscErrorCode pm_newton_fine_attach(pm_newton *s, KSP ksp);
 PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
                                   PetscBool *changed, void *ctx);
 PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx);

@@ -101,6 +101,13 @@ void fpm_static_choose_linear(const pm_scene *s, long unknowns,
   o->linear_max_iter = 1000;
   o->amg_reuse = true;
   o->amg_assembled_smoother = true;
+  o->amg_threaded = true;
+  /* The aggregation graph not squared: the tangent's 3 rings already
+   * make aggregates of about 60 points (a squared graph: about 480, a coarse
+   * level of 42 unknowns at 4036 points), and the finer hierarchy takes a
+   * third fewer GMRES iterations (docs/validation.md, "Static solves at
+   * 13762 points: the Krylov operator and the hierarchy"). */
+  o->amg_unsquared = true;
   o->gmres_restart = FPM_STATIC_AMG_RESTART;
   if (!pm_scene_has(s, "time.quasi_static.inexact")) o->linear_ew = true;
   if (!pm_scene_has(s, "time.quasi_static.reuse_iterations"))
@@ -225,6 +232,10 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
     v.prob.pc_pat_idx = c->sp.idx;
     no.op = PM_NEWTON_MATRIX_FREE_CHEAP_PC;
     no.pc_right = true;
+    /* a narrow stencil (the 1-ring): the squared graph's aggregates, as
+     * PETSc means them (unsquared at 474 points: 100 GMRES iterations a
+     * solve against 52) */
+    no.amg_unsquared = false;
   }
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
   c->solver = solver;
