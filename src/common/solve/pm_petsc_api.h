@@ -34,6 +34,7 @@
   X(KSPGMRESSetRestart)                                                        \
   X(KSPGetConvergedReason)                                                     \
   X(KSPGetIterationNumber)                                                     \
+  X(KSPGetOperators)                                                           \
   X(KSPGetPC)                                                                  \
   X(KSPGetType)                                                                \
   X(KSPSetConvergenceTest)                                                     \
@@ -56,6 +57,7 @@
   X(MatCreateShell)                                                            \
   X(MatDestroy)                                                                \
   X(MatDiagonalSet)                                                            \
+  X(MatGetRowIJ)                                                               \
   X(MatNullSpaceCreate)                                                        \
   X(MatNullSpaceDestroy)                                                       \
   X(MatPartitioningApply)                                                      \
@@ -67,6 +69,9 @@
   X(MatPartitioningSetType)                                                    \
   X(MatPartitioningSetVertexWeights)                                           \
   X(MatPreallocatorPreallocate)                                                \
+  X(MatRestoreRowIJ)                                                           \
+  X(MatSeqAIJGetArrayRead)                                                     \
+  X(MatSeqAIJRestoreArrayRead)                                                 \
   X(MatSeqAIJSetPreallocation)                                                 \
   X(MatSetBlockSize)                                                           \
   X(MatSetLocalToGlobalMapping)                                                \
@@ -81,6 +86,10 @@
   X(MatShellSetOperation)                                                      \
   X(MatZeroEntries)                                                            \
   X(PCFactorSetMatSolverType)                                                  \
+  X(PCMGGetLevels)                                                             \
+  X(PCMGGetSmoother)                                                           \
+  X(PCMGResidualDefault)                                                       \
+  X(PCMGSetResidual)                                                           \
   X(PCSetType)                                                                 \
   X(PCSetUseAmat)                                                              \
   X(PCShellGetContext)                                                         \
@@ -97,6 +106,7 @@
   X(PetscMallocA)                                                              \
   X(PetscMallocValidate)                                                       \
   X(PetscObjectSetOptions)                                                     \
+  X(PetscObjectTypeCompare)                                                    \
   X(PetscOptionsCreate)                                                        \
   X(PetscOptionsDestroy)                                                       \
   X(PetscOptionsInsertString)                                                  \
@@ -147,6 +157,7 @@
   X(VecDuplicate)                                                              \
   X(VecGetArray)                                                               \
   X(VecGetArrayRead)                                                           \
+  X(VecGetArrayWrite)                                                          \
   X(VecGhostGetLocalForm)                                                      \
   X(VecGhostRestoreLocalForm)                                                  \
   X(VecGhostUpdateBegin)                                                       \
@@ -155,6 +166,7 @@
   X(VecPointwiseMult)                                                          \
   X(VecRestoreArray)                                                           \
   X(VecRestoreArrayRead)                                                       \
+  X(VecRestoreArrayWrite)                                                      \
   X(VecWAXPY)
 
 /* Each entry is the address of its symbol: a function's or a variable's. */
@@ -186,6 +198,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define KSPGMRESSetRestart (*pm_petsc_api.KSPGMRESSetRestart)
 #define KSPGetConvergedReason (*pm_petsc_api.KSPGetConvergedReason)
 #define KSPGetIterationNumber (*pm_petsc_api.KSPGetIterationNumber)
+#define KSPGetOperators (*pm_petsc_api.KSPGetOperators)
 #define KSPGetPC (*pm_petsc_api.KSPGetPC)
 #define KSPGetType (*pm_petsc_api.KSPGetType)
 #define KSPSetConvergenceTest (*pm_petsc_api.KSPSetConvergenceTest)
@@ -208,6 +221,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define MatCreateShell (*pm_petsc_api.MatCreateShell)
 #define MatDestroy (*pm_petsc_api.MatDestroy)
 #define MatDiagonalSet (*pm_petsc_api.MatDiagonalSet)
+#define MatGetRowIJ (*pm_petsc_api.MatGetRowIJ)
 #define MatNullSpaceCreate (*pm_petsc_api.MatNullSpaceCreate)
 #define MatNullSpaceDestroy (*pm_petsc_api.MatNullSpaceDestroy)
 #define MatPartitioningApply (*pm_petsc_api.MatPartitioningApply)
@@ -221,6 +235,9 @@ pm_err pm_petsc_api_load(const char *need);
 #define MatPartitioningSetVertexWeights                                        \
   (*pm_petsc_api.MatPartitioningSetVertexWeights)
 #define MatPreallocatorPreallocate (*pm_petsc_api.MatPreallocatorPreallocate)
+#define MatRestoreRowIJ (*pm_petsc_api.MatRestoreRowIJ)
+#define MatSeqAIJGetArrayRead (*pm_petsc_api.MatSeqAIJGetArrayRead)
+#define MatSeqAIJRestoreArrayRead (*pm_petsc_api.MatSeqAIJRestoreArrayRead)
 #define MatSeqAIJSetPreallocation (*pm_petsc_api.MatSeqAIJSetPreallocation)
 #define MatSetBlockSize (*pm_petsc_api.MatSetBlockSize)
 #define MatSetLocalToGlobalMapping (*pm_petsc_api.MatSetLocalToGlobalMapping)
@@ -235,6 +252,10 @@ pm_err pm_petsc_api_load(const char *need);
 #define MatShellSetOperation (*pm_petsc_api.MatShellSetOperation)
 #define MatZeroEntries (*pm_petsc_api.MatZeroEntries)
 #define PCFactorSetMatSolverType (*pm_petsc_api.PCFactorSetMatSolverType)
+#define PCMGGetLevels (*pm_petsc_api.PCMGGetLevels)
+#define PCMGGetSmoother (*pm_petsc_api.PCMGGetSmoother)
+#define PCMGResidualDefault (*pm_petsc_api.PCMGResidualDefault)
+#define PCMGSetResidual (*pm_petsc_api.PCMGSetResidual)
 #define PCSetType (*pm_petsc_api.PCSetType)
 #define PCSetUseAmat (*pm_petsc_api.PCSetUseAmat)
 #define PCShellGetContext (*pm_petsc_api.PCShellGetContext)
@@ -251,6 +272,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define PetscMallocA (*pm_petsc_api.PetscMallocA)
 #define PetscMallocValidate (*pm_petsc_api.PetscMallocValidate)
 #define PetscObjectSetOptions (*pm_petsc_api.PetscObjectSetOptions)
+#define PetscObjectTypeCompare (*pm_petsc_api.PetscObjectTypeCompare)
 #define PetscOptionsCreate (*pm_petsc_api.PetscOptionsCreate)
 #define PetscOptionsDestroy (*pm_petsc_api.PetscOptionsDestroy)
 #define PetscOptionsInsertString (*pm_petsc_api.PetscOptionsInsertString)
@@ -302,6 +324,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define VecDuplicate (*pm_petsc_api.VecDuplicate)
 #define VecGetArray (*pm_petsc_api.VecGetArray)
 #define VecGetArrayRead (*pm_petsc_api.VecGetArrayRead)
+#define VecGetArrayWrite (*pm_petsc_api.VecGetArrayWrite)
 #define VecGhostGetLocalForm (*pm_petsc_api.VecGhostGetLocalForm)
 #define VecGhostRestoreLocalForm (*pm_petsc_api.VecGhostRestoreLocalForm)
 #define VecGhostUpdateBegin (*pm_petsc_api.VecGhostUpdateBegin)
@@ -310,6 +333,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define VecPointwiseMult (*pm_petsc_api.VecPointwiseMult)
 #define VecRestoreArray (*pm_petsc_api.VecRestoreArray)
 #define VecRestoreArrayRead (*pm_petsc_api.VecRestoreArrayRead)
+#define VecRestoreArrayWrite (*pm_petsc_api.VecRestoreArrayWrite)
 #define VecWAXPY (*pm_petsc_api.VecWAXPY)
 
 /* PETSc's own inline functions call the library by name, compiled where
