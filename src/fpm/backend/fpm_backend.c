@@ -388,6 +388,10 @@ static double ghost_layers(const pm_scene *s) {
   return fpm_scene_options(s)->jump == FPM_JUMP_QUADRATIC ? 5 : 3;
 }
 
+/* A rank's part of the cells: the share's rings and two more
+ * (fpm_region.h). */
+static double part_layers(const pm_scene *s) { return ghost_layers(s) + 2; }
+
 static void destroy(void *sim) { fpm_sim_destroy(sim); }
 
 const pm_backend fpm_backend = {
@@ -401,6 +405,7 @@ const pm_backend fpm_backend = {
     .estimate_bytes = fpm_estimate_bytes,
     .ghost_layers = ghost_layers,
     .geometry_bytes = fpm_estimate_geometry_bytes,
+    .part_layers = part_layers,
     .destroy = destroy,
     .plan = fpm_backend_plan,
     .run = fpm_backend_run,
