@@ -99,18 +99,6 @@ static pm_err sim_mesh(fpm_sim *sim) {
   return PM_SUCCESS;
 }
 
-static pm_err sim_geometry(const pm_scene *s, fpm_sim **out) {
-  fpm_sim *sim = NULL;
-  PM_CALL(sim_new(s, &sim));
-  pm_err e = sim_mesh(sim);
-  if (e) {
-    fpm_sim_destroy(sim);
-    return e;
-  }
-  *out = sim;
-  return PM_SUCCESS;
-}
-
 /* The step: time.dt, else dt_safety times the stable step of the scene's
  * rule. */
 static void pick_dt(fpm_sim *sim) {
@@ -143,8 +131,9 @@ static pm_err sim_model(fpm_sim *sim) {
 pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   fpm_sim *sim = NULL;
   *out = NULL;
-  PM_CALL(sim_geometry(s, &sim));
-  pm_err e = sim_model(sim);
+  PM_CALL(sim_new(s, &sim));
+  pm_err e = sim_mesh(sim);
+  if (!e) e = sim_model(sim);
   if (e) {
     fpm_sim_destroy(sim);
     return e;
