@@ -7,9 +7,12 @@
 # by the implicit MPM at 256^2 cells (its 10 load steps); with
 # BEFORE=BUILD_DIR the same runs by that build beside.  One line per rank:
 # KiB and CPU seconds (user).  A tiny scene (the disks) gives each rank's
-# floor: the program and its libraries (MPI, PETSc, HDF5).
-# usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] benchmarks/bench-rank-memory.sh [BUILD_DIR]
-bench_name=rank-memory bench_env="BEFORE RANKS"
+# floor: the program and its libraries (MPI, PETSc, HDF5).  With
+# METHOD=fpm: FPM F3 at 60% at 4036 and 13762 points (mesh_size 6.42e-3,
+# 4.15e-3), 20 steps and, labelled "setup", one step (the setup's CPU
+# seconds), its floor the same at 45 points (mesh_size 0.05).
+# usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] [METHOD=fpm] benchmarks/bench-rank-memory.sh [BUILD_DIR]
+bench_name=rank-memory bench_env="BEFORE RANKS METHOD"
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
   OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1 \
@@ -32,6 +35,21 @@ measure() { # LABEL BIN N NAME SCENE [--set KEY=VALUE]...
 }
 builds=("after:$bin")
 [ -n "${BEFORE:-}" ] && builds=("before:$BEFORE/pointmech" "${builds[@]}")
+if [ "${METHOD:-mpm}" = fpm ]; then
+  f3=cases/fpm/f3-extension-60.yaml
+  for n in ${RANKS:-1 2 4}; do
+    measure floor "$bin" "$n" f3-45 "$f3" --set discretization.mesh_size=0.05
+    for lb in "${builds[@]}"; do
+      l=${lb%%:*} b=${lb#*:}
+      for h in 6.42e-3 4.15e-3; do
+        measure "$l" "$b" "$n" "f3-$h" "$f3" --set discretization.mesh_size=$h
+        measure "$l-setup" "$b" "$n" "f3-$h" "$f3" \
+          --set discretization.mesh_size=$h --set time.max_steps=1
+      done
+    done
+  done
+  exit 0
+fi
 fine=(--set discretization.mesh_size=1.25e-3 --set output.every=1000)
 i2=(--set discretization.mesh_size=2.1e-6 --set output.every=1000)
 for n in ${RANKS:-1 2 4}; do

@@ -1,4 +1,5 @@
-/* The share a rank builds without the whole model (fpm_region.h) against
+/* The share a rank builds without the whole model, on the bytes of its
+ * part of the cells that rank 0 cuts and sends (fpm_region.h), against
  * the share cut from the whole model (fpm_share_create): every array, bit
  * for bit, on 2 and 4 ranks, for the linear and quadratic jumps, IIPG and
  * SIPG, the averaged volume and a traction face; and no rank's build
@@ -13,23 +14,9 @@
 #include "fpm_gfd.h"
 #include "fpm_region.h"
 #include "fpm_share.h"
+#include "fpm_share_testing.h"
 #include "fpm_stream.h"
 #include "fpm_testing.h"
-
-/* Arrays of count items of size bytes each, equal bit for bit (both NULL,
- * or both held). */
-static void same(const char *what, const void *a, const void *b, long count,
-                 size_t size) {
-  if (!a || !b) {
-    if (a != b) fail_msg("%s: held by one share only", what);
-    return;
-  }
-  if (count > 0 && memcmp(a, b, size * (size_t)count) != 0)
-    fail_msg("%s: the shares differ", what);
-}
-
-#define SAME(field, count)                                                     \
-  same(#field, a->field, b->field, (long)(count), sizeof *a->field)
 
 static void assert_same_share(const fpm_model *a, const fpm_model *b) {
   assert_int_equal(a->n, b->n);
@@ -37,62 +24,24 @@ static void assert_same_share(const fpm_model *a, const fpm_model *b) {
   assert_int_equal(a->n_flux, b->n_flux);
   assert_int_equal(a->n_stress, b->n_stress);
   assert_int_equal(a->nnz, b->nnz);
-  const long n = a->n, nnz = a->nnz, blocks = a->fs_ptr[a->n_stress];
-  SAME(gid, n);
-  SAME(x, 3 * n);
-  SAME(nbr_ptr, n + 1);
-  SAME(nbr, nnz);
-  SAME(g, 3 * nnz);
-  SAME(gsum, 3 * n);
-  SAME(mirror, nnz);
-  SAME(cond, n);
-  SAME(erec, FPM_EREC * nnz);
-  SAME(p_area, 3 * n);
-  SAME(p_mrel, 9 * n);
-  SAME(fs_ptr, a->n_stress + 1);
-  SAME(fs_nbr, FPM_LANES * blocks);
-  SAME(fs_g, 3 * FPM_LANES * blocks);
-  SAME(fs_gm, 3 * FPM_LANES * blocks);
-  if (a->fs_rec) SAME(fs_rec, 19 * FPM_LANES * blocks);
-  SAME(mat, n);
-  SAME(mass, n);
-  SAME(fixed, 3 * n);
-  same("volume", a->dual->volume, b->dual->volume, n, sizeof(double));
-  SAME(vavg, nnz);
-  SAME(vself, n);
-  if (a->qs_ptr) {
-    SAME(qs_ptr, n + 1);
-    SAME(qs_nbr, a->qs_ptr[n]);
-    SAME(qs_own, a->qs_ptr[n]);
-    SAME(q, FPM_QFIT * a->qs_ptr[n]);
-    SAME(qsum, FPM_QFIT * n);
-    SAME(qt_ptr, n + 1);
-    SAME(qt_entry, a->qt_ptr[n]);
-  }
-  /* The boundary: its counts, then each list of the flux points, the
-   * traction facets and the prescribed dofs. */
   assert_int_equal(a->n_dpts, b->n_dpts);
   assert_int_equal(a->n_tfacets, b->n_tfacets);
   assert_int_equal(a->n_cdofs, b->n_cdofs);
-  const long nd = a->n_dpts, nt = a->n_tfacets, nc = a->n_cdofs;
-  const char *name[] = {"dpt_point",   "dpt_area", "dpt_mrel", "tf_point",
-                        "tf_gid",      "tf_bc",    "tf_area",  "tf_rel",
-                        "tf_centroid", "tf_base",  "cd_point", "cd_comp",
-                        "cd_bc",       "cd_base"};
-  const void *in_a[] = {a->dpt_point,   a->dpt_area, a->dpt_mrel, a->tf_point,
-                        a->tf_gid,      a->tf_bc,    a->tf_area,  a->tf_rel,
-                        a->tf_centroid, a->tf_base,  a->cd_point, a->cd_comp,
-                        a->cd_bc,       a->cd_base};
-  const void *in_b[] = {b->dpt_point,   b->dpt_area, b->dpt_mrel, b->tf_point,
-                        b->tf_gid,      b->tf_bc,    b->tf_area,  b->tf_rel,
-                        b->tf_centroid, b->tf_base,  b->cd_point, b->cd_comp,
-                        b->cd_bc,       b->cd_base};
-  const long count[] = {nd,     9 * nd, 27 * nd, nt, nt, nt, nt,
-                        3 * nt, 3 * nt, 3 * nt,  nc, nc, nc, nc};
-  const size_t d = sizeof(double), l = sizeof(long), i = sizeof(int);
-  const size_t size[] = {l, d, d, l, l, i, d, d, d, d, l, i, i, d};
-  for (int k = 0; k < 14; k++)
-    same(name[k], in_a[k], in_b[k], count[k], size[k]);
+  fpm_share_array in_a[FPM_SHARE_ARRAYS], in_b[FPM_SHARE_ARRAYS];
+  const int na = fpm_share_arrays(a, in_a);
+  assert_int_equal(fpm_share_arrays(b, in_b), na);
+  for (int k = 0; k < na; k++) {
+    if (!in_a[k].data || !in_b[k].data) {
+      if (in_a[k].data != in_b[k].data)
+        fail_msg("%s: held by one share only", in_a[k].name);
+      continue;
+    }
+    assert_int_equal(in_a[k].bytes, in_b[k].bytes);
+    if (in_a[k].bytes && memcmp(in_a[k].data, in_b[k].data, in_a[k].bytes))
+      fail_msg("%s: the shares differ", in_a[k].name);
+  }
+  if (memcmp(a->dual->volume, b->dual->volume, sizeof(double) * a->n))
+    fail_msg("volume: the shares differ");
 }
 
 static void check_options(fixture *fx, const char *what) {

@@ -96,13 +96,26 @@ static void test_rank_estimate(void **state) {
   pm_scene *s = NULL;
   assert_ok(pm_scene_load(path, 0, NULL, &s));
   long whole_points = 0, held = 0;
-  const size_t whole = pm_memory_rank_estimate(s, 1, false, &whole_points);
+  const size_t whole =
+      pm_memory_rank_estimate(s, 1, false, false, &whole_points);
   assert_int_equal(whole, s->backend->estimate_bytes(s, &held));
-  const size_t rank = pm_memory_rank_estimate(s, 1000, false, &held);
+  const size_t rank = pm_memory_rank_estimate(s, 1000, false, false, &held);
   assert_true(held > 0 && held < whole_points);
   const double geometry = (double)s->backend->geometry_bytes(s);
   const double share = ((double)whole - geometry) * held / whole_points;
-  const double expect = (s->backend->setup_whole ? whole : geometry) + share;
+  /* a rank that does not mesh: the part it receives, with its model, and
+   * its share */
+  const double part = pm_memory_share_points(
+      (double)whole_points, 1000, s->dimension, s->backend->part_layers(s));
+  assert_true(part > held && part < whole_points);
+  const double expect = s->backend->setup_whole
+                            ? whole + share
+                            : (double)whole * part / whole_points + share;
+  /* rank 0, which meshes, the whole geometry and its share of the rest */
+  long held0 = 0;
+  const size_t rank0 = pm_memory_rank_estimate(s, 1000, false, true, &held0);
+  assert_true(fabs((double)rank0 - (geometry + share)) <=
+              1 + (double)whole / whole_points);
   /* held is the figure's whole points (a point's bytes apart) */
   assert_true(fabs((double)rank - expect) <= 1 + (double)whole / whole_points);
   print_message("f2 at %ld points: %zu bytes on one process, %zu on the "

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Explicit FPM across MPI ranks against the same runs on one process.
-# Usage: ranks-fpm.sh POINTMECH SOURCE_DIR
+# Usage: ranks-fpm.sh POINTMECH SOURCE_DIR RANKS_FPM_SETUP
 #
 # A rank's force on its own points is one process's, the same operations in
 # the same order (its ghosts carry what the force reads), so the fields are
@@ -20,6 +20,7 @@
 set -u
 bin=$1
 src=$2
+setup=$3
 . "$(dirname "$0")/lib.sh"
 . "$(dirname "$0")/ranks-lib.sh"
 bounds="damping=1e-8 dissipated=1e-8"
@@ -43,6 +44,24 @@ print('f2 on 3 ranks: points per rank %s, ghost points %s, %d pairs cut, '
          r['ghost_bytes_per_step']))
 sys.exit(not (r['count'] == 3 and sum(r['points']) == s['points'] and
               min(r['ghost_points']) > 0 and r['edge_cut'] > 0))"
+
+# Rank 0 alone meshes and builds the cells; where it keeps no whole model
+# (as when every rank writes its frames) it lets them go once the parts
+# are sent, and every share is still the one cut from the whole model, bit
+# for bit (ranks_fpm_setup): F2 (linear jump), F4 60% (the quadratic jump,
+# the averaged volume, stiffening) and the ring (2-D, follower pressure).
+for args in "2 $f2 discretization.mesh_size=0.015" \
+  "3 $f4 discretization.mesh_size=8.72e-3 fpm.volumetric=averaged" \
+  "3 $fpm/ring/ring-pressure.yaml"; do
+  set -- $args
+  n=$1
+  shift
+  ranks "$n" "$setup" "$@" >"$work/setup" 2>&1
+  rc=$?
+  grep -E '^(ok|FAIL|rank)' "$work/setup" | sed "s/^/$(basename "$1"): /"
+  check "setup on $n ranks without the whole model, $(basename "$1")" \
+    test $rc -eq 0
+done
 
 # One rank under mpirun is one process.
 ranks 1 "$bin" run "$f2" --out "$work/f2-np1" --quiet $f2set >/dev/null \

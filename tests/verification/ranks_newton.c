@@ -21,20 +21,12 @@
 #include "pm_par.h"
 #include "pm_par_mpi.h"
 #include "pm_petsc.h"
+#include "ranks_testing.h"
 
 #define N 400     /* unknowns: nodes 1..N; node 0 is fixed */
 #define K 2.0e3   /* spring stiffness, N/m */
 #define A 40.0    /* cubic hardening, 1/m^2 */
 #define LOAD 60.0 /* the end load, N */
-
-static int failures;
-
-static void expect(bool ok, const char *what) {
-  long bad = !ok;
-  pm_par_sum_long(&bad, 1);
-  if (pm_par_root()) printf("%s: %s\n", bad ? "FAIL" : "ok", what);
-  failures += bad != 0;
-}
 
 /* One rank's share: its nodes [lo, hi) of 1..N, the springs ending at them
  * (spring e joins nodes e and e + 1), and node lo - 1 as a ghost when it

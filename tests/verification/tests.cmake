@@ -90,15 +90,21 @@ if(PM_MPI)
   # The Newton layer and the implicit MPM across ranks.
   add_executable(ranks_newton ${PM_VERIFY_DIR}/ranks_newton.c)
   target_link_libraries(ranks_newton PRIVATE pm_app)
+  target_include_directories(ranks_newton PRIVATE ${PM_TEST_SUPPORT})
   add_test(NAME verification.ranks_implicit
     COMMAND bash ${PM_VERIFY_DIR}/ranks-implicit.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_newton>)
   set_tests_properties(verification.ranks_implicit PROPERTIES LABELS
     verification TIMEOUT 600 PROCESSORS 1
     RESOURCE_LOCK mpirun)
+  # FPM's setup with no whole model on any rank (rank 0 meshes, cuts and
+  # sends the parts, and lets its mesh and cells go).
+  add_executable(ranks_fpm_setup ${PM_VERIFY_DIR}/ranks_fpm_setup.c)
+  target_link_libraries(ranks_fpm_setup PRIVATE pm_app)
+  target_include_directories(ranks_fpm_setup PRIVATE ${PM_TEST_SUPPORT})
   add_test(NAME verification.ranks_fpm
     COMMAND bash ${PM_VERIFY_DIR}/ranks-fpm.sh $<TARGET_FILE:pointmech>
-      ${PROJECT_SOURCE_DIR})
+      ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_fpm_setup>)
   set_tests_properties(verification.ranks_fpm PROPERTIES LABELS verification
     TIMEOUT 600 PROCESSORS 1
     RESOURCE_LOCK mpirun)

@@ -165,9 +165,14 @@ typedef struct pm_backend {
    * takes its share (else only where pm_view_keeps_whole). */
   double (*ghost_layers)(const struct pm_scene *s);
   bool setup_whole;
-  /* The part of estimate_bytes every rank holds whole even so (FPM: the
-   * mesh and its cells), or NULL (none). */
+  /* The part of estimate_bytes the rank that meshes (rank 0) holds whole
+   * at setup even where it keeps no whole model (FPM: the mesh and its
+   * cells; the other ranks hold their part of it), or NULL (none). */
   size_t (*geometry_bytes)(const struct pm_scene *s);
+  /* The layers of the part of the geometry a rank that does not mesh
+   * receives and builds its share from, held with the share at setup
+   * (FPM: its ghosts' rings and two more), or NULL (none). */
+  double (*part_layers)(const struct pm_scene *s);
   void (*destroy)(void *sim);
   /* Print the pipeline, counts, time step, steps, memory and an estimated
    * run time, without running. */

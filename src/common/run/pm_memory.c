@@ -165,7 +165,7 @@ double pm_memory_share_points(double n, int ranks, int dim, double layers) {
 }
 
 size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
-                               long *points) {
+                               bool meshes, long *points) {
   const pm_backend *b = s->backend;
   const size_t whole = b->estimate_bytes(s, points);
   if (ranks <= 1 || !b->ghost_layers || *points <= 0) return whole;
@@ -173,11 +173,19 @@ size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
   const double held =
       pm_memory_share_points(n, ranks, s->dimension, b->ghost_layers(s));
   *points = (long)held;
-  /* The geometry every rank holds whole, the rest by the points held. */
+  /* The geometry the rank that meshes holds whole, the rest by the points
+   * held; elsewhere the part received (its geometry and the model built on
+   * it) with the share made of it. */
   const double geometry =
       b->geometry_bytes ? fmin((double)b->geometry_bytes(s), (double)whole) : 0;
-  const double bytes = (b->setup_whole || whole_here ? whole : geometry) +
-                       (whole - geometry) * held / n;
+  const double part =
+      b->part_layers
+          ? pm_memory_share_points(n, ranks, s->dimension, b->part_layers(s))
+          : 0;
+  const double rest = ((double)whole - geometry) * held / n;
+  const double bytes = b->setup_whole || whole_here ? (double)whole + rest
+                       : meshes                     ? geometry + rest
+                                : (double)whole * part / n + rest;
   return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
 }
 
@@ -186,7 +194,8 @@ pm_err pm_memory_check(const pm_scene *s) {
   long points = 0;
   const int ranks = pm_par_size();
   const bool whole = s->backend->setup_whole || pm_view_keeps_whole();
-  size_t need = pm_memory_rank_estimate(s, ranks, whole, &points);
+  size_t need =
+      pm_memory_rank_estimate(s, ranks, whole, pm_par_root(), &points);
   pm_memory_available avail;
   pm_err e = pm_memory_query(&avail);
   if (e == PM_ERR_IO) {
@@ -235,8 +244,8 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
           pm_memory_format(avail.bytes, b, sizeof b), avail.source);
   if (ranks > 1 && s->backend->ghost_layers) {
     long held = 0;
-    const size_t share = pm_memory_rank_estimate(s, ranks, false, &held);
-    need = pm_memory_rank_estimate(s, ranks, true, &held);
+    const size_t share = pm_memory_rank_estimate(s, ranks, false, false, &held);
+    need = pm_memory_rank_estimate(s, ranks, true, true, &held);
     if (s->backend->setup_whole)
       fprintf(out,
               "memory/rank  %s before setup on each of %d ranks at most "
@@ -246,9 +255,10 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
     else
       fprintf(out,
               "memory/rank  %s before setup on each of %d ranks at most (its "
-              "share with its ghosts, %ld points); %s on a rank that keeps "
+              "share with its ghosts, %ld points%s); %s on a rank that keeps "
               "the whole model (rank 0 where the frames are gathered)\n",
               pm_memory_format(share, a, sizeof a), ranks, held,
+              s->backend->part_layers ? ", and the part it is built from" : "",
               pm_memory_format(need, b, sizeof b));
   }
 }

@@ -51,15 +51,19 @@ void pm_memory_set_force(bool force);
 double pm_memory_share_points(double n, int ranks, int dim, double layers);
 
 /* The backend's estimate for s on `ranks` ranks, from the scene alone:
- * the bytes of the rank that holds the most: the geometry every rank
- * holds whole (the backend's geometry_bytes), the rest of the whole run's
- * estimate by the points it holds (pm_memory_share_points with the
- * backend's ghost layers), and the whole where the backend's setup builds
- * it on every rank or whole_here (this rank keeps it); on one rank, or for a
- * backend without ghost layers, the whole run's.  *points: the points that rank
- * holds. */
+ * the bytes of the rank that holds the most: its share of the whole run's
+ * estimate, less the geometry (the backend's geometry_bytes), by the
+ * points it holds (pm_memory_share_points with the backend's ghost
+ * layers), and
+ *  - the whole where the backend's setup builds it on every rank or
+ *    whole_here (this rank keeps it);
+ *  - else where the rank meshes (meshes: rank 0), the geometry whole;
+ *  - else the whole run's estimate by the points of the part it receives
+ *    and builds its share from (the backend's part_layers; none without).
+ * On one rank, or for a backend without ghost layers, the whole run's.
+ * *points: the points that rank holds. */
 size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
-                               long *points);
+                               bool meshes, long *points);
 
 /* Refuse s with PM_ERR_MEMORY when its backend's estimate exceeds the
  * memory available, naming both figures and their sources, unless forced:

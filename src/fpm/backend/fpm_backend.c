@@ -37,16 +37,14 @@ void fpm_sim_destroy(fpm_sim *sim) {
   free(sim);
 }
 
-/* The cheap geometry every rank holds: the mesh of the domain and its
- * cells (points, supports, interfaces' and facets' shapes). */
-static pm_err sim_geometry(const pm_scene *s, fpm_sim **out) {
-  pm_err ret = PM_SUCCESS;
+/* A simulation of scene s with its timers, before any geometry. */
+static pm_err sim_new(const pm_scene *s, fpm_sim **out) {
   fpm_sim *sim = NULL;
   *out = NULL;
-  PM_ENSURE(s->method && strcmp(s->method, "fpm") == 0, PM_ERR_ARG,
-            "fpm_sim_create: scene %s has method %s", s->path,
-            s->method ? s->method : "(none)");
-  PM_TRY(PM_ALLOC(sim, 1, "FPM simulation"));
+  PM_CHECK(s->method && strcmp(s->method, "fpm") == 0, PM_ERR_ARG,
+           "fpm_sim_create: scene %s has method %s", s->path,
+           s->method ? s->method : "(none)");
+  PM_CALL(PM_ALLOC(sim, 1, "FPM simulation"));
   sim->scene = s;
   pm_timers_init(&sim->timers);
   sim->tm_mesh = pm_timers_add(&sim->timers, "mesh (gmsh)");
@@ -63,37 +61,42 @@ static pm_err sim_geometry(const pm_scene *s, fpm_sim **out) {
   } else {
     sim->tm_update = pm_timers_add(&sim->timers, "time integration");
   }
+  sim->cells = gm_cells_find(fpm_scene_options(s)->cells);
+  *out = sim;
+  return PM_SUCCESS;
+}
+
+/* The cheap geometry: the mesh of the domain and its cells (points,
+ * supports, interfaces' and facets' shapes); across ranks, rank 0's
+ * alone. */
+static pm_err sim_mesh(fpm_sim *sim) {
+  const pm_scene *s = sim->scene;
   double t0 = pm_wtime();
   pm_timers_start(&sim->timers, sim->tm_mesh);
   /* The domain: the box, or the scene's one gmsh volume. */
   int domain = fpm_domain_body(s);
   sim->far_size = s->mesh_size;
   if (domain >= 0)
-    PM_TRY(gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
-                        (gm_sizes)s->mesh_sizes, &sim->mesh));
+    PM_CALL(gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
+                         (gm_sizes)s->mesh_sizes, &sim->mesh));
   else {
     gm_grade grade;
     fpm_grade_of(s, &grade, &sim->far_size);
-    PM_TRY(gm_mesh_box_graded(s->dimension, s->box_min, s->box_max,
-                              sim->far_size, &grade, &sim->mesh));
+    PM_CALL(gm_mesh_box_graded(s->dimension, s->box_min, s->box_max,
+                               sim->far_size, &grade, &sim->mesh));
     sim->near_size = grade.faces ? grade.size : 0.0;
   }
   pm_timers_stop(&sim->timers, sim->tm_mesh);
   /* A signal stops the setup between its stages (gmsh's meshing and the
    * stages themselves run to their end: seconds at 1e5 points). */
-  PM_TRY(pm_interrupt_check("after meshing (nothing written)"));
+  PM_CALL(pm_interrupt_check("after meshing (nothing written)"));
   sim->mean_edge = gm_mesh_mean_edge(sim->mesh);
   pm_timers_start(&sim->timers, sim->tm_dual);
-  sim->cells = gm_cells_find(fpm_scene_options(s)->cells);
-  PM_TRY(sim->cells->build(sim->mesh, &sim->dual));
+  PM_CALL(sim->cells->build(sim->mesh, &sim->dual));
   pm_timers_stop(&sim->timers, sim->tm_dual);
-  PM_TRY(pm_interrupt_check("after the subdomains (nothing written)"));
+  PM_CALL(pm_interrupt_check("after the subdomains (nothing written)"));
   sim->setup_wall = pm_wtime() - t0;
-  *out = sim;
-  sim = NULL;
-done:
-  fpm_sim_destroy(sim);
-  return ret;
+  return PM_SUCCESS;
 }
 
 /* The step: time.dt, else dt_safety times the stable step of the scene's
@@ -128,8 +131,9 @@ static pm_err sim_model(fpm_sim *sim) {
 pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
   fpm_sim *sim = NULL;
   *out = NULL;
-  PM_CALL(sim_geometry(s, &sim));
-  pm_err e = sim_model(sim);
+  PM_CALL(sim_new(s, &sim));
+  pm_err e = sim_mesh(sim);
+  if (!e) e = sim_model(sim);
   if (e) {
     fpm_sim_destroy(sim);
     return e;
@@ -295,14 +299,24 @@ done:
   return ret;
 }
 
-/* Across ranks every rank holds the geometry (fpm_region.h); the whole
- * model is built only where this rank keeps it (pm_view_keeps_whole), and
- * each rank makes its share, from the whole model there, from the cells
- * around its points elsewhere (collective). */
+/* Across ranks rank 0 alone meshes the domain and builds its cells; the
+ * whole model is built only where this rank keeps it (pm_view_keeps_whole),
+ * and each rank makes its share, from the whole model there, from the part
+ * of the cells rank 0 sends it elsewhere (collective). */
 static pm_err create_share(const pm_scene *s, fpm_sim **out) {
   fpm_sim *sim = NULL;
-  const bool whole = pm_view_keeps_whole();
-  pm_err e = pm_par_agree(sim_geometry(s, &sim));
+  const bool whole = pm_view_keeps_whole(), root = pm_par_root();
+  pm_err e = pm_par_agree(sim_new(s, &sim));
+  if (!e) e = pm_par_agree(root ? sim_mesh(sim) : PM_SUCCESS);
+  if (!e) { /* what every rank reports of the geometry */
+    double g[3] = {sim->mean_edge, sim->far_size, sim->near_size};
+    sim->n_whole = root ? sim->dual->n_points : 0;
+    pm_par_bcast(g, sizeof g);
+    pm_par_bcast(&sim->n_whole, sizeof sim->n_whole);
+    sim->mean_edge = g[0];
+    sim->far_size = g[1];
+    sim->near_size = g[2];
+  }
   if (!e) e = pm_par_agree(whole ? sim_model(sim) : PM_SUCCESS);
   if (!e)
     e = pm_par_agree(whole && sim->model->contact ? fpm_contact_refuse_ranks(s)
@@ -310,8 +324,8 @@ static pm_err create_share(const pm_scene *s, fpm_sim **out) {
   const double t0 = pm_wtime();
   if (!e) {
     pm_timers_start(&sim->timers, sim->tm_operators);
-    sim->n_whole = sim->dual->n_points;
-    e = fpm_par_create(s, sim->mesh, &sim->dual, sim->model, &sim->local_model);
+    e = fpm_par_create(s, &sim->mesh, &sim->dual, sim->model,
+                       &sim->local_model);
     pm_timers_stop(&sim->timers, sim->tm_operators);
   }
   if (!e)
@@ -363,6 +377,10 @@ static double ghost_layers(const pm_scene *s) {
   return fpm_scene_options(s)->jump == FPM_JUMP_QUADRATIC ? 5 : 3;
 }
 
+/* A rank's part of the cells: the share's rings and two more
+ * (fpm_region.h). */
+static double part_layers(const pm_scene *s) { return ghost_layers(s) + 2; }
+
 static void destroy(void *sim) { fpm_sim_destroy(sim); }
 
 const pm_backend fpm_backend = {
@@ -376,6 +394,7 @@ const pm_backend fpm_backend = {
     .estimate_bytes = fpm_estimate_bytes,
     .ghost_layers = ghost_layers,
     .geometry_bytes = fpm_estimate_geometry_bytes,
+    .part_layers = part_layers,
     .destroy = destroy,
     .plan = fpm_backend_plan,
     .run = fpm_backend_run,

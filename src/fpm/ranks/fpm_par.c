@@ -4,7 +4,7 @@
 
 #include <mpi.h>
 #include <petscsf.h>
-#include <stdint.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -43,65 +43,50 @@ static void par_destroy(void *ctx) {
   free(P);
 }
 
-/* A digest of the support graph and the positions (FNV-1a). */
-static uint64_t graph_digest(const gm_dual *d) {
-  uint64_t h = 1469598103934665603ull;
-  const long n = d->n_points;
-  const unsigned char *parts[3] = {(const unsigned char *)d->nbr_ptr,
-                                   (const unsigned char *)d->nbr,
-                                   (const unsigned char *)d->x};
-  const size_t bytes[3] = {sizeof(long) * (size_t)(n + 1),
-                           sizeof(long) * (size_t)d->nbr_ptr[n],
-                           sizeof(double) * 3 * (size_t)n};
-  for (int k = 0; k < 3; k++)
-    for (size_t b = 0; b < bytes[k]; b++) {
-      h ^= parts[k][b];
-      h *= 1099511628211ull;
-    }
-  return h;
-}
+/* Where the ghosts' values come from: each point's rank and its index
+ * among that rank's own points, over the points gid[0..n) (ascending; NULL:
+ * the whole model's, gid[i] = i). */
+typedef struct {
+  const long *gid;
+  const int *owner;
+  const long *index;
+  long n;
+} roots;
 
-/* The partition, made on rank 0 and sent to every rank, which must hold the
- * same graph (each meshed the domain itself). */
-static pm_err partition(struct fpm_par *P, const gm_dual *d) {
-  uint64_t mine = graph_digest(d), first = mine;
-  pm_par_bcast(&first, sizeof first);
-  PM_CALL(pm_par_agree(
-      first == mine
-          ? PM_SUCCESS
-          : PM_ERROR(PM_ERR_INTERNAL,
-                     "rank %d meshed the domain into another graph of "
-                     "points than rank 0 (%ld points): the ranks cannot "
-                     "share it",
-                     P->rank, d->n_points)));
-  PM_CALL(PM_ALLOC(P->owner, d->n_points + 1, "partition"));
-  PM_CALL(pm_par_agree(P->rank == 0 ? fpm_partition(d, P->size, P->owner)
-                                    : PM_SUCCESS));
-  pm_par_bcast(P->owner, sizeof(int) * (size_t)d->n_points);
-  return PM_SUCCESS;
+/* The position of whole point g among r's points. */
+static long root_of(const roots *r, long g) {
+  if (!r->gid) return g;
+  long lo = 0, hi = r->n - 1;
+  while (lo < hi) {
+    const long mid = lo + (hi - lo) / 2;
+    if (r->gid[mid] < g)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
 }
 
 /* The star forests: ghosts to their owners' own points (each rank's own
  * points are in one-process order, so an owner's index of a point is the
  * count of its points before it), own points to rank 0's whole arrays. */
-static pm_err make_forests(struct fpm_par *P, long n_whole,
-                           const fpm_model *s) {
+static pm_err make_forests(struct fpm_par *P, long n_whole, const fpm_model *s,
+                           const roots *from) {
   pm_err ret = PM_SUCCESS;
   const long n_ghost = s->n - s->n_own;
-  long *index = NULL, *seen = NULL;
   PetscInt *leaf = NULL;
   PetscSFNode *root = NULL;
-  PM_TRY(PM_ALLOC(index, n_whole + 1, "owners' indices"));
-  PM_TRY(PM_ALLOC(seen, P->size, "owners' indices"));
-  for (long i = 0; i < n_whole; i++) index[i] = seen[P->owner[i]]++;
   PM_TRY(PM_ALLOC(leaf, n_ghost + 1, "ghost points"));
   PM_TRY(PM_ALLOC(root, (n_ghost > s->n_own ? n_ghost : s->n_own) + 1,
                   "ghost points' owners"));
   for (long k = 0; k < n_ghost; k++) {
-    const long g = s->gid[s->n_own + k];
+    const long at = root_of(from, s->gid[s->n_own + k]);
+    PM_ENSURE(!from->gid || from->gid[at] == s->gid[s->n_own + k],
+              PM_ERR_INTERNAL, "ghost point %ld is not in its rank's part",
+              s->gid[s->n_own + k]);
     leaf[k] = (PetscInt)(s->n_own + k);
-    root[k].rank = P->owner[g];
-    root[k].index = (PetscInt)index[g];
+    root[k].rank = from->owner[at];
+    root[k].index = (PetscInt)from->index[at];
   }
   PM_PETSC(PetscSFCreate(PETSC_COMM_WORLD, &P->ghosts));
   PM_PETSC(PetscSFSetGraph(P->ghosts, (PetscInt)s->n_own, (PetscInt)n_ghost,
@@ -121,8 +106,6 @@ static pm_err make_forests(struct fpm_par *P, long n_whole,
   MPI_Type_contiguous(9, MPI_DOUBLE, &P->nine);
   MPI_Type_commit(&P->nine);
 done:
-  free(index);
-  free(seen);
   free(leaf);
   free(root);
   return ret;
@@ -197,23 +180,150 @@ static long offset(void *ctx, long count) {
   return pm_par_offset(count);
 }
 
-pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, gm_dual **cells,
+/* The parts travel in pieces of at most this many bytes (MPI counts in
+ * int); a rank that cannot hold its part drains them into `drain`. */
+#define PART_PIECE (1L << 22)
+static char drain[PART_PIECE];
+
+/* Rank 0 sends part bytes buf (len; -1: none, rank 0 failed) to rank r. */
+static void send_part(const char *buf, long len, int r) {
+  MPI_Send(&len, 1, MPI_LONG, r, 0, pm_par_comm());
+  for (long at = 0; at < len; at += PART_PIECE) {
+    const long n = len - at < PART_PIECE ? len - at : PART_PIECE;
+    MPI_Send(buf + at, (int)n, MPI_BYTE, r, 0, pm_par_comm());
+  }
+  pm_par_count_sent(len > 0 ? (double)len : 0);
+}
+
+/* This rank's part from rank 0 (PM_SUCCESS with no part where rank 0
+ * failed: the failure is agreed after). */
+static pm_err recv_part(fpm_part *p) {
+  pm_err ret = PM_SUCCESS;
+  long len = 0;
+  char *buf = NULL;
+  MPI_Recv(&len, 1, MPI_LONG, 0, 0, pm_par_comm(), MPI_STATUS_IGNORE);
+  if (len < 0) return PM_SUCCESS;
+  ret = PM_ALLOC(buf, len + 1, "this rank's part of the cells");
+  for (long at = 0; at < len; at += PART_PIECE) {
+    const long n = len - at < PART_PIECE ? len - at : PART_PIECE;
+    MPI_Recv(buf ? buf + at : drain, (int)n, MPI_BYTE, 0, 0, pm_par_comm(),
+             MPI_STATUS_IGNORE);
+  }
+  if (!ret) ret = fpm_part_unpack(buf, (size_t)len, p);
+  free(buf);
+  return ret;
+}
+
+/* Rank 0 cuts every other rank's part and sends it, one at a time, so
+ * that it holds the whole cells and one part at most (e: its failure so
+ * far, sent as no part); the others receive theirs into *mine.  Every
+ * rank's failure (collective). */
+static pm_err scatter_parts(const fpm_cutter *c, pm_err e, fpm_part *mine) {
+  const int size = pm_par_size();
+  if (!pm_par_root()) return pm_par_agree(recv_part(mine));
+  for (int r = 1; r < size; r++) {
+    fpm_part p = {0};
+    char *buf = NULL;
+    size_t len = 0;
+    if (!e) e = fpm_part_cut(c, r, &p);
+    if (!e) e = fpm_part_pack(&p, &buf, &len);
+    fpm_part_free(&p);
+    send_part(buf, e ? -1 : (long)len, r);
+    free(buf);
+  }
+  return pm_par_agree(e);
+}
+
+/* The whole mesh's surface names on every rank: the others' *mesh (NULL)
+ * made of rank 0's (fpm_mesh_names; collective). */
+static pm_err share_names(gm_mesh **mesh) {
+  pm_err ret = PM_SUCCESS;
+  gm_mesh head = {0};
+  char *names = NULL, **name = NULL;
+  long len = 0;
+  if (pm_par_root()) {
+    head = **mesh;
+    for (int k = 0; k < head.n_surfaces; k++)
+      len += (long)strlen(head.surface_name[k] ? head.surface_name[k] : "") + 1;
+  }
+  pm_par_bcast(&head, sizeof head);
+  pm_par_bcast(&len, sizeof len);
+  PM_TRY(pm_par_agree(PM_ALLOC(names, len + 1, "surface names")));
+  if (pm_par_root())
+    for (long k = 0, at = 0; k < head.n_surfaces; k++) {
+      const char *nm = (*mesh)->surface_name[k];
+      const size_t n = strlen(nm ? nm : "") + 1;
+      memcpy(names + at, nm ? nm : "", n);
+      at += (long)n;
+    }
+  pm_par_bcast(names, (size_t)len);
+  if (!pm_par_root()) {
+    PM_TRY(PM_ALLOC(name, head.n_surfaces + 1, "surface names"));
+    for (long k = 0, at = 0; k < head.n_surfaces; k++) {
+      name[k] = names + at;
+      at += (long)strlen(name[k]) + 1;
+    }
+    head.surface_name = name;
+    head.face_surface = NULL;
+    ret = fpm_mesh_names(&head, mesh);
+  }
+done:
+  ret = pm_par_agree(ret);
+  free(names);
+  free(name);
+  return ret;
+}
+
+/* Rank 0 without the whole model: its own part cut, the whole cells and
+ * mesh let go (the mesh for its surfaces' names), then its share. */
+static pm_err root_part(const fpm_cutter *c, gm_mesh **mesh, gm_dual **cells,
+                        fpm_part *p) {
+  gm_mesh *names = NULL;
+  PM_CALL(fpm_part_cut(c, 0, p));
+  PM_CALL(fpm_mesh_names(*mesh, &names));
+  gm_mesh_destroy(*mesh);
+  *mesh = names;
+  gm_dual_destroy(*cells);
+  *cells = NULL;
+  return PM_SUCCESS;
+}
+
+pm_err fpm_par_create(const pm_scene *sc, gm_mesh **mesh, gm_dual **cells,
                       const fpm_model *whole, fpm_model **local) {
   pm_err ret = PM_SUCCESS;
   struct fpm_par *P = NULL;
   fpm_model *s = NULL;
-  const long n = (*cells)->n_points;
+  fpm_cutter cut = {0};
+  fpm_part part = {0};
+  const fpm_options *o = fpm_scene_options(sc);
+  const bool root = pm_par_root();
+  long n = root ? (*cells)->n_points : 0;
   *local = NULL;
   PM_TRY(pm_par_agree(PM_ALLOC(P, 1, "FPM ranks")));
   P->rank = pm_par_rank();
   P->size = pm_par_size();
   PM_TRY(pm_par_agree(pm_petsc_init()));
-  PM_TRY(partition(P, *cells));
-  PM_TRY(pm_par_agree(whole ? fpm_share_create(whole, P->owner, P->rank, &s)
-                            : fpm_share_build(sc, fpm_scene_options(sc), mesh,
-                                              cells, true, P->owner, P->rank,
-                                              &s)));
-  PM_TRY(pm_par_agree(make_forests(P, n, s)));
+  pm_par_bcast(&n, sizeof n);
+  PM_TRY(share_names(mesh));
+  /* Rank 0 partitions the points and cuts every part. */
+  pm_err e = PM_SUCCESS;
+  if (root) {
+    e = PM_ALLOC(P->owner, n + 1, "partition");
+    if (!e) e = fpm_partition(*cells, P->size, P->owner);
+    if (!e) e = fpm_cutter_init(&cut, sc, o, *mesh, *cells, P->owner, P->size);
+  }
+  PM_TRY(scatter_parts(&cut, e, &part));
+  PM_TRY(pm_par_agree(root && !whole ? root_part(&cut, mesh, cells, &part)
+                                     : PM_SUCCESS));
+  /* This rank's share: cut from the whole model where it is held, else
+   * built on the part. */
+  roots from = {.gid = NULL, .owner = P->owner, .index = cut.index, .n = n};
+  if (part.cells)
+    from = (roots){part.gid, part.owner, part.index, part.cells->n_points};
+  PM_TRY(pm_par_agree(whole
+                          ? fpm_share_create(whole, P->owner, P->rank, &s)
+                          : fpm_part_share(sc, o, *mesh, &part, P->rank, &s)));
+  PM_TRY(pm_par_agree(make_forests(P, n, s, &from)));
   PM_TRY(pm_par_agree(count_shares(P, n, s)));
   P->n_ghost = s->n - s->n_own;
   P->xc = (fpm_exchange){.ctx = P,
@@ -230,6 +340,8 @@ pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, gm_dual **cells,
   *local = s;
   s = NULL;
 done:
+  fpm_cutter_free(&cut);
+  fpm_part_free(&part);
   par_destroy(P);
   fpm_model_destroy(s);
   return ret;

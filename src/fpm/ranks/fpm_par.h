@@ -18,7 +18,8 @@
  *    finite) agreed by every rank: the one one process meets first wins,
  *    and every rank stops with its message, which names the point by its
  *    index on one process.
- * No rank builds the whole model but where it keeps it (pm_view.h); rank 0
+ * Only rank 0 meshes the domain and builds its cells, and no rank builds
+ * the whole model but where it keeps it (pm_view.h); rank 0
  * keeps the whole model and gathers the state into it where the run
  * writes (another star forest, its own points to rank 0's whole arrays):
  * frames, history and checkpoints are those of one process.  The
@@ -32,18 +33,20 @@
 #include "fpm_model.h"
 #include "fpm_share.h"
 
-/* This rank's share of the model of scene sc on the cells *cells of the
- * whole mesh, which every rank holds (collective; every rank returns the
- * same error): rank 0 partitions the points (fpm_partition) after checking
- * that every rank meshed the same graph, every rank makes its share and
- * the exchanges are set up: the share's exchange (fpm_exchange.h: the
- * ghosts' displacements, the sums and minima, the failures agreed) is this
- * rank's.  whole: the whole model where this rank holds it (the share is
- * cut from it), else NULL: the share is built from the cells around its
- * points (fpm_region.h), the same model bit for bit, and the whole cells
- * are let go on the way (*cells NULL on return).  *local owns its arrays
- * and the exchanges (fpm_model_destroy). */
-pm_err fpm_par_create(const pm_scene *sc, const gm_mesh *mesh, gm_dual **cells,
+/* This rank's share of the model of scene sc (collective; every rank
+ * returns the same error).  Rank 0 alone holds the whole mesh *mesh and
+ * its cells *cells (NULL on the others): it partitions the points
+ * (fpm_partition), cuts every other rank's part of the cells and sends it
+ * (fpm_region.h), one at a time; every rank then makes its share and the
+ * exchanges are set up: the share's exchange (fpm_exchange.h: the ghosts'
+ * displacements, the sums and minima, the failures agreed) is this rank's.
+ * whole: the whole model where this rank holds it (rank 0 only; the share
+ * is cut from it), else NULL: the share is built on the rank's part, the
+ * same model bit for bit.  Every rank without the whole model returns
+ * with *mesh the names of the whole mesh's surfaces (fpm_mesh_names) and
+ * *cells NULL: rank 0 lets its whole mesh and cells go once the parts are
+ * sent.  *local owns its arrays and the exchanges (fpm_model_destroy). */
+pm_err fpm_par_create(const pm_scene *sc, gm_mesh **mesh, gm_dual **cells,
                       const fpm_model *whole, fpm_model **local);
 /* A share's state from the whole run's, which every rank holds (a
  * checkpoint read by every rank): displacements and velocities of every
@@ -62,8 +65,8 @@ pm_err fpm_par_gather(const fpm_model *m, const fpm_state *st,
 pm_err fpm_par_gather_points(const fpm_model *m, const double *local,
                              double *whole);
 
-/* The partition (every rank's owner, on every rank) and every rank's
- * counts (on rank 0; NULL on the others) of a share. */
+/* The partition (every point's rank) and every rank's counts of a
+ * share: on rank 0 (NULL on the others). */
 const int *fpm_par_owner(const fpm_model *m);
 const fpm_share_counts *fpm_par_counts(const fpm_model *m);
 

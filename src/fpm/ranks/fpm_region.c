@@ -1,5 +1,5 @@
-/* fpm_region: the part of the cells around a rank's own points, its model,
- * and the share made from it. */
+/* fpm_region: the part of the whole cells around a rank's own points, cut
+ * on rank 0, its model on that rank, and the share made from it. */
 #include "fpm_region.h"
 
 #include <limits.h>
@@ -82,15 +82,13 @@ done:
   return ret;
 }
 
-/* The boundary facets of the part's points, in the whole's order (*fgid:
- * each one's index in the whole). */
-static pm_err part_facets(const gm_dual *d, const long *lof, gm_dual *p,
-                          long **fgid) {
-  long nf = 0;
+/* The boundary facets of the part's points, in the whole's order. */
+static pm_err part_facets(const gm_dual *d, const long *lof, gm_dual *p) {
+  pm_err ret = PM_SUCCESS;
+  long nf = 0, *idx = NULL; /* each one's index in the whole */
   for (long f = 0; f < d->n_facets; f++) nf += lof[d->facet_point[f]] >= 0;
-  PM_CALL(PM_ALLOC(*fgid, nf + 1, "part's facets"));
-  PM_CALL(gm_dual_alloc_facets(p, nf));
-  long *idx = *fgid;
+  PM_TRY(PM_ALLOC(idx, nf + 1, "part's facets"));
+  PM_TRY(gm_dual_alloc_facets(p, nf));
   nf = 0;
   for (long f = 0; f < d->n_facets; f++)
     if (lof[d->facet_point[f]] >= 0) idx[nf++] = f;
@@ -102,14 +100,15 @@ static pm_err part_facets(const gm_dual *d, const long *lof, gm_dual *p,
   copy_items(p->facet_moment, d->facet_moment, idx, nf, 9);
   copy_items(p->facet_centroid, d->facet_centroid, idx, nf, 3);
   copy_items(p->facet_area, d->facet_area, idx, nf, 1);
-  return PM_SUCCESS;
+done:
+  free(idx);
+  return ret;
 }
 
 /* The cells of the points gid[0..np) (ascending): rows where ring <= rows
  * (their neighbours all among the points), none beyond. */
 static pm_err part_dual(const gm_dual *d, const int *ring, int rows, long np,
-                        const long *gid, const long *lof, gm_dual **out,
-                        long **fgid) {
+                        const long *gid, const long *lof, gm_dual **out) {
   pm_err ret = PM_SUCCESS;
   gm_dual *p = NULL;
   long *wif = NULL; /* the whole's interface of each entry */
@@ -139,7 +138,7 @@ static pm_err part_dual(const gm_dual *d, const int *ring, int rows, long np,
     }
   }
   PM_TRY(part_interfaces(d, lof, wif, p));
-  PM_TRY(part_facets(d, lof, p, fgid));
+  PM_TRY(part_facets(d, lof, p));
   p->n_dropped_faces = d->n_dropped_faces;
   p->n_slivers = d->n_slivers;
   p->min_quality = d->min_quality;
@@ -152,73 +151,169 @@ done:
   return ret;
 }
 
-/* Each traction facet of the part's model by its index among the whole
- * model's (the conditions in order, each one's facets in the whole's
- * order: w lists the whole's, fgid maps the part's facets to the whole's). */
-static pm_err traction_ids(const pm_scene *s, fpm_model *pm, const long *wptr,
-                           const long *wf, const long *fgid) {
-  PM_CALL(PM_ALLOC(pm->tf_gid, pm->n_tfacets + 1, "part's traction facets"));
-  long nt = 0, base = 0;
-  for (int b = 0; b < s->n_bcs; b++) {
-    if (!s->bcs[b].traction_mask) continue;
-    long w = wptr[b];
-    for (long e = pm->bcf_ptr[b]; e < pm->bcf_ptr[b + 1]; e++) {
-      const long f = fgid[pm->bcf_facet[e]];
-      while (w < wptr[b + 1] && wf[w] < f) w++;
-      pm->tf_gid[nt++] = base + w - wptr[b];
+pm_err fpm_cutter_init(fpm_cutter *c, const pm_scene *s, const fpm_options *o,
+                       const gm_mesh *mesh, const gm_dual *d, const int *owner,
+                       int parts) {
+  pm_err ret = PM_SUCCESS;
+  long *seen = NULL;
+  *c = (fpm_cutter){.d = d,
+                    .owner = owner,
+                    .held = o->jump == FPM_JUMP_QUADRATIC ? 5 : 3,
+                    .n_bcs = s->n_bcs};
+  PM_TRY(fpm_select_facets(d, s, mesh, true, &c->wptr, &c->wf));
+  PM_TRY(PM_ALLOC(c->traction, s->n_bcs + 1, "traction conditions"));
+  for (int b = 0; b < s->n_bcs; b++) /* a pressure's facets are traction's */
+    c->traction[b] = s->bcs[b].traction_mask || s->bcs[b].pressure;
+  PM_TRY(PM_ALLOC(c->index, d->n_points + 1, "owners' indices"));
+  PM_TRY(PM_ALLOC(seen, parts + 1, "owners' indices"));
+  for (long i = 0; i < d->n_points; i++) c->index[i] = seen[owner[i]]++;
+done:
+  free(seen);
+  if (ret) fpm_cutter_free(c);
+  return ret;
+}
+
+void fpm_cutter_free(fpm_cutter *c) {
+  free(c->traction);
+  free(c->index);
+  free(c->wptr);
+  free(c->wf);
+  *c = (fpm_cutter){0};
+}
+
+void fpm_part_free(fpm_part *p) {
+  gm_dual_destroy(p->cells);
+  free(p->gid);
+  free(p->owner);
+  free(p->index);
+  free(p->tf_ptr);
+  free(p->tf_id);
+  *p = (fpm_part){0};
+}
+
+/* The part's facets of each traction condition (those of its points, lof
+ * >= 0), each by its index among the whole model's traction facets: the
+ * conditions in order, each one's facets in the whole's order. */
+static pm_err part_tractions(const fpm_cutter *c, const long *lof,
+                             fpm_part *p) {
+  const long *wptr = c->wptr, *wf = c->wf;
+  const long *at = c->d->facet_point;
+  PM_CALL(PM_ALLOC(p->tf_ptr, c->n_bcs + 1, "part's traction facets"));
+  long nt = 0;
+  for (int pass = 0; pass < 2; pass++) {
+    long base = 0;
+    nt = 0;
+    for (int b = 0; b < c->n_bcs; b++) {
+      p->tf_ptr[b] = nt;
+      if (!c->traction[b]) continue;
+      for (long w = wptr[b]; w < wptr[b + 1]; w++)
+        if (lof[at[wf[w]]] >= 0) {
+          if (pass) p->tf_id[nt] = base + w - wptr[b];
+          nt++;
+        }
+      base += wptr[b + 1] - wptr[b];
     }
-    base += wptr[b + 1] - wptr[b];
+    p->tf_ptr[c->n_bcs] = nt;
+    if (!pass) PM_CALL(PM_ALLOC(p->tf_id, nt + 1, "part's traction facets"));
   }
   return PM_SUCCESS;
+}
+
+pm_err fpm_part_cut(const fpm_cutter *c, int r, fpm_part *p) {
+  pm_err ret = PM_SUCCESS;
+  const gm_dual *d = c->d;
+  const long n = d->n_points;
+  const int reach = c->held + 2;
+  int *ring = NULL;
+  long *lof = NULL;
+  *p = (fpm_part){.n_bcs = c->n_bcs, .n_whole = n};
+  PM_TRY(PM_ALLOC(ring, n + 1, "rings of points"));
+  PM_TRY(find_rings(d, c->owner, r, reach, ring));
+  PM_TRY(PM_ALLOC(lof, n + 1, "part's points"));
+  long np = 0;
+  for (long i = 0; i < n; i++) lof[i] = ring[i] <= reach ? np++ : -1;
+  PM_TRY(PM_ALLOC(p->gid, np + 1, "part's points"));
+  PM_TRY(PM_ALLOC(p->owner, np + 1, "part's partition"));
+  PM_TRY(PM_ALLOC(p->index, np + 1, "part's owners' indices"));
+  for (long i = 0; i < n; i++)
+    if (lof[i] >= 0) {
+      p->gid[lof[i]] = i;
+      p->owner[lof[i]] = c->owner[i];
+      p->index[lof[i]] = c->index[i];
+    }
+  PM_TRY(part_dual(d, ring, c->held + 1, np, p->gid, lof, &p->cells));
+  PM_TRY(part_tractions(c, lof, p));
+done:
+  free(ring);
+  free(lof);
+  if (ret) fpm_part_free(p);
+  return ret;
+}
+
+/* Each traction facet of the part's model by its index among the whole
+ * model's (the part's facets of each condition are the whole's facets of
+ * its points, in the whole's order, as p lists them). */
+static pm_err traction_ids(const fpm_part *p, fpm_model *pm) {
+  PM_CALL(PM_ALLOC(pm->tf_gid, pm->n_tfacets + 1, "part's traction facets"));
+  long nt = 0;
+  for (int b = 0; b < p->n_bcs; b++) {
+    if (p->tf_ptr[b + 1] == p->tf_ptr[b]) continue;
+    PM_CHECK(
+        pm->bcf_ptr[b + 1] - pm->bcf_ptr[b] == p->tf_ptr[b + 1] - p->tf_ptr[b],
+        PM_ERR_INTERNAL,
+        "condition %d selects %ld facets of the part, the whole %ld", b,
+        pm->bcf_ptr[b + 1] - pm->bcf_ptr[b], p->tf_ptr[b + 1] - p->tf_ptr[b]);
+    for (long k = p->tf_ptr[b]; k < p->tf_ptr[b + 1]; k++)
+      pm->tf_gid[nt++] = p->tf_id[k];
+  }
+  PM_CHECK(nt == pm->n_tfacets, PM_ERR_INTERNAL,
+           "%ld traction facets of the part, %ld named by the whole",
+           pm->n_tfacets, nt);
+  return PM_SUCCESS;
+}
+
+pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
+                      const gm_mesh *mesh, const fpm_part *p, int r,
+                      fpm_model **out) {
+  pm_err ret = PM_SUCCESS;
+  fpm_model *pm = NULL;
+  *out = NULL;
+  PM_TRY(fpm_model_create_part(s, o, mesh, p->cells, p->gid, &pm));
+  if (pm->contact) PM_TRY(fpm_contact_refuse_ranks(s));
+  PM_TRY(traction_ids(p, pm));
+  PM_TRY(fpm_share_create(pm, p->owner, r, out));
+done:
+  fpm_model_destroy(pm);
+  return ret;
 }
 
 pm_err fpm_share_build(const pm_scene *s, const fpm_options *o,
                        const gm_mesh *mesh, gm_dual **whole, bool release,
                        const int *owner, int r, fpm_model **out) {
   pm_err ret = PM_SUCCESS;
-  const gm_dual *d = *whole;
-  const long n = d->n_points;
-  const int held = o->jump == FPM_JUMP_QUADRATIC ? 5 : 3;
-  int *ring = NULL, *part_owner = NULL;
-  long *gid = NULL, *lof = NULL, *fgid = NULL, *wptr = NULL, *wf = NULL;
-  gm_dual *pd = NULL;
-  fpm_model *pm = NULL;
+  fpm_cutter c = {0};
+  fpm_part cut = {0}, part = {0};
+  char *buf = NULL;
+  size_t len = 0;
+  int parts = 0;
   *out = NULL;
-  /* The conditions' facets on the whole: its errors, and the traction
-   * facets' indices. */
-  PM_TRY(fpm_select_facets(d, s, mesh, true, &wptr, &wf));
-  PM_TRY(PM_ALLOC(ring, n + 1, "rings of points"));
-  PM_TRY(find_rings(d, owner, r, held + 2, ring));
-  PM_TRY(PM_ALLOC(lof, n + 1, "part's points"));
-  long np = 0;
-  for (long i = 0; i < n; i++) lof[i] = ring[i] <= held + 2 ? np++ : -1;
-  PM_TRY(PM_ALLOC(gid, np + 1, "part's points"));
-  for (long i = 0; i < n; i++)
-    if (lof[i] >= 0) gid[lof[i]] = i;
-  PM_TRY(part_dual(d, ring, held + 1, np, gid, lof, &pd, &fgid));
-  PM_TRY(PM_ALLOC(part_owner, np + 1, "part's partition"));
-  for (long li = 0; li < np; li++) part_owner[li] = owner[gid[li]];
-  free(ring);
-  free(lof);
-  ring = NULL;
-  lof = NULL;
+  for (long i = 0; i < (*whole)->n_points; i++)
+    parts = owner[i] >= parts ? owner[i] + 1 : parts;
+  PM_TRY(fpm_cutter_init(&c, s, o, mesh, *whole, owner, parts));
+  PM_TRY(fpm_part_cut(&c, r, &cut));
+  fpm_cutter_free(&c);
   if (release) { /* the part's cells are all the model reads */
     gm_dual_destroy(*whole);
     *whole = NULL;
   }
-  PM_TRY(fpm_model_create_part(s, o, mesh, pd, gid, &pm));
-  if (pm->contact) PM_TRY(fpm_contact_refuse_ranks(s));
-  PM_TRY(traction_ids(s, pm, wptr, wf, fgid));
-  PM_TRY(fpm_share_create(pm, part_owner, r, out));
+  PM_TRY(fpm_part_pack(&cut, &buf, &len));
+  fpm_part_free(&cut);
+  PM_TRY(fpm_part_unpack(buf, len, &part));
+  PM_TRY(fpm_part_share(s, o, mesh, &part, r, out));
 done:
-  fpm_model_destroy(pm);
-  gm_dual_destroy(pd);
-  free(ring);
-  free(part_owner);
-  free(gid);
-  free(lof);
-  free(fgid);
-  free(wptr);
-  free(wf);
+  fpm_cutter_free(&c);
+  fpm_part_free(&cut);
+  fpm_part_free(&part);
+  free(buf);
   return ret;
 }
