@@ -185,7 +185,7 @@ pm_err pm_memory_check(const pm_scene *s) {
   if (!s->backend || !s->backend->estimate_bytes) return PM_SUCCESS;
   long points = 0;
   const int ranks = pm_par_size();
-  const bool whole = s->backend->setup_whole || pm_view_keeps_whole();
+  const bool whole = s->backend->setup_whole || pm_view_keeps_whole_for(s);
   size_t need = pm_memory_rank_estimate(s, ranks, whole, &points);
   pm_memory_available avail;
   pm_err e = pm_memory_query(&avail);

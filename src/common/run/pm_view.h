@@ -47,6 +47,7 @@ typedef struct pm_view {
    * passed to every rank at the start): the folder and the last frame's
    * pieces. */
   bool in_pieces;
+  bool ending; /* the run has ended: gather's last call, for the figures */
   char dir[PM_PATH_MAX + 1];
   pm_view_pieces pieces;
 } pm_view;
@@ -54,8 +55,23 @@ typedef struct pm_view {
 /* Whether this rank holds the whole model and state through a run: across
  * ranks, rank 0 while frames, checkpoints and the end's figures are
  * gathered into its view.  Setup builds the whole model only where this is
- * true (and a share everywhere across ranks). */
+ * true (and a share everywhere across ranks).  For a backend that writes
+ * no frames in pieces (pm_backend.pieces NULL); otherwise
+ * pm_view_keeps_whole_for. */
 bool pm_view_keeps_whole(void);
+
+/* Whether a run of scene s across ranks needs the whole model on rank 0:
+ * unless its frames go in pieces (output.ranks: pieces, a backend that
+ * writes them) and nothing else reads the whole run: no checkpoints
+ * (output.checkpoint), no reference field (its errors are taken over every
+ * point).  Without it the history rows and the end's figures come from
+ * reductions over the shares (pm_view.gather then reduces), and a signal
+ * writes no checkpoint.  The same on every rank. */
+bool pm_view_whole_needed(const pm_scene *s);
+
+/* pm_view_keeps_whole for scene s: rank 0 across ranks where
+ * pm_view_whole_needed(s). */
+bool pm_view_keeps_whole_for(const pm_scene *s);
 
 /* The run starts with observer obs (which may be NULL): across ranks, the
  * ranks other than 0 release their view. */

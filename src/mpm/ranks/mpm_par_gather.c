@@ -1,5 +1,6 @@
 /* mpm_par_gather: every rank's particles and nodal arrays gathered into
  * the whole model's state on rank 0, in the order of one process. */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -151,4 +152,76 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
 pm_err mpm_par_gather_nodes(const mpm_model *m, const mpm_model *full,
                             const double *local, double *whole) {
   return gather_owned(m, full ? &full->grid : NULL, local, NULL, whole, NULL);
+}
+
+void mpm_par_whole_ranges(const mpm_model *m, mpm_par_ranges *out) {
+  const struct mpm_par *P = par_of(m);
+  *out = (mpm_par_ranges){.n = P->n_full,
+                          .gbegin = P->gbegin,
+                          .gend = P->gend,
+                          .bbegin = P->bbegin,
+                          .bend = P->bend};
+}
+
+pm_err mpm_par_gather_x0(const mpm_model *m, double **x0) {
+  struct mpm_par *P = par_of(m);
+  const int size = P->d.size;
+  long n = m->n, most = m->n, *gid = NULL;
+  double *all = NULL, *x = NULL;
+  pm_par_max_long(&most, 1);
+  *x0 = NULL;
+  pm_err e = PM_SUCCESS;
+  if (P->rank == 0) {
+    e = PM_ALLOC(all, 3 * P->n_full + 1, "reference positions");
+    if (!e) e = PM_ALLOC(gid, most + 1, "reference positions");
+    if (!e) e = PM_ALLOC(x, 3 * most + 1, "reference positions");
+  }
+  if ((e = pm_par_agree(e)) != PM_SUCCESS) goto done;
+  if (P->rank != 0) {
+    MPI_Send(&n, 1, MPI_LONG, 0, 0, pm_par_comm());
+    MPI_Send(m->gid, (int)n, MPI_LONG, 0, 1, pm_par_comm());
+    MPI_Send(m->x0, (int)(3 * n), MPI_DOUBLE, 0, 2, pm_par_comm());
+    pm_par_count_sent((double)n * (sizeof(long) + 3 * sizeof(double)));
+    return PM_SUCCESS;
+  }
+  for (int r = 0; r < size; r++) {
+    const long *g = m->gid;
+    const double *y = m->x0;
+    long k = n;
+    if (r > 0) {
+      MPI_Recv(&k, 1, MPI_LONG, r, 0, pm_par_comm(), MPI_STATUS_IGNORE);
+      MPI_Recv(gid, (int)k, MPI_LONG, r, 1, pm_par_comm(), MPI_STATUS_IGNORE);
+      MPI_Recv(x, (int)(3 * k), MPI_DOUBLE, r, 2, pm_par_comm(),
+               MPI_STATUS_IGNORE);
+      g = gid;
+      y = x;
+    }
+    for (long j = 0; j < k; j++) memcpy(all + 3 * g[j], y + 3 * j, 24);
+  }
+  *x0 = all;
+  all = NULL;
+done:
+  free(all);
+  free(gid);
+  free(x);
+  return e;
+}
+
+void mpm_par_extreme(double *v, long gid, double at[3], bool max) {
+  const int size = pm_par_size();
+  double mine[5] = {*v, (double)gid, at[0], at[1], at[2]}, *all = NULL;
+  double stack[5 * 64];
+  /* (a few doubles a rank: on the stack up to 64 ranks) */
+  all = size <= 64 ? stack : malloc(sizeof(double) * 5 * (size_t)size);
+  if (!all) pm_par_abort(1, "out of memory for the extreme over the ranks");
+  MPI_Allgather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, pm_par_comm());
+  int best = 0;
+  for (int r = 1; r < size; r++) {
+    const double *a = all + 5 * r, *b = all + 5 * best;
+    const bool beats = max ? a[0] > b[0] : a[0] < b[0];
+    if (beats || (a[0] == b[0] && a[1] < b[1])) best = r;
+  }
+  *v = all[5 * best];
+  memcpy(at, all + 5 * best + 2, 3 * sizeof(double));
+  if (all != stack) free(all);
 }
