@@ -82,6 +82,9 @@ pm_err mpm_sim_piece(void *p, const char *dir, long frame,
                      const pm_step_report *rep, long *n, int *n_fields,
                      pm_field *fields);
 const pm_view_pieces *mpm_sim_pieces(void *p);
+/* Doubles a particle of m the fields `want` (PM_FIELD_*) take in an
+ * output buffer (at most mpm_sim_scratch_per_particle). */
+long mpm_sim_fields_per_particle(const mpm_model *m, unsigned want);
 /* Room in the share's output buffer for its particles (grown with the
  * share; frame: for the message).  PM_ERR_MEMORY. */
 pm_err mpm_sim_share_scratch(mpm_sim *r, long frame);

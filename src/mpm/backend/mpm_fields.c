@@ -25,12 +25,11 @@ void mpm_sim_points(void *p, pm_points *pts) {
                      .surface = r->model->tri};
 }
 
-/* u = x - x0 of m's particles into the buffer's [6 n, 9 n). */
+/* u = x - x0 of m's particles into u (3 n). */
 static const double *displacement(const mpm_model *m, const mpm_state *s,
-                                  double *scratch) {
+                                  double *u) {
   const long n3 = 3 * m->n;
   const double *x = s->x, *x0 = m->x0;
-  double *u = scratch + 6 * m->n;
   PM_OMP(parallel for schedule(static) default(none) shared(n3, x, x0, u))
   for (long i = 0; i < n3; i++) u[i] = x[i] - x0[i];
   return u;
@@ -38,7 +37,7 @@ static const double *displacement(const mpm_model *m, const mpm_state *s,
 
 const double *mpm_sim_displacement(void *p) {
   mpm_sim *r = p;
-  return displacement(r->model, r->state, r->scratch);
+  return displacement(r->model, r->state, r->scratch + 6 * r->model->n);
 }
 
 /* Per particle of m into the buffer: strain energy density, J, density,
@@ -56,24 +55,46 @@ static void model_particle_fields(const mpm_model *m, const mpm_state *s,
     m->group[gi].kind->fields(m, s, &m->group[gi], sed, pres, ener);
 }
 
+long mpm_sim_fields_per_particle(const mpm_model *m, unsigned want) {
+  const bool gas = m->kinds & MPM_KIND_INTERNAL_ENERGY;
+  long k = 1;
+  if (gas || want & (PM_FIELD_STRAIN_ENERGY_DENSITY | PM_FIELD_JACOBIAN))
+    k += 5;
+  if (m->kinds & MPM_KIND_MEMBRANE) k += 5;
+  if (want & PM_FIELD_DISPLACEMENT) k += 3;
+  if (want & PM_FIELD_STRESS) k += gas ? 1 : 2;
+  return k;
+}
+
 /* The fields of m's particles (mpm_sim_fields), computed into scratch
- * (mpm_sim_scratch_per_particle doubles a particle). */
+ * (mpm_sim_fields_per_particle doubles a particle, one after another). */
 static int model_fields(const mpm_model *m, const mpm_state *s, double *scratch,
                         unsigned want, pm_field *f, int max) {
   const long n = m->n;
+  const bool gas = m->kinds & MPM_KIND_INTERNAL_ENERGY;
   int nf = 0;
   if (max < 15) return 0;
-  double *sed = scratch, *jac = sed + n, *rho = sed + 2 * n,
-         *pres = sed + 3 * n, *ener = sed + 4 * n, *mat = sed + 11 * n;
-  model_particle_fields(m, s, scratch);
+  double *next = scratch, *sed = NULL, *jac = NULL, *rho = NULL, *pres = NULL,
+         *ener = NULL;
+  if (gas || want & (PM_FIELD_STRAIN_ENERGY_DENSITY | PM_FIELD_JACOBIAN)) {
+    model_particle_fields(m, s, scratch);
+    sed = scratch;
+    jac = sed + n;
+    rho = sed + 2 * n;
+    pres = sed + 3 * n;
+    ener = sed + 4 * n;
+    next += 5 * n;
+  }
+  double *mat = next;
+  next += n;
   /* Each particle's material (the scene's index), to colour by. */
   for (int gi = 0; gi < m->n_groups; gi++)
     for (long p = m->group[gi].begin; p < m->group[gi].end; p++)
       mat[p] = m->group[gi].material;
   f[nf++] = (pm_field){"material", 1, mat};
   if (m->kinds & MPM_KIND_MEMBRANE) {
-    double *normal = sed + 12 * n, *damage = sed + 15 * n,
-           *failed = sed + 16 * n;
+    double *normal = next, *damage = next + 3 * n, *failed = next + 4 * n;
+    next += 5 * n;
     memset(normal, 0, 5 * sizeof(double) * (size_t)n);
     for (int gi = 0; gi < m->n_groups; gi++)
       if (m->group[gi].kind->surface_fields)
@@ -85,12 +106,13 @@ static int model_fields(const mpm_model *m, const mpm_state *s, double *scratch,
   }
   /* The particles' current positions are each frame's geometry. */
   f[nf++] = (pm_field){"position", 3, s->x};
-  if (want & PM_FIELD_DISPLACEMENT)
-    f[nf++] = (pm_field){"displacement", 3, displacement(m, s, scratch)};
+  if (want & PM_FIELD_DISPLACEMENT) {
+    f[nf++] = (pm_field){"displacement", 3, displacement(m, s, next)};
+    next += 3 * n;
+  }
   if (want & PM_FIELD_VELOCITY) f[nf++] = (pm_field){"velocity", 3, s->v};
   if (want & PM_FIELD_STRESS) {
-    const bool has_pressure = m->kinds & MPM_KIND_INTERNAL_ENERGY;
-    double *vm = sed + 9 * n, *mean = has_pressure ? NULL : sed + 10 * n;
+    double *vm = next, *mean = gas ? NULL : next + n;
     pm_stress_invariants(n, s->sigma, vm, mean);
     f[nf++] = (pm_field){"stress", 9, s->sigma};
     f[nf++] = (pm_field){"von_mises", 1, vm};
@@ -99,7 +121,7 @@ static int model_fields(const mpm_model *m, const mpm_state *s, double *scratch,
   if (want & PM_FIELD_STRAIN_ENERGY_DENSITY)
     f[nf++] = (pm_field){"strain_energy_density", 1, sed};
   if (want & PM_FIELD_JACOBIAN) f[nf++] = (pm_field){"jacobian", 1, jac};
-  if (m->kinds & MPM_KIND_INTERNAL_ENERGY) {
+  if (gas) {
     f[nf++] = (pm_field){"density", 1, rho};
     f[nf++] = (pm_field){"pressure", 1, pres};
     f[nf++] = (pm_field){"internal_energy", 1, ener};
@@ -117,7 +139,9 @@ pm_err mpm_sim_share_scratch(mpm_sim *r, long frame) {
   /* The share's buffer grows with the share (migration), as its arrays
    * do: at a frame or a history row, not in a step. */
   if (m->cap <= r->share_scratch_cap) return PM_SUCCESS;
-  const long per = mpm_sim_scratch_per_particle(m);
+  /* (what a frame takes, and the particle fields of the sums) */
+  const long fields = mpm_sim_fields_per_particle(m, r->scene->output.fields),
+             per = fields > 5 ? fields : 5;
   double *grown =
       realloc(r->share_scratch, (size_t)(per * m->cap) * sizeof *grown);
   PM_CHECK(grown, PM_ERR_MEMORY,

@@ -164,39 +164,44 @@ void mpm_par_whole_ranges(const mpm_model *m, mpm_par_ranges *out) {
 }
 
 pm_err mpm_par_gather_x0(const mpm_model *m, double **x0) {
+  enum { block = 1 << 15 }; /* particles a message */
   struct mpm_par *P = par_of(m);
   const int size = P->d.size;
-  long n = m->n, most = m->n, *gid = NULL;
+  long *gid = NULL;
   double *all = NULL, *x = NULL;
-  pm_par_max_long(&most, 1);
   *x0 = NULL;
   pm_err e = PM_SUCCESS;
   if (P->rank == 0) {
     e = PM_ALLOC(all, 3 * P->n_full + 1, "reference positions");
-    if (!e) e = PM_ALLOC(gid, most + 1, "reference positions");
-    if (!e) e = PM_ALLOC(x, 3 * most + 1, "reference positions");
+    if (!e) e = PM_ALLOC(gid, block, "reference positions");
+    if (!e) e = PM_ALLOC(x, 3 * block, "reference positions");
   }
   if ((e = pm_par_agree(e)) != PM_SUCCESS) goto done;
   if (P->rank != 0) {
-    MPI_Send(&n, 1, MPI_LONG, 0, 0, pm_par_comm());
-    MPI_Send(m->gid, (int)n, MPI_LONG, 0, 1, pm_par_comm());
-    MPI_Send(m->x0, (int)(3 * n), MPI_DOUBLE, 0, 2, pm_par_comm());
-    pm_par_count_sent((double)n * (sizeof(long) + 3 * sizeof(double)));
+    /* blocks, the last one short (empty where n is a multiple) */
+    for (long at = 0;; at += block) {
+      const int k = (int)(m->n - at < block ? m->n - at : block);
+      MPI_Send(m->gid + at, k, MPI_LONG, 0, 1, pm_par_comm());
+      MPI_Send(m->x0 + 3 * at, 3 * k, MPI_DOUBLE, 0, 2, pm_par_comm());
+      if (k < block) break;
+    }
+    pm_par_count_sent((double)m->n * (sizeof(long) + 3 * sizeof(double)));
     return PM_SUCCESS;
   }
-  for (int r = 0; r < size; r++) {
-    const long *g = m->gid;
-    const double *y = m->x0;
-    long k = n;
-    if (r > 0) {
-      MPI_Recv(&k, 1, MPI_LONG, r, 0, pm_par_comm(), MPI_STATUS_IGNORE);
-      MPI_Recv(gid, (int)k, MPI_LONG, r, 1, pm_par_comm(), MPI_STATUS_IGNORE);
-      MPI_Recv(x, (int)(3 * k), MPI_DOUBLE, r, 2, pm_par_comm(),
+  for (long j = 0; j < m->n; j++)
+    memcpy(all + 3 * m->gid[j], m->x0 + 3 * j, 3 * sizeof(double));
+  for (int r = 1; r < size; r++) {
+    for (;;) {
+      MPI_Status st;
+      int k = 0;
+      MPI_Recv(gid, block, MPI_LONG, r, 1, pm_par_comm(), &st);
+      MPI_Get_count(&st, MPI_LONG, &k);
+      MPI_Recv(x, 3 * block, MPI_DOUBLE, r, 2, pm_par_comm(),
                MPI_STATUS_IGNORE);
-      g = gid;
-      y = x;
+      for (int j = 0; j < k; j++)
+        memcpy(all + 3 * gid[j], x + 3 * j, 3 * sizeof(double));
+      if (k < block) break;
     }
-    for (long j = 0; j < k; j++) memcpy(all + 3 * g[j], y + 3 * j, 24);
   }
   *x0 = all;
   all = NULL;
