@@ -243,6 +243,12 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
               "(%ld points held: the whole model its setup builds, and its "
               "share with its ghosts)\n",
               pm_memory_format(need, a, sizeof a), ranks, held);
+    else if (!pm_view_whole_needed(s))
+      fprintf(out,
+              "memory/rank  %s before setup on each of %d ranks at most (its "
+              "share with its ghosts, %ld points; no rank keeps the whole "
+              "model: frames in pieces, no checkpoints)\n",
+              pm_memory_format(share, a, sizeof a), ranks, held);
     else
       fprintf(out,
               "memory/rank  %s before setup on each of %d ranks at most (its "

@@ -163,52 +163,57 @@ void mpm_par_whole_ranges(const mpm_model *m, mpm_par_ranges *out) {
                           .bend = P->bend};
 }
 
+enum { x0_block = 1 << 15 }; /* particles a message */
+
+/* A rank's particles' one-process indices and reference positions to rank
+ * 0, in blocks, the last one short (empty where n is a multiple). */
+static void send_x0(const mpm_model *m) {
+  for (long at = 0;; at += x0_block) {
+    const int k = (int)(m->n - at < x0_block ? m->n - at : x0_block);
+    MPI_Send(m->gid + at, k, MPI_LONG, 0, 1, pm_par_comm());
+    MPI_Send(m->x0 + 3 * at, 3 * k, MPI_DOUBLE, 0, 2, pm_par_comm());
+    if (k < x0_block) break;
+  }
+  pm_par_count_sent((double)m->n * (sizeof(long) + 3 * sizeof(double)));
+}
+
+/* On rank 0: rank r's blocks (send_x0) placed into all, through the
+ * buffers gid and x of a block. */
+static void receive_x0(int r, long *gid, double *x, double *all) {
+  for (;;) {
+    MPI_Status st;
+    int k = 0;
+    MPI_Recv(gid, x0_block, MPI_LONG, r, 1, pm_par_comm(), &st);
+    MPI_Get_count(&st, MPI_LONG, &k);
+    MPI_Recv(x, 3 * x0_block, MPI_DOUBLE, r, 2, pm_par_comm(),
+             MPI_STATUS_IGNORE);
+    for (int j = 0; j < k; j++)
+      memcpy(all + 3 * gid[j], x + 3 * j, 3 * sizeof(double));
+    if (k < x0_block) return;
+  }
+}
+
 pm_err mpm_par_gather_x0(const mpm_model *m, double **x0) {
-  enum { block = 1 << 15 }; /* particles a message */
   struct mpm_par *P = par_of(m);
-  const int size = P->d.size;
   long *gid = NULL;
   double *all = NULL, *x = NULL;
-  *x0 = NULL;
   pm_err e = PM_SUCCESS;
   if (P->rank == 0) {
     e = PM_ALLOC(all, 3 * P->n_full + 1, "reference positions");
-    if (!e) e = PM_ALLOC(gid, block, "reference positions");
-    if (!e) e = PM_ALLOC(x, 3 * block, "reference positions");
+    if (!e) e = PM_ALLOC(gid, x0_block, "reference positions");
+    if (!e) e = PM_ALLOC(x, 3 * x0_block, "reference positions");
   }
-  if ((e = pm_par_agree(e)) != PM_SUCCESS) goto done;
-  if (P->rank != 0) {
-    /* blocks, the last one short (empty where n is a multiple) */
-    for (long at = 0;; at += block) {
-      const int k = (int)(m->n - at < block ? m->n - at : block);
-      MPI_Send(m->gid + at, k, MPI_LONG, 0, 1, pm_par_comm());
-      MPI_Send(m->x0 + 3 * at, 3 * k, MPI_DOUBLE, 0, 2, pm_par_comm());
-      if (k < block) break;
-    }
-    pm_par_count_sent((double)m->n * (sizeof(long) + 3 * sizeof(double)));
-    return PM_SUCCESS;
+  e = pm_par_agree(e);
+  if (!e && P->rank != 0) send_x0(m);
+  if (!e && P->rank == 0) {
+    for (long j = 0; j < m->n; j++)
+      memcpy(all + 3 * m->gid[j], m->x0 + 3 * j, 3 * sizeof(double));
+    for (int r = 1; r < P->d.size; r++) receive_x0(r, gid, x, all);
   }
-  for (long j = 0; j < m->n; j++)
-    memcpy(all + 3 * m->gid[j], m->x0 + 3 * j, 3 * sizeof(double));
-  for (int r = 1; r < size; r++) {
-    for (;;) {
-      MPI_Status st;
-      int k = 0;
-      MPI_Recv(gid, block, MPI_LONG, r, 1, pm_par_comm(), &st);
-      MPI_Get_count(&st, MPI_LONG, &k);
-      MPI_Recv(x, 3 * block, MPI_DOUBLE, r, 2, pm_par_comm(),
-               MPI_STATUS_IGNORE);
-      for (int j = 0; j < k; j++)
-        memcpy(all + 3 * gid[j], x + 3 * j, 3 * sizeof(double));
-      if (k < block) break;
-    }
-  }
-  *x0 = all;
-  all = NULL;
-done:
-  free(all);
   free(gid);
   free(x);
+  if (e) free(all);
+  *x0 = e ? NULL : all;
   return e;
 }
 
