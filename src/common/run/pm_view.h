@@ -2,8 +2,11 @@
  * backend.  Each rank steps its share of the run; rank 0 also keeps the
  * whole model and state (its view), into which the shares are gathered
  * where the run writes (frames, history, checkpoints) and where it ends,
- * so that a run across ranks writes what one process writes.  On one
- * process the run is its own view and every call is the plain one. */
+ * so that a run across ranks writes what one process writes.  Where
+ * nothing reads the whole run (pm_view_whole_needed) no rank keeps it, and
+ * the backend's gather brings rank 0 the figures it reports as sums over
+ * the shares instead.  On one process the run is its own view and every
+ * call is the plain one. */
 #ifndef PM_VIEW_H
 #define PM_VIEW_H
 

@@ -41,7 +41,9 @@ typedef struct {
  * ranks (mpm_par.h) the time loop steps this rank's share (local_*), and
  * model, state and work are rank 0's view of the whole run, gathered into
  * when the run writes (NULL on the other ranks); work then holds only the
- * figures of the last step and the timers. */
+ * figures of the last step and the timers.  Without the whole model
+ * (whole false) rank 0's model is NULL and its state holds the run's
+ * scalars alone, its figures in sums. */
 typedef struct {
   const pm_scene *scene; /* borrowed: must outlive the simulation */
   mpm_model *model;
