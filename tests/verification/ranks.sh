@@ -103,6 +103,11 @@ check "disks on 3 ranks: frames in pieces as gathered, bit for bit" \
   $same --frames "$work/disks-3" "$work/disks-pieces-3"
 roundoff "disks on 3 ranks: in pieces (sums) against gathered" \
   "$work/disks-3" "$work/disks-pieces-3"
+# The errors against a reference field (time-dependent, two components)
+# summed over the shares too.
+across disks-ref $mpm/disks-collision.yaml 3 --set output.ranks=pieces \
+  --set 'reference.displacement.x=0.1*x*t' \
+  --set 'reference.displacement.y=0.05*y'
 check "disks on 3 ranks: in pieces, the mesh and the end's figures" $py -c "
 import h5py, json, sys
 import numpy as np

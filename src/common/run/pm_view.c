@@ -13,7 +13,8 @@ bool pm_view_whole_needed(const pm_scene *s) {
   const bool pieces =
       s->output.ranks == PM_OUTPUT_PIECES && s->backend && s->backend->pieces;
   return !pieces || s->output.checkpoint.every > 0 ||
-         s->output.checkpoint.minutes > 0 || s->reference_mask;
+         s->output.checkpoint.minutes > 0 ||
+         (s->reference_mask && !s->backend->errors);
 }
 
 bool pm_view_keeps_whole_for(const pm_scene *s) {

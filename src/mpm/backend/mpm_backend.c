@@ -334,6 +334,7 @@ const pm_backend mpm_backend = {
     .timers = mpm_sim_timers,
     .checkpoint = checkpoint,
     .pieces = mpm_sim_pieces,
+    .errors = mpm_sim_errors,
 };
 
 /* ---- method mpm-implicit ------------------------------------------------ */

@@ -31,6 +31,8 @@ typedef struct {
   double sed_volume, volume0;
   double max_von_mises, max_von_mises_at[3];
   double min_jacobian, min_jacobian_at[3];
+  /* the NRMSE of each reference component and of the field (NAN: none) */
+  double nrmse[3], nrmse_vector;
   long n;          /* particles */
   long grid_nodes; /* of the whole grid */
   double *buf;     /* what a rank sums: room made at setup */

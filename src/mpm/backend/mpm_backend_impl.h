@@ -66,6 +66,8 @@ pm_err mpm_view_sums_setup(mpm_sim *r);
  * state (energies, accounts, the bodies' columns; with fields, the end's
  * field figures) (collective). */
 pm_err mpm_view_sum(mpm_sim *r, bool fields);
+/* pm_backend.errors: the NRMSE of the last sums (r->whole false). */
+bool mpm_sim_errors(void *p, double nrmse[3], double *vector);
 /* What rank 0's observer reads of a converged implicit load step: every
  * rank's particles and load stepping's states (collective). */
 pm_err mpm_view_implicit_gather(void *ctx);
