@@ -3,7 +3,8 @@
 # around each rank), 20 steps, on 1, 2 and 4 ranks (4 oversubscribed on
 # fewer cores: memory, not time), for the 3-D block, the block at half its
 # cell (mesh_size 1.25e-3: 884 736 particles), the block with its frames
-# in pieces (output.ranks: pieces; label "pieces"), the reduced oocyte and I2
+# in pieces (output.ranks: pieces, no checkpoints: rank 0 without the
+# whole model; label "pieces", the fine block too), the reduced oocyte and I2
 # by the implicit MPM at 256^2 cells (its 10 load steps); with
 # BEFORE=BUILD_DIR the same runs by that build beside.  One line per rank:
 # KiB and CPU seconds (user).  A tiny scene (the disks) gives each rank's
@@ -11,8 +12,9 @@
 # METHOD=fpm: FPM F3 at 60% at 4036 and 13762 points (mesh_size 6.42e-3,
 # 4.15e-3), 20 steps and, labelled "setup", one step (the setup's CPU
 # seconds), its floor the same at 45 points (mesh_size 0.05).
-# usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] [METHOD=fpm] benchmarks/bench-rank-memory.sh [BUILD_DIR]
-bench_name=rank-memory bench_env="BEFORE RANKS METHOD"
+# ONLY="block block-fine" measures those MPM scenes alone (and the floor).
+# usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] [METHOD=fpm] [ONLY=NAMES] benchmarks/bench-rank-memory.sh [BUILD_DIR]
+bench_name=rank-memory bench_env="BEFORE RANKS METHOD ONLY"
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
   OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1 \
@@ -21,6 +23,8 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
 measure() { # LABEL BIN N NAME SCENE [--set KEY=VALUE]...
   local label=$1 b=$2 n=$3 name=$4 scene=$5 d
   shift 5
+  [ -z "${ONLY:-}" ] || [ "$label" = floor ] ||
+    [[ " $ONLY " == *" $name "* ]] || return 0
   d=$out/$label-$name-$n
   rm -rf "$d" && mkdir -p "$d"
   mpirun -np "$n" --bind-to none bash -c \
@@ -61,6 +65,8 @@ for n in ${RANKS:-1 2 4}; do
       cases/mpm/bench-block.yaml --set output.ranks=pieces
     measure "$l" "$b" "$n" oocyte cases/mpm/m4-oocyte-reduced.yaml
     measure "$l" "$b" "$n" block-fine cases/mpm/bench-block.yaml "${fine[@]}"
+    [ "$l" = after ] && measure pieces "$b" "$n" block-fine \
+      cases/mpm/bench-block.yaml "${fine[@]}" --set output.ranks=pieces
     measure "$l" "$b" "$n" i2-256 cases/mpm/i2-vessel-slice.yaml "${i2[@]}"
   done
 done

@@ -9,6 +9,7 @@
 #include "pm_backend.h"
 #include "pm_error.h"
 #include "pm_par.h"
+#include "pm_view.h"
 
 /* The simulation whose state is read: set up, and on rank 0 (the only one
  * holding the whole state across ranks). */
@@ -23,6 +24,19 @@ static pm_err readable(const pointmech *p, const char *what) {
   return PM_SUCCESS;
 }
 
+/* readable, and its arrays held whole on rank 0: not so across ranks with
+ * frames in pieces and no checkpoints (pm_view_whole_needed), where rank 0
+ * holds its share and the run's figures alone. */
+static pm_err readable_whole(const pointmech *p, const char *what) {
+  PM_CALL(readable(p, what));
+  PM_CHECK(!pm_par_active() || pm_view_whole_needed(p->s), PM_ERR_ARG,
+           "%s: across MPI ranks with output.ranks: pieces and no "
+           "output.checkpoint no rank holds the whole state (take "
+           "output.ranks: gather)",
+           what);
+  return PM_SUCCESS;
+}
+
 long pointmech_point_count(const pointmech *p) {
   if (readable(p, "pointmech_point_count")) return 0;
   pm_points pts;
@@ -31,7 +45,7 @@ long pointmech_point_count(const pointmech *p) {
 }
 
 static pm_err points_impl(pointmech *p, double *xyz, size_t capacity) {
-  PM_CALL(readable(p, "pointmech_points"));
+  PM_CALL(readable_whole(p, "pointmech_points"));
   pm_points pts;
   p->s->backend->points(p->sim, &pts);
   const size_t n = 3 * (size_t)pts.n;
@@ -44,7 +58,7 @@ static pm_err points_impl(pointmech *p, double *xyz, size_t capacity) {
 /* Every field the state gives, into p->fields (borrowed until the next
  * call). */
 static pm_err load_fields(pointmech *p, const char *what) {
-  PM_CALL(readable(p, what));
+  PM_CALL(readable_whole(p, what));
   const unsigned all = PM_FIELD_DISPLACEMENT | PM_FIELD_VELOCITY |
                        PM_FIELD_STRESS | PM_FIELD_STRAIN_ENERGY_DENSITY |
                        PM_FIELD_JACOBIAN | PM_FIELD_FORCE;
@@ -135,7 +149,8 @@ static const figure_entry figures[] = {
 /* The figures now: the run's outcome after it, the state's during it. */
 static pm_err current_figures(pointmech *p, bool fields, pm_figures *f,
                               const char *what) {
-  PM_CALL(readable(p, what));
+  /* (the field figures during a run read the whole state) */
+  PM_CALL(fields && p->running ? readable_whole(p, what) : readable(p, what));
   if (p->running)
     p->s->backend->figures(p->sim, f, fields);
   else

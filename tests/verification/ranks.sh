@@ -95,9 +95,36 @@ fails_alike left-the-grid 2 'step [0-9]*, .*left the grid' \
 # Frames in pieces (output.ranks: pieces): each rank writes its own
 # particles and rank 0 joins them; read in one-process order, the same
 # run's frames as gathered, bit for bit, and one process's to round-off.
+# Without checkpoints no rank holds the whole model: the history rows and
+# the end's figures are sums over the shares, the gathered run's to
+# round-off; the mesh is one process's, bit for bit.
 across disks-pieces $mpm/disks-collision.yaml 3 --set output.ranks=pieces
 check "disks on 3 ranks: frames in pieces as gathered, bit for bit" \
-  $same "$work/disks-3" "$work/disks-pieces-3"
+  $same --frames "$work/disks-3" "$work/disks-pieces-3"
+roundoff "disks on 3 ranks: in pieces (sums) against gathered" \
+  "$work/disks-3" "$work/disks-pieces-3"
+# The errors against a reference field (time-dependent, two components)
+# summed over the shares too.
+across disks-ref $mpm/disks-collision.yaml 3 --set output.ranks=pieces \
+  --set 'reference.displacement.x=0.1*x*t' \
+  --set 'reference.displacement.y=0.05*y'
+check "disks on 3 ranks: in pieces, the mesh and the end's figures" $py -c "
+import h5py, json, sys
+import numpy as np
+a, b = sys.argv[1:3]
+ma = h5py.File(a + '/results/mesh.h5', 'r')
+mb = h5py.File(b + '/results/mesh.h5', 'r')
+assert all(np.array_equal(ma[k][()], mb[k][()]) for k in ma), 'mesh'
+sa = json.load(open(a + '/summary.json'))
+sb = json.load(open(b + '/summary.json'))
+for k in ('points', 'particles', 'grid_nodes', 'groups', 'steps',
+          'max_von_mises_at', 'end_min_jacobian_at'):
+    assert sa[k] == sb[k] or np.allclose(sa[k], sb[k], rtol=1e-10), k
+for k in ('kinetic_energy', 'strain_energy', 'initial_energy',
+          'mean_strain_energy_density', 'max_von_mises', 'end_min_jacobian',
+          'min_jacobian'):
+    assert abs(sa[k] - sb[k]) <= 1e-10 * abs(sa[k]), (k, sa[k], sb[k])
+" "$work/disks-1" "$work/disks-pieces-3"
 check "disks on 3 ranks: a piece a rank a frame" \
   test "$(ls "$work/disks-pieces-3/results" | grep -c '\.piece_')" -eq \
   $((3 * $(ls "$work/disks-pieces-3/results" | grep -c '^frame_[0-9]*\.h5$')))
@@ -136,8 +163,9 @@ roundoff "interrupted on 2 ranks, resumed on 3" "$work/long-2" "$work/cut-3"
 roundoff "interrupted on 2 ranks, resumed on 1" "$work/long-1" "$work/cut-1"
 # The same with frames in pieces, resumed on 3 ranks: the frames after
 # the checkpoint (the signal's) and their pieces dropped, the later ones
-# in 3 pieces.
-interrupt 2 "$work/pcut" "$tube" $long --set output.ranks=pieces
+# in 3 pieces.  (Checkpoints named, so rank 0 keeps the whole model.)
+interrupt 2 "$work/pcut" "$tube" $long --set output.ranks=pieces \
+  --set output.checkpoint.minutes=60
 resume_on "$work/pcut" 3
 roundoff "in pieces, interrupted on 2 ranks, resumed on 3" "$work/long-2" \
   "$work/pcut-3"
@@ -150,6 +178,29 @@ pieces = {m.group(1) for n in os.listdir(d)
           for m in [re.match(r'frame_(\\d+)\\.piece_\\d+\\.h5$', n)] if m}
 assert pieces == frames, sorted(pieces ^ frames)
 " "$work/pcut-3"
+
+# In pieces without checkpoints no rank holds the whole model: a signal
+# stops the run with its frames, and says that it wrote no checkpoint.
+interrupt 2 "$work/pnone" "$tube" $long --set output.ranks=pieces
+check "in pieces, no checkpoints, interrupted: no checkpoint, said" \
+  grep -q 'no checkpoint: a run across ranks with frames in pieces' \
+  "$work/pnone/summary.json"
+
+# A rank's memory below one process's need: refused before the setup on
+# one process with both figures; on 2 ranks in pieces, where no rank
+# holds the whole model, it runs (one process's results to round-off).
+refused "one process past POINTMECH_MEMORY_LIMIT" \
+  "needs an estimated 324.1 KiB" "$work/mem-1" \
+  env POINTMECH_MEMORY_LIMIT=250K "$bin" run "$mpm/disks-collision.yaml" \
+  --out "$work/mem-1" --quiet
+check "past POINTMECH_MEMORY_LIMIT: what is available, said" \
+  grep -qF "but 250.0 KiB (256000 bytes) is available" "$work/err"
+POINTMECH_MEMORY_LIMIT=250K ranks 2 "$bin" run "$mpm/disks-collision.yaml" \
+  --set output.ranks=pieces --out "$work/mem-2" --quiet >/dev/null \
+  2>"$work/err"
+check "POINTMECH_MEMORY_LIMIT one process passes: 2 ranks in pieces run" \
+  test $? -eq 0
+roundoff "2 ranks in pieces under the limit" "$work/disks-1" "$work/mem-2"
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

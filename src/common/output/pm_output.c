@@ -133,6 +133,33 @@ void pm_output_free(pm_results *r) {
   free(r);
 }
 
+/* A point cloud's cells, point i's cell i, into the open dataset dset of
+ * n rows, a block at a time (the whole would be a long a point). */
+static pm_err write_cloud_cells(hid_t dset, long n, const char *path) {
+  enum { block = 1 << 12 };
+  pm_err ret = PM_SUCCESS;
+  hid_t file = -1, mem = -1;
+  long ids[block];
+  H5_OK(file = H5Dget_space(dset), "H5Dget_space", "/cells", path);
+  for (long at = 0; at < n; at += block) {
+    const long k = n - at < block ? n - at : block;
+    hsize_t start[2] = {(hsize_t)at, 0}, count[2] = {(hsize_t)k, 1};
+    for (long i = 0; i < k; i++) ids[i] = at + i;
+    H5_OK(H5Sselect_hyperslab(file, H5S_SELECT_SET, start, NULL, count, NULL),
+          "H5Sselect_hyperslab", "/cells", path);
+    H5_OK(mem = H5Screate_simple(2, count, NULL), "H5Screate_simple", "/cells",
+          path);
+    H5_OK(H5Dwrite(dset, H5T_NATIVE_LONG, mem, file, H5P_DEFAULT, ids),
+          "H5Dwrite", "/cells", path);
+    pm_h5_close_quiet(&mem);
+  }
+done:
+  pm_h5_close_quiet(&mem);
+  pm_h5_close_quiet(&file);
+  return ret;
+}
+
+/* cells NULL: a point cloud's (point i's cell i). */
 static pm_err write_mesh(const pm_results *r, const double *x,
                          const long *cells, const long *surface) {
   pm_err ret = PM_SUCCESS;
@@ -155,6 +182,7 @@ static pm_err write_mesh(const pm_results *r, const double *x,
                            H5T_NATIVE_DOUBLE, x, path, NULL));
   PM_TRY(pm_output_dataset(file, "cells", 2, cd, H5T_STD_I64LE, H5T_NATIVE_LONG,
                            cells, path, &dset));
+  if (!cells) PM_TRY(write_cloud_cells(dset, r->n_cells, path));
   PM_TRY(pm_h5_write_attr(dset, "nodes_per_cell", H5T_STD_I32LE, H5T_NATIVE_INT,
                           &npc, path));
   H5_OK(H5Dclose(dset), "H5Dclose", "/cells", path);
@@ -179,7 +207,6 @@ pm_err pm_results_create_ex(const char *dir, int dim, const pm_points *p,
                             pm_results **out) {
   pm_err ret = PM_SUCCESS;
   pm_results *r = NULL;
-  long *ids = NULL;
   PM_CHECK(out && p, PM_ERR_ARG, "pm_results_create: NULL out or points");
   *out = NULL;
   PM_CALL(check_mesh(dim, p));
@@ -190,12 +217,8 @@ pm_err pm_results_create_ex(const char *dir, int dim, const pm_points *p,
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   const long *cells = p->cells;
   long n_cells = p->n_cells;
-  if (p->nodes_per_cell == 1 && !cells) { /* point cloud: cell i is point i */
-    PM_TRY(PM_ALLOC(ids, p->n, "point cloud cells"));
-    for (long i = 0; i < p->n; i++) ids[i] = i;
-    cells = ids;
+  if (p->nodes_per_cell == 1 && !cells) /* point cloud: cell i is point i */
     n_cells = p->n;
-  }
   PM_TRY(PM_ALLOC(r, 1, "results writer"));
   r->dim = dim;
   r->nodes_per_cell = p->nodes_per_cell;
@@ -222,7 +245,6 @@ done:
     pm_results_close(r, false);
     r = NULL;
   }
-  free(ids);
   return ret;
 }
 

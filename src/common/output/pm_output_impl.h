@@ -80,7 +80,8 @@ pm_err pm_output_classify(pm_err e, int saved_errno, const char *path);
  * space on dir's disk cannot hold. */
 pm_err pm_output_check_room(const char *dir, const char *path, double bytes);
 
-/* Write the dataset loc/name of rank dims (file type ftype, memory mtype);
+/* Write the dataset loc/name of rank dims (file type ftype, memory mtype;
+ * data NULL: made, its values left for the caller to write);
  * keep_open: its handle is left open there (else NULL). */
 pm_err pm_output_dataset(hid_t loc, const char *name, int rank,
                          const hsize_t *dims, hid_t ftype, hid_t mtype,

@@ -76,8 +76,9 @@ pm_err pm_output_dataset(hid_t loc, const char *name, int rank,
   H5_OK(dset = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT,
                           H5P_DEFAULT),
         "H5Dcreate2", name, path);
-  H5_OK(H5Dwrite(dset, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "H5Dwrite",
-        name, path);
+  if (data)
+    H5_OK(H5Dwrite(dset, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
+          "H5Dwrite", name, path);
   if (keep_open) {
     *keep_open = dset;
     dset = -1;

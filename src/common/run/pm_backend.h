@@ -219,6 +219,14 @@ typedef struct pm_backend {
    * a frame whole (one process).  NULL: frames are always written whole
    * (the loader refuses pieces across ranks). */
   const struct pm_view_pieces *(*pieces)(void *sim);
+  /* Across ranks without the whole model (pm_view_whole_needed false):
+   * the NRMSE of each component of the scene's reference field (NAN where
+   * it has none) and of the field (as pm_run_compute_errors takes them)
+   * into nrmse and *vector, from the sums over the shares at the last
+   * gather (pm_view), and true; false where the driver computes them from
+   * the whole displacement.  NULL: a reference field keeps the whole model
+   * on rank 0. */
+  bool (*errors)(void *sim, double nrmse[3], double *vector);
 } pm_backend;
 
 /* ---- registry ------------------------------------------------------------ */

@@ -193,7 +193,7 @@ pm_err pm_memory_check(const pm_scene *s) {
   if (!s->backend || !s->backend->estimate_bytes) return PM_SUCCESS;
   long points = 0;
   const int ranks = pm_par_size();
-  const bool whole = s->backend->setup_whole || pm_view_keeps_whole();
+  const bool whole = s->backend->setup_whole || pm_view_keeps_whole_for(s);
   size_t need =
       pm_memory_rank_estimate(s, ranks, whole, pm_par_root(), &points);
   pm_memory_available avail;
@@ -252,6 +252,12 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
               "(%ld points held: the whole model its setup builds, and its "
               "share with its ghosts)\n",
               pm_memory_format(need, a, sizeof a), ranks, held);
+    else if (!pm_view_whole_needed(s))
+      fprintf(out,
+              "memory/rank  %s before setup on each of %d ranks at most (its "
+              "share with its ghosts, %ld points; no rank keeps the whole "
+              "model: frames in pieces, no checkpoints)\n",
+              pm_memory_format(share, a, sizeof a), ranks, held);
     else
       fprintf(out,
               "memory/rank  %s before setup on each of %d ranks at most (its "

@@ -79,7 +79,11 @@ pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
   c->ckpt_seconds = 60 * s->output.checkpoint.minutes;
   c->be->points(sim, &c->pts);
   PM_TRY(pm_run_setup_columns(c));
-  if (s->reference_mask) {
+  /* A backend that sums the errors over the ranks' shares (no rank holds
+   * the whole displacement) needs no reference field here. */
+  double skip[3], skip_vector;
+  const bool summed = c->be->errors && c->be->errors(sim, skip, &skip_vector);
+  if (s->reference_mask && !summed) {
     PM_TRY(PM_ALLOC(c->ref, 3 * c->pts.n, "reference field"));
     for (int k = 0; k < 3; k++)
       if ((s->reference_mask >> k & 1u) && pm_expr_uses(s->reference[k], 't'))

@@ -42,7 +42,11 @@ void pm_run_compute_errors(pm_run_ctx *c, double t) {
   int n_ref = 0;
   for (int k = 0; k < 3; k++) o->nrmse[k] = NAN;
   o->nrmse_vector = NAN;
-  if (!c->ref) return;
+  if (!c->ref) { /* across ranks without the whole displacement */
+    if (mask && c->be->errors)
+      c->be->errors(c->sim, o->nrmse, &o->nrmse_vector);
+    return;
+  }
   if (c->ref_time) pm_run_fill_reference(c, t);
   const double *u = c->be->displacement(c->sim);
   for (int k = 0; k < 3; k++) {
@@ -120,7 +124,7 @@ static pm_err write_row(pm_run_ctx *c) {
   k += c->n_own;
   for (; k < c->n_cols && c->react_bc[k] >= 0; k++)
     row[k] = f.reaction[c->react_bc[k]][c->react_comp[k]];
-  if (c->ref) {
+  if (c->s->reference_mask) {
     pm_run_compute_errors(c, f.time);
     for (int comp = 0; comp < 3; comp++)
       if (c->s->reference_mask >> comp & 1u) row[k++] = c->o->nrmse[comp];

@@ -9,6 +9,18 @@
 
 bool pm_view_keeps_whole(void) { return pm_par_active() && pm_par_root(); }
 
+bool pm_view_whole_needed(const pm_scene *s) {
+  const bool pieces =
+      s->output.ranks == PM_OUTPUT_PIECES && s->backend && s->backend->pieces;
+  return !pieces || s->output.checkpoint.every > 0 ||
+         s->output.checkpoint.minutes > 0 ||
+         (s->reference_mask && !s->backend->errors);
+}
+
+bool pm_view_keeps_whole_for(const pm_scene *s) {
+  return pm_view_keeps_whole() && pm_view_whole_needed(s);
+}
+
 void pm_view_release(pm_view *v) {
   if (v->ranks && !pm_par_root() && v->release) v->release(v->ctx);
 }
@@ -83,7 +95,9 @@ pm_err pm_view_stopped_inside(pm_view *v, const pm_step_report *r, pm_err e) {
 
 pm_err pm_view_end(pm_view *v, pm_err e) {
   if (v->ranks) {
+    v->ending = true;
     pm_err g = v->gather(v->ctx);
+    v->ending = false;
     if (!e) e = g;
   }
   v->obs = NULL;

@@ -2,8 +2,11 @@
  * backend.  Each rank steps its share of the run; rank 0 also keeps the
  * whole model and state (its view), into which the shares are gathered
  * where the run writes (frames, history, checkpoints) and where it ends,
- * so that a run across ranks writes what one process writes.  On one
- * process the run is its own view and every call is the plain one. */
+ * so that a run across ranks writes what one process writes.  Where
+ * nothing reads the whole run (pm_view_whole_needed) no rank keeps it, and
+ * the backend's gather brings rank 0 the figures it reports as sums over
+ * the shares instead.  On one process the run is its own view and every
+ * call is the plain one. */
 #ifndef PM_VIEW_H
 #define PM_VIEW_H
 
@@ -47,6 +50,7 @@ typedef struct pm_view {
    * passed to every rank at the start): the folder and the last frame's
    * pieces. */
   bool in_pieces;
+  bool ending; /* the run has ended: gather's last call, for the figures */
   char dir[PM_PATH_MAX + 1];
   pm_view_pieces pieces;
 } pm_view;
@@ -54,8 +58,23 @@ typedef struct pm_view {
 /* Whether this rank holds the whole model and state through a run: across
  * ranks, rank 0 while frames, checkpoints and the end's figures are
  * gathered into its view.  Setup builds the whole model only where this is
- * true (and a share everywhere across ranks). */
+ * true (and a share everywhere across ranks).  For a backend that writes
+ * no frames in pieces (pm_backend.pieces NULL); otherwise
+ * pm_view_keeps_whole_for. */
 bool pm_view_keeps_whole(void);
+
+/* Whether a run of scene s across ranks needs the whole model on rank 0:
+ * unless its frames go in pieces (output.ranks: pieces, a backend that
+ * writes them) and nothing else reads the whole run: no checkpoints
+ * (output.checkpoint), and a reference field only where the backend sums
+ * its errors over the shares (pm_backend.errors).  Without it the history rows
+ * and the end's figures come from reductions over the shares (pm_view.gather
+ * then reduces), and a signal writes no checkpoint.  The same on every rank. */
+bool pm_view_whole_needed(const pm_scene *s);
+
+/* pm_view_keeps_whole for scene s: rank 0 across ranks where
+ * pm_view_whole_needed(s). */
+bool pm_view_keeps_whole_for(const pm_scene *s);
 
 /* The run starts with observer obs (which may be NULL): across ranks, the
  * ranks other than 0 release their view. */

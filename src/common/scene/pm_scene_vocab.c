@@ -981,7 +981,9 @@ static const pm_key output_keys[] = {
             "0 and written whole) or pieces (explicit MPM without "
             "membranes: each rank writes its own particles, "
             "results/frame_NNNNNN.piece_RRRR.h5, joined by rank 0's frame "
-            "file; readers put them in one-process order)"},
+            "file; readers put them in one-process order; without "
+            "output.checkpoint no rank holds the whole model, and a "
+            "signal writes no checkpoint)"},
     {.name = "checkpoint",
      .type = PM_KEY_MAPPING,
      .keys = checkpoint_keys,

@@ -59,7 +59,8 @@ pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out) {
    * from the scene: the particles of its cells by their reference
    * positions, in one process's order. */
   const bool par = pm_par_active();
-  PM_TRY(pm_par_agree(!par || pm_view_keeps_whole()
+  r->whole = !par || pm_view_whole_needed(s);
+  PM_TRY(pm_par_agree(!par || pm_view_keeps_whole_for(s)
                           ? mpm_model_create(s, &r->model, &r->state)
                           : PM_SUCCESS));
   if (par)
@@ -76,6 +77,7 @@ pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out) {
     PM_TRY(pm_par_agree(mpm_work_create(r->local_model, &r->local_work)));
     PM_TRY(pm_par_agree(r->model ? mpm_sim_figures_work(r->model, &r->work)
                                  : PM_SUCCESS));
+    if (!r->whole) PM_TRY(mpm_view_sums_setup(r));
   } else {
     PM_TRY(mpm_work_create(r->model, &r->work));
   }
@@ -85,6 +87,8 @@ pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out) {
     PM_TRY(PM_ALLOC(r->scratch,
                     mpm_sim_scratch_per_particle(r->model) * r->model->n,
                     "output buffer"));
+    PM_TRY(mpm_sim_history_setup(r));
+  } else if (r->state && pm_par_root()) { /* rank 0 without the model */
     PM_TRY(mpm_sim_history_setup(r));
   }
   *out = r;
@@ -114,6 +118,9 @@ void mpm_sim_destroy(mpm_sim *r) {
   free(r->surface);
   free(r->scratch);
   free(r->share_scratch);
+  free(r->mesh_x0);
+  free(r->sums.buf);
+  free(r->sums.body);
   free(r);
 }
 
@@ -139,11 +146,12 @@ size_t mpm_sim_bytes(const mpm_sim *r) {
 /* The report of the step the state is at (the initial state as step 0). */
 pm_step_report mpm_sim_step_report(const mpm_sim *r, bool last) {
   const mpm_state *s = r->state;
+  const mpm_model *m = r->model ? r->model : r->local_model;
   return (pm_step_report){.last = last,
                           .step = s->step,
                           .t = s->t,
                           .residual = r->work->residual,
-                          .progress = s->t / r->model->opt.t_end};
+                          .progress = s->t / m->opt.t_end};
 }
 
 /* Report a step to the run's observer (rank 0's alone, across ranks). */
@@ -193,6 +201,8 @@ static pm_err run(void *p, const pm_observer *obs) {
   pm_err e = PM_SUCCESS;
   if (r->view.ranks && r->resumed) /* the shares of the checkpoint's state */
     PM_CALL(mpm_view_reshare(r));
+  free(r->mesh_x0); /* (the results' mesh is written) */
+  r->mesh_x0 = NULL;
   pm_view_start(&r->view, obs);
   e = pm_view_start_pieces(&r->view, r->scene); /* (agreed) */
   mpm_model *lm = r->view.ranks ? r->local_model : r->model;
@@ -208,6 +218,13 @@ static pm_err run(void *p, const pm_observer *obs) {
       for (long q = 0; q < r->model->n; q++)
         r->run_min_jacobian =
             fmin(r->run_min_jacobian, r->state->vol[q] / r->model->vol0[q]);
+    } else if (!r->whole) { /* the same summed over the shares */
+      if (!e) e = mpm_view_sum(r, false);
+      r->energy0 = r->sums.kinetic + r->sums.strain + r->sums.internal;
+      for (long q = 0; q < lm->n; q++)
+        r->run_min_jacobian =
+            fmin(r->run_min_jacobian, ls->vol[q] / lm->vol0[q]);
+      pm_par_min(&r->run_min_jacobian, 1);
     }
     if (!e) e = mpm_view_report(r, true, false);
   }
@@ -267,6 +284,10 @@ static pm_err ranks_checkpoint(mpm_sim *r, pm_ckpt *ck) {
 static pm_err checkpoint(void *p, pm_ckpt *ck) {
   mpm_sim *r = p;
   long iter_max_row = r->iter_max_row;
+  PM_CHECK(r->whole || pm_ckpt_reading(ck), PM_ERR_ARG,
+           "a run across ranks with frames in pieces and no "
+           "output.checkpoint keeps no whole model to checkpoint (set "
+           "output.checkpoint.every, or output.ranks: gather)");
   /* A rank without the whole model reads a checkpoint of the whole run
    * into one, from which its share is cut anew (mpm_view_reshare). */
   if (pm_ckpt_reading(ck) && !r->model)
@@ -313,6 +334,7 @@ const pm_backend mpm_backend = {
     .timers = mpm_sim_timers,
     .checkpoint = checkpoint,
     .pieces = mpm_sim_pieces,
+    .errors = mpm_sim_errors,
 };
 
 /* ---- method mpm-implicit ------------------------------------------------ */

@@ -17,11 +17,35 @@ extern const pm_backend mpm_implicit_backend;
 
 struct mpm_implicit;
 
+/* Rank 0's figures of a run across ranks without the whole model: what
+ * the history rows and the end read, summed (or the extreme taken) over
+ * the ranks' shares. */
+typedef struct {
+  double kinetic, strain, internal;
+  /* per scene body (MPM_SUMS_BODY each): the sum of mass times
+   * displacement (3), of mass, of pressure times volume and of volume */
+  double *body;
+  /* the end's fields: the solids' sum of V0 times the strain energy
+   * density and of V0; the largest von Mises stress and the smallest J,
+   * and where they are */
+  double sed_volume, volume0;
+  double max_von_mises, max_von_mises_at[3];
+  double min_jacobian, min_jacobian_at[3];
+  /* the NRMSE of each reference component and of the field (NAN: none) */
+  double nrmse[3], nrmse_vector;
+  long n;          /* particles */
+  long grid_nodes; /* of the whole grid */
+  double *buf;     /* what a rank sums: room made at setup */
+} mpm_sums;
+#define MPM_SUMS_BODY 6
+
 /* A prepared simulation.  Fields are read-only for callers.  Across MPI
  * ranks (mpm_par.h) the time loop steps this rank's share (local_*), and
  * model, state and work are rank 0's view of the whole run, gathered into
  * when the run writes (NULL on the other ranks); work then holds only the
- * figures of the last step and the timers. */
+ * figures of the last step and the timers.  Without the whole model
+ * (whole false) rank 0's model is NULL and its state holds the run's
+ * scalars alone, its figures in sums. */
 typedef struct {
   const pm_scene *scene; /* borrowed: must outlive the simulation */
   mpm_model *model;
@@ -66,7 +90,15 @@ typedef struct {
   long iter_capped_prev;
   mpm_step_info last; /* the last step's figures */
   bool resumed;       /* the state came from a checkpoint */
-  pm_view view;       /* the run's observer, and rank 0's view across ranks */
+  /* Across ranks, whether rank 0 keeps the whole model (its view,
+   * pm_view_whole_needed; the same on every rank).  Without it rank 0's
+   * state holds the run's scalars alone, and its figures come from sums
+   * over the shares (mpm_view_sums.c). */
+  bool whole;
+  double *mesh_x0; /* rank 0, until the run starts: every reference
+                      position, in one process's order (results' mesh) */
+  mpm_sums sums;
+  pm_view view; /* the run's observer, and rank 0's view across ranks */
 } mpm_sim;
 
 /* Model, initial state, workspace and output buffer of scene s.  Failures

@@ -57,6 +57,17 @@ pm_err mpm_view_reshare(mpm_sim *r);
 /* What the exchanges cost over the run, summed over the ranks (the
  * busiest rank's seconds), into r->ranks_counts (collective). */
 void mpm_view_counts(mpm_sim *r);
+/* Across ranks without the whole model (mpm_sim.whole false), at setup:
+ * rank 0's state of the run's scalars, its figures' workspace and the
+ * whole run's reference positions (mesh_x0), every rank's room for the
+ * bodies' sums (collective). */
+pm_err mpm_view_sums_setup(mpm_sim *r);
+/* The sums over the shares into rank 0's r->sums and the scalars of its
+ * state (energies, accounts, the bodies' columns; with fields, the end's
+ * field figures) (collective). */
+pm_err mpm_view_sum(mpm_sim *r, bool fields);
+/* pm_backend.errors: the NRMSE of the last sums (r->whole false). */
+bool mpm_sim_errors(void *p, double nrmse[3], double *vector);
 /* What rank 0's observer reads of a converged implicit load step: every
  * rank's particles and load stepping's states (collective). */
 pm_err mpm_view_implicit_gather(void *ctx);
@@ -73,6 +84,25 @@ pm_err mpm_sim_piece(void *p, const char *dir, long frame,
                      const pm_step_report *rep, long *n, int *n_fields,
                      pm_field *fields);
 const pm_view_pieces *mpm_sim_pieces(void *p);
+/* Doubles a particle of m the fields `want` (PM_FIELD_*) take in an
+ * output buffer (at most mpm_sim_scratch_per_particle). */
+long mpm_sim_fields_per_particle(const mpm_model *m, unsigned want);
+/* Room in the share's output buffer for its particles (grown with the
+ * share; frame: for the message).  PM_ERR_MEMORY. */
+pm_err mpm_sim_share_scratch(mpm_sim *r, long frame);
+/* The end's field figures of m's particles at state s (their fields
+ * computed into scratch, mpm_sim_scratch_per_particle doubles a particle)
+ * into out's sed_volume, volume0, max_von_mises and min_jacobian with
+ * where they are; at: the one-process indices of those two particles
+ * (LONG_MAX: none), the first in one process's order among equals. */
+void mpm_sim_field_sums(const mpm_model *m, const mpm_state *s, double *scratch,
+                        mpm_sums *out, long at[2]);
+/* Body b's sums over m's particles at state st into out (MPM_SUMS_BODY
+ * doubles: mass times displacement, mass, and with pressure, its
+ * pressure times volume and volume, its kind's fields computed into
+ * scratch). */
+void mpm_sim_body_sums(const mpm_model *m, const mpm_state *st, double *scratch,
+                       int b, bool pressure, double *out);
 void mpm_sim_figures(void *p, pm_figures *f, bool with_fields);
 /* The history columns of its own (mpm_sim.hist_names), on rank 0.
  * PM_ERR_MEMORY. */

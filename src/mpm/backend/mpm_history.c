@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "mpm_backend_impl.h"
+#include "mpm_par.h"
 #include "gm_inside.h"
 #include "gm_shape.h"
 #include "pm_omp.h"
@@ -23,13 +24,49 @@ static void add_hist(mpm_sim *r, const char *fmt, const char *a,
   r->n_hist++;
 }
 
-/* The kind of scene body b's particles. */
-static const mpm_kind *body_kind(const mpm_model *m, int b) {
+/* The whole run's ranges on one process: m's own (its groups' into gb,
+ * ge), or across ranks without the whole model those its share knows
+ * (mpm_par_whole_ranges). */
+typedef struct {
+  mpm_par_ranges w;
+  long gb[MPM_MAX_GROUPS], ge[MPM_MAX_GROUPS];
+} ranges;
+
+static void whole_ranges(const mpm_sim *r, ranges *rg) {
+  const mpm_model *m = r->model;
+  mpm_par_ranges *w = &rg->w;
+  long *gb = rg->gb, *ge = rg->ge;
+  if (!m) {
+    mpm_par_whole_ranges(r->local_model, w);
+    return;
+  }
+  for (int gi = 0; gi < m->n_groups; gi++) {
+    gb[gi] = m->group[gi].begin;
+    ge[gi] = m->group[gi].end;
+  }
+  *w = (mpm_par_ranges){.n = m->n,
+                        .gbegin = gb,
+                        .gend = ge,
+                        .bbegin = m->body_begin,
+                        .bend = m->body_end};
+}
+
+/* The kind of scene body b's particles (m: a model of the run, the whole
+ * or a share; w: the whole run's ranges). */
+static const mpm_kind *body_kind(const mpm_model *m, const mpm_par_ranges *w,
+                                 int b) {
   for (int gi = 0; gi < m->n_groups; gi++)
-    if (m->body_begin[b] >= m->group[gi].begin &&
-        m->body_end[b] <= m->group[gi].end)
+    if (w->bbegin[b] >= w->gbegin[gi] && w->bend[b] <= w->gend[gi])
       return m->group[gi].kind;
   return m->group[0].kind;
+}
+
+/* Whether body b has a history column of its own: a named volume body
+ * with particles. */
+static bool body_column(const pm_scene *s, const mpm_par_ranges *w, int b) {
+  const pm_scene_body *body = &s->bodies[b];
+  return body->name && body->shape != PM_BODY_MEMBRANE &&
+         w->bend[b] > w->bbegin[b];
 }
 
 /* Whether some membrane's normals come by isosurface least squares. */
@@ -42,8 +79,11 @@ static bool iso_normals_used(const mpm_model *m) {
 }
 
 pm_err mpm_sim_history_setup(mpm_sim *r) {
-  const mpm_model *m = r->model;
+  const mpm_model *m = r->model ? r->model : r->local_model;
   const pm_scene *s = r->scene;
+  ranges rg;
+  whole_ranges(r, &rg);
+  const mpm_par_ranges w = rg.w;
   r->n_hist = 0;
   PM_CALL(PM_ALLOC(r->surface, s->n_bodies, "membrane surfaces"));
   if (r->imp) {
@@ -57,12 +97,10 @@ pm_err mpm_sim_history_setup(mpm_sim *r) {
   }
   for (int b = 0; b < s->n_bodies; b++) {
     const pm_scene_body *body = &s->bodies[b];
-    if (!body->name || body->shape == PM_BODY_MEMBRANE ||
-        m->body_end[b] == m->body_begin[b])
-      continue;
+    if (!body_column(s, &w, b)) continue;
     for (int c = 0; c < m->dim; c++)
       add_hist(r, "%s_u%s", body->name, (const char[]){"xyz"[c], 0});
-    if (body_kind(m, b)->flags & MPM_KIND_INTERNAL_ENERGY)
+    if (body_kind(m, &w, b)->flags & MPM_KIND_INTERNAL_ENERGY)
       add_hist(r, "%s_pressure%s", body->name, "");
   }
   if (m->kinds & MPM_KIND_MEMBRANE) add_hist(r, "failed_points%s%s", "", "");
@@ -74,11 +112,12 @@ pm_err mpm_sim_history_setup(mpm_sim *r) {
   for (int b = 0; b < s->n_bodies; b++) {
     const pm_scene_body *body = &s->bodies[b];
     if ((body->shape == PM_BODY_INSIDE || body->shape == PM_BODY_OUTSIDE) &&
-        m->body_end[b] > m->body_begin[b]) {
+        w.bend[b] > w.bbegin[b]) {
       const int mb = body->surface_body;
       add_hist(r, "mass_inside_%s_%s", s->bodies[mb].name,
                body->name ? body->name : s->materials[body->material].name);
-      if (!r->surface[mb] && m->dim == 3)
+      /* (a membrane keeps the whole model: pm_view_whole_needed) */
+      if (!r->surface[mb] && m->dim == 3 && r->model)
         PM_CALL(mpm_triangles_local(m, m->body_tri_begin[mb],
                                     m->body_tri_end[mb], m->body_begin[mb],
                                     &r->surface[mb]));
@@ -135,28 +174,38 @@ static double mass_inside(const mpm_sim *r, int b, int mb) {
   return sum;
 }
 
-/* The mean pressure of body b's particles, weighted by their volumes. */
-static double body_pressure(const mpm_sim *r, int b) {
-  const mpm_model *m = r->model;
-  const mpm_state *st = r->state;
-  double *sed = r->scratch, *p = sed + m->n, *e = p + m->n, pv = 0, v = 0;
-  for (int gi = 0; gi < m->n_groups; gi++) {
-    const mpm_group *g = &m->group[gi];
-    if (m->body_begin[b] < g->begin || m->body_end[b] > g->end) continue;
-    g->kind->fields(m, st, g, sed, p, e);
-  }
+void mpm_sim_body_sums(const mpm_model *m, const mpm_state *st, double *scratch,
+                       int b, bool pressure, double *out) {
+  double u[3] = {0, 0, 0}, mt = 0, pv = 0, v = 0;
   for (long q = m->body_begin[b]; q < m->body_end[b]; q++) {
-    pv += p[q] * st->vol[q];
-    v += st->vol[q];
+    for (int c = 0; c < 3; c++)
+      u[c] += m->mass[q] * (st->x[3 * q + c] - m->x0[3 * q + c]);
+    mt += m->mass[q];
   }
-  return v > 0 ? pv / v : 0;
+  if (pressure) {
+    double *sed = scratch, *p = sed + m->n, *e = p + m->n;
+    for (int gi = 0; gi < m->n_groups; gi++) {
+      const mpm_group *g = &m->group[gi];
+      if (m->body_begin[b] < g->begin || m->body_end[b] > g->end) continue;
+      g->kind->fields(m, st, g, sed, p, e);
+    }
+    for (long q = m->body_begin[b]; q < m->body_end[b]; q++) {
+      pv += p[q] * st->vol[q];
+      v += st->vol[q];
+    }
+  }
+  const double sums[MPM_SUMS_BODY] = {u[0], u[1], u[2], mt, pv, v};
+  memcpy(out, sums, sizeof sums);
 }
 
 void mpm_sim_history_values(void *p, double *v) {
   mpm_sim *r = p;
-  const mpm_model *m = r->model;
+  const mpm_model *m = r->model ? r->model : r->local_model;
   const pm_scene *s = r->scene;
   const mpm_state *st = r->state;
+  ranges rg;
+  whole_ranges(r, &rg);
+  const mpm_par_ranges w = rg.w;
   int k = 0;
   if (r->imp) {
     v[k++] = r->imp_newton;
@@ -170,19 +219,17 @@ void mpm_sim_history_values(void *p, double *v) {
     r->iter_max_row = 0;
   }
   for (int b = 0; b < s->n_bodies && k < r->n_hist; b++) {
-    const pm_scene_body *body = &s->bodies[b];
-    if (!body->name || body->shape == PM_BODY_MEMBRANE ||
-        m->body_end[b] == m->body_begin[b])
-      continue;
-    double u[3] = {0, 0, 0}, mt = 0;
-    for (long q = m->body_begin[b]; q < m->body_end[b]; q++) {
-      for (int c = 0; c < 3; c++)
-        u[c] += m->mass[q] * (st->x[3 * q + c] - m->x0[3 * q + c]);
-      mt += m->mass[q];
+    if (!body_column(s, &w, b)) continue;
+    const bool pressure = body_kind(m, &w, b)->flags & MPM_KIND_INTERNAL_ENERGY;
+    /* summed over the shares already where no rank keeps the whole */
+    double own[MPM_SUMS_BODY];
+    const double *u = r->sums.body + MPM_SUMS_BODY * b;
+    if (r->model) {
+      mpm_sim_body_sums(m, st, r->scratch, b, pressure, own);
+      u = own;
     }
-    for (int c = 0; c < m->dim; c++) v[k++] = u[c] / mt;
-    if (body_kind(m, b)->flags & MPM_KIND_INTERNAL_ENERGY)
-      v[k++] = body_pressure(r, b);
+    for (int c = 0; c < m->dim; c++) v[k++] = u[c] / u[3];
+    if (pressure) v[k++] = u[5] > 0 ? u[4] / u[5] : 0;
   }
   if (m->kinds & MPM_KIND_MEMBRANE) {
     double *normal = r->scratch + 12 * m->n, *damage = normal + 3 * m->n,

@@ -21,12 +21,16 @@ const char *mpm_sim_update_name(mpm_update u, bool upper) {
   return (upper ? upper_names : lower_names)[u];
 }
 
-static pm_err summary_groups(pm_json *j, const mpm_model *m) {
+/* m: the whole model, or a share with its whole run's ranges (whole). */
+static pm_err summary_groups(pm_json *j, const mpm_model *m,
+                             const mpm_par_ranges *whole) {
   PM_CALL(pm_json_begin_object(j, "groups"));
   for (int gi = 0; gi < m->n_groups; gi++) {
     const mpm_group *g = &m->group[gi];
     PM_CALL(pm_json_begin_object(j, g->name));
-    PM_CALL(pm_json_integer(j, "particles", g->end - g->begin));
+    PM_CALL(pm_json_integer(j, "particles",
+                            whole ? whole->gend[gi] - whole->gbegin[gi]
+                                  : g->end - g->begin));
     PM_CALL(pm_json_string(j, "kind", g->kind->name));
     PM_CALL(pm_json_integer(j, "bytes_per_particle",
                             (long long)(mpm_particle_bytes_common() +
@@ -84,11 +88,15 @@ static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
 
 pm_err mpm_sim_summary(void *p, pm_json *j) {
   const mpm_sim *r = p;
-  const mpm_model *m = r->model;
+  /* without the whole model: the share's, with the whole run's counts */
+  const mpm_model *m = r->model ? r->model : r->local_model;
   const mpm_state *s = r->state;
-  PM_CALL(pm_json_integer(j, "particles", m->n));
-  PM_CALL(summary_groups(j, m));
-  PM_CALL(pm_json_integer(j, "grid_nodes", m->grid.n_nodes));
+  mpm_par_ranges whole;
+  if (!r->model) mpm_par_whole_ranges(m, &whole);
+  PM_CALL(pm_json_integer(j, "particles", r->model ? m->n : whole.n));
+  PM_CALL(summary_groups(j, m, r->model ? NULL : &whole));
+  PM_CALL(pm_json_integer(j, "grid_nodes",
+                          r->model ? m->grid.n_nodes : r->sums.grid_nodes));
   PM_CALL(pm_json_number(j, "cell_size", m->grid.h));
   PM_CALL(pm_json_string(j, "shape", mpm_sim_basis_name(m->opt.shape)));
   PM_CALL(
@@ -142,7 +150,7 @@ pm_err mpm_sim_implicit_summary(void *p, pm_json *j) {
   long unknowns, entries;
   mpm_implicit_size(r->imp, &unknowns, &entries);
   PM_CALL(pm_json_integer(j, "particles", m->n));
-  PM_CALL(summary_groups(j, m));
+  PM_CALL(summary_groups(j, m, NULL));
   PM_CALL(pm_json_integer(j, "grid_nodes", m->grid.n_nodes));
   PM_CALL(pm_json_number(j, "cell_size", m->grid.h));
   PM_CALL(pm_json_string(j, "shape", mpm_sim_basis_name(m->opt.shape)));

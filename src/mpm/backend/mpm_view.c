@@ -47,11 +47,12 @@ static void view_figures(mpm_sim *r) {
   w->min_jacobian = lw->min_jacobian;
   w->iter_max = lw->iter_max;
   w->iter_capped = lw->iter_capped;
-  if (r->model->n_bcs > 0) /* (a scene without conditions has no array) */
+  const int n_bcs = r->local_model->n_bcs;
+  if (n_bcs > 0) /* (a scene without conditions has no array) */
     memcpy(w->cond.reaction, lw->cond.reaction,
-           3 * sizeof(double) * (size_t)r->model->n_bcs);
+           3 * sizeof(double) * (size_t)n_bcs);
   w->timers = lw->timers;
-  mpm_state *v = r->state;
+  mpm_state *v = r->state; /* (without the whole model: the scalars) */
   const mpm_state *ls = r->local_state;
   v->t = ls->t;
   v->step = ls->step;
@@ -59,9 +60,16 @@ static void view_figures(mpm_sim *r) {
   v->dt_stable = ls->dt_stable;
 }
 
-/* Every rank's particles into rank 0's view (collective). */
+/* Every rank's particles into rank 0's view, or without the whole model
+ * the sums over the shares, with the field figures at the end
+ * (collective). */
 static pm_err gather(void *ctx) {
   mpm_sim *r = ctx;
+  if (!r->whole) {
+    PM_CALL(mpm_view_sum(r, r->view.ending));
+    if (r->state) view_figures(r);
+    return PM_SUCCESS;
+  }
   PM_CALL(pm_par_agree(
       mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
   if (r->model) view_figures(r);
@@ -78,7 +86,7 @@ void mpm_view_init(mpm_sim *r, bool implicit) {
 
 pm_err mpm_view_report(mpm_sim *r, bool frame, bool last) {
   pm_step_report rep = {0};
-  if (r->model) { /* one process, or rank 0 */
+  if (r->state) { /* one process, or rank 0 */
     if (r->view.ranks) view_figures(r);
     rep = mpm_sim_step_report(r, last);
   }

@@ -155,6 +155,26 @@ const double *mpm_par_accounts(const mpm_model *m);
 pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
                       const mpm_model *full, mpm_state *full_state);
 
+/* The whole run as one process numbers it, from local model m: its
+ * particles, and each group's and each scene body's range of indices. */
+typedef struct {
+  long n;
+  const long *gbegin, *gend; /* per group */
+  const long *bbegin, *bend; /* per body */
+} mpm_par_ranges;
+void mpm_par_whole_ranges(const mpm_model *m, mpm_par_ranges *out);
+/* The reference positions of every rank's particles in one process's order
+ * into *x0 on rank 0 (3 doubles a particle, allocated; NULL on the
+ * others), a rank's at a time so that rank 0 holds one share besides
+ * (collective; every rank returns the same error). */
+pm_err mpm_par_gather_x0(const mpm_model *m, double **x0);
+/* The extreme over the ranks of a value each rank found among its
+ * particles (*v: the largest where max, else the smallest), with the
+ * particle's one-process index gid (LONG_MAX: none) and its 3 doubles at:
+ * the first in one process's order among equal values, as one process
+ * finds it; into *v and at on every rank (collective). */
+void mpm_par_extreme(double *v, long gid, double at[3], bool max);
+
 /* Print the decomposition and every rank's share (particles, nodes, ghost
  * nodes, memory of the model and of the workspace w, which may be NULL) to
  * out on rank 0 (collective; out may be NULL on other ranks). */

@@ -1,5 +1,6 @@
 /* mpm_par_gather: every rank's particles and nodal arrays gathered into
  * the whole model's state on rank 0, in the order of one process. */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -151,4 +152,86 @@ pm_err mpm_par_gather(const mpm_model *m, const mpm_state *s,
 pm_err mpm_par_gather_nodes(const mpm_model *m, const mpm_model *full,
                             const double *local, double *whole) {
   return gather_owned(m, full ? &full->grid : NULL, local, NULL, whole, NULL);
+}
+
+void mpm_par_whole_ranges(const mpm_model *m, mpm_par_ranges *out) {
+  const struct mpm_par *P = par_of(m);
+  *out = (mpm_par_ranges){.n = P->n_full,
+                          .gbegin = P->gbegin,
+                          .gend = P->gend,
+                          .bbegin = P->bbegin,
+                          .bend = P->bend};
+}
+
+enum { x0_block = 1 << 15 }; /* particles a message */
+
+/* A rank's particles' one-process indices and reference positions to rank
+ * 0, in blocks, the last one short (empty where n is a multiple). */
+static void send_x0(const mpm_model *m) {
+  for (long at = 0;; at += x0_block) {
+    const int k = (int)(m->n - at < x0_block ? m->n - at : x0_block);
+    MPI_Send(m->gid + at, k, MPI_LONG, 0, 1, pm_par_comm());
+    MPI_Send(m->x0 + 3 * at, 3 * k, MPI_DOUBLE, 0, 2, pm_par_comm());
+    if (k < x0_block) break;
+  }
+  pm_par_count_sent((double)m->n * (sizeof(long) + 3 * sizeof(double)));
+}
+
+/* On rank 0: rank r's blocks (send_x0) placed into all, through the
+ * buffers gid and x of a block. */
+static void receive_x0(int r, long *gid, double *x, double *all) {
+  for (;;) {
+    MPI_Status st;
+    int k = 0;
+    MPI_Recv(gid, x0_block, MPI_LONG, r, 1, pm_par_comm(), &st);
+    MPI_Get_count(&st, MPI_LONG, &k);
+    MPI_Recv(x, 3 * x0_block, MPI_DOUBLE, r, 2, pm_par_comm(),
+             MPI_STATUS_IGNORE);
+    for (int j = 0; j < k; j++)
+      memcpy(all + 3 * gid[j], x + 3 * j, 3 * sizeof(double));
+    if (k < x0_block) return;
+  }
+}
+
+pm_err mpm_par_gather_x0(const mpm_model *m, double **x0) {
+  struct mpm_par *P = par_of(m);
+  long *gid = NULL;
+  double *all = NULL, *x = NULL;
+  pm_err e = PM_SUCCESS;
+  if (P->rank == 0) {
+    e = PM_ALLOC(all, 3 * P->n_full + 1, "reference positions");
+    if (!e) e = PM_ALLOC(gid, x0_block, "reference positions");
+    if (!e) e = PM_ALLOC(x, 3 * x0_block, "reference positions");
+  }
+  e = pm_par_agree(e);
+  if (!e && P->rank != 0) send_x0(m);
+  if (!e && P->rank == 0) {
+    for (long j = 0; j < m->n; j++)
+      memcpy(all + 3 * m->gid[j], m->x0 + 3 * j, 3 * sizeof(double));
+    for (int r = 1; r < P->d.size; r++) receive_x0(r, gid, x, all);
+  }
+  free(gid);
+  free(x);
+  if (e) free(all);
+  *x0 = e ? NULL : all;
+  return e;
+}
+
+void mpm_par_extreme(double *v, long gid, double at[3], bool max) {
+  const int size = pm_par_size();
+  double mine[5] = {*v, (double)gid, at[0], at[1], at[2]}, *all = NULL;
+  double stack[5 * 64];
+  /* (a few doubles a rank: on the stack up to 64 ranks) */
+  all = size <= 64 ? stack : malloc(sizeof(double) * 5 * (size_t)size);
+  if (!all) pm_par_abort(1, "out of memory for the extreme over the ranks");
+  MPI_Allgather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, pm_par_comm());
+  int best = 0;
+  for (int r = 1; r < size; r++) {
+    const double *a = all + 5 * r, *b = all + 5 * best;
+    const bool beats = max ? a[0] > b[0] : a[0] < b[0];
+    if (beats || (a[0] == b[0] && a[1] < b[1])) best = r;
+  }
+  *v = all[5 * best];
+  memcpy(at, all + 5 * best + 2, 3 * sizeof(double));
+  if (all != stack) free(all);
 }
