@@ -57,13 +57,15 @@ p2g_group(const mpm_model *m, const mpm_state *s, const mpm_work *w,
       double *r = acc + node * S;
       if (mode & MPM_P2G_MOM) {
         const pm_v4 r0 = pm_v4_load(r + MPM_ACC_M);
-        pm_v4_store(r + MPM_ACC_M, r0 + wk * mp * mv);
+        pm_v4_store(r + MPM_ACC_M, r0 + wkv * mp * mv);
       } else if (mode & MPM_P2G_MASS) {
         r[MPM_ACC_M] += wk * mp;
       }
       if (mode & MPM_P2G_FORCE) {
         const pm_v4 r1 = pm_v4_load(r + MPM_ACC_F);
-        pm_v4_store(r + MPM_ACC_F, r1 + (s0 * gk0 + s1 * gk1 + s2 * gk2));
+        pm_v4_store(r + MPM_ACC_F,
+                    r1 + (s0 * MPM_LANE(gkv, 0) + s1 * MPM_LANE(gkv, 1) +
+                          s2 * MPM_LANE(gkv, 2)));
         if (imp) {
           r[MPM_ACC_BASE + 0] += wk * mp * cp;
           r[MPM_ACC_BASE + 1] += wk * mp * cs;
@@ -182,8 +184,8 @@ g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
     MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
       const pm_v4 v1 = pm_v4_load(vel_new + 3 * node);
       const pm_v4 v0 = pm_v4_load(vel0 + 3 * node);
-      vn4 += wk * v1;
-      dv4 += wk * (v1 - v0);
+      vn4 += wkv * v1;
+      dv4 += wkv * (v1 - v0);
     });
     const double vn[3] = {vn4[0], vn4[1], vn4[2]},
                  dv[3] = {dv4[0], dv4[1], dv4[2]};
@@ -201,7 +203,7 @@ g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
       const pm_v4 mv = {1.0, vp[0], vp[1], vp[2]};
       MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
         double *r = acc + node * S;
-        pm_v4_store(r + MPM_ACC_M, pm_v4_load(r + MPM_ACC_M) + wk * mp * mv);
+        pm_v4_store(r + MPM_ACC_M, pm_v4_load(r + MPM_ACC_M) + wkv * mp * mv);
       });
     }
   }
