@@ -10,6 +10,7 @@
 #include "mpm_fbar.h"
 #include "mpm_kind.h"
 #include "mpm_state.h"
+#include "mpm_transfer.h"
 #include "pm_material.h"
 #include "pm_omp.h"
 
@@ -174,6 +175,8 @@ typedef struct {
   double *F, *vol, *sigma;
   double *q;    /* artificial viscosity pressure, or NULL */
   double *jbar; /* Jbar - 1 (F-bar), or NULL */
+  double *xm;   /* the positions to move (MPM_MOVE_FUSED), or NULL */
+  const double *dx;
 } solid_view;
 
 static solid_view view_of(const mpm_ctx *ctx, const mpm_group *gr) {
@@ -206,10 +209,13 @@ static solid_view view_of(const mpm_ctx *ctx, const mpm_group *gr) {
   return v;
 }
 
-/* Each particle's own F: deformation and stress in one pass. */
-static void stress_own(mpm_ctx *ctx, const mpm_group *gr) {
+/* Each particle's own F: deformation and stress in one pass, and with
+ * `move` the particle moved once its velocity gradient is read. */
+static void stress_own(mpm_ctx *ctx, const mpm_group *gr, bool move) {
   mpm_work *w = ctx->work;
-  const solid_view v = view_of(ctx, gr);
+  solid_view v = view_of(ctx, gr);
+  v.xm = move ? ctx->state->x : NULL;
+  v.dx = w->dx;
   double maxdiv = 0, Jlow = INFINITY;
   PM_OMP(parallel for schedule(static) default(none) firstprivate(v)
          shared(w) reduction(max : maxdiv) reduction(min : Jlow))
@@ -217,6 +223,7 @@ static void stress_own(mpm_ctx *ctx, const mpm_group *gr) {
     long k = p - v.begin;
     double L[9], D[9], W[9];
     mpm_velocity_gradient(v.g, v.vel, v.x + 3 * p, L);
+    if (v.xm) mpm_move_particle(v.g, w, v.xm, v.dx, p);
     double *F = v.F + 9 * k, *sig = v.sigma + 9 * p;
     advance_F(v.dt, L, F);
     double J = pm_t_det(F);
@@ -311,10 +318,14 @@ static void stress_fbar(mpm_ctx *ctx, const mpm_group *gr) {
   }
 }
 
+static bool solid_moves(const mpm_group *g) {
+  return ((const solid_params *)g->params)->fbar == MPM_FBAR_NONE;
+}
+
 static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
   const mpm_group *gr = &ctx->model->group[self->group];
-  if (((const solid_params *)gr->params)->fbar == MPM_FBAR_NONE)
-    stress_own(ctx, gr);
+  if (solid_moves(gr))
+    stress_own(ctx, gr, self->mode & MPM_MOVE_FUSED);
   else
     stress_fbar(ctx, gr);
   return mpm_stage_status(ctx, self);
@@ -404,6 +415,7 @@ const mpm_kind mpm_kind_solid = {
     .setup = solid_setup,
     .seed = solid_seed,
     .stress = solid_stress,
+    .moves = solid_moves,
     .describe = solid_describe,
     .wave_speeds = solid_wave_speeds,
     .energies = solid_energies,

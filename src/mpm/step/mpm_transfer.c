@@ -304,16 +304,9 @@ pm_err mpm_stage_move(mpm_ctx *ctx, const mpm_stage *self) {
   const long n = ctx->model->n;
   double *restrict x = ctx->state->x;
   const double *restrict dx = w->dx;
-  PM_OMP(parallel for schedule(static) default(none) shared(g, w, n, x, dx))
-  for (long p = 0; p < n; p++) {
-    double *xp = x + 3 * p;
-    for (int c = 0; c < 3; c++) xp[c] += dx[3 * p + c];
-    for (int c = 0; c < g->dim; c++)
-      if (!(xp[c] >= g->lo[c] && xp[c] < g->hi[c]))
-        mpm_fail(w, p,
-                 "left the grid (%g is outside the grid's reach along this "
-                 "axis, which ends at %g): enlarge domain.box",
-                 xp[c], xp[c] < g->lo[c] ? g->lo[c] : g->hi[c]);
+  if (!(self->mode & MPM_MOVE_FUSED)) {
+    PM_OMP(parallel for schedule(static) default(none) shared(g, w, n, x, dx))
+    for (long p = 0; p < n; p++) mpm_move_particle(g, w, x, dx, p);
   }
   return mpm_stage_status(ctx, self);
 }
