@@ -229,10 +229,12 @@ static void stress_own(mpm_ctx *ctx, const mpm_group *gr, bool move) {
     double J = pm_t_det(F);
     if (!jacobian_ok(w, p, J, v.jmin)) continue;
     v.vol[p] = v.vol0[p] * J;
-    Jlow = fmin(Jlow, J);
+    /* Comparisons, not fmin and fmax (calls into libm here): the same
+     * values, a NaN never taken. */
+    if (J < Jlow) Jlow = J;
     mpm_sym_skew(L, D, W);
     double trD = D[0] + D[4] + D[8];
-    maxdiv = fmax(maxdiv, fabs(trD));
+    if (fabs(trD) > maxdiv) maxdiv = fabs(trD);
     if (v.rate) {
       v.mat->model->rate(v.mat, D, W, v.dt, sig);
       if (v.q) sig[0] += v.q[k], sig[4] += v.q[k], sig[8] += v.q[k];

@@ -133,12 +133,24 @@ static void reduce_nodes(mpm_nodes *nd, long nn, const long span[2], int mode,
   PM_OMP(for schedule(static) nowait)
   for (long i = 0; i < nn; i++) {
     double sum[MPM_ACC_BASE + 2] = {0};
-    if (i >= lo && i <= hi)
+    if (i >= lo && i <= hi && S == MPM_ACC_BASE) {
+      /* the record as two vectors: lane by lane the scalar sums */
+      pm_v4 s0 = {0, 0, 0, 0}, s1 = s0;
+      for (int t = 0; t < T; t++) {
+        double *r = nd->acc + ((size_t)t * nn + i) * MPM_ACC_BASE;
+        s0 += pm_v4_load(r);
+        s1 += pm_v4_load(r + 4);
+        memset(r, 0, sizeof(double) * MPM_ACC_BASE);
+      }
+      pm_v4_store(sum, s0);
+      pm_v4_store(sum + 4, s1);
+    } else if (i >= lo && i <= hi) {
       for (int t = 0; t < T; t++) {
         double *r = nd->acc + ((size_t)t * nn + i) * S;
         for (int k = 0; k < S; k++) sum[k] += r[k];
         memset(r, 0, sizeof(double) * S);
       }
+    }
     if (mode & MPM_P2G_MASS) nd->mass[i] = sum[MPM_ACC_M];
     if (mode & MPM_P2G_MOM)
       for (int c = 0; c < 3; c++) nd->mom[3 * i + c] = sum[MPM_ACC_P + c];
