@@ -13,6 +13,7 @@
 #include "mpm_transfer.h"
 #include "pm_material.h"
 #include "pm_omp.h"
+#include "pm_v4.h"
 
 enum { SOLID_F = 0 }; /* state array slots: F, then q and the model's */
 
@@ -112,17 +113,30 @@ static inline double p_wave_speed(const pm_material *mat, double rho) {
   return sqrt(mat->wave_modulus / rho);
 }
 
+/* Rows 0 and 1 of a 3 x 3 matrix stored from their vectors four wide (the
+ * fourth lane lands on the next row's first entry, written after it),
+ * row 2 entry by entry. */
+static inline void store_rows(double M[9], pm_v4 r0, pm_v4 r1, pm_v4 r2) {
+  pm_v4_store(M, r0);
+  pm_v4_store(M + 3, r1);
+  M[6] = r2[0];
+  M[7] = r2[1];
+  M[8] = r2[2];
+}
+
 /* Cauchy stress sigma = P F^T / J of the model at F (J its determinant);
- * false when P is not finite. */
+ * false when P is not finite.  A row of sigma is one vector: lane by lane
+ * the scalar sums and quotients. */
 static inline bool cauchy(const pm_material *mat, const double F[9],
                           const double *ms, double J, double sig[9]) {
   double P[9];
   if (!pm_material_stress(mat, F, ms, P, NULL, NULL)) return false;
+  const pm_v4 c0 = {F[0], F[3], F[6], F[6]}, c1 = {F[1], F[4], F[7], F[7]},
+              c2 = {F[2], F[5], F[8], F[8]};
+  pm_v4 r[3];
   for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++)
-      sig[3 * i + j] = (P[3 * i] * F[3 * j] + P[3 * i + 1] * F[3 * j + 1] +
-                        P[3 * i + 2] * F[3 * j + 2]) /
-                       J;
+    r[i] = (P[3 * i] * c0 + P[3 * i + 1] * c1 + P[3 * i + 2] * c2) / J;
+  store_rows(sig, r[0], r[1], r[2]);
   return true;
 }
 
@@ -137,15 +151,20 @@ static inline void viscosity(const pm_material *mat, double c0, double c1,
   sig[8] -= *q;
 }
 
-/* F <- (I + dt L) F. */
+/* F <- (I + dt L) F, a row of the product as one vector (lane by lane the
+ * sums of pm_t_mul). */
 static inline void advance_F(double dt, const double L[9], double F[9]) {
-  double A[9], Fn[9];
+  double A[9];
   for (int i = 0; i < 9; i++) A[i] = dt * L[i];
   A[0] += 1;
   A[4] += 1;
   A[8] += 1;
-  pm_t_mul(A, F, Fn);
-  memcpy(F, Fn, sizeof Fn);
+  const pm_v4 f0 = {F[0], F[1], F[2], F[2]}, f1 = {F[3], F[4], F[5], F[5]},
+              f2 = {F[6], F[7], F[8], F[8]};
+  pm_v4 r[3];
+  for (int i = 0; i < 3; i++)
+    r[i] = A[3 * i] * f0 + A[3 * i + 1] * f1 + A[3 * i + 2] * f2;
+  store_rows(F, r[0], r[1], r[2]);
 }
 
 /* A volume ratio J that stops the run: at or below the bound, or not
