@@ -134,20 +134,35 @@ typedef struct {
  * the scalars would each be a multiplication and a broadcast.  No lane is
  * built as a zero, whose instruction (vmovq between registers) Valgrind
  * cannot run. */
-#define MPM_STENCIL_FOR(g, x, DIM, WIDTH, ...)                                 \
+
+/* A particle's 1-D weights and derivatives along each axis and its first
+ * node (the smallest index): what a walk of its stencil starts from. */
+typedef struct {
+  long base;
+  double w[3][3], dw[3][3];
+} mpm_axes;
+
+/* The axes of a particle at x, for a constant dimension and width. */
+static inline __attribute__((always_inline)) void
+mpm_axes_at(const mpm_grid *g, const double x[3], mpm_axes *ax, const int dim,
+            const int width) {
+  const mpm_basis sh = width == 3 ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;
+  ax->base = 0;
+  ax->w[2][0] = 1;
+  ax->dw[2][0] = 0;
+  for (int c = 0; c < dim; c++) {
+    long i0;
+    mpm_shape_1d(sh, (x[c] - g->origin[c]) * g->inv_h, g->inv_h, &i0, ax->w[c],
+                 ax->dw[c]);
+    ax->base += (i0 - g->offset[c]) * g->stride[c];
+  }
+}
+
+/* The stencil of axes ax (mpm_axes_at) walked in place: the body as in
+ * MPM_STENCIL_FOR.  Two walks of one particle's stencil share its axes. */
+#define MPM_STENCIL_WALK(g, ax, DIM, WIDTH, ...)                               \
   do {                                                                         \
-    const mpm_basis sh_ =                                                      \
-        (WIDTH) == 3 ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;                 \
-    long base_ = 0;                                                            \
-    double w_[3][3], dw_[3][3];                                                \
-    w_[2][0] = 1;                                                              \
-    dw_[2][0] = 0;                                                             \
-    for (int c_ = 0; c_ < (DIM); c_++) {                                       \
-      long i0_;                                                                \
-      mpm_shape_1d(sh_, ((x)[c_] - (g)->origin[c_]) * (g)->inv_h, (g)->inv_h,  \
-                   &i0_, w_[c_], dw_[c_]);                                     \
-      base_ += (i0_ - (g)->offset[c_]) * (g)->stride[c_];                      \
-    }                                                                          \
+    const double(*w_)[3] = (ax).w, (*dw_)[3] = (ax).dw;                        \
     pm_v4 wx_[3], gx_[3];                                                      \
     for (int a_ = 0; a_ < (WIDTH); a_++) {                                     \
       wx_[a_] = (pm_v4){w_[0][a_], w_[0][a_], w_[0][a_], w_[0][a_]};           \
@@ -160,7 +175,8 @@ typedef struct {
         const double gz_ = w_[1][b_] * dw_[2][c_];                             \
         const pm_v4 wbcv_ = {wbc_, wbc_, wbc_, wbc_};                          \
         const pm_v4 gyz_ = {wbc_, gy_, gz_, wbc_};                             \
-        const long row_ = base_ + b_ * (g)->stride[1] + c_ * (g)->stride[2];   \
+        const long row_ =                                                      \
+            (ax).base + b_ * (g)->stride[1] + c_ * (g)->stride[2];             \
         for (int a_ = 0; a_ < (WIDTH); a_++) {                                 \
           const long node = row_ + a_;                                         \
           const double wk = w_[0][a_] * wbc_;                                  \
@@ -174,6 +190,14 @@ typedef struct {
           __VA_ARGS__                                                          \
         }                                                                      \
       }                                                                        \
+  } while (0)
+
+/* The stencil of a particle at x walked in place: its axes, then the walk. */
+#define MPM_STENCIL_FOR(g, x, DIM, WIDTH, ...)                                 \
+  do {                                                                         \
+    mpm_axes ax_;                                                              \
+    mpm_axes_at((g), (x), &ax_, (DIM), (WIDTH));                               \
+    MPM_STENCIL_WALK(g, ax_, DIM, WIDTH, __VA_ARGS__);                         \
   } while (0)
 
 /* Lane L of v in every lane. */

@@ -20,15 +20,15 @@ static inline int thread_id(void) {
 #endif
 }
 
-/* Widens [*first, *last] to the nodes of a stencil whose last node (the
- * largest index, tensor-product order) is top. */
+/* Widens [*first, *last] to the nodes of the stencil of axes ax (its first
+ * node the smallest index, its last the largest). */
 static inline __attribute__((always_inline)) void
-touched(const mpm_grid *g, long top, const int dim, const int width,
+touched(const mpm_grid *g, const mpm_axes *ax, const int dim, const int width,
         long *first, long *last) {
   const long reach =
       (width - 1) * (1 + g->stride[1] + (dim == 3 ? g->stride[2] : 0));
-  if (top - reach < *first) *first = top - reach;
-  if (top > *last) *last = top;
+  if (ax->base < *first) *first = ax->base;
+  if (ax->base + reach > *last) *last = ax->base + reach;
 }
 
 /* One thread's share of the particles of a group into its accumulators
@@ -66,10 +66,10 @@ p2g_group(const mpm_model *m, const mpm_state *s, const mpm_work *w,
     const pm_v4 s0 = {sg[0], sg[3], sg[6], sg[6]},
                 s1 = {sg[1], sg[4], sg[7], sg[7]},
                 s2 = {sg[2], sg[5], sg[8], sg[8]};
-    long top = 0;
-    MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
+    mpm_axes ax;
+    mpm_axes_at(g, x + 3 * p, &ax, dim, width);
+    MPM_STENCIL_WALK(g, ax, dim, width, {
       double *r = acc + node * S;
-      top = node;
       if (mode & MPM_P2G_MOM) {
         const pm_v4 r0 = pm_v4_load(r + MPM_ACC_M);
         pm_v4_store(r + MPM_ACC_M, r0 + wkv * mp * mv);
@@ -87,7 +87,7 @@ p2g_group(const mpm_model *m, const mpm_state *s, const mpm_work *w,
         }
       }
     });
-    touched(g, top, dim, width, &first, &last);
+    touched(g, &ax, dim, width, &first, &last);
   }
   span[0] = first;
   span[1] = last;
@@ -231,7 +231,9 @@ g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
     /* A node's three components read as four (the nodal arrays are
      * padded), the fourth lane unused; lane by lane the scalar sums. */
     pm_v4 vn4 = {0, 0, 0, 0}, dv4 = vn4;
-    MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
+    mpm_axes ax;
+    mpm_axes_at(g, x + 3 * p, &ax, dim, width);
+    MPM_STENCIL_WALK(g, ax, dim, width, {
       const pm_v4 v1 = pm_v4_load(vel_new + 3 * node);
       const pm_v4 v0 = pm_v4_load(vel0 + 3 * node);
       vn4 += wkv * v1;
@@ -251,13 +253,11 @@ g2p_group(mpm_work *w, const mpm_model *m, const mpm_group *gr, double dt,
       /* As mpm_p2g's w m (1, v): the mass lane is not read back. */
       const double mp = mass[p];
       const pm_v4 mv = {1.0, vp[0], vp[1], vp[2]};
-      long top = 0;
-      MPM_STENCIL_FOR(g, x + 3 * p, dim, width, {
+      MPM_STENCIL_WALK(g, ax, dim, width, {
         double *r = acc + node * S;
-        top = node;
         pm_v4_store(r + MPM_ACC_M, pm_v4_load(r + MPM_ACC_M) + wkv * mp * mv);
       });
-      touched(g, top, dim, width, &first, &last);
+      touched(g, &ax, dim, width, &first, &last);
     }
   }
   span[0] = first;
