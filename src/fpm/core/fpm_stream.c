@@ -91,11 +91,10 @@ double fpm_stream_flux(const fpm_model *m, const double *restrict u,
       const int *kb = nb + FPM_LANES * b;
       const int k3[4] = {3 * kb[0], 3 * kb[1], 3 * kb[2], 3 * kb[3]};
       const int k9[4] = {9 * kb[0], 9 * kb[1], 9 * kb[2], 9 * kb[3]};
-      pm_v4 Pk[9], Mc[9], di[3], dk[3], jv[3], w[3];
-      for (int f = 0; f < 9; f++) {
-        Pk[f] = FPM_GATHER(P, k9, f);
-        Mc[f] = pm_v4_load(rb + FPM_LANES * (3 + f));
-      }
+      pm_v4 Pk[9], Hk[9], Mc[9], di[3], dk[3], jv[3], w[3];
+      fpm_gather9(P, k9, Pk);
+      fpm_gather9(H, k9, Hk);
+      for (int f = 0; f < 9; f++) Mc[f] = pm_v4_load(rb + FPM_LANES * (3 + f));
       for (int c = 0; c < 3; c++) {
         di[c] = pm_v4_load(rb + FPM_LANES * (12 + c));
         dk[c] = pm_v4_load(rb + FPM_LANES * (15 + c));
@@ -106,9 +105,8 @@ double fpm_stream_flux(const fpm_model *m, const double *restrict u,
       for (int c = 0; c < 3; c++) {
         jv[c] = ui[c] - FPM_GATHER(u, k3, c) + Hi[3 * c] * di[0] +
                 Hi[3 * c + 1] * di[1] + Hi[3 * c + 2] * di[2] -
-                FPM_GATHER(H, k9, 3 * c) * dk[0] -
-                FPM_GATHER(H, k9, 3 * c + 1) * dk[1] -
-                FPM_GATHER(H, k9, 3 * c + 2) * dk[2];
+                Hk[3 * c] * dk[0] - Hk[3 * c + 1] * dk[1] -
+                Hk[3 * c + 2] * dk[2];
         w[c] =
             0.5 * (Pk[3 * c] * a0 + Pk[3 * c + 1] * a1 + Pk[3 * c + 2] * a2) -
             be * jv[c];
@@ -158,10 +156,10 @@ void fpm_stream_gather(const fpm_model *m, const double *restrict T,
       const pm_v4 g0 = pm_v4_load(G + FPM_LANES * 3 * b),
                   g1 = pm_v4_load(G + FPM_LANES * (3 * b + 1)),
                   g2 = pm_v4_load(G + FPM_LANES * (3 * b + 2));
+      pm_v4 Tb[9];
+      fpm_gather9(T, k9, Tb);
       for (int c = 0; c < 3; c++)
-        fa[c] += FPM_GATHER(T, k9, 3 * c) * g0 +
-                 FPM_GATHER(T, k9, 3 * c + 1) * g1 +
-                 FPM_GATHER(T, k9, 3 * c + 2) * g2;
+        fa[c] += Tb[3 * c] * g0 + Tb[3 * c + 1] * g1 + Tb[3 * c + 2] * g2;
     }
     for (int c = 0; c < 3; c++) {
       double fk = r[3 * k + c] - (Tk[3 * c] * s[0] + Tk[3 * c + 1] * s[1] +

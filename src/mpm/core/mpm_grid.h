@@ -128,43 +128,80 @@ typedef struct {
  * they are used: nothing is stored and read back, and the compiler drops what
  * the body does not read.  DIM and WIDTH must be constants.  The body sees
  * `node` (the node's index), `wk` (its weight), `gk0`, `gk1`, `gk2` (its
- * gradient, 1/m) and `gkv` (the same gradient as a vector, the same products
- * lane by lane, the last lane a copy of the third: no lane is built as a zero,
- * whose instruction (vmovq between registers) Valgrind cannot run). */
-#define MPM_STENCIL_FOR(g, x, DIM, WIDTH, ...)                                 \
+ * gradient, 1/m) and, as vectors of the same products lane by lane, `wkv`
+ * (the weight in every lane) and `gkv` (gk0, gk1, gk2, wk): one vector
+ * multiplication each from factors broadcast once a particle or a row, where
+ * the scalars would each be a multiplication and a broadcast.  No lane is
+ * built as a zero, whose instruction (vmovq between registers) Valgrind
+ * cannot run. */
+
+/* A particle's 1-D weights and derivatives along each axis and its first
+ * node (the smallest index): what a walk of its stencil starts from. */
+typedef struct {
+  long base;
+  double w[3][3], dw[3][3];
+} mpm_axes;
+
+/* The axes of a particle at x, for a constant dimension and width. */
+static inline __attribute__((always_inline)) void
+mpm_axes_at(const mpm_grid *g, const double x[3], mpm_axes *ax, const int dim,
+            const int width) {
+  const mpm_basis sh = width == 3 ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;
+  ax->base = 0;
+  ax->w[2][0] = 1;
+  ax->dw[2][0] = 0;
+  for (int c = 0; c < dim; c++) {
+    long i0;
+    mpm_shape_1d(sh, (x[c] - g->origin[c]) * g->inv_h, g->inv_h, &i0, ax->w[c],
+                 ax->dw[c]);
+    ax->base += (i0 - g->offset[c]) * g->stride[c];
+  }
+}
+
+/* The stencil of axes ax (mpm_axes_at) walked in place: the body as in
+ * MPM_STENCIL_FOR.  Two walks of one particle's stencil share its axes. */
+#define MPM_STENCIL_WALK(g, ax, DIM, WIDTH, ...)                               \
   do {                                                                         \
-    const mpm_basis sh_ =                                                      \
-        (WIDTH) == 3 ? MPM_BASIS_QUADRATIC : MPM_BASIS_LINEAR;                 \
-    long base_ = 0;                                                            \
-    double w_[3][3], dw_[3][3];                                                \
-    w_[2][0] = 1;                                                              \
-    dw_[2][0] = 0;                                                             \
-    for (int c_ = 0; c_ < (DIM); c_++) {                                       \
-      long i0_;                                                                \
-      mpm_shape_1d(sh_, ((x)[c_] - (g)->origin[c_]) * (g)->inv_h, (g)->inv_h,  \
-                   &i0_, w_[c_], dw_[c_]);                                     \
-      base_ += (i0_ - (g)->offset[c_]) * (g)->stride[c_];                      \
+    const double(*w_)[3] = (ax).w, (*dw_)[3] = (ax).dw;                        \
+    pm_v4 wx_[3], gx_[3];                                                      \
+    for (int a_ = 0; a_ < (WIDTH); a_++) {                                     \
+      wx_[a_] = (pm_v4){w_[0][a_], w_[0][a_], w_[0][a_], w_[0][a_]};           \
+      gx_[a_] = (pm_v4){dw_[0][a_], w_[0][a_], w_[0][a_], w_[0][a_]};          \
     }                                                                          \
     for (int c_ = 0; c_ < ((DIM) == 3 ? (WIDTH) : 1); c_++)                    \
       for (int b_ = 0; b_ < (WIDTH); b_++) {                                   \
         const double wbc_ = w_[1][b_] * w_[2][c_];                             \
         const double gy_ = dw_[1][b_] * w_[2][c_];                             \
         const double gz_ = w_[1][b_] * dw_[2][c_];                             \
-        const long row_ = base_ + b_ * (g)->stride[1] + c_ * (g)->stride[2];   \
+        const pm_v4 wbcv_ = {wbc_, wbc_, wbc_, wbc_};                          \
+        const pm_v4 gyz_ = {wbc_, gy_, gz_, wbc_};                             \
+        const long row_ =                                                      \
+            (ax).base + b_ * (g)->stride[1] + c_ * (g)->stride[2];             \
         for (int a_ = 0; a_ < (WIDTH); a_++) {                                 \
           const long node = row_ + a_;                                         \
           const double wk = w_[0][a_] * wbc_;                                  \
           const double gk0 = dw_[0][a_] * wbc_;                                \
           const double gk1 = w_[0][a_] * gy_;                                  \
           const double gk2 = w_[0][a_] * gz_;                                  \
-          const pm_v4 gkv =                                                    \
-              (pm_v4){dw_[0][a_], w_[0][a_], w_[0][a_], w_[0][a_]} *           \
-              (pm_v4){wbc_, gy_, gz_, gz_};                                    \
-          (void)node, (void)wk, (void)gk0, (void)gk1, (void)gk2, (void)gkv;    \
+          const pm_v4 wkv = wx_[a_] * wbcv_;                                   \
+          const pm_v4 gkv = gx_[a_] * gyz_;                                    \
+          (void)node, (void)wk, (void)gk0, (void)gk1, (void)gk2, (void)wkv;    \
+          (void)gkv;                                                           \
           __VA_ARGS__                                                          \
         }                                                                      \
       }                                                                        \
   } while (0)
+
+/* The stencil of a particle at x walked in place: its axes, then the walk. */
+#define MPM_STENCIL_FOR(g, x, DIM, WIDTH, ...)                                 \
+  do {                                                                         \
+    mpm_axes ax_;                                                              \
+    mpm_axes_at((g), (x), &ax_, (DIM), (WIDTH));                               \
+    MPM_STENCIL_WALK(g, ax_, DIM, WIDTH, __VA_ARGS__);                         \
+  } while (0)
+
+/* Lane L of v in every lane. */
+#define MPM_LANE(v, L) __builtin_shufflevector((v), (v), L, L, L, L)
 
 /* Call FN(..., dim, width) with the grid's dimension and width as
  * constants (FN inline: one copy of its loops a combination). */
@@ -238,8 +275,9 @@ mpm_velocity_gradient_dw(const mpm_grid *g, const double *vel,
 
 /* Velocity gradient L_ij = sum_I v_Ii dS_I/dx_j at x from the nodal
  * velocities vel (3 per node). */
-static inline void mpm_velocity_gradient(const mpm_grid *g, const double *vel,
-                                         const double x[3], double L[9]) {
+static inline __attribute__((always_inline)) void
+mpm_velocity_gradient(const mpm_grid *g, const double *vel, const double x[3],
+                      double L[9]) {
   MPM_STENCIL_DISPATCH(g, mpm_velocity_gradient_dw, g, vel, x, L);
 }
 

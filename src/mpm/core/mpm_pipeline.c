@@ -164,8 +164,20 @@ void mpm_pipeline_build(mpm_model *m) {
                    : "MUSL: momentum from the updated particles");
   }
   if (o->update != MPM_USF) add_stress(m);
+  /* The only group's constitutive stage, last before the move, moves the
+   * particles as it goes when its kind can. */
+  mpm_stage *last = &pl->stage[pl->n - 1];
+  const mpm_group *g0 = &m->group[0];
+  const bool fused = o->update != MPM_USF && m->n_groups == 1 &&
+                     g0->begin == 0 && g0->end == m->n && last->group == 0 &&
+                     last->run == g0->kind->stress && g0->kind->moves &&
+                     g0->kind->moves(g0);
+  if (fused) last->mode |= MPM_MOVE_FUSED;
   st = add(pl, "move", mpm_stage_move);
-  snprintf(st->detail, sizeof st->detail, "positions x += dt v^L");
+  st->mode = fused ? MPM_MOVE_FUSED : 0;
+  snprintf(st->detail, sizeof st->detail, "%s",
+           fused ? "positions x += dt v^L (by the stress stage's loop)"
+                 : "positions x += dt v^L");
 }
 
 pm_err mpm_step(const mpm_model *m, mpm_state *s, mpm_work *w) {

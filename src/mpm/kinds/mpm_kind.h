@@ -112,6 +112,9 @@ typedef struct mpm_kind {
    * kind's state, for the particles of group self->group (NULL: none, for
    * particles that move as prescribed). */
   mpm_stage_fn stress;
+  /* Optional: whether the constitutive stage of group g moves its
+   * particles when its stage's mode has MPM_MOVE_FUSED (mpm_transfer.h). */
+  bool (*moves)(const mpm_group *g);
 
   /* The constitutive stage in a line for the plan (without the group's
    * name), into buf. */

@@ -10,8 +10,10 @@
 #include "mpm_fbar.h"
 #include "mpm_kind.h"
 #include "mpm_state.h"
+#include "mpm_transfer.h"
 #include "pm_material.h"
 #include "pm_omp.h"
+#include "pm_v4.h"
 
 enum { SOLID_F = 0 }; /* state array slots: F, then q and the model's */
 
@@ -111,17 +113,30 @@ static inline double p_wave_speed(const pm_material *mat, double rho) {
   return sqrt(mat->wave_modulus / rho);
 }
 
+/* Rows 0 and 1 of a 3 x 3 matrix stored from their vectors four wide (the
+ * fourth lane lands on the next row's first entry, written after it),
+ * row 2 entry by entry. */
+static inline void store_rows(double M[9], pm_v4 r0, pm_v4 r1, pm_v4 r2) {
+  pm_v4_store(M, r0);
+  pm_v4_store(M + 3, r1);
+  M[6] = r2[0];
+  M[7] = r2[1];
+  M[8] = r2[2];
+}
+
 /* Cauchy stress sigma = P F^T / J of the model at F (J its determinant);
- * false when P is not finite. */
+ * false when P is not finite.  A row of sigma is one vector: lane by lane
+ * the scalar sums and quotients. */
 static inline bool cauchy(const pm_material *mat, const double F[9],
                           const double *ms, double J, double sig[9]) {
   double P[9];
   if (!pm_material_stress(mat, F, ms, P, NULL, NULL)) return false;
+  const pm_v4 c0 = {F[0], F[3], F[6], F[6]}, c1 = {F[1], F[4], F[7], F[7]},
+              c2 = {F[2], F[5], F[8], F[8]};
+  pm_v4 r[3];
   for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++)
-      sig[3 * i + j] = (P[3 * i] * F[3 * j] + P[3 * i + 1] * F[3 * j + 1] +
-                        P[3 * i + 2] * F[3 * j + 2]) /
-                       J;
+    r[i] = (P[3 * i] * c0 + P[3 * i + 1] * c1 + P[3 * i + 2] * c2) / J;
+  store_rows(sig, r[0], r[1], r[2]);
   return true;
 }
 
@@ -136,15 +151,20 @@ static inline void viscosity(const pm_material *mat, double c0, double c1,
   sig[8] -= *q;
 }
 
-/* F <- (I + dt L) F. */
+/* F <- (I + dt L) F, a row of the product as one vector (lane by lane the
+ * sums of pm_t_mul). */
 static inline void advance_F(double dt, const double L[9], double F[9]) {
-  double A[9], Fn[9];
+  double A[9];
   for (int i = 0; i < 9; i++) A[i] = dt * L[i];
   A[0] += 1;
   A[4] += 1;
   A[8] += 1;
-  pm_t_mul(A, F, Fn);
-  memcpy(F, Fn, sizeof Fn);
+  const pm_v4 f0 = {F[0], F[1], F[2], F[2]}, f1 = {F[3], F[4], F[5], F[5]},
+              f2 = {F[6], F[7], F[8], F[8]};
+  pm_v4 r[3];
+  for (int i = 0; i < 3; i++)
+    r[i] = A[3 * i] * f0 + A[3 * i + 1] * f1 + A[3 * i + 2] * f2;
+  store_rows(F, r[0], r[1], r[2]);
 }
 
 /* A volume ratio J that stops the run: at or below the bound, or not
@@ -174,6 +194,8 @@ typedef struct {
   double *F, *vol, *sigma;
   double *q;    /* artificial viscosity pressure, or NULL */
   double *jbar; /* Jbar - 1 (F-bar), or NULL */
+  double *xm;   /* the positions to move (MPM_MOVE_FUSED), or NULL */
+  const double *dx;
 } solid_view;
 
 static solid_view view_of(const mpm_ctx *ctx, const mpm_group *gr) {
@@ -206,10 +228,13 @@ static solid_view view_of(const mpm_ctx *ctx, const mpm_group *gr) {
   return v;
 }
 
-/* Each particle's own F: deformation and stress in one pass. */
-static void stress_own(mpm_ctx *ctx, const mpm_group *gr) {
+/* Each particle's own F: deformation and stress in one pass, and with
+ * `move` the particle moved once its velocity gradient is read. */
+static void stress_own(mpm_ctx *ctx, const mpm_group *gr, bool move) {
   mpm_work *w = ctx->work;
-  const solid_view v = view_of(ctx, gr);
+  solid_view v = view_of(ctx, gr);
+  v.xm = move ? ctx->state->x : NULL;
+  v.dx = w->dx;
   double maxdiv = 0, Jlow = INFINITY;
   PM_OMP(parallel for schedule(static) default(none) firstprivate(v)
          shared(w) reduction(max : maxdiv) reduction(min : Jlow))
@@ -217,15 +242,18 @@ static void stress_own(mpm_ctx *ctx, const mpm_group *gr) {
     long k = p - v.begin;
     double L[9], D[9], W[9];
     mpm_velocity_gradient(v.g, v.vel, v.x + 3 * p, L);
+    if (v.xm) mpm_move_particle(v.g, w, v.xm, v.dx, p);
     double *F = v.F + 9 * k, *sig = v.sigma + 9 * p;
     advance_F(v.dt, L, F);
     double J = pm_t_det(F);
     if (!jacobian_ok(w, p, J, v.jmin)) continue;
     v.vol[p] = v.vol0[p] * J;
-    Jlow = fmin(Jlow, J);
+    /* Comparisons, not fmin and fmax (calls into libm here): the same
+     * values, a NaN never taken. */
+    if (J < Jlow) Jlow = J;
     mpm_sym_skew(L, D, W);
     double trD = D[0] + D[4] + D[8];
-    maxdiv = fmax(maxdiv, fabs(trD));
+    if (fabs(trD) > maxdiv) maxdiv = fabs(trD);
     if (v.rate) {
       v.mat->model->rate(v.mat, D, W, v.dt, sig);
       if (v.q) sig[0] += v.q[k], sig[4] += v.q[k], sig[8] += v.q[k];
@@ -311,10 +339,14 @@ static void stress_fbar(mpm_ctx *ctx, const mpm_group *gr) {
   }
 }
 
+static bool solid_moves(const mpm_group *g) {
+  return ((const solid_params *)g->params)->fbar == MPM_FBAR_NONE;
+}
+
 static pm_err solid_stress(mpm_ctx *ctx, const mpm_stage *self) {
   const mpm_group *gr = &ctx->model->group[self->group];
-  if (((const solid_params *)gr->params)->fbar == MPM_FBAR_NONE)
-    stress_own(ctx, gr);
+  if (solid_moves(gr))
+    stress_own(ctx, gr, self->mode & MPM_MOVE_FUSED);
   else
     stress_fbar(ctx, gr);
   return mpm_stage_status(ctx, self);
@@ -404,6 +436,7 @@ const mpm_kind mpm_kind_solid = {
     .setup = solid_setup,
     .seed = solid_seed,
     .stress = solid_stress,
+    .moves = solid_moves,
     .describe = solid_describe,
     .wave_speeds = solid_wave_speeds,
     .energies = solid_energies,

@@ -37,7 +37,7 @@ double mpm_stable_dt(const mpm_model *m, const mpm_state *s, double *cp) {
       double Q = c1 * cp[p] + c0 * h * div + 2.0 * nu / h;
       double speed = Q + sqrt(Q * Q + cp[p] * cp[p]) +
                      sqrt(vp[0] * vp[0] + vp[1] * vp[1] + vp[2] * vp[2]);
-      w = fmax(w, speed);
+      if (speed > w) w = speed; /* fmax's value, not its libm call */
     }
     worst = fmax(worst, w);
   }
