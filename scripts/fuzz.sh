@@ -90,6 +90,19 @@ checkpoint | index) max_len=81920 ;;
 gmsh) max_len=8192 ;;
 esac
 
+# The readers in the fuzzer's process, not in a child (pm_isolate.h):
+# coverage and the sanitizers see only the process they run in.
+export PM_ISOLATE=0
+case $target in
+gmsh | checkpoint | index)
+  # libgmsh 4.8 and libhdf5 1.10 stop on some inputs by themselves
+  # (tests/fuzz/upstream/): the campaign runs in a child of libFuzzer's
+  # that is restarted after a crash, a leak, a hang or running out of
+  # memory, and each finding is kept in build-fuzz/findings-TARGET/ for
+  # triage by its stack.
+  extra+=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
+  ;;
+esac
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1
 # What the distribution's libraries leak by themselves (tests/lsan.supp).
 export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:fast_unwind_on_malloc=0
