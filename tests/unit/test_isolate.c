@@ -1,7 +1,8 @@
 /* test_isolate: reading in a child process (pm_isolate): a result passed
  * back, the reader's own error passed back, a child stopped by a signal or
  * by its CPU limit refused with the file and the library named, the
- * reading done in the process with PM_ISOLATE=0; and every input of
+ * reading done in the process with PM_ISOLATE=0, a .geo meshed in a child
+ * after OpenMP's threads ran; and every input of
  * tests/fuzz/upstream/, which stops the process inside libgmsh or libhdf5
  * when read there, refused by the real readers with the file's name. */
 #include <setjmp.h>
@@ -28,6 +29,7 @@
 #include "pm_checkpoint.h"
 #include "pm_h5_vet.h"
 #include "pm_isolate.h"
+#include "pm_omp.h"
 #include "pm_output.h"
 #include "pm_probe.h"
 #include "pm_run_impl.h"
@@ -138,6 +140,25 @@ static void test_not_isolated(void **state) {
   assert_int_equal(a.pid, getpid());
   assert_true(a.v[2] == 1.0);
   free(a.v);
+}
+
+/* A .geo meshed in a child after OpenMP's threads ran in the parent: the
+ * child runs on one thread (libgomp's pool is not in it), and leaves the
+ * parent's thread count as it was. */
+static void test_after_threads(void **state) {
+  (void)state;
+  int team = 0;
+  PM_OMP(parallel num_threads(2))
+  PM_OMP(single)
+  team = pm_omp_team();
+  const int threads = pm_omp_threads();
+  gm_gmsh_mesh m;
+  assert_ok(gm_gmsh_load(PM_TEST_DATA "/geometry/sphere.geo", 3, 0.25,
+                         GM_SIZES_REPLACE, false, &m));
+  assert_true(m.meshed && m.n_nodes > 20 && m.n_elems > 20);
+  assert_int_equal(pm_omp_threads(), threads);
+  gm_gmsh_mesh_free(&m);
+  assert_true(team >= 1);
 }
 
 /* ---- The inputs that stop the libraries -------------------------------- */
@@ -257,6 +278,7 @@ int main(void) {
       cmocka_unit_test(test_signal_refused),
       cmocka_unit_test(test_cpu_limit),
       cmocka_unit_test(test_not_isolated),
+      cmocka_unit_test(test_after_threads),
       cmocka_unit_test(test_upstream_gmsh),
       cmocka_unit_test(test_upstream_checkpoint),
       cmocka_unit_test(test_upstream_index),

@@ -20,6 +20,7 @@
 #endif
 
 #include "pm_interrupt.h"
+#include "pm_omp.h"
 
 #define MARK_HEAD 0x706d6931u /* "pmi1" */
 #define MARK_END 0x706d6945u  /* "pmiE" */
@@ -158,6 +159,9 @@ static void child(const pm_isolate_job *job, int fd) {
   struct rlimit none = {0, 0};
   setrlimit(RLIMIT_CORE, &none); /* a library's fault leaves no core file */
   if (job->cpu_seconds > 0) pm_isolate_cpu_limit(job->cpu_seconds);
+  /* One OpenMP thread: libgomp's pool of the parent's threads is not in
+   * the child, and a region of more threads would wait on it for ever. */
+  pm_omp_set_threads(1);
   pm_error_clear();
   const int32_t code = (int32_t)job->work(job->arg);
   const char *msg = code ? pm_error_message() : "";

@@ -37,15 +37,16 @@ static void vet_object(vet_arg *a, hid_t obj, const char *name, int depth);
 /* HDF5 failed to read a value the readers may read (it may have needed
  * more memory than the child has): the file is refused. */
 static void read_failed(vet_arg *a, hid_t id, bool attr, const char *name) {
-  char obj[256] = "";
+  char obj[256] = "", why[512];
   if (a->err) return;
+  /* HDF5's message before another call clears its error stack. */
+  snprintf(why, sizeof why, "%s", pm_h5_message());
   if (attr) H5Iget_name(id, obj, sizeof obj);
-  a->err =
-      PM_ERROR(a->code,
-               "%s: HDF5 cannot read %s %s%s%s (%s): the file is damaged "
-               "or not %s",
-               a->current, attr ? "attribute" : "dataset", name,
-               attr ? " of " : "", attr ? obj : "", pm_h5_message(), a->what);
+  a->err = PM_ERROR(a->code,
+                    "%s: HDF5 cannot read %s %s%s%s (%s): the file is damaged "
+                    "or not %s",
+                    a->current, attr ? "attribute" : "dataset", name,
+                    attr ? " of " : "", attr ? obj : "", why, a->what);
 }
 
 /* An attribute or a dataset's values, read in the native type of its own
