@@ -13,8 +13,17 @@
 # (.msh volume and surface meshes), checkpoint (checkpoint.h5), index (the
 # results folder `resume` reopens).
 #
+# The readers run in the fuzzer's process (PM_ISOLATE=0: coverage and the
+# sanitizers see no child).  gmsh, checkpoint and index run in libFuzzer's
+# fork mode, which goes on past a crash: libgmsh and libhdf5 stop on some
+# inputs by themselves (tests/fuzz/upstream/, which the program refuses by
+# reading such files in a child).
+#
 # New inputs go to build-fuzz/corpus-TARGET/; crashes, leaks and hangs to
-# build-fuzz/findings-TARGET/.  To fold a campaign back into the small
+# build-fuzz/findings-TARGET/ (triage: build-fuzz/tests/fuzz_TARGET FILE
+# prints the stack; a crash wholly inside libgmsh or libhdf5 goes to
+# tests/fuzz/upstream/TARGET/, one in the project's code is fixed and its
+# input goes to tests/fuzz/regressions/TARGET/).  To fold a campaign back into the small
 # replayed corpus (tests/fuzz/corpus-TARGET, tests/fuzz/corpus for the
 # scene): build-fuzz/tests/fuzz_TARGET -merge=1 NEWDIR CORPUS
 # build-fuzz/corpus-TARGET, then replace CORPUS with NEWDIR.

@@ -39,7 +39,7 @@
 /* ---- The mechanism ----------------------------------------------------- */
 
 typedef struct {
-  int how; /* 0 result, 1 error, 2 SIGSEGV, 3 abort, 4 spin */
+  int how; /* 0 result, 1 error, 2 SIGSEGV, 3 abort, 4 spin, 5 exit */
   long n;
   double *v;
   pid_t pid; /* the process the work ran in */
@@ -52,6 +52,7 @@ static pm_err work(void *p) {
   case 1: return PM_ERROR(PM_ERR_ARG, "'f.msh': no element of dimension %d", 3);
   case 2: raise(SIGSEGV); break;
   case 3: abort();
+  case 5: exit(0);
   case 4:
     for (volatile unsigned long k = 0;; k++) {
     }
@@ -118,6 +119,11 @@ static void test_signal_refused(void **state) {
   a.how = 3;
   assert_fails(run(&a, 0), PM_ERR_MESH,
                "f.msh: gmsh stopped with SIGABRT while reading it");
+  /* exit() in the library: none of this process's atexit handlers run in
+   * the child (cmocka's, HDF5's). */
+  a.how = 5;
+  assert_fails(run(&a, 0), PM_ERR_MESH,
+               "f.msh: gmsh ended its process (exit) while reading it");
   pm_error_clear();
 }
 

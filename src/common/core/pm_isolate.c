@@ -24,6 +24,8 @@
 
 #define MARK_HEAD 0x706d6931u /* "pmi1" */
 #define MARK_END 0x706d6945u  /* "pmiE" */
+/* The child's status when the library called exit() (no status of ours). */
+#define EXIT_BY_LIBRARY 113
 
 bool pm_isolate_enabled(void) {
   const char *v = getenv("PM_ISOLATE");
@@ -141,6 +143,11 @@ void pm_isolate_memory_limit(size_t bytes) {
 #endif
 }
 
+/* In the child, registered last so that it runs first: a library that
+ * calls exit() must not run the parent's atexit handlers (HDF5's would
+ * flush and close files the parent has open for writing). */
+static void exit_by_library(void) { _exit(EXIT_BY_LIBRARY); }
+
 /* The child: read, pass the outcome and the result, leave without running
  * anything of the parent's (atexit handlers, MPI, stream buffers). */
 static void child(const pm_isolate_job *job, int fd) {
@@ -162,6 +169,7 @@ static void child(const pm_isolate_job *job, int fd) {
   /* One OpenMP thread: libgomp's pool of the parent's threads is not in
    * the child, and a region of more threads would wait on it for ever. */
   pm_omp_set_threads(1);
+  atexit(exit_by_library);
   pm_error_clear();
   const int32_t code = (int32_t)job->work(job->arg);
   const char *msg = code ? pm_error_message() : "";
@@ -258,6 +266,11 @@ pm_err pm_isolate_run(const pm_isolate_job *job) {
                     "damaged or not %s",
                     job->path, job->library, signal_name(sig), job->what);
   }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == EXIT_BY_LIBRARY)
+    return PM_ERROR(job->code,
+                    "%s: %s ended its process (exit) while reading it: the "
+                    "file is damaged or not %s",
+                    job->path, job->library, job->what);
   if (WIFEXITED(status) && WEXITSTATUS(status) != 0)
     return PM_ERROR(job->code,
                     "%s: %s stopped (exit status %d) while reading it: the "
