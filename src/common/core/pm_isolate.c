@@ -146,7 +146,11 @@ void pm_isolate_memory_limit(size_t bytes) {
 /* In the child, registered last so that it runs first: a library that
  * calls exit() must not run the parent's atexit handlers (HDF5's would
  * flush and close files the parent has open for writing). */
-static void exit_by_library(void) { _exit(EXIT_BY_LIBRARY); }
+static void exit_by_library(int status, void *arg) {
+  (void)status;
+  (void)arg;
+  _exit(EXIT_BY_LIBRARY);
+}
 
 /* The child: read, pass the outcome and the result, leave without running
  * anything of the parent's (atexit handlers, MPI, stream buffers). */
@@ -169,7 +173,7 @@ static void child(const pm_isolate_job *job, int fd) {
   /* One OpenMP thread: libgomp's pool of the parent's threads is not in
    * the child, and a region of more threads would wait on it for ever. */
   pm_omp_set_threads(1);
-  atexit(exit_by_library);
+  on_exit(exit_by_library, NULL);
   pm_error_clear();
   const int32_t code = (int32_t)job->work(job->arg);
   const char *msg = code ? pm_error_message() : "";
