@@ -225,7 +225,9 @@ pm_err gm_gmsh_corners(const char *name, const size_t *ctag, size_t nc,
     sorted[i] = (tag_at){tags[i], i};
     number[i] = -1;
   }
-  qsort(sorted, n_tags, sizeof *sorted, tag_order);
+  /* A model without nodes: no array to sort (qsort takes none, even of
+   * no elements). */
+  if (n_tags > 1) qsort(sorted, n_tags, sizeof *sorted, tag_order);
   PM_TRY(PM_ALLOC(nodes->tag, n_tags, "node tags"));
   PM_TRY(PM_ALLOC(nodes->number, n_tags, "node numbers"));
   nodes->n = n_tags;
