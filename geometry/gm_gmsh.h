@@ -143,6 +143,16 @@ pm_err gm_file_bounds(const char *path, int dim, double lo[3], double hi[3]);
 pm_err gm_gmsh_load(const char *path, int dim, double h, gm_sizes rule,
                     bool groups, gm_gmsh_mesh *out);
 
+/* gm_gmsh_load, gm_file_bounds and gm_trisurf_load (gm_trisurf.h) read the
+ * file in a child process (pm_isolate.h; gm_gmsh_isolate.c), so that gmsh
+ * stopping on a damaged file (a segmentation fault, an abort) refuses it,
+ * PM_ERR_MESH naming the file, instead of ending the process.  These are
+ * the same readers in the process itself, which the child runs. */
+pm_err gm_gmsh_load_here(const char *path, int dim, double h, gm_sizes rule,
+                         bool groups, gm_gmsh_mesh *out);
+pm_err gm_file_bounds_here(const char *path, int dim, double lo[3],
+                           double hi[3]);
+
 /* Frees the arrays of m and zeroes it; NULL is a no-op. */
 void gm_gmsh_mesh_free(gm_gmsh_mesh *m);
 

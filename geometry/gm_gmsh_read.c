@@ -225,7 +225,9 @@ pm_err gm_gmsh_corners(const char *name, const size_t *ctag, size_t nc,
     sorted[i] = (tag_at){tags[i], i};
     number[i] = -1;
   }
-  qsort(sorted, n_tags, sizeof *sorted, tag_order);
+  /* A model without nodes: no array to sort (qsort takes none, even of
+   * no elements). */
+  if (n_tags > 1) qsort(sorted, n_tags, sizeof *sorted, tag_order);
   PM_TRY(PM_ALLOC(nodes->tag, n_tags, "node tags"));
   PM_TRY(PM_ALLOC(nodes->number, n_tags, "node numbers"));
   nodes->n = n_tags;
@@ -395,8 +397,8 @@ done:
   return ret;
 }
 
-pm_err gm_gmsh_load(const char *path, int dim, double h, gm_sizes rule,
-                    bool groups, gm_gmsh_mesh *out) {
+pm_err gm_gmsh_load_here(const char *path, int dim, double h, gm_sizes rule,
+                         bool groups, gm_gmsh_mesh *out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_gmsh_load: out is NULL");
   memset(out, 0, sizeof *out);
   PM_CHECK(path && path[0], PM_ERR_ARG, "no volume file name");
@@ -470,7 +472,8 @@ long gm_msh_node_count(const char *path) {
   return count >= 0 ? count : -1;
 }
 
-pm_err gm_file_bounds(const char *path, int dim, double lo[3], double hi[3]) {
+pm_err gm_file_bounds_here(const char *path, int dim, double lo[3],
+                           double hi[3]) {
   PM_CHECK(path && path[0], PM_ERR_ARG, "no geometry file name");
   PM_CALL(gm_gmsh_check_file(path, "geometry file"));
   pm_err ret = PM_SUCCESS;

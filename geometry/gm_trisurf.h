@@ -50,6 +50,9 @@ pm_err gm_trisurf_sphere(const double center[3], double radius, int refinement,
  * failure out holds nothing.  Not thread-safe (gmsh keeps global state);
  * must not run inside another gmsh session. */
 pm_err gm_trisurf_load(const char *path, gm_trisurf *out);
+/* The same in the process itself (gm_trisurf_load runs it in a child
+ * process: gm_gmsh.h). */
+pm_err gm_trisurf_load_here(const char *path, gm_trisurf *out);
 
 /* Release the arrays (and zero s); NULL accepted. */
 void gm_trisurf_free(gm_trisurf *s);

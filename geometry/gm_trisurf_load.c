@@ -255,7 +255,7 @@ done:
   return ret;
 }
 
-pm_err gm_trisurf_load(const char *path, gm_trisurf *out) {
+pm_err gm_trisurf_load_here(const char *path, gm_trisurf *out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_trisurf_load: out is NULL");
   memset(out, 0, sizeof *out);
   PM_CHECK(path && path[0], PM_ERR_ARG, "no surface file name");

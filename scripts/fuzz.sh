@@ -13,8 +13,17 @@
 # (.msh volume and surface meshes), checkpoint (checkpoint.h5), index (the
 # results folder `resume` reopens).
 #
+# The readers run in the fuzzer's process (PM_ISOLATE=0: coverage and the
+# sanitizers see no child).  gmsh, checkpoint and index run in libFuzzer's
+# fork mode, which goes on past a crash: libgmsh and libhdf5 stop on some
+# inputs by themselves (tests/fuzz/upstream/, which the program refuses by
+# reading such files in a child).
+#
 # New inputs go to build-fuzz/corpus-TARGET/; crashes, leaks and hangs to
-# build-fuzz/findings-TARGET/.  To fold a campaign back into the small
+# build-fuzz/findings-TARGET/ (triage: build-fuzz/tests/fuzz_TARGET FILE
+# prints the stack; a crash wholly inside libgmsh or libhdf5 goes to
+# tests/fuzz/upstream/TARGET/, one in the project's code is fixed and its
+# input goes to tests/fuzz/regressions/TARGET/).  To fold a campaign back into the small
 # replayed corpus (tests/fuzz/corpus-TARGET, tests/fuzz/corpus for the
 # scene): build-fuzz/tests/fuzz_TARGET -merge=1 NEWDIR CORPUS
 # build-fuzz/corpus-TARGET, then replace CORPUS with NEWDIR.
@@ -90,6 +99,19 @@ checkpoint | index) max_len=81920 ;;
 gmsh) max_len=8192 ;;
 esac
 
+# The readers in the fuzzer's process, not in a child (pm_isolate.h):
+# coverage and the sanitizers see only the process they run in.
+export PM_ISOLATE=0
+case $target in
+gmsh | checkpoint | index)
+  # libgmsh 4.8 and libhdf5 1.10 stop on some inputs by themselves
+  # (tests/fuzz/upstream/): the campaign runs in a child of libFuzzer's
+  # that is restarted after a crash, a leak, a hang or running out of
+  # memory, and each finding is kept in build-fuzz/findings-TARGET/ for
+  # triage by its stack.
+  extra+=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
+  ;;
+esac
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1
 # What the distribution's libraries leak by themselves (tests/lsan.supp).
 export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:fast_unwind_on_malloc=0

@@ -69,3 +69,44 @@ const char *fuzz_file(const char *name, const uint8_t *data, size_t size) {
   }
   return path;
 }
+
+#define SEP "\n--pm-fuzz-file--\n"
+#define MAX_FRAMES 8
+
+/* The next part of the input from *at (to the separator or the end). */
+static size_t next_part(const uint8_t *data, size_t size, size_t *at,
+                        size_t *len) {
+  const size_t sep = sizeof SEP - 1, start = *at;
+  for (size_t k = start; k + sep <= size; k++)
+    if (memcmp(data + k, SEP, sep) == 0) {
+      *len = k - start;
+      *at = k + sep;
+      return start;
+    }
+  *len = size - start;
+  *at = size + 1;
+  return start;
+}
+
+bool fuzz_results_folder(const uint8_t *data, size_t size, long *n_points,
+                         long *n_frames) {
+  if (size < 4) return false;
+  *n_points = (long)((uint32_t)data[0] | (uint32_t)data[1] << 8 |
+                     (uint32_t)data[2] << 16 | (uint32_t)data[3] << 24);
+  size_t at = 4, len;
+  long n = -2; /* the index and the mesh come first */
+  char name[64];
+  while (at <= size && n < MAX_FRAMES) {
+    size_t start = next_part(data, size, &at, &len);
+    if (n == -2)
+      snprintf(name, sizeof name, "results.h5");
+    else if (n == -1)
+      snprintf(name, sizeof name, "results/mesh.h5");
+    else
+      snprintf(name, sizeof name, "results/frame_%06ld.h5", n);
+    (void)fuzz_file(name, data + start, len);
+    n++;
+  }
+  *n_frames = n;
+  return true;
+}

@@ -5,6 +5,7 @@
 #ifndef FUZZ_FILE_H
 #define FUZZ_FILE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -22,5 +23,15 @@ const char *fuzz_path(const char *name);
 /* Remove everything in the private folder (the folder stays): between two
  * inputs, so that no file of one is read with the next. */
 void fuzz_clear(void);
+
+/* A results folder from one input: the folder's files joined by the
+ * separator "\n--pm-fuzz-file--\n": results.h5 (the index), results/mesh.h5,
+ * then frames 0, 1, ... (as many as follow, up to 8: the frames kept); the
+ * mesh's point count a resumed run expects is the input's first 4 bytes
+ * (little-endian).  Written to the private folder; false for an input of
+ * fewer than 4 bytes.  *n_frames: the frames written (-2 or -1 when the
+ * input stops before the mesh or the first frame). */
+bool fuzz_results_folder(const uint8_t *data, size_t size, long *n_points,
+                         long *n_frames);
 
 #endif

@@ -12,6 +12,8 @@
 
 #include "pm_files.h"
 #include "pm_h5.h"
+#include "pm_h5_vet.h"
+#include "pm_isolate.h"
 #include "pm_mls.h"
 #include "pm_output.h"
 
@@ -193,8 +195,9 @@ done:
   return ret;
 }
 
-/* Coordinates and frame `frame` (last when < 0) of the results file. */
-static pm_err read_results(const char *path, long frame, cloud *c) {
+/* Coordinates and frame `frame` (last when < 0) of the results file, read
+ * in this process. */
+static pm_err read_results_here(const char *path, long frame, cloud *c) {
   pm_err ret = PM_SUCCESS;
   results r;
   char obj[OBJ_NAME_MAX];
@@ -211,6 +214,50 @@ static pm_err read_results(const char *path, long frame, cloud *c) {
 done:
   results_close(&r);
   return ret;
+}
+
+/* read_results in a child process (pm_isolate.h): libhdf5 1.10 stops the
+ * process on some damaged files, which are then refused by name. */
+typedef struct {
+  const char *path;
+  long frame;
+  cloud *c;
+} read_arg;
+
+static pm_err read_work(void *p) {
+  read_arg *a = p;
+  return read_results_here(a->path, a->frame, a->c);
+}
+
+static pm_err read_put(void *p, int fd) {
+  const cloud *c = ((read_arg *)p)->c;
+  PM_CALL(pm_isolate_put_array(fd, c->x, 3 * (size_t)c->n, sizeof *c->x));
+  return pm_isolate_put_array(fd, c->u, 3 * (size_t)c->n, sizeof *c->u);
+}
+
+static pm_err read_get(void *p, int fd) {
+  cloud *c = ((read_arg *)p)->c;
+  size_t nx = 0, nu = 0;
+  PM_CALL(pm_isolate_get_array(fd, (void **)&c->x, &nx, sizeof *c->x));
+  PM_CALL(pm_isolate_get_array(fd, (void **)&c->u, &nu, sizeof *c->u));
+  c->n = (long)(nx / 3);
+  PM_CHECK(nx == nu && nx % 3 == 0, PM_ERR_INTERNAL, "results passed back");
+  return PM_SUCCESS;
+}
+
+/* Coordinates and frame `frame` (last when < 0) of the results file. */
+static pm_err read_results(const char *path, long frame, cloud *c) {
+  read_arg a = {path, frame, c};
+  const pm_isolate_job job = {.path = path,
+                              .library = "HDF5",
+                              .what = "results of this program",
+                              .code = PM_ERR_HDF5,
+                              .cpu_seconds = PM_H5_VET_CPU_SECONDS,
+                              .work = read_work,
+                              .put = read_put,
+                              .get = read_get,
+                              .arg = &a};
+  return pm_isolate_run(&job);
 }
 
 /* ---- Query points ------------------------------------------------------ */

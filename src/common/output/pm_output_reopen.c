@@ -10,6 +10,7 @@
 
 #include "pm_files.h"
 #include "pm_h5.h"
+#include "pm_h5_vet.h"
 #include "pm_output_impl.h"
 
 /* Remove frame files of index >= n_keep, and the temporary files and
@@ -162,6 +163,7 @@ pm_err pm_results_reopen(const char *dir, long n_points, long n_keep,
   PM_TRY(PM_ALLOC(r, 1, "results writer"));
   PM_TRY(pm_output_set_paths(r, dir));
   path = r->index_path;
+  PM_TRY(pm_results_vet(r, n_keep));
   H5_OK(file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
         path);
   PM_TRY(pm_h5_read_string_attr(file, "scene", &r->scene_text, path));

@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "pm_h5_vet.h"
 #include "pm_memory.h"
 #include "pm_output.h"
 #include "pm_par.h"
@@ -41,6 +42,7 @@ static pm_err resume_open(const char *out_dir, pm_run_resume_info *rs,
              "a new run (--overwrite) to run it again",
              out_dir, status);
   }
+  PM_CALL(pm_ckpt_vet(out_dir));
   PM_CALL(pm_ckpt_open(out_dir, &rs->ck));
   PM_CALL(pm_run_header_items(rs->ck, &rs->h));
   PM_CHECK(strcmp(rs->h.version, PM_VERSION) == 0, PM_ERR_ARG,

@@ -1,0 +1,191 @@
+/* gm_gmsh_isolate: the readers of files through gmsh (gm_gmsh_load,
+ * gm_file_bounds, gm_trisurf_load) run in a child process (pm_isolate.h):
+ * gmsh 4.8 stops the process on some damaged files (a .msh whose elements
+ * name a node it does not list: a segmentation fault inside gmshOpen), and
+ * such a file is refused by name instead.  The child's gmsh model, with
+ * the memory gmsh keeps after finalizing, ends with it. */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gm_gmsh.h"
+#include "gm_trisurf.h"
+#include "pm_isolate.h"
+
+/* One reading of path through gmsh in a child: work, then put and get
+ * its result. */
+static pm_err isolate(const char *path, pm_err (*work)(void *),
+                      pm_err (*put)(void *, int), pm_err (*get)(void *, int),
+                      void *arg) {
+  const pm_isolate_job job = {.path = path ? path : "",
+                              .library = "gmsh",
+                              .what = "a mesh or geometry gmsh reads",
+                              .code = PM_ERR_MESH,
+                              .work = work,
+                              .put = put,
+                              .get = get,
+                              .arg = arg};
+  return pm_isolate_run(&job);
+}
+
+/* ---- gm_gmsh_load ------------------------------------------------------ */
+
+typedef struct {
+  const char *path;
+  int dim;
+  double h;
+  gm_sizes rule;
+  bool groups;
+  gm_gmsh_mesh *out;
+} load_arg;
+
+/* The scalars of a gm_gmsh_mesh, passed first. */
+typedef struct {
+  int dim, n_groups;
+  long n_nodes, n_elems;
+  bool meshed;
+  double size_factor;
+} mesh_head;
+
+static pm_err load_work(void *p) {
+  load_arg *a = p;
+  return gm_gmsh_load_here(a->path, a->dim, a->h, a->rule, a->groups, a->out);
+}
+
+static pm_err load_put(void *p, int fd) {
+  const gm_gmsh_mesh *m = ((load_arg *)p)->out;
+  const mesh_head head = {m->dim,     m->n_groups, m->n_nodes,
+                          m->n_elems, m->meshed,   m->size_factor};
+  PM_CALL(pm_isolate_put(fd, &head, sizeof head));
+  PM_CALL(pm_isolate_put_array(fd, m->x, 3 * (size_t)m->n_nodes, sizeof *m->x));
+  PM_CALL(pm_isolate_put_array(fd, m->elem, (size_t)(m->dim + 1) * m->n_elems,
+                               sizeof *m->elem));
+  if (m->n_groups == 0) return PM_SUCCESS;
+  for (int g = 0; g < m->n_groups; g++)
+    PM_CALL(pm_isolate_put_array(fd, m->group_name[g],
+                                 strlen(m->group_name[g]) + 1, 1));
+  PM_CALL(pm_isolate_put_array(fd, m->group_ptr, (size_t)m->n_groups + 1,
+                               sizeof *m->group_ptr));
+  return pm_isolate_put_array(fd, m->group_face,
+                              (size_t)m->dim * m->group_ptr[m->n_groups],
+                              sizeof *m->group_face);
+}
+
+/* The arrays of m from fd; the counts are checked against the scalars. */
+static pm_err mesh_get(int fd, gm_gmsh_mesh *m) {
+  pm_err ret = PM_SUCCESS;
+  mesh_head head;
+  size_t n = 0;
+  PM_CALL(pm_isolate_get(fd, &head, sizeof head));
+  m->dim = head.dim;
+  m->n_nodes = head.n_nodes;
+  m->n_elems = head.n_elems;
+  m->meshed = head.meshed;
+  m->size_factor = head.size_factor;
+  PM_TRY(pm_isolate_get_array(fd, (void **)&m->x, &n, sizeof *m->x));
+  PM_ENSURE(n == 3 * (size_t)m->n_nodes, PM_ERR_INTERNAL, "nodes passed back");
+  PM_TRY(pm_isolate_get_array(fd, (void **)&m->elem, &n, sizeof *m->elem));
+  PM_ENSURE(n == (size_t)(m->dim + 1) * m->n_elems, PM_ERR_INTERNAL,
+            "elements passed back");
+  if (head.n_groups == 0) return PM_SUCCESS;
+  PM_TRY(PM_ALLOC(m->group_name, head.n_groups, "group names"));
+  m->n_groups = head.n_groups;
+  for (int g = 0; g < m->n_groups; g++) {
+    PM_TRY(pm_isolate_get_array(fd, (void **)&m->group_name[g], &n, 1));
+    PM_ENSURE(n > 0 && m->group_name[g][n - 1] == '\0', PM_ERR_INTERNAL,
+              "group name passed back");
+  }
+  PM_TRY(pm_isolate_get_array(fd, (void **)&m->group_ptr, &n,
+                              sizeof *m->group_ptr));
+  PM_ENSURE(n == (size_t)m->n_groups + 1, PM_ERR_INTERNAL,
+            "groups passed back");
+  PM_TRY(pm_isolate_get_array(fd, (void **)&m->group_face, &n,
+                              sizeof *m->group_face));
+  PM_ENSURE(n == (size_t)m->dim * m->group_ptr[m->n_groups], PM_ERR_INTERNAL,
+            "group faces passed back");
+done:
+  if (ret) gm_gmsh_mesh_free(m);
+  return ret;
+}
+
+static pm_err load_get(void *p, int fd) {
+  return mesh_get(fd, ((load_arg *)p)->out);
+}
+
+pm_err gm_gmsh_load(const char *path, int dim, double h, gm_sizes rule,
+                    bool groups, gm_gmsh_mesh *out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_gmsh_load: out is NULL");
+  memset(out, 0, sizeof *out);
+  load_arg a = {path, dim, h, rule, groups, out};
+  return isolate(path, load_work, load_put, load_get, &a);
+}
+
+/* ---- gm_file_bounds ---------------------------------------------------- */
+
+typedef struct {
+  const char *path;
+  int dim;
+  double box[6]; /* lo, hi */
+} bounds_arg;
+
+static pm_err bounds_work(void *p) {
+  bounds_arg *a = p;
+  return gm_file_bounds_here(a->path, a->dim, a->box, a->box + 3);
+}
+
+static pm_err bounds_put(void *p, int fd) {
+  return pm_isolate_put(fd, ((bounds_arg *)p)->box, sizeof(double[6]));
+}
+
+static pm_err bounds_get(void *p, int fd) {
+  return pm_isolate_get(fd, ((bounds_arg *)p)->box, sizeof(double[6]));
+}
+
+pm_err gm_file_bounds(const char *path, int dim, double lo[3], double hi[3]) {
+  bounds_arg a = {.path = path, .dim = dim};
+  PM_CALL(isolate(path, bounds_work, bounds_put, bounds_get, &a));
+  memcpy(lo, a.box, 3 * sizeof *lo);
+  memcpy(hi, a.box + 3, 3 * sizeof *hi);
+  return PM_SUCCESS;
+}
+
+/* ---- gm_trisurf_load --------------------------------------------------- */
+
+typedef struct {
+  const char *path;
+  gm_trisurf *out;
+} surface_arg;
+
+static pm_err surface_work(void *p) {
+  surface_arg *a = p;
+  return gm_trisurf_load_here(a->path, a->out);
+}
+
+static pm_err surface_put(void *p, int fd) {
+  const gm_trisurf *s = ((surface_arg *)p)->out;
+  PM_CALL(
+      pm_isolate_put_array(fd, s->x, 3 * (size_t)s->n_points, sizeof *s->x));
+  return pm_isolate_put_array(fd, s->tri, 3 * (size_t)s->n_tris,
+                              sizeof *s->tri);
+}
+
+static pm_err surface_get(void *p, int fd) {
+  gm_trisurf *s = ((surface_arg *)p)->out;
+  size_t nx = 0, nt = 0;
+  pm_err ret = PM_SUCCESS;
+  PM_TRY(pm_isolate_get_array(fd, (void **)&s->x, &nx, sizeof *s->x));
+  PM_TRY(pm_isolate_get_array(fd, (void **)&s->tri, &nt, sizeof *s->tri));
+  PM_ENSURE(nx % 3 == 0 && nt % 3 == 0, PM_ERR_INTERNAL, "surface passed back");
+  s->n_points = (long)(nx / 3);
+  s->n_tris = (long)(nt / 3);
+done:
+  if (ret) gm_trisurf_free(s);
+  return ret;
+}
+
+pm_err gm_trisurf_load(const char *path, gm_trisurf *out) {
+  PM_CHECK(out, PM_ERR_ARG, "gm_trisurf_load: out is NULL");
+  memset(out, 0, sizeof *out);
+  surface_arg a = {path, out};
+  return isolate(path, surface_work, surface_put, surface_get, &a);
+}

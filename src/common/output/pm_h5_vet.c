@@ -1,0 +1,220 @@
+/* pm_h5_vet: HDF5 files read whole in a child process before the process
+ * trusts them (see pm_h5_vet.h). */
+#define _DEFAULT_SOURCE
+#include "pm_h5_vet.h"
+
+#include <hdf5.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "pm_files.h"
+#include "pm_h5.h"
+#include "pm_isolate.h"
+#include "pm_output_impl.h"
+
+/* Guards against a damaged file's cycles and sizes: links followed from
+ * the root, objects visited, and the bytes of one value read. */
+#define VET_DEPTH 16
+#define VET_OBJECTS 100000
+#define VET_STRING_MAX 4096
+
+typedef struct {
+  const char *const *paths;
+  int n;
+  bool data;
+  char *current; /* shared with the parent: the file being read */
+  const char *what;
+  pm_err code, err; /* the refusal's code; the first value HDF5 failed on */
+  long objects;
+  size_t value_max; /* bytes: the file's size (a value is in the file) */
+} vet_arg;
+
+static void vet_object(vet_arg *a, hid_t obj, const char *name, int depth);
+
+/* HDF5 failed to read a value the readers may read (it may have needed
+ * more memory than the child has): the file is refused. */
+static void read_failed(vet_arg *a, hid_t id, bool attr, const char *name) {
+  char obj[256] = "", why[512];
+  if (a->err) return;
+  /* HDF5's message before another call clears its error stack. */
+  snprintf(why, sizeof why, "%s", pm_h5_message());
+  if (attr) H5Iget_name(id, obj, sizeof obj);
+  a->err = PM_ERROR(a->code,
+                    "%s: HDF5 cannot read %s %s%s%s (%s): the file is damaged "
+                    "or not %s",
+                    a->current, attr ? "attribute" : "dataset", name,
+                    attr ? " of " : "", attr ? obj : "", why, a->what);
+}
+
+/* An attribute or a dataset's values, read in the native type of its own
+ * (strings of variable length as the readers read them). */
+static void read_values(vet_arg *a, hid_t id, bool attr, const char *name) {
+  /* A dataset's shape and type are read whatever a->data says. */
+  hid_t type = attr ? H5Aget_type(id) : H5Dget_type(id);
+  hid_t space = attr ? H5Aget_space(id) : H5Dget_space(id);
+  hid_t mem = -1;
+  hssize_t count = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
+  if (type < 0 || count < 0 || (!attr && !a->data)) goto done;
+  const H5T_class_t cls = H5Tget_class(type);
+  if (cls == H5T_STRING && H5Tis_variable_str(type) > 0) {
+    if (count < 1 || count > VET_STRING_MAX) goto done;
+    char **s = calloc((size_t)count, sizeof *s);
+    if (!s) goto done;
+    herr_t r = attr ? H5Aread(id, type, s)
+                    : H5Dread(id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, s);
+    if (r >= 0)
+      for (hssize_t k = 0; k < count; k++)
+        if (s[k]) H5free_memory(s[k]);
+    free(s);
+    if (r < 0) read_failed(a, id, attr, name);
+    goto done;
+  }
+  if (cls != H5T_INTEGER && cls != H5T_FLOAT && cls != H5T_STRING) goto done;
+  mem = H5Tget_native_type(type, H5T_DIR_DEFAULT);
+  const size_t size = mem >= 0 ? H5Tget_size(mem) : 0;
+  if (size == 0 || (size_t)count > a->value_max / size) goto done;
+  void *buf = malloc((size_t)count * size + 1);
+  if (!buf) goto done;
+  herr_t r = attr ? H5Aread(id, mem, buf)
+                  : H5Dread(id, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+  free(buf);
+  if (r < 0) read_failed(a, id, attr, name);
+done:
+  pm_h5_close_quiet(&mem);
+  pm_h5_close_quiet(&space);
+  pm_h5_close_quiet(&type);
+}
+
+static herr_t vet_attr(hid_t loc, const char *name, const H5A_info_t *info,
+                       void *p) {
+  (void)info;
+  hid_t attr = H5Aopen(loc, name, H5P_DEFAULT);
+  if (attr >= 0) read_values(p, attr, true, name);
+  pm_h5_close_quiet(&attr);
+  return ((vet_arg *)p)->err ? 1 : 0;
+}
+
+typedef struct {
+  vet_arg *a;
+  int depth;
+} link_walk;
+
+/* A link of a group: a soft link's value, and the object a hard or soft
+ * link leads to (an external link's file is vetted by itself). */
+static herr_t vet_link(hid_t group, const char *name, const H5L_info_t *info,
+                       void *p) {
+  link_walk *w = p;
+  if (w->a->objects >= VET_OBJECTS) return 1;
+  if (info->type == H5L_TYPE_SOFT || info->type == H5L_TYPE_EXTERNAL) {
+    size_t n = info->u.val_size;
+    char *val = n > 0 && n <= VET_STRING_MAX ? malloc(n) : NULL;
+    if (val) H5Lget_val(group, name, val, n, H5P_DEFAULT);
+    free(val);
+  }
+  if (info->type != H5L_TYPE_HARD && info->type != H5L_TYPE_SOFT) return 0;
+  hid_t obj = H5Oopen(group, name, H5P_DEFAULT);
+  if (obj >= 0) vet_object(w->a, obj, name, w->depth + 1);
+  pm_h5_close_quiet(&obj);
+  return w->a->err ? 1 : 0;
+}
+
+/* An object: its attributes, a group's links, a dataset's values. */
+static void vet_object(vet_arg *a, hid_t obj, const char *name, int depth) {
+  if (a->err || depth > VET_DEPTH || a->objects++ >= VET_OBJECTS) return;
+  H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_attr, a);
+  const H5I_type_t kind = H5Iget_type(obj);
+  if (kind == H5I_GROUP || kind == H5I_FILE) {
+    H5G_info_t info;
+    H5Gget_info(obj, &info);
+    link_walk w = {a, depth};
+    H5Literate(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_link, &w);
+    /* The readers also list links in creation order. */
+    H5Literate(obj, H5_INDEX_CRT_ORDER, H5_ITER_INC, NULL, vet_link, &w);
+  } else if (kind == H5I_DATASET) {
+    read_values(a, obj, false, name);
+  }
+}
+
+static pm_err vet_work(void *p) {
+  vet_arg *a = p;
+  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  for (int k = 0; k < a->n; k++) {
+    struct stat st;
+    if (stat(a->paths[k], &st) != 0 || !S_ISREG(st.st_mode)) continue;
+    snprintf(a->current, PM_PATH_MAX + 1, "%s", a->paths[k]);
+    pm_isolate_cpu_limit(PM_H5_VET_CPU_SECONDS);
+    /* What HDF5 needs of memory follows the file's size: a value that
+     * claims more than is in the file fails to allocate, cleanly. */
+    pm_isolate_memory_limit(((size_t)1 << 30) + 16 * (size_t)st.st_size);
+    a->objects = 0;
+    a->value_max = (size_t)st.st_size + 4096;
+    hid_t file = H5Fopen(a->paths[k], H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (file < 0) continue;
+    vet_object(a, file, "/", 0);
+    pm_h5_close_quiet(&file);
+    if (a->err) return a->err;
+  }
+  return PM_SUCCESS;
+}
+
+pm_err pm_h5_vet(const char *const *paths, int n, bool data, const char *what,
+                 pm_err code) {
+  /* Not isolated: the readers meet whatever HDF5 does themselves. */
+  if (n <= 0 || !pm_isolate_enabled()) return PM_SUCCESS;
+  /* The file being read, where the parent finds it once the child is
+   * gone. */
+  char *current = mmap(NULL, PM_PATH_MAX + 1, PROT_READ | PROT_WRITE,
+                       MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  PM_CHECK(current != MAP_FAILED, PM_ERR_MEMORY,
+           "cannot map a page to check '%s'", paths[0]);
+  snprintf(current, PM_PATH_MAX + 1, "%s", paths[0]);
+  vet_arg a = {.paths = paths,
+               .n = n,
+               .data = data,
+               .current = current,
+               .what = what,
+               .code = code};
+  const pm_isolate_job job = {.path = current,
+                              .library = "HDF5",
+                              .what = what,
+                              .code = code,
+                              .cpu_seconds = PM_H5_VET_CPU_SECONDS,
+                              .work = vet_work,
+                              .arg = &a};
+  pm_err ret = pm_isolate_run(&job);
+  munmap(current, PM_PATH_MAX + 1);
+  return ret;
+}
+
+pm_err pm_ckpt_vet(const char *dir) {
+  char path[PM_PATH_MAX + 1];
+  PM_CALL(pm_path_join(path, sizeof path, dir, "checkpoint.h5"));
+  const char *paths[1] = {path};
+  return pm_h5_vet(paths, 1, true, "a checkpoint of this program", PM_ERR_IO);
+}
+
+pm_err pm_results_vet(const pm_results *r, long n_keep) {
+  pm_err ret = PM_SUCCESS;
+  char **paths = NULL;
+  const long n = n_keep + 2;
+  PM_CHECK(n_keep >= 0 && n_keep < (1L << 24), PM_ERR_ARG,
+           "pm_results_vet: %ld frames", n_keep);
+  if (!pm_isolate_enabled()) return PM_SUCCESS;
+  PM_TRY(PM_ALLOC(paths, n, "paths of the results"));
+  for (long k = 0; k < n; k++)
+    PM_TRY(PM_ALLOC(paths[k], PM_PATH_MAX + 1, "paths of the results"));
+  snprintf(paths[0], PM_PATH_MAX + 1, "%s", r->index_path);
+  snprintf(paths[1], PM_PATH_MAX + 1, "%s", r->mesh_path);
+  for (long k = 0; k < n_keep; k++)
+    pm_output_frame_path(r, k, paths[k + 2], PM_PATH_MAX + 1);
+  ret = pm_h5_vet((const char *const *)paths, (int)n, false,
+                  "results of this program", PM_ERR_HDF5);
+done:
+  if (paths)
+    for (long k = 0; k < n; k++) free(paths[k]);
+  free(paths);
+  return ret;
+}
