@@ -120,10 +120,16 @@ else
   echo "read-only: skipped (a read-only bind mount is not allowed here)"
 fi
 
-# 4. The folder is removed during the run.
+# 4. The folder is removed during the run.  The folders of 2 and 3, checked,
+# go first: their runs write frames until stopped, as fast as the step
+# allows, and what they leave must not fill the disk before this run's
+# folder is removed (else it stops on ENOSPC, not on the removal).
+rm -rf "$mnt/filled" "$mnt/ro"
 out=$mnt/gone
 start "$out" 4
-rm -rf "$out"
+# rm -rf racing the run's next frame can leave the folder behind (a file
+# made between its unlink and rmdir): remove until it is gone.
+until rm -rf "$out" 2>/dev/null && [ ! -e "$out" ]; do :; done
 stopped "removed" "$out" "no longer exists|No such file"
 
 echo "$passes passed, $failures failed"
