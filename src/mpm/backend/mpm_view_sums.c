@@ -133,8 +133,8 @@ pm_err mpm_view_sum(mpm_sim *r, bool fields) {
   }
   pm_par_sum(v, (int)n);
   if (fields) {
-    mpm_par_extreme(&own.max_von_mises, at[0], own.max_von_mises_at, true);
-    mpm_par_extreme(&own.min_jacobian, at[1], own.min_jacobian_at, false);
+    mpm_par_extreme(lm, &own.max_von_mises, at[0], own.max_von_mises_at, true);
+    mpm_par_extreme(lm, &own.min_jacobian, at[1], own.min_jacobian_at, false);
   }
   if (!pm_par_root()) return PM_SUCCESS;
   mpm_sums *u = &r->sums;

@@ -348,6 +348,7 @@ static pm_err share_links(pm_qs_method qs, const mpm_grid *whole, bool gather,
   PM_CALL(PM_ALLOC(Q->rdisp, size + 1, "migration offsets"));
   PM_CALL(PM_ALLOC(Q->gcount, size, "gather counts"));
   PM_CALL(PM_ALLOC(Q->gdisp, size + 1, "gather offsets"));
+  PM_CALL(PM_ALLOC(Q->extreme, 5 * size, "extremes over the ranks"));
   Q->sbuf_room = Q->rbuf_room = 64 + room / 8;
   PM_CALL(PM_ALLOC(Q->sbuf, Q->sbuf_room * Q->rec, "migration buffer"));
   PM_CALL(PM_ALLOC(Q->rbuf, Q->rbuf_room * Q->rec, "migration buffer"));
@@ -466,6 +467,7 @@ static void par_free(struct mpm_par *P) {
     MPI_Type_free(&P->three);
   }
   free(P->nodal);
+  free(P->extreme);
   free(P->whole);
   mpm_ghosts_destroy(P->gh);
   if (P->near_of) MPI_Comm_free(&P->near);

@@ -172,8 +172,10 @@ pm_err mpm_par_gather_x0(const mpm_model *m, double **x0);
  * particles (*v: the largest where max, else the smallest), with the
  * particle's one-process index gid (LONG_MAX: none) and its 3 doubles at:
  * the first in one process's order among equal values, as one process
- * finds it; into *v and at on every rank (collective). */
-void mpm_par_extreme(double *v, long gid, double at[3], bool max);
+ * finds it; into *v and at on every rank (collective), in the share m's
+ * buffer: no allocation at a history row. */
+void mpm_par_extreme(const mpm_model *m, double *v, long gid, double at[3],
+                     bool max);
 
 /* Print the decomposition and every rank's share (particles, nodes, ghost
  * nodes, memory of the model and of the workspace w, which may be NULL) to

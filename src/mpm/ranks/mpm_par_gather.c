@@ -217,13 +217,11 @@ pm_err mpm_par_gather_x0(const mpm_model *m, double **x0) {
   return e;
 }
 
-void mpm_par_extreme(double *v, long gid, double at[3], bool max) {
+void mpm_par_extreme(const mpm_model *m, double *v, long gid, double at[3],
+                     bool max) {
   const int size = pm_par_size();
-  double mine[5] = {*v, (double)gid, at[0], at[1], at[2]}, *all = NULL;
-  double stack[5 * 64];
-  /* (a few doubles a rank: on the stack up to 64 ranks) */
-  all = size <= 64 ? stack : malloc(sizeof(double) * 5 * (size_t)size);
-  if (!all) pm_par_abort(1, "out of memory for the extreme over the ranks");
+  double mine[5] = {*v, (double)gid, at[0], at[1], at[2]};
+  double *all = par_of(m)->extreme; /* [5 size], made with the share */
   MPI_Allgather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, pm_par_comm());
   int best = 0;
   for (int r = 1; r < size; r++) {
@@ -233,5 +231,4 @@ void mpm_par_extreme(double *v, long gid, double at[3], bool max) {
   }
   *v = all[5 * best];
   memcpy(at, all + 5 * best + 2, 3 * sizeof(double));
-  if (all != stack) free(all);
 }

@@ -41,6 +41,8 @@ struct mpm_par {
   /* dynamic relaxation's nodal arrays to rank 0: a rank's owned nodes'
    * values, and on rank 0 every rank's */
   double *nodal, *whole;
+  /* mpm_par_extreme's: five doubles a rank (a value, its index and place) */
+  double *extreme;
   unsigned char *owned; /* per local node */
   long n_owned;         /* nodes this rank owns */
   /* the whole run's ranges, in indices on one process */
