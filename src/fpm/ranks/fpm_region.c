@@ -272,6 +272,50 @@ static pm_err traction_ids(const fpm_part *p, fpm_model *pm) {
   return PM_SUCCESS;
 }
 
+/* The share s's facets of each condition among its own points, from the
+ * part's model pm (whose facet lists are the whole's over its points, in
+ * the whole's order): each list entry a facet of s's dual (its point and
+ * area vector), so that fpm_reaction on the share gives its own points'
+ * part of each reaction, which a run without the whole model sums over
+ * the ranks. */
+static pm_err own_facets(const fpm_model *pm, fpm_model *s) {
+  pm_err ret = PM_SUCCESS;
+  const int n_bcs = pm->scene->n_bcs;
+  const gm_dual *pd = pm->dual;
+  gm_dual *d = s->own_dual;
+  long *own = NULL; /* each part point's index among s's own, or -1 */
+  PM_TRY(PM_ALLOC(own, pm->n + 1, "share's facets"));
+  for (long i = 0, k = 0; i < pm->n; i++) { /* (both ascending) */
+    while (k < s->n_own && s->gid[k] < pm->gid[i]) k++;
+    own[i] = k < s->n_own && s->gid[k] == pm->gid[i] ? k : -1;
+  }
+  long nf = 0;
+  for (long e = 0; e < pm->bcf_ptr[n_bcs]; e++)
+    nf += own[pd->facet_point[pm->bcf_facet[e]]] >= 0;
+  PM_TRY(PM_ALLOC(s->bcf_ptr, n_bcs + 1, "share's facet lists"));
+  PM_TRY(PM_ALLOC(s->bcf_facet, nf + 1, "share's facet lists"));
+  PM_TRY(PM_ALLOC(d->facet_point, nf + 1, "share's facets"));
+  PM_TRY(PM_ALLOC(d->facet_area_vec, 3 * nf + 1, "share's facets"));
+  nf = 0;
+  for (int b = 0; b < n_bcs; b++) {
+    s->bcf_ptr[b] = nf;
+    for (long e = pm->bcf_ptr[b]; e < pm->bcf_ptr[b + 1]; e++) {
+      const long f = pm->bcf_facet[e], i = own[pd->facet_point[f]];
+      if (i < 0) continue;
+      d->facet_point[nf] = i;
+      memcpy(d->facet_area_vec + 3 * nf, pd->facet_area_vec + 3 * f,
+             3 * sizeof(double));
+      s->bcf_facet[nf] = nf;
+      nf++;
+    }
+  }
+  s->bcf_ptr[n_bcs] = nf;
+  d->n_facets = nf;
+done:
+  free(own);
+  return ret;
+}
+
 pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
                       const gm_mesh *mesh, const fpm_part *p, int r,
                       fpm_model **out) {
@@ -282,7 +326,12 @@ pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
   if (pm->contact) PM_TRY(fpm_contact_refuse_ranks(s));
   PM_TRY(traction_ids(p, pm));
   PM_TRY(fpm_share_create(pm, p->owner, r, out));
+  PM_TRY(own_facets(pm, *out));
 done:
+  if (ret) {
+    fpm_model_destroy(*out);
+    *out = NULL;
+  }
   fpm_model_destroy(pm);
   return ret;
 }

@@ -66,7 +66,10 @@ void fpm_part_free(fpm_part *p);
 /* Rank r's share of the model of scene s (fpm options o; mesh: the names
  * of the whole mesh's surfaces, all the conditions read of it) built on
  * part p (left as it is): the model fpm_share_create makes of the whole
- * model, bit for bit.  *out owns its arrays. */
+ * model, bit for bit, with besides the facets of each condition among its
+ * own points (its dual's facet points and area vectors, and the lists of
+ * them; none in a share cut from the whole), on which fpm_reaction gives
+ * its own points' part of each reaction.  *out owns its arrays. */
 pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
                       const gm_mesh *mesh, const fpm_part *p, int r,
                       fpm_model **out);
