@@ -111,10 +111,12 @@ static void extreme(const fpm_model *m, double *v, long own, bool most,
                     double at[3]) {
   double best = most ? *v : -*v;
   pm_par_max(&best, 1);
-  const long id = m->gid[own];
-  long first = (most ? *v : -*v) == best ? -id : -LONG_MAX;
+  const bool has = own < m->n_own; /* (a share may own no point) */
+  const long id = has ? m->gid[own] : LONG_MAX;
+  long first = has && (most ? *v : -*v) == best ? -id : -LONG_MAX;
   pm_par_max_long(&first, 1);
-  for (int a = 0; a < 3; a++) at[a] = -first == id ? m->x[3 * own + a] : 0;
+  for (int a = 0; a < 3; a++)
+    at[a] = has && -first == id ? m->x[3 * own + a] : 0;
   pm_par_sum(at, 3); /* (the one rank's position, plus zeros) */
   *v = most ? best : -best;
 }
