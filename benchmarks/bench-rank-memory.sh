@@ -11,7 +11,9 @@
 # floor: the program and its libraries (MPI, PETSc, HDF5).  With
 # METHOD=fpm: FPM F3 at 60% at 4036 and 13762 points (mesh_size 6.42e-3,
 # 4.15e-3), 20 steps and, labelled "setup", one step (the setup's CPU
-# seconds), its floor the same at 45 points (mesh_size 0.05).
+# seconds), its floor the same at 45 points (mesh_size 0.05); labelled
+# "pieces", the 20 steps with frames in pieces (no rank keeps the whole
+# model).
 # ONLY="block block-fine" measures those MPM scenes alone (and the floor).
 # usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] [METHOD=fpm] [ONLY=NAMES] benchmarks/bench-rank-memory.sh [BUILD_DIR]
 bench_name=rank-memory bench_env="BEFORE RANKS METHOD ONLY"
@@ -47,6 +49,8 @@ if [ "${METHOD:-mpm}" = fpm ]; then
       l=${lb%%:*} b=${lb#*:}
       for h in 6.42e-3 4.15e-3; do
         measure "$l" "$b" "$n" "f3-$h" "$f3" --set discretization.mesh_size=$h
+        [ "$l" = after ] && measure pieces "$b" "$n" "f3-$h" "$f3" \
+          --set discretization.mesh_size=$h --set output.ranks=pieces
         measure "$l-setup" "$b" "$n" "f3-$h" "$f3" \
           --set discretization.mesh_size=$h --set time.max_steps=1
       done

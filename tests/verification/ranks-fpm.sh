@@ -45,6 +45,60 @@ print('f2 on 3 ranks: points per rank %s, ghost points %s, %d pairs cut, '
 sys.exit(not (r['count'] == 3 and sum(r['points']) == s['points'] and
               min(r['ghost_points']) > 0 and r['edge_cut'] > 0))"
 
+# Frames in pieces (output.ranks: pieces) without checkpoints: no rank
+# keeps the whole model.  Each rank writes its own points of a frame
+# (points alone, the frame's geometry its field "position"), rank 0 joins
+# them, and the history rows (reactions, energies, the relaxation's
+# figures, the ill-conditioned points, the errors against F2's reference
+# field) and the end's figures are sums and extremes over the shares.  On
+# 2 and 3 ranks: the frames, read in one-process order, the gathered run's
+# bit for bit; history and summary one process's to round-off.
+ln -s "$work/f2-1" "$work/f2-pieces-1" # (the same one-process run)
+for n in 2 3; do
+  want=3 across f2-pieces "$f2" $n $f2set --set output.ranks=pieces
+  check "f2 in pieces on $n ranks: frames as gathered, bit for bit" \
+    $same --frames "$work/f2-$n" "$work/f2-pieces-$n"
+done
+check "f2 in pieces on 3 ranks: the mesh, positions and summary" $py -c "
+import h5py, json, sys
+import numpy as np
+sys.path.insert(0, '$src/python')
+import pointmech
+a, b = sys.argv[1:3]
+fa, fb = h5py.File(a + '/results.h5', 'r'), h5py.File(b + '/results.h5', 'r')
+x = fb['mesh/coordinates'][()]
+assert np.array_equal(fa['mesh/coordinates'][()], x), 'mesh'
+assert fb['mesh/cells'].attrs['nodes_per_cell'] == 1, 'a point cloud'
+assert len(fb['frames']) == len(fa['frames']) == 11, 'frames'
+for k in fb['frames']:
+    g = fb['frames'][k]
+    assert np.array_equal(pointmech.read_rows(g, 'position'),
+                          x + pointmech.read_rows(g, 'displacement')), k
+sa = json.load(open(a + '/summary.json'))
+sb = json.load(open(b + '/summary.json'))
+for k in ('points', 'steps', 'cells', 'interfaces', 'boundary_facets',
+          'prescribed_dofs', 'ill_conditioned_points', 'dt_critical_point',
+          'max_von_mises_at', 'end_min_jacobian_at'):
+    assert sa[k] == sb[k], (k, sa[k], sb[k])
+for k in ('kinetic_energy', 'strain_energy', 'external_work',
+          'mean_strain_energy_density', 'max_von_mises', 'end_min_jacobian',
+          'min_jacobian', 'nrmse_displacement', 'max_support_condition'):
+    assert abs(sa[k] - sb[k]) <= 1e-10 * abs(sa[k]), (k, sa[k], sb[k])
+g = json.load(open(a.replace('f2-1', 'f2-3') + '/summary.json'))
+assert sb['ranks']['edge_cut'] == g['ranks']['edge_cut'], 'edge cut'
+" "$work/f2-1" "$work/f2-pieces-3"
+# In pieces without checkpoints a signal stops the run with its frames and
+# says that it wrote no checkpoint; a static solve writes its frames
+# gathered (refused in pieces, naming the key).
+interrupt 2 "$work/pnone" "$f2" $f2set --set output.ranks=pieces
+check "in pieces, no checkpoints, interrupted: no checkpoint, said" \
+  grep -q 'no checkpoint: a run across ranks with frames in pieces' \
+  "$work/pnone/summary.json"
+refused "a static solve in pieces on 2 ranks" \
+  "a static solve (time.quasi_static.method: static) across ranks writes" \
+  "$work/static-pieces" ranks 2 "$bin" run "$f2" --set output.ranks=pieces \
+  --set time.quasi_static.method=static --out "$work/static-pieces"
+
 # Rank 0 alone meshes and builds the cells; where it keeps no whole model
 # (as when every rank writes its frames) it lets them go once the parts
 # are sent, and every share is still the one cut from the whole model, bit

@@ -133,11 +133,6 @@ refused "frames in pieces with a membrane on 2 ranks" \
   "$work/membrane-pieces-2" ranks 2 "$bin" run \
   "$mpm/m3-gas-box-membrane.yaml" --set output.ranks=pieces \
   --out "$work/membrane-pieces-2"
-refused "frames in pieces of FPM on 2 ranks" \
-  "method fpm writes each frame gathered into rank 0" \
-  "$work/fpm-pieces-2" ranks 2 "$bin" run \
-  "$src/cases/fpm/cube-pressure.yaml" --set output.ranks=pieces \
-  --out "$work/fpm-pieces-2"
 
 refused "F-bar over node patches on 2 ranks" \
   "mpm.fbar: F-bar over node patches runs on one process" \

@@ -38,6 +38,47 @@ double pm_nrmse_vector(long n, unsigned mask, const double *u,
   return sqrt(sum / (double)n) / hi;
 }
 
+void pm_nrmse_part_init(pm_nrmse_part *p) {
+  for (int k = 0; k < 3; k++) {
+    p->d2[k] = 0;
+    p->lo[k] = INFINITY;
+    p->hi[k] = -INFINITY;
+  }
+  p->most = 0;
+}
+
+void pm_nrmse_part_add(pm_nrmse_part *p, unsigned mask, const double u[3],
+                       const double ref[3]) {
+  double r2 = 0;
+  for (int k = 0; k < 3; k++) {
+    if (!(mask >> k & 1u)) continue;
+    const double d = u[k] - ref[k];
+    p->d2[k] += d * d;
+    p->lo[k] = fmin(p->lo[k], ref[k]);
+    p->hi[k] = fmax(p->hi[k], ref[k]);
+    r2 += ref[k] * ref[k];
+  }
+  p->most = fmax(p->most, sqrt(r2));
+}
+
+void pm_nrmse_parts(const pm_nrmse_part *p, long n, unsigned mask,
+                    double nrmse[3], double *vector) {
+  int components = 0;
+  double all = 0;
+  *vector = NAN;
+  for (int k = 0; k < 3; k++) {
+    nrmse[k] = NAN;
+    if (!(mask >> k & 1u)) continue;
+    if (p->hi[k] > p->lo[k] && n > 0)
+      nrmse[k] = sqrt(p->d2[k] / (double)n) / (p->hi[k] - p->lo[k]);
+    *vector = nrmse[k];
+    all += p->d2[k];
+    components++;
+  }
+  if (components > 1)
+    *vector = p->most > 0 && n > 0 ? sqrt(all / (double)n) / p->most : NAN;
+}
+
 double pm_convergence_rate(int n, const double *h, const double *err) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   int m = 0;

@@ -19,6 +19,29 @@ double pm_nrmse(long n, int stride, const double *u, const double *ref);
 double pm_nrmse_vector(long n, unsigned mask, const double *u,
                        const double *ref);
 
+/* pm_nrmse and pm_nrmse_vector over points held in parts (the ranks'
+ * shares of a run): each part sums its points (pm_nrmse_part_add), the
+ * parts' sums are summed (d2) and their extremes taken (lo least, hi
+ * largest), and the errors are made of them (pm_nrmse_parts), equal to
+ * those of the whole to round-off. */
+typedef struct {
+  double d2[3];        /* squared differences per component */
+  double lo[3], hi[3]; /* each component's least and largest reference */
+  double most;         /* the largest magnitude of the reference */
+} pm_nrmse_part;
+
+/* An empty part's sums (lo +inf, hi -inf). */
+void pm_nrmse_part_init(pm_nrmse_part *p);
+/* A point's displacement u and reference ref (the components in mask)
+ * into p. */
+void pm_nrmse_part_add(pm_nrmse_part *p, unsigned mask, const double u[3],
+                       const double ref[3]);
+/* The NRMSE of each component in mask (NaN elsewhere) into nrmse, and of
+ * the field into *vector (one component's own, or pm_nrmse_vector's over
+ * two or three), of n points whose parts' sums are p. */
+void pm_nrmse_parts(const pm_nrmse_part *p, long n, unsigned mask,
+                    double nrmse[3], double *vector);
+
 /* Least-squares slope of log(err) against log(h) over n >= 2 pairs: the
  * observed convergence rate q.  NaN if fewer than two positive pairs. */
 double pm_convergence_rate(int n, const double *h, const double *err);

@@ -175,7 +175,9 @@ size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
   *points = (long)held;
   /* The geometry the rank that meshes holds whole, the rest by the points
    * held; elsewhere the part received (its geometry and the model built on
-   * it) with the share made of it. */
+   * it) with the share made of it.  A rank that meshes and keeps no whole
+   * model cuts its own part too and builds its share on it, its geometry
+   * let go only then: both counted. */
   const double geometry =
       b->geometry_bytes ? fmin((double)b->geometry_bytes(s), (double)whole) : 0;
   const double part =
@@ -183,9 +185,10 @@ size_t pm_memory_rank_estimate(const pm_scene *s, int ranks, bool whole_here,
           ? pm_memory_share_points(n, ranks, s->dimension, b->part_layers(s))
           : 0;
   const double rest = ((double)whole - geometry) * held / n;
-  const double bytes = b->setup_whole || whole_here ? (double)whole + rest
-                       : meshes                     ? geometry + rest
-                                : (double)whole * part / n + rest;
+  const double bytes =
+      b->setup_whole || whole_here
+          ? (double)whole + rest
+          : (meshes ? geometry : 0) + (double)whole * part / n + rest;
   return bytes < (double)SIZE_MAX ? (size_t)bytes : SIZE_MAX;
 }
 
@@ -244,7 +247,9 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
           pm_memory_format(avail.bytes, b, sizeof b), avail.source);
   if (ranks > 1 && s->backend->ghost_layers) {
     long held = 0;
+    long meshed = 0;
     const size_t share = pm_memory_rank_estimate(s, ranks, false, false, &held);
+    const size_t root = pm_memory_rank_estimate(s, ranks, false, true, &meshed);
     need = pm_memory_rank_estimate(s, ranks, true, true, &held);
     if (s->backend->setup_whole)
       fprintf(out,
@@ -252,12 +257,21 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
               "(%ld points held: the whole model its setup builds, and its "
               "share with its ghosts)\n",
               pm_memory_format(need, a, sizeof a), ranks, held);
-    else if (!pm_view_whole_needed(s))
+    else if (!pm_view_whole_needed(s) && !s->backend->geometry_bytes)
       fprintf(out,
               "memory/rank  %s before setup on each of %d ranks at most (its "
               "share with its ghosts, %ld points; no rank keeps the whole "
               "model: frames in pieces, no checkpoints)\n",
               pm_memory_format(share, a, sizeof a), ranks, held);
+    else if (!pm_view_whole_needed(s))
+      fprintf(out,
+              "memory/rank  %s before setup on each of %d ranks at most (its "
+              "share with its ghosts, %ld points, and the part it is built "
+              "from); %s on rank 0, which meshes (the whole mesh and its "
+              "cells besides; no rank keeps the whole model: frames in "
+              "pieces, no checkpoints)\n",
+              pm_memory_format(share, a, sizeof a), ranks, held,
+              pm_memory_format(root, b, sizeof b));
     else
       fprintf(out,
               "memory/rank  %s before setup on each of %d ranks at most (its "

@@ -979,7 +979,8 @@ static const pm_key output_keys[] = {
      .names = pm_output_ranks_names,
      .doc = "a run across MPI ranks: gather (each frame gathered into rank "
             "0 and written whole) or pieces (explicit MPM without "
-            "membranes: each rank writes its own particles, "
+            "membranes, FPM but its static solve: each rank writes its own "
+            "particles or points, over no cells, "
             "results/frame_NNNNNN.piece_RRRR.h5, joined by rank 0's frame "
             "file; readers put them in one-process order; without "
             "output.checkpoint no rank holds the whole model, and a "

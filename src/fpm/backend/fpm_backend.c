@@ -34,6 +34,9 @@ void fpm_sim_destroy(fpm_sim *sim) {
   gm_dual_destroy(sim->dual);
   gm_mesh_destroy(sim->mesh);
   free(sim->scratch);
+  free(sim->mesh_x);
+  free(sim->share_scratch);
+  free(sim->own_nbr);
   free(sim);
 }
 
@@ -138,6 +141,8 @@ pm_err fpm_sim_create(const pm_scene *s, fpm_sim **out) {
     fpm_sim_destroy(sim);
     return e;
   }
+  sim->whole = true;
+  sim->n_whole = sim->model->n;
   *out = sim;
   return PM_SUCCESS;
 }
@@ -256,6 +261,10 @@ done:
 
 static pm_err checkpoint(void *p, pm_ckpt *ck) {
   fpm_sim *sim = p;
+  PM_CHECK(sim->whole || pm_ckpt_reading(ck), PM_ERR_ARG,
+           "a run across ranks with frames in pieces and no "
+           "output.checkpoint keeps no whole model to checkpoint (set "
+           "output.checkpoint.every, or output.ranks: gather)");
   if (!sim->model) return checkpoint_share(sim, ck);
   return checkpoint_whole(sim, ck, sim->state, sim->model->n,
                           &sim->static_state);
@@ -299,17 +308,39 @@ done:
   return ret;
 }
 
+/* Across ranks with frames in pieces, this rank's own points of a frame
+ * and, without the whole model, of the figures: the share's output buffer
+ * (collective). */
+static pm_err share_pieces(fpm_sim *sim, const long whole_counts[3]) {
+  const fpm_model *lm = sim->local_model;
+  if (sim->pieces)
+    PM_CALL(pm_par_agree(PM_ALLOC(sim->share_scratch, 14 * lm->n_own + 1,
+                                  "the share's output")));
+  return sim->whole ? PM_SUCCESS : fpm_view_sums_setup(sim, whole_counts);
+}
+
 /* Across ranks rank 0 alone meshes the domain and builds its cells; the
- * whole model is built only where this rank keeps it (pm_view_keeps_whole),
- * and each rank makes its share, from the whole model there, from the part
- * of the cells rank 0 sends it elsewhere (collective). */
+ * whole model is built only where this rank keeps it
+ * (pm_view_keeps_whole_for: not where the frames go in pieces and nothing
+ * else reads the whole run), and each rank makes its share, from the
+ * whole model there, from the part of the cells rank 0 sends it elsewhere
+ * (collective). */
 static pm_err create_share(const pm_scene *s, fpm_sim **out) {
   fpm_sim *sim = NULL;
-  const bool whole = pm_view_keeps_whole(), root = pm_par_root();
+  const bool whole = pm_view_keeps_whole_for(s), root = pm_par_root();
+  long counts[3] = {0, 0, 0}; /* the whole cells', for the summary */
   pm_err e = pm_par_agree(sim_new(s, &sim));
   if (!e) e = pm_par_agree(root ? sim_mesh(sim) : PM_SUCCESS);
   if (!e) { /* what every rank reports of the geometry */
     double g[3] = {sim->mean_edge, sim->far_size, sim->near_size};
+    sim->whole = pm_view_whole_needed(s);
+    sim->pieces =
+        s->output.ranks == PM_OUTPUT_PIECES && s->time.qs != PM_QS_STATIC;
+    if (root) {
+      counts[0] = sim->mesh->n_cells;
+      counts[1] = sim->dual->n_ifaces;
+      counts[2] = sim->dual->n_facets;
+    }
     sim->n_whole = root ? sim->dual->n_points : 0;
     pm_par_bcast(g, sizeof g);
     pm_par_bcast(&sim->n_whole, sizeof sim->n_whole);
@@ -330,6 +361,7 @@ static pm_err create_share(const pm_scene *s, fpm_sim **out) {
   }
   if (!e)
     e = pm_par_agree(fpm_state_create(sim->local_model, &sim->local_state));
+  if (!e) e = share_pieces(sim, counts);
   if (!e && s->time.qs == PM_QS_STATIC) { /* its load stepping's share */
     const fpm_model *lm = sim->local_model;
     e = fpm_static_state_init(&sim->local_static, lm);
@@ -383,13 +415,28 @@ static double part_layers(const pm_scene *s) { return ghost_layers(s) + 2; }
 
 static void destroy(void *sim) { fpm_sim_destroy(sim); }
 
+/* The method's scene checks, and across ranks: a static solve writes its
+ * frames gathered (its load stepping's states are gathered into rank 0's
+ * whole model for its checkpoints). */
+static pm_err check(const pm_scene *s) {
+  PM_CALL(fpm_check_scene(s));
+  if (pm_par_active() && s->output.ranks == PM_OUTPUT_PIECES &&
+      s->time.qs == PM_QS_STATIC)
+    return pm_scene_fail(s, "output.ranks", false,
+                         "a static solve (time.quasi_static.method: static) "
+                         "across ranks writes each frame gathered into rank "
+                         "0 (this run has %d ranks): take gather",
+                         pm_par_size());
+  return PM_SUCCESS;
+}
+
 const pm_backend fpm_backend = {
     .method = "fpm",
     .description = "explicit total-Lagrangian Fragile Points Method",
     .section = &fpm_section,
     .dt_safety = 0.9,
     .ranks = true,
-    .check = fpm_check_scene,
+    .check = check,
     .create = create,
     .estimate_bytes = fpm_estimate_bytes,
     .ghost_layers = ghost_layers,
@@ -407,4 +454,6 @@ const pm_backend fpm_backend = {
     .summary = fpm_backend_summary,
     .timers = timers,
     .checkpoint = checkpoint,
+    .pieces = fpm_backend_pieces,
+    .errors = fpm_backend_errors,
 };

@@ -18,6 +18,22 @@
 
 extern const pm_backend fpm_backend;
 
+/* Across ranks where no rank keeps the whole model (pm_view_whole_needed
+ * false: frames in pieces, no checkpoints; fpm_view_sums.c): what rank 0
+ * reports of the whole run, summed over the shares' own points (or their
+ * extremes taken), where a gathered run reads the whole model. */
+typedef struct {
+  double reaction[PM_FIGURES_MAX_BCS][3]; /* of each condition */
+  long ill_conditioned;          /* points whose support is past FPM_COND_MAX */
+  double worst_condition;        /* the largest support condition */
+  double nrmse[3], nrmse_vector; /* against the scene's reference field */
+  /* the end's fields */
+  double mean_sed, max_von_mises, max_von_mises_at[3];
+  double end_min_jacobian, end_min_jacobian_at[3];
+  /* the whole model's counts (the summary's) */
+  long cells, interfaces, facets, cdofs, qwide, qlinear, edge_cut;
+} fpm_sums;
+
 /* A prepared simulation.  Fields are read-only for callers. */
 typedef struct {
   const pm_scene *scene; /* borrowed */
@@ -57,9 +73,10 @@ typedef struct {
   long first_step;                 /* the step this run started from */
   /* Across MPI ranks (fpm_par.h): this rank's share of the model and its
    * state, which it steps.  Only a rank that keeps the whole model
-   * (pm_view_keeps_whole: rank 0, as the run's view, gathered into where
-   * the run writes) builds the whole model and state above; the others
-   * hold the mesh and cells, and no model but their share. */
+   * (pm_view_keeps_whole_for: rank 0, as the run's view, gathered into
+   * where the run writes, unless the frames go in pieces and nothing else
+   * reads the whole run) builds the whole model and state above; the
+   * others hold no model but their share. */
   fpm_model *local_model;
   fpm_state *local_state;
   long n_whole;          /* the whole model's points (a rank without it lets the
@@ -79,6 +96,23 @@ typedef struct {
   unsigned char *whole_fixed;
   long free_whole;
   bool scattered; /* the share has the checkpoint's state already */
+  /* Whether a rank holds the whole model: one process, and across ranks
+   * rank 0 unless no rank needs it (pm_view_whole_needed; the same on
+   * every rank).  Without it rank 0 reports the sums over the shares. */
+  bool whole;
+  fpm_sums sums;
+  /* Rank 0 without the whole model: every point's reference position in
+   * one process's order, for results/mesh.h5 (let go when the run
+   * starts). */
+  double *mesh_x;
+  /* Across ranks with frames in pieces (output.ranks: pieces, an explicit
+   * run): each rank writes its own points of a frame from the share's
+   * output buffer, 14 doubles per own point (position, stress and its
+   * invariants). */
+  bool pieces;
+  double *share_scratch;
+  long *own_nbr; /* without the whole model: the own points' supports
+                    (the share's entries, as the conditioning reads them) */
 } fpm_sim;
 
 /* Mesh the scene's domain, build subdomains, operators and state, and pick

@@ -13,10 +13,7 @@
 #include "pm_par.h"
 #include "pm_tensor.h"
 
-/* Cauchy stress sigma = P F^T / J per point into scratch. */
-static void cauchy_stress(const fpm_model *m, const fpm_state *st,
-                          double *sig) {
-  const long n = m->n;
+void fpm_backend_cauchy_stress(long n, const fpm_state *st, double *sig) {
   PM_OMP(parallel for schedule(static) default(none) shared(n, st, sig))
   for (long i = 0; i < n; i++) {
     double F[9], FT[9];
@@ -32,6 +29,16 @@ static void cauchy_stress(const fpm_model *m, const fpm_state *st,
 
 void fpm_backend_points(void *p, pm_points *pts) {
   const fpm_sim *sim = p;
+  /* Frames in pieces hold points in piece order, over which one process's
+   * cells cannot be drawn: the points alone (each frame's geometry its
+   * field "position"), from the whole model or, without it, the positions
+   * gathered for the purpose. */
+  if (sim->pieces) {
+    *pts = (pm_points){.n = sim->n_whole,
+                       .x = sim->model ? sim->model->x : sim->mesh_x,
+                       .nodes_per_cell = 1};
+    return;
+  }
   *pts = (pm_points){.n = sim->model->n,
                      .x = sim->model->x,
                      .n_cells = sim->mesh->n_cells,
@@ -43,20 +50,21 @@ const double *fpm_backend_displacement(void *p) {
   return ((fpm_sim *)p)->state->u;
 }
 
-int fpm_backend_fields(void *p, unsigned want, pm_field *out, int max) {
-  fpm_sim *sim = p;
-  const fpm_state *st = sim->state;
+/* The fields wanted of the first n points of state st into out[0..max)
+ * (at least 8), the stress and its invariants made in scratch (11 n);
+ * how many. */
+static int state_fields(long n, const fpm_state *st, double *scratch,
+                        unsigned want, pm_field *out, int max) {
   int nf = 0;
   if (max < 8) return 0;
   if (want & PM_FIELD_DISPLACEMENT)
     out[nf++] = (pm_field){"displacement", 3, st->u};
   if (want & PM_FIELD_VELOCITY) out[nf++] = (pm_field){"velocity", 3, st->v};
   if (want & PM_FIELD_STRESS) {
-    const long n = sim->model->n;
-    double *vm = sim->scratch + 9 * n, *p_mean = vm + n;
-    cauchy_stress(sim->model, st, sim->scratch);
-    pm_stress_invariants(n, sim->scratch, vm, p_mean);
-    out[nf++] = (pm_field){"stress", 9, sim->scratch};
+    double *vm = scratch + 9 * n, *p_mean = vm + n;
+    fpm_backend_cauchy_stress(n, st, scratch);
+    pm_stress_invariants(n, scratch, vm, p_mean);
+    out[nf++] = (pm_field){"stress", 9, scratch};
     out[nf++] = (pm_field){"von_mises", 1, vm};
     out[nf++] = (pm_field){"pressure", 1, p_mean};
   }
@@ -67,13 +75,50 @@ int fpm_backend_fields(void *p, unsigned want, pm_field *out, int max) {
   return nf;
 }
 
+int fpm_backend_fields(void *p, unsigned want, pm_field *out, int max) {
+  fpm_sim *sim = p;
+  return state_fields(sim->model->n, sim->state, sim->scratch, want, out, max);
+}
+
+/* This rank's own points' fields of a frame in pieces into fields: their
+ * current positions (the frame's geometry), then the scene's; how many. */
+static int piece_fields(fpm_sim *sim, pm_field *fields) {
+  const fpm_model *m = sim->local_model;
+  const fpm_state *st = sim->local_state;
+  const long own = m->n_own;
+  double *position = sim->share_scratch + 11 * own;
+  for (long k = 0; k < 3 * own; k++) position[k] = m->x[k] + st->u[k];
+  fields[0] = (pm_field){"position", 3, position};
+  return 1 + state_fields(own, st, sim->share_scratch,
+                          sim->scene->output.fields, fields + 1,
+                          PM_VIEW_FIELDS - 1);
+}
+
+pm_err fpm_backend_piece(void *p, const char *dir, long frame,
+                         const pm_step_report *r, long *n, int *n_fields,
+                         pm_field *fields) {
+  fpm_sim *sim = p;
+  /* (r is rank 0's alone: the share's state has the step and time) */
+  const fpm_state *st = sim->local_state;
+  *n_fields = piece_fields(sim, fields);
+  *n = sim->local_model->n_own;
+  (void)r;
+  return pm_results_write_piece(dir, frame, pm_par_rank(), *n,
+                                sim->local_model->gid, st->step, st->t,
+                                *n_fields, fields);
+}
+
+const pm_view_pieces *fpm_backend_pieces(void *p) {
+  return pm_view_frame_pieces(&((const fpm_sim *)p)->view);
+}
+
 /* Mean strain energy density, largest von Mises stress and smallest J of
  * the current fields, with their points. */
 static void field_figures(fpm_sim *sim, pm_figures *f) {
   const fpm_model *m = sim->model;
   const fpm_state *st = sim->state;
   const double *vol = sim->dual->volume, *sig = sim->scratch;
-  cauchy_stress(m, st, sim->scratch);
+  fpm_backend_cauchy_stress(m->n, st, sim->scratch);
   double vsum = 0, wsum = 0;
   long vm_at = 0, j_at = 0;
   f->max_von_mises = -1;
@@ -98,14 +143,24 @@ static void field_figures(fpm_sim *sim, pm_figures *f) {
   }
 }
 
+/* The end's field figures summed over the shares (fpm_view_sums.c). */
+static void summed_figures(const fpm_sums *u, pm_figures *f) {
+  f->mean_sed = u->mean_sed;
+  f->max_von_mises = u->max_von_mises;
+  f->end_min_jacobian = u->end_min_jacobian;
+  memcpy(f->max_von_mises_at, u->max_von_mises_at, sizeof f->max_von_mises_at);
+  memcpy(f->end_min_jacobian_at, u->end_min_jacobian_at,
+         sizeof f->end_min_jacobian_at);
+}
+
 void fpm_backend_figures(void *p, pm_figures *f, bool with_fields) {
   fpm_sim *sim = p;
   const fpm_model *m = sim->model;
   const pm_scene *s = sim->scene;
   const fpm_step_info *l = &sim->last;
   f->status = sim->status;
-  f->dim = m->dim;
-  f->points = m->n;
+  f->dim = sim->scene->dimension;
+  f->points = sim->n_whole;
   f->steps = l->step;
   f->time = l->t;
   f->h = sim->mean_edge;
@@ -124,15 +179,21 @@ void fpm_backend_figures(void *p, pm_figures *f, bool with_fields) {
   f->min_jacobian = sim->run_min_jacobian;
   f->min_jacobian_step = sim->run_min_jacobian_step;
   for (int b = 0; b < s->n_bcs && b < PM_FIGURES_MAX_BCS; b++)
-    fpm_reaction(m, sim->state, b, f->reaction[b]);
+    if (m)
+      fpm_reaction(m, sim->state, b, f->reaction[b]);
+    else
+      memcpy(f->reaction[b], sim->sums.reaction[b], sizeof f->reaction[b]);
   f->setup_seconds = sim->setup_wall;
   f->step_seconds = pm_timers_seconds(&sim->timers, sim->tm_force) +
                     pm_timers_seconds(&sim->timers, sim->tm_update);
-  f->memory_bytes = fpm_model_bytes(m) + fpm_state_bytes(m);
+  f->memory_bytes = m ? fpm_model_bytes(m) + fpm_state_bytes(m) : 0;
   if (sim->local_model)
     f->memory_bytes +=
         fpm_model_bytes(sim->local_model) + fpm_state_bytes(sim->local_model);
-  if (with_fields) field_figures(sim, f);
+  if (with_fields && m)
+    field_figures(sim, f);
+  else if (with_fields)
+    summed_figures(&sim->sums, f);
 }
 
 static const char *const own_cols[] = {"damping", "ill_conditioned"};
@@ -147,7 +208,8 @@ int fpm_backend_history_names(void *p, const char **names, int max) {
 void fpm_backend_history_values(void *p, double *v) {
   fpm_sim *sim = p;
   v[0] = sim->last.damping;
-  v[1] = (double)fpm_sim_conditioning(sim, NULL, NULL);
+  v[1] = sim->model ? (double)fpm_sim_conditioning(sim, NULL, NULL)
+                    : (double)sim->sums.ill_conditioned;
 }
 
 /* The partition and what the exchanges cost (bytes a rank received per
@@ -160,7 +222,9 @@ static pm_err summary_ranks(pm_json *j, const fpm_sim *sim) {
   PM_CALL(pm_json_begin_object(j, "ranks"));
   PM_CALL(pm_json_integer(j, "count", size));
   PM_CALL(pm_json_integer(
-      j, "edge_cut", fpm_partition_edge_cut(sim->model, fpm_par_owner(lm))));
+      j, "edge_cut",
+      sim->model ? fpm_partition_edge_cut(sim->model, fpm_par_owner(lm))
+                 : sim->sums.edge_cut));
   PM_CALL(pm_json_begin_array(j, "points"));
   for (int r = 0; r < size; r++) PM_CALL(pm_json_integer(j, NULL, c[r].own));
   PM_CALL(pm_json_end_array(j));
@@ -176,17 +240,33 @@ static pm_err summary_ranks(pm_json *j, const fpm_sim *sim) {
   return pm_json_end_object(j);
 }
 
+/* The whole model's counts, of the model or summed over the shares. */
+static void whole_counts(const fpm_sim *sim, fpm_sums *c) {
+  const fpm_model *m = sim->model;
+  if (!m) {
+    *c = sim->sums;
+    return;
+  }
+  c->cells = sim->mesh->n_cells;
+  c->interfaces = sim->dual->n_ifaces;
+  c->facets = sim->dual->n_facets;
+  c->cdofs = m->n_cdofs;
+  c->qwide = m->n_qwide;
+  c->qlinear = m->n_qlinear;
+  c->ill_conditioned = fpm_sim_conditioning(sim, &c->worst_condition, NULL);
+}
+
 pm_err fpm_backend_summary(void *p, pm_json *j) {
   fpm_sim *sim = p;
-  const fpm_model *m = sim->model;
+  /* (the scalars of the whole model are its shares' too) */
+  const fpm_model *m = sim->model ? sim->model : sim->local_model;
   const pm_scene *s = sim->scene;
-  double worst;
-  long worst_point;
-  long ill = fpm_sim_conditioning(sim, &worst, &worst_point);
-  PM_CALL(pm_json_integer(j, "cells", sim->mesh->n_cells));
-  PM_CALL(pm_json_integer(j, "interfaces", sim->dual->n_ifaces));
-  PM_CALL(pm_json_integer(j, "boundary_facets", sim->dual->n_facets));
-  PM_CALL(pm_json_integer(j, "prescribed_dofs", m->n_cdofs));
+  fpm_sums c;
+  whole_counts(sim, &c);
+  PM_CALL(pm_json_integer(j, "cells", c.cells));
+  PM_CALL(pm_json_integer(j, "interfaces", c.interfaces));
+  PM_CALL(pm_json_integer(j, "boundary_facets", c.facets));
+  PM_CALL(pm_json_integer(j, "prescribed_dofs", c.cdofs));
   PM_CALL(pm_json_number(j, "mesh_size", s->mesh_size));
   PM_CALL(pm_json_number(j, "mean_edge_length", sim->mean_edge));
   PM_CALL(pm_json_number(j, "penalty", m->penalty));
@@ -200,7 +280,7 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
   if (sim->dt_spectral > 0)
     PM_CALL(pm_json_number(j, "dt_spectral", sim->dt_spectral));
   PM_CALL(pm_json_integer(j, "dt_critical_point", sim->dt_point));
-  PM_CALL(pm_json_integer(j, "ill_conditioned_points", ill));
+  PM_CALL(pm_json_integer(j, "ill_conditioned_points", c.ill_conditioned));
   PM_CALL(pm_json_string(j, "jump", m->q ? "quadratic" : "linear"));
   if (m->boundary_penalty > 0)
     PM_CALL(pm_json_number(j, "boundary_penalty", m->boundary_penalty));
@@ -216,8 +296,8 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(pm_json_number(j, "volume_penalty", m->volume_penalty));
   if (sim->local_model) PM_CALL(summary_ranks(j, sim));
   if (m->q) {
-    PM_CALL(pm_json_integer(j, "fit_points_two_rings", m->n_qwide));
-    PM_CALL(pm_json_integer(j, "fit_points_linear", m->n_qlinear));
+    PM_CALL(pm_json_integer(j, "fit_points_two_rings", c.qwide));
+    PM_CALL(pm_json_integer(j, "fit_points_linear", c.qlinear));
   }
   if (s->time.qs == PM_QS_STATIC) {
     const fpm_static_report *r = &sim->static_report;
@@ -280,5 +360,5 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(
         pm_json_number(j, "static_contact_frozen_gap", r->contact_frozen_gap));
   }
-  return pm_json_number(j, "max_support_condition", worst);
+  return pm_json_number(j, "max_support_condition", c.worst_condition);
 }

@@ -33,6 +33,33 @@ int fpm_backend_history_names(void *p, const char **names, int max);
 void fpm_backend_history_values(void *p, double *v);
 pm_err fpm_backend_summary(void *p, pm_json *j);
 
+/* Cauchy stress sigma = P F^T / J of the first n points of st into sig
+ * (9 n). */
+void fpm_backend_cauchy_stress(long n, const fpm_state *st, double *sig);
+/* Across ranks with frames in pieces: this rank's own points of frame
+ * `frame` written into the results folder dir (pm_view.piece), with a
+ * field "position" (the frame's geometry) before the scene's fields; and
+ * rank 0's record of the last frame's pieces (pm_backend.pieces). */
+pm_err fpm_backend_piece(void *p, const char *dir, long frame,
+                         const pm_step_report *r, long *n, int *n_fields,
+                         pm_field *fields);
+const pm_view_pieces *fpm_backend_pieces(void *p);
+
+/* fpm_view_sums.c: across ranks without the whole model (sim->whole
+ * false).  The setup (collective): the whole model's counts for the
+ * summary, of the cells, interfaces and boundary facets given in
+ * whole_counts (rank 0's, which meshed) and the others summed over the
+ * shares; the positions of the points for results/mesh.h5 on rank 0
+ * (sim->mesh_x). */
+pm_err fpm_view_sums_setup(fpm_sim *sim, const long whole_counts[3]);
+/* The figures of the shares' current state into sim->sums on every rank:
+ * the reactions, the conditioning, the errors against the reference
+ * field, and with fields the end's field figures (collective). */
+pm_err fpm_view_sum(fpm_sim *sim, bool fields);
+/* pm_backend.errors: the NRMSE of the last sums (false with the whole
+ * model). */
+bool fpm_backend_errors(void *p, double nrmse[3], double *vector);
+
 /* fpm_backend_plan.c: pointmech plan (pm_backend.plan; collective across
  * ranks). */
 pm_err fpm_backend_plan(void *p, FILE *out);

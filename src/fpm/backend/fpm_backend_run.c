@@ -97,9 +97,12 @@ void fpm_backend_scatter_static(fpm_sim *sim, const unsigned char *fixed,
   load_scalars(ls, ws);
 }
 
-/* Every rank's share of the state into rank 0's view (collective). */
+/* Every rank's share of the state into rank 0's view, or without the
+ * whole model the figures summed over the shares, with the field figures
+ * at the end (collective). */
 static pm_err gather(void *ctx) {
   fpm_sim *sim = ctx;
+  if (!sim->whole) return fpm_view_sum(sim, sim->view.ending);
   PM_CALL(pm_par_agree(fpm_par_gather(sim->local_model, sim->local_state,
                                       pm_par_root() ? sim->state : NULL)));
   if (sim->scene->time.qs == PM_QS_STATIC)
@@ -165,7 +168,8 @@ void fpm_backend_view_init(fpm_sim *sim) {
   sim->view = (pm_view){.ranks = sim->local_model != NULL,
                         .ctx = sim,
                         .gather = gather,
-                        .release = release_view};
+                        .release = release_view,
+                        .piece = sim->pieces ? fpm_backend_piece : NULL};
 }
 
 pm_err fpm_backend_run(void *p, const pm_observer *obs) {
@@ -195,7 +199,10 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
     else
       fpm_par_scatter(lm, sim->state, st);
   }
+  free(sim->mesh_x); /* (the results' mesh is written) */
+  sim->mesh_x = NULL;
   pm_view_start(&sim->view, obs);
+  pm_err e = pm_view_start_pieces(&sim->view, s); /* (agreed) */
   if (!sim->resumed) { /* a resumed run has these from its checkpoint */
     if (!is_static || !sim->local_model)
       memset(st->u, 0, 3 * lm->n * sizeof(double));
@@ -208,13 +215,13 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
   }
   sim->load_end = pm_scene_load_end(s);
   double stage[2] = {0, 0};
-  pm_err e;
   if (is_static) {
     fpm_static_report *r = &sim->static_report;
     double w0 = pm_wtime();
-    e = fpm_static_run_from(
-        lm, st, sim->local_model ? &sim->local_static : &sim->static_state,
-        observe, sim, &sim->last, r);
+    if (!e)
+      e = fpm_static_run_from(
+          lm, st, sim->local_model ? &sim->local_static : &sim->static_state,
+          observe, sim, &sim->last, r);
     e = stopped_inside(sim, e);
     double wall = pm_wtime() - w0;
     e = pm_view_end(&sim->view, e); /* the state it ended in, for figures */
@@ -240,7 +247,7 @@ pm_err fpm_backend_run(void *p, const pm_observer *obs) {
    * shares from the records). */
   if (sim->model) fpm_model_drop_static(sim->model); /* (a view released) */
   if (sim->local_model) fpm_model_drop_static(sim->local_model);
-  e = fpm_run(lm, st, &opt, observe, sim, &sim->last, stage);
+  if (!e) e = fpm_run(lm, st, &opt, observe, sim, &sim->last, stage);
   e = pm_view_end(&sim->view, e); /* the state it ended in, for figures */
   if (sim->local_model) ranks_costs(sim);
   sim->timers.stage[sim->tm_force].seconds += stage[0];

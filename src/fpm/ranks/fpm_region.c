@@ -272,17 +272,105 @@ static pm_err traction_ids(const fpm_part *p, fpm_model *pm) {
   return PM_SUCCESS;
 }
 
+/* The facets of each condition among rank r's own points of a part
+ * (owner: each part point's rank), from the part's model pm (whose facet
+ * lists are the whole's over its points, in the whole's order): each list
+ * entry a facet of the share's dual, its point numbered among the own
+ * points (the share's own points are the part's of rank r, in the same
+ * order), so that fpm_reaction on the share gives its own points' part of
+ * each reaction, which a run without the whole model sums over the
+ * ranks. */
+typedef struct {
+  long n, *ptr, *point; /* n facets; ptr[n_bcs + 1] */
+  double *area_vec;     /* 3 n */
+} own_facets;
+
+static pm_err own_facets_make(const fpm_model *pm, const int *owner, int r,
+                              own_facets *f) {
+  pm_err ret = PM_SUCCESS;
+  const int n_bcs = pm->scene->n_bcs;
+  const gm_dual *pd = pm->dual;
+  long *own = NULL; /* each part point's index among r's own, or -1 */
+  PM_TRY(PM_ALLOC(own, pm->n + 1, "share's facets"));
+  for (long i = 0, k = 0; i < pm->n; i++) own[i] = owner[i] == r ? k++ : -1;
+  long nf = 0;
+  for (long e = 0; e < pm->bcf_ptr[n_bcs]; e++)
+    nf += own[pd->facet_point[pm->bcf_facet[e]]] >= 0;
+  PM_TRY(PM_ALLOC(f->ptr, n_bcs + 1, "share's facet lists"));
+  PM_TRY(PM_ALLOC(f->point, nf + 1, "share's facets"));
+  PM_TRY(PM_ALLOC(f->area_vec, 3 * nf + 1, "share's facets"));
+  nf = 0;
+  for (int b = 0; b < n_bcs; b++) {
+    f->ptr[b] = nf;
+    for (long e = pm->bcf_ptr[b]; e < pm->bcf_ptr[b + 1]; e++) {
+      const long k = pm->bcf_facet[e], i = own[pd->facet_point[k]];
+      if (i < 0) continue;
+      f->point[nf] = i;
+      memcpy(f->area_vec + 3 * nf, pd->facet_area_vec + 3 * k,
+             3 * sizeof(double));
+      nf++;
+    }
+  }
+  f->ptr[n_bcs] = nf;
+  f->n = nf;
+done:
+  free(own);
+  return ret;
+}
+
+/* The facets f into share s (taken over): its dual's facets, and each
+ * condition's list of them. */
+static pm_err own_facets_give(own_facets *f, fpm_model *s) {
+  PM_CALL(PM_ALLOC(s->bcf_facet, f->n + 1, "share's facet lists"));
+  for (long k = 0; k < f->n; k++) s->bcf_facet[k] = k;
+  s->bcf_ptr = f->ptr;
+  s->own_dual->facet_point = f->point;
+  s->own_dual->facet_area_vec = f->area_vec;
+  s->own_dual->n_facets = f->n;
+  *f = (own_facets){0};
+  return PM_SUCCESS;
+}
+
+/* What the share reads of the part's cells d once the part's model is
+ * built: the points' positions, volumes and rows.  Their interfaces and
+ * facets (as much again as the rest at 14 neighbours a point) are let go
+ * first, so that they are not held with the share. */
+static void drop_faces(gm_dual *d) {
+  void **arrays[] = {(void **)&d->nbr_iface,      (void **)&d->if_pair,
+                     (void **)&d->if_area_vec,    (void **)&d->if_moment,
+                     (void **)&d->if_centroid,    (void **)&d->if_area,
+                     (void **)&d->facet_point,    (void **)&d->facet_surface,
+                     (void **)&d->facet_area_vec, (void **)&d->facet_moment,
+                     (void **)&d->facet_centroid, (void **)&d->facet_area};
+  for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) {
+    free(*arrays[k]);
+    *arrays[k] = NULL;
+  }
+  d->n_ifaces = d->n_facets = 0;
+}
+
 pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
-                      const gm_mesh *mesh, const fpm_part *p, int r,
+                      const gm_mesh *mesh, fpm_part *p, int r,
                       fpm_model **out) {
   pm_err ret = PM_SUCCESS;
   fpm_model *pm = NULL;
+  own_facets f = {0};
   *out = NULL;
   PM_TRY(fpm_model_create_part(s, o, mesh, p->cells, p->gid, &pm));
   if (pm->contact) PM_TRY(fpm_contact_refuse_ranks(s));
   PM_TRY(traction_ids(p, pm));
+  PM_TRY(own_facets_make(pm, p->owner, r, &f));
+  drop_faces(p->cells);
   PM_TRY(fpm_share_create(pm, p->owner, r, out));
+  PM_TRY(own_facets_give(&f, *out));
 done:
+  free(f.ptr);
+  free(f.point);
+  free(f.area_vec);
+  if (ret) {
+    fpm_model_destroy(*out);
+    *out = NULL;
+  }
   fpm_model_destroy(pm);
   return ret;
 }

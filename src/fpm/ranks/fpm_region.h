@@ -65,11 +65,15 @@ void fpm_part_free(fpm_part *p);
 
 /* Rank r's share of the model of scene s (fpm options o; mesh: the names
  * of the whole mesh's surfaces, all the conditions read of it) built on
- * part p (left as it is): the model fpm_share_create makes of the whole
- * model, bit for bit.  *out owns its arrays. */
+ * part p: the model fpm_share_create makes of the whole model, bit for
+ * bit, with besides the facets of each condition among its own points (its
+ * dual's facet points and area vectors, and the lists of them; none in a
+ * share cut from the whole), on which fpm_reaction gives its own points'
+ * part of each reaction.  The part's cells lose their interfaces and
+ * facets once the part's model is built (its points, gid, owner and index
+ * stay).  *out owns its arrays. */
 pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
-                      const gm_mesh *mesh, const fpm_part *p, int r,
-                      fpm_model **out);
+                      const gm_mesh *mesh, fpm_part *p, int r, fpm_model **out);
 
 /* Part p as the bytes rank 0 sends (*buf, *len; the caller frees *buf),
  * and the part read from them. */

@@ -10,6 +10,7 @@
 
 #include "mpm_backend_impl.h"
 #include "mpm_par.h"
+#include "pm_metrics.h"
 #include "pm_par.h"
 
 /* The buffer: the energies (3), the accounts (MPM_PAR_ACCOUNTS), the
@@ -19,51 +20,21 @@ static long sums_size(const pm_scene *s) {
   return 3 + MPM_PAR_ACCOUNTS + MPM_SUMS_BODY * s->n_bodies + 2 + 3;
 }
 
-/* The share's squared differences from the scene's reference field at
- * time t, per component, into d2, and the component's least and largest
- * value into lo, hi, with the largest magnitude of the components given
- * into hi[3] (as pm_nrmse and pm_nrmse_vector take them).  Serial: an
- * expression is not thread-safe. */
+/* The share's part of the errors against the scene's reference field at
+ * time t (pm_nrmse_part).  Serial: an expression is not thread-safe. */
 static void reference_sums(const mpm_model *m, const mpm_state *st,
-                           const pm_scene *s, double t, double d2[3],
-                           double lo[3], double hi[4]) {
+                           const pm_scene *s, double t, pm_nrmse_part *p) {
   const unsigned mask = s->reference_mask;
-  for (long p = 0; p < m->n; p++) {
-    const double *X = m->x0 + 3 * p;
-    double r2 = 0;
+  for (long q = 0; q < m->n; q++) {
+    const double *X = m->x0 + 3 * q;
+    double u[3], ref[3] = {0, 0, 0};
     for (int k = 0; k < 3; k++) {
-      if (!(mask >> k & 1u)) continue;
-      const double ref = pm_expr_eval(s->reference[k], X[0], X[1], X[2], t);
-      const double d = st->x[3 * p + k] - X[k] - ref;
-      d2[k] += d * d;
-      lo[k] = fmin(lo[k], ref);
-      hi[k] = fmax(hi[k], ref);
-      r2 += ref * ref;
+      u[k] = st->x[3 * q + k] - X[k];
+      if (mask >> k & 1u)
+        ref[k] = pm_expr_eval(s->reference[k], X[0], X[1], X[2], t);
     }
-    hi[3] = fmax(hi[3], sqrt(r2));
+    pm_nrmse_part_add(p, mask, u, ref);
   }
-}
-
-/* The NRMSE of the reference components and of the field from the sums
- * over the shares (d2, lo, hi as reference_sums makes them) of n
- * particles, as pm_run_compute_errors takes them from the whole. */
-static void reference_errors(mpm_sums *u, unsigned mask, const double d2[3],
-                             const double lo[3], const double hi[4]) {
-  int n_ref = 0;
-  double all = 0;
-  u->nrmse_vector = NAN;
-  for (int k = 0; k < 3; k++) {
-    u->nrmse[k] = NAN;
-    if (!(mask >> k & 1u)) continue;
-    if (hi[k] > lo[k] && u->n > 0)
-      u->nrmse[k] = sqrt(d2[k] / (double)u->n) / (hi[k] - lo[k]);
-    u->nrmse_vector = u->nrmse[k];
-    all += d2[k];
-    n_ref++;
-  }
-  if (n_ref > 1)
-    u->nrmse_vector =
-        hi[3] > 0 && u->n > 0 ? sqrt(all / (double)u->n) / hi[3] : NAN;
 }
 
 bool mpm_sim_errors(void *p, double nrmse[3], double *vector) {
@@ -106,8 +77,8 @@ pm_err mpm_view_sum(mpm_sim *r, bool fields) {
   const long n = sums_size(s);
   double *v = r->sums.buf, *acc = v + 3, *body = acc + n_acc,
          *field = body + MPM_SUMS_BODY * s->n_bodies, *d2 = field + 2;
-  double lo[3] = {INFINITY, INFINITY, INFINITY},
-         hi[4] = {-INFINITY, -INFINITY, -INFINITY, 0};
+  pm_nrmse_part part;
+  pm_nrmse_part_init(&part);
   PM_CALL(pm_par_agree(mpm_sim_share_scratch(r, ls->step)));
   memset(v, 0, sizeof *v * (size_t)n);
   mpm_energies(lm, ls, v, v + 1, v + 2);
@@ -127,9 +98,11 @@ pm_err mpm_view_sum(mpm_sim *r, bool fields) {
     field[1] = own.volume0;
   }
   if (s->reference_mask) {
-    reference_sums(lm, ls, s, ls->t, d2, lo, hi);
-    pm_par_min(lo, 3);
-    pm_par_max(hi, 4);
+    reference_sums(lm, ls, s, ls->t, &part);
+    memcpy(d2, part.d2, sizeof part.d2); /* (summed with the rest) */
+    pm_par_min(part.lo, 3);
+    pm_par_max(part.hi, 3);
+    pm_par_max(&part.most, 1);
   }
   pm_par_sum(v, (int)n);
   if (fields) {
@@ -142,7 +115,10 @@ pm_err mpm_view_sum(mpm_sim *r, bool fields) {
   u->strain = v[1];
   u->internal = v[2];
   memcpy(u->body, body, sizeof *body * MPM_SUMS_BODY * (size_t)s->n_bodies);
-  if (s->reference_mask) reference_errors(u, s->reference_mask, d2, lo, hi);
+  if (s->reference_mask) {
+    memcpy(part.d2, d2, sizeof part.d2);
+    pm_nrmse_parts(&part, u->n, s->reference_mask, u->nrmse, &u->nrmse_vector);
+  }
   if (fields) {
     u->sed_volume = field[0];
     u->volume0 = field[1];
