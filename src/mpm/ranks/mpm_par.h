@@ -42,7 +42,8 @@
  * sphere are shared as well as particles filling the box).  It leaves
  * uncut an axis along which a boundary wall moves (a face condition's
  * column is walked from the grid's edge to the wall) and keeps cuts clear
- * of face planes.  The node sums run on a PetscSF of the ghost nodes. */
+ * of face planes.  The node sums run on the ghost nodes' exchange
+ * (pm_halo: MPI alone). */
 #ifndef MPM_PAR_H
 #define MPM_PAR_H
 
