@@ -3,6 +3,7 @@
 #include "pm_halo.h"
 
 #include <limits.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -174,47 +175,116 @@ done:
 /* ---- the exchanges ---------------------------------------------------------
  */
 
+/* Items of an array are copied and summed in words of 8 bytes where
+ * their size allows (doubles and longs), with the common widths (1, 2, 3
+ * words) as constants so that each copy is a move; else byte by byte. */
+#define WORD 8
+
+static inline void pack_words(char *buf, int stride, const long *item, long n,
+                              const char *arr, int w) {
+  const long b = (long)w * WORD;
+  for (long i = 0; i < n; i++, buf += stride)
+    for (int c = 0; c < w; c++)
+      memcpy(buf + c * WORD, arr + item[i] * b + c * WORD, WORD);
+}
+
+static inline void unpack_words(const char *buf, int stride, const long *item,
+                                long n, char *arr, int w) {
+  const long b = (long)w * WORD;
+  for (long i = 0; i < n; i++, buf += stride)
+    for (int c = 0; c < w; c++)
+      memcpy(arr + item[i] * b + c * WORD, buf + c * WORD, WORD);
+}
+
+/* In the buffer's order: a root's sum does not depend on the messages'. */
+static inline void sum_words(const char *buf, int stride, const long *item,
+                             long n, char *arr, int w) {
+  for (long i = 0; i < n; i++, buf += stride) {
+    double *t = (double *)(void *)(arr + item[i] * w * WORD);
+    for (int c = 0; c < w; c++) {
+      double f;
+      memcpy(&f, buf + c * WORD, WORD);
+      t[c] += f;
+    }
+  }
+}
+
+/* Items item[0..n) of array arr (b bytes an item) into a buffer of items
+ * `stride` bytes apart, at byte `off` of each. */
+static void pack_one(char *buf, int stride, int off, const long *item, long n,
+                     const char *arr, int b) {
+  buf += off;
+  if (b % WORD || stride % WORD || off % WORD) {
+    for (long i = 0; i < n; i++, buf += stride)
+      memcpy(buf, arr + item[i] * b, (size_t)b);
+  } else if (b == WORD) {
+    pack_words(buf, stride, item, n, arr, 1);
+  } else if (b == 2 * WORD) {
+    pack_words(buf, stride, item, n, arr, 2);
+  } else if (b == 3 * WORD) {
+    pack_words(buf, stride, item, n, arr, 3);
+  } else {
+    pack_words(buf, stride, item, n, arr, b / WORD);
+  }
+}
+
+/* The buffer's items back into array arr by op (the inverse of pack_one). */
+static void unpack_one(const char *buf, int stride, int off, const long *item,
+                       long n, char *arr, int b, pm_halo_op op) {
+  buf += off;
+  const bool words = !(b % WORD || stride % WORD || off % WORD);
+  if (op == PM_HALO_REPLACE && !words) {
+    for (long i = 0; i < n; i++, buf += stride)
+      memcpy(arr + item[i] * b, buf, (size_t)b);
+  } else if (op == PM_HALO_REPLACE) {
+    if (b == WORD)
+      unpack_words(buf, stride, item, n, arr, 1);
+    else if (b == 3 * WORD)
+      unpack_words(buf, stride, item, n, arr, 3);
+    else
+      unpack_words(buf, stride, item, n, arr, b / WORD);
+  } else if (op == PM_HALO_SUM_DOUBLE) {
+    if (b == WORD)
+      sum_words(buf, stride, item, n, arr, 1);
+    else if (b == 2 * WORD)
+      sum_words(buf, stride, item, n, arr, 2);
+    else if (b == 3 * WORD)
+      sum_words(buf, stride, item, n, arr, 3);
+    else
+      sum_words(buf, stride, item, n, arr, b / WORD);
+  } else if (op == PM_HALO_MAX_BYTE) {
+    for (long i = 0; i < n; i++, buf += stride)
+      for (int c = 0; c < b; c++) {
+        unsigned char *t = (unsigned char *)arr + item[i] * b + c;
+        const unsigned char f = (unsigned char)buf[c];
+        *t = f > *t ? f : *t;
+      }
+  } else {
+    for (long i = 0; i < n; i++, buf += stride)
+      for (int c = 0; c < b / WORD; c++) {
+        double f, *t = (double *)(void *)(arr + item[i] * b) + c;
+        memcpy(&f, buf + c * WORD, WORD);
+        *t = f > *t ? f : *t;
+      }
+  }
+}
+
 /* Items item[0..n) of the arrays to a buffer, side by side (pack) or
  * back (unpack, by op). */
 static void pack(char *buf, const long *item, long n, int na, void *const *arr,
                  const int *bytes) {
   int stride = 0;
   for (int a = 0; a < na; a++) stride += bytes[a];
-  for (int a = 0, off = 0; a < na; off += bytes[a++]) {
-    const char *src = arr[a];
-    const size_t b = (size_t)bytes[a];
-    for (long i = 0; i < n; i++)
-      memcpy(buf + i * stride + off, src + item[i] * b, b);
-  }
-}
-
-/* Combine b bytes of from into to by op. */
-static inline void combine(char *to, const char *from, int b, pm_halo_op op) {
-  if (op == PM_HALO_REPLACE) {
-    memcpy(to, from, (size_t)b);
-  } else if (op == PM_HALO_MAX_BYTE) {
-    for (int c = 0; c < b; c++)
-      if ((unsigned char)from[c] > (unsigned char)to[c]) to[c] = from[c];
-  } else {
-    /* The buffer's doubles may be unaligned: each copied out first. */
-    double *t = (double *)(void *)to;
-    for (int c = 0; c < b / (int)sizeof(double); c++) {
-      double f;
-      memcpy(&f, from + c * sizeof(double), sizeof f);
-      t[c] = op == PM_HALO_SUM_DOUBLE ? t[c] + f : (f > t[c] ? f : t[c]);
-    }
-  }
+  for (int a = 0, off = 0; a < na; off += bytes[a++])
+    pack_one(buf, stride, off, item, n, arr[a], bytes[a]);
 }
 
 static void unpack(const char *buf, const long *item, long n, int na,
                    void *const *arr, const int *bytes, pm_halo_op op) {
   int stride = 0;
   for (int a = 0; a < na; a++) stride += bytes[a];
-  for (int a = 0, off = 0; a < na; off += bytes[a++]) {
-    char *dst = arr[a];
-    for (long i = 0; i < n; i++)
-      combine(dst + item[i] * bytes[a], buf + i * stride + off, bytes[a], op);
-  }
+  for (int a = 0, off = 0; a < na; off += bytes[a++])
+    unpack_one(buf, stride, off, item, n, arr[a], bytes[a], op);
 }
 
 /* Post the receives of `to` and the sends of `from` (packed already). */
@@ -257,8 +327,8 @@ void pm_halo_reduce(pm_halo *h, int n, void *const *root, void *const *leaf,
    * order): a root's sum is the same whichever message came first. */
   for (int a = 0; a < n; a++)
     for (long i = 0; i < h->n_self; i++)
-      combine((char *)root[a] + h->self_root[i] * bytes[a],
-              (const char *)leaf[a] + h->self_leaf[i] * bytes[a], bytes[a], op);
+      unpack_one((const char *)leaf[a] + h->self_leaf[i] * bytes[a], 0, 0,
+                 &h->self_root[i], 1, root[a], bytes[a], op);
   MPI_Waitall(h->leaves.n + h->roots.n, h->req, MPI_STATUSES_IGNORE);
   unpack(h->roots.buf, h->roots.item, h->roots.ptr[h->roots.n], n, root, bytes,
          op);
