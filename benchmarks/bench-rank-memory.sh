@@ -8,7 +8,8 @@
 # by the implicit MPM at 256^2 cells (its 10 load steps); with
 # BEFORE=BUILD_DIR the same runs by that build beside.  One line per rank:
 # KiB and CPU seconds (user).  A tiny scene (the disks) gives each rank's
-# floor: the program and its libraries (MPI, PETSc, HDF5).  With
+# floor: the program and its libraries (MPI, HDF5; PETSc only where the
+# run solves, Scotch where FPM partitions).  With
 # METHOD=fpm: FPM F3 at 60% at 4036 and 13762 points (mesh_size 6.42e-3,
 # 4.15e-3), 20 steps and, labelled "setup", one step (the setup's CPU
 # seconds), its floor the same at 45 points (mesh_size 0.05); labelled

@@ -14,6 +14,7 @@ packages=(
   libcmocka-dev
   libtiff-dev
   libpetsc-real-dev
+  libscotch-dev
   calculix-ccx
   clang-format python3-matplotlib python3-numpy python3-h5py python3-scipy
 )

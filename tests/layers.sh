@@ -21,7 +21,7 @@ check() { # check LABEL PATTERN FILES...: no file includes a header matching PAT
   done
 }
 
-mpi='mpi\.h|petscsf\.h|petscdm[a-z]*\.h|pm_par\.h|pm_par_mpi\.h'
+mpi='mpi\.h|petscsf\.h|petscdm[a-z]*\.h|pm_par\.h|pm_par_mpi\.h|pm_halo\.h'
 out=$(
   # the physics cores: no MPI, no rank code, nothing of the layers above
   mcore=$(find src/mpm/core src/mpm/step src/mpm/implicit src/mpm/kinds -name '*.[ch]' 2>/dev/null)

@@ -125,6 +125,15 @@ check "f2 on 1 rank: exit 3 (got $rc)" test $rc -eq 3
 check "f2 on 1 rank: one process, bit for bit" \
   $same "$work/f2-1" "$work/f2-np1"
 
+# Explicit FPM across ranks: Scotch partitions, the exchanges are MPI
+# alone, and no rank opens PETSc (the loader's record of each rank's).
+LD_DEBUG=files ranks 2 "$bin" run "$f2" --out "$work/f2-libs" --quiet \
+  --set discretization.mesh_size=0.015 --set time.max_steps=5 >/dev/null \
+  2>"$work/libs"
+check "f2 on 2 ranks: Scotch opened" grep -q 'file=libscotch' "$work/libs"
+check "f2 on 2 ranks: no rank opens PETSc" \
+  sh -c "! grep -q 'file=libpetsc' '$work/libs'"
+
 # The quadratic jump (F4 at 60%, coarsest h; its ghosts reach over the fits'
 # two rings), 200 steps.
 want=3 across f4-quadratic "$f4" 2 --set discretization.mesh_size=8.72e-3 \

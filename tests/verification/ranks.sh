@@ -50,6 +50,16 @@ ranks 1 "$bin" run "$mpm/disks-collision.yaml" --out "$work/disks-np1" \
 check "disks on 1 rank: one process, bit for bit" \
   $same "$work/disks-1" "$work/disks-np1"
 
+# An explicit run across ranks exchanges in MPI alone: no rank opens PETSc
+# (the loader's record of every library each rank opens).
+LD_DEBUG=files ranks 2 "$bin" run "$mpm/disks-collision.yaml" \
+  --out "$work/disks-libs" --set time.max_steps=5 --quiet >/dev/null \
+  2>"$work/libs"
+check "disks on 2 ranks: the libraries opened are recorded" \
+  grep -q 'file=libhdf5' "$work/libs"
+check "disks on 2 ranks: no rank opens PETSc" \
+  sh -c "! grep -q 'file=libpetsc' '$work/libs'"
+
 # The plan prints the decomposition and every rank's share.
 ranks 2 "$bin" plan "$mpm/f2-unconstrained-compression.yaml" >"$work/plan" \
   2>"$work/err"

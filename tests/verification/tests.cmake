@@ -87,6 +87,16 @@ if(PM_MPI)
   set_tests_properties(verification.ranks PROPERTIES LABELS verification
     TIMEOUT 600 PROCESSORS 1
     RESOURCE_LOCK mpirun)
+  # The neighbour exchange alone (pm_halo): random patterns on 3 ranks,
+  # every operation against what each root must hold, sums in rank order.
+  add_executable(ranks_halo ${PM_VERIFY_DIR}/ranks_halo.c)
+  target_link_libraries(ranks_halo PRIVATE pm_app)
+  add_test(NAME verification.ranks_halo
+    COMMAND ${MPIEXEC_EXECUTABLE} -np 3 --bind-to none
+      $<TARGET_FILE:ranks_halo>)
+  set_tests_properties(verification.ranks_halo PROPERTIES LABELS verification
+    TIMEOUT 60 PROCESSORS 1 RESOURCE_LOCK mpirun
+    ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_MCA_mpi_yield_when_idle=1")
   # The Newton layer and the implicit MPM across ranks.
   add_executable(ranks_newton ${PM_VERIFY_DIR}/ranks_newton.c)
   target_link_libraries(ranks_newton PRIVATE pm_app)

@@ -52,6 +52,15 @@ static pm_err open_outputs(pm_run_ctx *c, const char *out_dir, unsigned flags,
  * without (the run's own outcome stands). */
 static void gather_peaks(void) { (void)pm_memory_gather_peaks(); }
 
+/* PETSc's start is collective, and across ranks nothing before the run
+ * starts it (the exchanges are MPI alone): every rank of a scene solved
+ * by Newton's method starts it as its run begins, rank 0 before it opens
+ * its outputs. */
+static pm_err start_petsc(const pm_scene *s) {
+  if (!pm_par_active() || s->time.qs != PM_QS_STATIC) return PM_SUCCESS;
+  return pm_petsc_init();
+}
+
 pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
                    unsigned flags, pm_outcome *o, pm_outdir **outdir,
                    pm_run_resume_info *rs, const pm_observer *also) {
@@ -61,6 +70,7 @@ pm_err pm_run_root(const pm_scene *s, void *sim, const char *out_dir,
   bool agreed = false; /* across ranks: the others heard how setup went */
   void (*old_xfsz)(int) = SIG_ERR;
   memset(o, 0, sizeof *o);
+  PM_TRY(start_petsc(s));
   for (int k = 0; k < 3; k++) o->nrmse[k] = NAN;
   o->nrmse_vector = o->loaded_reaction = NAN;
   o->loaded_axis = -1;
@@ -157,7 +167,8 @@ pm_err pm_run_worker(const pm_scene *s, void *sim, pm_outcome *o) {
   sigemptyset(&ignore.sa_mask);
   sigaction(SIGINT, &ignore, &old[0]);
   sigaction(SIGTERM, &ignore, &old[1]);
-  pm_err e = pm_par_agree(PM_SUCCESS); /* rank 0's outputs are open */
+  pm_err e = start_petsc(s);
+  if (!e) e = pm_par_agree(PM_SUCCESS); /* rank 0's outputs are open */
   if (!e) {
     e = s->backend->run(sim, NULL);
     gather_peaks();

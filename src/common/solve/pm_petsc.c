@@ -36,11 +36,10 @@ pm_err pm_petsc_init(void) {
   PetscBool ready = PETSC_FALSE;
   PM_CHECK(!finished, PM_ERR_LINALG,
            "PETSc was finalised (pm_solve_finalize) and cannot start again");
-  /* The library is opened here, by its first user: a run that neither
-   * solves nor runs across ranks never maps it. */
+  /* The library is opened here, by its first user: a run that does not
+   * solve never maps it (the ranks' exchanges are MPI alone). */
   PM_CALL(pm_petsc_api_load(
-      "a static solve (time.quasi_static.method: static, implicit MPM) or "
-      "a run across ranks"));
+      "a static solve (time.quasi_static.method: static, implicit MPM)"));
   PM_PETSC_CALL(PetscInitialized(&ready));
   if (ready) return PM_SUCCESS;
   /* PETSc's objects live on the run's ranks (PETSc's own world where the

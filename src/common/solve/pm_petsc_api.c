@@ -1,5 +1,5 @@
 /* pm_petsc_api: libpetsc opened on first use and its symbols resolved into
- * the table the solvers and the ranks' exchanges use (pm_petsc_api.h). */
+ * the table the solvers use (pm_petsc_api.h). */
 #define PM_PETSC_API_IMPL
 #include "pm_petsc_api.h"
 

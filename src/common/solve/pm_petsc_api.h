@@ -1,7 +1,7 @@
 /* pm_petsc_api: PETSc reached through a table filled on first use, so that
  * a process opens libpetsc (and the fifty libraries only it brings: MUMPS,
- * SuperLU, hypre, Trilinos' ML, ...) only when its run solves or runs
- * across ranks.  Included after every PETSc header of a file, each name
+ * SuperLU, hypre, Trilinos' ML, ...) only when its run solves (a static
+ * solve, implicit MPM).  Included after every PETSc header of a file, each name
  * below becomes its entry in the table: a function keeps its call syntax
  * and a variable (PETSC_COMM_WORLD) its use.  A PETSc symbol not in the
  * table stays undefined, which the link of libpointmech.so
@@ -11,7 +11,6 @@
 
 #include <petscksp.h>
 #include <petscmat.h>
-#include <petscsf.h>
 #include <petscsnes.h>
 #include <petscsys.h>
 
@@ -20,11 +19,8 @@
 
 /* X(name): every function and variable of PETSc the program uses. */
 #define PM_PETSC_API(X)                                                        \
-  X(ISDestroy)                                                                 \
-  X(ISGetIndices)                                                              \
   X(ISLocalToGlobalMappingCreate)                                              \
   X(ISLocalToGlobalMappingDestroy)                                             \
-  X(ISRestoreIndices)                                                          \
   X(KSPConvergedDefault)                                                       \
   X(KSPConvergedDefaultCreate)                                                 \
   X(KSPConvergedDefaultDestroy)                                                \
@@ -53,21 +49,12 @@
   X(MatAssemblyBegin)                                                          \
   X(MatAssemblyEnd)                                                            \
   X(MatCreate)                                                                 \
-  X(MatCreateMPIAdj)                                                           \
   X(MatCreateShell)                                                            \
   X(MatDestroy)                                                                \
   X(MatDiagonalSet)                                                            \
   X(MatGetRowIJ)                                                               \
   X(MatNullSpaceCreate)                                                        \
   X(MatNullSpaceDestroy)                                                       \
-  X(MatPartitioningApply)                                                      \
-  X(MatPartitioningCreate)                                                     \
-  X(MatPartitioningDestroy)                                                    \
-  X(MatPartitioningSetAdjacency)                                               \
-  X(MatPartitioningSetFromOptions)                                             \
-  X(MatPartitioningSetNParts)                                                  \
-  X(MatPartitioningSetType)                                                    \
-  X(MatPartitioningSetVertexWeights)                                           \
   X(MatPreallocatorPreallocate)                                                \
   X(MatRestoreRowIJ)                                                           \
   X(MatSeqAIJGetArrayRead)                                                     \
@@ -114,14 +101,6 @@
   X(PetscOptionsPush)                                                          \
   X(PetscPopSignalHandler)                                                     \
   X(PetscPushErrorHandler)                                                     \
-  X(PetscSFBcastBegin)                                                         \
-  X(PetscSFBcastEnd)                                                           \
-  X(PetscSFCreate)                                                             \
-  X(PetscSFDestroy)                                                            \
-  X(PetscSFReduceBegin)                                                        \
-  X(PetscSFReduceEnd)                                                          \
-  X(PetscSFSetGraph)                                                           \
-  X(PetscSFSetUp)                                                              \
   X(PetscTrFree)                                                               \
   X(SNESConvergedReasons)                                                      \
   X(SNESCreate)                                                                \
@@ -182,13 +161,10 @@ pm_err pm_petsc_api_load(const char *need);
 /* pm_petsc_api.c fills the table by these names and so sees them as PETSc
  * declares them. */
 #ifndef PM_PETSC_API_IMPL
-#define ISDestroy (*pm_petsc_api.ISDestroy)
-#define ISGetIndices (*pm_petsc_api.ISGetIndices)
 #define ISLocalToGlobalMappingCreate                                           \
   (*pm_petsc_api.ISLocalToGlobalMappingCreate)
 #define ISLocalToGlobalMappingDestroy                                          \
   (*pm_petsc_api.ISLocalToGlobalMappingDestroy)
-#define ISRestoreIndices (*pm_petsc_api.ISRestoreIndices)
 #define KSPConvergedDefault (*pm_petsc_api.KSPConvergedDefault)
 #define KSPConvergedDefaultCreate (*pm_petsc_api.KSPConvergedDefaultCreate)
 #define KSPConvergedDefaultDestroy (*pm_petsc_api.KSPConvergedDefaultDestroy)
@@ -217,23 +193,12 @@ pm_err pm_petsc_api_load(const char *need);
 #define MatAssemblyBegin (*pm_petsc_api.MatAssemblyBegin)
 #define MatAssemblyEnd (*pm_petsc_api.MatAssemblyEnd)
 #define MatCreate (*pm_petsc_api.MatCreate)
-#define MatCreateMPIAdj (*pm_petsc_api.MatCreateMPIAdj)
 #define MatCreateShell (*pm_petsc_api.MatCreateShell)
 #define MatDestroy (*pm_petsc_api.MatDestroy)
 #define MatDiagonalSet (*pm_petsc_api.MatDiagonalSet)
 #define MatGetRowIJ (*pm_petsc_api.MatGetRowIJ)
 #define MatNullSpaceCreate (*pm_petsc_api.MatNullSpaceCreate)
 #define MatNullSpaceDestroy (*pm_petsc_api.MatNullSpaceDestroy)
-#define MatPartitioningApply (*pm_petsc_api.MatPartitioningApply)
-#define MatPartitioningCreate (*pm_petsc_api.MatPartitioningCreate)
-#define MatPartitioningDestroy (*pm_petsc_api.MatPartitioningDestroy)
-#define MatPartitioningSetAdjacency (*pm_petsc_api.MatPartitioningSetAdjacency)
-#define MatPartitioningSetFromOptions                                          \
-  (*pm_petsc_api.MatPartitioningSetFromOptions)
-#define MatPartitioningSetNParts (*pm_petsc_api.MatPartitioningSetNParts)
-#define MatPartitioningSetType (*pm_petsc_api.MatPartitioningSetType)
-#define MatPartitioningSetVertexWeights                                        \
-  (*pm_petsc_api.MatPartitioningSetVertexWeights)
 #define MatPreallocatorPreallocate (*pm_petsc_api.MatPreallocatorPreallocate)
 #define MatRestoreRowIJ (*pm_petsc_api.MatRestoreRowIJ)
 #define MatSeqAIJGetArrayRead (*pm_petsc_api.MatSeqAIJGetArrayRead)
@@ -280,14 +245,6 @@ pm_err pm_petsc_api_load(const char *need);
 #define PetscOptionsPush (*pm_petsc_api.PetscOptionsPush)
 #define PetscPopSignalHandler (*pm_petsc_api.PetscPopSignalHandler)
 #define PetscPushErrorHandler (*pm_petsc_api.PetscPushErrorHandler)
-#define PetscSFBcastBegin (*pm_petsc_api.PetscSFBcastBegin)
-#define PetscSFBcastEnd (*pm_petsc_api.PetscSFBcastEnd)
-#define PetscSFCreate (*pm_petsc_api.PetscSFCreate)
-#define PetscSFDestroy (*pm_petsc_api.PetscSFDestroy)
-#define PetscSFReduceBegin (*pm_petsc_api.PetscSFReduceBegin)
-#define PetscSFReduceEnd (*pm_petsc_api.PetscSFReduceEnd)
-#define PetscSFSetGraph (*pm_petsc_api.PetscSFSetGraph)
-#define PetscSFSetUp (*pm_petsc_api.PetscSFSetUp)
 #define PetscTrFree (*pm_petsc_api.PetscTrFree)
 #define SNESConvergedReasons (*pm_petsc_api.SNESConvergedReasons)
 #define SNESCreate (*pm_petsc_api.SNESCreate)

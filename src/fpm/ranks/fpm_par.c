@@ -1,17 +1,17 @@
 /* fpm_par: the shares of a run across ranks, the ghosts' displacements on
- * a star forest, the step's sums and failures, and the gather to rank 0. */
+ * a neighbour exchange (pm_halo), the step's sums and failures, and the
+ * gather to rank 0. */
 #include "fpm_par.h"
 
 #include <mpi.h>
-#include <petscsf.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fpm_region.h"
+#include "pm_halo.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
-#include "pm_petsc.h"
 #include "pm_progress.h"
 
 struct fpm_par {
@@ -21,11 +21,10 @@ struct fpm_par {
   fpm_share_counts *counts; /* every rank's share, on rank 0 */
   /* the ghosts' displacements: each ghost (a leaf) is a point its owner
    * holds among its own (a root) */
-  PetscSF ghosts;
+  pm_halo *ghosts;
   /* the gather: each own point (a leaf) is a point of rank 0's whole
    * arrays (a root; none on the other ranks) */
-  PetscSF to_root;
-  MPI_Datatype three, nine;
+  pm_halo *to_root;
   double none[9]; /* the roots of the gather on the other ranks */
   long n_ghost;   /* the share's ghost points */
   fpm_par_costs costs;
@@ -34,10 +33,8 @@ struct fpm_par {
 static void par_destroy(void *ctx) {
   struct fpm_par *P = ctx;
   if (!P) return;
-  if (P->ghosts) PetscSFDestroy(&P->ghosts);
-  if (P->to_root) PetscSFDestroy(&P->to_root);
-  if (P->three) MPI_Type_free(&P->three);
-  if (P->nine) MPI_Type_free(&P->nine);
+  pm_halo_destroy(P->ghosts);
+  pm_halo_destroy(P->to_root);
   free(P->owner);
   free(P->counts);
   free(P);
@@ -67,47 +64,43 @@ static long root_of(const roots *r, long g) {
   return lo;
 }
 
-/* The star forests: ghosts to their owners' own points (each rank's own
+/* The exchanges: ghosts to their owners' own points (each rank's own
  * points are in one-process order, so an owner's index of a point is the
  * count of its points before it), own points to rank 0's whole arrays. */
-static pm_err make_forests(struct fpm_par *P, long n_whole, const fpm_model *s,
-                           const roots *from) {
+static pm_err make_exchanges(struct fpm_par *P, const fpm_model *s,
+                             const roots *from) {
   pm_err ret = PM_SUCCESS;
   const long n_ghost = s->n - s->n_own;
-  PetscInt *leaf = NULL;
-  PetscSFNode *root = NULL;
-  PM_TRY(PM_ALLOC(leaf, n_ghost + 1, "ghost points"));
-  PM_TRY(PM_ALLOC(root, (n_ghost > s->n_own ? n_ghost : s->n_own) + 1,
-                  "ghost points' owners"));
+  const long most = (n_ghost > s->n_own ? n_ghost : s->n_own) + 1;
+  long *leaf = NULL, *index = NULL;
+  int *rank = NULL;
+  PM_TRY(PM_ALLOC(leaf, most, "ghost points"));
+  PM_TRY(PM_ALLOC(rank, most, "ghost points' owners"));
+  PM_TRY(PM_ALLOC(index, most, "ghost points' owners"));
   for (long k = 0; k < n_ghost; k++) {
     const long at = root_of(from, s->gid[s->n_own + k]);
     PM_ENSURE(!from->gid || from->gid[at] == s->gid[s->n_own + k],
               PM_ERR_INTERNAL, "ghost point %ld is not in its rank's part",
               s->gid[s->n_own + k]);
-    leaf[k] = (PetscInt)(s->n_own + k);
-    root[k].rank = from->owner[at];
-    root[k].index = (PetscInt)from->index[at];
+    leaf[k] = s->n_own + k;
+    rank[k] = from->owner[at];
+    index[k] = from->index[at];
   }
-  PM_PETSC(PetscSFCreate(PETSC_COMM_WORLD, &P->ghosts));
-  PM_PETSC(PetscSFSetGraph(P->ghosts, (PetscInt)s->n_own, (PetscInt)n_ghost,
-                           leaf, PETSC_COPY_VALUES, root, PETSC_COPY_VALUES));
-  PM_PETSC(PetscSFSetUp(P->ghosts));
+  /* A point's displacement, or its averaged pressure. */
+  PM_TRY(pm_halo_create(pm_par_comm(), n_ghost, leaf, rank, index,
+                        3 * (int)sizeof(double), &P->ghosts));
   for (long k = 0; k < s->n_own; k++) {
-    root[k].rank = 0;
-    root[k].index = (PetscInt)s->gid[k];
+    leaf[k] = k;
+    rank[k] = 0;
+    index[k] = s->gid[k];
   }
-  PM_PETSC(PetscSFCreate(PETSC_COMM_WORLD, &P->to_root));
-  PM_PETSC(PetscSFSetGraph(P->to_root, P->rank == 0 ? (PetscInt)n_whole : 0,
-                           (PetscInt)s->n_own, NULL, PETSC_COPY_VALUES, root,
-                           PETSC_COPY_VALUES));
-  PM_PETSC(PetscSFSetUp(P->to_root));
-  MPI_Type_contiguous(3, MPI_DOUBLE, &P->three);
-  MPI_Type_commit(&P->three);
-  MPI_Type_contiguous(9, MPI_DOUBLE, &P->nine);
-  MPI_Type_commit(&P->nine);
+  /* The gather's widest array: a point's tensor. */
+  PM_TRY(pm_halo_create(pm_par_comm(), s->n_own, leaf, rank, index,
+                        9 * (int)sizeof(double), &P->to_root));
 done:
   free(leaf);
-  free(root);
+  free(rank);
+  free(index);
   return ret;
 }
 
@@ -130,16 +123,16 @@ static pm_err count_shares(struct fpm_par *P, long n_whole,
 /* The exchange's operations (fpm_exchange.h) on a share's ranks.  The
  * bytes count every ghost value received; `exchanges` counts the
  * displacements' (one a step), so that their ratio is the bytes a step. */
-/* Broadcast the owners' values of width doubles a point (MPI type unit)
- * to the ghosts, counting the bytes and the time. */
-static void bcast_ghosts(struct fpm_par *P, MPI_Datatype unit, int width,
-                         double *v) {
+/* Broadcast the owners' values of width doubles a point to the ghosts,
+ * counting the bytes and the time. */
+static void bcast_ghosts(struct fpm_par *P, int width, double *v) {
   const double t0 = pm_wtime();
-  /* Nothing to report: a star forest set up once fails only on MPI's own
+  /* Nothing to report: an exchange set up once fails only on MPI's own
    * failures, which stop every rank (MPI_ERRORS_ARE_FATAL). */
-  PetscSFBcastBegin(P->ghosts, unit, v, v, MPI_REPLACE);
-  PetscSFBcastEnd(P->ghosts, unit, v, v, MPI_REPLACE);
-  const double bytes = width * sizeof(double) * (double)P->n_ghost;
+  void *a = v;
+  const int item = width * (int)sizeof(double);
+  pm_halo_bcast(P->ghosts, 1, &a, &a, &item);
+  const double bytes = item * (double)P->n_ghost;
   P->costs.ghost_bytes += bytes;
   pm_par_count_sent(bytes);
   P->costs.exchange_seconds += pm_wtime() - t0;
@@ -147,12 +140,12 @@ static void bcast_ghosts(struct fpm_par *P, MPI_Datatype unit, int width,
 
 static void exchange_ghosts(void *ctx, double *u) {
   struct fpm_par *P = ctx;
-  bcast_ghosts(P, P->three, 3, u);
+  bcast_ghosts(P, 3, u);
   P->costs.exchanges++;
 }
 
 static void exchange_ghost_scalars(void *ctx, double *v) {
-  bcast_ghosts(ctx, MPI_DOUBLE, 1, v);
+  bcast_ghosts(ctx, 1, v);
 }
 
 static pm_err agree(void *ctx, pm_err e, long key) {
@@ -302,7 +295,6 @@ pm_err fpm_par_create(const pm_scene *sc, gm_mesh **mesh, gm_dual **cells,
   PM_TRY(pm_par_agree(PM_ALLOC(P, 1, "FPM ranks")));
   P->rank = pm_par_rank();
   P->size = pm_par_size();
-  PM_TRY(pm_par_agree(pm_petsc_init()));
   pm_par_bcast(&n, sizeof n);
   PM_TRY(share_names(mesh));
   /* Rank 0 partitions the points and cuts every part. */
@@ -323,7 +315,7 @@ pm_err fpm_par_create(const pm_scene *sc, gm_mesh **mesh, gm_dual **cells,
   PM_TRY(pm_par_agree(whole
                           ? fpm_share_create(whole, P->owner, P->rank, &s)
                           : fpm_part_share(sc, o, *mesh, &part, P->rank, &s)));
-  PM_TRY(pm_par_agree(make_forests(P, n, s, &from)));
+  PM_TRY(pm_par_agree(make_exchanges(P, s, &from)));
   PM_TRY(pm_par_agree(count_shares(P, n, s)));
   P->n_ghost = s->n - s->n_own;
   P->xc = (fpm_exchange){.ctx = P,
@@ -380,14 +372,12 @@ pm_err fpm_par_gather(const fpm_model *m, const fpm_state *st,
     copy_carried(whole, st);
     whole->penalty_energy = st->penalty_energy;
   }
-  const MPI_Datatype unit[7] = {P->three, P->three,   P->three,  P->nine,
-                                P->nine,  MPI_DOUBLE, MPI_DOUBLE};
-  for (int k = 0; k < 7; k++)
-    PM_PETSC_CALL(
-        PetscSFReduceBegin(P->to_root, unit[k], from[k], to[k], MPI_REPLACE));
-  for (int k = 0; k < 7; k++)
-    PM_PETSC_CALL(
-        PetscSFReduceEnd(P->to_root, unit[k], from[k], to[k], MPI_REPLACE));
+  const int bytes[7] = {3, 3, 3, 9, 9, 1, 1};
+  for (int k = 0; k < 7; k++) {
+    void *leaf = (void *)from[k], *root = to[k];
+    const int b = bytes[k] * (int)sizeof(double);
+    pm_halo_reduce(P->to_root, 1, &root, &leaf, &b, PM_HALO_REPLACE);
+  }
   pm_par_count_sent(29.0 * sizeof(double) * (double)m->n_own);
   P->costs.gather_seconds += pm_wtime() - t0;
   return PM_SUCCESS;
@@ -398,9 +388,9 @@ pm_err fpm_par_gather_points(const fpm_model *m, const double *local,
   struct fpm_par *P = m->xc->ctx;
   const double t0 = pm_wtime();
   double *to = whole ? whole : P->none;
-  PM_PETSC_CALL(
-      PetscSFReduceBegin(P->to_root, P->three, local, to, MPI_REPLACE));
-  PM_PETSC_CALL(PetscSFReduceEnd(P->to_root, P->three, local, to, MPI_REPLACE));
+  void *leaf = (void *)local, *root = to;
+  const int bytes = 3 * sizeof(double);
+  pm_halo_reduce(P->to_root, 1, &root, &leaf, &bytes, PM_HALO_REPLACE);
   pm_par_count_sent(3.0 * sizeof(double) * (double)m->n_own);
   P->costs.gather_seconds += pm_wtime() - t0;
   return PM_SUCCESS;

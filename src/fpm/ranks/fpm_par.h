@@ -5,9 +5,9 @@
  * operations in the same order.  A step on a rank is the step of one
  * process on its share, with:
  *  - one exchange: once the rank's own displacements are updated and the
- *    supports moved, the ghosts' displacements come from their owners (a
- *    PETSc star forest whose leaves are the ghosts and whose roots their
- *    owners' points); with fpm.volumetric: averaged a second, inside the
+ *    supports moved, the ghosts' displacements come from their owners
+ *    (pm_halo, whose leaves are the ghosts and whose roots their owners'
+ *    points); with fpm.volumetric: averaged a second, inside the
  *    force, of one double a ghost: the averaged pressure U'(Jbar) of the
  *    owners' points (fpm_volumetric.h);
  *  - sums over the own points (energies, the residual, the supports' work,
@@ -21,7 +21,7 @@
  * Only rank 0 meshes the domain and builds its cells, and no rank builds
  * the whole model but where it keeps it (pm_view.h); rank 0
  * keeps the whole model and gathers the state into it where the run
- * writes (another star forest, its own points to rank 0's whole arrays):
+ * writes (another pm_halo, its own points to rank 0's whole arrays):
  * frames, history and checkpoints are those of one process.  The
  * functions below take a share (m->xc set by fpm_par_create); only
  * fpm_par_get_costs also takes a model on one process (all zero). */

@@ -1,63 +1,28 @@
-/* fpm_share: the partition of the points (MatPartitioning) and the choice
- * of a rank's share of an FPM model, its own points and ghosts in pass
- * order (the model of them is fpm_model_subset's). */
+/* fpm_share: the partition of the points (Scotch) and the choice of a
+ * rank's share of an FPM model, its own points and ghosts in pass order
+ * (the model of them is fpm_model_subset's). */
 #include "fpm_share.h"
 
-#include <petscmat.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "pm_petsc.h"
+#include "fpm_scotch.h"
 
 /* ---- partition ------------------------------------------------------------
  */
 
 pm_err fpm_partition(const gm_dual *d, int parts, int *owner) {
   pm_err ret = PM_SUCCESS;
-  const long n = d->n_points, nnz = d->nbr_ptr[n];
-  Mat adj = NULL;
-  MatPartitioning part = NULL;
-  IS is = NULL;
-  PetscInt *ia = NULL, *ja = NULL, *w = NULL;
+  const long n = d->n_points;
+  long *w = NULL;
   memset(owner, 0, sizeof(int) * (size_t)n);
   if (parts <= 1) return PM_SUCCESS;
-  PM_CALL(pm_petsc_init());
-  /* PT-Scotch's threads take turns in an order that varies from run to
-   * run, and so did its partitions (3 different ones in 6 runs of the
-   * same graph); on one thread it gives the same partition every time. */
-  setenv("SCOTCH_PTHREAD_NUMBER", "1", 1);
-  PM_PETSC(PetscMalloc1(n + 1, &ia));
-  PM_PETSC(PetscMalloc1(nnz + 1, &ja));
-  PM_PETSC(PetscMalloc1(n + 1, &w));
-  for (long i = 0; i <= n; i++) ia[i] = (PetscInt)d->nbr_ptr[i];
-  for (long e = 0; e < nnz; e++) ja[e] = (PetscInt)d->nbr[e];
-  for (long i = 0; i < n; i++)
-    w[i] = (PetscInt)(1 + d->nbr_ptr[i + 1] - d->nbr_ptr[i]);
-  /* The adjacency and the weights are PETSc's from here. */
-  PetscInt *a = ia, *b = ja;
-  ia = ja = NULL;
-  PM_PETSC(MatCreateMPIAdj(PETSC_COMM_SELF, (PetscInt)n, (PetscInt)n, a, b,
-                           NULL, &adj));
-  PM_PETSC(MatPartitioningCreate(PETSC_COMM_SELF, &part));
-  PM_PETSC(MatPartitioningSetAdjacency(part, adj));
-  PM_PETSC(MatPartitioningSetType(part, MATPARTITIONINGPTSCOTCH));
-  PM_PETSC(MatPartitioningSetNParts(part, (PetscInt)parts));
-  PetscInt *weights = w;
-  w = NULL;
-  PM_PETSC(MatPartitioningSetVertexWeights(part, weights));
-  PM_PETSC(MatPartitioningSetFromOptions(part));
-  PM_PETSC(MatPartitioningApply(part, &is));
-  const PetscInt *to;
-  PM_PETSC(ISGetIndices(is, &to));
-  for (long i = 0; i < n; i++) owner[i] = (int)to[i];
-  PM_PETSC(ISRestoreIndices(is, &to));
+  /* A point's work in the passes: its support's entries. */
+  PM_TRY(PM_ALLOC(w, n + 1, "partition weights"));
+  for (long i = 0; i < n; i++) w[i] = 1 + d->nbr_ptr[i + 1] - d->nbr_ptr[i];
+  PM_TRY(fpm_scotch_part(n, d->nbr_ptr, d->nbr, w, parts, owner));
 done:
-  ISDestroy(&is);
-  MatPartitioningDestroy(&part);
-  MatDestroy(&adj);
-  PetscFree(ia);
-  PetscFree(ja);
-  PetscFree(w);
+  free(w);
   return ret;
 }
 
@@ -158,8 +123,7 @@ void fpm_share_print(const fpm_model *m, const int *owner, int parts,
     ghosts += g;
   }
   fprintf(out,
-          "ranks        %d: points by PT-Scotch on the support graph "
-          "(MatPartitioning), %s\n"
+          "ranks        %d: points by Scotch on the support graph, %s\n"
           "             %ld support pairs cut of %ld; points per rank %ld at "
           "most (imbalance %.3f: the most over the mean)\n",
           parts,

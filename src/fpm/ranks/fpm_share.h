@@ -32,15 +32,15 @@
 #include "fpm_model.h"
 
 /* Partition the points of the cells d (of a whole model) among `parts`
- * ranks into owner (d->n_points ranks): PETSc's MatPartitioning
- * (PT-Scotch) on the support graph, each point weighted by its support's
+ * ranks into owner (d->n_points ranks): Scotch (fpm_scotch.h) on the
+ * support graph, each point weighted by its support's
  * entries (its work in the passes; the graph alone, so that a rank makes
  * the partition before any operator, fpm_region.h).
  * On one process and one thread of the partitioner, so that the partition
  * is the same wherever it is made (plan --ranks N on one process predicts
  * the run of N ranks, and a resumed run has the partition of the run it
- * continues).  parts 1: every point on rank 0, without PETSc.
- * PM_ERR_LINALG naming PETSc's failure. */
+ * continues).  parts 1: every point on rank 0, without Scotch.
+ * Scotch's failures as fpm_scotch_part's. */
 pm_err fpm_partition(const gm_dual *d, int parts, int *owner);
 
 /* Rank r's share of model m (held whole) under partition owner: its

@@ -8,7 +8,6 @@
 #include "mpm_seed.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
-#include "pm_petsc.h"
 
 static void fill_exchange(struct mpm_par *P);
 static pm_err share_links(pm_qs_method qs, const mpm_grid *whole, bool gather,
@@ -92,10 +91,11 @@ static pm_err make_ghosts(struct mpm_par *P, const mpm_grid *full,
   pm_err ret = PM_SUCCESS;
   const mpm_decomp *d = &P->d;
   const long n_ghost = g->n_nodes - P->n_owned;
-  PetscInt *leaf = NULL;
-  PetscSFNode *root = NULL;
+  long *leaf = NULL, *at = NULL;
+  int *owner = NULL;
   PM_TRY(PM_ALLOC(leaf, n_ghost + 1, "ghost nodes"));
-  PM_TRY(PM_ALLOC(root, n_ghost + 1, "ghost nodes' owners"));
+  PM_TRY(PM_ALLOC(owner, n_ghost + 1, "ghost nodes' owners"));
+  PM_TRY(PM_ALLOC(at, n_ghost + 1, "ghost nodes' owners"));
   long k = 0;
   for (long i = 0; i < g->n_nodes; i++) {
     if (P->owned[i]) continue;
@@ -103,30 +103,24 @@ static pm_err make_ghosts(struct mpm_par *P, const mpm_grid *full,
                        (i / g->nn[0]) % g->nn[1] + g->offset[1],
                        i / (g->nn[0] * g->nn[1]) + g->offset[2]};
     const int r = mpm_decomp_rank_of(d, q);
-    long lo[3], hi[3], at = 0, step = 1;
+    long lo[3], hi[3], step = 1;
     mpm_decomp_held(d, r, full, lo, hi);
+    at[k] = 0;
     for (int a = 0; a < 3; a++) {
-      at += (q[a] - lo[a]) * step;
+      at[k] += (q[a] - lo[a]) * step;
       step *= hi[a] - lo[a];
     }
-    leaf[k] = (PetscInt)i;
-    root[k].rank = r;
-    root[k].index = (PetscInt)at;
+    leaf[k] = i;
+    owner[k] = r;
     k++;
   }
-  PM_PETSC(PetscSFCreate(PETSC_COMM_WORLD, &P->ghosts));
-  PM_PETSC(PetscSFSetGraph(P->ghosts, (PetscInt)g->n_nodes, (PetscInt)k, leaf,
-                           PETSC_OWN_POINTER, root, PETSC_OWN_POINTER));
-  leaf = NULL;
-  root = NULL;
-  PM_PETSC(PetscSFSetUp(P->ghosts));
-  MPI_Type_contiguous(2, MPI_DOUBLE, &P->two);
-  MPI_Type_commit(&P->two);
-  MPI_Type_contiguous(3, MPI_DOUBLE, &P->three);
-  MPI_Type_commit(&P->three);
+  /* A node's mass, momentum, force and impedances at most at once. */
+  PM_TRY(pm_halo_create(pm_par_comm(), k, leaf, owner, at,
+                        9 * (int)sizeof(double), &P->ghosts));
 done:
   free(leaf);
-  free(root);
+  free(owner);
+  free(at);
   return ret;
 }
 
@@ -304,8 +298,7 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   *local_state_out = NULL;
   /* Every rank decomposes alike; a failure of one (memory) stops all
    * before the collectives that follow. */
-  ret = pm_petsc_init();
-  if (!ret) ret = PM_ALLOC(P, 1, "run across ranks");
+  ret = PM_ALLOC(P, 1, "run across ranks");
   if (!ret) ret = mpm_decomp_create(s, m, size, &P->d);
   PM_TRY(pm_par_agree(ret));
   P->rank = pm_par_rank();
@@ -413,8 +406,7 @@ pm_err mpm_par_create_seeded(const pm_scene *s, bool gather, mpm_model **local,
   mpm_seed_share sh = {.room = mpm_par_room_for};
   *local = NULL;
   *local_state_out = NULL;
-  ret = pm_petsc_init();
-  if (!ret) ret = mpm_model_frame(s, &frame);
+  ret = mpm_model_frame(s, &frame);
   if (!ret) ret = PM_ALLOC(P, 1, "run across ranks");
   if (!ret) ret = decompose(s, frame, &P->d);
   PM_TRY(pm_par_agree(ret));
@@ -461,11 +453,7 @@ done:
 
 static void par_free(struct mpm_par *P) {
   if (!P) return;
-  if (P->ghosts) {
-    PetscSFDestroy(&P->ghosts);
-    MPI_Type_free(&P->two);
-    MPI_Type_free(&P->three);
-  }
+  pm_halo_destroy(P->ghosts);
   free(P->nodal);
   free(P->extreme);
   free(P->whole);

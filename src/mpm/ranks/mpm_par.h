@@ -7,9 +7,9 @@
  * nodes, with three additions:
  *  - after every particle-to-grid transfer the ranks' contributions to a
  *    node are summed on its owner and the sums sent back to every rank
- *    that holds the node as a ghost (a PETSc star forest whose leaves are
- *    the ghost nodes and whose roots are their owners' nodes: reduce with
- *    MPI_SUM, then broadcast), so that each rank holds whole nodal sums on all
+ *    that holds the node as a ghost (pm_halo, whose leaves are the ghost
+ *    nodes and whose roots are their owners' nodes: reduce by sum, then
+ *    broadcast), so that each rank holds whole nodal sums on all
  * its nodes and updates its ghost nodes as their owner does: the grid's
  *    velocities need no second exchange;
  *  - sums over nodes (reactions, residual, damping, energies) count owned
@@ -42,7 +42,8 @@
  * sphere are shared as well as particles filling the box).  It leaves
  * uncut an axis along which a boundary wall moves (a face condition's
  * column is walked from the grid's edge to the wall) and keeps cuts clear
- * of face planes.  The node sums run on a PetscSF of the ghost nodes. */
+ * of face planes.  The node sums run on the ghost nodes' exchange
+ * (pm_halo: MPI alone). */
 #ifndef MPM_PAR_H
 #define MPM_PAR_H
 

@@ -9,7 +9,6 @@
 #include "mpm_par_impl.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
-#include "pm_petsc.h"
 #include "pm_progress.h"
 #include "pm_rigid.h"
 

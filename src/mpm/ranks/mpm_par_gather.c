@@ -10,7 +10,6 @@
 #include "pm_omp.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
-#include "pm_petsc.h"
 #include "pm_progress.h"
 
 /* ---- gather to rank 0 -------------------------------------------------------

@@ -5,12 +5,10 @@
 #define MPM_PAR_IMPL_H
 
 #include <mpi.h>
-#include <petscsf.h>
-
-#include "pm_petsc_api.h"
 
 #include "mpm_par.h"
 #include "mpm_par_ghosts.h"
+#include "pm_halo.h"
 
 /* A particle's record in a migration: its index on one process, its group,
  * x0 (3), mass, vol0, x (3), v (3), vol, sigma (9), then its group's
@@ -36,8 +34,7 @@ struct mpm_par {
   /* the node sums: each ghost node (a leaf) is a node of its owner (a
    * root); the sums go leaves to roots and back, on the ghost nodes and
    * the owned nodes next to other ranks only */
-  PetscSF ghosts;
-  MPI_Datatype two, three; /* a node's impedances, a node's vector */
+  pm_halo *ghosts;
   /* dynamic relaxation's nodal arrays to rank 0: a rank's owned nodes'
    * values, and on rank 0 every rank's */
   double *nodal, *whole;

@@ -1,5 +1,6 @@
 /* mpm_par_nodes: nodal arrays across ranks: the node sums after a
- * transfer on a PETSc star forest, typed reduces and broadcasts, the
+ * transfer on the ghost nodes' exchange (pm_halo), typed reduces and
+ * broadcasts, the
  * implicit solver's unknowns numbered over the ranks, a step's figures. */
 #include <math.h>
 #include <stdlib.h>
@@ -11,7 +12,6 @@
 #include "mpm_transfer.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
-#include "pm_petsc.h"
 #include "pm_progress.h"
 
 /* ---- node sums -------------------------------------------------------------
@@ -21,107 +21,78 @@ pm_err mpm_par_sum_nodes(const mpm_model *m, mpm_nodes *nd, int mode,
                          bool imp) {
   struct mpm_par *P = par_of(m);
   const double t0 = pm_wtime();
-  PetscSF sf = P->ghosts;
-  /* The arrays a transfer of `mode` filled, and their values per node. */
-  double *data[4];
-  MPI_Datatype unit[4];
+  /* The arrays a transfer of `mode` filled, and their bytes per node. */
+  void *data[4];
+  int bytes[4];
   int n = 0, values = 0;
   if (mode & MPM_P2G_MASS) {
     data[n] = nd->mass;
-    unit[n++] = MPI_DOUBLE;
-    values += 1;
+    bytes[n++] = sizeof(double);
   }
   if (mode & MPM_P2G_MOM) {
     data[n] = nd->mom;
-    unit[n++] = P->three;
-    values += 3;
+    bytes[n++] = 3 * sizeof(double);
   }
   if (mode & MPM_P2G_FORCE) {
     data[n] = nd->force;
-    unit[n++] = P->three;
-    values += 3;
+    bytes[n++] = 3 * sizeof(double);
     if (imp) {
       data[n] = nd->impedance;
-      unit[n++] = P->two;
-      values += 2;
+      bytes[n++] = 2 * sizeof(double);
     }
   }
+  for (int k = 0; k < n; k++) values += bytes[k] / (int)sizeof(double);
   /* Ghosts' contributions added on their owners, then the sums back. */
-  for (int k = 0; k < n; k++)
-    PM_PETSC_CALL(PetscSFReduceBegin(sf, unit[k], data[k], data[k], MPI_SUM));
-  for (int k = 0; k < n; k++)
-    PM_PETSC_CALL(PetscSFReduceEnd(sf, unit[k], data[k], data[k], MPI_SUM));
-  for (int k = 0; k < n; k++)
-    PM_PETSC_CALL(
-        PetscSFBcastBegin(sf, unit[k], data[k], data[k], MPI_REPLACE));
-  for (int k = 0; k < n; k++)
-    PM_PETSC_CALL(PetscSFBcastEnd(sf, unit[k], data[k], data[k], MPI_REPLACE));
+  pm_halo_reduce(P->ghosts, n, data, data, bytes, PM_HALO_SUM_DOUBLE);
+  pm_halo_bcast(P->ghosts, n, data, data, bytes);
   /* Each ghost node's values go to its owner and come back. */
-  const double bytes =
+  const double sent =
       2.0 * (double)(m->grid.n_nodes - P->n_owned) * values * sizeof(double);
-  P->counts.halo_bytes += bytes;
-  pm_par_count_sent(bytes);
+  P->counts.halo_bytes += sent;
+  pm_par_count_sent(sent);
   P->counts.halo_seconds += pm_wtime() - t0;
   return PM_SUCCESS;
 }
 
-/* One pass of a nodal array's ghost values (`unit` per node) between the
+/* One pass of a nodal array's ghost values (`bytes` per node) between the
  * ranks, counted. */
-static void count_ghosts(const mpm_model *m, MPI_Datatype unit) {
-  int size = 0;
-  MPI_Type_size(unit, &size);
-  const double bytes = (double)(m->grid.n_nodes - par_of(m)->n_owned) * size;
-  par_of(m)->counts.halo_bytes += bytes;
-  pm_par_count_sent(bytes);
+static void count_ghosts(const mpm_model *m, int bytes) {
+  const double sent = (double)(m->grid.n_nodes - par_of(m)->n_owned) * bytes;
+  par_of(m)->counts.halo_bytes += sent;
+  pm_par_count_sent(sent);
 }
 
-static pm_err bcast_nodes(const mpm_model *m, void *a, MPI_Datatype unit) {
-  PetscSF sf = par_of(m)->ghosts;
-  count_ghosts(m, unit);
-  PM_PETSC_CALL(PetscSFBcastBegin(sf, unit, a, a, MPI_REPLACE));
-  PM_PETSC_CALL(PetscSFBcastEnd(sf, unit, a, a, MPI_REPLACE));
-  return PM_SUCCESS;
-}
-
-static pm_err reduce_nodes(const mpm_model *m, void *a, MPI_Datatype unit,
-                           MPI_Op op) {
-  PetscSF sf = par_of(m)->ghosts;
-  const double t0 = pm_wtime();
-  count_ghosts(m, unit);
-  PM_PETSC_CALL(PetscSFReduceBegin(sf, unit, a, a, op));
-  PM_PETSC_CALL(PetscSFReduceEnd(sf, unit, a, a, op));
-  pm_err e = bcast_nodes(m, a, unit);
-  par_of(m)->counts.halo_seconds += pm_wtime() - t0;
-  return e;
-}
-
-/* The MPI type of a node's unit; *made when it was made here (to free). */
-static MPI_Datatype unit_type(mpm_xc_unit u, bool *made) {
-  *made = false;
-  if (u == MPM_XC_DOUBLE) return MPI_DOUBLE;
-  if (u == MPM_XC_BYTE) return MPI_UNSIGNED_CHAR;
-  MPI_Datatype t;
-  MPI_Type_contiguous(3, u == MPM_XC_LONG3 ? MPI_LONG : MPI_DOUBLE, &t);
-  MPI_Type_commit(&t);
-  *made = true;
-  return t;
+/* The bytes of a node's unit. */
+static int unit_bytes(mpm_xc_unit u) {
+  if (u == MPM_XC_DOUBLE) return sizeof(double);
+  if (u == MPM_XC_BYTE) return 1;
+  return 3 * (u == MPM_XC_LONG3 ? sizeof(long) : sizeof(double));
 }
 
 pm_err mpm_par_nodes_reduce(const mpm_model *m, void *a, mpm_xc_unit unit,
                             mpm_xc_op op) {
-  bool made;
-  MPI_Datatype t = unit_type(unit, &made);
-  pm_err e = reduce_nodes(m, a, t, op == MPM_XC_MAX ? MPI_MAX : MPI_SUM);
-  if (made) MPI_Type_free(&t);
-  return e;
+  const double t0 = pm_wtime();
+  const int bytes = unit_bytes(unit);
+  PM_CHECK(unit != MPM_XC_LONG3, PM_ERR_INTERNAL,
+           "a node sum of dof numbers across ranks");
+  const pm_halo_op how = op == MPM_XC_SUM      ? PM_HALO_SUM_DOUBLE
+                         : unit == MPM_XC_BYTE ? PM_HALO_MAX_BYTE
+                                               : PM_HALO_MAX_DOUBLE;
+  PM_CHECK(unit != MPM_XC_BYTE || op == MPM_XC_MAX, PM_ERR_INTERNAL,
+           "a node sum of flags across ranks");
+  count_ghosts(m, bytes);
+  pm_halo_reduce(par_of(m)->ghosts, 1, &a, &a, &bytes, how);
+  count_ghosts(m, bytes);
+  pm_halo_bcast(par_of(m)->ghosts, 1, &a, &a, &bytes);
+  par_of(m)->counts.halo_seconds += pm_wtime() - t0;
+  return PM_SUCCESS;
 }
 
 pm_err mpm_par_nodes_bcast(const mpm_model *m, void *a, mpm_xc_unit unit) {
-  bool made;
-  MPI_Datatype t = unit_type(unit, &made);
-  pm_err e = bcast_nodes(m, a, t);
-  if (made) MPI_Type_free(&t);
-  return e;
+  const int bytes = unit_bytes(unit);
+  count_ghosts(m, bytes);
+  pm_halo_bcast(par_of(m)->ghosts, 1, &a, &a, &bytes);
+  return PM_SUCCESS;
 }
 
 const unsigned char *mpm_par_owned(const mpm_model *m) {

@@ -10,7 +10,6 @@
 #include "mpm_transfer.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
-#include "pm_petsc.h"
 #include "pm_progress.h"
 
 /* ---- plan and counts -------------------------------------------------------
