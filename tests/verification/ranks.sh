@@ -163,7 +163,7 @@ roundoff "interrupted on 2 ranks, resumed on 3" "$work/long-2" "$work/cut-3"
 roundoff "interrupted on 2 ranks, resumed on 1" "$work/long-1" "$work/cut-1"
 # The same with frames in pieces, resumed on 3 ranks: the frames after
 # the checkpoint (the signal's) and their pieces dropped, the later ones
-# in 3 pieces.  (Checkpoints named, so rank 0 keeps the whole model.)
+# in 3 pieces.  (The checkpoints too are in pieces: ranks-checkpoint.sh.)
 interrupt 2 "$work/pcut" "$tube" $long --set output.ranks=pieces \
   --set output.checkpoint.minutes=60
 resume_on "$work/pcut" 3
@@ -179,12 +179,13 @@ pieces = {m.group(1) for n in os.listdir(d)
 assert pieces == frames, sorted(pieces ^ frames)
 " "$work/pcut-3"
 
-# In pieces without checkpoints no rank holds the whole model: a signal
-# stops the run with its frames, and says that it wrote no checkpoint.
+# In pieces without output.checkpoint no rank holds the whole model: a
+# signal stops the run with its frames and a checkpoint in pieces, a
+# piece a rank.
 interrupt 2 "$work/pnone" "$tube" $long --set output.ranks=pieces
-check "in pieces, no checkpoints, interrupted: no checkpoint, said" \
-  grep -q 'no checkpoint: a run across ranks with frames in pieces' \
-  "$work/pnone/summary.json"
+check "in pieces, no output.checkpoint, interrupted: a checkpoint in pieces" \
+  test -f "$work/pnone/checkpoint.h5" -a \
+  "$(ls "$work/pnone/checkpoint.pieces" | grep -c '\.piece_')" -eq 2
 
 # A rank's memory below one process's need: refused before the setup on
 # one process with both figures; on 2 ranks in pieces, where no rank

@@ -41,7 +41,7 @@ pm_err pm_ckpt_create(const char *dir, pm_ckpt **out) {
   PM_CALL(pm_path_join(path, sizeof path, dir, "checkpoint.h5"));
   PM_CALL(pm_ckpt_create_at(path, out));
   (*out)->index = true;
-  snprintf((*out)->dir, sizeof (*out)->dir, "%s", dir);
+  snprintf((*out)->dir, sizeof(*out)->dir, "%s", dir);
   return PM_SUCCESS;
 }
 
@@ -72,7 +72,7 @@ pm_err pm_ckpt_open(const char *dir, pm_ckpt **out) {
            "scene, or stop runs with SIGINT or SIGTERM, to have one",
            dir, path);
   PM_CALL(pm_ckpt_open_at(path, out));
-  snprintf((*out)->dir, sizeof (*out)->dir, "%s", dir);
+  snprintf((*out)->dir, sizeof(*out)->dir, "%s", dir);
   return PM_SUCCESS;
 }
 

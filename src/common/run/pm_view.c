@@ -64,8 +64,8 @@ static pm_err checkpoint_round(pm_view *v, long id) {
   memset(counts, 0, 2 * sizeof *counts * (size_t)n);
   memset(values, 0, PM_VIEW_CKPT_VALUES * sizeof *values * (size_t)n);
   unsigned long long sum = 0;
-  PM_CALL(pm_par_agree(v->ckpt_piece(v->ctx, v->dir, id, &counts[2 * me],
-                                     &sum, values + PM_VIEW_CKPT_VALUES * me)));
+  PM_CALL(pm_par_agree(v->ckpt_piece(v->ctx, v->dir, id, &counts[2 * me], &sum,
+                                     values + PM_VIEW_CKPT_VALUES * me)));
   /* (a rank's row is its own: the sums add zeros to it) */
   counts[2 * me + 1] = (long)sum;
   pm_par_sum_long(counts, 2 * n);
@@ -81,7 +81,7 @@ static void serve(pm_view *v) {
     pm_par_bcast(cmd, sizeof cmd);
     if (!cmd[0]) return;
     pm_error_clear();
-    if (cmd[0] == 1) /* (2: rank 0 could not start it) */
+    if (cmd[0] == 1)                     /* (2: rank 0 could not start it) */
       (void)checkpoint_round(v, cmd[1]); /* (rank 0 reports a failure) */
   }
 }

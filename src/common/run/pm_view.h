@@ -82,11 +82,13 @@ bool pm_view_keeps_whole(void);
 
 /* Whether a run of scene s across ranks needs the whole model on rank 0:
  * unless its frames go in pieces (output.ranks: pieces, a backend that
- * writes them) and nothing else reads the whole run: no checkpoints
- * (output.checkpoint), and a reference field only where the backend sums
- * its errors over the shares (pm_backend.errors).  Without it the history rows
- * and the end's figures come from reductions over the shares (pm_view.gather
- * then reduces), and a signal writes no checkpoint.  The same on every rank. */
+ * writes them) and nothing else reads the whole run: checkpoints
+ * (output.checkpoint) only where the backend writes them in pieces too
+ * (pm_backend.ckpt_pieces), and a reference field only where the backend
+ * sums its errors over the shares (pm_backend.errors).  Without it the
+ * history rows and the end's figures come from reductions over the shares
+ * (pm_view.gather then reduces), and checkpoints (a signal's too) are
+ * written in pieces.  The same on every rank. */
 bool pm_view_whole_needed(const pm_scene *s);
 
 /* pm_view_keeps_whole for scene s: rank 0 across ranks where

@@ -340,6 +340,7 @@ const pm_backend mpm_backend = {
     .checkpoint = checkpoint,
     .pieces = mpm_sim_pieces,
     .ckpt_pieces = mpm_sim_ckpt_pieces,
+    .pieces_apply = mpm_sim_pieces_apply,
     .errors = mpm_sim_errors,
 };
 

@@ -79,6 +79,9 @@ pm_err mpm_sim_run_items(mpm_sim *r, pm_ckpt *ck);
 /* pm_backend.ckpt_pieces: whether a run of s across ranks in pieces
  * checkpoints in pieces (not with dynamic relaxation's nodal arrays). */
 bool mpm_sim_ckpt_pieces(const pm_scene *s);
+/* pm_backend.pieces_apply: frames in pieces unless a body is a membrane
+ * or the run relaxes dynamically. */
+bool mpm_sim_pieces_apply(const pm_scene *s);
 /* pm_view.ckpt_piece: this rank's share as piece of checkpoint id. */
 pm_err mpm_sim_ckpt_piece(void *ctx, const char *dir, long id, long *count,
                           unsigned long long *sum, double *values);

@@ -27,6 +27,15 @@ bool mpm_sim_ckpt_pieces(const pm_scene *s) {
   return s->time.qs != PM_QS_DYNAMIC_RELAXATION;
 }
 
+bool mpm_sim_pieces_apply(const pm_scene *s) {
+  /* A membrane's triangles number its particles in one process's order;
+   * with dynamic relaxation a signal's checkpoint needs the whole grid's
+   * nodal arrays, which rank 0 keeps where frames are gathered. */
+  for (int b = 0; b < s->n_bodies; b++)
+    if (s->bodies[b].shape == PM_BODY_MEMBRANE) return false;
+  return mpm_sim_ckpt_pieces(s);
+}
+
 /* The common arrays of a state, as a piece names them. */
 static int common_arrays(mpm_state *s, const char **names, int *ncomp,
                          double **data) {
@@ -126,6 +135,10 @@ pm_err mpm_sim_ckpt_index(mpm_sim *r, pm_ckpt *ck) {
   const bool reading = pm_ckpt_reading(ck);
   long n = 0, id = 0;
   if (!reading) { /* rank 0: every rank's piece first */
+    PM_CHECK(mpm_sim_ckpt_pieces(r->scene), PM_ERR_ARG,
+             "dynamic relaxation across ranks with frames in pieces keeps "
+             "no whole model to checkpoint (set output.checkpoint, which "
+             "keeps it on rank 0, or output.ranks: gather)");
     id = r->local_state->step;
     n = pm_par_size();
     PM_CALL(pm_view_checkpoint_pieces(&r->view, id));
@@ -165,9 +178,8 @@ pm_err mpm_sim_ckpt_index(mpm_sim *r, pm_ckpt *ck) {
   PM_CALL(e);
   if (!reading) return PM_SUCCESS;
   for (int k = 0; k < n; k++)
-    PM_CHECK(cp->counts[2 * k] >= 0, PM_ERR_IO,
-             "%s: piece %d of %ld particles", pm_ckpt_path(ck), k,
-             cp->counts[2 * k]);
+    PM_CHECK(cp->counts[2 * k] >= 0, PM_ERR_IO, "%s: piece %d of %ld particles",
+             pm_ckpt_path(ck), k, cp->counts[2 * k]);
   /* Each rank's accounts, for a run resumed on as many ranks. */
   free(r->ckpt_accounts);
   r->ckpt_accounts = NULL;
@@ -204,9 +216,9 @@ bool mpm_sim_ckpt_is_pieces(const pm_ckpt *ck) {
 typedef struct {
   const mpm_model *m;
   mpm_state *s;
-  long n;     /* the piece's particles */
-  long *gid;  /* [n] */
-  long *at;   /* [n]: the particle's place in m, or -1 */
+  long n;    /* the piece's particles */
+  long *gid; /* [n] */
+  long *at;  /* [n]: the particle's place in m, or -1 */
   double *buf;
   long placed; /* particles placed, over the pieces */
   bool vetted; /* the pieces were vetted when picked */
@@ -415,9 +427,9 @@ static pm_err pick_prepare(void *ctx, const mpm_decomp *d, const mpm_grid *g,
   const mpm_ckpt_pieces *cp = ps->cp;
   PM_CALL(PM_ALLOC(ps->need, cp->n, "checkpoint pieces"));
   for (int k = 0; k < cp->n; k++) {
-    ps->need[k] = cp->counts[2 * k] > 0 &&
-                  meets(cp->values + PM_VIEW_CKPT_VALUES * k + REC_BOX, d, g,
-                        rank);
+    ps->need[k] =
+        cp->counts[2 * k] > 0 &&
+        meets(cp->values + PM_VIEW_CKPT_VALUES * k + REC_BOX, d, g, rank);
     if (ps->need[k]) PM_CALL(pick_piece(ps, k, d, g, rank));
   }
   uint64_t size = 16;

@@ -82,9 +82,10 @@ void mpm_view_init(mpm_sim *r, bool implicit) {
                       .gather = implicit ? mpm_view_implicit_gather : gather,
                       .release = release,
                       .piece = implicit ? NULL : mpm_sim_piece,
-                      .ckpt_piece = implicit || r->whole
-                                        ? NULL
-                                        : mpm_sim_ckpt_piece};
+                      .ckpt_piece =
+                          implicit || r->whole || !mpm_sim_ckpt_pieces(r->scene)
+                              ? NULL
+                              : mpm_sim_ckpt_piece};
 }
 
 pm_err mpm_view_report(mpm_sim *r, bool frame, bool last) {
