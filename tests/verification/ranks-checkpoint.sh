@@ -48,6 +48,14 @@ interrupt 3 "$work/cut3" "$disks" $slow
 resume_on "$work/cut3" 2
 roundoff "interrupted on 3 ranks, resumed on 2" "$work/whole-1" "$work/cut3-2"
 
+# One process's checkpoint (whole) resumed on 2 ranks, where no rank
+# keeps the whole model: each rank's share cut from it, then let go.
+# shellcheck disable=SC2086
+interrupt 1 "$work/cut1" "$disks" $slow
+resume_on "$work/cut1" 2
+roundoff "interrupted on one process, resumed on 2" "$work/whole-1" \
+  "$work/cut1-2"
+
 # A piece whose bytes changed: refused by name before the run goes on.
 cp -r "$work/cut" "$work/bad"
 piece=$(ls "$work/bad/checkpoint.pieces/"*.piece_0001.h5)

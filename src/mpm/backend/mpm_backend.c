@@ -107,6 +107,7 @@ void mpm_sim_destroy(mpm_sim *r) {
   free(r->ckpt_accounts);
   free(r->ckpt_pieces.counts);
   free(r->ckpt_pieces.values);
+  mpm_state_destroy(r->ckpt_scalars);
   free(r->imp_ranks);
   mpm_work_destroy(r->local_work);
   mpm_state_destroy(r->local_state);
@@ -201,8 +202,10 @@ static void conclude(mpm_sim *r, const mpm_model *m, pm_err e) {
 static pm_err run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
   pm_err e = PM_SUCCESS;
-  if (r->view.ranks && r->resumed) /* the shares of the checkpoint's state */
+  if (r->view.ranks && r->resumed) { /* the shares of the checkpoint's state */
     PM_CALL(r->ckpt_pieces.on ? mpm_view_reload(r) : mpm_view_reshare(r));
+    if (!r->whole) mpm_view_drop_whole(r);
+  }
   free(r->mesh_x0); /* (the results' mesh is written) */
   r->mesh_x0 = NULL;
   pm_view_start(&r->view, obs);
@@ -300,8 +303,11 @@ static pm_err checkpoint(void *p, pm_ckpt *ck) {
     return mpm_sim_ckpt_index(r, ck);
   /* A rank without the whole model reads a checkpoint of the whole run
    * into one, from which its share is cut anew (mpm_view_reshare). */
-  if (pm_ckpt_reading(ck) && !r->model)
+  if (pm_ckpt_reading(ck) && !r->model) {
+    r->ckpt_scalars = r->state; /* (rank 0 without the whole model's) */
+    r->state = NULL;
     PM_CALL(mpm_model_create(r->scene, &r->model, &r->state));
+  }
   PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
   PM_CALL(mpm_sim_run_items(r, ck));
   PM_CALL(ranks_checkpoint(r, ck));

@@ -78,6 +78,9 @@ typedef struct {
   int ckpt_ranks;
   double *ckpt_accounts;
   mpm_ckpt_pieces ckpt_pieces;
+  /* Rank 0 without the whole model reading a whole checkpoint: its state
+   * of the run's scalars, put back once the shares are cut. */
+  mpm_state *ckpt_scalars;
   struct mpm_implicit *imp;   /* method mpm-implicit: its solver (else NULL) */
   int imp_newton, imp_linear; /* the last load step's iterations */
   /* across ranks, at the end of an implicit run: per rank its particles,

@@ -51,6 +51,12 @@ void mpm_view_init(mpm_sim *r, bool implicit);
  * collective: rank 0 reports, the shares gathered into its view where the
  * observer reads them). */
 pm_err mpm_view_report(mpm_sim *r, bool frame, bool last);
+/* Let this rank's share (model, state, workspace) go, to make it anew. */
+void mpm_view_drop_share(mpm_sim *r);
+/* A run without the whole model resumed from a whole checkpoint, once its
+ * shares are cut: the whole model read for them goes, and rank 0's state
+ * of the run's scalars takes the checkpoint's values. */
+void mpm_view_drop_whole(mpm_sim *r);
 /* A resumed run across ranks: each rank's share anew from the whole state
  * read from the checkpoint (collective). */
 pm_err mpm_view_reshare(mpm_sim *r);

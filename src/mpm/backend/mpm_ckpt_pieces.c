@@ -224,17 +224,15 @@ typedef struct {
   bool vetted; /* the pieces were vetted when picked */
 } piece_reader;
 
+static int long_order(const void *a, const void *b) {
+  const long x = *(const long *)a, y = *(const long *)b;
+  return (x > y) - (x < y);
+}
+
 static long place_of(const mpm_model *m, long gid) {
   if (!m->gid) return gid >= 0 && gid < m->n ? gid : -1;
-  long lo = 0, hi = m->n;
-  while (lo < hi) {
-    const long mid = lo + (hi - lo) / 2;
-    if (m->gid[mid] < gid)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  return lo < m->n && m->gid[lo] == gid ? lo : -1;
+  const long *at = bsearch(&gid, m->gid, (size_t)m->n, sizeof gid, long_order);
+  return at ? (long)(at - m->gid) : -1;
 }
 
 /* Item name of nc values a particle into buf, then those of the particles
@@ -474,12 +472,9 @@ pm_err mpm_view_reload(mpm_sim *r) {
     ls->dissipated = row[MPM_PAR_ACCOUNTS - 1];
   }
   if (r->state) mpm_state_copy_values(r->state, &cp->vals);
-  mpm_work_destroy(r->local_work);
-  mpm_state_destroy(r->local_state);
-  mpm_model_destroy(r->local_model);
+  mpm_view_drop_share(r);
   r->local_model = lm;
   r->local_state = ls;
-  r->local_work = NULL;
   lm = NULL;
   ls = NULL;
   cp->on = false;

@@ -1,0 +1,54 @@
+#!/bin/bash
+# CPU seconds of a checkpoint of the block at about a million particles
+# (mesh_size 1.2e-3: 1 000 000) across RANKS ranks (default 2), gathered
+# into rank 0 (output.ranks: gather) against written in pieces (the
+# default): each way run for 6 steps with a checkpoint after steps 1 to 5
+# (output.checkpoint.every=1) and without one, REPEAT times (default 2);
+# every rank's user + system CPU seconds (/usr/bin/time), the least of the
+# repeats, their difference over 5 the CPU of a checkpoint.  One line per
+# way and rank: CPU s without and with the checkpoints, CPU s a
+# checkpoint, peak RSS (KiB) with them, and the checkpoint's bytes on disk.
+# usage: [RANKS=2] [REPEAT=2] benchmarks/bench-checkpoint-pieces.sh [BUILD_DIR]
+bench_name=checkpoint-pieces bench_env="RANKS REPEAT"
+source "$(dirname "$0")/bench-lib.sh"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
+  OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1 \
+  OMP_NUM_THREADS=1
+n=${RANKS:-2}
+# One run under mpirun into $out/LABEL, each rank's figures into time.RANK.
+run() { # LABEL [--set KEY=VALUE]...
+  local d=$out/$1
+  shift
+  rm -rf "$d" && mkdir -p "$d"
+  mpirun -np "$n" --bind-to none bash -c \
+    'exec /usr/bin/time -f "%U %S %M" -o "$0/time.$OMPI_COMM_WORLD_RANK" "$@"' \
+    "$d" "$bin" run cases/mpm/bench-block.yaml \
+    --set discretization.mesh_size=1.2e-3 --set time.max_steps=6 \
+    --set output.every=1000 "$@" --out "$d/out" --quiet >"$d/log" 2>&1 ||
+    echo "$d: failed (see $d/log)"
+}
+# cpu LABEL RANK: the least CPU seconds of the repeats.
+cpu() {
+  for ((k = 1; k <= ${REPEAT:-2}; k++)); do
+    awk '{print $1 + $2}' "$out/$1-$k/time.$2"
+  done | sort -g | head -1
+}
+for ((k = 1; k <= ${REPEAT:-2}; k++)); do
+  for way in gather pieces; do
+    run "$way-none-$k" --set output.ranks=$way
+    run "$way-ckpt-$k" --set output.ranks=$way --set output.checkpoint.every=1
+  done
+done
+printf '%-7s %-5s %10s %10s %14s %12s %14s\n' way rank "CPU s none" \
+  "CPU s ckpt" "CPU s a ckpt" "peak KiB" "ckpt bytes"
+for way in gather pieces; do
+  d=$out/$way-ckpt-1
+  bytes=$(du -cb "$d/out/checkpoint.h5" "$d/out/checkpoint.pieces" \
+    2>/dev/null | tail -1 | cut -f1)
+  for ((r = 0; r < n; r++)); do
+    a=$(cpu "$way-none" "$r") b=$(cpu "$way-ckpt" "$r")
+    printf '%-7s %-5s %10.2f %10.2f %14.3f %12s %14s\n' "$way" "$r" "$a" \
+      "$b" "$(echo "($b - $a) / 5" | bc -l)" \
+      "$(awk '{print $3}' "$d/time.$r")" "$bytes"
+  done
+done
