@@ -43,8 +43,8 @@ printf '%-7s %-5s %10s %10s %14s %12s %14s\n' way rank "CPU s none" \
   "CPU s ckpt" "CPU s a ckpt" "peak KiB" "ckpt bytes"
 for way in gather pieces; do
   d=$out/$way-ckpt-1
-  bytes=$(du -cb "$d/out/checkpoint.h5" "$d/out/checkpoint.pieces" \
-    2>/dev/null | tail -1 | cut -f1)
+  bytes=$(find "$d/out" \( -name checkpoint.h5 -o -path '*.pieces/*' \) \
+    -type f -printf '%s\n' | awk '{s += $1} END {print s}')
   for ((r = 0; r < n; r++)); do
     a=$(cpu "$way-none" "$r") b=$(cpu "$way-ckpt" "$r")
     printf '%-7s %-5s %10.2f %10.2f %14.3f %12s %14s\n' "$way" "$r" "$a" \

@@ -202,12 +202,12 @@ static void conclude(mpm_sim *r, const mpm_model *m, pm_err e) {
 static pm_err run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
   pm_err e = PM_SUCCESS;
+  free(r->mesh_x0); /* (the results' mesh is written) */
+  r->mesh_x0 = NULL;
   if (r->view.ranks && r->resumed) { /* the shares of the checkpoint's state */
     PM_CALL(r->ckpt_pieces.on ? mpm_view_reload(r) : mpm_view_reshare(r));
     if (!r->whole) mpm_view_drop_whole(r);
   }
-  free(r->mesh_x0); /* (the results' mesh is written) */
-  r->mesh_x0 = NULL;
   pm_view_start(&r->view, obs);
   e = pm_view_start_pieces(&r->view, r->scene); /* (agreed) */
   mpm_model *lm = r->view.ranks ? r->local_model : r->model;
