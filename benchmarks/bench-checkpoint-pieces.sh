@@ -52,3 +52,23 @@ for way in gather pieces; do
       "$(awk '{print $3}' "$d/time.$r")" "$bytes"
   done
 done
+# Peak resident memory of every rank resuming each way's checkpoint (of
+# step 5) on 1, 2 and 4 ranks, to step 6: a gathered checkpoint is read
+# whole by every rank, which cuts its share from it; one in pieces by each
+# rank from the pieces in its cells.  (The finished run's status is set to
+# interrupted in a copy: resume takes only a run that did not end.)
+printf '\n%-7s %-5s %-5s %12s\n' way ranks rank "peak KiB"
+for way in gather pieces; do
+  for m in 1 2 4; do
+    d=$out/$way-resume-$m
+    rm -rf "$d" && mkdir -p "$d" && cp -r "$out/$way-ckpt-1/out" "$d/out"
+    sed -i 's/"status": "[a-z_]*"/"status": "interrupted"/' "$d/out/summary.json"
+    mpirun -np "$m" --bind-to none bash -c \
+      'exec /usr/bin/time -f "%M" -o "$0/time.$OMPI_COMM_WORLD_RANK" "$@"' \
+      "$d" "$bin" resume "$d/out" --quiet >"$d/log" 2>&1 ||
+      echo "$d: failed (see $d/log)"
+    for ((r = 0; r < m; r++)); do
+      printf '%-7s %-5s %-5s %12s\n' "$way" "$m" "$r" "$(tail -1 "$d/time.$r")"
+    done
+  done
+done
