@@ -4,7 +4,9 @@
 # fewer cores: memory, not time), for the 3-D block, the block at half its
 # cell (mesh_size 1.25e-3: 884 736 particles), the block with its frames
 # in pieces (output.ranks: pieces, no checkpoints: rank 0 without the
-# whole model; label "pieces", the fine block too), the reduced oocyte and I2
+# whole model; label "pieces", the fine block too), both blocks with the
+# default output and a checkpoint after step 10 (label BUILD-ckpt), the
+# reduced oocyte and I2
 # by the implicit MPM at 256^2 cells (its 10 load steps); with
 # BEFORE=BUILD_DIR the same runs by that build beside.  One line per rank:
 # KiB and CPU seconds (user).  A tiny scene (the disks) gives each rank's
@@ -73,5 +75,9 @@ for n in ${RANKS:-1 2 4}; do
     [ "$l" = after ] && measure pieces "$b" "$n" block-fine \
       cases/mpm/bench-block.yaml "${fine[@]}" --set output.ranks=pieces
     measure "$l" "$b" "$n" i2-256 cases/mpm/i2-vessel-slice.yaml "${i2[@]}"
+    measure "$l-ckpt" "$b" "$n" block cases/mpm/bench-block.yaml \
+      --set output.checkpoint.every=10
+    measure "$l-ckpt" "$b" "$n" block-fine cases/mpm/bench-block.yaml \
+      "${fine[@]}" --set output.checkpoint.every=10
   done
 done

@@ -25,14 +25,14 @@ static pm_err readable(const pointmech *p, const char *what) {
 }
 
 /* readable, and its arrays held whole on rank 0: not so across ranks with
- * frames in pieces and no checkpoints (pm_view_whole_needed), where rank 0
+ * frames and checkpoints in pieces (pm_view_whole_needed), where rank 0
  * holds its share and the run's figures alone. */
 static pm_err readable_whole(const pointmech *p, const char *what) {
   PM_CALL(readable(p, what));
   PM_CHECK(!pm_par_active() || pm_view_whole_needed(p->s), PM_ERR_ARG,
-           "%s: across MPI ranks with output.ranks: pieces and no "
-           "output.checkpoint no rank holds the whole state (take "
-           "output.ranks: gather)",
+           "%s: across MPI ranks with frames and checkpoints in pieces "
+           "(output.ranks: auto or pieces) no rank holds the whole state "
+           "(take output.ranks: gather)",
            what);
   return PM_SUCCESS;
 }

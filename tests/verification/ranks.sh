@@ -71,16 +71,19 @@ check "plan on 2 ranks: z, where a wall moves, not cut" \
 check "plan on 2 ranks: a line per rank" \
   test "$(grep -cE '^ +[01] +[0-9]+ +[0-9]+ \(' "$work/plan")" -eq 2
 
-# Migration moves particles and nothing else.
+# Migration moves particles and nothing else (compared on rank 0's whole
+# model: frames gathered).
 for n in 2 3; do
-  ranks $n "$migrate" "$mpm/disks-collision.yaml" 157 >"$work/mig" 2>&1
+  ranks $n "$migrate" "$mpm/disks-collision.yaml" 157 output.ranks=gather \
+    >"$work/mig" 2>&1
   rc=$?
   tail -1 "$work/mig"
   check "migration on $n ranks (disks): exit 0 (got $rc)" test $rc -eq 0
   check "migration on $n ranks (disks): particles moved" \
     grep -qE 'ranks, [1-9][0-9]* particles migrated, 0 failed' "$work/mig"
 done
-ranks 2 "$migrate" "$mpm/m2-shock-tube-reduced.yaml" 296 >"$work/mig" 2>&1
+ranks 2 "$migrate" "$mpm/m2-shock-tube-reduced.yaml" 296 output.ranks=gather \
+  >"$work/mig" 2>&1
 rc=$?
 tail -1 "$work/mig"
 check "migration on 2 ranks (shock tube): exit 0 (got $rc)" test $rc -eq 0
@@ -168,7 +171,7 @@ roundoff "interrupted on 2 ranks, resumed on 3" "$work/long-2" "$work/cut-3"
 roundoff "interrupted on 2 ranks, resumed on 1" "$work/long-1" "$work/cut-1"
 # The same with frames in pieces, resumed on 3 ranks: the frames after
 # the checkpoint (the signal's) and their pieces dropped, the later ones
-# in 3 pieces.  (Checkpoints named, so rank 0 keeps the whole model.)
+# in 3 pieces.  (The checkpoints too are in pieces: ranks-checkpoint.sh.)
 interrupt 2 "$work/pcut" "$tube" $long --set output.ranks=pieces \
   --set output.checkpoint.minutes=60
 resume_on "$work/pcut" 3
@@ -184,12 +187,13 @@ pieces = {m.group(1) for n in os.listdir(d)
 assert pieces == frames, sorted(pieces ^ frames)
 " "$work/pcut-3"
 
-# In pieces without checkpoints no rank holds the whole model: a signal
-# stops the run with its frames, and says that it wrote no checkpoint.
+# In pieces without output.checkpoint no rank holds the whole model: a
+# signal stops the run with its frames and a checkpoint in pieces, a
+# piece a rank.
 interrupt 2 "$work/pnone" "$tube" $long --set output.ranks=pieces
-check "in pieces, no checkpoints, interrupted: no checkpoint, said" \
-  grep -q 'no checkpoint: a run across ranks with frames in pieces' \
-  "$work/pnone/summary.json"
+check "in pieces, no output.checkpoint, interrupted: a checkpoint in pieces" \
+  test -f "$work/pnone/checkpoint.h5" -a \
+  "$(ls "$work/pnone/checkpoint.pieces" | grep -c '\.piece_')" -eq 2
 
 # A rank's memory below one process's need: refused before the setup on
 # one process with both figures; on 2 ranks in pieces, where no rank

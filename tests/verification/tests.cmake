@@ -128,6 +128,13 @@ if(PM_MPI)
   set_tests_properties(verification.ranks_output PROPERTIES LABELS
     verification TIMEOUT 300 PROCESSORS 1
     RESOURCE_LOCK mpirun)
+  # Checkpoints in pieces, resumed on another count of ranks.
+  add_test(NAME verification.ranks_checkpoint
+    COMMAND bash ${PM_VERIFY_DIR}/ranks-checkpoint.sh $<TARGET_FILE:pointmech>
+      ${PROJECT_SOURCE_DIR})
+  set_tests_properties(verification.ranks_checkpoint PROPERTIES LABELS
+    verification TIMEOUT 300 PROCESSORS 1
+    RESOURCE_LOCK mpirun)
   # Membranes (their neighbours on other ranks) and bodies moving as
   # prescribed across ranks.
   add_test(NAME verification.ranks_membranes

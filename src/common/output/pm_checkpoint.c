@@ -3,25 +3,13 @@
 
 #include <errno.h>
 #include <fcntl.h>
-#include <hdf5.h>
-#include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "pm_files.h"
+#include "pm_checkpoint_impl.h"
 #include "pm_h5.h"
-
-#define CKPT_FORMAT "pointmech checkpoint 1"
-
-struct pm_ckpt {
-  hid_t file;
-  bool reading;
-  long items;
-  uint64_t sum; /* FNV-1a over names and bytes, in call order */
-  char path[PM_PATH_MAX + 1];
-  char tmp[PM_PATH_MAX + 40];
-};
 
 static void sum_bytes(pm_ckpt *c, const void *data, size_t n) {
   const unsigned char *p = data;
@@ -41,17 +29,28 @@ static pm_ckpt *ckpt_new(void) {
   pm_ckpt *c = calloc(1, sizeof *c);
   if (c) {
     c->file = -1;
+    c->pieces_id = -1;
     c->sum = 14695981039346656037ull;
   }
   return c;
 }
 
 pm_err pm_ckpt_create(const char *dir, pm_ckpt **out) {
+  char path[PM_PATH_MAX + 1];
+  *out = NULL;
+  PM_CALL(pm_path_join(path, sizeof path, dir, "checkpoint.h5"));
+  PM_CALL(pm_ckpt_create_at(path, out));
+  (*out)->index = true;
+  snprintf((*out)->dir, sizeof(*out)->dir, "%s", dir);
+  return PM_SUCCESS;
+}
+
+pm_err pm_ckpt_create_at(const char *path, pm_ckpt **out) {
   pm_err ret = PM_SUCCESS;
   pm_ckpt *c = ckpt_new();
   *out = NULL;
   PM_CHECK(c, PM_ERR_MEMORY, "cannot allocate a checkpoint writer");
-  PM_TRY(pm_path_join(c->path, sizeof c->path, dir, "checkpoint.h5"));
+  PM_TRY(pm_path_join(c->path, sizeof c->path, "", path));
   snprintf(c->tmp, sizeof c->tmp, "%s.tmp.%ld", c->path, (long)getpid());
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   H5_OK(c->file = H5Fcreate(c->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
@@ -65,17 +64,26 @@ done:
 }
 
 pm_err pm_ckpt_open(const char *dir, pm_ckpt **out) {
+  char path[PM_PATH_MAX + 1];
+  *out = NULL;
+  PM_CALL(pm_path_join(path, sizeof path, dir, "checkpoint.h5"));
+  PM_CHECK(access(path, F_OK) == 0, PM_ERR_IO,
+           "'%s' holds no checkpoint (%s): set output.checkpoint in the "
+           "scene, or stop runs with SIGINT or SIGTERM, to have one",
+           dir, path);
+  PM_CALL(pm_ckpt_open_at(path, out));
+  snprintf((*out)->dir, sizeof(*out)->dir, "%s", dir);
+  return PM_SUCCESS;
+}
+
+pm_err pm_ckpt_open_at(const char *path, pm_ckpt **out) {
   pm_err ret = PM_SUCCESS;
   pm_ckpt *c = ckpt_new();
   char *fmt = NULL;
   *out = NULL;
   PM_CHECK(c, PM_ERR_MEMORY, "cannot allocate a checkpoint reader");
   c->reading = true;
-  PM_TRY(pm_path_join(c->path, sizeof c->path, dir, "checkpoint.h5"));
-  PM_ENSURE(access(c->path, F_OK) == 0, PM_ERR_IO,
-            "'%s' holds no checkpoint (%s): set output.checkpoint in the "
-            "scene, or stop runs with SIGINT or SIGTERM, to have one",
-            dir, c->path);
+  PM_TRY(pm_path_join(c->path, sizeof c->path, "", path));
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   c->file = H5Fopen(c->path, H5F_ACC_RDONLY, H5P_DEFAULT);
   PM_ENSURE(c->file >= 0, PM_ERR_IO,
@@ -211,6 +219,11 @@ pm_err pm_ckpt_finish(pm_ckpt *c) {
               "checkpoint '%s' is damaged: checksum %016llx, the data sum to "
               "%016llx",
               c->path, stored[0], now[0]);
+    PM_ENSURE(!c->expect_set || stored[0] == c->expect, PM_ERR_IO,
+              "checkpoint '%s' is not the one its index names: checksum "
+              "%016llx, the index has %016llx (a piece of another "
+              "checkpoint)",
+              c->path, stored[0], (unsigned long long)c->expect);
   } else {
     H5_OK(space = H5Screate_simple(1, &two, NULL), "H5Screate_simple",
           "checksum", c->tmp);
@@ -226,6 +239,10 @@ pm_err pm_ckpt_finish(pm_ckpt *c) {
     H5_OK(H5Fclose(f), "H5Fclose", "/", c->tmp);
     PM_TRY(pm_sync_rename(c->tmp, c->path));
     c->tmp[0] = '\0';
+    if (c->sum_out) *c->sum_out = c->sum;
+    /* The index in place: the pieces of older checkpoints go (a crash
+     * before this leaves them, and the older index naming them, whole). */
+    if (c->index) pm_ckpt_drop_pieces(c->dir, c->pieces_id);
   }
 done:
   if (attr >= 0) H5Aclose(attr);

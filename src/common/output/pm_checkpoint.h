@@ -56,4 +56,46 @@ pm_err pm_ckpt_finish(pm_ckpt *c);
  * accepted). */
 void pm_ckpt_abort(pm_ckpt *c);
 
+/* pm_ckpt_create and pm_ckpt_open of a file at path (a piece). */
+pm_err pm_ckpt_create_at(const char *path, pm_ckpt **out);
+pm_err pm_ckpt_open_at(const char *path, pm_ckpt **out);
+
+/* Whether the file of reader c has an item name (a checkpoint's layout:
+ * whole, or an index of pieces).  Reads nothing: the checksum is
+ * untouched. */
+bool pm_ckpt_has(const pm_ckpt *c, const char *name);
+
+/* ---- A checkpoint in pieces (a run shared among ranks) ------------------
+ *
+ * Each rank writes its share's state as a piece,
+ * OUT/checkpoint.pieces/ID.piece_RRRR.h5 (ID the checkpoint's step), a
+ * checkpoint file of its own (items, checksum, written aside and renamed);
+ * rank 0 then writes OUT/checkpoint.h5 as the index naming them: their
+ * count, ID, each piece's checksum and what the backend records of it.
+ * Only once the index is in place do the older checkpoint's pieces go, so
+ * a crash at any point leaves a whole checkpoint, the older or the new. */
+
+/* The folder of the pieces, made if missing (rank 0, before the ranks
+ * write).  PM_ERR_IO naming it. */
+pm_err pm_ckpt_pieces_folder(const char *dir);
+/* The path of piece `piece` of checkpoint id under output folder dir. */
+pm_err pm_ckpt_piece_path(char *buf, size_t size, const char *dir, long id,
+                          int piece);
+/* Start writing piece `piece` of checkpoint id; its finish stores the
+ * checksum of its items into *sum (the index records it). */
+pm_err pm_ckpt_create_piece(const char *dir, long id, int piece,
+                            unsigned long long *sum, pm_ckpt **out);
+/* Open piece `piece` of checkpoint id for reading, with vet first vetted
+ * as `resume` vets the index (pm_h5_vet, in a child process); its finish
+ * also refuses a checksum other than sum, the one the index names.
+ * PM_ERR_IO naming the piece. */
+pm_err pm_ckpt_open_piece(const char *dir, long id, int piece,
+                          unsigned long long sum, bool vet, pm_ckpt **out);
+/* The index writer c names the pieces of checkpoint id: once it is in
+ * place (pm_ckpt_finish) the other pieces in the folder are removed. */
+void pm_ckpt_set_pieces(pm_ckpt *c, long id);
+/* Remove the pieces in dir's pieces folder but those of checkpoint keep
+ * (-1: all); what cannot be removed stays (a later checkpoint retries). */
+void pm_ckpt_drop_pieces(const char *dir, long keep);
+
 #endif

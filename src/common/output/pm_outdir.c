@@ -21,9 +21,9 @@ struct pm_outdir {
 };
 
 /* The files a run writes in its folder (results/ holds the frames). */
-static const char *const run_files[] = {"summary.json", "history.csv",
-                                        "results.h5", "results.xdmf",
-                                        "checkpoint.h5"};
+static const char *const run_files[] = {"summary.json",  "history.csv",
+                                        "results.h5",    "results.xdmf",
+                                        "checkpoint.h5", "checkpoint.pieces"};
 #define N_RUN_FILES (sizeof run_files / sizeof *run_files)
 #define LOCK_NAME ".pointmech.lock"
 

@@ -219,6 +219,14 @@ typedef struct pm_backend {
    * a frame whole (one process).  NULL: frames are always written whole
    * (the loader refuses pieces across ranks). */
   const struct pm_view_pieces *(*pieces)(void *sim);
+  /* Whether a run of scene s across ranks with frames in pieces writes its
+   * checkpoints in pieces too (pm_view.ckpt_piece), so that no rank keeps
+   * the whole model for them (pm_view_whole_needed).  NULL: never. */
+  bool (*ckpt_pieces)(const pm_scene *s);
+  /* Whether frames of scene s across ranks go in pieces where the scene
+   * leaves output.ranks to the method (auto).  NULL: wherever the method
+   * writes pieces. */
+  bool (*pieces_apply)(const pm_scene *s);
   /* Across ranks without the whole model (pm_view_whole_needed false):
    * the NRMSE of each component of the scene's reference field (NAN where
    * it has none) and of the field (as pm_run_compute_errors takes them)

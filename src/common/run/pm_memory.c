@@ -261,7 +261,7 @@ void pm_memory_plan(const pm_scene *s, FILE *out) {
       fprintf(out,
               "memory/rank  %s before setup on each of %d ranks at most (its "
               "share with its ghosts, %ld points; no rank keeps the whole "
-              "model: frames in pieces, no checkpoints)\n",
+              "model: frames and checkpoints in pieces)\n",
               pm_memory_format(share, a, sizeof a), ranks, held);
     else if (!pm_view_whole_needed(s))
       fprintf(out,

@@ -45,6 +45,13 @@ typedef struct pm_view {
   pm_err (*piece)(void *ctx, const char *dir, long frame,
                   const pm_step_report *r, long *n, int *n_fields,
                   pm_field *fields);
+  /* Checkpoints in pieces (may be NULL: the whole state, gathered): this
+   * rank's share of checkpoint id written as piece pm_par_rank() into
+   * the output folder dir (pm_ckpt_create_piece), and what the index
+   * records of it: its count of points and checksum into *count and *sum,
+   * PM_VIEW_CKPT_VALUES doubles of the backend's own into values. */
+  pm_err (*ckpt_piece)(void *ctx, const char *dir, long id, long *count,
+                       unsigned long long *sum, double *values);
   const pm_observer *obs; /* the run's, while it runs (rank 0 reports) */
   /* Across ranks with output.ranks: pieces and a results folder (rank 0's,
    * passed to every rank at the start): the folder and the last frame's
@@ -53,7 +60,17 @@ typedef struct pm_view {
   bool ending; /* the run has ended: gather's last call, for the figures */
   char dir[PM_PATH_MAX + 1];
   pm_view_pieces pieces;
+  /* Rank 0 while its observer reads the view in pieces: the other ranks
+   * wait for a checkpoint's pieces (pm_view_checkpoint_pieces). */
+  bool serving;
+  /* The last checkpoint's pieces (on rank 0): per rank its count and
+   * checksum (2 longs), and its PM_VIEW_CKPT_VALUES doubles. */
+  long *ckpt_counts;
+  double *ckpt_values;
 } pm_view;
+
+/* Doubles a checkpoint's piece records in its index (the backend's). */
+#define PM_VIEW_CKPT_VALUES 128
 
 /* Whether this rank holds the whole model and state through a run: across
  * ranks, rank 0 while frames, checkpoints and the end's figures are
@@ -65,11 +82,13 @@ bool pm_view_keeps_whole(void);
 
 /* Whether a run of scene s across ranks needs the whole model on rank 0:
  * unless its frames go in pieces (output.ranks: pieces, a backend that
- * writes them) and nothing else reads the whole run: no checkpoints
- * (output.checkpoint), and a reference field only where the backend sums
- * its errors over the shares (pm_backend.errors).  Without it the history rows
- * and the end's figures come from reductions over the shares (pm_view.gather
- * then reduces), and a signal writes no checkpoint.  The same on every rank. */
+ * writes them) and nothing else reads the whole run: checkpoints
+ * (output.checkpoint) only where the backend writes them in pieces too
+ * (pm_backend.ckpt_pieces), and a reference field only where the backend
+ * sums its errors over the shares (pm_backend.errors).  Without it the
+ * history rows and the end's figures come from reductions over the shares
+ * (pm_view.gather then reduces), and checkpoints (a signal's too) are
+ * written in pieces.  The same on every rank. */
 bool pm_view_whole_needed(const pm_scene *s);
 
 /* pm_view_keeps_whole for scene s: rank 0 across ranks where
@@ -107,6 +126,15 @@ pm_err pm_view_stopped_inside(pm_view *v, const pm_step_report *r, pm_err e);
  * too) gathered into rank 0's view for the figures (collective).  e, or the
  * gather's failure where e is PM_SUCCESS.  The observer is let go. */
 pm_err pm_view_end(pm_view *v, pm_err e);
+
+/* On rank 0, from the backend's checkpoint writer while its observer
+ * writes a checkpoint in pieces (the ranks' frames in pieces, and
+ * v->ckpt_piece): every rank writes its piece of checkpoint id into the
+ * output folder (collective with the other ranks, which wait in
+ * pm_view_step), then v->ckpt_counts and v->ckpt_values hold every
+ * piece's record.  The failure of any rank, agreed; PM_ERR_ARG where the
+ * run writes no checkpoint in pieces. */
+pm_err pm_view_checkpoint_pieces(pm_view *v, long id);
 
 /* The frame the ranks last wrote in pieces, or NULL where frames are
  * written whole (one process, output.ranks: gather, no results). */

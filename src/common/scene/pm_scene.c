@@ -101,6 +101,11 @@ static pm_err read_scene(pm_scene *s) {
                          "method %s runs on one process (this run has %d "
                          "ranks): run it without mpirun, or with -np 1",
                          s->method, pm_par_size());
+  if (s->output.ranks == PM_OUTPUT_AUTO) /* pieces where they apply */
+    s->output.ranks = s->backend->pieces && (!s->backend->pieces_apply ||
+                                             s->backend->pieces_apply(s))
+                          ? PM_OUTPUT_PIECES
+                          : PM_OUTPUT_GATHER;
   if (pm_par_active() && s->output.ranks == PM_OUTPUT_PIECES &&
       !s->backend->pieces)
     return pm_scene_fail(s, "output.ranks", false,

@@ -148,6 +148,8 @@ extern const pm_name pm_mesh_sizes_names[];
 enum {
   PM_OUTPUT_GATHER = 0, /* gathered into rank 0, which writes each whole */
   PM_OUTPUT_PIECES,     /* each rank its own points, joined by rank 0 */
+  PM_OUTPUT_AUTO        /* pieces where the method writes them, else gather
+                           (resolved when the scene is read) */
 };
 extern const pm_name pm_output_ranks_names[];
 

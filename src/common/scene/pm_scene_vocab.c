@@ -85,8 +85,10 @@ const pm_name pm_mesh_sizes_names[] = {{"scale", PM_MESH_SIZES_SCALE},
                                        {"replace", PM_MESH_SIZES_REPLACE},
                                        {"file", PM_MESH_SIZES_FILE},
                                        {NULL, 0}};
-const pm_name pm_output_ranks_names[] = {
-    {"gather", PM_OUTPUT_GATHER}, {"pieces", PM_OUTPUT_PIECES}, {NULL, 0}};
+const pm_name pm_output_ranks_names[] = {{"auto", PM_OUTPUT_AUTO},
+                                         {"gather", PM_OUTPUT_GATHER},
+                                         {"pieces", PM_OUTPUT_PIECES},
+                                         {NULL, 0}};
 const pm_name pm_refine_to_names[] = {
     {"faces", PM_REFINE_FACES}, {"edges", PM_REFINE_EDGES}, {NULL, 0}};
 static const pm_key refine_keys[] = {
@@ -975,21 +977,29 @@ static const pm_key output_keys[] = {
     {.name = "ranks",
      .type = PM_KEY_ENUM,
      .offset = S(output.ranks),
-     .def = "gather",
+     .def = "auto",
      .names = pm_output_ranks_names,
-     .doc = "a run across MPI ranks: gather (each frame gathered into rank "
-            "0 and written whole) or pieces (explicit MPM without "
+     .doc = "a run across MPI ranks: auto (pieces where the method writes "
+            "them: explicit MPM without membranes or dynamic relaxation; "
+            "else gather), gather (each frame and checkpoint gathered into "
+            "rank 0 and written whole) or pieces (explicit MPM without "
             "membranes, FPM but its static solve: each rank writes its own "
             "particles or points, over no cells, "
             "results/frame_NNNNNN.piece_RRRR.h5, joined by rank 0's frame "
-            "file; readers put them in one-process order; without "
-            "output.checkpoint no rank holds the whole model, and a "
-            "signal writes no checkpoint)"},
+            "file, which readers put in one-process order; explicit MPM "
+            "writes its share of each checkpoint too, checkpoint.pieces/, "
+            "joined by rank 0's checkpoint.h5 and resumed on any count of "
+            "ranks; no rank holds the whole model, but where checkpoints "
+            "are gathered: MPM's dynamic relaxation and FPM with "
+            "output.checkpoint; FPM in pieces without output.checkpoint "
+            "writes no checkpoint on a signal)"},
     {.name = "checkpoint",
      .type = PM_KEY_MAPPING,
      .keys = checkpoint_keys,
      .doc = "{every, minutes}: the whole state, written atomically (SIGINT "
-            "and SIGTERM write one too)"},
+            "and SIGTERM write one too; across ranks with frames in pieces "
+            "each rank writes its share, checkpoint.pieces/, joined by "
+            "checkpoint.h5)"},
     {0}};
 
 static const pm_key stability_keys[] = {

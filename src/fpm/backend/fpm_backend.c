@@ -430,6 +430,14 @@ static pm_err check(const pm_scene *s) {
   return PM_SUCCESS;
 }
 
+/* output.ranks: auto gathers FPM's frames: in pieces they are a point
+ * cloud without the mesh's cells, its static solve refuses them and its
+ * checkpoints are gathered into rank 0's whole model. */
+static bool pieces_apply(const pm_scene *s) {
+  (void)s;
+  return false;
+}
+
 const pm_backend fpm_backend = {
     .method = "fpm",
     .description = "explicit total-Lagrangian Fragile Points Method",
@@ -455,5 +463,6 @@ const pm_backend fpm_backend = {
     .timers = timers,
     .checkpoint = checkpoint,
     .pieces = fpm_backend_pieces,
+    .pieces_apply = pieces_apply,
     .errors = fpm_backend_errors,
 };

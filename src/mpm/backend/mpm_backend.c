@@ -105,6 +105,9 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
 void mpm_sim_destroy(mpm_sim *r) {
   if (!r) return;
   free(r->ckpt_accounts);
+  free(r->ckpt_pieces.counts);
+  free(r->ckpt_pieces.values);
+  mpm_state_destroy(r->ckpt_scalars);
   free(r->imp_ranks);
   mpm_work_destroy(r->local_work);
   mpm_state_destroy(r->local_state);
@@ -199,10 +202,12 @@ static void conclude(mpm_sim *r, const mpm_model *m, pm_err e) {
 static pm_err run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
   pm_err e = PM_SUCCESS;
-  if (r->view.ranks && r->resumed) /* the shares of the checkpoint's state */
-    PM_CALL(mpm_view_reshare(r));
   free(r->mesh_x0); /* (the results' mesh is written) */
   r->mesh_x0 = NULL;
+  if (r->view.ranks && r->resumed) { /* the shares of the checkpoint's state */
+    PM_CALL(r->ckpt_pieces.on ? mpm_view_reload(r) : mpm_view_reshare(r));
+    if (!r->whole) mpm_view_drop_whole(r);
+  }
   pm_view_start(&r->view, obs);
   e = pm_view_start_pieces(&r->view, r->scene); /* (agreed) */
   mpm_model *lm = r->view.ranks ? r->local_model : r->model;
@@ -280,25 +285,31 @@ static pm_err ranks_checkpoint(mpm_sim *r, pm_ckpt *ck) {
   return pm_ckpt_doubles(ck, "run.ranks.accounts", n * ranks, (double *)rows);
 }
 
-/* The state, and what the run reports over all its steps. */
-static pm_err checkpoint(void *p, pm_ckpt *ck) {
-  mpm_sim *r = p;
+pm_err mpm_sim_run_items(mpm_sim *r, pm_ckpt *ck) {
   long iter_max_row = r->iter_max_row;
-  PM_CHECK(r->whole || pm_ckpt_reading(ck), PM_ERR_ARG,
-           "a run across ranks with frames in pieces and no "
-           "output.checkpoint keeps no whole model to checkpoint (set "
-           "output.checkpoint.every, or output.ranks: gather)");
-  /* A rank without the whole model reads a checkpoint of the whole run
-   * into one, from which its share is cut anew (mpm_view_reshare). */
-  if (pm_ckpt_reading(ck) && !r->model)
-    PM_CALL(mpm_model_create(r->scene, &r->model, &r->state));
-  PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
   PM_CALL(pm_ckpt_double(ck, "run.energy0", &r->energy0));
   PM_CALL(pm_ckpt_double(ck, "run.min_jacobian", &r->run_min_jacobian));
   PM_CALL(pm_ckpt_long(ck, "run.min_jacobian_step", &r->run_min_jacobian_step));
   PM_CALL(pm_ckpt_long(ck, "run.iter_max_row", &iter_max_row));
   r->iter_max_row = (int)iter_max_row;
-  PM_CALL(pm_ckpt_long(ck, "run.iter_capped_prev", &r->iter_capped_prev));
+  return pm_ckpt_long(ck, "run.iter_capped_prev", &r->iter_capped_prev);
+}
+
+/* The state, and what the run reports over all its steps: across ranks
+ * without the whole model, in pieces (mpm_ckpt_pieces.c). */
+static pm_err checkpoint(void *p, pm_ckpt *ck) {
+  mpm_sim *r = p;
+  if (pm_ckpt_reading(ck) ? mpm_sim_ckpt_is_pieces(ck) : !r->whole)
+    return mpm_sim_ckpt_index(r, ck);
+  /* A rank without the whole model reads a checkpoint of the whole run
+   * into one, from which its share is cut anew (mpm_view_reshare). */
+  if (pm_ckpt_reading(ck) && !r->model) {
+    r->ckpt_scalars = r->state; /* (rank 0 without the whole model's) */
+    r->state = NULL;
+    PM_CALL(mpm_model_create(r->scene, &r->model, &r->state));
+  }
+  PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
+  PM_CALL(mpm_sim_run_items(r, ck));
   PM_CALL(ranks_checkpoint(r, ck));
   if (pm_ckpt_reading(ck)) {
     r->resumed = true;
@@ -334,6 +345,8 @@ const pm_backend mpm_backend = {
     .timers = mpm_sim_timers,
     .checkpoint = checkpoint,
     .pieces = mpm_sim_pieces,
+    .ckpt_pieces = mpm_sim_ckpt_pieces,
+    .pieces_apply = mpm_sim_pieces_apply,
     .errors = mpm_sim_errors,
 };
 

@@ -39,6 +39,20 @@ typedef struct {
 } mpm_sums;
 #define MPM_SUMS_BODY 6
 
+/* A checkpoint in pieces (mpm_ckpt_pieces.c) as its index names it: its
+ * folder, id and pieces, each's count and checksum (2 longs) and record
+ * (PM_VIEW_CKPT_VALUES doubles), and the run's values (no arrays); on
+ * until the state is read from the pieces. */
+typedef struct {
+  bool on;
+  long id;
+  int n;
+  long *counts;
+  double *values;
+  mpm_state vals;
+  char dir[PM_PATH_MAX + 1];
+} mpm_ckpt_pieces;
+
 /* A prepared simulation.  Fields are read-only for callers.  Across MPI
  * ranks (mpm_par.h) the time loop steps this rank's share (local_*), and
  * model, state and work are rank 0's view of the whole run, gathered into
@@ -63,6 +77,10 @@ typedef struct {
    * energy accounts (MPM_PAR_ACCOUNTS each) */
   int ckpt_ranks;
   double *ckpt_accounts;
+  mpm_ckpt_pieces ckpt_pieces;
+  /* Rank 0 without the whole model reading a whole checkpoint: its state
+   * of the run's scalars, put back once the shares are cut. */
+  mpm_state *ckpt_scalars;
   struct mpm_implicit *imp;   /* method mpm-implicit: its solver (else NULL) */
   int imp_newton, imp_linear; /* the last load step's iterations */
   /* across ranks, at the end of an implicit run: per rank its particles,

@@ -51,6 +51,12 @@ void mpm_view_init(mpm_sim *r, bool implicit);
  * collective: rank 0 reports, the shares gathered into its view where the
  * observer reads them). */
 pm_err mpm_view_report(mpm_sim *r, bool frame, bool last);
+/* Let this rank's share (model, state, workspace) go, to make it anew. */
+void mpm_view_drop_share(mpm_sim *r);
+/* A run without the whole model resumed from a whole checkpoint, once its
+ * shares are cut: the whole model read for them goes, and rank 0's state
+ * of the run's scalars takes the checkpoint's values. */
+void mpm_view_drop_whole(mpm_sim *r);
 /* A resumed run across ranks: each rank's share anew from the whole state
  * read from the checkpoint (collective). */
 pm_err mpm_view_reshare(mpm_sim *r);
@@ -71,6 +77,34 @@ bool mpm_sim_errors(void *p, double nrmse[3], double *vector);
 /* What rank 0's observer reads of a converged implicit load step: every
  * rank's particles and load stepping's states (collective). */
 pm_err mpm_view_implicit_gather(void *ctx);
+
+/* ---- checkpoints in pieces (mpm_ckpt_pieces.c) ---- */
+
+/* The driver's run items of a checkpoint after the state (both ways). */
+pm_err mpm_sim_run_items(mpm_sim *r, pm_ckpt *ck);
+/* pm_backend.ckpt_pieces: whether a run of s across ranks in pieces
+ * checkpoints in pieces (not with dynamic relaxation's nodal arrays). */
+bool mpm_sim_ckpt_pieces(const pm_scene *s);
+/* pm_backend.pieces_apply: frames in pieces unless a body is a membrane
+ * or the run relaxes dynamically. */
+bool mpm_sim_pieces_apply(const pm_scene *s);
+/* pm_view.ckpt_piece: this rank's share as piece of checkpoint id. */
+pm_err mpm_sim_ckpt_piece(void *ctx, const char *dir, long id, long *count,
+                          unsigned long long *sum, double *values);
+/* Whether reader ck is the index of a checkpoint in pieces. */
+bool mpm_sim_ckpt_is_pieces(const pm_ckpt *ck);
+/* The backend's items of a checkpoint in pieces: a writer (rank 0) has
+ * every rank write its piece (pm_view_checkpoint_pieces), then writes the
+ * index; a reader reads the index and, on one process or where the run
+ * keeps the whole model, every piece (mpm_sim_ckpt_load_whole), else
+ * leaves the pieces to mpm_view_reload. */
+pm_err mpm_sim_ckpt_index(mpm_sim *r, pm_ckpt *ck);
+/* The whole model (made if missing) and its state from every piece. */
+pm_err mpm_sim_ckpt_load_whole(mpm_sim *r);
+/* Across ranks, once the run starts: each rank's share made anew from the
+ * scene with the particles the pieces have in its cells, their state read
+ * from the pieces that hold them (collective). */
+pm_err mpm_view_reload(mpm_sim *r);
 
 /* ---- what the run driver reads (mpm_fields.c, mpm_history.c) ---- */
 

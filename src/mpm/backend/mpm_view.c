@@ -81,7 +81,11 @@ void mpm_view_init(mpm_sim *r, bool implicit) {
                       .ctx = r,
                       .gather = implicit ? mpm_view_implicit_gather : gather,
                       .release = release,
-                      .piece = implicit ? NULL : mpm_sim_piece};
+                      .piece = implicit ? NULL : mpm_sim_piece,
+                      .ckpt_piece =
+                          implicit || r->whole || !mpm_sim_ckpt_pieces(r->scene)
+                              ? NULL
+                              : mpm_sim_ckpt_piece};
 }
 
 pm_err mpm_view_report(mpm_sim *r, bool frame, bool last) {
@@ -93,13 +97,27 @@ pm_err mpm_view_report(mpm_sim *r, bool frame, bool last) {
   return pm_view_step(&r->view, &rep, frame);
 }
 
-pm_err mpm_view_reshare(mpm_sim *r) {
+void mpm_view_drop_share(mpm_sim *r) {
   mpm_work_destroy(r->local_work);
   mpm_state_destroy(r->local_state);
   mpm_model_destroy(r->local_model);
   r->local_work = NULL;
   r->local_state = NULL;
   r->local_model = NULL;
+}
+
+void mpm_view_drop_whole(mpm_sim *r) {
+  if (!r->model) return;
+  if (r->ckpt_scalars) mpm_state_copy_values(r->ckpt_scalars, r->state);
+  mpm_state_destroy(r->state);
+  mpm_model_destroy(r->model);
+  r->state = r->ckpt_scalars;
+  r->model = NULL;
+  r->ckpt_scalars = NULL;
+}
+
+pm_err mpm_view_reshare(mpm_sim *r) {
+  mpm_view_drop_share(r);
   return mpm_view_share(r, r->ckpt_ranks == pm_par_size() ? r->ckpt_accounts
                                                           : NULL);
 }

@@ -173,22 +173,21 @@ size_t mpm_work_bytes(const mpm_model *m, const mpm_work *w) {
          scratch;
 }
 
-pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck) {
-  mpm_array a[MPM_STATE_MAX_ARRAYS];
-  const long n3 = 3 * m->grid.n_nodes;
-  const long n_acc = (long)(sizeof s->energy / (sizeof(double)));
-  long iter_max = s->iter_max_total;
+/* The state's values before its arrays in a checkpoint. */
+static pm_err values_head(mpm_state *s, pm_ckpt *ck) {
   PM_CALL(pm_ckpt_double(ck, "mpm.t", &s->t));
   PM_CALL(pm_ckpt_long(ck, "mpm.step", &s->step));
   PM_CALL(pm_ckpt_double(ck, "mpm.dt", &s->dt));
   PM_CALL(pm_ckpt_double(ck, "mpm.dt_stable", &s->dt_stable));
-  PM_CALL(pm_ckpt_double(ck, "mpm.max_div_prev", &s->max_div_prev));
-  int na = mpm_state_arrays(m, s, a, MPM_STATE_MAX_ARRAYS);
-  for (int k = 0; k < na; k++) {
-    char name[96];
-    snprintf(name, sizeof name, "mpm.%02d.%s", k, a[k].name);
-    PM_CALL(pm_ckpt_doubles(ck, name, a[k].ncomp * a[k].count, a[k].data));
-  }
+  return pm_ckpt_double(ck, "mpm.max_div_prev", &s->max_div_prev);
+}
+
+/* The state's values after its arrays, with the nodal arrays of dynamic
+ * relaxation (n3 values: 0 without them) between the accounts and the
+ * counters. */
+static pm_err values_tail(mpm_state *s, long n3, pm_ckpt *ck) {
+  const long n_acc = (long)(sizeof s->energy / (sizeof(double)));
+  long iter_max = s->iter_max_total;
   PM_CALL(pm_ckpt_doubles(ck, "mpm.energy", n_acc, (double *)s->energy));
   PM_CALL(pm_ckpt_doubles(ck, "mpm.iso", (long)(sizeof s->iso / sizeof(double)),
                           (double *)&s->iso));
@@ -201,4 +200,21 @@ pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck) {
   PM_CALL(pm_ckpt_long(ck, "mpm.iter_max_total", &iter_max));
   s->iter_max_total = (int)iter_max;
   return pm_ckpt_long(ck, "mpm.iter_capped_total", &s->iter_capped_total);
+}
+
+pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck) {
+  mpm_array a[MPM_STATE_MAX_ARRAYS];
+  PM_CALL(values_head(s, ck));
+  int na = mpm_state_arrays(m, s, a, MPM_STATE_MAX_ARRAYS);
+  for (int k = 0; k < na; k++) {
+    char name[96];
+    snprintf(name, sizeof name, "mpm.%02d.%s", k, a[k].name);
+    PM_CALL(pm_ckpt_doubles(ck, name, a[k].ncomp * a[k].count, a[k].data));
+  }
+  return values_tail(s, 3 * m->grid.n_nodes, ck);
+}
+
+pm_err mpm_state_checkpoint_values(mpm_state *s, pm_ckpt *ck) {
+  PM_CALL(values_head(s, ck));
+  return values_tail(s, 0, ck);
 }

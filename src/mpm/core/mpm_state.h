@@ -107,6 +107,9 @@ int mpm_state_arrays(const mpm_model *m, const mpm_state *s, mpm_array *out,
 /* Write every value of the state to a checkpoint, or read it back (the
  * same items both ways: pm_checkpoint.h). */
 pm_err mpm_state_checkpoint(const mpm_model *m, mpm_state *s, pm_ckpt *ck);
+/* The same items but the particles' and the nodes' arrays (a checkpoint
+ * in pieces holds those in its pieces; s has no nodal arrays). */
+pm_err mpm_state_checkpoint_values(mpm_state *s, pm_ckpt *ck);
 
 /* Bytes of the state's arrays (particles and grid). */
 size_t mpm_state_bytes(const mpm_model *m, const mpm_state *s);

@@ -399,6 +399,12 @@ static pm_err decompose(const pm_scene *s, const mpm_model *frame,
 
 pm_err mpm_par_create_seeded(const pm_scene *s, bool gather, mpm_model **local,
                              mpm_state **local_state_out) {
+  return mpm_par_create_picked(s, gather, NULL, local, local_state_out);
+}
+
+pm_err mpm_par_create_picked(const pm_scene *s, bool gather,
+                             const mpm_par_pick *pick, mpm_model **local,
+                             mpm_state **local_state_out) {
   pm_err ret = PM_SUCCESS;
   struct mpm_par *P = NULL;
   mpm_model *frame = NULL, *lm = NULL;
@@ -418,6 +424,11 @@ pm_err mpm_par_create_seeded(const pm_scene *s, bool gather, mpm_model **local,
   box_test bt = {.d = &P->d, .g = &frame->grid, .rank = P->rank};
   sh.keep = in_box;
   sh.ctx = &bt;
+  if (pick) { /* (its particles are where a checkpoint has them) */
+    if (!ret) ret = pick->prepare(pick->ctx, &P->d, &frame->grid, P->rank);
+    sh.keep = pick->keep;
+    sh.ctx = pick->ctx;
+  }
   if (!ret) ret = mpm_model_share(s, &grid, &sh, &lm, &ls);
   PM_TRY(pm_par_agree(ret));
   /* The whole run's ranges, which migration keeps. */

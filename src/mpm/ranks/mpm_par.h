@@ -135,6 +135,23 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
 pm_err mpm_par_create_seeded(const pm_scene *s, bool gather, mpm_model **local,
                              mpm_state **local_state);
 
+/* A share other than the particles whose reference positions lie in the
+ * rank's cells (a run resumed from a checkpoint in pieces: those where
+ * the checkpoint has them): prepare learns the decomposition d of the
+ * whole grid g and this rank, then keep says which reference positions
+ * the share keeps (called as mpm_seed_share.keep). */
+typedef struct {
+  pm_err (*prepare)(void *ctx, const mpm_decomp *d, const mpm_grid *g,
+                    int rank);
+  bool (*keep)(void *ctx, const double x0[3]);
+  void *ctx;
+} mpm_par_pick;
+/* mpm_par_create_seeded keeping pick's particles (pick NULL: the
+ * rank's cells'). */
+pm_err mpm_par_create_picked(const pm_scene *s, bool gather,
+                             const mpm_par_pick *pick, mpm_model **local,
+                             mpm_state **local_state);
+
 /* The values of full state st (of full model m) of local model lm's
  * particles and nodes into local state ls, whose arrays have room for
  * them: particles, their groups' arrays, the scalars (but the energy

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Checkpoints across ranks written in pieces (frames in pieces, no whole
+# model on any rank): each rank its share, rank 0 the index naming them;
+# a run interrupted on 2 or 3 ranks and resumed from its pieces on 1, 2
+# or 3: on as many ranks bit for bit the run that was not interrupted, on
+# another count to round-off (the bound of ranks.sh); a damaged piece
+# refused by name.
+# Usage: ranks-checkpoint.sh POINTMECH SOURCE_DIR
+set -u
+bin=$1
+src=$2
+. "$(dirname "$0")/lib.sh"
+. "$(dirname "$0")/ranks-lib.sh"
+
+# The disks (2-D, each disk's particles shared among the boxes, moving
+# between them), slowed to some 1600 steps so that a signal stops them
+# midway; a checkpoint every 300 steps besides the signal's.
+disks=$mpm/disks-collision.yaml
+slow="--set time.dt_safety=0.05 --set output.every=100
+      --set output.ranks=pieces --set output.checkpoint.every=300"
+# shellcheck disable=SC2086
+"$bin" run "$disks" --out "$work/whole-1" --quiet $slow >/dev/null 2>&1 &
+one=$!
+# shellcheck disable=SC2086
+ranks 2 "$bin" run "$disks" --out "$work/whole-2" --quiet $slow \
+  >/dev/null 2>&1
+wait $one
+
+# shellcheck disable=SC2086
+interrupt 2 "$work/cut" "$disks" $slow
+check "interrupted on 2 ranks: the index and one piece a rank" $py -c "
+import os, sys, h5py
+d = sys.argv[1]
+names = sorted(os.listdir(d + '/checkpoint.pieces'))
+assert len(names) == 2 and names[0].endswith('.piece_0000.h5'), names
+assert names[0].split('.')[0] == names[1].split('.')[0], names
+with h5py.File(d + '/checkpoint.h5', 'r') as f:
+    assert f['pieces.n'][0] == 2 and 'mpm.00.position' not in f
+" "$work/cut"
+resume_on "$work/cut" 1 2 3
+check "interrupted on 2 ranks, resumed on 2: the run of 2 ranks, bit for bit" \
+  $same "$work/whole-2" "$work/cut-2"
+roundoff "interrupted on 2 ranks, resumed on 3" "$work/whole-2" "$work/cut-3"
+roundoff "interrupted on 2 ranks, resumed on 1" "$work/whole-1" "$work/cut-1"
+
+# shellcheck disable=SC2086
+interrupt 3 "$work/cut3" "$disks" $slow
+resume_on "$work/cut3" 2
+roundoff "interrupted on 3 ranks, resumed on 2" "$work/whole-1" "$work/cut3-2"
+
+# One process's checkpoint (whole) resumed on 2 ranks, where no rank
+# keeps the whole model: each rank's share cut from it, then let go.
+# shellcheck disable=SC2086
+interrupt 1 "$work/cut1" "$disks" $slow
+resume_on "$work/cut1" 2
+roundoff "interrupted on one process, resumed on 2" "$work/whole-1" \
+  "$work/cut1-2"
+
+# A piece whose bytes changed: refused by name before the run goes on.
+cp -r "$work/cut" "$work/bad"
+piece=$(ls "$work/bad/checkpoint.pieces/"*.piece_0001.h5)
+size=$(stat -c %s "$piece")
+printf '\x55\x55\x55\x55\x55\x55\x55\x55' |
+  dd of="$piece" bs=1 seek=$((size - 64)) conv=notrunc status=none
+ranks 2 "$bin" resume "$work/bad" --quiet >/dev/null 2>"$work/err"
+rc=$?
+check "a damaged piece: refused (exit $rc)" test $rc -ne 0
+check "a damaged piece: named" grep -q "piece_0001.h5" "$work/err"
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]
