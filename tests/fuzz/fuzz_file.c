@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <ftw.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,6 +69,23 @@ const char *fuzz_file(const char *name, const uint8_t *data, size_t size) {
     abort();
   }
   return path;
+}
+
+/* The sanitizers' hook, which libFuzzer sets to write the input that
+ * killed the process (absent without a sanitizer). */
+void __sanitizer_set_death_callback(void (*callback)(void))
+    __attribute__((weak));
+
+static void in_child(void) {
+  if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(NULL);
+}
+
+void fuzz_isolate(void) {
+  static bool done = false;
+  if (done) return;
+  done = true;
+  setenv("PM_ISOLATE_CPU_SECONDS", "1", 0);
+  pthread_atfork(NULL, NULL, in_child);
 }
 
 #define SEP "\n--pm-fuzz-file--\n"

@@ -3,6 +3,8 @@
 #define _DEFAULT_SOURCE
 #include "pm_h5_vet.h"
 
+#include <dirent.h>
+#include <errno.h>
 #include <hdf5.h>
 #include <stdlib.h>
 #include <string.h>
@@ -215,6 +217,51 @@ pm_err pm_results_vet(const pm_results *r, long n_keep) {
 done:
   if (paths)
     for (long k = 0; k < n; k++) free(paths[k]);
+  free(paths);
+  return ret;
+}
+
+/* Add dir's .h5 files to *paths (n of cap). */
+static pm_err add_h5_files(const char *dir, char ***paths, int *n, int *cap) {
+  DIR *d = opendir(dir);
+  if (!d) return PM_SUCCESS; /* a folder without results/ */
+  pm_err ret = PM_SUCCESS;
+  for (struct dirent *e; (e = readdir(d));) {
+    const size_t len = strlen(e->d_name);
+    if (len < 4 || strcmp(e->d_name + len - 3, ".h5") != 0) continue;
+    if (*n == *cap) {
+      PM_ENSURE(*cap < (1 << 24), PM_ERR_ARG, "'%s' holds too many files", dir);
+      char **grown = realloc(*paths, 2 * (size_t)*cap * sizeof *grown);
+      PM_ENSURE(grown, PM_ERR_MEMORY, "paths of '%s'", dir);
+      *paths = grown;
+      *cap *= 2;
+    }
+    (*paths)[*n] = malloc(PM_PATH_MAX + 1);
+    PM_ENSURE((*paths)[*n], PM_ERR_MEMORY, "paths of '%s'", dir);
+    PM_TRY(pm_path_join((*paths)[(*n)++], PM_PATH_MAX + 1, dir, e->d_name));
+  }
+done:
+  closedir(d);
+  return ret;
+}
+
+pm_err pm_h5_vet_path(const char *path) {
+  struct stat st;
+  PM_CHECK(stat(path, &st) == 0, PM_ERR_IO, "cannot read '%s': %s", path,
+           strerror(errno));
+  const char *what = "an HDF5 file of this program";
+  if (!S_ISDIR(st.st_mode)) return pm_h5_vet(&path, 1, true, what, PM_ERR_HDF5);
+  pm_err ret = PM_SUCCESS;
+  int n = 0, cap = 16;
+  char **paths = malloc((size_t)cap * sizeof *paths);
+  char results[PM_PATH_MAX + 1];
+  PM_CHECK(paths, PM_ERR_MEMORY, "paths of '%s'", path);
+  PM_TRY(pm_path_join(results, sizeof results, path, "results"));
+  PM_TRY(add_h5_files(path, &paths, &n, &cap));
+  PM_TRY(add_h5_files(results, &paths, &n, &cap));
+  ret = pm_h5_vet((const char *const *)paths, n, true, what, PM_ERR_HDF5);
+done:
+  for (int k = 0; k < n; k++) free(paths[k]);
   free(paths);
   return ret;
 }
