@@ -123,17 +123,34 @@ static herr_t vet_link(hid_t group, const char *name, const H5L_info_t *info,
   return w->a->err ? 1 : 0;
 }
 
+/* HDF5 failed to list what obj holds: a reader that opens one by name
+ * would meet what the listing did not reach (a damaged attribute message
+ * hid an attribute whose string loops HDF5), so the file is refused. */
+static void list_failed(vet_arg *a, hid_t obj, const char *what) {
+  char name[256] = "", why[512];
+  if (a->err) return;
+  snprintf(why, sizeof why, "%s", pm_h5_message());
+  H5Iget_name(obj, name, sizeof name);
+  a->err = PM_ERROR(a->code,
+                    "%s: HDF5 cannot list the %s of %s (%s): the file is "
+                    "damaged or not %s",
+                    a->current, what, name[0] ? name : "/", why, a->what);
+}
+
 /* An object: its attributes, a group's links, a dataset's values. */
 static void vet_object(vet_arg *a, hid_t obj, const char *name, int depth) {
   if (a->err || depth > VET_DEPTH || a->objects++ >= VET_OBJECTS) return;
-  H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_attr, a);
+  if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_attr, a) < 0)
+    list_failed(a, obj, "attributes");
   const H5I_type_t kind = H5Iget_type(obj);
-  if (kind == H5I_GROUP || kind == H5I_FILE) {
+  if (!a->err && (kind == H5I_GROUP || kind == H5I_FILE)) {
     H5G_info_t info;
     H5Gget_info(obj, &info);
     link_walk w = {a, depth};
-    H5Literate(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_link, &w);
-    /* The readers also list links in creation order. */
+    if (H5Literate(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_link, &w) < 0)
+      list_failed(a, obj, "links");
+    /* By creation order only where the group tracks it: no failure of
+     * this listing is a damage. */
     H5Literate(obj, H5_INDEX_CRT_ORDER, H5_ITER_INC, NULL, vet_link, &w);
   } else if (kind == H5I_DATASET) {
     read_values(a, obj, false, name);
