@@ -121,6 +121,9 @@ gmsh | checkpoint | index)
     # results folder's files vetted one after the other), each allowed
     # about a CPU second (PM_ISOLATE_CPU_SECONDS, fuzz_isolate).
     timeout=60
+    # A child that dies with a sanitizer's report is a refusal; its input
+    # is kept as findings-TARGET/child-PID, for triage by its report.
+    export PM_FUZZ_CHILD_FINDINGS=$PWD/$findings
     # A fork copies the page tables of what the process holds: a small
     # quarantine of freed memory keeps that small (13 against 20 ms of CPU
     # a checkpoint).

@@ -17,7 +17,7 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-  fuzz_isolate();
+  fuzz_isolate(data, size);
   (void)fuzz_file("checkpoint.h5", data, size);
   pm_ckpt *ck = NULL;
   pm_run_header h = {0};

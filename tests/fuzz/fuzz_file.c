@@ -76,12 +76,33 @@ const char *fuzz_file(const char *name, const uint8_t *data, size_t size) {
 void __sanitizer_set_death_callback(void (*callback)(void))
     __attribute__((weak));
 
-static void in_child(void) {
-  if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(NULL);
+/* The input being read, for a child that dies with a sanitizer's report:
+ * a refusal to the program, but the report may be of the project's code
+ * the child ran (gm_gmsh_read, the vetting), so the input is kept for
+ * triage as PM_FUZZ_CHILD_FINDINGS/child-PID. */
+static const uint8_t *input;
+static size_t input_size;
+
+static void child_died(void) {
+  const char *dir = getenv("PM_FUZZ_CHILD_FINDINGS");
+  char at[512];
+  if (!dir || !input) return;
+  snprintf(at, sizeof at, "%s/child-%ld", dir, (long)getpid());
+  FILE *f = fopen(at, "wb");
+  if (!f) return;
+  fwrite(input, 1, input_size, f);
+  fclose(f);
 }
 
-void fuzz_isolate(void) {
+static void in_child(void) {
+  if (__sanitizer_set_death_callback)
+    __sanitizer_set_death_callback(child_died);
+}
+
+void fuzz_isolate(const uint8_t *data, size_t size) {
   static bool done = false;
+  input = data;
+  input_size = size;
   if (done) return;
   done = true;
   setenv("PM_ISOLATE_CPU_SECONDS", "1", 0);

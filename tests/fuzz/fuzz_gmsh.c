@@ -21,8 +21,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   static bool warm = false;
+  fuzz_isolate(data, size);
   if (!warm && pm_isolate_enabled()) {
-    fuzz_isolate();
     warm = gm_gmsh_warm() == PM_SUCCESS;
     pm_error_clear();
   }

@@ -18,7 +18,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   long n_points = 0, n_frames = 0;
-  fuzz_isolate();
+  fuzz_isolate(data, size);
   if (!fuzz_results_folder(data, size, &n_points, &n_frames)) return 0;
   /* The first and the last frame, as probe reads them. */
   for (long frame = 0; frame >= -1; frame--) {
