@@ -6,6 +6,7 @@
 #include <stdio.h>
 
 #include "gm_gmsh_api.h"
+#include "pm_isolate.h"
 #include "pm_omp.h"
 #include "pm_scene.h"
 
@@ -63,6 +64,21 @@ static pm_err set_options(const gm_option *opts, size_t n, const char *path) {
   return PM_SUCCESS;
 }
 
+/* gmsh initialized by gm_gmsh_warm and not yet taken by a session. */
+static bool warm = false;
+
+pm_err gm_gmsh_warm(void) {
+  int ierr = 0;
+  if (warm) return PM_SUCCESS;
+  PM_CALL(gm_gmsh_api_load("reading gmsh files"));
+  const int threads = pm_omp_threads();
+  gmshInitialize(0, NULL, 0, &ierr);
+  pm_omp_set_threads(threads);
+  if (ierr) return gm_gmsh_fail("initialize", NULL);
+  warm = true;
+  return PM_SUCCESS;
+}
+
 pm_err gm_gmsh_begin(gm_gmsh_session *s, const char *path) {
   static const gm_option quiet[] = {
       {"General.Terminal", 0},
@@ -84,7 +100,10 @@ pm_err gm_gmsh_begin(gm_gmsh_session *s, const char *path) {
   /* gmsh sets the process-wide OpenMP thread count from its own option:
    * gm_gmsh_end puts ours back. */
   s->threads = pm_omp_threads();
-  gmshInitialize(0, NULL, 0, &ierr);
+  if (warm)
+    warm = false; /* initialized ahead by gm_gmsh_warm, and unused */
+  else
+    gmshInitialize(0, NULL, 0, &ierr);
   if (ierr) return gm_gmsh_fail("initialize", path);
   s->open = true;
   /* gmsh resets every option at initialization: nothing leaks between
@@ -94,7 +113,7 @@ pm_err gm_gmsh_begin(gm_gmsh_session *s, const char *path) {
 
 void gm_gmsh_end(gm_gmsh_session *s) {
   int ierr = 0;
-  if (s->open) gmshFinalize(&ierr);
+  if (s->open && !pm_isolate_in_child()) gmshFinalize(&ierr);
   s->open = false;
   if (s->threads > 0) pm_omp_set_threads(s->threads);
 }

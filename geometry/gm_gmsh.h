@@ -18,8 +18,17 @@ typedef struct {
  * (may be NULL) names the file in a failure message.  Call gm_gmsh_end
  * whatever this returns. */
 pm_err gm_gmsh_begin(gm_gmsh_session *s, const char *path);
-/* Finalize gmsh (if it was initialized) and restore the thread count. */
+/* Finalize gmsh (if it was initialized) and restore the thread count.  In
+ * a child of pm_isolate_run gmsh is left as it is: the child's memory, and
+ * gmsh's state with it, ends with the child, and finalizing costs as much
+ * as initializing. */
 void gm_gmsh_end(gm_gmsh_session *s);
+/* Initialize gmsh once ahead, in a process that then reads gmsh files in
+ * children (pm_isolate.h): the next session begun (in each child, which
+ * inherits it unused) takes it instead of initializing gmsh again.  A
+ * process that reads many files (a fuzzer) saves gmsh's start-up on each;
+ * the parent itself must begin no session of its own meanwhile. */
+pm_err gm_gmsh_warm(void);
 /* Element size h everywhere (overrides sizes a file sets). */
 pm_err gm_gmsh_size(double h, const char *path);
 
@@ -85,6 +94,12 @@ typedef struct {
  * message gives the model's dimension), 2D nodes off the z = 0 plane or
  * inconsistent gmsh data, PM_ERR_MEMORY.  On failure out holds nothing. */
 pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out);
+
+/* PM_ERR_MESH naming name (a file, or NULL for a model in memory) and the
+ * node when one of the n nodes x[3 n] has a coordinate that is not finite
+ * (gmsh reads "nan" and "inf" in a .msh; the mesh's ordering and volumes
+ * need numbers). */
+pm_err gm_gmsh_check_nodes(const char *name, const double *x, long n);
 
 /* The model's nodes by tag, sorted: each with its number among the
  * elements' corners (-1 for a node no element uses). */

@@ -104,6 +104,15 @@ done:
   return ret;
 }
 
+pm_err gm_gmsh_check_nodes(const char *name, const double *x, long n) {
+  for (long i = 0; i < 3 * n; i++)
+    PM_CHECK(isfinite(x[i]), PM_ERR_MESH,
+             "'%s' has node %ld at (%g, %g, %g): expected finite coordinates",
+             label(name), i / 3, x[i - i % 3], x[i - i % 3 + 1],
+             x[i - i % 3 + 2]);
+  return PM_SUCCESS;
+}
+
 /* Triangles must lie in z = 0: a surface mesh elsewhere projected onto the
  * plane would give nonsense.  Then z is set to 0 exactly. */
 static pm_err check_plane(const char *name, gm_gmsh_mesh *m) {
@@ -290,6 +299,7 @@ pm_err gm_gmsh_read(const char *name, int dim, bool groups, gm_gmsh_mesh *out) {
                          &nodes));
   out->n_nodes = nn;
   out->n_elems = n;
+  PM_TRY(gm_gmsh_check_nodes(name, out->x, nn));
   if (dim == 2) PM_TRY(check_plane(name, out));
   if (groups) PM_TRY(read_groups(name, dim, &nodes, out));
 done:

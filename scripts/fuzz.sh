@@ -11,13 +11,19 @@
 # stacks), raw (raw volumes), points (point clouds and voxel centres),
 # table (CSV tables: FE ladders, lattices, tolerances, history.csv), gmsh
 # (.msh volume and surface meshes), checkpoint (checkpoint.h5), index (the
-# results folder `resume` reopens).
+# results folder `resume` reads), pipe (what a child reading a file passes
+# back, pm_isolate.h).
 #
-# The readers run in the fuzzer's process (PM_ISOLATE=0: coverage and the
-# sanitizers see no child).  gmsh, checkpoint and index run in libFuzzer's
-# fork mode, which goes on past a crash: libgmsh and libhdf5 stop on some
-# inputs by themselves (tests/fuzz/upstream/, which the program refuses by
-# reading such files in a child).
+# gmsh, checkpoint and index run as the program reads such files: the
+# library in a child (gmsh initialized once before the children, HDF5's
+# child limited to about a CPU second), the project's code on what the
+# child passed back or vetted in the fuzzer's process, where any crash,
+# leak, sanitizer report or hang is the program's; libFuzzer's ordinary
+# mode.  With PM_ISOLATE=0 in the environment they read in the fuzzer's
+# process instead (coverage and the sanitizers then see the readers' own
+# code), in libFuzzer's fork mode, which goes on past a crash: libgmsh and
+# libhdf5 stop on some inputs by themselves (tests/fuzz/upstream/).  The
+# other readers run in the fuzzer's process.
 #
 # New inputs go to build-fuzz/corpus-TARGET/; crashes, leaks and hangs to
 # build-fuzz/findings-TARGET/ (triage: build-fuzz/tests/fuzz_TARGET FILE
@@ -30,13 +36,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 usage() {
-  echo "usage: $0 scene|tiff|raw|points|table|gmsh|checkpoint|index" \
+  echo "usage: $0 scene|tiff|raw|points|table|gmsh|checkpoint|index|pipe" \
     "[SECONDS | -runs=N] [LIBFUZZER OPTION]..." >&2
   exit 1
 }
 target=${1:-}
 case $target in
-scene | tiff | raw | points | table | gmsh | checkpoint | index) ;;
+scene | tiff | raw | points | table | gmsh | checkpoint | index | pipe) ;;
 *) usage ;;
 esac
 shift
@@ -96,27 +102,49 @@ scene)
   extra+=(-dict="$dict")
   ;;
 checkpoint | index) max_len=81920 ;;
+pipe) max_len=4096 ;;
 gmsh) max_len=8192 ;;
 esac
 
-# The readers in the fuzzer's process, not in a child (pm_isolate.h):
-# coverage and the sanitizers see only the process they run in.
-export PM_ISOLATE=0
+timeout=10
 case $target in
 gmsh | checkpoint | index)
-  # libgmsh 4.8 and libhdf5 1.10 stop on some inputs by themselves
-  # (tests/fuzz/upstream/): the campaign runs in a child of libFuzzer's
-  # that is restarted after a crash, a leak, a hang or running out of
-  # memory, and each finding is kept in build-fuzz/findings-TARGET/ for
-  # triage by its stack.
-  extra+=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
+  if [ "${PM_ISOLATE:-}" = 0 ]; then
+    # In the process: libgmsh 4.8 and libhdf5 1.10 stop on some inputs by
+    # themselves (tests/fuzz/upstream/): the campaign runs in a child of
+    # libFuzzer's that is restarted after a crash, a leak, a hang or
+    # running out of memory, and each finding is kept in
+    # build-fuzz/findings-TARGET/ for triage by its stack.
+    extra+=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
+  else
+    # As the program reads: an input may start a dozen children (the
+    # results folder's files vetted one after the other), each allowed
+    # about a CPU second (PM_ISOLATE_CPU_SECONDS, fuzz_isolate).
+    timeout=60
+    # A child that dies with a sanitizer's report is a refusal; its input
+    # is kept as findings-TARGET/child-PID, for triage by its report.
+    export PM_FUZZ_CHILD_FINDINGS=$PWD/$findings
+    # A fork copies the page tables of what the process holds: a small
+    # quarantine of freed memory keeps that small (13 against 20 ms of CPU
+    # a checkpoint).
+    asan=:quarantine_size_mb=16
+    # gmsh runs only in the children, whose leaks end with them: the
+    # fuzzer's process may unwind allocations by frame pointers.
+    [ "$target" = gmsh ] && unwind=1
+  fi
   ;;
+scene | tiff | raw | points | table) export PM_ISOLATE=0 ;;
+pipe) unwind=1 ;; # no library reads in its process
 esac
-export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1
-# What the distribution's libraries leak by themselves (tests/lsan.supp).
-export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:fast_unwind_on_malloc=0
+# A child reading HDF5 may allocate at most 1 GB at once: under
+# AddressSanitizer no address-space limit holds (pm_isolate_memory_limit),
+# so its allocator refuses what a damaged file announces.
+export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1:max_allocation_size_mb=1024${asan:-}
+# What the distribution's libraries leak by themselves (tests/lsan.supp),
+# matched on whole stacks (libgmsh and libhdf5 keep no frame pointers).
+export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:fast_unwind_on_malloc=${unwind:-0}
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 exec "$build/tests/fuzz_$target" "$budget" -max_len=$max_len \
-  -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  -timeout=$timeout -rss_limit_mb=2048 -print_final_stats=1 \
   -artifact_prefix="$findings/" "${extra[@]}" "$@" "$corpus" "$seeds" \
   "$replayed"

@@ -16,6 +16,13 @@ one a rank, joined by the frame's file; its fields read here in one
 process's order all the same.  This module reads those files directly and
 holds none of them open between calls, so it reads a run while it goes
 on and never blocks the writer.
+
+Each HDF5 file is vetted by the program before h5py opens it (`pointmech
+vet FILE`: HDF5 reads it whole in a child process): libhdf5 stops or
+loops the process that reads some damaged files, and such a file raises
+`Refused` with the program's reason instead.  The program is $POINTMECH,
+else `pointmech` on the PATH, else build/pointmech beside this module's
+folder; `open(folder, vet=False)` reads without it.
 """
 
 import builtins
@@ -23,18 +30,62 @@ import csv
 import json
 import os
 import re
+import shutil
+import subprocess
 import time as _time
 
 import h5py
 import numpy as np
 
-__all__ = ["open", "Run", "Frame", "read_rows"]
+__all__ = ["open", "Run", "Frame", "read_rows", "vet", "Refused"]
 
 _FRAME = re.compile(r"^frame_(\d{6,})\.h5$")
 
 
-def _read_group(path):
-    """Every dataset of an HDF5 file as numpy arrays, and its attributes."""
+class Refused(OSError):
+    """A file the program's vetting refused (or could not vet)."""
+
+
+def _program():
+    """The pointmech program that vets files."""
+    found = os.environ.get("POINTMECH") or shutil.which("pointmech")
+    if found:
+        return found
+    here = os.path.dirname(os.path.abspath(__file__))
+    built = os.path.join(here, os.pardir, os.pardir, "build", "pointmech")
+    if os.access(built, os.X_OK):
+        return os.path.normpath(built)
+    raise Refused("cannot vet HDF5 files: no pointmech program (set "
+                  "POINTMECH to it, put it on the PATH, or open the run "
+                  "with vet=False)")
+
+
+# Files vetted, by path, modification time and size: a frame is vetted
+# once however often it is read, and again if it is replaced.
+_vetted = set()
+
+
+def vet(path):
+    """Have the program read the HDF5 file `path` (or every HDF5 file of
+    the run folder `path`) whole in a child process: raises Refused with
+    the program's reason for a file that stops or loops HDF5."""
+    st = os.stat(path)
+    key = (os.path.abspath(path), st.st_mtime_ns, st.st_size)
+    if key in _vetted:
+        return
+    done = subprocess.run([_program(), "vet", path], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True)
+    if done.returncode != 0:
+        why = done.stderr.strip() or "exit status %d" % done.returncode
+        raise Refused("%s: refused by pointmech vet: %s" % (path, why))
+    _vetted.add(key)
+
+
+def _read_group(path, checked=True):
+    """Every dataset of an HDF5 file as numpy arrays, and its attributes
+    (the file vetted first when checked)."""
+    if checked:
+        vet(path)
     data = {}
     with h5py.File(path, "r") as f:
         def take(name, obj):
@@ -73,15 +124,16 @@ class Frame:
     """One output frame: its fields by name (numpy arrays, read at the
     first access), `step`, `time` and `index`."""
 
-    def __init__(self, path, index):
+    def __init__(self, path, index, checked=True):
         self.path = path
         self.index = index
+        self._checked = checked
         self._data = None
         self._attrs = None
 
     def _load(self):
         if self._data is None:
-            self._data, self._attrs = _read_group(self.path)
+            self._data, self._attrs = _read_group(self.path, self._checked)
 
     def __getitem__(self, name):
         self._load()
@@ -119,8 +171,9 @@ class _Frames:
     iteration.  Listed afresh at each call, so a running run's new frames
     appear."""
 
-    def __init__(self, folder):
+    def __init__(self, folder, checked=True):
         self._dir = os.path.join(folder, "results")
+        self._checked = checked
 
     def _paths(self):
         try:
@@ -137,22 +190,23 @@ class _Frames:
     def __getitem__(self, k):
         paths = self._paths()
         if isinstance(k, slice):
-            return [Frame(p, i) for i, p in paths[k]]
+            return [Frame(p, i, self._checked) for i, p in paths[k]]
         i, p = paths[k]
-        return Frame(p, i)
+        return Frame(p, i, self._checked)
 
     def __iter__(self):
-        return iter([Frame(p, i) for i, p in self._paths()])
+        return iter([Frame(p, i, self._checked) for i, p in self._paths()])
 
 
 class Run:
     """A run folder (`pointmech run ... --out FOLDER`)."""
 
-    def __init__(self, folder):
+    def __init__(self, folder, vet=True):
         if not os.path.isdir(folder):
             raise FileNotFoundError("no run folder %r" % folder)
         self.folder = folder
-        self.frames = _Frames(folder)
+        self.vet = vet
+        self.frames = _Frames(folder, vet)
         self._mesh = None
 
     @property
@@ -186,7 +240,7 @@ class Run:
         "cells", and "surface" where the run has a membrane."""
         if self._mesh is None:
             self._mesh, _ = _read_group(
-                os.path.join(self.folder, "results", "mesh.h5"))
+                os.path.join(self.folder, "results", "mesh.h5"), self.vet)
         return self._mesh
 
     def running(self):
@@ -205,7 +259,7 @@ class Run:
         while True:
             paths = self.frames._paths()
             for i, p in paths[seen:]:
-                yield Frame(p, i)
+                yield Frame(p, i, self.vet)
             if len(paths) > seen:
                 seen = len(paths)
                 idle_since = _time.monotonic()
@@ -213,7 +267,7 @@ class Run:
                 # the end: frames written before the summary's last word
                 paths = self.frames._paths()
                 for i, p in paths[seen:]:
-                    yield Frame(p, i)
+                    yield Frame(p, i, self.vet)
                 return
             if timeout is not None and \
                     _time.monotonic() - idle_since > timeout:
@@ -225,6 +279,7 @@ class Run:
                                                  len(self.frames))
 
 
-def open(folder):
-    """Open the run folder `folder`."""
-    return Run(folder)
+def open(folder, vet=True):
+    """Open the run folder `folder`; its HDF5 files are vetted by the
+    program before they are read, unless vet is False."""
+    return Run(folder, vet)

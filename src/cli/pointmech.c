@@ -12,6 +12,7 @@
 #include "pm_app.h"
 #include "pm_compare.h"
 #include "pm_error.h"
+#include "pm_h5_vet.h"
 #include "pm_memory.h"
 #include "pm_par.h"
 #include "pm_par_mpi.h"
@@ -57,6 +58,7 @@ static void usage(FILE *out) {
       "       pointmech bench SUITE [--only NAME,...] [--set KEY=VALUE]... "
       "[--out DIR]\n"
       "                 [--overwrite] [--quiet]\n"
+      "       pointmech vet PATH...\n"
       "       pointmech keys\n"
       "       pointmech normals\n"
       "       pointmech --help | --version\n"
@@ -94,6 +96,15 @@ static void usage(FILE *out) {
       "         every field at the points themselves (every point, or the "
       "one at\n"
       "         each coordinate of FILE.csv), no fit\n"
+      "  vet    read each HDF5 file of PATH (a run folder: its results "
+      "and\n"
+      "         checkpoint; or one file) whole by HDF5 in a child "
+      "process, and\n"
+      "         refuse a file that stops or loops HDF5, with the reason: "
+      "what a\n"
+      "         reader outside the program (the Python module) asks "
+      "before it\n"
+      "         opens them\n"
       "  convergence  run SCENE once per ladder value (several ladders "
       "go in\n"
       "         step) and tabulate h, points, steps, NRMSE against the "
@@ -420,6 +431,17 @@ int main(int argc, char **argv) {
       strcmp(cmd, "convergence") == 0 || strcmp(cmd, "compare") == 0 ||
       strcmp(cmd, "bench") == 0)
     pm_wait_policy_apply(argv);
+  if (strcmp(cmd, "vet") == 0) {
+    /* HDF5 files read by HDF5 in a child, for readers outside the
+     * program (the Python module): exit 0 when every one was read. */
+    for (int k = 2; k < argc; k++) {
+      pm_err e = pm_h5_vet_path(argv[k]);
+      if (e) return report(e);
+    }
+    if (argc > 2) return EXIT_OK;
+    fprintf(stderr, "pointmech: vet needs a run folder or HDF5 file\n");
+    return EXIT_INPUT;
+  }
   pm_err init = pm_app_init();
   if (!init) init = pm_par_init(&argc, &argv);
   if (!init) init = pm_par_attach(MPI_COMM_WORLD); /* the program's ranks */

@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <ftw.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,6 +69,44 @@ const char *fuzz_file(const char *name, const uint8_t *data, size_t size) {
     abort();
   }
   return path;
+}
+
+/* The sanitizers' hook, which libFuzzer sets to write the input that
+ * killed the process (absent without a sanitizer). */
+void __sanitizer_set_death_callback(void (*callback)(void))
+    __attribute__((weak));
+
+/* The input being read, for a child that dies with a sanitizer's report:
+ * a refusal to the program, but the report may be of the project's code
+ * the child ran (gm_gmsh_read, the vetting), so the input is kept for
+ * triage as PM_FUZZ_CHILD_FINDINGS/child-PID. */
+static const uint8_t *input;
+static size_t input_size;
+
+static void child_died(void) {
+  const char *dir = getenv("PM_FUZZ_CHILD_FINDINGS");
+  char at[512];
+  if (!dir || !input) return;
+  snprintf(at, sizeof at, "%s/child-%ld", dir, (long)getpid());
+  FILE *f = fopen(at, "wb");
+  if (!f) return;
+  fwrite(input, 1, input_size, f);
+  fclose(f);
+}
+
+static void in_child(void) {
+  if (__sanitizer_set_death_callback)
+    __sanitizer_set_death_callback(child_died);
+}
+
+void fuzz_isolate(const uint8_t *data, size_t size) {
+  static bool done = false;
+  input = data;
+  input_size = size;
+  if (done) return;
+  done = true;
+  setenv("PM_ISOLATE_CPU_SECONDS", "1", 0);
+  pthread_atfork(NULL, NULL, in_child);
 }
 
 #define SEP "\n--pm-fuzz-file--\n"

@@ -31,6 +31,16 @@ void fuzz_clear(void);
  * (little-endian).  Written to the private folder; false for an input of
  * fewer than 4 bytes.  *n_frames: the frames written (-2 or -1 when the
  * input stops before the mesh or the first frame). */
+/* Before each input (data, size) of a harness whose readers run in a
+ * child (pm_isolate.h): unless PM_ISOLATE_CPU_SECONDS is set, the child of
+ * an HDF5 reader may use about a CPU second (the program's allowance is
+ * 10: a damaged global heap loops HDF5 until then); and a child of the
+ * fuzzer that dies with a sanitizer's report writes the input to
+ * PM_FUZZ_CHILD_FINDINGS/child-PID (where set) instead of the fuzzer's own
+ * crash report: the harness process refuses the file as the program does
+ * and goes on. */
+void fuzz_isolate(const uint8_t *data, size_t size);
+
 bool fuzz_results_folder(const uint8_t *data, size_t size, long *n_points,
                          long *n_frames);
 

@@ -111,6 +111,9 @@ index)
     } >"$dir/results-keep$keep"
   done
   ;;
+pipe)
+  /usr/bin/python3 "$here/tests/fuzz/pipe_seeds.py" "$dir"
+  ;;
 *)
   echo "seeds.sh: no target $target" >&2
   exit 1

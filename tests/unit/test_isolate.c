@@ -4,7 +4,9 @@
  * reading done in the process with PM_ISOLATE=0, a .geo meshed in a child
  * after OpenMP's threads ran; and every input of
  * tests/fuzz/upstream/, which stops the process inside libgmsh or libhdf5
- * when read there, refused by the real readers with the file's name. */
+ * when read there, refused by the real readers with the file's name; and
+ * what a hostile child could pass back (pm_isolate_stream) refused by the
+ * parent with the file's name. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +16,8 @@
 #include "pm_testing.h"
 
 #include <dirent.h>
+#include <math.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -194,6 +198,13 @@ static void assert_names(pm_err e, const char *path) {
   pm_error_clear();
 }
 
+/* `pointmech vet`: a file HDF5 reads without fault passes (its damage is
+ * then the reader's to refuse: some of these fault only under
+ * AddressSanitizer); one that stops HDF5 is refused naming path. */
+static void assert_vetted(pm_err e, const char *path) {
+  if (e) assert_names(e, path);
+}
+
 static void test_upstream_gmsh(void **state) {
   (void)state;
   char names[8][1024];
@@ -247,6 +258,8 @@ static void test_upstream_checkpoint(void **state) {
     uint8_t *data = slurp(names[k], &size);
     const char *path = fuzz_file("checkpoint.h5", data, size);
     assert_names(read_checkpoint(fuzz_dir()), path);
+    /* `pointmech vet DIR`, as the Python module asks it. */
+    assert_vetted(pm_h5_vet_path(fuzz_dir()), path);
     free(data);
     fuzz_clear();
   }
@@ -266,6 +279,10 @@ static void test_upstream_index(void **state) {
     double *x = NULL, *u = NULL;
     assert_names(pm_results_read(fuzz_dir(), -1, &np, &x, &u), fuzz_dir());
     assert_null(x);
+    FILE *out = fopen("/dev/null", "w");
+    assert_names(pm_probe_points(fuzz_dir(), NULL, -1, out), fuzz_dir());
+    fclose(out);
+    assert_vetted(pm_h5_vet_path(fuzz_dir()), fuzz_dir());
     pm_results *r = NULL;
     assert_names(pm_results_reopen(fuzz_dir(), n_points,
                                    n_frames > 0 ? n_frames : 0, &r),
@@ -275,6 +292,102 @@ static void test_upstream_index(void **state) {
     fuzz_clear();
   }
   unsetenv("PM_ISOLATE_CPU_SECONDS");
+}
+
+/* ---- A hostile child's stream ------------------------------------------ */
+
+typedef struct {
+  uint8_t b[1024];
+  size_t n;
+} stream;
+
+static void add(stream *s, const void *p, size_t n) {
+  assert_true(s->n + n <= sizeof s->b);
+  memcpy(s->b + s->n, p, n);
+  s->n += n;
+}
+
+static void add_u32(stream *s, uint32_t v) { add(s, &v, sizeof v); }
+
+static void add_array(stream *s, const void *p, uint64_t count, size_t size) {
+  add(s, &count, sizeof count);
+  add(s, p, (size_t)count * size);
+}
+
+/* A tetrahedron as gm_gmsh_isolate.c passes a mesh back; corner 3 of the
+ * element is `last`, and the end mark is written when `end`. */
+static void tetrahedron(stream *s, long last, bool end) {
+  const struct {
+    int dim, n_groups;
+    long n_nodes, n_elems;
+    int meshed;
+    double size_factor;
+  } head = {3, 0, 4, 1, 0, 1.0};
+  const double x[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const long elem[4] = {0, 1, 2, last};
+  s->n = 0;
+  add_u32(s, 0x706d6931u); /* the mark, success, no message */
+  add_u32(s, 0);
+  add_u32(s, 0);
+  add(s, &head, sizeof head);
+  add_array(s, x, 12, sizeof *x);
+  add_array(s, elem, 4, sizeof *elem);
+  if (end) add_u32(s, 0x706d6945u);
+}
+
+/* gm_mesh_file of "mesh.msh" reading s as its child's stream. */
+static pm_err mesh_from(const stream *s, gm_mesh **m) {
+  const char *at = fuzz_file("stream", s->b, s->n);
+  const int fd = open(at, O_RDONLY);
+  assert_true(fd >= 0);
+  const char *path = fuzz_file("mesh.msh", (const uint8_t *)"", 0);
+  pm_isolate_stream(fd);
+  pm_err e = gm_mesh_file(path, 3, 0.1, GM_SIZES_REPLACE, m);
+  pm_isolate_stream(-1);
+  close(fd);
+  return e;
+}
+
+static void test_hostile_stream(void **state) {
+  (void)state;
+  stream s;
+  gm_mesh *m = NULL;
+  const char *path = fuzz_path("mesh.msh");
+  tetrahedron(&s, 3, true);
+  assert_ok(mesh_from(&s, &m));
+  assert_int_equal(m->n_nodes, 4);
+  assert_int_equal(m->n_cells, 1);
+  gm_mesh_destroy(m);
+  m = NULL;
+  /* A corner that is no node: the process would index past the nodes. */
+  tetrahedron(&s, 7, true);
+  assert_fails(mesh_from(&s, &m), PM_ERR_MESH, path);
+  assert_non_null(strstr(pm_error_message(),
+                         "passed a malformed result (an element's corner "
+                         "passed back is no node)"));
+  /* Cut short, and torn: no end mark, or another in its place. */
+  tetrahedron(&s, 3, false);
+  s.n -= 5;
+  assert_fails(mesh_from(&s, &m), PM_ERR_MESH, path);
+  tetrahedron(&s, 3, false);
+  add_u32(&s, 0x12345678u);
+  assert_fails(mesh_from(&s, &m), PM_ERR_MESH, path);
+  assert_non_null(strstr(pm_error_message(), "passed a torn result"));
+  /* An array of 2^40 coordinates announced, none sent: refused without
+   * allocating them. */
+  tetrahedron(&s, 3, true);
+  const uint64_t huge = (uint64_t)1 << 40;
+  memcpy(s.b + 12 + 40, &huge, sizeof huge);
+  assert_fails(mesh_from(&s, &m), PM_ERR_MESH, path);
+  /* A coordinate that is not a number. */
+  tetrahedron(&s, 3, true);
+  const double not_a_number = NAN;
+  memcpy(s.b + 12 + 40 + 8, &not_a_number, sizeof not_a_number);
+  assert_fails(mesh_from(&s, &m), PM_ERR_MESH, path);
+  assert_non_null(strstr(pm_error_message(), "expected finite coordinates"));
+  assert_null(m);
+  fuzz_clear();
+  pm_error_clear();
 }
 
 int main(void) {
@@ -288,6 +401,7 @@ int main(void) {
       cmocka_unit_test(test_upstream_gmsh),
       cmocka_unit_test(test_upstream_checkpoint),
       cmocka_unit_test(test_upstream_index),
+      cmocka_unit_test(test_hostile_stream),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -2,12 +2,15 @@
 # The Python module python/pointmech (Debian's h5py and numpy): opened from
 # the repository, it reads a coarse F2 run's frames, mesh, history and
 # summary (u_z = -0.4 z, F2's exact state, at every point of the last frame),
-# and follows a run while it goes on: every frame, in order, as written.
+# follows a run while it goes on: every frame, in order, as written; and
+# has the program vet each HDF5 file before h5py opens it (a damaged frame
+# refused with the reason).
 set -u
 bin=$1
 src=$2
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 export PYTHONPATH=$src/python
+export POINTMECH=$bin # the program that vets the files
 py=/usr/bin/python3
 scene=$src/cases/fpm/f2-unconstrained-compression.yaml
 # shellcheck source=lib.sh
@@ -63,6 +66,24 @@ check "follow: every frame in order, as many as the summary's" test $? -eq 0
 wait $pid
 check "the followed run ends well" test $? -eq 0
 echo "python: $(cat "$work/read"); followed: $(cat "$work/follow.txt")"
+
+# A frame whose global heap loops HDF5 (tests/fuzz/upstream/): refused by
+# the program's vetting, with its reason, before h5py opens it.
+bad=$work/bad
+mkdir -p "$bad/results"
+cp "$src/tests/fuzz/upstream/checkpoint/hdf5-global-heap-loop" \
+  "$bad/results/frame_000000.h5"
+PM_ISOLATE_CPU_SECONDS=1 $py - "$bad" >"$work/refused" 2>"$work/err" <<'PY'
+import sys, pointmech
+try:
+    pointmech.open(sys.argv[1]).frames[0].keys()
+except pointmech.Refused as e:
+    print(e)
+else:
+    raise SystemExit("not refused")
+PY
+check "a damaged frame refused by pointmech vet, with the reason" \
+  grep -q "frame_000000.h5: HDF5 used more than 1 CPU seconds" "$work/refused"
 
 # tools/paraview-open.py where ParaView is installed (Debian's paraview and
 # python3-paraview; xvfb-run for a machine without a display): a picture of

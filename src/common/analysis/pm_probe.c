@@ -15,25 +15,10 @@
 #include "pm_h5_vet.h"
 #include "pm_isolate.h"
 #include "pm_mls.h"
+#include "pm_probe_impl.h"
 #include "pm_output.h"
 
-#define OBJ_NAME_MAX 64
 #define SHOW_MAX 60 /* bytes of a bad CSV line quoted in errors */
-
-/* The result points, the chosen frame's displacement and their
- * moving-least-squares cloud. */
-typedef struct {
-  long n;
-  double *x, *u; /* [n][3] each */
-  pm_mls *mls;
-} cloud;
-
-/* The query points and the CSV line each came from (for messages). */
-typedef struct {
-  long m, cap;
-  double *p; /* [m][3] */
-  long *line;
-} queries;
 
 /* ---- HDF5 input -------------------------------------------------------- */
 
@@ -119,7 +104,7 @@ done:
 
 /* Rows v[n][width] in piece order into one-process order (index from
  * read_order; nothing to do when NULL). */
-static pm_err put_in_order(double *v, long n, int width, const long *index) {
+pm_err pm_probe_in_order(double *v, long n, int width, const long *index) {
   if (!index) return PM_SUCCESS;
   double *tmp = NULL;
   PM_CALL(PM_ALLOC(tmp, (size_t)n * width, "rows in one-process order"));
@@ -131,19 +116,7 @@ static pm_err put_in_order(double *v, long n, int width, const long *index) {
   return PM_SUCCESS;
 }
 
-/* The results file: its handle, the reference coordinates, and frame
- * `frame` (last when < 0) opened as a group, with that frame's index.
- * HDF5's own error printing is off while it is open (results_close
- * restores the caller's). */
-typedef struct {
-  hid_t file, group;
-  long frame;
-  long *order; /* the frame's rows' one-process indices, or NULL */
-  H5E_auto2_t old_func;
-  void *old_data;
-} results;
-
-static void results_close(results *r) {
+void pm_probe_results_close(results *r) {
   if (r->group >= 0) H5Gclose(r->group);
   if (r->file >= 0) H5Fclose(r->file);
   r->group = r->file = -1;
@@ -152,7 +125,8 @@ static void results_close(results *r) {
   H5Eset_auto2(H5E_DEFAULT, r->old_func, r->old_data);
 }
 
-static pm_err results_open(const char *path, long frame, cloud *c, results *r) {
+pm_err pm_probe_results_open(const char *path, long frame, cloud *c,
+                             results *r) {
   pm_err ret = PM_SUCCESS;
   hid_t frames = -1;
   H5G_info_t info;
@@ -171,7 +145,7 @@ static pm_err results_open(const char *path, long frame, cloud *c, results *r) {
                  &c->x));
   PM_TRY(read_order(r->file, "/mesh/" PM_PIECE_INDEX, "/mesh/" PM_PIECE_INDEX,
                     path, c->n, &order));
-  PM_TRY(put_in_order(c->x, c->n, 3, order));
+  PM_TRY(pm_probe_in_order(c->x, c->n, 3, order));
   H5_OK(frames = H5Gopen2(r->file, "/frames", H5P_DEFAULT), "H5Gopen2",
         "/frames", path);
   H5_OK(H5Gget_info(frames, &info), "H5Gget_info", "/frames", path);
@@ -191,7 +165,7 @@ static pm_err results_open(const char *path, long frame, cloud *c, results *r) {
 done:
   free(order);
   if (frames >= 0) H5Gclose(frames);
-  if (ret != PM_SUCCESS) results_close(r);
+  if (ret != PM_SUCCESS) pm_probe_results_close(r);
   return ret;
 }
 
@@ -202,7 +176,7 @@ static pm_err read_results_here(const char *path, long frame, cloud *c) {
   results r;
   char obj[OBJ_NAME_MAX];
   htri_t has;
-  PM_CALL(results_open(path, frame, c, &r));
+  PM_CALL(pm_probe_results_open(path, frame, c, &r));
   snprintf(obj, sizeof obj, "/frames/%06ld", r.frame);
   H5_OK(has = H5Lexists(r.group, "displacement", H5P_DEFAULT), "H5Lexists", obj,
         path);
@@ -210,9 +184,9 @@ static pm_err read_results_here(const char *path, long frame, cloud *c) {
             r.frame, path);
   snprintf(obj, sizeof obj, "/frames/%06ld/displacement", r.frame);
   PM_TRY(read_n3(r.group, "displacement", obj, path, &c->n, &c->u));
-  PM_TRY(put_in_order(c->u, c->n, 3, r.order));
+  PM_TRY(pm_probe_in_order(c->u, c->n, 3, r.order));
 done:
-  results_close(&r);
+  pm_probe_results_close(&r);
   return ret;
 }
 
@@ -245,19 +219,25 @@ static pm_err read_get(void *p, int fd) {
   return PM_SUCCESS;
 }
 
-/* Coordinates and frame `frame` (last when < 0) of the results file. */
-static pm_err read_results(const char *path, long frame, cloud *c) {
-  read_arg a = {path, frame, c};
+pm_err pm_probe_isolate(const char *path, pm_err (*work)(void *),
+                        pm_err (*put)(void *, int), pm_err (*get)(void *, int),
+                        void *arg) {
   const pm_isolate_job job = {.path = path,
                               .library = "HDF5",
                               .what = "results of this program",
                               .code = PM_ERR_HDF5,
                               .cpu_seconds = PM_H5_VET_CPU_SECONDS,
-                              .work = read_work,
-                              .put = read_put,
-                              .get = read_get,
-                              .arg = &a};
+                              .work = work,
+                              .put = put,
+                              .get = get,
+                              .arg = arg};
   return pm_isolate_run(&job);
+}
+
+/* Coordinates and frame `frame` (last when < 0) of the results file. */
+static pm_err read_results(const char *path, long frame, cloud *c) {
+  read_arg a = {path, frame, c};
+  return pm_probe_isolate(path, read_work, read_put, read_get, &a);
 }
 
 /* ---- Query points ------------------------------------------------------ */
@@ -309,7 +289,7 @@ static pm_err add_query(queries *qs, const double p[3], long line) {
 }
 
 /* Every point of the CSV file, skipping blanks, comments and a header. */
-static pm_err read_points(const char *csv, queries *qs) {
+pm_err pm_probe_read_points(const char *csv, queries *qs) {
   pm_err ret = PM_SUCCESS;
   pm_lines in = {0};
   char *s;
@@ -336,14 +316,14 @@ done:
   return ret;
 }
 
-static void cloud_free(cloud *c) {
+void pm_probe_cloud_free(cloud *c) {
   free(c->x);
   free(c->u);
   pm_mls_free(c->mls);
 }
 
 /* The cloud's fit structure, named by its results file in messages. */
-static pm_err index_cloud(cloud *c, const char *path) {
+pm_err pm_probe_index_cloud(cloud *c, const char *path) {
   char what[PM_PATH_MAX + 32];
   snprintf(what, sizeof what, "'%s'", path);
   return pm_mls_create(c->n, c->x, what, &c->mls);
@@ -368,7 +348,7 @@ pm_err pm_results_read(const char *out_dir, long frame, long *n, double **x,
   *u = c.u;
   c.x = c.u = NULL;
 done:
-  cloud_free(&c);
+  pm_probe_cloud_free(&c);
   return ret;
 }
 
@@ -379,14 +359,14 @@ pm_err pm_probe_map(const char *out_dir, long frame, long m, const double *q,
   char path[PM_PATH_MAX + 1];
   PM_CALL(pm_path_join(path, sizeof path, out_dir, "results.h5"));
   PM_TRY(read_results(path, frame, &c));
-  PM_TRY(index_cloud(&c, path));
+  PM_TRY(pm_probe_index_cloud(&c, path));
   for (long i = 0; i < m; i++)
     PM_ENSURE(probe_at(&c, q + 3 * i, u + 3 * i), PM_ERR_GEOMETRY,
               "no regular moving-least-squares fit at (%g, %g, %g) from the "
               "%ld points of '%s'",
               q[3 * i], q[3 * i + 1], q[3 * i + 2], c.n, path);
 done:
-  cloud_free(&c);
+  pm_probe_cloud_free(&c);
   return ret;
 }
 
@@ -402,8 +382,8 @@ pm_err pm_probe(const char *out_dir, const char *points_csv, long frame,
   PM_CHECK(out_dir && points_csv && out, PM_ERR_ARG, "pm_probe: NULL argument");
   PM_CALL(pm_path_join(path, sizeof path, out_dir, "results.h5"));
   PM_TRY(read_results(path, frame, &c));
-  PM_TRY(read_points(points_csv, &qs));
-  PM_TRY(index_cloud(&c, path));
+  PM_TRY(pm_probe_read_points(points_csv, &qs));
+  PM_TRY(pm_probe_index_cloud(&c, path));
   PM_TRY(PM_ALLOC(val, 3 * qs.m, "probe values"));
   for (long i = 0; i < qs.m; i++) {
     const double *q = &qs.p[3 * i];
@@ -426,171 +406,6 @@ done:
   free(val);
   free(qs.p);
   free(qs.line);
-  cloud_free(&c);
-  return ret;
-}
-
-/* ---- The points' own values (--at points) ------------------------------ */
-
-/* More per-point fields than a frame writes. */
-#define FIELDS_MAX 32
-
-/* A per-point dataset of a frame: float [n], [n][k] or [n][3][3]. */
-typedef struct {
-  char name[OBJ_NAME_MAX];
-  int rank, width; /* dataset rank; values per point (at most 9) */
-  double *v;       /* [n][width] */
-} field;
-
-static void fields_free(field *f, int nf) {
-  for (int k = 0; k < nf; k++) free(f[k].v);
-}
-
-/* Read one dataset of the frame into *f if it has a float row per point
- * and at most 9 values a row; *taken says whether it had. */
-static pm_err read_field(hid_t group, const char *name, const char *path,
-                         long n, field *f, bool *taken) {
-  pm_err ret = PM_SUCCESS;
-  hid_t dset = -1, space = -1, type = -1;
-  hsize_t dims[3] = {0, 0, 0};
-  int rank;
-  *taken = false;
-  /* a group (or anything not a dataset) is not a field */
-  if ((dset = H5Dopen2(group, name, H5P_DEFAULT)) < 0) return PM_SUCCESS;
-  H5_OK(type = H5Dget_type(dset), "H5Dget_type", name, path);
-  H5_OK(space = H5Dget_space(dset), "H5Dget_space", name, path);
-  H5_OK(rank = H5Sget_simple_extent_ndims(space), "H5Sget_simple_extent_ndims",
-        name, path);
-  if (H5Tget_class(type) != H5T_FLOAT || rank < 1 || rank > 3) goto done;
-  H5_OK(H5Sget_simple_extent_dims(space, dims, NULL),
-        "H5Sget_simple_extent_dims", name, path);
-  const hsize_t width = (rank > 1 ? dims[1] : 1) * (rank > 2 ? dims[2] : 1);
-  if (dims[0] != (hsize_t)n || width < 1 || width > 9) goto done;
-  snprintf(f->name, sizeof f->name, "%s", name);
-  f->rank = rank;
-  f->width = (int)width;
-  PM_TRY(PM_ALLOC(f->v, (size_t)n * width, name));
-  H5_OK(H5Dread(dset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, f->v),
-        "H5Dread", name, path);
-  *taken = true;
-done:
-  if (ret != PM_SUCCESS) {
-    free(f->v);
-    f->v = NULL;
-  }
-  if (space >= 0) H5Sclose(space);
-  if (type >= 0) H5Tclose(type);
-  H5Dclose(dset);
-  return ret;
-}
-
-/* Every per-point field of the frame, in the file's order. */
-static pm_err read_fields(hid_t group, const char *path, long n, field *f,
-                          int *nf) {
-  pm_err ret = PM_SUCCESS;
-  H5G_info_t info;
-  char name[OBJ_NAME_MAX];
-  *nf = 0;
-  H5_OK(H5Gget_info(group, &info), "H5Gget_info", "frame", path);
-  for (hsize_t k = 0; k < info.nlinks && *nf < FIELDS_MAX; k++) {
-    bool taken;
-    ssize_t len = H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, k,
-                                     name, sizeof name, H5P_DEFAULT);
-    if (len <= 0 || len >= (ssize_t)sizeof name) continue;
-    PM_TRY(read_field(group, name, path, n, &f[*nf], &taken));
-    *nf += taken;
-  }
-done:
-  return ret;
-}
-
-/* A field's column names: a vector's _x _y _z, a 3 x 3 tensor's _xx .. _zz,
- * anything else _0, _1, ... */
-static void write_columns(FILE *out, const field *f) {
-  static const char axis[] = "xyz";
-  if (f->width == 1) {
-    fprintf(out, ",%s", f->name);
-    return;
-  }
-  for (int c = 0; c < f->width; c++) {
-    if (f->rank == 2 && f->width == 3)
-      fprintf(out, ",%s_%c", f->name, axis[c]);
-    else if (f->rank == 3 && f->width == 9)
-      fprintf(out, ",%s_%c%c", f->name, axis[c / 3], axis[c % 3]);
-    else
-      fprintf(out, ",%s_%d", f->name, c);
-  }
-}
-
-static void write_point(FILE *out, const cloud *c, long i, const field *f,
-                        int nf) {
-  const double *x = c->x + 3 * i;
-  fprintf(out, "%ld,%.10g,%.10g,%.10g", i, x[0], x[1], x[2]);
-  for (int k = 0; k < nf; k++)
-    for (int a = 0; a < f[k].width; a++)
-      fprintf(out, ",%.10g", f[k].v[(size_t)i * f[k].width + a]);
-  fputc('\n', out);
-}
-
-pm_err pm_probe_points(const char *out_dir, const char *points_csv, long frame,
-                       FILE *out) {
-  pm_err ret = PM_SUCCESS;
-  cloud c = {.n = 0};
-  results r = {.file = -1, .group = -1, .order = NULL};
-  queries qs = {.m = 0};
-  field f[FIELDS_MAX] = {{.v = NULL}};
-  int nf = 0;
-  long *at = NULL;
-  double *dist = NULL;
-  char path[PM_PATH_MAX + 1];
-  PM_CHECK(out_dir && out, PM_ERR_ARG, "pm_probe_points: NULL argument");
-  PM_CALL(pm_path_join(path, sizeof path, out_dir, "results.h5"));
-  PM_TRY(results_open(path, frame, &c, &r));
-  PM_TRY(read_fields(r.group, path, c.n, f, &nf));
-  for (int k = 0; k < nf; k++)
-    PM_TRY(put_in_order(f[k].v, c.n, f[k].width, r.order));
-  if (points_csv) {
-    PM_TRY(read_points(points_csv, &qs));
-    PM_TRY(index_cloud(&c, path));
-    PM_TRY(PM_ALLOC(at, qs.m, "probe points"));
-    PM_TRY(PM_ALLOC(dist, qs.m, "probe distances"));
-    /* A query farther than half the points' mean gap from every point is
-     * at none of them: refused, not answered with a neighbour's value. */
-    const double reach = c.n > 1 ? 0.5 * pm_mls_gap(c.mls) : INFINITY;
-    for (long i = 0; i < qs.m; i++) {
-      const double *q = &qs.p[3 * i];
-      at[i] = pm_mls_nearest_point(c.mls, q, &dist[i]);
-      const double *x = c.x + 3 * at[i];
-      PM_ENSURE(dist[i] <= reach, PM_ERR_ARG,
-                "%s:%ld: no point of '%s' at (%g, %g, %g): the nearest, point "
-                "%ld at (%g, %g, %g), is %g away, more than half the points' "
-                "mean gap (%g); `--at lattice` interpolates between points",
-                points_csv, qs.line[i], path, q[0], q[1], q[2], at[i], x[0],
-                x[1], x[2], dist[i], reach);
-    }
-  }
-  /* Everything is read before the first byte is written: a failure leaves
-   * no partial table. */
-  if (points_csv) fprintf(out, "query_x,query_y,query_z,distance,");
-  fprintf(out, "point,x,y,z");
-  for (int k = 0; k < nf; k++) write_columns(out, &f[k]);
-  fputc('\n', out);
-  for (long i = 0; i < (points_csv ? qs.m : c.n); i++) {
-    if (points_csv) {
-      const double *q = &qs.p[3 * i];
-      fprintf(out, "%.10g,%.10g,%.10g,%.3g,", q[0], q[1], q[2], dist[i]);
-    }
-    write_point(out, &c, points_csv ? at[i] : i, f, nf);
-  }
-  PM_ENSURE(fflush(out) == 0 && !ferror(out), PM_ERR_IO,
-            "probe: cannot write the output: %s", strerror(errno));
-done:
-  results_close(&r);
-  fields_free(f, nf);
-  free(at);
-  free(dist);
-  free(qs.p);
-  free(qs.line);
-  cloud_free(&c);
+  pm_probe_cloud_free(&c);
   return ret;
 }

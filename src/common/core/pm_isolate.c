@@ -79,18 +79,42 @@ pm_err pm_isolate_get_array(int fd, void **data, size_t *count, size_t size) {
   PM_CHECK(n <= SIZE_MAX / size, PM_ERR_IO,
            "a child process passed an array of %llu items",
            (unsigned long long)n);
-  void *p = malloc((size_t)n * size);
-  PM_CHECK(p, PM_ERR_MEMORY, "cannot allocate %llu items passed back",
-           (unsigned long long)n);
-  pm_err e = pm_isolate_get(fd, p, (size_t)n * size);
-  if (e) {
-    free(p);
-    return e;
+  /* Grown as the bytes arrive, so that a count no bytes follow (a child
+   * that died, or lies) allocates no more than came. */
+  const size_t total = (size_t)n * size;
+  size_t got = 0, cap = 0;
+  char *p = NULL;
+  while (got < total) {
+    if (got == cap) {
+      cap = cap ? (cap < total / 2 ? 2 * cap : total)
+                : (total < (1u << 20) ? total : (1u << 20));
+      char *q = realloc(p, cap);
+      if (!q) {
+        free(p);
+        return PM_ERROR(PM_ERR_MEMORY, "cannot allocate %llu items passed back",
+                        (unsigned long long)n);
+      }
+      p = q;
+    }
+    pm_err e = pm_isolate_get(fd, p + got, cap - got);
+    if (e) {
+      free(p);
+      return e;
+    }
+    got = cap;
   }
   *data = p;
   *count = (size_t)n;
   return PM_SUCCESS;
 }
+
+/* Set in a child of pm_isolate_run; a stream replacing the next child's. */
+static bool in_child = false;
+static int stream_fd = -1;
+
+bool pm_isolate_in_child(void) { return in_child; }
+
+void pm_isolate_stream(int fd) { stream_fd = fd; }
 
 /* seconds, or PM_ISOLATE_CPU_SECONDS where it is a positive number. */
 static double cpu_allowance(double seconds) {
@@ -107,9 +131,14 @@ void pm_isolate_cpu_limit(double seconds) {
   if (getrusage(RUSAGE_SELF, &use) != 0 || getrlimit(RLIMIT_CPU, &cpu) != 0)
     return;
   /* SIGXCPU, whose default ends the process, once the soft limit is
-   * passed; the hard limit stays as it was. */
-  rlim_t s = (rlim_t)use.ru_utime.tv_sec + (rlim_t)use.ru_stime.tv_sec +
-             (rlim_t)seconds + 1;
+   * passed; the hard limit stays as it was.  The limit is in whole
+   * seconds: the nearest to what was used plus the allowance, past what was
+   * used (a fresh child allowed 1 s gets 1 s, not 2). */
+  const double used =
+      (double)use.ru_utime.tv_sec + (double)use.ru_stime.tv_sec +
+      1e-6 * (double)(use.ru_utime.tv_usec + use.ru_stime.tv_usec);
+  rlim_t s = (rlim_t)(used + seconds + 0.5);
+  if (s < (rlim_t)used + 1) s = (rlim_t)used + 1;
   if (cpu.rlim_max != RLIM_INFINITY && s > cpu.rlim_max) s = cpu.rlim_max;
   cpu.rlim_cur = s;
   setrlimit(RLIMIT_CPU, &cpu);
@@ -155,6 +184,7 @@ static void exit_by_library(int status, void *arg) {
 /* The child: read, pass the outcome and the result, leave without running
  * anything of the parent's (atexit handlers, MPI, stream buffers). */
 static void child(const pm_isolate_job *job, int fd) {
+  in_child = true;
   signal(SIGINT, SIG_DFL); /* interrupted with the parent, not polled */
   signal(SIGTERM, SIG_DFL);
   signal(SIGPIPE, SIG_IGN); /* a parent gone: write fails, child leaves */
@@ -220,6 +250,12 @@ static pm_err take(const pm_isolate_job *job, int fd, bool *complete) {
     return pm_error_set((pm_err)head[1], __FILE__, __LINE__, __func__, "%s",
                         msg);
   }
+  /* A success carries no message: bytes there would be read as the
+   * result's. */
+  PM_CHECK(head[2] == 0, PM_ERR_INTERNAL,
+           "'%s': the child process reading it passed a message with its "
+           "success",
+           job->path);
   if (job->get) PM_CALL(job->get(job->arg, fd));
   PM_CALL(pm_isolate_get(fd, &end, sizeof end));
   PM_CHECK(end == MARK_END, PM_ERR_INTERNAL,
@@ -229,8 +265,31 @@ static pm_err take(const pm_isolate_job *job, int fd, bool *complete) {
   return PM_SUCCESS;
 }
 
+/* A result that take refused (short, torn, or a count it cannot hold):
+ * the file, named, with the reason. */
+static pm_err malformed(const pm_isolate_job *job) {
+  char why[512];
+  snprintf(why, sizeof why, "%s", pm_error_message());
+  return PM_ERROR(job->code,
+                  "%s: the child process reading it with %s passed a "
+                  "malformed result (%s): the file is damaged or not %s",
+                  job->path, job->library, why, job->what);
+}
+
 pm_err pm_isolate_run(const pm_isolate_job *job) {
   if (!pm_isolate_enabled()) return job->work(job->arg);
+  if (stream_fd >= 0) {
+    const int fd = stream_fd;
+    bool complete = false;
+    stream_fd = -1;
+    const pm_err ret = take(job, fd, &complete);
+    if (complete || ret == PM_ERR_INTERRUPTED) return ret;
+    return ret ? malformed(job)
+               : PM_ERROR(PM_ERR_INTERNAL,
+                          "'%s': the child process reading it passed no "
+                          "result",
+                          job->path);
+  }
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0) return job->work(job->arg);
   fflush(NULL); /* nothing buffered is written twice */
@@ -280,7 +339,8 @@ pm_err pm_isolate_run(const pm_isolate_job *job) {
                     "%s: %s stopped (exit status %d) while reading it: the "
                     "file is damaged or not %s",
                     job->path, job->library, WEXITSTATUS(status), job->what);
-  return ret ? ret
+  if (ret == PM_ERR_INTERRUPTED) return ret;
+  return ret ? malformed(job)
              : PM_ERROR(PM_ERR_INTERNAL,
                         "'%s': the child process reading "
                         "it passed no result",

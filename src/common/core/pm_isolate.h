@@ -72,4 +72,16 @@ pm_err pm_isolate_put_array(int fd, const void *data, size_t count,
                             size_t size);
 pm_err pm_isolate_get_array(int fd, void **data, size_t *count, size_t size);
 
+/* Whether this process is a child pm_isolate_run started (its memory, and
+ * the library's state with it, is returned whole when it leaves: a reader
+ * need not tidy up there). */
+bool pm_isolate_in_child(void);
+
+/* For a test or a fuzzer of the parent's side alone: the next
+ * pm_isolate_run (isolated) starts no child and reads the outcome and the
+ * result from fd as if a child had written them, a child that then left
+ * with status 0.  The stream may be hostile: a malformed one is refused
+ * with job->code naming the file. */
+void pm_isolate_stream(int fd);
+
 #endif

@@ -3,6 +3,8 @@
 #define _DEFAULT_SOURCE
 #include "pm_h5_vet.h"
 
+#include <dirent.h>
+#include <errno.h>
 #include <hdf5.h>
 #include <stdlib.h>
 #include <string.h>
@@ -121,17 +123,34 @@ static herr_t vet_link(hid_t group, const char *name, const H5L_info_t *info,
   return w->a->err ? 1 : 0;
 }
 
+/* HDF5 failed to list what obj holds: a reader that opens one by name
+ * would meet what the listing did not reach (a damaged attribute message
+ * hid an attribute whose string loops HDF5), so the file is refused. */
+static void list_failed(vet_arg *a, hid_t obj, const char *what) {
+  char name[256] = "", why[512];
+  if (a->err) return;
+  snprintf(why, sizeof why, "%s", pm_h5_message());
+  H5Iget_name(obj, name, sizeof name);
+  a->err = PM_ERROR(a->code,
+                    "%s: HDF5 cannot list the %s of %s (%s): the file is "
+                    "damaged or not %s",
+                    a->current, what, name[0] ? name : "/", why, a->what);
+}
+
 /* An object: its attributes, a group's links, a dataset's values. */
 static void vet_object(vet_arg *a, hid_t obj, const char *name, int depth) {
   if (a->err || depth > VET_DEPTH || a->objects++ >= VET_OBJECTS) return;
-  H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_attr, a);
+  if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_attr, a) < 0)
+    list_failed(a, obj, "attributes");
   const H5I_type_t kind = H5Iget_type(obj);
-  if (kind == H5I_GROUP || kind == H5I_FILE) {
+  if (!a->err && (kind == H5I_GROUP || kind == H5I_FILE)) {
     H5G_info_t info;
     H5Gget_info(obj, &info);
     link_walk w = {a, depth};
-    H5Literate(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_link, &w);
-    /* The readers also list links in creation order. */
+    if (H5Literate(obj, H5_INDEX_NAME, H5_ITER_INC, NULL, vet_link, &w) < 0)
+      list_failed(a, obj, "links");
+    /* By creation order only where the group tracks it: no failure of
+     * this listing is a damage. */
     H5Literate(obj, H5_INDEX_CRT_ORDER, H5_ITER_INC, NULL, vet_link, &w);
   } else if (kind == H5I_DATASET) {
     read_values(a, obj, false, name);
@@ -215,6 +234,51 @@ pm_err pm_results_vet(const pm_results *r, long n_keep) {
 done:
   if (paths)
     for (long k = 0; k < n; k++) free(paths[k]);
+  free(paths);
+  return ret;
+}
+
+/* Add dir's .h5 files to *paths (n of cap). */
+static pm_err add_h5_files(const char *dir, char ***paths, int *n, int *cap) {
+  DIR *d = opendir(dir);
+  if (!d) return PM_SUCCESS; /* a folder without results/ */
+  pm_err ret = PM_SUCCESS;
+  for (struct dirent *e; (e = readdir(d));) {
+    const size_t len = strlen(e->d_name);
+    if (len < 4 || strcmp(e->d_name + len - 3, ".h5") != 0) continue;
+    if (*n == *cap) {
+      PM_ENSURE(*cap < (1 << 24), PM_ERR_ARG, "'%s' holds too many files", dir);
+      char **grown = realloc(*paths, 2 * (size_t)*cap * sizeof *grown);
+      PM_ENSURE(grown, PM_ERR_MEMORY, "paths of '%s'", dir);
+      *paths = grown;
+      *cap *= 2;
+    }
+    (*paths)[*n] = malloc(PM_PATH_MAX + 1);
+    PM_ENSURE((*paths)[*n], PM_ERR_MEMORY, "paths of '%s'", dir);
+    PM_TRY(pm_path_join((*paths)[(*n)++], PM_PATH_MAX + 1, dir, e->d_name));
+  }
+done:
+  closedir(d);
+  return ret;
+}
+
+pm_err pm_h5_vet_path(const char *path) {
+  struct stat st;
+  PM_CHECK(stat(path, &st) == 0, PM_ERR_IO, "cannot read '%s': %s", path,
+           strerror(errno));
+  const char *what = "an HDF5 file of this program";
+  if (!S_ISDIR(st.st_mode)) return pm_h5_vet(&path, 1, true, what, PM_ERR_HDF5);
+  pm_err ret = PM_SUCCESS;
+  int n = 0, cap = 16;
+  char **paths = malloc((size_t)cap * sizeof *paths);
+  char results[PM_PATH_MAX + 1];
+  PM_CHECK(paths, PM_ERR_MEMORY, "paths of '%s'", path);
+  PM_TRY(pm_path_join(results, sizeof results, path, "results"));
+  PM_TRY(add_h5_files(path, &paths, &n, &cap));
+  PM_TRY(add_h5_files(results, &paths, &n, &cap));
+  ret = pm_h5_vet((const char *const *)paths, n, true, what, PM_ERR_HDF5);
+done:
+  for (int k = 0; k < n; k++) free(paths[k]);
   free(paths);
   return ret;
 }

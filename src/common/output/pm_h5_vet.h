@@ -41,4 +41,11 @@ pm_err pm_ckpt_vet(const char *dir);
  * n_keep - 1 (PM_ERR_HDF5). */
 pm_err pm_results_vet(const pm_results *r, long n_keep);
 
+/* What `pointmech vet PATH` vets, with the values: the file PATH, or every
+ * .h5 file of the folder PATH and of its results/ (a run's index, mesh,
+ * frames and checkpoint), in one child (PM_ERR_HDF5; PM_ERR_IO for a PATH
+ * that is neither).  For a reader outside the program (the Python module)
+ * before it opens them. */
+pm_err pm_h5_vet_path(const char *path);
+
 #endif
