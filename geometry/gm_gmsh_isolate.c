@@ -3,7 +3,8 @@
  * gmsh 4.8 stops the process on some damaged files (a .msh whose elements
  * name a node it does not list: a segmentation fault inside gmshOpen), and
  * such a file is refused by name instead.  The child's gmsh model, with
- * the memory gmsh keeps after finalizing, ends with it. */
+ * the memory gmsh keeps after finalizing, ends with it; so gmsh meshes a
+ * box there too (gm_mesh_box_raw). */
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
@@ -11,6 +12,7 @@
 #include <string.h>
 
 #include "gm_gmsh.h"
+#include "gm_mesh.h"
 #include "gm_trisurf.h"
 #include "pm_isolate.h"
 
@@ -54,8 +56,8 @@ static pm_err load_work(void *p) {
   return gm_gmsh_load_here(a->path, a->dim, a->h, a->rule, a->groups, a->out);
 }
 
-static pm_err load_put(void *p, int fd) {
-  const gm_gmsh_mesh *m = ((load_arg *)p)->out;
+/* m down fd, as mesh_get reads it. */
+static pm_err mesh_put(int fd, const gm_gmsh_mesh *m) {
   const mesh_head head = {m->dim,     m->n_groups, m->n_nodes,
                           m->n_elems, m->meshed,   m->size_factor};
   PM_CALL(pm_isolate_put(fd, &head, sizeof head));
@@ -71,6 +73,10 @@ static pm_err load_put(void *p, int fd) {
   return pm_isolate_put_array(fd, m->group_face,
                               (size_t)m->dim * m->group_ptr[m->n_groups],
                               sizeof *m->group_face);
+}
+
+static pm_err load_put(void *p, int fd) {
+  return mesh_put(fd, ((load_arg *)p)->out);
 }
 
 /* Whether the n numbers of v are in [lo, hi). */
@@ -161,6 +167,48 @@ pm_err gm_gmsh_load(const char *path, int dim, double h, gm_sizes rule,
   memset(out, 0, sizeof *out);
   load_arg a = {path, dim, h, rule, groups, out};
   return isolate(path, load_work, load_put, load_get, &a);
+}
+
+/* ---- gm_mesh_box_raw --------------------------------------------------- */
+
+typedef struct {
+  int dim;
+  const double *min, *max;
+  double h;
+  const gm_grade *g;
+  gm_gmsh_mesh *out;
+} box_arg;
+
+static pm_err box_work(void *p) {
+  box_arg *a = p;
+  return gm_mesh_box_raw_here(a->dim, a->min, a->max, a->h, a->g, a->out);
+}
+
+static pm_err box_put(void *p, int fd) {
+  return mesh_put(fd, ((box_arg *)p)->out);
+}
+
+static pm_err box_get(void *p, int fd) {
+  const box_arg *a = p;
+  return mesh_get(fd, a->dim, a->out);
+}
+
+/* Not for safety from a file: gmsh's libraries (about 50 MB resident once
+ * loaded) and the model it keeps after finalizing stay in the child, so
+ * the process that meshes (rank 0 across ranks) holds its mesh alone. */
+pm_err gm_mesh_box_raw(int dim, const double min[3], const double max[3],
+                       double h, const gm_grade *g, gm_gmsh_mesh *raw) {
+  memset(raw, 0, sizeof *raw);
+  box_arg a = {dim, min, max, h, g, raw};
+  const pm_isolate_job job = {.path = "domain.box",
+                              .library = "gmsh",
+                              .what = "a box gmsh meshes (a fault of gmsh's)",
+                              .code = PM_ERR_MESH,
+                              .work = box_work,
+                              .put = box_put,
+                              .get = box_get,
+                              .arg = &a};
+  return pm_isolate_run(&job);
 }
 
 /* ---- gm_file_bounds ---------------------------------------------------- */

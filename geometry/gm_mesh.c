@@ -272,6 +272,35 @@ done:
 }
 
 /* Not thread-safe: gmsh keeps global state, initialized and finalized here. */
+pm_err gm_mesh_box_raw_here(int dim, const double min[3], const double max[3],
+                            double h, const gm_grade *g, gm_gmsh_mesh *raw) {
+  pm_err ret = PM_SUCCESS;
+  int ierr = 0;
+  gm_gmsh_session session = {.threads = 0, .open = false};
+  PM_TRY(gm_gmsh_begin(&session, NULL));
+  PM_TRY(gm_gmsh_size(h, NULL));
+  gmshModelAdd("pointmech_box", &ierr);
+  GM_GMSH_CHECK("model add", NULL);
+  if (dim == 3)
+    gmshModelOccAddBox(min[0], min[1], min[2], max[0] - min[0], max[1] - min[1],
+                       max[2] - min[2], -1, &ierr);
+  else
+    gmshModelOccAddRectangle(min[0], min[1], 0.0, max[0] - min[0],
+                             max[1] - min[1], -1, 0.0, &ierr);
+  GM_GMSH_CHECK("adding the box", NULL);
+  gmshModelOccSynchronize(&ierr);
+  GM_GMSH_CHECK("synchronize", NULL);
+  if (g && g->faces) PM_TRY(grade_fields(dim, min, max, h, g));
+  gmshModelMeshGenerate(dim, &ierr);
+  GM_GMSH_CHECK("mesh generation", NULL);
+  PM_TRY(gm_gmsh_read(NULL, dim, false, raw));
+done:
+  gm_gmsh_end(&session);
+  return ret;
+}
+
+/* gmsh meshes the box in a child process (gm_mesh_box_raw): its libraries
+ * and the model it keeps after finalizing are never the process's. */
 pm_err gm_mesh_box_graded(int dim, const double min[3], const double max[3],
                           double h, const gm_grade *g, gm_mesh **out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_mesh_box: out is NULL");
@@ -298,25 +327,7 @@ pm_err gm_mesh_box_graded(int dim, const double min[3], const double max[3],
   pm_err ret = PM_SUCCESS;
   gm_mesh *m = NULL;
   gm_gmsh_mesh raw = {.dim = 0};
-  int ierr = 0;
-  gm_gmsh_session session = {.threads = 0, .open = false};
-  PM_TRY(gm_gmsh_begin(&session, NULL));
-  PM_TRY(gm_gmsh_size(h, NULL));
-  gmshModelAdd("pointmech_box", &ierr);
-  GM_GMSH_CHECK("model add", NULL);
-  if (dim == 3)
-    gmshModelOccAddBox(min[0], min[1], min[2], max[0] - min[0], max[1] - min[1],
-                       max[2] - min[2], -1, &ierr);
-  else
-    gmshModelOccAddRectangle(min[0], min[1], 0.0, max[0] - min[0],
-                             max[1] - min[1], -1, 0.0, &ierr);
-  GM_GMSH_CHECK("adding the box", NULL);
-  gmshModelOccSynchronize(&ierr);
-  GM_GMSH_CHECK("synchronize", NULL);
-  if (g && g->faces) PM_TRY(grade_fields(dim, min, max, h, g));
-  gmshModelMeshGenerate(dim, &ierr);
-  GM_GMSH_CHECK("mesh generation", NULL);
-  PM_TRY(gm_gmsh_read(NULL, dim, false, &raw));
+  PM_TRY(gm_mesh_box_raw(dim, min, max, h, g, &raw));
   PM_TRY(mesh_from_raw(&raw, &m));
   for (int k = 0; k < 3; k++) {
     m->box_min[k] = k < dim ? min[k] : 0.0;
@@ -328,7 +339,6 @@ pm_err gm_mesh_box_graded(int dim, const double min[3], const double max[3],
   *out = m;
   m = NULL;
 done:
-  gm_gmsh_end(&session);
   gm_gmsh_mesh_free(&raw);
   gm_mesh_destroy(m);
   return ret;

@@ -70,6 +70,15 @@ typedef struct {
 pm_err gm_mesh_box_graded(int dim, const double min[3], const double max[3],
                           double h, const gm_grade *g, gm_mesh **out);
 
+/* The nodes and elements gmsh makes of the box graded by g (g may be
+ * NULL), as gm_gmsh_read leaves them: gm_mesh_box_raw meshes in a child
+ * process (pm_isolate.h; gm_gmsh_isolate.c), gm_mesh_box_raw_here in the
+ * process.  The arguments are gm_mesh_box_graded's, checked by it. */
+pm_err gm_mesh_box_raw(int dim, const double min[3], const double max[3],
+                       double h, const gm_grade *g, gm_gmsh_mesh *raw);
+pm_err gm_mesh_box_raw_here(int dim, const double min[3], const double max[3],
+                            double h, const gm_grade *g, gm_gmsh_mesh *raw);
+
 /* The element size g asks at x in the box [min, max] of a mesh of size h
  * (h where g is NULL or grades no face). */
 double gm_grade_size(const gm_grade *g, int dim, const double min[3],

@@ -17,6 +17,7 @@
 
 #include "gm_gmsh_api.h"
 #include "gm_mesh.h"
+#include "pm_isolate.h"
 
 /* Whether a mapping of this process comes from a file named like name. */
 static bool mapped(const char *name) {
@@ -55,6 +56,8 @@ static void test_library_without_gmsh(void **state) {
                "meshing a box needs it");
 }
 
+/* A box is meshed in a child process: the process itself never maps gmsh.
+ * Meshed here instead, the table is filled on first use. */
 static void test_box_through_table(void **state) {
   (void)state;
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
@@ -62,6 +65,12 @@ static void test_box_through_table(void **state) {
   assert_ok(gm_mesh_box(3, lo, hi, 0.5, &m));
   assert_true(m->n_nodes >= 8);
   assert_true(m->n_cells >= 6);
+  assert_int_equal(mapped("libgmsh"), !pm_isolate_enabled());
+  gm_gmsh_mesh raw = {.dim = 0};
+  assert_ok(gm_mesh_box_raw_here(3, lo, hi, 0.5, NULL, &raw));
+  assert_int_equal(raw.n_nodes, m->n_nodes);
+  assert_int_equal(raw.n_elems, m->n_cells);
+  gm_gmsh_mesh_free(&raw);
   gm_mesh_destroy(m);
   assert_true(mapped("libgmsh"));
   /* Opened once: a second request finds the table filled. */
