@@ -133,12 +133,16 @@ static pm_err snap_step(pm_newton *s, double *x, const double *xc,
   rep->snap_steps++;
   rep->snap_lambda = limit;
   rep->snap_eigenvalue = eig;
-  snprintf(rep->snap_note, sizeof rep->snap_note,
+  char line[256];
+  snprintf(line, sizeof line,
            "load step %d (lambda %.6g -> %.6g) carried by relaxation past a "
            "limit point at lambda %.7g (lowest eigenvalue %.3e at lambda "
            "%.6g)",
            rep->steps + 1, lambda, target, limit, eig, lambda);
-  fprintf(stderr, "pointmech: %s\n", rep->snap_note);
+  fprintf(stderr, "pointmech: %s\n", line);
+  /* every such step's line, while they fit */
+  pm_msg_appendf(rep->snap_note, sizeof rep->snap_note, "%s%s",
+                 rep->snap_note[0] ? "; " : "", line);
   return e;
 }
 

@@ -53,11 +53,11 @@ typedef struct {
   /* Steps carried past a limit point by relaxation (options.follow_fold
    * false): their number, the highest load the last one's path reached
    * (the limit point's, to the arcs' resolution), the lowest eigenvalue
-   * at the state before it, and its line; fallbacks stopped by
-   * options.fallback_seconds. */
+   * at the state before it, and the lines of all (as they fit); fallbacks
+   * stopped by options.fallback_seconds. */
   int snap_steps;
   double snap_lambda, snap_eigenvalue;
-  char snap_note[320];
+  char snap_note[1024];
   int fallbacks_timed_out;
   /* Newton solves run again for pm_newton_problem.settle, and the steps
    * that failed as their set did not settle. */
