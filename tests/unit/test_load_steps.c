@@ -337,13 +337,41 @@ static void test_relaxation_fallback(void **state) {
   pm_newton_destroy(&s);
 
   /* With the continuations first (pseudo_transient > 0): the lowest
-   * eigenvalue at the last state is positive (a limit point), and arc
-   * length passes it to lambda = 1 on the left root, without relaxation. */
+   * eigenvalue at the last state is positive (a limit point); arc length
+   * finds the load turning back at the limit point, lambda = 2/q, and
+   * relaxation at the step's load carries the step to the left root, the
+   * state the snap ends in. */
   opt.ptc_max_iter = 60;
   assert_ok(pm_newton_create(&prob, &opt, &s));
   x = sqrt(3);
   assert_ok(pm_load_steps(s, &x, &rep));
-  print_message("with continuation: %d steps, %d cuts, %d arc lengths (%d "
+  print_message("with continuation: %d steps, %d cuts, %d arc lengths (%ld "
+                "arcs), %d snaps (limit point at lambda %.7f, exact %.7f), "
+                "%d continuations, %d relaxations, x = %.15f against %.15f\n",
+                rep.steps, rep.cuts, rep.arc_runs, rep.arc_steps,
+                rep.snap_steps, rep.snap_lambda, 2 / 3.6, rep.ptc_runs,
+                rep.relaxations, x, snap_root(3.6));
+  assert_close(rep.lambda, 1, 0, 0);
+  assert_close(x, snap_root(3.6), 1e-9, 0);
+  assert_int_equal(rep.snap_steps, 1);
+  assert_int_equal(rep.arc_passes, 0);
+  assert_int_equal(rep.ptc_runs, 0);
+  /* the highest load the arcs reached: at most the limit point's, within
+   * the arc's first length of it */
+  assert_true(rep.snap_lambda <= 2 / 3.6 && rep.snap_lambda > 0.55);
+  assert_true(rep.mode_eigenvalue > 0);
+  assert_non_null(strstr(rep.snap_note, "carried by relaxation past a limit "
+                                        "point at lambda"));
+  pm_newton_destroy(&s);
+
+  /* follow_fold: arc length follows the path round the fold to lambda =
+   * 1, the same root here (one unknown: a single branch past the fold),
+   * without relaxation. */
+  opt.follow_fold = true;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  x = sqrt(3);
+  assert_ok(pm_load_steps(s, &x, &rep));
+  print_message("following the fold: %d steps, %d cuts, %d arc lengths (%d "
                 "passed, %ld arcs), %d continuations, %d relaxations, x = "
                 "%.15f against %.15f\n",
                 rep.steps, rep.cuts, rep.arc_runs, rep.arc_passes,
@@ -352,9 +380,27 @@ static void test_relaxation_fallback(void **state) {
   assert_close(rep.lambda, 1, 0, 0);
   assert_close(x, snap_root(3.6), 1e-9, 0);
   assert_true(rep.arc_passes >= 1);
-  assert_true(rep.mode_eigenvalue > 0);
+  assert_int_equal(rep.snap_steps, 0);
   assert_int_equal(rep.relaxations, 0);
   pm_newton_destroy(&s);
+  opt.follow_fold = false;
+
+  /* A fallback out of CPU time stops and the next is tried: with a bound
+   * no fallback can meet, the arc, relaxation and the continuation each
+   * stop at once and the step is given up, named. */
+  opt.fallback_seconds = 1e-300;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  x = sqrt(3);
+  e = pm_load_steps(s, &x, &rep);
+  print_message("without time for fallbacks: %d timed out: %s\n",
+                rep.fallbacks_timed_out, pm_error_message());
+  assert_int_equal(e, PM_ERR_NOT_CONVERGED);
+  assert_true(rep.fallbacks_timed_out >= 2);
+  assert_true(rep.lambda < 2 / 3.6);
+  assert_non_null(strstr(pm_error_message(), "fallback_seconds"));
+  pm_error_clear();
+  pm_newton_destroy(&s);
+  opt.fallback_seconds = 0;
   opt.ptc_max_iter = 0;
 
   /* Bad options are named. */
@@ -443,8 +489,10 @@ static void test_lowest_mode(void **state) {
  * r_y = y^3 - 3 y + c x (the gradient of an energy).  y snaps from its
  * upper root when c x passes 2: the tangent's lowest mode (mostly y) goes
  * to zero there (a limit point, the eigenvalue positive before it),
- * Newton stalls at every step size, and arc length follows the path round
- * the fold (the load falling, then rising again) to the lower root. */
+ * Newton stalls at every step size; arc length finds the load turning
+ * back and relaxation carries the step to the lower root, the state the
+ * snap ends in (with follow_fold, the arc follows the path round the fold,
+ * the load falling, then rising again, to the same root). */
 typedef struct {
   double k, c, lambda;
 } snap2;
@@ -511,6 +559,21 @@ static void test_arc_length(void **state) {
   assert_close(x[0], 1 - p.c * y / p.k, 1e-9, 0);
   assert_true(rep.mode_runs >= 1);
   assert_true(rep.mode_eigenvalue > 0);
+  assert_int_equal(rep.snap_steps, 1);
+  assert_int_equal(rep.ptc_runs, 0);
+  pm_newton_destroy(&s);
+
+  /* follow_fold: arc length round the fold to the same root */
+  opt.follow_fold = true;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  x[0] = 0;
+  x[1] = sqrt(3);
+  assert_ok(pm_load_steps(s, x, &rep));
+  print_message("following the fold: %d arc lengths (%d passed; %ld arcs), "
+                "%d relaxations: y = %.15f\n",
+                rep.arc_runs, rep.arc_passes, rep.arc_steps, rep.relaxations,
+                x[1]);
+  assert_close(x[1], y, 1e-9, 0);
   assert_true(rep.arc_passes >= 1);
   assert_int_equal(rep.ptc_runs, 0);
   assert_int_equal(rep.relaxations, 0);

@@ -349,6 +349,8 @@ typedef struct pm_scene {
     long qs_max_iterations; /* ...max_iterations per load step */
     long qs_relax_after;    /* ...relax_after: cuts before relaxation */
     long qs_ptc;            /* ...pseudo_transient: continuation iterations */
+    bool qs_follow_fold;    /* ...follow_fold: arc length past a limit point */
+    double qs_fallback_cpu; /* ...fallback_seconds: CPU s per fallback */
     pm_linear_solver qs_linear; /* ...linear_solver */
     long qs_reuse;              /* ...reuse_iterations (FPM static) */
     bool qs_inexact;            /* ...inexact: Eisenstat-Walker (FPM) */

@@ -818,6 +818,27 @@ static const pm_key quasi_static_keys[] = {
             "negative (a limit point), arc length follows the path "
             "round the fold first; 0: relaxation alone (the solver "
             "before)"},
+    {.name = "follow_fold",
+     .type = PM_KEY_BOOL,
+     .offset = S(time.qs_follow_fold),
+     .def = "false",
+     .doc = "method static (FPM, one process): where arc length finds a "
+            "limit point (the load turning back along the path: a snap), "
+            "false: the step is carried by relaxation at its load from "
+            "the last converged state to the stable branch the structure "
+            "jumps to (what relaxation in time finds); true: the arc "
+            "follows the path round the fold and on to the step's load, "
+            "which may end on another branch"},
+    {.name = "fallback_seconds",
+     .type = PM_KEY_NUMBER,
+     .offset = S(time.qs_fallback_cpu),
+     .def = "600",
+     .range = PM_RANGE_GE,
+     .unit = "s",
+     .doc = "method static (FPM): the CPU seconds (all threads) each "
+            "fallback of a load step (arc length, a continuation, a "
+            "relaxation) may take before it stops and the next is "
+            "tried; 0: no bound"},
     {.name = "max_iterations",
      .type = PM_KEY_INTEGER,
      .offset = S(time.qs_max_iterations),

@@ -108,16 +108,18 @@ static pm_err path_tangent(pm_newton *s, const double *x, double lambda,
 pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
                    const double *xprev, double lambda, double lambda_prev,
                    double target, double goal, pm_arc_work *w,
-                   pm_load_report *rep, char *msg, long cap) {
+                   pm_load_report *rep, double *limit, char *msg, long cap) {
   const pm_newton_problem *p = &s->p;
   const long n = p->n;
-  const double t0 = pm_wtime();
+  const double t0 = pm_wtime(), cpu0 = pm_cputime();
   double *xa = w->xa, *r = w->r, *t = w->t;
-  double la = lambda, tl = 0, rn = 0;
+  double la = lambda, tl = 0, rn = 0, peak = lambda;
   long its = 0;
   int steps = 0, back = 0;
+  bool timed = false;
   pm_err e = PM_SUCCESS;
   msg[0] = '\0';
+  *limit = NAN;
   PM_CHECK(!s->dist, PM_ERR_UNSUPPORTED, "arc length: one process only");
   rep->arc_runs++;
   memcpy(xa, xc, (size_t)n * sizeof *xa);
@@ -144,6 +146,11 @@ pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
   double ds = ds0;
   while (steps < ARC_STEPS) {
     PM_CALL(pm_interrupt_check("in the arc-length continuation"));
+    if (pm_load_out_of_time(s, cpu0, rep)) {
+      timed = true;
+      e = PM_ERR_NOT_CONVERGED;
+      goto out;
+    }
     /* predictor along the tangent, corrector in its normal plane */
     double l = la + ds * tl;
     PM_OMP(parallel for schedule(static))
@@ -195,6 +202,17 @@ pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
     }
     steps++;
     if (l < la) back++;
+    if (l < la && !s->o.follow_fold) {
+      /* The load turned back: a limit point at the highest load reached.
+       * Past it the structure snaps; the caller carries the step to the
+       * branch it jumps to (the unstable path beyond is not followed). */
+      fprintf(stderr, "pointmech: arc %d: lambda %.8g, %d iterations\n", steps,
+              l, k);
+      *limit = peak;
+      e = PM_ERR_NOT_CONVERGED;
+      goto out;
+    }
+    peak = fmax(peak, l);
     if (l < lambda - 1.5) {
       e = PM_ERROR(PM_ERR_NOT_CONVERGED,
                    "arc length: the path went back 1.5 loads (to lambda "
@@ -243,12 +261,17 @@ out:;
   pm_newton_note_load(s, target);
   pm_err e2 = p->set_load(p->ctx, target);
   if (e == PM_SUCCESS) e = e2;
-  snprintf(msg, (size_t)cap,
-           "arc length %s: %d arcs (%d with the load falling), %ld "
-           "iterations, reached lambda %.6g",
-           e == PM_SUCCESS ? "passed the fold"
-                           : "did not reach the step's load",
-           steps, back, its, la);
+  const int used = snprintf(
+      msg, (size_t)cap,
+      "arc length %s: %d arcs (%d with the load falling), %ld iterations, "
+      "reached lambda %.6g",
+      e == PM_SUCCESS    ? "passed the fold"
+      : isfinite(*limit) ? "found a limit point (the load turned back)"
+                         : "did not reach the step's load",
+      steps, back, its, isfinite(*limit) ? *limit : la);
+  if (timed && used >= 0 && used < cap)
+    snprintf(msg + used, (size_t)(cap - used),
+             "; stopped at its fallback_seconds");
   if (e == PM_SUCCESS) rep->arc_passes++;
   rep->arc_steps += steps;
   rep->arc_iterations += its;

@@ -58,12 +58,13 @@ pm_err pm_load_ptc(pm_newton *s, double *x, double goal, double shift0,
                    double *curvature, char *msg, long cap) {
   const long n = s->p.n;
   const long max_iter = s->o.ptc_max_iter;
-  const double t0 = pm_wtime();
+  const double t0 = pm_wtime(), cpu0 = pm_cputime();
   /* (the relaxation's work space: its velocities hold the increment) */
   double *m = w->mass, *dx = w->v, *r = w->r, *rt = w->rt, *xt = w->xt;
   double rn = 0, r0 = 0, qmin = INFINITY, made = 0;
   double shift = shift0 > 0 ? shift0 : PM_PTC_SHIFT0;
   long it = 0, rejected = 0;
+  bool timed = false;
   pm_err e;
   msg[0] = '\0';
   PM_CHECK(!s->dist && s->Shift, PM_ERR_UNSUPPORTED,
@@ -78,6 +79,11 @@ pm_err pm_load_ptc(pm_newton *s, double *x, double goal, double shift0,
     if ((e = pm_interrupt_check("in the continuation of a load step")) !=
         PM_SUCCESS)
       goto out;
+    if (pm_load_out_of_time(s, cpu0, rep)) {
+      timed = true;
+      it--;
+      break;
+    }
     e = shifted_solve(s, x, r, m, shift, &made, rt, dx, rep);
     double rtn = 0;
     if (e == PM_SUCCESS) {
@@ -122,9 +128,10 @@ pm_err pm_load_ptc(pm_newton *s, double *x, double goal, double shift0,
 out:;
   /* the kept factorisation is of a shifted matrix: Newton makes its own */
   s->pc_built = false;
-  char tail[80];
-  snprintf(tail, sizeof tail, "%ld not taken, smallest curvature %.2e",
-           rejected, isfinite(qmin) ? qmin : 0.0);
+  char tail[128];
+  snprintf(tail, sizeof tail, "%ld not taken, smallest curvature %.2e%s",
+           rejected, isfinite(qmin) ? qmin : 0.0,
+           timed ? "; stopped at its fallback_seconds" : "");
   e = pm_relax_outcome(e, "continuation", rn, r0, goal, it, tail, msg, cap);
   *curvature = isfinite(qmin) ? qmin : 0;
   rep->ptc_iterations += it;

@@ -87,6 +87,14 @@ pm_err pm_relax_outcome(pm_err e, const char *what, double rn, double r0,
   return e == PM_ERR_NOT_CONVERGED ? PM_ERROR(e, "%s", msg) : e;
 }
 
+bool pm_load_out_of_time(const pm_newton *s, double cpu0, pm_load_report *rep) {
+  if (!(s->o.fallback_seconds > 0 &&
+        pm_cputime() - cpu0 > s->o.fallback_seconds))
+    return false;
+  rep->fallbacks_timed_out++;
+  return true;
+}
+
 bool pm_load_relax_available(const pm_newton *s) {
   return s->o.relax_after > 0 && !s->dist;
 }
@@ -96,10 +104,11 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
                      char *msg, long cap) {
   const long n = s->p.n;
   const long max_iter = s->o.relax_max_iter;
-  const double t0 = pm_wtime();
+  const double t0 = pm_wtime(), cpu0 = pm_cputime();
   double *m = w->mass, *v = w->v, *r = w->r, *rt = w->rt, *xt = w->xt;
   double rn = 0, r0 = 0, c = 0, scale = 1;
   long it = 0, rejected = 0;
+  bool timed = false;
   pm_err e;
   msg[0] = '\0';
   PM_CHECK(!s->dist, PM_ERR_UNSUPPORTED,
@@ -116,6 +125,11 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
     if ((e = pm_interrupt_check("in the relaxation of a load step")) !=
         PM_SUCCESS)
       goto out;
+    if (pm_load_out_of_time(s, cpu0, rep)) {
+      timed = true;
+      it--;
+      break;
+    }
     /* v at the half step, damped by c (central difference, unit step) */
     const double keep = (1 - 0.5 * c) / (1 + 0.5 * c), push = 1 / (1 + 0.5 * c);
     PM_OMP(parallel for schedule(static))
@@ -162,8 +176,9 @@ pm_err pm_load_relax(pm_newton *s, double *x, double rel, double goal,
   }
   e = rn <= goal ? PM_SUCCESS : PM_ERR_NOT_CONVERGED;
 out:;
-  char tail[64];
-  snprintf(tail, sizeof tail, "%ld increments inadmissible", rejected);
+  char tail[128];
+  snprintf(tail, sizeof tail, "%ld increments inadmissible%s", rejected,
+           timed ? "; stopped at its fallback_seconds" : "");
   e = pm_relax_outcome(e, "relaxation", rn, r0, goal, it, tail, msg, cap);
   rep->relax_iterations += it;
   rep->time_relax += pm_wtime() - t0;

@@ -116,15 +116,47 @@ static pm_err relax_step(pm_newton *s, double *x, const double *xc,
   return e;
 }
 
+/* The step carried past a limit point at lambda limit (the highest load
+ * the arc reached; eig the lowest eigenvalue at xc) by relaxation at the
+ * step's load from xc: the stable state the structure snaps to.  Noted in
+ * rep (snap_*) and on stderr when it converges; x, msg and cap as
+ * relax_step's. */
+static pm_err snap_step(pm_newton *s, double *x, const double *xc,
+                        double lambda, double target, double limit, double eig,
+                        pm_relax_work *w, pm_load_report *rep, char *msg,
+                        size_t cap) {
+  const size_t used =
+      pm_msg_appendf(msg, cap, "; relaxation past the limit point: ");
+  if (used + 2 >= cap) return PM_ERR_NOT_CONVERGED;
+  pm_err e = relax_step(s, x, xc, w, rep, msg + used, cap - used);
+  if (e != PM_SUCCESS) return e;
+  rep->snap_steps++;
+  rep->snap_lambda = limit;
+  rep->snap_eigenvalue = eig;
+  char line[256];
+  snprintf(line, sizeof line,
+           "load step %d (lambda %.6g -> %.6g) carried by relaxation past a "
+           "limit point at lambda %.7g (lowest eigenvalue %.3e at lambda "
+           "%.6g)",
+           rep->steps + 1, lambda, target, limit, eig, lambda);
+  fprintf(stderr, "pointmech: %s\n", line);
+  /* every such step's line, while they fit */
+  pm_msg_appendf(rep->snap_note, sizeof rep->snap_note, "%s%s",
+                 rep->snap_note[0] ? "; " : "", line);
+  return e;
+}
+
 /* The fallback of a step Newton could not finish, at the step's load
  * (target, set; the last converged state xc at load lambda, the one before
  * xprev at lambda_prev), with options.ptc_max_iter > 0: the tangent's
  * lowest mode at xc (pm_load_mode_at), then where its eigenvalue is
  * negative (xc is unstable: past a bifurcation) the continuation started
- * off xc along the mode (pm_load_branch_switch), else arc length round a limit
- * point (pm_load_arc); where that fails the continuation from xc, shifted
- * above a negative eigenvalue; where that fails the relaxation of
- * relax_step.  x, msg and cap as relax_step's. */
+ * off xc along the mode (pm_load_branch_switch), else arc length round a
+ * limit point (pm_load_arc); where the arc finds the load turning back
+ * (options.follow_fold false), relaxation from xc at the step's load
+ * (snap_step); where that fails the continuation from xc, shifted above a
+ * negative eigenvalue; where that fails the relaxation of relax_step, if
+ * not tried.  x, msg and cap as relax_step's. */
 static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
                             const double *xprev, double lambda,
                             double lambda_prev, double target, double r_ref,
@@ -152,17 +184,24 @@ static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
   /* a shift above the negative eigenvalue: the shifted tangent definite */
   const double shift0 =
       isfinite(eig) && eig < 0 ? fmax(PM_PTC_SHIFT0, -4 * eig) : 0;
+  bool relaxed = false;
   e = PM_ERR_NOT_CONVERGED;
   if (isfinite(eig) && eig < 0) {
     e = pm_load_branch_switch(s, x, xc, goal, shift0, w, rep, msg, cap);
   } else if (isfinite(eig)) {
     const size_t used2 = pm_msg_appendf(msg, cap, "%s", msg[0] ? "; " : "");
+    double limit = NAN;
     e = pm_load_arc(s, x, xc, xprev, lambda, lambda_prev, target, goal, aw, rep,
-                    msg + used2, (long)(cap - used2));
-    if (e == PM_SUCCESS) {
+                    &limit, msg + used2, (long)(cap - used2));
+    if (e == PM_SUCCESS || isfinite(limit))
       fprintf(stderr, "pointmech: load step %d: %s\n", rep->steps + 1,
               msg + used2);
-      return e;
+    if (e == PM_SUCCESS) return e;
+    if (recoverable(e) && isfinite(limit)) {
+      pm_error_clear();
+      relaxed = true;
+      e = snap_step(s, x, xc, lambda, target, limit, eig, w, rep, msg, cap);
+      if (e == PM_SUCCESS || !recoverable(e)) return e;
     }
   }
   if (e != PM_SUCCESS && recoverable(e)) {
@@ -178,7 +217,7 @@ static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
     rep->last.message[0] = '\0';
     return e;
   }
-  if (!recoverable(e)) return e;
+  if (!recoverable(e) || relaxed) return e;
   pm_error_clear();
   const size_t used = strlen(msg);
   char *rest = msg + used;

@@ -80,6 +80,12 @@ typedef struct {
 pm_err pm_relax_work_init(pm_relax_work *w, long n);
 void pm_relax_work_free(pm_relax_work *w);
 
+/* Whether a fallback started at pm_cputime() cpu0 has used the
+ * options.fallback_seconds it may take (never when they are 0); if so it
+ * is counted in rep (fallbacks_timed_out): the fallback stops short of
+ * its goal and the next is tried. */
+bool pm_load_out_of_time(const pm_newton *s, double cpu0, pm_load_report *rep);
+
 /* Dynamic relaxation at the load set, from x (in/out: the last admissible
  * state reached) until |r| <= max(rel |r(x start)|, goal) (the start's
  * residual into *r_start) or options.relax_max_iter iterations,
@@ -188,12 +194,15 @@ void pm_arc_work_free(pm_arc_work *w);
  * at lambda_prev orients it) until the path passes target, then Newton at
  * target from the chord's point there; |r| <= goal ends a corrector.  x:
  * the state at target on success, else xc; the load is left at target.
- * Counts to rep (arc_*); msg (cap bytes) one line of what it did.
+ * Without options.follow_fold it stops where the load first falls along
+ * the path (a limit point) and sets *limit to the highest load the path
+ * reached (NAN otherwise).  Counts to rep (arc_*); msg (cap bytes) one
+ * line of what it did.
  * PM_SUCCESS; PM_ERR_NOT_CONVERGED raised with that line; a hard failure
  * of a callback as it is.  One process only. */
 pm_err pm_load_arc(pm_newton *s, double *x, const double *xc,
                    const double *xprev, double lambda, double lambda_prev,
                    double target, double goal, pm_arc_work *w,
-                   pm_load_report *rep, char *msg, long cap);
+                   pm_load_report *rep, double *limit, char *msg, long cap);
 
 #endif

@@ -354,6 +354,11 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
     PM_CALL(
         pm_json_integer(j, "static_arc_iterations", r->load.arc_iterations));
     PM_CALL(pm_json_number(j, "static_arc_seconds", r->load.time_arc));
+    PM_CALL(pm_json_integer(j, "static_snaps", r->load.snap_steps));
+    PM_CALL(pm_json_number(j, "static_snap_lambda", r->load.snap_lambda));
+    PM_CALL(pm_json_string(j, "static_snap", r->load.snap_note));
+    PM_CALL(pm_json_integer(j, "static_fallbacks_timed_out",
+                            r->load.fallbacks_timed_out));
     PM_CALL(pm_json_integer(j, "static_resolves", r->load.resolves));
     PM_CALL(pm_json_integer(j, "static_unsettled", r->load.unsettled));
     PM_CALL(pm_json_integer(j, "static_contact_frozen", r->contact_frozen));

@@ -193,6 +193,8 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
    * steps grow back after cuts at once when Newton found them easy. */
   no.relax_after = (int)s->time.qs_relax_after;
   no.ptc_max_iter = (int)s->time.qs_ptc;
+  no.follow_fold = s->time.qs_follow_fold;
+  no.fallback_seconds = s->time.qs_fallback_cpu;
   no.easy_iterations = 3;
   /* ...and, with max_load_step, grow past 1/load_steps up to it (not by
    * default: larger steps cost fewer Newton iterations but more CPU, the
