@@ -17,13 +17,15 @@
 #include "pm_isolate.h"
 
 /* One reading of path through gmsh in a child: work, then put and get
- * its result. */
-static pm_err isolate(const char *path, pm_err (*work)(void *),
-                      pm_err (*put)(void *, int), pm_err (*get)(void *, int),
-                      void *arg) {
+ * its result; what names what path should be where gmsh fails on it
+ * (NULL: a mesh or geometry gmsh reads). */
+static pm_err isolate(const char *path, const char *what,
+                      pm_err (*work)(void *), pm_err (*put)(void *, int),
+                      pm_err (*get)(void *, int), void *arg) {
   const pm_isolate_job job = {.path = path ? path : "",
                               .library = "gmsh",
-                              .what = "a mesh or geometry gmsh reads",
+                              .what =
+                                  what ? what : "a mesh or geometry gmsh reads",
                               .code = PM_ERR_MESH,
                               .work = work,
                               .put = put,
@@ -166,7 +168,7 @@ pm_err gm_gmsh_load(const char *path, int dim, double h, gm_sizes rule,
   PM_CHECK(out, PM_ERR_ARG, "gm_gmsh_load: out is NULL");
   memset(out, 0, sizeof *out);
   load_arg a = {path, dim, h, rule, groups, out};
-  return isolate(path, load_work, load_put, load_get, &a);
+  return isolate(path, NULL, load_work, load_put, load_get, &a);
 }
 
 /* ---- gm_mesh_box_raw --------------------------------------------------- */
@@ -200,15 +202,8 @@ pm_err gm_mesh_box_raw(int dim, const double min[3], const double max[3],
                        double h, const gm_grade *g, gm_gmsh_mesh *raw) {
   memset(raw, 0, sizeof *raw);
   box_arg a = {dim, min, max, h, g, raw};
-  const pm_isolate_job job = {.path = "domain.box",
-                              .library = "gmsh",
-                              .what = "a box gmsh meshes (a fault of gmsh's)",
-                              .code = PM_ERR_MESH,
-                              .work = box_work,
-                              .put = box_put,
-                              .get = box_get,
-                              .arg = &a};
-  return pm_isolate_run(&job);
+  return isolate("domain.box", "a box gmsh meshes (a fault of gmsh's)",
+                 box_work, box_put, box_get, &a);
 }
 
 /* ---- gm_file_bounds ---------------------------------------------------- */
@@ -243,7 +238,7 @@ static pm_err bounds_get(void *p, int fd) {
 
 pm_err gm_file_bounds(const char *path, int dim, double lo[3], double hi[3]) {
   bounds_arg a = {.path = path, .dim = dim};
-  PM_CALL(isolate(path, bounds_work, bounds_put, bounds_get, &a));
+  PM_CALL(isolate(path, NULL, bounds_work, bounds_put, bounds_get, &a));
   memcpy(lo, a.box, 3 * sizeof *lo);
   memcpy(hi, a.box + 3, 3 * sizeof *hi);
   return PM_SUCCESS;
@@ -291,5 +286,5 @@ pm_err gm_trisurf_load(const char *path, gm_trisurf *out) {
   PM_CHECK(out, PM_ERR_ARG, "gm_trisurf_load: out is NULL");
   memset(out, 0, sizeof *out);
   surface_arg a = {path, out};
-  return isolate(path, surface_work, surface_put, surface_get, &a);
+  return isolate(path, NULL, surface_work, surface_put, surface_get, &a);
 }
