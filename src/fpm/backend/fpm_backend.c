@@ -79,19 +79,24 @@ static pm_err sim_mesh(fpm_sim *sim) {
   /* The domain: the box, or the scene's one gmsh volume. */
   int domain = fpm_domain_body(s);
   sim->far_size = s->mesh_size;
+  pm_err meshed;
   if (domain >= 0)
-    PM_CALL(gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
-                         (gm_sizes)s->mesh_sizes, &sim->mesh));
+    meshed = gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
+                          (gm_sizes)s->mesh_sizes, &sim->mesh);
   else {
     gm_grade grade;
     fpm_grade_of(s, &grade, &sim->far_size);
-    PM_CALL(gm_mesh_box_graded(s->dimension, s->box_min, s->box_max,
-                               sim->far_size, &grade, &sim->mesh));
+    meshed = gm_mesh_box_graded(s->dimension, s->box_min, s->box_max,
+                                sim->far_size, &grade, &sim->mesh);
     sim->near_size = grade.faces ? grade.size : 0.0;
   }
+  /* gmsh meshes in a child process, which a signal stops at once. */
+  if (meshed == PM_ERR_INTERRUPTED)
+    PM_CALL(pm_interrupt_check("during meshing (nothing written)"));
+  PM_CALL(meshed);
   pm_timers_stop(&sim->timers, sim->tm_mesh);
-  /* A signal stops the setup between its stages (gmsh's meshing and the
-   * stages themselves run to their end: seconds at 1e5 points). */
+  /* A signal stops the setup between its other stages, which run to their
+   * end (seconds at 1e5 points). */
   PM_CALL(pm_interrupt_check("after meshing (nothing written)"));
   sim->mean_edge = gm_mesh_mean_edge(sim->mesh);
   pm_timers_start(&sim->timers, sim->tm_dual);
