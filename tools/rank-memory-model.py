@@ -5,10 +5,10 @@ A rank's peak resident memory is modelled as
 
     M(P) = F + G + b * held(P)
 
-F: the floor of every process (the program and its libraries: MPI, PETSc,
-HDF5, gmsh), measured on a scene of a few hundred points; G: what every
-rank holds whole whatever P (a membrane seeded whole, an image read whole,
-FPM's mesh and cells); b: bytes per point or particle held; held(P): the
+F: the floor of every process (the program and its libraries: MPI, HDF5;
+PETSc only where a run solves, gmsh only in the child that meshes),
+measured on a scene of a few hundred points; G: what every rank holds
+whatever P (a membrane seeded whole, an image read whole); b: bytes per point or particle held; held(P): the
 points of the largest rank's share with its ghosts, from `pointmech plan
 SCENE --ranks P` (the partition the run would make).  b and G come from
 two measured peaks of the scene, one process (held = N) and the largest
@@ -32,29 +32,32 @@ MIB = 2.0 ** 20
 RANK_BYTES = 12 * 2.0 ** 30  # a 24 GiB machine of 2 cores, a rank a core
 RANKS = [2, 4, 16, 64, 256, 1000]
 
-# Measured peaks, MiB (docs/validation.md: "Distributed MPM setup: memory
-# per rank" at eea19e9, "Distributed FPM setup and memory per rank" at
-# 29caefe, "Memory per rank past this machine" for the full oocyte).
-# n: points or particles; m1: one process; m2, m4: the largest rank other
-# than 0 on 2 and 4 ranks; g_scales: G is a whole copy that grows with the
-# scene.  The construct I1 at its full size was measured on one process
-# only (9.2 GB, issue 31): its G is the image every rank reads (8-bit,
-# one byte a particle), its b from the one-process peak.
+# Measured peaks, MiB (docs/validation.md: "Memory per rank, the
+# exchanges, checkpoints and meshing together (issue 31)", at cae4f27 for
+# the blocks and I2, 225f53f for the full oocyte and F3).  n: points or
+# particles; floor: a rank's floor (the disks; FPM's: F3 at 45 points on a
+# rank that does not mesh); m1: one process; m2, m4: the largest rank
+# other than 0 on 2 and 4 ranks; g_scales: G is a whole copy that grows
+# with the scene (a membrane, an image).  FPM's ranks other than 0 hold no
+# whole copy since only rank 0 meshes; rank 0's own bound is the text's.
+# The construct I1 at its full size was measured on one process only
+# (9.2 GB, issue 31): its G is the image every rank reads (8-bit, one
+# byte a particle), its b from the one-process peak.
 SCENES = [
     {"name": "MPM block, mesh_size 1.25e-3", "scene": "cases/mpm/bench-block.yaml",
-     "set": ["discretization.mesh_size=1.25e-3"], "n": 884736, "floor": 85.1,
-     "m1": 486.3, "m2": 260.8, "m4": 176.8, "g_scales": False},
+     "set": ["discretization.mesh_size=1.25e-3"], "n": 884736, "floor": 30.9,
+     "m1": 384.9, "m2": 217.7, "m4": 127.4, "g_scales": False},
     {"name": "full oocyte (M4)", "scene": "cases/mpm/m4-oocyte.yaml", "set": [],
-     "n": 176026, "floor": 85.1, "m1": 174.6, "m2": 146.1, "m4": 139.4,
+     "n": 176026, "floor": 30.9, "m1": 130.3, "m2": 91.3, "m4": 85.8,
      "g_scales": True},
     {"name": "I2 at 256^2 cells (implicit)", "scene": "cases/mpm/i2-vessel-slice.yaml",
-     "set": ["discretization.mesh_size=2.1e-6"], "n": 262144, "floor": 85.1,
-     "m1": 434.4, "m2": 275.1, "m4": 181.1, "g_scales": True},
+     "set": ["discretization.mesh_size=2.1e-6"], "n": 262144, "floor": 30.9,
+     "m1": 394.7, "m2": 232.5, "m4": 139.8, "g_scales": True},
     {"name": "FPM F3 60%, 32715 points", "scene": "cases/fpm/f3-extension-60.yaml",
-     "set": ["discretization.mesh_size=2.98e-3"], "n": 32715, "floor": 115.1,
-     "m1": 370.4, "m2": 374.4, "m4": 278.8, "g_scales": True},
+     "set": ["discretization.mesh_size=2.98e-3"], "n": 32715, "floor": 28.0,
+     "m1": 298.0, "m2": 254.7, "m4": 176.9, "g_scales": False},
     {"name": "full construct I1 (implicit)", "scene": "cases/mpm/i1-construct.yaml",
-     "set": [], "n": 13631488, "floor": 85.1, "m1": 9.2e9 / MIB, "m2": None,
+     "set": [], "n": 13631488, "floor": 30.9, "m1": 9.2e9 / MIB, "m2": None,
      "m4": None, "g_scales": True, "g_bytes_per_point": 1.0},
 ]
 
