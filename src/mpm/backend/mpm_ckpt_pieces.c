@@ -224,6 +224,9 @@ typedef struct {
   long *at;  /* [n]: the particle's place in m, or -1 */
   double *buf;
   long placed; /* particles placed, over the pieces */
+  bool *seen;  /* [m->n]: placed already (a particle in two pieces is
+                  refused: the count alone would let one stand for a
+                  missing one) */
   bool vetted; /* the pieces were vetted when picked */
 } piece_reader;
 
@@ -276,8 +279,14 @@ static pm_err read_piece(piece_reader *pr, const mpm_ckpt_pieces *cp, int k) {
   PM_TRY(PM_ALLOC(pr->buf, 9 * n + 1, "checkpoint piece"));
   PM_TRY(pm_ckpt_longs(ck, "piece.gid", n, pr->gid));
   for (long j = 0; j < n; j++) {
-    pr->at[j] = place_of(m, pr->gid[j]);
-    pr->placed += pr->at[j] >= 0;
+    const long p = pr->at[j] = place_of(m, pr->gid[j]);
+    if (p < 0) continue;
+    PM_ENSURE(!pr->seen[p], PM_ERR_IO,
+              "checkpoint '%s/checkpoint.h5': particle %ld is in two of its "
+              "pieces (the second: piece %d)",
+              cp->dir, pr->gid[j], k);
+    pr->seen[p] = true;
+    pr->placed++;
   }
   PM_TRY(pm_ckpt_doubles(ck, "piece.x0", 3 * n, pr->buf));
   for (int a = 0; a < common_arrays(pr->s, names, nc, data); a++) {
@@ -316,7 +325,7 @@ done:
 static pm_err read_pieces(const mpm_ckpt_pieces *cp, const bool *need,
                           const mpm_model *m, mpm_state *s) {
   piece_reader pr = {.m = m, .s = s, .vetted = need != NULL};
-  pm_err ret = PM_SUCCESS;
+  pm_err ret = PM_ALLOC(pr.seen, m->n + 1, "checkpoint pieces");
   for (int k = 0; k < cp->n && !ret; k++)
     if (!need || need[k]) ret = read_piece(&pr, cp, k);
   if (!ret && pr.placed != m->n)
@@ -327,6 +336,7 @@ static pm_err read_pieces(const mpm_ckpt_pieces *cp, const bool *need,
   free(pr.gid);
   free(pr.at);
   free(pr.buf);
+  free(pr.seen);
   return ret;
 }
 
