@@ -67,5 +67,17 @@ rc=$?
 check "a damaged piece: refused (exit $rc)" test $rc -ne 0
 check "a damaged piece: named" grep -q "piece_0001.h5" "$work/err"
 
+# A piece standing in for another (rank 0's copied over rank 1's): its
+# particles are refused as placed twice, by name, before its checksum is
+# read (one process reads every piece).
+cp -r "$work/cut" "$work/twice"
+first=$(ls "$work/twice/checkpoint.pieces/"*.piece_0000.h5)
+cp "$first" "${first%.piece_0000.h5}.piece_0001.h5"
+"$bin" resume "$work/twice" --quiet >/dev/null 2>"$work/err"
+rc=$?
+check "a piece copied over another: refused (exit $rc)" test $rc -ne 0
+check "a piece copied over another: a particle in two pieces, named" \
+  grep -q "is in two of its pieces (the second: piece 1)" "$work/err"
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
