@@ -119,13 +119,23 @@ struct pm_afile {
 /* Why a write into path failed (err: the errno seen, which a stream's
  * buffered write may have left stale): its folder gone (removed during the
  * run), a read-only or full file system, else err's text. */
-static const char *write_cause(const char *path, int err) {
+/* The folder path is in, and its file system: statvfs's outcome. */
+static int folder_stat(const char *path, struct statvfs *fs) {
   char dir[PM_PATH_MAX + 1];
   snprintf(dir, sizeof dir, "%s", path);
   char *slash = strrchr(dir, '/');
   if (slash) *slash = '\0';
+  return statvfs(slash ? (dir[0] ? dir : "/") : ".", fs);
+}
+
+bool pm_folder_gone(const char *path) {
   struct statvfs fs;
-  if (statvfs(slash ? (dir[0] ? dir : "/") : ".", &fs) != 0)
+  return folder_stat(path, &fs) != 0 && errno == ENOENT;
+}
+
+static const char *write_cause(const char *path, int err) {
+  struct statvfs fs;
+  if (folder_stat(path, &fs) != 0)
     return errno == ENOENT ? "its folder no longer exists" : strerror(err);
   if (fs.f_flag & ST_RDONLY) return strerror(EROFS);
   if (fs.f_bavail == 0) return strerror(ENOSPC);

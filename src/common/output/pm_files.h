@@ -20,6 +20,10 @@
  * message) when a component cannot be created or is not a directory. */
 pm_err pm_mkdir_p(const char *dir);
 
+/* Whether the folder path names a file in no longer exists (removed
+ * during a run, say). */
+bool pm_folder_gone(const char *path);
+
 /* Join dir and name as "dir/name" into buf (size bytes).  dir NULL or ""
  * gives name alone.  Fails with PM_ERR_ARG when the result does not fit. */
 pm_err pm_path_join(char *buf, size_t size, const char *dir, const char *name);

@@ -2,6 +2,8 @@
  * for the readers and writers in src/common. */
 #include "pm_h5.h"
 
+#include "pm_files.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,6 +22,14 @@ const char *pm_h5_message(void) {
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, h5_walk, buf);
   if (!buf[0]) snprintf(buf, sizeof buf, "no HDF5 error message");
   return buf;
+}
+
+pm_err pm_h5_fail(const char *file, int line, const char *func,
+                  const char *call, const char *obj, const char *path) {
+  return pm_error_set(
+      PM_ERR_HDF5, file, line, func, "%s(%s) failed on '%s': %s%s", call, obj,
+      path, pm_h5_message(),
+      path && pm_folder_gone(path) ? " (its folder no longer exists)" : "");
 }
 
 /* Close an identifier if open, ignoring errors (cleanup paths only). */

@@ -34,11 +34,13 @@ pm_err pm_h5_read_string_attr(hid_t loc, const char *name, char **out,
 #define H5_OK(expr, call, obj, path)                                           \
   do {                                                                         \
     if ((expr) < 0) {                                                          \
-      ret = pm_error_set(PM_ERR_HDF5, __FILE__, __LINE__, __func__,            \
-                         "%s(%s) failed on '%s': %s", (call), (obj), (path),   \
-                         pm_h5_message());                                     \
+      ret = pm_h5_fail(__FILE__, __LINE__, __func__, (call), (obj), (path));   \
       goto done;                                                               \
     }                                                                          \
   } while (0)
+/* H5_OK's error: HDF5's message, and where path's folder no longer exists
+ * (HDF5's own words then vary with the moment it was removed) that too. */
+pm_err pm_h5_fail(const char *file, int line, const char *func,
+                  const char *call, const char *obj, const char *path);
 
 #endif
