@@ -43,6 +43,17 @@ import json, sys
 r = json.load(open('$work/disks-4/summary.json'))['ranks']
 sys.exit(not (sum(r['particles_at_start']) == 416 and
               max(r['particles_at_start']) <= 1.1 * 416 / 4))"
+check "disks on 4 ranks: where the particles went, and the imbalance" $py -c "
+import json, sys
+r = json.load(open('$work/disks-4/summary.json'))['ranks']
+end, most, imb = r['particles_at_end'], r['particles_most'], r['imbalance']
+# the disks meet in the middle: two boxes empty, two fill
+sys.exit(not (sum(end) == 416 and min(end) < 104 < max(end) and
+              all(m >= max(a, e) for m, a, e in
+                  zip(most, r['particles_at_start'], end)) and
+              abs(imb['at_end'] - max(end) * 4 / 416) < 1e-12 and
+              abs(imb['most'] - max(most) * 4 / 416) < 1e-12 and
+              imb['at_start'] == 1))"
 
 # One rank under mpirun is one process.
 ranks 1 "$bin" run "$mpm/disks-collision.yaml" --out "$work/disks-np1" \

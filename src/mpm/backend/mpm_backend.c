@@ -109,6 +109,7 @@ void mpm_sim_destroy(mpm_sim *r) {
   free(r->ckpt_pieces.values);
   mpm_state_destroy(r->ckpt_scalars);
   free(r->imp_ranks);
+  free(r->ranks_held);
   mpm_work_destroy(r->local_work);
   mpm_state_destroy(r->local_state);
   mpm_model_destroy(r->local_model);
@@ -238,7 +239,10 @@ static pm_err run(void *p, const pm_observer *obs) {
                          .frame_every = r->scene->output.every};
   if (!e) e = mpm_solve(lm, ls, lw, &opt, observe, r, &r->last);
   e = pm_view_end(&r->view, e); /* the state it ended in, for the figures */
-  if (r->view.ranks) mpm_view_counts(r);
+  if (r->view.ranks) {
+    const pm_err c = mpm_view_counts(r);
+    if (!e) e = c;
+  }
   conclude(r, lm, e);
   return e;
 }

@@ -73,6 +73,9 @@ typedef struct {
    * the ranks' own work (stages less exchanges), the most and the mean;
    * the bytes of linked points' ghosts, summed */
   double ranks_counts[9];
+  /* across ranks, per rank: the particles it held at the end and the most
+   * it held after a migration (2 a rank), NULL on one process */
+  long *ranks_held;
   /* read from a checkpoint: the ranks of the run that wrote it and their
    * energy accounts (MPM_PAR_ACCOUNTS each) */
   int ckpt_ranks;

@@ -61,8 +61,9 @@ void mpm_view_drop_whole(mpm_sim *r);
  * read from the checkpoint (collective). */
 pm_err mpm_view_reshare(mpm_sim *r);
 /* What the exchanges cost over the run, summed over the ranks (the
- * busiest rank's seconds), into r->ranks_counts (collective). */
-void mpm_view_counts(mpm_sim *r);
+ * busiest rank's seconds), into r->ranks_counts, and the particles each
+ * rank held into r->ranks_held (collective). */
+pm_err mpm_view_counts(mpm_sim *r);
 /* Across ranks without the whole model (mpm_sim.whole false), at setup:
  * rank 0's state of the run's scalars, its figures' workspace and the
  * whole run's reference positions (mesh_x0), every rank's room for the

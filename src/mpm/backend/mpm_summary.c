@@ -57,6 +57,40 @@ static pm_err summary_stage_energy(pm_json *j, const mpm_model *m,
   return pm_json_end_object(j);
 }
 
+/* The most particles a rank held (of counts[stride * k], rank k) over the
+ * mean a rank holds (of the totals in `of`, alike). */
+static double imbalance(const long *counts, const long *of, int size,
+                        int stride) {
+  long most = 0, sum = 0;
+  for (int k = 0; k < size; k++) {
+    const long c = counts[(size_t)stride * k];
+    most = c > most ? c : most;
+    sum += of[(size_t)stride * k];
+  }
+  return sum > 0 ? (double)most * size / (double)sum : 1;
+}
+
+/* Each rank's particles at the end and the most it held, and the
+ * imbalance of the cut (the busiest rank over the mean) at the start, at
+ * the end and at its worst: what a cut made once has lost as the
+ * particles travelled. */
+static pm_err summary_held(pm_json *j, const mpm_decomp *d, const long *held) {
+  const char *names[2] = {"particles_at_end", "particles_most"};
+  for (int k = 0; k < 2; k++) {
+    PM_CALL(pm_json_begin_array(j, names[k]));
+    for (int q = 0; q < d->size; q++)
+      PM_CALL(pm_json_integer(j, NULL, held[2 * q + k]));
+    PM_CALL(pm_json_end_array(j));
+  }
+  PM_CALL(pm_json_begin_object(j, "imbalance"));
+  PM_CALL(
+      pm_json_number(j, "at_start", imbalance(d->count, d->count, d->size, 1)));
+  PM_CALL(pm_json_number(j, "at_end", imbalance(held, held, d->size, 2)));
+  /* (the most a rank held at any time, over the mean at the end) */
+  PM_CALL(pm_json_number(j, "most", imbalance(held + 1, held, d->size, 2)));
+  return pm_json_end_object(j);
+}
+
 /* The decomposition and what the exchanges cost (summed over the ranks;
  * seconds of the slowest rank). */
 static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
@@ -72,6 +106,7 @@ static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
   for (int k = 0; k < d->size; k++)
     PM_CALL(pm_json_integer(j, NULL, d->count[k]));
   PM_CALL(pm_json_end_array(j));
+  if (r->ranks_held) PM_CALL(summary_held(j, d, r->ranks_held));
   /* what a rank sent, on average */
   PM_CALL(pm_json_number(j, "node_bytes_per_step", c[0] / steps / d->size));
   PM_CALL(pm_json_number(j, "particle_bytes_per_step", c[1] / steps / d->size));

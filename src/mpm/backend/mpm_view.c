@@ -122,7 +122,7 @@ pm_err mpm_view_reshare(mpm_sim *r) {
                                                           : NULL);
 }
 
-void mpm_view_counts(mpm_sim *r) {
+pm_err mpm_view_counts(mpm_sim *r) {
   mpm_par_counts c;
   mpm_par_get_counts(r->local_model, &c);
   /* A rank's own work: its stages' time less the exchanges (in which it
@@ -144,6 +144,17 @@ void mpm_view_counts(mpm_sim *r) {
   r->ranks_counts[6] = most[2];                 /* the busiest rank's */
   r->ranks_counts[7] = sums[4] / pm_par_size(); /* the mean */
   r->ranks_counts[8] = sums[5];
+  /* Where the particles went: each rank's at the end and its most, the
+   * load balance the cut made at the start has kept or lost. */
+  const int size = pm_par_size(), me = pm_par_rank();
+  pm_err e = r->ranks_held ? PM_SUCCESS
+                           : PM_ALLOC(r->ranks_held, 2 * size, "ranks' counts");
+  PM_CALL(pm_par_agree(e));
+  memset(r->ranks_held, 0, 2 * (size_t)size * sizeof(long));
+  r->ranks_held[2 * me] = r->local_model->n;
+  r->ranks_held[2 * me + 1] = c.most;
+  pm_par_sum_long(r->ranks_held, 2 * size);
+  return PM_SUCCESS;
 }
 
 /* Across ranks, what rank 0's observer reads of a converged load step:

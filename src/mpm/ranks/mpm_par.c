@@ -327,6 +327,7 @@ static pm_err share_links(pm_qs_method qs, const mpm_grid *whole, bool gather,
                           mpm_model *lm, mpm_state *ls) {
   const int size = pm_par_size();
   struct mpm_par *Q = par_of(lm);
+  Q->counts.most = lm->n;
   PM_CALL(make_near(Q, lm));
   PM_CALL(mpm_ghosts_create(lm, ls, &Q->d, Q->gbegin, Q->gend, Q->near,
                             Q->n_near, &Q->gh));

@@ -217,6 +217,7 @@ typedef struct {
   double ghost_bytes;                    /* linked points' ghosts */
   long migrated;                         /* particles sent */
   long grown;                            /* times the arrays grew */
+  long most;                             /* particles held, the most */
 } mpm_par_counts;
 void mpm_par_get_counts(const mpm_model *m, mpm_par_counts *c);
 /* The decomposition of local model m. */

@@ -245,6 +245,7 @@ static pm_err move_particles(mpm_model *m, mpm_state *s, mpm_work *w) {
   }
   (void)old_n;
 done:
+  if (m->n > P->counts.most) P->counts.most = m->n;
   pm_timers_stop(&w->timers, w->timer_migrate);
   P->counts.migrate_seconds += pm_wtime() - t0;
   return pm_par_agree(ret);
