@@ -25,6 +25,41 @@ static bool inside(const long i[3], const long lo[3], const long hi[3]) {
   return true;
 }
 
+/* The cut as a checkpoint keeps it (mpm_decomp_pack) reads back the same,
+ * and integers that are no cut of the grid are refused: a child that goes
+ * back up the tree (a descent that never ends), a box past the grid. */
+static void check_pack(const mpm_decomp *d, const mpm_grid *g) {
+  const long n = mpm_decomp_items(d->size);
+  long *buf = calloc((size_t)n, sizeof *buf);
+  assert_non_null(buf);
+  mpm_decomp_pack(d, buf);
+  mpm_decomp e;
+  assert_ok(mpm_decomp_unpack(buf, d->size, g, "cut", &e));
+  assert_memory_equal(e.box, d->box, 6 * sizeof(long) * (size_t)d->size);
+  assert_memory_equal(e.count, d->count, sizeof(long) * (size_t)d->size);
+  assert_memory_equal(e.count0, d->count, sizeof(long) * (size_t)d->size);
+  for (int k = 0; k + 1 < d->size; k++) {
+    assert_int_equal(e.tree[k].axis, d->tree[k].axis);
+    assert_int_equal(e.tree[k].at, d->tree[k].at);
+    assert_int_equal(e.tree[k].child[0], d->tree[k].child[0]);
+    assert_int_equal(e.tree[k].child[1], d->tree[k].child[1]);
+  }
+  for (int a = 0; a < 3; a++) assert_int_equal(e.cuts[a], d->cuts[a]);
+  mpm_decomp_destroy(&e);
+  long *tree = buf + 4 + 6 * (long)d->size;
+  if (d->size > 2) { /* (a tree of more than one cut) */
+    const long keep = tree[2];
+    tree[2] = 0; /* the root's child the root */
+    assert_int_equal(mpm_decomp_unpack(buf, d->size, g, "cut", &e), PM_ERR_IO);
+    assert_non_null(strstr(pm_error_message(), "cut: expected the cut of"));
+    tree[2] = keep;
+  }
+  buf[4 + 3] = d->cells[0] + 1; /* rank 0's box past the grid */
+  assert_int_equal(mpm_decomp_unpack(buf, d->size, g, "cut", &e), PM_ERR_IO);
+  pm_error_clear();
+  free(buf);
+}
+
 /* The boxes of `size` ranks tile the grid's cells, every node has one
  * owner and is held where it is owned, and the particles at their reference
  * positions are counted on the rank whose box holds them. */
@@ -73,6 +108,7 @@ static void check_decomposition(const char *path, int size) {
   }
   assert_int_equal(total, md->n);
   free(count);
+  check_pack(&d, g);
   mpm_decomp_destroy(&d);
   drop_model(&m);
 }

@@ -44,6 +44,21 @@ roundoff "interrupted on 2 ranks, resumed on 3" "$work/whole-2" "$work/cut-3"
 roundoff "interrupted on 2 ranks, resumed on 1" "$work/whole-1" "$work/cut-1"
 
 # shellcheck disable=SC2086
+# On 4 ranks the boxes are cut anew as the disks meet (mpm.rebalance):
+# interrupted after some of those cuts, the run resumed on 4 ranks goes on
+# on the boxes it had (the checkpoint's cut), bit for bit.
+ranks 4 "$bin" run "$disks" --out "$work/whole-4" --quiet $slow \
+  >/dev/null 2>&1
+rows=10 interrupt 4 "$work/cut4" "$disks" $slow
+check "interrupted on 4 ranks: after the boxes were cut anew" $py -c "
+import h5py, sys
+with h5py.File(sys.argv[1] + '/checkpoint.h5', 'r') as f:
+    assert f['run.ranks.cut'][0] >= 1, f['run.ranks.cut'][:5]
+" "$work/cut4"
+resume_on "$work/cut4" 4
+check "interrupted on 4 ranks, resumed on 4: bit for bit" \
+  $same "$work/whole-4" "$work/cut4-4"
+
 interrupt 3 "$work/cut3" "$disks" $slow
 resume_on "$work/cut3" 2
 roundoff "interrupted on 3 ranks, resumed on 2" "$work/whole-1" "$work/cut3-2"

@@ -52,7 +52,7 @@ across() { # label, scene, ranks, overrides...
 }
 
 # Run SCENE with overrides on N ranks into OUT and send SIGTERM to rank 0
-# (its pid is in summary.json) once history.csv has 3 rows, which stops
+# (its pid is in summary.json) once history.csv has $rows rows (default 3), which stops
 # every rank after the step with a checkpoint; mpirun forwards a signal of
 # its own about 2 s late, or not before it gives up on its ranks (docs/user-guide.md,
 # "Across MPI ranks").
@@ -64,7 +64,7 @@ interrupt() { # ranks, out, scene, overrides...
   job=$!
   for _ in $(seq 600); do
     [ -f "$out/history.csv" ] &&
-      [ "$(wc -l <"$out/history.csv")" -ge 4 ] && break
+      [ "$(wc -l <"$out/history.csv")" -gt "${rows:-3}" ] && break
     sleep 0.05
   done
   pid=$(sed -n 's/^ *"pid": \([0-9]*\).*/\1/p' "$out/summary.json")

@@ -235,7 +235,8 @@ int main(int argc, char **argv) {
   mpm_state *seeded_state = NULL, *cut_state = NULL;
   if (mpm_par_create_seeded(sc, false, &seeded, &seeded_state)) return 2;
   if (mpm_model_create(sc, &ref, &ref_state)) return 2;
-  if (mpm_par_create(sc, ref, ref_state, NULL, &cut, &cut_state)) return 2;
+  if (mpm_par_create(sc, ref, ref_state, NULL, NULL, &cut, &cut_state))
+    return 2;
   expect(shares_alike(seeded, seeded_state, cut, cut_state),
          "the share seeded from the scene is the share cut from the whole "
          "model, bit for bit",

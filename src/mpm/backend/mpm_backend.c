@@ -105,6 +105,7 @@ pm_err mpm_sim_create(const pm_scene *s, mpm_sim **out) {
 void mpm_sim_destroy(mpm_sim *r) {
   if (!r) return;
   free(r->ckpt_accounts);
+  free(r->ckpt_cut);
   free(r->ckpt_pieces.counts);
   free(r->ckpt_pieces.values);
   mpm_state_destroy(r->ckpt_scalars);
@@ -260,6 +261,29 @@ static pm_err create(const pm_scene *s, void **out) {
 
 void mpm_sim_destroy_any(void *p) { mpm_sim_destroy(p); }
 
+pm_err mpm_sim_cut_items(mpm_sim *r, pm_ckpt *ck, long ranks) {
+  const long n = mpm_decomp_items((int)ranks);
+  if (pm_ckpt_reading(ck)) {
+    free(r->ckpt_cut);
+    r->ckpt_cut = NULL;
+    if (!pm_ckpt_has(ck, "run.ranks.cut")) return PM_SUCCESS;
+    PM_CALL(PM_ALLOC(r->ckpt_cut, n, "the cut of the boxes"));
+    PM_CALL(pm_ckpt_longs(ck, "run.ranks.cut", n, r->ckpt_cut));
+    if (ranks != pm_par_size()) { /* (another count cuts afresh) */
+      free(r->ckpt_cut);
+      r->ckpt_cut = NULL;
+    }
+    return PM_SUCCESS;
+  }
+  if (!r->local_model) return PM_SUCCESS;
+  long *buf = NULL;
+  PM_CALL(PM_ALLOC(buf, n, "the cut of the boxes"));
+  mpm_decomp_pack(mpm_par_decomp(r->local_model), buf);
+  const pm_err e = pm_ckpt_longs(ck, "run.ranks.cut", n, buf);
+  free(buf);
+  return e;
+}
+
 /* The ranks a run had and their energy accounts (one process: its own),
  * so that a run resumed on as many ranks goes on as it would have. */
 static pm_err ranks_checkpoint(mpm_sim *r, pm_ckpt *ck) {
@@ -274,9 +298,11 @@ static pm_err ranks_checkpoint(mpm_sim *r, pm_ckpt *ck) {
     r->ckpt_accounts = NULL;
     PM_CALL(PM_ALLOC(r->ckpt_accounts, n * ranks, "energy accounts"));
     r->ckpt_ranks = (int)ranks;
+    PM_CALL(mpm_sim_cut_items(r, ck, ranks));
     return pm_ckpt_doubles(ck, "run.ranks.accounts", n * ranks,
                            r->ckpt_accounts);
   }
+  PM_CALL(mpm_sim_cut_items(r, ck, ranks));
   double own[MPM_PAR_ACCOUNTS];
   const double *rows = own;
   if (r->local_model) {

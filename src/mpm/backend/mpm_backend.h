@@ -71,8 +71,10 @@ typedef struct {
   /* across ranks, at the end of the run: the exchanges' bytes and
    * particles summed over the ranks, their seconds the slowest rank's;
    * the ranks' own work (stages less exchanges), the most and the mean;
-   * the bytes of linked points' ghosts, summed */
-  double ranks_counts[9];
+   * the bytes of linked points' ghosts, summed; the busiest rank's
+   * particles and the mean summed over the looks at the balance; the
+   * slowest rank's seconds cutting the boxes anew */
+  double ranks_counts[12];
   /* across ranks, per rank: the particles it held at the end and the most
    * it held after a migration (2 a rank), NULL on one process */
   long *ranks_held;
@@ -80,6 +82,9 @@ typedef struct {
    * energy accounts (MPM_PAR_ACCOUNTS each) */
   int ckpt_ranks;
   double *ckpt_accounts;
+  /* and the cut of its boxes, when it had as many ranks as this run
+   * (mpm_decomp_pack's; NULL: none, or another count) */
+  long *ckpt_cut;
   mpm_ckpt_pieces ckpt_pieces;
   /* Rank 0 without the whole model reading a whole checkpoint: its state
    * of the run's scalars, put back once the shares are cut. */

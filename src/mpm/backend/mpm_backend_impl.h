@@ -64,6 +64,11 @@ pm_err mpm_view_reshare(mpm_sim *r);
  * busiest rank's seconds), into r->ranks_counts, and the particles each
  * rank held into r->ranks_held (collective). */
 pm_err mpm_view_counts(mpm_sim *r);
+/* A checkpoint's cut of the boxes across ranks (`ranks` of them): written
+ * from this rank's share, read into r->ckpt_cut when this run has as
+ * many ranks, so that the run goes on on the boxes it had (cut anew
+ * while it went on, mpm.rebalance, they are not the start's). */
+pm_err mpm_sim_cut_items(mpm_sim *r, pm_ckpt *ck, long ranks);
 /* Across ranks without the whole model (mpm_sim.whole false), at setup:
  * rank 0's state of the run's scalars, its figures' workspace and the
  * whole run's reference positions (mesh_x0), every rank's room for the

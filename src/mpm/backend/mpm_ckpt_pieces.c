@@ -174,6 +174,7 @@ pm_err mpm_sim_ckpt_index(mpm_sim *r, pm_ckpt *ck) {
                         cp->values);
   if (!e) e = mpm_state_checkpoint_values(&cp->vals, ck);
   if (!e) e = mpm_sim_run_items(r, ck);
+  if (!e) e = mpm_sim_cut_items(r, ck, n);
   if (!reading) { /* (the view's) */
     cp->counts = NULL;
     cp->values = NULL;
@@ -470,7 +471,8 @@ static pm_err reload(mpm_sim *r, pick_set *ps) {
 #ifdef __GLIBC__
   malloc_trim(0);
 #endif
-  pm_err ret = mpm_par_create_picked(r->scene, false, &pick, &lm, &ls);
+  pm_err ret =
+      mpm_par_create_cut(r->scene, false, r->ckpt_cut, &pick, &lm, &ls);
   free(ps->slot); /* (the seeding's alone) */
   free(ps->x0);
   ps->slot = NULL;

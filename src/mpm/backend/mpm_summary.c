@@ -74,7 +74,8 @@ static double imbalance(const long *counts, const long *of, int size,
  * imbalance of the cut (the busiest rank over the mean) at the start, at
  * the end and at its worst: what a cut made once has lost as the
  * particles travelled. */
-static pm_err summary_held(pm_json *j, const mpm_decomp *d, const long *held) {
+static pm_err summary_held(pm_json *j, const mpm_decomp *d, const long *held,
+                           const double steps[2]) {
   const char *names[2] = {"particles_at_end", "particles_most"};
   for (int k = 0; k < 2; k++) {
     PM_CALL(pm_json_begin_array(j, names[k]));
@@ -83,8 +84,13 @@ static pm_err summary_held(pm_json *j, const mpm_decomp *d, const long *held) {
     PM_CALL(pm_json_end_array(j));
   }
   PM_CALL(pm_json_begin_object(j, "imbalance"));
+  /* the busiest rank's particles over the mean, every 20 steps, summed:
+   * what the load costs a step's pace over the run (the efficiency the
+   * ranks' counts allow is its inverse) */
   PM_CALL(
-      pm_json_number(j, "at_start", imbalance(d->count, d->count, d->size, 1)));
+      pm_json_number(j, "over_run", steps[1] > 0 ? steps[0] / steps[1] : 1));
+  const long *start0 = d->count0 ? d->count0 : d->count;
+  PM_CALL(pm_json_number(j, "at_start", imbalance(start0, start0, d->size, 1)));
   PM_CALL(pm_json_number(j, "at_end", imbalance(held, held, d->size, 2)));
   /* (the most a rank held at any time, over the mean at the end) */
   PM_CALL(pm_json_number(j, "most", imbalance(held + 1, held, d->size, 2)));
@@ -103,10 +109,20 @@ static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
   for (int a = 0; a < 3; a++) PM_CALL(pm_json_integer(j, NULL, d->cuts[a]));
   PM_CALL(pm_json_end_array(j));
   PM_CALL(pm_json_begin_array(j, "particles_at_start"));
-  for (int k = 0; k < d->size; k++)
-    PM_CALL(pm_json_integer(j, NULL, d->count[k]));
+  const long *start = d->count0 ? d->count0 : d->count;
+  for (int k = 0; k < d->size; k++) PM_CALL(pm_json_integer(j, NULL, start[k]));
   PM_CALL(pm_json_end_array(j));
-  if (r->ranks_held) PM_CALL(summary_held(j, d, r->ranks_held));
+  /* the boxes cut anew as the particles travelled (mpm.rebalance), and
+   * the particles per rank of the last cut */
+  PM_CALL(pm_json_integer(j, "recuts", d->recuts));
+  PM_CALL(pm_json_number(j, "recut_seconds", c[11]));
+  if (d->recuts > 0) {
+    PM_CALL(pm_json_begin_array(j, "particles_at_last_cut"));
+    for (int k = 0; k < d->size; k++)
+      PM_CALL(pm_json_integer(j, NULL, d->count[k]));
+    PM_CALL(pm_json_end_array(j));
+  }
+  if (r->ranks_held) PM_CALL(summary_held(j, d, r->ranks_held, c + 9));
   /* what a rank sent, on average */
   PM_CALL(pm_json_number(j, "node_bytes_per_step", c[0] / steps / d->size));
   PM_CALL(pm_json_number(j, "particle_bytes_per_step", c[1] / steps / d->size));

@@ -15,7 +15,8 @@
  * the energy accounts of a checkpoint of as many ranks, if given. */
 pm_err mpm_view_share(mpm_sim *r, const double *accounts) {
   PM_CALL(pm_par_agree(mpm_par_create(r->scene, r->model, r->state, accounts,
-                                      &r->local_model, &r->local_state)));
+                                      r->ckpt_cut, &r->local_model,
+                                      &r->local_state)));
   return pm_par_agree(mpm_work_create(r->local_model, &r->local_work));
 }
 
@@ -136,14 +137,17 @@ pm_err mpm_view_counts(mpm_sim *r) {
                     (double)c.grown,
                     own,
                     c.ghost_bytes},
-         most[3] = {c.halo_seconds, c.migrate_seconds, own};
+         most[4] = {c.halo_seconds, c.migrate_seconds, own, c.recut_seconds};
   pm_par_sum(sums, 6);
-  pm_par_max(most, 3);
+  pm_par_max(most, 4);
   memcpy(r->ranks_counts, sums, 4 * sizeof(double));
   memcpy(r->ranks_counts + 4, most, 2 * sizeof(double));
   r->ranks_counts[6] = most[2];                 /* the busiest rank's */
   r->ranks_counts[7] = sums[4] / pm_par_size(); /* the mean */
   r->ranks_counts[8] = sums[5];
+  r->ranks_counts[9] = c.look_most; /* (every rank's alike) */
+  r->ranks_counts[10] = c.look_mean;
+  r->ranks_counts[11] = most[3];
   /* Where the particles went: each rank's at the end and its most, the
    * load balance the cut made at the start has kept or lost. */
   const int size = pm_par_size(), me = pm_par_rank();

@@ -150,6 +150,18 @@ static const pm_key mpm_keys[] = {
             "nodes' patches (patch); none: each particle's own.  Method "
             "mpm-implicit without the key: cell when a material's Poisson "
             "ratio is 0.45 or more, else none"},
+    {.name = "rebalance",
+     .type = PM_KEY_NUMBER,
+     .offset = O(rebalance),
+     .def = "1.1",
+     .range = PM_RANGE_GE,
+     .unit = "",
+     .doc = "across ranks (explicit steps without membranes or dynamic "
+            "relaxation): when the busiest rank holds more than this many "
+            "times the mean of the particles (looked at every 20 steps), "
+            "the boxes are cut anew where the particles are and each goes "
+            "to its new rank (a checkpoint keeps the cut); 0: the cut of "
+            "the start is kept"},
     {.name = "fluid",
      .type = PM_KEY_MAPPING,
      .keys = fluid_keys,
@@ -177,6 +189,10 @@ static pm_err check_section(const pm_scene *s, void *opts) {
    * face's value, bend the field (F2's NRMSE 3e-2 at 0.02 m cells). */
   if (!pm_scene_has(s, "mpm.shape") && strcmp(s->method, "mpm-implicit") == 0)
     o->shape = MPM_BASIS_LINEAR;
+  if (o->rebalance > 0 && o->rebalance <= 1)
+    return pm_scene_fail(s, "mpm.rebalance", false,
+                         "expected 0 (never) or an imbalance above 1, got %g",
+                         o->rebalance);
   if (s->dimension == 2 && (o->null_velocity & 4u))
     return pm_scene_fail(s, "mpm.null_velocity", false,
                          "expected a list of x, y (dimension 2), got z");

@@ -43,6 +43,8 @@ typedef struct {
   unsigned null_velocity; /* mpm.null_velocity: grid velocity components
                              held at zero (mask) */
   int fbar;               /* mpm_fbar_mode: mpm.fbar */
+  double rebalance;       /* mpm.rebalance: the imbalance past which a run
+                             across ranks cuts its boxes anew (0: never) */
   struct {
     int energy_update;   /* mpm_energy_update */
     double tolerance;    /* relative change that ends the iteration */

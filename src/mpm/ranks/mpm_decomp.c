@@ -88,7 +88,92 @@ void mpm_decomp_destroy(mpm_decomp *d) {
   free(d->box);
   free(d->tree);
   free(d->count);
+  free(d->count0);
   memset(d, 0, sizeof *d);
+}
+
+long mpm_decomp_items(int size) { return 4 + 12 * (long)size; }
+
+void mpm_decomp_pack(const mpm_decomp *d, long *buf) {
+  const long n = d->size;
+  memset(buf, 0, sizeof(long) * (size_t)mpm_decomp_items(d->size));
+  buf[0] = d->recuts;
+  for (int a = 0; a < 3; a++) buf[1 + a] = d->cuts[a];
+  long *box = buf + 4, *tree = box + 6 * n, *count = tree + 4 * n,
+       *count0 = count + n;
+  memcpy(box, d->box, 6 * sizeof(long) * (size_t)n);
+  for (long k = 0; k + 1 < n; k++) {
+    tree[4 * k] = d->tree[k].axis;
+    tree[4 * k + 1] = d->tree[k].at;
+    tree[4 * k + 2] = d->tree[k].child[0];
+    tree[4 * k + 3] = d->tree[k].child[1];
+  }
+  memcpy(count, d->count, sizeof(long) * (size_t)n);
+  memcpy(count0, d->count0 ? d->count0 : d->count, sizeof(long) * (size_t)n);
+}
+
+/* Whether buf's integers are a cut of d's grid (d's cells set): each cut
+ * of the tree inside its grid, its children later cuts or ranks (so that
+ * every descent ends), each box inside the grid and its corner the rank's
+ * own. */
+static bool cut_holds(const long *buf, const mpm_decomp *d) {
+  const long n = d->size;
+  const long *box = buf + 4, *tree = box + 6 * n, *count = tree + 4 * n;
+  if (buf[0] < 0) return false;
+  for (long k = 0; k + 1 < n; k++) {
+    const long a = tree[4 * k], at = tree[4 * k + 1];
+    if (a < 0 || a > 2 || at <= 0 || at >= d->cells[a]) return false;
+    for (int c = 0; c < 2; c++) {
+      const long q = tree[4 * k + 2 + c];
+      if (q < 0 ? -q - 1 >= n : q <= k || q + 1 >= n) return false;
+    }
+  }
+  for (long r = 0; r < n; r++) {
+    if (count[r] < 0 || count[r + n] < 0) return false;
+    for (int a = 0; a < 3; a++)
+      if (box[6 * r + a] < 0 || box[6 * r + a] >= box[6 * r + 3 + a] ||
+          box[6 * r + 3 + a] > d->cells[a])
+        return false;
+  }
+  return true;
+}
+
+pm_err mpm_decomp_unpack(const long *buf, int size, const mpm_grid *whole,
+                         const char *what, mpm_decomp *d) {
+  pm_err ret = PM_SUCCESS;
+  memset(d, 0, sizeof *d);
+  d->size = size;
+  d->ghost = whole->width - 1;
+  mpm_decomp_cells(whole, d->cells);
+  PM_CHECK(size >= 1 && cut_holds(buf, d), PM_ERR_IO,
+           "%s: expected the cut of a grid of %ld x %ld x %ld cells for %d "
+           "ranks, got integers that are none",
+           what, d->cells[0], d->cells[1], d->cells[2], size);
+  const long n = size;
+  const long *box = buf + 4, *tree = box + 6 * n, *count = tree + 4 * n;
+  PM_TRY(PM_ALLOC(d->box, 6 * n, "decomposition boxes"));
+  PM_TRY(PM_ALLOC(d->tree, n, "decomposition cuts"));
+  PM_TRY(PM_ALLOC(d->count, n, "particles per rank"));
+  PM_TRY(PM_ALLOC(d->count0, n, "particles per rank"));
+  d->recuts = buf[0];
+  for (int a = 0; a < 3; a++) d->cuts[a] = (int)buf[1 + a];
+  memcpy(d->box, box, 6 * sizeof(long) * (size_t)n);
+  for (long k = 0; k + 1 < n; k++)
+    d->tree[k] =
+        (mpm_decomp_cut){.axis = (int)tree[4 * k],
+                         .at = tree[4 * k + 1],
+                         .child = {(int)tree[4 * k + 2], (int)tree[4 * k + 3]}};
+  memcpy(d->count, count, sizeof(long) * (size_t)n);
+  memcpy(d->count0, count + n, sizeof(long) * (size_t)n);
+  for (int r = 0; r < size; r++) {
+    const long q[3] = {d->box[6 * r], d->box[6 * r + 1], d->box[6 * r + 2]};
+    PM_ENSURE(mpm_decomp_rank_of(d, q) == r, PM_ERR_IO,
+              "%s: the cut's box of rank %d is not where its tree puts it",
+              what, r);
+  }
+done:
+  if (ret) mpm_decomp_destroy(d);
+  return ret;
 }
 
 /* Cells a box keeps at least along an axis it is cut along, and how far a

@@ -286,9 +286,22 @@ static int record_doubles(const mpm_model *m, int *width) {
   return REC_BASE + most;
 }
 
+/* What cutting the boxes anew needs (mpm_par_balance): explicit steps
+ * without membranes (their links number particles in one process's
+ * order) nor dynamic relaxation (its nodal arrays span the steps). */
+static void set_balance(struct mpm_par *P, const pm_scene *s, bool gather) {
+  P->scene = s;
+  P->gather = gather;
+  P->balance = mpm_scene_settings(s)->rebalance;
+  if (strcmp(s->method, "mpm") != 0 || s->time.qs != PM_QS_NONE) P->balance = 0;
+  for (int b = 0; b < s->n_bodies; b++)
+    if (s->bodies[b].shape == PM_BODY_MEMBRANE) P->balance = 0;
+}
+
 pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
                       const mpm_state *st, const double *accounts,
-                      mpm_model **local, mpm_state **local_state_out) {
+                      const long *cut, mpm_model **local,
+                      mpm_state **local_state_out) {
   pm_err ret = PM_SUCCESS;
   struct mpm_par *P = NULL;
   mpm_model *lm = NULL;
@@ -299,10 +312,14 @@ pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
   /* Every rank decomposes alike; a failure of one (memory) stops all
    * before the collectives that follow. */
   ret = PM_ALLOC(P, 1, "run across ranks");
-  if (!ret) ret = mpm_decomp_create(s, m, size, &P->d);
+  if (!ret)
+    ret = cut ? mpm_decomp_unpack(cut, size, &m->grid, "the cut of the boxes",
+                                  &P->d)
+              : mpm_decomp_create(s, m, size, &P->d);
   PM_TRY(pm_par_agree(ret));
   P->rank = pm_par_rank();
   fill_exchange(P);
+  set_balance(P, s, true);
   ret = local_model(s, m, st, P, &lm);
   if (!ret) P = NULL; /* lm holds it */
   if (!ret) ret = local_state(m, st, lm, accounts, &ls);
@@ -406,6 +423,12 @@ pm_err mpm_par_create_seeded(const pm_scene *s, bool gather, mpm_model **local,
 pm_err mpm_par_create_picked(const pm_scene *s, bool gather,
                              const mpm_par_pick *pick, mpm_model **local,
                              mpm_state **local_state_out) {
+  return mpm_par_create_cut(s, gather, NULL, pick, local, local_state_out);
+}
+
+pm_err mpm_par_create_cut(const pm_scene *s, bool gather, const long *cut,
+                          const mpm_par_pick *pick, mpm_model **local,
+                          mpm_state **local_state_out) {
   pm_err ret = PM_SUCCESS;
   struct mpm_par *P = NULL;
   mpm_model *frame = NULL, *lm = NULL;
@@ -415,10 +438,14 @@ pm_err mpm_par_create_picked(const pm_scene *s, bool gather,
   *local_state_out = NULL;
   ret = mpm_model_frame(s, &frame);
   if (!ret) ret = PM_ALLOC(P, 1, "run across ranks");
-  if (!ret) ret = decompose(s, frame, &P->d);
+  if (!ret)
+    ret = cut ? mpm_decomp_unpack(cut, pm_par_size(), &frame->grid,
+                                  "the cut of the boxes", &P->d)
+              : decompose(s, frame, &P->d);
   PM_TRY(pm_par_agree(ret));
   P->rank = pm_par_rank();
   fill_exchange(P);
+  set_balance(P, s, gather);
   mpm_grid grid;
   ret = local_grid(P, &frame->grid, &grid);
   if (!ret) ret = make_ghosts(P, &frame->grid, &grid);

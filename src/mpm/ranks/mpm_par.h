@@ -69,7 +69,9 @@ typedef struct {
   long *box;            /* 6 per rank: its cells [lo, hi) along x, y, z */
   mpm_decomp_cut *tree; /* size - 1 cuts; the first is the root */
   int cuts[3];          /* cuts along each axis */
-  long *count;          /* particles per rank at the reference positions */
+  long *count;          /* particles per rank where the cut was made */
+  long *count0;         /* particles per rank at the run's start */
+  long recuts;          /* cuts made since the start (mpm_par_balance) */
   int ghost;            /* node layers a rank holds beyond its own nodes */
   char held[256];       /* the axes that are not cut, and why */
 } mpm_decomp;
@@ -94,6 +96,14 @@ long mpm_decomp_cells(const mpm_grid *g, long cells[3]);
 void mpm_decomp_count(const mpm_grid *g, const long cells[3], const double x[3],
                       long *per_cell);
 void mpm_decomp_destroy(mpm_decomp *d);
+/* The cut as mpm_decomp_items(size) integers (a checkpoint's), and back
+ * for the grid `whole` (mpm_decomp_unpack checks what it reads: PM_ERR_IO
+ * naming `what` when the integers are no cut of that grid for `size`
+ * ranks; release with mpm_decomp_destroy). */
+long mpm_decomp_items(int size);
+void mpm_decomp_pack(const mpm_decomp *d, long *buf);
+pm_err mpm_decomp_unpack(const long *buf, int size, const mpm_grid *whole,
+                         const char *what, mpm_decomp *d);
 /* The rank that owns the cell of position x. */
 int mpm_decomp_rank_at(const mpm_decomp *d, const mpm_grid *g,
                        const double x[3]);
@@ -113,7 +123,9 @@ pm_err mpm_par_check(const pm_scene *s);
 pm_err mpm_par_check_implicit(const pm_scene *s);
 
 /* This rank's model and state of the run of full model m (scene s) at
- * state st, which every rank holds: its cells' particles, its block of the
+ * state st, which every rank holds, on cut `cut` (mpm_decomp_pack's, or
+ * NULL: m's particles at their reference positions): its cells'
+ * particles, its block of the
  * grid, the conditions on it and the exchanges with the other ranks
  * (collective).  Its energy accounts are its row of `accounts`
  * (MPM_PAR_ACCOUNTS per rank, as a checkpoint of as many ranks keeps
@@ -122,7 +134,8 @@ pm_err mpm_par_check_implicit(const pm_scene *s);
  * this share, released with it); m and st are left as they are. */
 pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,
                       const mpm_state *st, const double *accounts,
-                      mpm_model **local, mpm_state **local_state);
+                      const long *cut, mpm_model **local,
+                      mpm_state **local_state);
 
 /* This rank's model and state at the start of a run of scene s, made from
  * the scene alone (collective): the decomposition from the particles per
@@ -151,6 +164,20 @@ typedef struct {
 pm_err mpm_par_create_picked(const pm_scene *s, bool gather,
                              const mpm_par_pick *pick, mpm_model **local,
                              mpm_state **local_state);
+/* mpm_par_create_picked on a cut (NULL: the particles per cell at the
+ * start's): mpm_decomp_pack's integers, as a checkpoint keeps them and
+ * mpm_par_create takes them. */
+pm_err mpm_par_create_cut(const pm_scene *s, bool gather, const long *cut,
+                          const mpm_par_pick *pick, mpm_model **local,
+                          mpm_state **local_state);
+
+/* After a step's migration: every 20 steps, whether the busiest rank holds
+ * more than mpm.rebalance times the mean of the particles, and if so the
+ * boxes cut anew from the particles where they are, each particle sent to
+ * its new rank with every array it carries, and this rank's share made
+ * anew in place (m, s and w keep their addresses; collective).  Explicit
+ * steps without membranes or dynamic relaxation only. */
+pm_err mpm_par_balance(mpm_model *m, mpm_state *s, mpm_work *w);
 
 /* The values of full state st (of full model m) of local model lm's
  * particles and nodes into local state ls, whose arrays have room for
@@ -218,6 +245,11 @@ typedef struct {
   long migrated;                         /* particles sent */
   long grown;                            /* times the arrays grew */
   long most;                             /* particles held, the most */
+  /* the busiest rank's particles and the mean, summed over the looks
+   * at the balance (every 20 steps): their ratio is what the load costs
+   * a step's pace over the run */
+  double look_most, look_mean;
+  double recut_seconds; /* cutting the boxes anew */
 } mpm_par_counts;
 void mpm_par_get_counts(const mpm_model *m, mpm_par_counts *c);
 /* The decomposition of local model m. */

@@ -73,7 +73,19 @@ struct mpm_par {
   double *gbuf;
   int *gcount, *gdisp;
   mpm_par_counts counts;
+  /* cutting the boxes anew (mpm_par_balance): the scene, whether rank 0
+   * gathers, and the imbalance that calls for it (0: never) */
+  const pm_scene *scene;
+  bool gather;
+  double balance;
 };
+
+/* Particle p of group gi (of m, s) into record q (REC_* then the group's
+ * arrays), and back from q into particle j of group gi. */
+void mpm_par_pack(const mpm_model *m, const mpm_state *s, long p, int gi,
+                  double *q);
+void mpm_par_unpack(const mpm_model *m, mpm_state *s, long j, int gi,
+                    const double *q);
 
 /* The share of local model m. */
 static inline struct mpm_par *par_of(const mpm_model *m) { return m->xc->ctx; }

@@ -84,6 +84,43 @@ static void permute(const struct mpm_par *P, double *data, long n_new, int nc,
   memcpy(data, tmp, sizeof(double) * (size_t)(n_new * nc));
 }
 
+void mpm_par_pack(const mpm_model *m, const mpm_state *s, long p, int gi,
+                  double *q) {
+  const mpm_group *g = &m->group[gi];
+  q[REC_GID] = (double)m->gid[p];
+  q[REC_GROUP] = gi;
+  memcpy(q + REC_X0, m->x0 + 3 * p, 3 * sizeof(double));
+  q[REC_MASS] = m->mass[p];
+  q[REC_VOL0] = m->vol0[p];
+  memcpy(q + REC_X, s->x + 3 * p, 3 * sizeof(double));
+  memcpy(q + REC_V, s->v + 3 * p, 3 * sizeof(double));
+  q[REC_VOL] = s->vol[p];
+  memcpy(q + REC_SIGMA, s->sigma + 9 * p, 9 * sizeof(double));
+  int off = REC_BASE;
+  for (int k = 0; k < s->group[gi].n; k++) {
+    const mpm_array *a = &s->group[gi].array[k];
+    memcpy(q + off, a->data + (p - g->begin) * a->ncomp,
+           a->ncomp * sizeof(double));
+    off += a->ncomp;
+  }
+}
+
+void mpm_par_unpack(const mpm_model *m, mpm_state *s, long j, int gi,
+                    const double *q) {
+  const mpm_group *g = &m->group[gi];
+  memcpy(s->x + 3 * j, q + REC_X, 3 * sizeof(double));
+  memcpy(s->v + 3 * j, q + REC_V, 3 * sizeof(double));
+  s->vol[j] = q[REC_VOL];
+  memcpy(s->sigma + 9 * j, q + REC_SIGMA, 9 * sizeof(double));
+  int off = REC_BASE;
+  for (int k = 0; k < s->group[gi].n; k++) {
+    const mpm_array *a = &s->group[gi].array[k];
+    memcpy(a->data + (j - g->begin) * a->ncomp, q + off,
+           a->ncomp * sizeof(double));
+    off += a->ncomp;
+  }
+}
+
 /* The particles' move between ranks (collective; every rank returns the
  * same). */
 static pm_err move_particles(mpm_model *m, mpm_state *s, mpm_work *w) {
@@ -135,23 +172,8 @@ static pm_err move_particles(mpm_model *m, mpm_state *s, mpm_work *w) {
       const int r = P->dest[p];
       if (r < 0) continue;
       P->linked_left += linked;
-      double *q = P->sbuf + (long)(P->sdisp[r] + P->scount[r]++) * rec;
-      q[REC_GID] = (double)m->gid[p];
-      q[REC_GROUP] = gi;
-      memcpy(q + REC_X0, m->x0 + 3 * p, 3 * sizeof(double));
-      q[REC_MASS] = m->mass[p];
-      q[REC_VOL0] = m->vol0[p];
-      memcpy(q + REC_X, s->x + 3 * p, 3 * sizeof(double));
-      memcpy(q + REC_V, s->v + 3 * p, 3 * sizeof(double));
-      q[REC_VOL] = s->vol[p];
-      memcpy(q + REC_SIGMA, s->sigma + 9 * p, 9 * sizeof(double));
-      int off = REC_BASE;
-      for (int k = 0; k < s->group[gi].n; k++) {
-        const mpm_array *a = &s->group[gi].array[k];
-        memcpy(q + off, a->data + (p - g->begin) * a->ncomp,
-               a->ncomp * sizeof(double));
-        off += a->ncomp;
-      }
+      mpm_par_pack(m, s, p, gi,
+                   P->sbuf + (long)(P->sdisp[r] + P->scount[r]++) * rec);
     }
   }
   for (int k = 0; k <= n_near; k++) {
@@ -267,7 +289,7 @@ static pm_err grow_scratch(const mpm_model *m, mpm_work *w) {
 pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   struct mpm_par *P = par_of(m);
   PM_CALL(move_particles(m, s, w));
-  if (!P->gh) return PM_SUCCESS;
+  if (!P->gh) return mpm_par_balance(m, s, w);
   /* The ghosts: their links anew when a linked point moved between any
    * two ranks, and their positions after this step's move. */
   const double t0 = pm_wtime();
@@ -281,7 +303,7 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   pm_par_count_sent(mpm_ghosts_bytes(P->gh) - sent);
   pm_timers_stop(&w->timers, w->timer_migrate);
   P->counts.migrate_seconds += pm_wtime() - t0;
-  return e;
+  return e ? e : mpm_par_balance(m, s, w);
 }
 
 const double *mpm_par_ghost_x(const mpm_model *m, int gi) {

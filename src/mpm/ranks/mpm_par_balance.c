@@ -1,0 +1,289 @@
+/* mpm_par_balance: the boxes cut anew while a run goes on, when the
+ * particles' travel has unbalanced them (mpm.rebalance).  The boxes of
+ * the start share the particles where they were seeded; particles that
+ * travel (a shock's gas, colliding bodies) crowd some boxes and empty
+ * others, and the busiest rank sets every step's pace.  Every 20 steps
+ * the ranks compare their counts; past the threshold the cut is made
+ * again by the same bisection from the particles per cell now, each
+ * particle goes to the rank whose new box holds it with every array it
+ * carries, and each rank makes its share anew from the scene (as a run
+ * resumed from a checkpoint in pieces does: the particles it received
+ * seeded in one process's order, then their state) and takes it in place
+ * of the old one.  The step is then one process's on the new boxes: the
+ * results stay those of one process to round-off (the nodes' sums are
+ * added in another order). */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm_par_impl.h"
+#include "pm_par.h"
+#include "pm_par_mpi.h"
+#include "pm_progress.h"
+
+/* Steps between two looks at the balance. */
+#define BALANCE_EVERY 20
+/* A new cut is taken when it lowers the busiest rank's count by this. */
+#define BALANCE_GAIN 0.05
+
+/* The particles a rank receives, known by their reference positions: an
+ * open-addressed set of the records' x0, which the share's seeding asks
+ * (mpm_par_pick). */
+typedef struct {
+  const double *recs;
+  int rec;
+  long n;
+  long *slot;
+  uint64_t mask;
+} received;
+
+static uint64_t hash_x(const double x[3]) {
+  uint64_t h = 1469598103934665603ull;
+  for (int a = 0; a < 3; a++) {
+    uint64_t b;
+    memcpy(&b, &x[a], sizeof b);
+    h = (h ^ b) * 0x9e3779b97f4a7c15ull;
+    h ^= h >> 29;
+  }
+  return h;
+}
+
+static const double *x0_of(const received *rv, long k) {
+  return rv->recs + k * rv->rec + REC_X0;
+}
+
+static pm_err received_index(received *rv) {
+  uint64_t size = 16;
+  while (size < 2 * (uint64_t)rv->n) size *= 2;
+  rv->mask = size - 1;
+  PM_CALL(PM_ALLOC(rv->slot, (long)size, "received particles"));
+  for (uint64_t i = 0; i < size; i++) rv->slot[i] = -1;
+  for (long k = 0; k < rv->n; k++) {
+    uint64_t i = hash_x(x0_of(rv, k)) & rv->mask;
+    while (rv->slot[i] >= 0) i = (i + 1) & rv->mask;
+    rv->slot[i] = k;
+  }
+  return PM_SUCCESS;
+}
+
+static pm_err received_prepare(void *ctx, const mpm_decomp *d,
+                               const mpm_grid *g, int rank) {
+  (void)ctx, (void)d, (void)g, (void)rank;
+  return PM_SUCCESS;
+}
+
+static bool received_keep(void *ctx, const double x[3]) {
+  const received *rv = ctx;
+  for (uint64_t i = hash_x(x) & rv->mask;; i = (i + 1) & rv->mask) {
+    const long k = rv->slot[i];
+    if (k < 0) return false;
+    if (!memcmp(x0_of(rv, k), x, 3 * sizeof(double))) return true;
+  }
+}
+
+static int by_gid(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* The group of particle j of m. */
+static int group_of(const mpm_model *m, long j) {
+  for (int gi = 0; gi < m->n_groups; gi++)
+    if (j >= m->group[gi].begin && j < m->group[gi].end) return gi;
+  return -1;
+}
+
+/* The buffers of one cut: per rank counts and offsets (in doubles), the
+ * records sent and received. */
+typedef struct {
+  int *scount, *rcount, *sdisp, *rdisp, *fill;
+  double *sbuf, *rbuf;
+  long arriving;
+} transfer;
+
+static void transfer_free(transfer *t) {
+  free(t->scount);
+  free(t->rcount);
+  free(t->sdisp);
+  free(t->rdisp);
+  free(t->fill);
+  free(t->sbuf);
+  free(t->rbuf);
+}
+
+/* Every particle of m (state s) to its rank in decomposition d of the
+ * whole grid g (collective). */
+static pm_err send_all(const mpm_model *m, const mpm_state *s,
+                       const mpm_decomp *d, const mpm_grid *g, transfer *t) {
+  struct mpm_par *P = par_of(m);
+  const int size = pm_par_size(), rec = P->rec;
+  pm_err ret = PM_SUCCESS;
+  PM_TRY(PM_ALLOC(t->scount, size, "cut counts"));
+  PM_TRY(PM_ALLOC(t->rcount, size, "cut counts"));
+  PM_TRY(PM_ALLOC(t->sdisp, size + 1, "cut offsets"));
+  PM_TRY(PM_ALLOC(t->rdisp, size + 1, "cut offsets"));
+  PM_TRY(PM_ALLOC(t->fill, size, "cut counts"));
+  for (long p = 0; p < m->n; p++) {
+    P->dest[p] = mpm_decomp_rank_at(d, g, s->x + 3 * p);
+    t->scount[P->dest[p]]++;
+  }
+done:
+  PM_CALL(pm_par_agree(ret));
+  MPI_Alltoall(t->scount, 1, MPI_INT, t->rcount, 1, MPI_INT, pm_par_comm());
+  t->sdisp[0] = t->rdisp[0] = 0;
+  for (int k = 0; k < size; k++) {
+    t->sdisp[k + 1] = t->sdisp[k] + t->scount[k];
+    t->rdisp[k + 1] = t->rdisp[k] + t->rcount[k];
+  }
+  t->arriving = t->rdisp[size];
+  ret = PM_ALLOC(t->sbuf, (long)rec * (m->n + 1), "cut records");
+  if (!ret)
+    ret = PM_ALLOC(t->rbuf, (long)rec * (t->arriving + 1), "cut records");
+  PM_CALL(pm_par_agree(ret));
+  for (int gi = 0; gi < m->n_groups; gi++)
+    for (long p = m->group[gi].begin; p < m->group[gi].end; p++) {
+      const int r = P->dest[p];
+      mpm_par_pack(m, s, p, gi,
+                   t->sbuf + (long)(t->sdisp[r] + t->fill[r]++) * rec);
+    }
+  for (int k = 0; k < size; k++) {
+    t->scount[k] *= rec;
+    t->rcount[k] *= rec;
+    t->sdisp[k] *= rec;
+    t->rdisp[k] *= rec;
+  }
+  MPI_Alltoallv(t->sbuf, t->scount, t->sdisp, MPI_DOUBLE, t->rbuf, t->rcount,
+                t->rdisp, MPI_DOUBLE, pm_par_comm());
+  P->counts.migrate_bytes += (double)m->n * rec * sizeof(double);
+  pm_par_count_sent((double)m->n * rec * sizeof(double));
+  qsort(t->rbuf, (size_t)t->arriving, (size_t)rec * sizeof(double), by_gid);
+  return PM_SUCCESS;
+}
+
+/* The share seeded on cut d with the particles received, their state from
+ * the records, the run's values from s (collective). */
+static pm_err share_anew(const mpm_model *m, const mpm_state *s,
+                         const long *cut, const transfer *t, mpm_model **lm,
+                         mpm_state **ls) {
+  const struct mpm_par *P = par_of(m);
+  received rv = {.recs = t->rbuf, .rec = P->rec, .n = t->arriving};
+  mpm_par_pick pick = {
+      .prepare = received_prepare, .keep = received_keep, .ctx = &rv};
+  pm_err ret = pm_par_agree(received_index(&rv));
+  if (!ret) ret = mpm_par_create_cut(P->scene, P->gather, cut, &pick, lm, ls);
+  free(rv.slot);
+  PM_CALL(ret);
+  /* Each particle seeded is one received, in the same order. */
+  long bad = -1;
+  if ((*lm)->n != t->arriving) bad = 0;
+  for (long j = 0; bad < 0 && j < (*lm)->n; j++)
+    if ((double)(*lm)->gid[j] != t->rbuf[j * P->rec + REC_GID] ||
+        group_of(*lm, j) != (int)t->rbuf[j * P->rec + REC_GROUP])
+      bad = j;
+  if (bad >= 0)
+    ret = PM_ERROR(PM_ERR_INTERNAL,
+                   "step %ld: cutting the boxes anew, rank %d received %ld "
+                   "particles and seeded %ld (the first apart: %ld)",
+                   s->step, pm_par_rank(), t->arriving, (*lm)->n, bad);
+  PM_CALL(pm_par_agree(ret));
+  for (long j = 0; j < (*lm)->n; j++)
+    mpm_par_unpack(*lm, *ls, j, group_of(*lm, j), t->rbuf + j * P->rec);
+  /* The run's values, this rank's energy accounts among them. */
+  mpm_state_copy_values(*ls, s);
+  return PM_SUCCESS;
+}
+
+/* The new share in place of the old: m, s and w keep their addresses
+ * (the time loop holds them), their contents swapped and the old freed;
+ * what the run counted so far goes on. */
+static void take(mpm_model *m, mpm_state *s, mpm_work *w, mpm_model *lm,
+                 mpm_state *ls, mpm_work *lw) {
+  struct mpm_par *P = par_of(m), *Q = par_of(lm);
+  Q->counts = P->counts;
+  if (lm->n > Q->counts.most) Q->counts.most = lm->n;
+  lw->timers = w->timers;
+  memcpy(lw->timer, w->timer, sizeof w->timer);
+  lw->timer_migrate = w->timer_migrate;
+  lw->max_div = w->max_div;
+  lw->min_jacobian = w->min_jacobian;
+  lw->residual = w->residual;
+  lw->iter_max = w->iter_max;
+  lw->iter_capped = w->iter_capped;
+  lw->fail = w->fail;
+  if (m->n_bcs > 0)
+    memcpy(lw->cond.reaction, w->cond.reaction,
+           3 * sizeof(double) * (size_t)m->n_bcs);
+  const mpm_model tm = *m;
+  *m = *lm;
+  *lm = tm;
+  const mpm_state ts = *s;
+  *s = *ls;
+  *ls = ts;
+  const mpm_work tw = *w;
+  *w = *lw;
+  *lw = tw;
+}
+
+pm_err mpm_par_balance(mpm_model *m, mpm_state *s, mpm_work *w) {
+  struct mpm_par *P = par_of(m);
+  /* (on steps of their own, so that a resumed run looks when the
+   * straight one did) */
+  if (s->step % BALANCE_EVERY != 0) return PM_SUCCESS;
+  const int size = pm_par_size();
+  double most = (double)m->n, total = (double)m->n;
+  pm_par_max(&most, 1);
+  pm_par_sum(&total, 1);
+  P->counts.look_most += most;
+  P->counts.look_mean += total / size;
+  if (P->balance <= 0 || total <= 0 || most * size <= P->balance * total)
+    return PM_SUCCESS;
+  /* The cut from the particles per cell where they are now. */
+  const double t0 = pm_wtime();
+  pm_err ret = PM_SUCCESS;
+  mpm_model *frame = NULL, *lm = NULL;
+  mpm_state *ls = NULL;
+  mpm_work *lw = NULL;
+  mpm_decomp d = {0};
+  transfer t = {0};
+  long cells[3], *per_cell = NULL, n_cells = 0, *cut = NULL;
+  ret = mpm_model_frame(P->scene, &frame);
+  if (!ret) {
+    n_cells = mpm_decomp_cells(&frame->grid, cells);
+    ret = PM_ALLOC(per_cell, n_cells, "particles per cell");
+  }
+  PM_TRY(pm_par_agree(ret));
+  for (long p = 0; p < m->n; p++)
+    mpm_decomp_count(&frame->grid, cells, s->x + 3 * p, per_cell);
+  pm_par_sum_long(per_cell, (int)n_cells);
+  PM_TRY(pm_par_agree(mpm_decomp_from_counts(P->scene, frame, size, per_cell,
+                                             (long)total, &d)));
+  long new_most = 0;
+  for (int k = 0; k < size; k++)
+    new_most = d.count[k] > new_most ? d.count[k] : new_most;
+  /* (every rank decides alike: the counts are the same everywhere) */
+  if ((double)new_most > (1 - BALANCE_GAIN) * most) goto done;
+  /* The new cut keeps the start's counts and counts itself. */
+  d.recuts = P->d.recuts + 1;
+  ret = PM_ALLOC(d.count0, size, "particles per rank");
+  if (!ret) ret = PM_ALLOC(cut, mpm_decomp_items(size), "the cut");
+  PM_TRY(pm_par_agree(ret));
+  memcpy(d.count0, P->d.count0 ? P->d.count0 : P->d.count,
+         sizeof(long) * (size_t)size);
+  mpm_decomp_pack(&d, cut);
+  PM_TRY(send_all(m, s, &d, &frame->grid, &t));
+  PM_TRY(share_anew(m, s, cut, &t, &lm, &ls));
+  PM_TRY(pm_par_agree(mpm_work_create(lm, &lw)));
+  take(m, s, w, lm, ls, lw);
+  P = par_of(m); /* (the new share's) */
+done:
+  P->counts.recut_seconds += pm_wtime() - t0;
+  transfer_free(&t);
+  free(per_cell);
+  free(cut);
+  mpm_decomp_destroy(&d);
+  mpm_work_destroy(lw);
+  mpm_state_destroy(ls);
+  mpm_model_destroy(lm);
+  mpm_model_destroy(frame);
+  return ret;
+}
