@@ -42,8 +42,11 @@
  * sphere are shared as well as particles filling the box).  It leaves
  * uncut an axis along which a boundary wall moves (a face condition's
  * column is walked from the grid's edge to the wall) and keeps cuts clear
- * of face planes.  The node sums run on the ghost nodes' exchange
- * (pm_halo: MPI alone). */
+ * of face planes.  Particles that travel unbalance the boxes: every 20
+ * steps the busiest rank's count is compared with the mean, and past
+ * mpm.rebalance the boxes are cut anew by the same bisection on the
+ * particles where they are (mpm_par_balance).  The node sums run on the
+ * ghost nodes' exchange (pm_halo: MPI alone). */
 #ifndef MPM_PAR_H
 #define MPM_PAR_H
 
