@@ -21,20 +21,11 @@ damaged=$src/tests/fuzz/upstream/checkpoint/hdf5-string-of-4gb
 # Short runs: a 2-D membrane (M5), a 3-D one (M4 reduced), a 2-D block
 # pulled on ymax, and a coarse F2 block beside a CalculiX referee of 2
 # elements a side (what nrmse-map's --fe-run reads).
-cat >"$work/pull.yaml" <<'YAML'
-name: pull
-method: mpm
-dimension: 2
-domain: {box: {min: [0, 0], max: [1, 0.5]}}
-discretization: {mesh_size: 0.1}
-materials:
-  - {name: rubber, model: linear-elastic, density: 1100, youngs_modulus: 1.0e6, poisson_ratio: 0.3}
-boundary:
-  - {on: ymin, velocity: {x: 0, y: 0}}
-  - {on: ymax, velocity: {x: 0, y: 0.01}}
-time: {end: 0.01}
-output: {every: 20}
-YAML
+{
+  cat "$src/tests/data/scenes/minimal-2d.yaml"
+  echo "boundary: [{on: ymin, velocity: {x: 0, y: 0}}, {on: ymax, velocity: {x: 0, y: 0.01}}]"
+  echo "output: {every: 20}"
+} >"$work/pull.yaml"
 run() { # name, scene, options...
   local name=$1 scene=$2
   shift 2
@@ -46,7 +37,7 @@ run m5 "$src/cases/mpm/m5-gas-circle.yaml" --set time.end=0.01 \
   --set output.every=100
 run m4 "$src/cases/mpm/m4-oocyte-reduced.yaml" --set time.end=3e-7 \
   --set output.every=10
-run pull "$work/pull.yaml"
+run pull "$work/pull.yaml" --set time.end=0.01
 f2=$src/cases/fpm/f2-unconstrained-compression.yaml
 "$bin" convergence "$f2" --set-ladder discretization.mesh_size=0.02 \
   --reference "fe:$src/cases/fe/f2-unconstrained-compression" \
@@ -56,6 +47,19 @@ $py "$tools/fe-referee.py" f2-unconstrained-compression --run --ladder 2 \
   --keep --work "$work/fe" --out "$work/fe-out" >/dev/null 2>"$work/err"
 check "the referee of 2 elements a side is kept" \
   test -d "$work/fe/f2-unconstrained-compression-N2-C3D20R"
+
+# A script refusing a damaged file: exit 1, the message (a regular
+# expression) on stderr, no traceback.
+reason='HDF5 cannot read attribute format of / \(memory allocation failed'
+refused() { # what, message, script and arguments...
+  local what=$1 message=$2 rc
+  shift 2
+  (cd "$tools" && $py "$@") >/dev/null 2>"$work/refused"
+  rc=$?
+  check "$what refused (exit $rc)" test $rc -eq 1
+  check "$what: named, with the reason" grep -qE "$message" "$work/refused"
+  check "$what: no traceback" bash -c "! grep -q Traceback '$work/refused'"
+}
 
 # Each script's command on a run folder (RUN), as a user types it.
 tool() { # key, run folder
@@ -93,13 +97,8 @@ for t in normal-angles nrmse-map plot-membrane-2d plot-points \
   cp -r "$work/${runs[$t]}" "$bad"
   cp "$damaged" "$bad/results/mesh.h5"
   # shellcheck disable=SC2046
-  (cd "$tools" && $py $(tool "$t" "$bad")) >/dev/null 2>"$work/refused"
-  rc=$?
-  check "$t: a damaged mesh refused (exit $rc)" test $rc -eq 1
-  check "$t: named, with HDF5's reason" grep -qE \
-    "^$t: $bad/results/mesh.h5: HDF5 cannot read attribute format of / \(memory allocation failed" \
-    "$work/refused"
-  check "$t: no traceback" bash -c "! grep -q Traceback '$work/refused'"
+  refused "$t: a damaged mesh" "^$t: $bad/results/mesh.h5: $reason" \
+    $(tool "$t" "$bad")
 done
 
 # A damaged last frame, and a truncated one (HDF5 cannot open it, so the
@@ -109,20 +108,12 @@ cp -r "$work/pull" "$bad"
 frames=("$bad"/results/frame_*.h5)
 last=${frames[-1]}
 cp "$damaged" "$last"
-$py "$tools/plot-points.py" "$bad" --out "$work/out.png" >/dev/null \
-  2>"$work/refused"
-check "plot-points: a damaged frame refused" test $? -eq 1
-check "plot-points: the frame named" grep -qF "$last: HDF5 cannot read attribute format" \
-  "$work/refused"
+refused "plot-points: a damaged frame" "^plot-points: $last: $reason" \
+  plot-points.py "$bad" --out "$work/out.png"
 head -c 3000 "$work/pull/results/${last##*/}" >"$last"
-$py "$tools/plot-vessel-stress.py" "$work/out.png" "$bad" >/dev/null \
-  2>"$work/refused"
-check "plot-vessel-stress: a truncated frame refused" test $? -eq 1
-check "plot-vessel-stress: the frame named, h5py's reason" grep -qF \
-  "$last: HDF5 cannot read it: Unable to open file (truncated file" \
-  "$work/refused"
-check "plot-vessel-stress: no traceback" \
-  bash -c "! grep -q Traceback '$work/refused'"
+refused "plot-vessel-stress: a truncated frame" \
+  "^plot-vessel-stress: $last: HDF5 cannot read it: Unable to open file \(truncated file" \
+  plot-vessel-stress.py "$work/out.png" "$bad"
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
