@@ -44,12 +44,6 @@ def load(out, frame):
     try:
         r = pointmech.open(out)
         path = r.folder
-        mesh = r.mesh
-        for name in ("coordinates", "cells"):
-            if name not in mesh:
-                fail(f"{path}/results/mesh.h5: missing /{name}")
-        x = np.asarray(mesh["coordinates"], dtype=float)
-        cells = np.asarray(mesh["cells"])
         frames = r.frames[:]
         if not frames:
             fail(f"{path}/results: no frame")
@@ -57,6 +51,13 @@ def load(out, frame):
             fail(f"{path}: --frame {frame} out of range "
                  f"({len(frames)} frames)")
         fr = frames[frame]
+        r.check([fr])  # the mesh and the frame, in one call of the program
+        mesh = r.mesh
+        for name in ("coordinates", "cells"):
+            if name not in mesh:
+                fail(f"{path}/results/mesh.h5: missing /{name}")
+        x = np.asarray(mesh["coordinates"], dtype=float)
+        cells = np.asarray(mesh["cells"])
         name = f"{fr.index:06d}"
         if "displacement" not in fr:
             fail(f"{fr.path}: missing /displacement")
