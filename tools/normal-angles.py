@@ -4,8 +4,10 @@ frame by frame.
 
 usage: normal-angles.py [--failed] RUN_DIR
 
-RUN_DIR holds results.h5 of an MPM run with a membrane whose normals came
-by isosurface least squares (or any method).  For each frame the normals
+RUN_DIR is an MPM run with a membrane whose normals came by isosurface
+least squares (or any method); its files are read through the project's
+Python module (python/pointmech), which has the program vet each before
+h5py opens it: a damaged one is refused with its name and the reason.  For each frame the normals
 the run carried (the "normal" field) are compared with the normals the
 membrane's connectivity gives on the frame's positions: in 3-D the mean of
 the unit normals of each point's triangles (/mesh/surface), in 2-D the
@@ -16,10 +18,14 @@ number above 10 degrees; with --failed (runs with damage), the same over
 the points within one triangle of a failed point, and over the others.
 """
 import argparse
+import os
 import sys
 
-import h5py
 import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "python"))
+import pointmech  # noqa: E402
 
 
 def fail(msg):
@@ -59,36 +65,39 @@ def main():
     ap.add_argument("--failed", action="store_true")
     a = ap.parse_args()
     try:
-        f = h5py.File(f"{a.run}/results.h5", "r")
-    except OSError as e:
-        fail(f"{a.run}/results.h5: {e}")
-    with f:
-        x0 = np.asarray(f["mesh/coordinates"][()], dtype=float)
-        tri = np.asarray(f["mesh/surface"][()], dtype=np.int64) \
-            if "mesh/surface" in f else None
-        table = sorted((float(f["frames"][k].attrs["time"]), k)
-                       for k in f["frames"])
-        head = "time           points    mean     rms     max   >10deg"
-        print(head + ("   | near failed ... | intact ..." if a.failed else ""))
-        for time, k in table:
-            g = f["frames"][k]
-            if "normal" not in g:
-                fail(f"frame {k} has no normal field")
-            x = x0 + np.asarray(g["displacement"][()], dtype=float)
-            nr = np.asarray(g["normal"][()], dtype=float)
-            mem = np.flatnonzero(np.linalg.norm(nr, axis=1) > 0.5)
-            nc = connectivity_normals(x, tri, mem)
-            c = np.abs(np.sum(nr[mem] * nc[mem], axis=1))
-            ang = np.degrees(np.arccos(np.clip(c, 0, 1)))
-            line = f"{time:<12.5g} {stats(ang)}"
-            if a.failed and "failed" in g and tri is not None:
-                failed = np.asarray(g["failed"][()], dtype=float) > 0.5
-                near = np.zeros(len(x0), bool)
-                bad = failed[tri].any(axis=1)
-                near[tri[bad].ravel()] = True
-                sel = near[mem]
-                line += f"   | {stats(ang[sel])} | {stats(ang[~sel])}"
-            print(line)
+        report(a.run, a.failed)
+    except (pointmech.Refused, OSError) as e:
+        fail(e)
+
+
+def report(run, with_failed):
+    r = pointmech.open(run)
+    r.check()  # the mesh and every frame, in one call of the program
+    mesh = r.mesh
+    x0 = np.asarray(mesh["coordinates"], dtype=float)
+    tri = np.asarray(mesh["surface"], dtype=np.int64) \
+        if "surface" in mesh else None
+    frames = sorted(r.frames, key=lambda fr: fr.time)
+    head = "time           points    mean     rms     max   >10deg"
+    print(head + ("   | near failed ... | intact ..." if with_failed else ""))
+    for fr in frames:
+        if "normal" not in fr:
+            fail(f"frame {fr.index:06d} ({fr.path}) has no normal field")
+        x = x0 + np.asarray(fr["displacement"], dtype=float)
+        nr = np.asarray(fr["normal"], dtype=float)
+        mem = np.flatnonzero(np.linalg.norm(nr, axis=1) > 0.5)
+        nc = connectivity_normals(x, tri, mem)
+        c = np.abs(np.sum(nr[mem] * nc[mem], axis=1))
+        ang = np.degrees(np.arccos(np.clip(c, 0, 1)))
+        line = f"{fr.time:<12.5g} {stats(ang)}"
+        if with_failed and "failed" in fr and tri is not None:
+            failed = np.asarray(fr["failed"], dtype=float) > 0.5
+            near = np.zeros(len(x0), bool)
+            bad = failed[tri].any(axis=1)
+            near[tri[bad].ravel()] = True
+            sel = near[mem]
+            line += f"   | {stats(ang[sel])} | {stats(ang[~sel])}"
+        print(line)
 
 
 if __name__ == "__main__":

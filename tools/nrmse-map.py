@@ -186,13 +186,31 @@ def mls(x, f, q, quadratic=False, local=None, factor=2.2):
 
 def run_points(run_dir):
     """The run's points, last displacement and each point's share of the
-    Delaunay volume (results/mesh.h5 and the last frame)."""
-    import h5py
-    with h5py.File(os.path.join(run_dir, "results", "mesh.h5"), "r") as f:
-        x, cells = f["coordinates"][:], f["cells"][:]
-    last = sorted(glob.glob(os.path.join(run_dir, "results", "frame_*.h5")))
-    with h5py.File(last[-1], "r") as f:
-        u = f["displacement"][:]
+    Delaunay volume (results/mesh.h5 and the last frame, read through the
+    project's Python module: the program vets each file before h5py opens
+    it, and a damaged one is refused with its name and the reason)."""
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(
+        os.path.abspath(__file__))), "python"))
+    import pointmech
+    try:
+        r = pointmech.open(run_dir)
+        if len(r.frames) == 0:
+            sys.exit(f"nrmse-map: {run_dir}/results: no frame")
+        last = r.frames[-1]
+        r.check([last])  # the mesh and the last frame, in one call
+        mesh = r.mesh
+        for name in ("coordinates", "cells"):
+            if name not in mesh:
+                sys.exit(f"nrmse-map: {run_dir}/results/mesh.h5: no {name}")
+        if "displacement" not in last:
+            sys.exit(f"nrmse-map: {last.path}: no displacement")
+        x, cells, u = mesh["coordinates"], mesh["cells"], last["displacement"]
+    except (pointmech.Refused, OSError) as e:
+        sys.exit(f"nrmse-map: {e}")
+    if cells.ndim != 2 or cells.shape[1] != 4 or u.shape != x.shape:
+        sys.exit(f"nrmse-map: {run_dir}: expected tetrahedra and one "
+                 f"displacement a point (cells {cells.shape}, points "
+                 f"{x.shape}, displacement {u.shape})")
     a, b, c, e = (x[cells[:, i]] for i in range(4))
     vol = np.abs(np.einsum("ij,ij->i", b - a, np.cross(c - a, e - a))) / 6
     share = np.zeros(len(x))
@@ -201,8 +219,8 @@ def run_points(run_dir):
     return x, u, share
 
 
-def mapping_report(run_dir, q, fe_at):
-    x, u, share = run_points(run_dir)
+def mapping_report(points, q, fe_at):
+    x, u, share = points
     fq, fx = fe_at(q), fe_at(x)
     scale = np.linalg.norm(fq, axis=1).max()
     w, _ = weights(q)
@@ -243,9 +261,13 @@ def main():
                     help="its case (default f4-compression-20)")
     ap.add_argument("--n", type=int, default=12, help="its mesh N (12)")
     a = ap.parse_args()
-    fe_at = referee_field(a.fe_run, a.case, a.n) if a.fe_run else None
+    fe_at = None
     for path in a.errors:
         t = read_csv(path)
+        points = None
+        if a.fe_run:  # the run's own files first: refused before any work
+            points = run_points(os.path.dirname(os.path.abspath(path)))
+            fe_at = fe_at or referee_field(a.fe_run, a.case, a.n)
         x = np.c_[t["x"], t["y"], t["z"]]
         u = np.c_[t["u_x"], t["u_y"], t["u_z"]]
         fe = np.c_[t["u_fe_x"], t["u_fe_y"], t["u_fe_z"]]
@@ -268,8 +290,8 @@ def main():
         for name, m, share, rms in regions(x, u - fe):
             print("| %s | %d | %.1f%% | %.2e |" % (name, m, 100 * share, rms))
         print()
-        if fe_at:
-            mapping_report(os.path.dirname(os.path.abspath(path)), x, fe_at)
+        if points is not None:
+            mapping_report(points, x, fe_at)
         if a.plot:
             import matplotlib
             matplotlib.use("Agg")

@@ -4,49 +4,50 @@ run, one row per time (as figs. 12 and 14 of the membrane-normals paper).
 
 usage: plot-membrane-2d.py --times T1,T2 [--scale S] --out PNG LABEL=RUN_DIR ...
 
-Each RUN_DIR holds results.h5 of a 2-D MPM run with a membrane.  For each
-time the frame nearest in time is drawn: the other particles as grey dots,
-the membrane's points (those whose "normal" field is a unit vector) in
+Each RUN_DIR is a 2-D MPM run with a membrane, read through the project's
+Python module (python/pointmech): the program vets each HDF5 file before
+h5py opens it, and a damaged one is refused with its name and the reason.
+For each time the frame nearest in time is drawn: the other particles as
+grey dots, the membrane's points (those whose "normal" field is a unit vector) in
 black with their normals as arrows of length S (default 0.1, in the
 results' length unit).
 """
 import argparse
+import os
 import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "python"))
+import pointmech  # noqa: E402
+
 
 def fail(msg):
     sys.exit(f"plot-membrane-2d: {msg}")
 
 
-def frames(f, path):
-    if "frames" not in f or len(f["frames"]) == 0:
-        fail(f"{path}: no frame")
-    return sorted((float(f["frames"][n].attrs["time"]), n) for n in f["frames"])
-
-
 def load(path, t):
     try:
-        f = h5py.File(f"{path}/results.h5", "r")
-    except OSError as e:
-        fail(f"{path}/results.h5: {e}")
-    with f:
-        table = frames(f, path)
-        time, name = min(table, key=lambda tn: abs(tn[0] - t))
-        g = f["frames"][name]
-        x0 = np.asarray(f["mesh/coordinates"][()], dtype=float)
-        x = x0 + np.asarray(g["displacement"][()], dtype=float) \
+        r = pointmech.open(path)
+        r.check()  # the mesh and every frame, in one call of the program
+        if len(r.frames) == 0:
+            fail(f"{path}: no frame")
+        g = min(r.frames, key=lambda fr: abs(fr.time - t))
+        x0 = np.asarray(r.mesh["coordinates"], dtype=float)
+        x = x0 + np.asarray(g["displacement"], dtype=float) \
             if "displacement" in g else x0
         if "normal" not in g:
-            fail(f"{path}: frame {name} has no normal field (no membrane?)")
-        n = np.asarray(g["normal"][()], dtype=float)
-        return time, x, n
+            fail(f"{path}: frame {g.index:06d} has no normal field "
+                 "(no membrane?)")
+        n = np.asarray(g["normal"], dtype=float)
+        return g.time, x, n
+    except (pointmech.Refused, OSError) as e:
+        fail(e)
 
 
 def main():

@@ -1,8 +1,10 @@
 #!/usr/bin/python3
 """Draw the deformed points of one or more pointmech runs side by side.
 
-Each OUT is a run directory holding results.h5 (or the results.h5 file
-itself).  One subplot per run, all with the same axis limits and equal
+Each OUT is a run directory (or its results.h5), read through the
+project's Python module (python/pointmech): the program vets each HDF5
+file before h5py opens it, and a damaged one is refused with its name and
+the reason.  One subplot per run, all with the same axis limits and equal
 aspect.  2-D runs (all z == 0, or triangle cells): the deformed triangulation
 drawn faintly, the deformed points as dots and the undeformed box outline
 dashed grey.  3-D runs: the x-z projection of the deformed points.  The
@@ -21,7 +23,6 @@ import argparse
 import os
 import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
@@ -40,31 +41,29 @@ def fail(msg):
 
 def load(out, frame):
     """Return (deformed [n][3], reference [n][3], cells, frame name)."""
-    path = out if os.path.isfile(out) else os.path.join(out, "results.h5")
-    if not os.path.isfile(path):
-        fail(f"{path}: no such file")
     try:
-        with h5py.File(path, "r") as f:
-            for name in ("mesh/coordinates", "mesh/cells", "frames"):
-                if name not in f:
-                    fail(f"{path}: missing /{name}")
-            x = np.asarray(pointmech.read_rows(f["mesh"], "coordinates"),
-                           dtype=float)
-            cells = np.asarray(f["mesh/cells"][()])
-            frames = sorted(f["frames"].keys())
-            if not frames:
-                fail(f"{path}: /frames holds no frame")
-            if not -len(frames) <= frame < len(frames):
-                fail(f"{path}: --frame {frame} out of range "
-                     f"({len(frames)} frames)")
-            name = frames[frame]
-            if "displacement" not in f["frames"][name]:
-                fail(f"{path}: missing /frames/{name}/displacement")
-            u = np.asarray(
-                pointmech.read_rows(f["frames"][name], "displacement"),
-                dtype=float)
-    except OSError as e:
-        fail(f"{path}: cannot read as HDF5: {e}")
+        r = pointmech.open(out)
+        path = r.folder
+        frames = r.frames[:]
+        if not frames:
+            fail(f"{path}/results: no frame")
+        if not -len(frames) <= frame < len(frames):
+            fail(f"{path}: --frame {frame} out of range "
+                 f"({len(frames)} frames)")
+        fr = frames[frame]
+        r.check([fr])  # the mesh and the frame, in one call of the program
+        mesh = r.mesh
+        for name in ("coordinates", "cells"):
+            if name not in mesh:
+                fail(f"{path}/results/mesh.h5: missing /{name}")
+        x = np.asarray(mesh["coordinates"], dtype=float)
+        cells = np.asarray(mesh["cells"])
+        name = f"{fr.index:06d}"
+        if "displacement" not in fr:
+            fail(f"{fr.path}: missing /displacement")
+        u = np.asarray(fr["displacement"], dtype=float)
+    except (pointmech.Refused, OSError) as e:
+        fail(e)
     if x.ndim != 2 or x.shape[1] != 3 or u.shape != x.shape:
         fail(f"{path}: coordinates {x.shape} and displacement {u.shape} "
              "must both be [n][3]")

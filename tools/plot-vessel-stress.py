@@ -5,7 +5,9 @@
                           [--depth 1e-6] [--voxel 1.05e-6]
 
 Each RUN is a run directory of cases/mpm/i2-vessel-slice.yaml (or the
-study's).  Writes OUT.png: on the left the reaction at the pulled end
+study's), its HDF5 files read through the project's Python module
+(python/pointmech): the program vets each before h5py opens it, and a
+damaged one is refused with its name and the reason.  Writes OUT.png: on the left the reaction at the pulled end
 against the applied strain for every run (fig. 7: per unit depth times
 --depth, in nN); then, for every run, its von Mises stress at the last
 frame drawn on the reference pixels (fig. 8), on one colour scale.
@@ -22,7 +24,6 @@ import json
 import os
 import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
@@ -52,14 +53,18 @@ def history(run):
 
 
 def last_frame(run):
-    path = os.path.join(run, "results.h5")
-    if not os.path.isfile(path):
-        fail(f"{path}: no such file")
-    with h5py.File(path, "r") as f:
-        names = sorted(f["frames"].keys())
-        fr = f["frames"][names[-1]]
-        x0 = np.array(pointmech.read_rows(f["mesh"], "coordinates"))
-        vm = np.array(pointmech.read_rows(fr, "von_mises"))
+    try:
+        r = pointmech.open(run)
+        if len(r.frames) == 0:
+            fail(f"{run}/results: no frame")
+        fr = r.frames[-1]
+        r.check([fr])  # the mesh and the last frame, in one call
+        if "von_mises" not in fr:
+            fail(f"{fr.path}: no von_mises field")
+        x0 = np.array(r.mesh["coordinates"])
+        vm = np.array(fr["von_mises"])
+    except (pointmech.Refused, OSError) as e:
+        fail(e)
     return x0, vm
 
 

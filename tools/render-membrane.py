@@ -2,7 +2,9 @@
 """Render a run's membrane (the triangles of results/mesh.h5's /surface) at
 chosen times, one panel per time, into one PNG.
 
-OUT is a run directory holding results.h5 (or the results.h5 file itself).
+OUT is a run directory (or its results.h5), read through the project's
+Python module (python/pointmech): the program vets each HDF5 file before
+h5py opens it, and a damaged one is refused with its name and the reason.
 For each time of --times the frame nearest in time is drawn: its triangles
 on the frame's "position" field (else the reference coordinates plus
 "displacement", else the reference coordinates), each triangle coloured by
@@ -18,7 +20,6 @@ import argparse
 import os
 import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
@@ -26,6 +27,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib import cm, colors  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 import numpy as np  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "python"))
+import pointmech  # noqa: E402
 
 
 def fail(msg):
@@ -42,17 +47,16 @@ def floats(text, what, count=None):
     return values
 
 
-def frame_table(f, path):
-    """[(time, name)] of every frame, in time order."""
-    if "frames" not in f or len(f["frames"]) == 0:
+def frame_table(r, path):
+    """[(time, frame)] of every frame, in time order."""
+    if len(r.frames) == 0:
         fail(f"{path}: no frame")
     table = []
-    for name in f["frames"]:
-        g = f["frames"][name]
-        if "time" not in g.attrs:
-            fail(f"{path}: frame {name} has no time attribute")
-        table.append((float(g.attrs["time"]), name))
-    return sorted(table)
+    for fr in r.frames:
+        if np.isnan(fr.time):
+            fail(f"{fr.path}: frame {fr.index:06d} has no time attribute")
+        table.append((fr.time, fr))
+    return sorted(table, key=lambda tf: (tf[0], tf[1].index))
 
 
 def nearest(table, t):
@@ -60,20 +64,20 @@ def nearest(table, t):
     return table[k]
 
 
-def geometry(f, g, x0):
+def geometry(g, x0):
     if "position" in g:
-        return np.asarray(g["position"][()], dtype=float)
+        return np.asarray(g["position"], dtype=float)
     if "displacement" in g:
-        return x0 + np.asarray(g["displacement"][()], dtype=float)
+        return x0 + np.asarray(g["displacement"], dtype=float)
     return x0
 
 
-def scalar(g, name, n, path):
+def scalar(g, name, n):
     if name not in g:
         return None
-    v = np.asarray(g[name][()], dtype=float)
+    v = np.asarray(g[name], dtype=float)
     if v.shape != (n,):
-        fail(f"{path}: field '{name}' is not a scalar field of {n} points "
+        fail(f"{g.path}: field '{name}' is not a scalar field of {n} points "
              f"(shape {v.shape})")
     return v
 
@@ -81,39 +85,39 @@ def scalar(g, name, n, path):
 def load(out, times, field):
     """Membrane triangles, the colour field's name and, per time asked,
     (frame time, positions, field values, failed flags or None)."""
-    path = out if os.path.isfile(out) else os.path.join(out, "results.h5")
-    if not os.path.isfile(path):
-        fail(f"{path}: no such file")
     try:
-        with h5py.File(path, "r") as f:
-            if "mesh/surface" not in f:
-                fail(f"{path}: no membrane (no /mesh/surface: the run has no "
-                     "surface triangles)")
-            tri = np.asarray(f["mesh/surface"][()], dtype=np.int64)
-            x0 = np.asarray(f["mesh/coordinates"][()], dtype=float)
-            n = len(x0)
-            if tri.ndim != 2 or tri.shape[1] != 3 or tri.min() < 0 or \
-                    tri.max() >= n:
-                fail(f"{path}: /mesh/surface is not triangles over {n} points")
-            table = frame_table(f, path)
-            first = f["frames"][table[0][1]]
-            if field is None:
-                field = "failed" if "failed" in first else "von_mises"
-            if times is None:  # four frames spread over the run
-                times = list(np.linspace(table[0][0], table[-1][0], 4))
-            frames = []
-            for t in times:
-                time, name = nearest(table, t)
-                g = f["frames"][name]
-                values = scalar(g, field, n, path)
-                if values is None:
-                    have = [k for k in g if g[k].shape == (n,)]
-                    fail(f"{path}: frame {name} has no scalar field "
-                         f"'{field}' (it has: {', '.join(have) or 'none'})")
-                frames.append((time, name, geometry(f, g, x0), values,
-                               scalar(g, "failed", n, path)))
-    except OSError as e:
-        fail(f"{path}: cannot read as HDF5: {e}")
+        r = pointmech.open(out)
+        path = r.folder
+        r.check()  # the mesh and every frame, in one call of the program
+        mesh = r.mesh
+        if "surface" not in mesh:
+            fail(f"{path}: no membrane (no /surface in results/mesh.h5: the "
+                 "run has no surface triangles)")
+        tri = np.asarray(mesh["surface"], dtype=np.int64)
+        x0 = np.asarray(mesh["coordinates"], dtype=float)
+        n = len(x0)
+        if tri.ndim != 2 or tri.shape[1] != 3 or tri.min() < 0 or \
+                tri.max() >= n:
+            fail(f"{path}: the mesh's /surface is not triangles over {n} "
+                 "points")
+        table = frame_table(r, path)
+        if field is None:
+            field = "failed" if "failed" in table[0][1] else "von_mises"
+        if times is None:  # four frames spread over the run
+            times = list(np.linspace(table[0][0], table[-1][0], 4))
+        frames = []
+        for t in times:
+            time, g = nearest(table, t)
+            name = f"{g.index:06d}"
+            values = scalar(g, field, n)
+            if values is None:
+                have = [k for k in g.keys() if g[k].shape == (n,)]
+                fail(f"{g.path}: frame {name} has no scalar field "
+                     f"'{field}' (it has: {', '.join(have) or 'none'})")
+            frames.append((time, name, geometry(g, x0), values,
+                           scalar(g, "failed", n)))
+    except (pointmech.Refused, OSError) as e:
+        fail(e)
     return tri, field, frames
 
 

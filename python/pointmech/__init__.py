@@ -22,7 +22,10 @@ vet FILE`: HDF5 reads it whole in a child process): libhdf5 stops or
 loops the process that reads some damaged files, and such a file raises
 `Refused` with the program's reason instead.  The program is $POINTMECH,
 else `pointmech` on the PATH, else build/pointmech beside this module's
-folder; `open(folder, vet=False)` reads without it.
+folder; `open(folder, vet=False)` reads without it.  A file HDF5 cannot
+open or read at all (truncated, not HDF5) raises `Refused` too, naming
+the file.  `Run.check()` vets the mesh and every frame (or those given) in
+one call of the program, for a reader about to read them all.
 """
 
 import builtins
@@ -65,35 +68,80 @@ def _program():
 _vetted = set()
 
 
-def vet(path):
-    """Have the program read the HDF5 file `path` (or every HDF5 file of
-    the run folder `path`) whole in a child process: raises Refused with
-    the program's reason for a file that stops or loops HDF5."""
+def _key(path):
     st = os.stat(path)
-    key = (os.path.abspath(path), st.st_mtime_ns, st.st_size)
-    if key in _vetted:
+    return (os.path.abspath(path), st.st_mtime_ns, st.st_size)
+
+
+def _h5_files(folder):
+    """The .h5 files `pointmech vet FOLDER` reads: the folder's and its
+    results/'s."""
+    found = []
+    for d in (folder, os.path.join(folder, "results")):
+        try:
+            names = sorted(os.listdir(d))
+        except (FileNotFoundError, NotADirectoryError):
+            continue
+        found += [os.path.join(d, n) for n in names if n.endswith(".h5")]
+    return found
+
+
+def vet(*paths):
+    """Have the program read each HDF5 file of `paths` (a run folder: every
+    HDF5 file of it and of its results/) whole in a child process, in one
+    call of the program: raises Refused with the program's reason for a
+    file that stops or loops HDF5.  Files vetted before and unchanged since
+    are not read again."""
+    files = []
+    for path in paths:
+        files += _h5_files(path) if os.path.isdir(path) else [path]
+    before = {}
+    for f in files:
+        try:
+            before[f] = _key(f)
+        except OSError as e:
+            raise Refused("%s: cannot read it: %s" % (
+                f, e.strerror or e)) from None
+    todo = [f for f in files if before[f] not in _vetted]
+    if not todo:
         return
-    done = subprocess.run([_program(), "vet", path], stdout=subprocess.PIPE,
+    done = subprocess.run([_program(), "vet"] + todo, stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, text=True)
     if done.returncode != 0:
-        why = done.stderr.strip() or "exit status %d" % done.returncode
-        raise Refused("%s: refused by pointmech vet: %s" % (path, why))
-    _vetted.add(key)
+        # The program's reason names the file: "pointmech: error: PATH: ..."
+        why = done.stderr.strip()
+        if why.startswith("pointmech: error: "):
+            why = why[len("pointmech: error: "):]
+        raise Refused(why or "%s: refused by pointmech vet (exit status %d)"
+                      % (" ".join(todo), done.returncode))
+    # What was read is what is known good: a file replaced during the
+    # call is vetted again when it is read.
+    for f in todo:
+        try:
+            if _key(f) == before[f]:
+                _vetted.add(before[f])
+        except OSError:
+            pass
 
 
-def _read_group(path, checked=True):
-    """Every dataset of an HDF5 file as numpy arrays, and its attributes
-    (the file vetted first when checked)."""
+def _read_group(path, checked=True, values=True):
+    """Every dataset of an HDF5 file as numpy arrays (none when not
+    values), and its attributes (the file vetted first when checked).  A
+    file HDF5 cannot read raises Refused naming it."""
     if checked:
         vet(path)
     data = {}
-    with h5py.File(path, "r") as f:
-        def take(name, obj):
-            if isinstance(obj, h5py.Dataset):
-                data[name] = obj[()]
-        f.visititems(take)
-        attrs = {k: (v.item() if hasattr(v, "item") else v)
-                 for k, v in f.attrs.items()}
+    try:
+        with h5py.File(path, "r") as f:
+            def take(name, obj):
+                if isinstance(obj, h5py.Dataset):
+                    data[name] = obj[()]
+            if values:
+                f.visititems(take)
+            attrs = {k: (v.item() if hasattr(v, "item") else v)
+                     for k, v in f.attrs.items()}
+    except (OSError, KeyError, RuntimeError, TypeError, ValueError) as e:
+        raise Refused("%s: HDF5 cannot read it: %s" % (path, e)) from None
     return _one_process_order(data), attrs
 
 
@@ -135,6 +183,12 @@ class Frame:
         if self._data is None:
             self._data, self._attrs = _read_group(self.path, self._checked)
 
+    def _load_attrs(self):
+        """step and time alone: a reader choosing frames by time reads
+        no field of the others."""
+        if self._attrs is None:
+            _, self._attrs = _read_group(self.path, self._checked, False)
+
     def __getitem__(self, name):
         self._load()
         try:
@@ -154,12 +208,12 @@ class Frame:
 
     @property
     def step(self):
-        self._load()
+        self._load_attrs()
         return int(self._attrs.get("step", -1))
 
     @property
     def time(self):
-        self._load()
+        self._load_attrs()
         return float(self._attrs.get("time", float("nan")))
 
     def __repr__(self):
@@ -199,9 +253,13 @@ class _Frames:
 
 
 class Run:
-    """A run folder (`pointmech run ... --out FOLDER`)."""
+    """A run folder (`pointmech run ... --out FOLDER`), or its results.h5
+    (the folder it is in: its files are read by their own names, not
+    through the index's links)."""
 
     def __init__(self, folder, vet=True):
+        if os.path.isfile(folder):
+            folder = os.path.dirname(os.path.abspath(folder))
         if not os.path.isdir(folder):
             raise FileNotFoundError("no run folder %r" % folder)
         self.folder = folder
@@ -243,6 +301,18 @@ class Run:
                 os.path.join(self.folder, "results", "mesh.h5"), self.vet)
         return self._mesh
 
+    def check(self, frames=None):
+        """Vet results/mesh.h5 and the frames given (default: every frame)
+        in one call of the program, for a reader about to read them all;
+        raises Refused naming a file HDF5 cannot read."""
+        if not self.vet:
+            return
+        if frames is None:
+            frames = self.frames[:]
+        mesh = os.path.join(self.folder, "results", "mesh.h5")
+        vet(*([mesh] if os.path.exists(mesh) else []) +
+            [f.path for f in frames])
+
     def running(self):
         """Whether the run is still going (summary.json says so)."""
         try:
@@ -280,6 +350,6 @@ class Run:
 
 
 def open(folder, vet=True):
-    """Open the run folder `folder`; its HDF5 files are vetted by the
-    program before they are read, unless vet is False."""
+    """Open the run folder `folder` (or its results.h5); its HDF5 files
+    are vetted by the program before they are read, unless vet is False."""
     return Run(folder, vet)

@@ -59,6 +59,12 @@ add_test(NAME verification.python
   COMMAND bash ${PM_VERIFY_DIR}/python.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.python PROPERTIES LABELS verification TIMEOUT 120 PROCESSORS 1)
 
+# The scripts of tools/ that read a run's HDF5 files: through the Python
+# module, each file vetted by the program first.
+add_test(NAME verification.tools
+  COMMAND bash ${PM_VERIFY_DIR}/tools.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
+set_tests_properties(verification.tools PROPERTIES LABELS verification TIMEOUT 120 PROCESSORS 1)
+
 add_test(NAME verification.compare
   COMMAND bash ${PM_VERIFY_DIR}/compare.sh $<TARGET_FILE:pointmech> ${PROJECT_SOURCE_DIR})
 set_tests_properties(verification.compare PROPERTIES LABELS verification TIMEOUT 300 PROCESSORS 1)

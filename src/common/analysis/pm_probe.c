@@ -128,7 +128,7 @@ void pm_probe_results_close(results *r) {
 pm_err pm_probe_results_open(const char *path, long frame, cloud *c,
                              results *r) {
   pm_err ret = PM_SUCCESS;
-  hid_t frames = -1;
+  hid_t frames = -1, mesh = -1;
   H5G_info_t info;
   char gname[32], obj[OBJ_NAME_MAX];
   long nframes, *order = NULL;
@@ -141,10 +141,13 @@ pm_err pm_probe_results_open(const char *path, long frame, cloud *c,
   H5_OK(r->file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), "H5Fopen", "/",
         path);
   c->n = -1;
-  PM_TRY(read_n3(r->file, "/mesh/coordinates", "/mesh/coordinates", path, &c->n,
-                 &c->x));
-  PM_TRY(read_order(r->file, "/mesh/" PM_PIECE_INDEX, "/mesh/" PM_PIECE_INDEX,
-                    path, c->n, &order));
+  /* The mesh's file opened once (the link followed once, not once a
+   * dataset: HDF5 opens an external link's file at every traversal). */
+  H5_OK(mesh = H5Gopen2(r->file, "/mesh", H5P_DEFAULT), "H5Gopen2", "/mesh",
+        path);
+  PM_TRY(read_n3(mesh, "coordinates", "/mesh/coordinates", path, &c->n, &c->x));
+  PM_TRY(read_order(mesh, PM_PIECE_INDEX, "/mesh/" PM_PIECE_INDEX, path, c->n,
+                    &order));
   PM_TRY(pm_probe_in_order(c->x, c->n, 3, order));
   H5_OK(frames = H5Gopen2(r->file, "/frames", H5P_DEFAULT), "H5Gopen2",
         "/frames", path);
@@ -164,6 +167,7 @@ pm_err pm_probe_results_open(const char *path, long frame, cloud *c,
   PM_TRY(read_order(r->group, PM_PIECE_INDEX, obj, path, c->n, &r->order));
 done:
   free(order);
+  if (mesh >= 0) H5Gclose(mesh);
   if (frames >= 0) H5Gclose(frames);
   if (ret != PM_SUCCESS) pm_probe_results_close(r);
   return ret;

@@ -32,6 +32,13 @@ typedef struct {
   pm_err code, err; /* the refusal's code; the first value HDF5 failed on */
   long objects;
   size_t value_max; /* bytes: the file's size (a value is in the file) */
+  /* The objects reached by hard links, by address, with the shallowest
+   * depth each was walked from: a group that tracks its links' creation
+   * order lists every link twice (by name, by creation order), and an
+   * object is one object however often it is linked. */
+  haddr_t *seen_addr;
+  int *seen_depth;
+  size_t seen_cap, seen_n;
 } vet_arg;
 
 static void vet_object(vet_arg *a, hid_t obj, const char *name, int depth);
@@ -104,6 +111,48 @@ typedef struct {
   int depth;
 } link_walk;
 
+/* Whether the object at addr was walked from depth or nearer to the root
+ * (its links then reached as deep as they can be again); if not, it is
+ * recorded as walked from depth.  The table is open-addressed and doubles
+ * at half full; without memory an object is walked again. */
+static bool walked(vet_arg *a, haddr_t addr, int depth) {
+  if (2 * (a->seen_n + 1) > a->seen_cap) {
+    const size_t cap = a->seen_cap ? 2 * a->seen_cap : 64;
+    haddr_t *ad = malloc(cap * sizeof *ad);
+    int *de = malloc(cap * sizeof *de);
+    if (!ad || !de) {
+      free(ad);
+      free(de);
+      return false;
+    }
+    for (size_t k = 0; k < cap; k++) ad[k] = HADDR_UNDEF;
+    for (size_t k = 0; k < a->seen_cap; k++) {
+      if (a->seen_addr[k] == HADDR_UNDEF) continue;
+      size_t h = (size_t)(a->seen_addr[k] * 0x9e3779b97f4a7c15u) & (cap - 1);
+      while (ad[h] != HADDR_UNDEF) h = (h + 1) & (cap - 1);
+      ad[h] = a->seen_addr[k];
+      de[h] = a->seen_depth[k];
+    }
+    free(a->seen_addr);
+    free(a->seen_depth);
+    a->seen_addr = ad;
+    a->seen_depth = de;
+    a->seen_cap = cap;
+  }
+  size_t h = (size_t)(addr * 0x9e3779b97f4a7c15u) & (a->seen_cap - 1);
+  while (a->seen_addr[h] != HADDR_UNDEF && a->seen_addr[h] != addr)
+    h = (h + 1) & (a->seen_cap - 1);
+  if (a->seen_addr[h] == addr) {
+    if (a->seen_depth[h] <= depth) return true;
+    a->seen_depth[h] = depth;
+    return false;
+  }
+  a->seen_addr[h] = addr;
+  a->seen_depth[h] = depth;
+  a->seen_n++;
+  return false;
+}
+
 /* A link of a group: a soft link's value, and the object a hard or soft
  * link leads to (an external link's file is vetted by itself). */
 static herr_t vet_link(hid_t group, const char *name, const H5L_info_t *info,
@@ -117,6 +166,9 @@ static herr_t vet_link(hid_t group, const char *name, const H5L_info_t *info,
     free(val);
   }
   if (info->type != H5L_TYPE_HARD && info->type != H5L_TYPE_SOFT) return 0;
+  if (info->type == H5L_TYPE_HARD && info->u.address != HADDR_UNDEF &&
+      walked(w->a, info->u.address, w->depth + 1))
+    return 0;
   hid_t obj = H5Oopen(group, name, H5P_DEFAULT);
   if (obj >= 0) vet_object(w->a, obj, name, w->depth + 1);
   pm_h5_close_quiet(&obj);
@@ -157,8 +209,7 @@ static void vet_object(vet_arg *a, hid_t obj, const char *name, int depth) {
   }
 }
 
-static pm_err vet_work(void *p) {
-  vet_arg *a = p;
+static pm_err vet_files(vet_arg *a) {
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   for (int k = 0; k < a->n; k++) {
     struct stat st;
@@ -169,6 +220,8 @@ static pm_err vet_work(void *p) {
      * claims more than is in the file fails to allocate, cleanly. */
     pm_isolate_memory_limit(((size_t)1 << 30) + 16 * (size_t)st.st_size);
     a->objects = 0;
+    a->seen_n = 0;
+    for (size_t j = 0; j < a->seen_cap; j++) a->seen_addr[j] = HADDR_UNDEF;
     a->value_max = (size_t)st.st_size + 4096;
     hid_t file = H5Fopen(a->paths[k], H5F_ACC_RDONLY, H5P_DEFAULT);
     if (file < 0) continue;
@@ -177,6 +230,17 @@ static pm_err vet_work(void *p) {
     if (a->err) return a->err;
   }
   return PM_SUCCESS;
+}
+
+static pm_err vet_work(void *p) {
+  vet_arg *a = p;
+  const pm_err ret = vet_files(a);
+  free(a->seen_addr);
+  free(a->seen_depth);
+  a->seen_addr = NULL;
+  a->seen_depth = NULL;
+  a->seen_cap = a->seen_n = 0;
+  return ret;
 }
 
 pm_err pm_h5_vet(const char *const *paths, int n, bool data, const char *what,
