@@ -156,6 +156,10 @@ done:
                 t->rdisp, MPI_DOUBLE, pm_par_comm());
   P->counts.migrate_bytes += (double)m->n * rec * sizeof(double);
   pm_par_count_sent((double)m->n * rec * sizeof(double));
+  /* (a rank holds its old share, the records received and the new share
+   * at once while it cuts: the records sent go first) */
+  free(t->sbuf);
+  t->sbuf = NULL;
   qsort(t->rbuf, (size_t)t->arriving, (size_t)rec * sizeof(double), by_gid);
   return PM_SUCCESS;
 }
