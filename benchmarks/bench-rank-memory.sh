@@ -7,7 +7,9 @@
 # whole model; label "pieces", the fine block too), both blocks with the
 # default output and a checkpoint after step 10 (label BUILD-ckpt), the
 # reduced oocyte and I2
-# by the implicit MPM at 256^2 cells (its 10 load steps); with
+# by the implicit MPM at 256^2 cells (its 10 load steps; label i2-256: the
+# default output, in pieces across ranks; "gather": output.ranks: gather;
+# BUILD-ckpt: a checkpoint after load step 5); with
 # BEFORE=BUILD_DIR the same runs by that build beside.  One line per rank:
 # KiB and CPU seconds (user).  A tiny scene (the disks) gives each rank's
 # floor: the program and its libraries (MPI, HDF5; PETSc only where the
@@ -75,6 +77,10 @@ for n in ${RANKS:-1 2 4}; do
     [ "$l" = after ] && measure pieces "$b" "$n" block-fine \
       cases/mpm/bench-block.yaml "${fine[@]}" --set output.ranks=pieces
     measure "$l" "$b" "$n" i2-256 cases/mpm/i2-vessel-slice.yaml "${i2[@]}"
+    [ "$l" = after ] && measure gather "$b" "$n" i2-256 \
+      cases/mpm/i2-vessel-slice.yaml "${i2[@]}" --set output.ranks=gather
+    measure "$l-ckpt" "$b" "$n" i2-256 cases/mpm/i2-vessel-slice.yaml \
+      "${i2[@]}" --set output.checkpoint.every=5
     measure "$l-ckpt" "$b" "$n" block cases/mpm/bench-block.yaml \
       --set output.checkpoint.every=10
     measure "$l-ckpt" "$b" "$n" block-fine cases/mpm/bench-block.yaml \

@@ -51,18 +51,38 @@ assert r['halo_bytes_per_product'] == 8 * sum(r['ghost_unknowns']) / 2, r
 jacobi="--set time.quasi_static.linear_solver=cg-jacobi
   --set discretization.mesh_size=16.8e-6
   --set time.quasi_static.load_steps=6"
+# Across ranks the frames and checkpoints go in pieces (output.ranks:
+# auto): no rank holds the whole model; the same run gathered
+# (output.ranks: gather) and in pieces on 3 ranks, against one process,
+# read in one process's order (CG on other ranks may take an iteration
+# more or less: a count, held to no bound).
 ranks 2 "$bin" run "$i2" --out "$work/j-2" --quiet $jacobi >/dev/null 2>&1
+check "I2 on 2 ranks: frames in pieces" \
+  test -f "$work/j-2/results/frame_000001.piece_0001.h5"
+bounds="linear_iterations=inf" across j "$i2" 3 $jacobi
+bounds="linear_iterations=inf" roundoff "I2 on 2 ranks in pieces, against one process" \
+  "$work/j-1" "$work/j-2"
+ranks 2 "$bin" run "$i2" --out "$work/jg-2" --quiet $jacobi \
+  --set output.ranks=gather >/dev/null 2>&1
+check "I2 on 2 ranks gathered: frames whole" \
+  test ! -e "$work/jg-2/results/frame_000001.piece_0000.h5"
+roundoff "I2 on 2 ranks, gathered against in pieces" "$work/jg-2" "$work/j-2"
 interrupt 2 "$work/cut" "$i2" $jacobi
 echo "I2 interrupted on 2 ranks after $(($(wc -l <"$work/cut/history.csv") - 1)) load steps"
+check "I2 interrupted on 2 ranks: its checkpoint in pieces" \
+  compgen -G "$work/cut/checkpoint.pieces/*.piece_0001.h5"
 resume_on "$work/cut" 1 2 3
 check "I2 interrupted on 2 ranks, resumed on 2: the run of 2 ranks, bit for bit" \
   $same "$work/j-2" "$work/cut-2"
-# (CG on other ranks may take an iteration more or less: a count, held to
-# no bound)
 for n in 1 3; do
   bounds="linear_iterations=inf" roundoff \
     "I2 interrupted on 2 ranks, resumed on $n" "$work/j-2" "$work/cut-$n"
 done
+# A whole checkpoint (one process's) resumed on 2 ranks in pieces.
+interrupt 1 "$work/cut1" "$i2" $jacobi
+resume_on "$work/cut1" 2
+bounds="linear_iterations=inf" roundoff \
+  "I2 interrupted on one process, resumed on 2 ranks" "$work/j-1" "$work/cut1-2"
 
 # What runs on one process only is refused, naming the key, before
 # anything is written; plan prints the decomposition.

@@ -223,7 +223,7 @@ pm_err mpm_sim_implicit_plan(void *p, FILE *out) {
   if (m) implicit_head(r, out);
   mpm_implicit_plan(r->imp, out);
   if (r->local_model) /* across ranks: the decomposition, each rank's share */
-    mpm_par_plan(r->local_model, NULL, m ? out : NULL);
+    mpm_par_plan(r->local_model, NULL, pm_par_root() ? out : NULL);
   else
     PM_CALL(plan_decomposition(r, out));
   if (!m) return PM_SUCCESS;

@@ -144,14 +144,18 @@ static pm_err implicit_summary_ranks(pm_json *j, const mpm_sim *r) {
 
 pm_err mpm_sim_implicit_summary(void *p, pm_json *j) {
   const mpm_sim *r = p;
-  const mpm_model *m = r->model;
+  /* without the whole model: the share's, with the whole run's counts */
+  const mpm_model *m = r->model ? r->model : r->local_model;
   const pm_load_report *lr = mpm_implicit_report(r->imp);
   const mpm_settings *ms = mpm_scene_settings(r->scene);
   long unknowns, entries;
   mpm_implicit_size(r->imp, &unknowns, &entries);
-  PM_CALL(pm_json_integer(j, "particles", m->n));
-  PM_CALL(summary_groups(j, m, NULL));
-  PM_CALL(pm_json_integer(j, "grid_nodes", m->grid.n_nodes));
+  mpm_par_ranges whole;
+  if (!r->model) mpm_par_whole_ranges(m, &whole);
+  PM_CALL(pm_json_integer(j, "particles", r->model ? m->n : whole.n));
+  PM_CALL(summary_groups(j, m, r->model ? NULL : &whole));
+  PM_CALL(pm_json_integer(j, "grid_nodes",
+                          r->model ? m->grid.n_nodes : r->sums.grid_nodes));
   PM_CALL(pm_json_number(j, "cell_size", m->grid.h));
   PM_CALL(pm_json_string(j, "shape", mpm_sim_basis_name(m->opt.shape)));
   PM_CALL(pm_json_string(
