@@ -91,9 +91,10 @@ check "migration on 2 ranks (shock tube): exit 0 (got $rc)" test $rc -eq 0
 # Each rank seeds its share from the scene alone, the share cut from the
 # whole model bit for bit (ranks_migrate's first check): a membrane with
 # bodies inside and outside it and cylinders (the reduced oocyte), dynamic
-# relaxation's nodal arrays (F2) and a TIFF image's voxels (I2's slice).
+# relaxation's nodal arrays (F2) and a TIFF image's voxels (I2's slice;
+# gathered: the check reads the whole model on rank 0).
 for sc in m4-oocyte-reduced f2-unconstrained-compression i2-vessel-slice; do
-  ranks 3 "$migrate" "$mpm/$sc.yaml" 1 >"$work/mig" 2>&1
+  ranks 3 "$migrate" "$mpm/$sc.yaml" 1 output.ranks=gather >"$work/mig" 2>&1
   rc=$?
   tail -1 "$work/mig"
   check "shares seeded on 3 ranks ($sc): exit 0 (got $rc)" test $rc -eq 0

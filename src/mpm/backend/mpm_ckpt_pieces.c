@@ -1,9 +1,10 @@
-/* mpm_ckpt_pieces: an explicit MPM run across ranks without the whole
- * model checkpointed in pieces (pm_checkpoint.h): each rank its share's
- * particles with their one-process indices, rank 0 the index with the
- * run's values; and resumed from them on any count of ranks, each rank
- * reading the pieces that hold particles in its cells, or on one process
- * all of them. */
+/* mpm_ckpt_pieces: an MPM run across ranks without the whole model
+ * checkpointed in pieces (pm_checkpoint.h): each rank its share's
+ * particles with their one-process indices (the implicit MPM's also its
+ * own unknowns of load stepping), rank 0 the index with the run's values;
+ * and resumed from them on any count of ranks, each rank reading the
+ * pieces that hold particles in its cells, or on one process all of
+ * them. */
 #include <stdint.h>
 #include <stdio.h>
 #ifdef __GLIBC__
