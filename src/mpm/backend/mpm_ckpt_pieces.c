@@ -238,6 +238,7 @@ typedef struct {
   mpm_implicit *imp; /* the implicit solver, whose unknowns the pieces
                         hold too (NULL: explicit) */
   long unk_placed;   /* its unknowns placed, over the pieces */
+  bool *unk_seen;    /* [its unknowns]: placed already */
 } piece_reader;
 
 static int long_order(const void *a, const void *b) {
@@ -322,7 +323,8 @@ static pm_err read_piece(piece_reader *pr, const mpm_ckpt_pieces *cp, int k) {
   PM_ENSURE(first == n, PM_ERR_IO,
             "checkpoint '%s': its groups hold %ld of its %ld particles",
             pm_ckpt_path(ck), first, n);
-  if (pr->imp) PM_TRY(mpm_implicit_read_piece(pr->imp, ck, &pr->unk_placed));
+  if (pr->imp)
+    PM_TRY(mpm_implicit_read_piece(pr->imp, ck, pr->unk_seen, &pr->unk_placed));
   pm_ckpt *done_ck = ck;
   ck = NULL;
   PM_TRY(pm_ckpt_finish(done_ck));
@@ -339,7 +341,9 @@ static pm_err read_pieces(const mpm_ckpt_pieces *cp, const bool *need,
                           bool vetted, const mpm_model *m, mpm_state *s,
                           mpm_implicit *imp) {
   piece_reader pr = {.m = m, .s = s, .vetted = vetted, .imp = imp};
+  const long unknowns = imp ? mpm_implicit_unknowns(imp) : 0;
   pm_err ret = PM_ALLOC(pr.seen, m->n + 1, "checkpoint pieces");
+  if (!ret) ret = PM_ALLOC(pr.unk_seen, unknowns + 1, "checkpoint pieces");
   for (int k = 0; k < cp->n && !ret; k++)
     if (!need || need[k]) ret = read_piece(&pr, cp, k);
   if (!ret && pr.placed != m->n)
@@ -347,7 +351,6 @@ static pm_err read_pieces(const mpm_ckpt_pieces *cp, const bool *need,
                    "checkpoint '%s/checkpoint.h5': its pieces hold %ld of "
                    "the %ld particles this run reads from them",
                    cp->dir, pr.placed, m->n);
-  const long unknowns = imp ? mpm_implicit_unknowns(imp) : 0;
   if (!ret && pr.unk_placed != unknowns)
     ret = PM_ERROR(PM_ERR_IO,
                    "checkpoint '%s/checkpoint.h5': its pieces hold %ld of "
@@ -358,6 +361,7 @@ static pm_err read_pieces(const mpm_ckpt_pieces *cp, const bool *need,
   free(pr.at);
   free(pr.buf);
   free(pr.seen);
+  free(pr.unk_seen);
   return ret;
 }
 
@@ -559,6 +563,14 @@ pm_err mpm_view_reload(mpm_sim *r) {
 
 /* ---- the implicit MPM's share, read in place ----------------------------- */
 
+/* Whether boxes of node indices a and b (lower corner, upper corner,
+ * inclusive) meet. */
+static bool nodes_meet(const double *a, const double *b) {
+  for (int ax = 0; ax < 3; ax++)
+    if (a[3 + ax] < b[ax] || a[ax] > b[3 + ax]) return false;
+  return true;
+}
+
 pm_err mpm_view_implicit_reload(mpm_sim *r) {
   mpm_ckpt_pieces *cp = &r->ckpt_pieces;
   const mpm_model *lm = r->local_model;
@@ -567,12 +579,15 @@ pm_err mpm_view_implicit_reload(mpm_sim *r) {
   /* The pieces with particles in this rank's cells by their reference
    * positions (which its particles keep), or unknowns at its nodes. */
   bool *need = NULL;
+  double own[6];
+  const bool unknowns = mpm_implicit_unknowns(r->imp) > 0;
+  mpm_implicit_nodes_box(r->imp, own);
   pm_err ret = PM_ALLOC(need, cp->n, "checkpoint pieces");
   for (int k = 0; k < cp->n && !ret; k++) {
     const double *rec = cp->values + PM_VIEW_CKPT_VALUES * k;
     need[k] =
         (cp->counts[2 * k] > 0 && meets(rec + REC_BOX, d, &lm->grid, me)) ||
-        mpm_implicit_piece_meets(r->imp, rec + REC_NODES);
+        (unknowns && nodes_meet(rec + REC_NODES, own));
   }
   if (!ret) ret = read_pieces(cp, need, false, lm, r->local_state, r->imp);
   free(need);

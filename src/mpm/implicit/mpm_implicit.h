@@ -137,12 +137,15 @@ pm_err mpm_implicit_checkpoint_scalars(mpm_implicit *im, pm_ckpt *ck);
  * inclusive; zeros without any). */
 pm_err mpm_implicit_checkpoint_piece(mpm_implicit *im, pm_ckpt *ck,
                                      double box[6]);
-/* Whether a piece's box of nodes (mpm_implicit_checkpoint_piece) meets
- * the nodes of this rank's unknowns. */
-bool mpm_implicit_piece_meets(const mpm_implicit *im, const double box[6]);
+/* The box of the nodes of this rank's unknowns, as
+ * mpm_implicit_checkpoint_piece records it. */
+void mpm_implicit_nodes_box(const mpm_implicit *im, double box[6]);
 /* Reading a piece's part: the values of this rank's unknowns it holds
- * into load stepping's states, *placed counting them. */
-pm_err mpm_implicit_read_piece(mpm_implicit *im, pm_ckpt *ck, long *placed);
+ * into load stepping's states, *placed counting them; seen (one a
+ * unknown, mpm_implicit_unknowns, the caller's) marks those placed over
+ * the pieces, and one in two pieces is refused (PM_ERR_IO). */
+pm_err mpm_implicit_read_piece(mpm_implicit *im, pm_ckpt *ck, bool *seen,
+                               long *placed);
 /* The unknowns a checkpoint's pieces must hold for this rank (0 where
  * the grid is reset: no nodal state is kept between load steps). */
 long mpm_implicit_unknowns(const mpm_implicit *im);

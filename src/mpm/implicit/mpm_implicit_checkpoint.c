@@ -91,6 +91,10 @@ pm_err mpm_implicit_checkpoint(mpm_implicit *im, const mpm_model *full,
 
 /* ---- in pieces ----------------------------------------------------------- */
 
+long mpm_implicit_unknowns(const mpm_implicit *im) {
+  return im->mode == MPM_GRID_KEPT ? im->nunk : 0;
+}
+
 /* Node i of the solver's grid as a node of the whole grid (nodes per axis
  * nn), and the whole node's indices along the axes. */
 static long grid_node(const mpm_grid *g, const long nn[3], long i,
@@ -108,23 +112,32 @@ static long whole_dof(const mpm_implicit *im, const long nn[3], long k,
   return 3 * grid_node(&im->g, nn, d / 3, ijk) + d % 3;
 }
 
-pm_err mpm_implicit_checkpoint_piece(mpm_implicit *im, pm_ckpt *ck,
-                                     double box[6]) {
-  long count = im->mode == MPM_GRID_KEPT ? im->nunk : 0, nn[3], lo[3], hi[3];
+void mpm_implicit_nodes_box(const mpm_implicit *im, double box[6]) {
+  long nn[3], lo[3], hi[3];
   mpm_xc_cells(im->m, nn, lo, hi);
   for (int a = 0; a < 3; a++) box[a] = box[3 + a] = 0;
+  for (long k = 0; k < mpm_implicit_unknowns(im); k++) {
+    long ijk[3];
+    whole_dof(im, nn, k, ijk);
+    for (int a = 0; a < 3; a++) {
+      if (k == 0 || ijk[a] < box[a]) box[a] = (double)ijk[a];
+      if (k == 0 || ijk[a] > box[3 + a]) box[3 + a] = (double)ijk[a];
+    }
+  }
+}
+
+pm_err mpm_implicit_checkpoint_piece(mpm_implicit *im, pm_ckpt *ck,
+                                     double box[6]) {
+  long count = mpm_implicit_unknowns(im), nn[3], lo[3], hi[3];
+  mpm_xc_cells(im->m, nn, lo, hi);
+  mpm_implicit_nodes_box(im, box);
   PM_CALL(pm_ckpt_long(ck, "implicit.piece.count", &count));
   if (!count) return PM_SUCCESS;
-  /* (the nodal work arrays hold a load step's values: free between steps) */
   long *dofs = NULL;
   pm_err e = PM_ALLOC(dofs, count, "checkpoint piece");
   for (long k = 0; k < count && !e; k++) {
     long ijk[3];
     dofs[k] = whole_dof(im, nn, k, ijk);
-    for (int a = 0; a < 3; a++) {
-      if (k == 0 || ijk[a] < box[a]) box[a] = (double)ijk[a];
-      if (k == 0 || ijk[a] > box[3 + a]) box[3 + a] = (double)ijk[a];
-    }
   }
   if (!e) e = pm_ckpt_longs(ck, "implicit.piece.dofs", count, dofs);
   if (!e) e = pm_ckpt_doubles(ck, "implicit.piece.u", count, im->ls.xc);
@@ -133,30 +146,13 @@ pm_err mpm_implicit_checkpoint_piece(mpm_implicit *im, pm_ckpt *ck,
   return e;
 }
 
-bool mpm_implicit_piece_meets(const mpm_implicit *im, const double box[6]) {
-  if (im->mode != MPM_GRID_KEPT || !im->nunk) return false;
-  long nn[3], lo[3], hi[3], own[6];
-  mpm_xc_cells(im->m, nn, lo, hi);
-  for (long k = 0; k < im->nunk; k++) {
-    long ijk[3];
-    whole_dof(im, nn, k, ijk);
-    for (int a = 0; a < 3; a++) {
-      if (k == 0 || ijk[a] < own[a]) own[a] = ijk[a];
-      if (k == 0 || ijk[a] > own[3 + a]) own[3 + a] = ijk[a];
-    }
-  }
-  for (int a = 0; a < 3; a++)
-    if (box[3 + a] < (double)own[a] || box[a] > (double)own[3 + a])
-      return false;
-  return true;
-}
-
 static int pair_order(const void *a, const void *b) {
   const long x = *(const long *)a, y = *(const long *)b;
   return (x > y) - (x < y);
 }
 
-pm_err mpm_implicit_read_piece(mpm_implicit *im, pm_ckpt *ck, long *placed) {
+pm_err mpm_implicit_read_piece(mpm_implicit *im, pm_ckpt *ck, bool *seen,
+                               long *placed) {
   pm_err ret = PM_SUCCESS;
   long count = 0, *dofs = NULL, *own = NULL;
   double *u = NULL;
@@ -185,6 +181,11 @@ pm_err mpm_implicit_read_piece(mpm_implicit *im, pm_ckpt *ck, long *placed) {
     const long *at =
         bsearch(&dofs[j], own, (size_t)im->nunk, 2 * sizeof *own, pair_order);
     if (!at) continue;
+    PM_ENSURE(!seen[at[1]], PM_ERR_IO,
+              "%s: the unknown of dof %ld on the whole grid is in another "
+              "piece too",
+              pm_ckpt_path(ck), dofs[j]);
+    seen[at[1]] = true;
     im->ls.xc[at[1]] = u[j];
     im->ls.xprev[at[1]] = u[count + j];
     (*placed)++;
@@ -194,8 +195,4 @@ done:
   free(u);
   free(own);
   return ret;
-}
-
-long mpm_implicit_unknowns(const mpm_implicit *im) {
-  return im->mode == MPM_GRID_KEPT ? im->nunk : 0;
 }
