@@ -7,7 +7,9 @@
 # whole model; label "pieces", the fine block too), both blocks with the
 # default output and a checkpoint after step 10 (label BUILD-ckpt), the
 # reduced oocyte and I2
-# by the implicit MPM at 256^2 cells (its 10 load steps); with
+# by the implicit MPM at 256^2 cells (its 10 load steps; label i2-256: the
+# default output, in pieces across ranks; "gather": output.ranks: gather;
+# BUILD-ckpt: a checkpoint after load step 5); with
 # BEFORE=BUILD_DIR the same runs by that build beside.  One line per rank:
 # KiB and CPU seconds (user).  A tiny scene (the disks) gives each rank's
 # floor: the program and its libraries (MPI, HDF5; PETSc only where the
@@ -17,9 +19,10 @@
 # seconds), its floor the same at 45 points (mesh_size 0.05); labelled
 # "pieces", the 20 steps with frames in pieces (no rank keeps the whole
 # model).
-# ONLY="block block-fine" measures those MPM scenes alone (and the floor).
-# usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] [METHOD=fpm] [ONLY=NAMES] benchmarks/bench-rank-memory.sh [BUILD_DIR]
-bench_name=rank-memory bench_env="BEFORE RANKS METHOD ONLY"
+# ONLY="block block-fine" measures those MPM scenes alone (and the floor;
+# ONLY=i2-256: I2 alone).
+# usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] [METHOD=fpm] [ONLY=NAMES] [RESUME=1] benchmarks/bench-rank-memory.sh [BUILD_DIR]
+bench_name=rank-memory bench_env="BEFORE RANKS METHOD ONLY RESUME"
 source "$(dirname "$0")/bench-lib.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
   OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1 \
@@ -63,7 +66,9 @@ if [ "${METHOD:-mpm}" = fpm ]; then
 fi
 fine=(--set discretization.mesh_size=1.25e-3 --set output.every=1000)
 i2=(--set discretization.mesh_size=2.1e-6 --set output.every=1000)
-for n in ${RANKS:-1 2 4}; do
+counts=${RANKS:-1 2 4}
+[ "${RESUME:-0}" = 1 ] && counts="" # (the resumes alone, below)
+for n in $counts; do
   measure floor "$bin" "$n" disks cases/mpm/disks-collision.yaml
   for lb in "${builds[@]}"; do
     l=${lb%%:*} b=${lb#*:}
@@ -75,9 +80,38 @@ for n in ${RANKS:-1 2 4}; do
     [ "$l" = after ] && measure pieces "$b" "$n" block-fine \
       cases/mpm/bench-block.yaml "${fine[@]}" --set output.ranks=pieces
     measure "$l" "$b" "$n" i2-256 cases/mpm/i2-vessel-slice.yaml "${i2[@]}"
+    [ "$l" = after ] && measure gather "$b" "$n" i2-256 \
+      cases/mpm/i2-vessel-slice.yaml "${i2[@]}" --set output.ranks=gather
+    measure "$l-ckpt" "$b" "$n" i2-256 cases/mpm/i2-vessel-slice.yaml \
+      "${i2[@]}" --set output.checkpoint.every=5
     measure "$l-ckpt" "$b" "$n" block cases/mpm/bench-block.yaml \
       --set output.checkpoint.every=10
     measure "$l-ckpt" "$b" "$n" block-fine cases/mpm/bench-block.yaml \
       "${fine[@]}" --set output.checkpoint.every=10
+  done
+done
+# RESUME=1, in place of the runs above (after them, with i2-256 among
+# them, into the same folder): each build's checkpoint of I2 on 2 ranks
+# (BUILD-ckpt, load step 5) resumed to the end on 1, 2 and 4 ranks by the
+# same build, each rank's peak (the finished run's status set to
+# interrupted in a copy: resume takes only a run that did not end).
+[ "${RESUME:-0}" = 1 ] || exit 0
+for lb in "${builds[@]}"; do
+  l=${lb%%:*} b=${lb#*:}
+  for n in 1 2 4; do
+    d=$out/$l-resume-i2-256-$n
+    rm -rf "$d" && mkdir -p "$d" && cp -r "$out/$l-ckpt-i2-256-2/out" "$d/out"
+    sed -i 's/"status": "[a-z_]*"/"status": "interrupted"/' \
+      "$d/out/summary.json"
+    mpirun -np "$n" --bind-to none bash -c \
+      'exec /usr/bin/time -v -o "$0/time.$OMPI_COMM_WORLD_RANK" "$@"' "$d" \
+      "$b" resume "$d/out" --quiet >"$d/log" 2>&1 ||
+      echo "$l resume on $n: failed (see $d/log)"
+    for ((r = 0; r < n; r++)); do
+      printf '%-8s %-18s %s ranks, rank %d: %8s KiB %6s s\n' "$l-resume" \
+        i2-256 "$n" "$r" \
+        "$(awk '/Maximum resident/ {print $NF}' "$d/time.$r")" \
+        "$(awk '/User time/ {print $NF}' "$d/time.$r")"
+    done
   done
 done

@@ -64,6 +64,53 @@ for n in 1 3; do
     "I2 interrupted on 2 ranks, resumed on $n" "$work/j-2" "$work/cut-$n"
 done
 
+# Frames and checkpoints in pieces (output.ranks: auto; the runs above
+# too): no rank holds the whole model.  A small slab (1600 particles,
+# tests/data/scenes/implicit-slab-2d.yaml) in 40 load steps on 2 and 3
+# ranks against one process, read in one-process order, with its
+# summary's figures; gathered (output.ranks: gather) against in pieces;
+# interrupted on 2 ranks (a checkpoint in pieces) and resumed on 1, 2 and
+# 3; interrupted on one process (a whole checkpoint) and resumed in pieces
+# on 2.  (The residual at convergence, some 1e-13 of the reactions, is
+# round-off itself: held to no bound, as CG's iteration counts; so are the
+# places of the smallest J and the largest stress, which particles equal
+# but for round-off share.)
+slab=$src/tests/data/scenes/implicit-slab-2d.yaml
+long="--set time.quasi_static.load_steps=40 --set output.every=4"
+export bounds="linear_iterations=inf residual=inf"
+across slab "$slab" 2 $long
+across slab "$slab" 3 $long
+check "slab on 2 ranks: a piece a rank a frame" \
+  test "$(ls "$work/slab-2/results" | grep -c '\.piece_')" -eq \
+  $((2 * $(ls "$work/slab-2/results" | grep -c '^frame_[0-9]*\.h5$')))
+for n in 2 3; do
+  check "slab on $n ranks: the mesh and the summary's figures" \
+    $py "$src/tests/verification/same_figures.py" "$work/slab-1" \
+    "$work/slab-$n" points,particles,grid_nodes,groups,steps,load_steps,unknowns \
+    strain_energy,mean_strain_energy_density,max_von_mises,end_min_jacobian,min_jacobian,load_reached 1
+done
+ranks 2 "$bin" run "$slab" --out "$work/slabg-2" --quiet $long \
+  --set output.ranks=gather >/dev/null 2>&1
+check "slab on 2 ranks gathered: frames whole" \
+  test ! -e "$work/slabg-2/results/frame_000001.piece_0000.h5"
+roundoff "slab on 2 ranks, gathered against in pieces" "$work/slabg-2" \
+  "$work/slab-2"
+interrupt 2 "$work/scut" "$slab" $long
+check "slab interrupted on 2 ranks: its checkpoint in pieces" \
+  compgen -G "$work/scut/checkpoint.pieces/*.piece_0001.h5"
+resume_on "$work/scut" 1 2 3
+check "slab interrupted on 2 ranks, resumed on 2: bit for bit" \
+  $same "$work/slab-2" "$work/scut-2"
+for n in 1 3; do
+  roundoff "slab interrupted on 2 ranks, resumed on $n" "$work/slab-2" \
+    "$work/scut-$n"
+done
+interrupt 1 "$work/scut1" "$slab" $long
+resume_on "$work/scut1" 2
+roundoff "slab interrupted on one process, resumed on 2 ranks" \
+  "$work/slab-1" "$work/scut1-2"
+unset bounds
+
 # What runs on one process only is refused, naming the key, before
 # anything is written; plan prints the decomposition.
 for kv in "mpm.implicit.grid=reset:mpm.implicit.grid" \

@@ -1001,13 +1001,13 @@ static const pm_key output_keys[] = {
      .def = "auto",
      .names = pm_output_ranks_names,
      .doc = "a run across MPI ranks: auto (pieces where the method writes "
-            "them: explicit MPM without membranes or dynamic relaxation; "
-            "else gather), gather (each frame and checkpoint gathered into "
-            "rank 0 and written whole) or pieces (explicit MPM without "
+            "them: MPM, explicit or implicit, without membranes or dynamic "
+            "relaxation; else gather), gather (each frame and checkpoint "
+            "gathered into rank 0 and written whole) or pieces (MPM without "
             "membranes, FPM but its static solve: each rank writes its own "
             "particles or points, over no cells, "
             "results/frame_NNNNNN.piece_RRRR.h5, joined by rank 0's frame "
-            "file, which readers put in one-process order; explicit MPM "
+            "file, which readers put in one-process order; MPM "
             "writes its share of each checkpoint too, checkpoint.pieces/, "
             "joined by rank 0's checkpoint.h5 and resumed on any count of "
             "ranks; no rank holds the whole model, but where checkpoints "

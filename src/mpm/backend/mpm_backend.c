@@ -73,6 +73,7 @@ pm_err mpm_sim_setup(const pm_scene *s, bool implicit, mpm_sim **out) {
         par ? mpm_implicit_create(s, r->local_model, r->local_state, &r->imp)
             : mpm_implicit_create(s, r->model, r->state, &r->imp)));
     r->run_min_jacobian = 1;
+    if (!r->whole) PM_TRY(mpm_view_sums_setup(r));
   } else if (par) {
     PM_TRY(pm_par_agree(mpm_work_create(r->local_model, &r->local_work)));
     PM_TRY(pm_par_agree(r->model ? mpm_sim_figures_work(r->model, &r->work)

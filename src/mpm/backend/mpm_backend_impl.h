@@ -83,6 +83,9 @@ bool mpm_sim_errors(void *p, double nrmse[3], double *vector);
 /* What rank 0's observer reads of a converged implicit load step: every
  * rank's particles and load stepping's states (collective). */
 pm_err mpm_view_implicit_gather(void *ctx);
+/* The same without the whole model: the sums over the shares
+ * (mpm_view_sum) and the share's scalars (collective). */
+pm_err mpm_view_implicit_sums(void *ctx);
 
 /* ---- checkpoints in pieces (mpm_ckpt_pieces.c) ---- */
 
@@ -111,6 +114,10 @@ pm_err mpm_sim_ckpt_load_whole(mpm_sim *r);
  * scene with the particles the pieces have in its cells, their state read
  * from the pieces that hold them (collective). */
 pm_err mpm_view_reload(mpm_sim *r);
+/* The same for an implicit run: its particles keep their ranks, so each
+ * rank's share stays as seeded and takes its particles' state and the
+ * solver's unknowns from the pieces that hold them (collective). */
+pm_err mpm_view_implicit_reload(mpm_sim *r);
 
 /* ---- what the run driver reads (mpm_fields.c, mpm_history.c) ---- */
 

@@ -68,16 +68,33 @@ static pm_err stopped_inside(mpm_sim *r, pm_err e) {
   return pm_view_stopped_inside(&r->view, &rep, e);
 }
 
+/* The initial state to the observer: rank 0's view holds it where it
+ * keeps the whole model; without it, every rank writes its piece of the
+ * frame and rank 0 reports the sums (collective). */
+static pm_err report_start(mpm_sim *r) {
+  if (!r->whole) {
+    const mpm_state *ls = r->local_state;
+    pm_step_report rep = {.step = ls->step, .t = ls->t};
+    return pm_view_step(&r->view, &rep, true);
+  }
+  pm_err e = pm_par_root() ? mpm_sim_report(r, true, false) : PM_SUCCESS;
+  return r->local_model ? pm_par_agree(e) : e;
+}
+
 static pm_err implicit_run(void *p, const pm_observer *obs) {
   mpm_sim *r = p;
   pm_err e = PM_SUCCESS;
+  free(r->mesh_x0); /* (the results' mesh is written) */
+  r->mesh_x0 = NULL;
+  /* a resumed run in pieces: each share's state and unknowns */
+  if (r->view.ranks && r->resumed && r->ckpt_pieces.on)
+    PM_CALL(mpm_view_implicit_reload(r));
   pm_view_start(&r->view, obs);
+  e = pm_view_start_pieces(&r->view, r->scene); /* (agreed) */
   if (!r->resumed) {
     r->energy0 = 0;
     r->run_min_jacobian_step = 0;
-    /* the initial state: rank 0's view holds it across ranks */
-    if (pm_par_root()) e = mpm_sim_report(r, true, false);
-    if (r->local_model) e = pm_par_agree(e);
+    if (!e) e = report_start(r);
   }
   if (!e) e = stopped_inside(r, mpm_implicit_run(r->imp, implicit_observe, r));
   /* Across ranks, the state the run ended in, for the figures (a
@@ -110,12 +127,41 @@ static pm_err implicit_run(void *p, const pm_observer *obs) {
   return e;
 }
 
+/* The reactions the solver read from a checkpoint, for the figures. */
+static void read_reactions(mpm_sim *r) {
+  const mpm_model *m = r->local_model ? r->local_model : r->model;
+  memcpy(r->work->cond.reaction, mpm_implicit_reactions(r->imp),
+         3 * sizeof(double) * (size_t)m->n_bcs);
+}
+
+/* A checkpoint in pieces (mpm_ckpt_pieces.c): each rank's piece holds its
+ * particles and its own unknowns of load stepping's states, the index the
+ * run's values and the solver's scalars.  Read: on one process or where
+ * the run keeps the whole model, every piece now (each rank's particles
+ * then take their state); in pieces, each rank's at the run's start
+ * (mpm_view_implicit_reload). */
+static pm_err implicit_index(mpm_sim *r, pm_ckpt *ck) {
+  PM_CALL(mpm_sim_ckpt_index(r, ck));
+  PM_CALL(mpm_implicit_checkpoint_scalars(r->imp, ck));
+  if (!pm_ckpt_reading(ck)) return PM_SUCCESS;
+  read_reactions(r);
+  if (r->local_model && !r->ckpt_pieces.on)
+    mpm_par_take_state(r->model, r->state, r->local_model, r->local_state);
+  return PM_SUCCESS;
+}
+
 static pm_err implicit_checkpoint(void *p, pm_ckpt *ck) {
   mpm_sim *r = p;
+  if (pm_ckpt_reading(ck) ? mpm_sim_ckpt_is_pieces(ck) : !r->whole)
+    return implicit_index(r, ck);
   /* A rank without the whole model reads a checkpoint of the whole run
-   * into one, whose state its particles then take. */
-  if (pm_ckpt_reading(ck) && !r->model)
+   * into one, whose state its particles then take (and which a run in
+   * pieces then lets go: mpm_view_drop_whole). */
+  if (pm_ckpt_reading(ck) && !r->model) {
+    r->ckpt_scalars = r->state; /* (rank 0 without the whole model's) */
+    r->state = NULL;
     PM_CALL(mpm_model_create(r->scene, &r->model, &r->state));
+  }
   PM_CALL(mpm_state_checkpoint(r->model, r->state, ck));
   /* A resumed run across ranks: each rank's particles take the state read
    * (they are those of its cells by their reference positions, as at the
@@ -127,8 +173,8 @@ static pm_err implicit_checkpoint(void *p, pm_ckpt *ck) {
   PM_CALL(pm_ckpt_long(ck, "run.min_jacobian_step", &r->run_min_jacobian_step));
   if (pm_ckpt_reading(ck)) {
     r->resumed = true;
-    memcpy(r->work->cond.reaction, mpm_implicit_reactions(r->imp),
-           3 * sizeof(double) * (size_t)r->model->n_bcs);
+    read_reactions(r);
+    if (!r->whole) mpm_view_drop_whole(r);
   }
   return PM_SUCCESS;
 }
@@ -158,4 +204,8 @@ const pm_backend mpm_implicit_backend = {
     .summary = mpm_sim_implicit_summary,
     .timers = mpm_sim_timers,
     .checkpoint = implicit_checkpoint,
+    .pieces = mpm_sim_pieces,
+    .ckpt_pieces = mpm_sim_ckpt_pieces,
+    .pieces_apply = mpm_sim_pieces_apply,
+    .errors = mpm_sim_errors,
 };

@@ -1,9 +1,10 @@
-/* mpm_ckpt_pieces: an explicit MPM run across ranks without the whole
- * model checkpointed in pieces (pm_checkpoint.h): each rank its share's
- * particles with their one-process indices, rank 0 the index with the
- * run's values; and resumed from them on any count of ranks, each rank
- * reading the pieces that hold particles in its cells, or on one process
- * all of them. */
+/* mpm_ckpt_pieces: an MPM run across ranks without the whole model
+ * checkpointed in pieces (pm_checkpoint.h): each rank its share's
+ * particles with their one-process indices (the implicit MPM's also its
+ * own unknowns of load stepping), rank 0 the index with the run's values;
+ * and resumed from them on any count of ranks, each rank reading the
+ * pieces that hold particles in its cells, or on one process all of
+ * them. */
 #include <stdint.h>
 #include <stdio.h>
 #ifdef __GLIBC__
@@ -19,10 +20,13 @@
 /* The index's item that marks a checkpoint in pieces. */
 #define PIECES_ITEM "pieces.n"
 /* A piece's record in the index: the box of its particles' positions
- * (lower corner, upper corner), then its rank's energy accounts. */
+ * (lower corner, upper corner; the implicit MPM's: reference positions,
+ * by which its particles keep their ranks), then its rank's energy
+ * accounts, then (implicit) the box of its unknowns' nodes. */
 #define REC_BOX 0
 #define REC_ACCOUNTS 6
-_Static_assert(REC_ACCOUNTS + MPM_PAR_ACCOUNTS <= PM_VIEW_CKPT_VALUES,
+#define REC_NODES (REC_ACCOUNTS + MPM_PAR_ACCOUNTS)
+_Static_assert(REC_NODES + 6 <= PM_VIEW_CKPT_VALUES,
                "a piece's record fits the view's");
 
 bool mpm_sim_ckpt_pieces(const pm_scene *s) {
@@ -89,6 +93,8 @@ pm_err mpm_sim_ckpt_piece(void *ctx, const char *dir, long id, long *count,
   pm_ckpt *ck = NULL;
   PM_CALL(pm_ckpt_create_piece(dir, id, pm_par_rank(), sum, &ck));
   pm_err e = write_items(m, s, ck);
+  if (!e && r->imp)
+    e = mpm_implicit_checkpoint_piece(r->imp, ck, values + REC_NODES);
   if (!e) {
     pm_ckpt *done = ck;
     ck = NULL;
@@ -98,13 +104,14 @@ pm_err mpm_sim_ckpt_piece(void *ctx, const char *dir, long id, long *count,
   PM_CALL(e);
   *count = m->n;
   double *box = values + REC_BOX, *acc = values + REC_ACCOUNTS;
+  const double *pos = r->imp ? m->x0 : s->x;
   for (int a = 0; a < 3; a++) {
-    box[a] = m->n ? s->x[a] : 0;
-    box[3 + a] = m->n ? s->x[a] : 0;
+    box[a] = m->n ? pos[a] : 0;
+    box[3 + a] = m->n ? pos[a] : 0;
   }
   for (long p = 0; p < m->n; p++)
     for (int a = 0; a < 3; a++) {
-      const double x = s->x[3 * p + a];
+      const double x = pos[3 * p + a];
       box[a] = x < box[a] ? x : box[a];
       box[3 + a] = x > box[3 + a] ? x : box[3 + a];
     }
@@ -224,11 +231,15 @@ typedef struct {
   long *gid; /* [n] */
   long *at;  /* [n]: the particle's place in m, or -1 */
   double *buf;
-  long placed; /* particles placed, over the pieces */
-  bool *seen;  /* [m->n]: placed already (a particle in two pieces is
-                  refused: the count alone would let one stand for a
-                  missing one) */
-  bool vetted; /* the pieces were vetted when picked */
+  long placed;       /* particles placed, over the pieces */
+  bool *seen;        /* [m->n]: placed already (a particle in two pieces is
+                        refused: the count alone would let one stand for a
+                        missing one) */
+  bool vetted;       /* the pieces were vetted when picked */
+  mpm_implicit *imp; /* the implicit solver, whose unknowns the pieces
+                        hold too (NULL: explicit) */
+  long unk_placed;   /* its unknowns placed, over the pieces */
+  bool *unk_seen;    /* [its unknowns]: placed already */
 } piece_reader;
 
 static int long_order(const void *a, const void *b) {
@@ -313,6 +324,8 @@ static pm_err read_piece(piece_reader *pr, const mpm_ckpt_pieces *cp, int k) {
   PM_ENSURE(first == n, PM_ERR_IO,
             "checkpoint '%s': its groups hold %ld of its %ld particles",
             pm_ckpt_path(ck), first, n);
+  if (pr->imp)
+    PM_TRY(mpm_implicit_read_piece(pr->imp, ck, pr->unk_seen, &pr->unk_placed));
   pm_ckpt *done_ck = ck;
   ck = NULL;
   PM_TRY(pm_ckpt_finish(done_ck));
@@ -321,12 +334,17 @@ done:
   return ret;
 }
 
-/* The pieces need[k] (all where need is NULL) into model m's state s; every
- * particle of m must be found in them once. */
+/* The pieces need[k] (all where need is NULL; vetted: vetted already)
+ * into model m's state s, and the implicit solver imp's unknowns (NULL:
+ * none); every particle of m and every unknown must be found in them
+ * once. */
 static pm_err read_pieces(const mpm_ckpt_pieces *cp, const bool *need,
-                          const mpm_model *m, mpm_state *s) {
-  piece_reader pr = {.m = m, .s = s, .vetted = need != NULL};
+                          bool vetted, const mpm_model *m, mpm_state *s,
+                          mpm_implicit *imp) {
+  piece_reader pr = {.m = m, .s = s, .vetted = vetted, .imp = imp};
+  const long unknowns = imp ? mpm_implicit_unknowns(imp) : 0;
   pm_err ret = PM_ALLOC(pr.seen, m->n + 1, "checkpoint pieces");
+  if (!ret) ret = PM_ALLOC(pr.unk_seen, unknowns + 1, "checkpoint pieces");
   for (int k = 0; k < cp->n && !ret; k++)
     if (!need || need[k]) ret = read_piece(&pr, cp, k);
   if (!ret && pr.placed != m->n)
@@ -334,10 +352,17 @@ static pm_err read_pieces(const mpm_ckpt_pieces *cp, const bool *need,
                    "checkpoint '%s/checkpoint.h5': its pieces hold %ld of "
                    "the %ld particles this run reads from them",
                    cp->dir, pr.placed, m->n);
+  if (!ret && pr.unk_placed != unknowns)
+    ret = PM_ERROR(PM_ERR_IO,
+                   "checkpoint '%s/checkpoint.h5': its pieces hold %ld of "
+                   "the %ld unknowns of load stepping this rank reads from "
+                   "them",
+                   cp->dir, pr.unk_placed, unknowns);
   free(pr.gid);
   free(pr.at);
   free(pr.buf);
   free(pr.seen);
+  free(pr.unk_seen);
   return ret;
 }
 
@@ -345,7 +370,7 @@ pm_err mpm_sim_ckpt_load_whole(mpm_sim *r) {
   mpm_ckpt_pieces *cp = &r->ckpt_pieces;
   if (!r->model) PM_CALL(mpm_model_create(r->scene, &r->model, &r->state));
   mpm_state_copy_values(r->state, &cp->vals);
-  PM_CALL(read_pieces(cp, NULL, r->model, r->state));
+  PM_CALL(read_pieces(cp, NULL, false, r->model, r->state, r->imp));
   cp->on = false; /* (read: a run across ranks shares it anew) */
   return PM_SUCCESS;
 }
@@ -457,6 +482,26 @@ static pm_err pick_prepare(void *ctx, const mpm_decomp *d, const mpm_grid *g,
   return PM_SUCCESS;
 }
 
+/* The checkpoint's values into share state ls (and rank 0's scalars):
+ * each rank's accounts as the checkpoint's ranks had them; on another
+ * count of ranks, their sums on rank 0. */
+static void share_values(mpm_sim *r, mpm_state *ls) {
+  const mpm_ckpt_pieces *cp = &r->ckpt_pieces;
+  mpm_state_copy_values(ls, &cp->vals);
+  const int me = pm_par_rank();
+  const bool same = cp->n == pm_par_size();
+  if (!same && me != 0) {
+    memset(ls->energy, 0, sizeof ls->energy);
+    ls->external_work = ls->dissipated = 0;
+  } else if (same) {
+    const double *row = r->ckpt_accounts + MPM_PAR_ACCOUNTS * me;
+    memcpy(ls->energy, row, sizeof ls->energy);
+    ls->external_work = row[MPM_PAR_ACCOUNTS - 2];
+    ls->dissipated = row[MPM_PAR_ACCOUNTS - 1];
+  }
+  if (r->state) mpm_state_copy_values(r->state, &cp->vals);
+}
+
 /* The share anew from the pieces into r (the old one let go first). */
 static pm_err reload(mpm_sim *r, pick_set *ps) {
   mpm_ckpt_pieces *cp = &r->ckpt_pieces;
@@ -482,23 +527,9 @@ static pm_err reload(mpm_sim *r, pick_set *ps) {
                    "checkpoint '%s/checkpoint.h5': rank %d's cells hold %ld "
                    "of its particles, the scene seeds %ld of them there",
                    cp->dir, pm_par_rank(), ps->n, lm->n);
-  if (!ret) ret = read_pieces(cp, ps->need, lm, ls);
+  if (!ret) ret = read_pieces(cp, ps->need, true, lm, ls, NULL);
   PM_TRY(pm_par_agree(ret));
-  mpm_state_copy_values(ls, &cp->vals);
-  /* Each rank's accounts as the checkpoint's ranks had them; on another
-   * count of ranks, their sums on rank 0. */
-  const int me = pm_par_rank();
-  const bool same = cp->n == pm_par_size();
-  if (!same && me != 0) {
-    memset(ls->energy, 0, sizeof ls->energy);
-    ls->external_work = ls->dissipated = 0;
-  } else if (same) {
-    const double *row = r->ckpt_accounts + MPM_PAR_ACCOUNTS * me;
-    memcpy(ls->energy, row, sizeof ls->energy);
-    ls->external_work = row[MPM_PAR_ACCOUNTS - 2];
-    ls->dissipated = row[MPM_PAR_ACCOUNTS - 1];
-  }
-  if (r->state) mpm_state_copy_values(r->state, &cp->vals);
+  share_values(r, ls);
   r->local_model = lm;
   r->local_state = ls;
   lm = NULL;
@@ -530,4 +561,40 @@ pm_err mpm_view_reload(mpm_sim *r) {
                             &r->local_state) == PM_SUCCESS)
     (void)pm_par_agree(mpm_work_create(r->local_model, &r->local_work));
   return PM_ERROR(ret, "%s", why);
+}
+
+/* ---- the implicit MPM's share, read in place ----------------------------- */
+
+/* Whether boxes of node indices a and b (lower corner, upper corner,
+ * inclusive) meet. */
+static bool nodes_meet(const double *a, const double *b) {
+  for (int ax = 0; ax < 3; ax++)
+    if (a[3 + ax] < b[ax] || a[ax] > b[3 + ax]) return false;
+  return true;
+}
+
+pm_err mpm_view_implicit_reload(mpm_sim *r) {
+  mpm_ckpt_pieces *cp = &r->ckpt_pieces;
+  const mpm_model *lm = r->local_model;
+  const mpm_decomp *d = mpm_par_decomp(lm);
+  const int me = pm_par_rank();
+  /* The pieces with particles in this rank's cells by their reference
+   * positions (which its particles keep), or unknowns at its nodes. */
+  bool *need = NULL;
+  double own[6];
+  const bool unknowns = mpm_implicit_unknowns(r->imp) > 0;
+  mpm_implicit_nodes_box(r->imp, own);
+  pm_err ret = PM_ALLOC(need, cp->n, "checkpoint pieces");
+  for (int k = 0; k < cp->n && !ret; k++) {
+    const double *rec = cp->values + PM_VIEW_CKPT_VALUES * k;
+    need[k] =
+        (cp->counts[2 * k] > 0 && meets(rec + REC_BOX, d, &lm->grid, me)) ||
+        (unknowns && nodes_meet(rec + REC_NODES, own));
+  }
+  if (!ret) ret = read_pieces(cp, need, false, lm, r->local_state, r->imp);
+  free(need);
+  PM_CALL(pm_par_agree(ret));
+  share_values(r, r->local_state);
+  cp->on = false;
+  return PM_SUCCESS;
 }

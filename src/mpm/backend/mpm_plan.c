@@ -12,7 +12,9 @@
 #include "pm_omp.h"
 #include "pm_par.h"
 
-static void plan_groups(const mpm_model *m, FILE *out) {
+/* m: the whole model, or a share with its whole run's ranges (w). */
+static void plan_groups(const mpm_model *m, const mpm_par_ranges *w,
+                        FILE *out) {
   size_t common = mpm_particle_bytes_common();
   for (int gi = 0; gi < m->n_groups; gi++) {
     const mpm_group *g = &m->group[gi];
@@ -20,8 +22,8 @@ static void plan_groups(const mpm_model *m, FILE *out) {
     fprintf(out,
             "  group %-8s %ld particles, %s, %zu bytes per particle (%zu "
             "common + %zu:",
-            g->name, g->end - g->begin, g->kind->name, common + own, common,
-            own);
+            g->name, w ? w->gend[gi] - w->gbegin[gi] : g->end - g->begin,
+            g->kind->name, common + own, common, own);
     for (int k = 0; k < g->n_arrays; k++)
       fprintf(out, " %s", g->layout[k].name);
     fprintf(out, "%s)\n", own ? "" : " none");
@@ -29,16 +31,18 @@ static void plan_groups(const mpm_model *m, FILE *out) {
 }
 
 /* Each body's particles: membranes with their triangles, thickness and
- * area; bodies seeded at their own density; moving bodies. */
-static void plan_bodies(const mpm_sim *r, FILE *out) {
-  const mpm_model *m = r->model;
+ * area; bodies seeded at their own density; moving bodies (m: the whole
+ * model, or a share with its whole run's ranges w, where no membrane
+ * is). */
+static void plan_bodies(const mpm_sim *r, const mpm_model *m,
+                        const mpm_par_ranges *w, FILE *out) {
   const pm_scene *s = r->scene;
   for (int b = 0; b < s->n_bodies; b++) {
     const pm_scene_body *body = &s->bodies[b];
-    long n = m->body_end[b] - m->body_begin[b];
+    long n = w ? w->bend[b] - w->bbegin[b] : m->body_end[b] - m->body_begin[b];
     fprintf(out, "  body %d%s%s: %ld particles", b, body->name ? " " : "",
             body->name ? body->name : "", n);
-    if (body->shape == PM_BODY_MEMBRANE) {
+    if (body->shape == PM_BODY_MEMBRANE && !w) {
       long nt = m->body_tri_end[b] - m->body_tri_begin[b];
       double area = 0;
       for (long q = m->body_begin[b]; q < m->body_end[b]; q++)
@@ -106,8 +110,8 @@ static double plan_head(const mpm_sim *r, FILE *out) {
   plan_layout(m, r->scene, out);
   fprintf(out, "particles    %ld (%d x %d x %d per cell)\n", m->n, o->ppc[0],
           o->ppc[1], m->dim == 3 ? o->ppc[2] : 1);
-  plan_groups(m, out);
-  plan_bodies(r, out);
+  plan_groups(m, NULL, out);
+  plan_bodies(r, m, NULL, out);
   fprintf(out, "pipeline\n");
   for (int k = 0; k < m->pipeline.n; k++)
     fprintf(out, "  %2d. %-20s %s\n", k + 1, m->pipeline.stage[k].name,
@@ -198,21 +202,25 @@ pm_err mpm_sim_plan(void *p, FILE *out) {
 }
 
 /* The whole run's lines of an implicit plan: the scene, grid, particles,
- * groups and bodies (rank 0's, where it holds the whole model). */
+ * groups and bodies (rank 0's: of the whole model, or without it of its
+ * share with the whole run's counts). */
 static void implicit_head(const mpm_sim *r, FILE *out) {
-  const mpm_model *m = r->model;
+  const mpm_model *m = r->model ? r->model : r->local_model;
   const pm_scene *s = r->scene;
-  const mpm_grid *g = &m->grid;
+  mpm_par_ranges whole, *w = NULL;
+  long nn[3], lo[3], hi[3];
+  mpm_xc_cells(m, nn, lo, hi); /* (the whole grid's nodes) */
+  if (!r->model) mpm_par_whole_ranges(m, w = &whole);
   fprintf(out, "scene        %s (%s)\n", s->name, s->path);
   fprintf(out, "method       mpm-implicit, %dD%s, %s B-splines, quasi-static\n",
           m->dim, m->dim == 2 ? " plane strain" : "",
           mpm_sim_basis_name(m->opt.shape));
-  fprintf(out, "grid         %ld x %ld x %ld nodes, cell %g m\n", g->nn[0],
-          g->nn[1], g->nn[2], g->h);
+  fprintf(out, "grid         %ld x %ld x %ld nodes, cell %g m\n", nn[0], nn[1],
+          nn[2], m->grid.h);
   plan_layout(m, r->scene, out);
-  fprintf(out, "particles    %ld\n", m->n);
-  plan_groups(m, out);
-  plan_bodies(r, out);
+  fprintf(out, "particles    %ld\n", w ? w->n : m->n);
+  plan_groups(m, w, out);
+  plan_bodies(r, m, w, out);
 }
 
 pm_err mpm_sim_implicit_plan(void *p, FILE *out) {
@@ -220,10 +228,10 @@ pm_err mpm_sim_implicit_plan(void *p, FILE *out) {
   const mpm_model *m = r->model;
   /* Across ranks a rank without the whole model has its share's lines
    * alone (the decomposition's are collective). */
-  if (m) implicit_head(r, out);
+  if (pm_par_root()) implicit_head(r, out);
   mpm_implicit_plan(r->imp, out);
   if (r->local_model) /* across ranks: the decomposition, each rank's share */
-    mpm_par_plan(r->local_model, NULL, m ? out : NULL);
+    mpm_par_plan(r->local_model, NULL, pm_par_root() ? out : NULL);
   else
     PM_CALL(plan_decomposition(r, out));
   if (!m) return PM_SUCCESS;

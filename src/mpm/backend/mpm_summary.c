@@ -137,11 +137,11 @@ static pm_err summary_ranks(pm_json *j, const mpm_sim *r) {
   return pm_json_end_object(j);
 }
 
-pm_err mpm_sim_summary(void *p, pm_json *j) {
-  const mpm_sim *r = p;
-  /* without the whole model: the share's, with the whole run's counts */
+/* The particles, groups, grid and shape of both methods' summaries: of
+ * the whole model, or without it of the share with the whole run's
+ * counts. */
+static pm_err summary_head(pm_json *j, const mpm_sim *r) {
   const mpm_model *m = r->model ? r->model : r->local_model;
-  const mpm_state *s = r->state;
   mpm_par_ranges whole;
   if (!r->model) mpm_par_whole_ranges(m, &whole);
   PM_CALL(pm_json_integer(j, "particles", r->model ? m->n : whole.n));
@@ -149,7 +149,14 @@ pm_err mpm_sim_summary(void *p, pm_json *j) {
   PM_CALL(pm_json_integer(j, "grid_nodes",
                           r->model ? m->grid.n_nodes : r->sums.grid_nodes));
   PM_CALL(pm_json_number(j, "cell_size", m->grid.h));
-  PM_CALL(pm_json_string(j, "shape", mpm_sim_basis_name(m->opt.shape)));
+  return pm_json_string(j, "shape", mpm_sim_basis_name(m->opt.shape));
+}
+
+pm_err mpm_sim_summary(void *p, pm_json *j) {
+  const mpm_sim *r = p;
+  const mpm_model *m = r->model ? r->model : r->local_model;
+  const mpm_state *s = r->state;
+  PM_CALL(summary_head(j, r));
   PM_CALL(
       pm_json_string(j, "update", mpm_sim_update_name(m->opt.update, false)));
   PM_CALL(pm_json_number(j, "flip", m->opt.flip));
@@ -195,16 +202,12 @@ static pm_err implicit_summary_ranks(pm_json *j, const mpm_sim *r) {
 
 pm_err mpm_sim_implicit_summary(void *p, pm_json *j) {
   const mpm_sim *r = p;
-  const mpm_model *m = r->model;
+  /* without the whole model: the share's, with the whole run's counts */
   const pm_load_report *lr = mpm_implicit_report(r->imp);
   const mpm_settings *ms = mpm_scene_settings(r->scene);
   long unknowns, entries;
   mpm_implicit_size(r->imp, &unknowns, &entries);
-  PM_CALL(pm_json_integer(j, "particles", m->n));
-  PM_CALL(summary_groups(j, m, NULL));
-  PM_CALL(pm_json_integer(j, "grid_nodes", m->grid.n_nodes));
-  PM_CALL(pm_json_number(j, "cell_size", m->grid.h));
-  PM_CALL(pm_json_string(j, "shape", mpm_sim_basis_name(m->opt.shape)));
+  PM_CALL(summary_head(j, r));
   PM_CALL(pm_json_string(
       j, "grid", ms->implicit.grid == MPM_GRID_KEPT ? "kept" : "reset"));
   PM_CALL(pm_json_string(j, "operator",

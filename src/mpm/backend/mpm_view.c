@@ -78,15 +78,16 @@ static pm_err gather(void *ctx) {
 }
 
 void mpm_view_init(mpm_sim *r, bool implicit) {
+  pm_err (*whole)(void *) = implicit ? mpm_view_implicit_gather : gather;
   r->view = (pm_view){.ranks = r->local_model != NULL,
                       .ctx = r,
-                      .gather = implicit ? mpm_view_implicit_gather : gather,
+                      .gather = implicit && !r->whole ? mpm_view_implicit_sums
+                                                      : whole,
                       .release = release,
-                      .piece = implicit ? NULL : mpm_sim_piece,
-                      .ckpt_piece =
-                          implicit || r->whole || !mpm_sim_ckpt_pieces(r->scene)
-                              ? NULL
-                              : mpm_sim_ckpt_piece};
+                      .piece = mpm_sim_piece,
+                      .ckpt_piece = r->whole || !mpm_sim_ckpt_pieces(r->scene)
+                                        ? NULL
+                                        : mpm_sim_ckpt_piece};
 }
 
 pm_err mpm_view_report(mpm_sim *r, bool frame, bool last) {
@@ -168,4 +169,10 @@ pm_err mpm_view_implicit_gather(void *ctx) {
   PM_CALL(pm_par_agree(
       mpm_par_gather(r->local_model, r->local_state, r->model, r->state)));
   return mpm_implicit_gather(r->imp, r->model);
+}
+
+pm_err mpm_view_implicit_sums(void *ctx) {
+  mpm_sim *r = ctx;
+  /* (the figures every rank shares are every rank's: implicit_observe) */
+  return mpm_view_sum(r, r->view.ending);
 }

@@ -63,7 +63,8 @@ pm_err mpm_view_sums_setup(mpm_sim *r) {
   if (!e && pm_par_root()) {
     e = PM_ALLOC(r->state, 1, "the run's scalars");
     if (!e) mpm_state_copy_values(r->state, r->local_state);
-    if (!e) e = mpm_sim_figures_work(lm, &r->work);
+    /* (the implicit solver's figures are every rank's already) */
+    if (!e && !r->work) e = mpm_sim_figures_work(lm, &r->work);
   }
   PM_CALL(pm_par_agree(e));
   return mpm_par_gather_x0(lm, &r->mesh_x0);

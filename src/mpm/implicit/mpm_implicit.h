@@ -126,6 +126,30 @@ void mpm_implicit_plan(const mpm_implicit *im, FILE *out);
 pm_err mpm_implicit_checkpoint(mpm_implicit *im, const mpm_model *full,
                                pm_ckpt *ck);
 
+/* A checkpoint in pieces (a run across ranks without the whole model):
+ * the solver's scalars (load stepping's figures, counters, reactions),
+ * which rank 0 writes into the index and every rank reads. */
+pm_err mpm_implicit_checkpoint_scalars(mpm_implicit *im, pm_ckpt *ck);
+/* This rank's part of a piece: load stepping's last two converged states
+ * at its own unknowns, each named by its dof on the whole grid (so that
+ * a run on any count of ranks finds its own), and into box the whole
+ * grid's node indices their nodes span (lower corner, upper corner,
+ * inclusive; zeros without any). */
+pm_err mpm_implicit_checkpoint_piece(mpm_implicit *im, pm_ckpt *ck,
+                                     double box[6]);
+/* The box of the nodes of this rank's unknowns, as
+ * mpm_implicit_checkpoint_piece records it. */
+void mpm_implicit_nodes_box(const mpm_implicit *im, double box[6]);
+/* Reading a piece's part: the values of this rank's unknowns it holds
+ * into load stepping's states, *placed counting them; seen (one a
+ * unknown, mpm_implicit_unknowns, the caller's) marks those placed over
+ * the pieces, and one in two pieces is refused (PM_ERR_IO). */
+pm_err mpm_implicit_read_piece(mpm_implicit *im, pm_ckpt *ck, bool *seen,
+                               long *placed);
+/* The unknowns a checkpoint's pieces must hold for this rank (0 where
+ * the grid is reset: no nodal state is kept between load steps). */
+long mpm_implicit_unknowns(const mpm_implicit *im);
+
 /* Across ranks: load stepping's last two converged states, as nodal
  * displacements of the whole grid, to rank 0 for its checkpoint (full:
  * the whole model there, NULL on the other ranks; collective). */
