@@ -384,28 +384,11 @@ typedef struct {
   bool *need;  /* per piece: it holds some */
   double *x0;  /* 3 per kept particle */
   long n, cap; /* kept, and room */
-  long *slot;  /* [mask + 1]: a kept particle, or -1 */
-  uint64_t mask;
+  mpm_x0_set set;
 } pick_set;
 
-static uint64_t hash_x(const double x[3]) {
-  uint64_t h = 1469598103934665603ull;
-  for (int a = 0; a < 3; a++) {
-    uint64_t b;
-    memcpy(&b, &x[a], sizeof b);
-    h = (h ^ b) * 0x9e3779b97f4a7c15ull;
-    h ^= h >> 29;
-  }
-  return h;
-}
-
 static bool pick_keep(void *ctx, const double x[3]) {
-  const pick_set *ps = ctx;
-  for (uint64_t i = hash_x(x) & ps->mask;; i = (i + 1) & ps->mask) {
-    const long k = ps->slot[i];
-    if (k < 0) return false;
-    if (!memcmp(ps->x0 + 3 * k, x, 3 * sizeof(double))) return true;
-  }
+  return mpm_x0_set_has(&((const pick_set *)ctx)->set, x);
 }
 
 /* Whether a piece's box of positions meets rank's box of cells. */
@@ -469,17 +452,8 @@ static pm_err pick_prepare(void *ctx, const mpm_decomp *d, const mpm_grid *g,
         meets(cp->values + PM_VIEW_CKPT_VALUES * k + REC_BOX, d, g, rank);
     if (ps->need[k]) PM_CALL(pick_piece(ps, k, d, g, rank));
   }
-  uint64_t size = 16;
-  while (size < 2 * (uint64_t)ps->n) size *= 2;
-  ps->mask = size - 1;
-  PM_CALL(PM_ALLOC(ps->slot, (long)size, "checkpoint particles"));
-  for (uint64_t i = 0; i < size; i++) ps->slot[i] = -1;
-  for (long k = 0; k < ps->n; k++) {
-    uint64_t i = hash_x(ps->x0 + 3 * k) & ps->mask;
-    while (ps->slot[i] >= 0) i = (i + 1) & ps->mask;
-    ps->slot[i] = k;
-  }
-  return PM_SUCCESS;
+  ps->set = (mpm_x0_set){.x0 = ps->x0, .stride = 3, .n = ps->n};
+  return mpm_x0_set_index(&ps->set);
 }
 
 /* The checkpoint's values into share state ls (and rank 0's scalars):
@@ -518,9 +492,8 @@ static pm_err reload(mpm_sim *r, pick_set *ps) {
 #endif
   pm_err ret =
       mpm_par_create_cut(r->scene, false, r->ckpt_cut, &pick, &lm, &ls);
-  free(ps->slot); /* (the seeding's alone) */
+  mpm_x0_set_free(&ps->set); /* (the seeding's alone) */
   free(ps->x0);
-  ps->slot = NULL;
   ps->x0 = NULL;
   if (!ret && lm->n != ps->n)
     ret = PM_ERROR(PM_ERR_IO,
@@ -547,7 +520,7 @@ pm_err mpm_view_reload(mpm_sim *r) {
   pm_err ret = reload(r, &ps);
   free(ps.need);
   free(ps.x0);
-  free(ps.slot);
+  mpm_x0_set_free(&ps.set);
 #ifdef __GLIBC__
   malloc_trim(0); /* (the pieces' buffers) */
 #endif

@@ -50,6 +50,7 @@
 #ifndef MPM_PAR_H
 #define MPM_PAR_H
 
+#include <stdint.h>
 #include <stdio.h>
 
 #include "mpm_exchange.h"
@@ -173,6 +174,20 @@ pm_err mpm_par_create_picked(const pm_scene *s, bool gather,
 pm_err mpm_par_create_cut(const pm_scene *s, bool gather, const long *cut,
                           const mpm_par_pick *pick, mpm_model **local,
                           mpm_state **local_state);
+
+/* A set of particles known by their reference positions, which a share's
+ * seeding asks (mpm_par_pick.keep): n positions of 3 doubles, `stride`
+ * doubles apart from x0 (borrowed); mpm_x0_set_index makes its table
+ * (PM_ERR_MEMORY), mpm_x0_set_free lets the table go. */
+typedef struct {
+  const double *x0;
+  long stride, n;
+  long *slot; /* [mask + 1]: a position's index, or -1 */
+  uint64_t mask;
+} mpm_x0_set;
+pm_err mpm_x0_set_index(mpm_x0_set *set);
+bool mpm_x0_set_has(const mpm_x0_set *set, const double x[3]);
+void mpm_x0_set_free(mpm_x0_set *set);
 
 /* After a step's migration: every 20 steps, whether the busiest rank holds
  * more than mpm.rebalance times the mean of the particles, and if so the

@@ -26,46 +26,7 @@
 /* A new cut is taken when it lowers the busiest rank's count by this. */
 #define BALANCE_GAIN 0.05
 
-/* The particles a rank receives, known by their reference positions: an
- * open-addressed set of the records' x0, which the share's seeding asks
- * (mpm_par_pick). */
-typedef struct {
-  const double *recs;
-  int rec;
-  long n;
-  long *slot;
-  uint64_t mask;
-} received;
-
-static uint64_t hash_x(const double x[3]) {
-  uint64_t h = 1469598103934665603ull;
-  for (int a = 0; a < 3; a++) {
-    uint64_t b;
-    memcpy(&b, &x[a], sizeof b);
-    h = (h ^ b) * 0x9e3779b97f4a7c15ull;
-    h ^= h >> 29;
-  }
-  return h;
-}
-
-static const double *x0_of(const received *rv, long k) {
-  return rv->recs + k * rv->rec + REC_X0;
-}
-
-static pm_err received_index(received *rv) {
-  uint64_t size = 16;
-  while (size < 2 * (uint64_t)rv->n) size *= 2;
-  rv->mask = size - 1;
-  PM_CALL(PM_ALLOC(rv->slot, (long)size, "received particles"));
-  for (uint64_t i = 0; i < size; i++) rv->slot[i] = -1;
-  for (long k = 0; k < rv->n; k++) {
-    uint64_t i = hash_x(x0_of(rv, k)) & rv->mask;
-    while (rv->slot[i] >= 0) i = (i + 1) & rv->mask;
-    rv->slot[i] = k;
-  }
-  return PM_SUCCESS;
-}
-
+/* Whether the seeding keeps x: a particle received (mpm_x0_set). */
 static pm_err received_prepare(void *ctx, const mpm_decomp *d,
                                const mpm_grid *g, int rank) {
   (void)ctx, (void)d, (void)g, (void)rank;
@@ -73,12 +34,7 @@ static pm_err received_prepare(void *ctx, const mpm_decomp *d,
 }
 
 static bool received_keep(void *ctx, const double x[3]) {
-  const received *rv = ctx;
-  for (uint64_t i = hash_x(x) & rv->mask;; i = (i + 1) & rv->mask) {
-    const long k = rv->slot[i];
-    if (k < 0) return false;
-    if (!memcmp(x0_of(rv, k), x, 3 * sizeof(double))) return true;
-  }
+  return mpm_x0_set_has(ctx, x);
 }
 
 static int by_gid(const void *a, const void *b) {
@@ -170,12 +126,12 @@ static pm_err share_anew(const mpm_model *m, const mpm_state *s,
                          const long *cut, const transfer *t, mpm_model **lm,
                          mpm_state **ls) {
   const struct mpm_par *P = par_of(m);
-  received rv = {.recs = t->rbuf, .rec = P->rec, .n = t->arriving};
+  mpm_x0_set rv = {.x0 = t->rbuf + REC_X0, .stride = P->rec, .n = t->arriving};
   mpm_par_pick pick = {
       .prepare = received_prepare, .keep = received_keep, .ctx = &rv};
-  pm_err ret = pm_par_agree(received_index(&rv));
+  pm_err ret = pm_par_agree(mpm_x0_set_index(&rv));
   if (!ret) ret = mpm_par_create_cut(P->scene, P->gather, cut, &pick, lm, ls);
-  free(rv.slot);
+  mpm_x0_set_free(&rv);
   PM_CALL(ret);
   /* Each particle seeded is one received, in the same order. */
   long bad = -1;
