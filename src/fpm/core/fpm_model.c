@@ -378,15 +378,24 @@ int fpm_domain_body(const pm_scene *s) {
   return s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH ? 0 : -1;
 }
 
-pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
-                        const gm_mesh *mesh, const gm_dual *d,
-                        fpm_model **out) {
-  return fpm_model_create_part(s, o, mesh, d, NULL, out);
+/* A part's interfaces (its points' shares of the cells' faces), which
+ * nothing reads once the interface records are built. */
+static void let_interfaces_go(gm_dual *d) {
+  void **arrays[] = {(void **)&d->nbr_iface,   (void **)&d->if_pair,
+                     (void **)&d->if_area_vec, (void **)&d->if_moment,
+                     (void **)&d->if_centroid, (void **)&d->if_area};
+  for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) {
+    free(*arrays[k]);
+    *arrays[k] = NULL;
+  }
+  d->n_ifaces = 0;
 }
 
-pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
-                             const gm_mesh *mesh, const gm_dual *d,
-                             const long *gid, fpm_model **out) {
+/* The model on cells d (of a part: gid, its interfaces let go after the
+ * records where part is d; of the whole: both NULL). */
+static pm_err model_create(const pm_scene *s, const fpm_options *o,
+                           const gm_mesh *mesh, const gm_dual *d,
+                           const long *gid, gm_dual *part, fpm_model **out) {
   pm_err ret = PM_SUCCESS;
   fpm_model *m = NULL;
   *out = NULL;
@@ -438,6 +447,7 @@ pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
   build_interfaces(m);
   if (m->jump == FPM_JUMP_QUADRATIC && m->boundary_penalty > 0)
     PM_TRY(boundary_penalty(m));
+  if (part) let_interfaces_go(part); /* before the fits, the largest */
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
   /* A part's share streams its own entries (fpm_model_subset); the part
    * is never stepped. */
@@ -450,6 +460,18 @@ pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
 done:
   fpm_model_destroy(m);
   return ret;
+}
+
+pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
+                        const gm_mesh *mesh, const gm_dual *d,
+                        fpm_model **out) {
+  return model_create(s, o, mesh, d, NULL, NULL, out);
+}
+
+pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
+                             const gm_mesh *mesh, gm_dual *d, const long *gid,
+                             fpm_model **out) {
+  return model_create(s, o, mesh, d, gid, d, out);
 }
 
 pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {
