@@ -378,19 +378,6 @@ int fpm_domain_body(const pm_scene *s) {
   return s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH ? 0 : -1;
 }
 
-/* A part's interfaces (its points' shares of the cells' faces), which
- * nothing reads once the interface records are built. */
-static void let_interfaces_go(gm_dual *d) {
-  void **arrays[] = {(void **)&d->nbr_iface,   (void **)&d->if_pair,
-                     (void **)&d->if_area_vec, (void **)&d->if_moment,
-                     (void **)&d->if_centroid, (void **)&d->if_area};
-  for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) {
-    free(*arrays[k]);
-    *arrays[k] = NULL;
-  }
-  d->n_ifaces = 0;
-}
-
 /* The model on cells d (of a part: gid, its interfaces let go after the
  * records where part is d; of the whole: both NULL). */
 static pm_err model_create(const pm_scene *s, const fpm_options *o,
@@ -447,7 +434,9 @@ static pm_err model_create(const pm_scene *s, const fpm_options *o,
   build_interfaces(m);
   if (m->jump == FPM_JUMP_QUADRATIC && m->boundary_penalty > 0)
     PM_TRY(boundary_penalty(m));
-  if (part) let_interfaces_go(part); /* before the fits, the largest */
+  /* Nothing reads a part's interfaces past the records: they go before
+   * the fits, the largest arrays, are built. */
+  if (part) gm_dual_drop(part, true, false);
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
   /* A part's share streams its own entries (fpm_model_subset); the part
    * is never stepped. */
