@@ -47,33 +47,29 @@ static void copy_items(double *to, const double *from, const long *idx,
     memcpy(to + width * k, from + width * idx[k], sizeof(double) * width);
 }
 
-/* Move the records of `width` doubles of *a (n_from of them) in place to
- * their places in the subset (dest[e]: the subset's record of e, n_to of
- * them, each one's source once; -1: not kept), by the cycles of the
- * permutation that sends the records not kept past n_to, then shrink *a
- * to the n_to records (and one zero double, as PM_ALLOC's). */
-static pm_err move_records(double **a, long n_from, long *dest, long n_to,
+/* Rearrange the n_from records of `width` doubles of *a in place so that
+ * the one at f is the one that was at src[f] (a permutation: the subset's
+ * records first, n_to of them, then those not kept), by its cycles, each
+ * record copied once, then shrink *a to the n_to records (and one zero
+ * double, as PM_ALLOC's). */
+static pm_err move_records(double **a, long n_from, const long *src, long n_to,
                            int width) {
   pm_err ret = PM_SUCCESS;
   unsigned char *done = NULL;
-  double *held = NULL, *swap = NULL;
+  double *held = NULL, *r = *a;
   PM_TRY(PM_ALLOC(done, n_from + 1, "records moved"));
-  PM_TRY(PM_ALLOC(held, 2 * width, "records moved"));
-  swap = held + width;
-  for (long e = 0, past = n_to; e < n_from; e++)
-    if (dest[e] < 0) dest[e] = past++;
-  const size_t bytes = sizeof(double) * (size_t)width;
-  for (long e = 0; e < n_from; e++) {
-    if (done[e]) continue;
-    memcpy(held, *a + width * e, bytes); /* the record of `at` in hand */
-    for (long at = e; !done[at];) {
-      const long to = dest[at];
-      memcpy(swap, *a + width * to, bytes);
-      memcpy(*a + width * to, held, bytes);
-      memcpy(held, swap, bytes);
+  PM_TRY(PM_ALLOC(held, width, "records moved"));
+  for (long f = 0; f < n_from; f++) {
+    if (done[f] || src[f] == f) continue;
+    for (int c = 0; c < width; c++) held[c] = r[width * f + c];
+    long at = f;
+    for (; src[at] != f; at = src[at]) {
+      for (int c = 0; c < width; c++)
+        r[width * at + c] = r[width * src[at] + c];
       done[at] = 1;
-      at = to;
     }
+    for (int c = 0; c < width; c++) r[width * at + c] = held[c];
+    done[at] = 1;
   }
   if (pm_realloc((void **)a, (size_t)width * n_to + 1, sizeof(double),
                  "records moved") == PM_SUCCESS)
@@ -104,18 +100,27 @@ static pm_err subset_entries(double **to, const double *m_a, double **take,
     return PM_SUCCESS;
   }
   pm_err ret = PM_SUCCESS;
-  long *dest = NULL;
-  PM_TRY(PM_ALLOC(dest, n_from + 1, what));
-  for (long e = 0; e < n_from; e++) dest[e] = -1;
+  long *src = NULL;
+  unsigned char *kept = NULL;
+  PM_TRY(PM_ALLOC(src, n_from + 1, what));
+  PM_TRY(PM_ALLOC(kept, n_from + 1, what));
   for (long li = 0; li < ns; li++) {
     const long e0 = m_ptr[s->gid[li]], f0 = s_ptr[li];
-    for (long f = f0; f < s_ptr[li + 1]; f++) dest[e0 + f - f0] = f;
+    for (long f = f0; f < s_ptr[li + 1]; f++) {
+      src[f] = e0 + f - f0;
+      kept[e0 + f - f0] = 1;
+    }
   }
-  PM_TRY(move_records(take, n_from, dest, n_to, width));
+  for (long e = 0, past = n_to; e < n_from; e++)
+    if (!kept[e]) src[past++] = e;
+  free(kept);
+  kept = NULL;
+  PM_TRY(move_records(take, n_from, src, n_to, width));
   *to = *take;
   *take = NULL;
 done:
-  free(dest);
+  free(src);
+  free(kept);
   return ret;
 }
 
