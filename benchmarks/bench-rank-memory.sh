@@ -1,7 +1,9 @@
 #!/bin/bash
 # Peak resident memory of every rank of an MPM run (/usr/bin/time -v
-# around each rank), 20 steps, on 1, 2 and 4 ranks (4 oversubscribed on
-# fewer cores: memory, not time), for the 3-D block, the block at half its
+# around each rank; after it, the peak the run's summary.json gives the
+# rank, without the child that meshes), 20 steps, on 1, 2 and 4 ranks (4
+# oversubscribed on fewer cores: memory, not time), for the 3-D block,
+# the block at half its
 # cell (mesh_size 1.25e-3: 884 736 particles), the block with its frames
 # in pieces (output.ranks: pieces, no checkpoints: rank 0 without the
 # whole model; label "pieces", the fine block too), both blocks with the
@@ -17,8 +19,8 @@
 # METHOD=fpm: FPM F3 at 60% at 4036 and 13762 points (mesh_size 6.42e-3,
 # 4.15e-3), 20 steps and, labelled "setup", one step (the setup's CPU
 # seconds), its floor the same at 45 points (mesh_size 0.05); labelled
-# "pieces", the 20 steps with frames in pieces (no rank keeps the whole
-# model).
+# BUILD-pieces, the 20 steps with frames in pieces (no rank keeps the whole
+# model), by either build.
 # ONLY="block block-fine" measures those MPM scenes alone (and the floor;
 # ONLY=i2-256: I2 alone).
 # usage: [BEFORE=BUILD_DIR] [RANKS="1 2 4"] [METHOD=fpm] [ONLY=NAMES] [RESUME=1] benchmarks/bench-rank-memory.sh [BUILD_DIR]
@@ -40,9 +42,12 @@ measure() { # LABEL BIN N NAME SCENE [--set KEY=VALUE]...
     "$b" run "$scene" --set time.max_steps=20 "$@" --out "$d/out" --quiet \
     >"$d/log" 2>&1 || echo "$label $name on $n: failed (see $d/log)"
   for ((r = 0; r < n; r++)); do
-    printf '%-8s %-18s %s ranks, rank %d: %8s KiB %6s s\n' "$label" "$name" \
-      "$n" "$r" "$(awk '/Maximum resident/ {print $NF}' "$d/time.$r")" \
-      "$(awk '/User time/ {print $NF}' "$d/time.$r")"
+    printf '%-8s %-18s %s ranks, rank %d: %8s KiB %6s s %8s KiB\n' "$label" \
+      "$name" "$n" "$r" "$(awk '/Maximum resident/ {print $NF}' "$d/time.$r")" \
+      "$(awk '/User time/ {print $NF}' "$d/time.$r")" \
+      "$(awk -v r="$r" '/"peak_rss_per_rank"/ {on = 1; k = 0; next}
+        on && /\]/ {on = 0} on {if (k++ == r) printf "%d", $1 / 1024}' \
+        "$d/out/summary.json" 2>/dev/null)"
   done
 }
 builds=("after:$bin")
@@ -55,7 +60,7 @@ if [ "${METHOD:-mpm}" = fpm ]; then
       l=${lb%%:*} b=${lb#*:}
       for h in 6.42e-3 4.15e-3; do
         measure "$l" "$b" "$n" "f3-$h" "$f3" --set discretization.mesh_size=$h
-        [ "$l" = after ] && measure pieces "$b" "$n" "f3-$h" "$f3" \
+        measure "$l-pieces" "$b" "$n" "f3-$h" "$f3" \
           --set discretization.mesh_size=$h --set output.ranks=pieces
         measure "$l-setup" "$b" "$n" "f3-$h" "$f3" \
           --set discretization.mesh_size=$h --set time.max_steps=1

@@ -43,6 +43,22 @@ void gm_dual_destroy(gm_dual *d) {
   free(d);
 }
 
+void gm_dual_drop(gm_dual *d, bool interfaces, bool facets) {
+  void **const at[] = {(void **)&d->nbr_iface,      (void **)&d->if_pair,
+                       (void **)&d->if_area_vec,    (void **)&d->if_moment,
+                       (void **)&d->if_centroid,    (void **)&d->if_area,
+                       (void **)&d->facet_point,    (void **)&d->facet_surface,
+                       (void **)&d->facet_area_vec, (void **)&d->facet_moment,
+                       (void **)&d->facet_centroid, (void **)&d->facet_area};
+  for (size_t k = 0; k < sizeof at / sizeof *at; k++)
+    if (k < 6 ? interfaces : facets) { /* the interfaces' six first */
+      free(*at[k]);
+      *at[k] = NULL;
+    }
+  if (interfaces) d->n_ifaces = 0;
+  if (facets) d->n_facets = 0;
+}
+
 static void cross(const double u[3], const double v[3], double w[3]) {
   w[0] = u[1] * v[2] - u[2] * v[1];
   w[1] = u[2] * v[0] - u[0] * v[2];

@@ -5,6 +5,8 @@
 #ifndef GM_DUAL_H
 #define GM_DUAL_H
 
+#include <stdbool.h>
+
 #include "gm_mesh.h"
 #include "pm_error.h"
 
@@ -74,5 +76,11 @@ pm_err gm_dual_alloc_facets(gm_dual *d, long nf);
 
 /* Frees the dual and all its arrays; NULL is a no-op. */
 void gm_dual_destroy(gm_dual *d);
+
+/* Let d's interfaces go (nbr_iface and the if_ arrays NULL, n_ifaces 0)
+ * and, or, its boundary facets (the facet_ arrays NULL, n_facets 0); its
+ * points and rows stay.  For a part of the cells whose model no longer
+ * reads them. */
+void gm_dual_drop(gm_dual *d, bool interfaces, bool facets);
 
 #endif

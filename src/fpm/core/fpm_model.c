@@ -316,23 +316,27 @@ static pm_err build_quadratic(fpm_model *m) {
   PM_TRY(PM_ALLOC(nbrq, nq, "quadratic fit supports"));
   PM_TRY(PM_ALLOC(m->qs_nbr, nq, "quadratic fit supports"));
   PM_TRY(PM_ALLOC(m->qs_own, nq, "quadratic fit owners"));
-  PM_TRY(PM_ALLOC(m->q, FPM_QFIT * nq, "quadratic fit weights"));
   PM_TRY(PM_ALLOC(m->qsum, FPM_QFIT * n, "quadratic fit sums"));
   /* A narrow point keeps its first fit; a wide one is fitted again over
-   * its two rings. */
-  for (long i = 0; i < n; i++) {
-    long b = m->qs_ptr[i];
+   * its two rings (each fit zeroes its entries first).  The first fits
+   * become the fits' weights in place, each narrow point's moved to its
+   * entries, the last point first (no row moves down: a fit's entries
+   * are at least its support's), so that the two arrays are never held
+   * together. */
+  PM_TRY(pm_realloc((void **)&q1, (size_t)FPM_QFIT * nq, sizeof(double),
+                    "quadratic fit weights"));
+  m->q = q1;
+  q1 = NULL;
+  for (long i = n - 1; i >= 0; i--) {
+    const long b = m->qs_ptr[i], e0 = m->nbr_ptr[i];
     if (wide[i]) {
       long c = two_rings(m, i, ring, cap);
       for (long a = 0; a < c; a++) nbrq[b + a] = ring[a];
       continue;
     }
-    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
-      long f = b + e - m->nbr_ptr[i];
-      nbrq[f] = nbr[e];
-      for (int a = 0; a < FPM_QFIT; a++)
-        m->q[FPM_QFIT * f + a] = q1[FPM_QFIT * e + a];
-    }
+    for (long e = e0; e < m->nbr_ptr[i + 1]; e++) nbrq[b + e - e0] = nbr[e];
+    memmove(m->q + FPM_QFIT * b, m->q + FPM_QFIT * e0,
+            sizeof(double) * FPM_QFIT * (size_t)(m->nbr_ptr[i + 1] - e0));
   }
   fpm_gfd_quadratic(m->dim, n, m->x, m->qs_ptr, nbrq, wide, m->q, cond);
   m->n_qlinear = 0;
@@ -378,15 +382,11 @@ int fpm_domain_body(const pm_scene *s) {
   return s->n_bodies == 1 && s->bodies[0].shape == PM_BODY_MESH ? 0 : -1;
 }
 
-pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
-                        const gm_mesh *mesh, const gm_dual *d,
-                        fpm_model **out) {
-  return fpm_model_create_part(s, o, mesh, d, NULL, out);
-}
-
-pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
-                             const gm_mesh *mesh, const gm_dual *d,
-                             const long *gid, fpm_model **out) {
+/* The model on cells d (of a part: gid, its interfaces let go after the
+ * records where part is d; of the whole: both NULL). */
+static pm_err model_create(const pm_scene *s, const fpm_options *o,
+                           const gm_mesh *mesh, const gm_dual *d,
+                           const long *gid, gm_dual *part, fpm_model **out) {
   pm_err ret = PM_SUCCESS;
   fpm_model *m = NULL;
   *out = NULL;
@@ -438,6 +438,9 @@ pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
   build_interfaces(m);
   if (m->jump == FPM_JUMP_QUADRATIC && m->boundary_penalty > 0)
     PM_TRY(boundary_penalty(m));
+  /* Nothing reads a part's interfaces past the records: they go before
+   * the fits, the largest arrays, are built. */
+  if (part) gm_dual_drop(part, true, false);
   if (m->jump == FPM_JUMP_QUADRATIC) PM_TRY(build_quadratic(m));
   /* A part's share streams its own entries (fpm_model_subset); the part
    * is never stepped. */
@@ -450,6 +453,18 @@ pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
 done:
   fpm_model_destroy(m);
   return ret;
+}
+
+pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
+                        const gm_mesh *mesh, const gm_dual *d,
+                        fpm_model **out) {
+  return model_create(s, o, mesh, d, NULL, NULL, out);
+}
+
+pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
+                             const gm_mesh *mesh, gm_dual *d, const long *gid,
+                             fpm_model **out) {
+  return model_create(s, o, mesh, d, gid, d, out);
 }
 
 pm_err fpm_state_create(const fpm_model *m, fpm_state **out) {

@@ -218,10 +218,12 @@ pm_err fpm_model_create(const pm_scene *s, const fpm_options *o,
  * point whose rows, and whose neighbours' rows, are held is the whole
  * model's, bit for bit.  Conditions may select none of its facets.  It
  * has no entry stream (it is never stepped: its shares are, with theirs).
- * gid is copied (m->gid). */
+ * gid is copied (m->gid).  d's interfaces are let go once the interface
+ * records are built (NULL, n_ifaces 0; d keeps its points, rows and
+ * facets). */
 pm_err fpm_model_create_part(const pm_scene *s, const fpm_options *o,
-                             const gm_mesh *mesh, const gm_dual *d,
-                             const long *gid, fpm_model **out);
+                             const gm_mesh *mesh, gm_dual *d, const long *gid,
+                             fpm_model **out);
 
 /* The points a model holds of a whole model's (a rank's share): its own
  * points [0, n_own), then the ghosts whose flux [n_own, n_flux), stress
@@ -241,6 +243,15 @@ typedef struct {
  * its arrays (fpm_model_destroy); m is left as it is.  PM_ERR_MEMORY. */
 pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
                         fpm_model **out);
+/* The same subset, m taken: the records of each support and fit entry (GFD
+ * and averaging weights, interface records, fits' weights) are moved in
+ * place into the subset's order and handed to it, and m's other arrays of
+ * points and entries are let go once copied, so that m and its subset are
+ * never held whole together (a part's model, fpm_region.h).  m keeps its
+ * boundary and gid, and is destroyed by the caller whatever the
+ * outcome. */
+pm_err fpm_model_subset_take(fpm_model *m, const fpm_points *pts,
+                             fpm_model **out);
 
 /* The body FPM meshes as its domain: the scene's only body when it is a
  * gmsh volume (bodies: [{mesh: FILE}]), whose physical surfaces then name

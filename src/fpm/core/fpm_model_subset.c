@@ -8,6 +8,19 @@
 #include "fpm_gfd.h"
 #include "fpm_model.h"
 
+/* Where the subset takes the model it is made of (t: that model, else
+ * NULL), each of the model's smaller arrays is let go once its last
+ * reader has copied it (the largest move into the subset's in place:
+ * subset_entries), so that the model and its subset are never held whole
+ * together. */
+#define LET_GO(t, field)                                                       \
+  do {                                                                         \
+    if (t) {                                                                   \
+      free((t)->field);                                                        \
+      (t)->field = NULL;                                                       \
+    }                                                                          \
+  } while (0)
+
 /* The rows (CSR) of the share's first n_rows points (those whose stress
  * it computes), entries in their order, neighbours as indices in the share
  * (the levels hold every one). */
@@ -34,9 +47,87 @@ static void copy_items(double *to, const double *from, const long *idx,
     memcpy(to + width * k, from + width * idx[k], sizeof(double) * width);
 }
 
+/* Rearrange the n_from records of `width` doubles of *a in place so that
+ * the one at f is the one that was at src[f] (a permutation: the subset's
+ * records first, n_to of them, then those not kept), by its cycles, each
+ * record copied once, then shrink *a to the n_to records (and one zero
+ * double, as PM_ALLOC's). */
+static pm_err move_records(double **a, long n_from, const long *src, long n_to,
+                           int width) {
+  pm_err ret = PM_SUCCESS;
+  unsigned char *done = NULL;
+  double *held = NULL, *r = *a;
+  PM_TRY(PM_ALLOC(done, n_from + 1, "records moved"));
+  PM_TRY(PM_ALLOC(held, width, "records moved"));
+  for (long f = 0; f < n_from; f++) {
+    if (done[f] || src[f] == f) continue;
+    for (int c = 0; c < width; c++) held[c] = r[width * f + c];
+    long at = f;
+    for (; src[at] != f; at = src[at]) {
+      for (int c = 0; c < width; c++)
+        r[width * at + c] = r[width * src[at] + c];
+      done[at] = 1;
+    }
+    for (int c = 0; c < width; c++) r[width * at + c] = held[c];
+    done[at] = 1;
+  }
+  if (pm_realloc((void **)a, (size_t)width * n_to + 1, sizeof(double),
+                 "records moved") == PM_SUCCESS)
+    (*a)[(size_t)width * n_to] = 0;
+done:
+  free(done);
+  free(held);
+  return ret;
+}
+
+/* The subset's records of `width` doubles per entry of the rows of its
+ * first n_stress points (s_ptr, over its points) from the model's (m_ptr,
+ * over the model's points; m_a, n_from records) into *to: copied, or where
+ * the model is taken (take: the model's array) moved in place and taken
+ * from it (*take NULL), so that the two arrays are never held together. */
+static pm_err subset_entries(double **to, const double *m_a, double **take,
+                             const long *m_ptr, long n_from, const long *s_ptr,
+                             const fpm_model *s, int width, const char *what) {
+  const long ns = s->n_stress, n_to = s_ptr[ns];
+  if (!take) {
+    PM_CALL(
+        pm_calloc((void **)to, (size_t)width * n_to + 1, sizeof(double), what));
+    for (long li = 0; li < ns; li++) {
+      const long e0 = m_ptr[s->gid[li]], f0 = s_ptr[li];
+      memcpy(*to + width * f0, m_a + width * e0,
+             sizeof(double) * width * (size_t)(s_ptr[li + 1] - f0));
+    }
+    return PM_SUCCESS;
+  }
+  pm_err ret = PM_SUCCESS;
+  long *src = NULL;
+  unsigned char *kept = NULL;
+  PM_TRY(PM_ALLOC(src, n_from + 1, what));
+  PM_TRY(PM_ALLOC(kept, n_from + 1, what));
+  for (long li = 0; li < ns; li++) {
+    const long e0 = m_ptr[s->gid[li]], f0 = s_ptr[li];
+    for (long f = f0; f < s_ptr[li + 1]; f++) {
+      src[f] = e0 + f - f0;
+      kept[e0 + f - f0] = 1;
+    }
+  }
+  for (long e = 0, past = n_to; e < n_from; e++)
+    if (!kept[e]) src[past++] = e;
+  free(kept);
+  kept = NULL;
+  PM_TRY(move_records(take, n_from, src, n_to, width));
+  *to = *take;
+  *take = NULL;
+done:
+  free(src);
+  free(kept);
+  return ret;
+}
+
 /* The points' own arrays: positions, volumes, rows of the support, GFD
  * weights, interface records, sums, materials, masses and the mask. */
-static pm_err subset_points(const fpm_model *m, fpm_model *s, const int *lof) {
+static pm_err subset_points(const fpm_model *m, fpm_model *s, const int *lof,
+                            fpm_model *t) {
   const long n = s->n, ns = s->n_stress;
   gm_dual *d = s->own_dual;
   PM_CALL(PM_ALLOC(d->x, 3 * n, "share's positions"));
@@ -50,15 +141,15 @@ static pm_err subset_points(const fpm_model *m, fpm_model *s, const int *lof) {
   s->nbr_ptr = d->nbr_ptr;
   s->nnz = d->nbr_ptr[n];
   const long nnz = s->nnz;
-  PM_CALL(PM_ALLOC(s->g, 3 * nnz + 1, "share's GFD weights"));
-  PM_CALL(PM_ALLOC(s->erec, FPM_EREC * nnz + 1, "share's interfaces"));
+  PM_CALL(subset_entries(&s->g, m->g, t ? &t->g : NULL, m->nbr_ptr, m->nnz,
+                         s->nbr_ptr, s, 3, "share's GFD weights"));
+  PM_CALL(subset_entries(&s->erec, m->erec, t ? &t->erec : NULL, m->nbr_ptr,
+                         m->nnz, s->nbr_ptr, s, FPM_EREC,
+                         "share's interfaces"));
   PM_CALL(PM_ALLOC(s->mirror, nnz + 1, "share's mirror entries"));
   for (long li = 0; li < ns; li++) {
     const long gi = s->gid[li], e0 = m->nbr_ptr[gi], f0 = s->nbr_ptr[li];
     const long cnt = m->nbr_ptr[gi + 1] - e0;
-    memcpy(s->g + 3 * f0, m->g + 3 * e0, sizeof(double) * 3 * cnt);
-    memcpy(s->erec + FPM_EREC * f0, m->erec + FPM_EREC * e0,
-           sizeof(double) * FPM_EREC * cnt);
     /* Entry (k, i) of entry (i, k), where k's row is held. */
     for (long f = f0; f < f0 + cnt; f++) {
       const long lk = s->nbr[f];
@@ -69,6 +160,8 @@ static pm_err subset_points(const fpm_model *m, fpm_model *s, const int *lof) {
               : -1;
     }
   }
+  LET_GO(t, mirror);
+  LET_GO(t, nbr);
   PM_CALL(PM_ALLOC(s->gsum, 3 * n, "share's GFD sums"));
   PM_CALL(PM_ALLOC(s->cond, n, "share's conditions"));
   PM_CALL(PM_ALLOC(s->p_area, 3 * n, "share's area sums"));
@@ -91,44 +184,52 @@ static pm_err subset_points(const fpm_model *m, fpm_model *s, const int *lof) {
                      "share's material state"));
     copy_items(s->mstate, m->mstate, s->gid, n, m->mstate_stride);
   }
+  LET_GO(t, gsum);
+  LET_GO(t, cond);
+  LET_GO(t, p_area);
+  LET_GO(t, p_mrel);
+  LET_GO(t, mass);
+  LET_GO(t, mat);
+  LET_GO(t, fixed);
+  LET_GO(t, mstate);
   return PM_SUCCESS;
 }
 
 /* The averaging weights of fpm.volumetric: averaged, the whole model's
  * (they read the supports' volumes of two rings): a_ik of the rows the
  * share holds, a_ii of its points. */
-static pm_err subset_averages(const fpm_model *m, fpm_model *s) {
-  PM_CALL(PM_ALLOC(s->vavg, s->nnz + 1, "share's averaging weights"));
+static pm_err subset_averages(const fpm_model *m, fpm_model *s, fpm_model *t) {
+  PM_CALL(subset_entries(&s->vavg, m->vavg, t ? &t->vavg : NULL, m->nbr_ptr,
+                         m->nnz, s->nbr_ptr, s, 1,
+                         "share's averaging weights"));
   PM_CALL(PM_ALLOC(s->vself, s->n, "share's averaging weights"));
-  for (long li = 0; li < s->n_stress; li++) {
-    const long e0 = m->nbr_ptr[s->gid[li]], f0 = s->nbr_ptr[li];
-    memcpy(s->vavg + f0, m->vavg + e0,
-           sizeof(double) * (size_t)(s->nbr_ptr[li + 1] - f0));
-  }
   copy_items(s->vself, m->vself, s->gid, s->n, 1);
+  LET_GO(t, vself);
   return PM_SUCCESS;
 }
 
 /* The quadratic fits of the points whose stress the share computes, and
  * for its own points the fits that hold them, in one process's order
  * (the order of their entries). */
-static pm_err subset_fits(const fpm_model *m, fpm_model *s, const int *lof) {
+static pm_err subset_fits(const fpm_model *m, fpm_model *s, const int *lof,
+                          fpm_model *t) {
   const long n = s->n, ns = s->n_stress, no = s->n_own;
   PM_CALL(PM_ALLOC(s->qs_ptr, n + 1, "share's fits"));
   PM_CALL(
       copy_rows(m->qs_ptr, m->qs_nbr, ns, s->gid, lof, s->qs_ptr, &s->qs_nbr));
+  LET_GO(t, qs_nbr);
   for (long li = ns; li < n; li++) s->qs_ptr[li + 1] = s->qs_ptr[ns];
   const long nq = s->qs_ptr[n];
-  PM_CALL(PM_ALLOC(s->qs_own, nq + 1, "share's fit owners"));
-  PM_CALL(PM_ALLOC(s->q, FPM_QFIT * nq + 1, "share's fit weights"));
+  PM_CALL(subset_entries(&s->q, m->q, t ? &t->q : NULL, m->qs_ptr,
+                         m->qs_ptr[m->n], s->qs_ptr, s, FPM_QFIT,
+                         "share's fit weights"));
   PM_CALL(PM_ALLOC(s->qsum, FPM_QFIT * n, "share's fit sums"));
   copy_items(s->qsum, m->qsum, s->gid, n, FPM_QFIT);
-  for (long li = 0; li < ns; li++) {
-    const long e0 = m->qs_ptr[s->gid[li]], f0 = s->qs_ptr[li];
-    memcpy(s->q + FPM_QFIT * f0, m->q + FPM_QFIT * e0,
-           sizeof(double) * FPM_QFIT * (s->qs_ptr[li + 1] - f0));
-    for (long f = f0; f < s->qs_ptr[li + 1]; f++) s->qs_own[f] = (int)li;
-  }
+  LET_GO(t, qsum);
+  PM_CALL(PM_ALLOC(s->qs_own, nq + 1, "share's fit owners"));
+  for (long li = 0; li < ns; li++)
+    for (long f = s->qs_ptr[li]; f < s->qs_ptr[li + 1]; f++)
+      s->qs_own[f] = (int)li;
   PM_CALL(PM_ALLOC(s->qt_ptr, n + 1, "share's fit transpose"));
   long nt = 0;
   for (long li = 0; li < no; li++) {
@@ -149,6 +250,10 @@ static pm_err subset_fits(const fpm_model *m, fpm_model *s, const int *lof) {
   s->qt_ptr[n] = nt;
   s->n_qwide = m->n_qwide;
   s->n_qlinear = m->n_qlinear;
+  LET_GO(t, qt_entry);
+  LET_GO(t, qt_ptr);
+  LET_GO(t, qs_own);
+  LET_GO(t, qs_ptr);
   return PM_SUCCESS;
 }
 
@@ -236,8 +341,10 @@ done:
   return ret;
 }
 
-pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
-                        fpm_model **out) {
+/* The subset of m's points pts; t: m where the subset takes it, else
+ * NULL. */
+static pm_err subset(const fpm_model *m, const fpm_points *pts, fpm_model *t,
+                     fpm_model **out) {
   pm_err ret = PM_SUCCESS;
   fpm_model *s = NULL;
   int *lof = NULL; /* each point's index in the subset, or -1 */
@@ -269,9 +376,9 @@ pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
   s->jump = m->jump;
   s->n_mats = m->n_mats;
   memcpy(s->mats, m->mats, sizeof s->mats);
-  PM_TRY(subset_points(m, s, lof));
-  if (m->vavg) PM_TRY(subset_averages(m, s));
-  if (m->qs_ptr) PM_TRY(subset_fits(m, s, lof));
+  PM_TRY(subset_points(m, s, lof, t));
+  if (m->vavg) PM_TRY(subset_averages(m, s, t));
+  if (m->qs_ptr) PM_TRY(subset_fits(m, s, lof, t));
   PM_TRY(subset_boundary(m, s, lof));
   PM_TRY(fpm_stream_build(s));
   /* The points and traction facets of a part (m->gid) by their indices on
@@ -287,4 +394,14 @@ done:
   fpm_model_destroy(s);
   free(lof);
   return ret;
+}
+
+pm_err fpm_model_subset(const fpm_model *m, const fpm_points *pts,
+                        fpm_model **out) {
+  return subset(m, pts, NULL, out);
+}
+
+pm_err fpm_model_subset_take(fpm_model *m, const fpm_points *pts,
+                             fpm_model **out) {
+  return subset(m, pts, m, out);
 }

@@ -5,6 +5,9 @@
 
 #include <mpi.h>
 #include <stdbool.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 
@@ -278,6 +281,12 @@ static pm_err root_part(const fpm_cutter *c, gm_mesh **mesh, gm_dual **cells,
   *mesh = names;
   gm_dual_destroy(*cells);
   *cells = NULL;
+#ifdef __GLIBC__
+  /* The whole cells leave holes in the heap that the part's model, built
+   * next, fills only in part: their pages go back now (F3 at 13762 points
+   * on 2 ranks: rank 0's peak 1.7 MiB lower). */
+  malloc_trim(0);
+#endif
   return PM_SUCCESS;
 }
 

@@ -331,24 +331,6 @@ static pm_err own_facets_give(own_facets *f, fpm_model *s) {
   return PM_SUCCESS;
 }
 
-/* What the share reads of the part's cells d once the part's model is
- * built: the points' positions, volumes and rows.  Their interfaces and
- * facets (as much again as the rest at 14 neighbours a point) are let go
- * first, so that they are not held with the share. */
-static void drop_faces(gm_dual *d) {
-  void **arrays[] = {(void **)&d->nbr_iface,      (void **)&d->if_pair,
-                     (void **)&d->if_area_vec,    (void **)&d->if_moment,
-                     (void **)&d->if_centroid,    (void **)&d->if_area,
-                     (void **)&d->facet_point,    (void **)&d->facet_surface,
-                     (void **)&d->facet_area_vec, (void **)&d->facet_moment,
-                     (void **)&d->facet_centroid, (void **)&d->facet_area};
-  for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) {
-    free(*arrays[k]);
-    *arrays[k] = NULL;
-  }
-  d->n_ifaces = d->n_facets = 0;
-}
-
 pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
                       const gm_mesh *mesh, fpm_part *p, int r,
                       fpm_model **out) {
@@ -360,8 +342,13 @@ pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
   if (pm->contact) PM_TRY(fpm_contact_refuse_ranks(s));
   PM_TRY(traction_ids(p, pm));
   PM_TRY(own_facets_make(pm, p->owner, r, &f));
-  drop_faces(p->cells);
-  PM_TRY(fpm_share_create(pm, p->owner, r, out));
+  /* What the share reads of the part's cells once the part's model is
+   * built: the points' positions, volumes and rows.  Their facets go
+   * first, so that they are not held with the share (the interfaces, as
+   * much again as the rest at 14 neighbours a point, went as the model
+   * built its interface records: fpm_model_create_part). */
+  gm_dual_drop(p->cells, false, true);
+  PM_TRY(fpm_share_take(pm, p->owner, r, out));
   PM_TRY(own_facets_give(&f, *out));
 done:
   free(f.ptr);

@@ -71,7 +71,8 @@ void fpm_part_free(fpm_part *p);
  * share cut from the whole), on which fpm_reaction gives its own points'
  * part of each reaction.  The part's cells lose their interfaces and
  * facets once the part's model is built (its points, gid, owner and index
- * stay).  *out owns its arrays. */
+ * stay), and the share takes the part's model (fpm_share_take), so that
+ * the two are not held whole together.  *out owns its arrays. */
 pm_err fpm_part_share(const pm_scene *s, const fpm_options *o,
                       const gm_mesh *mesh, fpm_part *p, int r, fpm_model **out);
 

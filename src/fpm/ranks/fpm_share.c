@@ -75,8 +75,9 @@ static void share_levels(const fpm_model *m, const int *owner, int r,
   mark_support(m, level, STRESS, DISPLACEMENT);
 }
 
-pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
-                        fpm_model **out) {
+/* Rank r's share of m (t: m where the share takes it, else NULL). */
+static pm_err share_make(const fpm_model *m, const int *owner, int r,
+                         fpm_model *t, fpm_model **out) {
   pm_err ret = PM_SUCCESS;
   signed char *level = NULL;
   long *gid = NULL;
@@ -95,11 +96,23 @@ pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
     for (long i = 0; i < m->n; i++)
       if (level[i] == lv) gid[at++] = i;
   pts.gid = gid;
-  PM_TRY(fpm_model_subset(m, &pts, out));
+  free(level);
+  level = NULL;
+  PM_TRY(t ? fpm_model_subset_take(t, &pts, out)
+           : fpm_model_subset(m, &pts, out));
 done:
   free(level);
   free(gid);
   return ret;
+}
+
+pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
+                        fpm_model **out) {
+  return share_make(m, owner, r, NULL, out);
+}
+
+pm_err fpm_share_take(fpm_model *m, const int *owner, int r, fpm_model **out) {
+  return share_make(m, owner, r, m, out);
 }
 
 void fpm_share_count(const fpm_model *s, fpm_share_counts *c) {

@@ -50,6 +50,10 @@ pm_err fpm_partition(const gm_dual *d, int parts, int *owner);
  * it is. */
 pm_err fpm_share_create(const fpm_model *m, const int *owner, int r,
                         fpm_model **out);
+/* The same share, m taken (fpm_model_subset_take: its records moved into
+ * the share in place, its other arrays let go as the share copies them;
+ * the caller destroys m whatever the outcome). */
+pm_err fpm_share_take(fpm_model *m, const int *owner, int r, fpm_model **out);
 
 /* What a share holds, for the plan and the summary. */
 typedef struct {
