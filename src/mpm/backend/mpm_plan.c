@@ -169,7 +169,7 @@ static pm_err plan_decomposition(const mpm_sim *r, FILE *out) {
   if (pm_par_plan_ranks() <= 1) return PM_SUCCESS;
   mpm_decomp d;
   PM_CALL(mpm_decomp_create(r->scene, r->model, pm_par_plan_ranks(), &d));
-  mpm_decomp_print(&d, r->model, out);
+  mpm_decomp_print(&d, r->scene, out);
   mpm_decomp_predict(&d, r->model, out);
   mpm_decomp_destroy(&d);
   return PM_SUCCESS;

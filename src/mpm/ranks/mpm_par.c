@@ -286,16 +286,17 @@ static int record_doubles(const mpm_model *m, int *width) {
   return REC_BASE + most;
 }
 
-/* What cutting the boxes anew needs (mpm_par_balance): explicit steps
- * without membranes (their links number particles in one process's
- * order) nor dynamic relaxation (its nodal arrays span the steps). */
+double mpm_par_balance_of(const pm_scene *s) {
+  if (strcmp(s->method, "mpm") != 0 || s->time.qs != PM_QS_NONE) return 0;
+  for (int b = 0; b < s->n_bodies; b++)
+    if (s->bodies[b].shape == PM_BODY_MEMBRANE) return 0;
+  return mpm_scene_settings(s)->rebalance;
+}
+
 static void set_balance(struct mpm_par *P, const pm_scene *s, bool gather) {
   P->scene = s;
   P->gather = gather;
-  P->balance = mpm_scene_settings(s)->rebalance;
-  if (strcmp(s->method, "mpm") != 0 || s->time.qs != PM_QS_NONE) P->balance = 0;
-  for (int b = 0; b < s->n_bodies; b++)
-    if (s->bodies[b].shape == PM_BODY_MEMBRANE) P->balance = 0;
+  P->balance = mpm_par_balance_of(s);
 }
 
 pm_err mpm_par_create(const pm_scene *s, const mpm_model *m,

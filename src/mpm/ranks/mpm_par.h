@@ -196,6 +196,11 @@ void mpm_x0_set_free(mpm_x0_set *set);
  * anew in place (m, s and w keep their addresses; collective).  Explicit
  * steps without membranes or dynamic relaxation only. */
 pm_err mpm_par_balance(mpm_model *m, mpm_state *s, mpm_work *w);
+/* The imbalance past which a run of scene s cuts its boxes anew, or 0:
+ * mpm.rebalance for explicit steps without membranes (their links number
+ * particles in one process's order) nor dynamic relaxation (its nodal
+ * arrays span the steps). */
+double mpm_par_balance_of(const pm_scene *s);
 
 /* The values of full state st (of full model m) of local model lm's
  * particles and nodes into local state ls, whose arrays have room for
@@ -246,7 +251,7 @@ void mpm_par_extreme(const mpm_model *m, double *v, long gid, double at[3],
 void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out);
 
 /* Print decomposition d of model m: its boxes, cuts and balance. */
-void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out);
+void mpm_decomp_print(const mpm_decomp *d, const pm_scene *s, FILE *out);
 /* Print what each rank of decomposition d would hold and send, from the
  * decomposition alone (pointmech plan --ranks N on one process): its
  * particles, owned and ghost nodes, and the bytes of node sums it sends

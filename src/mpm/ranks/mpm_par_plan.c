@@ -20,7 +20,7 @@ static int dof_of(int mode, bool imp) {
          (mode & MPM_P2G_FORCE ? 3 + (imp ? 2 : 0) : 0);
 }
 
-void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out) {
+void mpm_decomp_print(const mpm_decomp *d, const pm_scene *s, FILE *out) {
   fprintf(out,
           "ranks        %d: boxes of the grid's cells by recursive bisection "
           "(cuts along x %d, y %d, z %d), %d ghost node layer%s\n",
@@ -37,7 +37,23 @@ void mpm_decomp_print(const mpm_decomp *d, const mpm_model *m, FILE *out) {
           "             particles per rank %ld to %ld (imbalance %.3f: the "
           "most over the mean)\n",
           least, most, total > 0 ? most * (double)d->size / total : 0.0);
-  (void)m;
+  const double balance = mpm_par_balance_of(s);
+  if (balance > 0)
+    fprintf(out,
+            "             cut anew as the particles travel, when the busiest "
+            "rank holds more than %g times the mean (mpm.rebalance; 0 keeps "
+            "these boxes)\n",
+            balance);
+  else
+    fprintf(out, "             these boxes kept for the whole run (%s)\n",
+            strcmp(s->method, "mpm") != 0
+                ? "the implicit MPM's particles keep their ranks"
+            : s->time.qs != PM_QS_NONE
+                ? "dynamic relaxation's nodal arrays span the steps"
+            : mpm_scene_settings(s)->rebalance > 0
+                ? "a membrane's links number its particles in one process's "
+                  "order"
+                : "mpm.rebalance: 0");
 }
 
 /* Values per node the step's transfers exchange (mass, momentum, forces,
@@ -128,7 +144,7 @@ void mpm_par_plan(const mpm_model *m, const mpm_work *w, FILE *out) {
     free(all);
     return;
   }
-  mpm_decomp_print(&P->d, m, out);
+  mpm_decomp_print(&P->d, P->scene, out);
   const bool linked = P->gh != NULL;
   fprintf(out,
           "             rank  particles  nodes (owned + ghost)  memory%s\n",
