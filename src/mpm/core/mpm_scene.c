@@ -156,12 +156,12 @@ static const pm_key mpm_keys[] = {
      .def = "1.1",
      .range = PM_RANGE_GE,
      .unit = "",
-     .doc = "across ranks (explicit steps without membranes or dynamic "
-            "relaxation): when the busiest rank holds more than this many "
-            "times the mean of the particles (looked at every 20 steps), "
-            "the boxes are cut anew where the particles are and each goes "
-            "to its new rank (a checkpoint keeps the cut); 0: the cut of "
-            "the start is kept"},
+     .doc = "across ranks (explicit steps without dynamic relaxation): "
+            "when the busiest rank holds more than this many times the "
+            "mean of the particles (looked at every 20 steps), the boxes "
+            "are cut anew where the particles are and each goes to its new "
+            "rank (a checkpoint keeps the cut); 0: the cut of the start is "
+            "kept"},
     {.name = "fluid",
      .type = PM_KEY_MAPPING,
      .keys = fluid_keys,

@@ -288,8 +288,6 @@ static int record_doubles(const mpm_model *m, int *width) {
 
 double mpm_par_balance_of(const pm_scene *s) {
   if (strcmp(s->method, "mpm") != 0 || s->time.qs != PM_QS_NONE) return 0;
-  for (int b = 0; b < s->n_bodies; b++)
-    if (s->bodies[b].shape == PM_BODY_MEMBRANE) return 0;
   return mpm_scene_settings(s)->rebalance;
 }
 

@@ -194,11 +194,11 @@ void mpm_x0_set_free(mpm_x0_set *set);
  * boxes cut anew from the particles where they are, each particle sent to
  * its new rank with every array it carries, and this rank's share made
  * anew in place (m, s and w keep their addresses; collective).  Explicit
- * steps without membranes or dynamic relaxation only. */
+ * steps without dynamic relaxation only; a membrane's points are linked
+ * anew where they are. */
 pm_err mpm_par_balance(mpm_model *m, mpm_state *s, mpm_work *w);
 /* The imbalance past which a run of scene s cuts its boxes anew, or 0:
- * mpm.rebalance for explicit steps without membranes (their links number
- * particles in one process's order) nor dynamic relaxation (its nodal
+ * mpm.rebalance for explicit steps without dynamic relaxation (its nodal
  * arrays span the steps). */
 double mpm_par_balance_of(const pm_scene *s);
 

@@ -235,6 +235,12 @@ pm_err mpm_par_balance(mpm_model *m, mpm_state *s, mpm_work *w) {
   PM_TRY(pm_par_agree(mpm_work_create(lm, &lw)));
   take(m, s, w, lm, ls, lw);
   P = par_of(m); /* (the new share's) */
+  /* A membrane's ghosts were made at the seeded positions: linked anew
+   * where its points are now. */
+  if (P->gh) {
+    ret = mpm_ghosts_update(P->gh, m, s, true, true);
+    if (!ret) ret = pm_par_agree(mpm_par_grow_scratch(m, w));
+  }
 done:
   P->counts.recut_seconds += pm_wtime() - t0;
   transfer_free(&t);

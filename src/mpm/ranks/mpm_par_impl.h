@@ -86,6 +86,9 @@ void mpm_par_pack(const mpm_model *m, const mpm_state *s, long p, int gi,
                   double *q);
 void mpm_par_unpack(const mpm_model *m, mpm_state *s, long j, int gi,
                     const double *q);
+/* Room in each group's step workspace of w for what its kind needs now
+ * (its particles, a membrane's triangles). */
+pm_err mpm_par_grow_scratch(const mpm_model *m, mpm_work *w);
 
 /* The share of local model m. */
 static inline struct mpm_par *par_of(const mpm_model *m) { return m->xc->ctx; }

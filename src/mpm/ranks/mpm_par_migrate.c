@@ -275,7 +275,7 @@ done:
 
 /* Room in each group's step workspace for what its kind needs now (its
  * particles, a membrane's triangles). */
-static pm_err grow_scratch(const mpm_model *m, mpm_work *w) {
+pm_err mpm_par_grow_scratch(const mpm_model *m, mpm_work *w) {
   for (int gi = 0; gi < m->n_groups; gi++) {
     const mpm_group *g = &m->group[gi];
     const long need = g->kind->scratch ? g->kind->scratch(m, g) : 0;
@@ -298,7 +298,7 @@ pm_err mpm_par_migrate(mpm_model *m, mpm_state *s, mpm_work *w) {
   pm_par_sum_long(&moved, 1);
   const double sent = mpm_ghosts_bytes(P->gh);
   pm_err e = mpm_ghosts_update(P->gh, m, s, moved > 0, P->reordered);
-  if (!e) e = pm_par_agree(grow_scratch(m, w));
+  if (!e) e = pm_par_agree(mpm_par_grow_scratch(m, w));
   P->counts.ghost_bytes += mpm_ghosts_bytes(P->gh) - sent;
   pm_par_count_sent(mpm_ghosts_bytes(P->gh) - sent);
   pm_timers_stop(&w->timers, w->timer_migrate);

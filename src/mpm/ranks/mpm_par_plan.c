@@ -50,9 +50,6 @@ void mpm_decomp_print(const mpm_decomp *d, const pm_scene *s, FILE *out) {
                 ? "the implicit MPM's particles keep their ranks"
             : s->time.qs != PM_QS_NONE
                 ? "dynamic relaxation's nodal arrays span the steps"
-            : mpm_scene_settings(s)->rebalance > 0
-                ? "a membrane's links number its particles in one process's "
-                  "order"
                 : "mpm.rebalance: 0");
 }
 
