@@ -452,7 +452,8 @@ pm_err mpm_par_create_cut(const pm_scene *s, bool gather, const long *cut,
   sh.keep = in_box;
   sh.ctx = &bt;
   if (pick) { /* (its particles are where a checkpoint has them) */
-    if (!ret) ret = pick->prepare(pick->ctx, &P->d, &frame->grid, P->rank);
+    if (!ret && pick->prepare)
+      ret = pick->prepare(pick->ctx, &P->d, &frame->grid, P->rank);
     sh.keep = pick->keep;
     sh.ctx = pick->ctx;
   }
@@ -516,6 +517,8 @@ static void par_free(struct mpm_par *P) {
   free(P->gbuf);
   free(P->gcount);
   free(P->gdisp);
+  mpm_model_destroy(P->frame);
+  free(P->per_cell);
   free(P);
 }
 

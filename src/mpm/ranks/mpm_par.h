@@ -154,7 +154,7 @@ pm_err mpm_par_create_seeded(const pm_scene *s, bool gather, mpm_model **local,
 
 /* A share other than the particles whose reference positions lie in the
  * rank's cells (a run resumed from a checkpoint in pieces: those where
- * the checkpoint has them): prepare learns the decomposition d of the
+ * the checkpoint has them): prepare (if any) learns the decomposition d of the
  * whole grid g and this rank, then keep says which reference positions
  * the share keeps (called as mpm_seed_share.keep). */
 typedef struct {

@@ -27,19 +27,8 @@
 #define BALANCE_GAIN 0.05
 
 /* Whether the seeding keeps x: a particle received (mpm_x0_set). */
-static pm_err received_prepare(void *ctx, const mpm_decomp *d,
-                               const mpm_grid *g, int rank) {
-  (void)ctx, (void)d, (void)g, (void)rank;
-  return PM_SUCCESS;
-}
-
 static bool received_keep(void *ctx, const double x[3]) {
   return mpm_x0_set_has(ctx, x);
-}
-
-static int by_gid(const void *a, const void *b) {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
 }
 
 /* The group of particle j of m. */
@@ -116,7 +105,8 @@ done:
    * at once while it cuts: the records sent go first) */
   free(t->sbuf);
   t->sbuf = NULL;
-  qsort(t->rbuf, (size_t)t->arriving, (size_t)rec * sizeof(double), by_gid);
+  qsort(t->rbuf, (size_t)t->arriving, (size_t)rec * sizeof(double),
+        mpm_par_by_gid);
   return PM_SUCCESS;
 }
 
@@ -127,8 +117,7 @@ static pm_err share_anew(const mpm_model *m, const mpm_state *s,
                          mpm_state **ls) {
   const struct mpm_par *P = par_of(m);
   mpm_x0_set rv = {.x0 = t->rbuf + REC_X0, .stride = P->rec, .n = t->arriving};
-  mpm_par_pick pick = {
-      .prepare = received_prepare, .keep = received_keep, .ctx = &rv};
+  mpm_par_pick pick = {.keep = received_keep, .ctx = &rv};
   pm_err ret = pm_par_agree(mpm_x0_set_index(&rv));
   if (!ret) ret = mpm_par_create_cut(P->scene, P->gather, cut, &pick, lm, ls);
   mpm_x0_set_free(&rv);
@@ -160,6 +149,10 @@ static void take(mpm_model *m, mpm_state *s, mpm_work *w, mpm_model *lm,
                  mpm_state *ls, mpm_work *lw) {
   struct mpm_par *P = par_of(m), *Q = par_of(lm);
   Q->counts = P->counts;
+  Q->frame = P->frame; /* (the cuts' grid and counts go on) */
+  Q->per_cell = P->per_cell;
+  P->frame = NULL;
+  P->per_cell = NULL;
   if (lm->n > Q->counts.most) Q->counts.most = lm->n;
   lw->timers = w->timers;
   memcpy(lw->timer, w->timer, sizeof w->timer);
@@ -200,23 +193,26 @@ pm_err mpm_par_balance(mpm_model *m, mpm_state *s, mpm_work *w) {
   /* The cut from the particles per cell where they are now. */
   const double t0 = pm_wtime();
   pm_err ret = PM_SUCCESS;
-  mpm_model *frame = NULL, *lm = NULL;
+  mpm_model *lm = NULL;
   mpm_state *ls = NULL;
   mpm_work *lw = NULL;
   mpm_decomp d = {0};
   transfer t = {0};
-  long cells[3], *per_cell = NULL, n_cells = 0, *cut = NULL;
-  ret = mpm_model_frame(P->scene, &frame);
-  if (!ret) {
-    n_cells = mpm_decomp_cells(&frame->grid, cells);
-    ret = PM_ALLOC(per_cell, n_cells, "particles per cell");
-  }
+  long cells[3], *cut = NULL;
+  /* (the whole grid and its counts made at the first look past the
+   * threshold and kept: one that finds no better cut allocates nothing) */
+  if (!P->frame) ret = mpm_model_frame(P->scene, &P->frame);
+  const long n_cells = P->frame ? mpm_decomp_cells(&P->frame->grid, cells) : 0;
+  if (!ret && !P->per_cell)
+    ret = PM_ALLOC(P->per_cell, n_cells, "particles per cell");
   PM_TRY(pm_par_agree(ret));
+  const mpm_grid *g = &P->frame->grid;
+  memset(P->per_cell, 0, sizeof(long) * (size_t)n_cells);
   for (long p = 0; p < m->n; p++)
-    mpm_decomp_count(&frame->grid, cells, s->x + 3 * p, per_cell);
-  pm_par_sum_long(per_cell, (int)n_cells);
-  PM_TRY(pm_par_agree(mpm_decomp_from_counts(P->scene, frame, size, per_cell,
-                                             (long)total, &d)));
+    mpm_decomp_count(g, cells, s->x + 3 * p, P->per_cell);
+  pm_par_sum_long(P->per_cell, (int)n_cells);
+  PM_TRY(pm_par_agree(mpm_decomp_from_counts(P->scene, P->frame, size,
+                                             P->per_cell, (long)total, &d)));
   long new_most = 0;
   for (int k = 0; k < size; k++)
     new_most = d.count[k] > new_most ? d.count[k] : new_most;
@@ -230,7 +226,7 @@ pm_err mpm_par_balance(mpm_model *m, mpm_state *s, mpm_work *w) {
   memcpy(d.count0, P->d.count0 ? P->d.count0 : P->d.count,
          sizeof(long) * (size_t)size);
   mpm_decomp_pack(&d, cut);
-  PM_TRY(send_all(m, s, &d, &frame->grid, &t));
+  PM_TRY(send_all(m, s, &d, g, &t));
   PM_TRY(share_anew(m, s, cut, &t, &lm, &ls));
   PM_TRY(pm_par_agree(mpm_work_create(lm, &lw)));
   take(m, s, w, lm, ls, lw);
@@ -244,12 +240,10 @@ pm_err mpm_par_balance(mpm_model *m, mpm_state *s, mpm_work *w) {
 done:
   P->counts.recut_seconds += pm_wtime() - t0;
   transfer_free(&t);
-  free(per_cell);
   free(cut);
   mpm_decomp_destroy(&d);
   mpm_work_destroy(lw);
   mpm_state_destroy(ls);
   mpm_model_destroy(lm);
-  mpm_model_destroy(frame);
   return ret;
 }

@@ -78,7 +78,15 @@ struct mpm_par {
   const pm_scene *scene;
   bool gather;
   double balance;
+  /* a new cut's: the whole grid and its conditions (mpm_model_frame) and
+   * the particles per cell of it, made at the first and kept */
+  mpm_model *frame;
+  long *per_cell;
 };
+
+/* Records (doubles, the first their one-process index) by that index, for
+ * qsort. */
+int mpm_par_by_gid(const void *a, const void *b);
 
 /* Particle p of group gi (of m, s) into record q (REC_* then the group's
  * arrays), and back from q into particle j of group gi. */

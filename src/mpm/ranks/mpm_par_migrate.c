@@ -61,7 +61,7 @@ static pm_err grow_buffer(double **buf, long *room, long records, int rec) {
   return PM_SUCCESS;
 }
 
-static int by_gid(const void *a, const void *b) {
+int mpm_par_by_gid(const void *a, const void *b) {
   const double x = *(const double *)a, y = *(const double *)b;
   return (x > y) - (x < y);
 }
@@ -192,7 +192,8 @@ static pm_err move_particles(mpm_model *m, mpm_state *s, mpm_work *w) {
   if (leaving == 0 && arriving == 0) goto done;
   P->reordered = true;
   /* The new order: those that stay and those that came, by index. */
-  qsort(P->rbuf, (size_t)arriving, (size_t)rec * sizeof(double), by_gid);
+  qsort(P->rbuf, (size_t)arriving, (size_t)rec * sizeof(double),
+        mpm_par_by_gid);
   const long n_new = m->n - leaving + arriving;
   ret = grow(m, s, w, n_new);
   long gcount[MPM_MAX_GROUPS] = {0};
