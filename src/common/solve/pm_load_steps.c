@@ -391,8 +391,15 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       relaxed_dl = st->dl;
       snprintf(failed, sizeof failed, "%s", rep->last.message);
       const int ptc_before = rep->ptc_steps, arc_before = rep->arc_passes;
+      /* (with the fallbacks' own linear solver, if they have one) */
+      PM_TRY(pm_newton_use_fallback_linear(s, true));
       e = fallback_step(s, x, xc, xprev, lambda, lambda_prev, target, r_ref,
                         &rw, &aw, rep, relaxed, sizeof relaxed);
+      pm_err back = pm_newton_use_fallback_linear(s, false);
+      if (back != PM_SUCCESS) {
+        ret = back;
+        goto done;
+      }
       if (e == PM_SUCCESS && rep->ptc_steps == ptc_before &&
           rep->arc_passes == arc_before)
         rep->relaxed_steps++;

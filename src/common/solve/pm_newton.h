@@ -459,6 +459,20 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
 /* Releases everything of *s and sets it to NULL; NULL is allowed. */
 void pm_newton_destroy(pm_newton **s);
 
+/* The linear solver of load stepping's fallbacks (pm_load_steps: the
+ * tangent's lowest mode, arc length, continuation, relaxation and the
+ * Newton solves among them): alt's linear solver and its settings
+ * (linear, linear_rtol, linear_ew, linear_ew_max, linear_max_iter,
+ * gmres_restart, pc_reuse_its, pc_reuse_cost, pc_right, amg_*) in place of
+ * the solver's own while a step's fallback runs, its own again after it.
+ * Multigrid where Newton passes, the LU where the tangent turns singular
+ * (a fold): each where it is the cheaper.  alt's other fields are not
+ * read; NULL: the solver's own throughout (the default).  Not with the
+ * cheap operator (MATRIX_FREE_CHEAP_PC: its matrix is no tangent to
+ * factorise) nor the augmented preconditioner: PM_ERR_ARG. */
+pm_err pm_newton_set_fallback_linear(pm_newton *s,
+                                     const pm_newton_options *alt);
+
 /* Colours of the Jacobian's pattern (the jacobian_apply calls one
  * assembly takes), and of the cheap preconditioner's (0 if none). */
 int pm_newton_colors(const pm_newton *s);

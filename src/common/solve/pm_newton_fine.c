@@ -115,7 +115,10 @@ PetscErrorCode pm_newton_fine_attach(pm_newton *s, KSP ksp) {
   KSP smoother;
   Mat A, P;
   PetscFunctionBeginUser;
-  if (!s->Fine) PetscFunctionReturn(0);
+  /* (a multigrid solver's: not the fallbacks' LU in its place) */
+  if (!s->Fine ||
+      (s->o.linear != PM_NEWTON_GMRES_GAMG && s->o.linear != PM_NEWTON_CG_GAMG))
+    PetscFunctionReturn(0);
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCMGGetLevels(pc, &levels));
   if (levels < 2) PetscFunctionReturn(0);

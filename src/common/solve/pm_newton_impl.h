@@ -58,6 +58,12 @@ pm_err pm_newton_pc_save(const pm_newton *s, pm_load_state *st);
  * callback's failure or PETSc's is returned. */
 pm_err pm_newton_pc_rebuild(pm_newton *s, const pm_load_state *st);
 
+/* The fallbacks' linear solver (pm_newton_set_fallback_linear) in place
+ * (on) or the solver's own again (off): a new linear solver, built on the
+ * next Jacobian; nothing when there is no other or it is in place
+ * already. */
+pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on);
+
 /* r = the residual at x (both of the n owned values): the problem's
  * callback, through the held values of a shared problem (collective then,
  * with the ranks' agreed answer). */

@@ -208,6 +208,63 @@ pm_err pm_newton_replace_linear(pm_newton *s) {
   return PM_SUCCESS;
 }
 
+/* The linear settings of `from` into o. */
+static void take_linear(pm_newton_options *o, const pm_newton_options *from) {
+  o->linear = from->linear;
+  o->linear_rtol = from->linear_rtol;
+  o->linear_ew = from->linear_ew;
+  o->linear_ew_max = from->linear_ew_max;
+  o->linear_max_iter = from->linear_max_iter;
+  o->gmres_restart = from->gmres_restart;
+  o->pc_reuse_its = from->pc_reuse_its;
+  o->pc_reuse_cost = from->pc_reuse_cost;
+  o->pc_right = from->pc_right;
+  o->amg_reuse = from->amg_reuse;
+  o->amg_unsquared = from->amg_unsquared;
+  o->amg_assembled_smoother = from->amg_assembled_smoother;
+  o->amg_threaded = from->amg_threaded;
+}
+
+pm_err pm_newton_set_fallback_linear(pm_newton *s,
+                                     const pm_newton_options *alt) {
+  PM_CHECK(!s->on_alt, PM_ERR_ARG,
+           "pm_newton_set_fallback_linear: inside a fallback");
+  s->has_alt = false;
+  if (!alt) return PM_SUCCESS;
+  PM_CHECK(s->o.op != PM_NEWTON_MATRIX_FREE_CHEAP_PC && !s->aug, PM_ERR_ARG,
+           "pm_newton_set_fallback_linear: the cheap operator and the "
+           "augmented preconditioner keep their own linear solver");
+  PM_CHECK(alt->linear >= PM_NEWTON_DIRECT &&
+               alt->linear <= PM_NEWTON_CG_GAMG && alt->linear_rtol > 0 &&
+               alt->linear_rtol < 1 && alt->linear_max_iter >= 1 &&
+               alt->gmres_restart >= 0 && alt->pc_reuse_its >= 0 &&
+               alt->pc_reuse_cost >= 0,
+           PM_ERR_ARG,
+           "pm_newton_set_fallback_linear: linear solver %d, linear_rtol %g, "
+           "linear_max_iter %d, gmres_restart %d, pc_reuse_its %d, "
+           "pc_reuse_cost %g out of range",
+           (int)alt->linear, alt->linear_rtol, alt->linear_max_iter,
+           alt->gmres_restart, alt->pc_reuse_its, alt->pc_reuse_cost);
+  s->own = s->o;
+  s->alt = s->o;
+  take_linear(&s->alt, alt);
+  s->has_alt = true;
+  return PM_SUCCESS;
+}
+
+pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on) {
+  if (!s->has_alt || s->on_alt == on) return PM_SUCCESS;
+  take_linear(&s->o, on ? &s->alt : &s->own);
+  s->on_alt = on;
+  /* the kept preconditioner's record starts again with the new solver */
+  s->lin_its = 0;
+  s->lin_failed = false;
+  s->pc_pending = s->pc_fresh = s->pc_stale = false;
+  s->pc_budget = 0;
+  s->pc_first_its = -1;
+  return pm_newton_replace_linear(s);
+}
+
 /* What the linear solver multiplies by (A) and builds its preconditioner
  * from (B). */
 void pm_newton_operators(const pm_newton *s, Mat *A, Mat *B) {

@@ -20,6 +20,11 @@ typedef pm_err (*apply_fn)(void *ctx, const double *x, const double *dx,
 struct pm_newton {
   pm_newton_problem p; /* the caller's, with pattern pointers cleared */
   pm_newton_options o;
+  /* pm_newton_set_fallback_linear: the linear settings of the solver's
+   * own (own) and of load stepping's fallbacks (alt), whether there are
+   * such (has_alt) and which o holds now (on_alt). */
+  pm_newton_options own, alt;
+  bool has_alt, on_alt;
   char *petsc_options;     /* copy of o.petsc_options */
   pm_pattern jpat, ppat;   /* Jacobian's and cheap operator's */
   pm_coloring jcol, pcol;  /* their colourings (pcol: cheap only) */

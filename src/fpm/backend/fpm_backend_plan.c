@@ -175,15 +175,29 @@ static double plan_head(fpm_sim *sim, FILE *out) {
             : "",
         no.pc_reuse_its > 0 ? ", kept while GMRES takes few iterations" : "",
         no.linear_ew ? ", inexact Newton" : "");
-    const bool lu = no.linear == PM_NEWTON_DIRECT;
+    /* fpm_static_run_from's: the fallbacks on the LU */
+    const bool fallback_lu = fpm_static_fallback_direct(s, nfree) &&
+                             !fpm_static_amg_on_support(s, m, no.linear);
+    if (fallback_lu)
+      fprintf(out,
+              "             a load step's fallbacks (a fold: lowest mode, "
+              "arc length, continuation, relaxation) on the LU "
+              "(%ld free dofs <= %ld)\n",
+              nfree, FPM_STATIC_FALLBACK_DIRECT_MAX);
+    const bool lu = no.linear == PM_NEWTON_DIRECT || fallback_lu;
     double entries = 0;
-    const double solver = fpm_static_solver_bytes(nfree, m->q != NULL,
-                                                  no.linear, coupled, &entries);
+    const double solver = fpm_static_solver_bytes(
+        nfree, m->q != NULL, fallback_lu ? PM_NEWTON_DIRECT : no.linear,
+        coupled, &entries);
     fprintf(out,
             "memory       %.1f MiB (operators and state) + about %.0f MiB "
             "for the tangent (~%.3g entries) and its %s\n",
             (bytes + fpm_linear_bytes(m)) / 1048576.0, solver / 1048576.0,
-            entries, lu ? "LU factors" : "multigrid hierarchy");
+            entries,
+            fallback_lu ? "LU factors (at most; multigrid's hierarchy "
+                          "until a fallback)"
+            : lu        ? "LU factors"
+                        : "multigrid hierarchy");
     return 0;
   }
   fprintf(out, "             %d. central difference%s, %ld prescribed dofs\n",

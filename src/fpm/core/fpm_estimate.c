@@ -88,6 +88,11 @@ size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
          dofs <= FPM_STATIC_COUPLED_MAX);
     solver =
         fpm_static_solver_bytes((long)dofs, quadratic, linear, coupled, NULL);
+    /* the fallbacks' LU, beside the multigrid it stands in for */
+    if (fpm_static_fallback_direct(s, (long)dofs))
+      solver =
+          fmax(solver, fpm_static_solver_bytes((long)dofs, quadratic,
+                                               PM_NEWTON_DIRECT, false, NULL));
   }
   *points = n < (double)LONG_MAX ? (long)n : LONG_MAX;
   double bytes = n * per_point + solver;

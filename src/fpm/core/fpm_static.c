@@ -75,11 +75,14 @@ bool fpm_static_amg_on_support(const pm_scene *s, const fpm_model *m,
          !m->xc && s->time.qs_amg != PM_AMG_TANGENT;
 }
 
-void fpm_static_choose_linear(const pm_scene *s, long unknowns,
-                              pm_newton_options *o) {
-  o->linear = pm_scene_has(s, "time.quasi_static.linear_solver")
-                  ? pm_newton_linear_of(s->time.qs_linear)
-                  : fpm_static_default_linear(unknowns);
+bool fpm_static_fallback_direct(const pm_scene *s, long unknowns) {
+  return !pm_scene_has(s, "time.quasi_static.linear_solver") &&
+         unknowns > FPM_STATIC_DIRECT_MAX &&
+         unknowns <= FPM_STATIC_FALLBACK_DIRECT_MAX;
+}
+
+/* The settings of the linear solver o->linear (chosen). */
+static void linear_settings(const pm_scene *s, pm_newton_options *o) {
   o->pc_reuse_its = (int)s->time.qs_reuse;
   o->linear_ew = s->time.qs_inexact;
   /* The stop of a solve on a stale factorisation is decided by iteration
@@ -117,6 +120,14 @@ void fpm_static_choose_linear(const pm_scene *s, long unknowns,
    * new one cost 1.8 times the CPU at 4036 points (docs/validation.md,
    * "Static solves: big steps, cheap cuts"). */
   o->pc_reuse_cost = 0;
+}
+
+void fpm_static_choose_linear(const pm_scene *s, long unknowns,
+                              pm_newton_options *o) {
+  o->linear = pm_scene_has(s, "time.quasi_static.linear_solver")
+                  ? pm_newton_linear_of(s->time.qs_linear)
+                  : fpm_static_default_linear(unknowns);
+  linear_settings(s, o);
 }
 
 pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
@@ -241,6 +252,15 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   }
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
   c->solver = solver;
+  /* Multigrid where Newton passes, the LU in the fallbacks (a fold's
+   * singular tangent, where multigrid's solves crawl) while it fits. */
+  if (fpm_static_fallback_direct(s, rep->unknowns) &&
+      no.op != PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
+    pm_newton_options alt = pm_newton_options_default();
+    alt.linear = PM_NEWTON_DIRECT;
+    linear_settings(s, &alt);
+    PM_TRY(pm_newton_set_fallback_linear(solver, &alt));
+  }
   rep->setup_seconds = pm_wtime() - w0;
   ret = pm_load_steps_from(solver, v.x, &ss->load, &rep->load);
 done:

@@ -30,12 +30,20 @@ typedef struct {
  * iterations: time.quasi_static.reuse_iterations); above, GMRES with
  * algebraic multigrid (GAMG on the rigid-body near null space, blocks of
  * a point's components; FPM_STATIC_AMG_*), whose memory grows with the
- * tangent where the factorisation's grows faster.  Measured on F3 60%
- * (docs/validation.md, "Static solves at 13762 and 32715 points"): at
- * 1851 points (4359 free dofs) multigrid costs the CPU of the coupled LU
- * and less than the uncoupled one's, at 4036 (10 071) less than either;
- * at 13762 (36 549) the coupled LU took 13 GB. */
-#define FPM_STATIC_DIRECT_MAX 8000L
+ * tangent where the factorisation's grows faster.  Measured on F3 60% on a
+ * quiet machine (docs/validation.md, "Static solves: multigrid from 1500
+ * free dofs, the LU in the fallbacks"): at 474 points (1100 free dofs)
+ * the two cost the same wall time, multigrid 60% of the memory; at 700
+ * points multigrid 0.7 of the time, at 1851 points (4359) half the time
+ * and a third of the memory (the LU's factors are about as many as a
+ * dense matrix's); at 13762 (36 549) the coupled LU took 13 GB. */
+#define FPM_STATIC_DIRECT_MAX 1500L
+/* Free dofs up to which a default multigrid solve (above
+ * FPM_STATIC_DIRECT_MAX) hands load stepping's fallbacks (a fold's
+ * lowest mode, arc length, continuation, relaxation: a singular tangent,
+ * where multigrid's solves crawl) to the LU of the tangent
+ * (pm_newton_set_fallback_linear), the memory of the LU then needed. */
+#define FPM_STATIC_FALLBACK_DIRECT_MAX 8000L
 /* Free dofs (over all ranks) up to which the averaged volume's coupling
  * is factorised by default (time.quasi_static.averaged_coupling): its LU
  * takes about 1.8 times the memory of the tangent's (805 against 457 MiB
@@ -52,6 +60,11 @@ typedef struct {
  * is kept while the solves it preconditions take at most this many
  * iterations. */
 #define FPM_STATIC_AMG_REUSE 40
+
+/* Whether a static solve of scene s with this many free dofs (over all
+ * ranks) hands its fallbacks to the LU (FPM_STATIC_FALLBACK_DIRECT_MAX):
+ * no time.quasi_static.linear_solver, and multigrid by default. */
+bool fpm_static_fallback_direct(const pm_scene *s, long unknowns);
 
 /* Whether a static solve of scene s (model m, with this many free dofs
  * over all ranks, linear solver `linear`) factorises the averaged
