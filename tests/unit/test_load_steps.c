@@ -414,6 +414,18 @@ static void test_relaxation_fallback(void **state) {
   pm_newton_destroy(&s);
 }
 
+/* Load stepping through a fold: tight Newton, six cuts, the fallbacks
+ * (arc length, continuation, relaxation) after two. */
+static pm_newton_options fold_options(void) {
+  pm_newton_options opt = pm_newton_options_default();
+  opt.rtol = 1e-10;
+  opt.stall_after = 6;
+  opt.max_cuts = 6;
+  opt.relax_after = 2;
+  opt.ptc_max_iter = 60;
+  return opt;
+}
+
 /* ---- The fallbacks' own linear solver ------------------------------------
  * The snap-through with GMRES + ILU(0) as the solver's linear solver and
  * the LU as its fallbacks' (pm_newton_set_fallback_linear): the same root
@@ -452,12 +464,7 @@ static void test_fallback_linear(void **state) {
                             .pat_ptr = ptr,
                             .pat_idx = idx,
                             .set_load = watched_set_load};
-  pm_newton_options opt = pm_newton_options_default();
-  opt.rtol = 1e-10;
-  opt.stall_after = 6;
-  opt.max_cuts = 6;
-  opt.relax_after = 2;
-  opt.ptc_max_iter = 60;
+  pm_newton_options opt = fold_options();
   opt.linear = PM_NEWTON_GMRES_ILU;
   pm_newton_options alt = pm_newton_options_default();
   alt.linear = PM_NEWTON_DIRECT;
@@ -610,12 +617,7 @@ static void test_arc_length(void **state) {
                             .pat_ptr = ptr,
                             .pat_idx = idx,
                             .set_load = snap2_set_load};
-  pm_newton_options opt = pm_newton_options_default();
-  opt.rtol = 1e-10;
-  opt.stall_after = 6;
-  opt.max_cuts = 6;
-  opt.relax_after = 2;
-  opt.ptc_max_iter = 60;
+  pm_newton_options opt = fold_options();
   pm_newton *s = NULL;
   pm_load_report rep;
   assert_ok(pm_newton_create(&prob, &opt, &s));
