@@ -130,7 +130,8 @@ typedef struct {
    * failure aborts the solve.  Optional (NULL). */
   pm_err (*precond_values)(void *ctx, const double *x, double *val);
 
-  /* A preconditioner factorised from a larger matrix (the direct solver
+  /* A preconditioner factorised from a larger matrix (the direct solver,
+   * the solver's own or its fallbacks' (pm_newton_set_fallback_linear),
    * with op PM_NEWTON_MATRIX_FREE, one process): M = [J0 G; C I] over the
    * n unknowns and aux_n more, on the pattern aux_ptr/aux_idx (CSR over
    * n + aux_n; copied), its values from aux_values at each new
@@ -138,8 +139,8 @@ typedef struct {
    * repeated entries summed).  The LU of M applied to [r; 0], first n
    * values, is (J0 - G C)^-1 r: the exact inverse of J when J is J0
    * coupled through aux_n intermediate values (an averaged volume's).
-   * Used in place of the assembled Jacobian (jacobian_values is then not
-   * called).  Optional (0, NULL). */
+   * Used in place of the assembled Jacobian while the direct solver is
+   * (jacobian_values is then not called).  Optional (0, NULL). */
   long aux_n;
   const long *aux_ptr, *aux_idx;
   pm_err (*aux_values)(void *ctx, const double *x, double *val);

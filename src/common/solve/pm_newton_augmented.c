@@ -13,11 +13,9 @@ pm_err pm_newton_aug_init(pm_newton *s, const pm_newton_problem *p) {
   if (p->aux_n <= 0) return PM_SUCCESS;
   PM_CHECK(p->aux_ptr && p->aux_idx && p->aux_values, PM_ERR_ARG,
            "Newton problem: aux_n needs aux_ptr, aux_idx and aux_values");
-  PM_CHECK(!s->dist && s->o.op == PM_NEWTON_MATRIX_FREE &&
-               s->o.linear == PM_NEWTON_DIRECT,
-           PM_ERR_UNSUPPORTED,
-           "Newton problem: the augmented preconditioner (aux_n) needs the "
-           "direct solver, a matrix-free operator and one process");
+  PM_CHECK(!s->dist && s->o.op == PM_NEWTON_MATRIX_FREE, PM_ERR_UNSUPPORTED,
+           "Newton problem: the augmented preconditioner (aux_n) needs a "
+           "matrix-free operator and one process");
   const long N = p->n + p->aux_n;
   PM_CALL(pm_pattern_build(N, p->aux_ptr, p->aux_idx, true, &s->apat));
   PM_CALL(PM_ALLOC(s->avals, s->apat.ptr[N] > 0 ? s->apat.ptr[N] : 1,
@@ -65,7 +63,7 @@ pm_err pm_newton_aug_values(pm_newton *s, const double *x) {
 
 PetscErrorCode pm_newton_aug_factor(pm_newton *s) {
   PetscFunctionBeginUser;
-  if (!s->aug || !s->aug_dirty) PetscFunctionReturn(0);
+  if (!pm_newton_aug_on(s) || !s->aug_dirty) PetscFunctionReturn(0);
   PetscCall(KSPSetOperators(s->ka, s->Ma, s->Ma));
   PetscCall(KSPSetUp(s->ka));
   s->aug_dirty = false;

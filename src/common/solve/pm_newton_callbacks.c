@@ -55,7 +55,7 @@ PetscErrorCode pm_newton_snes_residual(SNES snes, Vec X, Vec R, void *ctx) {
  * matrix factorised: B's, or the augmented matrix's first n rows. */
 static PetscErrorCode add_shift(pm_newton *s, Mat B) {
   PetscFunctionBeginUser;
-  if (!s->aug) {
+  if (!pm_newton_aug_on(s)) {
     PetscCall(MatDiagonalSet(B, s->Shift, ADD_VALUES));
     PetscFunctionReturn(0);
   }
@@ -108,7 +108,7 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
   s->jacobians++;
   if (new_pc && s->rep) s->rep->pc_setups++;
   if (e == PM_SUCCESS && rebuild) {
-    if (s->aug) {
+    if (pm_newton_aug_on(s)) {
       e = pm_newton_agreed(s, pm_newton_aug_values(s, x));
     } else if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
       e = pm_newton_precond_values(s, x);

@@ -165,11 +165,11 @@ static pm_err create_petsc_objects(pm_newton *s) {
   }
   if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
     PM_CALL(pm_newton_create_matrix(s, &s->ppat, &s->pcols, s->pvals, &s->P));
-  } else if (!s->aug) {
+  } else if (!pm_newton_aug_on(s)) {
     PM_CALL(pm_newton_create_matrix(s, &s->jpat, &s->jcols, s->jvals, &s->J));
   }
   PM_CALL(pm_newton_fine_create(s));
-  if (s->p.near_null_count > 0 && !s->aug) {
+  if (s->p.near_null_count > 0 && !pm_newton_aug_on(s)) {
     Mat A, B;
     pm_newton_operators(s, &A, &B);
     PM_CALL(pm_newton_set_near_null(s, B));

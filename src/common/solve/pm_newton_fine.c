@@ -96,7 +96,7 @@ pm_err pm_newton_fine_create(pm_newton *s) {
       o->linear == PM_NEWTON_GMRES_GAMG || o->linear == PM_NEWTON_CG_GAMG;
   s->fine_threes = -1;
   if (!o->amg_threaded || !amg || !o->amg_assembled_smoother || s->dist ||
-      s->aug || pm_omp_threads() < 2)
+      pm_newton_aug_on(s) || pm_omp_threads() < 2)
     return PM_SUCCESS;
   PetscBool seqaij;
   PM_PETSC_CALL(

@@ -231,9 +231,10 @@ pm_err pm_newton_set_fallback_linear(pm_newton *s,
            "pm_newton_set_fallback_linear: inside a fallback");
   s->has_alt = false;
   if (!alt) return PM_SUCCESS;
-  PM_CHECK(s->o.op != PM_NEWTON_MATRIX_FREE_CHEAP_PC && !s->aug, PM_ERR_ARG,
+  PM_CHECK(s->o.op != PM_NEWTON_MATRIX_FREE_CHEAP_PC && !pm_newton_aug_on(s),
+           PM_ERR_ARG,
            "pm_newton_set_fallback_linear: the cheap operator and the "
-           "augmented preconditioner keep their own linear solver");
+           "augmented preconditioner in use keep their own linear solver");
   PM_CHECK(alt->linear >= PM_NEWTON_DIRECT &&
                alt->linear <= PM_NEWTON_CG_GAMG && alt->linear_rtol > 0 &&
                alt->linear_rtol < 1 && alt->linear_max_iter >= 1 &&
@@ -262,7 +263,12 @@ pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on) {
   s->pc_pending = s->pc_fresh = s->pc_stale = false;
   s->pc_budget = 0;
   s->pc_first_its = -1;
-  return pm_newton_replace_linear(s);
+  PM_CALL(pm_newton_replace_linear(s));
+  /* (the augmented preconditioner's shell, or the tangent, as B) */
+  Mat A, B;
+  pm_newton_operators(s, &A, &B);
+  PM_PETSC_CALL(SNESSetJacobian(s->snes, A, B, pm_newton_snes_jacobian, s));
+  return PM_SUCCESS;
 }
 
 /* What the linear solver multiplies by (A) and builds its preconditioner
@@ -270,7 +276,7 @@ pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on) {
 void pm_newton_operators(const pm_newton *s, Mat *A, Mat *B) {
   *A = s->o.op == PM_NEWTON_ASSEMBLED ? s->J : s->Shell;
   *B = s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC ? s->P
-       : s->aug                                  ? s->Shell
+       : pm_newton_aug_on(s)                     ? s->Shell
                                                  : s->J;
 }
 

@@ -228,6 +228,11 @@ PetscErrorCode pm_newton_converged_test(SNES snes, PetscInt it, PetscReal xnorm,
 /* Gives SNES a new linear solver (in place of one left inconsistent by a
  * failure inside it); s->ksp is it. */
 pm_err pm_newton_replace_linear(pm_newton *s);
+/* The augmented preconditioner in use: made (aux_n) and the linear solver
+ * now the direct one (the solver's own, or its fallbacks'). */
+static inline bool pm_newton_aug_on(const pm_newton *s) {
+  return s->aug && s->o.linear == PM_NEWTON_DIRECT;
+}
 
 /* What the linear solver multiplies by (A) and builds its preconditioner
  * from (B). */

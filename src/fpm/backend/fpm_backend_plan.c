@@ -164,8 +164,9 @@ static double plan_head(fpm_sim *sim, FILE *out) {
         "             tangent assembled directly (%s), linear solver "
         "%s (%s)%s%s%s\n",
         stage++, s->time.qs_load_steps, s->time.qs_max_iterations, m->n_cdofs,
-        coupled ? "with the averages' coupling through one unknown a point: "
-                  "the exact tangent's LU"
+        coupled && no.linear == PM_NEWTON_DIRECT
+            ? "with the averages' coupling through one unknown a point: "
+              "the exact tangent's LU"
         : m->flux == FPM_FLUX_SIPG || m->vavg
             ? "preconditioning the exact tangent applied matrix-free"
             : "exact",
@@ -181,9 +182,10 @@ static double plan_head(fpm_sim *sim, FILE *out) {
     if (fallback_lu)
       fprintf(out,
               "             a load step's fallbacks (a fold: lowest mode, "
-              "arc length, continuation, relaxation) on the LU "
+              "arc length, continuation, relaxation) on the LU%s "
               "(%ld free dofs <= %ld)\n",
-              nfree, FPM_STATIC_FALLBACK_DIRECT_MAX);
+              coupled ? " with the averages' coupling" : "", nfree,
+              FPM_STATIC_FALLBACK_DIRECT_MAX);
     const bool lu = no.linear == PM_NEWTON_DIRECT || fallback_lu;
     double entries = 0;
     const double solver = fpm_static_solver_bytes(

@@ -90,9 +90,12 @@ size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
         fpm_static_solver_bytes((long)dofs, quadratic, linear, coupled, NULL);
     /* the fallbacks' LU, beside the multigrid it stands in for */
     if (fpm_static_fallback_direct(s, (long)dofs))
-      solver =
-          fmax(solver, fpm_static_solver_bytes((long)dofs, quadratic,
-                                               PM_NEWTON_DIRECT, false, NULL));
+      solver = fmax(solver, fpm_static_solver_bytes(
+                                (long)dofs, quadratic, PM_NEWTON_DIRECT,
+                                o->volumetric == FPM_VOLUMETRIC_AVERAGED &&
+                                    s->time.qs_coupled &&
+                                    dofs <= FPM_STATIC_COUPLED_MAX,
+                                NULL));
   }
   *points = n < (double)LONG_MAX ? (long)n : LONG_MAX;
   double bytes = n * per_point + solver;

@@ -63,7 +63,8 @@ pm_newton_linear fpm_static_default_linear(long unknowns) {
 
 bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
                         pm_newton_linear linear) {
-  if (!m->vavg || m->xc || linear != PM_NEWTON_DIRECT || !s->time.qs_coupled)
+  if (!m->vavg || m->xc || !s->time.qs_coupled ||
+      (linear != PM_NEWTON_DIRECT && !fpm_static_fallback_direct(s, unknowns)))
     return false;
   return pm_scene_has(s, "time.quasi_static.averaged_coupling") ||
          unknowns <= FPM_STATIC_COUPLED_MAX;

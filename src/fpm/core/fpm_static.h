@@ -69,7 +69,9 @@ bool fpm_static_fallback_direct(const pm_scene *s, long unknowns);
 /* Whether a static solve of scene s (model m, with this many free dofs
  * over all ranks, linear solver `linear`) factorises the averaged
  * volume's coupling: the averaged volume, one process, the direct
- * solver, time.quasi_static.averaged_coupling, and when the key is not
+ * solver (or multigrid whose fallbacks take the LU:
+ * fpm_static_fallback_direct), time.quasi_static.averaged_coupling, and
+ * when the key is not
  * given at most FPM_STATIC_COUPLED_MAX free dofs. */
 bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
                         pm_newton_linear linear);
