@@ -215,6 +215,44 @@ static void test_static_linear_solvers(void **state) {
     assert_true(fabs(R[k] - R[0]) <= 1e-6 * fabs(R[0]));
 }
 
+/* Multigrid by default above FPM_STATIC_DIRECT_MAX free dofs, its load
+ * steps' fallbacks on the LU: F3 60% at mesh size 0.0125 m (700 points,
+ * 1512 free dofs), once as it is (no step falls back: the averages'
+ * coupling never made) and once with Newton held to 2 iterations and the
+ * fallbacks after one cut, so that steps fall back (the tangent's lowest
+ * mode, arc length) on the LU with the averages' coupling, made on first
+ * use.  The same top reaction to 1e-6 (Newton's tolerance is 1e-8 of the
+ * residual; measured 2.4e-9). */
+static void test_static_fallback_lu(void **state) {
+  (void)state;
+  const char *sets[] = {
+      "discretization.mesh_size=0.0125", "time.quasi_static.method=static",
+      "time.quasi_static.max_iterations=2", "time.quasi_static.relax_after=1"};
+  double R[2];
+  for (int k = 0; k < 2; k++) {
+    run_t r = {0};
+    run(CASES "f3-extension-60.yaml", k == 0 ? 2 : 4, sets, &r);
+    const fpm_static_report *sr = &r.sim->static_report;
+    R[k] = r.out.loaded_reaction;
+    print_message("F3 60%%, %ld points, %s: top reaction %.10g N, %d load "
+                  "steps (%d cuts), %d lowest modes, %d arc lengths, "
+                  "coupled LU of %ld entries\n",
+                  r.sim->model->n, k == 0 ? "as it is" : "falling back", R[k],
+                  sr->load.steps, sr->load.cuts, sr->load.mode_runs,
+                  sr->load.arc_runs, sr->coupled_entries);
+    assert_true(sr->unknowns > FPM_STATIC_DIRECT_MAX);
+    if (k == 0) {
+      assert_int_equal(sr->load.mode_runs, 0);
+      assert_int_equal(sr->coupled_entries, 0);
+    } else {
+      assert_true(sr->load.mode_runs > 0);
+      assert_true(sr->coupled_entries > 0);
+    }
+    done(&r);
+  }
+  assert_true(fabs(R[1] - R[0]) <= 1e-6 * fabs(R[0]));
+}
+
 /* The work of a traction: the near-incompressible panel (mesh size 0.65
  * m, 157 points) sheared by a dead traction on its free edge, in 1 and in
  * 10 load steps.  The tractions' work is booked by the trapezoidal rule on
@@ -250,6 +288,7 @@ int main(void) {
       cmocka_unit_test(test_f3_static_against_relaxation),
       cmocka_unit_test(test_f4_static_relaxation),
       cmocka_unit_test(test_static_linear_solvers),
+      cmocka_unit_test(test_static_fallback_lu),
       cmocka_unit_test(test_traction_work),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -144,6 +144,14 @@ typedef struct {
   long aux_n;
   const long *aux_ptr, *aux_idx;
   pm_err (*aux_values)(void *ctx, const double *x, double *val);
+  /* The same made on first use, for the fallbacks' direct solver
+   * (pm_newton_set_fallback_linear): with aux_n 0 and aux_values given,
+   * aux_prepare is called when a fallback first takes the direct solver,
+   * and gives aux_n and the pattern then (kept by the caller until the
+   * solver is destroyed): a run whose steps never fall back never holds
+   * it.  Optional (NULL). */
+  pm_err (*aux_prepare)(void *ctx, long *aux_n, const long **aux_ptr,
+                        const long **aux_idx);
 
   /* Vectors (near_null_count of n values each, one after the other) the
    * Jacobian nearly annihilates -- for a solid, its rigid motions -- given

@@ -80,6 +80,8 @@ static pm_err check_problem(const pm_newton_problem *p,
            PM_ERR_ARG,
            "Newton problem: the cheap preconditioner needs precond_apply or "
            "precond_values");
+  PM_CHECK(!p->aux_prepare || p->aux_values, PM_ERR_ARG,
+           "Newton problem: aux_prepare needs aux_values");
   PM_CHECK(!p->pc_pat_ptr == !p->pc_pat_idx, PM_ERR_ARG,
            "Newton problem: give both pc_pat_ptr and pc_pat_idx, or neither");
   if (!p->shared || !pm_par_active()) return PM_SUCCESS;

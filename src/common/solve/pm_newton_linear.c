@@ -255,6 +255,14 @@ pm_err pm_newton_set_fallback_linear(pm_newton *s,
 
 pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on) {
   if (!s->has_alt || s->on_alt == on) return PM_SUCCESS;
+  if (on && s->alt.linear == PM_NEWTON_DIRECT && s->p.aux_prepare && !s->aug) {
+    /* the augmented preconditioner, made now (pm_newton_problem) */
+    pm_newton_problem p = s->p;
+    PM_CALL(s->p.aux_prepare(s->p.ctx, &p.aux_n, &p.aux_ptr, &p.aux_idx));
+    PM_CALL(pm_newton_aug_init(s, &p));
+    s->p.aux_n = p.aux_n;
+    PM_CALL(pm_newton_aug_objects(s));
+  }
   take_linear(&s->o, on ? &s->alt : &s->own);
   s->on_alt = on;
   /* the kept preconditioner's record starts again with the new solver */

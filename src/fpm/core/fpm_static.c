@@ -76,6 +76,19 @@ bool fpm_static_amg_on_support(const pm_scene *s, const fpm_model *m,
          !m->xc && s->time.qs_amg != PM_AMG_TANGENT;
 }
 
+/* pm_newton_problem.aux_prepare: the averages' coupling, for the
+ * fallbacks' LU (ctx: the solve's context, the first member of its
+ * fpm_static_solve). */
+static pm_err coupled_prepare(void *ctx, long *aux_n, const long **aux_ptr,
+                              const long **aux_idx) {
+  fpm_static_solve *v = (fpm_static_solve *)ctx;
+  PM_CALL(fpm_static_coupled_build(v));
+  *aux_n = v->prob.aux_n;
+  *aux_ptr = v->prob.aux_ptr;
+  *aux_idx = v->prob.aux_idx;
+  return PM_SUCCESS;
+}
+
 bool fpm_static_fallback_direct(const pm_scene *s, long unknowns) {
   return !pm_scene_has(s, "time.quasi_static.linear_solver") &&
          unknowns > FPM_STATIC_DIRECT_MAX &&
@@ -230,8 +243,13 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   /* ...unless the factorisation takes the coupling in (one value per
    * point more): then GMRES converges in an iteration or two. */
   if (fpm_static_couples(s, m, rep->unknowns, no.linear)) {
-    PM_TRY(fpm_static_coupled_build(&v));
-    rep->coupled_entries = v.c.cp.ptr[c->nf + m->n];
+    if (no.linear == PM_NEWTON_DIRECT) {
+      PM_TRY(fpm_static_coupled_build(&v));
+    } else {
+      /* the fallbacks' LU only: made if a step falls back */
+      v.prob.aux_prepare = coupled_prepare;
+      v.prob.aux_values = fpm_static_coupled_values;
+    }
   }
   /* Multigrid on one process built on the tangent on each point's own
    * support (multigrid_operator support or support2,
@@ -265,6 +283,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   rep->setup_seconds = pm_wtime() - w0;
   ret = pm_load_steps_from(solver, v.x, &ss->load, &rep->load);
 done:
+  if (v.c.cp.ptr) rep->coupled_entries = v.c.cp.ptr[c->nf + m->n];
   if (info) *info = c->si;
   rep->contact_frozen = c->contact_frozen;
   rep->contact_frozen_gap = c->contact_frozen_gap;

@@ -106,7 +106,7 @@ typedef struct {
  * linearisation's work space, and the problem for pm_newton.  Released by
  * fpm_static_solve_free (also after a failure in fpm_static_setup). */
 typedef struct {
-  fpm_static_ctx c;
+  fpm_static_ctx c; /* first: the problem's ctx is &c (coupled_prepare) */
   long *free_of, *ptr, *idx;
   double *x;
   double *rigid; /* the rigid motions on the free dofs (for multigrid) */
