@@ -1,8 +1,7 @@
 /* Unit tests of load stepping on the shared Newton solver: steps cut and
  * grown (a run that completes), the iterations' bound, a load that no
  * step can carry, named with its cause, the relaxation fallback
- * through a limit point where Newton stalls (on the solver's own linear
- * solver or the fallbacks' own), and the tangent's lowest
+ * through a limit point where Newton stalls, and the tangent's lowest
  * mode, and arc length round a limit point. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -20,6 +19,7 @@
 #include "pm_newton_impl.h"
 #include "pm_testing.h"
 #include "newton_chain.h"
+#include "snap_through.h"
 
 /* ---- Load stepping ----------------------------------------------------- */
 
@@ -249,45 +249,8 @@ static void test_load_steps_impossible(void **state) {
   free(idx);
 }
 
-/* ---- Snap-through: r(x) = x^3 - 3 x + q lambda, x = sqrt(3) at rest --------
- * The energy x^4/4 - 3 x^2/2 + q lambda x has its right well until q lambda
- * = 2 (a limit point at x = 1, lambda = 2/q); past it the only equilibrium
- * is in the left well, which Newton cannot reach from the right (the
- * residual's norm has its minimum at the limit point) but relaxation,
- * going downhill, does. */
-typedef struct {
-  double q, lambda;
-} snap;
-
-static pm_err snap_residual(void *ctx, const double *x, double *r) {
-  const snap *sn = ctx;
-  r[0] = x[0] * x[0] * x[0] - 3 * x[0] + sn->q * sn->lambda;
-  return PM_SUCCESS;
-}
-
-static pm_err snap_apply(void *ctx, const double *x, const double *dx,
-                         double *dr) {
-  (void)ctx;
-  dr[0] = (3 * x[0] * x[0] - 3) * dx[0];
-  return PM_SUCCESS;
-}
-
-static pm_err snap_set_load(void *ctx, double lambda) {
-  ((snap *)ctx)->lambda = lambda;
-  return PM_SUCCESS;
-}
-
-static pm_err snap_diagnose(void *ctx, const double *x, char *buf, long cap) {
-  (void)ctx;
-  snprintf(buf, (size_t)cap, "x = %.4f", x[0]);
-  return PM_SUCCESS;
-}
-
-/* The real root of x^3 - 3 x + c (c > 2: one real root), by Cardano. */
-static double snap_root(double c) {
-  double d = sqrt(c * c / 4 - 1);
-  return cbrt(-c / 2 + d) + cbrt(-c / 2 - d);
-}
+/* ---- Snap-through (snap_through.h) ----------------------------------------
+ */
 
 static void test_relaxation_fallback(void **state) {
   (void)state;
@@ -412,94 +375,6 @@ static void test_relaxation_fallback(void **state) {
   assert_non_null(strstr(pm_error_message(), "relax_rtol"));
   pm_error_clear();
   pm_newton_destroy(&s);
-}
-
-/* Load stepping through a fold: tight Newton, six cuts, the fallbacks
- * (arc length, continuation, relaxation) after two. */
-static pm_newton_options fold_options(void) {
-  pm_newton_options opt = pm_newton_options_default();
-  opt.rtol = 1e-10;
-  opt.stall_after = 6;
-  opt.max_cuts = 6;
-  opt.relax_after = 2;
-  opt.ptc_max_iter = 60;
-  return opt;
-}
-
-/* ---- The fallbacks' own linear solver ------------------------------------
- * The snap-through with GMRES + ILU(0) as the solver's linear solver and
- * the LU as its fallbacks' (pm_newton_set_fallback_linear): the same root
- * and snap as with one solver throughout; the Jacobians of the fallbacks
- * are made under the LU, those of the steps under GMRES, and the solver's
- * own settings are back after the run.  Bad settings are named. */
-typedef struct {
-  snap sn;
-  pm_newton *s;
-  int seen[PM_NEWTON_CG_GAMG + 1]; /* Jacobian products under each solver */
-} snap_watched;
-
-static pm_err watched_residual(void *ctx, const double *x, double *r) {
-  return snap_residual(&((snap_watched *)ctx)->sn, x, r);
-}
-
-static pm_err watched_apply(void *ctx, const double *x, const double *dx,
-                            double *dr) {
-  snap_watched *w = ctx;
-  if (w->s) w->seen[pm_newton_options_of(w->s)->linear]++;
-  return snap_apply(&w->sn, x, dx, dr);
-}
-
-static pm_err watched_set_load(void *ctx, double lambda) {
-  return snap_set_load(&((snap_watched *)ctx)->sn, lambda);
-}
-
-static void test_fallback_linear(void **state) {
-  (void)state;
-  snap_watched w = {.sn = {3.6, 0}};
-  long ptr[2] = {0, 1}, idx[1] = {0};
-  pm_newton_problem prob = {.n = 1,
-                            .ctx = &w,
-                            .residual = watched_residual,
-                            .jacobian_apply = watched_apply,
-                            .pat_ptr = ptr,
-                            .pat_idx = idx,
-                            .set_load = watched_set_load};
-  pm_newton_options opt = fold_options();
-  opt.linear = PM_NEWTON_GMRES_ILU;
-  pm_newton_options alt = pm_newton_options_default();
-  alt.linear = PM_NEWTON_DIRECT;
-  alt.pc_reuse_its = 10;
-  pm_load_report rep;
-
-  /* one solver throughout, then the LU in the fallbacks */
-  double x1 = sqrt(3), x2 = sqrt(3);
-  pm_load_report one;
-  assert_ok(pm_newton_create(&prob, &opt, &w.s));
-  assert_ok(pm_load_steps(w.s, &x1, &one));
-  assert_int_equal(w.seen[PM_NEWTON_DIRECT], 0);
-  pm_newton_destroy(&w.s);
-  memset(w.seen, 0, sizeof w.seen);
-  assert_ok(pm_newton_create(&prob, &opt, &w.s));
-  assert_ok(pm_newton_set_fallback_linear(w.s, &alt));
-  assert_ok(pm_load_steps(w.s, &x2, &rep));
-  print_message("GMRES + ILU(0) throughout: x = %.15f, %d snaps; with the LU "
-                "in the fallbacks: x = %.15f, %d snaps, Jacobian products "
-                "%d under GMRES, %d under the LU\n",
-                x1, one.snap_steps, x2, rep.snap_steps,
-                w.seen[PM_NEWTON_GMRES_ILU], w.seen[PM_NEWTON_DIRECT]);
-  assert_close(x2, snap_root(3.6), 1e-9, 0);
-  assert_close(x1, x2, 1e-12, 0);
-  assert_int_equal(rep.snap_steps, 1);
-  assert_int_equal(one.snap_steps, 1);
-  assert_true(w.seen[PM_NEWTON_DIRECT] > 0);
-  assert_true(w.seen[PM_NEWTON_GMRES_ILU] > 0);
-  assert_int_equal(pm_newton_options_of(w.s)->linear, PM_NEWTON_GMRES_ILU);
-  /* settings out of range, named */
-  alt.linear_rtol = 2;
-  assert_int_equal(pm_newton_set_fallback_linear(w.s, &alt), PM_ERR_ARG);
-  assert_non_null(strstr(pm_error_message(), "linear_rtol 2"));
-  pm_error_clear();
-  pm_newton_destroy(&w.s);
 }
 
 /* ---- The lowest mode and the branch switch ----------------------------- */
@@ -671,7 +546,6 @@ int main(void) {
       cmocka_unit_test(test_load_steps_stale_factorisation),
       cmocka_unit_test(test_load_steps_impossible),
       cmocka_unit_test(test_relaxation_fallback),
-      cmocka_unit_test(test_fallback_linear),
       cmocka_unit_test(test_lowest_mode),
       cmocka_unit_test(test_arc_length),
   };
