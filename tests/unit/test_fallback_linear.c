@@ -69,7 +69,7 @@ static void test_fallback_linear(void **state) {
   pm_newton_destroy(&w.s);
   memset(w.seen, 0, sizeof w.seen);
   assert_ok(pm_newton_create(&prob, &opt, &w.s));
-  assert_ok(pm_newton_set_fallback_linear(w.s, &alt));
+  assert_ok(pm_newton_set_fallback_linear(w.s, &alt, false));
   assert_ok(pm_load_steps(w.s, &x2, &rep));
   print_message("GMRES + ILU(0) throughout: x = %.15f, %d snaps; with the LU "
                 "in the fallbacks: x = %.15f, %d snaps, Jacobian products "
@@ -83,9 +83,29 @@ static void test_fallback_linear(void **state) {
   assert_true(w.seen[PM_NEWTON_DIRECT] > 0);
   assert_true(w.seen[PM_NEWTON_GMRES_ILU] > 0);
   assert_int_equal(pm_newton_options_of(w.s)->linear, PM_NEWTON_GMRES_ILU);
+  pm_newton_destroy(&w.s);
+  /* kept once a step has fallen back: the state says so, and the LU
+   * stays to the end */
+  memset(w.seen, 0, sizeof w.seen);
+  double x3 = sqrt(3);
+  pm_load_state st;
+  assert_ok(pm_load_state_init(&st, 1));
+  assert_ok(pm_newton_create(&prob, &opt, &w.s));
+  assert_ok(pm_newton_set_fallback_linear(w.s, &alt, true));
+  assert_ok(pm_load_steps_from(w.s, &x3, &st, &rep));
+  print_message("kept: x = %.15f, %d snaps, Jacobian products %d under "
+                "GMRES, %d under the LU\n",
+                x3, rep.snap_steps, w.seen[PM_NEWTON_GMRES_ILU],
+                w.seen[PM_NEWTON_DIRECT]);
+  assert_close(x3, x2, 1e-12, 0);
+  assert_int_equal(st.fallback_kept, 1);
+  assert_int_equal(pm_newton_options_of(w.s)->linear, PM_NEWTON_DIRECT);
+  pm_load_state_free(&st);
+  pm_newton_destroy(&w.s);
   /* settings out of range, named */
+  assert_ok(pm_newton_create(&prob, &opt, &w.s));
   alt.linear_rtol = 2;
-  assert_int_equal(pm_newton_set_fallback_linear(w.s, &alt), PM_ERR_ARG);
+  assert_int_equal(pm_newton_set_fallback_linear(w.s, &alt, false), PM_ERR_ARG);
   assert_non_null(strstr(pm_error_message(), "linear_rtol 2"));
   pm_error_clear();
   pm_newton_destroy(&w.s);

@@ -334,6 +334,8 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     st->good = st->have_prev = 0;
     rep->dlambda_min = nominal;
   }
+  if (resumed && st->fallback_kept)
+    PM_TRY(pm_newton_use_fallback_linear(s, true));
   if (resumed && st->pc_built) {
     /* The factorisation the first run kept, made again where it was. */
     PM_TRY(set_load(s, st->pc_lambda));
@@ -395,10 +397,14 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       PM_TRY(pm_newton_use_fallback_linear(s, true));
       e = fallback_step(s, x, xc, xprev, lambda, lambda_prev, target, r_ref,
                         &rw, &aw, rep, relaxed, sizeof relaxed);
-      pm_err back = pm_newton_use_fallback_linear(s, false);
-      if (back != PM_SUCCESS) {
-        ret = back;
-        goto done;
+      if (pm_newton_fallback_kept(s)) {
+        st->fallback_kept = 1;
+      } else {
+        pm_err back = pm_newton_use_fallback_linear(s, false);
+        if (back != PM_SUCCESS) {
+          ret = back;
+          goto done;
+        }
       }
       if (e == PM_SUCCESS && rep->ptc_steps == ptc_before &&
           rep->arc_passes == arc_before)
@@ -494,6 +500,9 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
       PM_CALL(pm_ckpt_double(ck, NAME("pc_lambda"), &st->pc_lambda));
       PM_CALL(pm_ckpt_doubles(ck, NAME("pc_x"), n, st->pc_x));
       PM_CALL(pm_ckpt_long(ck, NAME("pc_first_its"), &st->pc_first_its));
+      /* (not in a checkpoint of a build before it: 0) */
+      if (!pm_ckpt_reading(ck) || pm_ckpt_has(ck, NAME("fallback_kept")))
+        PM_CALL(pm_ckpt_long(ck, NAME("fallback_kept"), &st->fallback_kept));
     }
   }
   long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,

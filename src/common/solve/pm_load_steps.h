@@ -101,6 +101,9 @@ typedef struct {
   double pc_lambda;
   double *pc_x;
   long pc_first_its; /* pc_reuse_cost: the kept one's first solve's its */
+  /* The fallbacks' linear solver kept since a step fell back
+   * (pm_newton_set_fallback_linear with keep): 1, else 0. */
+  long fallback_kept;
 } pm_load_state;
 
 /* Allocate a state's arrays for a problem of n unknowns, zeroed (lambda 0:

@@ -473,14 +473,17 @@ void pm_newton_destroy(pm_newton **s);
  * Newton solves among them): alt's linear solver and its settings
  * (linear, linear_rtol, linear_ew, linear_ew_max, linear_max_iter,
  * gmres_restart, pc_reuse_its, pc_reuse_cost, pc_right, amg_*) in place of
- * the solver's own while a step's fallback runs, its own again after it.
+ * the solver's own while a step's fallback runs, and with keep for every
+ * step after the first that fell back (the load stepping's state says so,
+ * and a resume takes it), else the solver's own again after it.
  * Multigrid where Newton passes, the LU where the tangent turns singular
- * (a fold): each where it is the cheaper.  alt's other fields are not
- * read; NULL: the solver's own throughout (the default).  Not with the
- * cheap operator (MATRIX_FREE_CHEAP_PC: its matrix is no tangent to
- * factorise) nor the augmented preconditioner: PM_ERR_ARG. */
-pm_err pm_newton_set_fallback_linear(pm_newton *s,
-                                     const pm_newton_options *alt);
+ * (a fold, and the steps near it, where multigrid's solves crawl): each
+ * where it is the cheaper.  alt's other fields are not read; NULL: the
+ * solver's own throughout (the default).  Not with the cheap operator
+ * (MATRIX_FREE_CHEAP_PC: its matrix is no tangent to factorise) nor the
+ * augmented preconditioner as the solver's own: PM_ERR_ARG. */
+pm_err pm_newton_set_fallback_linear(pm_newton *s, const pm_newton_options *alt,
+                                     bool keep);
 
 /* Colours of the Jacobian's pattern (the jacobian_apply calls one
  * assembly takes), and of the cheap preconditioner's (0 if none). */

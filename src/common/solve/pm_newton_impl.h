@@ -63,6 +63,9 @@ pm_err pm_newton_pc_rebuild(pm_newton *s, const pm_load_state *st);
  * next Jacobian; nothing when there is no other or it is in place
  * already. */
 pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on);
+/* Whether the fallbacks' linear solver, once taken, is kept for the rest
+ * of the run (pm_newton_set_fallback_linear's keep). */
+bool pm_newton_fallback_kept(const pm_newton *s);
 
 /* r = the residual at x (both of the n owned values): the problem's
  * callback, through the held values of a shared problem (collective then,

@@ -225,8 +225,8 @@ static void take_linear(pm_newton_options *o, const pm_newton_options *from) {
   o->amg_threaded = from->amg_threaded;
 }
 
-pm_err pm_newton_set_fallback_linear(pm_newton *s,
-                                     const pm_newton_options *alt) {
+pm_err pm_newton_set_fallback_linear(pm_newton *s, const pm_newton_options *alt,
+                                     bool keep) {
   PM_CHECK(!s->on_alt, PM_ERR_ARG,
            "pm_newton_set_fallback_linear: inside a fallback");
   s->has_alt = false;
@@ -250,7 +250,12 @@ pm_err pm_newton_set_fallback_linear(pm_newton *s,
   s->alt = s->o;
   take_linear(&s->alt, alt);
   s->has_alt = true;
+  s->alt_keep = keep;
   return PM_SUCCESS;
+}
+
+bool pm_newton_fallback_kept(const pm_newton *s) {
+  return s->has_alt && s->alt_keep;
 }
 
 pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on) {

@@ -24,7 +24,7 @@ struct pm_newton {
    * own (own) and of load stepping's fallbacks (alt), whether there are
    * such (has_alt) and which o holds now (on_alt). */
   pm_newton_options own, alt;
-  bool has_alt, on_alt;
+  bool has_alt, on_alt, alt_keep;
   char *petsc_options;     /* copy of o.petsc_options */
   pm_pattern jpat, ppat;   /* Jacobian's and cheap operator's */
   pm_coloring jcol, pcol;  /* their colourings (pcol: cheap only) */

@@ -54,6 +54,7 @@ static void load_scalars(fpm_static_state *to, const fpm_static_state *from) {
   to->load.pc_failed = from->load.pc_failed;
   to->load.pc_lambda = from->load.pc_lambda;
   to->load.pc_first_its = from->load.pc_first_its;
+  to->load.fallback_kept = from->load.fallback_kept;
   to->external_work = from->external_work;
 }
 

@@ -278,7 +278,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
     pm_newton_options alt = pm_newton_options_default();
     alt.linear = PM_NEWTON_DIRECT;
     linear_settings(s, &alt);
-    PM_TRY(pm_newton_set_fallback_linear(solver, &alt));
+    PM_TRY(pm_newton_set_fallback_linear(solver, &alt, true));
   }
   rep->setup_seconds = pm_wtime() - w0;
   ret = pm_load_steps_from(solver, v.x, &ss->load, &rep->load);
