@@ -33,7 +33,8 @@ for (m, at), rows in runs.items():
     c = [float(x["cpu_seconds"]) for x in rows]
     wm, cm = statistics.median(w), statistics.median(c)
     print(f"| {m} | {at} | {rows[0]['points']} | "
-          f"{float(rows[0]['reaction_error_fe']):+.3f} | {wm:.3g} | {cm:.3g} | "
+          f"{100 * float(rows[0]['reaction_error_fe']):+.3f} | {wm:.3g} | "
+          f"{cm:.3g} | "
           f"{cm / wm:.2f} | {', '.join(f'{x:.3g}' for x in w)} |")
 PY
 # Peak memory, one run each.
@@ -49,8 +50,9 @@ for solver in default direct; do
     "(summary.json, the process alone: $(($(json "$out/mem-$solver/summary.json" memory peak_rss_max) / 1048576)) MiB)"
 done
 if command -v ccx >/dev/null; then
+  # (its exit status says the ladder holds no referee mesh: not a failure)
   $py tools/fe-referee.py f3-extension-60 --run --ladder 6 --keep \
-    --work "$out/fe" --out "$out/fe-out" >/dev/null
+    --work "$out/fe" --out "$out/fe-out" >/dev/null || true
   (cd "$out/fe/f3-extension-60-N6-C3D20R" &&
     /usr/bin/time -f "%M" -o ../rss ccx -i f3-extension-60-N6-C3D20R >/dev/null)
   echo "CalculiX N = 6: peak $(($(cat "$out/fe/rss") / 1024)) MiB"
