@@ -181,9 +181,9 @@ static double plan_head(fpm_sim *sim, FILE *out) {
                              !fpm_static_amg_on_support(s, m, no.linear);
     if (fallback_lu)
       fprintf(out,
-              "             a load step's fallbacks (a fold: lowest mode, "
-              "arc length, continuation, relaxation) on the LU%s "
-              "(%ld free dofs <= %ld)\n",
+              "             from a load step's first fallback (a fold: "
+              "lowest mode, arc length, continuation, relaxation) on, "
+              "the LU%s (%ld free dofs <= %ld)\n",
               coupled ? " with the averages' coupling" : "", nfree,
               FPM_STATIC_FALLBACK_DIRECT_MAX);
     const bool lu = no.linear == PM_NEWTON_DIRECT || fallback_lu;

@@ -41,8 +41,9 @@ typedef struct {
 /* Free dofs up to which a default multigrid solve (above
  * FPM_STATIC_DIRECT_MAX) hands load stepping's fallbacks (a fold's
  * lowest mode, arc length, continuation, relaxation: a singular tangent,
- * where multigrid's solves crawl) to the LU of the tangent
- * (pm_newton_set_fallback_linear), the memory of the LU then needed. */
+ * where multigrid's solves crawl) to the LU of the tangent, kept for the
+ * rest of the run (pm_newton_set_fallback_linear), the memory of the LU
+ * then needed. */
 #define FPM_STATIC_FALLBACK_DIRECT_MAX 8000L
 /* Free dofs (over all ranks) up to which the averaged volume's coupling
  * is factorised by default (time.quasi_static.averaged_coupling): its LU
