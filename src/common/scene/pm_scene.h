@@ -47,6 +47,14 @@ typedef enum {
   PM_AMG_SUPPORT2     /* the tangent on its supports' supports */
 } pm_amg_operator;
 
+/* The line search of a static solve's Newton iterations
+ * (time.quasi_static.line_search). */
+typedef enum {
+  PM_QS_LS_AUTO = 0,     /* the method's own: backtracking */
+  PM_QS_LS_BACKTRACKING, /* cubic backtracking from the full step */
+  PM_QS_LS_SECANT        /* a secant step on the residual's norm */
+} pm_qs_line_search;
+
 /* How the stable time step is found. */
 typedef enum {
   PM_DT_PAPER = 0, /* the method's bound (FPM: eqs. 24-26 of its paper) */
@@ -350,7 +358,8 @@ typedef struct pm_scene {
     long qs_relax_after;    /* ...relax_after: cuts before relaxation */
     long qs_ptc;            /* ...pseudo_transient: continuation iterations */
     bool qs_follow_fold;    /* ...follow_fold: arc length past a limit point */
-    double qs_fallback_cpu; /* ...fallback_seconds: CPU s per fallback */
+    pm_qs_line_search qs_line_search; /* ...line_search */
+    double qs_fallback_cpu;     /* ...fallback_seconds: CPU s per fallback */
     pm_linear_solver qs_linear; /* ...linear_solver */
     long qs_reuse;              /* ...reuse_iterations (FPM static) */
     bool qs_inexact;            /* ...inexact: Eisenstat-Walker (FPM) */

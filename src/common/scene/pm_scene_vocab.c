@@ -31,6 +31,11 @@ static const pm_name linear_names[] = {
     {"direct", PM_LINEAR_DIRECT},       {"gmres-gamg", PM_LINEAR_GMRES_GAMG},
     {"cg-jacobi", PM_LINEAR_CG_JACOBI}, {"gmres-ilu", PM_LINEAR_GMRES_ILU},
     {"cg-gamg", PM_LINEAR_CG_GAMG},     {NULL, 0}};
+static const pm_name line_search_names[] = {
+    {"auto", PM_QS_LS_AUTO},
+    {"backtracking", PM_QS_LS_BACKTRACKING},
+    {"secant", PM_QS_LS_SECANT},
+    {NULL, 0}};
 static const pm_name amg_operator_names[] = {{"support", PM_AMG_SUPPORT},
                                              {"support2", PM_AMG_SUPPORT2},
                                              {"tangent", PM_AMG_TANGENT},
@@ -818,6 +823,20 @@ static const pm_key quasi_static_keys[] = {
             "negative (a limit point), arc length follows the path "
             "round the fold first; 0: relaxation alone (the solver "
             "before)"},
+    {.name = "line_search",
+     .type = PM_KEY_ENUM,
+     .offset = S(time.qs_line_search),
+     .def = "auto",
+     .names = line_search_names,
+     .doc = "method static: the line search along each Newton step: "
+            "secant, a secant step on the residual's norm from its values "
+            "at the half and the whole step (PETSc's l2); backtracking, "
+            "the whole step unless the residual does not fall enough, then "
+            "cubic backtracking (PETSc's bt); auto: backtracking.  The "
+            "secant takes F3 200% at 1851 points (FPM) in 65 Newton "
+            "iterations where backtracking takes 131, but its step is "
+            "seldom exactly the whole one, so Newton's last iterations "
+            "lose some of their quadratic order"},
     {.name = "follow_fold",
      .type = PM_KEY_BOOL,
      .offset = S(time.qs_follow_fold),
