@@ -177,8 +177,7 @@ static double plan_head(fpm_sim *sim, FILE *out) {
         no.pc_reuse_its > 0 ? ", kept while GMRES takes few iterations" : "",
         no.linear_ew ? ", inexact Newton" : "");
     /* fpm_static_run_from's: the fallbacks on the LU */
-    const bool fallback_lu = fpm_static_fallback_direct(s, nfree) &&
-                             !fpm_static_amg_on_support(s, m, no.linear);
+    const bool fallback_lu = fpm_static_fallback_direct(s, m, nfree);
     if (fallback_lu)
       fprintf(out,
               "             from a load step's first fallback (a fold: "

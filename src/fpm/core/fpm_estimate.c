@@ -81,21 +81,19 @@ size_t fpm_estimate_bytes(const pm_scene *s, long *points) {
         pm_scene_has(s, "time.quasi_static.linear_solver")
             ? pm_newton_linear_of(s->time.qs_linear)
             : fpm_static_default_linear((long)dofs);
-    const bool coupled =
-        o->volumetric == FPM_VOLUMETRIC_AVERAGED &&
-        linear == PM_NEWTON_DIRECT && s->time.qs_coupled &&
+    /* (whether an LU, the solve's or its fallbacks', takes the coupling) */
+    const bool couples =
+        o->volumetric == FPM_VOLUMETRIC_AVERAGED && s->time.qs_coupled &&
         (pm_scene_has(s, "time.quasi_static.averaged_coupling") ||
          dofs <= FPM_STATIC_COUPLED_MAX);
     solver =
-        fpm_static_solver_bytes((long)dofs, quadratic, linear, coupled, NULL);
+        fpm_static_solver_bytes((long)dofs, quadratic, linear,
+                                couples && linear == PM_NEWTON_DIRECT, NULL);
     /* the fallbacks' LU, beside the multigrid it stands in for */
-    if (fpm_static_fallback_direct(s, (long)dofs))
-      solver = fmax(solver, fpm_static_solver_bytes(
-                                (long)dofs, quadratic, PM_NEWTON_DIRECT,
-                                o->volumetric == FPM_VOLUMETRIC_AVERAGED &&
-                                    s->time.qs_coupled &&
-                                    dofs <= FPM_STATIC_COUPLED_MAX,
-                                NULL));
+    if (fpm_static_fallback_direct(s, NULL, (long)dofs))
+      solver = fmax(solver,
+                    fpm_static_solver_bytes((long)dofs, quadratic,
+                                            PM_NEWTON_DIRECT, couples, NULL));
   }
   *points = n < (double)LONG_MAX ? (long)n : LONG_MAX;
   double bytes = n * per_point + solver;

@@ -64,7 +64,8 @@ pm_newton_linear fpm_static_default_linear(long unknowns) {
 bool fpm_static_couples(const pm_scene *s, const fpm_model *m, long unknowns,
                         pm_newton_linear linear) {
   if (!m->vavg || m->xc || !s->time.qs_coupled ||
-      (linear != PM_NEWTON_DIRECT && !fpm_static_fallback_direct(s, unknowns)))
+      (linear != PM_NEWTON_DIRECT &&
+       !fpm_static_fallback_direct(s, m, unknowns)))
     return false;
   return pm_scene_has(s, "time.quasi_static.averaged_coupling") ||
          unknowns <= FPM_STATIC_COUPLED_MAX;
@@ -89,10 +90,12 @@ static pm_err coupled_prepare(void *ctx, long *aux_n, const long **aux_ptr,
   return PM_SUCCESS;
 }
 
-bool fpm_static_fallback_direct(const pm_scene *s, long unknowns) {
+bool fpm_static_fallback_direct(const pm_scene *s, const fpm_model *m,
+                                long unknowns) {
   return !pm_scene_has(s, "time.quasi_static.linear_solver") &&
          unknowns > FPM_STATIC_DIRECT_MAX &&
-         unknowns <= FPM_STATIC_FALLBACK_DIRECT_MAX;
+         unknowns <= FPM_STATIC_FALLBACK_DIRECT_MAX &&
+         !(m && fpm_static_amg_on_support(s, m, PM_NEWTON_GMRES_GAMG));
 }
 
 /* The settings of the linear solver o->linear (chosen). */
@@ -278,8 +281,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   c->solver = solver;
   /* Multigrid where Newton passes, the LU in the fallbacks (a fold's
    * singular tangent, where multigrid's solves crawl) while it fits. */
-  if (fpm_static_fallback_direct(s, rep->unknowns) &&
-      no.op != PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
+  if (fpm_static_fallback_direct(s, m, rep->unknowns)) {
     pm_newton_options alt = pm_newton_options_default();
     alt.linear = PM_NEWTON_DIRECT;
     linear_settings(s, &alt);

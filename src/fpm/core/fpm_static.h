@@ -62,10 +62,14 @@ typedef struct {
  * iterations. */
 #define FPM_STATIC_AMG_REUSE 40
 
-/* Whether a static solve of scene s with this many free dofs (over all
- * ranks) hands its fallbacks to the LU (FPM_STATIC_FALLBACK_DIRECT_MAX):
- * no time.quasi_static.linear_solver, and multigrid by default. */
-bool fpm_static_fallback_direct(const pm_scene *s, long unknowns);
+/* Whether a static solve of scene s (model m) with this many free dofs
+ * (over all ranks) hands its fallbacks to the LU
+ * (FPM_STATIC_FALLBACK_DIRECT_MAX): no time.quasi_static.linear_solver,
+ * multigrid by default, built on the tangent (not on the supports:
+ * fpm_static_amg_on_support).  m NULL (an estimate before the model):
+ * the supports' case counted as falling back. */
+bool fpm_static_fallback_direct(const pm_scene *s, const fpm_model *m,
+                                long unknowns);
 
 /* Whether a static solve of scene s (model m, with this many free dofs
  * over all ranks, linear solver `linear`) factorises the averaged

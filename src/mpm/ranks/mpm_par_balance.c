@@ -31,13 +31,6 @@ static bool received_keep(void *ctx, const double x[3]) {
   return mpm_x0_set_has(ctx, x);
 }
 
-/* The group of particle j of m. */
-static int group_of(const mpm_model *m, long j) {
-  for (int gi = 0; gi < m->n_groups; gi++)
-    if (j >= m->group[gi].begin && j < m->group[gi].end) return gi;
-  return -1;
-}
-
 /* The buffers of one cut: per rank counts and offsets (in doubles), the
  * records sent and received. */
 typedef struct {
@@ -123,20 +116,22 @@ static pm_err share_anew(const mpm_model *m, const mpm_state *s,
   mpm_x0_set_free(&rv);
   PM_CALL(ret);
   /* Each particle seeded is one received, in the same order. */
-  long bad = -1;
-  if ((*lm)->n != t->arriving) bad = 0;
-  for (long j = 0; bad < 0 && j < (*lm)->n; j++)
-    if ((double)(*lm)->gid[j] != t->rbuf[j * P->rec + REC_GID] ||
-        group_of(*lm, j) != (int)t->rbuf[j * P->rec + REC_GROUP])
-      bad = j;
+  const mpm_model *n = *lm;
+  long bad = n->n != t->arriving ? 0 : -1;
+  for (int gi = 0; bad < 0 && gi < n->n_groups; gi++)
+    for (long j = n->group[gi].begin; bad < 0 && j < n->group[gi].end; j++)
+      if ((double)n->gid[j] != t->rbuf[j * P->rec + REC_GID] ||
+          gi != (int)t->rbuf[j * P->rec + REC_GROUP])
+        bad = j;
   if (bad >= 0)
     ret = PM_ERROR(PM_ERR_INTERNAL,
                    "step %ld: cutting the boxes anew, rank %d received %ld "
                    "particles and seeded %ld (the first apart: %ld)",
                    s->step, pm_par_rank(), t->arriving, (*lm)->n, bad);
   PM_CALL(pm_par_agree(ret));
-  for (long j = 0; j < (*lm)->n; j++)
-    mpm_par_unpack(*lm, *ls, j, group_of(*lm, j), t->rbuf + j * P->rec);
+  for (int gi = 0; gi < n->n_groups; gi++)
+    for (long j = n->group[gi].begin; j < n->group[gi].end; j++)
+      mpm_par_unpack(n, *ls, j, gi, t->rbuf + j * P->rec);
   /* The run's values, this rank's energy accounts among them. */
   mpm_state_copy_values(*ls, s);
   return PM_SUCCESS;
