@@ -37,6 +37,8 @@ pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
   PM_TRY(PM_ALLOC(p->ptr, n + 1, "pattern rows"));
   PM_TRY(PM_ALLOC(p->idx, ptr[n] + (diagonal ? n : 0), "pattern columns"));
   PM_TRY(PM_ALLOC(p->src, ptr[n] > 0 ? ptr[n] : 1, "pattern map"));
+  PM_TRY(PM_ALLOC(p->sptr, n + 1, "pattern map"));
+  memcpy(p->sptr, ptr, (size_t)(n + 1) * sizeof *ptr);
   PM_TRY(PM_ALLOC(row, longest + 1, "pattern row"));
   for (long i = 0; i < n; i++) {
     long len = 0;
@@ -56,16 +58,29 @@ pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
       p->src[k] = at - p->idx;
     }
   }
+  /* A source that is the pattern itself needs no map. */
+  bool same = p->nsrc == p->ptr[n];
+  for (long k = 0; same && k < p->nsrc; k++) same = p->src[k] == k;
+  if (same) {
+    free(p->src);
+    free(p->sptr);
+    p->src = p->sptr = NULL;
+  }
 done:
   free(row);
   if (ret != PM_SUCCESS) pm_pattern_free(p);
   return ret;
 }
 
+void pm_pattern_sort_row(long *row, long len) {
+  qsort(row, (size_t)len, sizeof *row, compare_long);
+}
+
 void pm_pattern_free(pm_pattern *p) {
   free(p->ptr);
   free(p->idx);
   free(p->src);
+  free(p->sptr);
   memset(p, 0, sizeof *p);
 }
 

@@ -14,8 +14,11 @@ typedef struct {
   long *ptr; /* n + 1 */
   long *idx; /* ptr[n] */
   /* Where each entry of the pattern it was built from went: entry k of
-   * the source is idx[src[k]] (duplicates share a place). */
-  long *src;
+   * the source is idx[src[k]] (duplicates share a place), and the
+   * source's rows: row i's entries are sptr[i] .. sptr[i + 1] (n + 1).
+   * Both NULL where the source is the pattern itself (its rows sorted,
+   * unique and holding the diagonal where it is added): src[k] = k. */
+  long *src, *sptr;
   long nsrc; /* entries of the source */
 } pm_pattern;
 
@@ -26,6 +29,8 @@ typedef struct {
 pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
                         pm_pattern *p);
 void pm_pattern_free(pm_pattern *p);
+/* row[0 .. len) in increasing order. */
+void pm_pattern_sort_row(long *row, long len);
 
 /* Largest number of entries in a row. */
 long pm_pattern_max_row(const pm_pattern *p);

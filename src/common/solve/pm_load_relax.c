@@ -46,12 +46,14 @@ void pm_relax_work_free(pm_relax_work *w) {
 pm_err pm_relax_masses(pm_newton *s, const double *x, double *m) {
   const long n = s->p.n;
   if (s->p.jacobian_prepare) PM_CALL(s->p.jacobian_prepare(s->p.ctx, x));
-  PM_CALL(pm_newton_values_at(s, x, s->jvals));
+  double *vals;
+  PM_CALL(pm_newton_jvals(s, &vals));
+  PM_CALL(pm_newton_values_at(s, x, vals));
   double top = 0;
   for (long i = 0; i < n; i++) {
     double sum = 0;
     for (long k = s->jpat.ptr[i]; k < s->jpat.ptr[i + 1]; k++)
-      sum += fabs(s->jvals[k]);
+      sum += fabs(vals[k]);
     m[i] = 0.5 * sum;
     top = fmax(top, m[i]);
   }

@@ -7,6 +7,7 @@
 #include <petscsnes.h>
 
 #include "pm_newton_solver_impl.h"
+#include "pm_omp.h"
 #include "pm_petsc.h"
 
 pm_err pm_newton_copy_in(Vec v, const double *x, long n) {
@@ -47,25 +48,74 @@ pm_err pm_newton_color_values(pm_newton *s, apply_fn f, const pm_coloring *col,
   return PM_SUCCESS;
 }
 
+/* vals (pat's order) = the caller's values src (the source's order)
+ * summed into their places, row by row on every thread (each row's sums
+ * in the source's order, as one thread makes them). */
+static void scatter(const pm_pattern *pat, const double *src, double *vals) {
+  const long n = pat->n;
+  if (!pat->src) { /* the source is the pattern */
+    if (vals != src) memcpy(vals, src, (size_t)pat->ptr[n] * sizeof *vals);
+    return;
+  }
+  const long *ptr = pat->ptr, *sptr = pat->sptr, *to = pat->src;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, ptr, sptr, to, src, vals))
+  for (long i = 0; i < n; i++) {
+    for (long k = ptr[i]; k < ptr[i + 1]; k++) vals[k] = 0;
+    for (long k = sptr[i]; k < sptr[i + 1]; k++) vals[to[k]] += src[k];
+  }
+}
+
 /* The Jacobian's values at x in pattern order: the caller's assembly when
  * it gives one, else colouring. */
 pm_err pm_newton_values_at(pm_newton *s, const double *x, double *vals) {
   if (!s->p.jacobian_values)
     return pm_newton_color_values(s, s->p.jacobian_apply, &s->jcol, x, vals);
-  PM_CALL(s->p.jacobian_values(s->p.ctx, x, s->srcvals));
-  memset(vals, 0, (size_t)s->jpat.ptr[s->jpat.n] * sizeof *vals);
-  for (long k = 0; k < s->jpat.nsrc; k++) vals[s->jpat.src[k]] += s->srcvals[k];
+  /* (the caller's order the pattern's: its values in place) */
+  double *src = s->jpat.src ? s->srcvals : vals;
+  PM_CALL(s->p.jacobian_values(s->p.ctx, x, src));
+  scatter(&s->jpat, src, vals);
   return PM_SUCCESS;
 }
 
-pm_err pm_newton_precond_values(pm_newton *s, const double *x) {
+pm_err pm_newton_precond_values(pm_newton *s, const double *x, double *vals) {
   if (!s->p.precond_values)
-    return pm_newton_color_values(s, s->p.precond_apply, &s->pcol, x, s->pvals);
-  PM_CALL(s->p.precond_values(s->p.ctx, x, s->psrcvals));
-  memset(s->pvals, 0, (size_t)s->ppat.ptr[s->ppat.n] * sizeof *s->pvals);
-  for (long k = 0; k < s->ppat.nsrc; k++)
-    s->pvals[s->ppat.src[k]] += s->psrcvals[k];
+    return pm_newton_color_values(s, s->p.precond_apply, &s->pcol, x, vals);
+  double *src = s->ppat.src ? s->psrcvals : vals;
+  PM_CALL(s->p.precond_values(s->p.ctx, x, src));
+  scatter(&s->ppat, src, vals);
   return PM_SUCCESS;
+}
+
+pm_err pm_newton_jvals(pm_newton *s, double **vals) {
+  if (!s->jvals)
+    PM_CALL(PM_ALLOC(s->jvals, s->jpat.ptr[s->jpat.n] + 1, "Jacobian values"));
+  *vals = s->jvals;
+  return PM_SUCCESS;
+}
+
+pm_err pm_newton_pattern_columns(pm_newton *s) {
+  if (s->jpat.idx) return PM_SUCCESS;
+  pm_err ret = PM_SUCCESS;
+  PetscInt n;
+  const PetscInt *ia, *ja;
+  PetscBool done;
+  long *idx = NULL;
+  const long total = s->jpat.ptr[s->jpat.n];
+  PM_CALL(PM_ALLOC(idx, total + 1, "pattern columns"));
+  PM_PETSC(MatGetRowIJ(s->J, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+  const bool same = done && n == s->jpat.n && ia[n] == total;
+  if (same)
+    for (long k = 0; k < total; k++) idx[k] = ja[k];
+  PM_PETSC(
+      MatRestoreRowIJ(s->J, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+  PM_ENSURE(same, PM_ERR_INTERNAL,
+            "the Jacobian's matrix does not hold its pattern");
+  s->jpat.idx = idx;
+  idx = NULL;
+done:
+  free(idx);
+  return ret;
 }
 
 /* Rows of the pattern into M: their values (one process), or added to
@@ -89,8 +139,44 @@ static pm_err set_rows(Mat M, bool dist, const pm_pattern *pat,
 /* M = vals on the pattern (the matrix's preallocated structure). */
 pm_err pm_newton_insert_values(const pm_newton *s, Mat M, const pm_pattern *pat,
                                const PetscInt *cols, const double *vals) {
+  if (!cols) {
+    double *a;
+    const long nnz = pat->ptr[pat->n];
+    PM_PETSC_CALL(MatSeqAIJGetArrayWrite(M, &a));
+    memcpy(a, vals, (size_t)nnz * sizeof *a);
+    PM_PETSC_CALL(MatSeqAIJRestoreArrayWrite(M, &a));
+    return PM_SUCCESS;
+  }
   if (s->dist) PM_PETSC_CALL(MatZeroEntries(M));
   return set_rows(M, s->dist, pat, cols, vals);
+}
+
+pm_err pm_newton_fill(pm_newton *s, Mat M, const pm_pattern *pat,
+                      const PetscInt *cols, double *vals, pm_newton_values_fn f,
+                      const double *x) {
+  if (cols) {
+    PM_CALL(f(s, x, vals));
+    return pm_newton_insert_values(s, M, pat, cols, vals);
+  }
+  double *a;
+  PM_PETSC_CALL(MatSeqAIJGetArrayWrite(M, &a));
+  pm_err e = f(s, x, a);
+  PM_PETSC_CALL(MatSeqAIJRestoreArrayWrite(M, &a));
+  return e;
+}
+
+pm_err pm_newton_scatter_into(const pm_newton *s, Mat M, const pm_pattern *pat,
+                              const PetscInt *cols, const double *src,
+                              double *vals) {
+  if (cols) {
+    scatter(pat, src, vals);
+    return pm_newton_insert_values(s, M, pat, cols, vals);
+  }
+  double *a;
+  PM_PETSC_CALL(MatSeqAIJGetArrayWrite(M, &a));
+  scatter(pat, src, a);
+  PM_PETSC_CALL(MatSeqAIJRestoreArrayWrite(M, &a));
+  return PM_SUCCESS;
 }
 
 /* Across ranks: M's structure from every rank's rows, whichever rank owns
@@ -113,15 +199,22 @@ done:
   return ret;
 }
 
-/* An AIJ matrix with the pattern's structure (zeros): sequential, or over
- * the ranks with every rank's rows. */
-pm_err pm_newton_create_matrix(const pm_newton *s, const pm_pattern *pat,
-                               PetscInt **cols, double *zeros, Mat *M) {
+/* An AIJ matrix with the pattern's structure (zeros): sequential, its
+ * storage the pattern's order (*cols then NULL: values are written in
+ * place), or over the ranks with every rank's rows (zeros: the values
+ * inserted, as many as the pattern's entries). */
+pm_err pm_newton_create_matrix(const pm_newton *s, pm_pattern *pat,
+                               bool release, PetscInt **cols, double *zeros,
+                               Mat *M) {
   pm_err ret = PM_SUCCESS;
-  PetscInt *nnz = NULL;
+  PetscInt *ia = NULL;
   long n = pat->n, total = pat->ptr[n];
   PM_TRY(PM_ALLOC(*cols, total > 0 ? total : 1, "matrix columns"));
   for (long k = 0; k < total; k++) (*cols)[k] = (PetscInt)pat->idx[k];
+  if (release && !s->dist) {
+    free(pat->idx);
+    pat->idx = NULL;
+  }
   if (s->dist) {
     PetscInt own = (PetscInt)s->p.n;
     PM_PETSC(MatCreate(s->comm, M));
@@ -129,24 +222,27 @@ pm_err pm_newton_create_matrix(const pm_newton *s, const pm_pattern *pat,
     PM_PETSC(MatSetSizes(*M, own, own, PETSC_DETERMINE, PETSC_DETERMINE));
     PM_PETSC(MatSetLocalToGlobalMapping(*M, s->l2g, s->l2g));
     PM_TRY(preallocate_shared(s, pat, *cols, zeros, *M));
-  } else {
-    PM_TRY(PM_ALLOC(nnz, n, "matrix row lengths"));
-    for (long i = 0; i < n; i++)
-      nnz[i] = (PetscInt)(pat->ptr[i + 1] - pat->ptr[i]);
-    PM_PETSC(MatCreate(PETSC_COMM_SELF, M));
-    PM_PETSC(
-        MatSetSizes(*M, (PetscInt)n, (PetscInt)n, (PetscInt)n, (PetscInt)n));
-    PM_PETSC(MatSetType(*M, MATSEQAIJ));
-    /* unknowns in blocks (a point's components): multigrid aggregates
-     * the blocks and fits the near null space on them */
-    if (s->p.block_size > 1 && n % s->p.block_size == 0)
-      PM_PETSC(MatSetBlockSize(*M, (PetscInt)s->p.block_size));
-    PM_PETSC(MatSeqAIJSetPreallocation(*M, 0, nnz));
+    PM_PETSC(MatSetOption(*M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+    PM_TRY(pm_newton_insert_values(s, *M, pat, *cols, zeros));
+    goto done;
   }
+  PM_TRY(PM_ALLOC(ia, n + 1, "matrix rows"));
+  for (long i = 0; i <= n; i++) ia[i] = (PetscInt)pat->ptr[i];
+  PM_PETSC(MatCreate(PETSC_COMM_SELF, M));
+  PM_PETSC(MatSetSizes(*M, (PetscInt)n, (PetscInt)n, (PetscInt)n, (PetscInt)n));
+  PM_PETSC(MatSetType(*M, MATSEQAIJ));
+  /* unknowns in blocks (a point's components): multigrid aggregates
+   * the blocks and fits the near null space on them */
+  if (s->p.block_size > 1 && n % s->p.block_size == 0)
+    PM_PETSC(MatSetBlockSize(*M, (PetscInt)s->p.block_size));
+  /* the rows' sorted columns: PETSc keeps them in this order, so the
+   * pattern's places are its storage's */
+  PM_PETSC(MatSeqAIJSetPreallocationCSR(*M, ia, *cols, NULL));
   PM_PETSC(MatSetOption(*M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  PM_TRY(pm_newton_insert_values(s, *M, pat, *cols, zeros));
+  free(*cols);
+  *cols = NULL;
 done:
-  free(nnz);
+  free(ia);
   return ret;
 }
 

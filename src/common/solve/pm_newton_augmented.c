@@ -18,8 +18,6 @@ pm_err pm_newton_aug_init(pm_newton *s, const pm_newton_problem *p) {
            "matrix-free operator and one process");
   const long N = p->n + p->aux_n;
   PM_CALL(pm_pattern_build(N, p->aux_ptr, p->aux_idx, true, &s->apat));
-  PM_CALL(PM_ALLOC(s->avals, s->apat.ptr[N] > 0 ? s->apat.ptr[N] : 1,
-                   "augmented matrix values"));
   PM_CALL(PM_ALLOC(s->asrc, s->apat.nsrc > 0 ? s->apat.nsrc : 1,
                    "augmented matrix values"));
   s->aug = true;
@@ -30,7 +28,7 @@ pm_err pm_newton_aug_objects(pm_newton *s) {
   if (!s->aug) return PM_SUCCESS;
   PC pc;
   const PetscInt N = (PetscInt)s->apat.n;
-  PM_CALL(pm_newton_create_matrix(s, &s->apat, &s->acols, s->avals, &s->Ma));
+  PM_CALL(pm_newton_create_matrix(s, &s->apat, false, &s->acols, NULL, &s->Ma));
   PM_PETSC_CALL(VecCreateSeq(PETSC_COMM_SELF, N, &s->Ab));
   PM_PETSC_CALL(VecDuplicate(s->Ab, &s->Ay));
   PM_PETSC_CALL(KSPCreate(PETSC_COMM_SELF, &s->ka));
@@ -51,12 +49,9 @@ pm_err pm_newton_aug_objects(pm_newton *s) {
 }
 
 pm_err pm_newton_aug_values(pm_newton *s, const double *x) {
-  const long N = s->apat.n;
   PM_CALL(s->p.aux_values(s->p.ctx, x, s->asrc));
-  memset(s->avals, 0, (size_t)s->apat.ptr[N] * sizeof *s->avals);
-  for (long k = 0; k < s->apat.nsrc; k++)
-    s->avals[s->apat.src[k]] += s->asrc[k];
-  PM_CALL(pm_newton_insert_values(s, s->Ma, &s->apat, s->acols, s->avals));
+  /* (one process: into the matrix's own storage) */
+  PM_CALL(pm_newton_scatter_into(s, s->Ma, &s->apat, s->acols, s->asrc, NULL));
   s->aug_dirty = true;
   return PM_SUCCESS;
 }
@@ -109,6 +104,5 @@ void pm_newton_aug_free(pm_newton *s) {
   VecDestroy(&s->Ay);
   pm_pattern_free(&s->apat);
   free(s->acols);
-  free(s->avals);
   free(s->asrc);
 }

@@ -111,13 +111,15 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
     if (pm_newton_aug_on(s)) {
       e = pm_newton_agreed(s, pm_newton_aug_values(s, x));
     } else if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
-      e = pm_newton_precond_values(s, x);
-      if (e == PM_SUCCESS)
-        e = pm_newton_insert_values(s, B, &s->ppat, s->pcols, s->pvals);
-    } else {
+      e = pm_newton_fill(s, B, &s->ppat, s->pcols, s->pvals,
+                         pm_newton_precond_values, x);
+    } else if (s->dist) {
       e = pm_newton_agreed(s, pm_newton_values_at(s, x, s->jvals));
       if (e == PM_SUCCESS)
         e = pm_newton_insert_values(s, B, &s->jpat, s->jcols, s->jvals);
+    } else {
+      e = pm_newton_fill(s, B, &s->jpat, s->jcols, s->jvals,
+                         pm_newton_values_at, x);
     }
     /* pseudo-transient continuation: the shift in the matrix factorised
      * (and, assembled, multiplied by) */

@@ -14,8 +14,11 @@ pm_err pm_newton_jacobian_values(pm_newton *s, const double *x, double *val) {
   PM_CHECK(!s->dist, PM_ERR_UNSUPPORTED,
            "pm_newton_jacobian_values: one process's problems only");
   if (s->p.jacobian_prepare) PM_CALL(s->p.jacobian_prepare(s->p.ctx, x));
-  PM_CALL(pm_newton_values_at(s, x, s->jvals));
-  for (long k = 0; k < s->jpat.nsrc; k++) val[k] = s->jvals[s->jpat.src[k]];
+  double *vals;
+  PM_CALL(pm_newton_jvals(s, &vals));
+  PM_CALL(pm_newton_values_at(s, x, vals));
+  for (long k = 0; k < s->jpat.nsrc; k++)
+    val[k] = vals[s->jpat.src ? s->jpat.src[k] : k];
   return PM_SUCCESS;
 }
 
@@ -32,11 +35,15 @@ pm_err pm_newton_check_jacobian(pm_newton *s, const double *x, double h,
   long n = s->p.n;
   /* The pattern by columns (a caller-assembled Jacobian has no colouring
    * yet). */
-  if (!s->jcol.col_ptr)
+  if (!s->jcol.col_ptr) {
+    PM_CALL(pm_newton_pattern_columns(s));
     PM_CALL(pm_coloring_build(&s->jpat, s->o.coloring, &s->jcol));
+  }
   const pm_coloring *c = &s->jcol;
   if (s->p.jacobian_prepare) PM_CALL(s->p.jacobian_prepare(s->p.ctx, x));
-  PM_CALL(pm_newton_values_at(s, x, s->jvals));
+  double *vals;
+  PM_CALL(pm_newton_jvals(s, &vals));
+  PM_CALL(pm_newton_values_at(s, x, vals));
   PM_TRY(PM_ALLOC(xp, n, "perturbed state"));
   PM_TRY(PM_ALLOC(rp, n, "perturbed residual"));
   PM_TRY(PM_ALLOC(rm, n, "perturbed residual"));
@@ -52,7 +59,7 @@ pm_err pm_newton_check_jacobian(pm_newton *s, const double *x, double h,
     PM_TRY(s->p.residual(s->p.ctx, xp, rm));
     xp[j] = x[j];
     for (long q = c->col_ptr[j]; q < c->col_ptr[j + 1]; q++)
-      column[c->col_row[q]] = s->jvals[c->col_pos[q]];
+      column[c->col_row[q]] = vals[c->col_pos[q]];
     for (long i = 0; i < n; i++) {
       double fd = (rp[i] - rm[i]) / (2 * step);
       double err = fabs(fd - column[i]);

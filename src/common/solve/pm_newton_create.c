@@ -166,10 +166,19 @@ static pm_err create_petsc_objects(pm_newton *s) {
     PM_PETSC_CALL(VecDuplicate(s->X, &s->ShiftWork));
   }
   if (s->o.op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
-    PM_CALL(pm_newton_create_matrix(s, &s->ppat, &s->pcols, s->pvals, &s->P));
+    PM_CALL(pm_newton_create_matrix(s, &s->ppat, false, &s->pcols, s->pvals,
+                                    &s->P));
   } else if (!pm_newton_aug_on(s)) {
-    PM_CALL(pm_newton_create_matrix(s, &s->jpat, &s->jcols, s->jvals, &s->J));
+    /* The caller's assembly on one process: the columns are the matrix's
+     * (pm_newton_pattern_columns gives them back where wanted). */
+    const bool release = !s->dist && s->p.jacobian_values;
+    PM_CALL(pm_newton_create_matrix(s, &s->jpat, release, &s->jcols, s->jvals,
+                                    &s->J));
   }
+  /* the caller's values, made once the matrix holds the pattern */
+  if (s->p.jacobian_values && s->jpat.src)
+    PM_CALL(PM_ALLOC(s->srcvals, s->jpat.nsrc > 0 ? s->jpat.nsrc : 1,
+                     "Jacobian values"));
   PM_CALL(pm_newton_fine_create(s));
   if (s->p.near_null_count > 0 && !pm_newton_aug_on(s)) {
     Mat A, B;
@@ -216,24 +225,24 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
   long n = s->nloc;
   PM_TRY(
       pm_pattern_build(n, problem->pat_ptr, problem->pat_idx, true, &s->jpat));
-  if (problem->jacobian_values)
-    PM_TRY(PM_ALLOC(s->srcvals, s->jpat.nsrc > 0 ? s->jpat.nsrc : 1,
-                    "Jacobian values"));
-  else
+  if (!problem->jacobian_values)
     PM_TRY(pm_coloring_build(&s->jpat, options->coloring, &s->jcol));
-  PM_TRY(PM_ALLOC(s->jvals, s->jpat.ptr[n], "Jacobian values"));
+  /* across ranks the values go through jvals into the matrix; on one
+   * process into its own storage */
+  if (s->dist) PM_TRY(pm_newton_jvals(s, &s->jvals));
   if (options->op == PM_NEWTON_MATRIX_FREE_CHEAP_PC) {
     const long *ptr =
         problem->pc_pat_ptr ? problem->pc_pat_ptr : problem->pat_ptr;
     const long *idx =
         problem->pc_pat_ptr ? problem->pc_pat_idx : problem->pat_idx;
     PM_TRY(pm_pattern_build(n, ptr, idx, true, &s->ppat));
-    if (problem->precond_values)
+    if (problem->precond_values && s->ppat.src)
       PM_TRY(PM_ALLOC(s->psrcvals, s->ppat.nsrc > 0 ? s->ppat.nsrc : 1,
                       "preconditioner values"));
     else
       PM_TRY(pm_coloring_build(&s->ppat, options->coloring, &s->pcol));
-    PM_TRY(PM_ALLOC(s->pvals, s->ppat.ptr[n], "preconditioner values"));
+    if (s->dist)
+      PM_TRY(PM_ALLOC(s->pvals, s->ppat.ptr[n] + 1, "preconditioner values"));
   }
   PM_TRY(pm_newton_aug_init(s, problem));
   s->p.aux_ptr = s->p.aux_idx = NULL; /* the caller's: copied */

@@ -29,10 +29,12 @@ struct pm_newton {
   pm_pattern jpat, ppat;   /* Jacobian's and cheap operator's */
   pm_coloring jcol, pcol;  /* their colourings (pcol: cheap only) */
   PetscInt *jcols, *pcols; /* pattern columns as PETSc indices */
-  double *jvals, *pvals;   /* values in pattern order */
-  double *seed, *dr;       /* colour seed and its image */
-  double *srcvals;         /* jacobian_values: values in the caller's order */
-  double *psrcvals;        /* precond_values: values in the caller's order */
+  /* values in pattern order: across ranks (inserted into the matrix);
+   * on one process jvals is made on first use (pm_newton_jvals) */
+  double *jvals, *pvals;
+  double *seed, *dr; /* colour seed and its image */
+  double *srcvals;   /* jacobian_values: values in the caller's order */
+  double *psrcvals;  /* precond_values: values in the caller's order */
   Vec X, R, Xstart, Xlin, Xacc, Work;
   /* pc_reuse_its: where the kept factorisation or preconditioner was
    * built (Xpc) and under which load (pc_load; load: the last set). */
@@ -101,13 +103,14 @@ struct pm_newton {
   double ew_rprev, ew_eta;
   int lin_its;
   bool started; /* the initial state was admissible */
-  /* pm_newton_problem.aux_n: the augmented matrix's pattern, columns and
-   * values (asrc: in the caller's order), the matrix, its LU (ka) and
+  /* pm_newton_problem.aux_n: the augmented matrix's pattern, columns
+   * (NULL: its values go into its own storage) and values in the caller's
+   * order (asrc), the matrix, its LU (ka) and
    * its right-hand side and solution; dirty: new values not factorised. */
   bool aug, aug_dirty;
   pm_pattern apat;
   PetscInt *acols;
-  double *avals, *asrc;
+  double *asrc;
   Mat Ma;
   KSP ka;
   Vec Ab, Ay;
@@ -139,20 +142,44 @@ pm_err pm_newton_color_values(pm_newton *s, apply_fn f, const pm_coloring *col,
 /* The Jacobian's values at x in pattern order: the caller's assembly when
  * it gives one, else colouring. */
 pm_err pm_newton_values_at(pm_newton *s, const double *x, double *vals);
-/* The cheaper operator's values at x into s->pvals (pattern order): the
+/* The cheaper operator's values at x into vals (pattern order): the
  * caller's assembly (precond_values) when it gives one, else colouring of
  * precond_apply. */
-pm_err pm_newton_precond_values(pm_newton *s, const double *x);
+pm_err pm_newton_precond_values(pm_newton *s, const double *x, double *vals);
+typedef pm_err (*pm_newton_values_fn)(pm_newton *s, const double *x,
+                                      double *vals);
+/* s->jvals (the Jacobian's values apart from its matrix: relaxation's
+ * masses, the checks), made on first use. */
+pm_err pm_newton_jvals(pm_newton *s, double **vals);
 
-/* M = vals on the pattern (the matrix's preallocated structure). */
+/* s->jpat.idx again, from the Jacobian's matrix, where it was let go (a
+ * caller's assembly on one process keeps the columns in the matrix). */
+pm_err pm_newton_pattern_columns(pm_newton *s);
+
+/* M = vals on the pattern (the matrix's preallocated structure; cols NULL:
+ * M's storage is the pattern's, one process). */
 pm_err pm_newton_insert_values(const pm_newton *s, Mat M, const pm_pattern *pat,
                                const PetscInt *cols, const double *vals);
+/* M = f's values at x: written by f into M's own storage where cols is
+ * NULL, else into vals and inserted. */
+pm_err pm_newton_fill(pm_newton *s, Mat M, const pm_pattern *pat,
+                      const PetscInt *cols, double *vals, pm_newton_values_fn f,
+                      const double *x);
+/* M = the caller's values src (the pattern's source order) summed into
+ * their places: in M's own storage where cols is NULL, else through vals. */
+pm_err pm_newton_scatter_into(const pm_newton *s, Mat M, const pm_pattern *pat,
+                              const PetscInt *cols, const double *src,
+                              double *vals);
 
-/* *M: an AIJ matrix with pat's structure, set to zeros (n values, the
- * caller's); *cols (allocated, the caller frees) the pattern's columns as
- * PETSc indices.  Sequential, or over the ranks with every rank's rows. */
-pm_err pm_newton_create_matrix(const pm_newton *s, const pm_pattern *pat,
-                               PetscInt **cols, double *zeros, Mat *M);
+/* *M: an AIJ matrix with pat's structure, set to zeros.  On one process
+ * its storage is the pattern's order and *cols is NULL (with release, the
+ * pattern's columns are let go before the matrix is made: the matrix holds
+ * them); across ranks *cols (allocated, the caller frees) holds the
+ * pattern's columns as PETSc indices and zeros the pattern's count of
+ * zeros (the caller's). */
+pm_err pm_newton_create_matrix(const pm_newton *s, pm_pattern *pat,
+                               bool release, PetscInt **cols, double *zeros,
+                               Mat *M);
 
 /* The problem's near-null vectors, orthonormalised, as M's near null space
  * (at most 16 of them, else PM_ERR_ARG). */

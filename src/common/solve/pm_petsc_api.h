@@ -58,8 +58,10 @@
   X(MatPreallocatorPreallocate)                                                \
   X(MatRestoreRowIJ)                                                           \
   X(MatSeqAIJGetArrayRead)                                                     \
+  X(MatSeqAIJGetArrayWrite)                                                    \
   X(MatSeqAIJRestoreArrayRead)                                                 \
-  X(MatSeqAIJSetPreallocation)                                                 \
+  X(MatSeqAIJRestoreArrayWrite)                                                \
+  X(MatSeqAIJSetPreallocationCSR)                                              \
   X(MatSetBlockSize)                                                           \
   X(MatSetLocalToGlobalMapping)                                                \
   X(MatSetNearNullSpace)                                                       \
@@ -202,8 +204,11 @@ pm_err pm_petsc_api_load(const char *need);
 #define MatPreallocatorPreallocate (*pm_petsc_api.MatPreallocatorPreallocate)
 #define MatRestoreRowIJ (*pm_petsc_api.MatRestoreRowIJ)
 #define MatSeqAIJGetArrayRead (*pm_petsc_api.MatSeqAIJGetArrayRead)
+#define MatSeqAIJGetArrayWrite (*pm_petsc_api.MatSeqAIJGetArrayWrite)
 #define MatSeqAIJRestoreArrayRead (*pm_petsc_api.MatSeqAIJRestoreArrayRead)
-#define MatSeqAIJSetPreallocation (*pm_petsc_api.MatSeqAIJSetPreallocation)
+#define MatSeqAIJRestoreArrayWrite (*pm_petsc_api.MatSeqAIJRestoreArrayWrite)
+#define MatSeqAIJSetPreallocationCSR                                           \
+  (*pm_petsc_api.MatSeqAIJSetPreallocationCSR)
 #define MatSetBlockSize (*pm_petsc_api.MatSetBlockSize)
 #define MatSetLocalToGlobalMapping (*pm_petsc_api.MatSetLocalToGlobalMapping)
 #define MatSetNearNullSpace (*pm_petsc_api.MatSetNearNullSpace)

@@ -279,6 +279,11 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   }
   PM_TRY(pm_newton_create(&v.prob, &no, &solver));
   c->solver = solver;
+  /* The solver holds the pattern now (a coupled pattern made later takes
+   * the tangent's rows from the points that reach each point). */
+  free(v.idx);
+  v.idx = NULL;
+  v.prob.pat_idx = NULL;
   /* Multigrid where Newton passes, the LU in the fallbacks (a fold's
    * singular tangent, where multigrid's solves crawl) while it fits. */
   if (fpm_static_fallback_direct(s, m, rep->unknowns)) {

@@ -96,9 +96,18 @@ pm_err fpm_static_coupled_build(fpm_static_solve *v) {
   }
   PM_CALL(PM_ALLOC(cp->idx, cp->ptr[nf + n], "coupled pattern"));
   for (long row = 0; row < nf; row++) {
+    /* the tangent's row (its pattern's columns, in fpm_static_pattern's
+     * order, from the points that reach k) */
     const long k = c->dof[row] / 3, nj = v->ptr[row + 1] - v->ptr[row];
-    long *out = cp->idx + cp->ptr[row];
-    memcpy(out, v->idx + v->ptr[row], (size_t)nj * sizeof *out);
+    long *out = cp->idx + cp->ptr[row], w = 0;
+    for (long t = c->tg.R_ptr[k]; t < c->tg.R_ptr[k + 1]; t++)
+      for (int a = 0; a < 3; a++) {
+        const long col = free_of[3 * c->tg.R_list[t] + a];
+        if (col >= 0) out[w++] = col;
+      }
+    PM_CHECK(w == nj, PM_ERR_INTERNAL,
+             "coupled pattern: row %ld holds %ld columns, the tangent's %ld",
+             row, w, nj);
     for (long q = cp->Z_ptr[k]; q < cp->Z_ptr[k + 1]; q++)
       out[nj + q - cp->Z_ptr[k]] = nf + cp->Z_i[q];
   }

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "fpm_static_impl.h"
+#include "pm_coloring.h"
 
 /* Marks the points of S(i) and i into list (marker: stamp). */
 static long add_support(const fpm_model *m, long i, long *list, long cnt,
@@ -80,6 +81,10 @@ pm_err fpm_static_pattern(const fpm_model *m, const long *free_of, long nf,
   for (int pass = 0; pass < 2; pass++) {
     for (long k = 0; k < rows; k++) {
       long nr = reach(m, k, r_list, a_list, mark_a, mark_r, pass * n + k);
+      /* in increasing order: the rows' columns then are (the unknowns
+       * number the free dofs in order), and the solver takes the tangent's
+       * values in place */
+      if (pass == 1) pm_pattern_sort_row(r_list, nr);
       if (pass == 0)
         tg->R_ptr[k + 1] = nr;
       else
