@@ -52,7 +52,9 @@ typedef enum {
 typedef enum {
   PM_QS_LS_AUTO = 0,     /* the method's own: backtracking */
   PM_QS_LS_BACKTRACKING, /* cubic backtracking from the full step */
-  PM_QS_LS_SECANT        /* a secant step on the residual's norm */
+  PM_QS_LS_SECANT,       /* a secant step on the residual's norm */
+  PM_QS_LS_FULL_SECANT   /* the whole step where it lowers the residual,
+                            else the secant */
 } pm_qs_line_search;
 
 /* How the stable time step is found. */

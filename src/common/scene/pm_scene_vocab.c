@@ -35,6 +35,7 @@ static const pm_name line_search_names[] = {
     {"auto", PM_QS_LS_AUTO},
     {"backtracking", PM_QS_LS_BACKTRACKING},
     {"secant", PM_QS_LS_SECANT},
+    {"whole-then-secant", PM_QS_LS_FULL_SECANT},
     {NULL, 0}};
 static const pm_name amg_operator_names[] = {{"support", PM_AMG_SUPPORT},
                                              {"support2", PM_AMG_SUPPORT2},

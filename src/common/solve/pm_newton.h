@@ -234,7 +234,10 @@ typedef enum {
   PM_LINE_SEARCH_BT = 0, /* backtracking (cubic), the default */
   PM_LINE_SEARCH_BASIC,  /* full Newton step; a domain error then fails */
   PM_LINE_SEARCH_L2,     /* secant on the residual norm along the step */
-  PM_LINE_SEARCH_CP      /* critical point (for residuals that are gradients) */
+  PM_LINE_SEARCH_CP,     /* critical point (for residuals that are gradients) */
+  PM_LINE_SEARCH_FULL_L2 /* the full step where it lowers the residual
+                            enough (as backtracking's first trial), else
+                            the secant (PM_LINE_SEARCH_L2) */
 } pm_line_search;
 
 typedef struct {
@@ -386,6 +389,9 @@ typedef struct {
 
 /* The solver of a scene's time.quasi_static.linear_solver. */
 pm_newton_linear pm_newton_linear_of(pm_linear_solver l);
+/* The line search a scene's time.quasi_static.line_search names (auto:
+ * backtracking). */
+pm_line_search pm_newton_line_search_of(pm_qs_line_search l);
 
 /* The options above with their defaults. */
 pm_newton_options pm_newton_options_default(void);

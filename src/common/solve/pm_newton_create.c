@@ -34,7 +34,7 @@ static pm_err check_options(const pm_newton_options *o) {
                o->coloring == PM_COLORING_NATURAL,
            PM_ERR_ARG, "unknown colouring order %d", (int)o->coloring);
   PM_CHECK(o->line_search >= PM_LINE_SEARCH_BT &&
-               o->line_search <= PM_LINE_SEARCH_CP,
+               o->line_search <= PM_LINE_SEARCH_FULL_L2,
            PM_ERR_ARG, "unknown line search %d", (int)o->line_search);
   PM_CHECK(o->linear_rtol > 0 && o->linear_rtol < 1, PM_ERR_ARG,
            "linear_rtol must be in (0, 1) (got %g)", o->linear_rtol);
@@ -101,8 +101,8 @@ static pm_err check_problem(const pm_newton_problem *p,
 static pm_err configure_snes(pm_newton *s) {
   const pm_newton_options *o = &s->o;
   static const SNESLineSearchType types[] = {
-      SNESLINESEARCHBT, SNESLINESEARCHBASIC, SNESLINESEARCHL2,
-      SNESLINESEARCHCP};
+      SNESLINESEARCHBT, SNESLINESEARCHBASIC, SNESLINESEARCHL2, SNESLINESEARCHCP,
+      SNESLINESEARCHSHELL};
   PM_PETSC_CALL(PetscOptionsCreate(&s->opts));
   /* MUMPS: a singular matrix (a limit point) factors with its null pivots
    * set aside instead of failing with an error. */
@@ -140,6 +140,8 @@ static pm_err configure_snes(pm_newton *s) {
                                             PETSC_DEFAULT, PETSC_DEFAULT,
                                             PETSC_DEFAULT, PETSC_DEFAULT));
   PM_PETSC_CALL(SNESLineSearchSetPreCheck(s->ls, pm_newton_precheck, s));
+  if (o->line_search == PM_LINE_SEARCH_FULL_L2)
+    PM_CALL(pm_newton_full_l2_create(s));
   PM_PETSC_CALL(PetscOptionsPush(s->opts));
   PetscErrorCode code = SNESSetFromOptions(s->snes);
   PetscOptionsPop();
@@ -266,6 +268,7 @@ void pm_newton_destroy(pm_newton **sp) {
   pm_newton *s = *sp;
   /* Destruction never fails in practice; its codes have nowhere to go. */
   SNESDestroy(&s->snes);
+  SNESLineSearchDestroy(&s->ls2);
   pm_newton_aug_free(s);
   MatDestroy(&s->Shell);
   MatDestroy(&s->Fine);

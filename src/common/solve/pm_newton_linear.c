@@ -293,6 +293,16 @@ void pm_newton_operators(const pm_newton *s, Mat *A, Mat *B) {
                                                  : s->J;
 }
 
+pm_line_search pm_newton_line_search_of(pm_qs_line_search l) {
+  switch (l) {
+  case PM_QS_LS_SECANT: return PM_LINE_SEARCH_L2;
+  case PM_QS_LS_FULL_SECANT: return PM_LINE_SEARCH_FULL_L2;
+  case PM_QS_LS_AUTO:
+  case PM_QS_LS_BACKTRACKING: break;
+  }
+  return PM_LINE_SEARCH_BT;
+}
+
 pm_newton_linear pm_newton_linear_of(pm_linear_solver l) {
   switch (l) {
   case PM_LINEAR_GMRES_GAMG: return PM_NEWTON_GMRES_GAMG;

@@ -56,6 +56,9 @@ struct pm_newton {
   SNES snes;
   KSP ksp;
   SNESLineSearch ls;
+  /* PM_LINE_SEARCH_FULL_L2: the secant taken where the full step does not
+   * lower the residual enough */
+  SNESLineSearch ls2;
   PetscOptions opts;
   /* Across ranks (dist): the ranks' communicator (PETSC_COMM_SELF on one
    * process), the values a rank holds (owned and ghosts: nloc), the
@@ -217,6 +220,9 @@ pm_err pm_newton_fine_create(pm_newton *s);
 /* After the preconditioner's set-up: Fine in the finest smoother and
  * residual (again after a new hierarchy). */
 PetscErrorCode pm_newton_fine_attach(pm_newton *s, KSP ksp);
+/* ---- pm_newton_line_search.c: the full step, else the secant. */
+/* s->ls runs it (a shell line search), s->ls2 the secant. */
+pm_err pm_newton_full_l2_create(pm_newton *s);
 PetscErrorCode pm_newton_precheck(SNESLineSearch ls, Vec X, Vec Y,
                                   PetscBool *changed, void *ctx);
 PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx);

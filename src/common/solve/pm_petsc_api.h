@@ -104,6 +104,7 @@
   X(PetscPopSignalHandler)                                                     \
   X(PetscPushErrorHandler)                                                     \
   X(PetscTrFree)                                                               \
+  X(SNESComputeFunction)                                                       \
   X(SNESConvergedReasons)                                                      \
   X(SNESCreate)                                                                \
   X(SNESDestroy)                                                               \
@@ -113,10 +114,24 @@
   X(SNESGetLineSearch)                                                         \
   X(SNESGetLinearSolveIterations)                                              \
   X(SNESGetSolution)                                                           \
+  X(SNESLineSearchApply)                                                       \
+  X(SNESLineSearchCreate)                                                      \
+  X(SNESLineSearchDestroy)                                                     \
   X(SNESLineSearchGetLambda)                                                   \
+  X(SNESLineSearchGetNorms)                                                    \
+  X(SNESLineSearchGetReason)                                                   \
+  X(SNESLineSearchGetSNES)                                                     \
+  X(SNESLineSearchGetVecs)                                                     \
+  X(SNESLineSearchPreCheck)                                                    \
+  X(SNESLineSearchSetFunction)                                                 \
+  X(SNESLineSearchSetLambda)                                                   \
+  X(SNESLineSearchSetNorms)                                                    \
   X(SNESLineSearchSetPreCheck)                                                 \
+  X(SNESLineSearchSetReason)                                                   \
+  X(SNESLineSearchSetSNES)                                                     \
   X(SNESLineSearchSetTolerances)                                               \
   X(SNESLineSearchSetType)                                                     \
+  X(SNESLineSearchShellSetUserFunc)                                            \
   X(SNESSetConvergenceTest)                                                    \
   X(SNESSetFromOptions)                                                        \
   X(SNESSetFunction)                                                           \
@@ -251,6 +266,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define PetscPopSignalHandler (*pm_petsc_api.PetscPopSignalHandler)
 #define PetscPushErrorHandler (*pm_petsc_api.PetscPushErrorHandler)
 #define PetscTrFree (*pm_petsc_api.PetscTrFree)
+#define SNESComputeFunction (*pm_petsc_api.SNESComputeFunction)
 #define SNESConvergedReasons (*pm_petsc_api.SNESConvergedReasons)
 #define SNESCreate (*pm_petsc_api.SNESCreate)
 #define SNESDestroy (*pm_petsc_api.SNESDestroy)
@@ -261,10 +277,25 @@ pm_err pm_petsc_api_load(const char *need);
 #define SNESGetLinearSolveIterations                                           \
   (*pm_petsc_api.SNESGetLinearSolveIterations)
 #define SNESGetSolution (*pm_petsc_api.SNESGetSolution)
+#define SNESLineSearchApply (*pm_petsc_api.SNESLineSearchApply)
+#define SNESLineSearchCreate (*pm_petsc_api.SNESLineSearchCreate)
+#define SNESLineSearchDestroy (*pm_petsc_api.SNESLineSearchDestroy)
 #define SNESLineSearchGetLambda (*pm_petsc_api.SNESLineSearchGetLambda)
+#define SNESLineSearchGetNorms (*pm_petsc_api.SNESLineSearchGetNorms)
+#define SNESLineSearchGetReason (*pm_petsc_api.SNESLineSearchGetReason)
+#define SNESLineSearchGetSNES (*pm_petsc_api.SNESLineSearchGetSNES)
+#define SNESLineSearchGetVecs (*pm_petsc_api.SNESLineSearchGetVecs)
+#define SNESLineSearchPreCheck (*pm_petsc_api.SNESLineSearchPreCheck)
+#define SNESLineSearchSetFunction (*pm_petsc_api.SNESLineSearchSetFunction)
+#define SNESLineSearchSetLambda (*pm_petsc_api.SNESLineSearchSetLambda)
+#define SNESLineSearchSetNorms (*pm_petsc_api.SNESLineSearchSetNorms)
 #define SNESLineSearchSetPreCheck (*pm_petsc_api.SNESLineSearchSetPreCheck)
+#define SNESLineSearchSetReason (*pm_petsc_api.SNESLineSearchSetReason)
+#define SNESLineSearchSetSNES (*pm_petsc_api.SNESLineSearchSetSNES)
 #define SNESLineSearchSetTolerances (*pm_petsc_api.SNESLineSearchSetTolerances)
 #define SNESLineSearchSetType (*pm_petsc_api.SNESLineSearchSetType)
+#define SNESLineSearchShellSetUserFunc                                         \
+  (*pm_petsc_api.SNESLineSearchShellSetUserFunc)
 #define SNESSetConvergenceTest (*pm_petsc_api.SNESSetConvergenceTest)
 #define SNESSetFromOptions (*pm_petsc_api.SNESSetFromOptions)
 #define SNESSetFunction (*pm_petsc_api.SNESSetFunction)

@@ -222,11 +222,13 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   no.relax_after = (int)s->time.qs_relax_after;
   no.ptc_max_iter = (int)s->time.qs_ptc;
   no.follow_fold = s->time.qs_follow_fold;
-  /* The secant line search where the scene asks for it: near a stretched
-   * block's necking the whole step overshoots, and backtracking creeps
-   * (docs/validation.md, "The secant line search"). */
-  if (s->time.qs_line_search == PM_QS_LS_SECANT)
-    no.line_search = PM_LINE_SEARCH_L2;
+  /* Newton's whole step where it lowers the residual enough, else the
+   * secant: near a stretched block's necking the whole step overshoots,
+   * and backtracking creeps (docs/validation.md, "The secant line search"
+   * and "The whole step, else the secant"). */
+  no.line_search = s->time.qs_line_search == PM_QS_LS_AUTO
+                       ? PM_LINE_SEARCH_FULL_L2
+                       : pm_newton_line_search_of(s->time.qs_line_search);
   no.fallback_seconds = s->time.qs_fallback_cpu;
   no.easy_iterations = 3;
   /* ...and, with max_load_step, grow past 1/load_steps up to it (not by
