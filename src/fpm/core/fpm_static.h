@@ -43,8 +43,11 @@ typedef struct {
  * lowest mode, arc length, continuation, relaxation: a singular tangent,
  * where multigrid's solves crawl) to the LU of the tangent, kept for the
  * rest of the run (pm_newton_set_fallback_linear), the memory of the LU
- * then needed. */
-#define FPM_STATIC_FALLBACK_DIRECT_MAX 8000L
+ * then needed: FPM_STATIC_COUPLED_MAX, the coupled LU's bound, so that
+ * the blocks' 4036-point budgets (8877-10071 free dofs) get it (F3 200%
+ * there: 1034 CPU s and 1.7 GiB, where multigrid's arcs crawled past 18
+ * minutes; docs/validation.md, "The completion matrix"). */
+#define FPM_STATIC_FALLBACK_DIRECT_MAX FPM_STATIC_COUPLED_MAX
 /* Free dofs (over all ranks) up to which the averaged volume's coupling
  * is factorised by default (time.quasi_static.averaged_coupling): its LU
  * takes about 1.8 times the memory of the tangent's (805 against 457 MiB
