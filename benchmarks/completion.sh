@@ -52,7 +52,11 @@ if os.path.exists(d + "/summary.json"):
         s = json.load(open(d + "/summary.json"))
     except ValueError:
         s = {}
-t = open(d + ".time").read().split() if os.path.exists(d + ".time") else []
+# /usr/bin/time's last line (a failed run's first says its status)
+t = []
+if os.path.exists(d + ".time"):
+    lines = [l for l in open(d + ".time").read().splitlines() if l.strip()]
+    t = lines[-1].split() if lines else []
 cpu = f"{float(t[0]) + float(t[1]):.0f}" if len(t) >= 4 else ""
 wall = f"{float(t[2]):.0f}" if len(t) >= 4 else ""
 peak = f"{int(t[3]) / 1024:.0f}" if len(t) >= 4 else ""
