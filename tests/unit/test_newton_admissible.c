@@ -44,28 +44,36 @@ static pm_err cubic_apply(void *ctx, const double *x, const double *dx,
   return PM_SUCCESS;
 }
 
+/* x^3 - 1 = 0 solved from x (in place) to 1e-14 with line search ls; c
+ * counts the refused trials. */
+static void solve_cubic(cubic *c, pm_line_search ls, double *x,
+                        pm_newton_report *rep) {
+  long ptr[2] = {0, 1}, idx[1] = {0};
+  pm_newton_problem prob = {.n = 1,
+                            .ctx = c,
+                            .residual = cubic_residual,
+                            .jacobian_apply = cubic_apply,
+                            .pat_ptr = ptr,
+                            .pat_idx = idx};
+  pm_newton_options opt = pm_newton_options_default();
+  opt.rtol = 1e-14;
+  opt.line_search = ls;
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  assert_ok(pm_newton_solve(s, x, rep));
+  pm_newton_destroy(&s);
+}
+
 static void test_inadmissible_trials(void **state) {
   (void)state;
-  long ptr[2] = {0, 1}, idx[1] = {0};
   for (int k = 0; k < 4; k++) {
     const int nan = k % 2;
     const pm_line_search ls =
         k < 2 ? PM_LINE_SEARCH_BT : PM_LINE_SEARCH_FULL_L2;
     cubic c = {nan != 0, 0};
-    pm_newton_problem prob = {.n = 1,
-                              .ctx = &c,
-                              .residual = cubic_residual,
-                              .jacobian_apply = cubic_apply,
-                              .pat_ptr = ptr,
-                              .pat_idx = idx};
-    pm_newton_options opt = pm_newton_options_default();
-    opt.rtol = 1e-14;
-    opt.line_search = ls;
-    pm_newton *s = NULL;
-    assert_ok(pm_newton_create(&prob, &opt, &s));
     double x = 0.2;
     pm_newton_report rep;
-    assert_ok(pm_newton_solve(s, &x, &rep));
+    solve_cubic(&c, ls, &x, &rep);
     print_message("%s, %s trials: %s in %d iterations, %ld residuals (%ld "
                   "refused), first step length %.3g, x - 1 = %.1e\n",
                   ls == PM_LINE_SEARCH_BT ? "backtracking"
@@ -78,7 +86,6 @@ static void test_inadmissible_trials(void **state) {
     assert_true(rep.step_length[1] < 1);
     assert_true(rep.reason == PM_NEWTON_CONVERGED_RESIDUAL ||
                 rep.reason == PM_NEWTON_CONVERGED_ABSOLUTE);
-    pm_newton_destroy(&s);
   }
 }
 
@@ -87,25 +94,13 @@ static void test_inadmissible_trials(void **state) {
  * iterates to the last bit. */
 static void test_whole_steps_as_backtracking(void **state) {
   (void)state;
-  long ptr[2] = {0, 1}, idx[1] = {0};
   double x[2];
   pm_newton_report rep[2];
   for (int k = 0; k < 2; k++) {
     cubic c = {false, 0};
-    pm_newton_problem prob = {.n = 1,
-                              .ctx = &c,
-                              .residual = cubic_residual,
-                              .jacobian_apply = cubic_apply,
-                              .pat_ptr = ptr,
-                              .pat_idx = idx};
-    pm_newton_options opt = pm_newton_options_default();
-    opt.rtol = 1e-14;
-    opt.line_search = k ? PM_LINE_SEARCH_FULL_L2 : PM_LINE_SEARCH_BT;
-    pm_newton *s = NULL;
-    assert_ok(pm_newton_create(&prob, &opt, &s));
     x[k] = 1.2;
-    assert_ok(pm_newton_solve(s, &x[k], &rep[k]));
-    pm_newton_destroy(&s);
+    solve_cubic(&c, k ? PM_LINE_SEARCH_FULL_L2 : PM_LINE_SEARCH_BT, &x[k],
+                &rep[k]);
   }
   print_message("from x = 1.2: %d and %d iterations, %ld and %ld residuals, "
                 "x - 1 = %.1e and %.1e\n",
