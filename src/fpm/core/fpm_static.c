@@ -43,7 +43,10 @@ static double force_floor(const fpm_model *m) {
  * with the fill about as the free dofs to the power 0.25 (nested
  * dissection's factors grow as n^(4/3) against the tangent's n; the
  * coupled LU took 13.0 GB at 36 549 free dofs); multigrid (GAMG, its
- * operator complexity included) 116 at 4359, taken as 120, flat.  Entries
+ * operator complexity included) 68 at 4359, 48 at 36 549 and 46 at
+ * 89 535 since the tangent is written in the matrix's own storage
+ * (docs/validation.md, "Static solves: the matrix in the pattern's
+ * order"; 116 at 4359 before), taken as 75, flat.  Entries
  * per free dof: 650 with the quadratic jump (3 rings), 403 with the linear
  * jump. */
 double fpm_static_solver_bytes(long free_dofs, bool quadratic,
@@ -52,7 +55,7 @@ double fpm_static_solver_bytes(long free_dofs, bool quadratic,
   const double n = (double)free_dofs, nnz = (quadratic ? 650.0 : 403.0) * n,
                fill = pow(n / 4359.0, 0.25);
   if (entries) *entries = nnz;
-  if (linear != PM_NEWTON_DIRECT) return 120.0 * nnz;
+  if (linear != PM_NEWTON_DIRECT) return 75.0 * nnz;
   return (coupled ? 330.0 : 210.0) * fill * nnz;
 }
 
