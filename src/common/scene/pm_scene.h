@@ -50,7 +50,8 @@ typedef enum {
 /* The line search of a static solve's Newton iterations
  * (time.quasi_static.line_search). */
 typedef enum {
-  PM_QS_LS_AUTO = 0,     /* the method's own: backtracking */
+  PM_QS_LS_AUTO = 0,     /* the method's own: FPM whole-then-secant, the
+                            implicit MPM backtracking */
   PM_QS_LS_BACKTRACKING, /* cubic backtracking from the full step */
   PM_QS_LS_SECANT,       /* a secant step on the residual's norm */
   PM_QS_LS_FULL_SECANT   /* the whole step where it lowers the residual,

@@ -830,14 +830,16 @@ static const pm_key quasi_static_keys[] = {
      .def = "auto",
      .names = line_search_names,
      .doc = "method static: the line search along each Newton step: "
-            "secant, a secant step on the residual's norm from its values "
-            "at the half and the whole step (PETSc's l2); backtracking, "
-            "the whole step unless the residual does not fall enough, then "
-            "cubic backtracking (PETSc's bt); auto: backtracking.  The "
-            "secant takes F3 200% at 1851 points (FPM) in 65 Newton "
-            "iterations where backtracking takes 131, but its step is "
-            "seldom exactly the whole one, so Newton's last iterations "
-            "lose some of their quadratic order"},
+            "whole-then-secant, Newton's whole step where it lowers the "
+            "residual's norm as backtracking's first trial asks, else the "
+            "secant; secant, a secant step on the residual's norm from its "
+            "values at the half and the whole step (PETSc's l2: its step "
+            "seldom exactly the whole one, Newton's last iterations lose "
+            "some quadratic order); backtracking, the whole step unless the "
+            "residual does not fall enough, then cubic backtracking "
+            "(PETSc's bt); auto: whole-then-secant for FPM (F3 200% at 1851 "
+            "points in 65 Newton iterations where backtracking takes 131), "
+            "backtracking for the implicit MPM"},
     {.name = "follow_fold",
      .type = PM_KEY_BOOL,
      .offset = S(time.qs_follow_fold),

@@ -390,8 +390,9 @@ typedef struct {
 /* The solver of a scene's time.quasi_static.linear_solver. */
 pm_newton_linear pm_newton_linear_of(pm_linear_solver l);
 /* The line search a scene's time.quasi_static.line_search names (auto:
- * backtracking). */
-pm_line_search pm_newton_line_search_of(pm_qs_line_search l);
+ * the method's own, own). */
+pm_line_search pm_newton_line_search_of(pm_qs_line_search l,
+                                        pm_line_search own);
 
 /* The options above with their defaults. */
 pm_newton_options pm_newton_options_default(void);

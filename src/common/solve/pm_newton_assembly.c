@@ -139,14 +139,6 @@ static pm_err set_rows(Mat M, bool dist, const pm_pattern *pat,
 /* M = vals on the pattern (the matrix's preallocated structure). */
 pm_err pm_newton_insert_values(const pm_newton *s, Mat M, const pm_pattern *pat,
                                const PetscInt *cols, const double *vals) {
-  if (!cols) {
-    double *a;
-    const long nnz = pat->ptr[pat->n];
-    PM_PETSC_CALL(MatSeqAIJGetArrayWrite(M, &a));
-    memcpy(a, vals, (size_t)nnz * sizeof *a);
-    PM_PETSC_CALL(MatSeqAIJRestoreArrayWrite(M, &a));
-    return PM_SUCCESS;
-  }
   if (s->dist) PM_PETSC_CALL(MatZeroEntries(M));
   return set_rows(M, s->dist, pat, cols, vals);
 }
@@ -165,13 +157,7 @@ pm_err pm_newton_fill(pm_newton *s, Mat M, const pm_pattern *pat,
   return e;
 }
 
-pm_err pm_newton_scatter_into(const pm_newton *s, Mat M, const pm_pattern *pat,
-                              const PetscInt *cols, const double *src,
-                              double *vals) {
-  if (cols) {
-    scatter(pat, src, vals);
-    return pm_newton_insert_values(s, M, pat, cols, vals);
-  }
+pm_err pm_newton_scatter_into(Mat M, const pm_pattern *pat, const double *src) {
   double *a;
   PM_PETSC_CALL(MatSeqAIJGetArrayWrite(M, &a));
   scatter(pat, src, a);
@@ -239,9 +225,12 @@ pm_err pm_newton_create_matrix(const pm_newton *s, pm_pattern *pat,
    * pattern's places are its storage's */
   PM_PETSC(MatSeqAIJSetPreallocationCSR(*M, ia, *cols, NULL));
   PM_PETSC(MatSetOption(*M, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  free(*cols);
-  *cols = NULL;
 done:
+  /* (one process: the matrix holds the columns; none kept) */
+  if (!s->dist) {
+    free(*cols);
+    *cols = NULL;
+  }
   free(ia);
   return ret;
 }

@@ -28,7 +28,8 @@ pm_err pm_newton_aug_objects(pm_newton *s) {
   if (!s->aug) return PM_SUCCESS;
   PC pc;
   const PetscInt N = (PetscInt)s->apat.n;
-  PM_CALL(pm_newton_create_matrix(s, &s->apat, false, &s->acols, NULL, &s->Ma));
+  PetscInt *cols; /* (one process: none kept) */
+  PM_CALL(pm_newton_create_matrix(s, &s->apat, false, &cols, NULL, &s->Ma));
   PM_PETSC_CALL(VecCreateSeq(PETSC_COMM_SELF, N, &s->Ab));
   PM_PETSC_CALL(VecDuplicate(s->Ab, &s->Ay));
   PM_PETSC_CALL(KSPCreate(PETSC_COMM_SELF, &s->ka));
@@ -50,8 +51,7 @@ pm_err pm_newton_aug_objects(pm_newton *s) {
 
 pm_err pm_newton_aug_values(pm_newton *s, const double *x) {
   PM_CALL(s->p.aux_values(s->p.ctx, x, s->asrc));
-  /* (one process: into the matrix's own storage) */
-  PM_CALL(pm_newton_scatter_into(s, s->Ma, &s->apat, s->acols, s->asrc, NULL));
+  PM_CALL(pm_newton_scatter_into(s->Ma, &s->apat, s->asrc));
   s->aug_dirty = true;
   return PM_SUCCESS;
 }
@@ -103,6 +103,5 @@ void pm_newton_aug_free(pm_newton *s) {
   VecDestroy(&s->Ab);
   VecDestroy(&s->Ay);
   pm_pattern_free(&s->apat);
-  free(s->acols);
   free(s->asrc);
 }

@@ -238,11 +238,11 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
     const long *idx =
         problem->pc_pat_ptr ? problem->pc_pat_idx : problem->pat_idx;
     PM_TRY(pm_pattern_build(n, ptr, idx, true, &s->ppat));
-    if (problem->precond_values && s->ppat.src)
+    if (!problem->precond_values)
+      PM_TRY(pm_coloring_build(&s->ppat, options->coloring, &s->pcol));
+    else if (s->ppat.src)
       PM_TRY(PM_ALLOC(s->psrcvals, s->ppat.nsrc > 0 ? s->ppat.nsrc : 1,
                       "preconditioner values"));
-    else
-      PM_TRY(pm_coloring_build(&s->ppat, options->coloring, &s->pcol));
     if (s->dist)
       PM_TRY(PM_ALLOC(s->pvals, s->ppat.ptr[n] + 1, "preconditioner values"));
   }

@@ -293,14 +293,15 @@ void pm_newton_operators(const pm_newton *s, Mat *A, Mat *B) {
                                                  : s->J;
 }
 
-pm_line_search pm_newton_line_search_of(pm_qs_line_search l) {
+pm_line_search pm_newton_line_search_of(pm_qs_line_search l,
+                                        pm_line_search own) {
   switch (l) {
   case PM_QS_LS_SECANT: return PM_LINE_SEARCH_L2;
   case PM_QS_LS_FULL_SECANT: return PM_LINE_SEARCH_FULL_L2;
-  case PM_QS_LS_AUTO:
-  case PM_QS_LS_BACKTRACKING: break;
+  case PM_QS_LS_BACKTRACKING: return PM_LINE_SEARCH_BT;
+  case PM_QS_LS_AUTO: break;
   }
-  return PM_LINE_SEARCH_BT;
+  return own;
 }
 
 pm_newton_linear pm_newton_linear_of(pm_linear_solver l) {

@@ -106,13 +106,12 @@ struct pm_newton {
   double ew_rprev, ew_eta;
   int lin_its;
   bool started; /* the initial state was admissible */
-  /* pm_newton_problem.aux_n: the augmented matrix's pattern, columns
-   * (NULL: its values go into its own storage) and values in the caller's
-   * order (asrc), the matrix, its LU (ka) and
+  /* pm_newton_problem.aux_n (one process): the augmented matrix's pattern
+   * and values in the caller's order (asrc), the matrix (its values in its
+   * own storage), its LU (ka) and
    * its right-hand side and solution; dirty: new values not factorised. */
   bool aug, aug_dirty;
   pm_pattern apat;
-  PetscInt *acols;
   double *asrc;
   Mat Ma;
   KSP ka;
@@ -159,8 +158,8 @@ pm_err pm_newton_jvals(pm_newton *s, double **vals);
  * caller's assembly on one process keeps the columns in the matrix). */
 pm_err pm_newton_pattern_columns(pm_newton *s);
 
-/* M = vals on the pattern (the matrix's preallocated structure; cols NULL:
- * M's storage is the pattern's, one process). */
+/* M = vals on the pattern (the matrix's preallocated structure, its
+ * columns cols). */
 pm_err pm_newton_insert_values(const pm_newton *s, Mat M, const pm_pattern *pat,
                                const PetscInt *cols, const double *vals);
 /* M = f's values at x: written by f into M's own storage where cols is
@@ -168,11 +167,9 @@ pm_err pm_newton_insert_values(const pm_newton *s, Mat M, const pm_pattern *pat,
 pm_err pm_newton_fill(pm_newton *s, Mat M, const pm_pattern *pat,
                       const PetscInt *cols, double *vals, pm_newton_values_fn f,
                       const double *x);
-/* M = the caller's values src (the pattern's source order) summed into
- * their places: in M's own storage where cols is NULL, else through vals. */
-pm_err pm_newton_scatter_into(const pm_newton *s, Mat M, const pm_pattern *pat,
-                              const PetscInt *cols, const double *src,
-                              double *vals);
+/* M's own storage (one process: the pattern's order) = the caller's values
+ * src (the pattern's source order) summed into their places. */
+pm_err pm_newton_scatter_into(Mat M, const pm_pattern *pat, const double *src);
 
 /* *M: an AIJ matrix with pat's structure, set to zeros.  On one process
  * its storage is the pattern's order and *cols is NULL (with release, the

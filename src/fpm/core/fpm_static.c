@@ -229,9 +229,8 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
    * secant: near a stretched block's necking the whole step overshoots,
    * and backtracking creeps (docs/validation.md, "The secant line search"
    * and "The whole step, else the secant"). */
-  no.line_search = s->time.qs_line_search == PM_QS_LS_AUTO
-                       ? PM_LINE_SEARCH_FULL_L2
-                       : pm_newton_line_search_of(s->time.qs_line_search);
+  no.line_search =
+      pm_newton_line_search_of(s->time.qs_line_search, PM_LINE_SEARCH_FULL_L2);
   no.fallback_seconds = s->time.qs_fallback_cpu;
   no.easy_iterations = 3;
   /* ...and, with max_load_step, grow past 1/load_steps up to it (not by

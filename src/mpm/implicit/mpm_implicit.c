@@ -300,7 +300,8 @@ pm_err mpm_implicit_create(const pm_scene *s, const mpm_model *m, mpm_state *st,
   o->linear_rtol = 1e-10;
   o->linear_max_iter = 20000;
   o->petsc_options = s->time.qs_solver_options;
-  o->line_search = pm_newton_line_search_of(s->time.qs_line_search);
+  o->line_search =
+      pm_newton_line_search_of(s->time.qs_line_search, PM_LINE_SEARCH_BT);
   if (im->mode == MPM_GRID_RESET) im->lam1 = 1.0 / im->opt_steps;
   mpm_implicit_make_buckets(im);
   PM_TRY(mpm_implicit_make_dofs(im));
