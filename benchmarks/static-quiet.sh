@@ -4,7 +4,8 @@
 # CalculiX N = 4, 6, 8; every run's wall and CPU seconds and error against
 # the referee) REPEATS times in turn (default 3) on OMP_NUM_THREADS threads
 # (default 2), the medians by run; then the peak memory of each FPM
-# setting at 1851 points and of ccx at N = 6 (/usr/bin/time, one run each).
+# setting at 1851 points, of the quarter at 404 points and of ccx at N = 6
+# (/usr/bin/time, one run each).
 # usage: benchmarks/static-quiet.sh [BUILD_DIR]   (about 3 min)
 bench_name=static-quiet
 bench_env="REPEATS OMP_NUM_THREADS"
@@ -49,6 +50,16 @@ for solver in default direct; do
   echo "FPM static, 1851 points, $solver: peak $(($(cat "$out/rss-$solver") / 1024)) MiB" \
     "(summary.json, the process alone: $(($(json "$out/mem-$solver/summary.json" memory peak_rss_max) / 1048576)) MiB)"
 done
+# The quarter (two symmetry planes) where it reaches 1%: 1e-2, 404 points.
+/usr/bin/time -f "%M" -o "$out/rss-quarter" "$bin" run "$f3" \
+  --set discretization.mesh_size=1e-2 \
+  --set time.quasi_static.method=static --set output.every=100000 \
+  --set 'domain.box.min=[0.05, 0.05, 0]' \
+  --set 'boundary.2={on: xmin, symmetry: true}' \
+  --set 'boundary.3={on: ymin, symmetry: true}' \
+  --out "$out/mem-quarter" --overwrite --quiet
+echo "FPM static on the quarter, 404 points: peak $(($(cat "$out/rss-quarter") / 1024)) MiB" \
+  "(summary.json, the process alone: $(($(json "$out/mem-quarter/summary.json" memory peak_rss_max) / 1048576)) MiB)"
 if command -v ccx >/dev/null; then
   # (its exit status says the ladder holds no referee mesh: not a failure)
   $py tools/fe-referee.py f3-extension-60 --run --ladder 6 --keep \

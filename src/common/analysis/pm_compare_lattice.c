@@ -8,6 +8,7 @@
 #include "pm_compare_impl.h"
 #include "pm_mls.h"
 #include "pm_probe.h"
+#include "pm_scene_mirror.h"
 
 /* How far a lattice point's fit may reach, in mean point spacings, and
  * how far its nearest point may be, in mean nearest-neighbour distances: a
@@ -142,8 +143,14 @@ bool cmp_fit_on_cloud(pm_mls *mls, const double *q, int ncomp, const double *f,
 long cmp_map_lattice(const cmp_study *c, pm_mls *mls, const double *u,
                      double *out) {
   long flagged = 0;
-  for (long i = 0; i < c->m; i++)
-    flagged += !cmp_fit_on_cloud(mls, c->x + 3 * i, 3, u, out + 3 * i);
+  /* A scene of a part mirrored about its symmetry planes: a lattice point
+   * of the whole body takes its image's value in the part. */
+  for (long i = 0; i < c->m; i++) {
+    double y[3];
+    const unsigned flips = pm_scene_mirror_fold(c->base, c->x + 3 * i, y);
+    flagged += !cmp_fit_on_cloud(mls, y, 3, u, out + 3 * i);
+    pm_scene_mirror_unfold(flips, out + 3 * i);
+  }
   return flagged;
 }
 

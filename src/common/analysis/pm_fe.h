@@ -142,11 +142,13 @@ pm_err pm_fe_write_errors(const pm_fe_reference *r, const double *mapped,
 void pm_fe_errors_of(const pm_fe_reference *r, const double *mapped,
                      const pm_outcome *o, pm_fe_errors *e);
 
-/* Compare the run written to out_dir (its last frame, mapped onto the
- * lattice by moving least squares) and its outcome o with r; the pointwise
- * errors go to out_dir/fe-errors.csv (pm_fe_write_errors).  The
- * reaction error is NaN when o has no loaded face. */
-pm_err pm_fe_compare(const pm_fe_reference *r, const char *out_dir,
-                     const pm_outcome *o, pm_fe_errors *e);
+/* Compare the run of scene s written to out_dir (its last frame, mapped
+ * onto the lattice by moving least squares; a lattice point outside a part
+ * mirrored about symmetry planes takes its image's value) and its outcome
+ * o with r; the pointwise errors go to out_dir/fe-errors.csv
+ * (pm_fe_write_errors).  The reaction error is NaN when o has no loaded
+ * face. */
+pm_err pm_fe_compare(const pm_fe_reference *r, const pm_scene *s,
+                     const char *out_dir, const pm_outcome *o, pm_fe_errors *e);
 
 #endif

@@ -393,13 +393,13 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
       fprintf(out, " -> %s\n", L->dir);
     }
     L->err = pm_run_scene(s, L->dir, run_flags(o), &L->out);
-    pm_scene_destroy(s);
-    s = NULL;
     L->error = L->rate = NAN;
     L->reaction_error = L->reaction_rate = L->sed_error = NAN;
     L->tip_error = NAN;
     L->error_interior = L->error_volume = NAN;
     if (L->err != PM_SUCCESS) {
+      pm_scene_destroy(s);
+      s = NULL;
       if (out) fprintf(out, "  %s\n", pm_error_message());
       if (first_fail == PM_SUCCESS) first_fail = L->err;
       continue;
@@ -408,7 +408,7 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
       L->error = L->out.nrmse_vector;
     } else if (mode == REF_FE) {
       pm_fe_errors e;
-      PM_TRY(pm_fe_compare(fe, L->dir, &L->out, &e));
+      PM_TRY(pm_fe_compare(fe, s, L->dir, &L->out, &e));
       L->error = e.nrmse;
       L->error_interior = e.nrmse_interior;
       L->error_volume = e.nrmse_volume;
@@ -419,6 +419,8 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
       PM_TRY(
           error_against(L->dir, L->out.fig.dim, rn, rx, ru, work, &L->error));
     }
+    pm_scene_destroy(s);
+    s = NULL;
   }
   /* Rates: in h for a resolution ladder, else in the first key's value. */
   bool by_h = false;

@@ -57,6 +57,13 @@ pm_err pm_par_init(int *argc, char ***argv) {
 #endif
 }
 
+void pm_par_singleton_quiet(void) {
+  if (launched()) return;
+  /* (overwrite 0: the user's own settings stand) */
+  setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
+  setenv("OMPI_MCA_pml", "ob1", 0);
+}
+
 pm_err pm_par_attach(MPI_Comm comm) {
 #ifndef PM_HAVE_MPI
   (void)comm; /* a build without MPI is one process */

@@ -10,6 +10,7 @@
 #include "pm_omp.h"
 #include "pm_output.h"
 #include "pm_run_impl.h"
+#include "pm_scene_mirror.h"
 
 static pm_err json_point(pm_json *j, const char *key, int dim,
                          const double x[3]) {
@@ -99,7 +100,15 @@ static pm_err summary_accuracy(pm_run_ctx *c, pm_json *j) {
       PM_CALL(pm_json_number(j, NULL, o->fig.reaction[b][k]));
     PM_CALL(pm_json_end_array(j));
   }
-  return pm_json_end_object(j);
+  PM_CALL(pm_json_end_object(j));
+  if (s->mirror_mask) {
+    PM_CALL(pm_json_begin_array(j, "symmetry_planes"));
+    for (int b = 0; b < s->n_bcs; b++)
+      if (s->bcs[b].symmetry)
+        PM_CALL(pm_json_string(j, NULL, pm_face_name(s->bcs[b].face)));
+    PM_CALL(pm_json_end_array(j));
+  }
+  return pm_json_number(j, "loaded_reaction", o->loaded_reaction);
 }
 
 /* OUT/summary.json.  running: while the run goes on, status "running" and
@@ -148,6 +157,7 @@ static void loaded_face(const pm_scene *s, int *bc, int *comp) {
   *comp = 0;
   for (int b = 0; b < s->n_bcs; b++) {
     const pm_scene_bc *B = &s->bcs[b];
+    if (B->symmetry) continue;
     double x[3];
     for (int a = 0; a < 3; a++) x[a] = 0.5 * (s->box_min[a] + s->box_max[a]);
     if (B->on == PM_ON_FACE)
@@ -203,7 +213,15 @@ void pm_run_conclude(pm_run_ctx *c, pm_err run_err) {
   }
   int bc, comp;
   loaded_face(s, &bc, &comp);
-  o->loaded_reaction = bc >= 0 ? f->reaction[bc][comp] : NAN;
+  /* The whole body's, where the scene is a part mirrored about planes. */
+  o->loaded_reaction =
+      bc >= 0 ? f->reaction[bc][comp] *
+                    pm_scene_mirror_factor(s,
+                                           s->bcs[bc].on == PM_ON_FACE
+                                               ? pm_face_axis(s->bcs[bc].face)
+                                               : -1,
+                                           comp)
+              : NAN;
   o->loaded_axis = bc >= 0 ? comp : -1;
 }
 

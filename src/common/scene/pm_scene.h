@@ -286,6 +286,8 @@ typedef struct {
   pm_expr *velocity[3];
   struct pm_curve *curve; /* curve: the load curve, or NULL (factor 1) */
   bool absorbing;         /* viscous (absorbing) boundary */
+  bool symmetry; /* a symmetry plane (on a face): the normal component held
+                    at 0, and the scene's figures are the mirrored body's */
   pm_ramp ramp;
   double ramp_time; /* s; time.ramp when not given */
   /* A rigid body (PM_ON_PLATE, PM_ON_SPHERE): its reference geometry,
@@ -340,6 +342,13 @@ typedef struct pm_scene {
   int n_bcs;
   double gravity[3]; /* gravity: m/s^2 */
   bool has_gravity;
+  /* The symmetry planes (boundary conditions with symmetry: true): bit a
+   * for the plane normal to axis a, at mirror_at[a].  The scene models the
+   * part of a body mirrored about them: figures compared with the whole
+   * body's (the loaded face's reaction, a referee's lattice) mirror it
+   * (pm_scene_mirror.h). */
+  unsigned mirror_mask;
+  double mirror_at[3];
   /* body_force: a force per unit mass f(x, y, z, t) per component (N/kg),
    * added to gravity; both times body_curve(t) (NULL: 1) */
   unsigned body_force_mask;

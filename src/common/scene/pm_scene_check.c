@@ -468,6 +468,48 @@ static pm_err finish_on(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc) {
   return PM_SUCCESS;
 }
 
+/* A symmetry plane (boundary i with symmetry: true): on a face of the
+ * domain's box, nothing else prescribed there; its normal component held
+ * at 0 from the start, and the plane recorded as a mirror of the scene. */
+static pm_err finish_symmetry(pm_reader *r, pm_scene *s, int i,
+                              pm_scene_bc *bc) {
+  char p[PM_SDOC_PATH];
+  if (bc->on != PM_ON_FACE)
+    return pm_reader_fail(
+        r, PM_PATH(p, "boundary.%d.%s", i, bc->surface ? "on" : "symmetry"),
+        true,
+        "expected symmetry on a face xmin ... zmax (a plane normal to an "
+        "axis; elsewhere prescribe the normal component: displacement: "
+        "{x: 0}), got %s",
+        bc->surface ? bc->surface : "no face");
+  static const char *const other[] = {"displacement", "traction", "pressure",
+                                      "force",        "velocity", "absorbing",
+                                      "curve"};
+  const bool has[] = {bc->disp_mask != 0,     bc->traction_mask != 0,
+                      bc->pressure != NULL,   bc->force_mask != 0,
+                      bc->velocity_mask != 0, bc->absorbing,
+                      bc->curve != NULL};
+  for (int k = 0; k < 7; k++)
+    if (has[k])
+      return pm_reader_fail(r, PM_PATH(p, "boundary.%d.%s", i, other[k]), true,
+                            "expected symmetry alone (the plane holds the "
+                            "normal component at 0), got %s with it",
+                            other[k]);
+  const int a = pm_face_axis(bc->face);
+  if (s->mirror_mask >> a & 1u)
+    return pm_reader_fail(r, PM_PATH(p, "boundary.%d.on", i), true,
+                          "expected one symmetry plane normal to %c, got a "
+                          "second (%s)",
+                          "xyz"[a], bc -> surface);
+  PM_CALL(pm_reader_expr(r, PM_PATH(p, "boundary.%d.symmetry", i), "0", "xyzt",
+                         &bc->disp[a]));
+  bc->disp_mask = 1u << a;
+  bc->ramp = PM_RAMP_NONE;
+  s->mirror_mask |= 1u << a;
+  s->mirror_at[a] = pm_face_plane(bc->face, s->box_min, s->box_max);
+  return PM_SUCCESS;
+}
+
 static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
   char p[PM_SDOC_PATH];
   for (int i = 0; i < s->n_bcs; i++) {
@@ -475,6 +517,7 @@ static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
     bc->mark = pm_sdoc_mark(
         r->doc, pm_sdoc_find(r->doc, PM_PATH(p, "boundary.%d", i), false));
     PM_CALL(finish_on(r, s, i, bc));
+    if (bc->symmetry) PM_CALL(finish_symmetry(r, s, i, bc));
     if (!bc->disp_mask && !bc->traction_mask && !bc->velocity_mask &&
         !bc->force_mask && !bc->pressure && !bc->absorbing)
       return pm_reader_fail(r, PM_PATH(p, "boundary.%d", i), false,

@@ -698,6 +698,15 @@ static const pm_key bc_keys[] = {
      .offset = C(absorbing),
      .def = "false",
      .doc = "viscous (absorbing) boundary (MPM)"},
+    {.name = "symmetry",
+     .type = PM_KEY_BOOL,
+     .offset = C(symmetry),
+     .def = "false",
+     .doc = "on a face xmin ... zmax: a symmetry plane (the normal "
+            "displacement held at 0, the tangential free); the scene is then "
+            "the part of a body mirrored about it, and the loaded face's "
+            "reaction and the comparisons with a referee are the whole "
+            "body's"},
     {.name = "ramp",
      .type = PM_KEY_ENUM,
      .offset = C(ramp),

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "pm_newton.h"
+#include "pm_par.h"
 #include "pm_par_mpi.h"
 
 static bool started;  /* this module called PetscInitialize */
@@ -45,6 +46,9 @@ pm_err pm_petsc_init(void) {
   /* PETSc's objects live on the run's ranks (PETSc's own world where the
    * program attached none: it starts MPI itself then). */
   if (pm_par_comm() != MPI_COMM_NULL) PETSC_COMM_WORLD = pm_par_comm();
+  int mpi_ready = 0;
+  MPI_Initialized(&mpi_ready);
+  if (!mpi_ready) pm_par_singleton_quiet();
   PetscErrorCode code = PetscInitializeNoArguments();
   PM_CHECK(code == 0, PM_ERR_LINALG, "PetscInitializeNoArguments failed (%d)",
            (int)code);
