@@ -136,14 +136,22 @@ done:
   return ret;
 }
 
+/* The point of the r-th member of i's reconstruction support (r = 0: i). */
+static long recon_id(const fpm_model *m, bool quad, long i, long r) {
+  if (!quad) {
+    const double *g;
+    return closed_member(m, i, r, &g);
+  }
+  return r == 0 ? i : m->qs_nbr[m->qs_ptr[i] + r - 1];
+}
+
 /* The penalty's reconstruction weight of u_x in point i's field at offset
- * d (linear: H_i d; quadratic: theta_i phi(d)), for the r-th member of
+ * d (linear: H_i d; quadratic: theta_i phi with phi = fpm_gfd_phi(d), which
+ * the caller evaluates once for all members), for the r-th member of
  * i's reconstruction support; returns the member's point. */
 static long recon_member(const fpm_model *m, bool quad, long i, long r,
-                         const double d[3], double *w) {
+                         const double d[3], const double *phi, double *w) {
   if (quad) {
-    double phi[FPM_QFIT];
-    fpm_gfd_phi(d, phi);
     const double *q;
     long x;
     if (r == 0) {
@@ -169,7 +177,8 @@ static long recon_size(const fpm_model *m, bool quad, long i) {
   return quad ? m->qs_ptr[i + 1] - m->qs_ptr[i] + 1 : closed_size(m, i);
 }
 
-/* The row scratch of build_S: mark[x] is x's slot in list/acc, or -1. */
+/* The row scratch of build_S (a thread's): mark[x] is x's slot in
+ * list/acc, or -1. */
 typedef struct {
   long *mark, *list, cnt;
   double *acc;
@@ -196,14 +205,19 @@ static void add_S_row(const fpm_model *m, bool quad, long k, srow *w) {
       const double *di = rec + 12, *dk = rec + 15, be = rec[slot];
       const long kk = m->nbr[e];
       if (be == 0) continue;
+      double phi[2][FPM_QFIT];
+      if (quad) fpm_gfd_phi(di, phi[0]);
       /* t_ek: k's weight in u_i + recon_i(d_i) */
       double tk = 0;
       for (long r = 0; r < recon_size(m, quad, i); r++) {
+        if (recon_id(m, quad, i, r) != k) continue;
         double wt;
-        if (recon_member(m, quad, i, r, di, &wt) == k) tk += wt;
+        recon_member(m, quad, i, r, di, quad ? phi[0] : NULL, &wt);
+        tk += wt;
       }
       if (k == i) tk += 1;
       if (tk == 0) continue;
+      if (quad) fpm_gfd_phi(dk, phi[1]);
       /* J_em over both sides */
       for (int side = 0; side < 2; side++) {
         long p = side ? kk : i;
@@ -211,7 +225,7 @@ static void add_S_row(const fpm_model *m, bool quad, long k, srow *w) {
         const double *d = side ? dk : di;
         for (long r = 0; r < recon_size(m, quad, p); r++) {
           double wt;
-          long x = recon_member(m, quad, p, r, d, &wt);
+          long x = recon_member(m, quad, p, r, d, quad ? phi[side] : NULL, &wt);
           if (r == 0) wt += 1;
           if (w->mark[x] < 0) {
             w->mark[x] = w->cnt;
@@ -231,33 +245,44 @@ static void add_S_row(const fpm_model *m, bool quad, long k, srow *w) {
  * the quadratic jump, plus the boundary interfaces' linear-jump term.
  * fpm.stiffening's quartic term and fpm.volume_penalty are not in S (their
  * tangents depend on the state): with them this tangent is approximate and
- * preconditions fpm_force_linear's exact linearisation (fpm_static.c). */
+ * preconditions fpm_force_linear's exact linearisation (fpm_static.c).
+ * Rows on every thread, each with its own scratch: a row's sum is one
+ * thread's, in the order one thread takes, so the bits do not depend on
+ * the threads. */
 static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
   pm_err ret = PM_SUCCESS;
   const long n = m->n, rows = m->n_own;
-  srow w = {0};
+  const int threads = pm_omp_threads();
+  long *mark = NULL, *list = NULL;
+  double *acc = NULL;
   bool lin_too = false;
   if (m->q)
     for (long e = 0; e < m->nnz && !lin_too; e++)
       lin_too = m->erec[FPM_EREC * e + 19] != 0;
-  PM_TRY(PM_ALLOC(w.mark, n, "penalty marks"));
-  PM_TRY(PM_ALLOC(w.list, n, "penalty lists"));
-  PM_TRY(PM_ALLOC(w.acc, n, "penalty row"));
+  PM_TRY(PM_ALLOC(mark, (size_t)threads * n, "penalty marks"));
+  PM_TRY(PM_ALLOC(list, (size_t)threads * n, "penalty lists"));
+  PM_TRY(PM_ALLOC(acc, (size_t)threads * n, "penalty row"));
   PM_TRY(PM_ALLOC(t->S_ptr, n + 1, "penalty matrix"));
-  for (long i = 0; i < n; i++) w.mark[i] = -1;
+  for (long i = 0; i < (long)threads * n; i++) mark[i] = -1;
   for (int pass = 0; pass < 2; pass++) {
-    for (long k = 0; k < rows; k++) {
-      w.cnt = 0;
-      add_S_row(m, m->q != NULL, k, &w);
-      if (lin_too) add_S_row(m, false, k, &w);
-      if (pass == 0)
-        t->S_ptr[k + 1] = w.cnt;
-      else
-        for (long a = 0; a < w.cnt; a++) {
-          t->S_m[t->S_ptr[k] + a] = w.list[a];
-          t->S[t->S_ptr[k] + a] = w.acc[a];
-        }
-      for (long a = 0; a < w.cnt; a++) w.mark[w.list[a]] = -1;
+    PM_OMP(parallel default(none)
+               shared(m, t, mark, list, acc, n, rows, lin_too, pass)) {
+      const long off = (long)pm_omp_thread() * n;
+      srow w = {.mark = mark + off, .list = list + off, .acc = acc + off};
+      PM_OMP(for schedule(dynamic, 16))
+      for (long k = 0; k < rows; k++) {
+        w.cnt = 0;
+        add_S_row(m, m->q != NULL, k, &w);
+        if (lin_too) add_S_row(m, false, k, &w);
+        if (pass == 0)
+          t->S_ptr[k + 1] = w.cnt;
+        else
+          for (long a = 0; a < w.cnt; a++) {
+            t->S_m[t->S_ptr[k] + a] = w.list[a];
+            t->S[t->S_ptr[k] + a] = w.acc[a];
+          }
+        for (long a = 0; a < w.cnt; a++) w.mark[w.list[a]] = -1;
+      }
     }
     if (pass == 0) {
       for (long k = 0; k < rows; k++) t->S_ptr[k + 1] += t->S_ptr[k];
@@ -268,9 +293,9 @@ static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
     }
   }
 done:
-  free(w.mark);
-  free(w.list);
-  free(w.acc);
+  free(mark);
+  free(list);
+  free(acc);
   return ret;
 }
 
