@@ -26,16 +26,20 @@ for r in range(1, repeats + 1):
             continue
         at = f"N {row['fe_n']}" if row["label"] == "fe" else row["resolution"]
         runs.setdefault((row["label"], at), []).append(row)
+# (a method's wall: its setup and its run; ccx's: its run)
 print("| method | resolution | points / nodes | reaction error (%) | "
-      "wall (s), median | CPU (s), median | CPU / wall | walls (s) |")
-print("|---|---|---|---|---|---|---|---|")
+      "wall (s), median | of which setup (s) | CPU (s), median | "
+      "CPU / wall | walls (s) |")
+print("|---|---|---|---|---|---|---|---|---|")
 for (m, at), rows in runs.items():
     w = [float(x["wall_seconds"]) for x in rows]
     c = [float(x["cpu_seconds"]) for x in rows]
+    st = [float(x["setup_seconds"] or "nan") for x in rows]
     wm, cm = statistics.median(w), statistics.median(c)
+    sm = statistics.median(st)
     print(f"| {m} | {at} | {rows[0]['points']} | "
           f"{100 * float(rows[0]['reaction_error_fe']):+.3f} | {wm:.3g} | "
-          f"{cm:.3g} | "
+          f"{'' if sm != sm else f'{sm:.3g}'} | {cm:.3g} | "
           f"{cm / wm:.2f} | {', '.join(f'{x:.3g}' for x in w)} |")
 PY
 # Peak memory, one run each.

@@ -269,8 +269,7 @@ static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
              "below; a mesh at or finer than the referee's own is marked "
              "reference and not measured against itself.  CPU: user and "
              "system time of every thread, a method's over its setup and "
-             "time loop (so against wall plus setup), ccx's over its "
-             "run.\n");
+             "run (its wall time's span), ccx's over its run.\n");
   for (int c = 0; c < S->n_cases; c++)
     if (fe[c].n_levels)
       fprintf(m,
@@ -327,7 +326,9 @@ static void write_md(const pm_bench_suite *S, const pm_bench_comparison *runs,
              "the displacement against the FE referee's lattice when the "
              "scene has one, else against the analytic field "
              "(reference.displacement), mapped by moving least squares.  "
-             "Wall time: the run's own, setup included.  Pictures: "
+             "Wall time: a method's setup (FPM: meshing, cells and "
+             "operators; MPM: seeding) and its run, the CPU time's span.  "
+             "Pictures: "
              "accuracy-cost.png (tools/plot-bench.py).\n");
 }
 

@@ -24,7 +24,11 @@ typedef struct {
   char message[PM_COMPARE_MESSAGE_MAX]; /* why it failed ("" if it did not) */
   bool ran;                             /* it has a run's figures */
   long points, steps, flagged;
-  double h, wall_seconds, setup_seconds;
+  double h;
+  double wall_seconds;  /* its setup's and its run's (summary.json's
+                           wall_seconds is the run's alone) */
+  double setup_seconds; /* its setup's: before the run, as the backend
+                           made its model */
   double cpu_seconds; /* the process's CPU time (user + system, every
                          thread) over the run's setup and time loop */
   size_t memory_bytes;
