@@ -29,8 +29,8 @@ typedef struct {
                            wall_seconds is the run's alone) */
   double setup_seconds; /* its setup's: before the run, as the backend
                            made its model */
-  double cpu_seconds; /* the process's CPU time (user + system, every
-                         thread) over the run's setup and time loop */
+  double cpu_seconds;   /* the process's CPU time (user + system, every
+                           thread) over the run's setup and time loop */
   size_t memory_bytes;
   /* NRMSE against the analytic field, the FE lattice, a reference run;
    * the loaded face's reaction and the mean SED against FE's (relative);
