@@ -6,6 +6,10 @@
 # other, 20 times slower), and their comparisons with one process.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1
+# One machine: the ranks talk through shared memory (ob1 over vader), and
+# Open MPI probes no network device at each start (its default selection
+# tries UCX, libfabric and PSM first: 0.2-0.5 s an mpirun here).
+export OMPI_MCA_pml=ob1 OMPI_MCA_btl=self,vader
 export OMP_NUM_THREADS=1
 py=/usr/bin/python3
 same="$py $src/tests/verification/same_results.py"

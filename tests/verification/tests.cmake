@@ -102,7 +102,7 @@ if(PM_MPI)
       $<TARGET_FILE:ranks_halo>)
   set_tests_properties(verification.ranks_halo PROPERTIES LABELS verification
     TIMEOUT 60 PROCESSORS 1 RESOURCE_LOCK mpirun
-    ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_MCA_mpi_yield_when_idle=1")
+    ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_MCA_mpi_yield_when_idle=1;OMPI_MCA_pml=ob1;OMPI_MCA_btl=self,vader")
   # The Newton layer and the implicit MPM across ranks.
   add_executable(ranks_newton ${PM_VERIFY_DIR}/ranks_newton.c)
   target_link_libraries(ranks_newton PRIVATE pm_app)
