@@ -36,7 +36,6 @@ static pm_err load(const char *box_min, const char *bcs, pm_scene **s) {
            "  - {on: zmax, displacement: {x: 0, y: 0, z: 0.06}}\n%s"
            "time: {end: 1}\n",
            box_min, bcs);
-  *s = NULL;
   pm_error_clear();
   return pm_scene_load_text(text, strlen(text), NAME, 0, NULL, s);
 }
@@ -65,7 +64,17 @@ static void test_quarter(void **state) {
   assert_near(pm_scene_mirror_factor(s, 2, 2), 4, 0);
   assert_near(pm_scene_mirror_factor(s, 2, 0), 0, 0);
   assert_near(pm_scene_mirror_factor(s, 0, 0), 2, 0);
+  /* A boundary of no known orientation (a region): along the planes
+   * doubled by each, across one not known. */
   assert_near(pm_scene_mirror_factor(s, -1, 2), 4, 0);
+  assert_true(isnan(pm_scene_mirror_factor(s, -1, 0)));
+  /* The conditions' own axes: a face's, a plate's normal along an axis. */
+  assert_int_equal(pm_scene_bc_axis(&s->bcs[1]), 2);
+  pm_scene_bc plate = {.on = PM_ON_PLATE, .rigid_normal = {-1, 0, 0}};
+  assert_int_equal(pm_scene_bc_axis(&plate), 0);
+  plate.rigid_normal[0] = -0.6;
+  plate.rigid_normal[1] = 0.8;
+  assert_int_equal(pm_scene_bc_axis(&plate), -1);
   /* A point of another quarter takes its image's value in this one. */
   double y[3], v[3] = {1, 2, 3};
   unsigned flips = pm_scene_mirror_fold(s, (double[3]){0.02, 0.07, 0.03}, y);
@@ -107,6 +116,15 @@ static void test_refused(void **state) {
        "boundary.2.traction: expected symmetry alone"},
       {"  - {on: xmin, symmetry: true}\n  - {on: xmax, symmetry: true}\n",
        "boundary.3.on: expected one symmetry plane normal to x"},
+      {"  - {on: xmin, symmetry: true, ramp: linear}\n",
+       "boundary.2.ramp: expected symmetry alone"},
+      {"  - {on: xmin, symmetry: true}\n"
+       "  - {on: xmin, traction: {y: 5}}\n",
+       "boundary.3.on: expected no other condition on xmin, a symmetry plane "
+       "(boundary.2)"},
+      {"  - {plate: {point: [0.2, 0, 0], normal: [-1, 0, 0]}, "
+       "symmetry: true}\n",
+       "boundary.2.plate: expected symmetry on a face"},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     pm_scene *s = (pm_scene *)&s;

@@ -21,7 +21,7 @@
  * (measured +0.71%), and the displacement at the whole block's lattice
  * (each point outside the quarter from its image) at or below the FPM
  * paper's NRMSE carried to this h by its rate (1.35e-3 at h = 3.73e-3,
- * q = 2.02: 1.42e-2 at h = 1.2e-2; measured 1.09e-2).
+ * q = 2.02: 1.43e-2 at h = 1.2e-2; measured 1.09e-2).
  * F4 60% (no converged referee) at 237 points by dynamic relaxation, as
  * its scene runs it (the default formulation and the quadratic jump's
  * stiffening from an onset in the current spacing, which the scene names:

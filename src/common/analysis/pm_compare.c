@@ -9,6 +9,7 @@
 #include <sys/resource.h>
 
 #include "pm_compare_impl.h"
+#include "pm_scene_mirror.h"
 #include "pm_memory.h"
 #include "pm_metrics.h"
 #include "pm_mls.h"
@@ -146,8 +147,9 @@ static pm_err von_mises_of(const pm_backend *be, void *sim, long n,
 
 /* The displacement at the lattice and von Mises stress at the centre of
  * the simulation sim after its run. */
-static pm_err map_method(cmp_study *c, cmp_method *M, const pm_backend *be,
+static pm_err map_method(cmp_study *c, cmp_method *M, const pm_scene *s,
                          void *sim) {
+  const pm_backend *be = s->backend;
   pm_err ret = PM_SUCCESS;
   pm_points p;
   pm_mls *mls = NULL;
@@ -158,10 +160,14 @@ static pm_err map_method(cmp_study *c, cmp_method *M, const pm_backend *be,
   snprintf(what, sizeof what, "the points of %s", M->name);
   PM_TRY(pm_mls_create(p.n, p.x, what, &mls));
   PM_TRY(PM_ALLOC(M->u, 3 * c->m, "displacement at the lattice"));
-  M->flagged = cmp_map_lattice(c, mls, be->displacement(sim), M->u);
+  M->flagged = cmp_map_lattice(c, s, mls, be->displacement(sim), M->u);
   M->mapped = true;
   PM_TRY(von_mises_of(be, sim, p.n, &own, &vm));
-  if (vm) cmp_fit_on_cloud(mls, c->centre, 1, vm, &M->von_mises_centre);
+  if (vm) { /* (a scalar: the image's value as it is) */
+    double centre[3];
+    pm_scene_mirror_fold(s, c->centre, centre);
+    cmp_fit_on_cloud(mls, centre, 1, vm, &M->von_mises_centre);
+  }
 done:
   pm_mls_free(mls);
   free(own);
@@ -212,7 +218,7 @@ static pm_err run_method(cmp_study *c, int k, FILE *out) {
    * finished is not compared. */
   if (st == PM_STATUS_COMPLETED || st == PM_STATUS_CONVERGED ||
       st == PM_STATUS_NOT_CONVERGED) {
-    pm_err m = map_method(c, M, s->backend, sim);
+    pm_err m = map_method(c, M, s, sim);
     if (m != PM_SUCCESS && e == PM_SUCCESS) e = method_failed(M, m, NULL, NULL);
   }
 done:

@@ -84,9 +84,12 @@ bool cmp_fit_on_cloud(pm_mls *mls, const double *q, int ncomp, const double *f,
                       double *v);
 
 /* The field u of the cloud mls at every lattice point into out ([m][3]),
- * NaN where flagged; returns the flagged count. */
-long cmp_map_lattice(const cmp_study *c, pm_mls *mls, const double *u,
-                     double *out);
+ * NaN where flagged; returns the flagged count.  part: the scene of the
+ * run that made the cloud, whose symmetry planes fold a lattice point
+ * outside it onto its image (pm_scene_mirror.h); a method's scene has its
+ * own overrides, which may give the planes. */
+long cmp_map_lattice(const cmp_study *c, const pm_scene *part, pm_mls *mls,
+                     const double *u, double *out);
 
 /* The last frame of the reference run c->run_dir, on the lattice
  * (c->run_u). */

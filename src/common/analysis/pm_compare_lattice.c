@@ -140,14 +140,14 @@ bool cmp_fit_on_cloud(pm_mls *mls, const double *q, int ncomp, const double *f,
   return false;
 }
 
-long cmp_map_lattice(const cmp_study *c, pm_mls *mls, const double *u,
-                     double *out) {
+long cmp_map_lattice(const cmp_study *c, const pm_scene *part, pm_mls *mls,
+                     const double *u, double *out) {
   long flagged = 0;
   /* A scene of a part mirrored about its symmetry planes: a lattice point
    * of the whole body takes its image's value in the part. */
   for (long i = 0; i < c->m; i++) {
     double y[3];
-    const unsigned flips = pm_scene_mirror_fold(c->base, c->x + 3 * i, y);
+    const unsigned flips = pm_scene_mirror_fold(part, c->x + 3 * i, y);
     flagged += !cmp_fit_on_cloud(mls, y, 3, u, out + 3 * i);
     pm_scene_mirror_unfold(flips, out + 3 * i);
   }
@@ -165,7 +165,8 @@ pm_err cmp_map_run(cmp_study *c) {
   snprintf(what, sizeof what, "the reference run %s", c->run_dir);
   PM_TRY(pm_mls_create(n, x, what, &mls));
   PM_TRY(PM_ALLOC(c->run_u, 3 * c->m, "reference at the lattice"));
-  cmp_map_lattice(c, mls, u, c->run_u);
+  /* (a reference run of the base scene: its planes) */
+  cmp_map_lattice(c, c->base, mls, u, c->run_u);
 done:
   pm_mls_free(mls);
   free(x);

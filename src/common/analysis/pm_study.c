@@ -12,6 +12,7 @@
 #include "pm_memory.h"
 #include "pm_metrics.h"
 #include "pm_probe.h"
+#include "pm_scene_mirror.h"
 
 #define VALUE_MAX 128
 
@@ -78,11 +79,15 @@ static pm_err load_level(const pm_study_options *o, const ladder_key *keys,
   return pm_scene_load(o->scene, n, sets, s);
 }
 
-/* Error of run dir (points x, n) against the reference (rx, ru, rn). */
-static pm_err error_against(const char *dir, int dim, long rn, const double *rx,
-                            const double *ru, double *work, double *err) {
+/* Error of run dir of scene s (points x, n) against the reference (rx,
+ * ru, rn); a reference point outside a part mirrored about the scene's
+ * symmetry planes takes its image's value (pm_scene_mirror.h). */
+static pm_err error_against(const pm_scene *s, const char *dir, int dim,
+                            long rn, const double *rx, const double *ru,
+                            double *work, double *err) {
   long n;
-  double *x = NULL, *u = NULL;
+  double *x = NULL, *u = NULL, *folded = NULL;
+  unsigned *flips = NULL;
   pm_err ret = PM_SUCCESS;
   unsigned mask = dim == 2 ? 3u : 7u;
   PM_TRY(pm_results_read(dir, -1, &n, &x, &u));
@@ -92,12 +97,23 @@ static pm_err error_against(const char *dir, int dim, long rn, const double *rx,
   if (same) {
     *err = pm_nrmse_vector(rn, mask, u, ru);
   } else {
-    PM_TRY(pm_probe_map(dir, -1, rn, rx, work));
+    if (s->mirror_mask) {
+      PM_TRY(PM_ALLOC(folded, 3 * rn, "the reference's images in the part"));
+      PM_TRY(PM_ALLOC(flips, rn, "the reference's reflections"));
+      for (long j = 0; j < rn; j++)
+        flips[j] = pm_scene_mirror_fold(s, rx + 3 * j, folded + 3 * j);
+    }
+    PM_TRY(pm_probe_map(dir, -1, rn, folded ? folded : rx, work));
+    if (flips)
+      for (long j = 0; j < rn; j++)
+        pm_scene_mirror_unfold(flips[j], work + 3 * j);
     *err = pm_nrmse_vector(rn, mask, work, ru);
   }
 done:
   free(x);
   free(u);
+  free(folded);
+  free(flips);
   return ret;
 }
 
@@ -416,8 +432,8 @@ pm_err pm_study_run(const pm_study_options *o, FILE *out) {
       L->sed_error = e.sed_error;
       L->tip_error = e.tip_error;
     } else {
-      PM_TRY(
-          error_against(L->dir, L->out.fig.dim, rn, rx, ru, work, &L->error));
+      PM_TRY(error_against(s, L->dir, L->out.fig.dim, rn, rx, ru, work,
+                           &L->error));
     }
     pm_scene_destroy(s);
     s = NULL;

@@ -215,13 +215,10 @@ void pm_run_conclude(pm_run_ctx *c, pm_err run_err) {
   loaded_face(s, &bc, &comp);
   /* The whole body's, where the scene is a part mirrored about planes. */
   o->loaded_reaction =
-      bc >= 0 ? f->reaction[bc][comp] *
-                    pm_scene_mirror_factor(s,
-                                           s->bcs[bc].on == PM_ON_FACE
-                                               ? pm_face_axis(s->bcs[bc].face)
-                                               : -1,
-                                           comp)
-              : NAN;
+      bc >= 0
+          ? f->reaction[bc][comp] *
+                pm_scene_mirror_factor(s, pm_scene_bc_axis(&s->bcs[bc]), comp)
+          : NAN;
   o->loaded_axis = bc >= 0 ? comp : -1;
 }
 

@@ -474,22 +474,33 @@ static pm_err finish_on(pm_reader *r, pm_scene *s, int i, pm_scene_bc *bc) {
 static pm_err finish_symmetry(pm_reader *r, pm_scene *s, int i,
                               pm_scene_bc *bc) {
   char p[PM_SDOC_PATH];
-  if (bc->on != PM_ON_FACE)
+  if (bc->on != PM_ON_FACE) {
+    const char *key = PM_BC_RIGID(bc)
+                          ? (bc->on == PM_ON_PLATE ? "plate" : "sphere")
+                      : bc->on == PM_ON_SURFACE ? "on"
+                                                : "symmetry";
     return pm_reader_fail(
-        r, PM_PATH(p, "boundary.%d.%s", i, bc->surface ? "on" : "symmetry"),
-        true,
+        r, PM_PATH(p, "boundary.%d.%s", i, key), true,
         "expected symmetry on a face xmin ... zmax (a plane normal to an "
         "axis; elsewhere prescribe the normal component: displacement: "
         "{x: 0}), got %s",
-        bc->surface ? bc->surface : "no face");
+        PM_BC_RIGID(bc)           ? "a rigid body"
+        : bc->on == PM_ON_SURFACE ? bc->surface
+                                  : "no face");
+  }
   static const char *const other[] = {"displacement", "traction", "pressure",
                                       "force",        "velocity", "absorbing",
-                                      "curve"};
-  const bool has[] = {bc->disp_mask != 0,     bc->traction_mask != 0,
-                      bc->pressure != NULL,   bc->force_mask != 0,
-                      bc->velocity_mask != 0, bc->absorbing,
-                      bc->curve != NULL};
-  for (int k = 0; k < 7; k++)
+                                      "curve",        "ramp",     "ramp_time"};
+  const bool has[] = {bc->disp_mask != 0,
+                      bc->traction_mask != 0,
+                      bc->pressure != NULL,
+                      bc->force_mask != 0,
+                      bc->velocity_mask != 0,
+                      bc->absorbing,
+                      bc->curve != NULL,
+                      pm_reader_has(r, PM_PATH(p, "boundary.%d.ramp", i)),
+                      pm_reader_has(r, PM_PATH(p, "boundary.%d.ramp_time", i))};
+  for (int k = 0; k < 9; k++)
     if (has[k])
       return pm_reader_fail(r, PM_PATH(p, "boundary.%d.%s", i, other[k]), true,
                             "expected symmetry alone (the plane holds the "
@@ -536,6 +547,18 @@ static pm_err finish_bcs(pm_reader *r, pm_scene *s) {
               "(also in boundary.%d.displacement)",
               "xyz"[c], i);
     if (isnan(bc->ramp_time)) bc->ramp_time = s->time.ramp;
+  }
+  /* A symmetry plane's face carries no other condition: it would move the
+   * plane or load the part alone. */
+  for (int i = 0; i < s->n_bcs; i++) {
+    const pm_scene_bc *bc = &s->bcs[i];
+    if (bc->symmetry || bc->on != PM_ON_FACE) continue;
+    for (int j = 0; j < s->n_bcs; j++)
+      if (s->bcs[j].symmetry && s->bcs[j].face == bc->face)
+        return pm_reader_fail(r, PM_PATH(p, "boundary.%d.on", i), true,
+                              "expected no other condition on %s, a "
+                              "symmetry plane (boundary.%d), got one",
+                              bc->surface, j);
   }
   return PM_SUCCESS;
 }

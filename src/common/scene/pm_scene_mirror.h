@@ -6,20 +6,38 @@
 #ifndef PM_SCENE_MIRROR_H
 #define PM_SCENE_MIRROR_H
 
+#include <math.h>
+
 #include "pm_scene.h"
 
 /* The whole body's force component comp on a face from the part's: for
  * every plane, the face's image is the face itself (x2: the image carries
  * the same component, 0 for the component normal to the plane, which
  * cancels) unless the face is parallel to the plane (face_axis == its
- * axis: the image is the opposite face, x1).  face_axis -1: a boundary
- * that is not a face of the box (taken to cross every plane). */
+ * axis: the image is the opposite face, x1).  face_axis -1: a boundary of
+ * no known orientation (a region, a named surface, a sphere), taken to
+ * cross every plane; its component across a plane is then not known
+ * (NaN: it cancels if the boundary crosses the plane, it is the part's
+ * own if it lies beside it). */
 static inline double pm_scene_mirror_factor(const pm_scene *s, int face_axis,
                                             int comp) {
   double f = 1;
   for (int a = 0; a < 3; a++)
-    if ((s->mirror_mask >> a & 1u) && a != face_axis) f *= a == comp ? 0 : 2;
+    if ((s->mirror_mask >> a & 1u) && a != face_axis) {
+      if (a == comp && face_axis < 0) return (double)NAN;
+      f *= a == comp ? 0 : 2;
+    }
   return f;
+}
+
+/* The axis a boundary condition's face is normal to: a face of the box's,
+ * a plate's normal along an axis; -1 otherwise. */
+static inline int pm_scene_bc_axis(const pm_scene_bc *bc) {
+  if (bc->on == PM_ON_FACE) return bc->face / 2;
+  if (bc->on == PM_ON_PLATE)
+    for (int a = 0; a < 3; a++)
+      if (fabs(bc->rigid_normal[a]) > 1 - 1e-12) return a;
+  return -1;
 }
 
 /* The point of the part whose image is x (x itself in the part): y, and
