@@ -59,13 +59,19 @@ case $limit in
 esac
 
 build=build-fuzz
-CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DPM_FUZZ=ON -DPM_OPENMP=OFF -DPM_VERIFICATION=OFF >/dev/null
+mkdir -p "$build"
 # The program makes the scene's dictionary and the run whose checkpoint
 # and results seed those targets.
 targets=("fuzz_$target")
 case $target in scene | checkpoint | index) targets+=(pointmech) ;; esac
-cmake --build "$build" -j"${PM_FUZZ_BUILD_JOBS:-1}" --target "${targets[@]}"
+# Campaigns started together configure and build one at a time (two
+# configurations of one folder at once break each other's files).
+(
+  flock 9
+  CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DPM_FUZZ=ON -DPM_OPENMP=OFF -DPM_VERIFICATION=OFF >/dev/null
+  cmake --build "$build" -j"${PM_FUZZ_BUILD_JOBS:-1}" --target "${targets[@]}"
+) 9>"$build/.build.lock"
 
 seeds=$build/seeds-$target
 corpus=$build/corpus-$target
