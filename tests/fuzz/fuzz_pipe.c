@@ -60,7 +60,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   case 5: {
     const double q[12] = {0, 0, 0, 0.5, 0.5, 0, 1, 0, 0.25, -1, 2, 0};
     double u[12];
-    (void)pm_probe_map(fuzz_dir(), -1, 4, q, u);
+    (void)pm_probe_map(fuzz_dir(), -1, NULL, 4, q, u);
     break;
   }
   default: (void)pm_ckpt_vet(fuzz_dir()); break;

@@ -8,7 +8,6 @@
 
 #include "pm_metrics.h"
 #include "pm_probe.h"
-#include "pm_scene_mirror.h"
 
 /* The lattice's bounding box. */
 static void lattice_box(const pm_fe_reference *r, double lo[3], double hi[3]) {
@@ -124,28 +123,16 @@ pm_err pm_fe_compare(const pm_fe_reference *r, const pm_scene *s,
                      const char *out_dir, const pm_outcome *o,
                      pm_fe_errors *e) {
   pm_err ret = PM_SUCCESS;
-  double *mapped = NULL, *folded = NULL;
-  unsigned *flips = NULL;
+  double *mapped = NULL;
   char path[PM_PATH_MAX + 1];
   e->nrmse = e->nrmse_interior = e->reaction_error = e->sed_error = NAN;
   e->nrmse_volume = e->tip_error = NAN;
   PM_TRY(PM_ALLOC(mapped, 3 * r->n, "displacement at the FE lattice"));
-  if (s->mirror_mask) {
-    PM_TRY(PM_ALLOC(folded, 3 * r->n, "the lattice's images in the part"));
-    PM_TRY(PM_ALLOC(flips, r->n, "the lattice's reflections"));
-    for (long j = 0; j < r->n; j++)
-      flips[j] = pm_scene_mirror_fold(s, r->x + 3 * j, folded + 3 * j);
-  }
-  PM_TRY(pm_probe_map(out_dir, -1, r->n, folded ? folded : r->x, mapped));
-  if (flips)
-    for (long j = 0; j < r->n; j++)
-      pm_scene_mirror_unfold(flips[j], mapped + 3 * j);
+  PM_TRY(pm_probe_map(out_dir, -1, s, r->n, r->x, mapped));
   pm_fe_errors_of(r, mapped, o, e);
   PM_TRY(pm_path_join(path, sizeof path, out_dir, "fe-errors.csv"));
   PM_TRY(pm_fe_write_errors(r, mapped, path));
 done:
   free(mapped);
-  free(folded);
-  free(flips);
   return ret;
 }

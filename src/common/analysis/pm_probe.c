@@ -17,6 +17,7 @@
 #include "pm_mls.h"
 #include "pm_probe_impl.h"
 #include "pm_output.h"
+#include "pm_scene_mirror.h"
 
 #define SHOW_MAX 60 /* bytes of a bad CSV line quoted in errors */
 
@@ -356,19 +357,23 @@ done:
   return ret;
 }
 
-pm_err pm_probe_map(const char *out_dir, long frame, long m, const double *q,
-                    double *u) {
+pm_err pm_probe_map(const char *out_dir, long frame, const pm_scene *part,
+                    long m, const double *q, double *u) {
   pm_err ret = PM_SUCCESS;
   cloud c = {.n = 0};
   char path[PM_PATH_MAX + 1];
   PM_CALL(pm_path_join(path, sizeof path, out_dir, "results.h5"));
   PM_TRY(read_results(path, frame, &c));
   PM_TRY(pm_probe_index_cloud(&c, path));
-  for (long i = 0; i < m; i++)
-    PM_ENSURE(probe_at(&c, q + 3 * i, u + 3 * i), PM_ERR_GEOMETRY,
+  for (long i = 0; i < m; i++) {
+    double y[3] = {q[3 * i], q[3 * i + 1], q[3 * i + 2]};
+    const unsigned flips = part ? pm_scene_mirror_fold(part, q + 3 * i, y) : 0;
+    PM_ENSURE(probe_at(&c, y, u + 3 * i), PM_ERR_GEOMETRY,
               "no regular moving-least-squares fit at (%g, %g, %g) from the "
               "%ld points of '%s'",
-              q[3 * i], q[3 * i + 1], q[3 * i + 2], c.n, path);
+              y[0], y[1], y[2], c.n, path);
+    pm_scene_mirror_unfold(flips, u + 3 * i);
+  }
 done:
   pm_probe_cloud_free(&c);
   return ret;

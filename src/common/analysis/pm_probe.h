@@ -33,9 +33,14 @@ pm_err pm_probe_points(const char *out_dir, const char *points_csv, long frame,
 pm_err pm_results_read(const char *out_dir, long frame, long *n, double **x,
                        double **u);
 
+struct pm_scene;
 /* The displacement of OUT/results.h5 (frame as above) at the m reference
- * points q ([m][3]) by the same moving least squares, into u ([m][3]). */
-pm_err pm_probe_map(const char *out_dir, long frame, long m, const double *q,
+ * points q ([m][3]) by the same moving least squares, into u ([m][3]).
+ * part: the scene of the run (NULL: none), where a point outside a part
+ * mirrored about its symmetry planes takes its image's value
+ * (pm_scene_mirror.h). */
+pm_err pm_probe_map(const char *out_dir, long frame,
+                    const struct pm_scene *part, long m, const double *q,
                     double *u);
 
 #endif

@@ -12,7 +12,6 @@
 #include "pm_memory.h"
 #include "pm_metrics.h"
 #include "pm_probe.h"
-#include "pm_scene_mirror.h"
 
 #define VALUE_MAX 128
 
@@ -81,13 +80,12 @@ static pm_err load_level(const pm_study_options *o, const ladder_key *keys,
 
 /* Error of run dir of scene s (points x, n) against the reference (rx,
  * ru, rn); a reference point outside a part mirrored about the scene's
- * symmetry planes takes its image's value (pm_scene_mirror.h). */
+ * symmetry planes takes its image's value (pm_probe_map). */
 static pm_err error_against(const pm_scene *s, const char *dir, int dim,
                             long rn, const double *rx, const double *ru,
                             double *work, double *err) {
   long n;
-  double *x = NULL, *u = NULL, *folded = NULL;
-  unsigned *flips = NULL;
+  double *x = NULL, *u = NULL;
   pm_err ret = PM_SUCCESS;
   unsigned mask = dim == 2 ? 3u : 7u;
   PM_TRY(pm_results_read(dir, -1, &n, &x, &u));
@@ -97,23 +95,12 @@ static pm_err error_against(const pm_scene *s, const char *dir, int dim,
   if (same) {
     *err = pm_nrmse_vector(rn, mask, u, ru);
   } else {
-    if (s->mirror_mask) {
-      PM_TRY(PM_ALLOC(folded, 3 * rn, "the reference's images in the part"));
-      PM_TRY(PM_ALLOC(flips, rn, "the reference's reflections"));
-      for (long j = 0; j < rn; j++)
-        flips[j] = pm_scene_mirror_fold(s, rx + 3 * j, folded + 3 * j);
-    }
-    PM_TRY(pm_probe_map(dir, -1, rn, folded ? folded : rx, work));
-    if (flips)
-      for (long j = 0; j < rn; j++)
-        pm_scene_mirror_unfold(flips[j], work + 3 * j);
+    PM_TRY(pm_probe_map(dir, -1, s, rn, rx, work));
     *err = pm_nrmse_vector(rn, mask, work, ru);
   }
 done:
   free(x);
   free(u);
-  free(folded);
-  free(flips);
   return ret;
 }
 

@@ -33,7 +33,7 @@ static inline double pm_scene_mirror_factor(const pm_scene *s, int face_axis,
 /* The axis a boundary condition's face is normal to: a face of the box's,
  * a plate's normal along an axis; -1 otherwise. */
 static inline int pm_scene_bc_axis(const pm_scene_bc *bc) {
-  if (bc->on == PM_ON_FACE) return bc->face / 2;
+  if (bc->on == PM_ON_FACE) return pm_face_axis(bc->face);
   if (bc->on == PM_ON_PLATE)
     for (int a = 0; a < 3; a++)
       if (fabs(bc->rigid_normal[a]) > 1 - 1e-12) return a;
