@@ -5,27 +5,37 @@
 # without MPI (PM_MPI=OFF: the build that is one process whatever starts
 # it), builds and runs the unit tests alone (target unit-tests, label unit).
 #
-# The sanitizer build compiles at the lowest priority (nice 19) from the
-# start, beside the optimized build and its tests: those leave part of the
-# two cores idle (the serial configure and links, single-threaded
-# stretches of tests that hold both cores, signals awaited, files polled),
-# and a compiler at nice 19 takes only what they leave.  Its unit tests run
-# after the optimized build's, at normal priority (their timeouts are wall
-# time).
+# The sanitizer build and its unit tests run beside the optimized build and
+# its tests, at a lower priority: those leave part of the two cores idle
+# (the serial configure and links, single-threaded stretches of tests that
+# hold both cores, runs across ranks that wait on each other, signals
+# awaited, files polled), and a job at low priority takes only what they
+# leave, or little more.  The compiler runs at nice 19; the sanitizer's
+# unit tests at nice 10 (a share of a core under full load, so that none
+# waits for minutes: their timeouts are wall time, and those of the
+# sanitizer build are three times the optimized build's).  Whatever of
+# them is left when the optimized build's tests end runs alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
 
 ./scripts/install-deps.sh
 
-# The sanitizer build in the background, in its own process group (setsid),
-# stopped with everything it started if the script stops first.
+# The sanitizer build and its tests in the background, in their own
+# process group (setsid), stopped with everything they started if the
+# script stops first.
 mkdir -p build-sanitize
 san_log=build-sanitize/build.log
-setsid -w nice -n 19 bash -c "
-  cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DPM_SANITIZE=ON \
-    -DPM_VERIFICATION=OFF -DPM_MPI=OFF -DPM_WARNINGS_AS_ERRORS=ON &&
-  cmake --build build-sanitize -j$jobs --target unit-tests" >"$san_log" 2>&1 &
+san_tests=build-sanitize/tests.log
+setsid -w bash -c "
+  nice -n 19 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug \
+    -DPM_SANITIZE=ON -DPM_VERIFICATION=OFF -DPM_MPI=OFF \
+    -DPM_WARNINGS_AS_ERRORS=ON >'$san_log' 2>&1 &&
+  nice -n 19 cmake --build build-sanitize -j$jobs --target unit-tests \
+    >>'$san_log' 2>&1 || exit 90
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 nice -n 10 \
+    ctest --test-dir build-sanitize --output-on-failure -L unit -j$jobs \
+    >'$san_tests' 2>&1" &
 san=$!
 trap 'kill -- -$san 2>/dev/null || true' EXIT
 
@@ -37,9 +47,12 @@ san_rc=0
 wait $san || san_rc=$?
 trap - EXIT
 cat "$san_log"
+if [ "$san_rc" -eq 90 ]; then
+  echo "test.sh: the sanitizer build failed" >&2
+  exit 1
+fi
+cat "$san_tests"
 if [ "$san_rc" -ne 0 ]; then
-  echo "test.sh: the sanitizer build failed (exit $san_rc)" >&2
+  echo "test.sh: the sanitizer build's unit tests failed (ctest exit $san_rc)" >&2
   exit "$san_rc"
 fi
-ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build-sanitize --output-on-failure -L unit -j"$jobs"

@@ -16,10 +16,44 @@ same="$py $src/tests/verification/same_results.py"
 tol=1e-10
 mpm=$src/cases/mpm
 
+# Each rank's exit status is its own: mpirun does not abort the job when a
+# rank exits with a status other than 0 (orte_abort_on_non_zero_status 0),
+# each rank writes its status to a file, and ranks returns it when every
+# rank's is the same (else it prints them and returns 99).  Aborting cost
+# each run that ends with a status of the program's (3, not yet
+# quasi-static; 2, unstable; 4, interrupted) a second: mpirun's wait
+# between the SIGTERM and the SIGKILL it sends the ranks it aborts.  A rank
+# killed by a signal (status above 128) stops mpirun (its parent), which
+# stops the others: a rank's death by a signal with the abort off leaves
+# mpirun waiting (Open MPI 4.1), and the ranks left would wait in their
+# collectives.
 ranks() { # N, command...
-  local n=$1
+  local n=$1 dir rc r codes=""
   shift
-  timeout 300 mpirun -np "$n" --bind-to none "$@"
+  dir=$(mktemp -d -p "$work" rc.XXXXXX)
+  # shellcheck disable=SC2016
+  PM_RANKS_RC=$dir timeout 300 mpirun --mca orte_abort_on_non_zero_status 0 \
+    -np "$n" --bind-to none sh -c '"$@"; rc=$?
+      echo $rc >"$PM_RANKS_RC/$OMPI_COMM_WORLD_RANK"
+      [ $rc -le 128 ] || kill -TERM $PPID
+      exit $rc' sh "$@"
+  rc=$?
+  for r in $(seq 0 $((n - 1))); do
+    codes="$codes $(cat "$dir/$r" 2>/dev/null || echo none)"
+  done
+  rm -rf "$dir"
+  set -- $codes
+  if [ "$rc" -ne 0 ]; then
+    echo "ranks: mpirun exit $rc, ranks:$codes" >&2
+    return "$rc"
+  fi
+  for r; do
+    if [ "$r" != "$1" ] || [ "$r" = none ]; then
+      echo "ranks: the ranks' exit statuses differ or are missing:$codes" >&2
+      return 99
+    fi
+  done
+  return "$1"
 }
 
 # Two runs' results and history to round-off: $tol, and the history

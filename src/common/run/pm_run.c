@@ -212,6 +212,9 @@ pm_err pm_run_scene_observed(const pm_scene *s, const char *out_dir,
     ret = pm_run_root(s, sim, out_dir, flags, o, &outdir, NULL, also);
   else
     ret = pm_run_worker(s, sim, o);
+  /* Rank 0 concludes the run (not converged, interrupted): every rank
+   * leaves with its outcome, and so with its exit status. */
+  if (ranks) ret = pm_par_agree(ret);
 done:
   *simp = sim;
   pm_outdir_release(outdir);

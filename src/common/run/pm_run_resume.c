@@ -95,6 +95,7 @@ pm_err pm_resume(const char *out_dir, unsigned flags, pm_outcome *o) {
     ret = pm_run_root(s, sim, out_dir, flags, o, &outdir, &rs, NULL);
   else
     ret = resume_worker(s, sim, &rs, o);
+  ret = pm_par_agree(ret); /* rank 0's conclusion, on every rank */
 done:
   if (sim) s->backend->destroy(sim);
   pm_scene_destroy(s);
