@@ -6,15 +6,13 @@
 # it), builds and runs the unit tests alone (target unit-tests, label unit).
 #
 # The sanitizer build and its unit tests run beside the optimized build and
-# its tests, at a lower priority: those leave part of the two cores idle
-# (the serial configure and links, single-threaded stretches of tests that
-# hold both cores, runs across ranks that wait on each other, signals
-# awaited, files polled), and a job at low priority takes only what they
-# leave, or little more.  The compiler runs at nice 19; the sanitizer's
-# unit tests at nice 10 (a share of a core under full load, so that none
-# waits for minutes: their timeouts are wall time, and those of the
-# sanitizer build are three times the optimized build's).  Whatever of
-# them is left when the optimized build's tests end runs alone.
+# its tests, at the lowest priority (nice 19): those leave part of the two
+# cores idle (the serial configure and links, single-threaded stretches of
+# tests that hold both cores, signals awaited, files polled), and a job at
+# nice 19 takes only what they leave.  The sanitizer build's timeouts are
+# wall time, five times the optimized build's, so that a test kept waiting
+# for its share does not time out.  Whatever of them is left when the
+# optimized build's tests end runs alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
@@ -33,7 +31,7 @@ setsid -w bash -c "
     -DPM_WARNINGS_AS_ERRORS=ON >'$san_log' 2>&1 &&
   nice -n 19 cmake --build build-sanitize -j$jobs --target unit-tests \
     >>'$san_log' 2>&1 || exit 90
-  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 nice -n 10 \
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 nice -n 19 \
     ctest --test-dir build-sanitize --output-on-failure -L unit -j$jobs \
     >'$san_tests' 2>&1" &
 san=$!

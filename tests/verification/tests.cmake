@@ -76,14 +76,13 @@ set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 4
 # Runs across MPI ranks (mpirun -np 2 and 3) against the same scenes on one
 # process, explicit MPM (ranks.sh) and FPM (ranks-fpm.sh); ranks_migrate
 # checks that migration moves particles and nothing else.
-# One core each (PROCESSORS 1), one at a time (RESOURCE_LOCK mpirun): their
-# ranks run one thread and yield their core while they wait, and the
-# scripts spend most of their time outside the ranks' work (starting
-# mpirun and the one-process runs, Python comparisons, signals awaited):
-# ranks_fpm used 51 CPU s where it held both cores for 86 s of wall
-# (docs/validation.md, "The suite, cut again"), so ctest -j2 runs a
-# one-core test beside them.  Never two of them together: their ranks
-# would yield to each other's on the same two cores.
+# The whole machine each (PROCESSORS 2), one at a time (RESOURCE_LOCK
+# mpirun): their ranks step in lockstep, and a rank that another test's
+# process takes the core from stalls the others.  Beside a one-core test
+# (and the sanitizer build's tests) ranks_fpm took 316 s of wall and
+# studies 296; alone, 71 and 88 (docs/validation.md, "The suite: each
+# rank's status, and the ranks tests alone").  ranks_halo and ranks_output,
+# a few seconds each, keep one core.
 if(PM_MPI)
   add_executable(ranks_migrate ${PM_VERIFY_DIR}/ranks_migrate.c)
   target_link_libraries(ranks_migrate PRIVATE pm_app)
@@ -91,7 +90,7 @@ if(PM_MPI)
     COMMAND bash ${PM_VERIFY_DIR}/ranks.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_migrate>)
   set_tests_properties(verification.ranks PROPERTIES LABELS verification
-    TIMEOUT 600 PROCESSORS 1
+    TIMEOUT 600 PROCESSORS 2
     RESOURCE_LOCK mpirun)
   # The neighbour exchange alone (pm_halo): random patterns on 3 ranks,
   # every operation against what each root must hold, sums in rank order.
@@ -111,7 +110,7 @@ if(PM_MPI)
     COMMAND bash ${PM_VERIFY_DIR}/ranks-implicit.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_newton>)
   set_tests_properties(verification.ranks_implicit PROPERTIES LABELS
-    verification TIMEOUT 600 PROCESSORS 1
+    verification TIMEOUT 600 PROCESSORS 2
     RESOURCE_LOCK mpirun)
   # FPM's setup with no whole model on any rank (rank 0 meshes, cuts and
   # sends the parts, and lets its mesh and cells go).
@@ -122,7 +121,7 @@ if(PM_MPI)
     COMMAND bash ${PM_VERIFY_DIR}/ranks-fpm.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_fpm_setup>)
   set_tests_properties(verification.ranks_fpm PROPERTIES LABELS verification
-    TIMEOUT 600 PROCESSORS 1
+    TIMEOUT 600 PROCESSORS 2
     RESOURCE_LOCK mpirun)
   # A frame across ranks written in pieces against the gathered frame.
   add_executable(ranks_output ${PM_VERIFY_DIR}/ranks_output.c)
@@ -139,7 +138,7 @@ if(PM_MPI)
     COMMAND bash ${PM_VERIFY_DIR}/ranks-checkpoint.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR})
   set_tests_properties(verification.ranks_checkpoint PROPERTIES LABELS
-    verification TIMEOUT 300 PROCESSORS 1
+    verification TIMEOUT 300 PROCESSORS 2
     RESOURCE_LOCK mpirun)
   # Membranes (their neighbours on other ranks) and bodies moving as
   # prescribed across ranks.
@@ -147,7 +146,7 @@ if(PM_MPI)
     COMMAND bash ${PM_VERIFY_DIR}/ranks-membranes.sh $<TARGET_FILE:pointmech>
       ${PROJECT_SOURCE_DIR} $<TARGET_FILE:ranks_migrate>)
   set_tests_properties(verification.ranks_membranes PROPERTIES LABELS
-    verification TIMEOUT 600 PROCESSORS 1
+    verification TIMEOUT 600 PROCESSORS 2
     RESOURCE_LOCK mpirun)
 endif()
 
