@@ -80,7 +80,7 @@ set_tests_properties(verification.bench PROPERTIES LABELS verification TIMEOUT 4
 # mpirun): their ranks step in lockstep, and a rank that another test's
 # process takes the core from stalls the others.  Beside a one-core test
 # (and the sanitizer build's tests) ranks_fpm took 316 s of wall and
-# studies 296; alone, 71 and 88 (docs/validation.md, "The suite: each
+# studies 296; alone, 65 and 80 (docs/validation.md, "The suite: each
 # rank's status, and the ranks tests alone").  ranks_halo and ranks_output,
 # a few seconds each, keep one core.
 if(PM_MPI)

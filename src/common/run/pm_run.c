@@ -214,7 +214,7 @@ pm_err pm_run_scene_observed(const pm_scene *s, const char *out_dir,
     ret = pm_run_worker(s, sim, o);
   /* Rank 0 concludes the run (not converged, interrupted): every rank
    * leaves with its outcome, and so with its exit status. */
-  if (ranks) ret = pm_par_agree(ret);
+  ret = pm_par_agree(ret);
 done:
   *simp = sim;
   pm_outdir_release(outdir);
