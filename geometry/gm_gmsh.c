@@ -79,6 +79,8 @@ pm_err gm_gmsh_warm(void) {
   return PM_SUCCESS;
 }
 
+pm_err gm_gmsh_preload(const char *need) { return gm_gmsh_api_load(need); }
+
 pm_err gm_gmsh_begin(gm_gmsh_session *s, const char *path) {
   static const gm_option quiet[] = {
       {"General.Terminal", 0},

@@ -29,6 +29,15 @@ void gm_gmsh_end(gm_gmsh_session *s);
  * process that reads many files (a fuzzer) saves gmsh's start-up on each;
  * the parent itself must begin no session of its own meanwhile. */
 pm_err gm_gmsh_warm(void);
+/* Map libgmsh in this process now, without starting gmsh.  Every mesh and
+ * gmsh file is made or read in a child (gm_gmsh_load and the others below;
+ * pm_isolate.h), which maps and relocates libgmsh and the hundred libraries
+ * it brings unless its parent has: about 0.2 s a child, 0.3 s under the
+ * sanitizers.  A process that meshes many times (a test's fixtures) maps
+ * it once here; a run that meshes once leaves it to its child, so that its
+ * own memory never holds gmsh.  need says what needs gmsh, for the message
+ * when it cannot be loaded (PM_ERR_UNSUPPORTED). */
+pm_err gm_gmsh_preload(const char *need);
 /* Element size h everywhere (overrides sizes a file sets). */
 pm_err gm_gmsh_size(double h, const char *path);
 

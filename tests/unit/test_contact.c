@@ -18,6 +18,7 @@
 #include "pm_app.h"
 #include "pm_scene.h"
 #include "pm_testing.h"
+#include "gmsh_testing.h"
 
 /* A rigid body as the scene loader leaves it. */
 static pm_scene_bc rigid(pm_on on, pm_contact contact, const double p[3],
@@ -457,6 +458,7 @@ static void test_static_glued(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_plate_frictionless),
       cmocka_unit_test(test_plate_sticking),

@@ -22,6 +22,7 @@
 #include "gm_voronoi.h"
 #include "pm_omp.h"
 #include "pm_random.h"
+#include "gmsh_testing.h"
 
 /* u = H X + c for a fixed H: the GFD gradient equals H at every point. */
 static void test_gfd_linear(void **state) {
@@ -344,6 +345,7 @@ static void test_meshing_keeps_threads(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_meshing_keeps_threads),
       cmocka_unit_test(test_gfd_linear),

@@ -17,6 +17,7 @@
 #include "fpm_share_testing.h"
 #include "fpm_stream.h"
 #include "fpm_testing.h"
+#include "gmsh_testing.h"
 
 static void assert_same_share(const fpm_model *a, const fpm_model *b) {
   assert_int_equal(a->n, b->n);
@@ -121,6 +122,7 @@ static void test_shares_built_defaults(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_shares_built),
       cmocka_unit_test(test_shares_built_defaults),

@@ -15,6 +15,7 @@
 #include "fpm_model.h"
 #include "fpm_static.h"
 #include "fpm_testing.h"
+#include "gmsh_testing.h"
 
 /* The stiffening's onset tau of the tests: about half the interfaces of
  * their rough fields have a linear jump beyond tau h (printed by
@@ -330,6 +331,7 @@ static void test_current_spacing_acts(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sipg_is_gradient),
       cmocka_unit_test(test_force_linearisation),

@@ -16,6 +16,7 @@
 #include "fpm_model.h"
 #include "fpm_share.h"
 #include "fpm_testing.h"
+#include "gmsh_testing.h"
 
 static fixture *averaged(double h, bool defaults, fpm_model **m,
                          fpm_state **st) {
@@ -239,6 +240,7 @@ static void test_split_models(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_stress_is_gradient),
       cmocka_unit_test(test_uniform_dilatation),

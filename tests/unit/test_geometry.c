@@ -16,6 +16,7 @@
 
 #include "gm_cells.h"
 #include "gm_dual.h"
+#include "gmsh_testing.h"
 
 #define DATA PM_TEST_DATA "/geometry/"
 
@@ -468,6 +469,7 @@ static void test_cells_table(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_hand_made_3d), cmocka_unit_test(test_hand_made_2d),
       cmocka_unit_test(test_single_tet),   cmocka_unit_test(test_bad_input),

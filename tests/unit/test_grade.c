@@ -17,6 +17,7 @@
 #include "pm_app.h"
 #include "pm_scene.h"
 #include "pm_testing.h"
+#include "gmsh_testing.h"
 
 /* Nodes with coordinate c below lo and above hi. */
 static void count_slabs(const gm_mesh *m, int c, double lo, double hi,
@@ -301,6 +302,7 @@ static void test_ratio_budget(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_graded_3d),
       cmocka_unit_test(test_graded_2d),

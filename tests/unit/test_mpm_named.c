@@ -19,6 +19,7 @@
 #include "mpm_panel_testing.h"
 #include "mpm_testing.h"
 #include "mpm_traction.h"
+#include "gmsh_testing.h"
 
 /* The static implicit run of the panel with overrides set[0..n) into *o. */
 static void run_panel(const char *dir, const char *name, int n,
@@ -210,6 +211,7 @@ static void test_pressure_explicit(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup_teardown(test_clamp_as_face, pm_test_make_dir,
                                       pm_test_drop_dir),

@@ -12,6 +12,7 @@
 #include "mpm_panel_testing.h"
 #include "mpm_testing.h"
 #include "mpm_traction.h"
+#include "gmsh_testing.h"
 
 /* The sum of the tractions' nodal forces at full load into sum. */
 static void resultant(const model *m, double sum[3]) {
@@ -140,6 +141,7 @@ static void test_curve(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup_teardown(test_resultant, pm_test_make_dir,
                                       pm_test_drop_dir),

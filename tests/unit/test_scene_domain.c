@@ -16,6 +16,7 @@
 #include "pm_app.h"
 #include "pm_scene.h"
 #include "pm_testing.h"
+#include "gmsh_testing.h"
 
 /* Scenes named as if in tests/data/scenes, so that ../geometry resolves. */
 #define NAME PM_TEST_DATA "/scenes/no-domain.yaml"
@@ -98,6 +99,7 @@ static void test_refused(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_bounds_from_body),
       cmocka_unit_test(test_refused),

@@ -14,6 +14,7 @@
 #include "pm_testing.h"
 
 #include "gm_dual.h"
+#include "gmsh_testing.h"
 
 #define PI 3.14159265358979323846
 #define DATA PM_TEST_DATA "/geometry/"
@@ -384,6 +385,7 @@ static void test_errors(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_box_names),     cmocka_unit_test(test_block_file),
       cmocka_unit_test(test_cylinder_file), cmocka_unit_test(test_same_as_box),

@@ -23,6 +23,7 @@
 #include "gm_trisurf.h"
 #include "pm_omp.h"
 #include "pm_tensor.h"
+#include "gmsh_testing.h"
 
 #define PI 3.14159265358979323846
 
@@ -327,6 +328,7 @@ static void test_load_errors(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_rectangle),
       cmocka_unit_test(test_sphere_counts),
