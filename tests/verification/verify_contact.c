@@ -20,6 +20,7 @@
 #include "pm_run.h"
 #include "pm_scene.h"
 #include "pm_testing.h"
+#include "gmsh_testing.h"
 
 #define CASES PM_SOURCE_DIR "/cases/fpm/"
 
@@ -163,6 +164,7 @@ static void test_plate_touch_static(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_plate_default),
       cmocka_unit_test(test_plate_stiff),

@@ -15,6 +15,7 @@
 #include "pm_run.h"
 #include "pm_metrics.h"
 #include "pm_scene.h"
+#include "gmsh_testing.h"
 
 #define CASES PM_SOURCE_DIR "/cases/fpm/"
 
@@ -103,6 +104,7 @@ static void test_f2_voronoi(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_f2_h1),
       cmocka_unit_test(test_f2_h2),

@@ -44,6 +44,7 @@
 #include "pm_fe.h"
 #include "pm_run.h"
 #include "pm_scene.h"
+#include "gmsh_testing.h"
 
 #define CASES PM_SOURCE_DIR "/cases/fpm/"
 
@@ -181,6 +182,7 @@ static void test_f4_60_completes(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_f4_60_completes),
       cmocka_unit_test(test_f3_60_quarter),

@@ -22,6 +22,7 @@
 #include "pm_app.h"
 #include "pm_run.h"
 #include "pm_scene.h"
+#include "gmsh_testing.h"
 
 /* The column hanging under gravity (129 points): NRMSE of u against the
  * exact field below 2e-3 (measured 9.4e-4; 1.7e-4 and 4.6e-5 at half and a
@@ -192,6 +193,7 @@ static void test_cube_pressure(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   pm_app_init();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_column_gravity),

@@ -24,6 +24,7 @@
 #include "pm_metrics.h"
 #include "pm_run.h"
 #include "pm_scene.h"
+#include "gmsh_testing.h"
 
 /* A run that must converge. */
 static void run(const char *file, int n_sets, const char **sets, run_t *r) {
@@ -282,6 +283,7 @@ static void test_traction_work(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   pm_app_init();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_f2_static),

@@ -18,6 +18,7 @@
 #include "pm_metrics.h"
 #include "pm_run.h"
 #include "pm_scene.h"
+#include "gmsh_testing.h"
 
 #define CASES PM_SOURCE_DIR "/cases/"
 
@@ -129,6 +130,7 @@ static void test_named_surfaces(void **state) {
 }
 
 int main(void) {
+  gmsh_testing_preload();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_fpm),
       cmocka_unit_test(test_named_surfaces),
