@@ -64,13 +64,15 @@ static pm_err set_options(const gm_option *opts, size_t n, const char *path) {
   return PM_SUCCESS;
 }
 
+pm_err gm_gmsh_preload(const char *need) { return gm_gmsh_api_load(need); }
+
 /* gmsh initialized by gm_gmsh_warm and not yet taken by a session. */
 static bool warm = false;
 
 pm_err gm_gmsh_warm(void) {
   int ierr = 0;
   if (warm) return PM_SUCCESS;
-  PM_CALL(gm_gmsh_api_load("reading gmsh files"));
+  PM_CALL(gm_gmsh_preload("reading gmsh files"));
   const int threads = pm_omp_threads();
   gmshInitialize(0, NULL, 0, &ierr);
   pm_omp_set_threads(threads);
@@ -78,8 +80,6 @@ pm_err gm_gmsh_warm(void) {
   warm = true;
   return PM_SUCCESS;
 }
-
-pm_err gm_gmsh_preload(const char *need) { return gm_gmsh_api_load(need); }
 
 pm_err gm_gmsh_begin(gm_gmsh_session *s, const char *path) {
   static const gm_option quiet[] = {
