@@ -74,9 +74,21 @@ static void aug_rows(const chain *ch, long *ptr, long *idx, double *val) {
   }
 }
 
+/* The factor of M's last rows (D = aux_scale I: the Schur complement the
+ * same). */
+static double aux_scale = 1;
+
 static pm_err aug_values(void *ctx, const double *x, double *val) {
   (void)x;
-  aug_rows(ctx, NULL, NULL, val);
+  const chain *ch = ctx;
+  aug_rows(ch, NULL, NULL, val);
+  if (aux_scale != 1) {
+    long *ptr = calloc(2 * (size_t)ch->n + 1, sizeof *ptr);
+    if (!ptr) return PM_ERR_MEMORY;
+    aug_rows(ch, ptr, NULL, NULL);
+    for (long k = ptr[ch->n]; k < ptr[2 * ch->n]; k++) val[k] *= aux_scale;
+    free(ptr);
+  }
   return PM_SUCCESS;
 }
 
@@ -110,6 +122,26 @@ static void test_augmented_preconditioner(void **state) {
                 chain_error(&ch, ch.x, 1));
   assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
   assert_true(rep.linear_iterations <= 2 * rep.iterations);
+  /* That was dense (the Schur complement by LAPACK, n = 120 within
+   * PM_NEWTON_AUG_DENSE_MAX); then MUMPS's LU of M (-pm_aug_dense_max 0),
+   * and dense again with D = 3 I: the same preconditioner each time, so
+   * the same Newton iterations and at most two GMRES iterations each. */
+  const char *modes[2] = {"-pm_aug_dense_max 0", NULL};
+  for (int m = 0; m < 2; m++) {
+    pm_newton_report r2;
+    aux_scale = m == 1 ? 3 : 1;
+    opt.petsc_options = modes[m];
+    assert_ok(chain_solve(&ch, &prob, &opt, &r2));
+    print_message("augmented LU (%s, D = %g I): %d Newton, %d linear, error "
+                  "%.1e\n",
+                  m == 0 ? "sparse" : "dense", aux_scale, r2.iterations,
+                  r2.linear_iterations, chain_error(&ch, ch.x, 1));
+    assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+    assert_int_equal(r2.iterations, rep.iterations);
+    assert_true(r2.linear_iterations <= 2 * r2.iterations);
+  }
+  aux_scale = 1;
+  opt.petsc_options = NULL;
   prob.aux_n = 0;
   opt.op = PM_NEWTON_ASSEMBLED;
   assert_ok(chain_solve(&ch, &prob, &opt, &ref));

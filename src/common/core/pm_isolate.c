@@ -276,6 +276,10 @@ static pm_err malformed(const pm_isolate_job *job) {
                   job->path, job->library, why, job->what);
 }
 
+static void (*meanwhile)(void);
+
+void pm_isolate_meanwhile(void (*task)(void)) { meanwhile = task; }
+
 pm_err pm_isolate_run(const pm_isolate_job *job) {
   if (!pm_isolate_enabled()) return job->work(job->arg);
   if (stream_fd >= 0) {
@@ -304,6 +308,11 @@ pm_err pm_isolate_run(const pm_isolate_job *job) {
     child(job, fds[1]);
   }
   close(fds[1]);
+  if (meanwhile) {
+    void (*task)(void) = meanwhile;
+    meanwhile = NULL;
+    task();
+  }
   bool complete = false;
   pm_err ret = take(job, fds[0], &complete);
   close(fds[0]);

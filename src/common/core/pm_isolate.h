@@ -39,6 +39,12 @@ typedef struct {
   void *arg;
 } pm_isolate_job;
 
+/* A task for the parent while the next child reads (once; NULL: none):
+ * what the run will need next and can do without the file, as opening a
+ * library.  Called after the fork, so the child never sees it half done;
+ * not called where nothing is isolated. */
+void pm_isolate_meanwhile(void (*task)(void));
+
 /* Whether reads are isolated (PM_ISOLATE unset or not "0"). */
 bool pm_isolate_enabled(void);
 

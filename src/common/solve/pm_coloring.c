@@ -4,27 +4,69 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int compare_long(const void *a, const void *b) {
-  long x = *(const long *)a, y = *(const long *)b;
-  return (x > y) - (x < y);
+#include "pm_omp.h"
+#include "pm_sorted.h"
+
+/* Sorts a[0 .. len) in increasing order: quicksort on the median of
+ * three, insertion below 24 entries, the smaller part first (the stack
+ * stays within 64 levels).  Rows of a pattern are a few hundred columns,
+ * often runs already in order. */
+static void sort_longs(long *a, long len) {
+  long lo_stack[64], hi_stack[64];
+  int top = 0;
+  long lo = 0, hi = len - 1;
+  for (;;) {
+    while (hi - lo >= 24) {
+      const long mid = lo + (hi - lo) / 2;
+      long x = a[lo], y = a[mid], z = a[hi], pivot;
+      pivot =
+          x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
+      long i = lo, j = hi;
+      while (i <= j) {
+        while (a[i] < pivot) i++;
+        while (a[j] > pivot) j--;
+        if (i <= j) {
+          const long t = a[i];
+          a[i++] = a[j];
+          a[j--] = t;
+        }
+      }
+      /* the larger part waits on the stack */
+      if (j - lo < hi - i) {
+        lo_stack[top] = i;
+        hi_stack[top++] = hi;
+        hi = j;
+      } else {
+        lo_stack[top] = lo;
+        hi_stack[top++] = j;
+        lo = i;
+      }
+    }
+    for (long i = lo + 1; i <= hi; i++) {
+      const long v = a[i];
+      long k = i - 1;
+      for (; k >= lo && a[k] > v; k--) a[k + 1] = a[k];
+      a[k + 1] = v;
+    }
+    if (top == 0) return;
+    top--;
+    lo = lo_stack[top];
+    hi = hi_stack[top];
+  }
 }
 
 pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
                         pm_pattern *p) {
   pm_err ret = PM_SUCCESS;
-  long *row = NULL;
   memset(p, 0, sizeof *p);
   PM_CHECK(n > 0 && ptr && idx, PM_ERR_ARG,
            "pattern: n must be > 0 (got %ld) with ptr and idx given", n);
   PM_CHECK(ptr[0] == 0, PM_ERR_ARG, "pattern: ptr[0] must be 0 (got %ld)",
            ptr[0]);
-  long longest = 0;
-  for (long i = 0; i < n; i++) {
+  for (long i = 0; i < n; i++)
     PM_CHECK(ptr[i + 1] >= ptr[i], PM_ERR_ARG,
              "pattern: ptr must not decrease (row %ld: %ld -> %ld)", i, ptr[i],
              ptr[i + 1]);
-    if (ptr[i + 1] - ptr[i] > longest) longest = ptr[i + 1] - ptr[i];
-  }
   for (long k = 0; k < ptr[n]; k++) {
     if (idx[k] >= 0 && idx[k] < n) continue;
     long i = 0;
@@ -34,30 +76,43 @@ pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
   }
   p->n = n;
   p->nsrc = ptr[n];
+  const long extra = diagonal ? 1 : 0;
   PM_TRY(PM_ALLOC(p->ptr, n + 1, "pattern rows"));
-  PM_TRY(PM_ALLOC(p->idx, ptr[n] + (diagonal ? n : 0), "pattern columns"));
+  PM_TRY(PM_ALLOC(p->idx, ptr[n] + extra * n, "pattern columns"));
   PM_TRY(PM_ALLOC(p->src, ptr[n] > 0 ? ptr[n] : 1, "pattern map"));
   PM_TRY(PM_ALLOC(p->sptr, n + 1, "pattern map"));
   memcpy(p->sptr, ptr, (size_t)(n + 1) * sizeof *ptr);
-  PM_TRY(PM_ALLOC(row, longest + 1, "pattern row"));
+  long *out = p->idx, *cnt = p->ptr;
+  /* Each row sorted and made unique in its own slot (its source's place
+   * and one more for the diagonal), every thread its rows; then the rows
+   * moved down in order, which only ever moves a row to where rows before
+   * it have been; then each source entry's place by bisection. */
+  PM_OMP(parallel for schedule(dynamic, 64) default(none)
+         shared(n, ptr, idx, extra, out, cnt))
   for (long i = 0; i < n; i++) {
-    long len = 0;
+    long *row = out + ptr[i] + extra * i, len = 0;
     for (long k = ptr[i]; k < ptr[i + 1]; k++) row[len++] = idx[k];
-    if (diagonal) row[len++] = i;
-    qsort(row, (size_t)len, sizeof *row, compare_long);
-    long start = p->ptr[i], m = 0;
+    if (extra) row[len++] = i;
+    sort_longs(row, len);
+    long m = 0;
     for (long k = 0; k < len; k++)
-      if (m == 0 || row[k] != p->idx[start + m - 1])
-        p->idx[start + m++] = row[k];
-    p->ptr[i + 1] = start + m;
-    /* Each source entry's place, by bisection in the sorted row. */
-    for (long k = ptr[i]; k < ptr[i + 1]; k++) {
-      long *at = bsearch(&idx[k], p->idx + start, (size_t)m, sizeof(long),
-                         compare_long);
-      PM_ASSERT(at);
-      p->src[k] = at - p->idx;
-    }
+      if (m == 0 || row[k] != row[m - 1]) row[m++] = row[k];
+    cnt[i + 1] = m;
   }
+  cnt[0] = 0;
+  for (long i = 0; i < n; i++) {
+    const long m = cnt[i + 1], from = ptr[i] + extra * i;
+    cnt[i + 1] = cnt[i] + m;
+    if (from != cnt[i])
+      memmove(out + cnt[i], out + from, (size_t)m * sizeof *out);
+  }
+  long *src = p->src;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, ptr, idx, out, cnt, src))
+  for (long i = 0; i < n; i++)
+    for (long k = ptr[i]; k < ptr[i + 1]; k++)
+      src[k] =
+          cnt[i] + pm_lower_bound(out + cnt[i], cnt[i + 1] - cnt[i], idx[k]);
   /* A source that is the pattern itself needs no map. */
   bool same = p->nsrc == p->ptr[n];
   for (long k = 0; same && k < p->nsrc; k++) same = p->src[k] == k;
@@ -67,14 +122,11 @@ pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
     p->src = p->sptr = NULL;
   }
 done:
-  free(row);
   if (ret != PM_SUCCESS) pm_pattern_free(p);
   return ret;
 }
 
-void pm_pattern_sort_row(long *row, long len) {
-  qsort(row, (size_t)len, sizeof *row, compare_long);
-}
+void pm_pattern_sort_row(long *row, long len) { sort_longs(row, len); }
 
 void pm_pattern_free(pm_pattern *p) {
   free(p->ptr);

@@ -92,6 +92,14 @@
  * per-iteration arrays of a report, less one). */
 #define PM_NEWTON_MAX_ITER 200
 
+/* Up to this many unknowns the augmented preconditioner (aux_n) is
+ * factorised dense: the Schur complement J0 - G D^-1 C formed and its LU
+ * taken by LAPACK on every OpenMP thread, instead of the sparse LU of the
+ * augmented matrix (docs/validation.md, "The coupled LU dense when it is
+ * small").  The PETSc option -pm_aug_dense_max N (solver_options) sets
+ * the bound of a run; 0: never dense. */
+#define PM_NEWTON_AUG_DENSE_MAX 5000L
+
 struct pm_newton_report;
 
 typedef struct {
@@ -134,7 +142,9 @@ typedef struct {
    * the solver's own or its fallbacks' (pm_newton_set_fallback_linear),
    * with op PM_NEWTON_MATRIX_FREE, one process): M = [J0 G; C I] over the
    * n unknowns and aux_n more, on the pattern aux_ptr/aux_idx (CSR over
-   * n + aux_n; copied), its values from aux_values at each new
+   * n + aux_n; kept by the caller until the solver is destroyed; the rows
+   * past n hold no column past n but their own for the dense path,
+   * PM_NEWTON_AUG_DENSE_MAX), its values from aux_values at each new
    * preconditioner (after jacobian_prepare, in the pattern's order,
    * repeated entries summed).  The LU of M applied to [r; 0], first n
    * values, is (J0 - G C)^-1 r: the exact inverse of J when J is J0

@@ -1,12 +1,20 @@
 /* pm_newton_augmented: a preconditioner factorised from a larger matrix
- * (pm_newton_problem.aux_n): the LU of [J0 G; C I] applied to [r; 0],
- * whose first n values are (J0 - G C)^-1 r. */
+ * (pm_newton_problem.aux_n): M = [J0 G; C D], D diagonal, applied to
+ * [r; 0], whose first n values are (J0 - G D^-1 C)^-1 r.  Up to
+ * PM_NEWTON_AUG_DENSE_MAX unknowns that Schur complement is formed dense,
+ * straight from the caller's rows, and factorised by LAPACK on every
+ * OpenMP thread (a tangent of three rings is a third to two thirds full
+ * there, and MUMPS's set-up and triangular solves cost more than the dense
+ * ones); above, or where M's last rows are not so, MUMPS factorises M. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <lapacke.h>
 #include <petscsnes.h>
 
 #include "pm_newton_solver_impl.h"
+#include "pm_omp.h"
 #include "pm_petsc.h"
 
 pm_err pm_newton_aug_init(pm_newton *s, const pm_newton_problem *p) {
@@ -17,20 +25,60 @@ pm_err pm_newton_aug_init(pm_newton *s, const pm_newton_problem *p) {
            "Newton problem: the augmented preconditioner (aux_n) needs a "
            "matrix-free operator and one process");
   const long N = p->n + p->aux_n;
-  PM_CALL(pm_pattern_build(N, p->aux_ptr, p->aux_idx, true, &s->apat));
-  PM_CALL(PM_ALLOC(s->asrc, s->apat.nsrc > 0 ? s->apat.nsrc : 1,
-                   "augmented matrix values"));
+  PM_CHECK(p->aux_ptr[0] == 0, PM_ERR_ARG,
+           "Newton problem: aux_ptr[0] must be 0 (got %ld)", p->aux_ptr[0]);
+  for (long i = 0; i < N; i++)
+    PM_CHECK(p->aux_ptr[i + 1] >= p->aux_ptr[i], PM_ERR_ARG,
+             "Newton problem: aux_ptr must not decrease (row %ld)", i);
+  for (long k = 0; k < p->aux_ptr[N]; k++)
+    PM_CHECK(p->aux_idx[k] >= 0 && p->aux_idx[k] < N, PM_ERR_ARG,
+             "Newton problem: aux_idx[%ld] = %ld is outside [0, %ld)", k,
+             p->aux_idx[k], N);
+  s->aux_N = N;
+  s->aux_ptr = p->aux_ptr;
+  s->aux_idx = p->aux_idx;
   s->aug = true;
   return PM_SUCCESS;
 }
 
+/* The bound on the unknowns of the dense path: -pm_aug_dense_max, else
+ * PM_NEWTON_AUG_DENSE_MAX. */
+static long dense_max(const pm_newton *s) {
+  PetscInt v = (PetscInt)PM_NEWTON_AUG_DENSE_MAX;
+  PetscBool set = PETSC_FALSE;
+  if (PetscOptionsGetInt(s->opts, NULL, "-pm_aug_dense_max", &v, &set) || !set)
+    return PM_NEWTON_AUG_DENSE_MAX;
+  return (long)v;
+}
+
+/* Whether the dense path serves: n within its bound, and M's rows past n
+ * holding no column past n but their own (D diagonal). */
+static bool dense_fits(const pm_newton *s) {
+  const long n = s->p.n, N = s->aux_N, *ptr = s->aux_ptr, *idx = s->aux_idx;
+  if (n > dense_max(s) || (double)n * (double)n > 2147483647.0) return false;
+  for (long i = n; i < N; i++)
+    for (long k = ptr[i]; k < ptr[i + 1]; k++)
+      if (idx[k] >= n && idx[k] != i) return false;
+  return true;
+}
+
 pm_err pm_newton_aug_objects(pm_newton *s) {
   if (!s->aug) return PM_SUCCESS;
+  const long n = s->p.n, N = s->aux_N, nsrc = s->aux_ptr[N];
+  PM_CALL(PM_ALLOC(s->asrc, nsrc > 0 ? nsrc : 1, "augmented matrix values"));
+  if (dense_fits(s)) {
+    PM_CALL(PM_ALLOC(s->ashift, n, "augmented matrix shift"));
+    PM_CALL(PM_ALLOC(s->adiag, N - n, "augmented matrix diagonal"));
+    PM_CALL(PM_ALLOC(s->Sd, n * n, "dense Schur complement"));
+    PM_CALL(PM_ALLOC(s->ipiv, n, "dense Schur complement pivots"));
+    s->aug_dense = true;
+    return PM_SUCCESS;
+  }
   PC pc;
-  const PetscInt N = (PetscInt)s->apat.n;
   PetscInt *cols; /* (one process: none kept) */
+  PM_CALL(pm_pattern_build(N, s->aux_ptr, s->aux_idx, true, &s->apat));
   PM_CALL(pm_newton_create_matrix(s, &s->apat, false, &cols, NULL, &s->Ma));
-  PM_PETSC_CALL(VecCreateSeq(PETSC_COMM_SELF, N, &s->Ab));
+  PM_PETSC_CALL(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)N, &s->Ab));
   PM_PETSC_CALL(VecDuplicate(s->Ab, &s->Ay));
   PM_PETSC_CALL(KSPCreate(PETSC_COMM_SELF, &s->ka));
   PM_PETSC_CALL(PetscObjectSetOptions((PetscObject)s->ka, s->opts));
@@ -51,17 +99,101 @@ pm_err pm_newton_aug_objects(pm_newton *s) {
 
 pm_err pm_newton_aug_values(pm_newton *s, const double *x) {
   PM_CALL(s->p.aux_values(s->p.ctx, x, s->asrc));
-  PM_CALL(pm_newton_scatter_into(s->Ma, &s->apat, s->asrc));
+  if (s->aug_dense)
+    memset(s->ashift, 0, (size_t)s->p.n * sizeof *s->ashift);
+  else
+    PM_CALL(pm_newton_scatter_into(s->Ma, &s->apat, s->asrc));
   s->aug_dirty = true;
   return PM_SUCCESS;
+}
+
+PetscErrorCode pm_newton_aug_shift(pm_newton *s, const double *d) {
+  PetscFunctionBeginUser;
+  if (s->aug_dense) {
+    for (long i = 0; i < s->p.n; i++) s->ashift[i] += d[i];
+    PetscFunctionReturn(0);
+  }
+  for (PetscInt i = 0; i < (PetscInt)s->p.n; i++)
+    PetscCall(MatSetValue(s->Ma, i, i, d[i], ADD_VALUES));
+  PetscCall(MatAssemblyBegin(s->Ma, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(s->Ma, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
+/* S = J0 + shift - G D^-1 C into Sd from M's rows as the caller gives
+ * them (repeated entries add up), row i of S in Sd's row i, each thread
+ * its rows; then the LU of the buffer (S^T to LAPACK).  An exact zero in
+ * D or a zero pivot marks the factorisation failed. */
+static void dense_factor(pm_newton *s) {
+  const long n = s->p.n, N = s->aux_N, *ptr = s->aux_ptr, *idx = s->aux_idx;
+  const double *v = s->asrc, *shift = s->ashift;
+  double *S = s->Sd, *D = s->adiag;
+  bool zero = false;
+  for (long a = n; a < N; a++) {
+    D[a - n] = 0;
+    for (long k = ptr[a]; k < ptr[a + 1]; k++)
+      if (idx[k] == a) D[a - n] += v[k];
+    zero = zero || D[a - n] == 0;
+  }
+  s->aug_failed = zero;
+  if (zero) return;
+  PM_OMP(parallel for schedule(static) default(none)
+         shared(n, ptr, idx, v, shift, S, D))
+  for (long i = 0; i < n; i++) {
+    double *Si = S + i * n;
+    memset(Si, 0, (size_t)n * sizeof *Si);
+    Si[i] = shift[i];
+    for (long k = ptr[i]; k < ptr[i + 1]; k++) {
+      const long c = idx[k];
+      if (c < n) {
+        Si[c] += v[k];
+        continue;
+      }
+      const double g = v[k] / D[c - n];
+      for (long q = ptr[c]; q < ptr[c + 1]; q++)
+        if (idx[q] < n) Si[idx[q]] -= g * v[q];
+    }
+  }
+  const lapack_int info =
+      LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, (lapack_int)n, (lapack_int)n, S,
+                          (lapack_int)n, s->ipiv);
+  s->aug_failed = info != 0;
 }
 
 PetscErrorCode pm_newton_aug_factor(pm_newton *s) {
   PetscFunctionBeginUser;
   if (!pm_newton_aug_on(s) || !s->aug_dirty) PetscFunctionReturn(0);
-  PetscCall(KSPSetOperators(s->ka, s->Ma, s->Ma));
-  PetscCall(KSPSetUp(s->ka));
+  if (s->aug_dense) {
+    dense_factor(s);
+  } else {
+    PetscCall(KSPSetOperators(s->ka, s->Ma, s->Ma));
+    PetscCall(KSPSetUp(s->ka));
+  }
   s->aug_dirty = false;
+  PetscFunctionReturn(0);
+}
+
+/* y = S^-1 x by the dense factors; after a failed factorisation,
+ * infinities and the preconditioner failed (the linear solve then fails
+ * as after a failed sparse LU). */
+static PetscErrorCode dense_apply(pm_newton *s, PC pc, Vec x, Vec y) {
+  const long n = s->p.n;
+  const double *a;
+  double *b;
+  PetscFunctionBeginUser;
+  PetscCall(VecGetArrayRead(x, &a));
+  PetscCall(VecGetArray(y, &b));
+  if (s->aug_failed) {
+    for (long i = 0; i < n; i++) b[i] = INFINITY;
+  } else {
+    memcpy(b, a, (size_t)n * sizeof *b);
+    LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'T', (lapack_int)n, 1, s->Sd,
+                        (lapack_int)n, s->ipiv, b, (lapack_int)n);
+  }
+  PetscCall(VecRestoreArray(y, &b));
+  PetscCall(VecRestoreArrayRead(x, &a));
+  if (s->aug_failed)
+    PetscCall(PCSetFailedReason(pc, PC_FACTOR_NUMERIC_ZEROPIVOT));
   PetscFunctionReturn(0);
 }
 
@@ -72,7 +204,11 @@ static PetscErrorCode aug_apply(PC pc, Vec x, Vec y) {
   double *b;
   PetscFunctionBeginUser;
   PetscCall(PCShellGetContext(pc, &s));
-  const long n = s->p.n, N = s->apat.n;
+  if (s->aug_dense) {
+    PetscCall(dense_apply(s, pc, x, y));
+    PetscFunctionReturn(0);
+  }
+  const long n = s->p.n, N = s->aux_N;
   PetscCall(VecGetArrayRead(x, &a));
   PetscCall(VecGetArray(s->Ab, &b));
   memcpy(b, a, (size_t)n * sizeof *b);
@@ -104,4 +240,8 @@ void pm_newton_aug_free(pm_newton *s) {
   VecDestroy(&s->Ay);
   pm_pattern_free(&s->apat);
   free(s->asrc);
+  free(s->ashift);
+  free(s->adiag);
+  free(s->Sd);
+  free(s->ipiv);
 }

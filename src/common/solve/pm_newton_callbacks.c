@@ -61,11 +61,9 @@ static PetscErrorCode add_shift(pm_newton *s, Mat B) {
   }
   const double *d;
   PetscCall(VecGetArrayRead(s->Shift, &d));
-  for (PetscInt i = 0; i < (PetscInt)s->p.n; i++)
-    PetscCall(MatSetValue(s->Ma, i, i, d[i], ADD_VALUES));
+  PetscErrorCode code = pm_newton_aug_shift(s, d);
   PetscCall(VecRestoreArrayRead(s->Shift, &d));
-  PetscCall(MatAssemblyBegin(s->Ma, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(s->Ma, MAT_FINAL_ASSEMBLY));
+  PetscCall(code);
   PetscFunctionReturn(0);
 }
 

@@ -247,7 +247,7 @@ pm_err pm_newton_create(const pm_newton_problem *problem,
       PM_TRY(PM_ALLOC(s->pvals, s->ppat.ptr[n] + 1, "preconditioner values"));
   }
   PM_TRY(pm_newton_aug_init(s, problem));
-  s->p.aux_ptr = s->p.aux_idx = NULL; /* the caller's: copied */
+  s->p.aux_ptr = s->p.aux_idx = NULL; /* the caller's: kept in aux_* */
   PM_TRY(PM_ALLOC(s->seed, n, "colour seed"));
   PM_TRY(PM_ALLOC(s->dr, n, "colour image"));
   s->p.ghost = problem->ghost;

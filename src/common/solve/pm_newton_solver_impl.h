@@ -106,16 +106,26 @@ struct pm_newton {
   double ew_rprev, ew_eta;
   int lin_its;
   bool started; /* the initial state was admissible */
-  /* pm_newton_problem.aux_n (one process): the augmented matrix's pattern
-   * and values in the caller's order (asrc), the matrix (its values in its
-   * own storage), its LU (ka) and
-   * its right-hand side and solution; dirty: new values not factorised. */
-  bool aug, aug_dirty;
-  pm_pattern apat;
+  /* pm_newton_problem.aux_n (one process): M's rows as the caller gives
+   * them (aux_ptr, aux_idx over aux_N = n + aux_n, kept by the caller) and
+   * their values (asrc, in that order); dirty: new values not
+   * factorised.  Sparse: the pattern (apat), the matrix (its values in its
+   * own storage), its LU (ka), its right-hand side and solution.  Dense
+   * (aug_dense: n <= PM_NEWTON_AUG_DENSE_MAX): the shift of the first n
+   * diagonal entries (ashift), D's values (adiag), the Schur complement
+   * S = J0 - G D^-1 C formed in Sd (n x n, row-major: LAPACK's S^T) and
+   * factorised there with its pivots (ipiv); failed: the last
+   * factorisation met a zero in D or a zero pivot. */
+  bool aug, aug_dirty, aug_dense, aug_failed;
+  long aux_N;
+  const long *aux_ptr, *aux_idx;
   double *asrc;
+  pm_pattern apat;
   Mat Ma;
   KSP ka;
   Vec Ab, Ay;
+  double *ashift, *adiag, *Sd;
+  int *ipiv;
 };
 
 /* A callback's failure that aborts the solve (not an inadmissible state);
@@ -169,6 +179,9 @@ pm_err pm_newton_fill(pm_newton *s, Mat M, const pm_pattern *pat,
                       const double *x);
 /* M's own storage (one process: the pattern's order) = the caller's values
  * src (the pattern's source order) summed into their places. */
+/* The values of pat's source (src) into its own order (vals, ptr[n]):
+ * repeated entries summed. */
+void pm_newton_scatter(const pm_pattern *pat, const double *src, double *vals);
 pm_err pm_newton_scatter_into(Mat M, const pm_pattern *pat, const double *src);
 
 /* *M: an AIJ matrix with pat's structure, set to zeros.  On one process
@@ -243,6 +256,9 @@ pm_err pm_newton_aug_objects(pm_newton *s);
 pm_err pm_newton_aug_values(pm_newton *s, const double *x);
 PetscErrorCode pm_newton_aug_factor(pm_newton *s);
 PetscErrorCode pm_newton_aug_set_pc(pm_newton *s, PC pc);
+/* Adds d (n values) to the diagonal of M's first n rows (the shift of
+ * pseudo-transient continuation). */
+PetscErrorCode pm_newton_aug_shift(pm_newton *s, const double *d);
 void pm_newton_aug_free(pm_newton *s);
 
 /* ---- pm_newton_convergence.c ---- */

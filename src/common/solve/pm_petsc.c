@@ -33,6 +33,12 @@ static PetscErrorCode record_error(MPI_Comm comm, int line, const char *func,
   return code;
 }
 
+void pm_petsc_preload(void) {
+  if (pm_petsc_api_load("a static solve (time.quasi_static.method: static, "
+                        "implicit MPM)") != PM_SUCCESS)
+    pm_error_clear();
+}
+
 pm_err pm_petsc_init(void) {
   PetscBool ready = PETSC_FALSE;
   PM_CHECK(!finished, PM_ERR_LINALG,

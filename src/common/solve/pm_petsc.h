@@ -13,6 +13,11 @@
  * PETSc errors are recorded instead of printed.  PM_ERR_LINALG if PETSc
  * cannot start or was finalised. */
 pm_err pm_petsc_init(void);
+/* Opens libpetsc (its table filled) ahead of pm_petsc_init, for a run that
+ * will solve: a failure is left for pm_petsc_init to report.  A
+ * pm_isolate_meanwhile task (about 0.08 s here: the loader's relocations
+ * of libpetsc and the fifty libraries it brings, while gmsh meshes). */
+void pm_petsc_preload(void);
 
 /* Records a failed PETSc call (code != 0) as PM_ERR_LINALG with the call's
  * text and PETSc's message; returns PM_ERR_LINALG. */

@@ -79,6 +79,7 @@
   X(PCMGGetSmoother)                                                           \
   X(PCMGResidualDefault)                                                       \
   X(PCMGSetResidual)                                                           \
+  X(PCSetFailedReason)                                                         \
   X(PCSetType)                                                                 \
   X(PCSetUseAmat)                                                              \
   X(PCShellGetContext)                                                         \
@@ -98,6 +99,7 @@
   X(PetscObjectTypeCompare)                                                    \
   X(PetscOptionsCreate)                                                        \
   X(PetscOptionsDestroy)                                                       \
+  X(PetscOptionsGetInt)                                                        \
   X(PetscOptionsInsertString)                                                  \
   X(PetscOptionsPop)                                                           \
   X(PetscOptionsPush)                                                          \
@@ -241,6 +243,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define PCMGGetSmoother (*pm_petsc_api.PCMGGetSmoother)
 #define PCMGResidualDefault (*pm_petsc_api.PCMGResidualDefault)
 #define PCMGSetResidual (*pm_petsc_api.PCMGSetResidual)
+#define PCSetFailedReason (*pm_petsc_api.PCSetFailedReason)
 #define PCSetType (*pm_petsc_api.PCSetType)
 #define PCSetUseAmat (*pm_petsc_api.PCSetUseAmat)
 #define PCShellGetContext (*pm_petsc_api.PCShellGetContext)
@@ -260,6 +263,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define PetscObjectTypeCompare (*pm_petsc_api.PetscObjectTypeCompare)
 #define PetscOptionsCreate (*pm_petsc_api.PetscOptionsCreate)
 #define PetscOptionsDestroy (*pm_petsc_api.PetscOptionsDestroy)
+#define PetscOptionsGetInt (*pm_petsc_api.PetscOptionsGetInt)
 #define PetscOptionsInsertString (*pm_petsc_api.PetscOptionsInsertString)
 #define PetscOptionsPop (*pm_petsc_api.PetscOptionsPop)
 #define PetscOptionsPush (*pm_petsc_api.PetscOptionsPush)

@@ -18,7 +18,9 @@
 #include "fpm_scene.h"
 #include "gm_cells.h"
 #include "pm_interrupt.h"
+#include "pm_isolate.h"
 #include "pm_par.h"
+#include "pm_petsc.h"
 
 void fpm_sim_destroy(fpm_sim *sim) {
   if (!sim) return;
@@ -80,6 +82,8 @@ static pm_err sim_mesh(fpm_sim *sim) {
   int domain = fpm_domain_body(s);
   sim->far_size = s->mesh_size;
   pm_err meshed;
+  /* A static solve's PETSc opened while gmsh meshes in its child. */
+  if (s->time.qs == PM_QS_STATIC) pm_isolate_meanwhile(pm_petsc_preload);
   if (domain >= 0)
     meshed = gm_mesh_file(s->bodies[domain].mesh, s->dimension, s->mesh_size,
                           (gm_sizes)s->mesh_sizes, &sim->mesh);
@@ -90,6 +94,7 @@ static pm_err sim_mesh(fpm_sim *sim) {
                                 sim->far_size, &grade, &sim->mesh);
     sim->near_size = grade.faces ? grade.size : 0.0;
   }
+  pm_isolate_meanwhile(NULL);
   /* gmsh meshes in a child process, which a signal stops at once. */
   if (meshed == PM_ERR_INTERRUPTED)
     PM_CALL(pm_interrupt_check("during meshing (nothing written)"));

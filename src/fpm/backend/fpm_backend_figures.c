@@ -310,6 +310,8 @@ pm_err fpm_backend_summary(void *p, pm_json *j) {
                             r->load.newton_iterations));
     PM_CALL(pm_json_integer(j, "static_linear_iterations",
                             r->load.linear_iterations));
+    PM_CALL(pm_json_number(j, "static_seconds", r->seconds));
+    PM_CALL(pm_json_number(j, "static_cpu_seconds", r->cpu_seconds));
     PM_CALL(pm_json_number(j, "static_setup_seconds", r->setup_seconds));
     PM_CALL(
         pm_json_number(j, "static_residual_seconds", r->load.time_residual));

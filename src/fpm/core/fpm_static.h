@@ -18,6 +18,9 @@ typedef struct {
   long pattern_entries; /* stored Jacobian entries */
   long coupled_entries; /* those of the coupled factorisation (0: none) */
   double setup_seconds; /* pattern, tangent geometry, PETSc objects */
+  /* The whole solve of this run (set-up and load steps): wall and CPU
+   * seconds (the process's, every thread's). */
+  double seconds, cpu_seconds;
   /* Sticking contact: points held at a converged step though pulled off
    * their body (grazing: let go once in the step, they came back), summed
    * over steps, and the largest gap one was held at (m). */

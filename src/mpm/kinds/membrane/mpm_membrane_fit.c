@@ -9,6 +9,7 @@
 #include "mpm_membrane_impl.h"
 #include "mpm_exchange.h"
 #include "pm_omp.h"
+#include "pm_sorted.h"
 
 /* ---- normals by isosurface least squares ---------------------------------
  * Per body, each step: the points sorted by grid cell; each cell fitted on
@@ -328,19 +329,6 @@ pm_err mpm_membrane_fit(const mpm_grid *g, const iso_cells *cells, iso_work *w,
   return err;
 }
 
-/* The first of the n increasing a[] that is at least v. */
-static long lower_bound(const long *a, long n, long v) {
-  long lo = 0, hi = n;
-  while (lo < hi) {
-    const long mid = lo + (hi - lo) / 2;
-    if (a[mid] < v)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  return lo;
-}
-
 /* Across ranks, the fitted normals nn of body b's points of the rank
  * (group points [b0, b1), positions x from the group's start): fitted with
  * the nearby points of other ranks (those within the merged blocks' reach
@@ -356,8 +344,8 @@ pm_err mpm_membrane_fit_ranks(const mpm_model *m, const mpm_group *gr,
   const long *own = m->gid + gr->begin, *ids;
   long n_near;
   const double *xn = mpm_xc_nearby(m, gr->index, &n_near, &ids);
-  const long j0 = lower_bound(ids, n_near, mp->whole.first + b->begin),
-             j1 = lower_bound(ids, n_near, mp->whole.first + b->end);
+  const long j0 = pm_lower_bound(ids, n_near, mp->whole.first + b->begin),
+             j1 = pm_lower_bound(ids, n_near, mp->whole.first + b->end);
   long e = 0;
   for (long k = b0, j = j0; k < b1 || j < j1; e++) {
     const bool mine = j >= j1 || (k < b1 && own[k] < ids[j]);
