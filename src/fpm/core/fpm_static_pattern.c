@@ -5,6 +5,7 @@
 
 #include "fpm_static_impl.h"
 #include "pm_coloring.h"
+#include "pm_omp.h"
 
 /* Marks the points of S(i) and i into list (marker: stamp). */
 static long add_support(const fpm_model *m, long i, long *list, long cnt,
@@ -68,43 +69,50 @@ pm_err fpm_static_pattern(const fpm_model *m, const long *free_of, long nf,
                           long **idx_out) {
   pm_err ret = PM_SUCCESS;
   const long n = m->n, rows = m->n_own;
-  long *mark_a = NULL, *mark_r = NULL, *a_list = NULL, *r_list = NULL,
-       *ptr = NULL, *idx = NULL;
-  PM_TRY(PM_ALLOC(mark_a, n, "pattern marks"));
-  PM_TRY(PM_ALLOC(mark_r, n, "pattern marks"));
-  PM_TRY(PM_ALLOC(a_list, n, "pattern lists"));
-  PM_TRY(PM_ALLOC(r_list, n, "pattern lists"));
+  const int threads = pm_omp_threads();
+  long *marks = NULL, *lists = NULL, *ptr = NULL, *idx = NULL;
+  /* each thread's marks and lists (a and r), n each */
+  PM_TRY(PM_ALLOC(marks, 2 * (size_t)threads * n, "pattern marks"));
+  PM_TRY(PM_ALLOC(lists, 2 * (size_t)threads * n, "pattern lists"));
   PM_TRY(PM_ALLOC(ptr, nf + 1, "Jacobian pattern"));
   PM_TRY(PM_ALLOC(tg->R_ptr, n + 1, "Jacobian reach"));
-  for (long i = 0; i < n; i++) mark_a[i] = mark_r[i] = -1;
-  /* Count, then fill. */
+  for (long i = 0; i < 2 * (long)threads * n; i++) marks[i] = -1;
+  /* Count, then fill: rows on every thread, each its own. */
   for (int pass = 0; pass < 2; pass++) {
-    for (long k = 0; k < rows; k++) {
-      long nr = reach(m, k, r_list, a_list, mark_a, mark_r, pass * n + k);
-      /* in increasing order: the rows' columns then are (the unknowns
-       * number the free dofs in order), and the solver takes the tangent's
-       * values in place */
-      if (pass == 1) pm_pattern_sort_row(r_list, nr);
-      if (pass == 0)
-        tg->R_ptr[k + 1] = nr;
-      else
-        for (long t = 0; t < nr; t++) tg->R_list[tg->R_ptr[k] + t] = r_list[t];
-      long cols = 0;
-      for (long t = 0; t < nr; t++)
-        for (int a = 0; a < 3; a++) cols += free_of[3 * r_list[t] + a] >= 0;
-      for (int c = 0; c < 3; c++) {
-        long row = free_of[3 * k + c];
-        if (row < 0) continue;
-        if (pass == 0) {
-          ptr[row + 1] = cols;
-          continue;
-        }
-        long w = ptr[row];
+    PM_OMP(parallel default(none)
+               shared(m, free_of, tg, marks, lists, ptr, idx, n, rows, pass)) {
+      const size_t off = 2 * (size_t)pm_omp_thread() * n;
+      long *mark_a = marks + off, *mark_r = mark_a + n, *a_list = lists + off,
+           *r_list = a_list + n;
+      PM_OMP(for schedule(dynamic, 16))
+      for (long k = 0; k < rows; k++) {
+        long nr = reach(m, k, r_list, a_list, mark_a, mark_r, pass * n + k);
+        /* in increasing order: the rows' columns then are (the unknowns
+         * number the free dofs in order), and the solver takes the
+         * tangent's values in place */
+        if (pass == 1) pm_pattern_sort_row(r_list, nr);
+        if (pass == 0)
+          tg->R_ptr[k + 1] = nr;
+        else
+          for (long t = 0; t < nr; t++)
+            tg->R_list[tg->R_ptr[k] + t] = r_list[t];
+        long cols = 0;
         for (long t = 0; t < nr; t++)
-          for (int a = 0; a < 3; a++) {
-            long col = free_of[3 * r_list[t] + a];
-            if (col >= 0) idx[w++] = col;
+          for (int a = 0; a < 3; a++) cols += free_of[3 * r_list[t] + a] >= 0;
+        for (int c = 0; c < 3; c++) {
+          long row = free_of[3 * k + c];
+          if (row < 0) continue;
+          if (pass == 0) {
+            ptr[row + 1] = cols;
+            continue;
           }
+          long w = ptr[row];
+          for (long t = 0; t < nr; t++)
+            for (int a = 0; a < 3; a++) {
+              long col = free_of[3 * r_list[t] + a];
+              if (col >= 0) idx[w++] = col;
+            }
+        }
       }
     }
     if (pass == 0) {
@@ -118,10 +126,8 @@ pm_err fpm_static_pattern(const fpm_model *m, const long *free_of, long nf,
   *idx_out = idx;
   ptr = idx = NULL;
 done:
-  free(mark_a);
-  free(mark_r);
-  free(a_list);
-  free(r_list);
+  free(marks);
+  free(lists);
   free(ptr);
   free(idx);
   return ret;

@@ -177,6 +177,57 @@ static long recon_size(const fpm_model *m, bool quad, long i) {
   return quad ? m->qs_ptr[i + 1] - m->qs_ptr[i] + 1 : closed_size(m, i);
 }
 
+/* The reconstruction weights of one kind of jump (quad: the fits'; else
+ * the linear fields'), for every interface e of beta_e != 0 in that kind's
+ * slot of erec: at w + off[e], the weights (recon_member) of the members
+ * of its point i's reconstruction at d_i, then those of its neighbour's at
+ * d_k.  Made once for the rows of S, which each read them many times. */
+typedef struct {
+  long *off;
+  double *w;
+} sweights;
+
+static int s_slot(const fpm_model *m, bool quad) {
+  return quad || !m->q ? 18 : 19;
+}
+
+static void sweights_free(sweights *sw) {
+  free(sw->off);
+  free(sw->w);
+}
+
+static pm_err sweights_build(const fpm_model *m, bool quad, sweights *sw) {
+  const long n = m->n, ne = m->nbr_ptr[n];
+  const int slot = s_slot(m, quad);
+  PM_CALL(PM_ALLOC(sw->off, ne + 1, "penalty weights"));
+  for (long i = 0; i < n; i++)
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++)
+      sw->off[e + 1] =
+          m->erec[FPM_EREC * e + slot] == 0
+              ? 0
+              : recon_size(m, quad, i) + recon_size(m, quad, m->nbr[e]);
+  for (long e = 0; e < ne; e++) sw->off[e + 1] += sw->off[e];
+  PM_CALL(PM_ALLOC(sw->w, sw->off[ne] + 1, "penalty weights"));
+  const long *off = sw->off;
+  double *w = sw->w;
+  PM_OMP(parallel for schedule(dynamic, 16) default(none)
+         shared(m, quad, slot, n, off, w))
+  for (long i = 0; i < n; i++)
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+      const double *rec = m->erec + FPM_EREC * e;
+      if (rec[slot] == 0) continue;
+      const long kk = m->nbr[e], ri = recon_size(m, quad, i);
+      double phi[FPM_QFIT], *out = w + off[e];
+      if (quad) fpm_gfd_phi(rec + 12, phi);
+      for (long r = 0; r < ri; r++)
+        recon_member(m, quad, i, r, rec + 12, quad ? phi : NULL, out + r);
+      if (quad) fpm_gfd_phi(rec + 15, phi);
+      for (long r = 0; r < recon_size(m, quad, kk); r++)
+        recon_member(m, quad, kk, r, rec + 15, quad ? phi : NULL, out + ri + r);
+    }
+  return PM_SUCCESS;
+}
+
 /* The row scratch of build_S (a thread's): mark[x] is x's slot in
  * list/acc, or -1. */
 typedef struct {
@@ -186,9 +237,10 @@ typedef struct {
 
 /* Adds to row k of S the penalty of one reconstruction (quad: the fits'
  * jump with beta = rec[18]; else the linear fields' jump with beta =
- * rec[18], or rec[19] beside the quadratic jump). */
-static void add_S_row(const fpm_model *m, bool quad, long k, srow *w) {
-  const int slot = quad || !m->q ? 18 : 19;
+ * rec[18], or rec[19] beside the quadratic jump), from its weights sw. */
+static void add_S_row(const fpm_model *m, bool quad, const sweights *sw, long k,
+                      srow *w) {
+  const int slot = s_slot(m, quad);
   /* the points i whose own field at their interfaces moves with u_k:
    * k itself and those whose reconstruction holds k */
   long ni = quad ? 1 + m->qt_ptr[k + 1] - m->qt_ptr[k] : closed_size(m, k);
@@ -200,32 +252,25 @@ static void add_S_row(const fpm_model *m, bool quad, long k, srow *w) {
       i = m->qs_own[m->qt_entry[m->qt_ptr[k] + ii - 1]];
     else
       i = m->nbr[m->nbr_ptr[k] + ii - 1];
+    const long ri = recon_size(m, quad, i);
     for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
-      const double *rec = m->erec + FPM_EREC * e;
-      const double *di = rec + 12, *dk = rec + 15, be = rec[slot];
+      const double be = m->erec[FPM_EREC * e + slot];
       const long kk = m->nbr[e];
       if (be == 0) continue;
-      double phi[2][FPM_QFIT];
-      if (quad) fpm_gfd_phi(di, phi[0]);
+      const double *wi = sw->w + sw->off[e];
       /* t_ek: k's weight in u_i + recon_i(d_i) */
       double tk = 0;
-      for (long r = 0; r < recon_size(m, quad, i); r++) {
-        if (recon_id(m, quad, i, r) != k) continue;
-        double wt;
-        recon_member(m, quad, i, r, di, quad ? phi[0] : NULL, &wt);
-        tk += wt;
-      }
+      for (long r = 0; r < ri; r++)
+        if (recon_id(m, quad, i, r) == k) tk += wi[r];
       if (k == i) tk += 1;
       if (tk == 0) continue;
-      if (quad) fpm_gfd_phi(dk, phi[1]);
       /* J_em over both sides */
       for (int side = 0; side < 2; side++) {
-        long p = side ? kk : i;
-        double sign = side ? -1 : 1;
-        const double *d = side ? dk : di;
+        const long p = side ? kk : i;
+        const double sign = side ? -1 : 1, *ws = side ? wi + ri : wi;
         for (long r = 0; r < recon_size(m, quad, p); r++) {
-          double wt;
-          long x = recon_member(m, quad, p, r, d, quad ? phi[side] : NULL, &wt);
+          double wt = ws[r];
+          const long x = recon_id(m, quad, p, r);
           if (r == 0) wt += 1;
           if (w->mark[x] < 0) {
             w->mark[x] = w->cnt;
@@ -255,10 +300,13 @@ static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
   const int threads = pm_omp_threads();
   long *mark = NULL, *list = NULL;
   double *acc = NULL;
+  sweights sq = {0}, sl = {0};
   bool lin_too = false;
   if (m->q)
     for (long e = 0; e < m->nnz && !lin_too; e++)
       lin_too = m->erec[FPM_EREC * e + 19] != 0;
+  PM_TRY(sweights_build(m, m->q != NULL, &sq));
+  if (lin_too) PM_TRY(sweights_build(m, false, &sl));
   PM_TRY(PM_ALLOC(mark, (size_t)threads * n, "penalty marks"));
   PM_TRY(PM_ALLOC(list, (size_t)threads * n, "penalty lists"));
   PM_TRY(PM_ALLOC(acc, (size_t)threads * n, "penalty row"));
@@ -266,14 +314,14 @@ static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
   for (long i = 0; i < (long)threads * n; i++) mark[i] = -1;
   for (int pass = 0; pass < 2; pass++) {
     PM_OMP(parallel default(none)
-               shared(m, t, mark, list, acc, n, rows, lin_too, pass)) {
+               shared(m, t, mark, list, acc, n, rows, lin_too, pass, sq, sl)) {
       const long off = (long)pm_omp_thread() * n;
       srow w = {.mark = mark + off, .list = list + off, .acc = acc + off};
       PM_OMP(for schedule(dynamic, 16))
       for (long k = 0; k < rows; k++) {
         w.cnt = 0;
-        add_S_row(m, m->q != NULL, k, &w);
-        if (lin_too) add_S_row(m, false, k, &w);
+        add_S_row(m, m->q != NULL, &sq, k, &w);
+        if (lin_too) add_S_row(m, false, &sl, k, &w);
         if (pass == 0)
           t->S_ptr[k + 1] = w.cnt;
         else
@@ -293,6 +341,8 @@ static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
     }
   }
 done:
+  sweights_free(&sq);
+  sweights_free(&sl);
   free(mark);
   free(list);
   free(acc);
