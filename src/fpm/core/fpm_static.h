@@ -39,7 +39,12 @@ typedef struct {
  * the two cost the same wall time, multigrid 60% of the memory; at 700
  * points multigrid 0.7 of the time, at 1851 points (4359) half the time
  * and a third of the memory (the LU's factors are about as many as a
- * dense matrix's); at 13762 (36 549) the coupled LU took 13 GB. */
+ * dense matrix's); at 13762 (36 549) the coupled LU took 13 GB.  Those
+ * were MUMPS's figures: up to PM_NEWTON_AUG_DENSE_MAX free dofs the
+ * coupled LU is now dense (LAPACK), and it took 0.77, 0.88 and 0.92 of
+ * multigrid's wall time at 700, 1201 and 1851 points, at 1.7 to 2.1 times
+ * its memory (docs/validation.md, "The coupled LU dense"): the bound was
+ * left where it was. */
 #define FPM_STATIC_DIRECT_MAX 1500L
 /* Free dofs up to which a default multigrid solve (above
  * FPM_STATIC_DIRECT_MAX) hands load stepping's fallbacks (a fold's
