@@ -41,7 +41,7 @@ typedef struct {
  * and a third of the memory (the LU's factors are about as many as a
  * dense matrix's); at 13762 (36 549) the coupled LU took 13 GB.  Those
  * were MUMPS's figures: up to PM_NEWTON_AUG_DENSE_MAX free dofs the
- * coupled LU is now dense (LAPACK), and it took 0.77, 0.88 and 0.92 of
+ * coupled LU is now dense (LAPACK), and it took 0.73, 0.71 and 0.89 of
  * multigrid's wall time at 700, 1201 and 1851 points, at 1.7 to 2.1 times
  * its memory (docs/validation.md, "The coupled LU dense"): the bound was
  * left where it was. */
