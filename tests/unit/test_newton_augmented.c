@@ -1,6 +1,6 @@
 /* Unit test of the Newton layer's augmented preconditioner
  * (pm_newton_problem.aux_n): the LU of a larger matrix whose Schur
- * complement is the Jacobian. */
+ * complement is the Jacobian; and the direct solver's LU dense. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -155,9 +155,41 @@ static void test_augmented_preconditioner(void **state) {
   chain_free(&ch);
 }
 
+/* The direct solver's own LU dense (pm_newton_dense.c: the chain of 30
+ * unknowns and reach 2, its pattern 5 n entries, a sixth full) against
+ * MUMPS's (-pm_aug_dense_max 0), with the operator assembled (the LU
+ * alone) and matrix-free (the LU preconditions GMRES): the same Newton
+ * and linear iterations and the solution to 1e-8. */
+static void test_dense_direct(void **state) {
+  (void)state;
+  chain ch;
+  chain_init(&ch, 30, 2, 2);
+  pm_newton_problem prob = chain_problem(&ch);
+  for (int o = 0; o < 2; o++) {
+    pm_newton_report rep[2];
+    for (int m = 0; m < 2; m++) {
+      pm_newton_options opt = pm_newton_options_default();
+      opt.rtol = 1e-10;
+      opt.linear = PM_NEWTON_DIRECT;
+      opt.op = o ? PM_NEWTON_MATRIX_FREE : PM_NEWTON_ASSEMBLED;
+      opt.petsc_options = m ? "-pm_aug_dense_max 0" : NULL;
+      assert_ok(chain_solve(&ch, &prob, &opt, &rep[m]));
+      print_message("direct, %s, %s: %d Newton, %d linear, error %.1e\n",
+                    o ? "matrix-free" : "assembled", m ? "MUMPS" : "dense",
+                    rep[m].iterations, rep[m].linear_iterations,
+                    chain_error(&ch, ch.x, 1));
+      assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+    }
+    assert_int_equal(rep[0].iterations, rep[1].iterations);
+    assert_int_equal(rep[0].linear_iterations, rep[1].linear_iterations);
+  }
+  chain_free(&ch);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_augmented_preconditioner),
+      cmocka_unit_test(test_dense_direct),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -92,12 +92,13 @@
  * per-iteration arrays of a report, less one). */
 #define PM_NEWTON_MAX_ITER 200
 
-/* Up to this many unknowns the augmented preconditioner (aux_n) is
- * factorised dense: the Schur complement J0 - G D^-1 C formed and its LU
- * taken by LAPACK on every OpenMP thread, instead of the sparse LU of the
- * augmented matrix (docs/validation.md, "The coupled LU dense when it is
- * small").  The PETSc option -pm_aug_dense_max N (solver_options) sets
- * the bound of a run; 0: never dense. */
+/* Up to this many unknowns the direct solver's LU is dense (on one
+ * process): the augmented preconditioner's (aux_n: the Schur complement
+ * J0 - G D^-1 C formed), and the matrix's own where its pattern is a
+ * tenth full or more; LAPACK's LU on every OpenMP thread, in place of
+ * MUMPS's (docs/validation.md, "The coupled LU dense when it is small").
+ * The PETSc option -pm_aug_dense_max N (solver_options) sets the bound of
+ * a run; 0: never dense. */
 #define PM_NEWTON_AUG_DENSE_MAX 5000L
 
 struct pm_newton_report;

@@ -2,15 +2,13 @@
  * (pm_newton_problem.aux_n): M = [J0 G; C D], D diagonal, applied to
  * [r; 0], whose first n values are (J0 - G D^-1 C)^-1 r.  Up to
  * PM_NEWTON_AUG_DENSE_MAX unknowns that Schur complement is formed dense,
- * straight from the caller's rows, and factorised by LAPACK on every
- * OpenMP thread (a tangent of three rings is a third to two thirds full
- * there, and MUMPS's set-up and triangular solves cost more than the dense
- * ones); above, or where M's last rows are not so, MUMPS factorises M. */
+ * straight from the caller's rows on every OpenMP thread, and factorised
+ * dense (pm_newton_dense.c); above, or where M's last rows are not so,
+ * MUMPS factorises M. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <lapacke.h>
 #include <petscsnes.h>
 
 #include "pm_newton_solver_impl.h"
@@ -41,21 +39,12 @@ pm_err pm_newton_aug_init(pm_newton *s, const pm_newton_problem *p) {
   return PM_SUCCESS;
 }
 
-/* The bound on the unknowns of the dense path: -pm_aug_dense_max, else
- * PM_NEWTON_AUG_DENSE_MAX. */
-static long dense_max(const pm_newton *s) {
-  PetscInt v = (PetscInt)PM_NEWTON_AUG_DENSE_MAX;
-  PetscBool set = PETSC_FALSE;
-  if (PetscOptionsGetInt(s->opts, NULL, "-pm_aug_dense_max", &v, &set) || !set)
-    return PM_NEWTON_AUG_DENSE_MAX;
-  return (long)v;
-}
-
 /* Whether the dense path serves: n within its bound, and M's rows past n
  * holding no column past n but their own (D diagonal). */
 static bool dense_fits(const pm_newton *s) {
   const long n = s->p.n, N = s->aux_N, *ptr = s->aux_ptr, *idx = s->aux_idx;
-  if (n > dense_max(s) || (double)n * (double)n > 2147483647.0) return false;
+  if (n > pm_newton_dense_max(s) || (double)n * (double)n > 2147483647.0)
+    return false;
   for (long i = n; i < N; i++)
     for (long k = ptr[i]; k < ptr[i + 1]; k++)
       if (idx[k] >= n && idx[k] != i) return false;
@@ -69,8 +58,7 @@ pm_err pm_newton_aug_objects(pm_newton *s) {
   if (dense_fits(s)) {
     PM_CALL(PM_ALLOC(s->ashift, n, "augmented matrix shift"));
     PM_CALL(PM_ALLOC(s->adiag, N - n, "augmented matrix diagonal"));
-    PM_CALL(PM_ALLOC(s->Sd, n * n, "dense Schur complement"));
-    PM_CALL(PM_ALLOC(s->ipiv, n, "dense Schur complement pivots"));
+    PM_CALL(pm_newton_dense_storage(s));
     s->aug_dense = true;
     return PM_SUCCESS;
   }
@@ -135,7 +123,7 @@ static void dense_factor(pm_newton *s) {
       if (idx[k] == a) D[a - n] += v[k];
     zero = zero || D[a - n] == 0;
   }
-  s->aug_failed = zero;
+  s->dense_failed = zero;
   if (zero) return;
   PM_OMP(parallel for schedule(static) default(none)
          shared(n, ptr, idx, v, shift, S, D))
@@ -154,10 +142,7 @@ static void dense_factor(pm_newton *s) {
         if (idx[q] < n) Si[idx[q]] -= g * v[q];
     }
   }
-  const lapack_int info =
-      LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, (lapack_int)n, (lapack_int)n, S,
-                          (lapack_int)n, s->ipiv);
-  s->aug_failed = info != 0;
+  pm_newton_dense_factor(s);
 }
 
 PetscErrorCode pm_newton_aug_factor(pm_newton *s) {
@@ -173,30 +158,6 @@ PetscErrorCode pm_newton_aug_factor(pm_newton *s) {
   PetscFunctionReturn(0);
 }
 
-/* y = S^-1 x by the dense factors; after a failed factorisation,
- * infinities and the preconditioner failed (the linear solve then fails
- * as after a failed sparse LU). */
-static PetscErrorCode dense_apply(pm_newton *s, PC pc, Vec x, Vec y) {
-  const long n = s->p.n;
-  const double *a;
-  double *b;
-  PetscFunctionBeginUser;
-  PetscCall(VecGetArrayRead(x, &a));
-  PetscCall(VecGetArray(y, &b));
-  if (s->aug_failed) {
-    for (long i = 0; i < n; i++) b[i] = INFINITY;
-  } else {
-    memcpy(b, a, (size_t)n * sizeof *b);
-    LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'T', (lapack_int)n, 1, s->Sd,
-                        (lapack_int)n, s->ipiv, b, (lapack_int)n);
-  }
-  PetscCall(VecRestoreArray(y, &b));
-  PetscCall(VecRestoreArrayRead(x, &a));
-  if (s->aug_failed)
-    PetscCall(PCSetFailedReason(pc, PC_FACTOR_NUMERIC_ZEROPIVOT));
-  PetscFunctionReturn(0);
-}
-
 /* y = the first n values of M^-1 [x; 0]. */
 static PetscErrorCode aug_apply(PC pc, Vec x, Vec y) {
   pm_newton *s;
@@ -205,7 +166,7 @@ static PetscErrorCode aug_apply(PC pc, Vec x, Vec y) {
   PetscFunctionBeginUser;
   PetscCall(PCShellGetContext(pc, &s));
   if (s->aug_dense) {
-    PetscCall(dense_apply(s, pc, x, y));
+    PetscCall(pm_newton_dense_solve(s, pc, x, y));
     PetscFunctionReturn(0);
   }
   const long n = s->p.n, N = s->aux_N;
@@ -225,12 +186,7 @@ static PetscErrorCode aug_apply(PC pc, Vec x, Vec y) {
 }
 
 PetscErrorCode pm_newton_aug_set_pc(pm_newton *s, PC pc) {
-  PetscFunctionBeginUser;
-  PetscCall(PCSetType(pc, PCSHELL));
-  PetscCall(PCShellSetContext(pc, s));
-  PetscCall(PCShellSetApply(pc, aug_apply));
-  PetscCall(PCShellSetName(pc, "augmented LU"));
-  PetscFunctionReturn(0);
+  return pm_newton_shell_pc(s, pc, NULL, aug_apply, "augmented LU");
 }
 
 void pm_newton_aug_free(pm_newton *s) {

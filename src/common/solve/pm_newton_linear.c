@@ -145,6 +145,12 @@ static pm_err create_linear(pm_newton *s, KSP *out) {
       PM_PETSC(pm_newton_aug_set_pc(s, pc));
       break;
     }
+    s->dense_direct = pm_newton_dense_direct_fits(s);
+    if (s->dense_direct) { /* the LU dense (pm_newton_dense.c) */
+      PM_TRY(pm_newton_dense_storage(s));
+      PM_PETSC(pm_newton_dense_set_pc(s, pc));
+      break;
+    }
     PM_PETSC(PCSetType(pc, PCLU));
 #ifdef PETSC_HAVE_MUMPS
     PM_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));

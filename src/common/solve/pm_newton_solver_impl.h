@@ -111,12 +111,10 @@ struct pm_newton {
    * their values (asrc, in that order); dirty: new values not
    * factorised.  Sparse: the pattern (apat), the matrix (its values in its
    * own storage), its LU (ka), its right-hand side and solution.  Dense
-   * (aug_dense: n <= PM_NEWTON_AUG_DENSE_MAX): the shift of the first n
-   * diagonal entries (ashift), D's values (adiag), the Schur complement
-   * S = J0 - G D^-1 C formed in Sd (n x n, row-major: LAPACK's S^T) and
-   * factorised there with its pivots (ipiv); failed: the last
-   * factorisation met a zero in D or a zero pivot. */
-  bool aug, aug_dirty, aug_dense, aug_failed;
+   * (aug_dense: n <= the dense bound, pm_newton_dense.c): the shift of the
+   * first n diagonal entries (ashift) and D's values (adiag); the Schur
+   * complement S = J0 - G D^-1 C is formed in Sd. */
+  bool aug, aug_dirty, aug_dense;
   long aux_N;
   const long *aux_ptr, *aux_idx;
   double *asrc;
@@ -124,7 +122,14 @@ struct pm_newton {
   Mat Ma;
   KSP ka;
   Vec Ab, Ay;
-  double *ashift, *adiag, *Sd;
+  double *ashift, *adiag;
+  /* The direct solver dense (pm_newton_dense.c): the augmented
+   * preconditioner's (aug_dense), or the matrix's own (dense_direct: one
+   * process, small and full enough); the matrix in Sd (n x n, row-major:
+   * LAPACK's transpose), factorised there with its pivots (ipiv); failed:
+   * the last factorisation met a zero pivot (or a zero in D). */
+  bool dense_direct, dense_failed;
+  double *Sd;
   int *ipiv;
 };
 
@@ -260,6 +265,30 @@ PetscErrorCode pm_newton_aug_set_pc(pm_newton *s, PC pc);
  * pseudo-transient continuation). */
 PetscErrorCode pm_newton_aug_shift(pm_newton *s, const double *d);
 void pm_newton_aug_free(pm_newton *s);
+
+/* ---- pm_newton_dense.c ---- */
+
+/* The bound on the unknowns of a dense LU: -pm_aug_dense_max, else
+ * PM_NEWTON_AUG_DENSE_MAX. */
+long pm_newton_dense_max(const pm_newton *s);
+/* Sd and ipiv for the n unknowns, once. */
+pm_err pm_newton_dense_storage(pm_newton *s);
+/* The LU of Sd in place (dense_failed after a zero pivot). */
+void pm_newton_dense_factor(pm_newton *s);
+/* y = S^-1 x by Sd's factors; after a failed factorisation, infinities and
+ * pc failed (the linear solve then fails as after a failed sparse LU). */
+PetscErrorCode pm_newton_dense_solve(pm_newton *s, PC pc, Vec x, Vec y);
+/* Whether the direct solver's own LU (no aux_n) is dense: one process, n
+ * within the bound and the pattern a tenth full or more. */
+bool pm_newton_dense_direct_fits(const pm_newton *s);
+/* pc as the dense LU of the preconditioner's matrix (B of
+ * pm_newton_operators), set up from its values at each new matrix. */
+PetscErrorCode pm_newton_dense_set_pc(pm_newton *s, PC pc);
+/* pc as a shell of s: setup (NULL: none) at each new matrix, apply. */
+PetscErrorCode pm_newton_shell_pc(pm_newton *s, PC pc,
+                                  PetscErrorCode (*setup)(PC),
+                                  PetscErrorCode (*apply)(PC, Vec, Vec),
+                                  const char *name);
 
 /* ---- pm_newton_convergence.c ---- */
 

@@ -86,6 +86,7 @@
   X(PCShellSetApply)                                                           \
   X(PCShellSetContext)                                                         \
   X(PCShellSetName)                                                            \
+  X(PCShellSetSetUp)                                                           \
   X(PETSC_COMM_WORLD)                                                          \
   X(PetscError)                                                                \
   X(PetscErrorMessage)                                                         \
@@ -250,6 +251,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define PCShellSetApply (*pm_petsc_api.PCShellSetApply)
 #define PCShellSetContext (*pm_petsc_api.PCShellSetContext)
 #define PCShellSetName (*pm_petsc_api.PCShellSetName)
+#define PCShellSetSetUp (*pm_petsc_api.PCShellSetSetUp)
 #define PETSC_COMM_WORLD (*pm_petsc_api.PETSC_COMM_WORLD)
 #define PetscError (*pm_petsc_api.PetscError)
 #define PetscErrorMessage (*pm_petsc_api.PetscErrorMessage)

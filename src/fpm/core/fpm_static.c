@@ -48,8 +48,9 @@ static double force_floor(const fpm_model *m) {
  * (docs/validation.md, "Static solves: the matrix in the pattern's
  * order"; 116 at 4359 before), taken as 75, flat.  Entries
  * per free dof: 650 with the quadratic jump (3 rings), 403 with the linear
- * jump.  The coupled LU up to PM_NEWTON_AUG_DENSE_MAX free dofs is dense:
- * 8 n^2 bytes and the coupled values. */
+ * jump.  The LU up to PM_NEWTON_AUG_DENSE_MAX free dofs is dense (the
+ * tangent's alone where it is a tenth full or more): 8 n^2 bytes, and the
+ * coupled values. */
 double fpm_static_solver_bytes(long free_dofs, bool quadratic,
                                pm_newton_linear linear, bool coupled,
                                double *entries) {
@@ -57,11 +58,12 @@ double fpm_static_solver_bytes(long free_dofs, bool quadratic,
                fill = pow(n / 4359.0, 0.25);
   if (entries) *entries = nnz;
   if (linear != PM_NEWTON_DIRECT) return 75.0 * nnz;
-  /* the coupled LU dense (pm_newton_augmented.c): the Schur complement,
-   * and the coupled matrix's values (about 1.4 times the tangent's
-   * entries: 493 k against 359 k at 813 free dofs) */
-  if (coupled && free_dofs <= PM_NEWTON_AUG_DENSE_MAX)
-    return 8.0 * n * n + 8.0 * 1.4 * nnz;
+  /* the LU dense (pm_newton_dense.c): the matrix, and with the coupling
+   * the coupled matrix's values (about 1.4 times the tangent's entries:
+   * 493 k against 359 k at 813 free dofs); without it where the tangent is
+   * a tenth full or more */
+  if (free_dofs <= PM_NEWTON_AUG_DENSE_MAX && (coupled || nnz >= 0.1 * n * n))
+    return 8.0 * n * n + 8.0 * (coupled ? 1.4 : 0.0) * nnz;
   return (coupled ? 330.0 : 210.0) * fill * nnz;
 }
 
