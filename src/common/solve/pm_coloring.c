@@ -55,10 +55,7 @@ static void sort_longs(long *a, long len) {
   }
 }
 
-pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
-                        pm_pattern *p) {
-  pm_err ret = PM_SUCCESS;
-  memset(p, 0, sizeof *p);
+pm_err pm_pattern_check(long n, const long *ptr, const long *idx) {
   PM_CHECK(n > 0 && ptr && idx, PM_ERR_ARG,
            "pattern: n must be > 0 (got %ld) with ptr and idx given", n);
   PM_CHECK(ptr[0] == 0, PM_ERR_ARG, "pattern: ptr[0] must be 0 (got %ld)",
@@ -74,6 +71,14 @@ pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
     PM_CHECK(false, PM_ERR_ARG,
              "pattern: row %ld has column %ld, outside [0, %ld)", i, idx[k], n);
   }
+  return PM_SUCCESS;
+}
+
+pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
+                        pm_pattern *p) {
+  pm_err ret = PM_SUCCESS;
+  memset(p, 0, sizeof *p);
+  PM_CALL(pm_pattern_check(n, ptr, idx));
   p->n = n;
   p->nsrc = ptr[n];
   const long extra = diagonal ? 1 : 0;

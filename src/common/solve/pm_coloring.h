@@ -28,6 +28,9 @@ typedef struct {
  * ptr is not non-decreasing from 0 or a column is outside [0, n). */
 pm_err pm_pattern_build(long n, const long *ptr, const long *idx, bool diagonal,
                         pm_pattern *p);
+/* The same checks alone: PM_ERR_ARG naming the row as above, else
+ * PM_SUCCESS. */
+pm_err pm_pattern_check(long n, const long *ptr, const long *idx);
 void pm_pattern_free(pm_pattern *p);
 /* row[0 .. len) in increasing order. */
 void pm_pattern_sort_row(long *row, long len);

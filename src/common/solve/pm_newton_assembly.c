@@ -51,7 +51,7 @@ pm_err pm_newton_color_values(pm_newton *s, apply_fn f, const pm_coloring *col,
 /* vals (pat's order) = the caller's values src (the source's order)
  * summed into their places, row by row on every thread (each row's sums
  * in the source's order, as one thread makes them). */
-void pm_newton_scatter(const pm_pattern *pat, const double *src, double *vals) {
+static void scatter(const pm_pattern *pat, const double *src, double *vals) {
   const long n = pat->n;
   if (!pat->src) { /* the source is the pattern */
     if (vals != src) memcpy(vals, src, (size_t)pat->ptr[n] * sizeof *vals);
@@ -74,7 +74,7 @@ pm_err pm_newton_values_at(pm_newton *s, const double *x, double *vals) {
   /* (the caller's order the pattern's: its values in place) */
   double *src = s->jpat.src ? s->srcvals : vals;
   PM_CALL(s->p.jacobian_values(s->p.ctx, x, src));
-  pm_newton_scatter(&s->jpat, src, vals);
+  scatter(&s->jpat, src, vals);
   return PM_SUCCESS;
 }
 
@@ -83,7 +83,7 @@ pm_err pm_newton_precond_values(pm_newton *s, const double *x, double *vals) {
     return pm_newton_color_values(s, s->p.precond_apply, &s->pcol, x, vals);
   double *src = s->ppat.src ? s->psrcvals : vals;
   PM_CALL(s->p.precond_values(s->p.ctx, x, src));
-  pm_newton_scatter(&s->ppat, src, vals);
+  scatter(&s->ppat, src, vals);
   return PM_SUCCESS;
 }
 
@@ -160,7 +160,7 @@ pm_err pm_newton_fill(pm_newton *s, Mat M, const pm_pattern *pat,
 pm_err pm_newton_scatter_into(Mat M, const pm_pattern *pat, const double *src) {
   double *a;
   PM_PETSC_CALL(MatSeqAIJGetArrayWrite(M, &a));
-  pm_newton_scatter(pat, src, a);
+  scatter(pat, src, a);
   PM_PETSC_CALL(MatSeqAIJRestoreArrayWrite(M, &a));
   return PM_SUCCESS;
 }

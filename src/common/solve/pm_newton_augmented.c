@@ -23,15 +23,7 @@ pm_err pm_newton_aug_init(pm_newton *s, const pm_newton_problem *p) {
            "Newton problem: the augmented preconditioner (aux_n) needs a "
            "matrix-free operator and one process");
   const long N = p->n + p->aux_n;
-  PM_CHECK(p->aux_ptr[0] == 0, PM_ERR_ARG,
-           "Newton problem: aux_ptr[0] must be 0 (got %ld)", p->aux_ptr[0]);
-  for (long i = 0; i < N; i++)
-    PM_CHECK(p->aux_ptr[i + 1] >= p->aux_ptr[i], PM_ERR_ARG,
-             "Newton problem: aux_ptr must not decrease (row %ld)", i);
-  for (long k = 0; k < p->aux_ptr[N]; k++)
-    PM_CHECK(p->aux_idx[k] >= 0 && p->aux_idx[k] < N, PM_ERR_ARG,
-             "Newton problem: aux_idx[%ld] = %ld is outside [0, %ld)", k,
-             p->aux_idx[k], N);
+  PM_CALL(pm_pattern_check(N, p->aux_ptr, p->aux_idx));
   s->aux_N = N;
   s->aux_ptr = p->aux_ptr;
   s->aux_idx = p->aux_idx;
@@ -43,8 +35,7 @@ pm_err pm_newton_aug_init(pm_newton *s, const pm_newton_problem *p) {
  * holding no column past n but their own (D diagonal). */
 static bool dense_fits(const pm_newton *s) {
   const long n = s->p.n, N = s->aux_N, *ptr = s->aux_ptr, *idx = s->aux_idx;
-  if (n > pm_newton_dense_max(s) || (double)n * (double)n > 2147483647.0)
-    return false;
+  if (!pm_newton_dense_within(s)) return false;
   for (long i = n; i < N; i++)
     for (long k = ptr[i]; k < ptr[i + 1]; k++)
       if (idx[k] >= n && idx[k] != i) return false;

@@ -17,12 +17,13 @@
 #include "pm_omp.h"
 #include "pm_petsc.h"
 
-long pm_newton_dense_max(const pm_newton *s) {
+bool pm_newton_dense_within(const pm_newton *s) {
   PetscInt v = (PetscInt)PM_NEWTON_AUG_DENSE_MAX;
   PetscBool set = PETSC_FALSE;
   if (PetscOptionsGetInt(s->opts, NULL, "-pm_aug_dense_max", &v, &set) || !set)
-    return PM_NEWTON_AUG_DENSE_MAX;
-  return (long)v;
+    v = (PetscInt)PM_NEWTON_AUG_DENSE_MAX;
+  const double n = (double)s->p.n;
+  return !s->dist && s->p.n <= (long)v && n * n <= 2147483647.0;
 }
 
 pm_err pm_newton_dense_storage(pm_newton *s) {
@@ -62,8 +63,8 @@ PetscErrorCode pm_newton_dense_solve(pm_newton *s, PC pc, Vec x, Vec y) {
 
 bool pm_newton_dense_direct_fits(const pm_newton *s) {
   const double n = (double)s->p.n;
-  return !s->dist && !s->aug && s->p.n <= pm_newton_dense_max(s) &&
-         n * n <= 2147483647.0 && (double)s->jpat.ptr[s->p.n] >= 0.1 * n * n;
+  return !s->aug && pm_newton_dense_within(s) &&
+         (double)s->jpat.ptr[s->p.n] >= 0.1 * n * n;
 }
 
 /* The preconditioner's matrix into Sd, row by row on every thread; then

@@ -184,9 +184,6 @@ pm_err pm_newton_fill(pm_newton *s, Mat M, const pm_pattern *pat,
                       const double *x);
 /* M's own storage (one process: the pattern's order) = the caller's values
  * src (the pattern's source order) summed into their places. */
-/* The values of pat's source (src) into its own order (vals, ptr[n]):
- * repeated entries summed. */
-void pm_newton_scatter(const pm_pattern *pat, const double *src, double *vals);
 pm_err pm_newton_scatter_into(Mat M, const pm_pattern *pat, const double *src);
 
 /* *M: an AIJ matrix with pat's structure, set to zeros.  On one process
@@ -268,9 +265,9 @@ void pm_newton_aug_free(pm_newton *s);
 
 /* ---- pm_newton_dense.c ---- */
 
-/* The bound on the unknowns of a dense LU: -pm_aug_dense_max, else
- * PM_NEWTON_AUG_DENSE_MAX. */
-long pm_newton_dense_max(const pm_newton *s);
+/* Whether a dense LU may serve: one process, and n within -pm_aug_dense_max
+ * (else PM_NEWTON_AUG_DENSE_MAX) and LAPACK's int indices. */
+bool pm_newton_dense_within(const pm_newton *s);
 /* Sd and ipiv for the n unknowns, once. */
 pm_err pm_newton_dense_storage(pm_newton *s);
 /* The LU of Sd in place (dense_failed after a zero pivot). */
