@@ -561,6 +561,25 @@ static void test_no_admissible_step(void **state) {
   assert_int_equal(pm_newton_create(&prob, &opt, &s), PM_ERR_ARG);
   assert_non_null(strstr(pm_error_message(), "stall_after"));
   pm_error_clear();
+
+  /* With stall_linear, from the second iteration once its linear solves
+   * have taken more iterations than that (the LU: one a solve). */
+  opt.stall_after = 0;
+  opt.stall_linear = 1;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  x = 0;
+  assert_int_equal(pm_newton_solve(s, &x, &rep), PM_ERR_NOT_CONVERGED);
+  print_message("%s (%d linear iterations)\n", rep.message,
+                rep.linear_iterations);
+  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_STALLED);
+  assert_int_equal(rep.iterations, 2);
+  assert_true(rep.linear_iterations > 1);
+  pm_error_clear();
+  pm_newton_destroy(&s);
+  opt.stall_linear = -1;
+  assert_int_equal(pm_newton_create(&prob, &opt, &s), PM_ERR_ARG);
+  assert_non_null(strstr(pm_error_message(), "stall_linear"));
+  pm_error_clear();
 }
 
 int main(void) {

@@ -281,6 +281,11 @@ typedef struct {
    * failure load stepping answers by cutting the step, instead of creeping
    * on with short line-search steps up to max_iter); 0: never. */
   int stall_after; /* 0 */
+  /* ...and, from the second iteration on, one whose linear solves have
+   * taken more than stall_linear iterations in all: an iterative solver's
+   * work far from Newton's basin, each solve dearer than the smaller step
+   * a cut would take; 0: never. */
+  int stall_linear; /* 0 */
 
   pm_newton_linear linear; /* PM_NEWTON_DIRECT */
   double linear_rtol;      /* iterative solvers: 1e-10 */
@@ -418,8 +423,9 @@ typedef enum {
   PM_NEWTON_CONVERGED_ENERGY,       /* etol */
   PM_NEWTON_CONVERGED_ALL,          /* every criterion on (all_criteria) */
   PM_NEWTON_DIVERGED_MAX_ITER,      /* max_iter without converging */
-  PM_NEWTON_DIVERGED_STALLED,       /* stall_after: the residual not halved
-                                       over two iterations */
+  PM_NEWTON_DIVERGED_STALLED,       /* the residual not halved over two
+                                       iterations (stall_after,
+                                       stall_linear) */
   PM_NEWTON_DIVERGED_LINE_SEARCH,   /* no step decreased the residual */
   PM_NEWTON_DIVERGED_NAN,           /* residual not finite */
   PM_NEWTON_DIVERGED_DOMAIN,        /* residual inadmissible at the start,
@@ -507,6 +513,13 @@ pm_err pm_newton_set_fallback_linear(pm_newton *s, const pm_newton_options *alt,
  * assembly takes), and of the cheap preconditioner's (0 if none). */
 int pm_newton_colors(const pm_newton *s);
 int pm_newton_pc_colors(const pm_newton *s);
+
+/* How multigrid's finest level has multiplied since the solver was made
+ * (pm_newton_fine.c): "petsc" (PETSc's own product: one thread, across
+ * ranks, a level that did not come to be, or no multigrid), "double" (the
+ * values as they are, on every thread), "single" (their single-precision
+ * copy) or "single, 3 x 3 blocks". */
+const char *pm_newton_fine_storage(const pm_newton *s);
 
 /* One Newton solve from x[0..n-1], the initial guess, which receives the
  * last iterate (the solution on success; on failure the last iterate

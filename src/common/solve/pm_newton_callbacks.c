@@ -122,6 +122,7 @@ PetscErrorCode pm_newton_snes_jacobian(SNES snes, Vec X, Mat A, Mat B,
     /* pseudo-transient continuation: the shift in the matrix factorised
      * (and, assembled, multiplied by) */
     if (e == PM_SUCCESS && s->shifted) PetscCall(add_shift(s, B));
+    s->fine_stale = true; /* the finest level's copy (pm_newton_fine.c) */
   }
   e = pm_newton_agreed(s, e);
   PetscCall(pm_newton_in_done(s, s->Glin, &xl, &x));

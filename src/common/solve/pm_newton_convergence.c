@@ -7,6 +7,14 @@
 
 #include "pm_newton_solver_impl.h"
 
+/* The linear iterations of this solve so far (a solve made again from its
+ * last iterate counts on). */
+static long linear_so_far(const pm_newton *s, SNES snes) {
+  PetscInt lits = 0;
+  if (SNESGetLinearSolveIterations(snes, &lits)) return 0;
+  return (long)s->lin_base + (long)lits;
+}
+
 /* Called with the state after `it` iterations (accepted by the line
  * search). */
 PetscErrorCode pm_newton_converged_test(SNES snes, PetscInt it, PetscReal xnorm,
@@ -79,9 +87,11 @@ PetscErrorCode pm_newton_converged_test(SNES snes, PetscInt it, PetscReal xnorm,
     s->reason = PM_NEWTON_DIVERGED_MAX_ITER;
     *reason = SNES_DIVERGED_MAX_IT;
     PetscFunctionReturn(0);
-  } else if (o->stall_after > 0 && it >= o->stall_after &&
-             it <= PM_NEWTON_MAX_ITER &&
-             fnorm > 0.5 * rep->residual_norm[it - 2]) {
+  } else if (it >= 2 && it <= PM_NEWTON_MAX_ITER &&
+             fnorm > 0.5 * rep->residual_norm[it - 2] &&
+             ((o->stall_after > 0 && it >= o->stall_after) ||
+              (o->stall_linear > 0 &&
+               linear_so_far(s, snes) > o->stall_linear))) {
     s->reason = PM_NEWTON_DIVERGED_STALLED;
     *reason = SNES_DIVERGED_MAX_IT;
     PetscFunctionReturn(0);

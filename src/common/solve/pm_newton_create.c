@@ -41,6 +41,9 @@ static pm_err check_options(const pm_newton_options *o) {
   PM_CHECK(o->stall_after == 0 || o->stall_after >= 2, PM_ERR_ARG,
            "Newton stall_after must be 0 (off) or >= 2 (got %d)",
            o->stall_after);
+  PM_CHECK(o->stall_linear >= 0, PM_ERR_ARG,
+           "Newton stall_linear must be 0 (off) or > 0 (got %d)",
+           o->stall_linear);
   PM_CHECK(o->linear_max_iter >= 1, PM_ERR_ARG,
            "linear_max_iter must be >= 1 (got %d)", o->linear_max_iter);
   PM_CHECK(o->gmres_restart >= 0, PM_ERR_ARG,
@@ -272,6 +275,9 @@ void pm_newton_destroy(pm_newton **sp) {
   pm_newton_aug_free(s);
   MatDestroy(&s->Shell);
   MatDestroy(&s->Fine);
+  free(s->fine_a);
+  free(s->fine_ib);
+  free(s->fine_jb);
   MatDestroy(&s->J);
   MatDestroy(&s->P);
   VecDestroy(&s->X);

@@ -48,6 +48,18 @@ struct pm_newton {
    * known) */
   Mat Fine;
   int fine_threes;
+  /* Fine's single-precision copy of the values (fine_a, room for
+   * fine_cap), wanted (fine_single), made from the values now held
+   * (fine_single_ok), or to be made again (fine_stale: the Jacobian has
+   * written new values); in 3 x 3 blocks where the matrix is made of them
+   * (fine_blocks, -1: not yet known; fine_ib, fine_jb: each block row's
+   * blocks and their block columns) */
+  float *fine_a;
+  long fine_cap;
+  int fine_blocks;
+  PetscInt *fine_ib, *fine_jb;
+  int fine_single; /* -1: not yet read */
+  bool fine_single_ok, fine_stale, fine_used;
   /* Pseudo-transient continuation (pm_load_ptc.c): while shifted, the
    * linear solves are of J + diag(Shift) (ShiftWork: the shell's term);
    * one process only. */

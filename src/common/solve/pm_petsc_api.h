@@ -100,6 +100,7 @@
   X(PetscObjectTypeCompare)                                                    \
   X(PetscOptionsCreate)                                                        \
   X(PetscOptionsDestroy)                                                       \
+  X(PetscOptionsGetBool)                                                       \
   X(PetscOptionsGetInt)                                                        \
   X(PetscOptionsInsertString)                                                  \
   X(PetscOptionsPop)                                                           \
@@ -265,6 +266,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define PetscObjectTypeCompare (*pm_petsc_api.PetscObjectTypeCompare)
 #define PetscOptionsCreate (*pm_petsc_api.PetscOptionsCreate)
 #define PetscOptionsDestroy (*pm_petsc_api.PetscOptionsDestroy)
+#define PetscOptionsGetBool (*pm_petsc_api.PetscOptionsGetBool)
 #define PetscOptionsGetInt (*pm_petsc_api.PetscOptionsGetInt)
 #define PetscOptionsInsertString (*pm_petsc_api.PetscOptionsInsertString)
 #define PetscOptionsPop (*pm_petsc_api.PetscOptionsPop)

@@ -46,7 +46,9 @@ static double force_floor(const fpm_model *m) {
  * operator complexity included) 68 at 4359, 48 at 36 549 and 46 at
  * 89 535 since the tangent is written in the matrix's own storage
  * (docs/validation.md, "Static solves: the matrix in the pattern's
- * order"; 116 at 4359 before), taken as 75, flat.  Entries
+ * order"; 116 at 4359 before; the finest level's single-precision copy,
+ * 4.4 bytes an entry, within it: the peak comes before), taken as 75,
+ * flat.  Entries
  * per free dof: 650 with the quadratic jump (3 rings), 403 with the linear
  * jump.  The LU up to PM_NEWTON_AUG_DENSE_MAX free dofs is dense (the
  * tangent's alone where it is a tenth full or more): 8 n^2 bytes, and the
@@ -140,6 +142,7 @@ static void linear_settings(const pm_scene *s, pm_newton_options *o) {
    * 13762 points: the Krylov operator and the hierarchy"). */
   o->amg_unsquared = true;
   o->gmres_restart = FPM_STATIC_AMG_RESTART;
+  o->stall_linear = FPM_STATIC_STALL_LINEAR;
   if (!pm_scene_has(s, "time.quasi_static.inexact")) o->linear_ew = true;
   if (!pm_scene_has(s, "time.quasi_static.reuse_iterations"))
     o->pc_reuse_its = FPM_STATIC_AMG_REUSE;

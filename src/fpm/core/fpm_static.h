@@ -72,6 +72,12 @@ typedef struct {
  * is kept while the solves it preconditions take at most this many
  * iterations. */
 #define FPM_STATIC_AMG_REUSE 40
+/* With multigrid: a load step's Newton solve that has not halved the
+ * residual over two iterations while its solves took more than this many
+ * GMRES iterations in all (five times a usual solve's 20-45) is cut then,
+ * not at stall_after (pm_newton_options.stall_linear; docs/validation.md,
+ * "The finest level in single precision, and the first step cut sooner"). */
+#define FPM_STATIC_STALL_LINEAR 200
 
 /* Whether a static solve of scene s (model m) with this many free dofs
  * (over all ranks) hands its fallbacks to the LU
