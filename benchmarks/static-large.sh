@@ -26,7 +26,7 @@ for h in "${sizes[@]}"; do
       /usr/bin/time -f "%e %U %S %M" -o "$out/$tag.time" "$b/pointmech" run \
         "$f3" --set discretization.mesh_size="$h" \
         --set time.quasi_static.method=static --set output.every=100000 \
-        --out "$out/$tag" --overwrite --quiet || true
+        --out "$out/$tag" --overwrite --quiet >/dev/null || true
       rows+=("$b $h $r $out/$tag")
     done
   done
