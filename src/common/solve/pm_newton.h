@@ -329,7 +329,8 @@ typedef struct {
    * matrix, not the operator (PETSc's -pc_use_amat false; with PETSc's
    * default they call jacobian_apply about four times a V-cycle). */
   bool amg_assembled_smoother; /* false */
-  /* and, on one process, on every OpenMP thread (pm_newton_fine.c) */
+  /* and, on one process, through a shell on the OpenMP threads, from a
+   * single-precision copy (pm_newton_fine.c) */
   bool amg_threaded; /* false */
   /* Krylov solvers preconditioned on the right: their residual and
    * tolerance are the true residual's (on the left, PETSc's default, the
@@ -515,10 +516,10 @@ int pm_newton_colors(const pm_newton *s);
 int pm_newton_pc_colors(const pm_newton *s);
 
 /* How multigrid's finest level has multiplied since the solver was made
- * (pm_newton_fine.c): "petsc" (PETSc's own product: one thread, across
- * ranks, a level that did not come to be, or no multigrid), "double" (the
- * values as they are, on every thread), "single" (their single-precision
- * copy) or "single, 3 x 3 blocks". */
+ * (pm_newton_fine.c): "petsc" (PETSc's own product: across ranks, a
+ * level that did not come to be, or no multigrid), "double" (the values
+ * as they are, on every thread), "single" (their single-precision copy)
+ * or "single, 3 x 3 blocks". */
 const char *pm_newton_fine_storage(const pm_newton *s);
 
 /* One Newton solve from x[0..n-1], the initial guess, which receives the

@@ -6,15 +6,18 @@
  * They go through a shell (Fine) that multiplies the same assembled
  * matrix, by PETSc's own structure, in an OpenMP loop over the rows.
  *
- * The products stream the matrix from memory, and a value is two thirds
- * of what they read (an index serves a point's three rows).  By default
- * they read a single-precision copy of the values, made when the Jacobian
- * writes new ones: a preconditioner is an approximation of the tangent
- * already, and rounding its values to 6e-8 leaves the hierarchy's work
- * what it was, for 60% of the bytes a product reads.  The vectors and
- * sums stay in double; Newton's and GMRES's operator is the exact tangent,
- * untouched.  solver_options "-pm_fine_single false": the values as they
- * are (docs/validation.md, "The finest level in single precision"). */
+ * By default they read a single-precision copy of the values, made when
+ * the Jacobian writes new ones, in 3 x 3 blocks with one column index a
+ * block where the matrix is made of whole points (else row by row): 4.4
+ * bytes an entry against 9.3, and independent multiply-adds where a row's
+ * sum was a chain of dependent additions; 2.6 times faster on two threads
+ * and 2.8 on one (benchmarks/fine-product.c), so the shell serves one
+ * thread too.  A preconditioner approximates the tangent already:
+ * rounding its values to 6e-8 leaves the hierarchy's work what it was.
+ * The vectors and sums stay in double; Newton's and GMRES's operator is
+ * the exact tangent, untouched.  solver_options "-pm_fine_single false":
+ * the values as they are (docs/validation.md, "The finest level in single
+ * precision, and the first step cut sooner"). */
 #include <math.h>
 #include <stdbool.h>
 #include <stdlib.h>
@@ -273,7 +276,7 @@ pm_err pm_newton_fine_create(pm_newton *s) {
   s->fine_stale = true;
   s->fine_single = -1; /* (the options are read at the first product) */
   if (!o->amg_threaded || !amg || !o->amg_assembled_smoother || s->dist ||
-      pm_newton_aug_on(s) || pm_omp_threads() < 2)
+      pm_newton_aug_on(s))
     return PM_SUCCESS;
   PetscBool seqaij;
   PM_PETSC_CALL(
