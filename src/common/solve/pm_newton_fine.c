@@ -140,14 +140,12 @@ static void mult_blocks(const pm_newton *s, PetscInt nb, const PetscScalar *x,
   }
 }
 
-/* The blocks' structure, once a solver (the pattern is fixed over its load
- * steps); false where it cannot be had (the values then as they are). */
-static bool fine_structure(pm_newton *s, PetscInt n, const PetscInt *ia,
-                           const PetscInt *ja) {
+/* The copy's storage and the blocks' structure, once a solver (the pattern
+ * is fixed over its load steps); false where it cannot be had (the values
+ * then as they are). */
+static bool fine_storage(pm_newton *s, PetscInt n, const PetscInt *ia,
+                         const PetscInt *ja) {
   const long nnz = (long)ia[n];
-  if (s->fine_threes < 0) s->fine_threes = rows_in_threes(n, ia, ja);
-  if (s->fine_blocks < 0)
-    s->fine_blocks = s->fine_threes && columns_in_threes(n, ia, ja);
   if (nnz > s->fine_cap) {
     free(s->fine_a);
     free(s->fine_ib);
@@ -183,11 +181,9 @@ static bool fine_structure(pm_newton *s, PetscInt n, const PetscInt *ia,
 /* The single-precision copy of B's values, made again after the Jacobian
  * has written them (fine_stale); none where a value is beyond 1e30 or not
  * finite (then the matrix's own values serve). */
-static PetscErrorCode fine_refresh(pm_newton *s, Mat B) {
-  PetscInt n;
-  const PetscInt *ia, *ja;
+static PetscErrorCode fine_refresh(pm_newton *s, Mat B, PetscInt n,
+                                   const PetscInt *ia, const PetscInt *ja) {
   const PetscScalar *a;
-  PetscBool done;
   PetscFunctionBeginUser;
   s->fine_stale = false;
   s->fine_single_ok = false;
@@ -198,10 +194,7 @@ static PetscErrorCode fine_refresh(pm_newton *s, Mat B) {
     s->fine_single = single == PETSC_TRUE;
   }
   if (!s->fine_single) PetscFunctionReturn(0);
-  PetscCall(MatGetRowIJ(B, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
-  PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP,
-             "the finest level's matrix gives no rows");
-  const bool room = fine_structure(s, n, ia, ja);
+  const bool room = fine_storage(s, n, ia, ja);
   PetscCall(MatSeqAIJGetArrayRead(B, &a));
   int bad = !room;
   float *f = s->fine_a;
@@ -228,8 +221,6 @@ static PetscErrorCode fine_refresh(pm_newton *s, Mat B) {
     }
   }
   PetscCall(MatSeqAIJRestoreArrayRead(B, &a));
-  PetscCall(
-      MatRestoreRowIJ(B, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
   s->fine_single_ok = !bad;
   PetscFunctionReturn(0);
 }
@@ -244,11 +235,14 @@ static PetscErrorCode fine_mult(Mat F, Vec in, Vec out) {
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(F, &s));
   const Mat B = fine_source(s);
-  if (s->fine_stale) PetscCall(fine_refresh(s, B));
   PetscCall(MatGetRowIJ(B, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
   PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP,
              "the finest level's matrix gives no rows");
-  if (s->fine_threes < 0) s->fine_threes = rows_in_threes(n, ia, ja);
+  if (s->fine_threes < 0) {
+    s->fine_threes = rows_in_threes(n, ia, ja);
+    s->fine_blocks = s->fine_threes && columns_in_threes(n, ia, ja);
+  }
+  if (s->fine_stale) PetscCall(fine_refresh(s, B, n, ia, ja));
   s->fine_used = true;
   PetscCall(VecGetArrayRead(in, &x));
   PetscCall(VecGetArrayWrite(out, &y));
