@@ -66,6 +66,38 @@ check "unstable: exit 2 (got $rc)" test $rc -eq 2
 check "unstable: diagnosis" grep -Eq "step [0-9]+, t = .*point [0-9]+ at \(" "$work/err"
 check "unstable: summary says so" grep -q '"status": "unstable"' "$work/out-unstable/summary.json"
 check "unstable: results kept" test -f "$work/out-unstable/results.h5"
+check "unstable: the step's advice (F2's supports at 0.15 of the shear wave speed)" \
+  grep -q "reduce time.dt_safety or time.dt" "$work/err"
+
+# Supports that outrun the body in a quasi-static run: F3 200% at 237
+# points ramped over 0.05 s (the scene's smooth ramp moves the top face at
+# 7.5 m/s, 7.5 times the shear wave speed sqrt(mu/rho) = 1.0 m/s) inverts a
+# point during the ramp; the diagnosis puts it down to the ramp, with the
+# ramp that moves them at 0.2 of it (1.87 s: 0.2 m at 1.875 / T of the
+# quintic ramp), and plan says so before the run.
+f3=(--set discretization.mesh_size=2e-2 --set discretization.refine.size_ratio=1
+  --set time.ramp=0.05)
+"$bin" run "$src/cases/fpm/f3-extension-200.yaml" "${f3[@]}" \
+  --out "$work/out-ramp" --quiet >/dev/null 2>"$work/err"
+rc=$?
+check "fast ramp: exit 2 (got $rc)" test $rc -eq 2
+check "fast ramp: diagnosis names the point and the ramp" grep -Eq \
+  "point [0-9]+ at \(.*during the ramp \(it ends at t = 0.05 s\) the supports move at up to 7.5 m/s, 7.49 of the shear wave speed" \
+  "$work/err"
+check "fast ramp: the ramp that holds" grep -q "about 1.87 s moves them at 0.20" "$work/err"
+check "fast ramp: summary's speeds" grep -Eq '"support_speed": 7.49' \
+  "$work/out-ramp/summary.json"
+"$bin" plan "$src/cases/fpm/f3-extension-200.yaml" "${f3[@]}" >"$work/plan-ramp" 2>&1
+check "fast ramp: plan says so" grep -q \
+  "above 0.25: the body may lag behind them (inertia, and the damping's drag on what moves), stretched near them; a" \
+  "$work/plan-ramp"
+check "fast ramp: plan's ramp that holds" grep -q "time.ramp of about 1.87 s moves them at 0.20" \
+  "$work/plan-ramp"
+"$bin" plan "$src/cases/fpm/f3-extension-200.yaml" "${f3[@]}" --set time.ramp=2 \
+  >"$work/plan-ramp2" 2>&1
+check "slow ramp: plan's speed without the warning" grep -q \
+  "supports move at up to 0.187 m/s until t = 2 s, 0.19 of" "$work/plan-ramp2"
+check "slow ramp: no warning" bash -c "! grep -q 'above 0.25' $work/plan-ramp2"
 
 # The stability bounds: J falling to stability.min_jacobian, and energy
 # created by the non-symmetric flux in undamped dynamics, each stop the run

@@ -262,6 +262,18 @@ double pm_scene_load_end(const pm_scene *s) {
   return end;
 }
 
+double pm_scene_shear_wave_speed(const pm_scene *s) {
+  double c = 0;
+  for (int i = 0; i < s->n_materials; i++) {
+    const pm_material *m = &s->materials[i].mat;
+    if (pm_material_is_fluid(m) || !(m->shear_modulus > 0) || !(m->density > 0))
+      continue;
+    const double ci = sqrt(m->shear_modulus / m->density);
+    if (c == 0 || ci < c) c = ci;
+  }
+  return c;
+}
+
 double pm_bc_factor(const pm_scene_bc *bc, double t) {
   return pm_curve_at(bc->curve, t) * pm_ramp_factor(bc->ramp, bc->ramp_time, t);
 }

@@ -467,4 +467,8 @@ double pm_bc_factor(const pm_scene_bc *bc, double t);
  * or velocity) has reached its full value. */
 double pm_scene_load_end(const pm_scene *s);
 
+/* The slowest shear wave speed sqrt(mu_0 / rho_0) of the scene's solid
+ * materials, m/s (0 where none has both). */
+double pm_scene_shear_wave_speed(const pm_scene *s);
+
 #endif

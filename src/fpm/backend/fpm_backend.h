@@ -42,16 +42,17 @@ typedef struct {
   gm_dual *dual;
   fpm_model *model;
   fpm_state *state;
-  double dt;          /* the step used, s */
-  double dt_stable;   /* stable step of the scene's rule, s */
-  double dt_paper;    /* bound of eqs. 24-26, s */
-  double dt_spectral; /* 2 / sqrt(lambda_max(M^-1 K)), s; 0 if not
-                         measured */
-  long dt_point;      /* point that sets the paper's bound */
-  double mean_edge;   /* mean mesh edge length, m */
-  double far_size;    /* the mesh's size away from graded faces, m
-                         (mesh_size unless refine.size_ratio) */
-  double near_size;   /* its size on the graded faces, m; 0: uniform */
+  double dt;            /* the step used, s */
+  double dt_stable;     /* stable step of the scene's rule, s */
+  double dt_paper;      /* bound of eqs. 24-26, s */
+  double dt_spectral;   /* 2 / sqrt(lambda_max(M^-1 K)), s; 0 if not
+                           measured */
+  long dt_point;        /* point that sets the paper's bound */
+  double support_speed; /* fpm_support_speed over the whole run, m/s */
+  double mean_edge;     /* mean mesh edge length, m */
+  double far_size;      /* the mesh's size away from graded faces, m
+                           (mesh_size unless refine.size_ratio) */
+  double near_size;     /* its size on the graded faces, m; 0: uniform */
   pm_timers timers;
   int tm_mesh, tm_dual, tm_operators, tm_force, tm_update;
   int tm_assembly, tm_pcsetup, tm_linear; /* static solves only (else -1) */

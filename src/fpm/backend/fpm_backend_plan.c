@@ -39,6 +39,30 @@ static void plan_estimate(const fpm_sim *sim, double per_step, double steps,
           pm_par_active() ? " per rank" : "", sim->setup_wall);
 }
 
+/* How fast the supports move in a quasi-static run by relaxation or
+ * damping, against the slowest shear wave speed. */
+static void plan_supports(const fpm_sim *sim, FILE *out) {
+  const pm_scene *s = sim->scene;
+  const double c = pm_scene_shear_wave_speed(s), v = sim->support_speed;
+  if (!(s->time.qs == PM_QS_DYNAMIC_RELAXATION ||
+        s->time.qs == PM_QS_DAMPING) ||
+      !(c > 0) || !(v > 0))
+    return;
+  const double ratio = v / c, end = pm_scene_load_end(s);
+  fprintf(out,
+          "ramp         supports move at up to %.3g m/s until t = %g s, %.2f "
+          "of the shear wave speed sqrt(mu/rho) = %.3g m/s\n",
+          v, end, ratio, c);
+  if (ratio > PM_QS_SUPPORT_SPEED_FAST)
+    fprintf(out,
+            "             above %.2f: the body may lag behind them (inertia, "
+            "and the damping's drag on what moves), stretched near them; a "
+            "time.ramp of about %.3g s moves them at "
+            "%.2f\n",
+            PM_QS_SUPPORT_SPEED_FAST, end * ratio / PM_QS_SUPPORT_SPEED_HELD,
+            PM_QS_SUPPORT_SPEED_HELD);
+}
+
 /* The plan's lines from the scene to the memory; the steps (0 for a static
  * solve, whose lines end there). */
 static double plan_head(fpm_sim *sim, FILE *out) {
@@ -222,6 +246,7 @@ static double plan_head(fpm_sim *sim, FILE *out) {
           sim->dt_spectral, sim->dt_spectral / sim->dt_paper);
   fprintf(out, "steps        %.0f to t = %g s%s\n", steps, s->time.end,
           s->time.qs != PM_QS_NONE ? " (at most: stops when converged)" : "");
+  plan_supports(sim, out);
   fprintf(out, "memory       %.1f MiB (operators and state)\n",
           bytes / 1048576.0);
   return steps;

@@ -233,3 +233,44 @@ pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
   return pm_expr_fail_value(e, pm_expr_eval(e, x[0], x[1], x[2], t), step, t,
                             "point", fpm_point_id(m, m->cd_point[k]), x);
 }
+
+/* Samples of the ramps' span (the factors are smooth or piecewise linear
+ * between a table's rows: the largest difference quotient over this many
+ * steps is the peak rate to a fraction of a percent); a condition whose
+ * expressions use t is sampled more coarsely, an evaluation a dof each. */
+#define SPEED_SAMPLES 512
+#define SPEED_SAMPLES_EXPR 64
+
+double fpm_support_speed(const fpm_model *m) {
+  const pm_scene *s = m->scene;
+  const double end = pm_scene_load_end(s);
+  double vmax = 0;
+  if (end > 0 && m->n_cdofs > 0) {
+    if (!m->cd_time_dependent) {
+      /* r(t) cd_base[k]: each condition's peak rate, then its dofs' */
+      const double dt = end / SPEED_SAMPLES;
+      for (int b = 0; b < s->n_bcs; b++) {
+        double rate = 0, r0 = pm_bc_factor(&s->bcs[b], 0);
+        for (int i = 1; i <= SPEED_SAMPLES; i++) {
+          const double r1 = pm_bc_factor(&s->bcs[b], i * dt);
+          rate = fmax(rate, fabs(r1 - r0) / dt);
+          r0 = r1;
+        }
+        for (long k = 0; k < m->n_cdofs; k++)
+          if (m->cd_bc[k] == b) vmax = fmax(vmax, rate * fabs(m->cd_base[k]));
+      }
+    } else {
+      const double dt = end / SPEED_SAMPLES_EXPR;
+      for (long k = 0; k < m->n_cdofs; k++) {
+        double u0 = fpm_prescribed(m, k, 0);
+        for (int i = 1; i <= SPEED_SAMPLES_EXPR; i++) {
+          const double u1 = fpm_prescribed(m, k, i * dt);
+          if (isfinite(u1) && isfinite(u0))
+            vmax = fmax(vmax, fabs(u1 - u0) / dt);
+          u0 = u1;
+        }
+      }
+    }
+  }
+  return vmax;
+}
