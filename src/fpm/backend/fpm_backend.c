@@ -134,7 +134,8 @@ static pm_err sim_model(fpm_sim *sim) {
     PM_CALL(fpm_static_state_init(&sim->static_state, sim->model));
   PM_CALL(PM_ALLOC(sim->scratch, 11 * sim->model->n, "output buffer"));
   sim->dt_paper = fpm_stable_dt(sim->model, &sim->dt_point);
-  sim->support_speed = fpm_support_speed(sim->model);
+  if (s->time.qs == PM_QS_DYNAMIC_RELAXATION || s->time.qs == PM_QS_DAMPING)
+    sim->support_speed = fpm_support_speed(sim->model);
   if (s->time.dt_rule == PM_DT_SPECTRAL) fpm_sim_measure_spectrum(sim);
   pick_dt(sim);
   pm_timers_stop(&sim->timers, sim->tm_operators);
@@ -293,8 +294,11 @@ static void shares_dt(fpm_sim *sim) {
   pm_par_max_long(&first, 1);
   sim->dt_point = -first;
   sim->dt_paper = fpm_stable_dt_of(lm, most);
-  sim->support_speed = fpm_support_speed(lm);
-  pm_par_max(&sim->support_speed, 1);
+  const int qs = sim->scene->time.qs;
+  if (qs == PM_QS_DYNAMIC_RELAXATION || qs == PM_QS_DAMPING) {
+    sim->support_speed = fpm_support_speed(lm);
+    pm_par_max(&sim->support_speed, 1);
+  }
 }
 
 /* A static solve across ranks: the whole run's prescribed dofs (3 per

@@ -236,10 +236,13 @@ pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
 
 /* Samples of the ramps' span (the factors are smooth or piecewise linear
  * between a table's rows: the largest difference quotient over this many
- * steps is the peak rate to a fraction of a percent); a condition whose
- * expressions use t is sampled more coarsely, an evaluation a dof each. */
+ * steps is the peak rate to a fraction of a percent); conditions whose
+ * expressions use t take an evaluation a dof and a sample, so they are
+ * sampled more coarsely: at most SPEED_SAMPLES_EXPR times, and at most
+ * SPEED_EVALUATIONS evaluations in all (at least 8 samples). */
 #define SPEED_SAMPLES 512
 #define SPEED_SAMPLES_EXPR 64
+#define SPEED_EVALUATIONS 1000000L
 
 double fpm_support_speed(const fpm_model *m) {
   const pm_scene *s = m->scene;
@@ -260,10 +263,12 @@ double fpm_support_speed(const fpm_model *m) {
           if (m->cd_bc[k] == b) vmax = fmax(vmax, rate * fabs(m->cd_base[k]));
       }
     } else {
-      const double dt = end / SPEED_SAMPLES_EXPR;
+      long ns = SPEED_EVALUATIONS / m->n_cdofs;
+      ns = ns > SPEED_SAMPLES_EXPR ? SPEED_SAMPLES_EXPR : ns < 8 ? 8 : ns;
+      const double dt = end / (double)ns;
       for (long k = 0; k < m->n_cdofs; k++) {
         double u0 = fpm_prescribed(m, k, 0);
-        for (int i = 1; i <= SPEED_SAMPLES_EXPR; i++) {
+        for (long i = 1; i <= ns; i++) {
           const double u1 = fpm_prescribed(m, k, i * dt);
           if (isfinite(u1) && isfinite(u0))
             vmax = fmax(vmax, fabs(u1 - u0) / dt);
