@@ -98,6 +98,12 @@ check "fast ramp: plan's ramp that holds" grep -q "time.ramp of about 1.87 s mov
 check "slow ramp: plan's speed without the warning" grep -q \
   "supports move at up to 0.187 m/s until t = 2 s, 0.19 of" "$work/plan-ramp2"
 check "slow ramp: no warning" bash -c "! grep -q 'above 0.25' $work/plan-ramp2"
+# A support given by an expression of t, sampled: z = 0.06 t under the
+# 1 s smooth ramp moves at most d/dt (0.06 t r(t)) = 0.1067 m/s.
+"$bin" plan "$src/cases/fpm/f3-extension-60.yaml" --set discretization.mesh_size=2e-2 \
+  --set 'boundary.1.displacement.z=0.06*t' >"$work/plan-expr" 2>&1
+check "expression of t: plan's speed" grep -q "supports move at up to 0.107 m/s" \
+  "$work/plan-expr"
 
 # The stability bounds: J falling to stability.min_jacobian, and energy
 # created by the non-symmetric flux in undamped dynamics, each stop the run
