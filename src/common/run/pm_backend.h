@@ -72,10 +72,10 @@ typedef struct {
                        time.dt_safety, s */
   double residual;  /* quasi-static: out-of-balance force over the
                        reactions (0 in dynamics) */
-  /* The fastest a prescribed motion moves while the ramps run, and the
-   * slowest shear wave speed sqrt(mu_0 / rho_0) of the scene's solids,
-   * m/s (0: not known; FPM gives both). */
-  double support_speed, shear_wave_speed;
+  /* Quasi-static by relaxation or damping: the fastest a prescribed
+   * motion moves while the ramps run, m/s (0 otherwise, or not known; FPM
+   * gives it), against pm_scene_shear_wave_speed. */
+  double support_speed;
   /* Energies, J (per unit thickness in 2D). */
   double kinetic, strain, internal, interface;
   double external_work, dissipated;

@@ -30,9 +30,10 @@ static pm_err summary_figures(pm_run_ctx *c, pm_json *j) {
   PM_CALL(pm_json_number(j, "dt", f->dt));
   PM_CALL(pm_json_number(j, "dt_stable", f->dt_stable));
   PM_CALL(pm_json_number(j, "dt_safety", s->time.dt_safety));
-  if (f->support_speed > 0 && f->shear_wave_speed > 0) {
+  if (f->support_speed > 0) {
     PM_CALL(pm_json_number(j, "support_speed", f->support_speed));
-    PM_CALL(pm_json_number(j, "shear_wave_speed", f->shear_wave_speed));
+    PM_CALL(
+        pm_json_number(j, "shear_wave_speed", pm_scene_shear_wave_speed(s)));
   }
   PM_CALL(pm_json_number(j, "residual", f->residual));
   PM_CALL(pm_json_bool(j, "converged", f->status == PM_STATUS_CONVERGED));
@@ -179,10 +180,8 @@ static void loaded_face(const pm_scene *s, int *bc, int *comp) {
 }
 
 static bool fast_supports(const pm_scene *s, const pm_figures *f) {
-  return (s->time.qs == PM_QS_DYNAMIC_RELAXATION ||
-          s->time.qs == PM_QS_DAMPING) &&
-         f->shear_wave_speed > 0 &&
-         f->support_speed > PM_QS_SUPPORT_SPEED_FAST * f->shear_wave_speed &&
+  const double c = pm_scene_shear_wave_speed(s);
+  return c > 0 && f->support_speed > PM_QS_SUPPORT_SPEED_FAST * c &&
          f->time < pm_scene_load_end(s);
 }
 
@@ -210,8 +209,8 @@ void pm_run_conclude(pm_run_ctx *c, pm_err run_err) {
     /* A quasi-static run whose supports outrun the body during the ramp:
      * the body's lag behind them (its inertia, and relaxation's damping
      * dragging on what moves), not the step, is the first suspect. */
-    const double end = pm_scene_load_end(s),
-                 ratio = f->support_speed / f->shear_wave_speed;
+    const double end = pm_scene_load_end(s), c_s = pm_scene_shear_wave_speed(s),
+                 ratio = f->support_speed / c_s;
     f->status = PM_STATUS_UNSTABLE;
     snprintf(o->message, sizeof o->message,
              "%s; during the ramp (it ends at t = %.4g s) the supports move "
@@ -220,9 +219,9 @@ void pm_run_conclude(pm_run_ctx *c, pm_err run_err) {
              "drag on what moves), stretched near them; a longer time.ramp "
              "(about %.3g s moves them at %.2f of it) keeps the run "
              "quasi-static (stable step %.4g s)",
-             pm_error_message(), end, f->support_speed, ratio,
-             f->shear_wave_speed, end * ratio / PM_QS_SUPPORT_SPEED_HELD,
-             PM_QS_SUPPORT_SPEED_HELD, f->dt_stable);
+             pm_error_message(), end, f->support_speed, ratio, c_s,
+             end * ratio / PM_QS_SUPPORT_SPEED_HELD, PM_QS_SUPPORT_SPEED_HELD,
+             f->dt_stable);
   } else if (run_err == PM_ERR_UNSTABLE) {
     f->status = PM_STATUS_UNSTABLE;
     snprintf(o->message, sizeof o->message,

@@ -121,6 +121,12 @@ static void pick_dt(fpm_sim *sim) {
   sim->dt = s->time.dt > 0 ? s->time.dt : s->time.dt_safety * sim->dt_stable;
 }
 
+/* The supports' speed is a figure of quasi-static runs by relaxation or
+ * damping, where the body must keep up with them. */
+static bool relaxes(const pm_scene *s) {
+  return s->time.qs == PM_QS_DYNAMIC_RELAXATION || s->time.qs == PM_QS_DAMPING;
+}
+
 /* The whole model on the geometry, its state and step. */
 static pm_err sim_model(fpm_sim *sim) {
   const pm_scene *s = sim->scene;
@@ -134,8 +140,7 @@ static pm_err sim_model(fpm_sim *sim) {
     PM_CALL(fpm_static_state_init(&sim->static_state, sim->model));
   PM_CALL(PM_ALLOC(sim->scratch, 11 * sim->model->n, "output buffer"));
   sim->dt_paper = fpm_stable_dt(sim->model, &sim->dt_point);
-  if (s->time.qs == PM_QS_DYNAMIC_RELAXATION || s->time.qs == PM_QS_DAMPING)
-    sim->support_speed = fpm_support_speed(sim->model);
+  if (relaxes(s)) sim->support_speed = fpm_support_speed(sim->model);
   if (s->time.dt_rule == PM_DT_SPECTRAL) fpm_sim_measure_spectrum(sim);
   pick_dt(sim);
   pm_timers_stop(&sim->timers, sim->tm_operators);
@@ -294,8 +299,7 @@ static void shares_dt(fpm_sim *sim) {
   pm_par_max_long(&first, 1);
   sim->dt_point = -first;
   sim->dt_paper = fpm_stable_dt_of(lm, most);
-  const int qs = sim->scene->time.qs;
-  if (qs == PM_QS_DYNAMIC_RELAXATION || qs == PM_QS_DAMPING) {
+  if (relaxes(sim->scene)) {
     sim->support_speed = fpm_support_speed(lm);
     pm_par_max(&sim->support_speed, 1);
   }

@@ -48,7 +48,8 @@ typedef struct {
   double dt_spectral;   /* 2 / sqrt(lambda_max(M^-1 K)), s; 0 if not
                            measured */
   long dt_point;        /* point that sets the paper's bound */
-  double support_speed; /* fpm_support_speed over the whole run, m/s */
+  double support_speed; /* fpm_support_speed over the whole run, m/s, by
+                           relaxation or damping; else 0 */
   double mean_edge;     /* mean mesh edge length, m */
   double far_size;      /* the mesh's size away from graded faces, m
                            (mesh_size unless refine.size_ratio) */

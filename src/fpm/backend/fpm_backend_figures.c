@@ -167,7 +167,6 @@ void fpm_backend_figures(void *p, pm_figures *f, bool with_fields) {
   f->dt = sim->dt;
   f->dt_stable = sim->dt_stable;
   f->support_speed = sim->support_speed;
-  f->shear_wave_speed = pm_scene_shear_wave_speed(s);
   f->residual = l->residual;
   f->kinetic = l->kinetic;
   f->strain = l->strain;

@@ -40,14 +40,12 @@ static void plan_estimate(const fpm_sim *sim, double per_step, double steps,
 }
 
 /* How fast the supports move in a quasi-static run by relaxation or
- * damping, against the slowest shear wave speed. */
+ * damping (sim->support_speed, 0 in other runs), against the slowest shear
+ * wave speed. */
 static void plan_supports(const fpm_sim *sim, FILE *out) {
   const pm_scene *s = sim->scene;
   const double c = pm_scene_shear_wave_speed(s), v = sim->support_speed;
-  if (!(s->time.qs == PM_QS_DYNAMIC_RELAXATION ||
-        s->time.qs == PM_QS_DAMPING) ||
-      !(c > 0) || !(v > 0))
-    return;
+  if (!(c > 0) || !(v > 0)) return;
   const double ratio = v / c, end = pm_scene_load_end(s);
   fprintf(out,
           "ramp         supports move at up to %.3g m/s until t = %g s, %.2f "
