@@ -105,6 +105,59 @@ check "slow ramp: no warning" bash -c "! grep -q 'above 0.25' $work/plan-ramp2"
 check "expression of t: plan's speed" grep -q "supports move at up to 0.107 m/s" \
   "$work/plan-expr"
 
+# Tension past the material's cavitation load.  A cube dilated on all six
+# faces by u = e X holds the uniform hydrostatic tension K (J - 1), J = (1 +
+# e)^3, at every point (FPM's gradient is exact on a linear field; the
+# neo-Hookean's isochoric stress vanishes): with K = 1e5 Pa and e = 0.0093,
+# 2816.03 Pa, 1.20609 times the gel's cavitation load 2334.848 Pa
+# (tools/cavitation-load.py); the run says so, and at e = 0.006 (1810.8 Pa,
+# 0.77556) it does not.
+dilate() { # e, out-name
+  local e=$1
+  cat >"$work/dilate.yaml" <<YAML
+name: dilate
+method: fpm
+dimension: 3
+domain: {box: {min: [0, 0, 0], max: [0.1, 0.1, 0.1]}}
+discretization: {mesh_size: 2e-2}
+materials:
+  - {name: gel, model: neo-hookean, density: 1000, youngs_modulus: 3000, poisson_ratio: 0.495}
+bodies: [{material: gel, region: domain}]
+boundary:
+YAML
+  for f in xmin xmax ymin ymax zmin zmax; do
+    echo "  - {on: $f, displacement: {x: $e*x, y: $e*y, z: $e*z}}" >>"$work/dilate.yaml"
+  done
+  echo "time: {end: 1, quasi_static: {method: static}}" >>"$work/dilate.yaml"
+  "$bin" run "$work/dilate.yaml" --out "$work/$2" >/dev/null 2>"$work/err"
+  rc=$?
+}
+near() { # value, expected, relative tolerance
+  awk -v v="$1" -v x="$2" -v r="$3" 'BEGIN { d = v - x; if (d < 0) d = -d;
+    exit !(v != "" && d <= r * (x < 0 ? -x : x)) }'
+}
+json_of() { # summary.json, key
+  grep -o "\"$2\": [-0-9.e+]*" "$1" | head -1 | awk '{ print $2 }'
+}
+dilate 0.0093 out-dilate
+sj=$work/out-dilate/summary.json
+check "cavitation: dilated cube converged (got $rc)" test $rc -eq 0
+check "cavitation: tension K (J - 1) = 2816.03 Pa to 1e-6 (got $(json_of "$sj" \
+  max_hydrostatic_tension))" near "$(json_of "$sj" max_hydrostatic_tension)" \
+  2816.02744 1e-6
+check "cavitation: the gel's load 2334.848 Pa to 1e-6" \
+  near "$(json_of "$sj" cavitation_load)" 2334.84802 1e-6
+check "cavitation: ratio 1.20609 to 1e-6 (got $(json_of "$sj" cavitation_ratio))" \
+  near "$(json_of "$sj" cavitation_ratio)" 1.206086 1e-6
+check "cavitation: the note" grep -q \
+  "note: the hydrostatic tension reaches 2816 Pa at (.*), 1.21 times its material's cavitation load (2335 Pa)" \
+  "$work/err"
+dilate 0.006 out-dilate-low
+check "cavitation: below the load, ratio 0.77556 (got $(json_of \
+  "$work/out-dilate-low/summary.json" cavitation_ratio))" near \
+  "$(json_of "$work/out-dilate-low/summary.json" cavitation_ratio)" 0.775563 1e-6
+check "cavitation: below the load, no note" bash -c "! grep -q 'cavitation load' $work/err"
+
 # The stability bounds: J falling to stability.min_jacobian, and energy
 # created by the non-symmetric flux in undamped dynamics, each stop the run
 # with the step, time and cause.

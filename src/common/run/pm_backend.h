@@ -91,6 +91,13 @@ typedef struct {
   double max_von_mises_at[3];
   double end_min_jacobian; /* smallest J at the end, and where */
   double end_min_jacobian_at[3];
+  /* Where a backend gives them (tension true): the solids' largest
+   * hydrostatic tension tr(sigma)/3 at the end, Pa, and where; the largest
+   * ratio of a point's tension to its material's cavitation load
+   * (pm_cavitation_load), where, and that load (0: no material has one). */
+  bool tension;
+  double max_tension, max_tension_at[3];
+  double cavitation_ratio, cavitation_ratio_at[3], cavitation_load;
   /* Reactions of each boundary condition (N; per unit thickness in 2D):
    * the force the supports apply on the body. */
   double reaction[PM_FIGURES_MAX_BCS][3];

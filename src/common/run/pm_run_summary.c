@@ -53,6 +53,17 @@ static pm_err summary_figures(pm_run_ctx *c, pm_json *j) {
   PM_CALL(pm_json_number(j, "mean_strain_energy_density", f->mean_sed));
   PM_CALL(pm_json_number(j, "max_von_mises", f->max_von_mises));
   PM_CALL(json_point(j, "max_von_mises_at", f->dim, f->max_von_mises_at));
+  if (f->tension) {
+    PM_CALL(pm_json_number(j, "max_hydrostatic_tension", f->max_tension));
+    PM_CALL(
+        json_point(j, "max_hydrostatic_tension_at", f->dim, f->max_tension_at));
+  }
+  if (f->tension && f->cavitation_load > 0) {
+    PM_CALL(pm_json_number(j, "cavitation_load", f->cavitation_load));
+    PM_CALL(pm_json_number(j, "cavitation_ratio", f->cavitation_ratio));
+    PM_CALL(
+        json_point(j, "cavitation_ratio_at", f->dim, f->cavitation_ratio_at));
+  }
   return PM_SUCCESS;
 }
 
@@ -185,6 +196,23 @@ static bool fast_supports(const pm_scene *s, const pm_figures *f) {
          f->time < pm_scene_load_end(s);
 }
 
+/* Where the solids' hydrostatic tension passed their cavitation load at
+ * the end: what that means, into buf (false, buf untouched: it did not). */
+static bool cavitation_note(const pm_figures *f, char *buf, size_t size) {
+  if (!f->tension || !(f->cavitation_load > 0) || !(f->cavitation_ratio > 1))
+    return false;
+  const double *x = f->cavitation_ratio_at;
+  snprintf(buf, size,
+           "the hydrostatic tension reaches %.4g Pa at (%.4g, %.4g, %.4g), "
+           "%.2f times its material's cavitation load (%.4g Pa): past it the "
+           "model admits a second equilibrium there, a void grown from a "
+           "point, which finer discretizations approach and no solver holds "
+           "off (docs/formulation.md, \"Cavitation\")",
+           f->cavitation_ratio * f->cavitation_load, x[0], x[1], x[2],
+           f->cavitation_ratio, f->cavitation_load);
+  return true;
+}
+
 /* Status and message from the loop's error and the figures. */
 void pm_run_conclude(pm_run_ctx *c, pm_err run_err) {
   pm_outcome *o = c->o;
@@ -239,6 +267,12 @@ void pm_run_conclude(pm_run_ctx *c, pm_err run_err) {
              "after %ld steps (raise time.end or time.max_steps)",
              f->residual, s->time.qs_tolerance, f->time, f->steps);
   }
+  /* A run that did not end converged: the tension may say why. */
+  char note[512];
+  const size_t len = strlen(o->message);
+  if (f->status != PM_STATUS_CONVERGED && len > 0 &&
+      cavitation_note(f, note, sizeof note))
+    snprintf(o->message + len, sizeof o->message - len, "; %s", note);
   int bc, comp;
   loaded_face(s, &bc, &comp);
   /* The whole body's, where the scene is a part mirrored about planes. */
@@ -258,6 +292,9 @@ void pm_run_report(pm_run_ctx *c) {
           "residual %.3g, energy balance error %.3g\n",
           c->s->name, pm_status_name(f->status), f->steps, f->time, f->dt,
           f->points, f->residual, f->energy_error);
+  char note[512];
+  if (f->status == PM_STATUS_CONVERGED && cavitation_note(f, note, sizeof note))
+    fprintf(stderr, "  note: %s\n", note);
   for (int k = 0; k < 3; k++)
     if (isfinite(o->nrmse[k]))
       fprintf(stderr, "  NRMSE u_%c = %.4e\n", "xyz"[k], o -> nrmse[k]);

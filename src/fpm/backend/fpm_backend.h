@@ -30,6 +30,8 @@ typedef struct {
   /* the end's fields */
   double mean_sed, max_von_mises, max_von_mises_at[3];
   double end_min_jacobian, end_min_jacobian_at[3];
+  double max_tension, max_tension_at[3];
+  double cavitation_ratio, cavitation_ratio_at[3], cavitation_load;
   /* the whole model's counts (the summary's) */
   long cells, interfaces, facets, cdofs, qwide, qlinear, edge_cut;
 } fpm_sums;

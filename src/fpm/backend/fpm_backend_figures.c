@@ -8,6 +8,7 @@
 #include "fpm_backend_impl.h"
 #include "fpm_gfd.h"
 #include "fpm_par.h"
+#include "pm_cavitation.h"
 #include "pm_metrics.h"
 #include "pm_omp.h"
 #include "pm_par.h"
@@ -24,6 +25,36 @@ void fpm_backend_cauchy_stress(long n, const fpm_state *st, double *sig) {
     pm_t_transpose(F, FT);
     pm_t_mul(st->P + 9 * i, FT, sig + 9 * i);
     for (int a = 0; a < 9; a++) sig[9 * i + a] /= st->J[i];
+  }
+}
+
+void fpm_backend_tension(const fpm_model *m, long n, const double *sig,
+                         bool spherical, fpm_tension *t) {
+  double load[FPM_MAX_MATERIALS];
+  for (int k = 0; k < m->n_mats; k++) {
+    load[k] = spherical ? pm_cavitation_load(&m->mats[k]) : 0;
+    if (!(isfinite(load[k]) && load[k] > 0)) load[k] = 0;
+  }
+  *t = (fpm_tension){.tension = -INFINITY, .tension_at = -1, .ratio_at = -1};
+  const double *vol = m->dual->volume, e = (m->dim - 1.0) / m->dim;
+  for (long i = 0; i < n; i++) {
+    const double *s = sig + 9 * i, p = (s[0] + s[4] + s[8]) / 3,
+                 *a = m->p_area + 3 * i;
+    /* A void opens inside the body: a point on its boundary (its
+     * interfaces' area vectors do not close: its facets' do) is passed
+     * over. */
+    const bool inside =
+        sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) <= 1e-8 * pow(vol[i], e);
+    const double l = inside ? load[m->mat[i]] : 0;
+    if (p > t->tension) {
+      t->tension = p;
+      t->tension_at = i;
+    }
+    if (l > 0 && (t->ratio_at < 0 || p / l > t->ratio)) {
+      t->ratio = p / l;
+      t->ratio_at = i;
+      t->load = l;
+    }
   }
 }
 
@@ -137,9 +168,17 @@ static void field_figures(fpm_sim *sim, pm_figures *f) {
     }
   }
   f->mean_sed = vsum > 0 ? wsum / vsum : 0;
+  fpm_tension tn;
+  fpm_backend_tension(m, m->n, sig, sim->scene->dimension == 3, &tn);
+  f->tension = m->n > 0;
+  f->max_tension = tn.tension;
+  f->cavitation_ratio = tn.ratio;
+  f->cavitation_load = tn.load;
   for (int a = 0; a < 3; a++) {
     f->max_von_mises_at[a] = m->x[3 * vm_at + a];
     f->end_min_jacobian_at[a] = m->x[3 * j_at + a];
+    f->max_tension_at[a] = tn.tension_at < 0 ? 0 : m->x[3 * tn.tension_at + a];
+    f->cavitation_ratio_at[a] = tn.ratio_at < 0 ? 0 : m->x[3 * tn.ratio_at + a];
   }
 }
 
@@ -151,6 +190,13 @@ static void summed_figures(const fpm_sums *u, pm_figures *f) {
   memcpy(f->max_von_mises_at, u->max_von_mises_at, sizeof f->max_von_mises_at);
   memcpy(f->end_min_jacobian_at, u->end_min_jacobian_at,
          sizeof f->end_min_jacobian_at);
+  f->tension = true;
+  f->max_tension = u->max_tension;
+  f->cavitation_ratio = u->cavitation_ratio;
+  f->cavitation_load = u->cavitation_load;
+  memcpy(f->max_tension_at, u->max_tension_at, sizeof f->max_tension_at);
+  memcpy(f->cavitation_ratio_at, u->cavitation_ratio_at,
+         sizeof f->cavitation_ratio_at);
 }
 
 void fpm_backend_figures(void *p, pm_figures *f, bool with_fields) {

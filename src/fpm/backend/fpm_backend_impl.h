@@ -36,6 +36,20 @@ pm_err fpm_backend_summary(void *p, pm_json *j);
 /* Cauchy stress sigma = P F^T / J of the first n points of st into sig
  * (9 n). */
 void fpm_backend_cauchy_stress(long n, const fpm_state *st, double *sig);
+/* The end's tension over the first n points of m, their Cauchy stresses
+ * sig: the largest hydrostatic tension tr(sigma)/3 and its point, and, in
+ * 3-D (spherical: a void from a point; a plane's cylindrical void has no
+ * such load), the largest ratio of it to the point's material's cavitation
+ * load (pm_cavitation_load; a material without a finite one, and the
+ * points on the body's boundary, where no void opens, are passed over),
+ * its point and that load (0, ratio_at -1: none).  The first point in
+ * order among equal values. */
+typedef struct {
+  double tension, ratio, load;
+  long tension_at, ratio_at;
+} fpm_tension;
+void fpm_backend_tension(const fpm_model *m, long n, const double *sig,
+                         bool spherical, fpm_tension *t);
 /* Across ranks with frames in pieces: this rank's own points of frame
  * `frame` written into the results folder dir (pm_view.piece), with a
  * field "position" (the frame's geometry) before the scene's fields; and
