@@ -150,7 +150,7 @@ check "cavitation: the gel's load 2334.848 Pa to 1e-6" \
 check "cavitation: ratio 1.20609 to 1e-6 (got $(json_of "$sj" cavitation_ratio))" \
   near "$(json_of "$sj" cavitation_ratio)" 1.206086 1e-6
 check "cavitation: the note" grep -q \
-  "note: the hydrostatic tension reaches 2816 Pa at (.*), 1.21 times its material's cavitation load (2335 Pa)" \
+  "note: the hydrostatic tension reaches 2816 Pa at (.*), 1.21 times its material's cavitation load under hydrostatic tension (2335 Pa)" \
   "$work/err"
 dilate 0.006 out-dilate-low
 check "cavitation: below the load, ratio 0.77556 (got $(json_of \

@@ -204,10 +204,11 @@ static bool cavitation_note(const pm_figures *f, char *buf, size_t size) {
   const double *x = f->cavitation_ratio_at;
   snprintf(buf, size,
            "the hydrostatic tension reaches %.4g Pa at (%.4g, %.4g, %.4g), "
-           "%.2f times its material's cavitation load (%.4g Pa): past it the "
-           "model admits a second equilibrium there, a void grown from a "
-           "point, which finer discretizations approach and no solver holds "
-           "off (docs/formulation.md, \"Cavitation\")",
+           "%.2f times its material's cavitation load under hydrostatic "
+           "tension (%.4g Pa): where the stress is near hydrostatic the model "
+           "admits a second equilibrium past it, a void grown from a point, "
+           "which finer discretizations approach and no solver holds off "
+           "(docs/formulation.md, \"Cavitation\")",
            f->cavitation_ratio * f->cavitation_load, x[0], x[1], x[2],
            f->cavitation_ratio, f->cavitation_load);
   return true;
