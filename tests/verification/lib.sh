@@ -129,6 +129,11 @@ stop_after() { # lines, seconds, out, scene, args...
   local t0
   t0=$(date +%s.%N)
   kill -TERM $pid 2>/dev/null
+  # STOP_AGAIN=SECONDS: a second SIGTERM that long after the first.
+  if [ -n "${STOP_AGAIN:-}" ]; then
+    sleep "$STOP_AGAIN"
+    kill -TERM $pid 2>/dev/null
+  fi
   wait $pid
   rc=$?
   lag=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }')

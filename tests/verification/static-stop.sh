@@ -4,7 +4,8 @@
 # figure printed) with its reason; SIGTERM after converged load steps
 # leaves the checkpoint of the last converged one, which `resume` takes to
 # the end; SIGTERM during the setup (meshing, subdomains, operators) stops
-# it once the stage running ends, nothing written.
+# it once the stage running ends, nothing written; two SIGTERMs at once
+# are one.
 set -u
 bin=$1
 src=$2
@@ -62,6 +63,21 @@ check "setup: exit 4 (got $rc)" test $rc -eq 4
 check "setup: within 5 s of the signal (took $lag s)" within "$lag" 5
 check "setup: the message says where" \
   grep -Eq "interrupted by SIGTERM (after|during) .*\(nothing written\)" "$work/err"
+
+# 4. Two SIGTERMs 0.05 s apart, as GNU timeout sends them (one to the
+# run, one to its process group): one request, the run stops as for one
+# (before, the second killed it with nothing written but the frames).
+out=$work/twice
+STOP_AGAIN=0.05 stop_after 3 0.2 "$out" "$f2" "${static[@]}" --set output.every=1
+echo "two SIGTERMs 0.05 s apart: exit $rc after $lag s"
+if [ $rc -eq 0 ]; then
+  echo "the run ended before the signals: nothing to check"
+else
+  check "twice: exit 4 (got $rc)" test $rc -eq 4
+  check "twice: checkpoint written" test -s "$out/checkpoint.h5"
+  check "twice: summary says interrupted" \
+    grep -q '"status": "interrupted"' "$out/summary.json"
+fi
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

@@ -16,9 +16,10 @@ int pm_interrupt_signal(void);
 const char *pm_interrupt_name(int sig);
 
 /* Catch SIGINT and SIGTERM (old: the handlers before, for
- * pm_interrupt_release).  once: the handler resets itself after the first
- * signal, so that a second one acts as usual (kills a run that does not
- * reach a point where it polls). */
+ * pm_interrupt_release).  once: a second signal half a second or more
+ * after the first acts as usual (kills a run that does not reach a point
+ * where it polls); signals closer together are one request (GNU timeout
+ * sends its child SIGTERM and then its whole process group the same). */
 void pm_interrupt_catch(struct sigaction old[2], int once);
 void pm_interrupt_release(const struct sigaction old[2]);
 
