@@ -34,15 +34,21 @@ static double residual(const pm_material *m, double x, double l, double t,
 }
 
 /* The radial stretch x with dW/dlambda_r(x, l) = t (it grows with x):
- * bracketed, then Newton's steps kept inside the bracket. */
+ * bracketed outward from *out (the last one found: the next is near it;
+ * 1 where none), then Newton's steps kept inside the bracket. */
 static bool radial_stretch(const pm_material *m, double l, double t,
                            double *out) {
-  double lo = 1e-12, hi = 1;
+  const double x0 = *out > 0 && isfinite(*out) ? *out : 1;
+  double lo = x0, hi = x0;
   while (residual(m, hi, l, t, false) < 0)
     if ((hi *= 2) > 1e30) return false;
   while (residual(m, lo, l, t, true) > 0)
     if ((lo /= 2) < 1e-300) return false;
-  double x = sqrt(lo * hi);
+  if (lo == hi) {
+    *out = x0;
+    return true;
+  }
+  double x = hi / lo > 4 ? sqrt(lo * hi) : 0.5 * (lo + hi);
   for (int it = 0; it < 100; it++) {
     double p1, d1;
     if (!principal(m, x, l, &p1, NULL, &d1)) {
@@ -68,14 +74,14 @@ static bool radial_stretch(const pm_material *m, double l, double t,
   return isfinite(x) && x > 0;
 }
 
-/* d(r, q)/ds at s = ln R. */
-static bool rhs(const pm_material *m, double s, const double y[2],
-                double dy[2]) {
+/* d(r, q)/ds at s = ln R; *l1: the radial stretch there (in: the last). */
+static bool rhs(const pm_material *m, double s, const double y[2], double dy[2],
+                double *l1) {
   const double R = exp(s), l = y[0] / R;
-  double l1, p23;
-  if (!(l > 0) || !radial_stretch(m, l, y[1] / (R * R), &l1)) return false;
-  if (!principal(m, l1, l, NULL, &p23, NULL)) return false;
-  dy[0] = R * l1;
+  double p23;
+  if (!(l > 0) || !radial_stretch(m, l, y[1] / (R * R), l1)) return false;
+  if (!principal(m, *l1, l, NULL, &p23, NULL)) return false;
+  dy[0] = R * *l1;
   dy[1] = R * R * p23;
   return isfinite(dy[0]) && isfinite(dy[1]);
 }
@@ -100,9 +106,9 @@ double pm_cavitation_tension(const pm_material *m, double a, double c) {
       !(c < 1))
     return NAN;
   const double rtol = 1e-11, atol[2] = {1e-18, 1e-18 * m->shear_modulus};
-  double s = log(a), h = 1e-3, y[2] = {c, 0}, k[7][2];
+  double s = log(a), h = 1e-3, y[2] = {c, 0}, k[7][2], l1 = 0;
   const double end = 0; /* ln B, B = 1 */
-  if (!rhs(m, s, y, k[0])) return NAN;
+  if (!rhs(m, s, y, k[0], &l1)) return NAN;
   for (long step = 0; step < 20000 && s < end; step++) {
     if (s + h > end) h = end - s;
     double yt[2], err = 0;
@@ -113,7 +119,7 @@ double pm_cavitation_tension(const pm_material *m, double a, double c) {
         for (int j = 0; j < st; j++) sum += A[st][j] * k[j][i];
         yt[i] = y[i] + h * sum;
       }
-      ok = rhs(m, s + C[st] * h, yt, k[st]);
+      ok = rhs(m, s + C[st] * h, yt, k[st], &l1);
     }
     if (ok)
       for (int i = 0; i < 2; i++) {
@@ -136,7 +142,7 @@ double pm_cavitation_tension(const pm_material *m, double a, double c) {
   }
   if (s < end) return NAN;
   /* The radial Cauchy stress at R = 1: P_11 lambda_r / J = P_11 / l^2. */
-  double l1, p1;
+  double p1;
   const double l = y[0];
   if (!radial_stretch(m, l, y[1], &l1) || !principal(m, l1, l, &p1, NULL, NULL))
     return NAN;
