@@ -40,8 +40,9 @@ void fpm_backend_cauchy_stress(long n, const fpm_state *st, double *sig);
  * sig: the largest hydrostatic tension tr(sigma)/3 and its point, and, in
  * 3-D (spherical: a void from a point; a plane's cylindrical void has no
  * such load), the largest ratio of it to the point's material's cavitation
- * load (pm_cavitation_load; a material without a finite one, and the
- * points on the body's boundary, where no void opens, are passed over),
+ * load (pm_cavitation_load, computed for the materials some point inside
+ * holds in tension; a material without a finite one, and the points on
+ * the body's boundary, where no void opens, are passed over),
  * its point and that load (0, ratio_at -1: none).  The first point in
  * order among equal values. */
 typedef struct {
