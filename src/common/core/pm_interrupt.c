@@ -9,21 +9,25 @@ static volatile sig_atomic_t interrupt_signal;
 static volatile sig_atomic_t catch_once;
 static struct timespec first_at; /* the first signal's time */
 
+/* Seconds from the first signal to now (async-signal-safe). */
+static double since_first(void) {
+  struct timespec now;
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  return (double)(now.tv_sec - first_at.tv_sec) +
+         1e-9 * (double)(now.tv_nsec - first_at.tv_nsec);
+}
+
 /* A second signal kills (the default action, raised again) once half a
  * second has passed since the first: a second Ctrl-C, or a scheduler that
  * escalates.  The two copies GNU timeout sends at once (to its child and to
  * its process group) are one request. */
 static void on_interrupt(int sig) {
-  struct timespec now;
-  clock_gettime(CLOCK_MONOTONIC, &now);
   if (!interrupt_signal) {
-    first_at = now;
+    clock_gettime(CLOCK_MONOTONIC, &first_at);
     interrupt_signal = sig;
     return;
   }
-  const double since = (double)(now.tv_sec - first_at.tv_sec) +
-                       1e-9 * (double)(now.tv_nsec - first_at.tv_nsec);
-  if (catch_once && since >= 0.5) {
+  if (catch_once && since_first() >= 0.5) {
     signal(sig, SIG_DFL);
     raise(sig);
   }
@@ -51,11 +55,9 @@ void pm_interrupt_release(const struct sigaction old[2]) {
    * this handler, not the one before (at most half a second's wait, and
    * only after a signal). */
   if (interrupt_signal && catch_once) {
-    struct timespec now, rest;
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    const double left = 0.5 - ((double)(now.tv_sec - first_at.tv_sec) +
-                               1e-9 * (double)(now.tv_nsec - first_at.tv_nsec));
+    const double left = 0.5 - since_first();
     if (left > 0) {
+      struct timespec rest;
       rest.tv_sec = 0;
       rest.tv_nsec = (long)(left * 1e9);
       while (nanosleep(&rest, &rest) != 0 && errno == EINTR) {

@@ -106,10 +106,11 @@ bool fpm_backend_errors(void *p, double nrmse[3], double *vector) {
 /* The extreme over the ranks of each rank's value *v at its own point of
  * one-process index id (largest, or with most false smallest; own outside
  * the share's points: none): the first in one process's order among equal
- * values, its position into at and the n_carry values carry of the rank
- * that has it into carry, on every rank (collective). */
+ * values, its position into at and, where carry is not NULL, the value
+ * *carry of the rank that has it into *carry, on every rank
+ * (collective). */
 static void extreme(const fpm_model *m, double *v, long own, bool most,
-                    double at[3], double *carry, int n_carry) {
+                    double at[3], double *carry) {
   double best = most ? *v : -*v;
   pm_par_max(&best, 1);
   const bool has = own >= 0 && own < m->n_own; /* (a share may own none) */
@@ -117,13 +118,13 @@ static void extreme(const fpm_model *m, double *v, long own, bool most,
   long first = has && (most ? *v : -*v) == best ? -id : -LONG_MAX;
   pm_par_max_long(&first, 1);
   const bool mine = has && -first == id;
-  double buf[6];
+  double buf[4];
   for (int a = 0; a < 3; a++) buf[a] = mine ? m->x[3 * own + a] : 0;
-  for (int k = 0; k < n_carry && k < 3; k++) buf[3 + k] = mine ? carry[k] : 0;
-  /* (the one rank's position and values, plus zeros) */
-  pm_par_sum(buf, 3 + (n_carry < 3 ? n_carry : 3));
+  buf[3] = mine && carry ? *carry : 0;
+  /* (the one rank's position and value, plus zeros) */
+  pm_par_sum(buf, carry ? 4 : 3);
   for (int a = 0; a < 3; a++) at[a] = buf[a];
-  for (int k = 0; k < n_carry && k < 3; k++) carry[k] = buf[3 + k];
+  if (carry) *carry = buf[3];
   *v = most ? best : -best;
 }
 
@@ -152,15 +153,15 @@ static void field_sums(fpm_sim *sim) {
   }
   pm_par_sum(sums, 2);
   u->mean_sed = sums[0] > 0 ? sums[1] / sums[0] : 0;
-  extreme(m, &vm_most, vm_at, true, u->max_von_mises_at, NULL, 0);
-  extreme(m, &j_least, j_at, false, u->end_min_jacobian_at, NULL, 0);
+  extreme(m, &vm_most, vm_at, true, u->max_von_mises_at, NULL);
+  extreme(m, &j_least, j_at, false, u->end_min_jacobian_at, NULL);
   u->max_von_mises = vm_most;
   u->end_min_jacobian = j_least;
   fpm_tension tn;
   fpm_backend_tension(m, m->n_own, sig, sim->scene->dimension == 3, &tn);
-  extreme(m, &tn.tension, tn.tension_at, true, u->max_tension_at, NULL, 0);
+  extreme(m, &tn.tension, tn.tension_at, true, u->max_tension_at, NULL);
   if (tn.ratio_at < 0) tn.ratio = -INFINITY;
-  extreme(m, &tn.ratio, tn.ratio_at, true, u->cavitation_ratio_at, &tn.load, 1);
+  extreme(m, &tn.ratio, tn.ratio_at, true, u->cavitation_ratio_at, &tn.load);
   u->max_tension = tn.tension;
   u->cavitation_ratio = tn.load > 0 ? tn.ratio : 0;
   u->cavitation_load = tn.load;
