@@ -227,14 +227,14 @@ check "averaged, interrupted on 2 ranks, resumed on 2: bit for bit" \
 roundoff "averaged, interrupted on 2 ranks, resumed on 1" \
   "$work/f2-averaged-1" "$work/acut-1"
 
-# A static run interrupted on 2 ranks after 3 of 20 load steps: resumed
+# A static run interrupted on 2 ranks after 3 of 10 load steps: resumed
 # on 2 ranks bit for bit the run not interrupted (GMRES with ILU(0) in
 # each rank's block repeats bit for bit; LU across ranks (MUMPS) analyses
 # its matrix anew in a new run and repeats to round-off only), on one
 # process and on 3 ranks to round-off the run not interrupted on as many
 # (ILU(0) in 1, 2 or 3 blocks is another preconditioner each: the runs of
 # different counts agree to GMRES's tolerance, 1e-10, not to round-off).
-slow="$static $coarse --set time.quasi_static.load_steps=20
+slow="$static $coarse --set time.quasi_static.load_steps=10
   --set time.quasi_static.linear_solver=gmres-ilu"
 # (The one-process run, one thread, beside the runs on ranks.)
 "$bin" run "$f2" --out "$work/s-1" --quiet $slow >/dev/null 2>&1 &
