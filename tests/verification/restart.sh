@@ -122,11 +122,11 @@ resume_case membranes-2d "$src/cases/mpm/m5-gas-circle.yaml" 4 \
 # bit.  In 12 load steps of some 0.06 s: SIGTERM after the second,
 # SIGKILL after the fifth, seven to go.
 ckpt_every=3
-i2_short=(--set time.quasi_static.linear_solver=direct
+i2_set=(--set time.quasi_static.linear_solver=direct
   --set time.quasi_static.load_steps=12)
 i2=$src/tests/data/scenes/i2-window.yaml
-resume_case mpm-implicit "$i2" 4 "${i2_short[@]}"
-resume_case mpm-implicit-reset "$i2" 4 "${i2_short[@]}" \
+resume_case mpm-implicit "$i2" 4 "${i2_set[@]}"
+resume_case mpm-implicit-reset "$i2" 4 "${i2_set[@]}" \
   --set mpm.implicit.grid=reset
 
 # Checkpoints by wall time: every 0.03 s of a run of 0.3 s or more (1201

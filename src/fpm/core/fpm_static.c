@@ -161,21 +161,6 @@ void fpm_static_choose_linear(const pm_scene *s, long unknowns,
   linear_settings(s, o);
 }
 
-/* A solve that stops (not converged, unstable, interrupted) ends in its
- * last converged state, which load stepping left in v->x with its load
- * set: the state's fields (the summary's figures, and the message's) are
- * that state's, as its last frame and its checkpoint are, not those of the
- * last iterate tried.  (Collective across ranks, as every rank stops.) */
-static void end_converged(fpm_static_solve *v, pm_newton *solver) {
-  fpm_static_ctx *c = &v->c;
-  const double *x = v->x;
-  if (c->m->xc) {
-    if (pm_newton_held_values(solver, v->x, c->held) != PM_SUCCESS) return;
-    x = c->held;
-  }
-  (void)fpm_static_evaluate(c, x);
-}
-
 pm_err fpm_static_run(const fpm_model *m, fpm_state *st, fpm_observer observer,
                       void *ctx, fpm_step_info *info, fpm_static_report *rep) {
   fpm_static_state ss;
@@ -324,7 +309,15 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   }
   rep->setup_seconds = pm_wtime() - w0;
   ret = pm_load_steps_from(solver, v.x, &ss->load, &rep->load);
-  if (ret != PM_SUCCESS) end_converged(&v, solver);
+  if (ret != PM_SUCCESS) {
+    /* A solve that stops (not converged, unstable, interrupted) ends in
+     * its last converged state, which load stepping left in v.x with its
+     * load set: the fields (the summary's figures, the message's) are that
+     * state's, as its last frame and checkpoint are, not the last iterate
+     * tried's.  (Every rank stops: collective.) */
+    long bad = -1;
+    (void)fpm_static_evaluate_owned(c, v.x, &bad);
+  }
 done:
   rep->seconds = pm_wtime() - w0;
   rep->cpu_seconds = pm_cputime() - c0;

@@ -145,6 +145,9 @@ void fpm_static_coupled_free(fpm_static_coupled *cp);
  * prescribed dofs as set by fpm_static_set_load): its force; returns -1 or
  * the first inadmissible point. */
 long fpm_static_evaluate(fpm_static_ctx *c, const double *x);
+/* fpm_static_evaluate at the owned unknowns x (n values), their ghosts'
+ * from their owners across ranks (collective); *bad as it returns. */
+pm_err fpm_static_evaluate_owned(fpm_static_ctx *c, const double *x, long *bad);
 /* The state just evaluated (bad: its first inadmissible point, or -1),
  * admissible on every rank or on none (the failure one process meets
  * first): PM_ERR_UNSTABLE naming the point. */

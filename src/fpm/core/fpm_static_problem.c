@@ -42,6 +42,17 @@ pm_err fpm_static_admissible(const fpm_static_ctx *c, long bad) {
                             bad >= 0 ? fpm_point_id(c->m, bad) : 0);
 }
 
+pm_err fpm_static_evaluate_owned(fpm_static_ctx *c, const double *x,
+                                 long *bad) {
+  *bad = -1;
+  if (c->m->xc) { /* x: the own unknowns; the ghosts' from their owners */
+    PM_CALL(pm_newton_held_values(c->solver, x, c->held));
+    x = c->held;
+  }
+  *bad = fpm_static_evaluate(c, x);
+  return PM_SUCCESS;
+}
+
 static pm_err residual(void *ctx, const double *x, double *r) {
   fpm_static_ctx *c = ctx;
   long bad = fpm_static_evaluate(c, x);
@@ -229,11 +240,9 @@ static pm_err on_step(void *ctx, int step, double lambda, const double *x,
   fpm_static_ctx *c = ctx;
   (void)report;
   c->t = lambda * c->load_end;
-  if (c->m->xc) { /* x: the own unknowns; the ghosts' from their owners */
-    PM_CALL(pm_newton_held_values(c->solver, x, c->held));
-    x = c->held;
-  }
-  PM_CALL(fpm_static_admissible(c, fpm_static_evaluate(c, x)));
+  long bad = -1;
+  PM_CALL(fpm_static_evaluate_owned(c, x, &bad));
+  PM_CALL(fpm_static_admissible(c, bad));
   /* the contact's state of this step: sticking points that touched anew
    * hold on from here (the residual at x is the same) */
   fpm_contact_commit(c->m, c->st, c->load_end, lambda);
