@@ -300,6 +300,30 @@ static void test_relaxation_fallback(void **state) {
   assert_true(rep.relaxed_steps >= 1);
   pm_newton_destroy(&s);
 
+  /* Relaxed first after the step relaxation carried (relax_first): every
+   * step after the snap relaxed, then Newton from there, to the same end
+   * state; the Newton attempts that fail before a relaxation do not
+   * grow. */
+  const int alone = rep.relaxed_steps, alone_cuts = rep.cuts;
+  const int alone_newton = rep.newton_iterations;
+  opt.relax_first = true;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  x = sqrt(3);
+  assert_ok(pm_load_steps(s, &x, &rep));
+  print_message("relaxed first: %d steps, %d cuts, %d relaxations, %d steps "
+                "converged by it (%d alone), %d Newton iterations (%d), x = "
+                "%.15f\n",
+                rep.steps, rep.cuts, rep.relaxations, rep.relaxed_steps, alone,
+                rep.newton_iterations, alone_newton, x);
+  assert_close(rep.lambda, 1, 0, 0);
+  assert_close(x, snap_root(3.6), 1e-9, 0);
+  /* the steps before the snap are Newton's as before; every one after it
+   * relaxed first */
+  assert_true(rep.relaxed_steps > alone);
+  assert_true(rep.cuts <= alone_cuts);
+  opt.relax_first = false;
+  pm_newton_destroy(&s);
+
   /* With the continuations first (pseudo_transient > 0): the lowest
    * eigenvalue at the last state is positive (a limit point); arc length
    * finds the load turning back at the limit point, lambda = 2/q, and

@@ -259,19 +259,24 @@ static void test_static_fallback_lu(void **state) {
  * 10 load steps.  The tractions' work is booked by the trapezoidal rule on
  * what they work on (the point's displacement carried to each facet by its
  * gradient), so the energy balance does not depend on the load steps:
- * measured 9.2e-4 and 9.4e-4.  What is left is the IIPG flux's, which is
+ * measured 8.4e-4 and 9.3e-4.  What is left is the IIPG flux's, which is
  * not the gradient of an energy (3.5e-3 on the scene's 420 points, with 1,
- * 10 or 40 load steps).  Booked at the end of each step, as before, it was
- * -0.061 with 10 load steps on the 420 points. */
+ * 10 or 40 load steps), and depends on the steps the solver takes: the
+ * single load step is cut and carried by the fallbacks in 9 steps,
+ * every step the ordinary way (relax_first false), or in 6 with the steps
+ * after a relaxed one relaxed first (the default), 8.0e-4.  Booked at the
+ * end of each step, as before, it was -0.061 with 10 load steps on the
+ * 420 points. */
 static void test_traction_work(void **state) {
   (void)state;
   double e[2];
   const char *steps[2] = {"time.quasi_static.load_steps=1",
                           "time.quasi_static.load_steps=10"};
   for (int k = 0; k < 2; k++) {
-    const char *sets[] = {"discretization.mesh_size=0.65", steps[k]};
+    const char *sets[] = {"discretization.mesh_size=0.65", steps[k],
+                          "time.quasi_static.relax_first=false"};
     run_t r = {0};
-    run(CASES "panel-near-incompressible.yaml", 2, sets, &r);
+    run(CASES "panel-near-incompressible.yaml", 3, sets, &r);
     e[k] = r.out.fig.energy_error;
     print_message("panel, %s: external work %.6g J, energy balance error "
                   "%.3e\n",

@@ -370,6 +370,7 @@ typedef struct pm_scene {
     long qs_relax_after;    /* ...relax_after: cuts before relaxation */
     long qs_ptc;            /* ...pseudo_transient: continuation iterations */
     bool qs_follow_fold;    /* ...follow_fold: arc length past a limit point */
+    bool qs_relax_first;    /* ...relax_first: after a relaxed step, relax */
     pm_qs_line_search qs_line_search; /* ...line_search */
     double qs_fallback_cpu;     /* ...fallback_seconds: CPU s per fallback */
     pm_linear_solver qs_linear; /* ...linear_solver */

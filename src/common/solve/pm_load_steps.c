@@ -257,6 +257,61 @@ static pm_err settle_step(pm_newton *s, double *x, const double *xc,
   }
 }
 
+/* A step (lambda -> target) converged at x: x the last converged state
+ * (the one before kept), the report's counts, the next step's size and
+ * whether it relaxes first (relax_next), set before on_step (the state it
+ * sees is the one the next step starts from, as a checkpoint keeps it);
+ * nominal and largest the step sizes of pm_load_steps_from. */
+static pm_err converged(pm_newton *s, const double *x, pm_load_state *st,
+                        pm_load_report *rep, double lambda, double target,
+                        double nominal, double largest, bool relax_next,
+                        int *cuts) {
+  const pm_newton_options *o = pm_newton_options_of(s);
+  const pm_newton_problem *p = pm_newton_problem_of(s);
+  const long n = p->n;
+  memcpy(st->xprev, st->xc, (size_t)n * sizeof *st->xc);
+  memcpy(st->xc, x, (size_t)n * sizeof *st->xc);
+  st->lambda_prev = lambda;
+  st->lambda = target;
+  st->have_prev = 1;
+  rep->steps++;
+  rep->lambda = target;
+  if (target - lambda < rep->dlambda_min) rep->dlambda_min = target - lambda;
+  *cuts = 0;
+  const bool easy =
+      o->easy_iterations > 0 && rep->last.iterations <= o->easy_iterations;
+  if (easy && st->dl < largest) {
+    st->dl = fmin(1.5 * st->dl, largest);
+    st->good = 0;
+  } else if (st->dl < nominal && o->grow_after > 0 &&
+             ++st->good >= o->grow_after) {
+    st->dl = fmin(1.5 * st->dl, nominal);
+    st->good = 0;
+  }
+  st->relax_first = o->relax_first && relax_next;
+  PM_CALL(pm_newton_pc_save(s, st));
+  if (p->on_step)
+    PM_CALL(p->on_step(p->ctx, rep->steps, target, st->xc, &rep->last));
+  return PM_SUCCESS;
+}
+
+/* options.relax_first: the step at the load set, from the last converged
+ * state xc, by relax_step with the fallbacks' linear solver (x, w, rep,
+ * msg and cap as relax_step's). */
+static pm_err relaxed_first(pm_newton *s, double *x, const double *xc,
+                            pm_load_state *st, pm_relax_work *w,
+                            pm_load_report *rep, char *msg, size_t cap) {
+  PM_CALL(pm_newton_use_fallback_linear(s, true));
+  pm_err e = relax_step(s, x, xc, w, rep, msg, cap);
+  if (pm_newton_fallback_kept(s)) {
+    st->fallback_kept = 1;
+  } else if (e == PM_SUCCESS || recoverable(e)) {
+    pm_err back = pm_newton_use_fallback_linear(s, false);
+    if (back != PM_SUCCESS) return back;
+  }
+  return e;
+}
+
 pm_err pm_load_state_init(pm_load_state *state, long n) {
   memset(state, 0, sizeof *state);
   pm_err ret = PM_SUCCESS;
@@ -331,7 +386,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     memcpy(xc, x, (size_t)n * sizeof *xc);
     st->lambda = st->lambda_prev = 0;
     st->dl = nominal;
-    st->good = st->have_prev = 0;
+    st->good = st->have_prev = st->relax_first = 0;
     rep->dlambda_min = nominal;
   }
   if (resumed && st->fallback_kept)
@@ -347,6 +402,28 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     double target = lambda + st->dl;
     if (target > 1 - PM_LOAD_END_SLACK) target = 1;
     PM_TRY(set_load(s, target));
+    char relaxed[2048] = "", failed[sizeof rep->last.message] = "";
+    if (o->relax_first && relaxing && st->relax_first) {
+      /* The step before was carried by relaxation: this one too, first. */
+      pm_err e = relaxed_first(s, x, xc, st, &rw, rep, relaxed, sizeof relaxed);
+      if (e == PM_SUCCESS && p->settle) e = settle_step(s, x, xc, 0, rep);
+      if (e == PM_SUCCESS) {
+        rep->relaxed_steps++;
+        relaxed_dl = -1;
+        PM_TRY(converged(s, x, st, rep, lambda, target, nominal, largest, true,
+                         &cuts));
+        continue;
+      }
+      if (!recoverable(e)) {
+        ret = e;
+        goto done;
+      }
+      /* Not carried: the ordinary way, from here on until relaxation
+       * carries a step again. */
+      pm_error_clear();
+      st->relax_first = 0;
+      relaxed[0] = '\0';
+    }
     memcpy(x, xc, (size_t)n * sizeof *x);
     bool predicted = false;
     if (o->predictor && st->have_prev && lambda > lambda_prev) {
@@ -383,7 +460,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       e = pm_newton_solve_from(s, x, xc, r_ref, &rep->last);
       add_solve(rep, &rep->last);
     }
-    char relaxed[2048] = "", failed[sizeof rep->last.message] = "";
+    bool by_relaxation = false;
     if (e != PM_SUCCESS && recoverable(e) && relaxing && st->dl != relaxed_dl &&
         (cuts == o->relax_after || cuts >= o->max_cuts ||
          st->dl / 2 < o->min_dlambda * (1 - 1e-12))) {
@@ -407,38 +484,17 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
         }
       }
       if (e == PM_SUCCESS && rep->ptc_steps == ptc_before &&
-          rep->arc_passes == arc_before)
+          rep->arc_passes == arc_before) {
         rep->relaxed_steps++;
+        by_relaxation = true;
+      }
       if (e == PM_ERR_UNSUPPORTED) e = PM_ERR_NOT_CONVERGED;
     }
     if (e == PM_SUCCESS && p->settle) e = settle_step(s, x, xc, r_ref, rep);
     if (e == PM_SUCCESS) {
-      memcpy(xprev, xc, (size_t)n * sizeof *xc);
-      memcpy(xc, x, (size_t)n * sizeof *xc);
-      st->lambda_prev = lambda;
-      st->lambda = target;
-      st->have_prev = 1;
-      rep->steps++;
-      rep->lambda = target;
       relaxed_dl = -1;
-      if (target - lambda < rep->dlambda_min)
-        rep->dlambda_min = target - lambda;
-      cuts = 0;
-      /* The next step's size, before on_step: the state it sees is the
-       * one the next step starts from. */
-      const bool easy =
-          o->easy_iterations > 0 && rep->last.iterations <= o->easy_iterations;
-      if (easy && st->dl < largest) {
-        st->dl = fmin(1.5 * st->dl, largest);
-        st->good = 0;
-      } else if (st->dl < nominal && o->grow_after > 0 &&
-                 ++st->good >= o->grow_after) {
-        st->dl = fmin(1.5 * st->dl, nominal);
-        st->good = 0;
-      }
-      PM_TRY(pm_newton_pc_save(s, st));
-      if (p->on_step)
-        PM_TRY(p->on_step(p->ctx, rep->steps, target, xc, &rep->last));
+      PM_TRY(converged(s, x, st, rep, lambda, target, nominal, largest,
+                       by_relaxation, &cuts));
       continue;
     }
     if (!recoverable(e)) {
@@ -503,6 +559,8 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
       /* (not in a checkpoint of a build before it: 0) */
       if (!pm_ckpt_reading(ck) || pm_ckpt_has(ck, NAME("fallback_kept")))
         PM_CALL(pm_ckpt_long(ck, NAME("fallback_kept"), &st->fallback_kept));
+      if (!pm_ckpt_reading(ck) || pm_ckpt_has(ck, NAME("relax_first")))
+        PM_CALL(pm_ckpt_long(ck, NAME("relax_first"), &st->relax_first));
     }
   }
   long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,

@@ -104,6 +104,9 @@ typedef struct {
   /* The fallbacks' linear solver kept since a step fell back
    * (pm_newton_set_fallback_linear with keep): 1, else 0. */
   long fallback_kept;
+  /* options.relax_first: the last step was carried by relaxation, so the
+   * next is relaxed first (1), else 0. */
+  long relax_first;
 } pm_load_state;
 
 /* Allocate a state's arrays for a problem of n unknowns, zeroed (lambda 0:

@@ -367,6 +367,14 @@ typedef struct {
   int relax_after;    /* 2 */
   int relax_max_iter; /* 20000 */
   double relax_rtol;  /* 1e-3 */
+  /* After a step that relaxation carried (the continuation before it
+   * failed, or is off), the steps that follow are relaxed first (then
+   * Newton from there, as that relaxation), skipping the Newton attempts
+   * and the continuation that failed on the step before; the first step
+   * this fails on goes the ordinary way, and so do the steps after it
+   * until relaxation carries one again.  false: every step the ordinary
+   * way. */
+  bool relax_first; /* false */
   /* Before that relaxation, where relax_after would try it: pseudo-
    * transient continuation within the step (pm_load_ptc.c), from the last
    * converged state under the step's load to Newton's tolerance: Newton

@@ -236,6 +236,7 @@ pm_err fpm_static_run_from(const fpm_model *m, fpm_state *st,
   no.relax_after = (int)s->time.qs_relax_after;
   no.ptc_max_iter = (int)s->time.qs_ptc;
   no.follow_fold = s->time.qs_follow_fold;
+  no.relax_first = s->time.qs_relax_first;
   /* Newton's whole step where it lowers the residual enough, else the
    * secant: near a stretched block's necking the whole step overshoots,
    * and backtracking creeps (docs/validation.md, "The secant line search"
