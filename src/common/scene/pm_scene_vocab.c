@@ -854,9 +854,9 @@ static const pm_key quasi_static_keys[] = {
      .offset = S(time.qs_relax_first),
      .def = "true",
      .doc = "method static (FPM, one process): true: after a load step "
-            "that relaxation carried (the continuation before it failed, "
-            "or is off), the next steps are relaxed first, then Newton "
-            "from there, skipping the Newton attempts and the "
+            "that relaxation carried (the continuation before it failed "
+            "or is off, or past a snap), the next steps are relaxed first, "
+            "then Newton from there, skipping the Newton attempts and the "
             "continuation that failed on the step before; the first step "
             "relaxation does not carry goes the ordinary way, and so do "
             "those after it until relaxation carries one again (F4 40% "

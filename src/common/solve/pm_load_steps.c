@@ -403,7 +403,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     if (target > 1 - PM_LOAD_END_SLACK) target = 1;
     PM_TRY(set_load(s, target));
     char relaxed[2048] = "", failed[sizeof rep->last.message] = "";
-    if (o->relax_first && relaxing && st->relax_first) {
+    if (relaxing && st->relax_first) {
       /* The step before was carried by relaxation: this one too, first. */
       pm_err e = relaxed_first(s, x, xc, st, &rw, rep, relaxed, sizeof relaxed);
       if (e == PM_SUCCESS && p->settle) e = settle_step(s, x, xc, 0, rep);

@@ -368,7 +368,8 @@ typedef struct {
   int relax_max_iter; /* 20000 */
   double relax_rtol;  /* 1e-3 */
   /* After a step that relaxation carried (the continuation before it
-   * failed, or is off), the steps that follow are relaxed first (then
+   * failed or is off, or past a snap arc length found), the steps that
+   * follow are relaxed first (then
    * Newton from there, as that relaxation), skipping the Newton attempts
    * and the continuation that failed on the step before; the first step
    * this fails on goes the ordinary way, and so do the steps after it
