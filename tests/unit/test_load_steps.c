@@ -373,6 +373,38 @@ static void test_relaxation_fallback(void **state) {
   pm_newton_destroy(&s);
   opt.follow_fold = false;
 
+  /* Relaxation ahead of the continuations (relax_first, once relaxation
+   * has carried a step: a resumed state that says so): the step Newton
+   * cannot finish at the snap is carried by relaxation alone, to the same
+   * root, without the lowest mode or arc length. */
+  opt.relax_first = true;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  pm_load_state st;
+  assert_ok(pm_load_state_init(&st, 1));
+  st.xc[0] = st.xprev[0] = sqrt(3);
+  st.lambda = 1e-6;
+  st.dl = 1.0 / opt.load_steps;
+  st.relax_carried = 1;
+  memset(&rep, 0, sizeof rep);
+  x = sqrt(3);
+  assert_ok(pm_load_steps_from(s, &x, &st, &rep));
+  print_message("relaxation ahead: %d steps, %d cuts, %d relaxations, %d "
+                "steps converged by it, %d lowest modes, %d arc lengths, %d "
+                "continuations, x = %.15f\n",
+                rep.steps, rep.cuts, rep.relaxations, rep.relaxed_steps,
+                rep.mode_runs, rep.arc_runs, rep.ptc_runs, x);
+  assert_close(rep.lambda, 1, 0, 0);
+  assert_close(x, snap_root(3.6), 1e-9, 0);
+  assert_true(rep.relaxed_steps >= 1);
+  assert_int_equal(rep.mode_runs, 0);
+  assert_int_equal(rep.arc_runs, 0);
+  assert_int_equal(rep.ptc_runs, 0);
+  assert_int_equal(rep.snap_steps, 0);
+  assert_int_equal(st.relax_carried, 1);
+  pm_load_state_free(&st);
+  pm_newton_destroy(&s);
+  opt.relax_first = false;
+
   /* A fallback out of CPU time stops and the next is tried: with a bound
    * no fallback can meet, the arc, relaxation and the continuation each
    * stop at once and the step is given up, named. */

@@ -15,6 +15,7 @@
 
 #include "pm_coloring.h"
 #include "pm_newton.h"
+#include "pm_newton_impl.h"
 #include "pm_testing.h"
 #include "newton_chain.h"
 
@@ -430,6 +431,27 @@ static void test_petsc_options(void **state) {
   assert_ok(chain_solve(&ch, &prob, &opt, &rep));
   assert_true(rep.linear_iterations > 5 * rep.iterations);
   assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+
+  /* A cap on the linear iterations (pm_newton_cap_linear, the relaxation's
+   * Newton in load stepping): at 2 a solve stops there and Newton fails on
+   * it, named; lifted, the same solver converges as before. */
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  pm_newton_cap_linear(s, 2);
+  memset(ch.x, 0, (size_t)ch.n * sizeof *ch.x);
+  pm_err e = pm_newton_solve(s, ch.x, &rep);
+  print_message("capped at 2 linear iterations: %s\n", pm_error_message());
+  assert_int_equal(e, PM_ERR_NOT_CONVERGED);
+  assert_int_equal(rep.reason, PM_NEWTON_DIVERGED_LINEAR);
+  assert_true(rep.linear_iterations <= 2 * (rep.iterations + 1));
+  assert_non_null(strstr(pm_error_message(), "iteration limit"));
+  pm_error_clear();
+  pm_newton_cap_linear(s, 0);
+  memset(ch.x, 0, (size_t)ch.n * sizeof *ch.x);
+  assert_ok(pm_newton_solve(s, ch.x, &rep));
+  assert_true(rep.linear_iterations > 5 * rep.iterations);
+  assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+  pm_newton_destroy(&s);
 
   /* An option PETSc rejects inside the solve is an error with PETSc's
    * message, not a failed step. */

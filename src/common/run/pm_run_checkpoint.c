@@ -111,6 +111,7 @@ pm_err pm_run_restore(pm_run_ctx *c, pm_run_resume_info *rs) {
   c->resumes = rs->h.resumes + 1;
   c->resumed_from = rs->h.step;
   c->ckpt_step = rs->h.step;
+  c->last_step = rs->h.step; /* a signal before the next step names it */
   c->out_timer.stage[c->tm_output].seconds = rs->h.output_seconds;
   c->out_timer.stage[c->tm_checkpoint].seconds = rs->h.checkpoint_seconds;
   if (rs->h.threads != pm_omp_threads())

@@ -859,10 +859,12 @@ static const pm_key quasi_static_keys[] = {
             "then Newton from there, skipping the Newton attempts and the "
             "continuation that failed on the step before; the first step "
             "relaxation does not carry goes the ordinary way, and so do "
-            "those after it until relaxation carries one again (F4 40% "
-            "at 1851 points in 13 load steps and half the time, F4 60% "
-            "completed); false: every step the ordinary way (the solver "
-            "before)"},
+            "those after it until relaxation carries one again; and "
+            "once relaxation has carried a step, a step that falls back "
+            "tries relaxation ahead of the lowest mode, arc length and "
+            "the continuation (F4 40% at 1851 points in 13 load steps and "
+            "half the time, F4 60% completed); false: every step the "
+            "ordinary way (the solver before)"},
     {.name = "follow_fold",
      .type = PM_KEY_BOOL,
      .offset = S(time.qs_follow_fold),

@@ -13,6 +13,12 @@
 /* Load factors this close to 1 are 1 (steps of 1/load_steps do not add up
  * to 1 exactly). */
 #define PM_LOAD_END_SLACK 1e-12
+/* The linear iterations a solve of the Newton that finishes a relaxation
+ * may take (relax_step): near a fold an iterative solve on a kept or
+ * approximate preconditioner crawls (hundreds of GMRES iterations, each
+ * dearer than tens of relaxation iterations), and relaxation on to
+ * Newton's tolerance is the cheaper way there. */
+#define PM_RELAX_NEWTON_LINEAR 100
 
 void pm_load_add_costs(pm_load_report *rep, const pm_newton_report *nr) {
   rep->time_residual += nr->time_residual;
@@ -82,10 +88,11 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
 
 /* The fallback of a step Newton could not finish, at the step's load (set):
  * relaxation from the last converged state xc to relax_rtol of its
- * imbalance, Newton from there, and if Newton fails again relaxation on
- * from its last iterate to Newton's own tolerance.  x receives the state
- * (converged on success, else the last admissible one); what happened goes
- * to msg (cap bytes). */
+ * imbalance, Newton from there (each linear solve held to
+ * PM_RELAX_NEWTON_LINEAR iterations), and if Newton fails again
+ * relaxation on from its last iterate to Newton's own tolerance.  x receives
+ * the state (converged on success, else the last admissible one); what happened
+ * goes to msg (cap bytes). */
 static pm_err relax_step(pm_newton *s, double *x, const double *xc,
                          pm_relax_work *w, pm_load_report *rep, char *msg,
                          size_t cap) {
@@ -99,7 +106,9 @@ static pm_err relax_step(pm_newton *s, double *x, const double *xc,
   snprintf(msg, cap, "%s", part);
   if (e != PM_SUCCESS && e != PM_ERR_NOT_CONVERGED) return e;
   pm_error_clear();
+  pm_newton_cap_linear(s, PM_RELAX_NEWTON_LINEAR);
   e = pm_newton_solve_from(s, x, xc, r0, &rep->last);
+  pm_newton_cap_linear(s, 0);
   add_solve(rep, &rep->last);
   if (e == PM_SUCCESS || !recoverable(e)) return e;
   pm_error_clear();
@@ -156,15 +165,26 @@ static pm_err snap_step(pm_newton *s, double *x, const double *xc,
  * (options.follow_fold false), relaxation from xc at the step's load
  * (snap_step); where that fails the continuation from xc, shifted above a
  * negative eigenvalue; where that fails the relaxation of relax_step, if
- * not tried.  x, msg and cap as relax_step's. */
+ * not tried.  With ahead (relaxation has carried a step of this run,
+ * options.relax_first) relax_step is tried first, and the rest only where
+ * it fails, without a relaxation of their own.  x, msg and cap as
+ * relax_step's. */
 static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
                             const double *xprev, double lambda,
                             double lambda_prev, double target, double r_ref,
-                            pm_relax_work *w, pm_arc_work *aw,
+                            bool ahead, pm_relax_work *w, pm_arc_work *aw,
                             pm_load_report *rep, char *msg, size_t cap) {
   const pm_newton_options *o = pm_newton_options_of(s);
   const long n = pm_newton_problem_of(s)->n;
   if (o->ptc_max_iter <= 0) return relax_step(s, x, xc, w, rep, msg, cap);
+  if (ahead) {
+    const size_t used0 = pm_msg_appendf(msg, cap, "relaxation first: ");
+    pm_err e = relax_step(s, x, xc, w, rep, msg + used0, cap - used0);
+    if (e == PM_SUCCESS || !recoverable(e)) return e;
+    pm_error_clear();
+    fprintf(stderr, "pointmech: load step %d (lambda %.6g -> %.6g): %s\n",
+            rep->steps + 1, lambda, target, msg);
+  }
   /* the goal: Newton's, relative to the step's imbalance at xc */
   double r0 = 0, eig = NAN;
   if (pm_newton_residual(s, xc, w->r) == PM_SUCCESS)
@@ -175,16 +195,16 @@ static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
                              rep->mode_note, sizeof rep->mode_note);
   if (e != PM_SUCCESS && !recoverable(e)) return e;
   pm_error_clear();
-  msg[0] = '\0';
+  if (!ahead) msg[0] = '\0';
   if (rep->mode_note[0]) {
     fprintf(stderr, "pointmech: load step %d (lambda %.6g -> %.6g): %s\n",
             rep->steps + 1, lambda, target, rep->mode_note);
-    snprintf(msg, cap, "%s", rep->mode_note);
+    pm_msg_appendf(msg, cap, "%s%s", msg[0] ? "; " : "", rep->mode_note);
   }
   /* a shift above the negative eigenvalue: the shifted tangent definite */
   const double shift0 =
       isfinite(eig) && eig < 0 ? fmax(PM_PTC_SHIFT0, -4 * eig) : 0;
-  bool relaxed = false;
+  bool relaxed = ahead;
   e = PM_ERR_NOT_CONVERGED;
   if (isfinite(eig) && eig < 0) {
     e = pm_load_branch_switch(s, x, xc, goal, shift0, w, rep, msg, cap);
@@ -197,7 +217,7 @@ static pm_err fallback_step(pm_newton *s, double *x, const double *xc,
       fprintf(stderr, "pointmech: load step %d: %s\n", rep->steps + 1,
               msg + used2);
     if (e == PM_SUCCESS) return e;
-    if (recoverable(e) && isfinite(limit)) {
+    if (recoverable(e) && isfinite(limit) && !ahead) {
       pm_error_clear();
       relaxed = true;
       e = snap_step(s, x, xc, lambda, target, limit, eig, w, rep, msg, cap);
@@ -289,6 +309,7 @@ static pm_err converged(pm_newton *s, const double *x, pm_load_state *st,
     st->good = 0;
   }
   st->relax_first = o->relax_first && relax_next;
+  if (st->relax_first) st->relax_carried = 1;
   PM_CALL(pm_newton_pc_save(s, st));
   if (p->on_step)
     PM_CALL(p->on_step(p->ctx, rep->steps, target, st->xc, &rep->last));
@@ -310,24 +331,6 @@ static pm_err relaxed_first(pm_newton *s, double *x, const double *xc,
     if (back != PM_SUCCESS) return back;
   }
   return e;
-}
-
-pm_err pm_load_state_init(pm_load_state *state, long n) {
-  memset(state, 0, sizeof *state);
-  pm_err ret = PM_SUCCESS;
-  PM_TRY(PM_ALLOC(state->xc, n, "converged state"));
-  PM_TRY(PM_ALLOC(state->xprev, n, "previous converged state"));
-  PM_TRY(PM_ALLOC(state->pc_x, n, "kept factorisation's state"));
-done:
-  if (ret != PM_SUCCESS) pm_load_state_free(state);
-  return ret;
-}
-
-void pm_load_state_free(pm_load_state *state) {
-  free(state->xc);
-  free(state->xprev);
-  free(state->pc_x);
-  state->xc = state->xprev = state->pc_x = NULL;
 }
 
 pm_err pm_load_steps(pm_newton *s, double *x, pm_load_report *report) {
@@ -386,7 +389,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     memcpy(xc, x, (size_t)n * sizeof *xc);
     st->lambda = st->lambda_prev = 0;
     st->dl = nominal;
-    st->good = st->have_prev = st->relax_first = 0;
+    st->good = st->have_prev = st->relax_first = st->relax_carried = 0;
     rep->dlambda_min = nominal;
   }
   if (resumed && st->fallback_kept)
@@ -420,6 +423,10 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       }
       /* Not carried: the ordinary way, from here on until relaxation
        * carries a step again. */
+      fprintf(stderr,
+              "pointmech: load step %d (lambda %.6g -> %.6g): relaxed first: "
+              "%s; the ordinary way\n",
+              rep->steps + 1, lambda, target, relaxed);
       pm_error_clear();
       st->relax_first = 0;
       relaxed[0] = '\0';
@@ -473,7 +480,8 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       /* (with the fallbacks' own linear solver, if they have one) */
       PM_TRY(pm_newton_use_fallback_linear(s, true));
       e = fallback_step(s, x, xc, xprev, lambda, lambda_prev, target, r_ref,
-                        &rw, &aw, rep, relaxed, sizeof relaxed);
+                        o->relax_first && st->relax_carried, &rw, &aw, rep,
+                        relaxed, sizeof relaxed);
       if (pm_newton_fallback_kept(s)) {
         st->fallback_kept = 1;
       } else {
@@ -535,46 +543,4 @@ done:
   pm_relax_work_free(&rw);
   pm_arc_work_free(&aw);
   return ret;
-}
-
-pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
-                          pm_load_state *st, pm_load_report *rep) {
-  char name[96];
-#define NAME(item) (snprintf(name, sizeof name, "%s.%s", prefix, item), name)
-  if (st) {
-    PM_CALL(pm_ckpt_double(ck, NAME("lambda"), &st->lambda));
-    PM_CALL(pm_ckpt_double(ck, NAME("lambda_prev"), &st->lambda_prev));
-    PM_CALL(pm_ckpt_double(ck, NAME("dl"), &st->dl));
-    PM_CALL(pm_ckpt_long(ck, NAME("good"), &st->good));
-    PM_CALL(pm_ckpt_long(ck, NAME("have_prev"), &st->have_prev));
-    if (n > 0) {
-      PM_CALL(pm_ckpt_doubles(ck, NAME("xc"), n, st->xc));
-      PM_CALL(pm_ckpt_doubles(ck, NAME("xprev"), n, st->xprev));
-      PM_CALL(pm_ckpt_long(ck, NAME("pc_built"), &st->pc_built));
-      PM_CALL(pm_ckpt_long(ck, NAME("pc_its"), &st->pc_its));
-      PM_CALL(pm_ckpt_long(ck, NAME("pc_failed"), &st->pc_failed));
-      PM_CALL(pm_ckpt_double(ck, NAME("pc_lambda"), &st->pc_lambda));
-      PM_CALL(pm_ckpt_doubles(ck, NAME("pc_x"), n, st->pc_x));
-      PM_CALL(pm_ckpt_long(ck, NAME("pc_first_its"), &st->pc_first_its));
-      /* (not in a checkpoint of a build before it: 0) */
-      if (!pm_ckpt_reading(ck) || pm_ckpt_has(ck, NAME("fallback_kept")))
-        PM_CALL(pm_ckpt_long(ck, NAME("fallback_kept"), &st->fallback_kept));
-      if (!pm_ckpt_reading(ck) || pm_ckpt_has(ck, NAME("relax_first")))
-        PM_CALL(pm_ckpt_long(ck, NAME("relax_first"), &st->relax_first));
-    }
-  }
-  long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,
-       linear = rep->linear_iterations;
-  PM_CALL(pm_ckpt_long(ck, NAME("steps"), &steps));
-  PM_CALL(pm_ckpt_long(ck, NAME("cuts"), &cuts));
-  PM_CALL(pm_ckpt_long(ck, NAME("newton_iterations"), &newton));
-  PM_CALL(pm_ckpt_long(ck, NAME("linear_iterations"), &linear));
-  PM_CALL(pm_ckpt_double(ck, NAME("dlambda_min"), &rep->dlambda_min));
-#undef NAME
-  rep->steps = (int)steps;
-  rep->cuts = (int)cuts;
-  rep->newton_iterations = (int)newton;
-  rep->linear_iterations = (int)linear;
-  if (st) rep->lambda = st->lambda;
-  return PM_SUCCESS;
 }

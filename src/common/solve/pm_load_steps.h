@@ -107,6 +107,10 @@ typedef struct {
   /* options.relax_first: the last step was carried by relaxation, so the
    * next is relaxed first (1), else 0. */
   long relax_first;
+  /* options.relax_first: relaxation has carried a step of this run (1),
+   * so a step that falls back tries it ahead of the continuations, else
+   * 0. */
+  long relax_carried;
 } pm_load_state;
 
 /* Allocate a state's arrays for a problem of n unknowns, zeroed (lambda 0:

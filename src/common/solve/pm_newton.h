@@ -373,8 +373,11 @@ typedef struct {
    * Newton from there, as that relaxation), skipping the Newton attempts
    * and the continuation that failed on the step before; the first step
    * this fails on goes the ordinary way, and so do the steps after it
-   * until relaxation carries one again.  false: every step the ordinary
-   * way. */
+   * until relaxation carries one again.  Once relaxation has carried a
+   * step, a step that falls back (Newton cut relax_after times) tries
+   * relaxation before the lowest mode, arc length and the continuation,
+   * which then go without a relaxation of their own.  false: every step
+   * the ordinary way. */
   bool relax_first; /* false */
   /* Before that relaxation, where relax_after would try it: pseudo-
    * transient continuation within the step (pm_load_ptc.c), from the last

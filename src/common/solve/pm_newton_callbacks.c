@@ -226,12 +226,21 @@ static double forcing_term(pm_newton *s, double rk) {
 PetscErrorCode pm_newton_linear_presolve(KSP ksp, Vec b, Vec x, void *ctx) {
   pm_newton *s = ctx;
   (void)x;
+  const bool capped = s->lin_cap > 0 && s->lin_cap < s->o.linear_max_iter;
+  const PetscInt max_it = capped ? s->lin_cap : s->o.linear_max_iter;
   if (s->o.linear_ew) {
     PetscReal rk;
     PetscCall(VecNorm(b, NORM_2, &rk));
     PetscCall(KSPSetTolerances(ksp, forcing_term(s, rk), PETSC_DEFAULT,
-                               PETSC_DEFAULT, s->o.linear_max_iter));
+                               PETSC_DEFAULT, max_it));
+  } else if (capped || s->lin_capped) {
+    /* the cap set or lifted, the tolerances kept */
+    PetscReal rtol, abstol, dtol;
+    PetscInt was;
+    PetscCall(KSPGetTolerances(ksp, &rtol, &abstol, &dtol, &was));
+    PetscCall(KSPSetTolerances(ksp, rtol, abstol, dtol, max_it));
   }
+  s->lin_capped = capped;
   s->linear_started = pm_wtime();
   s->linear_started_cpu = pm_cputime();
   s->in_linear = true;

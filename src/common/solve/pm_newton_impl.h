@@ -66,6 +66,10 @@ pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on);
 /* Whether the fallbacks' linear solver, once taken, is kept for the rest
  * of the run (pm_newton_set_fallback_linear's keep). */
 bool pm_newton_fallback_kept(const pm_newton *s);
+/* At most max_its iterations for each linear solve from now on (fewer
+ * than the options' linear_max_iter; 0: theirs again): a solve that
+ * reaches it fails as at linear_max_iter. */
+void pm_newton_cap_linear(pm_newton *s, int max_its);
 
 /* r = the residual at x (both of the n owned values): the problem's
  * callback, through the held values of a shared problem (collective then,

@@ -264,6 +264,10 @@ bool pm_newton_fallback_kept(const pm_newton *s) {
   return s->has_alt && s->alt_keep;
 }
 
+void pm_newton_cap_linear(pm_newton *s, int max_its) {
+  s->lin_cap = max_its > 0 ? max_its : 0;
+}
+
 pm_err pm_newton_use_fallback_linear(pm_newton *s, bool on) {
   if (!s->has_alt || s->on_alt == on) return PM_SUCCESS;
   if (on && s->alt.linear == PM_NEWTON_DIRECT && s->p.aux_prepare && !s->aug) {

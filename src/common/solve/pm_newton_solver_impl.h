@@ -117,6 +117,11 @@ struct pm_newton {
    * none yet) and the tolerance it was given. */
   double ew_rprev, ew_eta;
   int lin_its;
+  /* pm_newton_cap_linear: at most this many iterations a linear solve (0:
+   * the options' linear_max_iter), and whether the last solve's limit was
+   * set by it. */
+  int lin_cap;
+  bool lin_capped;
   bool started; /* the initial state was admissible */
   /* pm_newton_problem.aux_n (one process): M's rows as the caller gives
    * them (aux_ptr, aux_idx over aux_N = n + aux_n, kept by the caller) and

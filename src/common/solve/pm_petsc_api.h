@@ -32,6 +32,7 @@
   X(KSPGetIterationNumber)                                                     \
   X(KSPGetOperators)                                                           \
   X(KSPGetPC)                                                                  \
+  X(KSPGetTolerances)                                                          \
   X(KSPGetType)                                                                \
   X(KSPSetConvergenceTest)                                                     \
   X(KSPSetFromOptions)                                                         \
@@ -197,6 +198,7 @@ pm_err pm_petsc_api_load(const char *need);
 #define KSPGetIterationNumber (*pm_petsc_api.KSPGetIterationNumber)
 #define KSPGetOperators (*pm_petsc_api.KSPGetOperators)
 #define KSPGetPC (*pm_petsc_api.KSPGetPC)
+#define KSPGetTolerances (*pm_petsc_api.KSPGetTolerances)
 #define KSPGetType (*pm_petsc_api.KSPGetType)
 #define KSPSetConvergenceTest (*pm_petsc_api.KSPSetConvergenceTest)
 #define KSPSetFromOptions (*pm_petsc_api.KSPSetFromOptions)

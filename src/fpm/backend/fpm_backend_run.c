@@ -56,6 +56,7 @@ static void load_scalars(fpm_static_state *to, const fpm_static_state *from) {
   to->load.pc_first_its = from->load.pc_first_its;
   to->load.fallback_kept = from->load.fallback_kept;
   to->load.relax_first = from->load.relax_first;
+  to->load.relax_carried = from->load.relax_carried;
   to->external_work = from->external_work;
 }
 

@@ -109,14 +109,6 @@ static void fit_pass(const fpm_model *m, const double *restrict u,
   }
 }
 
-/* theta (3 x FPM_QFIT) applied to phi: the fit's increment at an offset. */
-static inline double fit_at(const double *theta, int c, const double *phi) {
-  const double *t = theta + FPM_QFIT * c;
-  double v = 0;
-  for (int a = 0; a < FPM_QFIT; a++) v += t[a] * phi[a];
-  return v;
-}
-
 /* The jump of the linear fields at an interface: u_i + H_i d_i - u_k -
  * H_k d_k. */
 static inline void linear_jump(const double *ui, const double *uk,
@@ -126,16 +118,6 @@ static inline void linear_jump(const double *ui, const double *uk,
     j[c] = ui[c] - uk[c] + Hi[3 * c] * di[0] + Hi[3 * c + 1] * di[1] +
            Hi[3 * c + 2] * di[2] - Hk[3 * c] * dk[0] - Hk[3 * c + 1] * dk[1] -
            Hk[3 * c + 2] * dk[2];
-}
-
-/* The jump of the quadratic fits: u_i + theta_i phi_i - u_k - theta_k
- * phi_k. */
-static inline void quad_jump(const double *ui, const double *uk,
-                             const double *thi, const double *thk,
-                             const double *phi_i, const double *phi_k,
-                             double *j) {
-  for (int c = 0; c < 3; c++)
-    j[c] = ui[c] - uk[c] + fit_at(thi, c, phi_i) - fit_at(thk, c, phi_k);
 }
 
 /* Pass 2: per point i, over its interfaces e with outward area vector a,
@@ -206,12 +188,12 @@ static double flux_general(const fpm_model *m, const fields *fl) {
       if (quad) {
         fpm_gfd_phi(di, phi_i);
         fpm_gfd_phi(dk, phi_k);
-        quad_jump(ui, uk, th + 27 * i, th + 27 * k, phi_i, phi_k, jq);
+        fpm_quad_jump(ui, uk, th + 27 * i, th + 27 * k, phi_i, phi_k, jq);
         if (cs != 0 && squad) {
           double jq0[3];
           if (base)
-            quad_jump(bu + 3 * i, bu + 3 * k, bth + 27 * i, bth + 27 * k, phi_i,
-                      phi_k, jq0);
+            fpm_quad_jump(bu + 3 * i, bu + 3 * k, bth + 27 * i, bth + 27 * k,
+                          phi_i, phi_k, jq0);
           eadd += fpm_stiffen_entry(m, cs, rec[22], jq, base ? jq0 : NULL, ui,
                                     uk, bui, buk, di, dk, sq, sd);
         }
@@ -425,11 +407,11 @@ static void fit_gather_pass(const fpm_model *m, const fields *fl) {
   for (long k = 0; k < n; k++) {
     double fk[3];
     for (int c = 0; c < 3; c++)
-      fk[c] = zq[3 * k + c] - fit_at(Zq + 27 * k, c, qs + FPM_QFIT * k);
+      fk[c] = zq[3 * k + c] - fpm_fit_at(Zq + 27 * k, c, qs + FPM_QFIT * k);
     for (long t = tp[k]; t < tp[k + 1]; t++) {
       const long e = te[t];
       const double *Zi = Zq + 27 * own[e], *qe = q + FPM_QFIT * e;
-      for (int c = 0; c < 3; c++) fk[c] += fit_at(Zi, c, qe);
+      for (int c = 0; c < 3; c++) fk[c] += fpm_fit_at(Zi, c, qe);
     }
     for (int c = 0; c < 3; c++) f[3 * k + c] += fk[c];
   }

@@ -72,6 +72,12 @@ size_t fpm_linear_bytes(const fpm_model *m) {
 
 const double *fpm_linear_tangent(const fpm_linear *l) { return l->D; }
 
+void fpm_linear_base(const fpm_linear *l, const double **u,
+                     const double **theta) {
+  *u = l->bu;
+  *theta = l->btheta;
+}
+
 const fpm_volumetric_lin *fpm_linear_volumetric(const fpm_linear *l) {
   return &l->vol;
 }

@@ -335,6 +335,11 @@ void fpm_linear_prepare(const fpm_model *m, const fpm_state *st, fpm_linear *l);
 /* The tangent moduli dP/dF of the last prepare: 81 per point, row-major
  * (row a = 3 i + j of P, column b of F). */
 const double *fpm_linear_tangent(const fpm_linear *l);
+/* The last prepare's displacements (3 per point) and, with fpm.stiffening
+ * on the quadratic jump, its fits' coefficients (27 per point; else
+ * NULL). */
+void fpm_linear_base(const fpm_linear *l, const double **u,
+                     const double **theta);
 /* df (3 n) = K du (3 n), every dof (prescribed ones included); collective
  * on a share with fpm.volumetric: averaged. */
 void fpm_force_linear(const fpm_model *m, fpm_linear *l, const double *du,

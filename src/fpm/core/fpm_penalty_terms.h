@@ -6,8 +6,28 @@
 
 #include <math.h>
 
+#include "fpm_gfd.h"
 #include "fpm_model.h"
 #include "pm_tensor.h"
+
+/* theta (3 x FPM_QFIT) applied to phi: the fit's increment at an offset. */
+static inline double fpm_fit_at(const double *theta, int c, const double *phi) {
+  const double *t = theta + FPM_QFIT * c;
+  double v = 0;
+  for (int a = 0; a < FPM_QFIT; a++) v += t[a] * phi[a];
+  return v;
+}
+
+/* The jump of the quadratic fits: u_i + theta_i phi_i - u_k - theta_k
+ * phi_k. */
+static inline void fpm_quad_jump(const double *ui, const double *uk,
+                                 const double *thi, const double *thk,
+                                 const double *phi_i, const double *phi_k,
+                                 double *j) {
+  for (int c = 0; c < 3; c++)
+    j[c] =
+        ui[c] - uk[c] + fpm_fit_at(thi, c, phi_i) - fpm_fit_at(thk, c, phi_k);
+}
 
 /* The stiffening on jump j: the energy c phi / 4 with s = |j|^2,
  * g = s - t2 and phi = g^3 / s for g > 0, 0 below (phi = g^3 / (g + t2)
@@ -46,6 +66,25 @@ static inline double fpm_stiffen(double c, double tau2, const double *j,
     if (dc) sd[a] += 0.5 * c * tau2 * pt * dc[a];
   }
   return 0.125 * c * g * g * x;
+}
+
+/* The stiffening's second derivative in the jump at j0 (onset t2, as
+ * fpm_stiffen's), into the 3 x 3 block A: c (phi_s I + 2 phi_ss j0 (x)
+ * j0) / 2 (with fpm.stiffening_spacing: current the onset's own
+ * derivative left out), for the assembled tangent (its S's blocks), so
+ * that it preconditions the exact linearisation closely; 0 below the
+ * onset. */
+static inline void fpm_stiffen_block(double c, double t2, const double *j0,
+                                     double *A) {
+  const double q = pm_v_dot(j0, j0), g = q - t2;
+  for (int a = 0; a < 9; a++) A[a] = 0;
+  if (g <= 0) return;
+  const double x = g / q;
+  const double ps = g * x * (3 - x), pss = x * (6 - 6 * x + 2 * x * x);
+  for (int a = 0; a < 3; a++) {
+    A[4 * a] += 0.5 * c * ps;
+    for (int b = 0; b < 3; b++) A[3 * a + b] += c * pss * j0[a] * j0[b];
+  }
 }
 
 /* The stiffening of entry (i, k) on jump j (j0: the base's when

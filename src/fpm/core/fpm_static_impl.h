@@ -28,6 +28,16 @@ typedef struct {
   long *mark;        /* threads x n: a row's points */
   double *work;      /* threads x 9 max_reach: a row's blocks */
   const double *Dpc; /* the moduli to assemble with (NULL: the tangent's) */
+  /* fpm.stiffening on the quadratic jump: its second derivative in the
+   * jump at the linearisation point, a 3 x 3 block per entry (Sx_e, 9 an
+   * entry, fpm_stiffen_block) gathered as S is, by the fits' weights
+   * (Sq_off, Sq_w), at each assembly, with a row's scratch per thread
+   * (Sx_mark, Sx_list: threads x n; Sx_acc: threads x 9 n); NULL without
+   * it. */
+  long *Sq_off;
+  double *Sq_w, *Sx_e;
+  long *Sx_mark, *Sx_list;
+  double *Sx_acc;
 } fpm_static_tangent;
 
 /* The averaged volume's coupling in the preconditioner (fpm.volumetric

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fpm_gfd.h"
+#include "fpm_penalty_terms.h"
 #include "fpm_static_impl.h"
 #include "pm_omp.h"
 
@@ -23,6 +24,12 @@ void fpm_static_tangent_free(fpm_static_tangent *t) {
   free(t->Dg_ptr);
   free(t->work);
   free(t->mark);
+  free(t->Sq_off);
+  free(t->Sq_w);
+  free(t->Sx_e);
+  free(t->Sx_mark);
+  free(t->Sx_list);
+  free(t->Sx_acc);
 }
 
 /* Adds the 3 x 3 geometry C^c_ij (rows s, columns q) of T_i = sum_j P_j C_ij
@@ -232,14 +239,16 @@ static pm_err sweights_build(const fpm_model *m, bool quad, sweights *sw) {
  * list/acc, or -1. */
 typedef struct {
   long *mark, *list, cnt;
-  double *acc;
+  double *acc; /* 1 per slot, or 9 (a 3 x 3 block) with add_S_row's blocks */
 } srow;
 
 /* Adds to row k of S the penalty of one reconstruction (quad: the fits'
  * jump with beta = rec[18]; else the linear fields' jump with beta =
- * rec[18], or rec[19] beside the quadratic jump), from its weights sw. */
+ * rec[18], or rec[19] beside the quadratic jump), from its weights sw;
+ * with blocks not NULL, the 3 x 3 block blocks[9 e] in place of beta on
+ * the entries that have one, into 9 values a slot of w->acc. */
 static void add_S_row(const fpm_model *m, bool quad, const sweights *sw, long k,
-                      srow *w) {
+                      const double *blocks, srow *w) {
   const int slot = s_slot(m, quad);
   /* the points i whose own field at their interfaces moves with u_k:
    * k itself and those whose reconstruction holds k */
@@ -255,8 +264,10 @@ static void add_S_row(const fpm_model *m, bool quad, const sweights *sw, long k,
     const long ri = recon_size(m, quad, i);
     for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
       const double be = m->erec[FPM_EREC * e + slot];
+      const double *blk = blocks ? blocks + 9 * e : NULL;
       const long kk = m->nbr[e];
-      if (be == 0) continue;
+      if (be == 0 || (blk && blk[0] == 0 && blk[4] == 0 && blk[8] == 0))
+        continue;
       const double *wi = sw->w + sw->off[e];
       /* t_ek: k's weight in u_i + recon_i(d_i) */
       double tk = 0;
@@ -272,12 +283,17 @@ static void add_S_row(const fpm_model *m, bool quad, const sweights *sw, long k,
           double wt = ws[r];
           const long x = recon_id(m, quad, p, r);
           if (r == 0) wt += 1;
+          const long width = blk ? 9 : 1;
           if (w->mark[x] < 0) {
             w->mark[x] = w->cnt;
             w->list[w->cnt++] = x;
-            w->acc[w->mark[x]] = 0;
+            for (long q = 0; q < width; q++) w->acc[width * w->mark[x] + q] = 0;
           }
-          w->acc[w->mark[x]] += be * tk * sign * wt;
+          if (blk)
+            for (int q = 0; q < 9; q++)
+              w->acc[9 * w->mark[x] + q] += tk * sign * wt * blk[q];
+          else
+            w->acc[w->mark[x]] += be * tk * sign * wt;
         }
       }
     }
@@ -290,7 +306,9 @@ static void add_S_row(const fpm_model *m, bool quad, const sweights *sw, long k,
  * the quadratic jump, plus the boundary interfaces' linear-jump term.
  * fpm.stiffening's quartic term and fpm.volume_penalty are not in S (their
  * tangents depend on the state): with them this tangent is approximate and
- * preconditions fpm_force_linear's exact linearisation (fpm_static.c).
+ * preconditions fpm_force_linear's exact linearisation (fpm_static.c); the
+ * stiffening of the quadratic jump adds its 3 x 3 blocks at each assembly
+ * (tangent_values, Sx_e), the weights of the fits kept for it.
  * Rows on every thread, each with its own scratch: a row's sum is one
  * thread's, in the order one thread takes, so the bits do not depend on
  * the threads. */
@@ -320,8 +338,8 @@ static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
       PM_OMP(for schedule(dynamic, 16))
       for (long k = 0; k < rows; k++) {
         w.cnt = 0;
-        add_S_row(m, m->q != NULL, &sq, k, &w);
-        if (lin_too) add_S_row(m, false, &sl, k, &w);
+        add_S_row(m, m->q != NULL, &sq, k, NULL, &w);
+        if (lin_too) add_S_row(m, false, &sl, k, NULL, &w);
         if (pass == 0)
           t->S_ptr[k + 1] = w.cnt;
         else
@@ -339,6 +357,19 @@ static pm_err build_S(const fpm_model *m, fpm_static_tangent *t) {
       PM_TRY(PM_ALLOC(t->S, t->S_ptr[rows] > 0 ? t->S_ptr[rows] : 1,
                       "penalty matrix"));
     }
+  }
+  if (m->q && m->stiffening > 0 && m->stiffen_quadratic) {
+    /* the stiffening's blocks, gathered at each assembly */
+    const long ne = m->nbr_ptr[n];
+    t->Sq_off = sq.off;
+    t->Sq_w = sq.w;
+    sq.off = NULL;
+    sq.w = NULL;
+    PM_TRY(PM_ALLOC(t->Sx_e, 9 * (ne > 0 ? ne : 1), "stiffening blocks"));
+    PM_TRY(PM_ALLOC(t->Sx_mark, (size_t)threads * n, "stiffening marks"));
+    PM_TRY(PM_ALLOC(t->Sx_list, (size_t)threads * n, "stiffening lists"));
+    PM_TRY(PM_ALLOC(t->Sx_acc, (size_t)threads * 9 * n, "stiffening row"));
+    for (long i = 0; i < (long)threads * n; i++) t->Sx_mark[i] = -1;
   }
 done:
   sweights_free(&sq);
@@ -371,6 +402,38 @@ pm_err fpm_static_tangent_build(const fpm_model *m, fpm_static_tangent *t) {
   return PM_SUCCESS;
 }
 
+/* The stiffening's block of every entry (fpm_stiffen_block, 9 an entry)
+ * at the linearisation point's displacements u and fits theta: on the
+ * quadratic jump, with its onset at the points' deformed distance
+ * (fpm.stiffening_spacing: current) or the record's. */
+static void stiffen_blocks(const fpm_model *m, const double *u,
+                           const double *theta, double *we) {
+  const long n = m->n;
+  const double tau2 = m->stiffening_onset * m->stiffening_onset;
+  PM_OMP(parallel for schedule(dynamic, 64) default(none)
+         shared(m, u, theta, we, n, tau2))
+  for (long i = 0; i < n; i++)
+    for (long e = m->nbr_ptr[i]; e < m->nbr_ptr[i + 1]; e++) {
+      const double *rec = m->erec + FPM_EREC * e;
+      const long k = m->nbr[e];
+      double *A = we + 9 * e;
+      for (int q = 0; q < 9; q++) A[q] = 0;
+      if (rec[20] == 0 || rec[18] == 0) continue;
+      double phi_i[FPM_QFIT], phi_k[FPM_QFIT], j[3], t2 = rec[22];
+      fpm_gfd_phi(rec + 12, phi_i);
+      fpm_gfd_phi(rec + 15, phi_k);
+      fpm_quad_jump(u + 3 * i, u + 3 * k, theta + 27 * i, theta + 27 * k, phi_i,
+                    phi_k, j);
+      if (m->stiffen_current) {
+        double dc[3];
+        for (int a = 0; a < 3; a++)
+          dc[a] = rec[12 + a] - rec[15 + a] + u[3 * k + a] - u[3 * i + a];
+        t2 = tau2 * pm_v_dot(dc, dc);
+      }
+      fpm_stiffen_block(rec[20], t2, j, A);
+    }
+}
+
 /* The tangent's values into val: in the Jacobian's pattern, or (sp) in
  * the support operator's. */
 static void tangent_values(fpm_static_ctx *c, const fpm_static_support *sp,
@@ -397,13 +460,24 @@ static void tangent_values(fpm_static_ctx *c, const fpm_static_support *sp,
                              Dj[9 * row + 3 * a + 2] * g[2];
     }
   }
+  if (t->Sx_e) {
+    const double *bu, *bth;
+    fpm_linear_base(c->lin, &bu, &bth);
+    stiffen_blocks(m, bu, bth, t->Sx_e);
+  }
+  const sweights sx = {.off = t->Sq_off, .w = t->Sq_w};
   const long *free_of = c->free_of, *pat = c->pat_ptr;
   const double *K = c->contact_K;
   PM_OMP(parallel default(none)
-             shared(n, rows, m, t, free_of, pat, val, K, sp)) {
+             shared(n, rows, m, t, free_of, pat, val, K, sp, sx)) {
     const int th = pm_omp_thread();
     long *mark = t->mark + (size_t)th * n;
     double *blk = t->work + (size_t)th * 9 * t->max_reach;
+    srow xw = {0};
+    if (t->Sx_e)
+      xw = (srow){.mark = t->Sx_mark + (size_t)th * n,
+                  .list = t->Sx_list + (size_t)th * n,
+                  .acc = t->Sx_acc + (size_t)th * 9 * n};
     PM_OMP(for schedule(dynamic, 16))
     for (long k = 0; k < rows; k++) {
       const long r0 = t->R_ptr[k], nr = t->R_ptr[k + 1] - r0;
@@ -427,6 +501,15 @@ static void tangent_values(fpm_static_ctx *c, const fpm_static_support *sp,
       for (long q = t->S_ptr[k]; q < t->S_ptr[k + 1]; q++) {
         double *b = blk + 9 * mark[t->S_m[q]];
         for (int cc = 0; cc < 3; cc++) b[4 * cc] += t->S[q];
+      }
+      if (t->Sx_e) { /* the stiffening's, in S's pattern */
+        xw.cnt = 0;
+        add_S_row(m, true, &sx, k, t->Sx_e, &xw);
+        for (long a = 0; a < xw.cnt; a++) {
+          double *b = blk + 9 * mark[xw.list[a]];
+          for (int q = 0; q < 9; q++) b[q] += xw.acc[9 * a + q];
+          xw.mark[xw.list[a]] = -1;
+        }
       }
       if (K) /* the contact's block on the diagonal */
         for (int a = 0; a < 9; a++) blk[9 * mark[k] + a] += K[9 * k + a];
