@@ -87,20 +87,20 @@ static pm_err tangent_predictor(pm_newton *s, double lambda, double target,
 }
 
 /* The fallback of a step Newton could not finish, at the step's load (set):
- * relaxation from the last converged state xc to relax_rtol of its
- * imbalance, Newton from there (each linear solve held to
- * PM_RELAX_NEWTON_LINEAR iterations), and if Newton fails again
- * relaxation on from its last iterate to Newton's own tolerance.  x receives
- * the state (converged on success, else the last admissible one); what happened
- * goes to msg (cap bytes). */
-static pm_err relax_step(pm_newton *s, double *x, const double *xc,
-                         pm_relax_work *w, pm_load_report *rep, char *msg,
-                         size_t cap) {
+ * relaxation from the last converged state xc (or, with x_start, from the
+ * state x holds) to relax_rtol of its imbalance, Newton from there (each
+ * linear solve held to PM_RELAX_NEWTON_LINEAR iterations), and if Newton
+ * fails again relaxation on from its last iterate to Newton's own
+ * tolerance.  x receives the state (converged on success, else the last
+ * admissible one); what happened goes to msg (cap bytes). */
+static pm_err relax_from(pm_newton *s, double *x, bool x_start,
+                         const double *xc, pm_relax_work *w,
+                         pm_load_report *rep, char *msg, size_t cap) {
   const pm_newton_options *o = pm_newton_options_of(s);
   const long n = pm_newton_problem_of(s)->n;
   char part[256];
   double r0 = 0, r1 = 0;
-  memcpy(x, xc, (size_t)n * sizeof *x);
+  if (!x_start) memcpy(x, xc, (size_t)n * sizeof *x);
   pm_err e = pm_load_relax(s, x, o->relax_rtol, o->atol, w, rep, &r0, part,
                            sizeof part);
   snprintf(msg, cap, "%s", part);
@@ -123,6 +123,12 @@ static pm_err relax_step(pm_newton *s, double *x, const double *xc,
     rep->last.message[0] = '\0';
   }
   return e;
+}
+
+static pm_err relax_step(pm_newton *s, double *x, const double *xc,
+                         pm_relax_work *w, pm_load_report *rep, char *msg,
+                         size_t cap) {
+  return relax_from(s, x, false, xc, w, rep, msg, cap);
 }
 
 /* The step carried past a limit point at lambda limit (the highest load
@@ -316,14 +322,30 @@ static pm_err converged(pm_newton *s, const double *x, pm_load_state *st,
   return PM_SUCCESS;
 }
 
-/* options.relax_first: the step at the load set, from the last converged
- * state xc, by relax_step with the fallbacks' linear solver (x, w, rep,
- * msg and cap as relax_step's). */
+/* options.relax_first: the step at the load set (target), by relax_from
+ * with the fallbacks' linear solver, from the state the last two
+ * converged ones extrapolate to (options.predictor; where it is
+ * inadmissible at the start, from the last converged state xc), else
+ * from xc: the last converged state under the step's load can invert a
+ * point beside a moved face (x, w, rep, msg and cap as relax_step's). */
 static pm_err relaxed_first(pm_newton *s, double *x, const double *xc,
-                            pm_load_state *st, pm_relax_work *w,
+                            pm_load_state *st, double target, pm_relax_work *w,
                             pm_load_report *rep, char *msg, size_t cap) {
+  const pm_newton_options *o = pm_newton_options_of(s);
+  const long n = pm_newton_problem_of(s)->n;
   PM_CALL(pm_newton_use_fallback_linear(s, true));
-  pm_err e = relax_step(s, x, xc, w, rep, msg, cap);
+  const bool predict =
+      o->predictor && st->have_prev && st->lambda > st->lambda_prev;
+  if (predict) {
+    const double f = (target - st->lambda) / (st->lambda - st->lambda_prev);
+    for (long i = 0; i < n; i++) x[i] = xc[i] + f * (xc[i] - st->xprev[i]);
+  }
+  const long its = rep->relax_iterations;
+  pm_err e = relax_from(s, x, predict, xc, w, rep, msg, cap);
+  if (predict && recoverable(e) && rep->relax_iterations == its) {
+    pm_error_clear();
+    e = relax_step(s, x, xc, w, rep, msg, cap);
+  }
   if (pm_newton_fallback_kept(s)) {
     st->fallback_kept = 1;
   } else if (e == PM_SUCCESS || recoverable(e)) {
@@ -408,7 +430,8 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     char relaxed[2048] = "", failed[sizeof rep->last.message] = "";
     if (relaxing && st->relax_first) {
       /* The step before was carried by relaxation: this one too, first. */
-      pm_err e = relaxed_first(s, x, xc, st, &rw, rep, relaxed, sizeof relaxed);
+      pm_err e = relaxed_first(s, x, xc, st, target, &rw, rep, relaxed,
+                               sizeof relaxed);
       if (e == PM_SUCCESS && p->settle) e = settle_step(s, x, xc, 0, rep);
       if (e == PM_SUCCESS) {
         rep->relaxed_steps++;
