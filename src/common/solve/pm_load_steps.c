@@ -322,6 +322,19 @@ static pm_err converged(pm_newton *s, const double *x, pm_load_state *st,
   return PM_SUCCESS;
 }
 
+/* options.predictor: x = the state at the load target the last two
+ * converged states of st extrapolate to, where there are two; returns
+ * whether x was set. */
+static bool extrapolate(const pm_newton_options *o, const pm_load_state *st,
+                        double target, long n, double *x) {
+  if (!o->predictor || !st->have_prev || !(st->lambda > st->lambda_prev))
+    return false;
+  const double f = (target - st->lambda) / (st->lambda - st->lambda_prev);
+  for (long i = 0; i < n; i++)
+    x[i] = st->xc[i] + f * (st->xc[i] - st->xprev[i]);
+  return true;
+}
+
 /* options.relax_first: the step at the load set (target), by relax_from
  * with the fallbacks' linear solver, from the state the last two
  * converged ones extrapolate to (options.predictor; where it is
@@ -334,12 +347,7 @@ static pm_err relaxed_first(pm_newton *s, double *x, const double *xc,
   const pm_newton_options *o = pm_newton_options_of(s);
   const long n = pm_newton_problem_of(s)->n;
   PM_CALL(pm_newton_use_fallback_linear(s, true));
-  const bool predict =
-      o->predictor && st->have_prev && st->lambda > st->lambda_prev;
-  if (predict) {
-    const double f = (target - st->lambda) / (st->lambda - st->lambda_prev);
-    for (long i = 0; i < n; i++) x[i] = xc[i] + f * (xc[i] - st->xprev[i]);
-  }
+  const bool predict = extrapolate(o, st, target, n, x);
   const long its = rep->relax_iterations;
   pm_err e = relax_from(s, x, predict, xc, w, rep, msg, cap);
   if (predict && recoverable(e) && rep->relax_iterations == its) {
@@ -455,12 +463,8 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       relaxed[0] = '\0';
     }
     memcpy(x, xc, (size_t)n * sizeof *x);
-    bool predicted = false;
-    if (o->predictor && st->have_prev && lambda > lambda_prev) {
-      double f = (target - lambda) / (lambda - lambda_prev);
-      for (long i = 0; i < n; i++) x[i] = xc[i] + f * (xc[i] - xprev[i]);
-      predicted = true;
-    } else if (o->predictor) {
+    bool predicted = extrapolate(o, st, target, n, x);
+    if (!predicted && o->predictor) {
       /* No two states to extrapolate from: the tangent predictor. */
       pm_err e = tangent_predictor(s, lambda, target, xc, r, rh, x, rep);
       if (e != PM_SUCCESS && !recoverable(e)) {
