@@ -25,7 +25,9 @@
 # libhdf5 stop on some inputs by themselves (tests/fuzz/upstream/).  The
 # other readers run in the fuzzer's process.
 #
-# New inputs go to build-fuzz/corpus-TARGET/; crashes, leaks and hangs to
+# New inputs go to build-fuzz/corpus-TARGET/ (with PM_ISOLATE=0, to
+# build-fuzz/corpus-TARGET-screened/, the inputs that read through in the
+# process alone; see below); crashes, leaks and hangs to
 # build-fuzz/findings-TARGET/ (triage: build-fuzz/tests/fuzz_TARGET FILE
 # prints the stack; a crash wholly inside libgmsh or libhdf5 goes to
 # tests/fuzz/upstream/TARGET/, one in the project's code is fixed and its
@@ -122,6 +124,7 @@ gmsh | checkpoint | index)
     # running out of memory, and each finding is kept in
     # build-fuzz/findings-TARGET/ for triage by its stack.
     extra+=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
+    screen=1
     # Inputs of at most 80 kB: no reader needs an allocation past a few
     # MB (a damaged file's announced blocks, zeroed page by page, cost
     # most of such an input), and a small quarantine of freed memory keeps
@@ -166,7 +169,32 @@ export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1:max_allocation_si
 # matched on whole stacks (libgmsh and libhdf5 keep no frame pointers).
 export LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:fast_unwind_on_malloc=${unwind:-0}
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+dirs=("$corpus" "$seeds" "$replayed")
+if [ "${screen:-}" = 1 ]; then
+  # In the process, an input of the corpus that stops libgmsh or libhdf5
+  # by itself (a replayed input the program refuses in its child, say)
+  # would stop every job of the fork mode that draws it, and the campaign
+  # would spend its time restarting jobs (3 inputs a second, against 54).
+  # The jobs draw from the inputs that read through alone: each is read
+  # once in a process of its own, and those that stop it are left out.
+  screened=$build/corpus-$target-screened
+  mkdir -p "$screened"
+  kept=0 left=0
+  for f in "$corpus"/* "$seeds"/* "$replayed"/*; do
+    [ -f "$f" ] || continue
+    [ -f "$screened/${f##*/}" ] && continue
+    if timeout $((timeout + 2)) "$build/tests/fuzz_$target" -timeout=$timeout \
+      "$f" >/dev/null 2>&1; then
+      cp "$f" "$screened/"
+      kept=$((kept + 1))
+    else
+      left=$((left + 1))
+    fi
+  done
+  echo "fuzz: $kept new inputs screened in, $left left out (they stop" \
+    "the library in the process); corpus $screened" >&2
+  dirs=("$screened")
+fi
 exec "$build/tests/fuzz_$target" "$budget" -max_len=$max_len \
   -timeout=$timeout -rss_limit_mb=2048 -print_final_stats=1 \
-  -artifact_prefix="$findings/" "${extra[@]}" "$@" "$corpus" "$seeds" \
-  "$replayed"
+  -artifact_prefix="$findings/" "${extra[@]}" "$@" "${dirs[@]}"

@@ -239,6 +239,67 @@ static void test_deformed_condition(void **state) {
   fixture_free(fx);
 }
 
+/* A part mirrored about a symmetry plane (x = 0 here, the part at x >=
+ * 0): a state with a point past the plane (its surface folded through it,
+ * into the mirrored part) is found and named with the plane; points on
+ * the plane, sliding along it, and a scene without planes are not. */
+static void test_symmetry_crossed(void **state) {
+  (void)state;
+  fixture *fx = fixture_new(3, 0.04, 20, true);
+  fpm_model *m;
+  fpm_state *st;
+  fixture_model(fx, &m, &st);
+  int axis = 7;
+  assert_int_equal(fpm_symmetry_crossed(m, st, &axis), -1);
+  assert_int_equal(axis, -1);
+  fx->scene.mirror_mask = 1u;
+  fx->scene.mirror_at[0] = 0;
+  /* at rest, and every point on the plane moved along it */
+  for (long i = 0; i < m->n; i++)
+    if (m->x[3 * i] == 0) st->u[3 * i + 1] = 0.03;
+  assert_int_equal(fpm_symmetry_crossed(m, st, &axis), -1);
+  /* the two innermost points off the plane pushed past it */
+  long inner[2] = {-1, -1};
+  for (long i = 0; i < m->n; i++)
+    if (m->x[3 * i] > 0 && m->x[3 * i + 1] > 0 && m->x[3 * i + 2] > 0) {
+      if (inner[0] < 0 || m->x[3 * i] < m->x[3 * inner[0]]) {
+        inner[1] = inner[0];
+        inner[0] = i;
+      } else if (inner[1] < 0 || m->x[3 * i] < m->x[3 * inner[1]]) {
+        inner[1] = i;
+      }
+    }
+  const long first = inner[0] < inner[1] ? inner[0] : inner[1];
+  for (int k = 0; k < 2; k++) st->u[3 * inner[k]] = -m->x[3 * inner[k]] - 1e-3;
+  assert_int_equal(fpm_symmetry_crossed(m, st, &axis), first);
+  assert_int_equal(axis, 0);
+  assert_int_equal(fpm_symmetry_failure(m, st, first, axis, "step 3: "),
+                   PM_ERR_UNSTABLE);
+  const char *msg = pm_error_message();
+  print_message("%s\n", msg);
+  char want[64];
+  snprintf(want, sizeof want, "step 3: point %ld at (", first);
+  assert_non_null(strstr(msg, want));
+  assert_non_null(strstr(msg, "passed the symmetry plane x = 0 (now at x = "
+                              "-0.001)"));
+  pm_error_clear();
+  /* a plane at x = 0.1, the part on its other side (x <= 0.1): those
+   * points are on the part's side, and a point of the face x = 0.1 moved
+   * out past it is the one named */
+  fx->scene.mirror_at[0] = 0.1;
+  assert_int_equal(fpm_symmetry_crossed(m, st, &axis), -1);
+  long out = -1;
+  for (long i = 0; i < m->n && out < 0; i++)
+    if (m->x[3 * i] == 0.1) out = i;
+  st->u[3 * out] = 1e-3;
+  assert_int_equal(fpm_symmetry_crossed(m, st, &axis), out);
+  fx->scene.mirror_mask = 0;
+  assert_int_equal(fpm_symmetry_crossed(m, st, &axis), -1);
+  fpm_state_destroy(st);
+  fpm_model_destroy(m);
+  fixture_free(fx);
+}
+
 /* A support that does not span 3D (all neighbours in one plane) is
  * reported with the point's id and position. */
 static void test_gfd_ill_conditioned(void **state) {
@@ -355,6 +416,7 @@ int main(void) {
       cmocka_unit_test(test_patch_f2),
       cmocka_unit_test(test_patch_f2_voronoi),
       cmocka_unit_test(test_deformed_condition),
+      cmocka_unit_test(test_symmetry_crossed),
       cmocka_unit_test(test_shares),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

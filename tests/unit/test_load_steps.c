@@ -27,15 +27,23 @@
  * 1/16 (two cuts), steps grow by half after two converged ones and are cut
  * again past the limit, and the run reaches lambda = 1 on u*; on_step sees
  * each converged step. */
-static void test_load_steps_cut(void **state) {
-  (void)state;
-  chain ch;
-  chain_init(&ch, 60, 2, 2);
-  ch.jump_limit = 0.1;
-  pm_newton_problem prob = chain_problem(&ch);
+/* The chain with an inadmissible load jump above 0.1, and options of
+ * steps of 1/4 to 1e-10. */
+static pm_newton_options jump_chain(chain *ch, pm_newton_problem *prob) {
+  chain_init(ch, 60, 2, 2);
+  ch->jump_limit = 0.1;
+  *prob = chain_problem(ch);
   pm_newton_options opt = pm_newton_options_default();
   opt.load_steps = 4;
   opt.rtol = 1e-10;
+  return opt;
+}
+
+static void test_load_steps_cut(void **state) {
+  (void)state;
+  chain ch;
+  pm_newton_problem prob;
+  pm_newton_options opt = jump_chain(&ch, &prob);
   pm_load_report rep;
   assert_ok(chain_load_steps(&ch, &prob, &opt, &rep));
   print_message("jump limit 0.1, steps of 0.25: %d steps, %d cuts, smallest "
@@ -104,6 +112,49 @@ static void test_load_steps_iterations(void **state) {
     iterations[predictor] = rep.newton_iterations;
   }
   assert_true(iterations[1] < iterations[0]);
+  chain_free(&ch);
+}
+
+/* Steps relaxed first (relax_first, a resumed state whose last step
+ * relaxation carried) whose start is inadmissible before relaxation's
+ * first iteration (a load jump above 0.1, as a point beside a moved face
+ * inverts when the face travels too far in one step): the step is cut and
+ * relaxed first again, and every step of the run is carried by relaxation
+ * to u*; before, the first such failure went the ordinary way (Newton,
+ * cut there) and no later step was relaxed first. */
+static void test_load_steps_relaxed_first_cut(void **state) {
+  (void)state;
+  chain ch;
+  pm_newton_problem prob;
+  pm_newton_options opt = jump_chain(&ch, &prob);
+  opt.relax_after = 2;
+  opt.relax_first = true;
+  pm_newton *s = NULL;
+  assert_ok(pm_newton_create(&prob, &opt, &s));
+  pm_load_state st;
+  assert_ok(pm_load_state_init(&st, ch.n));
+  st.lambda = 1e-6;
+  st.dl = 1.0 / opt.load_steps;
+  st.relax_first = st.relax_carried = 1;
+  memset(ch.x, 0, (size_t)ch.n * sizeof *ch.x);
+  ch.lambda_done = 0;
+  pm_load_report rep;
+  memset(&rep, 0, sizeof rep);
+  rep.dlambda_min = st.dl;
+  assert_ok(pm_load_steps_from(s, ch.x, &st, &rep));
+  print_message("relaxed first, jump limit 0.1, steps of 0.25: %d steps, %d "
+                "cuts, smallest dlambda %g, %d steps relaxed, %ld relaxation "
+                "iterations, error %.2e\n",
+                rep.steps, rep.cuts, rep.dlambda_min, rep.relaxed_steps,
+                rep.relax_iterations, chain_error(&ch, ch.x, 1.0));
+  assert_true(rep.lambda == 1.0);
+  assert_true(rep.cuts >= 2);
+  assert_true(rep.dlambda_min <= 0.1 && rep.dlambda_min >= 0.05);
+  assert_int_equal(rep.relaxed_steps, rep.steps);
+  assert_int_equal(st.relax_first, 1);
+  assert_true(chain_error(&ch, ch.x, 1.0) < 1e-8);
+  pm_load_state_free(&st);
+  pm_newton_destroy(&s);
   chain_free(&ch);
 }
 
@@ -438,6 +489,7 @@ int main(void) {
       cmocka_unit_test(test_load_steps_cut),
       cmocka_unit_test(test_load_steps_iterations),
       cmocka_unit_test(test_load_steps_stale_factorisation),
+      cmocka_unit_test(test_load_steps_relaxed_first_cut),
       cmocka_unit_test(test_load_steps_impossible),
       cmocka_unit_test(test_relaxation_fallback),
   };

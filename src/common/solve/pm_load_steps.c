@@ -438,6 +438,7 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
     char relaxed[2048] = "", failed[sizeof rep->last.message] = "";
     if (relaxing && st->relax_first) {
       /* The step before was carried by relaxation: this one too, first. */
+      const long its = rep->relax_iterations;
       pm_err e = relaxed_first(s, x, xc, st, target, &rw, rep, relaxed,
                                sizeof relaxed);
       if (e == PM_SUCCESS && p->settle) e = settle_step(s, x, xc, 0, rep);
@@ -451,6 +452,22 @@ pm_err pm_load_steps_from(pm_newton *s, double *x, pm_load_state *st,
       if (!recoverable(e)) {
         ret = e;
         goto done;
+      }
+      if (rep->relax_iterations == its && cuts < o->max_cuts &&
+          st->dl / 2 >= o->min_dlambda * (1 - 1e-12)) {
+        /* Inadmissible before relaxation's first iteration, from the
+         * extrapolation and from the last converged state alike (a point
+         * beside the moved face inverted by the face's travel over the
+         * step): a shorter step, relaxed first again. */
+        fprintf(stderr,
+                "pointmech: load step %d (lambda %.6g -> %.6g): relaxed "
+                "first: %s; the step cut\n",
+                rep->steps + 1, lambda, target, relaxed);
+        pm_error_clear();
+        cuts++;
+        rep->cuts++;
+        st->dl /= 2;
+        continue;
       }
       /* Not carried: the ordinary way, from here on until relaxation
        * carries a step again. */

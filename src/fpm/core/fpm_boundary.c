@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fpm_loads.h"
+#include "pm_omp.h"
 #include "fpm_model.h"
 
 pm_err fpm_select_facets(const gm_dual *d, const pm_scene *s,
@@ -232,6 +233,48 @@ pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
   const double *x = m->x + 3 * m->cd_point[k];
   return pm_expr_fail_value(e, pm_expr_eval(e, x[0], x[1], x[2], t), step, t,
                             "point", fpm_point_id(m, m->cd_point[k]), x);
+}
+
+/* Past a plane by more than this fraction of the box along its axis
+ * (points on the plane hold their normal displacement at exactly 0). */
+#define FPM_SYMMETRY_SLACK 1e-9
+
+long fpm_symmetry_crossed(const fpm_model *m, const fpm_state *st, int *axis) {
+  const pm_scene *s = m->scene;
+  *axis = -1;
+  if (!s || !s->mirror_mask) return -1;
+  long first = m->n_own;
+  for (int a = 0; a < 3; a++) {
+    if (!(s->mirror_mask >> a & 1u)) continue;
+    const double at = s->mirror_at[a];
+    /* the part on the box's side of its plane (pm_scene_mirror_fold) */
+    const double side =
+        at <= 0.5 * (s->box_min[a] + s->box_max[a]) ? 1.0 : -1.0;
+    const double slack = FPM_SYMMETRY_SLACK * (s->box_max[a] - s->box_min[a]);
+    long bad = m->n_own;
+    PM_OMP(parallel for schedule(static) reduction(min : bad))
+    for (long i = 0; i < m->n_own; i++)
+      if (side * (m->x[3 * i + a] + st->u[3 * i + a] - at) < -slack && i < bad)
+        bad = i;
+    if (bad < first) {
+      first = bad;
+      *axis = a;
+    }
+  }
+  return first < m->n_own ? first : -1;
+}
+
+pm_err fpm_symmetry_failure(const fpm_model *m, const fpm_state *st, long p,
+                            int axis, const char *prefix) {
+  const double *x = m->x + 3 * p, *u = st->u + 3 * p;
+  const char name = (char)('x' + axis);
+  return PM_ERROR(PM_ERR_UNSTABLE,
+                  "%spoint %ld at (%g, %g, %g) passed the symmetry plane %c = "
+                  "%g (now at %c = %.6g): the part's surface folded through "
+                  "the plane, into the mirrored part (nothing holds the two "
+                  "apart: no self-contact)",
+                  prefix, fpm_point_id(m, p), x[0], x[1], x[2], name,
+                  m->scene->mirror_at[axis], name, x[axis] + u[axis]);
 }
 
 /* Samples of the ramps' span (the factors are smooth or piecewise linear

@@ -304,6 +304,15 @@ long fpm_update_tractions(const fpm_model *m, fpm_state *st, double t);
  * naming the point, the scene key and the expression. */
 pm_err fpm_condition_failure(const fpm_model *m, bool traction, long k,
                              long step, double t);
+/* The first of the model's own points whose current position lies past
+ * a symmetry plane of the scene (on the side the mirrored part fills:
+ * the surface has folded through the plane), or -1 (at once where the
+ * scene has no plane); *axis receives its plane's axis. */
+long fpm_symmetry_crossed(const fpm_model *m, const fpm_state *st, int *axis);
+/* PM_ERR_UNSTABLE naming point p past the plane normal to axis (prefix:
+ * the step and time where that applies, or ""). */
+pm_err fpm_symmetry_failure(const fpm_model *m, const fpm_state *st, long p,
+                            int axis, const char *prefix);
 
 /* The net nodal force f = f_int(u) - f_ext(t) into st->f (also F, P, W, J,
  * T, r).  Returns -1, or the smallest point id whose deformation gradient

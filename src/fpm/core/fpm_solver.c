@@ -222,8 +222,14 @@ static pm_err force_at(const fpm_model *m, fpm_state *st, long step, double t,
     if (bad < 0) fpm_contact_force(m, st, t);
     if (bad < 0 && m->contact && tail) PM_OMP(parallel) tail(ctx);
     *seconds += pm_wtime() - w;
+    int axis = -1;
     if (bad >= 0) {
       e = unstable(m, st, step, t, dt, bad, 0);
+      key = 2 * KEY_STAGE + fpm_point_id(m, bad);
+    } else if ((bad = fpm_symmetry_crossed(m, st, &axis)) >= 0) {
+      char when[64];
+      snprintf(when, sizeof when, "step %ld, t = %.6g s: ", step, t);
+      e = fpm_symmetry_failure(m, st, bad, axis, when);
       key = 2 * KEY_STAGE + fpm_point_id(m, bad);
     }
   } else {

@@ -95,6 +95,10 @@ typedef struct {
    * and |F|^2 of the contact forces last evaluated. */
   double *contact_K;
   double contact_fsq;
+  /* The axis of the symmetry plane the point fpm_static_evaluate last
+   * returned has passed (fpm_symmetry_crossed), or -1: that point's J is
+   * admissible. */
+  int crossed_axis;
   /* The sticking anchors at the last converged load step (3 per pair):
    * each attempt at a step starts from them (fpm_static_set_load), as
    * the anchors set within it belong to that attempt. */

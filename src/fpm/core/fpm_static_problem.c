@@ -15,16 +15,20 @@
 long fpm_static_evaluate(fpm_static_ctx *c, const double *x) {
   if (x)
     for (long j = 0; j < c->nheld; j++) c->st->u[c->dof[j]] = x[j];
-  const long bad = fpm_force(c->m, c->st);
+  long bad = fpm_force(c->m, c->st);
   /* the rigid bodies at lambda times their displacement at the end of the
    * ramps, as the supports */
   if (bad < 0 && c->m->contact)
     c->contact_fsq =
         fpm_contact_force_fixed(c->m, c->st, c->load_end, c->lambda);
+  c->crossed_axis = -1;
+  if (bad < 0) bad = fpm_symmetry_crossed(c->m, c->st, &c->crossed_axis);
   return bad;
 }
 
 static pm_err inadmissible(const fpm_static_ctx *c, long p) {
+  if (c->crossed_axis >= 0)
+    return fpm_symmetry_failure(c->m, c->st, p, c->crossed_axis, "");
   const double *x = c->m->x + 3 * p;
   return PM_ERROR(PM_ERR_UNSTABLE,
                   "point %ld at (%g, %g, %g): volume ratio J = %g%s",
