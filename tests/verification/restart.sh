@@ -53,6 +53,15 @@ resume_case() { # label, scene, lines before the signals, args...
   check "$label SIGTERM: resumed once" grep -q '"resumes": 1' "$out/summary.json"
   check "$label SIGTERM + resume: bit-identical to the straight run" \
     $py "$here/same_results.py" "$straight" "$out"
+  # A static solve's counts are the whole run's, its fallbacks' too.
+  local k want
+  for k in static_cuts static_newton_iterations static_relaxations \
+    static_relaxed_steps static_relax_iterations; do
+    want=$(grep "\"$k\"" "$straight/summary.json" || true)
+    [ -z "$want" ] ||
+      check "$label SIGTERM + resume: $k as the straight run's" \
+        grep -qF "$want" "$out/summary.json"
+  done
 
   out=$work/$label-kill
   run_until KILL $((n + 3)) "$out" "$scene" "$@" --set output.checkpoint.every=$((${ckpt_every}))

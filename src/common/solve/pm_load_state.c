@@ -25,6 +25,26 @@ void pm_load_state_free(pm_load_state *state) {
   state->xc = state->xprev = state->pc_x = NULL;
 }
 
+/* An int count as a checkpoint item; one a checkpoint of a build before
+ * it lacks stays as it is (the resumed part's count). */
+static pm_err ckpt_count(pm_ckpt *ck, const char *name, int *v) {
+  if (pm_ckpt_reading(ck) && !pm_ckpt_has(ck, name)) return PM_SUCCESS;
+  long t = *v;
+  PM_CALL(pm_ckpt_long(ck, name, &t));
+  *v = (int)t;
+  return PM_SUCCESS;
+}
+
+static pm_err ckpt_long(pm_ckpt *ck, const char *name, long *v) {
+  if (pm_ckpt_reading(ck) && !pm_ckpt_has(ck, name)) return PM_SUCCESS;
+  return pm_ckpt_long(ck, name, v);
+}
+
+static pm_err ckpt_double(pm_ckpt *ck, const char *name, double *v) {
+  if (pm_ckpt_reading(ck) && !pm_ckpt_has(ck, name)) return PM_SUCCESS;
+  return pm_ckpt_double(ck, name, v);
+}
+
 pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
                           pm_load_state *st, pm_load_report *rep) {
   char name[96];
@@ -56,6 +76,10 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
         st->relax_carried = st->relax_first;
     }
   }
+  /* Written: the counts as the last converged step left them (the
+   * state's); read: into the report, and the state's copy with them. */
+  pm_load_report *live = rep;
+  if (st && !pm_ckpt_reading(ck)) rep = &st->done;
   long steps = rep->steps, cuts = rep->cuts, newton = rep->newton_iterations,
        linear = rep->linear_iterations;
   PM_CALL(pm_ckpt_long(ck, NAME("steps"), &steps));
@@ -63,7 +87,35 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
   PM_CALL(pm_ckpt_long(ck, NAME("newton_iterations"), &newton));
   PM_CALL(pm_ckpt_long(ck, NAME("linear_iterations"), &linear));
   PM_CALL(pm_ckpt_double(ck, NAME("dlambda_min"), &rep->dlambda_min));
+  /* The fallbacks' counts, so that a resumed run's summary counts the
+   * whole run's (its seconds are its own process's). */
+  struct {
+    const char *item;
+    int *count;
+  } counts[] = {{"relaxations", &rep->relaxations},
+                {"relaxed_steps", &rep->relaxed_steps},
+                {"ptc_runs", &rep->ptc_runs},
+                {"ptc_steps", &rep->ptc_steps},
+                {"mode_runs", &rep->mode_runs},
+                {"branch_switches", &rep->branch_switches},
+                {"arc_runs", &rep->arc_runs},
+                {"arc_passes", &rep->arc_passes},
+                {"snap_steps", &rep->snap_steps},
+                {"fallbacks_timed_out", &rep->fallbacks_timed_out},
+                {"resolves", &rep->resolves},
+                {"unsettled", &rep->unsettled}};
+  for (size_t k = 0; k < sizeof counts / sizeof counts[0]; k++)
+    PM_CALL(ckpt_count(ck, NAME(counts[k].item), counts[k].count));
+  PM_CALL(ckpt_long(ck, NAME("relax_iterations"), &rep->relax_iterations));
+  PM_CALL(ckpt_long(ck, NAME("ptc_iterations"), &rep->ptc_iterations));
+  PM_CALL(ckpt_long(ck, NAME("arc_steps"), &rep->arc_steps));
+  PM_CALL(ckpt_long(ck, NAME("arc_iterations"), &rep->arc_iterations));
+  PM_CALL(ckpt_double(ck, NAME("ptc_curvature"), &rep->ptc_curvature));
+  PM_CALL(ckpt_double(ck, NAME("mode_eigenvalue"), &rep->mode_eigenvalue));
+  PM_CALL(ckpt_double(ck, NAME("snap_lambda"), &rep->snap_lambda));
+  PM_CALL(ckpt_double(ck, NAME("snap_eigenvalue"), &rep->snap_eigenvalue));
 #undef NAME
+  if (st && pm_ckpt_reading(ck)) st->done = *live;
   rep->steps = (int)steps;
   rep->cuts = (int)cuts;
   rep->newton_iterations = (int)newton;

@@ -316,6 +316,7 @@ static pm_err converged(pm_newton *s, const double *x, pm_load_state *st,
   }
   st->relax_first = o->relax_first && relax_next;
   if (st->relax_first) st->relax_carried = 1;
+  st->done = *rep;
   PM_CALL(pm_newton_pc_save(s, st));
   if (p->on_step)
     PM_CALL(p->on_step(p->ctx, rep->steps, target, st->xc, &rep->last));

@@ -111,6 +111,10 @@ typedef struct {
    * so a step that falls back tries it ahead of the continuations, else
    * 0. */
   long relax_carried;
+  /* The report as it stood when the last step converged: the counts a
+   * checkpoint keeps, so that a run stopped inside a step and resumed
+   * counts that step's attempts once. */
+  pm_load_report done;
 } pm_load_state;
 
 /* Allocate a state's arrays for a problem of n unknowns, zeroed (lambda 0:
