@@ -462,9 +462,11 @@ pm_err fpm_run(const fpm_model *m, fpm_state *st, const fpm_run_options *opt,
           "step %ld, t = %.6g s: energy balance error %.3g exceeds "
           "stability.max_energy_error = %g (kinetic %.4g + strain %.4g + "
           "interface %.4g + dissipated %.4g J against external work %.4g J): "
-          "the discretization is creating energy; dt = %.4g s",
+          "the discretization is creating energy; smallest volume ratio J "
+          "%.3g (the stable step is the reference state's, J = 1, and a "
+          "subdomain compressed far stiffens past it); dt = %.4g s",
           step, t, si.energy_error, opt->max_energy_error, kin, se,
-          st->penalty_energy, dissipated, ext_work, dt);
+          st->penalty_energy, dissipated, ext_work, jmin, dt);
     }
     if (jmin <= opt->min_jacobian) {
       si.converged = false;
