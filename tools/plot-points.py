@@ -43,34 +43,17 @@ def load(out, frame):
     """Return (deformed [n][3], reference [n][3], cells, frame name)."""
     try:
         r = pointmech.open(out)
-        path = r.folder
-        frames = r.frames[:]
-        if not frames:
-            fail(f"{path}/results: no frame")
-        if not -len(frames) <= frame < len(frames):
-            fail(f"{path}: --frame {frame} out of range "
-                 f"({len(frames)} frames)")
-        fr = frames[frame]
-        r.check([fr])  # the mesh and the frame, in one call of the program
-        mesh = r.mesh
-        for name in ("coordinates", "cells"):
-            if name not in mesh:
-                fail(f"{path}/results/mesh.h5: missing /{name}")
-        x = np.asarray(mesh["coordinates"], dtype=float)
-        cells = np.asarray(mesh["cells"])
-        name = f"{fr.index:06d}"
-        if "displacement" not in fr:
-            fail(f"{fr.path}: missing /displacement")
-        u = np.asarray(fr["displacement"], dtype=float)
+        x, deformed, fr = r.positions(frame)
+        if "cells" not in r.mesh:
+            fail(f"{r.folder}/results/mesh.h5: missing /cells")
+        cells = np.asarray(r.mesh["cells"])
     except (pointmech.Refused, OSError) as e:
         fail(e)
-    if x.ndim != 2 or x.shape[1] != 3 or u.shape != x.shape:
-        fail(f"{path}: coordinates {x.shape} and displacement {u.shape} "
-             "must both be [n][3]")
     if cells.ndim != 2 or (cells.size and
                            (cells.min() < 0 or cells.max() >= len(x))):
-        fail(f"{path}: /mesh/cells must be [m][k] point indices < {len(x)}")
-    return x + u, x, cells, name
+        fail(f"{r.folder}: /mesh/cells must be [m][k] point indices < "
+             f"{len(x)}")
+    return deformed, x, cells, f"{fr.index:06d}"
 
 
 def gradients(x, u, cells):

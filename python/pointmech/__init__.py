@@ -313,6 +313,31 @@ class Run:
         vet(*([mesh] if os.path.exists(mesh) else []) +
             [f.path for f in frames])
 
+    def positions(self, frame=-1):
+        """The points' reference and deformed positions at frame `frame`
+        (its index among the frames; -1 the last), both [n][3], and the
+        Frame: the mesh and the frame vetted in one call of the program;
+        raises Refused naming what is missing or of the wrong shape."""
+        frames = self.frames[:]
+        if not frames:
+            raise Refused("%s/results: no frame" % self.folder)
+        if not -len(frames) <= frame < len(frames):
+            raise Refused("%s: frame %d out of range (%d frames)" %
+                          (self.folder, frame, len(frames)))
+        fr = frames[frame]
+        self.check([fr])
+        if "coordinates" not in self.mesh:
+            raise Refused("%s/results/mesh.h5: missing /coordinates" %
+                          self.folder)
+        if "displacement" not in fr:
+            raise Refused("%s: missing /displacement" % fr.path)
+        X = np.asarray(self.mesh["coordinates"], dtype=float)
+        u = np.asarray(fr["displacement"], dtype=float)
+        if X.ndim != 2 or X.shape[1] != 3 or u.shape != X.shape:
+            raise Refused("%s: coordinates %s and displacement %s must "
+                          "both be [n][3]" % (self.folder, X.shape, u.shape))
+        return X, X + u, fr
+
     def running(self):
         """Whether the run is still going (summary.json says so)."""
         try:

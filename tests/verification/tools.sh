@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The Python scripts of tools/ that read a run's HDF5 files (normal-angles,
-# nrmse-map, plot-membrane-2d, plot-points, plot-vessel-stress,
-# render-membrane) read them through python/pointmech, which has the
+# The Python scripts of tools/ that read a run's HDF5 files (fold-over,
+# normal-angles, nrmse-map, plot-membrane-2d, plot-points,
+# plot-vessel-stress, render-membrane) read them through python/pointmech, which has the
 # program vet each file before h5py opens it: each draws or prints its
 # figures from short runs of the kinds it is for, and refuses a run whose
 # mesh is a damaged HDF5 file (a string of 4 GB announced, which h5py would
@@ -39,6 +39,7 @@ run m4 "$src/cases/mpm/m4-oocyte-reduced.yaml" --set time.end=3e-7 \
   --set output.every=10
 run pull "$work/pull.yaml" --set time.end=0.01
 f2=$src/cases/fpm/f2-unconstrained-compression.yaml
+run f2 "$f2" --set discretization.mesh_size=0.02
 "$bin" convergence "$f2" --set-ladder discretization.mesh_size=0.02 \
   --reference "fe:$src/cases/fe/f2-unconstrained-compression" \
   --out "$work/conv" >/dev/null 2>"$work/err"
@@ -65,6 +66,7 @@ refused() { # what, message, script and arguments...
 tool() { # key, run folder
   local r=$2
   case $1 in
+  fold-over) echo fold-over.py "$r" --travel 0.04 ;;
   normal-angles) echo normal-angles.py "$r" ;;
   nrmse-map) echo nrmse-map.py "$r/fe-errors.csv" --fe-run "$work/fe" \
     --case f2-unconstrained-compression --n 2 ;;
@@ -76,14 +78,15 @@ tool() { # key, run folder
   render-membrane) echo render-membrane.py "$r" -o "$work/out.png" ;;
   esac
 }
-declare -A runs=([normal-angles]=m5 [nrmse-map]=conv/level-1
+declare -A runs=([fold-over]=f2 [normal-angles]=m5 [nrmse-map]=conv/level-1
   [plot-membrane-2d]=m5 [plot-points]=pull [plot-vessel-stress]=pull
   [render-membrane]=m4)
-declare -A says=([normal-angles]='^0\.01 +91 '
+declare -A says=([fold-over]='points; top face at z = 0\.06: 0 past it'
+  [normal-angles]='^0\.01 +91 '
   [nrmse-map]='^\| linear MLS'
   [plot-membrane-2d]='wrote' [plot-points]='out\.png'
   [plot-vessel-stress]='^pull +[0-9]' [render-membrane]='^wrote')
-for t in normal-angles nrmse-map plot-membrane-2d plot-points \
+for t in fold-over normal-angles nrmse-map plot-membrane-2d plot-points \
   plot-vessel-stress render-membrane; do
   # shellcheck disable=SC2046 # the command's words, none with a space
   (cd "$tools" && $py $(tool "$t" "$work/${runs[$t]}")) >"$work/good" \
