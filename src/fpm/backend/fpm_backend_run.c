@@ -57,6 +57,7 @@ static void load_scalars(fpm_static_state *to, const fpm_static_state *from) {
   to->load.fallback_kept = from->load.fallback_kept;
   to->load.relax_first = from->load.relax_first;
   to->load.relax_carried = from->load.relax_carried;
+  to->load.done = from->load.done;
   to->external_work = from->external_work;
 }
 
