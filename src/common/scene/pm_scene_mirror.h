@@ -7,6 +7,7 @@
 #define PM_SCENE_MIRROR_H
 
 #include <math.h>
+#include <stdbool.h>
 
 #include "pm_scene.h"
 
@@ -40,6 +41,13 @@ static inline int pm_scene_bc_axis(const pm_scene_bc *bc) {
   return -1;
 }
 
+/* Whether the part lies above the plane normal to axis a (on the side of
+ * larger coordinates), which lies on a face of the box: the part is the
+ * box's side of it. */
+static inline bool pm_scene_mirror_above(const pm_scene *s, int a) {
+  return s->mirror_at[a] <= 0.5 * (s->box_min[a] + s->box_max[a]);
+}
+
 /* The point of the part whose image is x (x itself in the part): y, and
  * the axes along which it was reflected (a bit each). */
 static inline unsigned pm_scene_mirror_fold(const pm_scene *s,
@@ -49,9 +57,7 @@ static inline unsigned pm_scene_mirror_fold(const pm_scene *s,
     y[a] = x[a];
     if (!(s->mirror_mask >> a & 1u)) continue;
     const double at = s->mirror_at[a];
-    /* The part lies on the box's side of its plane. */
-    const bool part_above = at <= 0.5 * (s->box_min[a] + s->box_max[a]);
-    if (part_above ? x[a] < at : x[a] > at) {
+    if (pm_scene_mirror_above(s, a) ? x[a] < at : x[a] > at) {
       y[a] = 2 * at - x[a];
       flips |= 1u << a;
     }

@@ -25,8 +25,9 @@ void pm_load_state_free(pm_load_state *state) {
   state->xc = state->xprev = state->pc_x = NULL;
 }
 
-/* An int count as a checkpoint item; one a checkpoint of a build before
- * it lacks stays as it is (the resumed part's count). */
+/* Checkpoint items added after the format's first builds: an item that
+ * a checkpoint of a build before it lacks is left as it is when read (a
+ * state's 0, or the resumed part's count).  ckpt_count: an int count. */
 static pm_err ckpt_count(pm_ckpt *ck, const char *name, int *v) {
   if (pm_ckpt_reading(ck) && !pm_ckpt_has(ck, name)) return PM_SUCCESS;
   long t = *v;
@@ -65,10 +66,8 @@ pm_err pm_load_checkpoint(pm_ckpt *ck, const char *prefix, long n,
       PM_CALL(pm_ckpt_doubles(ck, NAME("pc_x"), n, st->pc_x));
       PM_CALL(pm_ckpt_long(ck, NAME("pc_first_its"), &st->pc_first_its));
       /* (not in a checkpoint of a build before it: 0) */
-      if (!pm_ckpt_reading(ck) || pm_ckpt_has(ck, NAME("fallback_kept")))
-        PM_CALL(pm_ckpt_long(ck, NAME("fallback_kept"), &st->fallback_kept));
-      if (!pm_ckpt_reading(ck) || pm_ckpt_has(ck, NAME("relax_first")))
-        PM_CALL(pm_ckpt_long(ck, NAME("relax_first"), &st->relax_first));
+      PM_CALL(ckpt_long(ck, NAME("fallback_kept"), &st->fallback_kept));
+      PM_CALL(ckpt_long(ck, NAME("relax_first"), &st->relax_first));
       /* (a checkpoint of a build before it: carried if relaxed first) */
       if (!pm_ckpt_reading(ck) || pm_ckpt_has(ck, NAME("relax_carried")))
         PM_CALL(pm_ckpt_long(ck, NAME("relax_carried"), &st->relax_carried));

@@ -8,8 +8,9 @@
 #include <string.h>
 
 #include "fpm_loads.h"
-#include "pm_omp.h"
 #include "fpm_model.h"
+#include "pm_omp.h"
+#include "pm_scene_mirror.h"
 
 pm_err fpm_select_facets(const gm_dual *d, const pm_scene *s,
                          const gm_mesh *mesh, bool whole, long **ptr,
@@ -247,9 +248,7 @@ long fpm_symmetry_crossed(const fpm_model *m, const fpm_state *st, int *axis) {
   for (int a = 0; a < 3; a++) {
     if (!(s->mirror_mask >> a & 1u)) continue;
     const double at = s->mirror_at[a];
-    /* the part on the box's side of its plane (pm_scene_mirror_fold) */
-    const double side =
-        at <= 0.5 * (s->box_min[a] + s->box_max[a]) ? 1.0 : -1.0;
+    const double side = pm_scene_mirror_above(s, a) ? 1.0 : -1.0;
     const double slack = FPM_SYMMETRY_SLACK * (s->box_max[a] - s->box_min[a]);
     long bad = m->n_own;
     PM_OMP(parallel for schedule(static) reduction(min : bad))
